@@ -1,0 +1,160 @@
+/*
+ * ts_bench: throughput and memory of the core algorithms.
+ *
+ *   ts_bench [--size N] [--threads T] [--cell M] [--dirs 16,64] [--repeat R]
+ *
+ * Generates an N x N fractal DEM (fBm value noise, Hurst 0.8, 1500 m relief,
+ * M metre cells), then times the horizon sweep for each direction count
+ * (million pixel-directions per second) and the shadow height map for 8
+ * sun azimuths (million pixels per second), and reports peak memory.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/utsname.h>
+#include <time.h>
+
+#include "fractal_dem.h"
+#include "terrashade.h"
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static double peak_mib(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return ru.ru_maxrss / 1024.0;
+}
+
+static void cpu_name(char *buf, size_t n)
+{
+    snprintf(buf, n, "unknown CPU");
+    FILE *f = fopen("/proc/cpuinfo", "r");
+    if (!f)
+        return;
+    char line[512];
+    while (fgets(line, sizeof line, f))
+        if (!strncmp(line, "model name", 10)) {
+            char *c = strchr(line, ':');
+            if (c) {
+                snprintf(buf, n, "%s", c + 2);
+                buf[strcspn(buf, "\n")] = 0;
+            }
+            break;
+        }
+    fclose(f);
+}
+
+static void die(const char *what, const ts_error *e)
+{
+    fprintf(stderr, "ts_bench: %s: %s\n", what, e->message);
+    exit(1);
+}
+
+int main(int argc, char **argv)
+{
+    int size = 4096, threads = 0, repeat = 3;
+    double cell = 10.0;
+    char dirs_arg[256] = "16,64";
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--size") && i + 1 < argc)
+            size = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--threads") && i + 1 < argc)
+            threads = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--cell") && i + 1 < argc)
+            cell = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--repeat") && i + 1 < argc)
+            repeat = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--dirs") && i + 1 < argc)
+            snprintf(dirs_arg, sizeof dirs_arg, "%s", argv[++i]);
+        else {
+            fprintf(stderr, "usage: %s [--size N] [--threads T] [--cell M] [--dirs 16,64] [--repeat R]\n",
+                    argv[0]);
+            return 2;
+        }
+    }
+    if (size < 2 || repeat < 1) {
+        fprintf(stderr, "ts_bench: --size must be >= 2 and --repeat >= 1\n");
+        return 2;
+    }
+    char cpu[256];
+    cpu_name(cpu, sizeof cpu);
+    struct utsname u;
+    uname(&u);
+    printf("command: ");
+    for (int i = 0; i < argc; i++)
+        printf("%s%s", argv[i], i + 1 < argc ? " " : "\n");
+    printf("machine: %s, %d cores, %s %s; threads: %d\n", cpu, ts_cpu_count(), u.sysname,
+           u.release, threads > 0 ? threads : ts_cpu_count());
+
+    ts_error e;
+    ts_grid g;
+    if (ts_grid_create(&g, size, size, cell, cell, &e))
+        die("grid", &e);
+    double t0 = now();
+    ts_fractal_fill(&g, 1234, 0.8, 1500.0);
+    printf("DEM: %d x %d fractal (fBm value noise, Hurst 0.8, 1500 m relief), %g m cells, "
+           "generated in %.2f s\n", size, size, cell, now() - t0);
+    double cells = (double)size * size;
+    double dem_mib = cells * 4 / 1048576.0;
+    double base_mib = peak_mib();
+
+    ts_horizon_opts o;
+    ts_horizon_opts_default(&o);
+    o.threads = threads;
+    char *save = NULL;
+    for (char *tok = strtok_r(dirs_arg, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        o.directions = atoi(tok);
+        if (o.directions < 1)
+            continue;
+        float *out = malloc((size_t)cells * o.directions * sizeof(float));
+        if (!out) {
+            fprintf(stderr, "ts_bench: cannot allocate %d horizon planes\n", o.directions);
+            return 1;
+        }
+        double best = INFINITY;
+        for (int r = 0; r < repeat; r++) {
+            t0 = now();
+            if (ts_horizon_compute(&g, &o, out, &e))
+                die("horizon", &e);
+            double dt = now() - t0;
+            best = dt < best ? dt : best;
+        }
+        double out_mib = cells * o.directions * 4 / 1048576.0;
+        printf("horizon %3d directions: %.3f s best of %d, %8.1f M pixel-directions/s; "
+               "peak RSS %.0f MiB = DEM %.0f + outputs %.0f + %.0f other\n",
+               o.directions, best, repeat, cells * o.directions / best / 1e6, peak_mib(), dem_mib,
+               out_mib, peak_mib() - dem_mib - out_mib);
+        free(out);
+    }
+
+    float *vis = malloc((size_t)cells * sizeof(float));
+    if (!vis)
+        return 1;
+    const double az[8] = {0, 45, 90, 135, 180, 225, 270, 315};
+    double total = 0;
+    for (int a = 0; a < 8; a++) {
+        double best = INFINITY;
+        for (int r = 0; r < repeat; r++) {
+            t0 = now();
+            if (ts_shm_compute(&g, az[a] + 17.0, 25.0, 0.0, threads, vis, NULL, &e))
+                die("shadow height map", &e);
+            double dt = now() - t0;
+            best = dt < best ? dt : best;
+        }
+        total += best;
+    }
+    printf("shadow height map: %.4f s mean per light over 8 azimuths, %8.1f M pixels/s\n",
+           total / 8, cells * 8 / total / 1e6);
+    printf("peak RSS %.0f MiB (baseline after DEM %.0f MiB)\n", peak_mib(), base_mib);
+    free(vis);
+    ts_grid_free(&g);
+    return 0;
+}

@@ -1,0 +1,367 @@
+/*
+ * Exact horizon sweep for one azimuth (Timonen & Westerholm 2010, Alg. 1).
+ *
+ * Each sweep line keeps the upper convex hull of the samples behind it in a
+ * stack; a new sample pops the hull points it hides and its horizon is the
+ * slope to the new top, so a line of N samples costs O(N). Heights enter
+ * the hull as g = h - c d^2 (d = distance along the line, c = (1-k)/2R):
+ * the curvature drop c (d_p - d_q)^2 then becomes a per-query constant
+ * -2 c d_p, so the hull stays exact with curvature on.
+ *
+ * Lines are one cell apart, so every cell lies between two lines in its
+ * column (see line_geometry.h). A cell's horizon is the larger of
+ *  - the near field: the first cells of the cell's own ray, solved exactly
+ *    on the bilinear surface (near_field.h), and
+ *  - the far field: the weighted mean (weights = 1 - distance to the line)
+ *    of the slopes from the cell's own height to the hull points of the two
+ *    neighbouring lines that lie beyond the near field.
+ */
+#include <math.h>
+#include <stdlib.h>
+
+#include "fastmath.h"
+#include "line_geometry.h"
+#include "near_field.h"
+#include "parallel.h"
+#include "status_internal.h"
+
+typedef struct {
+    double d, g;
+} hull_pt;
+
+typedef struct {
+    const ts_grid *grid;
+    const ts_line_geom *geom;
+    double c;           /* curvature coefficient (1-k)/(2R), 0 when off */
+    double cap;         /* max distance in metres, 0 = none */
+    float *out;         /* slopes, row stride = width */
+    ptrdiff_t o_origin, o_u_stride, o_v_stride;
+    long b0;            /* first line */
+    /* visitor mode (single-threaded) */
+    ts_line_visitor visit;
+    void *user;
+    int *alloc_failed;  /* set by a worker that cannot get its workspace */
+    ts_near_plan near;
+    double near_skip;   /* hull points closer than this are near field */
+} sweep_ctx;
+
+typedef struct {
+    hull_pt *stack;
+    int n;
+    hull_pt *raw;       /* every pushed sample, for the distance cap */
+    int raw_n;
+    float *prev_lo, *cur_lo;
+    int prev_k0, prev_k1;
+    /* visitor buffers */
+    float *vx, *vy, *vh, *vs;
+    double *vd;
+} sweep_ws;
+
+/* Max slope (without the -2cd term) from (d, g) over raw samples within
+ * the cap, scanning back from the newest. */
+static double capped_scan(const sweep_ws *w, int n_raw, double d, double g, double cap)
+{
+    double best = -INFINITY;
+    for (int j = n_raw - 1; j >= 0 && d - w->raw[j].d <= cap; j--) {
+        double s = (w->raw[j].g - g) / (d - w->raw[j].d);
+        if (s > best)
+            best = s;
+    }
+    return best;
+}
+
+/* Horizon slope from a point at distance d, height h, against the first n
+ * hull points: walk to farther points while the slope grows (the slopes to
+ * an upper convex hull from a point beyond it are unimodal). */
+static float hull_query(const sweep_ctx *C, const sweep_ws *w, int n, int n_raw,
+                        double d, float h)
+{
+    if (n <= 0)
+        return -INFINITY;
+    const hull_pt *S = w->stack;
+    double g = h - C->c * d * d;
+    int j = n - 1;
+    while (j >= 0 && d - S[j].d < C->near_skip)
+        j--;
+    if (j < 0)
+        return -INFINITY;
+    while (j > 0 && (S[j - 1].g - g) * (d - S[j].d) >= (S[j].g - g) * (d - S[j - 1].d))
+        j--;
+    double s;
+    if (C->cap > 0 && d - S[j].d > C->cap)
+        s = capped_scan(w, n_raw, d, g, C->cap);
+    else
+        s = (S[j].g - g) / (d - S[j].d);
+    return (float)(s - 2.0 * C->c * d);
+}
+
+/* Mean of the slopes toward the lower line (weight F) and the upper line
+ * (weight 1 - F). NaN = that line has no sample there; -inf = the line has
+ * no occluder, in which case the other line decides. */
+static inline float combine(float lo, float hi, float F)
+{
+    if (F == 0.0f || isnan(lo))
+        return hi;
+    if (isnan(hi))
+        return lo;
+    if (lo == -INFINITY)
+        return hi;
+    if (hi == -INFINITY)
+        return lo;
+    return F * lo + (1.0f - F) * hi;
+}
+
+static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
+{
+    const ts_line_geom *G = C->geom;
+    const float *z = C->grid->z;
+    float *t = w->prev_lo;
+    w->prev_lo = w->cur_lo;
+    w->cur_lo = t;
+    int pk0 = w->prev_k0, pk1 = w->prev_k1;
+    int k0, k1;
+    if (!ts_line_k_range(G, b, &k0, &k1)) {
+        w->prev_k0 = 1;
+        w->prev_k1 = 0;
+        return;
+    }
+    w->prev_k0 = k0;
+    w->prev_k1 = k1;
+    w->n = 0;
+    w->raw_n = 0;
+    const int V = G->V;
+    const double c = C->c;
+    double d = 0.0;
+    int nv = 0;
+    for (int k = k0; k <= k1; k++) {
+        int i = (int)(b + G->fl[k]);
+        float F = G->fr[k];
+        ptrdiff_t p = G->origin + (ptrdiff_t)k * G->u_stride + (ptrdiff_t)i * G->v_stride;
+        int has_next = F > 0.0f && i + 1 < V;
+        float hc = z[p];
+        float hn = has_next ? z[p + G->v_stride] : NAN;
+        if (G->step_row) {
+            if (k > k0) {
+                int row = G->x_major ? i : G->u_start + k * G->u_step;
+                d += G->step_row[row];
+            }
+        } else {
+            d = (double)(k - k0) * G->step_m;
+        }
+        /* The sample on the line: between cell i and i+1, or outside the
+         * grid when i is the last row and the line is past it. */
+        int inside = F == 0.0f || has_next;
+        float hs;
+        if (!inside)
+            hs = NAN;
+        else if (F == 0.0f || isnan(hn))
+            hs = hc;
+        else if (isnan(hc))
+            hs = hn;
+        else
+            hs = hc + F * (hn - hc);
+
+        int pushed = 0;
+        float slope = -INFINITY;
+        if (!isnan(hs)) {
+            double gs = hs - c * d * d;
+            hull_pt *S = w->stack;
+            int n = w->n;
+            while (n >= 2 &&
+                   (S[n - 2].g - gs) * (d - S[n - 1].d) >= (S[n - 1].g - gs) * (d - S[n - 2].d))
+                n--;
+            if (w->vs && n > 0) {
+                double s = (C->cap > 0 && d - S[n - 1].d > C->cap)
+                               ? capped_scan(w, w->raw_n, d, gs, C->cap)
+                               : (S[n - 1].g - gs) / (d - S[n - 1].d);
+                slope = (float)(s - 2.0 * c * d);
+            }
+            S[n].d = d;
+            S[n].g = gs;
+            w->n = n + 1;
+            if (C->cap > 0)
+                w->raw[w->raw_n++] = S[n];
+            pushed = 1;
+        }
+        int nh = w->n - pushed, nr = w->raw_n - pushed;
+        if (write) {
+            float s_out;
+            if (isnan(hc)) {
+                s_out = NAN;
+            } else {
+                float hi = inside ? hull_query(C, w, nh, nr, d, hc) : NAN;
+                float lo = (F > 0.0f && k >= pk0 && k <= pk1) ? w->prev_lo[k] : NAN;
+                int left;
+                int row = G->x_major ? i : G->u_start + k * G->u_step;
+                double step = G->step_row ? G->step_row[row] : G->step_m;
+                float nf = ts_near_field(&C->near, G, z, k, i, hc, step, c, &left);
+                s_out = left ? nf : fmaxf(nf, combine(lo, hi, F));
+            }
+            C->out[C->o_origin + (ptrdiff_t)k * C->o_u_stride + (ptrdiff_t)i * C->o_v_stride] = s_out;
+        }
+        w->cur_lo[k] = (has_next && !isnan(hn)) ? hull_query(C, w, nh, nr, d, hn) : NAN;
+        if (w->vs) {
+            w->vx[nv] = G->x_major ? (float)(G->u_start + k * G->u_step) : (float)i + F;
+            w->vy[nv] = G->x_major ? (float)i + F : (float)(G->u_start + k * G->u_step);
+            w->vh[nv] = hs;
+            w->vd[nv] = d;
+            w->vs[nv] = isnan(hs) ? NAN : slope;
+            nv++;
+        }
+    }
+    if (w->vs && nv > 0)
+        C->visit(C->user, nv, w->vx, w->vy, w->vh, w->vd, w->vs);
+}
+
+static void ws_free(sweep_ws *w)
+{
+    free(w->stack);
+    free(w->raw);
+    free(w->prev_lo);
+    free(w->cur_lo);
+    free(w->vx);
+    free(w->vy);
+    free(w->vh);
+    free(w->vs);
+    free(w->vd);
+}
+
+static int ws_init(sweep_ws *w, int U, int need_raw, int need_visit)
+{
+    *w = (sweep_ws){0};
+    w->stack = malloc((size_t)(U + 1) * sizeof *w->stack);
+    w->prev_lo = malloc((size_t)U * sizeof(float));
+    w->cur_lo = malloc((size_t)U * sizeof(float));
+    w->prev_k0 = 1;
+    w->prev_k1 = 0;
+    if (need_raw)
+        w->raw = malloc((size_t)(U + 1) * sizeof *w->raw);
+    if (need_visit) {
+        w->vx = malloc((size_t)U * sizeof(float));
+        w->vy = malloc((size_t)U * sizeof(float));
+        w->vh = malloc((size_t)U * sizeof(float));
+        w->vs = malloc((size_t)U * sizeof(float));
+        w->vd = malloc((size_t)U * sizeof(double));
+    }
+    return w->stack && w->prev_lo && w->cur_lo && (!need_raw || w->raw) &&
+           (!need_visit || (w->vx && w->vy && w->vh && w->vs && w->vd));
+}
+
+/* Lines [b0 + begin, b0 + end): prime with the line before, then write. */
+static void sweep_range(void *ctx, int worker, long begin, long end)
+{
+    (void)worker;
+    const sweep_ctx *C = ctx;
+    sweep_ws w;
+    if (!ws_init(&w, C->geom->U, C->cap > 0, C->visit != NULL)) {
+        ws_free(&w);
+        __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
+        return;
+    }
+    if (begin > 0)
+        process_line(C, &w, C->b0 + begin - 1, 0);
+    for (long b = C->b0 + begin; b < C->b0 + end; b++)
+        process_line(C, &w, b, 1);
+    ws_free(&w);
+}
+
+static void convert_range(void *ctx, int worker, long begin, long end)
+{
+    (void)worker;
+    float *o = ctx;
+    for (long i = begin; i < end; i++)
+        o[i] = ts_atan_deg(o[i]);
+}
+
+/* Shared set-up and checks of both sweep entry points. */
+static ts_status sweep_setup(const ts_grid *grid, double azimuth,
+                             const ts_horizon_opts *opts, ts_line_geom *geom,
+                             sweep_ctx *C, ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if (!opts)
+        return ts_fail(err, TS_ERR_ARG, "horizon options are NULL");
+    ts_horizon_opts o = *opts;
+    o.directions = o.directions < 1 ? 1 : o.directions;
+    if ((st = ts_horizon_opts_validate(&o, err)) != TS_OK)
+        return st;
+    if (!isfinite(azimuth))
+        return ts_fail(err, TS_ERR_ARG, "azimuth must be a finite number of degrees, got %g",
+                       azimuth);
+    azimuth = fmod(azimuth, 360.0);
+    if (azimuth < 0)
+        azimuth += 360.0;
+    if ((st = ts_line_geom_init(geom, grid, azimuth, err)) != TS_OK)
+        return st;
+    *C = (sweep_ctx){0};
+    C->grid = grid;
+    C->geom = geom;
+    C->c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
+    C->cap = opts->max_distance;
+    ptrdiff_t ou = geom->x_major ? 1 : grid->width;
+    C->o_v_stride = geom->x_major ? grid->width : 1;
+    C->o_u_stride = ou * geom->u_step;
+    C->o_origin = ou * geom->u_start;
+    C->b0 = geom->b_lo;
+    ts_near_plan_init(&C->near, geom);
+    C->near_skip = (TS_NEAR_STEPS + 0.5) * geom->step_m;
+    return TS_OK;
+}
+
+ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
+                           const ts_horizon_opts *opts, float *out, ts_error *err)
+{
+    if (!out)
+        return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
+    ts_line_geom geom;
+    sweep_ctx C;
+    ts_status st = sweep_setup(grid, azimuth, opts, &geom, &C, err);
+    if (st != TS_OK)
+        return st;
+    int failed = 0;
+    C.out = out;
+    C.alloc_failed = &failed;
+    long lines = geom.b_hi - geom.b_lo + 1;
+    /* One chunk per thread: each chunk re-primes one line. */
+    int threads = ts_thread_count(opts->threads, lines);
+    st = ts_parallel_for(threads, lines, sweep_range, &C, err);
+    ts_line_geom_free(&geom);
+    if (st != TS_OK)
+        return st;
+    if (failed)
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate sweep workspace");
+    long n = (long)grid->width * grid->height;
+    return ts_parallel_for(ts_thread_count(opts->threads, n), n, convert_range, out, err);
+}
+
+ts_status ts_horizon_sweep_lines(const ts_grid *grid, double azimuth,
+                                 const ts_horizon_opts *opts, ts_line_visitor visit,
+                                 void *user, ts_error *err)
+{
+    if (!visit)
+        return ts_fail(err, TS_ERR_ARG, "line visitor is NULL");
+    ts_line_geom geom;
+    sweep_ctx C;
+    ts_status st = sweep_setup(grid, azimuth, opts, &geom, &C, err);
+    if (st != TS_OK)
+        return st;
+    size_t n = (size_t)grid->width * grid->height;
+    float *scratch = malloc(n * sizeof *scratch);
+    if (!scratch) {
+        ts_line_geom_free(&geom);
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate sweep scratch");
+    }
+    int failed = 0;
+    C.out = scratch;
+    C.visit = visit;
+    C.user = user;
+    C.alloc_failed = &failed;
+    sweep_range(&C, 0, 0, geom.b_hi - geom.b_lo + 1);
+    free(scratch);
+    ts_line_geom_free(&geom);
+    if (failed)
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate sweep workspace");
+    return ts_ok(err);
+}

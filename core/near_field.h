@@ -1,0 +1,44 @@
+/*
+ * Near field of the horizon: the first few cells of a cell's own ray,
+ * evaluated exactly on the bilinear surface through the cell centres.
+ *
+ * Close occluders are where the sweep's line interpolation would cost most
+ * (a lateral offset of a fraction of a cell, at a distance of one cell, is
+ * degrees). Along a straight ray the bilinear surface is quadratic in the
+ * distance s inside each cell patch, so the maximum of (h(s) - h0) / s per
+ * patch has a closed form.
+ */
+#ifndef TS_NEAR_FIELD_H
+#define TS_NEAR_FIELD_H
+
+#include "line_geometry.h"
+
+/* Cells of the ray solved exactly, then whole-step samples up to
+ * TS_NEAR_STEPS; the sweep's hulls cover what lies beyond. */
+#define TS_NEAR_EXACT 4
+#define TS_NEAR_STEPS 10
+#define TS_NEAR_MAX_PIECES (2 * TS_NEAR_EXACT + 2)
+
+typedef struct {
+    int du, dv;      /* patch corner (k + du, i + dv) */
+    double sa, sb;   /* piece of the ray, in steps */
+} ts_near_piece;
+
+typedef struct {
+    double t;                              /* v per step, as the geometry */
+    int npieces;
+    ts_near_piece piece[TS_NEAR_MAX_PIECES];
+    int sample_dv[TS_NEAR_STEPS + 1];      /* whole step j: v offset */
+    float sample_fv[TS_NEAR_STEPS + 1];
+} ts_near_plan;
+
+/* Pieces and samples for the geometry's direction. */
+void ts_near_plan_init(ts_near_plan *p, const ts_line_geom *g);
+
+/* Largest horizon slope (with curvature term -c d) from cell (k, i) at
+ * height h over the near field, step = metres per step; -inf if none.
+ * *left is set when the ray leaves the grid inside the near field. */
+float ts_near_field(const ts_near_plan *p, const ts_line_geom *g, const float *z, int k,
+                    int i, float h, double step, double c, int *left);
+
+#endif

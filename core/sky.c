@@ -1,0 +1,134 @@
+/*
+ * Sky terms from horizons: sky-view factor with the surface normal and
+ * uniform-sky light (Timonen & Westerholm 2010, eq. 4-5 with c = 1), and
+ * positive openness. Each azimuth k is a swath of 360/n degrees; inside it
+ * the sky is visible from zenith down to theta_k = min(horizon zenith
+ * angle, the zenith angle where the tangent plane cuts azimuth k).
+ */
+#include <math.h>
+#include <string.h>
+
+#include "parallel.h"
+#include "status_internal.h"
+
+#define DEG2RAD (M_PI / 180.0)
+
+typedef struct {
+    const ts_grid *g;
+    const float *nx, *ny, *nz, *plane;
+    float sa, ca;       /* sin, cos of the azimuth */
+    float w1, w2;       /* 1/n and sin(pi/n)/pi */
+    float *svf, *sky, *open;
+} sky_ctx;
+
+/* One swath's share of eq. 5 for zenith limit theta. */
+static inline float swath(float nz, float a, float theta, float w1, float w2)
+{
+    float s = sinf(theta), c = cosf(theta);
+    return w1 * nz * s * s + w2 * (theta - s * c) * a;
+}
+
+static void sky_rows(void *ctx, int worker, long y0, long y1)
+{
+    (void)worker;
+    const sky_ctx *C = ctx;
+    size_t W = (size_t)C->g->width;
+    for (size_t i = (size_t)y0 * W; i < (size_t)y1 * W; i++) {
+        float h = C->plane[i], nz = C->nz[i];
+        if (isnan(h) || isnan(nz)) {
+            if (C->svf) C->svf[i] = NAN;
+            if (C->sky) C->sky[i] = NAN;
+            if (C->open) C->open[i] = NAN;
+            continue;
+        }
+        float a = C->nx[i] * C->sa + C->ny[i] * C->ca;
+        float theta_n = (float)(M_PI / 2) + atanf(a / nz);
+        float theta_h = (float)(M_PI / 2) - h * (float)DEG2RAD;
+        if (C->svf)
+            C->svf[i] += swath(nz, a, fminf(theta_h, theta_n), C->w1, C->w2);
+        if (C->sky)
+            C->sky[i] += swath(nz, a, fminf(fminf(theta_h, (float)(M_PI / 2)), theta_n), C->w1,
+                               C->w2);
+        if (C->open)
+            C->open[i] += 90.0f - h;
+    }
+}
+
+static ts_status check_common(const ts_grid *grid, const float *nx, const float *ny,
+                              const float *nz, int directions, ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if (!nx || !ny || !nz)
+        return ts_fail(err, TS_ERR_ARG, "normals must not be NULL");
+    if (directions < 1)
+        return ts_fail(err, TS_ERR_ARG, "directions must be at least 1, got %d", directions);
+    return TS_OK;
+}
+
+ts_status ts_sky_accumulate(const ts_grid *grid, const float *nx, const float *ny,
+                            const float *nz, const float *plane, double azimuth,
+                            int directions, float *svf_acc, float *sky_acc,
+                            float *openness_acc, ts_error *err)
+{
+    ts_status st = check_common(grid, nx, ny, nz, directions, err);
+    if (st != TS_OK)
+        return st;
+    if (!plane)
+        return ts_fail(err, TS_ERR_ARG, "horizon plane must not be NULL");
+    if (!isfinite(azimuth))
+        return ts_fail(err, TS_ERR_ARG, "azimuth must be a finite number of degrees, got %g",
+                       azimuth);
+    sky_ctx C = {grid, nx, ny, nz, plane,
+                 (float)sin(azimuth * DEG2RAD), (float)cos(azimuth * DEG2RAD),
+                 (float)(1.0 / directions), (float)(sin(M_PI / directions) / M_PI),
+                 svf_acc, sky_acc, openness_acc};
+    return ts_parallel_for(ts_thread_count(0, grid->height), grid->height, sky_rows, &C, err);
+}
+
+ts_status ts_sky_finish(const ts_grid *grid, int directions, float *svf_acc, float *sky_acc,
+                        float *openness_acc, ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if (directions < 1)
+        return ts_fail(err, TS_ERR_ARG, "directions must be at least 1, got %d", directions);
+    size_t n = (size_t)grid->width * grid->height;
+    /* Discretisation can overshoot 1 by ~1e-4 on steep open slopes. */
+    for (size_t i = 0; i < n; i++) {
+        if (svf_acc && svf_acc[i] > 1.0f)
+            svf_acc[i] = 1.0f;
+        if (sky_acc && sky_acc[i] > 1.0f)
+            sky_acc[i] = 1.0f;
+        if (openness_acc)
+            openness_acc[i] /= (float)directions;
+    }
+    return ts_ok(err);
+}
+
+ts_status ts_sky_terms(const ts_grid *grid, const float *nx, const float *ny, const float *nz,
+                       const float *horizons, const ts_horizon_opts *opts, float *svf,
+                       float *sky, float *openness, ts_error *err)
+{
+    ts_status st = ts_horizon_opts_validate(opts, err);
+    if (st != TS_OK)
+        return st;
+    if ((st = check_common(grid, nx, ny, nz, opts->directions, err)) != TS_OK)
+        return st;
+    if (!horizons)
+        return ts_fail(err, TS_ERR_ARG, "horizons must not be NULL");
+    size_t n = (size_t)grid->width * grid->height;
+    float *acc[3] = {svf, sky, openness};
+    for (int j = 0; j < 3; j++)
+        if (acc[j])
+            memset(acc[j], 0, n * sizeof(float));
+    for (int k = 0; k < opts->directions; k++) {
+        st = ts_sky_accumulate(grid, nx, ny, nz, horizons + n * k, ts_horizon_azimuth(opts, k),
+                               opts->directions, svf, sky, openness, err);
+        if (st != TS_OK)
+            return st;
+    }
+    return ts_sky_finish(grid, opts->directions, svf, sky, openness, err);
+}
