@@ -70,21 +70,18 @@ static double capped_scan(const sweep_ws *w, int n_raw, double d, double g, doub
     return best;
 }
 
-/* Horizon slope from a point at distance d, height h, against the first n
- * hull points: walk to farther points while the slope grows (the slopes to
- * an upper convex hull from a point beyond it are unimodal). */
-static float hull_query(const sweep_ctx *C, const sweep_ws *w, int n, int n_raw,
+/* Far-field horizon slope from a point at distance d, height h, against the
+ * hull points 0..far (those beyond the near field): walk to farther points
+ * while the slope grows (the slopes to an upper convex hull from a point
+ * beyond it are unimodal). */
+static float hull_query(const sweep_ctx *C, const sweep_ws *w, int far, int n_raw,
                         double d, float h)
 {
-    if (n <= 0)
+    if (far < 0)
         return -INFINITY;
     const hull_pt *S = w->stack;
     double g = h - C->c * d * d;
-    int j = n - 1;
-    while (j >= 0 && d - S[j].d < C->near_skip)
-        j--;
-    if (j < 0)
-        return -INFINITY;
+    int j = far;
     while (j > 0 && (S[j - 1].g - g) * (d - S[j].d) >= (S[j].g - g) * (d - S[j - 1].d))
         j--;
     double s;
@@ -133,6 +130,7 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
     const double c = C->c;
     double d = 0.0;
     int nv = 0;
+    int far = -1; /* top-most hull point beyond the near field */
     for (int k = k0; k <= k1; k++) {
         int i = (int)(b + G->fl[k]);
         float F = G->fr[k];
@@ -176,6 +174,12 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
                                : (S[n - 1].g - gs) / (d - S[n - 1].d);
                 slope = (float)(s - 2.0 * c * d);
             }
+            /* Hull points 0..far lie beyond the near field; pops only take
+             * from the top, and d only grows, so far moves in O(1) amortised. */
+            if (far > n - 1)
+                far = n - 1;
+            while (far + 1 < n && d - S[far + 1].d >= C->near_skip)
+                far++;
             S[n].d = d;
             S[n].g = gs;
             w->n = n + 1;
@@ -183,23 +187,22 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
                 w->raw[w->raw_n++] = S[n];
             pushed = 1;
         }
-        int nh = w->n - pushed, nr = w->raw_n - pushed;
+        int nr = w->raw_n - pushed;
+        if (!pushed)
+            while (far + 1 < w->n && d - w->stack[far + 1].d >= C->near_skip)
+                far++;
         if (write) {
             float s_out;
             if (isnan(hc)) {
                 s_out = NAN;
             } else {
-                float hi = inside ? hull_query(C, w, nh, nr, d, hc) : NAN;
+                float hi = inside ? hull_query(C, w, far, nr, d, hc) : NAN;
                 float lo = (F > 0.0f && k >= pk0 && k <= pk1) ? w->prev_lo[k] : NAN;
-                int left;
-                int row = G->x_major ? i : G->u_start + k * G->u_step;
-                double step = G->step_row ? G->step_row[row] : G->step_m;
-                float nf = ts_near_field(&C->near, G, z, k, i, hc, step, c, &left);
-                s_out = left ? nf : fmaxf(nf, combine(lo, hi, F));
+                s_out = combine(lo, hi, F); /* far field; near field later */
             }
             C->out[C->o_origin + (ptrdiff_t)k * C->o_u_stride + (ptrdiff_t)i * C->o_v_stride] = s_out;
         }
-        w->cur_lo[k] = (has_next && !isnan(hn)) ? hull_query(C, w, nh, nr, d, hn) : NAN;
+        w->cur_lo[k] = (has_next && !isnan(hn)) ? hull_query(C, w, far, nr, d, hn) : NAN;
         if (w->vs) {
             w->vx[nv] = G->x_major ? (float)(G->u_start + k * G->u_step) : (float)i + F;
             w->vy[nv] = G->x_major ? (float)i + F : (float)(G->u_start + k * G->u_step);
@@ -265,12 +268,43 @@ static void sweep_range(void *ctx, int worker, long begin, long end)
     ws_free(&w);
 }
 
-static void convert_range(void *ctx, int worker, long begin, long end)
+/* Rows [y0, y1): add each cell's near field to the far-field slope the
+ * lines left in out, then turn slopes into degrees. */
+static void finish_rows(void *ctx, int worker, long y0, long y1)
 {
     (void)worker;
-    float *o = ctx;
-    for (long i = begin; i < end; i++)
-        o[i] = ts_atan_deg(o[i]);
+    const sweep_ctx *C = ctx;
+    const ts_grid *grid = C->grid;
+    const ts_line_geom *G = C->geom;
+    const int W = grid->width, H = grid->height, m = TS_NEAR_MARGIN;
+    float *scratch = malloc(2 * (size_t)W * sizeof *scratch);
+    for (long y = y0; y < y1; y++) {
+        const float *zrow = grid->z + y * grid->stride;
+        float *orow = C->out + y * W;
+        double step = G->step_row ? G->step_row[y] : G->step_m;
+        int interior = scratch && y >= m && y < H - m && W > 2 * m;
+        int xa = interior ? m : W, xb = interior ? W - m : W;
+        if (interior)
+            ts_near_row(&C->near, G, grid->z, zrow, (int)y, xa, xb, step, C->c, orow, scratch);
+        for (int x = 0; x < W; x++) {
+            if (x == xa)
+                x = xb;
+            if (x >= W)
+                break;
+            if (isnan(zrow[x]))
+                continue;
+            int u = G->x_major ? x : (int)y, v = G->x_major ? (int)y : x;
+            int left;
+            float nf = ts_near_field(&C->near, G, grid->z, (u - G->u_start) * G->u_step, v,
+                                     zrow[x], step, C->c, &left);
+            orow[x] = left ? nf : fmaxf(nf, orow[x]);
+        }
+        for (int x = 0; x < W; x++)
+            orow[x] = ts_atan_deg(orow[x]);
+    }
+    if (!scratch)
+        __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
+    free(scratch);
 }
 
 /* Shared set-up and checks of both sweep entry points. */
@@ -327,13 +361,15 @@ ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
     /* One chunk per thread: each chunk re-primes one line. */
     int threads = ts_thread_count(opts->threads, lines);
     st = ts_parallel_for(threads, lines, sweep_range, &C, err);
+    if (st == TS_OK && !failed)
+        st = ts_parallel_for(ts_thread_count(opts->threads, grid->height), grid->height,
+                             finish_rows, &C, err);
     ts_line_geom_free(&geom);
     if (st != TS_OK)
         return st;
     if (failed)
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate sweep workspace");
-    long n = (long)grid->width * grid->height;
-    return ts_parallel_for(ts_thread_count(opts->threads, n), n, convert_range, out, err);
+    return ts_ok(err);
 }
 
 ts_status ts_horizon_sweep_lines(const ts_grid *grid, double azimuth,

@@ -35,6 +35,13 @@ void ts_near_plan_init(ts_near_plan *p, const ts_line_geom *g)
         q->du = (int)floor(-mid);
         q->dv = at > 1e-12 ? (int)floor(-g->t * mid) : 0;
     }
+    for (int n = 0; n < p->npieces; n++) {
+        ptrdiff_t o = p->piece[n].du * g->u_stride + p->piece[n].dv * g->v_stride;
+        p->piece_off[n][0] = o;
+        p->piece_off[n][1] = o + g->u_stride;
+        p->piece_off[n][2] = o + g->v_stride;
+        p->piece_off[n][3] = o + g->u_stride + g->v_stride;
+    }
     for (int j = 0; j <= TS_NEAR_STEPS; j++) {
         double v = -g->t * j, f = floor(v);
         p->sample_dv[j] = (int)f;
@@ -43,6 +50,8 @@ void ts_near_plan_init(ts_near_plan *p, const ts_line_geom *g)
             p->sample_dv[j]++;
             p->sample_fv[j] = 0.0f;
         }
+        p->sample_off[j][0] = -j * g->u_stride + p->sample_dv[j] * g->v_stride;
+        p->sample_off[j][1] = p->sample_off[j][0] + g->v_stride;
     }
 }
 
@@ -133,4 +142,87 @@ float ts_near_field(const ts_near_plan *p, const ts_line_geom *g, const float *z
         best = s > best ? s : best;
     }
     return (float)best;
+}
+
+/* One piece over a run of cells: plain float arithmetic in a loop the
+ * compiler vectorises. NaN corners make the slope NaN, which the
+ * comparison ignores; such cells are flagged and redone in scalar code. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+static void near_run(const ts_near_plan *p, const float *restrict zrow, int x0, int x1,
+                     float L, float c, float *restrict best, float *restrict flag)
+{
+    for (int x = x0; x < x1; x++) {
+        best[x] = -INFINITY;
+        flag[x] = 0.0f;
+    }
+    const float t = (float)p->t;
+    for (int n = 0; n < p->npieces; n++) {
+        const ts_near_piece *q = &p->piece[n];
+        const float *restrict c00 = zrow + p->piece_off[n][0];
+        const float *restrict c10 = zrow + p->piece_off[n][1];
+        const float *restrict c01 = zrow + p->piece_off[n][2];
+        const float *restrict c11 = zrow + p->piece_off[n][3];
+        const float a0 = (float)-q->du, b0 = fabs(p->t) <= 1e-12 ? 0.0f : (float)-q->dv;
+        const float sa = (float)q->sa, sb = (float)q->sb;
+        const float inv_b = 1.0f / (sb * L), cb = c * sb * L, cLL = c * L * L, invL = 1.0f / L;
+        /* fa = P * ka + beta * kb + gamma * kc - ca; at s = 0 it is the limit
+         * beta / L, since P is 0 there. */
+        const int has_sa = sa > 0;
+        const float ka = has_sa ? 1.0f / (sa * L) : 0.0f;
+        const float kb = has_sa ? sa * ka : invL, kc = has_sa ? sa * sa * ka : 0.0f;
+        const float ca = has_sa ? c * sa * L : 0.0f;
+        for (int x = x0; x < x1; x++) {
+            float h = zrow[x];
+            float A = c10[x] - c00[x], B = c01[x] - c00[x];
+            float X = c11[x] - c10[x] - c01[x] + c00[x];
+            float alpha = c00[x] + A * a0 + B * b0 + X * a0 * b0;
+            float beta = -(A + B * t + X * (a0 * t + b0));
+            float gamma = X * t;
+            float P = alpha - h;
+            float fb = (P + beta * sb + gamma * sb * sb) * inv_b - cb;
+            float fa = P * ka + beta * kb + gamma * kc - ca;
+            float m = fa > fb ? fa : fb;
+            float g2 = gamma - cLL;
+            float r = P / g2;
+            float ss = sqrtf(r > 0.0f ? r : 0.0f);
+            float sd = ss > 0.0f ? ss : 1.0f;
+            float fs = (P / sd + beta + gamma * ss) * invL - c * ss * L;
+            int inner = has_sa & (P < 0.0f) & (g2 < 0.0f) & (ss > sa) & (ss < sb) & (fs > m);
+            m = inner ? fs : m;
+            best[x] = m > best[x] ? m : best[x];
+            flag[x] += (m != m) ? 1.0f : 0.0f;
+        }
+    }
+    for (int j = TS_NEAR_EXACT + 1; j <= TS_NEAR_STEPS; j++) {
+        const float *restrict sa_ = zrow + p->sample_off[j][0];
+        const float *restrict sb_ = zrow + p->sample_off[j][1];
+        const float f = p->sample_fv[j], d = (float)j * L, invd = 1.0f / d, cd = c * d;
+        for (int x = x0; x < x1; x++) {
+            float hj = sa_[x] + f * (sb_[x] - sa_[x]);
+            float s = (hj - zrow[x]) * invd - cd;
+            best[x] = s > best[x] ? s : best[x];
+            flag[x] += (s != s) ? 1.0f : 0.0f;
+        }
+    }
+}
+
+void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
+                 const float *zrow, int y, int x0, int x1, double step, double c,
+                 float *out, float *scratch)
+{
+    float *best = scratch, *flag = scratch + x1;
+    near_run(p, zrow, x0, x1, (float)step, (float)c, best, flag);
+    for (int x = x0; x < x1; x++) {
+        if (isnan(zrow[x]))
+            continue;
+        float nf = best[x];
+        if (flag[x] != 0.0f) {
+            int u = g->x_major ? x : y, v = g->x_major ? y : x;
+            int left;
+            nf = ts_near_field(p, g, z, (u - g->u_start) * g->u_step, v, zrow[x], step, c, &left);
+        }
+        out[x] = nf > out[x] ? nf : out[x];
+    }
 }

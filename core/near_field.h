@@ -30,7 +30,16 @@ typedef struct {
     ts_near_piece piece[TS_NEAR_MAX_PIECES];
     int sample_dv[TS_NEAR_STEPS + 1];      /* whole step j: v offset */
     float sample_fv[TS_NEAR_STEPS + 1];
+    /* Element offsets from the cell, for the vectorised interior pass:
+     * corners 00, 10, 01, 11 of each piece, and the two cells of each whole
+     * step sample. */
+    ptrdiff_t piece_off[TS_NEAR_MAX_PIECES][4];
+    ptrdiff_t sample_off[TS_NEAR_STEPS + 1][2];
 } ts_near_plan;
+
+/* Cells at least this far from every edge have their whole near field on
+ * the grid. */
+#define TS_NEAR_MARGIN (TS_NEAR_STEPS + 2)
 
 /* Pieces and samples for the geometry's direction. */
 void ts_near_plan_init(ts_near_plan *p, const ts_line_geom *g);
@@ -40,5 +49,15 @@ void ts_near_plan_init(ts_near_plan *p, const ts_line_geom *g);
  * *left is set when the ray leaves the grid inside the near field. */
 float ts_near_field(const ts_near_plan *p, const ts_line_geom *g, const float *z, int k,
                     int i, float h, double step, double c, int *left);
+
+/*
+ * Near field of the interior cells x0 <= x < x1 of one grid row, all with
+ * the same metres per step. zrow points at the row's first height;
+ * out[x] receives max(out[x], near field) (the far field is already there).
+ * Cells whose near field touches nodata are redone by ts_near_field.
+ */
+void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
+                 const float *zrow, int y, int x0, int x1, double step, double c,
+                 float *out, float *scratch);
 
 #endif
