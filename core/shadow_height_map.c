@@ -29,6 +29,7 @@ typedef struct {
     float F;
     int bands;
     atomic_long *progress;     /* per band: last finished step */
+    int *failed;               /* set when a band cannot get its buffers */
     ptrdiff_t o_origin, o_u_stride, o_v_stride;
 } shm_ctx;
 
@@ -54,22 +55,61 @@ static inline float shm_cell(const float *prev, int v, int V, int off, float F, 
     return (isnan(p) || h >= p) ? h : p;
 }
 
-static inline float visibility(float s, float h, float depth)
-{
-    if (isnan(h))
-        return NAN;
-    float under = s - h;
-    if (depth <= 0.0f)
-        return under > 0.0f ? 0.0f : 1.0f;
-    float a = under / depth;
-    return 1.0f - (a < 0.0f ? 0.0f : a > 1.0f ? 1.0f : a);
-}
-
 static void wait_for(atomic_long *p, long step)
 {
     while (atomic_load_explicit(p, memory_order_acquire) < step)
         sched_yield();
 }
+
+/*
+ * One u-row of the recurrence for v0 <= v < v1: cur[v] from prev, heights
+ * h[v] (contiguous), the drop per v (dropv, or the constant drop), then the
+ * outputs vis[v] / sh[v] (contiguous, may be NULL). Cells whose
+ * interpolation reaches past the grid edge go through shm_cell; the rest is
+ * a branch-free loop the compiler vectorises.
+ */
+static void shm_row(const float *restrict prev, float *restrict cur, const float *restrict h,
+                    const float *restrict dropv, float drop, int v0, int v1, int V, int off,
+                    float F, int first, float depth, float *restrict vis, float *restrict sh)
+{
+    /* interior: both v + off and v + off + 1 inside [0, V - 1] */
+    int lo = -off > v0 ? -off : v0, hi = V - 1 - off < v1 ? V - 1 - off : v1;
+    if (first || lo > hi) {
+        lo = v1;
+        hi = v1;
+    }
+    for (int v = v0; v < lo; v++)
+        cur[v] = shm_cell(prev, v, V, off, F, h[v], dropv ? dropv[v] : drop, first);
+    for (int v = hi; v < v1; v++)
+        cur[v] = shm_cell(prev, v, V, off, F, h[v], dropv ? dropv[v] : drop, first);
+    const float *restrict pa_ = prev + off, *restrict pb_ = prev + off + 1;
+    for (int v = lo; v < hi; v++) {
+        float pa = pa_[v], pb = F > 0.0f ? pb_[v] : pa;
+        float a = pa != pa ? pb : pa, b = pb != pb ? pa : pb;
+        float p = a + F * (b - a) - (dropv ? dropv[v] : drop);
+        float hv = h[v];
+        float s = (hv >= p) | (p != p) ? hv : p;
+        cur[v] = hv != hv ? p : s;
+    }
+    for (int v = v0; v < v1; v++) {
+        float hv = h[v], under = cur[v] - hv;
+        float lit;
+        if (depth <= 0.0f) {
+            lit = under > 0.0f ? 0.0f : 1.0f;
+        } else {
+            float q = under / depth;
+            lit = 1.0f - (q < 0.0f ? 0.0f : q > 1.0f ? 1.0f : q);
+        }
+        if (vis)
+            vis[v] = hv != hv ? NAN : lit;
+        if (sh)
+            sh[v] = cur[v];
+    }
+}
+
+/* Columns of x-major light are handled TILE u-rows at a time through
+ * transposed copies, so that the recurrence runs on contiguous memory. */
+#define TILE 32
 
 /* Bands [begin, end) as one contiguous v range; waits only on the bands
  * beside the range. */
@@ -79,46 +119,102 @@ static void shm_bands(void *ctx, int worker, long begin, long end)
     const ts_line_geom *G = C->G;
     const ts_grid *grid = C->grid;
     const int V = G->V;
-    const float *z = grid->z;
     (void)worker;
     int v0 = (int)((long)V * begin / C->bands), v1 = (int)((long)V * end / C->bands);
-    for (int k = 0; k < G->U; k++) {
-        if (k > 0) {
-            if (begin > 0)
-                wait_for(&C->progress[begin - 1], k - 1);
-            if (end < C->bands)
-                wait_for(&C->progress[end], k - 1);
-        }
-        const float *prev = C->ring[(k + 1) & 1];
-        float *cur = C->ring[k & 1];
-        int u = G->u_start + k * G->u_step;
-        const float *zrow = z + G->origin + (ptrdiff_t)k * G->u_stride;
-        ptrdiff_t orow = C->o_origin + (ptrdiff_t)k * C->o_u_stride;
-        if (G->x_major) {
-            /* v = y: strided, per-row step length. */
-            for (int v = v0; v < v1; v++) {
-                double step = G->step_row ? G->step_row[v] : G->step_m;
-                float h = zrow[(ptrdiff_t)v * G->v_stride];
-                cur[v] = shm_cell(prev, v, V, C->off, C->F, h, (float)(step * C->tan_el), k == 0);
-            }
+    int tile = G->x_major ? TILE : 1;
+    /* transposed tiles (x-major only): heights, visibility, shadow height */
+    float *th = NULL, *tv = NULL, *ts = NULL, *dropv = NULL;
+    if (G->x_major) {
+        size_t n = (size_t)TILE * V;
+        th = malloc(n * sizeof *th);
+        tv = C->vis ? malloc(n * sizeof *tv) : NULL;
+        ts = C->sh ? malloc(n * sizeof *ts) : NULL;
+        dropv = malloc((size_t)V * sizeof *dropv);
+        if (!th || (C->vis && !tv) || (C->sh && !ts) || !dropv) {
+            free(th), free(tv), free(ts), free(dropv);
+            th = tv = ts = dropv = NULL;
+            tile = 1; /* fall back to strided access, same arithmetic */
         } else {
-            /* v = x: contiguous, one step length per row u. */
-            double step = G->step_row ? G->step_row[u] : G->step_m;
-            float drop = (float)(step * C->tan_el);
-            for (int v = v0; v < v1; v++)
-                cur[v] = shm_cell(prev, v, V, C->off, C->F, zrow[v], drop, k == 0);
+            for (int v = 0; v < V; v++)
+                dropv[v] = (float)((G->step_row ? G->step_row[v] : G->step_m) * C->tan_el);
         }
-        for (int v = v0; v < v1; v++) {
-            ptrdiff_t o = orow + (ptrdiff_t)v * C->o_v_stride;
-            float h = zrow[(ptrdiff_t)v * G->v_stride];
-            if (C->sh)
-                C->sh[o] = cur[v];
-            if (C->vis)
-                C->vis[o] = visibility(cur[v], h, C->depth);
-        }
-        for (long b = begin; b < end; b++)
-            atomic_store_explicit(&C->progress[b], k, memory_order_release);
     }
+    float *hrow = NULL, *vrow = NULL, *srow = NULL;
+    if (G->x_major && !th) {
+        hrow = malloc((size_t)V * sizeof *hrow);
+        vrow = malloc((size_t)V * sizeof *vrow);
+        srow = malloc((size_t)V * sizeof *srow);
+        dropv = malloc((size_t)V * sizeof *dropv);
+        if (!hrow || !vrow || !srow || !dropv) {
+            /* Nothing left to try: mark the outputs as failed. */
+            __atomic_store_n(C->failed, 1, __ATOMIC_RELAXED);
+        } else {
+            for (int v = 0; v < V; v++)
+                dropv[v] = (float)((G->step_row ? G->step_row[v] : G->step_m) * C->tan_el);
+        }
+    }
+    for (int k0 = 0; k0 < G->U; k0 += tile) {
+        int kn = G->U - k0 < tile ? G->U - k0 : tile;
+        if (th) /* gather: row v of the grid holds the tile's u-rows side by side */
+            for (int v = v0; v < v1; v++) {
+                const float *zr = grid->z + G->origin + (ptrdiff_t)v * G->v_stride;
+                for (int j = 0; j < kn; j++)
+                    th[(size_t)j * V + v] = zr[(ptrdiff_t)(k0 + j) * G->u_stride];
+            }
+        for (int j = 0; j < kn; j++) {
+            int k = k0 + j;
+            if (k > 0) {
+                if (begin > 0)
+                    wait_for(&C->progress[begin - 1], k - 1);
+                if (end < C->bands)
+                    wait_for(&C->progress[end], k - 1);
+            }
+            const float *prev = C->ring[(k + 1) & 1];
+            float *cur = C->ring[k & 1];
+            const float *zrow = grid->z + G->origin + (ptrdiff_t)k * G->u_stride;
+            ptrdiff_t orow = C->o_origin + (ptrdiff_t)k * C->o_u_stride;
+            if (th) {
+                shm_row(prev, cur, th + (size_t)j * V, dropv, 0.0f, v0, v1, V, C->off, C->F,
+                        k == 0, C->depth, tv ? tv + (size_t)j * V : NULL,
+                        ts ? ts + (size_t)j * V : NULL);
+            } else if (G->x_major) {
+                if (hrow && vrow && srow && dropv) {
+                    for (int v = v0; v < v1; v++)
+                        hrow[v] = zrow[(ptrdiff_t)v * G->v_stride];
+                    shm_row(prev, cur, hrow, dropv, 0.0f, v0, v1, V, C->off, C->F, k == 0,
+                            C->depth, vrow, srow);
+                    for (int v = v0; v < v1; v++) {
+                        ptrdiff_t o = orow + (ptrdiff_t)v * C->o_v_stride;
+                        if (C->vis)
+                            C->vis[o] = vrow[v];
+                        if (C->sh)
+                            C->sh[o] = srow[v];
+                    }
+                }
+            } else {
+                int u = G->u_start + k * G->u_step;
+                double step = G->step_row ? G->step_row[u] : G->step_m;
+                shm_row(prev, cur, zrow, NULL, (float)(step * C->tan_el), v0, v1, V, C->off,
+                        C->F, k == 0, C->depth, C->vis ? C->vis + orow : NULL,
+                        C->sh ? C->sh + orow : NULL);
+            }
+            for (long b = begin; b < end; b++)
+                atomic_store_explicit(&C->progress[b], k, memory_order_release);
+        }
+        if (th) /* scatter the tile's outputs back to grid rows */
+            for (int v = v0; v < v1; v++) {
+                ptrdiff_t o = C->o_origin + (ptrdiff_t)k0 * C->o_u_stride +
+                              (ptrdiff_t)v * C->o_v_stride;
+                for (int j = 0; j < kn; j++) {
+                    if (tv)
+                        C->vis[o + (ptrdiff_t)j * C->o_u_stride] = tv[(size_t)j * V + v];
+                    if (ts)
+                        C->sh[o + (ptrdiff_t)j * C->o_u_stride] = ts[(size_t)j * V + v];
+                }
+            }
+    }
+    free(th), free(tv), free(ts), free(dropv);
+    free(hrow), free(vrow), free(srow);
 }
 
 ts_status ts_shm_compute(const ts_grid *grid, double azimuth, double elevation,
@@ -170,9 +266,13 @@ ts_status ts_shm_compute(const ts_grid *grid, double azimuth, double elevation,
     if (!C.ring[0] || !C.ring[1] || !C.progress) {
         st = ts_fail(err, TS_ERR_NOMEM, "cannot allocate shadow height map rows");
     } else {
+        int failed = 0;
+        C.failed = &failed;
         for (int i = 0; i < C.bands; i++)
             atomic_init(&C.progress[i], -1L);
         st = ts_parallel_for(C.bands, C.bands, shm_bands, &C, err);
+        if (st == TS_OK && failed)
+            st = ts_fail(err, TS_ERR_NOMEM, "cannot allocate shadow height map buffers");
     }
     free(C.ring[0]);
     free(C.ring[1]);
