@@ -1,6 +1,7 @@
 /* Direct sun with the visible fraction of the sun's disk, and the final mix. */
 #include <math.h>
 
+#include "parallel.h"
 #include "status_internal.h"
 
 #define DEG2RAD (M_PI / 180.0)
@@ -16,6 +17,28 @@ double ts_sun_disk_fraction(double sun_elevation, double horizon)
         return 0.0;
     /* Area of the disk above a horizontal chord at height -u radii. */
     return 0.5 + (u * sqrt(1.0 - u * u) + asin(u)) / M_PI;
+}
+
+typedef struct {
+    const float *nx, *ny, *nz, *h0, *h1;
+    float w, lx, ly, lz;
+    double sun_el;
+    float *out;
+} direct_ctx;
+
+static void direct_range(void *ctx, int worker, long begin, long end)
+{
+    (void)worker;
+    const direct_ctx *C = ctx;
+    for (long i = begin; i < end; i++) {
+        float hz = (1.0f - C->w) * C->h0[i] + C->w * C->h1[i];
+        float ndotl = C->nx[i] * C->lx + C->ny[i] * C->ly + C->nz[i] * C->lz;
+        if (isnan(hz) || isnan(ndotl)) {
+            C->out[i] = NAN;
+            continue;
+        }
+        C->out[i] = ndotl > 0 ? ndotl * (float)ts_sun_disk_fraction(C->sun_el, hz) : 0.0f;
+    }
 }
 
 ts_status ts_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
@@ -56,19 +79,12 @@ ts_status ts_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
     if (n == 1)
         w = 0;
     size_t plane = (size_t)grid->width * grid->height;
-    const float *h0 = horizons + plane * k0, *h1 = horizons + plane * k1;
     double az = sun_azimuth * DEG2RAD, el = sun_elevation * DEG2RAD;
-    float lx = (float)(sin(az) * cos(el)), ly = (float)(cos(az) * cos(el)), lz = (float)sin(el);
-    for (size_t i = 0; i < plane; i++) {
-        float hz = (float)((1.0 - w) * h0[i] + w * h1[i]);
-        float ndotl = nx[i] * lx + ny[i] * ly + nz[i] * lz;
-        if (isnan(hz) || isnan(ndotl)) {
-            out[i] = NAN;
-            continue;
-        }
-        out[i] = ndotl > 0 ? ndotl * (float)ts_sun_disk_fraction(sun_elevation, hz) : 0.0f;
-    }
-    return ts_ok(err);
+    direct_ctx C = {nx, ny, nz, horizons + plane * k0, horizons + plane * k1, (float)w,
+                    (float)(sin(az) * cos(el)), (float)(cos(az) * cos(el)), (float)sin(el),
+                    sun_elevation, out};
+    return ts_parallel_for(ts_thread_count(0, (long)(plane >> 16) + 1), (long)plane,
+                           direct_range, &C, err);
 }
 
 ts_status ts_shade_combine(const ts_grid *grid, const float *direct, const float *sky,

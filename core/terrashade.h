@@ -176,6 +176,12 @@ ts_status ts_shm_compute(const ts_grid *grid, double azimuth, double elevation,
 /** Angular radius of the sun's disk, degrees. */
 #define TS_SUN_RADIUS_DEG 0.2666
 
+/*
+ * Layout of per-cell arrays: normals, horizon planes and every output are
+ * width*height floats with a row stride of width, whatever the grid's
+ * stride. Functions without a thread count use all cores.
+ */
+
 /**
  * Unit surface normals by Horn's method (as gdaldem hillshade), components
  * x = east, y = north, z = up; each array width*height (may not be NULL).
@@ -223,7 +229,8 @@ ts_status ts_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
  * Accumulating form of ts_sky_terms for one direction at a time, so that a
  * caller need not keep every horizon plane: call ts_sky_accumulate for each
  * direction k (plane = its horizon plane) on zeroed accumulators, then
- * ts_sky_finish. Accumulator arrays are width*height floats.
+ * ts_sky_finish. Accumulator arrays are width*height floats; any of them
+ * may be NULL when that term is not wanted.
  */
 ts_status ts_sky_accumulate(const ts_grid *grid, const float *nx,
                             const float *ny, const float *nz,

@@ -1,0 +1,95 @@
+#!/bin/sh
+# driver_bench.sh - the TERRASHADE driver against gdaldem hillshade, one run.
+#
+#   bench/driver_bench.sh [SIZE] [REPEATS]      (defaults: 4096 3)
+#
+# Generates a SIZE x SIZE fractal DEM with 10 m cells in EPSG:32617, then
+# times, on the same DEM and in the same run,
+#   gdaldem hillshade dem.tif out.tif                       (no cast shadows)
+#   gdal_translate TERRASHADE:dem.tif out.tif              (cast shadows)
+# each REPEATS times, and prints the best wall time of each and the ratio.
+# Goal: ratio <= 1.5.
+#
+# The plugin is taken from $BUILDDIR/plugin/.libs (BUILDDIR defaults to the
+# current directory, i.e. run it from the build tree) or, if that has no
+# gdal_TERRASHADE.so, from wherever GDAL finds it (GDAL_DRIVER_PATH or the
+# installed plugin directory). Needs /usr/bin/python3 with numpy and osgeo.
+set -eu
+
+SIZE=${1:-4096}
+REPEATS=${2:-3}
+PYTHON=${PYTHON:-/usr/bin/python3}
+BUILDDIR=${BUILDDIR:-$(pwd)}
+if [ -f "$BUILDDIR/plugin/.libs/gdal_TERRASHADE.so" ]; then
+    GDAL_DRIVER_PATH="$BUILDDIR/plugin/.libs"
+    export GDAL_DRIVER_PATH
+fi
+if ! gdalinfo --formats | grep -q TERRASHADE; then
+    echo "driver_bench: GDAL cannot find the TERRASHADE driver; build it (make)" \
+         "and run from the build directory, or set GDAL_DRIVER_PATH" >&2
+    exit 1
+fi
+
+WORK=$(mktemp -d "${TMPDIR:-/tmp}/driver_bench.XXXXXX")
+trap 'rm -rf "$WORK"' EXIT INT TERM
+DEM="$WORK/fractal_${SIZE}.tif"
+
+echo "== DEM: $SIZE x $SIZE cells of 10 m, EPSG:32617, Float32"
+echo "   synthesis: spectral (FFT) fractal surface, amplitude ~ f^-1.1"
+echo "   (power spectrum f^-2.2), fixed seed 42, scaled to 100..1500 m"
+"$PYTHON" - "$SIZE" "$DEM" <<'EOF'
+import sys
+import numpy as np
+from osgeo import gdal, osr
+n, path = int(sys.argv[1]), sys.argv[2]
+rng = np.random.default_rng(42)
+f = np.hypot(np.fft.fftfreq(n)[None, :], np.fft.fftfreq(n)[:, None])
+f[0, 0] = 1
+spec = (rng.standard_normal((n, n)) + 1j * rng.standard_normal((n, n))) / f ** 1.1
+spec[0, 0] = 0
+z = np.fft.ifft2(spec).real
+z = (100 + 1400 * (z - z.min()) / (z.max() - z.min())).astype(np.float32)
+ds = gdal.GetDriverByName("GTiff").Create(path, n, n, 1, gdal.GDT_Float32,
+                                          ["TILED=YES"])
+ds.SetGeoTransform((500000.0, 10.0, 0.0, 4000000.0, 0.0, -10.0))
+srs = osr.SpatialReference()
+srs.ImportFromEPSG(32617)
+ds.SetProjection(srs.ExportToWkt())
+ds.GetRasterBand(1).WriteArray(z)
+ds = None
+EOF
+
+CPUS=$(nproc 2>/dev/null || echo "?")
+echo "== machine: $CPUS CPU(s); GDAL $(gdal-config --version 2>/dev/null || gdalinfo --version)"
+echo "   GDAL_DRIVER_PATH=${GDAL_DRIVER_PATH:-<default>}"
+
+# best wall time of REPEATS runs of a command, in seconds
+best_time() {
+    best=""
+    i=0
+    while [ "$i" -lt "$REPEATS" ]; do
+        rm -f "$WORK/out.tif"
+        t0=$(date +%s.%N)
+        "$@" >/dev/null
+        t1=$(date +%s.%N)
+        best=$(awk -v a="$t0" -v b="$t1" -v best="$best" \
+            'BEGIN { t = b - a; if (best == "" || t < best) best = t; print best }')
+        i=$((i + 1))
+    done
+    printf '%.3f' "$best"
+}
+
+echo "== timing, best of $REPEATS"
+echo "\$ gdaldem hillshade -q $DEM $WORK/out.tif"
+T_DEM=$(best_time gdaldem hillshade -q "$DEM" "$WORK/out.tif")
+echo "   gdaldem hillshade:             ${T_DEM} s"
+echo "\$ gdal_translate -q TERRASHADE:$DEM $WORK/out.tif"
+T_TS=$(best_time gdal_translate -q "TERRASHADE:$DEM" "$WORK/out.tif")
+echo "   TERRASHADE shade (cast shadows): ${T_TS} s"
+echo "\$ gdal_translate -q -oo METHOD=shm TERRASHADE:$DEM $WORK/out.tif"
+T_SHM=$(best_time gdal_translate -q -oo METHOD=shm "TERRASHADE:$DEM" "$WORK/out.tif")
+echo "   TERRASHADE shade, METHOD=shm:    ${T_SHM} s  (for reference)"
+awk -v a="$T_TS" -v b="$T_DEM" -v c="$T_SHM" 'BEGIN {
+    printf "== ratio TERRASHADE / gdaldem = %.2f (goal <= 1.5)\n", a / b
+    printf "   (METHOD=shm: %.2f)\n", c / b }'
+echo "   (CPL_DEBUG=TERRASHADE gdal_translate ... shows the driver's own timings)"

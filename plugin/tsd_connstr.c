@@ -1,0 +1,128 @@
+/* TERRASHADE connection strings: inline options and the DEM's name. */
+#include "tsd_connstr.h"
+
+#include <ctype.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+int tsd_connstr_matches(const char *name)
+{
+    return name && strncasecmp(name, TSD_PREFIX, strlen(TSD_PREFIX)) == 0;
+}
+
+/* Is s[0..len) "KEY=VALUE" with KEY an identifier (blanks allowed around)? */
+static int is_item(const char *s, size_t len)
+{
+    size_t i = 0;
+    while (i < len && s[i] == ' ')
+        i++;
+    if (i == len || !(isalpha((unsigned char)s[i]) || s[i] == '_'))
+        return 0;
+    while (i < len && (isalnum((unsigned char)s[i]) || s[i] == '_'))
+        i++;
+    while (i < len && s[i] == ' ')
+        i++;
+    return i < len && s[i] == '=';
+}
+
+/* Does s[0..len) consist of comma-separated KEY=VALUE items? */
+static int is_option_segment(const char *s, size_t len)
+{
+    if (len == 0)
+        return 0;
+    size_t start = 0;
+    for (size_t i = 0; i <= len; i++) {
+        if (i == len || s[i] == ',') {
+            if (!is_item(s + start, i - start))
+                return 0;
+            start = i + 1;
+        }
+    }
+    return 1;
+}
+
+static char *dup_range(const char *s, size_t len)
+{
+    char *d = malloc(len + 1);
+    if (d) {
+        memcpy(d, s, len);
+        d[len] = '\0';
+    }
+    return d;
+}
+
+static int fail(char *msg, size_t n, const char *text, const char *arg)
+{
+    if (msg && n)
+        snprintf(msg, n, text, arg);
+    return -1;
+}
+
+int tsd_connstr_parse(const char *name, tsd_connstr *out, char *msg,
+                      size_t msg_size)
+{
+    out->options = NULL;
+    out->dem = NULL;
+    if (!tsd_connstr_matches(name))
+        return fail(msg, msg_size, "'%s' does not start with " TSD_PREFIX,
+                    name ? name : "");
+    const char *rest = name + strlen(TSD_PREFIX);
+    const char *colon = strchr(rest, ':');
+    size_t seg_len = colon ? (size_t)(colon - rest) : strlen(rest);
+    int n_items = 0;
+    if (is_option_segment(rest, seg_len)) {
+        if (!colon)
+            return fail(msg, msg_size,
+                        "'%s' names no DEM: write TERRASHADE:KEY=VALUE,...:<dem> "
+                        "(quote a DEM name that contains '=' before any ':')",
+                        name);
+        n_items = 1;
+        for (size_t i = 0; i < seg_len; i++)
+            n_items += rest[i] == ',';
+    } else {
+        seg_len = 0;
+        colon = NULL;
+    }
+    out->options = calloc((size_t)n_items + 1, sizeof *out->options);
+    if (!out->options)
+        return fail(msg, msg_size, "%s", "out of memory");
+    const char *p = rest;
+    for (int k = 0; k < n_items; k++) {
+        const char *end = memchr(p, ',', (size_t)(rest + seg_len - p));
+        if (!end)
+            end = rest + seg_len;
+        out->options[k] = dup_range(p, (size_t)(end - p));
+        if (!out->options[k])
+            return fail(msg, msg_size, "%s", "out of memory");
+        p = end + 1;
+    }
+    const char *dem = colon ? colon + 1 : rest;
+    size_t dem_len = strlen(dem);
+    if (dem_len >= 2 && dem[0] == '"' && dem[dem_len - 1] == '"') {
+        dem++;
+        dem_len -= 2;
+    }
+    if (dem_len == 0)
+        return fail(msg, msg_size,
+                    "'%s' names no DEM: write TERRASHADE:<dem> or "
+                    "TERRASHADE:KEY=VALUE,...:<dem>", name);
+    out->dem = dup_range(dem, dem_len);
+    if (!out->dem)
+        return fail(msg, msg_size, "%s", "out of memory");
+    return 0;
+}
+
+void tsd_connstr_free(tsd_connstr *c)
+{
+    if (!c)
+        return;
+    if (c->options)
+        for (char **p = c->options; *p; p++)
+            free(*p);
+    free(c->options);
+    free(c->dem);
+    c->options = NULL;
+    c->dem = NULL;
+}

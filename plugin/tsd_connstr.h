@@ -1,0 +1,46 @@
+/*
+ * tsd_connstr.h - split a TERRASHADE connection string into inline options
+ * and the DEM's name. Plain C, no GDAL.
+ *
+ *   TERRASHADE:<dem>
+ *   TERRASHADE:KEY=VALUE,KEY=VALUE:<dem>
+ *   TERRASHADE:KEY=VALUE:"<dem>"      (quotes: a name that itself starts
+ *                                      like KEY=VALUE:)
+ *
+ * The option segment is recognised only if every comma-separated item is
+ * KEY=VALUE with KEY an identifier ([A-Za-z_][A-Za-z0-9_]*) and it ends at a
+ * ':'; values cannot contain ',' or ':'. Everything after it is the DEM's
+ * name, passed to GDAL unchanged: /vsi paths, names with colons, drive
+ * letters ("C:\dem.tif" starts with "C", which has no '=').
+ */
+#ifndef TSD_CONNSTR_H
+#define TSD_CONNSTR_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define TSD_PREFIX "TERRASHADE:"
+
+typedef struct {
+    char **options; /* NULL-terminated "KEY=VALUE" list (never NULL on success) */
+    char *dem;      /* the DEM's name */
+} tsd_connstr;
+
+/** 1 if name starts with TERRASHADE: (case-insensitive). Cheap, silent. */
+int tsd_connstr_matches(const char *name);
+
+/** Parse; 0 on success, -1 with a sentence in msg. Free with
+ * tsd_connstr_free (also after a failure). */
+int tsd_connstr_parse(const char *name, tsd_connstr *out, char *msg,
+                      size_t msg_size);
+
+void tsd_connstr_free(tsd_connstr *c);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

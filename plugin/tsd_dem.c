@@ -1,0 +1,101 @@
+/* Read a DEM band into a core grid. */
+#include "tsd_dem.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cpl_error.h"
+
+#define STRIP_ROWS 256
+
+static void flip(ts_grid *g, int flip_x, int flip_y)
+{
+    int w = g->width, h = g->height;
+    if (flip_x)
+        for (int y = 0; y < h; y++) {
+            float *r = g->z + (ptrdiff_t)y * g->stride;
+            for (int a = 0, b = w - 1; a < b; a++, b--) {
+                float t = r[a];
+                r[a] = r[b];
+                r[b] = t;
+            }
+        }
+    if (flip_y)
+        for (int a = 0, b = h - 1; a < b; a++, b--) {
+            float *ra = g->z + (ptrdiff_t)a * g->stride;
+            float *rb = g->z + (ptrdiff_t)b * g->stride;
+            for (int x = 0; x < w; x++) {
+                float t = ra[x];
+                ra[x] = rb[x];
+                rb[x] = t;
+            }
+        }
+}
+
+static int gdal_fail(char *msg, size_t n, const char *what)
+{
+    const char *last = CPLGetLastErrorMsg();
+    snprintf(msg, n, "%s%s%s", what, last && *last ? ": " : "",
+             last ? last : "");
+    return -1;
+}
+
+int tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
+                 ts_grid *grid, char *msg, size_t n)
+{
+    ts_error err;
+    int w = GDALGetRasterBandXSize(band), h = GDALGetRasterBandYSize(band);
+    if (ts_grid_create(grid, w, h, cells->cell_x, cells->cell_y, &err) != TS_OK) {
+        snprintf(msg, n, "%s", err.message);
+        return -1;
+    }
+    if (cells->cell_x_row &&
+        ts_grid_set_row_spacing(grid, cells->cell_x_row, &err) != TS_OK) {
+        snprintf(msg, n, "%s", err.message);
+        ts_grid_free(grid);
+        return -1;
+    }
+    int has_scale = 0, has_offset = 0;
+    double scale = GDALGetRasterScale(band, &has_scale);
+    double offset = GDALGetRasterOffset(band, &has_offset);
+    if (!has_scale)
+        scale = 1;
+    if (!has_offset)
+        offset = 0;
+    scale *= z_factor;
+    offset *= z_factor;
+
+    int all_valid = GDALGetMaskFlags(band) == GMF_ALL_VALID;
+    GDALRasterBandH mask = all_valid ? NULL : GDALGetMaskBand(band);
+    unsigned char *m = NULL;
+    if (mask && !(m = malloc((size_t)w * STRIP_ROWS))) {
+        snprintf(msg, n, "out of memory reading the DEM's mask");
+        ts_grid_free(grid);
+        return -1;
+    }
+    for (int y0 = 0; y0 < h; y0 += STRIP_ROWS) {
+        int rows = h - y0 < STRIP_ROWS ? h - y0 : STRIP_ROWS;
+        float *z = grid->z + (ptrdiff_t)y0 * grid->stride;
+        if (GDALRasterIO(band, GF_Read, 0, y0, w, rows, z, w, rows, GDT_Float32,
+                         0, (int)(grid->stride * sizeof(float))) != CE_None ||
+            (mask && GDALRasterIO(mask, GF_Read, 0, y0, w, rows, m, w, rows,
+                                  GDT_Byte, 0, w) != CE_None)) {
+            free(m);
+            ts_grid_free(grid);
+            return gdal_fail(msg, n, "cannot read the DEM");
+        }
+        for (int y = 0; y < rows; y++) {
+            float *r = z + (ptrdiff_t)y * grid->stride;
+            const unsigned char *mr = m ? m + (size_t)y * w : NULL;
+            for (int x = 0; x < w; x++) {
+                double v = r[x] * scale + offset;
+                r[x] = (mr && !mr[x]) || !isfinite(v) ? NAN : (float)v;
+            }
+        }
+    }
+    free(m);
+    flip(grid, cells->flip_x, cells->flip_y);
+    return 0;
+}

@@ -1,0 +1,28 @@
+/*
+ * tsd_dem.h - read a DEM band through GDAL's C API into a core grid:
+ * float metres, NaN where the band's mask (nodata, alpha, mask band) says
+ * invalid, scale/offset and Z_FACTOR applied, flipped to row 0 = north.
+ */
+#ifndef TSD_DEM_H
+#define TSD_DEM_H
+
+#include <stddef.h>
+
+#include "gdal.h"
+#include "terrashade.h"
+#include "tsd_geodesy.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Fill `grid` (created here; free with ts_grid_free) from `band`.
+ * 0 on success; -1 with a sentence in msg. */
+int tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
+                 ts_grid *grid, char *msg, size_t msg_size);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,133 @@
+/* Cell sizes in metres from a geotransform and a CRS. */
+#include "tsd_geodesy.h"
+
+#include <geodesic.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 3, 4)))
+#endif
+static int fail(char *msg, size_t n, const char *fmt, ...)
+{
+    if (msg && n) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(msg, n, fmt, ap);
+        va_end(ap);
+    }
+    return -1;
+}
+
+/* Geodesic cell sizes of a geographic DEM; gt in degrees. */
+static int geographic(const double gt[6], int width, int height, double a,
+                      double invf, tsd_cells *c, char *msg, size_t n)
+{
+    struct geod_geodesic g;
+    double top = gt[3], bottom = gt[3] + height * gt[5];
+    double dlon = fabs(gt[1]);
+    if (fabs(top) > 90 + 1e-9 || fabs(bottom) > 90 + 1e-9)
+        return fail(msg, n,
+                    "the DEM reaches beyond the poles (latitudes %g to %g); its "
+                    "geotransform is not in degrees of a geographic CRS",
+                    bottom, top);
+    if (width * dlon > 360 + 1e-9)
+        return fail(msg, n,
+                    "the DEM spans %g degrees of longitude (cell %g degrees), "
+                    "more than the whole Earth", width * dlon, dlon);
+    geod_init(&g, a, invf != 0 ? 1.0 / invf : 0.0);
+    c->cell_x_row = malloc((size_t)height * sizeof *c->cell_x_row);
+    if (!c->cell_x_row)
+        return fail(msg, n, "out of memory for %d rows", height);
+    double lon0 = gt[0] + 0.5 * width * gt[1];
+    for (int y = 0; y < height; y++) {
+        double lat = gt[3] + (y + 0.5) * gt[5];
+        double s12 = 0;
+        geod_inverse(&g, lat, lon0, lat, lon0 + dlon, &s12, NULL, NULL);
+        /* a row at a pole has no width: keep it positive and tiny */
+        if (!(s12 > 1e-6 * a * dlon * M_PI / 180))
+            s12 = 1e-6 * a * dlon * M_PI / 180;
+        c->cell_x_row[y] = s12; /* gt is north-up here: row 0 = north */
+    }
+    double ns = 0;
+    geod_inverse(&g, top, lon0, bottom, lon0, &ns, NULL, NULL);
+    c->cell_y = ns / height;
+    c->cell_x = c->cell_x_row[height / 2];
+    if (!(c->cell_y > 0))
+        return fail(msg, n, "cannot compute the north-south cell size "
+                    "(latitudes %g to %g)", bottom, top);
+    return 0;
+}
+
+int tsd_cells_compute(const double gt[6], int width, int height,
+                      OGRSpatialReferenceH srs, tsd_cells *c, char *msg,
+                      size_t n)
+{
+    memset(c, 0, sizeof *c);
+    if (width < 1 || height < 1)
+        return fail(msg, n, "the DEM has no cells (%d x %d)", width, height);
+    for (int i = 0; i < 6; i++)
+        if (!isfinite(gt[i]))
+            return fail(msg, n, "the DEM's geotransform is not finite");
+    double scale = fmax(fabs(gt[1]), fabs(gt[5]));
+    if (fabs(gt[2]) > 1e-9 * scale || fabs(gt[4]) > 1e-9 * scale)
+        return fail(msg, n,
+                    "the DEM's geotransform is rotated or sheared (GT[2] = %g, "
+                    "GT[4] = %g); terrashade needs a north-up grid: warp it first, "
+                    "e.g. gdalwarp dem.tif north_up.tif", gt[2], gt[4]);
+    if (gt[1] == 0 || gt[5] == 0)
+        return fail(msg, n,
+                    "the DEM's pixel size is zero (GT[1] = %g, GT[5] = %g)",
+                    gt[1], gt[5]);
+    c->flip_x = gt[1] < 0;
+    c->flip_y = gt[5] > 0;
+    c->unit_to_m = 1;
+    if (srs && OSRIsGeographic(srs)) {
+        OGRErr e1 = OGRERR_NONE, e2 = OGRERR_NONE;
+        double a = OSRGetSemiMajor(srs, &e1);
+        double invf = OSRGetInvFlattening(srs, &e2);
+        double rad = OSRGetAngularUnits(srs, NULL); /* radians per unit */
+        if (e1 != OGRERR_NONE || e2 != OGRERR_NONE || !(a > 0) || !(rad > 0))
+            return fail(msg, n, "cannot read the ellipsoid of the DEM's "
+                        "geographic CRS (a = %g, 1/f = %g)", a, invf);
+        double deg = rad * 180.0 / M_PI, g[6];
+        for (int i = 0; i < 6; i++)
+            g[i] = gt[i] * deg;
+        /* the geotransform of a north-up geographic raster: x = longitude */
+        if (c->flip_y) {
+            g[3] = g[3] + height * g[5];
+            g[5] = -g[5];
+        }
+        c->kind = TSD_CRS_GEOGRAPHIC;
+        return geographic(g, width, height, a, invf, c, msg, n);
+    }
+    if (srs && (OSRIsProjected(srs) || OSRIsLocal(srs))) {
+        c->kind = TSD_CRS_PROJECTED;
+        c->unit_to_m = OSRGetLinearUnits(srs, NULL);
+        if (!(c->unit_to_m > 0))
+            return fail(msg, n, "the DEM's CRS has an invalid linear unit "
+                        "(%g metres)", c->unit_to_m);
+    } else if (srs && OSRIsGeocentric(srs)) {
+        return fail(msg, n, "the DEM's CRS is neither projected nor geographic "
+                    "(it is geocentric); warp it to a projected CRS first");
+    } else {
+        c->kind = TSD_CRS_NONE;
+        snprintf(c->warning, sizeof c->warning,
+                 "the DEM has no CRS: its cell size (%g x %g) is taken as metres",
+                 fabs(gt[1]), fabs(gt[5]));
+    }
+    c->cell_x = fabs(gt[1]) * c->unit_to_m;
+    c->cell_y = fabs(gt[5]) * c->unit_to_m;
+    return 0;
+}
+
+void tsd_cells_free(tsd_cells *c)
+{
+    if (c) {
+        free(c->cell_x_row);
+        c->cell_x_row = NULL;
+    }
+}

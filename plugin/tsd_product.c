@@ -1,0 +1,245 @@
+/* The products: which core calls, in which order, with how much memory. */
+#include "tsd_product.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    float *nx, *ny, *nz;
+} normals;
+
+static int core_fail(char *msg, size_t n, const ts_error *err)
+{
+    snprintf(msg, n, "%s", err->message[0] ? err->message
+                                           : ts_status_name(err->code));
+    return -1;
+}
+
+static int oom(char *msg, size_t n, const char *what)
+{
+    snprintf(msg, n, "out of memory for %s", what);
+    return -1;
+}
+
+static void horizon_opts(const tsd_options *o, ts_horizon_opts *h)
+{
+    ts_horizon_opts_default(h);
+    h->directions = o->directions;
+    h->start_azimuth = o->start_azimuth;
+    h->max_distance = o->max_distance;
+    h->curvature = o->curvature;
+    h->refraction = o->refraction;
+    h->threads = o->threads;
+}
+
+/* Extra float planes (besides the DEM grid and the product) at the peak. */
+static int extra_planes(const tsd_options *o)
+{
+    switch (o->product) {
+    case TSD_PRODUCT_SHADE:
+        /* normals, a horizon plane or the SHM visibility, the sky
+         * accumulator and its horizon plane */
+        return 3 + 1 + (o->sky_weight > 0 ? 2 : 0);
+    case TSD_PRODUCT_SHADOW:
+    case TSD_PRODUCT_HORIZON:
+        return 0;
+    case TSD_PRODUCT_SVF:
+    case TSD_PRODUCT_OPENNESS:
+    case TSD_PRODUCT_SKY:
+        return 3 + 1; /* normals and one horizon plane */
+    }
+    return 0;
+}
+
+double tsd_product_peak_bytes(const tsd_options *o, int width, int height,
+                              double *steady)
+{
+    double plane = (double)width * (double)height * sizeof(float);
+    double bands = tsd_options_band_count(o);
+    if (steady)
+        *steady = bands * plane;
+    return (1 + bands + extra_planes(o)) * plane;
+}
+
+static void free_normals(normals *nm)
+{
+    free(nm->nx);
+    free(nm->ny);
+    free(nm->nz);
+}
+
+static int make_normals(const ts_grid *g, normals *nm, char *msg, size_t n)
+{
+    size_t cells = (size_t)g->width * g->height;
+    ts_error err;
+    nm->nx = malloc(cells * sizeof(float));
+    nm->ny = malloc(cells * sizeof(float));
+    nm->nz = malloc(cells * sizeof(float));
+    if (!nm->nx || !nm->ny || !nm->nz)
+        return oom(msg, n, "the surface normals");
+    if (ts_normals(g, nm->nx, nm->ny, nm->nz, &err) != TS_OK)
+        return core_fail(msg, n, &err);
+    return 0;
+}
+
+/* Stream the DIRECTIONS horizon planes into one sky accumulator; `which`:
+ * 0 = svf, 1 = sky, 2 = openness. acc must be zeroed. */
+static int sky_stream(const ts_grid *g, const normals *nm, const tsd_options *o,
+                      int which, float *acc, char *msg, size_t n)
+{
+    size_t cells = (size_t)g->width * g->height;
+    ts_horizon_opts h;
+    ts_error err;
+    horizon_opts(o, &h);
+    float *plane = malloc(cells * sizeof(float));
+    if (!plane)
+        return oom(msg, n, "a horizon plane");
+    float *svf = which == 0 ? acc : NULL, *sky = which == 1 ? acc : NULL,
+          *open = which == 2 ? acc : NULL;
+    for (int k = 0; k < h.directions; k++) {
+        double az = ts_horizon_azimuth(&h, k);
+        if (ts_horizon_sweep(g, az, &h, plane, &err) != TS_OK ||
+            ts_sky_accumulate(g, nm->nx, nm->ny, nm->nz, plane, az, h.directions,
+                              svf, sky, open, &err) != TS_OK) {
+            free(plane);
+            return core_fail(msg, n, &err);
+        }
+    }
+    free(plane);
+    if (ts_sky_finish(g, h.directions, svf, sky, open, &err) != TS_OK)
+        return core_fail(msg, n, &err);
+    return 0;
+}
+
+/* Shadow height map visibility of the sun into vis. */
+static int shm_visibility(const ts_grid *g, const tsd_options *o, float *vis,
+                          char *msg, size_t n)
+{
+    ts_error err;
+    if (ts_shm_compute(g, o->sun_azimuth, o->sun_elevation, o->penumbra_depth,
+                       o->threads, vis, NULL, &err) != TS_OK)
+        return core_fail(msg, n, &err);
+    return 0;
+}
+
+/* Exact horizon at the sun's azimuth into plane; *h describes it. */
+static int sun_horizon(const ts_grid *g, const tsd_options *o,
+                       ts_horizon_opts *h, float *plane, char *msg, size_t n)
+{
+    ts_error err;
+    horizon_opts(o, h);
+    h->directions = 1;
+    h->start_azimuth = o->sun_azimuth;
+    if (ts_horizon_sweep(g, o->sun_azimuth, h, plane, &err) != TS_OK)
+        return core_fail(msg, n, &err);
+    return 0;
+}
+
+static int shade(const ts_grid *g, const tsd_options *o, float *out, char *msg,
+                 size_t n)
+{
+    size_t cells = (size_t)g->width * g->height;
+    normals nm = {0};
+    ts_error err;
+    int rc = -1;
+    float *work = malloc(cells * sizeof(float));
+    if (!work) {
+        oom(msg, n, "a horizon plane");
+        goto done;
+    }
+    if (make_normals(g, &nm, msg, n) != 0)
+        goto done;
+    if (o->method == TSD_METHOD_EXACT) {
+        ts_horizon_opts h;
+        if (sun_horizon(g, o, &h, work, msg, n) != 0)
+            goto done;
+        if (ts_shade_direct(g, nm.nx, nm.ny, nm.nz, work, &h, o->sun_azimuth,
+                            o->sun_elevation, out, &err) != TS_OK) {
+            core_fail(msg, n, &err);
+            goto done;
+        }
+    } else {
+        if (shm_visibility(g, o, work, msg, n) != 0)
+            goto done;
+        double az = o->sun_azimuth * M_PI / 180, el = o->sun_elevation * M_PI / 180;
+        double lx = sin(az) * cos(el), ly = cos(az) * cos(el), lz = sin(el);
+        for (size_t i = 0; i < cells; i++) {
+            double d = nm.nx[i] * lx + nm.ny[i] * ly + nm.nz[i] * lz;
+            out[i] = (float)((d > 0 ? d : 0) * work[i]); /* NaN stays NaN */
+        }
+    }
+    if (o->sky_weight > 0) {
+        memset(work, 0, cells * sizeof(float));
+        if (sky_stream(g, &nm, o, 1, work, msg, n) != 0)
+            goto done;
+        if (ts_shade_combine(g, out, work, o->sky_weight, out, &err) != TS_OK) {
+            core_fail(msg, n, &err);
+            goto done;
+        }
+    }
+    rc = 0;
+done:
+    free(work);
+    free_normals(&nm);
+    return rc;
+}
+
+static int shadow(const ts_grid *g, const tsd_options *o, float *out, char *msg,
+                  size_t n)
+{
+    size_t cells = (size_t)g->width * g->height;
+    if (o->method == TSD_METHOD_SHM)
+        return shm_visibility(g, o, out, msg, n);
+    ts_horizon_opts h;
+    if (sun_horizon(g, o, &h, out, msg, n) != 0)
+        return -1;
+    for (size_t i = 0; i < cells; i++)
+        if (out[i] == out[i])
+            out[i] = (float)ts_sun_disk_fraction(o->sun_elevation, out[i]);
+    return 0;
+}
+
+static int sky_product(const ts_grid *g, const tsd_options *o, int which,
+                       float *out, char *msg, size_t n)
+{
+    normals nm = {0};
+    int rc = -1;
+    memset(out, 0, (size_t)g->width * g->height * sizeof(float));
+    if (make_normals(g, &nm, msg, n) == 0 &&
+        sky_stream(g, &nm, o, which, out, msg, n) == 0)
+        rc = 0;
+    free_normals(&nm);
+    return rc;
+}
+
+int tsd_product_compute(const ts_grid *grid, const tsd_options *o, float *out,
+                        char *msg, size_t n)
+{
+    ts_error err;
+    ts_horizon_opts h;
+    if (ts_grid_validate(grid, &err) != TS_OK)
+        return core_fail(msg, n, &err);
+    horizon_opts(o, &h);
+    if (ts_horizon_opts_validate(&h, &err) != TS_OK)
+        return core_fail(msg, n, &err);
+    switch (o->product) {
+    case TSD_PRODUCT_SHADE:
+        return shade(grid, o, out, msg, n);
+    case TSD_PRODUCT_SHADOW:
+        return shadow(grid, o, out, msg, n);
+    case TSD_PRODUCT_HORIZON:
+        if (ts_horizon_compute(grid, &h, out, &err) != TS_OK)
+            return core_fail(msg, n, &err);
+        return 0;
+    case TSD_PRODUCT_SVF:
+        return sky_product(grid, o, 0, out, msg, n);
+    case TSD_PRODUCT_SKY:
+        return sky_product(grid, o, 1, out, msg, n);
+    case TSD_PRODUCT_OPENNESS:
+        return sky_product(grid, o, 2, out, msg, n);
+    }
+    snprintf(msg, n, "unknown product");
+    return -1;
+}

@@ -1,0 +1,60 @@
+#!/bin/sh
+# render.sh - the README's pictures of jacksboro.tif, through gdal_translate
+# and the TERRASHADE plugin, next to plain gdaldem hillshade.
+#
+#   samples/render.sh [OUTDIR]          (default: samples/out)
+#
+# The plugin is taken from $BUILDDIR/plugin/.libs (BUILDDIR defaults to the
+# current directory, so run it from the build tree after make), else from
+# wherever GDAL finds it (GDAL_DRIVER_PATH, or the installed plugin).
+# Reads only jacksboro.tif beside this script.
+set -eu
+
+HERE=$(cd "$(dirname "$0")" && pwd)
+DEM="$HERE/jacksboro.tif"
+OUT=${1:-$HERE/out}
+BUILDDIR=${BUILDDIR:-$(pwd)}
+if [ -f "$BUILDDIR/plugin/.libs/gdal_TERRASHADE.so" ]; then
+    GDAL_DRIVER_PATH="$BUILDDIR/plugin/.libs"
+    export GDAL_DRIVER_PATH
+fi
+if ! gdalinfo --formats | grep -q TERRASHADE; then
+    echo "render.sh: GDAL cannot find the TERRASHADE driver; build it (make)" \
+         "and run from the build directory, or set GDAL_DRIVER_PATH" >&2
+    exit 1
+fi
+# PNGs only: no .aux.xml beside them, none beside the DEM
+GDAL_PAM_ENABLED=NO
+export GDAL_PAM_ENABLED
+mkdir -p "$OUT"
+
+run() {
+    echo "\$ $*"
+    "$@"
+}
+
+# 1. plain gdaldem hillshade, sun at 315 deg / 20 deg (degrees need a scale)
+run gdaldem hillshade -q -az 315 -alt 20 -s 111120 -compute_edges -of PNG \
+    "$DEM" "$OUT/hillshade_gdaldem.png"
+
+# 2. the same sun with cast shadows, a little sky light in the shadows
+run gdal_translate -q -of PNG \
+    -oo SUN_AZIMUTH=315 -oo SUN_ELEVATION=20 -oo SKY_WEIGHT=0.25 \
+    "TERRASHADE:$DEM" "$OUT/shade_terrashade.png"
+
+# 3. shadow at low sun: visible fraction of the sun's disk, 0..1 -> 0..255
+run gdal_translate -q -of PNG -ot Byte -scale 0 1 0 255 -a_nodata none \
+    "TERRASHADE:PRODUCT=shadow,SUN_AZIMUTH=135,SUN_ELEVATION=5:$DEM" \
+    "$OUT/shadow_low_sun.png"
+
+# 4. sky-view factor, 32 directions, 0.88..1 stretched to 0..255
+run gdal_translate -q -of PNG -ot Byte -scale 0.88 1 0 255 -a_nodata none \
+    -oo PRODUCT=svf -oo DIRECTIONS=32 \
+    "TERRASHADE:$DEM" "$OUT/svf.png"
+
+# 5. a horizon band: 8 directions from 0, band 4 = azimuth 135, -5..25 deg
+run gdal_translate -q -of PNG -ot Byte -b 4 -scale -5 25 0 255 -a_nodata none \
+    "TERRASHADE:PRODUCT=horizon,DIRECTIONS=8:$DEM" "$OUT/horizon_135.png"
+
+echo "wrote:"
+ls -l "$OUT"/*.png

@@ -1,0 +1,106 @@
+"""Bad inputs: each gives a clear message and a non-zero exit, never a crash,
+through gdal_translate, gdalinfo and Python."""
+import os
+import unittest
+
+import tsdriver as T
+from tsdriver import gdal
+
+DEM = T.LUX
+
+# (description, connection string, open options, text the message must hold)
+CASES = [
+    ("unknown open option", T.conn(DEM), ["FOO=1"], "unknown option 'FOO'"),
+    ("unknown inline option", "TERRASHADE:SUN_AZIMUT=10:" + DEM, [],
+     "unknown option 'SUN_AZIMUT'"),
+    ("elevation out of range", T.conn(DEM), ["SUN_ELEVATION=95"],
+     "SUN_ELEVATION must be between -90 and 90, got 95"),
+    ("azimuth out of range", T.conn(DEM), ["SUN_AZIMUTH=-1"],
+     "SUN_AZIMUTH must be between 0 and 360, got -1"),
+    ("not a number", T.conn(DEM), ["SUN_AZIMUTH=west"],
+     "SUN_AZIMUTH must be a number, got 'west'"),
+    ("not a whole number", T.conn(DEM), ["DIRECTIONS=2.5"],
+     "DIRECTIONS must be a whole number, got '2.5'"),
+    ("too many directions", T.conn(DEM), ["DIRECTIONS=100000"],
+     "DIRECTIONS must be between 1 and 3600"),
+    ("zero z factor", T.conn(DEM), ["Z_FACTOR=0"],
+     "Z_FACTOR must be greater than 0"),
+    ("bad product", T.conn(DEM), ["PRODUCT=hillshade"],
+     "PRODUCT must be one of shade, shadow, horizon, svf, openness, sky, got "
+     "'hillshade'"),
+    ("bad boolean", T.conn(DEM), ["CURVATURE=maybe"],
+     "CURVATURE must be YES or NO"),
+    ("empty value", T.conn(DEM), ["SUN_AZIMUTH="], "SUN_AZIMUTH needs a value"),
+    ("conflicting duplicates", "TERRASHADE:SUN_AZIMUTH=10:" + DEM,
+     ["SUN_AZIMUTH=20"], "SUN_AZIMUTH is given twice"),
+    ("Byte horizon", T.conn(DEM), ["PRODUCT=horizon", "OUTPUT_TYPE=Byte"],
+     "OUTPUT_TYPE=Byte is only for"),
+    ("shm svf", T.conn(DEM), ["PRODUCT=svf", "METHOD=shm"],
+     "METHOD=shm applies to PRODUCT=shade and PRODUCT=shadow only"),
+    ("band beyond the DEM", T.conn(DEM), ["BAND=2"],
+     "BAND=2, but the DEM"),
+    ("missing file", T.conn("/nonexistent/dem.tif"), [],
+     "cannot open the DEM '/nonexistent/dem.tif'"),
+    ("empty name", "TERRASHADE:", [], "names no DEM"),
+    ("options but no name", "TERRASHADE:PRODUCT=svf", [], "names no DEM"),
+    ("options and empty name", "TERRASHADE:PRODUCT=svf:", [], "names no DEM"),
+]
+
+
+class Errors(unittest.TestCase):
+    def check_tools(self, name, connection, oo, text, tmp):
+        args = []
+        for o in oo:
+            args += ["-oo", o]
+        out = os.path.join(tmp, "out.tif")
+        p = T.run(["gdal_translate"] + args + [connection, out], ok=False)
+        print("%-24s -> %s" % (name, p.stderr.strip().splitlines()[-1]))
+        self.assertIn(text, p.stderr)
+        self.assertIn("TERRASHADE:", p.stderr)
+        self.assertFalse(os.path.exists(out), "an output was written")
+        p = T.run(["gdalinfo"] + args + [connection], ok=False)
+        self.assertIn(text, p.stderr)
+
+    def test_bad_inputs_through_the_tools(self):
+        with T.TempDir() as tmp:
+            for name, connection, oo, text in CASES:
+                with self.subTest(name):
+                    self.check_tools(name, connection, oo, text, tmp)
+
+    def test_bad_inputs_through_python(self):
+        for name, connection, oo, text in CASES:
+            with self.subTest(name):
+                with self.assertRaises(RuntimeError) as e:
+                    gdal.OpenEx(connection, gdal.OF_RASTER, open_options=oo)
+                self.assertIn(text, str(e.exception))
+
+    def test_not_a_raster(self):
+        with T.TempDir() as tmp:
+            text = os.path.join(tmp, "notes.txt")
+            with open(text, "w") as f:
+                f.write("this is not a DEM\n")
+            shp = os.path.join(tmp, "points.csv")
+            with open(shp, "w") as f:
+                f.write("x,y\n1,2\n")
+            for path in (text, shp, tmp):
+                with self.subTest(path=path):
+                    self.check_tools("not a raster", T.conn(path), [],
+                                     "cannot open the DEM '%s' as a raster" % path,
+                                     tmp)
+
+    def test_update_access_refused(self):
+        with self.assertRaises(RuntimeError) as e:
+            gdal.Open(T.conn(DEM), gdal.GA_Update)
+        self.assertIn("read-only", str(e.exception))
+
+    def test_memory_limit_is_a_clear_error(self):
+        """A product too large for the limit: refused at open, not a crash."""
+        p = T.run(["gdalinfo", "-oo", "PRODUCT=horizon", "-oo", "DIRECTIONS=3600",
+                   "-oo", "MAX_MEMORY=100", T.conn(T.JACKSBORO)], ok=False)
+        print(p.stderr.strip())
+        self.assertIn("needs about", p.stderr)
+        self.assertIn("raise MAX_MEMORY", p.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

@@ -1,0 +1,188 @@
+"""Shared helpers of the TERRASHADE driver tests (not a test itself).
+
+The tests run from the top build directory (automake's test harness runs
+them there and exports $srcdir). They use the plugin in place:
+GDAL_DRIVER_PATH = <builddir>/plugin/.libs, set here before osgeo is
+imported, and passed on to every GDAL tool they run.
+"""
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+BUILDDIR = os.path.abspath(os.environ.get("TS_BUILDDIR", os.getcwd()))
+SRCDIR = os.path.abspath(
+    os.environ.get("srcdir")
+    or os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+PLUGIN_DIR = os.path.join(BUILDDIR, "plugin", ".libs")
+PLUGIN = os.path.join(PLUGIN_DIR, "gdal_TERRASHADE.so")
+CORE_REFERENCE = os.path.join(BUILDDIR, "tests", "driver", "core_reference")
+DATA = os.path.join(SRCDIR, "tests", "data")
+JACKSBORO = os.path.join(DATA, "jacksboro.tif")
+LUX = os.path.join(DATA, "lux_elev.tif")
+
+if not os.path.exists(PLUGIN):
+    sys.exit("FAIL: %s is missing: the plugin was not built (did configure "
+             "find GDAL? run make first)" % PLUGIN)
+
+os.environ["GDAL_DRIVER_PATH"] = PLUGIN_DIR
+os.environ.setdefault("GDAL_CACHEMAX", "256")
+os.environ.pop("CPL_DEBUG", None)
+
+import numpy as np  # noqa: E402
+from osgeo import gdal, osr  # noqa: E402
+
+gdal.UseExceptions()
+osr.UseExceptions()
+
+if gdal.GetDriverByName("TERRASHADE") is None:
+    sys.exit("FAIL: GDAL did not load the TERRASHADE driver from %s" % PLUGIN_DIR)
+
+
+def env(**extra):
+    """Environment for a GDAL tool: the in-place plugin, plus extra."""
+    e = dict(os.environ)
+    e.update({k: str(v) for k, v in extra.items()})
+    return e
+
+
+def run(args, ok=True, cwd=None, **extra_env):
+    """Run a command; check its exit status is 0 (ok=True) or not 0.
+
+    Returns the CompletedProcess with .stdout/.stderr as text. A process
+    killed by a signal (a crash) always fails the test."""
+    p = subprocess.run([str(a) for a in args], capture_output=True, text=True,
+                       cwd=cwd, env=env(**extra_env), timeout=600)
+    out = "$ %s\n%s%s" % (" ".join(map(str, args)), p.stdout, p.stderr)
+    if p.returncode < 0:
+        raise AssertionError("crashed with signal %d:\n%s" % (-p.returncode, out))
+    if ok and p.returncode != 0:
+        raise AssertionError("failed (exit %d):\n%s" % (p.returncode, out))
+    if not ok and p.returncode == 0:
+        raise AssertionError("succeeded but should have failed:\n%s" % out)
+    return p
+
+
+def conn(dem, **inline):
+    """TERRASHADE:KEY=VALUE,...:<dem> (or TERRASHADE:<dem>)."""
+    if not inline:
+        return "TERRASHADE:" + dem
+    opts = ",".join("%s=%s" % kv for kv in inline.items())
+    return "TERRASHADE:%s:%s" % (opts, dem)
+
+
+def oo_args(options):
+    args = []
+    for k, v in options.items():
+        args += ["-oo", "%s=%s" % (k, v)]
+    return args
+
+
+def translate(dem, out, options=None, inline=None, extra=()):
+    """gdal_translate TERRASHADE:... out.tif with -oo options; returns out."""
+    run(["gdal_translate", "-q", "-of", "GTiff"] + oo_args(options or {})
+        + list(extra) + [conn(dem, **(inline or {})), out])
+    return out
+
+
+def read(path, band=None, options=None):
+    """All bands (3-D array) or one band (2-D) of a raster as float64 arrays,
+    nodata (declared) as NaN. options: open options for TERRASHADE."""
+    oo = ["%s=%s" % kv for kv in (options or {}).items()]
+    ds = gdal.OpenEx(path, gdal.OF_RASTER, open_options=oo)
+    bands = [band] if band else range(1, ds.RasterCount + 1)
+    arrays = []
+    for b in bands:
+        rb = ds.GetRasterBand(b)
+        a = rb.ReadAsArray().astype(np.float64)
+        nd = rb.GetNoDataValue()
+        if nd is not None and not np.isnan(nd):
+            a[a == nd] = np.nan
+        arrays.append(a)
+    ds = None
+    return arrays[0] if band else np.array(arrays)
+
+
+def read_dem(path, band=1):
+    """The DEM as the driver sees it: float32 metres, NaN where masked."""
+    ds = gdal.Open(path)
+    rb = ds.GetRasterBand(band)
+    z = rb.ReadAsArray().astype(np.float32)
+    mask = rb.GetMaskBand().ReadAsArray()
+    z[mask == 0] = np.nan
+    gt = ds.GetGeoTransform()
+    return z, gt, ds.GetProjection()
+
+
+def write_tif(path, array, gt, srs, nodata=None, dtype=gdal.GDT_Float32):
+    """Write a 2-D (or 3-D: bands first) array as GeoTIFF. srs: EPSG code,
+    WKT/PROJ string or None."""
+    a = np.asarray(array)
+    if a.ndim == 2:
+        a = a[None]
+    ds = gdal.GetDriverByName("GTiff").Create(path, a.shape[2], a.shape[1],
+                                              a.shape[0], dtype)
+    ds.SetGeoTransform(gt)
+    if srs is not None:
+        s = osr.SpatialReference()
+        if isinstance(srs, int):
+            s.ImportFromEPSG(srs)
+        else:
+            s.SetFromUserInput(srs)
+        ds.SetProjection(s.ExportToWkt())
+    for i in range(a.shape[0]):
+        rb = ds.GetRasterBand(i + 1)
+        if nodata is not None:
+            rb.SetNoDataValue(nodata)
+        rb.WriteArray(a[i])
+    ds = None
+    return path
+
+
+def fractal_dem(n, seed=1, relief=300.0):
+    """A reproducible fractal DEM (spectral synthesis, beta = 2.2)."""
+    rng = np.random.default_rng(seed)
+    fx = np.fft.fftfreq(n)[None, :]
+    fy = np.fft.fftfreq(n)[:, None]
+    f = np.hypot(fx, fy)
+    f[0, 0] = 1.0
+    spec = (rng.normal(size=(n, n)) + 1j * rng.normal(size=(n, n))) / f ** 1.1
+    spec[0, 0] = 0
+    z = np.real(np.fft.ifft2(spec))
+    z = (z - z.min()) / (z.max() - z.min()) * relief + 100.0
+    return z.astype(np.float32)
+
+
+_UTM = {}
+
+
+def jacksboro_utm(tmp):
+    """jacksboro warped to UTM 17N (EPSG:32617), 90 m, bilinear, Float32
+    with -32768 as nodata outside the source footprint."""
+    out = os.path.join(tmp, "jacksboro_utm.tif")
+    if not os.path.exists(out):
+        run(["gdalwarp", "-q", "-t_srs", "EPSG:32617", "-tr", "90", "90",
+             "-r", "bilinear", "-ot", "Float32", "-dstnodata", "-32768",
+             JACKSBORO, out])
+    return out
+
+
+class TempDir:
+    """with TempDir() as d: ...  (removed afterwards)"""
+
+    def __enter__(self):
+        self.path = tempfile.mkdtemp(prefix="tsdriver-")
+        return self.path
+
+    def __exit__(self, *exc):
+        shutil.rmtree(self.path, ignore_errors=True)
+
+
+def describe(name, a, b):
+    """One line comparing two arrays, for the test output."""
+    d = np.abs(a - b)
+    both = ~np.isnan(a) & ~np.isnan(b)
+    return "%s: max |diff| %.3g over %d cells, nodata masks %s" % (
+        name, np.nanmax(d[both]) if both.any() else 0.0, both.sum(),
+        "equal" if np.array_equal(np.isnan(a), np.isnan(b)) else "DIFFER")
