@@ -150,12 +150,11 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
          * grid when i is the last row and the line is past it. */
         int inside = F == 0.0f || has_next;
         float hs;
+        /* NaN when either cell is nodata: the sample is no occluder. */
         if (!inside)
             hs = NAN;
-        else if (F == 0.0f || isnan(hn))
+        else if (F == 0.0f)
             hs = hc;
-        else if (isnan(hc))
-            hs = hn;
         else
             hs = hc + F * (hn - hc);
 

@@ -60,19 +60,6 @@ static inline double slope_at(double P, double beta, double gamma, double s, dou
     return (P + beta * s + gamma * s * s) / (s * L) - c * s * L;
 }
 
-/* Height at s on a patch with NaN corners: bilinear over valid corners. */
-static double patch_height_nan(const float hc[4], double a, double b)
-{
-    double w[4] = {(1 - a) * (1 - b), a * (1 - b), (1 - a) * b, a * b};
-    double sum = 0, ws = 0;
-    for (int q = 0; q < 4; q++)
-        if (w[q] > 0 && !isnan(hc[q])) {
-            sum += w[q] * hc[q];
-            ws += w[q];
-        }
-    return ws > 0 ? sum / ws : NAN;
-}
-
 float ts_near_field(const ts_near_plan *p, const ts_line_geom *g, const float *z, int k,
                     int i, float h, double step, double c, int *left)
 {
@@ -94,14 +81,10 @@ float ts_near_field(const ts_near_plan *p, const ts_line_geom *g, const float *z
                        has_r1 ? z[o + g->u_stride + g->v_stride] : z[o + g->u_stride]};
         /* local coordinates in the patch: a = a0 - s, b = b0 - t s */
         double a0 = -q->du, b0 = flat_v ? 0.0 : -q->dv;
-        if (isnan(hc[0]) || isnan(hc[1]) || isnan(hc[2]) || isnan(hc[3])) {
-            double hb = patch_height_nan(hc, a0 - q->sb, b0 - p->t * q->sb);
-            if (!isnan(hb)) {
-                double s = (hb - h) / (q->sb * step) - c * q->sb * step;
-                best = s > best ? s : best;
-            }
+        /* The surface exists only on patches with four valid corners:
+         * nodata is no terrain, so a patch touching it is skipped. */
+        if (isnan(hc[0]) || isnan(hc[1]) || isnan(hc[2]) || isnan(hc[3]))
             continue;
-        }
         double A = hc[1] - hc[0], B = hc[2] - hc[0], X = hc[3] - hc[1] - hc[2] + hc[0];
         double t = flat_v ? 0.0 : p->t;
         double alpha = hc[0] + A * a0 + B * b0 + X * a0 * b0;
@@ -133,8 +116,8 @@ float ts_near_field(const ts_near_plan *p, const ts_line_geom *g, const float *z
             break;
         }
         ptrdiff_t o = g->origin + (ptrdiff_t)kk * g->u_stride + (ptrdiff_t)r0 * g->v_stride;
-        float va = z[o], vb = f > 0.0f ? z[o + g->v_stride] : NAN;
-        float hj = isnan(vb) ? va : isnan(va) ? vb : va + f * (vb - va);
+        float va = z[o], vb = f > 0.0f ? z[o + g->v_stride] : va;
+        float hj = va + f * (vb - va); /* NaN if either cell is nodata */
         if (isnan(hj))
             continue;
         double d = j * step;
