@@ -27,7 +27,15 @@
 
 typedef struct {
     double d, g;
+    int k;              /* step index of the sample on its line */
 } hull_pt;
+
+/* The far-field occluder a hull query found: its step index on the line and
+ * its distance from the query point; k < 0 when there is none. */
+typedef struct {
+    int k;
+    float dd;
+} occluder;
 
 typedef struct {
     const ts_grid *grid;
@@ -50,69 +58,97 @@ typedef struct {
     int n;
     hull_pt *raw;       /* every pushed sample, for the distance cap */
     int raw_n;
-    float *prev_lo, *cur_lo;
+    occluder *prev_lo, *cur_lo;
     int prev_k0, prev_k1;
     /* visitor buffers */
     float *vx, *vy, *vh, *vs;
     double *vd;
 } sweep_ws;
 
-/* Max slope (without the -2cd term) from (d, g) over raw samples within
- * the cap, scanning back from the newest. */
-static double capped_scan(const sweep_ws *w, int n_raw, double d, double g, double cap)
-{
-    double best = -INFINITY;
-    for (int j = n_raw - 1; j >= 0 && d - w->raw[j].d <= cap; j--) {
-        double s = (w->raw[j].g - g) / (d - w->raw[j].d);
-        if (s > best)
-            best = s;
-    }
-    return best;
-}
-
-/* Far-field horizon slope from a point at distance d, height h, against the
+/* The far-field occluder of a point at distance d, height h, among the
  * hull points 0..far (those beyond the near field): walk to farther points
  * while the slope grows (the slopes to an upper convex hull from a point
  * beyond it are unimodal). */
-static float hull_query(const sweep_ctx *C, const sweep_ws *w, int far, int n_raw,
-                        double d, float h)
+static occluder hull_query(const sweep_ctx *C, const sweep_ws *w, int far, double d, float h)
 {
+    occluder none = {-1, 0.0f};
     if (far < 0)
-        return -INFINITY;
+        return none;
     const hull_pt *S = w->stack;
     double g = h - C->c * d * d;
     int j = far;
     while (j > 0 && (S[j - 1].g - g) * (d - S[j].d) >= (S[j].g - g) * (d - S[j - 1].d))
         j--;
-    double s;
-    if (C->cap > 0 && d - S[j].d > C->cap)
-        s = capped_scan(w, n_raw, d, g, C->cap);
-    else
-        s = (S[j].g - g) / (d - S[j].d);
-    return (float)(s - 2.0 * C->c * d);
+    return (occluder){S[j].k, (float)(d - S[j].d)};
 }
 
-/* Mean of the slopes toward the lower line (weight F) and the upper line
- * (weight 1 - F). NaN = that line has no sample there; -inf = the line has
- * no occluder, in which case the other line decides. */
-static inline float combine(float lo, float hi, float F)
+/* Slope from cell (k, i) at height h to its own ray, dk steps back (at
+ * distance dd), where the ray crosses that column; -inf if the ray is off
+ * the grid there or touches nodata. */
+static inline float ray_slope(const sweep_ctx *C, int k, int i, float h, int dk, float dd)
 {
-    if (F == 0.0f || isnan(lo))
-        return hi;
-    if (isnan(hi))
-        return lo;
-    if (lo == -INFINITY)
-        return hi;
-    if (hi == -INFINITY)
-        return lo;
-    return F * lo + (1.0f - F) * hi;
+    const ts_line_geom *G = C->geom;
+    int kk = k - dk;
+    if (dk <= 0 || kk < 0 || dd <= 0.0f)
+        return -INFINITY;
+    double pv = -G->t * dk, o = floor(pv);
+    int r0 = i + (int)o;
+    float f = (float)(pv - o);
+    if (r0 < 0 || r0 > G->V - 1 || (f > 0.0f && r0 + 1 > G->V - 1))
+        return -INFINITY;
+    const float *z = C->grid->z + G->origin + (ptrdiff_t)kk * G->u_stride +
+                     (ptrdiff_t)r0 * G->v_stride;
+    float a = z[0], b = f > 0.0f ? z[G->v_stride] : a;
+    float hz = a + f * (b - a);
+    if (isnan(hz))
+        return -INFINITY;
+    return (hz - h) / dd - (float)C->c * dd;
+}
+
+/* Steps on either side of a line's occluder at which the cell's ray is
+ * also sampled. */
+#ifndef FAR_SPREAD
+#define FAR_SPREAD 0
+#endif
+
+/* Far field of cell (k, i): its own ray evaluated at and beside the
+ * occluders that the hulls of the two neighbouring lines found. Taking the
+ * maximum of each line's horizon and interpolating would overestimate (the
+ * maximum of a mean is at most the mean of the maxima); sampling the
+ * cell's ray where the lines see their occluders does not. */
+static float far_field(const sweep_ctx *C, int k, int i, float h, occluder lo, occluder hi,
+                       double step)
+{
+    float best = -INFINITY;
+    int beyond_cap = 0;
+    const occluder cand[2] = {lo, hi};
+    for (int c = 0; c < 2; c++) {
+        if (cand[c].k < 0 || (c == 1 && cand[1].k == cand[0].k))
+            continue;
+        int dk = k - cand[c].k;
+        beyond_cap |= C->cap > 0 && cand[c].dd > C->cap;
+        for (int e = -FAR_SPREAD; e <= FAR_SPREAD; e++) {
+            if (dk + e <= TS_NEAR_STEPS)
+                continue;
+            float s = ray_slope(C, k, i, h, dk + e, cand[c].dd + (float)(e * step));
+            best = s > best ? s : best;
+        }
+    }
+    if (!beyond_cap)
+        return best;
+    /* An occluder lies past the maximum distance: march the cell's ray over
+     * the far part of the radius instead, and never rise above the
+     * unbounded horizon (a smaller radius cannot raise it). */
+    const ts_line_geom *G = C->geom;
+    float win = ts_ray_exact(G, C->grid->z, k, i, h, TS_NEAR_EXACT, C->cap / step, step, C->c);
+    return win;
 }
 
 static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
 {
     const ts_line_geom *G = C->geom;
     const float *z = C->grid->z;
-    float *t = w->prev_lo;
+    occluder *t = w->prev_lo;
     w->prev_lo = w->cur_lo;
     w->cur_lo = t;
     int pk0 = w->prev_k0, pk1 = w->prev_k1;
@@ -168,9 +204,13 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
                    (S[n - 2].g - gs) * (d - S[n - 1].d) >= (S[n - 1].g - gs) * (d - S[n - 2].d))
                 n--;
             if (w->vs && n > 0) {
-                double s = (C->cap > 0 && d - S[n - 1].d > C->cap)
-                               ? capped_scan(w, w->raw_n, d, gs, C->cap)
-                               : (S[n - 1].g - gs) / (d - S[n - 1].d);
+                double s = -INFINITY;
+                if (C->cap > 0 && d - S[n - 1].d > C->cap) {
+                    for (int j = w->raw_n - 1; j >= 0 && d - w->raw[j].d <= C->cap; j--)
+                        s = fmax(s, (w->raw[j].g - gs) / (d - w->raw[j].d));
+                } else {
+                    s = (S[n - 1].g - gs) / (d - S[n - 1].d);
+                }
                 slope = (float)(s - 2.0 * c * d);
             }
             /* Hull points 0..far lie beyond the near field; pops only take
@@ -181,27 +221,28 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
                 far++;
             S[n].d = d;
             S[n].g = gs;
+            S[n].k = k;
             w->n = n + 1;
             if (C->cap > 0)
                 w->raw[w->raw_n++] = S[n];
             pushed = 1;
         }
-        int nr = w->raw_n - pushed;
         if (!pushed)
             while (far + 1 < w->n && d - w->stack[far + 1].d >= C->near_skip)
                 far++;
+        occluder none = {-1, 0.0f};
         if (write) {
-            float s_out;
-            if (isnan(hc)) {
-                s_out = NAN;
-            } else {
-                float hi = inside ? hull_query(C, w, far, nr, d, hc) : NAN;
-                float lo = (F > 0.0f && k >= pk0 && k <= pk1) ? w->prev_lo[k] : NAN;
-                s_out = combine(lo, hi, F); /* far field; near field later */
+            float s_out = NAN;
+            if (!isnan(hc)) {
+                occluder hi = inside ? hull_query(C, w, far, d, hc) : none;
+                occluder lo = (F > 0.0f && k >= pk0 && k <= pk1) ? w->prev_lo[k] : none;
+                int row = G->x_major ? i : G->u_start + k * G->u_step;
+                double step = G->step_row ? G->step_row[row] : G->step_m;
+                s_out = far_field(C, k, i, hc, lo, hi, step); /* near field later */
             }
             C->out[C->o_origin + (ptrdiff_t)k * C->o_u_stride + (ptrdiff_t)i * C->o_v_stride] = s_out;
         }
-        w->cur_lo[k] = (has_next && !isnan(hn)) ? hull_query(C, w, far, nr, d, hn) : NAN;
+        w->cur_lo[k] = (has_next && !isnan(hn)) ? hull_query(C, w, far, d, hn) : none;
         if (w->vs) {
             w->vx[nv] = G->x_major ? (float)(G->u_start + k * G->u_step) : (float)i + F;
             w->vy[nv] = G->x_major ? (float)i + F : (float)(G->u_start + k * G->u_step);
@@ -232,8 +273,8 @@ static int ws_init(sweep_ws *w, int U, int need_raw, int need_visit)
 {
     *w = (sweep_ws){0};
     w->stack = malloc((size_t)(U + 1) * sizeof *w->stack);
-    w->prev_lo = malloc((size_t)U * sizeof(float));
-    w->cur_lo = malloc((size_t)U * sizeof(float));
+    w->prev_lo = malloc((size_t)U * sizeof *w->prev_lo);
+    w->cur_lo = malloc((size_t)U * sizeof *w->cur_lo);
     w->prev_k0 = 1;
     w->prev_k1 = 0;
     if (need_raw)
@@ -281,7 +322,8 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
         const float *zrow = grid->z + y * grid->stride;
         float *orow = C->out + y * W;
         double step = G->step_row ? G->step_row[y] : G->step_m;
-        int interior = scratch && y >= m && y < H - m && W > 2 * m;
+        /* The vectorised pass has no distance cap. */
+        int interior = scratch && C->cap == 0 && y >= m && y < H - m && W > 2 * m;
         int xa = interior ? m : W, xb = interior ? W - m : W;
         if (interior)
             ts_near_row(&C->near, G, grid->z, zrow, (int)y, xa, xb, step, C->c, orow, scratch);
@@ -295,7 +337,7 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
             int u = G->x_major ? x : (int)y, v = G->x_major ? (int)y : x;
             int left;
             float nf = ts_near_field(&C->near, G, grid->z, (u - G->u_start) * G->u_step, v,
-                                     zrow[x], step, C->c, &left);
+                                     zrow[x], step, C->c, C->cap, &left);
             orow[x] = left ? nf : fmaxf(nf, orow[x]);
         }
         for (int x = 0; x < W; x++)

@@ -45,10 +45,18 @@ typedef struct {
 void ts_near_plan_init(ts_near_plan *p, const ts_line_geom *g);
 
 /* Largest horizon slope (with curvature term -c d) from cell (k, i) at
- * height h over the near field, step = metres per step; -inf if none.
- * *left is set when the ray leaves the grid inside the near field. */
+ * height h over the near field, step = metres per step, cap = the maximum
+ * distance in metres (0 = none); -inf if none. *left is set when the ray
+ * leaves the grid inside the near field. */
 float ts_near_field(const ts_near_plan *p, const ts_line_geom *g, const float *z, int k,
-                    int i, float h, double step, double c, int *left);
+                    int i, float h, double step, double c, double cap, int *left);
+
+/* Largest horizon slope from cell (k, i) at height h over its ray between
+ * s_from and s_to steps (exclusive, inclusive) on the exact bilinear
+ * surface, patch by patch: the brute force the near field is a table-driven
+ * case of. -inf if nothing there. */
+float ts_ray_exact(const ts_line_geom *g, const float *z, int k, int i, float h, double s_from,
+                   double s_to, double step, double c);
 
 /*
  * Near field of the interior cells x0 <= x < x1 of one grid row, all with

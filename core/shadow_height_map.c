@@ -38,10 +38,12 @@ static inline float shm_cell(const float *prev, int v, int V, int off, float F, 
                              float drop, int first)
 {
     float p = NAN;
-    if (!first) {
-        int a = v + off, b = a + 1;
-        float pa = (a >= 0 && a < V) ? prev[a] : NAN;
-        float pb = (F > 0.0f && b >= 0 && b < V) ? prev[b] : NAN;
+    int a = v + off, b = a + 1;
+    /* Off the grid toward the light there is nothing to cast a shadow. */
+    int off_grid = a < 0 || a >= V || (F > 0.0f && (b < 0 || b >= V));
+    if (!first && !off_grid) {
+        float pa = prev[a];
+        float pb = F > 0.0f ? prev[b] : NAN;
         if (F == 0.0f || isnan(pb))
             p = pa;
         else if (isnan(pa))

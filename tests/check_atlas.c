@@ -1,0 +1,479 @@
+/* Far shadows and the far-shadow atlas (core/shadow_atlas.h): the far-field
+ * horizon against brute force, binary maps, the tile dictionary + LZMA
+ * file round trip (lossless, any size, with nodata, 2- and 4-byte
+ * indices), damaged files, and a day's far-shadow atlas of jacksboro. */
+#include <check.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "day_cycle.h"
+#include "shadow_atlas.h"
+
+#ifndef TS_TEST_DATA
+#define TS_TEST_DATA "tests/data"
+#endif
+
+#define EXPECT_ARG(call, errp)                                                        \
+    do {                                                                              \
+        memset((errp), 0, sizeof *(errp));                                            \
+        ts_status st_ = (call);                                                       \
+        ck_assert_msg(st_ == TS_ERR_ARG, "%s returned %d, want TS_ERR_ARG", #call,    \
+                      (int)st_);                                                      \
+        ck_assert_msg((errp)->message[0] != '\0', "%s: no message", #call);           \
+        printf("%-58.58s -> %s\n", #call, (errp)->message);                           \
+    } while (0)
+
+static uint32_t rng_state = 12345;
+static uint32_t rnd(void)
+{
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 17;
+    rng_state ^= rng_state << 5;
+    return rng_state;
+}
+
+/* A raw test DEM (tests/data/make_raw.py). */
+static void load_raw(const char *name, ts_grid *g)
+{
+    char path[512];
+    ts_error err;
+    snprintf(path, sizeof path, "%s/%s.hdr", TS_TEST_DATA, name);
+    FILE *f = fopen(path, "r");
+    ck_assert_msg(f != NULL, "cannot open %s (run tests/data/make_raw.py)", path);
+    int w = 0, h = 0;
+    double cy = 0;
+    char key[64];
+    double *rows = NULL;
+    while (fscanf(f, "%63s", key) == 1) {
+        if (key[0] == '#') {
+            int c;
+            while ((c = fgetc(f)) != '\n' && c != EOF)
+                ;
+        } else if (!strcmp(key, "width")) {
+            ck_assert(fscanf(f, "%d", &w) == 1);
+        } else if (!strcmp(key, "height")) {
+            ck_assert(fscanf(f, "%d", &h) == 1);
+        } else if (!strcmp(key, "cell_y")) {
+            ck_assert(fscanf(f, "%lf", &cy) == 1);
+        } else if (!strcmp(key, "cell_x_row")) {
+            rows = malloc(h * sizeof *rows);
+            for (int i = 0; i < h; i++)
+                ck_assert(fscanf(f, "%lf", &rows[i]) == 1);
+        } else {
+            double dummy;
+            ck_assert(fscanf(f, "%lf", &dummy) == 1);
+        }
+    }
+    fclose(f);
+    ck_assert(w > 0 && h > 0 && cy > 0 && rows);
+    ck_assert(ts_grid_create(g, w, h, rows[h / 2], cy, &err) == TS_OK);
+    ck_assert(ts_grid_set_row_spacing(g, rows, &err) == TS_OK);
+    free(rows);
+    snprintf(path, sizeof path, "%s/%s.f32", TS_TEST_DATA, name);
+    f = fopen(path, "rb");
+    ck_assert_msg(f != NULL, "cannot open %s", path);
+    ck_assert(fread(g->z, sizeof(float), (size_t)w * h, f) == (size_t)w * h);
+    fclose(f);
+}
+
+/* Brute-force far horizon along a grid axis or diagonal (lines through
+ * cell centres): max over samples k steps away, k step >= T. */
+static double brute_far(const ts_grid *g, int x, int y, int dx, int dy, double step,
+                        double T, double c)
+{
+    double best = -INFINITY;
+    float z0 = ts_grid_at(g, x, y);
+    for (int k = 1;; k++) {
+        int xx = x + k * dx, yy = y + k * dy;
+        if (xx < 0 || yy < 0 || xx >= g->width || yy >= g->height)
+            break;
+        double d = k * step;
+        float z = ts_grid_at(g, xx, yy);
+        if (d < T || isnan(z))
+            continue;
+        double s = (z - z0 - c * d * d) / d;
+        if (s > best)
+            best = s;
+    }
+    return best == -INFINITY ? -90.0 : atan(best) * 180.0 / M_PI;
+}
+
+static void random_dem(ts_grid *g, int w, int h, double cell)
+{
+    ts_error err;
+    ck_assert(ts_grid_create(g, w, h, cell, cell, &err) == TS_OK);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            g->z[y * w + x] = (float)(300.0 * sin(x * 0.21) * cos(y * 0.17) +
+                                      (rnd() % 1000) * 0.2);
+}
+
+START_TEST(test_far_horizon_brute_force)
+{
+    ts_error err;
+    ts_grid g;
+    random_dem(&g, 97, 83, 25.0);
+    g.z[40 * 97 + 40] = NAN; /* nodata: no occluder, NaN out */
+    float *out = malloc(97 * 83 * sizeof *out);
+    ts_horizon_opts o;
+    ts_horizon_opts_default(&o);
+    struct {
+        double az;
+        int dx, dy;
+    } dirs[] = {{90, 1, 0}, {270, -1, 0}, {0, 0, -1}, {180, 0, 1},
+                {45, 1, -1}, {225, -1, 1}, {135, 1, 1}, {315, -1, -1}};
+    double worst = 0;
+    for (int curv = 0; curv < 2; curv++) {
+        o.curvature = curv;
+        double c = curv ? (1 - o.refraction) / (2 * TS_EARTH_RADIUS) : 0;
+        for (size_t k = 0; k < sizeof dirs / sizeof dirs[0]; k++)
+            for (int ti = 0; ti < 3; ti++) {
+                double T = (double[]){10.0, 400.0, 1500.0}[ti];
+                o.threads = 1 + (int)(k % 3);
+                ck_assert(ts_far_horizon(&g, dirs[k].az, T, &o, out, &err) == TS_OK);
+                double step = (dirs[k].dx && dirs[k].dy) ? hypot(25.0, 25.0) : 25.0;
+                for (int y = 0; y < 83; y++)
+                    for (int x = 0; x < 97; x++) {
+                        float got = out[y * 97 + x];
+                        if (isnan(g.z[y * 97 + x])) {
+                            ck_assert(isnan(got));
+                            continue;
+                        }
+                        double want = brute_far(&g, x, y, dirs[k].dx, dirs[k].dy, step, T, c);
+                        double e = fabs(got - want);
+                        if (e > worst)
+                            worst = e;
+                        ck_assert_msg(e < 1e-3, "az %g T %g (%d,%d): got %g want %g",
+                                      dirs[k].az, T, x, y, got, want);
+                    }
+            }
+    }
+    printf("far horizon vs brute force on axes and diagonals: max |diff| %.2g deg\n", worst);
+    free(out);
+    ts_grid_free(&g);
+}
+END_TEST
+
+/* Any azimuth: a far threshold beyond the grid leaves no occluder; the far
+ * horizon never rises much above the full horizon, and where the far part
+ * dominates the two agree. */
+START_TEST(test_far_horizon_against_full)
+{
+    ts_error err;
+    ts_grid g;
+    load_raw("jacksboro", &g);
+    size_t n = (size_t)g.width * g.height;
+    float *far = malloc(n * sizeof *far), *full = malloc(n * sizeof *full);
+    ts_horizon_opts o;
+    ts_horizon_opts_default(&o);
+    ck_assert(ts_far_horizon(&g, 123.4, 1e7, &o, far, &err) == TS_OK);
+    for (size_t i = 0; i < n; i++)
+        ck_assert(far[i] == -90.0f);
+    const double azs[] = {17.5, 123.4, 260.0};
+    for (int a = 0; a < 3; a++) {
+        ck_assert(ts_far_horizon(&g, azs[a], 20 * 74.4, &o, far, &err) == TS_OK);
+        ck_assert(ts_horizon_sweep(&g, azs[a], &o, full, &err) == TS_OK);
+        size_t above = 0, dom = 0, agree = 0;
+        for (size_t i = 0; i < n; i++) {
+            if (far[i] > full[i] + 0.25f)
+                above++;
+            if (far[i] > 1.0f && far[i] > full[i] - 0.25f) {
+                dom++;
+                agree += fabsf(far[i] - full[i]) < 0.25f;
+            }
+        }
+        printf("az %.1f, T = 20 cells: far above full by > 0.25 deg in %zu of %zu cells; "
+               "where far dominates, %zu of %zu within 0.25 deg\n",
+               azs[a], above, n, agree, dom);
+        ck_assert(above < n / 200);
+        ck_assert(agree >= dom * 95 / 100);
+    }
+    free(far);
+    free(full);
+    ts_grid_free(&g);
+}
+END_TEST
+
+START_TEST(test_far_shadow_bits)
+{
+    ts_error err;
+    ts_grid g;
+    ck_assert(ts_grid_create(&g, 64, 8, 10.0, 10.0, &err) == TS_OK);
+    for (int i = 0; i < 64 * 8; i++)
+        g.z[i] = 0;
+    for (int y = 0; y < 8; y++)
+        g.z[y * 64 + 60] = 100.0f; /* a wall to the east */
+    g.z[3 * 64 + 5] = NAN;
+    ts_horizon_opts o;
+    ts_horizon_opts_default(&o);
+    o.curvature = 0;
+    uint8_t bits[64 * 8];
+    /* sun due east at 10 deg: the wall (100 m) shades up to 567 m west of
+     * it; with a threshold of 200 m only cells at least 200 m away count */
+    ck_assert(ts_far_shadow(&g, 90.0, 10.0, 200.0, &o, bits, &err) == TS_OK);
+    for (int x = 0; x < 64; x++) {
+        double d = (60 - x) * 10.0;
+        int want = d >= 200.0 && 100.0 / d > tan(10 * M_PI / 180) ? 1 : 0;
+        ck_assert_msg(bits[64 + x] == want, "x %d: got %d want %d", x, bits[64 + x], want);
+    }
+    ck_assert(bits[3 * 64 + 5] == TS_ATLAS_NODATA);
+    EXPECT_ARG(ts_far_shadow(&g, 90.0, 10.0, 0.0, &o, bits, &err), &err);
+    EXPECT_ARG(ts_far_shadow(&g, 90.0, 95.0, 100.0, &o, bits, &err), &err);
+    o.max_distance = 1000;
+    EXPECT_ARG(ts_far_shadow(&g, 90.0, 10.0, 100.0, &o, bits, &err), &err);
+    ts_grid_free(&g);
+}
+END_TEST
+
+/* ----------------------------------------------------------- the file */
+
+/* Write `steps` planes, read them back whole and by windows. */
+static void round_trip(int W, int H, int steps, int nodata, int noise, size_t *file_size,
+                       int *index_bytes)
+{
+    ts_error err;
+    size_t n = (size_t)W * H;
+    uint8_t *planes = malloc(n * steps), *back = malloc(n);
+    for (int s = 0; s < steps; s++)
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                uint8_t v;
+                if (nodata && (x * 7 + y * 3) % 11 == 0)
+                    v = TS_ATLAS_NODATA;
+                else if (noise)
+                    v = rnd() & 1;
+                else /* a shadow front moving with the step */
+                    v = x + y / 2 < (W * (s + 1)) / (steps + 1) ? 1 : 0;
+                planes[s * n + (size_t)y * W + x] = v;
+            }
+    ts_atlas_writer *w;
+    ck_assert(ts_atlas_writer_new(W, H, &w, &err) == TS_OK);
+    for (int s = 0; s < steps; s++) {
+        ts_atlas_step rec = {1.75e9 + 600.0 * s, 90.0 + s, 92.5 + s, 5.0 + s, -300};
+        ck_assert_msg(ts_atlas_writer_add(w, planes + s * n, W, &rec, &err) == TS_OK, "%s",
+                      err.message);
+    }
+    ts_atlas_info info;
+    memset(&info, 0, sizeof info);
+    info.threshold_cells = 512;
+    info.threshold_m = 512 * 30.0;
+    info.has_geotransform = 1;
+    double gt[6] = {500000, 30, 0, 4100000, 0, -30};
+    memcpy(info.geotransform, gt, sizeof gt);
+    info.metadata = "PRODUCT=farshadow\nDATE=2026-06-21\n";
+    uint8_t *file;
+    size_t size;
+    ck_assert(ts_atlas_writer_finish(w, &info, &file, &size, &err) == TS_OK);
+    ts_atlas_writer_free(w);
+    ck_assert(ts_atlas_identify(file, size));
+    ts_atlas *a;
+    ck_assert_msg(ts_atlas_open(file, size, &a, &err) == TS_OK, "%s", err.message);
+    free(file);
+    const ts_atlas_info *ai = ts_atlas_get_info(a);
+    ck_assert(ai->width == W && ai->height == H && ai->steps == steps);
+    ck_assert(ai->threshold_cells == 512 && ai->threshold_m == 512 * 30.0);
+    ck_assert(ai->has_geotransform && memcmp(ai->geotransform, gt, sizeof gt) == 0);
+    ck_assert(ai->has_nodata == nodata);
+    ck_assert_str_eq(ai->metadata, "PRODUCT=farshadow\nDATE=2026-06-21\n");
+    for (int s = 0; s < steps; s++) {
+        const ts_atlas_step *r = ts_atlas_get_step(a, s);
+        ck_assert(r->unix_time == 1.75e9 + 600.0 * s && r->azimuth == 90.0 + s &&
+                  r->grid_azimuth == 92.5 + s && r->elevation == 5.0 + s &&
+                  r->utc_offset_minutes == -300);
+        memset(back, 7, n);
+        ck_assert(ts_atlas_read(a, s, 0, 0, W, H, back, W, &err) == TS_OK);
+        ck_assert_msg(memcmp(back, planes + s * n, n) == 0, "map %d differs", s);
+        /* odd windows */
+        for (int k = 0; k < 5; k++) {
+            int x0 = rnd() % W, y0 = rnd() % H;
+            int ww = 1 + rnd() % (W - x0), hh = 1 + rnd() % (H - y0);
+            uint8_t *win = malloc((size_t)ww * hh);
+            ck_assert(ts_atlas_read(a, s, x0, y0, ww, hh, win, ww, &err) == TS_OK);
+            for (int y = 0; y < hh; y++)
+                ck_assert(memcmp(win + (size_t)y * ww,
+                                 planes + s * n + (size_t)(y0 + y) * W + x0, ww) == 0);
+            free(win);
+        }
+    }
+    ck_assert(ts_atlas_get_step(a, steps) == NULL);
+    EXPECT_ARG(ts_atlas_read(a, steps, 0, 0, 1, 1, back, 1, &err), &err);
+    EXPECT_ARG(ts_atlas_read(a, 0, W - 1, 0, 2, 1, back, 2, &err), &err);
+    *file_size = ai->file_bytes;
+    *index_bytes = ai->index_bytes;
+    ts_atlas_free(a);
+    free(planes);
+    free(back);
+}
+
+START_TEST(test_round_trip)
+{
+    size_t size;
+    int ib;
+    const int sizes[][2] = {{1, 1}, {8, 8}, {9, 7}, {37, 29}, {130, 70}, {256, 3}};
+    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++)
+        for (int nd = 0; nd < 2; nd++)
+            for (int noise = 0; noise < 2; noise++) {
+                round_trip(sizes[i][0], sizes[i][1], 5, nd, noise, &size, &ib);
+                ck_assert_int_eq(ib, 2);
+            }
+    round_trip(200, 160, 40, 0, 0, &size, &ib);
+    printf("moving front, 200 x 160, 40 maps: %zu bytes = %.3f bits per cell\n", size,
+           size * 8.0 / (200 * 160));
+    /* noise: more than 65536 distinct tiles, so 4-byte indices */
+    round_trip(1024, 1024, 5, 1, 1, &size, &ib);
+    ck_assert_int_eq(ib, 4);
+    printf("noise, 1024 x 1024, 5 maps: %d-byte indices, %zu bytes\n", ib, size);
+}
+END_TEST
+
+START_TEST(test_bad_maps_and_files)
+{
+    ts_error err;
+    ts_atlas_writer *w;
+    uint8_t plane[16 * 16], other[16 * 16];
+    memset(plane, 0, sizeof plane);
+    ck_assert(ts_atlas_writer_new(16, 16, &w, &err) == TS_OK);
+    ts_atlas_info info;
+    memset(&info, 0, sizeof info);
+    uint8_t *file;
+    size_t size;
+    EXPECT_ARG(ts_atlas_writer_finish(w, &info, &file, &size, &err), &err); /* no map */
+    plane[17] = 2;
+    EXPECT_ARG(ts_atlas_writer_add(w, plane, 16, NULL, &err), &err);
+    ck_assert(strstr(err.message, "binary"));
+    plane[17] = TS_ATLAS_NODATA;
+    ck_assert(ts_atlas_writer_add(w, plane, 16, NULL, &err) == TS_OK);
+    memcpy(other, plane, sizeof other);
+    other[17] = 1;
+    EXPECT_ARG(ts_atlas_writer_add(w, other, 16, NULL, &err), &err);
+    ck_assert(strstr(err.message, "nodata"));
+    ck_assert(ts_atlas_writer_finish(w, &info, &file, &size, &err) == TS_OK);
+    ts_atlas_writer_free(w);
+    EXPECT_ARG(ts_atlas_writer_new(0, 5, &w, &err), &err);
+
+    ts_atlas *a;
+    /* truncated anywhere */
+    for (size_t cut = 0; cut < size; cut += 1 + cut / 3) {
+        ts_status st = ts_atlas_open(file, cut, &a, &err);
+        ck_assert_msg(st == TS_ERR_ARG, "truncated at %zu: status %d", cut, (int)st);
+    }
+    /* one flipped bit anywhere */
+    int caught = 0, total = 0;
+    for (size_t i = 0; i < size; i++) {
+        uint8_t *copy = malloc(size);
+        memcpy(copy, file, size);
+        copy[i] ^= 0x10;
+        ts_status st = ts_atlas_open(copy, size, &a, &err);
+        if (st == TS_OK) {
+            /* a flip in a step record or the metadata text is not checked;
+             * reading must still be safe */
+            uint8_t out[256];
+            ck_assert(ts_atlas_read(a, 0, 0, 0, 16, 16, out, 16, &err) == TS_OK);
+            ts_atlas_free(a);
+        } else {
+            ck_assert(st == TS_ERR_ARG);
+            caught++;
+        }
+        total++;
+        free(copy);
+    }
+    printf("damaged atlas (%zu bytes): %d of %d single-bit flips refused (the rest lie in "
+           "the step records and metadata text)\n", size, caught, total);
+    ck_assert(caught >= total - TS_ATLAS_STEP_SIZE);
+    /* not an atlas */
+    EXPECT_ARG(ts_atlas_open((const uint8_t *)"GIF89a..........", 16, &a, &err), &err);
+    ck_assert(!ts_atlas_identify((const uint8_t *)"\x89PNG", 4));
+    /* a future version */
+    file[8] = 2;
+    EXPECT_ARG(ts_atlas_open(file, size, &a, &err), &err);
+    ck_assert(strstr(err.message, "version 2"));
+    free(file);
+}
+END_TEST
+
+/* A day of far shadows over jacksboro: far threshold 24 cells so that
+ * the small DEM has some; written, read back identical; bits per cell. */
+START_TEST(test_jacksboro_day)
+{
+    ts_error err;
+    ts_grid g;
+    load_raw("jacksboro", &g);
+    size_t n = (size_t)g.width * g.height;
+    double lon = -84.245, lat = 36.589, north = 0;
+    ts_sun_sites s = {1, 1, 0, 0, 0, 0, &lon, &lat, &north};
+    ts_day_opts o;
+    ts_day_opts_default(&o);
+    double start = ts_local_midnight(2026, 12, 21, -300);
+    enum { STEPS = 24 };
+    double t[STEPS];
+    int steps;
+    ck_assert(ts_day_atlas_times(&s, &o, start, 86400, STEPS, t, &steps, &err) == TS_OK);
+    ck_assert_int_eq(steps, STEPS);
+    double T = 24 * 74.4;
+    uint8_t *maps = malloc(n * STEPS), *back = malloc(n);
+    ts_atlas_writer *w;
+    ck_assert(ts_atlas_writer_new(g.width, g.height, &w, &err) == TS_OK);
+    size_t shadowed = 0;
+    for (int k = 0; k < STEPS; k++) {
+        ts_sun_sample sun;
+        ck_assert(ts_sun_at_site(&s, &o, t[k], &sun, &err) == TS_OK);
+        ck_assert(ts_far_shadow(&g, sun.grid_azimuth, sun.elevation, T, &o.horizon,
+                                maps + k * n, &err) == TS_OK);
+        for (size_t i = 0; i < n; i++)
+            shadowed += maps[k * n + i] == 1;
+        ts_atlas_step rec = {t[k], sun.azimuth, sun.grid_azimuth, sun.elevation, -300};
+        ck_assert(ts_atlas_writer_add(w, maps + k * n, g.width, &rec, &err) == TS_OK);
+    }
+    uint8_t *file;
+    size_t size;
+    ts_atlas_info info;
+    memset(&info, 0, sizeof info);
+    ck_assert(ts_atlas_writer_finish(w, &info, &file, &size, &err) == TS_OK);
+    ts_atlas_writer_free(w);
+    ts_atlas *a;
+    ck_assert(ts_atlas_open(file, size, &a, &err) == TS_OK);
+    for (int k = 0; k < STEPS; k++) {
+        ck_assert(ts_atlas_read(a, k, 0, 0, g.width, g.height, back, g.width, &err) == TS_OK);
+        ck_assert(memcmp(back, maps + k * n, n) == 0);
+    }
+    printf("jacksboro 2026-12-21, far threshold 24 cells, %d maps: %.1f%% of cell-maps in "
+           "far shadow, %u distinct tiles, %zu bytes = %.4f bits per cell per day\n",
+           STEPS, 100.0 * shadowed / (n * STEPS), ts_atlas_get_info(a)->dictionary_tiles,
+           size, size * 8.0 / n);
+    ck_assert(shadowed > 0);
+    ck_assert(size * 8.0 / n < 3.0);
+    ts_atlas_free(a);
+    free(file);
+    free(maps);
+    free(back);
+    ts_grid_free(&g);
+}
+END_TEST
+
+static Suite *suite(void)
+{
+    Suite *s = suite_create("atlas");
+    TCase *tc = tcase_create("core");
+    tcase_set_timeout(tc, 60);
+    tcase_add_test(tc, test_far_horizon_brute_force);
+    tcase_add_test(tc, test_far_horizon_against_full);
+    tcase_add_test(tc, test_far_shadow_bits);
+    tcase_add_test(tc, test_round_trip);
+    tcase_add_test(tc, test_bad_maps_and_files);
+    tcase_add_test(tc, test_jacksboro_day);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    setvbuf(stdout, NULL, _IOLBF, 0);
+    SRunner *sr = srunner_create(suite());
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}

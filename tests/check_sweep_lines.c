@@ -1,0 +1,250 @@
+/* The convex-hull sweep against an O(n^2) brute force along its own sample
+ * lines: same samples, so the slopes must agree to float precision. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "oracle.h"
+#include "terrashade.h"
+#include "test_dem.h"
+
+static const double DEG = 3.14159265358979323846 / 180.0;
+static const double AZ[] = {0, 33.7, 45, 90, 137, 180, 222.2, 300};
+#define N_AZ ((int)(sizeof AZ / sizeof AZ[0]))
+
+typedef struct {
+    const ts_grid *g;
+    double azimuth, c, max_distance;
+    long lines, samples, occluded, bad_slope, bad_geometry, bad_height;
+    char first[256]; /* the first failure, for the message */
+} lines_ctx;
+
+static void record(lines_ctx *u, long *counter, const char *what, int i,
+                 double got, double want)
+{
+    if (u->bad_slope + u->bad_geometry + u->bad_height == 0)
+        snprintf(u->first, sizeof u->first,
+                 "line %ld sample %d: %s: got %.9g, want %.9g", u->lines, i,
+                 what, got, want);
+    (*counter)++;
+}
+
+/* Brute force horizon slope of sample i over all valid j < i. */
+static double brute_slope(const lines_ctx *u, int i, const float *h,
+                          const double *d)
+{
+    double best = -INFINITY;
+    for (int j = 0; j < i; j++) {
+        double dd = d[i] - d[j];
+        if (isnan(h[j]) || (u->max_distance > 0 && dd > u->max_distance))
+            continue;
+        double s = ((double)h[j] - (double)h[i] - u->c * dd * dd) / dd;
+        if (s > best)
+            best = s;
+    }
+    return best;
+}
+
+/* A sample on a grid line: its height must be the linear interpolation of
+ * its two cells; NaN only if a cell it really uses (weight above 1e-4, the
+ * float precision of the position) is nodata. */
+static void check_height(lines_ctx *u, int i, float x, float y, float h)
+{
+    const ts_grid *g = u->g;
+    if (!(fabs(x - rint(x)) < 1e-4 || fabs(y - rint(y)) < 1e-4))
+        return; /* not on a line: nothing to compare with */
+    if (x < -1e-4 || y < -1e-4 || x > g->width - 1 + 1e-4 || y > g->height - 1 + 1e-4)
+        return;
+    double xc = fmin(fmax(x, 0), g->width - 1), yc = fmin(fmax(y, 0), g->height - 1);
+    int x0 = (int)floor(xc), y0 = (int)floor(yc);
+    double fx = xc - x0, fy = yc - y0, lo = INFINITY, hi = -INFINITY;
+    int used_nodata = 0, any_nodata = 0;
+    for (int dy = 0; dy <= 1; dy++)
+        for (int dx = 0; dx <= 1; dx++) {
+            int xx = x0 + dx < g->width ? x0 + dx : x0;
+            int yy = y0 + dy < g->height ? y0 + dy : y0;
+            double w = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy);
+            double c = ts_grid_at(g, xx, yy);
+            any_nodata |= isnan(c);
+            used_nodata |= isnan(c) && w > 1e-4;
+            lo = fmin(lo, c), hi = fmax(hi, c);
+        }
+    if (isnan(h)) {
+        /* on the border itself the position's float rounding decides */
+        int border = xc < 1e-4 || yc < 1e-4 || xc > g->width - 1 - 1e-4 ||
+                     yc > g->height - 1 - 1e-4;
+        if (!used_nodata && !border)
+            record(u, &u->bad_height, "sample on valid cells reported as nodata", i, x, y);
+        return;
+    }
+    if (any_nodata)
+        return; /* renormalised or not: a policy, see test_stats.h */
+    /* x, y come as floats: 1e-5 cell of position is worth that fraction of
+     * the height step between the corners */
+    double want = oracle_bilinear(g, x, y);
+    if (fabs(h - want) > 1e-4 * (1 + fabs(want)) + 2e-5 * (hi - lo))
+        record(u, &u->bad_height, "sample height", i, h, want);
+}
+
+static void visit(void *user, int n, const float *x, const float *y,
+                  const float *h, const double *d, const float *slope)
+{
+    lines_ctx *u = user;
+    const ts_grid *g = u->g;
+    double ex = -sin(u->azimuth * DEG), ey = cos(u->azimuth * DEG); /* east, south */
+    for (int i = 0; i < n; i++) {
+        /* geometry: moving away from the azimuth, in metres; a sample past
+         * the last row or column is allowed only as a skipped one (NaN) */
+        if (!(x[i] >= -1e-4 && x[i] <= g->width - 1 + 1e-4 && y[i] >= -1e-4 &&
+              y[i] <= g->height - 1 + 1e-4) && !isnan(h[i]))
+            record(u, &u->bad_geometry, "valid sample outside the grid", i, x[i], y[i]);
+        if (i > 0) {
+            double dd = d[i] - d[i - 1];
+            double vx = (x[i] - x[i - 1]) * oracle_cell_x(g, 0.5 * (y[i] + y[i - 1]));
+            double vy = (y[i] - y[i - 1]) * g->cell_y;
+            double len = hypot(vx, vy);
+            if (!(dd > 0))
+                record(u, &u->bad_geometry, "distance not increasing", i, d[i], d[i - 1]);
+            else if (fabs(len - dd) > 1e-3 * dd + 1e-3 * g->cell_y)
+                record(u, &u->bad_geometry, "distance step != metres moved", i, dd, len);
+            else if (len > 0.5 * g->cell_y && (vx * ex + vy * ey) / len < 0.9999)
+                record(u, &u->bad_geometry, "step direction . (-sin az, cos az)", i,
+                     (vx * ex + vy * ey) / len, 1.0);
+        }
+        check_height(u, i, x[i], y[i], h[i]);
+        /* the point of the test: hull slope == brute-force slope */
+        if (isnan(h[i]))
+            continue;
+        double want = brute_slope(u, i, h, d);
+        double got = slope[i];
+        if (want == -INFINITY) {
+            if (got != -INFINITY)
+                record(u, &u->bad_slope, "slope without occluder", i, got, want);
+        } else {
+            u->occluded++;
+            if (!(fabs(got - want) <= 1e-5 * (1 + fabs(want))))
+                record(u, &u->bad_slope, "slope", i, got, want);
+        }
+    }
+    u->lines++;
+    u->samples += n;
+}
+
+static void check_lines(const char *label, const ts_grid *g, int curvature,
+                        double k, double max_distance)
+{
+    for (int a = 0; a < N_AZ; a++) {
+        ts_horizon_opts o;
+        ts_horizon_opts_default(&o);
+        o.curvature = curvature;
+        o.refraction = k;
+        o.max_distance = max_distance;
+        lines_ctx u = {g, AZ[a], curvature ? (1 - k) / (2 * TS_EARTH_RADIUS) : 0,
+                       max_distance, 0, 0, 0, 0, 0, 0, ""};
+        ts_error err;
+        ck_assert_msg(ts_horizon_sweep_lines(g, AZ[a], &o, visit, &u, &err) == TS_OK,
+                      "%s az %g: %s", label, AZ[a], err.message);
+        printf("%-36s az %6.1f: %ld lines, %ld samples (%ld occluded); bad slope "
+               "%ld, geometry %ld, height %ld\n", label, AZ[a], u.lines,
+               u.samples, u.occluded, u.bad_slope, u.bad_geometry, u.bad_height);
+        fflush(stdout);
+        ck_assert_msg(u.lines > 0 && u.occluded > 0, "%s az %g: no lines", label, AZ[a]);
+        ck_assert_msg(u.bad_slope + u.bad_geometry + u.bad_height == 0,
+                      "%s az %g: %ld slope, %ld geometry, %ld height errors; first: %s",
+                      label, AZ[a], u.bad_slope, u.bad_geometry, u.bad_height,
+                      u.first);
+    }
+}
+
+START_TEST(test_sharp_flat_earth)
+{
+    ts_grid g;
+    tdem_create(&g, 120, 90, 10.0, 10.0);
+    tdem_sharp(&g, 1);
+    check_lines("sharp 120x90 10m, no curvature", &g, 0, 0.13, 0);
+    ts_grid_free(&g);
+}
+END_TEST
+
+START_TEST(test_sharp_curved)
+{
+    /* 100 m cells: at 10 km the curvature drop is ~7 m, well above 1e-5 */
+    ts_grid g;
+    tdem_create(&g, 120, 90, 100.0, 80.0);
+    tdem_sharp(&g, 2);
+    check_lines("sharp 120x90 100x80m, k=0.13", &g, 1, TS_DEFAULT_REFRACTION, 0);
+    check_lines("sharp 120x90 100x80m, k=0.5", &g, 1, 0.5, 0);
+    ts_grid_free(&g);
+}
+END_TEST
+
+START_TEST(test_sharp_max_distance)
+{
+    /* 303.7 m: not a multiple of the cell, so no sample sits on the cut */
+    ts_grid g;
+    tdem_create(&g, 120, 90, 10.0, 10.0);
+    tdem_sharp(&g, 3);
+    check_lines("sharp, max_distance 303.7 m", &g, 0, 0.13, 303.7);
+    ts_grid_free(&g);
+    tdem_create(&g, 120, 90, 100.0, 100.0);
+    tdem_sharp(&g, 4);
+    check_lines("sharp 100m, curved, max_distance 2537", &g, 1, 0.13, 2537.0);
+    ts_grid_free(&g);
+}
+END_TEST
+
+START_TEST(test_nodata_skipped)
+{
+    /* NaN blocks: skipped samples, never occluders */
+    ts_grid g;
+    tdem_create(&g, 100, 80, 10.0, 10.0);
+    tdem_sharp(&g, 5);
+    for (int y = 20; y < 50; y++)
+        for (int x = 30; x < 45; x++)
+            g.z[y * g.stride + x] = NAN;
+    for (int x = 0; x < 100; x += 7)
+        g.z[60 * g.stride + x] = NAN;
+    check_lines("sharp with nodata", &g, 0, 0.13, 0);
+    ts_grid_free(&g);
+}
+END_TEST
+
+START_TEST(test_jacksboro_rows)
+{
+    /* per-row spacing; a 160x140 window keeps the O(n^2) brute force fast */
+    ts_grid full, g;
+    tdem_load(&full, "jacksboro");
+    tdem_create(&g, 160, 140, full.cell_x, full.cell_y);
+    double cx[140];
+    for (int y = 0; y < 140; y++) {
+        cx[y] = full.cell_x_row[y + 100];
+        for (int x = 0; x < 160; x++)
+            g.z[y * g.stride + x] = ts_grid_at(&full, x + 120, y + 100);
+    }
+    ts_error err;
+    ck_assert(ts_grid_set_row_spacing(&g, cx, &err) == TS_OK);
+    check_lines("jacksboro window, curved", &g, 1, TS_DEFAULT_REFRACTION, 0);
+    ts_grid_free(&g);
+    ts_grid_free(&full);
+}
+END_TEST
+
+int main(void)
+{
+    setvbuf(stdout, NULL, _IOLBF, 0); /* lines reach the log before a failure exits */
+    Suite *s = suite_create("sweep_lines");
+    TCase *tc = tcase_create("hull_vs_brute_force");
+    tcase_set_timeout(tc, 300);
+    tcase_add_test(tc, test_sharp_flat_earth);
+    tcase_add_test(tc, test_sharp_curved);
+    tcase_add_test(tc, test_sharp_max_distance);
+    tcase_add_test(tc, test_nodata_skipped);
+    tcase_add_test(tc, test_jacksboro_rows);
+    suite_add_tcase(s, tc);
+    SRunner *sr = srunner_create(s);
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
