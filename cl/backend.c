@@ -1,0 +1,205 @@
+/*
+ * Backend dispatcher: run a product on OpenCL or C, fall back to C on any
+ * OpenCL failure, and report what ran. See terrashade_backend.h.
+ */
+#ifdef HAVE_CONFIG_H
+#include <config.h>
+#endif
+
+#include <ctype.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "status_internal.h"
+#include "terrashade_backend.h"
+#include "terrashade_cl.h"
+
+const char *ts_backend_name(ts_backend backend)
+{
+    switch (backend) {
+    case TS_BACKEND_AUTO: return "auto";
+    case TS_BACKEND_C: return "c";
+    case TS_BACKEND_OPENCL: return "opencl";
+    }
+    return "unknown";
+}
+
+ts_status ts_backend_parse(const char *text, ts_backend *backend, ts_error *err)
+{
+    if (!text || !backend)
+        return ts_fail(err, TS_ERR_ARG, "backend name or result is NULL");
+    char buf[16];
+    size_t n = 0;
+    while (isspace((unsigned char)*text))
+        text++;
+    while (text[n] && !isspace((unsigned char)text[n]) && n < sizeof buf - 1) {
+        buf[n] = text[n];
+        n++;
+    }
+    buf[n] = '\0';
+    if (!strcasecmp(buf, "auto") || !buf[0])
+        *backend = TS_BACKEND_AUTO;
+    else if (!strcasecmp(buf, "c"))
+        *backend = TS_BACKEND_C;
+    else if (!strcasecmp(buf, "opencl"))
+        *backend = TS_BACKEND_OPENCL;
+    else
+        return ts_fail(err, TS_ERR_ARG, "backend must be auto, c or opencl, got '%.40s'", text);
+    return ts_ok(err);
+}
+
+/* The backend to run: an explicit argument, else TERRASHADE_BACKEND. */
+static ts_status resolve(ts_backend requested, ts_backend *eff, ts_error *err)
+{
+    if (requested != TS_BACKEND_AUTO && requested != TS_BACKEND_C &&
+        requested != TS_BACKEND_OPENCL)
+        return ts_fail(err, TS_ERR_ARG, "unknown backend %d", (int)requested);
+    *eff = requested;
+    if (requested != TS_BACKEND_AUTO)
+        return TS_OK;
+    const char *env = getenv("TERRASHADE_BACKEND");
+    if (!env || !*env)
+        return TS_OK;
+    ts_error e;
+    if (ts_backend_parse(env, eff, &e) != TS_OK)
+        return ts_fail(err, TS_ERR_ARG, "TERRASHADE_BACKEND must be auto, c or opencl, got '%.40s'",
+                       env);
+    return TS_OK;
+}
+
+static void report_c(ts_backend_report *r)
+{
+    r->used = TS_BACKEND_C;
+    snprintf(r->backend, sizeof r->backend, "c");
+    snprintf(r->device, sizeof r->device, "CPU, %d cores", ts_cpu_count());
+}
+
+/* Whether to try OpenCL for backend `eff`; fills the report either way. */
+static int want_opencl(ts_backend eff, ts_backend_report *r)
+{
+    memset(r, 0, sizeof *r);
+    r->requested = eff;
+    report_c(r);
+    if (eff == TS_BACKEND_C) {
+        snprintf(r->reason, sizeof r->reason, "the C backend was requested");
+        return 0;
+    }
+    ts_cl_info info;
+    ts_error e;
+    if (ts_cl_available(&info, &e) != TS_OK) {
+        r->fell_back = 1;
+        snprintf(r->reason, sizeof r->reason, "%s", e.message);
+        return 0;
+    }
+    const char *dev = getenv("TERRASHADE_OPENCL_DEVICE");
+    int named = dev && *dev;
+    if (eff == TS_BACKEND_AUTO && !named && !strcmp(info.type, "CPU")) {
+        snprintf(r->reason, sizeof r->reason,
+                 "auto: the OpenCL device (%.60s) is a CPU, where the C backend is faster; "
+                 "TERRASHADE_BACKEND=opencl uses it anyway",
+                 info.device);
+        return 0;
+    }
+    r->used = TS_BACKEND_OPENCL;
+    snprintf(r->backend, sizeof r->backend, "opencl");
+    snprintf(r->device, sizeof r->device, "%.100s (%.80s)", info.device, info.platform);
+    return 1;
+}
+
+/* After an OpenCL attempt: success, or note the fallback. */
+static int cl_done(ts_status st, const ts_error *e, ts_backend_report *r)
+{
+    if (st == TS_OK)
+        return 1;
+    r->fell_back = 1;
+    snprintf(r->reason, sizeof r->reason, "%s", e->message);
+    report_c(r);
+    return 0;
+}
+
+ts_status ts_backend_choose(ts_backend requested, ts_backend_report *report, ts_error *err)
+{
+    ts_backend eff;
+    ts_backend_report tmp;
+    ts_backend_report *r = report ? report : &tmp;
+    ts_status st = resolve(requested, &eff, err);
+    if (st != TS_OK)
+        return st;
+    want_opencl(eff, r);
+    return ts_ok(err);
+}
+
+/* The common shape of every product: resolve, try OpenCL, else C. */
+#define DISPATCH(CL_CALL, C_CALL)                                                             \
+    do {                                                                                       \
+        ts_backend eff;                                                                        \
+        ts_backend_report tmp;                                                                 \
+        ts_backend_report *r = report ? report : &tmp;                                        \
+        ts_status st = resolve(backend, &eff, err);                                            \
+        if (st != TS_OK)                                                                       \
+            return st;                                                                         \
+        if (want_opencl(eff, r)) {                                                             \
+            ts_error e = {TS_OK, ""};                                                          \
+            ts_error *cl_err = &e;                                                             \
+            st = CL_CALL;                                                                      \
+            if (cl_done(st, cl_err, r))                                                        \
+                return ts_ok(err);                                                             \
+        }                                                                                      \
+        return C_CALL;                                                                         \
+    } while (0)
+
+ts_status ts_backend_horizon_sweep(ts_backend backend, const ts_grid *grid, double azimuth,
+                                   const ts_horizon_opts *opts, float *out,
+                                   ts_backend_report *report, ts_error *err)
+{
+    DISPATCH(ts_cl_horizon_sweep(grid, azimuth, opts, out, cl_err),
+             ts_horizon_sweep(grid, azimuth, opts, out, err));
+}
+
+ts_status ts_backend_horizon_compute(ts_backend backend, const ts_grid *grid,
+                                     const ts_horizon_opts *opts, float *out,
+                                     ts_backend_report *report, ts_error *err)
+{
+    DISPATCH(ts_cl_horizon_compute(grid, opts, out, cl_err),
+             ts_horizon_compute(grid, opts, out, err));
+}
+
+ts_status ts_backend_shm_compute(ts_backend backend, const ts_grid *grid, double azimuth,
+                                 double elevation, double penumbra_depth, int threads,
+                                 float *visibility, float *shadow_height,
+                                 ts_backend_report *report, ts_error *err)
+{
+    DISPATCH(ts_cl_shm_compute(grid, azimuth, elevation, penumbra_depth, threads, visibility,
+                               shadow_height, cl_err),
+             ts_shm_compute(grid, azimuth, elevation, penumbra_depth, threads, visibility,
+                            shadow_height, err));
+}
+
+ts_status ts_backend_normals(ts_backend backend, const ts_grid *grid, float *nx, float *ny,
+                             float *nz, ts_backend_report *report, ts_error *err)
+{
+    DISPATCH(ts_cl_normals(grid, nx, ny, nz, cl_err), ts_normals(grid, nx, ny, nz, err));
+}
+
+ts_status ts_backend_shade_direct(ts_backend backend, const ts_grid *grid, const float *nx,
+                                  const float *ny, const float *nz, const float *horizons,
+                                  const ts_horizon_opts *opts, double sun_azimuth,
+                                  double sun_elevation, float *out, ts_backend_report *report,
+                                  ts_error *err)
+{
+    DISPATCH(ts_cl_shade_direct(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
+                                out, cl_err),
+             ts_shade_direct(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation, out,
+                             err));
+}
+
+ts_status ts_backend_sky_terms(ts_backend backend, const ts_grid *grid, const float *nx,
+                               const float *ny, const float *nz, const float *horizons,
+                               const ts_horizon_opts *opts, float *svf, float *sky,
+                               float *openness, ts_backend_report *report, ts_error *err)
+{
+    DISPATCH(ts_cl_sky_terms(grid, nx, ny, nz, horizons, opts, svf, sky, openness, cl_err),
+             ts_sky_terms(grid, nx, ny, nz, horizons, opts, svf, sky, openness, err));
+}

@@ -1,0 +1,657 @@
+/*
+ * OpenCL platform and device discovery, device selection, the per-device
+ * cache (context, queue, program), error names and the job helpers.
+ *
+ * Process-wide state, the only in terrashade: the device list (filled once
+ * by pthread_once: the ICD loader reads its vendor files once anyway) and
+ * the devices made so far (under a mutex; a device is made once and kept
+ * until exit, a failure to make it is remembered too). See terrashade_cl.h.
+ */
+#ifdef HAVE_CONFIG_H
+#include <config.h>
+#endif
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cl_internal.h"
+#include "near_field.h"
+#include "status_internal.h"
+
+extern const char *const ts_cl_source[];
+extern const size_t ts_cl_source_count;
+
+#define TS_CL_MAX_DEVICES 64
+
+/* ------------------------------------------------------------ error names */
+
+const char *ts_cl_error_name(cl_int code)
+{
+    switch (code) {
+#define E(x) case x: return #x;
+    E(CL_SUCCESS) E(CL_DEVICE_NOT_FOUND) E(CL_DEVICE_NOT_AVAILABLE)
+    E(CL_COMPILER_NOT_AVAILABLE) E(CL_MEM_OBJECT_ALLOCATION_FAILURE)
+    E(CL_OUT_OF_RESOURCES) E(CL_OUT_OF_HOST_MEMORY) E(CL_PROFILING_INFO_NOT_AVAILABLE)
+    E(CL_MEM_COPY_OVERLAP) E(CL_IMAGE_FORMAT_MISMATCH) E(CL_IMAGE_FORMAT_NOT_SUPPORTED)
+    E(CL_BUILD_PROGRAM_FAILURE) E(CL_MAP_FAILURE) E(CL_MISALIGNED_SUB_BUFFER_OFFSET)
+    E(CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST) E(CL_COMPILE_PROGRAM_FAILURE)
+    E(CL_LINKER_NOT_AVAILABLE) E(CL_LINK_PROGRAM_FAILURE) E(CL_DEVICE_PARTITION_FAILED)
+    E(CL_KERNEL_ARG_INFO_NOT_AVAILABLE) E(CL_INVALID_VALUE) E(CL_INVALID_DEVICE_TYPE)
+    E(CL_INVALID_PLATFORM) E(CL_INVALID_DEVICE) E(CL_INVALID_CONTEXT)
+    E(CL_INVALID_QUEUE_PROPERTIES) E(CL_INVALID_COMMAND_QUEUE) E(CL_INVALID_HOST_PTR)
+    E(CL_INVALID_MEM_OBJECT) E(CL_INVALID_IMAGE_FORMAT_DESCRIPTOR) E(CL_INVALID_IMAGE_SIZE)
+    E(CL_INVALID_SAMPLER) E(CL_INVALID_BINARY) E(CL_INVALID_BUILD_OPTIONS)
+    E(CL_INVALID_PROGRAM) E(CL_INVALID_PROGRAM_EXECUTABLE) E(CL_INVALID_KERNEL_NAME)
+    E(CL_INVALID_KERNEL_DEFINITION) E(CL_INVALID_KERNEL) E(CL_INVALID_ARG_INDEX)
+    E(CL_INVALID_ARG_VALUE) E(CL_INVALID_ARG_SIZE) E(CL_INVALID_KERNEL_ARGS)
+    E(CL_INVALID_WORK_DIMENSION) E(CL_INVALID_WORK_GROUP_SIZE) E(CL_INVALID_WORK_ITEM_SIZE)
+    E(CL_INVALID_GLOBAL_OFFSET) E(CL_INVALID_EVENT_WAIT_LIST) E(CL_INVALID_EVENT)
+    E(CL_INVALID_OPERATION) E(CL_INVALID_GL_OBJECT) E(CL_INVALID_BUFFER_SIZE)
+    E(CL_INVALID_MIP_LEVEL) E(CL_INVALID_GLOBAL_WORK_SIZE) E(CL_INVALID_PROPERTY)
+    E(CL_INVALID_IMAGE_DESCRIPTOR) E(CL_INVALID_COMPILER_OPTIONS) E(CL_INVALID_LINKER_OPTIONS)
+    E(CL_INVALID_DEVICE_PARTITION_COUNT)
+#undef E
+    case -1001: return "CL_PLATFORM_NOT_FOUND_KHR";
+    case -9999: return "CL_INVALID_COMMAND (device fault)";
+    }
+    return "unknown OpenCL error";
+}
+
+static ts_status map_code(cl_int e)
+{
+    switch (e) {
+    case CL_MEM_OBJECT_ALLOCATION_FAILURE:
+    case CL_OUT_OF_RESOURCES:
+    case CL_OUT_OF_HOST_MEMORY:
+    case CL_INVALID_BUFFER_SIZE:
+        return TS_ERR_NOMEM;
+    default:
+        return TS_ERR_INTERNAL;
+    }
+}
+
+/* ------------------------------------------------------------- discovery */
+
+typedef struct {
+    cl_platform_id platform;
+    cl_device_id id;
+    int p, d;
+} dev_ref;
+
+static struct {
+    cl_int err;          /* CL_SUCCESS, or why there is no device */
+    const char *call;
+    int ndev;
+    dev_ref dev[TS_CL_MAX_DEVICES];
+} g_list;
+static pthread_once_t g_list_once = PTHREAD_ONCE_INIT;
+
+static pthread_mutex_t g_lock = PTHREAD_MUTEX_INITIALIZER;
+static ts_cl_dev *g_dev[TS_CL_MAX_DEVICES];
+static ts_error g_dev_fail[TS_CL_MAX_DEVICES]; /* code != OK: making it failed */
+
+static void discover(void)
+{
+    cl_uint np = 0;
+    cl_platform_id plat[16];
+    cl_int e = clGetPlatformIDs(16, plat, &np);
+    g_list.call = "clGetPlatformIDs";
+    if (e != CL_SUCCESS) {
+        g_list.err = e;
+        return;
+    }
+    if (np > 16)
+        np = 16;
+    for (cl_uint p = 0; p < np; p++) {
+        cl_uint nd = 0;
+        cl_device_id ids[TS_CL_MAX_DEVICES];
+        e = clGetDeviceIDs(plat[p], CL_DEVICE_TYPE_ALL, TS_CL_MAX_DEVICES, ids, &nd);
+        if (e != CL_SUCCESS)
+            continue; /* CL_DEVICE_NOT_FOUND: a platform without devices */
+        if (nd > TS_CL_MAX_DEVICES)
+            nd = TS_CL_MAX_DEVICES;
+        for (cl_uint d = 0; d < nd && g_list.ndev < TS_CL_MAX_DEVICES; d++)
+            g_list.dev[g_list.ndev++] = (dev_ref){plat[p], ids[d], (int)p, (int)d};
+    }
+    if (g_list.ndev == 0) {
+        g_list.err = CL_DEVICE_NOT_FOUND;
+        g_list.call = "clGetDeviceIDs";
+    }
+}
+
+static void fill_info(const dev_ref *r, int index, ts_cl_info *info)
+{
+    memset(info, 0, sizeof *info);
+    clGetPlatformInfo(r->platform, CL_PLATFORM_NAME, sizeof info->platform - 1, info->platform,
+                      NULL);
+    clGetDeviceInfo(r->id, CL_DEVICE_NAME, sizeof info->device - 1, info->device, NULL);
+    clGetDeviceInfo(r->id, CL_DEVICE_VERSION, sizeof info->version - 1, info->version, NULL);
+    cl_device_type type = 0;
+    clGetDeviceInfo(r->id, CL_DEVICE_TYPE, sizeof type, &type, NULL);
+    snprintf(info->type, sizeof info->type, "%s",
+             (type & CL_DEVICE_TYPE_GPU)           ? "GPU"
+             : (type & CL_DEVICE_TYPE_ACCELERATOR) ? "accelerator"
+             : (type & CL_DEVICE_TYPE_CPU)         ? "CPU"
+                                                   : "other");
+    info->index = index;
+    info->platform_index = r->p;
+    info->device_index = r->d;
+    cl_uint cu = 0;
+    clGetDeviceInfo(r->id, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof cu, &cu, NULL);
+    info->compute_units = (int)cu;
+    cl_device_fp_config fp = 0;
+    clGetDeviceInfo(r->id, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof fp, &fp, NULL);
+    info->fp64 = fp != 0;
+    cl_ulong gm = 0, ma = 0;
+    clGetDeviceInfo(r->id, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof gm, &gm, NULL);
+    clGetDeviceInfo(r->id, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof ma, &ma, NULL);
+    info->global_mem = gm;
+    info->max_alloc = ma;
+    size_t wg = 0;
+    clGetDeviceInfo(r->id, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof wg, &wg, NULL);
+    info->max_work_group = wg;
+}
+
+/* Parse TERRASHADE_OPENCL_MAX_ALLOC: bytes with an optional k/M/G suffix. */
+static ts_status env_max_alloc(unsigned long long *limit, ts_error *err)
+{
+    *limit = 0;
+    const char *s = getenv("TERRASHADE_OPENCL_MAX_ALLOC");
+    if (!s || !*s)
+        return TS_OK;
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    double mul = 1;
+    if (*end == 'k' || *end == 'K')
+        mul = 1024.0, end++;
+    else if (*end == 'm' || *end == 'M')
+        mul = 1024.0 * 1024, end++;
+    else if (*end == 'g' || *end == 'G')
+        mul = 1024.0 * 1024 * 1024, end++;
+    if (end == s || *end || errno || !(v >= 1) || !isfinite(v))
+        return ts_fail(err, TS_ERR_ARG,
+                    "TERRASHADE_OPENCL_MAX_ALLOC must be a number of bytes (k, M, G suffixes "
+                    "allowed), got '%.60s'",
+                    s);
+    *limit = (unsigned long long)(v * mul);
+    return TS_OK;
+}
+
+/* Which device: TERRASHADE_OPENCL_DEVICE, or the first GPU, accelerator,
+ * device. Call after discovery succeeded. */
+static ts_status select_device(int *index, ts_error *err)
+{
+    const char *s = getenv("TERRASHADE_OPENCL_DEVICE");
+    while (s && isspace((unsigned char)*s))
+        s++;
+    if (!s || !*s) {
+        int best = 0, rank = 3;
+        for (int i = 0; i < g_list.ndev; i++) {
+            cl_device_type t = 0;
+            clGetDeviceInfo(g_list.dev[i].id, CL_DEVICE_TYPE, sizeof t, &t, NULL);
+            int r = (t & CL_DEVICE_TYPE_GPU) ? 0 : (t & CL_DEVICE_TYPE_ACCELERATOR) ? 1 : 2;
+            if (r < rank) {
+                rank = r;
+                best = i;
+            }
+        }
+        *index = best;
+        return TS_OK;
+    }
+    char *end;
+    long a = strtol(s, &end, 10);
+    int found = -1;
+    if (end != s && a >= 0 && (*end == '\0' || isspace((unsigned char)*end))) {
+        if (a < g_list.ndev)
+            found = (int)a;
+    } else if (end != s && a >= 0 && *end == ':') {
+        const char *t = end + 1;
+        long b = strtol(t, &end, 10);
+        if (end == t || b < 0 || (*end && !isspace((unsigned char)*end)))
+            goto bad;
+        for (int i = 0; i < g_list.ndev; i++)
+            if (g_list.dev[i].p == a && g_list.dev[i].d == b)
+                found = i;
+    } else {
+        goto bad;
+    }
+    if (found < 0) {
+        char name[96] = "";
+        clGetDeviceInfo(g_list.dev[0].id, CL_DEVICE_NAME, sizeof name - 1, name, NULL);
+        return ts_fail(err, TS_ERR_INTERNAL,
+                    "TERRASHADE_OPENCL_DEVICE=%.40s: no such OpenCL device; there %s %d "
+                    "(0 = platform 0 device 0: %.60s)",
+                    s, g_list.ndev == 1 ? "is" : "are", g_list.ndev, name);
+    }
+    *index = found;
+    return TS_OK;
+bad:
+    return ts_fail(err, TS_ERR_INTERNAL,
+                "TERRASHADE_OPENCL_DEVICE must be a device index (0, 1, ...) or "
+                "platform:device (e.g. 0:1), got '%.40s'",
+                s);
+}
+
+static ts_status list_ready(ts_error *err)
+{
+    pthread_once(&g_list_once, discover);
+    if (g_list.err != CL_SUCCESS) {
+        if (g_list.err == -1001 || (g_list.err == CL_DEVICE_NOT_FOUND && g_list.ndev == 0))
+            return ts_fail(err, TS_ERR_INTERNAL,
+                        "no OpenCL %s found (%s: %s); check the ICD files in "
+                        "/etc/OpenCL/vendors or OCL_ICD_VENDORS",
+                        g_list.err == -1001 ? "platform" : "device", g_list.call,
+                        ts_cl_error_name(g_list.err));
+        return ts_fail(err, map_code(g_list.err), "OpenCL %s failed: %s", g_list.call,
+                    ts_cl_error_name(g_list.err));
+    }
+    return TS_OK;
+}
+
+/* Make context, queue and program for device i; on failure err is set. */
+static ts_cl_dev *make_device(int i, ts_error *err)
+{
+    const dev_ref *r = &g_list.dev[i];
+    ts_cl_dev *d = calloc(1, sizeof *d);
+    if (!d) {
+        ts_fail(err, TS_ERR_NOMEM, "cannot allocate the OpenCL device record");
+        return NULL;
+    }
+    d->platform = r->platform;
+    d->id = r->id;
+    fill_info(r, i, &d->info);
+    const char *fp = getenv("TERRASHADE_OPENCL_FP64");
+    if (fp && !strcmp(fp, "0"))
+        d->info.fp64 = 0;
+    cl_device_type type = 0;
+    clGetDeviceInfo(r->id, CL_DEVICE_TYPE, sizeof type, &type, NULL);
+    d->is_cpu = (type & CL_DEVICE_TYPE_CPU) != 0;
+    clGetDeviceInfo(r->id, CL_DEVICE_LOCAL_MEM_SIZE, sizeof d->local_mem, &d->local_mem, NULL);
+
+    cl_int e;
+    const char *call = "clCreateContext";
+    cl_context_properties props[] = {CL_CONTEXT_PLATFORM, (cl_context_properties)r->platform, 0};
+    d->ctx = clCreateContext(props, 1, &r->id, NULL, NULL, &e);
+    if (e == CL_SUCCESS) {
+        call = "clCreateCommandQueue";
+        d->queue = clCreateCommandQueue(d->ctx, r->id, 0, &e);
+    }
+    if (e == CL_SUCCESS) {
+        call = "clCreateProgramWithSource";
+        d->prog = clCreateProgramWithSource(d->ctx, (cl_uint)ts_cl_source_count,
+                                            (const char **)ts_cl_source, NULL, &e);
+    }
+    if (e == CL_SUCCESS) {
+        call = "clBuildProgram";
+        char opts[512];
+        char cver[64] = "";
+        clGetDeviceInfo(r->id, CL_DEVICE_OPENCL_C_VERSION, sizeof cver - 1, cver, NULL);
+        int major = 0, minor = 0;
+        sscanf(cver, "OpenCL C %d.%d", &major, &minor);
+        cl_device_fp_config sp = 0;
+        clGetDeviceInfo(r->id, CL_DEVICE_SINGLE_FP_CONFIG, sizeof sp, &sp, NULL);
+        snprintf(opts, sizeof opts,
+                 "%s%s%s-DTS_NEAR_EXACT=%d -DTS_NEAR_STEPS=%d -DTS_NEAR_MAX_PIECES=%d "
+                 "-DTS_NEAR_MARGIN=%d",
+                 (major > 1 || (major == 1 && minor >= 2)) ? "-cl-std=CL1.2 " : "",
+                 d->info.fp64 ? "-DTS_FP64=1 " : "",
+                 (sp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT)
+                     ? "-cl-fp32-correctly-rounded-divide-sqrt "
+                     : "",
+                 TS_NEAR_EXACT, TS_NEAR_STEPS, TS_NEAR_MAX_PIECES, TS_NEAR_MARGIN);
+        e = clBuildProgram(d->prog, 1, &r->id, opts, NULL, NULL);
+        if (e == CL_SUCCESS && getenv("TERRASHADE_OPENCL_VERBOSE")) {
+            char log[4096] = "";
+            clGetProgramBuildInfo(d->prog, r->id, CL_PROGRAM_BUILD_LOG, sizeof log - 1, log,
+                                  NULL);
+            fprintf(stderr, "terrashade: OpenCL kernels built on %s with '%s'%s%s\n",
+                    d->info.device, opts, log[0] ? ", log:\n" : "", log);
+        }
+        if (e != CL_SUCCESS) {
+            char log[4096] = "";
+            clGetProgramBuildInfo(d->prog, r->id, CL_PROGRAM_BUILD_LOG, sizeof log - 1, log,
+                                  NULL);
+            if (getenv("TERRASHADE_OPENCL_VERBOSE"))
+                fprintf(stderr, "terrashade: OpenCL build log for %s:\n%s\n", d->info.device,
+                        log);
+            /* first error line of the log */
+            char *l = strstr(log, "error");
+            if (!l)
+                l = log;
+            l[strcspn(l, "\n")] = '\0';
+            ts_fail(err, TS_ERR_INTERNAL,
+                 "OpenCL kernels failed to build on %.60s (%s): %.120s", d->info.device,
+                 ts_cl_error_name(e), l);
+            goto failed;
+        }
+    }
+    if (e != CL_SUCCESS) {
+        ts_fail(err, map_code(e), "OpenCL %s failed on %.60s: %s", call, d->info.device,
+             ts_cl_error_name(e));
+        goto failed;
+    }
+    return d;
+failed:
+    if (d->prog)
+        clReleaseProgram(d->prog);
+    if (d->queue)
+        clReleaseCommandQueue(d->queue);
+    if (d->ctx)
+        clReleaseContext(d->ctx);
+    free(d);
+    return NULL;
+}
+
+ts_status ts_cl_device(ts_cl_dev **dev, ts_error *err)
+{
+    *dev = NULL;
+    ts_status st = list_ready(err);
+    if (st != TS_OK)
+        return st;
+    int i = 0;
+    if ((st = select_device(&i, err)) != TS_OK)
+        return st;
+    pthread_mutex_lock(&g_lock);
+    if (!g_dev[i] && g_dev_fail[i].code == TS_OK) {
+        ts_error e = {0};
+        g_dev[i] = make_device(i, &e);
+        if (!g_dev[i])
+            g_dev_fail[i] = e.code != TS_OK ? e : (ts_error){TS_ERR_INTERNAL, "OpenCL failure"};
+    }
+    ts_cl_dev *d = g_dev[i];
+    ts_error f = g_dev_fail[i];
+    pthread_mutex_unlock(&g_lock);
+    if (!d) {
+        if (err)
+            *err = f;
+        return f.code;
+    }
+    *dev = d;
+    return ts_ok(err);
+}
+
+int ts_cl_built(void)
+{
+    return 1;
+}
+
+ts_status ts_cl_available(ts_cl_info *info, ts_error *err)
+{
+    ts_cl_dev *d;
+    ts_status st = ts_cl_device(&d, err);
+    if (st != TS_OK)
+        return st;
+    unsigned long long cap;
+    if ((st = env_max_alloc(&cap, err)) != TS_OK)
+        return st;
+    if (info) {
+        *info = d->info;
+        if (cap && cap < info->max_alloc)
+            info->max_alloc = cap;
+    }
+    return ts_ok(err);
+}
+
+ts_status ts_cl_devices(ts_cl_info *list, int max, int *count, ts_error *err)
+{
+    if (!count || (max > 0 && !list))
+        return ts_fail(err, TS_ERR_ARG, "device list or count is NULL");
+    *count = 0;
+    ts_status st = list_ready(err);
+    if (st != TS_OK)
+        return st;
+    *count = g_list.ndev;
+    for (int i = 0; i < g_list.ndev && i < max; i++)
+        fill_info(&g_list.dev[i], i, &list[i]);
+    return ts_ok(err);
+}
+
+/* ------------------------------------------------------------------ jobs */
+
+/* "12.3 MiB", or "4096 bytes" below a MiB. */
+static const char *size_text(char *buf, size_t n, unsigned long long bytes)
+{
+    if (bytes >= (1ull << 20))
+        snprintf(buf, n, "%.1f MiB", bytes / 1048576.0);
+    else
+        snprintf(buf, n, "%llu bytes", bytes);
+    return buf;
+}
+
+static void job_cl_fail(ts_cl_job *j, cl_int e, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+static void job_cl_fail(ts_cl_job *j, cl_int e, const char *fmt, ...)
+{
+    if (j->st != TS_OK)
+        return;
+    char what[128];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    j->st = ts_fail(j->err, map_code(e), "OpenCL %s failed on %.60s: %s", what,
+                 j->d ? j->d->info.device : "?", ts_cl_error_name(e));
+}
+
+void ts_cl_job_fail(ts_cl_job *j, ts_status code, const char *fmt, ...)
+{
+    if (j->st != TS_OK)
+        return;
+    if (j->err) {
+        va_list ap;
+        va_start(ap, fmt);
+        j->err->code = code;
+        vsnprintf(j->err->message, sizeof j->err->message, fmt, ap);
+        va_end(ap);
+    }
+    j->st = code;
+}
+
+ts_status ts_cl_job_begin(ts_cl_job *j, ts_error *err)
+{
+    memset(j, 0, sizeof *j);
+    j->err = err;
+    ts_status st = ts_cl_device(&j->d, err);
+    if (st == TS_OK) {
+        unsigned long long cap;
+        st = env_max_alloc(&cap, err);
+        j->max_alloc = j->d->info.max_alloc;
+        j->capped = 0;
+        if (st == TS_OK && cap && cap < j->max_alloc) {
+            j->max_alloc = cap;
+            j->capped = 1;
+        }
+        /* Half the device memory for one call, at most. */
+        j->budget = j->d->info.global_mem / 2;
+        if (j->budget < j->max_alloc)
+            j->budget = j->max_alloc;
+    }
+    j->st = st;
+    return st;
+}
+
+cl_mem ts_cl_job_buffer(ts_cl_job *j, cl_mem_flags flags, size_t bytes, const void *host,
+                        const char *what)
+{
+    if (j->st != TS_OK)
+        return NULL;
+    if (j->nmem >= TS_CL_JOB_MEM) {
+        ts_cl_job_fail(j, TS_ERR_INTERNAL, "OpenCL job has too many buffers");
+        return NULL;
+    }
+    if (bytes < 16)
+        bytes = 16;
+    /* Over the TERRASHADE_OPENCL_MAX_ALLOC cap: refused here. Over the
+     * device's own limit: clCreateBuffer says so (CL_INVALID_BUFFER_SIZE). */
+    if (j->capped && bytes > j->max_alloc) {
+        char a[32], b[32];
+        ts_cl_job_fail(j, TS_ERR_NOMEM,
+                       "OpenCL clCreateBuffer (%s, %s) refused on %.60s: larger than the "
+                       "TERRASHADE_OPENCL_MAX_ALLOC limit of %s (CL_INVALID_BUFFER_SIZE)",
+                       what, size_text(a, sizeof a, bytes), j->d->info.device,
+                       size_text(b, sizeof b, j->max_alloc));
+        return NULL;
+    }
+    cl_int e;
+    cl_mem m = clCreateBuffer(j->d->ctx, flags, bytes, NULL, &e);
+    if (e != CL_SUCCESS) {
+        char a[32];
+        job_cl_fail(j, e, "clCreateBuffer (%s, %s)", what, size_text(a, sizeof a, bytes));
+        return NULL;
+    }
+    j->mem[j->nmem++] = m;
+    if (host)
+        ts_cl_job_write(j, m, 0, bytes, host, what);
+    return j->st == TS_OK ? m : NULL;
+}
+
+void ts_cl_job_release(ts_cl_job *j, cl_mem m)
+{
+    for (int i = 0; i < j->nmem; i++)
+        if (j->mem[i] == m) {
+            clReleaseMemObject(m);
+            j->mem[i] = j->mem[--j->nmem];
+            return;
+        }
+}
+
+cl_kernel ts_cl_job_kernel(ts_cl_job *j, const char *name)
+{
+    if (j->st != TS_OK)
+        return NULL;
+    if (j->nkern >= TS_CL_JOB_KERNELS) {
+        ts_cl_job_fail(j, TS_ERR_INTERNAL, "OpenCL job has too many kernels");
+        return NULL;
+    }
+    cl_int e;
+    cl_kernel k = clCreateKernel(j->d->prog, name, &e);
+    if (e != CL_SUCCESS) {
+        job_cl_fail(j, e, "clCreateKernel (%s)", name);
+        return NULL;
+    }
+    j->kern[j->nkern++] = k;
+    return k;
+}
+
+void ts_cl_job_arg(ts_cl_job *j, cl_kernel k, cl_uint index, size_t size, const void *value)
+{
+    if (j->st != TS_OK)
+        return;
+    cl_int e = clSetKernelArg(k, index, size, value);
+    if (e != CL_SUCCESS)
+        job_cl_fail(j, e, "clSetKernelArg (argument %u)", index);
+}
+
+void ts_cl_job_arg_real(ts_cl_job *j, cl_kernel k, cl_uint index, double value)
+{
+    if (j->st != TS_OK)
+        return;
+    if (j->d->info.fp64) {
+        ts_cl_job_arg(j, k, index, sizeof(double), &value);
+    } else {
+        float f = (float)value;
+        ts_cl_job_arg(j, k, index, sizeof(float), &f);
+    }
+}
+
+size_t ts_cl_job_wg(ts_cl_job *j, cl_kernel k, size_t want)
+{
+    if (j->st != TS_OK)
+        return 1;
+    size_t kmax = 0;
+    cl_int e = clGetKernelWorkGroupInfo(k, j->d->id, CL_KERNEL_WORK_GROUP_SIZE, sizeof kmax,
+                                        &kmax, NULL);
+    if (e != CL_SUCCESS) {
+        job_cl_fail(j, e, "clGetKernelWorkGroupInfo");
+        return 1;
+    }
+    size_t lim = j->d->info.max_work_group;
+    if (kmax && kmax < lim)
+        lim = kmax;
+    size_t wg = 1;
+    while (wg * 2 <= want && wg * 2 <= lim)
+        wg *= 2;
+    return wg;
+}
+
+void ts_cl_job_run(ts_cl_job *j, cl_kernel k, cl_uint dims, const size_t *global,
+                   const size_t *local, const char *what)
+{
+    if (j->st != TS_OK)
+        return;
+    for (cl_uint i = 0; i < dims; i++)
+        if (global[i] == 0)
+            return; /* nothing to do */
+    cl_int e = clEnqueueNDRangeKernel(j->d->queue, k, dims, NULL, global, local, 0, NULL, NULL);
+    if (e != CL_SUCCESS)
+        job_cl_fail(j, e, "clEnqueueNDRangeKernel (%s)", what);
+}
+
+void ts_cl_job_write(ts_cl_job *j, cl_mem m, size_t offset, size_t bytes, const void *src,
+                     const char *what)
+{
+    if (j->st != TS_OK || bytes == 0)
+        return;
+    cl_int e = clEnqueueWriteBuffer(j->d->queue, m, CL_TRUE, offset, bytes, src, 0, NULL, NULL);
+    if (e != CL_SUCCESS)
+        job_cl_fail(j, e, "clEnqueueWriteBuffer (%s)", what);
+}
+
+void ts_cl_job_read(ts_cl_job *j, cl_mem m, size_t offset, size_t bytes, void *dst,
+                    const char *what)
+{
+    if (j->st != TS_OK || bytes == 0)
+        return;
+    cl_int e = clEnqueueReadBuffer(j->d->queue, m, CL_TRUE, offset, bytes, dst, 0, NULL, NULL);
+    if (e != CL_SUCCESS)
+        job_cl_fail(j, e, "clEnqueueReadBuffer (%s)", what);
+}
+
+void ts_cl_job_fill0(ts_cl_job *j, cl_mem m, size_t bytes, const char *what)
+{
+    if (j->st != TS_OK || bytes == 0)
+        return;
+    float zero = 0.0f;
+    cl_int e = clEnqueueFillBuffer(j->d->queue, m, &zero, sizeof zero, 0, bytes, 0, NULL, NULL);
+    if (e != CL_SUCCESS)
+        job_cl_fail(j, e, "clEnqueueFillBuffer (%s)", what);
+}
+
+ts_status ts_cl_job_end(ts_cl_job *j)
+{
+    if (j->d) {
+        cl_int e = clFinish(j->d->queue);
+        if (e != CL_SUCCESS)
+            job_cl_fail(j, e, "clFinish");
+    }
+    for (int i = 0; i < j->nkern; i++)
+        clReleaseKernel(j->kern[i]);
+    for (int i = 0; i < j->nmem; i++)
+        clReleaseMemObject(j->mem[i]);
+    j->nkern = j->nmem = 0;
+    if (j->st == TS_OK)
+        ts_ok(j->err);
+    return j->st;
+}
+
+void ts_cl_to_real(const ts_cl_dev *d, void *dst, const double *src, size_t n)
+{
+    if (d->info.fp64) {
+        memcpy(dst, src, n * sizeof(double));
+    } else {
+        float *f = dst;
+        for (size_t i = 0; i < n; i++)
+            f[i] = (float)src[i];
+    }
+}

@@ -1,0 +1,325 @@
+/*
+ * Horizon sweep on the OpenCL device; the kernels are in cl/horizon.cl.
+ *
+ * The line geometry (ts_line_geom_init) and the near-field plan
+ * (ts_near_plan_init) are computed here, on the host, by the C core's own
+ * functions, and handed to the kernels as tables, so that both backends
+ * walk exactly the same lines. Azimuths go in batches: as many horizon
+ * planes as fit the device (per azimuth the output plane and two planes of
+ * far-field occluders, the one handed from each line to the next), and the
+ * lines of a batch in launches of as many hull stacks as fit.
+ */
+#ifdef HAVE_CONFIG_H
+#include <config.h>
+#endif
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cl_internal.h"
+#include "line_geometry.h"
+#include "near_field.h"
+#include "status_internal.h"
+#include "ts_cl_params.h"
+
+/* Hull stacks on a CPU device are host memory: keep them modest. */
+#define CPU_STACK_BUDGET (256ull << 20)
+/* Azimuths per batch, at most. */
+#define MAX_BATCH 32
+
+/* Fill the table rows of azimuth `a` of a batch; returns 0 on NOMEM. */
+static int fill_azimuth(const ts_grid *pg, double azimuth, int a, int line0, int floff,
+                        int *ip, double *dp, int *fl, float *fr, double *sr, int *lines,
+                        ts_error *err)
+{
+    ts_line_geom G;
+    if (ts_line_geom_init(&G, pg, azimuth, err) != TS_OK)
+        return 0;
+    ts_near_plan NP;
+    ts_near_plan_init(&NP, &G);
+    int *I = ip + (size_t)a * TS_CLI_N;
+    double *Dp = dp + (size_t)a * TS_CLD_N;
+    memset(I, 0, TS_CLI_N * sizeof *I);
+    memset(Dp, 0, TS_CLD_N * sizeof *Dp);
+    I[TS_CLI_XMAJOR] = G.x_major;
+    I[TS_CLI_U] = G.U;
+    I[TS_CLI_V] = G.V;
+    I[TS_CLI_USTART] = G.u_start;
+    I[TS_CLI_USTEP] = G.u_step;
+    I[TS_CLI_BLO] = (int)G.b_lo;
+    I[TS_CLI_LINE0] = line0;
+    I[TS_CLI_FLOFF] = floff;
+    I[TS_CLI_SROFF] = G.step_row ? a * pg->height : -1;
+    I[TS_CLI_PLANE] = a;
+    I[TS_CLI_NPIECES] = NP.npieces;
+    for (int n = 0; n < NP.npieces; n++) {
+        I[TS_CLI_PDU + n] = NP.piece[n].du;
+        I[TS_CLI_PDV + n] = NP.piece[n].dv;
+        Dp[TS_CLD_PSA + n] = NP.piece[n].sa;
+        Dp[TS_CLD_PSB + n] = NP.piece[n].sb;
+    }
+    for (int j = 0; j <= TS_NEAR_STEPS; j++) {
+        I[TS_CLI_SDV + j] = NP.sample_dv[j];
+        Dp[TS_CLD_SFV + j] = NP.sample_fv[j];
+    }
+    Dp[TS_CLD_T] = G.t;
+    Dp[TS_CLD_STEPM] = G.step_m;
+    Dp[TS_CLD_NEARSKIP] = (TS_NEAR_STEPS + 0.5) * G.step_m;
+    memcpy(fl + floff, G.fl, (size_t)G.U * sizeof *fl);
+    memcpy(fr + floff, G.fr, (size_t)G.U * sizeof *fr);
+    if (G.step_row)
+        memcpy(sr + (size_t)a * pg->height, G.step_row, (size_t)pg->height * sizeof *sr);
+    *lines = (int)(G.b_hi - G.b_lo + 1);
+    ts_line_geom_free(&G);
+    return 1;
+}
+
+/* Horizons for the n azimuths az[] (already in [0, 360)), plane k of out
+ * for az[k]. Arguments are checked by the callers. */
+static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, const double *az,
+                             int n, float *out, ts_error *err)
+{
+    const int W = grid->width, H = grid->height;
+    const size_t cells = (size_t)W * H, plane_bytes = cells * sizeof(float);
+    ts_cl_job J;
+    if (ts_cl_job_begin(&J, err) != TS_OK)
+        return J.st;
+    ts_cl_dev *D = J.d;
+    const size_t rs = ts_cl_real_size(D);
+    const int Umax = W > H ? W : H;
+    const double c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
+    const double cap = opts->max_distance;
+
+    /* Packed heights (stride = width): the geometry's strides then index
+     * the device copy directly. */
+    float *packed = NULL;
+    const float *zsrc = grid->z;
+    if (grid->stride != W) {
+        packed = malloc(plane_bytes);
+        if (!packed) {
+            ts_cl_job_fail(&J, TS_ERR_NOMEM, "cannot allocate a packed copy of the grid");
+            return ts_cl_job_end(&J);
+        }
+        for (int y = 0; y < H; y++)
+            memcpy(packed + (size_t)y * W, grid->z + (ptrdiff_t)y * grid->stride,
+                   (size_t)W * sizeof(float));
+        zsrc = packed;
+    }
+    ts_grid pg = *grid;
+    pg.stride = W;
+    pg.z = (float *)zsrc;
+
+    /* Batch size: the output planes (float) and the two occluder planes
+     * (int2) each within one buffer, all within half the budget. */
+    const size_t occ_bytes = cells * 2 * sizeof(cl_int);
+    size_t A = (size_t)n < MAX_BATCH ? (size_t)n : MAX_BATCH;
+    if (A > J.max_alloc / occ_bytes)
+        A = J.max_alloc / occ_bytes;
+    if (A > J.budget / 2 / (plane_bytes + 2 * occ_bytes))
+        A = J.budget / 2 / (plane_bytes + 2 * occ_bytes);
+    if (A < 1)
+        A = 1; /* the buffers below then fail with a clean error */
+
+    /* Lines per batch, for the hull stacks. */
+    int max_items = 0;
+    {
+        ts_line_geom G;
+        int items = 0;
+        for (int k = 0; k < n && J.st == TS_OK; k++) {
+            if (k % A == 0)
+                items = 0;
+            if (ts_line_geom_init(&G, &pg, az[k], err) != TS_OK) {
+                J.st = err ? err->code : TS_ERR_NOMEM;
+                break;
+            }
+            items += (int)(G.b_hi - G.b_lo + 1);
+            ts_line_geom_free(&G);
+            if (items > max_items)
+                max_items = items;
+        }
+    }
+    const size_t slot_entries = (size_t)(Umax + 1);
+    const size_t slot_bytes = slot_entries * (2 * rs + sizeof(cl_int));
+    unsigned long long sbud = J.budget / 2;
+    if (sbud > J.max_alloc)
+        sbud = J.max_alloc;
+    if (D->is_cpu && sbud > CPU_STACK_BUDGET)
+        sbud = CPU_STACK_BUDGET;
+    size_t nslots = sbud / slot_bytes;
+    if (nslots > (size_t)max_items)
+        nslots = (size_t)max_items;
+    if (nslots < 1)
+        nslots = 1;
+
+    int *ip = malloc(A * TS_CLI_N * sizeof *ip);
+    double *dp = malloc(A * TS_CLD_N * sizeof *dp);
+    void *dpr = malloc(A * TS_CLD_N * rs);
+    int *fl = malloc(A * (size_t)Umax * sizeof *fl);
+    float *fr = malloc(A * (size_t)Umax * sizeof *fr);
+    double *sr = grid->cell_x_row ? malloc(A * (size_t)H * sizeof *sr) : NULL;
+    void *srr = grid->cell_x_row ? malloc(A * (size_t)H * rs) : NULL;
+    if (J.st == TS_OK &&
+        (!ip || !dp || !dpr || !fl || !fr || (grid->cell_x_row && (!sr || !srr))))
+        ts_cl_job_fail(&J, TS_ERR_NOMEM, "cannot allocate the horizon sweep tables");
+
+    cl_mem zb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, plane_bytes, zsrc, "heights");
+    cl_mem ob = ts_cl_job_buffer(&J, CL_MEM_WRITE_ONLY, A * plane_bytes, NULL, "horizon planes");
+    cl_mem hib = ts_cl_job_buffer(&J, CL_MEM_READ_WRITE, A * occ_bytes, NULL,
+                                  "far-field occluders");
+    cl_mem lob = ts_cl_job_buffer(&J, CL_MEM_READ_WRITE, A * occ_bytes, NULL,
+                                  "far-field occluders");
+    cl_mem sb = ts_cl_job_buffer(&J, CL_MEM_READ_WRITE, nslots * slot_entries * 2 * rs, NULL,
+                                 "hull stacks");
+    cl_mem skb = ts_cl_job_buffer(&J, CL_MEM_READ_WRITE, nslots * slot_entries * sizeof(cl_int),
+                                  NULL, "hull stacks");
+    cl_mem ipb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, A * TS_CLI_N * sizeof *ip, NULL,
+                                  "azimuth table");
+    cl_mem dpb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, A * TS_CLD_N * rs, NULL, "azimuth table");
+    cl_mem flb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, A * Umax * sizeof *fl, NULL, "line table");
+    cl_mem frb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, A * Umax * sizeof *fr, NULL, "line table");
+    cl_mem srb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, sr ? A * H * rs : 16, NULL, "step table");
+    cl_kernel k1 = ts_cl_job_kernel(&J, "ts_sweep_lines");
+    cl_kernel k2 = ts_cl_job_kernel(&J, "ts_sweep_finish");
+    size_t wg1 = ts_cl_job_wg(&J, k1, 64);
+    size_t wg2 = ts_cl_job_wg(&J, k2, D->is_cpu ? 256 : 128);
+    const cl_int cW = W, cH = H, cslots = (cl_int)nslots;
+    const cl_long cplane = (cl_long)cells;
+
+    for (int first = 0; first < n && J.st == TS_OK; first += (int)A) {
+        int nb = n - first < (int)A ? n - first : (int)A;
+        int items = 0, floff = 0;
+        for (int a = 0; a < nb; a++) {
+            int lines;
+            if (!fill_azimuth(&pg, az[first + a], a, items, floff, ip, dp, fl, fr, sr, &lines,
+                              err)) {
+                J.st = err ? err->code : TS_ERR_NOMEM;
+                break;
+            }
+            items += lines;
+            floff += ip[(size_t)a * TS_CLI_N + TS_CLI_U];
+        }
+        if (J.st != TS_OK)
+            break;
+        ts_cl_to_real(D, dpr, dp, (size_t)nb * TS_CLD_N);
+        ts_cl_job_write(&J, ipb, 0, (size_t)nb * TS_CLI_N * sizeof *ip, ip, "azimuth table");
+        ts_cl_job_write(&J, dpb, 0, (size_t)nb * TS_CLD_N * rs, dpr, "azimuth table");
+        ts_cl_job_write(&J, flb, 0, (size_t)floff * sizeof *fl, fl, "line table");
+        ts_cl_job_write(&J, frb, 0, (size_t)floff * sizeof *fr, fr, "line table");
+        if (sr) {
+            ts_cl_to_real(D, srr, sr, (size_t)nb * H);
+            ts_cl_job_write(&J, srb, 0, (size_t)nb * H * rs, srr, "step table");
+        }
+        const cl_int cnaz = nb, citems = items;
+        /* pass 1: lines */
+        ts_cl_job_arg(&J, k1, 0, sizeof zb, &zb);
+        ts_cl_job_arg(&J, k1, 1, sizeof cW, &cW);
+        ts_cl_job_arg(&J, k1, 2, sizeof cnaz, &cnaz);
+        ts_cl_job_arg(&J, k1, 3, sizeof ipb, &ipb);
+        ts_cl_job_arg(&J, k1, 4, sizeof dpb, &dpb);
+        ts_cl_job_arg(&J, k1, 5, sizeof flb, &flb);
+        ts_cl_job_arg(&J, k1, 6, sizeof frb, &frb);
+        ts_cl_job_arg(&J, k1, 7, sizeof srb, &srb);
+        ts_cl_job_arg(&J, k1, 9, sizeof citems, &citems);
+        ts_cl_job_arg_real(&J, k1, 10, c);
+        ts_cl_job_arg(&J, k1, 11, sizeof hib, &hib);
+        ts_cl_job_arg(&J, k1, 12, sizeof lob, &lob);
+        ts_cl_job_arg(&J, k1, 13, sizeof cplane, &cplane);
+        ts_cl_job_arg(&J, k1, 14, sizeof sb, &sb);
+        ts_cl_job_arg(&J, k1, 15, sizeof skb, &skb);
+        ts_cl_job_arg(&J, k1, 16, sizeof cslots, &cslots);
+        for (int item0 = 0; item0 < items && J.st == TS_OK; item0 += (int)nslots) {
+            const cl_int citem0 = item0;
+            size_t active = (size_t)(items - item0) < nslots ? (size_t)(items - item0) : nslots;
+            size_t global = ts_cl_round_up(active, wg1);
+            ts_cl_job_arg(&J, k1, 8, sizeof citem0, &citem0);
+            ts_cl_job_run(&J, k1, 1, &global, &wg1, "ts_sweep_lines");
+        }
+        /* pass 2: cells */
+        ts_cl_job_arg(&J, k2, 0, sizeof zb, &zb);
+        ts_cl_job_arg(&J, k2, 1, sizeof cW, &cW);
+        ts_cl_job_arg(&J, k2, 2, sizeof cH, &cH);
+        ts_cl_job_arg(&J, k2, 3, sizeof ipb, &ipb);
+        ts_cl_job_arg(&J, k2, 4, sizeof dpb, &dpb);
+        ts_cl_job_arg(&J, k2, 5, sizeof frb, &frb);
+        ts_cl_job_arg(&J, k2, 6, sizeof srb, &srb);
+        ts_cl_job_arg_real(&J, k2, 7, c);
+        ts_cl_job_arg_real(&J, k2, 8, cap);
+        ts_cl_job_arg(&J, k2, 9, sizeof ob, &ob);
+        ts_cl_job_arg(&J, k2, 10, sizeof hib, &hib);
+        ts_cl_job_arg(&J, k2, 11, sizeof lob, &lob);
+        ts_cl_job_arg(&J, k2, 12, sizeof cplane, &cplane);
+        size_t global2[2] = {ts_cl_round_up(cells, wg2), (size_t)nb}, local2[2] = {wg2, 1};
+        ts_cl_job_run(&J, k2, 2, global2, local2, "ts_sweep_finish");
+        ts_cl_job_read(&J, ob, 0, (size_t)nb * plane_bytes, out + (size_t)first * cells,
+                       "horizon planes");
+    }
+    ts_status st = ts_cl_job_end(&J);
+    free(packed);
+    free(ip);
+    free(dp);
+    free(dpr);
+    free(fl);
+    free(fr);
+    free(sr);
+    free(srr);
+    return st;
+}
+
+/* Argument checks of sweep_setup (horizon_sweep.c); normalises azimuth. */
+static ts_status check_sweep(const ts_grid *grid, double *azimuth, const ts_horizon_opts *opts,
+                             ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if (!opts)
+        return ts_fail(err, TS_ERR_ARG, "horizon options are NULL");
+    ts_horizon_opts o = *opts;
+    o.directions = o.directions < 1 ? 1 : o.directions;
+    if ((st = ts_horizon_opts_validate(&o, err)) != TS_OK)
+        return st;
+    if (!isfinite(*azimuth))
+        return ts_fail(err, TS_ERR_ARG, "azimuth must be a finite number of degrees, got %g",
+                       *azimuth);
+    *azimuth = fmod(*azimuth, 360.0);
+    if (*azimuth < 0)
+        *azimuth += 360.0;
+    return TS_OK;
+}
+
+ts_status ts_cl_horizon_sweep(const ts_grid *grid, double azimuth, const ts_horizon_opts *opts,
+                              float *out, ts_error *err)
+{
+    if (!out)
+        return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
+    ts_status st = check_sweep(grid, &azimuth, opts, err);
+    if (st != TS_OK)
+        return st;
+    return horizon_run(grid, opts, &azimuth, 1, out, err);
+}
+
+ts_status ts_cl_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts, float *out,
+                                ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if ((st = ts_horizon_opts_validate(opts, err)) != TS_OK)
+        return st;
+    if (!out)
+        return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
+    size_t plane = (size_t)grid->width * (size_t)grid->height;
+    if (plane > SIZE_MAX / sizeof(float) / (size_t)opts->directions)
+        return ts_fail(err, TS_ERR_NOMEM, "%d horizon planes of %d x %d cells are too large",
+                       opts->directions, grid->width, grid->height);
+    double *az = malloc((size_t)opts->directions * sizeof *az);
+    if (!az)
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the azimuth list");
+    for (int k = 0; k < opts->directions; k++)
+        az[k] = ts_horizon_azimuth(opts, k); /* in [0, 360) */
+    st = horizon_run(grid, opts, az, opts->directions, out, err);
+    free(az);
+    return st;
+}

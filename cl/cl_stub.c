@@ -1,0 +1,81 @@
+/*
+ * The OpenCL backend when the library is built without OpenCL (configure
+ * found no CL/cl.h or libOpenCL): every function exists and reports that.
+ */
+#ifdef HAVE_CONFIG_H
+#include <config.h>
+#endif
+
+#include "status_internal.h"
+#include "terrashade_cl.h"
+
+#define NOT_BUILT(err)                                                                         \
+    ts_fail(err, TS_ERR_INTERNAL,                                                              \
+            "OpenCL support was not built (configure found no OpenCL headers or library)")
+
+int ts_cl_built(void)
+{
+    return 0;
+}
+
+ts_status ts_cl_available(ts_cl_info *info, ts_error *err)
+{
+    (void)info;
+    return NOT_BUILT(err);
+}
+
+ts_status ts_cl_devices(ts_cl_info *list, int max, int *count, ts_error *err)
+{
+    (void)list;
+    (void)max;
+    if (count)
+        *count = 0;
+    return NOT_BUILT(err);
+}
+
+ts_status ts_cl_horizon_sweep(const ts_grid *grid, double azimuth, const ts_horizon_opts *opts,
+                              float *out, ts_error *err)
+{
+    (void)grid, (void)azimuth, (void)opts, (void)out;
+    return NOT_BUILT(err);
+}
+
+ts_status ts_cl_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts, float *out,
+                                ts_error *err)
+{
+    (void)grid, (void)opts, (void)out;
+    return NOT_BUILT(err);
+}
+
+ts_status ts_cl_shm_compute(const ts_grid *grid, double azimuth, double elevation,
+                            double penumbra_depth, int threads, float *visibility,
+                            float *shadow_height, ts_error *err)
+{
+    (void)grid, (void)azimuth, (void)elevation, (void)penumbra_depth, (void)threads;
+    (void)visibility, (void)shadow_height;
+    return NOT_BUILT(err);
+}
+
+ts_status ts_cl_normals(const ts_grid *grid, float *nx, float *ny, float *nz, ts_error *err)
+{
+    (void)grid, (void)nx, (void)ny, (void)nz;
+    return NOT_BUILT(err);
+}
+
+ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
+                             const float *nz, const float *horizons, const ts_horizon_opts *opts,
+                             double sun_azimuth, double sun_elevation, float *out, ts_error *err)
+{
+    (void)grid, (void)nx, (void)ny, (void)nz, (void)horizons, (void)opts;
+    (void)sun_azimuth, (void)sun_elevation, (void)out;
+    return NOT_BUILT(err);
+}
+
+ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny, const float *nz,
+                          const float *horizons, const ts_horizon_opts *opts, float *svf,
+                          float *sky, float *openness, ts_error *err)
+{
+    (void)grid, (void)nx, (void)ny, (void)nz, (void)horizons, (void)opts;
+    (void)svf, (void)sky, (void)openness;
+    return NOT_BUILT(err);
+}

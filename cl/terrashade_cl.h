@@ -1,0 +1,112 @@
+/*
+ * terrashade_cl.h - the OpenCL backend of libterrashade.
+ *
+ * The same products as the C core (terrashade.h), computed by OpenCL
+ * kernels, with the same results: every function mirrors the C function of
+ * the same name without the "cl_" and checks its arguments the same way.
+ * Measured differences to the C backend are in docs/opencl.md.
+ *
+ * Device: the environment variable TERRASHADE_OPENCL_DEVICE picks it, as a
+ * flat index over all devices of all platforms ("0", "1", ...) or as
+ * "platform:device" ("1:0"); unset or empty means the first GPU, else the
+ * first accelerator, else the first device. ts_cl_devices lists them.
+ * TERRASHADE_OPENCL_MAX_ALLOC (bytes, or with a k/M/G suffix) caps the size
+ * of any one device buffer below the device's own limit, for a device shared
+ * with other programs.
+ *
+ * Failures: no platform, no device, a bad TERRASHADE_OPENCL_DEVICE, a
+ * kernel build failure, a device allocation that fails or is too large, a
+ * kernel that fails: the function returns an error whose message names the
+ * OpenCL call and the OpenCL error (e.g. "CL_INVALID_BUFFER_SIZE"); nothing
+ * crashes and nothing is left allocated. Device memory errors give
+ * TS_ERR_NOMEM, the other OpenCL failures TS_ERR_INTERNAL, argument errors
+ * TS_ERR_ARG exactly as the C function would. The caller then uses the C
+ * backend, which is what the dispatcher of terrashade_backend.h does.
+ *
+ * Process-wide state: the list of platforms and devices (read once, as the
+ * ICD loader reads its vendor files once), and per device that has been used
+ * one context, one in-order command queue and one built program. They are
+ * made on first use under a mutex (pthread_once / pthread_mutex) and kept
+ * until the process exits; this is the only global state of terrashade.
+ * Every function is thread-safe: kernels and buffers are per call.
+ *
+ * Without OpenCL at build time (configure found no CL/cl.h or libOpenCL)
+ * the functions exist and return TS_ERR_INTERNAL with the message "OpenCL
+ * support was not built".
+ */
+#ifndef TERRASHADE_CL_H
+#define TERRASHADE_CL_H
+
+#include "terrashade.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** What an OpenCL device is. */
+typedef struct {
+    char platform[128];     /**< CL_PLATFORM_NAME */
+    char device[128];       /**< CL_DEVICE_NAME */
+    char version[96];       /**< CL_DEVICE_VERSION, e.g. "OpenCL 3.0 PoCL ..." */
+    char type[16];          /**< "GPU", "CPU", "accelerator" or "other" */
+    int index;              /**< flat index (a TERRASHADE_OPENCL_DEVICE value) */
+    int platform_index;     /**< platform:device form of the same */
+    int device_index;
+    int compute_units;      /**< CL_DEVICE_MAX_COMPUTE_UNITS */
+    int fp64;               /**< 1: kernels compute in double where the C code does */
+    unsigned long long global_mem; /**< bytes */
+    unsigned long long max_alloc;  /**< bytes per buffer, after TERRASHADE_OPENCL_MAX_ALLOC */
+    size_t max_work_group;  /**< CL_DEVICE_MAX_WORK_GROUP_SIZE */
+} ts_cl_info;
+
+/** 1 if the library was built with OpenCL support, else 0. */
+int ts_cl_built(void);
+
+/**
+ * Select the device (TERRASHADE_OPENCL_DEVICE), make its context, queue and
+ * program (first call only) and describe it in *info (may be NULL). TS_OK
+ * means the OpenCL functions below can run.
+ */
+ts_status ts_cl_available(ts_cl_info *info, ts_error *err);
+
+/**
+ * List every OpenCL device of every platform (nothing is built): up to
+ * `max` entries into `list`, the number found into *count.
+ */
+ts_status ts_cl_devices(ts_cl_info *list, int max, int *count, ts_error *err);
+
+/** ts_horizon_sweep on the device: one azimuth, width*height degrees. */
+ts_status ts_cl_horizon_sweep(const ts_grid *grid, double azimuth,
+                              const ts_horizon_opts *opts, float *out,
+                              ts_error *err);
+
+/** ts_horizon_compute on the device: opts->directions planes. */
+ts_status ts_cl_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts,
+                                float *out, ts_error *err);
+
+/** ts_shm_compute on the device (`threads` is checked, then unused). */
+ts_status ts_cl_shm_compute(const ts_grid *grid, double azimuth, double elevation,
+                            double penumbra_depth, int threads, float *visibility,
+                            float *shadow_height, ts_error *err);
+
+/** ts_normals on the device. */
+ts_status ts_cl_normals(const ts_grid *grid, float *nx, float *ny, float *nz,
+                        ts_error *err);
+
+/** ts_shade_direct on the device. */
+ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
+                             const float *nz, const float *horizons,
+                             const ts_horizon_opts *opts, double sun_azimuth,
+                             double sun_elevation, float *out, ts_error *err);
+
+/** ts_sky_terms on the device (any of svf, sky, openness may be NULL). */
+ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
+                          const float *nz, const float *horizons,
+                          const ts_horizon_opts *opts, float *svf, float *sky,
+                          float *openness, ts_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* TERRASHADE_CL_H */
