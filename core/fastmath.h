@@ -1,18 +1,21 @@
-/* Small branch-free math that the compiler can vectorise. */
+/* Small branch-free math that the compiler can vectorise (glibc's libm
+ * calls cannot be). Accuracy is stated per function. */
 #ifndef TS_FASTMATH_H
 #define TS_FASTMATH_H
 
 #include <math.h>
 
 #define TS_RAD2DEG_F 57.295779513082321f
+#define TS_PI_2_F 1.57079632679f
 
-/* atan(s) in degrees, max error 3e-6 deg; +-inf -> +-90, NaN -> NaN.
+/* atan(s) in radians, max error 5e-8 rad; +-inf -> +-pi/2, NaN -> NaN.
  * Odd least-squares polynomial on [0, 1], atan(1/x) identity beyond. */
-static inline float ts_atan_deg(float s)
+static inline float ts_atanf(float s)
 {
     float a = fabsf(s);
     int big = a > 1.0f;
-    float x = big ? 1.0f / a : a;
+    float inv = 1.0f / a; /* always computed: a select, not a branch */
+    float x = big ? inv : a;
     float x2 = x * x;
     float p = -4.065356858e-03f;
     p = p * x2 + 2.189318185e-02f;
@@ -23,8 +26,49 @@ static inline float ts_atan_deg(float s)
     p = p * x2 - 3.332982797e-01f;
     p = p * x2 + 9.999993225e-01f;
     p *= x;
-    p = big ? 1.57079632679f - p : p;
-    return copysignf(p, s) * TS_RAD2DEG_F;
+    p = big ? TS_PI_2_F - p : p;
+    return copysignf(p, s);
+}
+
+/* atan(s) in degrees, max error 3e-6 deg. */
+static inline float ts_atan_deg(float s)
+{
+    return ts_atanf(s) * TS_RAD2DEG_F;
+}
+
+/* sin and cos of x in [0, pi] (zenith angles), max error 1e-7, from
+ * polynomials in y = x - pi/2 on [-pi/2, pi/2]: sin x = cos y,
+ * cos x = -sin y. */
+static inline void ts_sincos_0_pi(float x, float *s, float *c)
+{
+    float y = x - TS_PI_2_F, y2 = y * y;
+    float sy = -2.3843565983e-08f;
+    sy = sy * y2 + 2.7521933788e-06f;
+    sy = sy * y2 - 1.9840772786e-04f;
+    sy = sy * y2 + 8.3333299520e-03f;
+    sy = sy * y2 - 1.6666666569e-01f;
+    sy = (sy * y2 + 9.9999999992e-01f) * y;
+    float cy = 1.9942810736e-09f;
+    cy = cy * y2 - 2.7527114971e-07f;
+    cy = cy * y2 + 2.4801102961e-05f;
+    cy = cy * y2 - 1.3888884914e-03f;
+    cy = cy * y2 + 4.1666666512e-02f;
+    cy = cy * y2 - 4.9999999998e-01f;
+    cy = cy * y2 + 1.0f;
+    *s = cy;
+    *c = -sy;
+}
+
+/* Visible fraction of the sun's disk for u = (elevation - horizon) / radius:
+ * the area of a unit disk above a chord at height -u, over pi. */
+static inline float ts_disk_fraction_u(float u)
+{
+    float uc = u > 1.0f ? 1.0f : u < -1.0f ? -1.0f : u;
+    float r = sqrtf(1.0f - uc * uc);
+    /* asin(uc) = atan(uc / r), and +-pi/2 where r is 0 */
+    float q = uc / (r > 0.0f ? r : 1.0f);
+    float as = r > 0.0f ? ts_atanf(q) : copysignf(TS_PI_2_F, uc);
+    return 0.5f + (uc * r + as) * 0.318309886f;
 }
 
 #endif

@@ -8,6 +8,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "fastmath.h"
 #include "parallel.h"
 #include "status_internal.h"
 
@@ -24,33 +25,52 @@ typedef struct {
 /* One swath's share of eq. 5 for zenith limit theta. */
 static inline float swath(float nz, float a, float theta, float w1, float w2)
 {
-    float s = sinf(theta), c = cosf(theta);
+    float s, c;
+    ts_sincos_0_pi(theta, &s, &c);
     return w1 * nz * s * s + w2 * (theta - s * c) * a;
 }
 
+/* Zenith limit of one swath at a cell: the horizon's zenith angle, raised
+ * to at most pi/2 (the horizontal) for sky light, and never below the
+ * tangent plane. Branch-free, so that the loops vectorise. */
+static inline float swath_theta(float nx, float ny, float nz, float h, float sa, float ca,
+                                int sky_only, float *a_out)
+{
+    const float half_pi = (float)(M_PI / 2), d2r = (float)DEG2RAD;
+    float a = nx * sa + ny * ca;
+    float theta_n = half_pi + ts_atanf(a / nz);
+    float theta_h = half_pi - h * d2r;
+    if (sky_only)
+        theta_h = theta_h < half_pi ? theta_h : half_pi;
+    *a_out = a;
+    return theta_h < theta_n ? theta_h : theta_n;
+}
+
+/* One loop per term, each vectorised; NaN (nodata) is carried explicitly
+ * because the comparisons drop it. */
 static void sky_rows(void *ctx, int worker, long y0, long y1)
 {
     (void)worker;
     const sky_ctx *C = ctx;
-    size_t W = (size_t)C->g->width;
-    for (size_t i = (size_t)y0 * W; i < (size_t)y1 * W; i++) {
-        float h = C->plane[i], nz = C->nz[i];
-        if (isnan(h) || isnan(nz)) {
-            if (C->svf) C->svf[i] = NAN;
-            if (C->sky) C->sky[i] = NAN;
-            if (C->open) C->open[i] = NAN;
+    size_t W = (size_t)C->g->width, i0 = (size_t)y0 * W, i1 = (size_t)y1 * W;
+    const float *restrict nx = C->nx, *restrict ny = C->ny, *restrict nz = C->nz;
+    const float *restrict plane = C->plane;
+    const float sa = C->sa, ca = C->ca, w1 = C->w1, w2 = C->w2;
+    float *restrict acc[2] = {C->svf, C->sky};
+    for (int term = 0; term < 2; term++) {
+        float *restrict out = acc[term];
+        if (!out)
             continue;
+        for (size_t i = i0; i < i1; i++) {
+            float a, h = plane[i], z = nz[i];
+            float th = swath_theta(nx[i], ny[i], z, h, sa, ca, term == 1, &a);
+            out[i] += swath(z, a, th, w1, w2) + (h - h) + (z - z);
         }
-        float a = C->nx[i] * C->sa + C->ny[i] * C->ca;
-        float theta_n = (float)(M_PI / 2) + atanf(a / nz);
-        float theta_h = (float)(M_PI / 2) - h * (float)DEG2RAD;
-        if (C->svf)
-            C->svf[i] += swath(nz, a, fminf(theta_h, theta_n), C->w1, C->w2);
-        if (C->sky)
-            C->sky[i] += swath(nz, a, fminf(fminf(theta_h, (float)(M_PI / 2)), theta_n), C->w1,
-                               C->w2);
-        if (C->open)
-            C->open[i] += 90.0f - h;
+    }
+    if (C->open) {
+        float *restrict open = C->open;
+        for (size_t i = i0; i < i1; i++)
+            open[i] += 90.0f - plane[i] + (nz[i] - nz[i]);
     }
 }
 

@@ -1,0 +1,220 @@
+/*
+ * day_cycle.h - the sun over a day: sampling times, per-cell sun
+ * visibility at an instant, hours of direct sun, clear-sky irradiation
+ * (insolation) over a local day, and the dawn/dusk-weighted times of the
+ * far-shadow atlas (Chajdas et al. 2015). No GDAL, no global state.
+ *
+ * Where the sun is seen from: a `ts_sun_sites` is one site (the DEM's
+ * centre) or a lattice of sites over the grid; with a lattice the sun's
+ * azimuth and elevation are computed with the SPA at every node and
+ * interpolated bilinearly to each cell. Azimuths from the SPA are true
+ * azimuths; each site also gives the grid azimuth of true north (the
+ * meridian convergence of a projected CRS, with the opposite sign), and the
+ * horizon sweeps use grid azimuth = true azimuth + north_azimuth.
+ *
+ * See docs/day-cycle.md for the models.
+ */
+#ifndef TS_DAY_CYCLE_H
+#define TS_DAY_CYCLE_H
+
+#include "terrashade.h"
+#include "terrashade_sun.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------- dates, offsets */
+
+/**
+ * Parse a calendar date "YYYY-MM-DD" (exactly that form; the date must
+ * exist in the proleptic Gregorian calendar). The message says what is
+ * wrong and what is expected.
+ */
+ts_status ts_parse_date(const char *s, int *year, int *month, int *day,
+                        ts_error *err);
+
+/**
+ * Parse a fixed offset from UTC: "Z", "UTC", "+hh:mm", "-hh:mm", "+hhmm" or
+ * "+hh" (hh <= 23, mm <= 59). *minutes receives the offset east of UTC.
+ * Named time zones (Europe/Zurich) are refused: a fixed offset makes the
+ * day exactly 24 hours long.
+ */
+ts_status ts_parse_utc_offset(const char *s, int *minutes, ts_error *err);
+
+/** Unix time of local midnight starting the given date at a fixed offset. */
+double ts_local_midnight(int year, int month, int day, int offset_minutes);
+
+/** Unix time of the local midnight that starts the local day containing the
+ * instant `unix_time`, at a fixed offset. */
+double ts_local_day_start(double unix_time, int offset_minutes);
+
+/* ------------------------------------------------------------ the sites */
+
+/**
+ * Where the sun is seen from. nx = ny = 1: one site for the whole grid.
+ * Otherwise an nx x ny lattice, node (i, j) at pixel coordinates
+ * (x0 + i dx, y0 + j dy), where the centre of cell (c, r) is (c + 0.5,
+ * r + 0.5) and row 0 is north. Cells beyond the lattice take the nearest
+ * edge values. Arrays hold nx*ny values, node (i, j) at j*nx + i.
+ */
+typedef struct {
+    int nx, ny;
+    double x0, y0, dx, dy;
+    const double *longitude;     /**< degrees east, [-180, 180] */
+    const double *latitude;      /**< degrees north, [-90, 90] */
+    const double *north_azimuth; /**< grid azimuth of true north, degrees;
+                                      NULL = 0 (grid north = true north) */
+} ts_sun_sites;
+
+/** Options of the day computations. Fill with ts_day_opts_default. */
+typedef struct {
+    ts_horizon_opts horizon; /**< curvature, refraction, max_distance, threads;
+                                  `directions` = azimuths of the sky-view term
+                                  of the insolation */
+    ts_sun_input sun;        /**< template of the SPA input: pressure,
+                                  temperature, delta_t, atmos_refraction,
+                                  elevation (jd, latitude, longitude are set
+                                  per site and instant) */
+    double linke_turbidity;  /**< Linke turbidity factor (air mass 2), >= 1 */
+    int earth_horizon;       /**< 1: the horizon of a cell is at least the dip
+                                  of the sea-level horizon seen from its height
+                                  (ts_earth_horizon); 0: terrain only */
+} ts_day_opts;
+
+/** Defaults: ts_horizon_opts_default, ts_sun_input_default, Linke turbidity
+ * 3, Earth horizon on. */
+void ts_day_opts_default(ts_day_opts *o);
+
+/** Check options and sites (counts, finite coordinates, latitudes within
+ * +/-90, longitudes within +/-180); the message names what is wrong. */
+ts_status ts_sun_sites_validate(const ts_sun_sites *s, ts_error *err);
+
+/**
+ * Elevation angle (degrees, <= 0) of the sea-level horizon seen from
+ * `height_m` metres: -acos(R' / (R' + h)) with R' = R / (1 - k) when
+ * curvature is on (k = refraction), 0 when it is off or h <= 0.
+ */
+double ts_earth_horizon(double height_m, const ts_horizon_opts *o);
+
+/** The sun seen from one site at one instant. */
+typedef struct {
+    double unix_time;
+    double azimuth;      /**< true azimuth, degrees from true north */
+    double grid_azimuth; /**< azimuth + north_azimuth, in [0, 360) */
+    double elevation;    /**< apparent (refracted) elevation of the centre */
+    double distance_au;  /**< Earth-Sun distance, astronomical units */
+} ts_sun_sample;
+
+/**
+ * The sun at the reference site of `sites` (the single site, or the node
+ * nearest the lattice's middle) at `unix_time`.
+ */
+ts_status ts_sun_at_site(const ts_sun_sites *sites, const ts_day_opts *o,
+                         double unix_time, ts_sun_sample *out, ts_error *err);
+
+/* ------------------------------------------------------- sampling times */
+
+/**
+ * Number of steps of STEP seconds that cover [0, length): ceil(length/step).
+ */
+int ts_day_step_count(double length_s, double step_s);
+
+/**
+ * Uniform steps over [start, start + length): step i covers
+ * [start + i step, min(start + (i+1) step, end)); mid[i] receives its
+ * middle and dur[i] its length in seconds (the last step may be shorter).
+ * Both arrays hold ts_day_step_count(length, step) values.
+ */
+ts_status ts_day_uniform_times(double start_unix, double length_s,
+                               double step_s, double *mid, double *dur,
+                               ts_error *err);
+
+/**
+ * Times of the far-shadow atlas: n instants within [start, start + length)
+ * while the sun (at the reference site) is up, i.e. its apparent centre is
+ * above -TS_SUN_RADIUS_DEG, sampled more densely near dawn and dusk: the
+ * instants are the midpoints of n equal shares of the integral of
+ * w(t) = 1 / max(sin e(t), sin 2 deg) over the daylight (e = apparent sun
+ * elevation, evaluated every minute and interpolated linearly). *n_out is
+ * n, or 0 when the sun does not rise (polar night).
+ */
+ts_status ts_day_atlas_times(const ts_sun_sites *sites, const ts_day_opts *o,
+                             double start_unix, double length_s, int n,
+                             double *times, int *n_out, ts_error *err);
+
+/* ---------------------------------------------------- sun on the grid */
+
+/**
+ * The sun seen from every cell at one instant: vis (width*height, may not
+ * be NULL) receives the visible fraction (0..1) of the sun's disk above
+ * the cell's horizon toward the sun (ts_horizon_sweep at the sun's grid
+ * azimuth; with a lattice, sweeps at azimuths 1 deg apart or less across
+ * the cells' range, interpolated linearly), raised to the Earth's horizon
+ * when o->earth_horizon; NaN for nodata. az and el (may be NULL) receive
+ * each cell's grid azimuth and apparent elevation of the sun. `ref` (may
+ * be NULL) receives the sun at the reference site. No sweep is run while
+ * the sun is below every cell's possible horizon.
+ */
+ts_status ts_sun_visibility(const ts_grid *grid, const ts_sun_sites *sites,
+                            const ts_day_opts *o, double unix_time, float *vis,
+                            float *az, float *el, ts_sun_sample *ref,
+                            ts_error *err);
+
+/**
+ * Hours of direct sun over [start, start + length): the sum over uniform
+ * steps of step_s seconds of the visible fraction of the sun's disk at the
+ * middle of each step times the step's length. `hours` width*height, NaN
+ * for nodata.
+ */
+ts_status ts_sun_hours(const ts_grid *grid, const ts_sun_sites *sites,
+                       const ts_day_opts *o, double start_unix,
+                       double length_s, double step_s, float *hours,
+                       ts_error *err);
+
+/* ------------------------------------------------------------ clear sky */
+
+/** Solar constant of the clear-sky model, W/m^2 (ESRA). */
+#define TS_SOLAR_CONSTANT 1367.0
+
+/** Clear-sky irradiances, W/m^2. */
+typedef struct {
+    double beam_normal;        /**< on a plane facing the sun */
+    double beam_horizontal;    /**< beam_normal x sin(elevation) */
+    double diffuse_horizontal; /**< from the whole sky on a level plane */
+} ts_clear_sky;
+
+/**
+ * ESRA clear-sky model (Rigollier, Bauer & Wald 2000, as in the European
+ * Solar Radiation Atlas and GRASS r.sun): beam normal
+ * I0 eps exp(-0.8662 TL m dR(m)) with the Kasten & Young (1989) air mass m
+ * corrected for the site's height (p/p0 = exp(-z / 8434.5 m)) and Kasten's
+ * Rayleigh optical thickness dR; diffuse horizontal I0 eps Trd(TL) Fd(h).
+ * eps = 1 / distance_au^2. `elevation` is the apparent sun elevation in
+ * degrees; everything is 0 when it is <= 0.
+ */
+void ts_clear_sky_esra(double elevation, double height_m, double linke,
+                       double distance_au, ts_clear_sky *out);
+
+/**
+ * Clear-sky irradiation over [start, start + length) in Wh/m^2 on each
+ * cell's own tilted surface: at the middle of each step of step_s seconds,
+ *   beam = beam_normal x max(0, N.L) x visible fraction of the sun's disk,
+ *   diffuse = diffuse_horizontal x sky,
+ * with N the Horn normal, L the direction to the sun, and `sky` the
+ * irradiance of a uniform sky (ts_sky_terms, o->horizon.directions
+ * azimuths: the sky-view factor with the horizon raised to at least 0 deg,
+ * 1 on an open level plane); times the step's length in hours. `total`
+ * (may not be NULL), `beam` and `diffuse` (may be NULL) width*height, NaN
+ * for nodata. Ground-reflected light is not included.
+ */
+ts_status ts_insolation(const ts_grid *grid, const ts_sun_sites *sites,
+                        const ts_day_opts *o, double start_unix,
+                        double length_s, double step_s, float *total,
+                        float *beam, float *diffuse, ts_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* TS_DAY_CYCLE_H */
