@@ -1,20 +1,28 @@
 /*
  * gdal_terrashade.cpp - the TERRASHADE GDAL driver: a thin C++ layer over the
  * C option parser (tsd_options, tsd_connstr), the geodesy (tsd_geodesy), the
- * DEM reader (tsd_dem) and the product pipeline (tsd_product).
+ * sun (tsd_sun), the DEM reader (tsd_dem) and the product pipeline
+ * (tsd_product).
  *
  * A dataset computes its whole product once, lazily on the first block read
- * (under a mutex), keeps it in memory as float planes and copies 256 x 256
- * blocks out of it.
+ * (under a mutex), keeps it in memory as float planes (bytes for
+ * PRODUCT=farshadow) and copies 256 x 256 blocks out of it.
+ *
+ * The driver also reads and writes far-shadow atlases (*.tsa,
+ * docs/atlas-format.md): CreateCopy stores any raster of binary bands
+ * (0, 1, nodata), typically PRODUCT=farshadow, and Open recognises the file
+ * by its magic and decodes blocks lazily (tsd_atlas_* below).
  */
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "cpl_conv.h"
 #include "cpl_string.h"
@@ -22,11 +30,13 @@
 #include "gdal_priv.h"
 #include "ogr_spatialref.h"
 
+#include "shadow_atlas.h"
 #include "tsd_connstr.h"
 #include "tsd_dem.h"
 #include "tsd_geodesy.h"
 #include "tsd_options.h"
 #include "tsd_product.h"
+#include "tsd_sun.h"
 
 namespace
 {
@@ -51,8 +61,12 @@ class TSDataset final : public GDALPamDataset
     bool m_bTried = false;
     std::string m_osError{};
     float *m_pafProduct = nullptr;
+    GByte *m_pabyProduct = nullptr; // PRODUCT=farshadow
+    bool m_bHasSun = false;
+    tsd_sun m_sSun{};
 
     CPLErr EnsureComputed();
+    void SetupSunMetadata();
     void SetupMetadata();
     void SetupPam(const char *pszConnection);
 
@@ -99,13 +113,25 @@ double TSRasterBand::GetNoDataValue(int *pbSuccess)
 {
     if (pbSuccess)
         *pbSuccess = TRUE;
+    if (static_cast<TSDataset *>(poDS)->m_sOpts.product == TSD_PRODUCT_FARSHADOW)
+        return TS_ATLAS_NODATA;
     return eDataType == GDT_Byte ? 0.0 : std::numeric_limits<double>::quiet_NaN();
 }
 
 const char *TSRasterBand::GetUnitType()
 {
-    const tsd_product p = static_cast<TSDataset *>(poDS)->m_sOpts.product;
-    return p == TSD_PRODUCT_HORIZON || p == TSD_PRODUCT_OPENNESS ? "degree" : "";
+    switch (static_cast<TSDataset *>(poDS)->m_sOpts.product)
+    {
+        case TSD_PRODUCT_HORIZON:
+        case TSD_PRODUCT_OPENNESS:
+            return "degree";
+        case TSD_PRODUCT_SUNHOURS:
+            return "hour";
+        case TSD_PRODUCT_INSOLATION:
+            return "Wh/m2";
+        default:
+            return "";
+    }
 }
 
 CPLErr TSRasterBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
@@ -116,8 +142,26 @@ CPLErr TSRasterBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
     const int W = nRasterXSize, H = nRasterYSize;
     const int x0 = nBlockXOff * nBlockXSize, y0 = nBlockYOff * nBlockYSize;
     const bool bByte = eDataType == GDT_Byte;
-    const float *plane = ds->m_pafProduct + static_cast<size_t>(m_nPlane) * W * H;
     GByte *pabyOut = static_cast<GByte *>(pImage);
+    if (ds->m_pabyProduct)
+    {
+        const GByte *bplane = ds->m_pabyProduct + static_cast<size_t>(m_nPlane) * W * H;
+        for (int by = 0; by < nBlockYSize; by++)
+        {
+            const int y = y0 + by;
+            const int gy = ds->m_sCells.flip_y ? H - 1 - y : y;
+            for (int bx = 0; bx < nBlockXSize; bx++)
+            {
+                const int x = x0 + bx;
+                const int gx = ds->m_sCells.flip_x ? W - 1 - x : x;
+                pabyOut[static_cast<size_t>(by) * nBlockXSize + bx] =
+                    y < H && x < W ? bplane[static_cast<size_t>(gy) * W + gx]
+                                   : static_cast<GByte>(TS_ATLAS_NODATA);
+            }
+        }
+        return CE_None;
+    }
+    const float *plane = ds->m_pafProduct + static_cast<size_t>(m_nPlane) * W * H;
     float *pafOut = static_cast<float *>(pImage);
     const float fNaN = std::numeric_limits<float>::quiet_NaN();
     for (int by = 0; by < nBlockYSize; by++)
@@ -148,7 +192,9 @@ TSDataset::~TSDataset()
     if (m_poDEM)
         GDALClose(m_poDEM);
     tsd_cells_free(&m_sCells);
+    tsd_sun_free(&m_sSun);
     VSIFree(m_pafProduct);
+    VSIFree(m_pabyProduct);
 }
 
 CPLErr TSDataset::GetGeoTransform(double *padfGT)
@@ -196,11 +242,15 @@ CPLErr TSDataset::EnsureComputed()
             const std::chrono::duration<double> dfRead =
                 std::chrono::steady_clock::now() - tStart;
             CPLDebug(DRIVER, "read the DEM in %.3f s", dfRead.count());
-            m_pafProduct = static_cast<float *>(
-                VSI_MALLOC3_VERBOSE(nCells, nBands, sizeof(float)));
-            if (!m_pafProduct)
+            if (m_sOpts.product == TSD_PRODUCT_FARSHADOW)
+                m_pabyProduct = static_cast<GByte *>(VSI_MALLOC2_VERBOSE(nCells, nBands));
+            else
+                m_pafProduct = static_cast<float *>(
+                    VSI_MALLOC3_VERBOSE(nCells, nBands, sizeof(float)));
+            if (!m_pafProduct && !m_pabyProduct)
                 m_osError = "TERRASHADE: out of memory for the product";
-            else if (tsd_product_compute(&sGrid, &m_sOpts, m_pafProduct, szMsg,
+            else if (tsd_product_compute(&sGrid, &m_sOpts, m_bHasSun ? &m_sSun : nullptr,
+                                         m_pafProduct, m_pabyProduct, szMsg,
                                          sizeof szMsg) != 0)
                 m_osError = std::string("TERRASHADE: ") + szMsg;
             ts_grid_free(&sGrid);
@@ -209,6 +259,8 @@ CPLErr TSDataset::EnsureComputed()
         {
             VSIFree(m_pafProduct);
             m_pafProduct = nullptr;
+            VSIFree(m_pabyProduct);
+            m_pabyProduct = nullptr;
         }
         GDALClose(m_poDEM);
         m_poDEM = nullptr;
@@ -232,7 +284,7 @@ void TSDataset::SetupMetadata()
     for (int i = 0; i < tsd_options_count(); i++)
     {
         const char *pszName = tsd_options_value(&m_sOpts, i, szValue, sizeof szValue);
-        if (EQUAL(pszName, "THREADS") || EQUAL(pszName, "MAX_MEMORY"))
+        if (EQUAL(pszName, "THREADS") || EQUAL(pszName, "MAX_MEMORY") || !szValue[0])
             continue;
         GDALDataset::SetMetadataItem(pszName, szValue);
     }
@@ -266,11 +318,89 @@ void TSDataset::SetupMetadata()
             poBand->GDALMajorObject::SetMetadataItem("AZIMUTH", pszAz);
         }
     }
-    else
+    else if (m_sOpts.product == TSD_PRODUCT_INSOLATION)
+    {
+        const char *apszNames[3] = {"global", "beam", "diffuse"};
+        for (int k = 0; k < 3; k++)
+            GetRasterBand(k + 1)->GDALMajorObject::SetDescription(
+                CPLSPrintf("insolation %s", apszNames[k]));
+    }
+    else if (m_sOpts.product != TSD_PRODUCT_DAYCYCLE &&
+             m_sOpts.product != TSD_PRODUCT_FARSHADOW)
     {
         GetRasterBand(1)->GDALMajorObject::SetDescription(
             tsd_product_name(m_sOpts.product));
     }
+    if (m_bHasSun)
+        SetupSunMetadata();
+}
+
+/* The metadata of one time step: its instant and the sun there. */
+static void SetStepMetadata(GDALMajorObject *poObj, double dfTime, int nOffset,
+                            double dfAzTrue, double dfAzGrid, double dfEl,
+                            double dfDuration)
+{
+    if (std::isfinite(dfTime))
+    {
+        char szTime[64];
+        tsd_format_time(dfTime, nOffset, szTime, sizeof szTime);
+        poObj->SetDescription(szTime);
+        poObj->SetMetadataItem("TIME", szTime);
+        poObj->SetMetadataItem("UNIX_TIME", CPLSPrintf("%.3f", dfTime));
+    }
+    if (std::isfinite(dfDuration))
+        poObj->SetMetadataItem("DURATION_MINUTES", CPLSPrintf("%.10g", dfDuration / 60));
+    if (std::isfinite(dfAzGrid))
+        poObj->SetMetadataItem("SUN_AZIMUTH", CPLSPrintf("%.6f", dfAzGrid));
+    if (std::isfinite(dfAzTrue))
+        poObj->SetMetadataItem("SUN_AZIMUTH_TRUE", CPLSPrintf("%.6f", dfAzTrue));
+    if (std::isfinite(dfEl))
+        poObj->SetMetadataItem("SUN_ELEVATION", CPLSPrintf("%.6f", dfEl));
+}
+
+/* Where and when the sun was placed, with the names of the values used. */
+void TSDataset::SetupSunMetadata()
+{
+    const tsd_sun &s = m_sSun;
+    const int nRef = (s.sites.ny / 2) * s.sites.nx + s.sites.nx / 2;
+    const double dfNorth = s.sites.north_azimuth[nRef];
+    GDALDataset::SetMetadataItem("SUN_SITE_LONGITUDE",
+                                 CPLSPrintf("%.8f", s.sites.longitude[nRef]));
+    GDALDataset::SetMetadataItem("SUN_SITE_LATITUDE",
+                                 CPLSPrintf("%.8f", s.sites.latitude[nRef]));
+    GDALDataset::SetMetadataItem("MERIDIAN_CONVERGENCE", CPLSPrintf("%.6f", -dfNorth));
+    GDALDataset::SetMetadataItem("SUN_MODEL", "SPA (Reda & Andreas 2004), apparent "
+                                              "elevation with refraction");
+    char szTime[64];
+    if (!tsd_product_is_daily(m_sOpts.product))
+    {
+        tsd_format_time(s.instant, s.offset_minutes, szTime, sizeof szTime);
+        GDALDataset::SetMetadataItem("SUN_TIME", szTime);
+        GDALDataset::SetMetadataItem("SUN_AZIMUTH", CPLSPrintf("%.6f", s.sun.grid_azimuth));
+        GDALDataset::SetMetadataItem("SUN_AZIMUTH_TRUE", CPLSPrintf("%.6f", s.sun.azimuth));
+        GDALDataset::SetMetadataItem("SUN_ELEVATION", CPLSPrintf("%.6f", s.sun.elevation));
+        return;
+    }
+    /* a day: the sun's azimuth and elevation change; SUN_AZIMUTH and
+     * SUN_ELEVATION of the options do not apply */
+    GDALDataset::SetMetadataItem("SUN_AZIMUTH", nullptr);
+    GDALDataset::SetMetadataItem("SUN_ELEVATION", nullptr);
+    tsd_format_time(s.day_start, s.offset_minutes, szTime, sizeof szTime);
+    GDALDataset::SetMetadataItem("DAY_START", szTime);
+    tsd_format_time(s.day_start + s.day_length, s.offset_minutes, szTime, sizeof szTime);
+    GDALDataset::SetMetadataItem("DAY_END", szTime);
+    GDALDataset::SetMetadataItem("UTC_OFFSET_MINUTES", CPLSPrintf("%d", s.offset_minutes));
+    if (m_sOpts.product == TSD_PRODUCT_INSOLATION)
+        GDALDataset::SetMetadataItem(
+            "CLEAR_SKY_MODEL",
+            "ESRA (Rigollier et al. 2000): beam on the tilted surface x visible "
+            "fraction of the sun + diffuse horizontal x sky-view factor (sky term)");
+    if (m_sOpts.product == TSD_PRODUCT_FARSHADOW)
+        GDALDataset::SetMetadataItem("FAR_THRESHOLD_M", CPLSPrintf("%.6f", s.threshold_m));
+    for (int k = 0; k < s.steps; k++)
+        SetStepMetadata(GetRasterBand(k + 1), s.times[k], s.offset_minutes,
+                        s.samples[k].azimuth, s.samples[k].grid_azimuth,
+                        s.samples[k].elevation, s.durations[k]);
 }
 
 /* Auxiliary metadata (statistics...) goes next to the DEM's file, in a
@@ -395,6 +525,32 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     if (tsd_cells_compute(poDS->m_adfGT, W, H, hSRS, &poDS->m_sCells, szMsg,
                           sizeof szMsg) != 0)
         return OpenFailed(CPLE_AppDefined, szMsg);
+    if (tsd_options_sun_from_time(&sOpts))
+    {
+        const char *pszWhat = sOpts.datetime[0] ? "DATETIME" : "DATE";
+        if (!poDS->m_bHasGT || !hSRS)
+            return OpenFailed(
+                CPLE_AppDefined,
+                CPLSPrintf("%s needs a georeferenced DEM, but '%s' has no %s: the sun's "
+                           "position over it is unknown. Give it one (gdal_edit.py "
+                           "-a_srs / -a_ullr) or use SUN_AZIMUTH and SUN_ELEVATION",
+                           pszWhat, osDEM.c_str(),
+                           !poDS->m_bHasGT ? "geotransform" : "CRS"));
+        tsd_sites sSites;
+        if (tsd_sites_compute(poDS->m_adfGT, W, H, hSRS, &poDS->m_sCells,
+                              sOpts.sun_position == TSD_SUN_PER_CELL, &sSites, szMsg,
+                              sizeof szMsg) != 0)
+            return OpenFailed(CPLE_AppDefined, CPLSPrintf("%s: %s", pszWhat, szMsg));
+        double dfMinCell = poDS->m_sCells.cell_y;
+        for (int y = 0; y < H; y++)
+            dfMinCell = std::min(dfMinCell, poDS->m_sCells.cell_x_row
+                                                ? poDS->m_sCells.cell_x_row[y]
+                                                : poDS->m_sCells.cell_x);
+        if (tsd_sun_setup(&poDS->m_sOpts, &sSites, dfMinCell, &poDS->m_sSun, szMsg,
+                          sizeof szMsg) != 0)
+            return OpenFailed(CPLE_AppDefined, szMsg);
+        poDS->m_bHasSun = true;
+    }
     if (poDS->m_sCells.warning[0])
         CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s",
                  poDS->m_sCells.warning);
@@ -404,11 +560,492 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     poDS->nRasterXSize = W;
     poDS->nRasterYSize = H;
     const GDALDataType eType = tsd_options_output_byte(&sOpts) ? GDT_Byte : GDT_Float32;
+    sOpts = poDS->m_sOpts; // with the sun placed
     for (int i = 1; i <= tsd_options_band_count(&sOpts); i++)
         poDS->SetBand(i, new TSRasterBand(poDS.get(), i, eType));
     poDS->SetupMetadata();
     poDS->SetupPam(poOpenInfo->pszFilename);
     return poDS.release();
+}
+
+/* ============================================================== atlases */
+
+/* KEY=VALUE lines of an atlas's metadata text. */
+static CPLStringList AtlasMetadata(const char *pszText)
+{
+    CPLStringList aosOut;
+    const CPLStringList aosLines(CSLTokenizeStringComplex(pszText, "\n", FALSE, FALSE));
+    for (int i = 0; i < aosLines.size(); i++)
+        if (strchr(aosLines[i], '='))
+            aosOut.AddString(aosLines[i]);
+    return aosOut;
+}
+
+class TSAtlasBand;
+
+class TSAtlasDataset final : public GDALPamDataset
+{
+    friend class TSAtlasBand;
+
+    ts_atlas *m_psAtlas = nullptr;
+    OGRSpatialReference m_oSRS{};
+    double m_adfGT[6] = {0, 1, 0, 0, 0, 1};
+    bool m_bHasGT = false;
+    bool m_bAll = false; // SHADOWS=all: far | near, near recomputed from the DEM
+    std::string m_osDEM{};
+    int m_nThreads = 0;
+    CPLStringList m_aosMeta{};
+    std::mutex m_oMutex{};
+    bool m_bTried = false;
+    std::string m_osError{};
+    GByte *m_pabyNear = nullptr; // near-shadow bits, raster order, one plane per map
+
+    CPLErr EnsureNear();
+
+  public:
+    TSAtlasDataset() = default;
+    ~TSAtlasDataset() override;
+
+    static GDALDataset *Open(GDALOpenInfo *poOpenInfo);
+    static GDALDataset *CreateCopy(const char *pszFilename, GDALDataset *poSrcDS,
+                                   int bStrict, char **papszOptions,
+                                   GDALProgressFunc pfnProgress, void *pProgressData);
+
+    CPLErr GetGeoTransform(double *padfGT) override
+    {
+        if (!m_bHasGT)
+            return GDALPamDataset::GetGeoTransform(padfGT);
+        memcpy(padfGT, m_adfGT, sizeof m_adfGT);
+        return CE_None;
+    }
+    const OGRSpatialReference *GetSpatialRef() const override
+    {
+        return m_oSRS.IsEmpty() ? nullptr : &m_oSRS;
+    }
+};
+
+class TSAtlasBand final : public GDALPamRasterBand
+{
+    int m_nStep;
+
+  public:
+    TSAtlasBand(TSAtlasDataset *poDSIn, int nBandIn) : m_nStep(nBandIn - 1)
+    {
+        poDS = poDSIn;
+        nBand = nBandIn;
+        eDataType = GDT_Byte;
+        nBlockXSize = std::min(BLOCK, poDSIn->GetRasterXSize());
+        nBlockYSize = std::min(BLOCK, poDSIn->GetRasterYSize());
+    }
+
+    CPLErr IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage) override;
+    double GetNoDataValue(int *pbSuccess = nullptr) override
+    {
+        // as PRODUCT=farshadow, whether or not the maps have nodata cells
+        if (pbSuccess)
+            *pbSuccess = TRUE;
+        return TS_ATLAS_NODATA;
+    }
+    GDALColorInterp GetColorInterpretation() override
+    {
+        return GCI_GrayIndex;
+    }
+};
+
+TSAtlasDataset::~TSAtlasDataset()
+{
+    TSAtlasDataset::FlushCache(true);
+    ts_atlas_free(m_psAtlas);
+    VSIFree(m_pabyNear);
+}
+
+CPLErr TSAtlasBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
+{
+    TSAtlasDataset *ds = static_cast<TSAtlasDataset *>(poDS);
+    if (ds->m_bAll && ds->EnsureNear() != CE_None)
+        return CE_Failure;
+    const int W = nRasterXSize, H = nRasterYSize;
+    const int x0 = nBlockXOff * nBlockXSize, y0 = nBlockYOff * nBlockYSize;
+    const int w = std::min(nBlockXSize, W - x0), h = std::min(nBlockYSize, H - y0);
+    GByte *pabyOut = static_cast<GByte *>(pImage);
+    memset(pabyOut, TS_ATLAS_NODATA, static_cast<size_t>(nBlockXSize) * nBlockYSize);
+    ts_error sErr;
+    if (ts_atlas_read(ds->m_psAtlas, m_nStep, x0, y0, w, h, pabyOut, nBlockXSize, &sErr) !=
+        TS_OK)
+    {
+        CPLError(CE_Failure, CPLE_AppDefined, "TERRASHADE: %s", sErr.message);
+        return CE_Failure;
+    }
+    if (ds->m_bAll)
+    {
+        const GByte *near = ds->m_pabyNear + static_cast<size_t>(m_nStep) * W * H;
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++)
+            {
+                GByte &v = pabyOut[static_cast<size_t>(y) * nBlockXSize + x];
+                if (v != TS_ATLAS_NODATA)
+                    v |= near[static_cast<size_t>(y0 + y) * W + x0 + x];
+            }
+    }
+    return CE_None;
+}
+
+/* SHADOWS=all: near shadows (occluders within the far threshold) of every
+ * map, from the DEM, with the exact horizon sweep capped at the
+ * threshold. */
+CPLErr TSAtlasDataset::EnsureNear()
+{
+    std::lock_guard<std::mutex> oLock(m_oMutex);
+    if (!m_bTried)
+    {
+        m_bTried = true;
+        const ts_atlas_info *psInfo = ts_atlas_get_info(m_psAtlas);
+        const int W = psInfo->width, H = psInfo->height;
+        char szMsg[1024] = "";
+        GDALDataset *poDEM = nullptr;
+        tsd_cells sCells{};
+        ts_grid sGrid{};
+        bool bGrid = false;
+        float *pafPlane = nullptr;
+        const char *pszZ = m_aosMeta.FetchNameValueDef("Z_FACTOR", "1");
+        const int nBandDEM = atoi(m_aosMeta.FetchNameValueDef("BAND", "1"));
+        ts_horizon_opts sH;
+        ts_horizon_opts_default(&sH);
+        sH.curvature = CPLTestBool(m_aosMeta.FetchNameValueDef("CURVATURE", "YES"));
+        sH.refraction = CPLAtof(m_aosMeta.FetchNameValueDef("REFRACTION", "0.13"));
+        sH.threads = m_nThreads;
+        sH.directions = 1;
+        sH.max_distance = psInfo->threshold_m;
+        double adfGT[6];
+        if (!(std::isfinite(psInfo->threshold_m) && psInfo->threshold_m > 0))
+            m_osError = "TERRASHADE: SHADOWS=all needs the atlas's far threshold in "
+                        "metres, which this atlas does not record";
+        else if (!(poDEM = GDALDataset::Open(m_osDEM.c_str(),
+                                             GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR)))
+            m_osError = CPLSPrintf("TERRASHADE: SHADOWS=all cannot open the DEM '%s' "
+                                   "(give it with the open option DEM=...)",
+                                   m_osDEM.c_str());
+        else if (poDEM->GetRasterXSize() != W || poDEM->GetRasterYSize() != H ||
+                 nBandDEM < 1 || nBandDEM > poDEM->GetRasterCount())
+            m_osError = CPLSPrintf("TERRASHADE: SHADOWS=all: the DEM '%s' (%d x %d) does "
+                                   "not match the %d x %d atlas", m_osDEM.c_str(),
+                                   poDEM->GetRasterXSize(), poDEM->GetRasterYSize(), W, H);
+        else if (poDEM->GetGeoTransform(adfGT) != CE_None)
+            m_osError = "TERRASHADE: SHADOWS=all: the DEM has no geotransform";
+        else
+        {
+            const OGRSpatialReference *poSRS = poDEM->GetSpatialRef();
+            OGRSpatialReferenceH hSRS =
+                poSRS ? OGRSpatialReference::ToHandle(const_cast<OGRSpatialReference *>(poSRS))
+                      : nullptr;
+            if (tsd_cells_compute(adfGT, W, H, hSRS, &sCells, szMsg, sizeof szMsg) != 0 ||
+                tsd_dem_load(GDALRasterBand::ToHandle(poDEM->GetRasterBand(nBandDEM)),
+                             &sCells, CPLAtof(pszZ), &sGrid, szMsg, sizeof szMsg) != 0)
+                m_osError = std::string("TERRASHADE: SHADOWS=all: ") + szMsg;
+            else
+                bGrid = true;
+        }
+        const size_t nCells = static_cast<size_t>(W) * H;
+        if (bGrid)
+        {
+            m_pabyNear = static_cast<GByte *>(VSI_MALLOC2_VERBOSE(nCells, psInfo->steps));
+            pafPlane = static_cast<float *>(VSI_MALLOC2_VERBOSE(nCells, sizeof(float)));
+            if (!m_pabyNear || !pafPlane)
+                m_osError = "TERRASHADE: out of memory for the near shadows";
+        }
+        for (int k = 0; bGrid && m_osError.empty() && k < psInfo->steps; k++)
+        {
+            const ts_atlas_step *psStep = ts_atlas_get_step(m_psAtlas, k);
+            ts_error sErr;
+            GByte *pabyOut = m_pabyNear + static_cast<size_t>(k) * nCells;
+            if (!std::isfinite(psStep->grid_azimuth) || !std::isfinite(psStep->elevation))
+            {
+                m_osError = CPLSPrintf("TERRASHADE: SHADOWS=all: map %d of the atlas "
+                                       "records no sun position", k + 1);
+                break;
+            }
+            if (ts_horizon_sweep(&sGrid, psStep->grid_azimuth, &sH, pafPlane, &sErr) != TS_OK)
+            {
+                m_osError = std::string("TERRASHADE: ") + sErr.message;
+                break;
+            }
+            const float fEl = static_cast<float>(psStep->elevation);
+            for (int y = 0; y < H; y++)
+            {
+                const int gy = sCells.flip_y ? H - 1 - y : y;
+                for (int x = 0; x < W; x++)
+                {
+                    const int gx = sCells.flip_x ? W - 1 - x : x;
+                    const float v = pafPlane[static_cast<size_t>(gy) * W + gx];
+                    pabyOut[static_cast<size_t>(y) * W + x] = v > fEl ? 1 : 0;
+                }
+            }
+        }
+        VSIFree(pafPlane);
+        if (bGrid)
+            ts_grid_free(&sGrid);
+        tsd_cells_free(&sCells);
+        if (poDEM)
+            GDALClose(poDEM);
+        if (!m_osError.empty())
+        {
+            VSIFree(m_pabyNear);
+            m_pabyNear = nullptr;
+        }
+    }
+    if (!m_osError.empty())
+    {
+        CPLError(CE_Failure, CPLE_AppDefined, "%s", m_osError.c_str());
+        return CE_Failure;
+    }
+    return CE_None;
+}
+
+GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
+{
+    if (poOpenInfo->eAccess == GA_Update)
+        return OpenFailed(CPLE_NotSupported,
+                          "far-shadow atlases are read-only; write a new one with "
+                          "gdal_translate -of TERRASHADE");
+    bool bAll = false;
+    std::string osDEM;
+    int nThreads = 0;
+    for (char **p = poOpenInfo->papszOpenOptions; p && *p; p++)
+    {
+        char *pszKey = nullptr;
+        const char *pszValue = CPLParseNameValue(*p, &pszKey);
+        const std::string osKey = pszKey ? pszKey : "";
+        CPLFree(pszKey);
+        if (!pszValue)
+            return OpenFailed(CPLE_IllegalArg,
+                              CPLSPrintf("open option '%s' is not of the form KEY=VALUE", *p));
+        if (EQUAL(osKey.c_str(), "SHADOWS"))
+        {
+            if (!EQUAL(pszValue, "far") && !EQUAL(pszValue, "all"))
+                return OpenFailed(CPLE_IllegalArg,
+                                  CPLSPrintf("SHADOWS must be one of far, all, got '%s'",
+                                             pszValue));
+            bAll = EQUAL(pszValue, "all");
+        }
+        else if (EQUAL(osKey.c_str(), "DEM"))
+            osDEM = pszValue;
+        else if (EQUAL(osKey.c_str(), "THREADS"))
+            nThreads = std::max(0, atoi(pszValue));
+        else
+            return OpenFailed(CPLE_IllegalArg,
+                              CPLSPrintf("an atlas takes the open options SHADOWS, DEM and "
+                                         "THREADS, not '%s'", osKey.c_str()));
+    }
+    VSILFILE *fp = VSIFOpenL(poOpenInfo->pszFilename, "rb");
+    if (!fp)
+        return OpenFailed(CPLE_OpenFailed, CPLSPrintf("cannot open the atlas '%s'",
+                                                      poOpenInfo->pszFilename));
+    VSIFSeekL(fp, 0, SEEK_END);
+    const vsi_l_offset nSize = VSIFTellL(fp);
+    VSIFSeekL(fp, 0, SEEK_SET);
+    GByte *pabyFile = nSize < (static_cast<vsi_l_offset>(1) << 40)
+                          ? static_cast<GByte *>(VSI_MALLOC_VERBOSE(static_cast<size_t>(nSize)))
+                          : nullptr;
+    const bool bRead = pabyFile && VSIFReadL(pabyFile, 1, static_cast<size_t>(nSize), fp) ==
+                                       static_cast<size_t>(nSize);
+    VSIFCloseL(fp);
+    ts_atlas *psAtlas = nullptr;
+    ts_error sErr;
+    if (!bRead)
+    {
+        VSIFree(pabyFile);
+        return OpenFailed(CPLE_FileIO, CPLSPrintf("cannot read the atlas '%s'",
+                                                  poOpenInfo->pszFilename));
+    }
+    const ts_status eSt = ts_atlas_open(pabyFile, static_cast<size_t>(nSize), &psAtlas, &sErr);
+    VSIFree(pabyFile);
+    if (eSt != TS_OK)
+        return OpenFailed(CPLE_AppDefined, CPLSPrintf("'%s': %s", poOpenInfo->pszFilename,
+                                                      sErr.message));
+    auto poDS = std::unique_ptr<TSAtlasDataset>(new TSAtlasDataset());
+    poDS->m_psAtlas = psAtlas;
+    const ts_atlas_info *psInfo = ts_atlas_get_info(psAtlas);
+    poDS->nRasterXSize = psInfo->width;
+    poDS->nRasterYSize = psInfo->height;
+    poDS->m_bHasGT = psInfo->has_geotransform;
+    memcpy(poDS->m_adfGT, psInfo->geotransform, sizeof poDS->m_adfGT);
+    poDS->m_aosMeta = AtlasMetadata(psInfo->metadata);
+    poDS->m_bAll = bAll;
+    poDS->m_nThreads = nThreads;
+    poDS->m_osDEM = !osDEM.empty() ? osDEM
+                                   : poDS->m_aosMeta.FetchNameValueDef("SOURCE_DEM", "");
+    if (bAll && poDS->m_osDEM.empty())
+        return OpenFailed(CPLE_IllegalArg,
+                          "SHADOWS=all recomputes the near shadows from the DEM, but the "
+                          "atlas names none: give it with the open option DEM=...");
+    int nOffset = atoi(poDS->m_aosMeta.FetchNameValueDef("UTC_OFFSET_MINUTES", "0"));
+    for (int i = 0; i < poDS->m_aosMeta.size(); i++)
+    {
+        char *pszKey = nullptr;
+        const char *pszValue = CPLParseNameValue(poDS->m_aosMeta[i], &pszKey);
+        if (pszKey && pszValue)
+        {
+            if (EQUAL(pszKey, "SRS_WKT"))
+            {
+                poDS->m_oSRS.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+                poDS->m_oSRS.importFromWkt(pszValue);
+            }
+            else
+                poDS->GDALDataset::SetMetadataItem(pszKey, pszValue);
+        }
+        CPLFree(pszKey);
+    }
+    for (int k = 0; k < psInfo->steps; k++)
+    {
+        auto poBand = new TSAtlasBand(poDS.get(), k + 1);
+        poDS->SetBand(k + 1, poBand);
+        const ts_atlas_step *r = ts_atlas_get_step(psAtlas, k);
+        SetStepMetadata(poBand, r->unix_time, std::isfinite(r->unix_time)
+                                                  ? r->utc_offset_minutes : nOffset,
+                        r->azimuth, r->grid_azimuth, r->elevation,
+                        std::numeric_limits<double>::quiet_NaN());
+        if (!std::isfinite(r->unix_time))
+            poBand->GDALMajorObject::SetDescription(CPLSPrintf("map %d", k + 1));
+    }
+    poDS->SetDescription(poOpenInfo->pszFilename);
+    poDS->TryLoadXML();
+    poDS->nPamFlags &= ~GPF_DIRTY;
+    return poDS.release();
+}
+
+/* Store the bands of any raster whose values are 0, 1 or nodata. */
+GDALDataset *TSAtlasDataset::CreateCopy(const char *pszFilename, GDALDataset *poSrcDS,
+                                        int /*bStrict*/, char ** /*papszOptions*/,
+                                        GDALProgressFunc pfnProgress, void *pProgressData)
+{
+    const int W = poSrcDS->GetRasterXSize(), H = poSrcDS->GetRasterYSize();
+    const int nBands = poSrcDS->GetRasterCount();
+    if (nBands < 1)
+        return OpenFailed(CPLE_NotSupported, "an atlas needs at least one band");
+    if (!pfnProgress)
+        pfnProgress = GDALDummyProgress;
+    ts_error sErr;
+    ts_atlas_writer *psW = nullptr;
+    if (ts_atlas_writer_new(W, H, &psW, &sErr) != TS_OK)
+        return OpenFailed(CPLE_AppDefined, sErr.message);
+    std::unique_ptr<ts_atlas_writer, void (*)(ts_atlas_writer *)> oW(psW, ts_atlas_writer_free);
+    const size_t nCells = static_cast<size_t>(W) * H;
+    std::vector<GByte> abyPlane;
+    std::vector<double> adfRow;
+    try
+    {
+        abyPlane.resize(nCells);
+        adfRow.resize(static_cast<size_t>(W));
+    }
+    catch (const std::bad_alloc &)
+    {
+        return OpenFailed(CPLE_OutOfMemory, "out of memory for one map of the atlas");
+    }
+    const int nOffset =
+        atoi(CSLFetchNameValueDef(poSrcDS->GetMetadata(), "UTC_OFFSET_MINUTES", "0"));
+    for (int b = 1; b <= nBands; b++)
+    {
+        GDALRasterBand *poBand = poSrcDS->GetRasterBand(b);
+        int bHasNoData = FALSE;
+        const double dfNoData = poBand->GetNoDataValue(&bHasNoData);
+        for (int y = 0; y < H; y++)
+        {
+            if (poBand->RasterIO(GF_Read, 0, y, W, 1, adfRow.data(), W, 1, GDT_Float64, 0, 0,
+                                 nullptr) != CE_None)
+                return nullptr; // GDAL has said why
+            GByte *row = abyPlane.data() + static_cast<size_t>(y) * W;
+            for (int x = 0; x < W; x++)
+            {
+                const double v = adfRow[x];
+                if (std::isnan(v) || (bHasNoData && v == dfNoData))
+                    row[x] = TS_ATLAS_NODATA;
+                else if (v == 0 || v == 1)
+                    row[x] = static_cast<GByte>(v);
+                else
+                    return OpenFailed(
+                        CPLE_NotSupported,
+                        CPLSPrintf("band %d holds the value %g at column %d, row %d: an "
+                                   "atlas stores binary maps (0, 1 and nodata), such as "
+                                   "PRODUCT=farshadow", b, v, x, y));
+            }
+        }
+        auto fetch = [poBand](const char *pszKey) {
+            const char *v = poBand->GetMetadataItem(pszKey);
+            return v ? CPLAtof(v) : std::numeric_limits<double>::quiet_NaN();
+        };
+        ts_atlas_step sStep{fetch("UNIX_TIME"), fetch("SUN_AZIMUTH_TRUE"),
+                            fetch("SUN_AZIMUTH"), fetch("SUN_ELEVATION"), nOffset};
+        if (ts_atlas_writer_add(psW, abyPlane.data(), W, &sStep, &sErr) != TS_OK)
+            return OpenFailed(CPLE_AppDefined, CPLSPrintf("band %d: %s", b, sErr.message));
+        if (!pfnProgress(0.95 * b / nBands, nullptr, pProgressData))
+        {
+            CPLError(CE_Failure, CPLE_UserInterrupt, "TERRASHADE: interrupted");
+            return nullptr;
+        }
+    }
+    /* metadata text: the source's metadata, its CRS, its threshold */
+    std::string osText;
+    for (char **p = poSrcDS->GetMetadata(); p && *p; p++)
+    {
+        std::string osLine = *p;
+        std::replace(osLine.begin(), osLine.end(), '\n', ' ');
+        std::replace(osLine.begin(), osLine.end(), '\r', ' ');
+        if (!STARTS_WITH_CI(osLine.c_str(), "SRS_WKT="))
+            osText += osLine + "\n";
+    }
+    if (const OGRSpatialReference *poSRS = poSrcDS->GetSpatialRef())
+    {
+        char *pszWKT = nullptr;
+        const char *apszOpts[] = {"FORMAT=WKT2_2019", "MULTILINE=NO", nullptr};
+        if (poSRS->exportToWkt(&pszWKT, apszOpts) == OGRERR_NONE && pszWKT)
+            osText += std::string("SRS_WKT=") + pszWKT + "\n";
+        CPLFree(pszWKT);
+    }
+    ts_atlas_info sInfo{};
+    sInfo.has_geotransform = poSrcDS->GetGeoTransform(sInfo.geotransform) == CE_None;
+    const char *pszT = poSrcDS->GetMetadataItem("FAR_THRESHOLD");
+    const char *pszTm = poSrcDS->GetMetadataItem("FAR_THRESHOLD_M");
+    sInfo.threshold_cells = pszT ? atoi(pszT) : 0;
+    sInfo.threshold_m = pszTm ? CPLAtof(pszTm) : std::numeric_limits<double>::quiet_NaN();
+    sInfo.metadata = osText.c_str();
+    uint8_t *pabyFile = nullptr;
+    size_t nSize = 0;
+    if (ts_atlas_writer_finish(psW, &sInfo, &pabyFile, &nSize, &sErr) != TS_OK)
+        return OpenFailed(CPLE_AppDefined, sErr.message);
+    VSILFILE *fp = VSIFOpenL(pszFilename, "wb");
+    bool bOK = fp && VSIFWriteL(pabyFile, 1, nSize, fp) == nSize;
+    if (fp && VSIFCloseL(fp) != 0)
+        bOK = false;
+    free(pabyFile);
+    if (!bOK)
+    {
+        VSIUnlink(pszFilename);
+        return OpenFailed(CPLE_FileIO, CPLSPrintf("cannot write the atlas '%s'", pszFilename));
+    }
+    CPLDebug(DRIVER, "wrote the atlas %s: %d maps of %d x %d, %zu bytes (%.4f bits per cell)",
+             pszFilename, nBands, W, H, nSize, nSize * 8.0 / nCells);
+    pfnProgress(1.0, nullptr, pProgressData);
+    GDALOpenInfo oOpenInfo(pszFilename, GA_ReadOnly);
+    return TSAtlasDataset::Open(&oOpenInfo);
+}
+
+/* TERRASHADE:... connection strings, and atlas files by their magic. */
+static int IdentifyAny(GDALOpenInfo *poOpenInfo)
+{
+    if (tsd_connstr_matches(poOpenInfo->pszFilename))
+        return TRUE;
+    return poOpenInfo->nHeaderBytes >= 8 &&
+           ts_atlas_identify(poOpenInfo->pabyHeader,
+                             static_cast<size_t>(poOpenInfo->nHeaderBytes));
+}
+
+static GDALDataset *OpenAny(GDALOpenInfo *poOpenInfo)
+{
+    if (tsd_connstr_matches(poOpenInfo->pszFilename))
+        return TSDataset::Open(poOpenInfo);
+    if (!IdentifyAny(poOpenInfo))
+        return nullptr;
+    return TSAtlasDataset::Open(poOpenInfo);
 }
 
 } // namespace
@@ -430,13 +1067,17 @@ void GDALRegister_TERRASHADE()
     poDriver->SetMetadataItem(GDAL_DMD_HELPTOPIC,
                               "https://example.invalid/terrashade/docs/driver.md");
     poDriver->SetMetadataItem(GDAL_DCAP_VIRTUALIO, "YES");
+    poDriver->SetMetadataItem(GDAL_DCAP_CREATECOPY, "YES");
+    poDriver->SetMetadataItem(GDAL_DMD_EXTENSION, "tsa");
+    poDriver->SetMetadataItem(GDAL_DMD_CREATIONDATATYPES, "Byte");
     poDriver->SetMetadataItem(GDAL_DMD_CONNECTION_PREFIX, TSD_PREFIX);
     if (char *pszXML = tsd_options_xml())
     {
         poDriver->SetMetadataItem(GDAL_DMD_OPENOPTIONLIST, pszXML);
         free(pszXML);
     }
-    poDriver->pfnIdentify = TSDataset::Identify;
-    poDriver->pfnOpen = TSDataset::Open;
+    poDriver->pfnIdentify = IdentifyAny;
+    poDriver->pfnOpen = OpenAny;
+    poDriver->pfnCreateCopy = TSAtlasDataset::CreateCopy;
     GetGDALDriverManager()->RegisterDriver(poDriver);
 }

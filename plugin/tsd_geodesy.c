@@ -131,3 +131,135 @@ void tsd_cells_free(tsd_cells *c)
         c->cell_x_row = NULL;
     }
 }
+
+/* ------------------------------------------------------------- sites */
+
+/* Longitude into [-180, 180]. */
+static double wrap_lon(double lon)
+{
+    lon = fmod(lon + 180.0, 360.0);
+    if (lon < 0)
+        lon += 360.0;
+    return lon - 180.0;
+}
+
+int tsd_sites_compute(const double gt[6], int width, int height,
+                      OGRSpatialReferenceH srs, const tsd_cells *cells, int per_cell,
+                      tsd_sites *s, char *msg, size_t n)
+{
+    memset(s, 0, sizeof *s);
+    if (!srs)
+        return fail(msg, n, "the DEM has no CRS, so the sun's position over it is "
+                    "unknown: give it a CRS (gdal_edit.py -a_srs) or use "
+                    "SUN_AZIMUTH and SUN_ELEVATION");
+    int geographic = OSRIsGeographic(srs);
+    if (!geographic && !OSRIsProjected(srs))
+        return fail(msg, n, "the DEM's CRS is neither geographic nor projected (a "
+                    "local or engineering CRS), so its longitudes and latitudes are "
+                    "unknown; use SUN_AZIMUTH and SUN_ELEVATION instead");
+    /* lattice: every 32 cells or so, at most 65 nodes a side */
+    if (per_cell) {
+        s->nx = width < 2 ? 1 : width / 32 + 2;
+        s->ny = height < 2 ? 1 : height / 32 + 2;
+        if (s->nx > 65) s->nx = 65;
+        if (s->ny > 65) s->ny = 65;
+    } else {
+        s->nx = s->ny = 1;
+    }
+    s->x0 = s->nx > 1 ? 0.5 : 0.5 * width;
+    s->y0 = s->ny > 1 ? 0.5 : 0.5 * height;
+    s->dx = s->nx > 1 ? (width - 1.0) / (s->nx - 1) : 1.0;
+    s->dy = s->ny > 1 ? (height - 1.0) / (s->ny - 1) : 1.0;
+    size_t nodes = (size_t)s->nx * s->ny;
+    s->lon = malloc(nodes * sizeof *s->lon);
+    s->lat = malloc(nodes * sizeof *s->lat);
+    s->north = malloc(nodes * sizeof *s->north);
+    if (!s->lon || !s->lat || !s->north) {
+        tsd_sites_free(s);
+        return fail(msg, n, "out of memory for %zu sun sites", nodes);
+    }
+    OGRSpatialReferenceH geo = NULL;
+    OGRCoordinateTransformationH fwd = NULL, inv = NULL;
+    if (!geographic) {
+        geo = OSRCloneGeogCS(srs);
+        if (geo) {
+            OSRSetAxisMappingStrategy(geo, OAMS_TRADITIONAL_GIS_ORDER);
+            OGRSpatialReferenceH src = OSRClone(srs);
+            OSRSetAxisMappingStrategy(src, OAMS_TRADITIONAL_GIS_ORDER);
+            fwd = OCTNewCoordinateTransformation(src, geo);
+            inv = OCTNewCoordinateTransformation(geo, src);
+            OSRDestroySpatialReference(src);
+        }
+        if (!fwd || !inv) {
+            if (fwd) OCTDestroyCoordinateTransformation(fwd);
+            if (inv) OCTDestroyCoordinateTransformation(inv);
+            if (geo) OSRDestroySpatialReference(geo);
+            tsd_sites_free(s);
+            return fail(msg, n, "PROJ cannot transform the DEM's CRS to longitude and "
+                        "latitude, so the sun's position over it is unknown");
+        }
+    }
+    double deg = geographic ? OSRGetAngularUnits(srs, NULL) * 180.0 / M_PI : 1.0;
+    int rc = 0;
+    for (int j = 0; j < s->ny && rc == 0; j++)
+        for (int i = 0; i < s->nx && rc == 0; i++) {
+            /* core pixel -> DEM pixel -> georeferenced */
+            double cx = s->x0 + i * s->dx, cy = s->y0 + j * s->dy;
+            double px = cells->flip_x ? width - cx : cx;
+            double py = cells->flip_y ? height - cy : cy;
+            double X = gt[0] + px * gt[1] + py * gt[2];
+            double Y = gt[3] + px * gt[4] + py * gt[5];
+            double lon, lat, north = 0.0;
+            if (geographic) {
+                lon = X * deg;
+                lat = Y * deg;
+            } else {
+                double x = X, y = Y, z = 0;
+                if (!OCTTransform(fwd, 1, &x, &y, &z) || !isfinite(x) || !isfinite(y)) {
+                    rc = fail(msg, n, "PROJ cannot find the longitude and latitude of "
+                              "the DEM's point (%.10g, %.10g), so the sun's position "
+                              "over it is unknown", X, Y);
+                    break;
+                }
+                lon = x;
+                lat = y;
+                /* grid azimuth of true north: a small step north, back */
+                double step = lat + 1e-4 <= 90.0 ? 1e-4 : -1e-4;
+                double x2 = lon, y2 = lat + step, z2 = 0;
+                if (!OCTTransform(inv, 1, &x2, &y2, &z2) || !isfinite(x2) || !isfinite(y2)) {
+                    rc = fail(msg, n, "PROJ cannot transform a point north of (%.8g, "
+                              "%.8g) back into the DEM's CRS", lon, lat);
+                    break;
+                }
+                double dx = (x2 - X) * (step > 0 ? 1 : -1), dy = (y2 - Y) * (step > 0 ? 1 : -1);
+                north = atan2(dx, dy) * 180.0 / M_PI;
+            }
+            if (!isfinite(lat) || lat < -90.0 - 1e-9 || lat > 90.0 + 1e-9) {
+                rc = fail(msg, n, "the DEM's georeferencing puts a point at latitude %g, "
+                          "beyond +/-90 degrees: the geotransform or the CRS is wrong",
+                          lat);
+                break;
+            }
+            lat = lat > 90.0 ? 90.0 : lat < -90.0 ? -90.0 : lat;
+            size_t k = (size_t)j * s->nx + i;
+            s->lon[k] = wrap_lon(lon);
+            s->lat[k] = lat;
+            s->north[k] = north;
+        }
+    if (fwd) OCTDestroyCoordinateTransformation(fwd);
+    if (inv) OCTDestroyCoordinateTransformation(inv);
+    if (geo) OSRDestroySpatialReference(geo);
+    if (rc != 0)
+        tsd_sites_free(s);
+    return rc;
+}
+
+void tsd_sites_free(tsd_sites *s)
+{
+    if (!s)
+        return;
+    free(s->lon);
+    free(s->lat);
+    free(s->north);
+    s->lon = s->lat = s->north = NULL;
+}

@@ -47,6 +47,34 @@ int tsd_cells_compute(const double gt[6], int width, int height,
 
 void tsd_cells_free(tsd_cells *c);
 
+/**
+ * Where the sun is seen from, in the core grid's frame (row 0 north, after
+ * the flips of tsd_cells): one site at the DEM's centre, or (per_cell) a
+ * lattice of nx x ny sites, node (i, j) at pixel (x0 + i dx, y0 + j dy)
+ * (cell (c, r) has its centre at (c + 0.5, r + 0.5)). Longitude and
+ * latitude in degrees on the CRS's own datum (geodetic); `north` is the
+ * grid azimuth of true north (0 for a geographic CRS; in a projected CRS
+ * minus the meridian convergence), found through PROJ by stepping 1e-4
+ * degrees north. Arrays are malloc'd; free with tsd_sites_free.
+ */
+typedef struct {
+    int nx, ny;
+    double x0, y0, dx, dy;
+    double *lon, *lat, *north;
+} tsd_sites;
+
+/**
+ * Compute the sites of a width x height DEM with geotransform gt and CRS
+ * srs (not NULL). 0 on success; -1 with a sentence in msg: no CRS usable
+ * for geographic coordinates, a transformation PROJ cannot do, a latitude
+ * beyond +/-90.
+ */
+int tsd_sites_compute(const double gt[6], int width, int height,
+                      OGRSpatialReferenceH srs, const tsd_cells *cells,
+                      int per_cell, tsd_sites *out, char *msg, size_t msg_size);
+
+void tsd_sites_free(tsd_sites *s);
+
 #ifdef __cplusplus
 }
 #endif

@@ -18,8 +18,17 @@ typedef enum {
     TSD_PRODUCT_HORIZON,
     TSD_PRODUCT_SVF,
     TSD_PRODUCT_OPENNESS,
-    TSD_PRODUCT_SKY
+    TSD_PRODUCT_SKY,
+    TSD_PRODUCT_SUNHOURS,   /* hours of direct sun over a local day */
+    TSD_PRODUCT_INSOLATION, /* clear-sky irradiation over a day: total, beam, diffuse */
+    TSD_PRODUCT_DAYCYCLE,   /* visible fraction of the sun, one band per time step */
+    TSD_PRODUCT_FARSHADOW   /* binary far-shadow maps of the atlas, one per sun position */
 } tsd_product;
+
+typedef enum { TSD_SUN_CENTER = 0, TSD_SUN_PER_CELL } tsd_sun_position;
+
+/* Longest text value of a string option (DATETIME, DATE, TIMEZONE). */
+#define TSD_TEXT_MAX 64
 
 typedef enum { TSD_METHOD_EXACT = 0, TSD_METHOD_SHM } tsd_method;
 
@@ -43,7 +52,36 @@ typedef struct {
     int threads;             /* 0 = all cores */
     tsd_output_type output_type; /* as asked; see tsd_options_output_byte */
     int max_memory_mb;       /* 0 = automatic */
+    /* the sun from a date and time (see tsd_sun.h) */
+    char datetime[TSD_TEXT_MAX]; /* ISO 8601 with an offset, "" = not given */
+    char date[TSD_TEXT_MAX];     /* YYYY-MM-DD, "" = not given */
+    char timezone[TSD_TEXT_MAX]; /* fixed UTC offset, "" = not given */
+    int step_minutes;        /* sampling step of the day products */
+    double pressure;         /* hPa, for the refraction */
+    double temperature;      /* degrees C, for the refraction */
+    double delta_t;          /* TT - UT, seconds */
+    tsd_sun_position sun_position; /* one site at the centre, or per cell */
+    double linke_turbidity;  /* clear-sky model of PRODUCT=insolation */
+    int far_threshold;       /* cells: nearer occluders are not in farshadow */
+    int atlas_steps;         /* sun positions of PRODUCT=farshadow */
+    /* which of SUN_AZIMUTH / SUN_ELEVATION were given explicitly */
+    int sun_azimuth_given, sun_elevation_given;
 } tsd_options;
+
+/** 1 if the product takes its sun from DATE / DATETIME over a whole day. */
+int tsd_product_is_daily(tsd_product p);
+
+/** 1 if the options place the sun from a date and time (DATETIME with
+ * shade or shadow, or a daily product). */
+int tsd_options_sun_from_time(const tsd_options *o);
+
+/**
+ * Normalise an ISO 8601 date and time written without colons (basic
+ * format, which inline options need: 2026-06-21T073000+0200 or
+ * 20260621T0730Z) into the extended form ts_parse_iso8601 reads
+ * (2026-06-21T07:30:00+02:00). Other text is copied unchanged.
+ */
+void tsd_datetime_normalise(const char *in, char *out, size_t out_size);
 
 /** Fill `o` with the defaults (sun at 315 / 45 degrees as gdaldem). */
 void tsd_options_defaults(tsd_options *o);

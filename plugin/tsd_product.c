@@ -1,6 +1,8 @@
 /* The products: which core calls, in which order, with how much memory. */
 #include "tsd_product.h"
 
+#include "shadow_atlas.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,18 +39,31 @@ static void horizon_opts(const tsd_options *o, ts_horizon_opts *h)
 /* Extra float planes (besides the DEM grid and the product) at the peak. */
 static int extra_planes(const tsd_options *o)
 {
+    int lattice = o->sun_position == TSD_SUN_PER_CELL;
     switch (o->product) {
     case TSD_PRODUCT_SHADE:
         /* normals, a horizon plane or the SHM visibility, the sky
          * accumulator and its horizon plane */
-        return 3 + 1 + (o->sky_weight > 0 ? 2 : 0);
+        return 3 + 1 + (o->sky_weight > 0 ? 2 : 0) + (lattice ? 7 : 0);
     case TSD_PRODUCT_SHADOW:
+        return lattice ? 7 : 0;
     case TSD_PRODUCT_HORIZON:
         return 0;
     case TSD_PRODUCT_SVF:
     case TSD_PRODUCT_OPENNESS:
     case TSD_PRODUCT_SKY:
         return 3 + 1; /* normals and one horizon plane */
+    case TSD_PRODUCT_SUNHOURS:
+        /* Earth horizon, horizon plane, visibility, double accumulator */
+        return 5 + (lattice ? 3 : 0);
+    case TSD_PRODUCT_INSOLATION:
+        /* normals, sky, visibility, pressure factor, two double
+         * accumulators, Earth horizon, horizon plane */
+        return 12 + (lattice ? 5 : 0);
+    case TSD_PRODUCT_DAYCYCLE:
+        return 2 + (lattice ? 3 : 0);
+    case TSD_PRODUCT_FARSHADOW:
+        return 1; /* the far-field slopes */
     }
     return 0;
 }
@@ -58,9 +73,11 @@ double tsd_product_peak_bytes(const tsd_options *o, int width, int height,
 {
     double plane = (double)width * (double)height * sizeof(float);
     double bands = tsd_options_band_count(o);
+    /* farshadow keeps bytes, a quarter of a float plane per band */
+    double kept = o->product == TSD_PRODUCT_FARSHADOW ? bands / 4 : bands;
     if (steady)
-        *steady = bands * plane;
-    return (1 + bands + extra_planes(o)) * plane;
+        *steady = kept * plane;
+    return (1 + kept + extra_planes(o)) * plane;
 }
 
 static void free_normals(normals *nm)
@@ -137,21 +154,48 @@ static int sun_horizon(const ts_grid *g, const tsd_options *o,
     return 0;
 }
 
-static int shade(const ts_grid *g, const tsd_options *o, float *out, char *msg,
-                 size_t n)
+/* Per-cell sun (SUN_POSITION=per_cell): visibility of the disk, and the
+ * sun's grid azimuth and elevation per cell; terrain only, as the
+ * classic shade and shadow. */
+static int sun_per_cell(const ts_grid *g, const tsd_sun *sun, float *vis, float *az,
+                        float *el, char *msg, size_t n)
+{
+    ts_error err;
+    ts_day_opts d = sun->day;
+    d.earth_horizon = 0;
+    if (ts_sun_visibility(g, &sun->sites, &d, sun->instant, vis, az, el, NULL, &err) !=
+        TS_OK)
+        return core_fail(msg, n, &err);
+    return 0;
+}
+
+static int shade(const ts_grid *g, const tsd_options *o, const tsd_sun *sun, float *out,
+                 char *msg, size_t n)
 {
     size_t cells = (size_t)g->width * g->height;
     normals nm = {0};
     ts_error err;
     int rc = -1;
+    int lattice = sun && sun->sites.nx * sun->sites.ny > 1;
     float *work = malloc(cells * sizeof(float));
-    if (!work) {
+    float *az = lattice ? malloc(cells * sizeof(float)) : NULL;
+    float *el = lattice ? malloc(cells * sizeof(float)) : NULL;
+    if (!work || (lattice && (!az || !el))) {
         oom(msg, n, "a horizon plane");
         goto done;
     }
     if (make_normals(g, &nm, msg, n) != 0)
         goto done;
-    if (o->method == TSD_METHOD_EXACT) {
+    if (lattice) {
+        if (sun_per_cell(g, sun, work, az, el, msg, n) != 0)
+            goto done;
+        for (size_t i = 0; i < cells; i++) {
+            double a = az[i] * M_PI / 180, e = el[i] * M_PI / 180;
+            double d = nm.nx[i] * sin(a) * cos(e) + nm.ny[i] * cos(a) * cos(e) +
+                       nm.nz[i] * sin(e);
+            out[i] = (float)((d > 0 ? d : 0) * work[i]); /* NaN stays NaN */
+        }
+    } else if (o->method == TSD_METHOD_EXACT) {
         ts_horizon_opts h;
         if (sun_horizon(g, o, &h, work, msg, n) != 0)
             goto done;
@@ -163,8 +207,8 @@ static int shade(const ts_grid *g, const tsd_options *o, float *out, char *msg,
     } else {
         if (shm_visibility(g, o, work, msg, n) != 0)
             goto done;
-        double az = o->sun_azimuth * M_PI / 180, el = o->sun_elevation * M_PI / 180;
-        double lx = sin(az) * cos(el), ly = cos(az) * cos(el), lz = sin(el);
+        double az0 = o->sun_azimuth * M_PI / 180, el0 = o->sun_elevation * M_PI / 180;
+        double lx = sin(az0) * cos(el0), ly = cos(az0) * cos(el0), lz = sin(el0);
         for (size_t i = 0; i < cells; i++) {
             double d = nm.nx[i] * lx + nm.ny[i] * ly + nm.nz[i] * lz;
             out[i] = (float)((d > 0 ? d : 0) * work[i]); /* NaN stays NaN */
@@ -182,14 +226,18 @@ static int shade(const ts_grid *g, const tsd_options *o, float *out, char *msg,
     rc = 0;
 done:
     free(work);
+    free(az);
+    free(el);
     free_normals(&nm);
     return rc;
 }
 
-static int shadow(const ts_grid *g, const tsd_options *o, float *out, char *msg,
-                  size_t n)
+static int shadow(const ts_grid *g, const tsd_options *o, const tsd_sun *sun, float *out,
+                  char *msg, size_t n)
 {
     size_t cells = (size_t)g->width * g->height;
+    if (sun && sun->sites.nx * sun->sites.ny > 1 && o->method == TSD_METHOD_EXACT)
+        return sun_per_cell(g, sun, out, NULL, NULL, msg, n);
     if (o->method == TSD_METHOD_SHM)
         return shm_visibility(g, o, out, msg, n);
     ts_horizon_opts h;
@@ -199,6 +247,44 @@ static int shadow(const ts_grid *g, const tsd_options *o, float *out, char *msg,
         if (out[i] == out[i])
             out[i] = (float)ts_sun_disk_fraction(o->sun_elevation, out[i]);
     return 0;
+}
+
+/* The day products. */
+static int daily(const ts_grid *g, const tsd_options *o, const tsd_sun *sun, float *out,
+                 uint8_t *bytes, char *msg, size_t n)
+{
+    size_t cells = (size_t)g->width * g->height;
+    ts_error err;
+    ts_status st = TS_OK;
+    if (!sun) {
+        snprintf(msg, n, "PRODUCT=%s needs the sun's day (internal error)",
+                 tsd_product_name(o->product));
+        return -1;
+    }
+    switch (o->product) {
+    case TSD_PRODUCT_SUNHOURS:
+        st = ts_sun_hours(g, &sun->sites, &sun->day, sun->day_start, sun->day_length,
+                          o->step_minutes * 60.0, out, &err);
+        break;
+    case TSD_PRODUCT_INSOLATION:
+        st = ts_insolation(g, &sun->sites, &sun->day, sun->day_start, sun->day_length,
+                           o->step_minutes * 60.0, out, out + cells, out + 2 * cells, &err);
+        break;
+    case TSD_PRODUCT_DAYCYCLE:
+        for (int k = 0; k < sun->steps && st == TS_OK; k++)
+            st = ts_sun_visibility(g, &sun->sites, &sun->day, sun->times[k],
+                                   out + (size_t)k * cells, NULL, NULL, NULL, &err);
+        break;
+    case TSD_PRODUCT_FARSHADOW:
+        for (int k = 0; k < sun->steps && st == TS_OK; k++)
+            st = ts_far_shadow(g, sun->samples[k].grid_azimuth, sun->samples[k].elevation,
+                               sun->threshold_m, &sun->day.horizon,
+                               bytes + (size_t)k * cells, &err);
+        break;
+    default:
+        break;
+    }
+    return st == TS_OK ? 0 : core_fail(msg, n, &err);
 }
 
 static int sky_product(const ts_grid *g, const tsd_options *o, int which,
@@ -214,8 +300,8 @@ static int sky_product(const ts_grid *g, const tsd_options *o, int which,
     return rc;
 }
 
-int tsd_product_compute(const ts_grid *grid, const tsd_options *o, float *out,
-                        char *msg, size_t n)
+int tsd_product_compute(const ts_grid *grid, const tsd_options *o, const tsd_sun *sun,
+                        float *out, uint8_t *bytes, char *msg, size_t n)
 {
     ts_error err;
     ts_horizon_opts h;
@@ -226,9 +312,14 @@ int tsd_product_compute(const ts_grid *grid, const tsd_options *o, float *out,
         return core_fail(msg, n, &err);
     switch (o->product) {
     case TSD_PRODUCT_SHADE:
-        return shade(grid, o, out, msg, n);
+        return shade(grid, o, sun, out, msg, n);
     case TSD_PRODUCT_SHADOW:
-        return shadow(grid, o, out, msg, n);
+        return shadow(grid, o, sun, out, msg, n);
+    case TSD_PRODUCT_SUNHOURS:
+    case TSD_PRODUCT_INSOLATION:
+    case TSD_PRODUCT_DAYCYCLE:
+    case TSD_PRODUCT_FARSHADOW:
+        return daily(grid, o, sun, out, bytes, msg, n);
     case TSD_PRODUCT_HORIZON:
         if (ts_horizon_compute(grid, &h, out, &err) != TS_OK)
             return core_fail(msg, n, &err);

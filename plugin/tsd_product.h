@@ -7,9 +7,11 @@
 #define TSD_PRODUCT_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "terrashade.h"
 #include "tsd_options.h"
+#include "tsd_sun.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -26,9 +28,14 @@ double tsd_product_peak_bytes(const tsd_options *o, int width, int height,
 /**
  * Compute the product into `out`: tsd_options_band_count(o) planes of
  * width*height floats (row stride = width), in the grid's orientation,
- * NaN = nodata. 0 on success, -1 with a sentence in msg.
+ * NaN = nodata; PRODUCT=farshadow writes `bytes` instead (planes of
+ * width*height bytes: 0, 1, 255 = nodata) and leaves out unused (it may be
+ * NULL then). `sun` (NULL when the sun is given by SUN_AZIMUTH and
+ * SUN_ELEVATION) comes from tsd_sun_setup. 0 on success, -1 with a
+ * sentence in msg.
  */
-int tsd_product_compute(const ts_grid *grid, const tsd_options *o, float *out,
+int tsd_product_compute(const ts_grid *grid, const tsd_options *o,
+                        const tsd_sun *sun, float *out, uint8_t *bytes,
                         char *msg, size_t msg_size);
 
 /** Byte value of a 0..1 product as gdaldem writes it: 0 for nodata, else

@@ -488,6 +488,41 @@ START_TEST(test_insolation_flat)
 }
 END_TEST
 
+/* The lattice path of the insolation (per-cell sun) gives the single
+ * site's result when every node is that site. */
+START_TEST(test_insolation_lattice)
+{
+    ts_error err;
+    const int n = 24;
+    ts_grid g;
+    ck_assert(ts_grid_create(&g, n, n, 30.0, 30.0, &err) == TS_OK);
+    for (int y = 0; y < n; y++)
+        for (int x = 0; x < n; x++)
+            g.z[y * n + x] = (float)(800 + 60 * sin(x * 0.4) * cos(y * 0.3) + 4 * y);
+    ts_day_opts o;
+    ts_day_opts_default(&o);
+    o.horizon.directions = 8;
+    double start = ts_local_midnight(2026, 3, 1, 60);
+    site p;
+    site_init(&p, 46.5, 7.9);
+    p.north = 1.5;
+    double lon[4] = {7.9, 7.9, 7.9, 7.9}, lat[4] = {46.5, 46.5, 46.5, 46.5},
+           north[4] = {1.5, 1.5, 1.5, 1.5};
+    ts_sun_sites s = {2, 2, 0.5, 0.5, n - 1.0, n - 1.0, lon, lat, north};
+    float a[3][24 * 24], b[3][24 * 24];
+    ck_assert(ts_insolation(&g, &p.s, &o, start, 86400, 900, a[0], a[1], a[2], &err) == TS_OK);
+    ck_assert(ts_insolation(&g, &s, &o, start, 86400, 900, b[0], b[1], b[2], &err) == TS_OK);
+    double worst = 0;
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < n * n; i++)
+            worst = fmax(worst, fabs(a[k][i] - b[k][i]) / fmax(1.0, fabs(a[k][i])));
+    printf("insolation, one site vs a lattice of the same site: max relative diff %.2g\n",
+           worst);
+    ck_assert(worst < 1e-4);
+    ts_grid_free(&g);
+}
+END_TEST
+
 /* Slopes: in December at 46.5 N a south-facing slope gets more than the
  * plain, a north-facing one less; a pit's floor gets little beam. */
 START_TEST(test_insolation_slopes)
@@ -568,6 +603,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_esra);
     tcase_add_test(tc, test_insolation_flat);
     tcase_add_test(tc, test_insolation_slopes);
+    tcase_add_test(tc, test_insolation_lattice);
     tcase_add_test(tc, test_atlas_times);
     suite_add_tcase(s, tc);
     return s;

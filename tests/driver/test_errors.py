@@ -26,8 +26,8 @@ CASES = [
     ("zero z factor", T.conn(DEM), ["Z_FACTOR=0"],
      "Z_FACTOR must be greater than 0"),
     ("bad product", T.conn(DEM), ["PRODUCT=hillshade"],
-     "PRODUCT must be one of shade, shadow, horizon, svf, openness, sky, got "
-     "'hillshade'"),
+     "PRODUCT must be one of shade, shadow, horizon, svf, openness, sky, sunhours, "
+     "insolation, daycycle, farshadow, got 'hillshade'"),
     ("bad boolean", T.conn(DEM), ["CURVATURE=maybe"],
      "CURVATURE must be YES or NO"),
     ("empty value", T.conn(DEM), ["SUN_AZIMUTH="], "SUN_AZIMUTH needs a value"),
@@ -35,6 +35,10 @@ CASES = [
      ["SUN_AZIMUTH=20"], "SUN_AZIMUTH is given twice"),
     ("Byte horizon", T.conn(DEM), ["PRODUCT=horizon", "OUTPUT_TYPE=Byte"],
      "OUTPUT_TYPE=Byte is only for"),
+    ("atlas option on a DEM", T.conn(DEM), ["SHADOWS=all"],
+     "SHADOWS is an open option of far-shadow atlas files"),
+    ("DATETIME without offset", T.conn(DEM), ["DATETIME=2026-06-21T07:30:00"],
+     "an offset from UTC is required"),
     ("shm svf", T.conn(DEM), ["PRODUCT=svf", "METHOD=shm"],
      "METHOD=shm applies to PRODUCT=shade and PRODUCT=shadow only"),
     ("band beyond the DEM", T.conn(DEM), ["BAND=2"],

@@ -1,7 +1,8 @@
 """The driver is registered, documented and installable.
 
-- gdalinfo --formats lists TERRASHADE as a read-only raster driver with
-  virtual I/O; gdalinfo --format TERRASHADE documents every option with its
+- gdalinfo --formats lists TERRASHADE as a raster driver with virtual I/O
+  that reads (TERRASHADE:<dem> and far-shadow atlases) and writes atlases
+  by CreateCopy (*.tsa); gdalinfo --format TERRASHADE documents every option with its
   type, default, range and description;
 - the plugin exports only GDALRegister_TERRASHADE and does not depend on a
   shared libterrashade (self-contained);
@@ -35,7 +36,7 @@ class Registration(unittest.TestCase):
         print(line)
         self.assertEqual(len(line), 1, p.stdout)
         self.assertIn("-raster-", line[0])
-        self.assertIn("(rov)", line[0])  # read-only, virtual I/O
+        self.assertIn("(rwv)", line[0])  # read, CreateCopy (atlases), virtual I/O
 
     def test_format_documents_every_option(self):
         p = T.run(["gdalinfo", "--format", "TERRASHADE"])
@@ -61,13 +62,20 @@ class Registration(unittest.TestCase):
         self.assertEqual(opts["SUN_AZIMUTH"].get("default"), "315")
         self.assertEqual(opts["SUN_ELEVATION"].get("default"), "45")
         self.assertEqual([v.text for v in opts["PRODUCT"]],
-                         ["shade", "shadow", "horizon", "svf", "openness", "sky"])
+                         ["shade", "shadow", "horizon", "svf", "openness", "sky",
+                          "sunhours", "insolation", "daycycle", "farshadow"])
+        for name in ("DATETIME", "DATE", "TIMEZONE", "STEP_MINUTES", "PRESSURE",
+                     "TEMPERATURE", "DELTA_T", "SUN_POSITION", "LINKE_TURBIDITY",
+                     "FAR_THRESHOLD", "ATLAS_STEPS", "SHADOWS", "DEM"):
+            self.assertTrue(opts[name].get("description"), name)
 
     def test_driver_metadata(self):
         drv = T.gdal.GetDriverByName("TERRASHADE")
         md = drv.GetMetadata()
         self.assertEqual(md.get("DCAP_RASTER"), "YES")
         self.assertEqual(md.get("DCAP_VIRTUALIO"), "YES")
+        self.assertEqual(md.get("DCAP_CREATECOPY"), "YES")
+        self.assertEqual(md.get("DMD_EXTENSION"), "tsa")
         self.assertTrue(md.get("DMD_LONGNAME"))
         self.assertTrue(md.get("DMD_HELPTOPIC"))
 

@@ -1,0 +1,158 @@
+/* The sun from DATETIME / DATE / TIMEZONE; see tsd_sun.h. */
+#include "tsd_sun.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int fail(char *msg, size_t n, const char *what, const ts_error *err)
+{
+    snprintf(msg, n, "%s%s%s", what, err ? ": " : "", err ? err->message : "");
+    return -1;
+}
+
+void tsd_format_time(double t, int offset, char *buf, size_t n)
+{
+    if (!isfinite(t)) {
+        snprintf(buf, n, "unknown");
+        return;
+    }
+    long long local = (long long)llround(t) + offset * 60LL;
+    long long days = local >= 0 ? local / 86400 : -((-local + 86399) / 86400);
+    long long sec = local - days * 86400;
+    /* civil from days (Howard Hinnant's algorithm) */
+    long long z = days + 719468;
+    long long era = (z >= 0 ? z : z - 146096) / 146097;
+    long long doe = z - era * 146097;
+    long long yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
+    long long y = yoe + era * 400;
+    long long doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    long long mp = (5 * doy + 2) / 153;
+    long long d = doy - (153 * mp + 2) / 5 + 1;
+    long long m = mp < 10 ? mp + 3 : mp - 9;
+    if (m <= 2)
+        y++;
+    char off[16];
+    if (offset == 0)
+        snprintf(off, sizeof off, "Z");
+    else
+        snprintf(off, sizeof off, "%c%02d:%02d", offset < 0 ? '-' : '+', abs(offset) / 60,
+                 abs(offset) % 60);
+    snprintf(buf, n, "%04lld-%02lld-%02lldT%02lld:%02lld:%02lld%s", y, m, d, sec / 3600,
+             sec / 60 % 60, sec % 60, off);
+}
+
+void tsd_sun_free(tsd_sun *s)
+{
+    if (!s)
+        return;
+    tsd_sites_free(&s->sites_owned);
+    free(s->times);
+    free(s->durations);
+    free(s->samples);
+    memset(s, 0, sizeof *s);
+}
+
+int tsd_sun_setup(tsd_options *o, tsd_sites *sites, double min_cell_m, tsd_sun *s,
+                  char *msg, size_t n)
+{
+    memset(s, 0, sizeof *s);
+    s->sites_owned = *sites;
+    memset(sites, 0, sizeof *sites);
+    s->instant = NAN;
+    s->sites.nx = s->sites_owned.nx;
+    s->sites.ny = s->sites_owned.ny;
+    s->sites.x0 = s->sites_owned.x0;
+    s->sites.y0 = s->sites_owned.y0;
+    s->sites.dx = s->sites_owned.dx;
+    s->sites.dy = s->sites_owned.dy;
+    s->sites.longitude = s->sites_owned.lon;
+    s->sites.latitude = s->sites_owned.lat;
+    s->sites.north_azimuth = s->sites_owned.north;
+
+    ts_day_opts_default(&s->day);
+    s->day.horizon.directions = o->directions;
+    s->day.horizon.start_azimuth = o->start_azimuth;
+    s->day.horizon.max_distance = o->max_distance;
+    s->day.horizon.curvature = o->curvature;
+    s->day.horizon.refraction = o->refraction;
+    s->day.horizon.threads = o->threads;
+    s->day.sun.pressure = o->pressure;
+    s->day.sun.temperature = o->temperature;
+    s->day.sun.delta_t = o->delta_t;
+    s->day.linke_turbidity = o->linke_turbidity;
+
+    ts_error err;
+    if (ts_sun_sites_validate(&s->sites, &err) != TS_OK)
+        return fail(msg, n, "cannot place the sun over the DEM", &err);
+    if (o->datetime[0]) {
+        char norm[2 * TSD_TEXT_MAX];
+        tsd_datetime_normalise(o->datetime, norm, sizeof norm);
+        if (ts_parse_iso8601(norm, &s->instant, &s->offset_minutes, &err) != TS_OK)
+            return fail(msg, n, "DATETIME", &err);
+    }
+    if (o->timezone[0] && ts_parse_utc_offset(o->timezone, &s->offset_minutes, &err) != TS_OK)
+        return fail(msg, n, "TIMEZONE", &err);
+
+    if (!tsd_product_is_daily(o->product)) {
+        /* shade, shadow: the sun at DATETIME */
+        if (ts_sun_at_site(&s->sites, &s->day, s->instant, &s->sun, &err) != TS_OK)
+            return fail(msg, n, "cannot compute the sun's position", &err);
+        o->sun_azimuth = s->sun.grid_azimuth;
+        o->sun_elevation = s->sun.elevation;
+        return 0;
+    }
+
+    /* the local day */
+    if (o->date[0]) {
+        int y, m, d;
+        if (ts_parse_date(o->date, &y, &m, &d, &err) != TS_OK)
+            return fail(msg, n, "DATE", &err);
+        s->day_start = ts_local_midnight(y, m, d, s->offset_minutes);
+    } else {
+        s->day_start = ts_local_day_start(s->instant, s->offset_minutes);
+    }
+    s->day_length = 86400.0;
+    /* the SPA's range of years, checked once here */
+    ts_sun_sample probe;
+    if (ts_sun_at_site(&s->sites, &s->day, s->day_start, &probe, &err) != TS_OK)
+        return fail(msg, n, "cannot compute the sun's position", &err);
+
+    if (o->product == TSD_PRODUCT_DAYCYCLE || o->product == TSD_PRODUCT_FARSHADOW) {
+        int steps = tsd_options_band_count(o);
+        s->times = malloc((size_t)steps * sizeof *s->times);
+        s->durations = malloc((size_t)steps * sizeof *s->durations);
+        s->samples = malloc((size_t)steps * sizeof *s->samples);
+        if (!s->times || !s->durations || !s->samples)
+            return fail(msg, n, "out of memory for the time steps", NULL);
+        if (o->product == TSD_PRODUCT_DAYCYCLE) {
+            if (ts_day_uniform_times(s->day_start, s->day_length, o->step_minutes * 60.0,
+                                     s->times, s->durations, &err) != TS_OK)
+                return fail(msg, n, "cannot lay out the day's steps", &err);
+        } else {
+            int got = 0;
+            if (ts_day_atlas_times(&s->sites, &s->day, s->day_start, s->day_length, steps,
+                                   s->times, &got, &err) != TS_OK)
+                return fail(msg, n, "cannot lay out the atlas's sun positions", &err);
+            if (got == 0) {
+                char day[40];
+                tsd_format_time(s->day_start, s->offset_minutes, day, sizeof day);
+                snprintf(msg, n,
+                         "the sun does not rise on the day starting %s at latitude %.4g "
+                         "(polar night): PRODUCT=farshadow has no sun positions to map; "
+                         "PRODUCT=sunhours gives 0 hours there",
+                         day, s->sites.latitude[0]);
+                return -1;
+            }
+            for (int k = 0; k < steps; k++)
+                s->durations[k] = NAN;
+            s->threshold_m = o->far_threshold * min_cell_m;
+        }
+        s->steps = steps;
+        for (int k = 0; k < steps; k++)
+            if (ts_sun_at_site(&s->sites, &s->day, s->times[k], &s->samples[k], &err) != TS_OK)
+                return fail(msg, n, "cannot compute the sun's position", &err);
+    }
+    return 0;
+}

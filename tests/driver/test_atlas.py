@@ -1,0 +1,218 @@
+"""The far-shadow atlas through GDAL (issue 5, item 4).
+
+- PRODUCT=farshadow: one binary band per sun position of the day (denser
+  near dawn and dusk), each with its time and sun, far shadows only;
+- gdal_translate -of TERRASHADE writes it as an atlas (*.tsa: 8 x 8 tile
+  dictionary + index maps + LZMA, docs/atlas-format.md), and GDAL reads the
+  file back, recognised by its magic, identical to the uncompressed result:
+  pixels, nodata, band metadata, dataset metadata, georeferencing;
+- SHADOWS=all recomputes the near shadows on read and gives the full
+  shadows;
+- bits per cell per day on jacksboro; bad sources and damaged files give
+  clear errors.
+"""
+import datetime
+import os
+import unittest
+
+import tsdriver as T
+from tsdriver import gdal, np
+
+DAY = {"PRODUCT": "farshadow", "DATE": "2026-12-21", "TIMEZONE": "-05:00",
+       "FAR_THRESHOLD": 24, "ATLAS_STEPS": 32}
+
+
+def oo(d):
+    return ["%s=%s" % kv for kv in d.items()]
+
+
+def band_metadata(ds):
+    return [(ds.GetRasterBand(b).GetDescription(), ds.GetRasterBand(b).GetMetadata())
+            for b in range(1, ds.RasterCount + 1)]
+
+
+class Atlas(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = T.TempDir()
+        cls.dir = cls.tmp.__enter__()
+        cls.tsa = os.path.join(cls.dir, "jacksboro.tsa")
+        T.run(["gdal_translate", "-q", "-of", "TERRASHADE"] + sum(
+            (["-oo", o] for o in oo(DAY)), []) + [T.conn(T.JACKSBORO), cls.tsa])
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.__exit__(None, None, None)
+
+    def test_farshadow_product(self):
+        ds = gdal.OpenEx(T.conn(T.JACKSBORO), open_options=oo(DAY))
+        self.assertEqual(ds.RasterCount, 32)
+        self.assertAlmostEqual(float(ds.GetMetadataItem("FAR_THRESHOLD_M")),
+                               24 * float(ds.GetMetadataItem("CELL_SIZE_X_NORTH")), places=3)
+        times, share = [], []
+        for b in range(1, 33):
+            rb = ds.GetRasterBand(b)
+            self.assertEqual(rb.DataType, gdal.GDT_Byte)
+            self.assertEqual(rb.GetNoDataValue(), 255)
+            m = rb.GetMetadata()
+            self.assertEqual(rb.GetDescription(), m["TIME"])
+            self.assertTrue(m["TIME"].startswith("2026-12-21T") and m["TIME"].endswith("-05:00"))
+            self.assertGreater(float(m["SUN_ELEVATION"]), -0.3)
+            times.append(float(m["UNIX_TIME"]))
+            a = rb.ReadAsArray()
+            self.assertTrue(set(np.unique(a)) <= {0, 1})
+            share.append(a.mean())
+        gaps = np.diff(times) / 60
+        print("farshadow: %d maps %s .. %s; gaps %.1f min at dawn, %.1f at noon; in far "
+              "shadow: %.1f%% at dawn, %.1f%% at noon" % (
+                  len(times), ds.GetRasterBand(1).GetDescription(),
+                  ds.GetRasterBand(32).GetDescription(), gaps[0], gaps[15],
+                  100 * share[0], 100 * share[16]))
+        self.assertTrue(np.all(gaps > 0))
+        self.assertLess(gaps[0], 0.5 * gaps[15])
+        self.assertGreater(share[0], share[16])
+
+    def test_far_shadows_are_shadows(self):
+        """A cell in far shadow is in shadow: against the exact shadow of the
+        same sun (PRODUCT=shadow at the band's instant)."""
+        ds = gdal.OpenEx(T.conn(T.JACKSBORO), open_options=oo(DAY))
+        for b in (1, 8, 16, 32):
+            far = ds.GetRasterBand(b).ReadAsArray() == 1
+            t = float(ds.GetRasterBand(b).GetMetadataItem("UNIX_TIME"))
+            dt = datetime.datetime.fromtimestamp(t, datetime.timezone.utc)
+            iso = dt.strftime("%Y-%m-%dT%H:%M:%S.%f")[:-3] + "Z"
+            full = T.read(T.conn(T.JACKSBORO), 1, {"PRODUCT": "shadow", "DATETIME": iso}) < 0.5
+            inside = full[far].mean() if far.any() else 1.0
+            print("band %2d (%s): %.2f%% far shadow, %.2f%% shadow; %.3f%% of far shadow "
+                  "lies in shadow" % (b, iso, 100 * far.mean(), 100 * full.mean(),
+                                      100 * inside))
+            self.assertGreater(inside, 0.99)
+
+    def test_round_trip_is_identical(self):
+        """The atlas reads back as the uncompressed product: pixels, nodata,
+        band descriptions and metadata, dataset metadata, georeferencing."""
+        src = gdal.OpenEx(T.conn(T.JACKSBORO), open_options=oo(DAY))
+        ds = gdal.Open(self.tsa)
+        self.assertEqual(ds.GetDriver().ShortName, "TERRASHADE")
+        self.assertEqual(gdal.IdentifyDriver(self.tsa).ShortName, "TERRASHADE")
+        self.assertEqual(ds.RasterCount, src.RasterCount)
+        for b in range(1, ds.RasterCount + 1):
+            np.testing.assert_array_equal(ds.GetRasterBand(b).ReadAsArray(),
+                                          src.GetRasterBand(b).ReadAsArray())
+            self.assertEqual(ds.GetRasterBand(b).GetNoDataValue(), 255)
+            self.assertEqual(ds.GetRasterBand(b).DataType, gdal.GDT_Byte)
+        self.assertEqual(band_metadata(ds), band_metadata(src))
+        self.assertEqual(ds.GetMetadata(), src.GetMetadata())
+        self.assertEqual(ds.GetGeoTransform(), src.GetGeoTransform())
+        self.assertTrue(ds.GetSpatialRef().IsSame(src.GetSpatialRef()))
+        size = os.path.getsize(self.tsa)
+        raw = src.RasterXSize * src.RasterYSize
+        print("jacksboro atlas, FAR_THRESHOLD=24, 32 maps: %d bytes = %.4f bits per cell "
+              "per day (%.1f x smaller than one bit per cell per map)"
+              % (size, size * 8.0 / raw, raw * 32 / 8.0 / size))
+        # any window, any order
+        a = ds.GetRasterBand(7).ReadAsArray(100, 50, 123, 77)
+        np.testing.assert_array_equal(a, src.GetRasterBand(7).ReadAsArray(100, 50, 123, 77))
+
+    def test_round_trip_through_geotiff_and_python(self):
+        tif = os.path.join(self.dir, "far.tif")
+        T.translate(T.JACKSBORO, tif, DAY)
+        tsa = os.path.join(self.dir, "from_tif.tsa")
+        T.run(["gdal_translate", "-q", "-of", "TERRASHADE", tif, tsa])
+        np.testing.assert_array_equal(T.read(tsa), T.read(tif))
+        self.assertEqual(band_metadata(gdal.Open(tsa))[5][1]["TIME"],
+                         band_metadata(gdal.Open(tif))[5][1]["TIME"])
+        py = os.path.join(self.dir, "python.tsa")
+        out = gdal.GetDriverByName("TERRASHADE").CreateCopy(py, gdal.Open(tif))
+        self.assertIsNotNone(out)
+        out = None
+        np.testing.assert_array_equal(T.read(py), T.read(tif))
+
+    def test_nodata_round_trip(self):
+        """lux_elev has nodata outside Luxembourg: 255 in every map, kept."""
+        d = dict(DAY, FAR_THRESHOLD=4, ATLAS_STEPS=12)
+        tsa = os.path.join(self.dir, "lux.tsa")
+        T.run(["gdal_translate", "-q", "-of", "TERRASHADE"] + sum(
+            (["-oo", o] for o in oo(d)), []) + [T.conn(T.LUX), tsa])
+        src = gdal.OpenEx(T.conn(T.LUX), open_options=oo(d))
+        ds = gdal.Open(tsa)
+        for b in range(1, 13):
+            a = ds.GetRasterBand(b).ReadAsArray()
+            np.testing.assert_array_equal(a, src.GetRasterBand(b).ReadAsArray())
+        print("lux: %.1f%% nodata, %.1f%% far shadow in map 1"
+              % (100 * np.mean(a == 255), 100 * np.mean(
+                  ds.GetRasterBand(1).ReadAsArray() == 1)))
+        self.assertGreater(np.mean(a == 255), 0.2)
+
+    def test_default_threshold_bits_per_cell(self):
+        """The defaults (512 cells, 158 maps): jacksboro is smaller than the
+        threshold, so its maps are empty; the atlas costs almost nothing."""
+        d = {"PRODUCT": "farshadow", "DATE": "2026-06-21", "TIMEZONE": "-04:00"}
+        tsa = os.path.join(self.dir, "default.tsa")
+        T.run(["gdal_translate", "-q", "-of", "TERRASHADE"] + sum(
+            (["-oo", o] for o in oo(d)), []) + [T.conn(T.JACKSBORO), tsa])
+        ds = gdal.Open(tsa)
+        self.assertEqual(ds.RasterCount, 158)
+        bits = os.path.getsize(tsa) * 8.0 / (ds.RasterXSize * ds.RasterYSize)
+        print("jacksboro atlas with the defaults (FAR_THRESHOLD=512, 158 maps): %d bytes "
+              "= %.4f bits per cell per day" % (os.path.getsize(tsa), bits))
+        self.assertLessEqual(bits, 3.0)
+
+    def test_shadows_all_recomputes_the_near_shadows(self):
+        """SHADOWS=all: far shadows from the atlas OR near shadows recomputed
+        from the DEM (horizon within the threshold above the sun) = the full
+        shadow of the same sun."""
+        far = gdal.Open(self.tsa)
+        ds = gdal.OpenEx(self.tsa, open_options=["SHADOWS=all"])
+        for b in (1, 16, 32):
+            f = far.GetRasterBand(b).ReadAsArray()
+            a = ds.GetRasterBand(b).ReadAsArray()
+            self.assertTrue(np.all(a >= f))
+            t = float(ds.GetRasterBand(b).GetMetadataItem("UNIX_TIME"))
+            iso = datetime.datetime.fromtimestamp(t, datetime.timezone.utc).strftime(
+                "%Y-%m-%dT%H:%M:%S.%f")[:-3] + "Z"
+            full = T.read(T.conn(T.JACKSBORO), 1, {"PRODUCT": "shadow", "DATETIME": iso}) < 0.5
+            agree = np.mean((a == 1) == full)
+            print("band %2d: far %.2f%%, far | near %.2f%%, full shadow %.2f%%, agree %.3f%%"
+                  % (b, 100 * np.mean(f == 1), 100 * np.mean(a == 1), 100 * full.mean(),
+                     100 * agree))
+            self.assertGreater(agree, 0.995)
+        # the DEM can be named when the atlas's SOURCE_DEM is gone
+        named = gdal.OpenEx(self.tsa, open_options=["SHADOWS=all", "DEM=" + T.JACKSBORO])
+        self.assertEqual(named.GetRasterBand(1).Checksum(), ds.GetRasterBand(1).Checksum())
+
+    def test_bad_sources_and_damaged_files(self):
+        out = os.path.join(self.dir, "bad.tsa")
+        p = T.run(["gdal_translate", "-of", "TERRASHADE", T.JACKSBORO, out], ok=False)
+        print(p.stderr.strip().splitlines()[-1])
+        self.assertIn("holds the value", p.stderr)
+        self.assertIn("binary maps", p.stderr)
+        self.assertFalse(os.path.exists(out))
+        with open(self.tsa, "rb") as f:
+            data = f.read()
+        cases = [("truncated", data[:len(data) // 2], "truncated"),
+                 ("header", data[:20] + bytes([data[20] ^ 1]) + data[21:], "damaged"),
+                 ("index", data[:-40] + bytes([data[-40] ^ 0x20]) + data[-39:], "damaged"),
+                 ("version", data[:8] + bytes([9]) + data[9:], "version 9")]
+        for name, blob, text in cases:
+            with self.subTest(name):
+                path = os.path.join(self.dir, name + ".tsa")
+                with open(path, "wb") as f:
+                    f.write(blob)
+                p = T.run(["gdalinfo", path], ok=False)
+                print("%-9s -> %s" % (name, [l for l in p.stderr.splitlines()
+                                             if "TERRASHADE" in l][0]))
+                self.assertIn(text, p.stderr)
+                self.assertIn("TERRASHADE", p.stderr)
+        for opts, text in ((["SHADOWS=near"], "SHADOWS must be one of far, all"),
+                           (["PRODUCT=shade"], "an atlas takes the open options")):
+            with self.assertRaises(RuntimeError) as e:
+                gdal.OpenEx(self.tsa, open_options=opts)
+            self.assertIn(text, str(e.exception))
+        with self.assertRaises(RuntimeError) as e:
+            gdal.Open(self.tsa, gdal.GA_Update)
+        self.assertIn("read-only", str(e.exception))
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

@@ -1,0 +1,401 @@
+"""The sun from a date and time (issue 5, items 2, 3 and 5).
+
+- DATETIME places the sun with the SPA at the DEM's centre; the dataset
+  metadata names the azimuth and elevation used; the result equals the
+  product with SUN_AZIMUTH / SUN_ELEVATION set to them; a projected DEM gets
+  its azimuth turned from true to grid north (meridian convergence);
+- sunhours on a flat plane is the astronomical day length within one step
+  (against NOAA's sunrise equation, an independent reference), per cell on
+  a large extent (SUN_POSITION=per_cell), 0 in the polar night, 24 in the
+  polar day;
+- insolation is beam + diffuse, plausible in size, larger on south slopes
+  in winter; daycycle bands carry their time and sun and add up to sunhours;
+- bad input: malformed dates, a missing offset, latitudes beyond +/-90, a DEM
+  without georeferencing, options that do not go together: clear errors.
+"""
+import math
+import os
+import unittest
+
+import tsdriver as T
+from tsdriver import gdal, np, osr
+
+
+def noaa_day_length(lat, lon, year, month, day, zenith=90.833):
+    """Hours between sunrise and sunset (sun's centre at `zenith`: 90.833 =
+    upper limb on the horizon with refraction) by NOAA's solar calculator
+    equations (Meeus), declination at local solar noon. None in polar
+    night or day."""
+    a = (14 - month) // 12
+    y, m = year + 4800 - a, month + 12 * a - 3
+    jdn = day + (153 * m + 2) // 5 + 365 * y + y // 4 - y // 100 + y // 400 - 32045
+    jd = jdn - 0.5 + (12.0 - lon / 15.0) / 24.0
+    jc = (jd - 2451545.0) / 36525.0
+    L = (280.46646 + jc * (36000.76983 + jc * 0.0003032)) % 360
+    M = 357.52911 + jc * (35999.05029 - 0.0001537 * jc)
+    r = math.radians
+    C = (math.sin(r(M)) * (1.914602 - jc * (0.004817 + 0.000014 * jc))
+         + math.sin(r(2 * M)) * (0.019993 - 0.000101 * jc)
+         + math.sin(r(3 * M)) * 0.000289)
+    omega = 125.04 - 1934.136 * jc
+    app = L + C - 0.00569 - 0.00478 * math.sin(r(omega))
+    eps0 = 23 + (26 + (21.448 - jc * (46.815 + jc * (0.00059 - jc * 0.001813))) / 60) / 60
+    eps = eps0 + 0.00256 * math.cos(r(omega))
+    decl = math.degrees(math.asin(math.sin(r(eps)) * math.sin(r(app))))
+    c = (math.cos(r(zenith)) / (math.cos(r(lat)) * math.cos(r(decl)))
+         - math.tan(r(lat)) * math.tan(r(decl)))
+    if abs(c) > 1:
+        return None
+    return 8 * math.degrees(math.acos(c)) / 60.0
+
+
+def flat_dem(path, lat, lon, n=32, cell=0.0005, z=0.0):
+    """A flat n x n DEM in EPSG:4326 centred at (lat, lon)."""
+    gt = (lon - n * cell / 2, cell, 0, lat + n * cell / 2, 0, -cell)
+    return T.write_tif(path, np.full((n, n), z, np.float32), gt, 4326)
+
+
+def md(path, oo):
+    ds = gdal.OpenEx(path, gdal.OF_RASTER, open_options=["%s=%s" % kv for kv in oo.items()])
+    return ds.GetMetadata()
+
+
+class Sun(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = T.TempDir()
+        cls.dir = cls.tmp.__enter__()
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.__exit__(None, None, None)
+
+    # ------------------------------------------------------------ DATETIME
+
+    def test_datetime_places_the_sun(self):
+        """At solar noon of the June solstice the sun stands at 90 - lat + 23.44
+        degrees, due south; the metadata says so, with the names of the values."""
+        conn = T.conn(T.JACKSBORO)
+        m = md(conn, {"PRODUCT": "shadow", "DATETIME": "2026-06-21T13:36:00-04:00"})
+        print({k: v for k, v in m.items() if k.startswith("SUN") or "MERID" in k})
+        lat = float(m["SUN_SITE_LATITUDE"])
+        self.assertAlmostEqual(lat, 36.5896, places=3)
+        self.assertAlmostEqual(float(m["SUN_SITE_LONGITUDE"]), -84.2458, places=3)
+        self.assertAlmostEqual(float(m["SUN_ELEVATION"]), 90 - lat + 23.44, delta=0.3)
+        self.assertAlmostEqual(float(m["SUN_AZIMUTH_TRUE"]), 180, delta=3)
+        self.assertEqual(m["SUN_AZIMUTH"], m["SUN_AZIMUTH_TRUE"])  # geographic grid
+        self.assertEqual(float(m["MERIDIAN_CONVERGENCE"]), 0)
+        self.assertEqual(m["SUN_TIME"], "2026-06-21T13:36:00-04:00")
+        self.assertEqual(m["DATETIME"], "2026-06-21T13:36:00-04:00")
+
+    def test_datetime_equals_the_explicit_sun(self):
+        """DATETIME gives the pixels of SUN_AZIMUTH / SUN_ELEVATION set to the
+        values it reports, for shadow and shade; Z and an offset name the
+        same instant; inline, the time is written without colons."""
+        dt = "2026-12-21T08:40:00-05:00"
+        for product in ("shadow", "shade"):
+            conn = T.conn(T.JACKSBORO)
+            a = T.read(conn, 1, {"PRODUCT": product, "DATETIME": dt})
+            m = md(conn, {"PRODUCT": product, "DATETIME": dt})
+            b = T.read(conn, 1, {"PRODUCT": product, "SUN_AZIMUTH": m["SUN_AZIMUTH"],
+                                 "SUN_ELEVATION": m["SUN_ELEVATION"]})
+            d = np.nanmax(np.abs(a - b))
+            print("%s at %s (az %s, el %s): max |DATETIME - explicit| = %.2g, %.1f%% in "
+                  "shadow" % (product, dt, m["SUN_AZIMUTH"], m["SUN_ELEVATION"], d,
+                              100 * np.mean(a < (0.5 if product == "shadow" else 60))))
+            self.assertLessEqual(d, 2e-3 if product == "shadow" else 1)
+        z = T.read(T.conn(T.JACKSBORO), 1, {"PRODUCT": "shadow",
+                                            "DATETIME": "2026-12-21T13:40:00Z"})
+        a = T.read(T.conn(T.JACKSBORO), 1, {"PRODUCT": "shadow", "DATETIME": dt})
+        np.testing.assert_array_equal(z, a)
+        inline = T.read(T.conn(T.JACKSBORO, PRODUCT="shadow",
+                               DATETIME="2026-12-21T084000-0500"), 1)
+        np.testing.assert_array_equal(inline, a)
+        inline = T.read(T.conn(T.JACKSBORO, PRODUCT="shadow", DATETIME="20261221T1340Z"), 1)
+        np.testing.assert_array_equal(inline, a)
+
+    def test_per_cell_datetime_on_a_small_extent(self):
+        """SUN_POSITION=per_cell over jacksboro (0.3 x 0.3 deg): the sun moves
+        by ~0.2 deg across it, so the shadows barely change."""
+        dt = "2026-12-21T08:40:00-05:00"
+        for product in ("shadow", "shade"):
+            a = T.read(T.conn(T.JACKSBORO), 1, {"PRODUCT": product, "DATETIME": dt})
+            b = T.read(T.conn(T.JACKSBORO), 1, {"PRODUCT": product, "DATETIME": dt,
+                                                "SUN_POSITION": "per_cell"})
+            lit_a, lit_b = a >= (0.5 if product == "shadow" else 128), \
+                b >= (0.5 if product == "shadow" else 128)
+            agree = np.mean(lit_a == lit_b)
+            print("%s, per cell vs centre: lit/unlit agree in %.3f%% of cells, mean %.4f vs "
+                  "%.4f" % (product, 100 * agree, a.mean(), b.mean()))
+            self.assertGreater(agree, 0.97)
+
+    def test_grid_north_of_a_projected_dem(self):
+        """jacksboro in UTM 17N lies west of the central meridian: grid north
+        is west of true north by about (lon - lon0) sin(lat) ~ 1.85 deg. The
+        driver turns the sun's true azimuth into the grid's and says by how
+        much; the true azimuth matches the geographic DEM's."""
+        utm = T.jacksboro_utm(self.dir)
+        dt = "2026-06-21T09:00:00-04:00"
+        mu = md(T.conn(utm), {"PRODUCT": "shadow", "DATETIME": dt})
+        mg = md(T.conn(T.JACKSBORO), {"PRODUCT": "shadow", "DATETIME": dt})
+        lat, lon = float(mu["SUN_SITE_LATITUDE"]), float(mu["SUN_SITE_LONGITUDE"])
+        wgs, u = osr.SpatialReference(), osr.SpatialReference()
+        wgs.ImportFromEPSG(4326)
+        u.ImportFromEPSG(32617)
+        for s in (wgs, u):
+            s.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+        ct = osr.CoordinateTransformation(wgs, u)
+        x0, y0, _ = ct.TransformPoint(lon, lat)
+        x1, y1, _ = ct.TransformPoint(lon, lat + 0.01)
+        north = math.degrees(math.atan2(x1 - x0, y1 - y0))
+        conv = float(mu["MERIDIAN_CONVERGENCE"])
+        print("UTM: convergence %.4f deg (osr: %.4f, (lon + 81) sin(lat): %.4f); sun true "
+              "%s, grid %s; geographic DEM: %s" % (
+                  conv, -north, (lon + 81) * math.sin(math.radians(lat)),
+                  mu["SUN_AZIMUTH_TRUE"], mu["SUN_AZIMUTH"], mg["SUN_AZIMUTH"]))
+        self.assertAlmostEqual(conv, -north, delta=0.01)
+        self.assertAlmostEqual(conv, (lon + 81) * math.sin(math.radians(lat)), delta=0.05)
+        self.assertAlmostEqual(float(mu["SUN_AZIMUTH"]),
+                               (float(mu["SUN_AZIMUTH_TRUE"]) - conv) % 360, places=4)
+        self.assertAlmostEqual(float(mu["SUN_AZIMUTH_TRUE"]), float(mg["SUN_AZIMUTH"]),
+                               delta=0.05)
+        self.assertAlmostEqual(float(mu["SUN_ELEVATION"]), float(mg["SUN_ELEVATION"]),
+                               delta=0.05)
+
+    # ------------------------------------------------------------- sunhours
+
+    def test_sunhours_flat_plane_is_the_day_length(self):
+        cases = [(46.5, 7.9, "2026-06-21", "+02:00"), (46.5, 7.9, "2026-12-21", "+01:00"),
+                 (-33.9, 18.4, "2026-06-21", "+02:00"), (0.2, -78.5, "2026-03-20", "-05:00"),
+                 (36.6, -84.2, "2026-09-01", "-04:00")]
+        for lat, lon, date, tz in cases:
+            with self.subTest(lat=lat, date=date):
+                dem = flat_dem(os.path.join(self.dir, "flat.tif"), lat, lon)
+                h = T.read(T.conn(dem), 1, {"PRODUCT": "sunhours", "DATE": date,
+                                            "TIMEZONE": tz})
+                y, mo, d = map(int, date.split("-"))
+                astro = noaa_day_length(lat, lon, y, mo, d)
+                centre = noaa_day_length(lat, lon, y, mo, d, 90.5667)
+                print("flat plane at %5.1f, %s: sun hours %.4f..%.4f h; NOAA day length "
+                      "%.4f h (diff %+.2f min), centre above the horizon %.4f h (%+.2f min)"
+                      % (lat, date, h.min(), h.max(), astro, (h.max() - astro) * 60,
+                         centre, (h.max() - centre) * 60))
+                self.assertLess(h.max() - h.min(), 1e-3)
+                self.assertLessEqual(abs(h.mean() - astro) * 60, 5.0)  # one step
+                self.assertLessEqual(abs(h.mean() - centre) * 60, 2.5)
+
+    def test_sunhours_step_and_datetime(self):
+        """STEP_MINUTES changes the sampling only; DATETIME names the day in
+        its own offset (or TIMEZONE's)."""
+        dem = flat_dem(os.path.join(self.dir, "flat.tif"), 46.5, 7.9)
+        a = T.read(T.conn(dem), 1, {"PRODUCT": "sunhours", "DATE": "2026-06-21",
+                                    "TIMEZONE": "+02:00", "STEP_MINUTES": 1})
+        b = T.read(T.conn(dem), 1, {"PRODUCT": "sunhours",
+                                    "DATETIME": "2026-06-21T23:59:00+02:00",
+                                    "STEP_MINUTES": 1})
+        np.testing.assert_array_equal(a, b)
+        c = T.read(T.conn(dem), 1, {"PRODUCT": "sunhours",
+                                    "DATETIME": "2026-06-21T21:59:00Z", "TIMEZONE": "+02:00",
+                                    "STEP_MINUTES": 1})
+        np.testing.assert_array_equal(a, c)
+        e = T.read(T.conn(dem), 1, {"PRODUCT": "sunhours", "DATE": "2026-06-21",
+                                    "TIMEZONE": "+02:00", "STEP_MINUTES": 30})
+        print("Bern, 2026-06-21: %.4f h (1-minute steps), %.4f h (30-minute steps)"
+              % (a.mean(), e.mean()))
+        self.assertLessEqual(abs(a.mean() - e.mean()), 0.5)
+
+    def test_sunhours_jacksboro(self):
+        h = T.read(T.conn(T.JACKSBORO), 1, {"PRODUCT": "sunhours", "DATE": "2026-12-21",
+                                            "TIMEZONE": "-05:00"})
+        astro = noaa_day_length(36.59, -84.25, 2026, 12, 21)
+        print("jacksboro, 2026-12-21: sun hours %.2f..%.2f (mean %.2f) h, day length "
+              "%.2f h" % (h.min(), h.max(), h.mean(), astro))
+        self.assertLess(h.max(), astro + 0.3)  # ridge tops see a little more
+        self.assertLess(h.min(), astro - 1.5)  # valleys lose hours
+        # steep north faces (> ~30 deg) see no sun at all in December
+        self.assertGreaterEqual(h.min(), 0)
+        self.assertLess(np.mean(h == 0), 0.01)
+        ds = gdal.OpenEx(T.conn(T.JACKSBORO), open_options=[
+            "PRODUCT=sunhours", "DATE=2026-12-21", "TIMEZONE=-05:00"])
+        self.assertEqual(ds.GetRasterBand(1).GetUnitType(), "hour")
+        m = ds.GetMetadata()
+        self.assertEqual(m["DAY_START"], "2026-12-21T00:00:00-05:00")
+        self.assertEqual(m["DAY_END"], "2026-12-22T00:00:00-05:00")
+        self.assertNotIn("SUN_AZIMUTH", m)  # no single sun over a day
+
+    def test_polar_night_and_day(self):
+        dem = flat_dem(os.path.join(self.dir, "svalbard.tif"), 78.2, 15.6, z=10.0)
+        night = T.read(T.conn(dem), 1, {"PRODUCT": "sunhours", "DATE": "2026-12-21",
+                                        "TIMEZONE": "+01:00"})
+        day = T.read(T.conn(dem), 1, {"PRODUCT": "sunhours", "DATE": "2026-06-21",
+                                      "TIMEZONE": "+02:00"})
+        print("Longyearbyen: %.3f h on 2026-12-21, %.3f h on 2026-06-21"
+              % (night.max(), day.min()))
+        self.assertEqual(night.max(), 0.0)
+        self.assertAlmostEqual(day.min(), 24.0, places=3)
+        ins = T.read(T.conn(dem), 1, {"PRODUCT": "insolation", "DATE": "2026-12-21",
+                                      "TIMEZONE": "+01:00"})
+        self.assertEqual(ins.max(), 0.0)
+        with self.assertRaises(RuntimeError) as e:
+            gdal.OpenEx(T.conn(dem), open_options=["PRODUCT=farshadow", "DATE=2026-12-21",
+                                                   "TIMEZONE=+01:00"])
+        print(e.exception)
+        self.assertIn("the sun does not rise", str(e.exception))
+
+    def test_per_cell_sun_on_a_large_extent(self):
+        """A flat DEM from 56 N to 40 N: with SUN_POSITION=per_cell each row
+        gets its own latitude's day length; at the centre, one for all."""
+        n, cell = 32, 0.5
+        gt = (0.0, cell, 0, 56.0, 0, -cell)
+        dem = T.write_tif(os.path.join(self.dir, "europe.tif"),
+                          np.zeros((n, n), np.float32), gt, 4326)
+        oo = {"PRODUCT": "sunhours", "DATE": "2026-06-21", "TIMEZONE": "Z"}
+        centre = T.read(T.conn(dem), 1, oo)
+        per = T.read(T.conn(dem), 1, dict(oo, SUN_POSITION="per_cell"))
+        self.assertLess(centre.max() - centre.min(), 1e-3)
+        for row in (0, n // 2, n - 1):
+            lat = 56.0 - (row + 0.5) * cell
+            want = noaa_day_length(lat, 8.0, 2026, 6, 21, 90.5667)  # centre on the horizon
+            print("per cell, row %2d (lat %.2f): %.3f h, NOAA (centre) %.3f h; centre mode "
+                  "%.3f h" % (row, lat, per[row, n // 2], want, centre[row, n // 2]))
+            self.assertLessEqual(abs(per[row, n // 2] - want) * 60, 2.5)
+        self.assertGreater(per[0].mean(), per[-1].mean() + 1.5)
+
+    # ------------------------------------------------------------ insolation
+
+    def test_insolation(self):
+        ds = gdal.OpenEx(T.conn(T.JACKSBORO), open_options=[
+            "PRODUCT=insolation", "DATE=2026-12-21", "TIMEZONE=-05:00",
+            "DIRECTIONS=8", "STEP_MINUTES=10"])
+        self.assertEqual(ds.RasterCount, 3)
+        names = [ds.GetRasterBand(b).GetDescription() for b in (1, 2, 3)]
+        self.assertEqual(names, ["insolation global", "insolation beam",
+                                 "insolation diffuse"])
+        self.assertEqual(ds.GetRasterBand(1).GetUnitType(), "Wh/m2")
+        self.assertIn("ESRA", ds.GetMetadataItem("CLEAR_SKY_MODEL"))
+        tot, beam, dif = (ds.GetRasterBand(b).ReadAsArray().astype(float) for b in (1, 2, 3))
+        np.testing.assert_allclose(tot, beam + dif, rtol=1e-5, atol=1e-2)
+        # slopes facing south get more than slopes facing north in December
+        dem, gt, _ = T.read_dem(T.JACKSBORO)
+        dy = np.gradient(dem.astype(float), axis=0)  # > 0: heights grow southward
+        south = dy < -15    # falls to the south: faces south
+        north = dy > 15
+        print("jacksboro, 2026-12-21: global %.0f..%.0f Wh/m2; south faces %.0f, north "
+              "faces %.0f; diffuse %.0f..%.0f" % (tot.min(), tot.max(), tot[south].mean(),
+                                                  tot[north].mean(), dif.min(), dif.max()))
+        self.assertGreater(tot[south].mean(), 1.5 * tot[north].mean())
+        self.assertGreater(tot.min(), 0)
+        self.assertLess(tot.max(), 6000)
+        # a flat plane gets the clear-sky global horizontal irradiation of a
+        # June day at 46.5 N: about 8 kWh/m2
+        flat = flat_dem(os.path.join(self.dir, "flat.tif"), 46.5, 7.9, z=400)
+        g = T.read(T.conn(flat), 1, {"PRODUCT": "insolation", "DATE": "2026-06-21",
+                                     "TIMEZONE": "+02:00", "DIRECTIONS": 4})
+        print("flat plane, Bern 400 m, 2026-06-21: %.0f Wh/m2" % g.mean())
+        self.assertTrue(7000 < g.mean() < 9500)
+        turbid = T.read(T.conn(flat), 1, {"PRODUCT": "insolation", "DATE": "2026-06-21",
+                                          "TIMEZONE": "+02:00", "DIRECTIONS": 4,
+                                          "LINKE_TURBIDITY": 6})
+        self.assertLess(turbid.mean(), g.mean())
+
+    # -------------------------------------------------------------- daycycle
+
+    def test_daycycle(self):
+        oo = {"PRODUCT": "daycycle", "DATE": "2026-06-21", "TIMEZONE": "-04:00",
+              "STEP_MINUTES": 60}
+        ds = gdal.OpenEx(T.conn(T.JACKSBORO), open_options=["%s=%s" % kv for kv in oo.items()])
+        self.assertEqual(ds.RasterCount, 24)
+        b = ds.GetRasterBand(13)
+        bm = b.GetMetadata()
+        print("band 13:", b.GetDescription(), bm)
+        self.assertEqual(b.GetDescription(), "2026-06-21T12:30:00-04:00")
+        self.assertEqual(bm["TIME"], "2026-06-21T12:30:00-04:00")
+        self.assertEqual(float(bm["DURATION_MINUTES"]), 60)
+        self.assertGreater(float(bm["SUN_ELEVATION"]), 60)
+        night = ds.GetRasterBand(1)
+        self.assertLess(float(night.GetMetadataItem("SUN_ELEVATION")), -10)
+        cube = T.read(T.conn(T.JACKSBORO), None, oo)
+        self.assertEqual(cube.shape, (24, 344, 403))
+        self.assertEqual(np.nanmax(cube[0]), 0.0)
+        self.assertGreater(np.nanmean(cube[12]), 0.95)
+        hours = T.read(T.conn(T.JACKSBORO), 1, dict(oo, PRODUCT="sunhours"))
+        np.testing.assert_allclose(cube.sum(axis=0), hours, atol=1e-4)
+        # Byte like shadow: 1 + 254 v
+        ds = gdal.OpenEx(T.conn(T.JACKSBORO), open_options=[
+            "%s=%s" % kv for kv in dict(oo, OUTPUT_TYPE="Byte").items()])
+        self.assertEqual(ds.GetRasterBand(13).DataType, gdal.GDT_Byte)
+
+    # ------------------------------------------------------------ bad input
+
+    def test_bad_input(self):
+        nogt = os.path.join(self.dir, "nogt.tif")
+        ds = gdal.GetDriverByName("GTiff").Create(nogt, 8, 8, 1, gdal.GDT_Float32)
+        ds.GetRasterBand(1).Fill(100)
+        ds = None
+        nocrs = T.write_tif(os.path.join(self.dir, "nocrs.tif"),
+                            np.zeros((8, 8), np.float32), (0, 30, 0, 0, 0, -30), None)
+        polar = T.write_tif(os.path.join(self.dir, "beyond.tif"),
+                            np.zeros((8, 8), np.float32), (0, 1, 0, 94, 0, -1), 4326)
+        J = T.conn(T.JACKSBORO)
+        day = ["DATE=2026-06-21", "TIMEZONE=+02:00"]
+        cases = [
+            (J, ["PRODUCT=shadow", "DATETIME=2026-13-01T10:00Z"], "month"),
+            (J, ["PRODUCT=shadow", "DATETIME=yesterday"], "Cannot read 'yesterday'"),
+            (J, ["PRODUCT=shadow", "DATETIME=2026-06-21T07:30:00"],
+             "an offset from UTC is required"),
+            (J, ["PRODUCT=shadow", "DATETIME=2026-02-29T07:30:00Z"], "DATETIME"),
+            (J, ["PRODUCT=shadow", "DATETIME=2026-06-21T25:00:00Z"], "DATETIME"),
+            (J, ["PRODUCT=sunhours", "DATE=2026-02-30", "TIMEZONE=Z"], "there is no day 30"),
+            (J, ["PRODUCT=sunhours", "DATE=21/06/2026", "TIMEZONE=Z"], "YYYY-MM-DD"),
+            (J, ["PRODUCT=sunhours", "DATE=2026-06-21"], "needs TIMEZONE"),
+            (J, ["PRODUCT=sunhours", "DATE=2026-06-21", "TIMEZONE=Europe/Zurich"],
+             "named time zones are not supported"),
+            (J, ["PRODUCT=sunhours"], "PRODUCT=sunhours needs a day"),
+            (J, ["PRODUCT=sunhours", "DATETIME=2026-06-21T07:30Z"] + day,
+             "not both"),
+            (J, ["PRODUCT=shadow", "DATETIME=2026-06-21T07:30Z", "SUN_AZIMUTH=100"],
+             "DATETIME places the sun"),
+            (J, ["PRODUCT=shade", "DATE=2026-06-21", "TIMEZONE=Z"],
+             "give the sun's instant as DATETIME"),
+            (J, ["PRODUCT=svf", "DATETIME=2026-06-21T07:30Z"], "not to PRODUCT=svf"),
+            (J, ["PRODUCT=sunhours", "OUTPUT_TYPE=Byte"] + day, "in hours"),
+            (J, ["PRODUCT=farshadow", "SUN_POSITION=per_cell"] + day, "SUN_POSITION=center"),
+            (J, ["PRODUCT=shadow", "SUN_POSITION=per_cell"], "needs the sun from DATETIME"),
+            (J, ["PRODUCT=sunhours", "PRESSURE=0"] + day, "PRESSURE must be greater than 0"),
+            (J, ["PRODUCT=sunhours", "TEMPERATURE=-300"] + day, "TEMPERATURE must be"),
+            (J, ["PRODUCT=sunhours", "DELTA_T=9000"] + day, "DELTA_T must be between"),
+            (J, ["PRODUCT=sunhours", "STEP_MINUTES=0"] + day, "STEP_MINUTES must be between"),
+            (J, ["PRODUCT=insolation", "LINKE_TURBIDITY=0.5"] + day, "LINKE_TURBIDITY"),
+            (J, ["PRODUCT=sunhours", "DATE=7000-01-01", "TIMEZONE=Z"], "valid"),
+            (T.conn(nogt), ["PRODUCT=shadow", "DATETIME=2026-06-21T07:30Z"],
+             "DATETIME needs a georeferenced DEM"),
+            (T.conn(nogt), ["PRODUCT=sunhours"] + day, "has no geotransform"),
+            (T.conn(nocrs), ["PRODUCT=sunhours"] + day, "has no CRS"),
+            (T.conn(polar), ["PRODUCT=sunhours"] + day, "beyond the poles"),
+        ]
+        for conn, oo, text in cases:
+            with self.subTest(oo=oo):
+                with self.assertRaises(RuntimeError) as e:
+                    ds = gdal.OpenEx(conn, gdal.OF_RASTER, open_options=oo)
+                    ds.GetRasterBand(1).Checksum()
+                print("%-60s -> %s" % (" ".join(oo), str(e.exception)[:150]))
+                self.assertIn(text, str(e.exception))
+                self.assertIn("TERRASHADE", str(e.exception))
+        # and through the tools: non-zero exit, no output, no crash
+        out = os.path.join(self.dir, "bad.tif")
+        p = T.run(["gdal_translate", "-oo", "PRODUCT=sunhours", "-oo", "DATE=2026-06-21",
+                   T.conn(T.JACKSBORO), out], ok=False)
+        self.assertIn("needs TIMEZONE", p.stderr)
+        self.assertFalse(os.path.exists(out))
+
+    def test_without_georeferencing_the_classic_sun_still_works(self):
+        nogt = os.path.join(self.dir, "nogt2.tif")
+        ds = gdal.GetDriverByName("GTiff").Create(nogt, 8, 8, 1, gdal.GDT_Float32)
+        ds.GetRasterBand(1).Fill(100)
+        ds = None
+        a = T.read(T.conn(nogt), 1, {"PRODUCT": "shadow", "SUN_ELEVATION": 30})
+        self.assertEqual(np.nanmin(a), 1.0)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
