@@ -64,8 +64,14 @@ class TSDataset final : public GDALPamDataset
     GByte *m_pabyProduct = nullptr; // PRODUCT=farshadow
     bool m_bHasSun = false;
     tsd_sun m_sSun{};
+    bool m_bUsesBackend = false;
+    bool m_bBackendKnown = false;     // m_sBackend filled (predicted or ran)
+    tsd_backend_summary m_sBackend{}; // predicted, then what ran
 
     CPLErr EnsureComputed();
+    void EnsureBackendMetadata();
+    void SetupBackendMetadata();
+    void ReportBackend();
     void SetupSunMetadata();
     void SetupMetadata();
     void SetupPam(const char *pszConnection);
@@ -79,6 +85,8 @@ class TSDataset final : public GDALPamDataset
 
     CPLErr GetGeoTransform(double *padfGT) override;
     const OGRSpatialReference *GetSpatialRef() const override;
+    char **GetMetadata(const char *pszDomain = "") override;
+    const char *GetMetadataItem(const char *pszName, const char *pszDomain = "") override;
 };
 
 class TSRasterBand final : public GDALPamRasterBand
@@ -249,10 +257,21 @@ CPLErr TSDataset::EnsureComputed()
                     VSI_MALLOC3_VERBOSE(nCells, nBands, sizeof(float)));
             if (!m_pafProduct && !m_pabyProduct)
                 m_osError = "TERRASHADE: out of memory for the product";
-            else if (tsd_product_compute(&sGrid, &m_sOpts, m_bHasSun ? &m_sSun : nullptr,
-                                         m_pafProduct, m_pabyProduct, szMsg,
-                                         sizeof szMsg) != 0)
-                m_osError = std::string("TERRASHADE: ") + szMsg;
+            else
+            {
+                tsd_backend_summary sRan{};
+                if (tsd_product_compute(&sGrid, &m_sOpts, m_bHasSun ? &m_sSun : nullptr,
+                                        m_pafProduct, m_pabyProduct, &sRan, szMsg,
+                                        sizeof szMsg) != 0)
+                    m_osError = std::string("TERRASHADE: ") + szMsg;
+                else if (sRan.calls > 0)
+                {
+                    m_sBackend = sRan;
+                    m_bBackendKnown = true;
+                    SetupBackendMetadata();
+                    ReportBackend();
+                }
+            }
             ts_grid_free(&sGrid);
         }
         if (!m_osError.empty())
@@ -278,14 +297,78 @@ CPLErr TSDataset::EnsureComputed()
     return CE_None;
 }
 
+/* The BACKEND items asked for before the product is computed (gdalinfo;
+ * gdal_translate copies the metadata before reading): the dispatcher's
+ * choice, which probes the OpenCL device. Not done at open, so that opening
+ * costs no OpenCL initialisation. */
+void TSDataset::EnsureBackendMetadata()
+{
+    std::lock_guard<std::mutex> oLock(m_oMutex);
+    if (!m_bUsesBackend || m_bBackendKnown || m_bTried)
+        return;
+    char szMsg[256];
+    if (tsd_backend_predict(&m_sOpts, &m_sBackend, szMsg, sizeof szMsg) != 0)
+        return; // TERRASHADE_BACKEND changed since open: computing will say
+    m_bBackendKnown = true;
+    SetupBackendMetadata();
+}
+
+char **TSDataset::GetMetadata(const char *pszDomain)
+{
+    if (!pszDomain || !*pszDomain)
+        EnsureBackendMetadata();
+    return GDALPamDataset::GetMetadata(pszDomain);
+}
+
+const char *TSDataset::GetMetadataItem(const char *pszName, const char *pszDomain)
+{
+    if ((!pszDomain || !*pszDomain) && pszName && STARTS_WITH_CI(pszName, "BACKEND"))
+        EnsureBackendMetadata();
+    return GDALPamDataset::GetMetadataItem(pszName, pszDomain);
+}
+
+/* BACKEND, BACKEND_DEVICE, BACKEND_FALLBACK_REASON of m_sBackend. */
+void TSDataset::SetupBackendMetadata()
+{
+    if (!m_bUsesBackend || !m_bBackendKnown)
+        return;
+    char szBackend[16], szDevice[512];
+    tsd_backend_summary_text(&m_sBackend, szBackend, sizeof szBackend, szDevice,
+                             sizeof szDevice);
+    GDALDataset::SetMetadataItem("BACKEND", szBackend);
+    GDALDataset::SetMetadataItem("BACKEND_DEVICE", szDevice);
+    GDALDataset::SetMetadataItem("BACKEND_FALLBACK_REASON",
+                                 m_sBackend.reason[0] ? m_sBackend.reason : nullptr);
+}
+
+/* After computing: say where it ran; a warning when OpenCL was asked for
+ * (BACKEND=opencl or TERRASHADE_BACKEND=opencl) and C ran. */
+void TSDataset::ReportBackend()
+{
+    const tsd_backend_summary &s = m_sBackend;
+    char szBackend[16], szDevice[512];
+    tsd_backend_summary_text(&s, szBackend, sizeof szBackend, szDevice, sizeof szDevice);
+    if (s.requested == TS_BACKEND_OPENCL && s.c_calls > 0)
+        CPLError(CE_Warning, CPLE_AppDefined,
+                 "TERRASHADE: BACKEND=opencl was requested, but %d of %d computation(s) "
+                 "ran on the C backend instead: %s",
+                 s.c_calls, s.calls, s.reason[0] ? s.reason : "(no reason given)");
+    else if (s.c_calls > 0 && s.reason[0])
+        CPLDebug(DRIVER, "backend %s (%s) requested, C ran: %s",
+                 ts_backend_name(s.requested), szDevice, s.reason);
+    CPLDebug(DRIVER, "backend: %s on %s (%d call(s): %d OpenCL, %d C)", szBackend,
+             szDevice, s.calls, s.opencl_calls, s.c_calls);
+}
+
 void TSDataset::SetupMetadata()
 {
     char szValue[128];
     for (int i = 0; i < tsd_options_count(); i++)
     {
         const char *pszName = tsd_options_value(&m_sOpts, i, szValue, sizeof szValue);
-        if (EQUAL(pszName, "THREADS") || EQUAL(pszName, "MAX_MEMORY") || !szValue[0])
-            continue;
+        if (EQUAL(pszName, "THREADS") || EQUAL(pszName, "MAX_MEMORY") ||
+            EQUAL(pszName, "BACKEND") || !szValue[0])
+            continue; // BACKEND: what ran (SetupBackendMetadata)
         GDALDataset::SetMetadataItem(pszName, szValue);
     }
     GDALDataset::SetMetadataItem("SOURCE_DEM", m_osDEM.c_str());
@@ -333,6 +416,7 @@ void TSDataset::SetupMetadata()
     }
     if (m_bHasSun)
         SetupSunMetadata();
+    SetupBackendMetadata();
 }
 
 /* The metadata of one time step: its instant and the sun there. */
@@ -556,6 +640,12 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
                  poDS->m_sCells.warning);
     if (!CheckMemory(sOpts, W, H))
         return nullptr;
+    /* a bad TERRASHADE_BACKEND is an error here (without probing OpenCL) */
+    poDS->m_bUsesBackend =
+        tsd_product_uses_backend(&sOpts, poDS->m_bHasSun ? &poDS->m_sSun : nullptr) != 0;
+    if (poDS->m_bUsesBackend &&
+        tsd_backend_check_env(&sOpts, szMsg, sizeof szMsg) != 0)
+        return OpenFailed(CPLE_IllegalArg, szMsg);
 
     poDS->nRasterXSize = W;
     poDS->nRasterYSize = H;

@@ -20,7 +20,7 @@ typedef enum {
     O_REFRACTION, O_SKY_WEIGHT, O_BAND, O_THREADS, O_OUTPUT_TYPE,
     O_MAX_MEMORY, O_DATETIME, O_DATE, O_TIMEZONE, O_STEP_MINUTES, O_PRESSURE,
     O_TEMPERATURE, O_DELTA_T, O_SUN_POSITION, O_LINKE_TURBIDITY, O_FAR_THRESHOLD,
-    O_ATLAS_STEPS, O_COUNT
+    O_ATLAS_STEPS, O_BACKEND, O_COUNT
 } opt_id;
 
 typedef struct {
@@ -122,6 +122,14 @@ static const opt_def OPTS[O_COUNT] = {
     {"ATLAS_STEPS", T_INT, "158", 1, 1024, 0, 1, NULL, 1,
      "farshadow: number of sun positions between sunrise and sunset, denser "
      "near dawn and dusk"},
+    {"BACKEND", T_SELECT, "auto", 0, 0, 0, 0, "auto|opencl|c", 0,
+     "Where the horizon sweeps, shadow height maps, normals and direct sun "
+     "of shade, shadow, horizon, svf, openness and sky run: opencl (falls "
+     "back to c, with a warning, when OpenCL cannot run), c (the "
+     "multithreaded C core), or auto (the environment variable "
+     "TERRASHADE_BACKEND, else OpenCL on a GPU or accelerator or on a device "
+     "named by TERRASHADE_OPENCL_DEVICE, else c). The metadata item BACKEND "
+     "says what ran"},
 };
 
 static int fail(char *msg, size_t n, const char *fmt, ...)
@@ -234,6 +242,11 @@ void tsd_datetime_normalise(const char *in, char *out, size_t n)
     snprintf(out, n, "%s", buf);
 }
 
+const char *tsd_backend_name(tsd_backend b)
+{
+    return b == TSD_BACKEND_OPENCL ? "opencl" : b == TSD_BACKEND_C ? "c" : "auto";
+}
+
 const char *tsd_method_name(tsd_method m)
 {
     return m == TSD_METHOD_SHM ? "shm" : "exact";
@@ -266,6 +279,7 @@ void tsd_options_defaults(tsd_options *o)
     o->linke_turbidity = 3;
     o->far_threshold = 512;
     o->atlas_steps = 158;
+    o->backend = TSD_BACKEND_AUTO;
 }
 
 /* Copy s without surrounding blanks into buf; returns buf. */
@@ -435,6 +449,7 @@ static int set_option(tsd_options *o, int id, const char *v, char *msg, size_t n
     case O_LINKE_TURBIDITY: o->linke_turbidity = x; break;
     case O_FAR_THRESHOLD: o->far_threshold = (int)x; break;
     case O_ATLAS_STEPS: o->atlas_steps = (int)x; break;
+    case O_BACKEND: o->backend = (tsd_backend)sel; break;
     case O_COUNT: break;
     }
     return 0;
@@ -615,6 +630,7 @@ const char *tsd_options_value(const tsd_options *o, int i, char *buf,
     case O_LINKE_TURBIDITY: snprintf(buf, n, "%.10g", o->linke_turbidity); break;
     case O_FAR_THRESHOLD: snprintf(buf, n, "%d", o->far_threshold); break;
     case O_ATLAS_STEPS: snprintf(buf, n, "%d", o->atlas_steps); break;
+    case O_BACKEND: snprintf(buf, n, "%s", tsd_backend_name(o->backend)); break;
     case O_COUNT: break;
     }
     return OPTS[i].name;

@@ -34,6 +34,9 @@ typedef enum { TSD_METHOD_EXACT = 0, TSD_METHOD_SHM } tsd_method;
 
 typedef enum { TSD_OUT_AUTO = 0, TSD_OUT_BYTE, TSD_OUT_FLOAT32 } tsd_output_type;
 
+/* BACKEND: where the heavy core calls run (cl/terrashade_backend.h). */
+typedef enum { TSD_BACKEND_AUTO = 0, TSD_BACKEND_OPENCL, TSD_BACKEND_C } tsd_backend;
+
 /** Every option of a TERRASHADE dataset, with its effective value. */
 typedef struct {
     tsd_product product;
@@ -64,6 +67,7 @@ typedef struct {
     double linke_turbidity;  /* clear-sky model of PRODUCT=insolation */
     int far_threshold;       /* cells: nearer occluders are not in farshadow */
     int atlas_steps;         /* sun positions of PRODUCT=farshadow */
+    tsd_backend backend;     /* auto (TERRASHADE_BACKEND, then the device), opencl, c */
     /* which of SUN_AZIMUTH / SUN_ELEVATION were given explicitly */
     int sun_azimuth_given, sun_elevation_given;
 } tsd_options;
@@ -111,6 +115,9 @@ const char *tsd_product_name(tsd_product p);
 /** Name of a method, e.g. "exact". */
 const char *tsd_method_name(tsd_method m);
 
+/** Name of a BACKEND value: "auto", "opencl" or "c". */
+const char *tsd_backend_name(tsd_backend b);
+
 /**
  * The GDAL open-option list (XML) describing every option with its type,
  * default, range and description. Caller frees with free().
@@ -126,7 +133,7 @@ const char *tsd_options_value(const tsd_options *o, int i, char *buf,
 
 /**
  * A canonical, comma-separated "KEY=VALUE,..." string of all the options
- * that change the product's pixels (not THREADS or MAX_MEMORY), in table
+ * that change the product's pixels (not THREADS, MAX_MEMORY or BACKEND), in table
  * order. Returns 0, or -1 if buf is too small.
  */
 int tsd_options_canonical(const tsd_options *o, char *buf, size_t buf_size);

@@ -25,6 +25,88 @@ static int oom(char *msg, size_t n, const char *what)
     return -1;
 }
 
+ts_backend tsd_backend_to_ts(tsd_backend b)
+{
+    return b == TSD_BACKEND_OPENCL ? TS_BACKEND_OPENCL
+           : b == TSD_BACKEND_C    ? TS_BACKEND_C
+                                   : TS_BACKEND_AUTO;
+}
+
+int tsd_product_uses_backend(const tsd_options *o, const tsd_sun *sun)
+{
+    int lattice = sun && sun->sites.nx * sun->sites.ny > 1;
+    switch (o->product) {
+    case TSD_PRODUCT_SHADE: /* the normals at least */
+    case TSD_PRODUCT_HORIZON:
+    case TSD_PRODUCT_SVF:
+    case TSD_PRODUCT_OPENNESS:
+    case TSD_PRODUCT_SKY:
+        return 1;
+    case TSD_PRODUCT_SHADOW:
+        return !(lattice && o->method == TSD_METHOD_EXACT);
+    default:
+        return 0;
+    }
+}
+
+void tsd_backend_summary_add(tsd_backend_summary *s, const ts_backend_report *r)
+{
+    if (!s->calls)
+        s->requested = r->requested;
+    s->calls++;
+    if (r->used == TS_BACKEND_OPENCL) {
+        s->opencl_calls++;
+        snprintf(s->device_opencl, sizeof s->device_opencl, "%s", r->device);
+        return;
+    }
+    s->c_calls++;
+    snprintf(s->device_c, sizeof s->device_c, "%s", r->device);
+    /* the first reason; the first failure wins over a choice (auto on a CPU) */
+    if (r->requested != TS_BACKEND_C && r->reason[0] &&
+        (!s->reason[0] || (r->fell_back && !s->fell_back)))
+        snprintf(s->reason, sizeof s->reason, "%s", r->reason);
+    s->fell_back |= r->fell_back;
+}
+
+int tsd_backend_predict(const tsd_options *o, tsd_backend_summary *s, char *msg,
+                        size_t n)
+{
+    ts_backend_report r;
+    ts_error err;
+    memset(s, 0, sizeof *s);
+    if (ts_backend_choose(tsd_backend_to_ts(o->backend), &r, &err) != TS_OK)
+        return core_fail(msg, n, &err);
+    tsd_backend_summary_add(s, &r);
+    return 0;
+}
+
+int tsd_backend_check_env(const tsd_options *o, char *msg, size_t n)
+{
+    const char *env = getenv("TERRASHADE_BACKEND");
+    ts_backend b;
+    ts_error err;
+    if (o->backend != TSD_BACKEND_AUTO || !env || !*env ||
+        ts_backend_parse(env, &b, &err) == TS_OK)
+        return 0;
+    snprintf(msg, n, "TERRASHADE_BACKEND must be auto, c or opencl, got '%.40s'", env);
+    return -1;
+}
+
+void tsd_backend_summary_text(const tsd_backend_summary *s, char *backend, size_t bn,
+                              char *device, size_t dn)
+{
+    if (s->opencl_calls && s->c_calls) {
+        snprintf(backend, bn, "mixed");
+        snprintf(device, dn, "opencl: %s; c: %s", s->device_opencl, s->device_c);
+    } else if (s->opencl_calls) {
+        snprintf(backend, bn, "opencl");
+        snprintf(device, dn, "%s", s->device_opencl);
+    } else {
+        snprintf(backend, bn, "c");
+        snprintf(device, dn, "%s", s->device_c);
+    }
+}
+
 static void horizon_opts(const tsd_options *o, ts_horizon_opts *h)
 {
     ts_horizon_opts_default(h);
@@ -80,6 +162,18 @@ double tsd_product_peak_bytes(const tsd_options *o, int width, int height,
     return (1 + kept + extra_planes(o)) * plane;
 }
 
+/* The backend of the options, and the report of a call added to bs. */
+#define BK(o) tsd_backend_to_ts((o)->backend)
+#define NOTE(bs, call, rep) note((bs), (call), &(rep))
+
+/* After a ts_backend_* call (its status st): add its report, if filled. */
+static ts_status note(tsd_backend_summary *bs, ts_status st, const ts_backend_report *r)
+{
+    if (bs && r->backend[0])
+        tsd_backend_summary_add(bs, r);
+    return st;
+}
+
 static void free_normals(normals *nm)
 {
     free(nm->nx);
@@ -87,16 +181,19 @@ static void free_normals(normals *nm)
     free(nm->nz);
 }
 
-static int make_normals(const ts_grid *g, normals *nm, char *msg, size_t n)
+static int make_normals(const ts_grid *g, const tsd_options *o, normals *nm,
+                        tsd_backend_summary *bs, char *msg, size_t n)
 {
     size_t cells = (size_t)g->width * g->height;
     ts_error err;
+    ts_backend_report rep = {0};
     nm->nx = malloc(cells * sizeof(float));
     nm->ny = malloc(cells * sizeof(float));
     nm->nz = malloc(cells * sizeof(float));
     if (!nm->nx || !nm->ny || !nm->nz)
         return oom(msg, n, "the surface normals");
-    if (ts_normals(g, nm->nx, nm->ny, nm->nz, &err) != TS_OK)
+    if (NOTE(bs, ts_backend_normals(BK(o), g, nm->nx, nm->ny, nm->nz, &rep, &err), rep) !=
+        TS_OK)
         return core_fail(msg, n, &err);
     return 0;
 }
@@ -104,7 +201,8 @@ static int make_normals(const ts_grid *g, normals *nm, char *msg, size_t n)
 /* Stream the DIRECTIONS horizon planes into one sky accumulator; `which`:
  * 0 = svf, 1 = sky, 2 = openness. acc must be zeroed. */
 static int sky_stream(const ts_grid *g, const normals *nm, const tsd_options *o,
-                      int which, float *acc, char *msg, size_t n)
+                      int which, float *acc, tsd_backend_summary *bs, char *msg,
+                      size_t n)
 {
     size_t cells = (size_t)g->width * g->height;
     ts_horizon_opts h;
@@ -117,7 +215,10 @@ static int sky_stream(const ts_grid *g, const normals *nm, const tsd_options *o,
           *open = which == 2 ? acc : NULL;
     for (int k = 0; k < h.directions; k++) {
         double az = ts_horizon_azimuth(&h, k);
-        if (ts_horizon_sweep(g, az, &h, plane, &err) != TS_OK ||
+        ts_backend_report rep = {0};
+        /* the sweep on the backend; the accumulation is C only */
+        if (NOTE(bs, ts_backend_horizon_sweep(BK(o), g, az, &h, plane, &rep, &err), rep) !=
+                TS_OK ||
             ts_sky_accumulate(g, nm->nx, nm->ny, nm->nz, plane, az, h.directions,
                               svf, sky, open, &err) != TS_OK) {
             free(plane);
@@ -132,24 +233,29 @@ static int sky_stream(const ts_grid *g, const normals *nm, const tsd_options *o,
 
 /* Shadow height map visibility of the sun into vis. */
 static int shm_visibility(const ts_grid *g, const tsd_options *o, float *vis,
-                          char *msg, size_t n)
+                          tsd_backend_summary *bs, char *msg, size_t n)
 {
     ts_error err;
-    if (ts_shm_compute(g, o->sun_azimuth, o->sun_elevation, o->penumbra_depth,
-                       o->threads, vis, NULL, &err) != TS_OK)
+    ts_backend_report rep = {0};
+    if (NOTE(bs, ts_backend_shm_compute(BK(o), g, o->sun_azimuth, o->sun_elevation,
+                                        o->penumbra_depth, o->threads, vis, NULL, &rep,
+                                        &err),
+             rep) != TS_OK)
         return core_fail(msg, n, &err);
     return 0;
 }
 
 /* Exact horizon at the sun's azimuth into plane; *h describes it. */
-static int sun_horizon(const ts_grid *g, const tsd_options *o,
-                       ts_horizon_opts *h, float *plane, char *msg, size_t n)
+static int sun_horizon(const ts_grid *g, const tsd_options *o, ts_horizon_opts *h,
+                       float *plane, tsd_backend_summary *bs, char *msg, size_t n)
 {
     ts_error err;
+    ts_backend_report rep = {0};
     horizon_opts(o, h);
     h->directions = 1;
     h->start_azimuth = o->sun_azimuth;
-    if (ts_horizon_sweep(g, o->sun_azimuth, h, plane, &err) != TS_OK)
+    if (NOTE(bs, ts_backend_horizon_sweep(BK(o), g, o->sun_azimuth, h, plane, &rep, &err),
+             rep) != TS_OK)
         return core_fail(msg, n, &err);
     return 0;
 }
@@ -170,7 +276,7 @@ static int sun_per_cell(const ts_grid *g, const tsd_sun *sun, float *vis, float 
 }
 
 static int shade(const ts_grid *g, const tsd_options *o, const tsd_sun *sun, float *out,
-                 char *msg, size_t n)
+                 tsd_backend_summary *bs, char *msg, size_t n)
 {
     size_t cells = (size_t)g->width * g->height;
     normals nm = {0};
@@ -184,7 +290,7 @@ static int shade(const ts_grid *g, const tsd_options *o, const tsd_sun *sun, flo
         oom(msg, n, "a horizon plane");
         goto done;
     }
-    if (make_normals(g, &nm, msg, n) != 0)
+    if (make_normals(g, o, &nm, bs, msg, n) != 0)
         goto done;
     if (lattice) {
         if (sun_per_cell(g, sun, work, az, el, msg, n) != 0)
@@ -197,15 +303,18 @@ static int shade(const ts_grid *g, const tsd_options *o, const tsd_sun *sun, flo
         }
     } else if (o->method == TSD_METHOD_EXACT) {
         ts_horizon_opts h;
-        if (sun_horizon(g, o, &h, work, msg, n) != 0)
+        ts_backend_report rep = {0};
+        if (sun_horizon(g, o, &h, work, bs, msg, n) != 0)
             goto done;
-        if (ts_shade_direct(g, nm.nx, nm.ny, nm.nz, work, &h, o->sun_azimuth,
-                            o->sun_elevation, out, &err) != TS_OK) {
+        if (NOTE(bs, ts_backend_shade_direct(BK(o), g, nm.nx, nm.ny, nm.nz, work, &h,
+                                             o->sun_azimuth, o->sun_elevation, out, &rep,
+                                             &err),
+                 rep) != TS_OK) {
             core_fail(msg, n, &err);
             goto done;
         }
     } else {
-        if (shm_visibility(g, o, work, msg, n) != 0)
+        if (shm_visibility(g, o, work, bs, msg, n) != 0)
             goto done;
         double az0 = o->sun_azimuth * M_PI / 180, el0 = o->sun_elevation * M_PI / 180;
         double lx = sin(az0) * cos(el0), ly = cos(az0) * cos(el0), lz = sin(el0);
@@ -216,7 +325,7 @@ static int shade(const ts_grid *g, const tsd_options *o, const tsd_sun *sun, flo
     }
     if (o->sky_weight > 0) {
         memset(work, 0, cells * sizeof(float));
-        if (sky_stream(g, &nm, o, 1, work, msg, n) != 0)
+        if (sky_stream(g, &nm, o, 1, work, bs, msg, n) != 0)
             goto done;
         if (ts_shade_combine(g, out, work, o->sky_weight, out, &err) != TS_OK) {
             core_fail(msg, n, &err);
@@ -233,15 +342,15 @@ done:
 }
 
 static int shadow(const ts_grid *g, const tsd_options *o, const tsd_sun *sun, float *out,
-                  char *msg, size_t n)
+                  tsd_backend_summary *bs, char *msg, size_t n)
 {
     size_t cells = (size_t)g->width * g->height;
     if (sun && sun->sites.nx * sun->sites.ny > 1 && o->method == TSD_METHOD_EXACT)
         return sun_per_cell(g, sun, out, NULL, NULL, msg, n);
     if (o->method == TSD_METHOD_SHM)
-        return shm_visibility(g, o, out, msg, n);
+        return shm_visibility(g, o, out, bs, msg, n);
     ts_horizon_opts h;
-    if (sun_horizon(g, o, &h, out, msg, n) != 0)
+    if (sun_horizon(g, o, &h, out, bs, msg, n) != 0)
         return -1;
     for (size_t i = 0; i < cells; i++)
         if (out[i] == out[i])
@@ -288,23 +397,27 @@ static int daily(const ts_grid *g, const tsd_options *o, const tsd_sun *sun, flo
 }
 
 static int sky_product(const ts_grid *g, const tsd_options *o, int which,
-                       float *out, char *msg, size_t n)
+                       float *out, tsd_backend_summary *bs, char *msg, size_t n)
 {
     normals nm = {0};
     int rc = -1;
     memset(out, 0, (size_t)g->width * g->height * sizeof(float));
-    if (make_normals(g, &nm, msg, n) == 0 &&
-        sky_stream(g, &nm, o, which, out, msg, n) == 0)
+    if (make_normals(g, o, &nm, bs, msg, n) == 0 &&
+        sky_stream(g, &nm, o, which, out, bs, msg, n) == 0)
         rc = 0;
     free_normals(&nm);
     return rc;
 }
 
 int tsd_product_compute(const ts_grid *grid, const tsd_options *o, const tsd_sun *sun,
-                        float *out, uint8_t *bytes, char *msg, size_t n)
+                        float *out, uint8_t *bytes, tsd_backend_summary *bs, char *msg,
+                        size_t n)
 {
     ts_error err;
     ts_horizon_opts h;
+    ts_backend_report rep = {0};
+    if (bs)
+        memset(bs, 0, sizeof *bs);
     if (ts_grid_validate(grid, &err) != TS_OK)
         return core_fail(msg, n, &err);
     horizon_opts(o, &h);
@@ -312,24 +425,25 @@ int tsd_product_compute(const ts_grid *grid, const tsd_options *o, const tsd_sun
         return core_fail(msg, n, &err);
     switch (o->product) {
     case TSD_PRODUCT_SHADE:
-        return shade(grid, o, sun, out, msg, n);
+        return shade(grid, o, sun, out, bs, msg, n);
     case TSD_PRODUCT_SHADOW:
-        return shadow(grid, o, sun, out, msg, n);
+        return shadow(grid, o, sun, out, bs, msg, n);
     case TSD_PRODUCT_SUNHOURS:
     case TSD_PRODUCT_INSOLATION:
     case TSD_PRODUCT_DAYCYCLE:
     case TSD_PRODUCT_FARSHADOW:
         return daily(grid, o, sun, out, bytes, msg, n);
     case TSD_PRODUCT_HORIZON:
-        if (ts_horizon_compute(grid, &h, out, &err) != TS_OK)
+        if (NOTE(bs, ts_backend_horizon_compute(BK(o), grid, &h, out, &rep, &err), rep) !=
+            TS_OK)
             return core_fail(msg, n, &err);
         return 0;
     case TSD_PRODUCT_SVF:
-        return sky_product(grid, o, 0, out, msg, n);
+        return sky_product(grid, o, 0, out, bs, msg, n);
     case TSD_PRODUCT_SKY:
-        return sky_product(grid, o, 1, out, msg, n);
+        return sky_product(grid, o, 1, out, bs, msg, n);
     case TSD_PRODUCT_OPENNESS:
-        return sky_product(grid, o, 2, out, msg, n);
+        return sky_product(grid, o, 2, out, bs, msg, n);
     }
     snprintf(msg, n, "unknown product");
     return -1;

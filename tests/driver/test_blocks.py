@@ -171,7 +171,10 @@ class Blocks(unittest.TestCase):
                 """The process's VmHWM (peak resident set), polled until it
                 exits (rusage would report the parent's RSS, inherited
                 through fork and exec)."""
-                p = subprocess.Popen(args, env=T.env(GDAL_CACHEMAX=32))
+                # the C backend's planes: BACKEND=auto would probe OpenCL,
+                # whose runtime (PoCL loads LLVM, ~75 MiB) is not the driver's
+                p = subprocess.Popen(args, env=T.env(GDAL_CACHEMAX=32,
+                                                     TERRASHADE_BACKEND="c"))
                 hwm = 0
                 while p.poll() is None:
                     try:

@@ -1,0 +1,222 @@
+"""BACKEND=auto|opencl|c: the same products on the C core and on OpenCL
+(PoCL on the test machine), the metadata saying what ran, the fall back to
+C with a warning when OpenCL was asked for and cannot run, bad values.
+
+- BACKEND=c and BACKEND=opencl agree (docs/opencl.md tolerances: horizon
+  angles and openness within 1e-3 deg, the 0..1 products within 1e-4 as
+  Float32, Byte within 1 DN) on jacksboro and on a synthetic DEM with
+  holes, and BACKEND says which ran (opencl must really run here);
+- BACKEND=opencl (option or TERRASHADE_BACKEND) with
+  TERRASHADE_OPENCL_DEVICE=99 gives the C results, a warning on stderr,
+  BACKEND=c and BACKEND_FALLBACK_REASON; with BACKEND=auto the same fall
+  back is silent (CPLDebug);
+- BACKEND=bogus and TERRASHADE_BACKEND=cuda: non-zero exit, clear message;
+- the default (auto) on a CPU OpenCL device runs C and says why.
+"""
+import os
+import sys
+import unittest
+
+import tsdriver as T
+from tsdriver import gdal, np
+
+# the tests decide the backend themselves
+for _k in ("TERRASHADE_BACKEND", "TERRASHADE_OPENCL_DEVICE", "TERRASHADE_OPENCL_MAX_ALLOC"):
+    os.environ.pop(_k, None)
+
+GT = (600000, 30, 0, 4000000, 0, -30)
+
+# (name, open options, tolerance: None = Byte within 1 DN)
+PRODUCTS = [
+    ("shade", {}, None),
+    ("shade float sky", {"OUTPUT_TYPE": "Float32", "SKY_WEIGHT": 0.3, "DIRECTIONS": 8}, 1e-4),
+    ("shade shm", {"OUTPUT_TYPE": "Float32", "METHOD": "shm", "PENUMBRA_DEPTH": 20}, 1e-4),
+    ("shadow", {"PRODUCT": "shadow", "SUN_ELEVATION": 12}, 1e-4),
+    ("shadow shm", {"PRODUCT": "shadow", "METHOD": "shm", "SUN_ELEVATION": 12}, 1e-4),
+    ("horizon", {"PRODUCT": "horizon", "DIRECTIONS": 8, "START_AZIMUTH": 10}, 1e-3),
+    ("svf", {"PRODUCT": "svf", "DIRECTIONS": 16}, 1e-4),
+    ("sky", {"PRODUCT": "sky", "DIRECTIONS": 8}, 1e-4),
+    ("openness", {"PRODUCT": "openness", "DIRECTIONS": 8}, 1e-3),
+]
+
+
+def backend_md(ds):
+    return {k: v for k, v in ds.GetMetadata().items() if k.startswith("BACKEND")}
+
+
+def compute(dem, options):
+    """(bands as float64, BACKEND metadata at open, after computing, type)."""
+    oo = ["%s=%s" % kv for kv in options.items()]
+    ds = gdal.OpenEx(T.conn(dem), gdal.OF_RASTER, open_options=oo)
+    before = backend_md(ds)
+    arrays = []
+    for b in range(1, ds.RasterCount + 1):
+        rb = ds.GetRasterBand(b)
+        a = rb.ReadAsArray().astype(np.float64)
+        if rb.DataType == gdal.GDT_Byte:
+            a[a == 0] = np.nan
+        arrays.append(a)
+    return np.array(arrays), before, backend_md(ds), ds.GetRasterBand(1).DataType
+
+
+def synthetic(tmp):
+    z = T.fractal_dem(150, seed=7, relief=600.0)[:, :133].copy()
+    z[20:30, 40:52] = -9999
+    z[::37, ::29] = -9999
+    return T.write_tif(os.path.join(tmp, "synthetic.tif"), z, GT, 32617, nodata=-9999)
+
+
+class Backend(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = T.TempDir()
+        cls.dir = cls.tmp.__enter__()
+        cls.dems = {"jacksboro": T.JACKSBORO, "synthetic": synthetic(cls.dir)}
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.__exit__(None, None, None)
+
+    def assert_same(self, name, c, cl, tol):
+        np.testing.assert_array_equal(np.isnan(c), np.isnan(cl), name + ": nodata")
+        both = ~np.isnan(c)
+        d = np.abs(c - cl)[both]
+        print("  %s: max |c - opencl| %.3g over %d cells" % (name, d.max() if d.size else 0,
+                                                             d.size))
+        self.assertLessEqual(d.max() if d.size else 0, 1 if tol is None else tol, name)
+
+    def test_option_is_declared(self):
+        import xml.etree.ElementTree as ET
+        drv = gdal.GetDriverByName("TERRASHADE")
+        opts = {o.get("name"): o for o in ET.fromstring(
+            drv.GetMetadataItem(gdal.DMD_OPENOPTIONLIST))}
+        o = opts["BACKEND"]
+        self.assertEqual(o.get("type"), "string-select")
+        self.assertEqual(o.get("default"), "auto")
+        self.assertEqual([v.text for v in o], ["auto", "opencl", "c"])
+        self.assertIn("TERRASHADE_BACKEND", o.get("description"))
+
+    def test_c_and_opencl_agree(self):
+        for dem_name, dem in self.dems.items():
+            for name, options, tol in PRODUCTS:
+                with self.subTest(dem=dem_name, product=name):
+                    c, c0, c1, dt = compute(dem, dict(options, BACKEND="c"))
+                    cl, cl0, cl1, _ = compute(dem, dict(options, BACKEND="opencl"))
+                    print("%s %s: c %s, opencl %s" % (dem_name, name, c1, cl1))
+                    self.assertEqual(c1["BACKEND"], "c")
+                    self.assertTrue(c1["BACKEND_DEVICE"].startswith("CPU"))
+                    self.assertNotIn("BACKEND_FALLBACK_REASON", c1)
+                    self.assertEqual(cl1["BACKEND"], "opencl", cl1)
+                    self.assertTrue(cl1["BACKEND_DEVICE"])
+                    self.assertNotIn("BACKEND_FALLBACK_REASON", cl1)
+                    # known at open already (GDAL tools copy metadata first)
+                    self.assertEqual(c0, c1)
+                    self.assertEqual(cl0, cl1)
+                    if tol is None:
+                        self.assertEqual(dt, gdal.GDT_Byte)
+                    else:
+                        self.assertEqual(dt, gdal.GDT_Float32)
+                    self.assertEqual(c.shape, cl.shape)
+                    self.assertTrue((~np.isnan(c)).any())
+                    self.assert_same("%s %s" % (dem_name, name), c, cl, tol)
+
+    def test_opencl_with_a_bad_device_falls_back_with_a_warning(self):
+        dem = self.dems["synthetic"]
+        for name, options, tol in PRODUCTS[:1] + PRODUCTS[5:7]:
+            with self.subTest(product=name):
+                ref = compute(dem, dict(options, BACKEND="c"))[0]
+                out = os.path.join(self.dir, "fallback.tif")
+                p = T.run(["gdal_translate", "-q"] + T.oo_args(dict(options, BACKEND="opencl"))
+                          + [T.conn(dem), out], TERRASHADE_OPENCL_DEVICE=99)
+                print(p.stderr)
+                self.assertIn("Warning", p.stderr)
+                self.assertIn("BACKEND=opencl was requested", p.stderr)
+                self.assertIn("TERRASHADE_OPENCL_DEVICE=99", p.stderr)
+                self.assertEqual(p.stderr.count("BACKEND=opencl was requested"), 1)
+                md = gdal.Open(out).GetMetadata()
+                self.assertEqual(md["BACKEND"], "c")
+                self.assertTrue(md["BACKEND_DEVICE"].startswith("CPU"))
+                self.assertIn("TERRASHADE_OPENCL_DEVICE=99", md["BACKEND_FALLBACK_REASON"])
+                np.testing.assert_array_equal(T.read(out), ref)
+
+    def test_env_opencl_with_a_bad_device_falls_back_with_a_warning(self):
+        """TERRASHADE_BACKEND=opencl asks for OpenCL as the option does."""
+        dem = self.dems["synthetic"]
+        out = os.path.join(self.dir, "env.npy")
+        code = ("import sys; sys.path.insert(0, %r); import tsdriver as T; "
+                "from tsdriver import gdal, np; "
+                "ds = gdal.OpenEx(T.conn(%r), open_options=['PRODUCT=svf', 'DIRECTIONS=8']); "
+                "np.save(%r, ds.GetRasterBand(1).ReadAsArray()); "
+                "md = ds.GetMetadata(); "
+                "print('BACKEND=' + md['BACKEND']); "
+                "print('REASON=' + md.get('BACKEND_FALLBACK_REASON', ''))"
+                % (os.path.dirname(os.path.abspath(__file__)), dem, out))
+        p = T.run([sys.executable, "-c", code], TERRASHADE_BACKEND="opencl",
+                  TERRASHADE_OPENCL_DEVICE=99)
+        print(p.stdout, p.stderr)
+        self.assertIn("BACKEND=c\n", p.stdout)
+        self.assertIn("REASON=TERRASHADE_OPENCL_DEVICE=99", p.stdout)
+        self.assertIn("BACKEND=opencl was requested", p.stderr)
+        ref = compute(dem, {"PRODUCT": "svf", "DIRECTIONS": 8, "BACKEND": "c"})[0][0]
+        np.testing.assert_array_equal(np.load(out), ref)
+
+    def test_auto_with_a_bad_device_falls_back_silently(self):
+        dem = self.dems["synthetic"]
+        out = os.path.join(self.dir, "auto.tif")
+        p = T.run(["gdal_translate", "-q", "-oo", "PRODUCT=shadow", T.conn(dem), out],
+                  TERRASHADE_OPENCL_DEVICE=99)
+        self.assertNotIn("Warning", p.stderr)
+        md = gdal.Open(out).GetMetadata()
+        self.assertEqual(md["BACKEND"], "c")
+        self.assertIn("TERRASHADE_OPENCL_DEVICE=99", md["BACKEND_FALLBACK_REASON"])
+        p = T.run(["gdal_translate", "-q", "-oo", "PRODUCT=shadow", T.conn(dem), out],
+                  TERRASHADE_OPENCL_DEVICE=99, CPL_DEBUG="TERRASHADE")
+        self.assertIn("TERRASHADE_OPENCL_DEVICE=99", p.stderr)
+        self.assertNotIn("Warning", p.stderr)
+
+    def test_bad_values_are_errors(self):
+        dem = self.dems["synthetic"]
+        out = os.path.join(self.dir, "bad.tif")
+        for args, extra, text in [
+                (["-oo", "BACKEND=bogus", T.conn(dem)], {},
+                 "BACKEND must be one of auto, opencl, c, got 'bogus'"),
+                (["TERRASHADE:BACKEND=cuda:" + dem], {},
+                 "BACKEND must be one of auto, opencl, c, got 'cuda'"),
+                ([T.conn(dem)], {"TERRASHADE_BACKEND": "cuda"},
+                 "TERRASHADE_BACKEND must be auto, c or opencl, got 'cuda'")]:
+            with self.subTest(args=args, env=extra):
+                p = T.run(["gdal_translate", "-q"] + args + [out], ok=False, **extra)
+                print(p.stderr)
+                self.assertIn(text, p.stderr)
+        with self.assertRaises(RuntimeError) as e:
+            gdal.OpenEx(T.conn(dem), open_options=["BACKEND=gpu"])
+        self.assertIn("BACKEND must be one of auto, opencl, c, got 'gpu'", str(e.exception))
+
+    def test_default_auto(self):
+        """No option, no environment: the dispatcher decides; on a CPU OpenCL
+        device (PoCL here) that is C, with the reason."""
+        dem = self.dems["jacksboro"]
+        _, before, md, _ = compute(dem, {"PRODUCT": "svf", "DIRECTIONS": 4})
+        _, _, cl, _ = compute(dem, {"PRODUCT": "svf", "DIRECTIONS": 4, "BACKEND": "opencl"})
+        print("auto:", md, "\nopencl:", cl)
+        self.assertEqual(before, md)
+        cpu_device = ("pthread" in cl["BACKEND_DEVICE"] or
+                      "Portable Computing Language" in cl["BACKEND_DEVICE"])
+        if md["BACKEND"] == "opencl":
+            self.assertFalse(cpu_device, md)
+            self.assertNotIn("BACKEND_FALLBACK_REASON", md)
+        else:
+            self.assertEqual(md["BACKEND"], "c")
+            self.assertTrue(md["BACKEND_FALLBACK_REASON"])
+        if cpu_device:
+            self.assertEqual(md["BACKEND"], "c")
+            self.assertIn("is a CPU", md["BACKEND_FALLBACK_REASON"])
+        # products that make no backend call say nothing about one
+        ds = gdal.OpenEx(T.conn(dem), open_options=[
+            "PRODUCT=sunhours", "DATE=2026-06-21", "TIMEZONE=-05:00", "STEP_MINUTES=60"])
+        ds.GetRasterBand(1).Checksum()
+        self.assertEqual(backend_md(ds), {})
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
