@@ -1,6 +1,7 @@
 /* Direct sun with the visible fraction of the sun's disk, and the final mix. */
 #include <math.h>
 
+#include "arg_checks.h"
 #include "fastmath.h"
 #include "parallel.h"
 #include "status_internal.h"
@@ -52,38 +53,12 @@ ts_status ts_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
                           const ts_horizon_opts *opts, double sun_azimuth,
                           double sun_elevation, float *out, ts_error *err)
 {
-    ts_status st = ts_grid_validate(grid, err);
+    int k0, k1;
+    double w;
+    ts_status st = ts_direct_setup(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
+                                   out, &k0, &k1, &w, err);
     if (st != TS_OK)
         return st;
-    if ((st = ts_horizon_opts_validate(opts, err)) != TS_OK)
-        return st;
-    if (!nx || !ny || !nz || !horizons || !out)
-        return ts_fail(err, TS_ERR_ARG, "normals, horizons and output must not be NULL");
-    if (!isfinite(sun_azimuth))
-        return ts_fail(err, TS_ERR_ARG, "sun azimuth must be a finite number of degrees, got %g",
-                       sun_azimuth);
-    if (!(sun_elevation >= -90 && sun_elevation <= 90))
-        return ts_fail(err, TS_ERR_ARG, "sun elevation must be between -90 and 90, got %g",
-                       sun_elevation);
-    int n = opts->directions;
-    double step = 360.0 / n;
-    double p = fmod(sun_azimuth - opts->start_azimuth, 360.0);
-    if (p < 0)
-        p += 360.0;
-    p /= step;
-    int k0 = (int)floor(p);
-    double w = p - k0;
-    if (k0 >= n) {
-        k0 = 0;
-        w = 0;
-    }
-    int k1 = (k0 + 1) % n;
-    if (n == 1 && w * step > 1e-9 && (1 - w) * step > 1e-9)
-        return ts_fail(err, TS_ERR_ARG,
-                       "the horizons were computed for azimuth %g only, not for the sun's azimuth %g",
-                       opts->start_azimuth, sun_azimuth);
-    if (n == 1)
-        w = 0;
     size_t plane = (size_t)grid->width * grid->height;
     double az = sun_azimuth * DEG2RAD, el = sun_elevation * DEG2RAD;
     direct_ctx C = {nx, ny, nz, horizons + plane * k0, horizons + plane * k1, (float)w,

@@ -14,6 +14,7 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 
+#include "arg_checks.h"
 #include "line_geometry.h"
 #include "parallel.h"
 #include "status_internal.h"
@@ -223,23 +224,10 @@ ts_status ts_shm_compute(const ts_grid *grid, double azimuth, double elevation,
                          double penumbra_depth, int threads, float *vis,
                          float *shadow_height, ts_error *err)
 {
-    ts_status st = ts_grid_validate(grid, err);
+    ts_status st = ts_check_shm_args(grid, azimuth, elevation, penumbra_depth, threads, vis,
+                                     shadow_height, err);
     if (st != TS_OK)
         return st;
-    if (!isfinite(azimuth))
-        return ts_fail(err, TS_ERR_ARG, "sun azimuth must be a finite number of degrees, got %g",
-                       azimuth);
-    if (!(elevation >= -90 && elevation <= 90))
-        return ts_fail(err, TS_ERR_ARG, "sun elevation must be between -90 and 90, got %g",
-                       elevation);
-    if (!(penumbra_depth >= 0) || isinf(penumbra_depth))
-        return ts_fail(err, TS_ERR_ARG,
-                       "penumbra depth must be 0 (hard shadows) or a positive number of metres, got %g",
-                       penumbra_depth);
-    if (threads < 0)
-        return ts_fail(err, TS_ERR_ARG, "threads must be 0 (all cores) or more, got %d", threads);
-    if (!vis && !shadow_height)
-        return ts_fail(err, TS_ERR_ARG, "both outputs are NULL");
     azimuth = fmod(azimuth, 360.0);
     if (azimuth < 0)
         azimuth += 360.0;

@@ -1,0 +1,70 @@
+/* Argument checks shared by the C and OpenCL backends (arg_checks.h). */
+#include <math.h>
+
+#include "arg_checks.h"
+#include "status_internal.h"
+
+ts_status ts_check_shm_args(const ts_grid *grid, double azimuth, double elevation,
+                            double penumbra_depth, int threads, const float *vis,
+                            const float *shadow_height, ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if (!isfinite(azimuth))
+        return ts_fail(err, TS_ERR_ARG, "sun azimuth must be a finite number of degrees, got %g",
+                       azimuth);
+    if (!(elevation >= -90 && elevation <= 90))
+        return ts_fail(err, TS_ERR_ARG, "sun elevation must be between -90 and 90, got %g",
+                       elevation);
+    if (!(penumbra_depth >= 0) || isinf(penumbra_depth))
+        return ts_fail(err, TS_ERR_ARG,
+                       "penumbra depth must be 0 (hard shadows) or a positive number of metres, got %g",
+                       penumbra_depth);
+    if (threads < 0)
+        return ts_fail(err, TS_ERR_ARG, "threads must be 0 (all cores) or more, got %d", threads);
+    if (!vis && !shadow_height)
+        return ts_fail(err, TS_ERR_ARG, "both outputs are NULL");
+    return TS_OK;
+}
+
+ts_status ts_direct_setup(const ts_grid *grid, const float *nx, const float *ny,
+                          const float *nz, const float *horizons,
+                          const ts_horizon_opts *opts, double sun_azimuth,
+                          double sun_elevation, const float *out, int *k0, int *k1,
+                          double *w, ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if ((st = ts_horizon_opts_validate(opts, err)) != TS_OK)
+        return st;
+    if (!nx || !ny || !nz || !horizons || !out)
+        return ts_fail(err, TS_ERR_ARG, "normals, horizons and output must not be NULL");
+    if (!isfinite(sun_azimuth))
+        return ts_fail(err, TS_ERR_ARG, "sun azimuth must be a finite number of degrees, got %g",
+                       sun_azimuth);
+    if (!(sun_elevation >= -90 && sun_elevation <= 90))
+        return ts_fail(err, TS_ERR_ARG, "sun elevation must be between -90 and 90, got %g",
+                       sun_elevation);
+    int n = opts->directions;
+    double step = 360.0 / n;
+    double p = fmod(sun_azimuth - opts->start_azimuth, 360.0);
+    if (p < 0)
+        p += 360.0;
+    p /= step;
+    *k0 = (int)floor(p);
+    *w = p - *k0;
+    if (*k0 >= n) {
+        *k0 = 0;
+        *w = 0;
+    }
+    *k1 = (*k0 + 1) % n;
+    if (n == 1 && *w * step > 1e-9 && (1 - *w) * step > 1e-9)
+        return ts_fail(err, TS_ERR_ARG,
+                       "the horizons were computed for azimuth %g only, not for the sun's azimuth %g",
+                       opts->start_azimuth, sun_azimuth);
+    if (n == 1)
+        *w = 0;
+    return TS_OK;
+}
