@@ -10,6 +10,7 @@
 #include "terrashade.h"
 #include "test_dem.h"
 #include "test_stats.h"
+#include "test_run.h"
 
 static const double DEG = 3.14159265358979323846 / 180.0;
 static const double AZ[] = {0, 33.7, 45, 90, 137, 180, 222.2, 300};
@@ -453,9 +454,5 @@ int main(void)
     tcase_add_test(tc, test_nodata_hole_fractal);
     tcase_add_test(tc, test_tiny_grids);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return test_run_suite(s);
 }

@@ -8,6 +8,7 @@
 
 #include "terrashade.h"
 #include "test_dem.h"
+#include "test_run.h"
 
 /* Assert an argument error with a non-empty message. */
 #define EXPECT_ARG(call)                                                          \
@@ -285,9 +286,5 @@ int main(void)
     tcase_add_test(tc, test_shading_args);
     tcase_add_test(tc, test_no_writes_outside);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return test_run_suite(s);
 }

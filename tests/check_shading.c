@@ -6,6 +6,7 @@
 
 #include "terrashade.h"
 #include "test_dem.h"
+#include "test_run.h"
 
 static const double PI = 3.14159265358979323846;
 static const double DEG = 3.14159265358979323846 / 180.0;
@@ -366,9 +367,5 @@ int main(void)
     tcase_add_test(tc, test_sky_flat_and_tilted);
     tcase_add_test(tc, test_sky_rough);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return test_run_suite(s);
 }

@@ -7,6 +7,7 @@
 
 #include "terrashade.h"
 #include "test_dem.h"
+#include "test_run.h"
 
 /* Hard shadows of the shadow height map and of the exact horizon differ
  * where the map's linear interpolation moves a shadow edge or blurs a
@@ -196,9 +197,5 @@ int main(void)
     tcase_add_test(tc, test_penumbra_formula);
     tcase_add_test(tc, test_overhead_sun);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return test_run_suite(s);
 }

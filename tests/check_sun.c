@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "terrashade_sun.h"
+#include "test_run.h"
 
 #define CK_NEAR(got, want, tol, what)                                            \
     ck_assert_msg(fabs((got) - (want)) <= (tol), "%s: got %.10f, want %.10f +/- %g", \
@@ -586,9 +587,5 @@ int main(void)
     tcase_add_test(spa, test_ranges);
     tcase_add_test(spa, test_input_errors);
     suite_add_tcase(s, spa);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return test_run_suite(s);
 }
