@@ -56,7 +56,7 @@ typedef struct {
 typedef struct {
     hull_pt *stack;
     int n;
-    hull_pt *raw;       /* every pushed sample, for the distance cap */
+    hull_pt *raw;       /* every pushed sample: the capped line slopes of the visitor */
     int raw_n;
     occluder *prev_lo, *cur_lo;
     int prev_k0, prev_k1;
@@ -223,7 +223,7 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
             S[n].g = gs;
             S[n].k = k;
             w->n = n + 1;
-            if (C->cap > 0)
+            if (w->raw)
                 w->raw[w->raw_n++] = S[n];
             pushed = 1;
         }
@@ -296,7 +296,7 @@ static void sweep_range(void *ctx, int worker, long begin, long end)
     (void)worker;
     const sweep_ctx *C = ctx;
     sweep_ws w;
-    if (!ws_init(&w, C->geom->U, C->cap > 0, C->visit != NULL)) {
+    if (!ws_init(&w, C->geom->U, C->cap > 0 && C->visit, C->visit != NULL)) {
         ws_free(&w);
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
         return;
