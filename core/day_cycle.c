@@ -109,6 +109,7 @@ void ts_day_opts_default(ts_day_opts *o)
     ts_sun_input_default(&o->sun);
     o->linke_turbidity = 3.0;
     o->earth_horizon = 1;
+    o->sun_hours_rule = TS_SUN_HOURS_VISIBLE;
 }
 
 ts_status ts_sun_sites_validate(const ts_sun_sites *s, ts_error *err)
@@ -154,6 +155,11 @@ static ts_status opts_validate(const ts_day_opts *o, ts_error *err)
         return ts_fail(err, TS_ERR_ARG,
                        "the Linke turbidity must be between 1 and 10, got %g",
                        o->linke_turbidity);
+    if (o->sun_hours_rule != TS_SUN_HOURS_VISIBLE &&
+        o->sun_hours_rule != TS_SUN_HOURS_DISK_FRACTION)
+        return ts_fail(err, TS_ERR_ARG,
+                       "unknown sun-hours rule %d (visible or disk fraction)",
+                       (int)o->sun_hours_rule);
     return ts_ok(err);
 }
 
@@ -599,8 +605,12 @@ ts_status ts_sun_hours(const ts_grid *grid, const ts_sun_sites *sites,
         if (dark)
             continue;
         double hrs = dur[k] / 3600.0;
-        for (size_t i = 0; i < c.cells; i++)
-            acc[i] += vis[i] * hrs;
+        if (o->sun_hours_rule == TS_SUN_HOURS_DISK_FRACTION)
+            for (size_t i = 0; i < c.cells; i++)
+                acc[i] += vis[i] * hrs;
+        else
+            for (size_t i = 0; i < c.cells; i++)
+                acc[i] += vis[i] > 0.0f ? hrs : 0.0;
     }
     for (int y = 0; y < c.H; y++)
         for (int x = 0; x < c.W; x++) {

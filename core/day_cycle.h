@@ -67,6 +67,17 @@ typedef struct {
                                       NULL = 0 (grid north = true north) */
 } ts_sun_sites;
 
+/** How ts_sun_hours counts a time step. */
+typedef enum {
+    /** The step counts in full while any part of the sun's disk is above the
+     * cell's horizon. Sunrise and sunset are defined by the upper limb, so
+     * on a flat plane this is the astronomical day length. */
+    TS_SUN_HOURS_VISIBLE = 0,
+    /** The step is weighted by the visible fraction of the disk; on a flat
+     * plane this is the time the sun's centre is above the horizon. */
+    TS_SUN_HOURS_DISK_FRACTION = 1
+} ts_sun_hours_rule;
+
 /** Options of the day computations. Fill with ts_day_opts_default. */
 typedef struct {
     ts_horizon_opts horizon; /**< curvature, refraction, max_distance, threads;
@@ -80,10 +91,11 @@ typedef struct {
     int earth_horizon;       /**< 1: the horizon of a cell is at least the dip
                                   of the sea-level horizon seen from its height
                                   (ts_earth_horizon); 0: terrain only */
+    ts_sun_hours_rule sun_hours_rule; /**< what a step of ts_sun_hours counts */
 } ts_day_opts;
 
 /** Defaults: ts_horizon_opts_default, ts_sun_input_default, Linke turbidity
- * 3, Earth horizon on. */
+ * 3, Earth horizon on, sun hours TS_SUN_HOURS_VISIBLE. */
 void ts_day_opts_default(ts_day_opts *o);
 
 /** Check options and sites (counts, finite coordinates, latitudes within
@@ -163,9 +175,10 @@ ts_status ts_sun_visibility(const ts_grid *grid, const ts_sun_sites *sites,
 
 /**
  * Hours of direct sun over [start, start + length): the sum over uniform
- * steps of step_s seconds of the visible fraction of the sun's disk at the
- * middle of each step times the step's length. `hours` width*height, NaN
- * for nodata.
+ * steps of step_s seconds of the step's length times, at the middle of the
+ * step, 1 if any of the sun's disk is visible (o->sun_hours_rule
+ * TS_SUN_HOURS_VISIBLE) or the visible fraction of the disk
+ * (TS_SUN_HOURS_DISK_FRACTION). `hours` width*height, NaN for nodata.
  */
 ts_status ts_sun_hours(const ts_grid *grid, const ts_sun_sites *sites,
                        const ts_day_opts *o, double start_unix,

@@ -20,7 +20,7 @@ typedef enum {
     O_REFRACTION, O_SKY_WEIGHT, O_BAND, O_THREADS, O_OUTPUT_TYPE,
     O_MAX_MEMORY, O_DATETIME, O_DATE, O_TIMEZONE, O_STEP_MINUTES, O_PRESSURE,
     O_TEMPERATURE, O_DELTA_T, O_SUN_POSITION, O_LINKE_TURBIDITY, O_FAR_THRESHOLD,
-    O_ATLAS_STEPS, O_BACKEND, O_COUNT
+    O_ATLAS_STEPS, O_BACKEND, O_SUNHOURS_RULE, O_COUNT
 } opt_id;
 
 typedef struct {
@@ -130,6 +130,12 @@ static const opt_def OPTS[O_COUNT] = {
      "TERRASHADE_BACKEND, else OpenCL on a GPU or accelerator or on a device "
      "named by TERRASHADE_OPENCL_DEVICE, else c). The metadata item BACKEND "
      "says what ran"},
+    {"SUNHOURS_RULE", T_SELECT, "visible", 0, 0, 0, 0, "visible|fraction", 1,
+     "sunhours: what a time step counts: visible (the whole step while any "
+     "part of the sun's disk is above the cell's horizon; on a flat plane "
+     "the astronomical day length, sunrise to sunset by the upper limb) or "
+     "fraction (the step times the visible fraction of the disk; on a flat "
+     "plane the time the sun's centre is up)"},
 };
 
 static int fail(char *msg, size_t n, const char *fmt, ...)
@@ -280,6 +286,7 @@ void tsd_options_defaults(tsd_options *o)
     o->far_threshold = 512;
     o->atlas_steps = 158;
     o->backend = TSD_BACKEND_AUTO;
+    o->sunhours_fraction = 0;
 }
 
 /* Copy s without surrounding blanks into buf; returns buf. */
@@ -450,6 +457,7 @@ static int set_option(tsd_options *o, int id, const char *v, char *msg, size_t n
     case O_FAR_THRESHOLD: o->far_threshold = (int)x; break;
     case O_ATLAS_STEPS: o->atlas_steps = (int)x; break;
     case O_BACKEND: o->backend = (tsd_backend)sel; break;
+    case O_SUNHOURS_RULE: o->sunhours_fraction = sel; break;
     case O_COUNT: break;
     }
     return 0;
@@ -631,6 +639,9 @@ const char *tsd_options_value(const tsd_options *o, int i, char *buf,
     case O_FAR_THRESHOLD: snprintf(buf, n, "%d", o->far_threshold); break;
     case O_ATLAS_STEPS: snprintf(buf, n, "%d", o->atlas_steps); break;
     case O_BACKEND: snprintf(buf, n, "%s", tsd_backend_name(o->backend)); break;
+    case O_SUNHOURS_RULE:
+        snprintf(buf, n, "%s", o->sunhours_fraction ? "fraction" : "visible");
+        break;
     case O_COUNT: break;
     }
     return OPTS[i].name;

@@ -68,6 +68,8 @@ typedef struct {
     int far_threshold;       /* cells: nearer occluders are not in farshadow */
     int atlas_steps;         /* sun positions of PRODUCT=farshadow */
     tsd_backend backend;     /* auto (TERRASHADE_BACKEND, then the device), opencl, c */
+    int sunhours_fraction;   /* sunhours: 0 = a step counts while any of the
+                                disk is visible, 1 = weighted by the fraction */
     /* which of SUN_AZIMUTH / SUN_ELEVATION were given explicitly */
     int sun_azimuth_given, sun_elevation_given;
 } tsd_options;

@@ -82,6 +82,8 @@ int tsd_sun_setup(tsd_options *o, tsd_sites *sites, double min_cell_m, tsd_sun *
     s->day.sun.temperature = o->temperature;
     s->day.sun.delta_t = o->delta_t;
     s->day.linke_turbidity = o->linke_turbidity;
+    s->day.sun_hours_rule =
+        o->sunhours_fraction ? TS_SUN_HOURS_DISK_FRACTION : TS_SUN_HOURS_VISIBLE;
 
     ts_error err;
     if (ts_sun_sites_validate(&s->sites, &err) != TS_OK)

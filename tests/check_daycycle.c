@@ -170,12 +170,38 @@ END_TEST
 
 /* --------------------------------------------------------- sun hours */
 
-/* Sun hours of a flat plane at sea level against the astronomical day
- * length (upper limb on the horizon, refraction included), and against
- * the time the sun's centre is above the horizon, which the visible
- * fraction of the disk integrates to. */
+/* Sun hours of a flat plane at sea level under both rules: a step counted
+ * while any of the disk is up gives the astronomical day length (upper
+ * limb on the horizon, refraction included) within one step; a step
+ * weighted by the visible fraction gives the disk fraction above the
+ * horizon integrated in 20-second steps, within half a step (which is
+ * close to the time the sun's centre is up, unless the sun only grazes
+ * the horizon). */
+static double flat_sun_hours(const ts_sun_sites *s, double start, double step_min,
+                             ts_sun_hours_rule rule)
+{
+    ts_error err;
+    ts_day_opts o;
+    ts_day_opts_default(&o);
+    o.horizon.threads = 1;
+    o.sun_hours_rule = rule;
+    ts_grid g;
+    flat(&g, 16, 30.0, 0.0f);
+    float hours[256];
+    ck_assert_msg(ts_sun_hours(&g, s, &o, start, 86400, step_min * 60, hours, &err) ==
+                      TS_OK, "%s", err.message);
+    double lo = INFINITY, hi = -INFINITY;
+    for (int i = 0; i < 256; i++) {
+        lo = fmin(lo, hours[i]);
+        hi = fmax(hi, hours[i]);
+    }
+    ck_assert_msg(hi - lo < 1e-4, "a flat plane: every cell the same");
+    ts_grid_free(&g);
+    return hi;
+}
+
 static void day_length_case(double lat, double lon, const char *date, int offset,
-                            double step_min, int vs_astro)
+                            double step_min)
 {
     int y, m, d;
     ts_error err;
@@ -185,45 +211,35 @@ static void day_length_case(double lat, double lon, const char *date, int offset
     site_init(&p, lat, lon);
     ts_day_opts o;
     ts_day_opts_default(&o);
-    o.horizon.threads = 1;
-    ts_grid g;
-    flat(&g, 16, 30.0, 0.0f);
-    float hours[256];
-    ck_assert_msg(ts_sun_hours(&g, &p.s, &o, start, 86400, step_min * 60, hours, &err) ==
-                      TS_OK, "%s", err.message);
     double astro = time_above(&p.s, &o, start, -TS_SUN_RADIUS_DEG) / 3600.0;
     double centre = time_above(&p.s, &o, start, 0.0) / 3600.0;
-    double lo = INFINITY, hi = -INFINITY;
-    for (int i = 0; i < 256; i++) {
-        lo = fmin(lo, hours[i]);
-        hi = fmax(hi, hours[i]);
-    }
-    printf("day length %s at %.1f, %.1f: sun hours %.4f h (every cell %.4f..%.4f), "
-           "astronomical day %.4f h (diff %+.1f min), centre above the horizon %.4f h "
-           "(diff %+.2f min), step %.0f min\n",
-           date, lat, lon, hi, lo, hi, astro, (hi - astro) * 60, centre,
-           (hi - centre) * 60, step_min);
-    ck_assert_msg(hi - lo < 1e-4, "a flat plane: every cell the same");
-    if (vs_astro)
-        CK_NEAR(hi, astro, step_min / 60.0, "sun hours vs astronomical day length");
-    CK_NEAR(hi, centre, 0.5 * step_min / 60.0, "sun hours vs centre above the horizon");
-    ts_grid_free(&g);
+    double disk = 0;
+    for (double t = start + 10.0; t < start + 86400.0; t += 20.0)
+        disk += ts_sun_disk_fraction(elev_at(&p.s, &o, t), 0.0) * 20.0 / 3600.0;
+    double vis = flat_sun_hours(&p.s, start, step_min, TS_SUN_HOURS_VISIBLE);
+    double frac = flat_sun_hours(&p.s, start, step_min, TS_SUN_HOURS_DISK_FRACTION);
+    printf("day length %s at %5.1f, %6.1f, step %.0f min: visible %.4f h vs "
+           "astronomical day %.4f h (%+.1f min); disk fraction %.4f h vs its integral "
+           "%.4f h (%+.2f min), centre up %.4f h\n",
+           date, lat, lon, step_min, vis, astro, (vis - astro) * 60, frac, disk,
+           (frac - disk) * 60, centre);
+    CK_NEAR(vis, astro, step_min / 60.0, "sun hours vs astronomical day length");
+    CK_NEAR(frac, disk, 0.5 * step_min / 60.0, "disk-fraction hours vs their integral");
 }
 
 START_TEST(test_flat_plane_day_length)
 {
-    /* Up to mid latitudes the sun takes less than half a step to rise by
-     * its own radius, so sun hours (the visible fraction of the disk,
-     * integrated) are within one step of the astronomical day length (upper
-     * limb on the horizon). Farther north it rises slowly, and the sun
-     * hours follow the time its centre is above the horizon. */
-    day_length_case(46.5, 7.9, "2026-06-21", 120, 5, 1);   /* Bern, summer */
-    day_length_case(46.5, 7.9, "2026-12-21", 60, 5, 1);    /* Bern, winter */
-    day_length_case(0.0, -78.5, "2026-03-20", -300, 5, 1); /* Quito, equinox */
-    day_length_case(-33.9, 18.4, "2026-06-21", 120, 5, 1); /* Cape Town, winter */
-    day_length_case(36.6, -84.2, "2026-06-21", -240, 5, 1); /* jacksboro, summer */
-    day_length_case(46.5, 7.9, "2026-06-21", 120, 1, 0);   /* one-minute steps */
-    day_length_case(64.1, -21.9, "2026-06-01", 0, 5, 0);   /* Reykjavik, long day */
+    day_length_case(46.5, 7.9, "2026-06-21", 120, 5);    /* Bern, summer */
+    day_length_case(46.5, 7.9, "2026-12-21", 60, 5);     /* Bern, winter */
+    day_length_case(0.0, -78.5, "2026-03-20", -300, 5);  /* Quito, equinox */
+    day_length_case(-33.9, 18.4, "2026-06-21", 120, 5);  /* Cape Town, winter */
+    day_length_case(36.6, -84.2, "2026-06-21", -240, 5); /* jacksboro, summer */
+    day_length_case(46.5, 7.9, "2026-06-21", 120, 1);    /* one-minute steps */
+    day_length_case(64.1, -21.9, "2026-06-01", 0, 5);    /* Reykjavik, long day */
+    day_length_case(64.1, -21.9, "2026-12-21", 0, 5);    /* Reykjavik, short day */
+    day_length_case(69.6, 18.9, "2026-01-15", 60, 5);    /* Tromso, first days of sun */
+    day_length_case(69.6, 18.9, "2026-05-15", 120, 15);  /* Tromso, near midnight sun */
+    day_length_case(-77.8, 166.7, "2026-02-20", 780, 5); /* McMurdo, autumn */
 }
 END_TEST
 
@@ -322,6 +338,24 @@ START_TEST(test_shadows_cut_sun_hours)
     ck_assert(west < far - 5.0 && east < far - 5.0);
     ck_assert(crest >= far);
     ck_assert(pit == 0.0f);
+    /* Weighting by the disk fraction never gives more, and gives less
+     * where the disk is cut by the ridge or the plane's own horizon. */
+    float *f = malloc(n * n * sizeof *f);
+    o.sun_hours_rule = TS_SUN_HOURS_DISK_FRACTION;
+    ck_assert(ts_sun_hours(&g, &p.s, &o, start, 86400, 300, f, &err) == TS_OK);
+    double less = 0;
+    for (int i = 0; i < n * n; i++) {
+        ck_assert_msg(f[i] <= h[i] + 1e-5f, "cell %d: fraction %g h > visible %g h", i,
+                      f[i], h[i]);
+        less = fmax(less, h[i] - f[i]);
+    }
+    printf("ridge: disk-fraction hours at most %.3f h below visible hours\n", less);
+    ck_assert(f[32 * n + 2] < far);
+    ck_assert(f[11 * n + 11] == 0.0f);
+    o.sun_hours_rule = (ts_sun_hours_rule)7;
+    EXPECT_ARG(ts_sun_hours(&g, &p.s, &o, start, 86400, 300, f, &err), &err);
+    ck_assert(strstr(err.message, "sun-hours rule"));
+    free(f);
     free(h);
     ts_grid_free(&g);
 }
