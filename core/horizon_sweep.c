@@ -144,6 +144,10 @@ static float far_field(const sweep_ctx *C, int k, int i, float h, occluder lo, o
     return win;
 }
 
+#ifndef PREFETCH_AHEAD
+#define PREFETCH_AHEAD 8
+#endif
+
 static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
 {
     const ts_line_geom *G = C->geom;
@@ -168,6 +172,16 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
     int nv = 0;
     int far = -1; /* top-most hull point beyond the near field */
     for (int k = k0; k <= k1; k++) {
+        /* A line crosses a grid row per step: fetch the DEM and the output
+         * a few steps ahead, as no hardware prefetcher follows this path. */
+        if (k + PREFETCH_AHEAD <= k1) {
+            int ka = k + PREFETCH_AHEAD, ia = (int)(b + G->fl[ka]);
+            __builtin_prefetch(z + G->origin + (ptrdiff_t)ka * G->u_stride +
+                               (ptrdiff_t)ia * G->v_stride);
+            if (write)
+                __builtin_prefetch(C->out + C->o_origin + (ptrdiff_t)ka * C->o_u_stride +
+                                   (ptrdiff_t)ia * C->o_v_stride, 1);
+        }
         int i = (int)(b + G->fl[k]);
         float F = G->fr[k];
         ptrdiff_t p = G->origin + (ptrdiff_t)k * G->u_stride + (ptrdiff_t)i * G->v_stride;
