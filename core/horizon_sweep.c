@@ -58,8 +58,7 @@ typedef struct {
     int n;
     hull_pt *raw;       /* every pushed sample: the capped line slopes of the visitor */
     int raw_n;
-    occluder *prev_lo, *cur_lo;
-    int prev_k0, prev_k1;
+    ts_line_pair lo;    /* occluders of the far side (occluder entries) */
     /* visitor buffers */
     float *vx, *vy, *vh, *vs;
     double *vd;
@@ -152,21 +151,14 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
 {
     const ts_line_geom *G = C->geom;
     const float *z = C->grid->z;
-    occluder *t = w->prev_lo;
-    w->prev_lo = w->cur_lo;
-    w->cur_lo = t;
-    int pk0 = w->prev_k0, pk1 = w->prev_k1;
+    const int pk0 = w->lo.prev_k0, pk1 = w->lo.prev_k1;
     int k0, k1;
-    if (!ts_line_k_range(G, b, &k0, &k1)) {
-        w->prev_k0 = 1;
-        w->prev_k1 = 0;
+    if (!ts_line_pair_next(&w->lo, G, b, &k0, &k1))
         return;
-    }
-    w->prev_k0 = k0;
-    w->prev_k1 = k1;
+    const occluder *prev_lo = w->lo.prev;
+    occluder *cur_lo = w->lo.cur;
     w->n = 0;
     w->raw_n = 0;
-    const int V = G->V;
     const double c = C->c;
     double d = 0.0;
     int nv = 0;
@@ -182,31 +174,10 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
                 __builtin_prefetch(C->out + C->o_origin + (ptrdiff_t)ka * C->o_u_stride +
                                    (ptrdiff_t)ia * C->o_v_stride, 1);
         }
-        int i = (int)(b + G->fl[k]);
-        float F = G->fr[k];
-        ptrdiff_t p = G->origin + (ptrdiff_t)k * G->u_stride + (ptrdiff_t)i * G->v_stride;
-        int has_next = F > 0.0f && i + 1 < V;
-        float hc = z[p];
-        float hn = has_next ? z[p + G->v_stride] : NAN;
-        if (G->step_row) {
-            if (k > k0) {
-                int row = G->x_major ? i : G->u_start + k * G->u_step;
-                d += G->step_row[row];
-            }
-        } else {
-            d = (double)(k - k0) * G->step_m;
-        }
-        /* The sample on the line: between cell i and i+1, or outside the
-         * grid when i is the last row and the line is past it. */
-        int inside = F == 0.0f || has_next;
-        float hs;
-        /* NaN when either cell is nodata: the sample is no occluder. */
-        if (!inside)
-            hs = NAN;
-        else if (F == 0.0f)
-            hs = hc;
-        else
-            hs = hc + F * (hn - hc);
+        ts_line_sample ls;
+        ts_line_sample_at(G, z, b, k, k0, 0.0f, &d, &ls);
+        const int i = ls.i, has_next = ls.has_next, inside = ls.inside;
+        const float F = ls.F, hc = ls.hc, hn = ls.hn, hs = ls.hs;
 
         int pushed = 0;
         float slope = -INFINITY;
@@ -249,14 +220,14 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
             float s_out = NAN;
             if (!isnan(hc)) {
                 occluder hi = inside ? hull_query(C, w, far, d, hc) : none;
-                occluder lo = (F > 0.0f && k >= pk0 && k <= pk1) ? w->prev_lo[k] : none;
+                occluder lo = (F > 0.0f && k >= pk0 && k <= pk1) ? prev_lo[k] : none;
                 int row = G->x_major ? i : G->u_start + k * G->u_step;
                 double step = G->step_row ? G->step_row[row] : G->step_m;
                 s_out = far_field(C, k, i, hc, lo, hi, step); /* near field later */
             }
             C->out[C->o_origin + (ptrdiff_t)k * C->o_u_stride + (ptrdiff_t)i * C->o_v_stride] = s_out;
         }
-        w->cur_lo[k] = (has_next && !isnan(hn)) ? hull_query(C, w, far, d, hn) : none;
+        cur_lo[k] = (has_next && !isnan(hn)) ? hull_query(C, w, far, d, hn) : none;
         if (w->vs) {
             w->vx[nv] = G->x_major ? (float)(G->u_start + k * G->u_step) : (float)i + F;
             w->vy[nv] = G->x_major ? (float)i + F : (float)(G->u_start + k * G->u_step);
@@ -274,8 +245,8 @@ static void ws_free(sweep_ws *w)
 {
     free(w->stack);
     free(w->raw);
-    free(w->prev_lo);
-    free(w->cur_lo);
+    free(w->lo.prev);
+    free(w->lo.cur);
     free(w->vx);
     free(w->vy);
     free(w->vh);
@@ -287,10 +258,10 @@ static int ws_init(sweep_ws *w, int U, int need_raw, int need_visit)
 {
     *w = (sweep_ws){0};
     w->stack = malloc((size_t)(U + 1) * sizeof *w->stack);
-    w->prev_lo = malloc((size_t)U * sizeof *w->prev_lo);
-    w->cur_lo = malloc((size_t)U * sizeof *w->cur_lo);
-    w->prev_k0 = 1;
-    w->prev_k1 = 0;
+    w->lo.prev = malloc((size_t)U * sizeof(occluder));
+    w->lo.cur = malloc((size_t)U * sizeof(occluder));
+    w->lo.prev_k0 = 1;
+    w->lo.prev_k1 = 0;
     if (need_raw)
         w->raw = malloc((size_t)(U + 1) * sizeof *w->raw);
     if (need_visit) {
@@ -300,7 +271,7 @@ static int ws_init(sweep_ws *w, int U, int need_raw, int need_visit)
         w->vs = malloc((size_t)U * sizeof(float));
         w->vd = malloc((size_t)U * sizeof(double));
     }
-    return w->stack && w->prev_lo && w->cur_lo && (!need_raw || w->raw) &&
+    return w->stack && w->lo.prev && w->lo.cur && (!need_raw || w->raw) &&
            (!need_visit || (w->vx && w->vy && w->vh && w->vs && w->vd));
 }
 
@@ -389,10 +360,7 @@ static ts_status sweep_setup(const ts_grid *grid, double azimuth,
     C->geom = geom;
     C->c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
     C->cap = opts->max_distance;
-    ptrdiff_t ou = geom->x_major ? 1 : grid->width;
-    C->o_v_stride = geom->x_major ? grid->width : 1;
-    C->o_u_stride = ou * geom->u_step;
-    C->o_origin = ou * geom->u_start;
+    ts_line_out_strides(geom, grid->width, &C->o_origin, &C->o_u_stride, &C->o_v_stride);
     C->b0 = geom->b_lo;
     ts_near_plan_init(&C->near, geom);
     C->near_skip = (TS_NEAR_STEPS + 0.5) * geom->step_m;

@@ -123,3 +123,12 @@ int ts_line_k_range(const ts_line_geom *g, long b, int *k0, int *k1)
     *k1 = z;
     return 1;
 }
+
+void ts_line_out_strides(const ts_line_geom *g, int width, ptrdiff_t *origin,
+                         ptrdiff_t *u_stride, ptrdiff_t *v_stride)
+{
+    ptrdiff_t ou = g->x_major ? 1 : width;
+    *v_stride = g->x_major ? width : 1;
+    *u_stride = ou * g->u_step;
+    *origin = ou * g->u_start;
+}

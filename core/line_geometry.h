@@ -13,6 +13,9 @@
 #ifndef TS_LINE_GEOMETRY_H
 #define TS_LINE_GEOMETRY_H
 
+#include <math.h>
+#include <stddef.h>
+
 #include "terrashade.h"
 
 typedef struct {
@@ -38,5 +41,74 @@ void ts_line_geom_free(ts_line_geom *g);
 /* First and last k (inclusive) at which line b's lower row b + fl[k] lies in
  * [0, V-1]; returns 0 if the line misses the grid. */
 int ts_line_k_range(const ts_line_geom *g, long b, int *k0, int *k1);
+
+/* A sweep's results per step of the line before the current one (the far
+ * side of the cells between them) and of the current line. */
+typedef struct {
+    void *prev, *cur;          /* U entries each, of the sweep's own type */
+    int prev_k0, prev_k1;      /* steps of the line before; k0 > k1: none */
+} ts_line_pair;
+
+/* Start line b: the current line's results become the previous ones and
+ * *k0, *k1 receive its steps; returns 0 when it misses the grid. */
+static inline int ts_line_pair_next(ts_line_pair *lp, const ts_line_geom *G, long b,
+                                    int *k0, int *k1)
+{
+    void *t = lp->prev;
+    lp->prev = lp->cur;
+    lp->cur = t;
+    if (!ts_line_k_range(G, b, k0, k1)) {
+        lp->prev_k0 = 1;
+        lp->prev_k1 = 0;
+        return 0;
+    }
+    lp->prev_k0 = *k0;
+    lp->prev_k1 = *k1;
+    return 1;
+}
+
+/* Element offsets of sample (k, row v) in a width-wide output plane laid
+ * out like the grid: origin + k * u_stride + v * v_stride. */
+void ts_line_out_strides(const ts_line_geom *g, int width, ptrdiff_t *origin,
+                         ptrdiff_t *u_stride, ptrdiff_t *v_stride);
+
+/* Sample k of a line: the cell below it and the one after, and the height
+ * on the line between them. */
+typedef struct {
+    int i;             /* row (or column) b + fl[k] */
+    float F;           /* fraction toward i + 1 */
+    ptrdiff_t p;       /* element offset of cell (k, i) in the grid */
+    int has_next;      /* F > 0 and i + 1 is on the grid */
+    int inside;        /* the sample is on the grid (F == 0 or has_next) */
+    float hc, hn;      /* heights of cells i and i + 1 (NaN if no next) */
+    float hs;          /* height on the line; NaN off the grid or at nodata */
+} ts_line_sample;
+
+/*
+ * Sample k of line b, and the distance d (metres) along the line from its
+ * first sample k0 to it: d is advanced from sample k - 1 (pass k0 first,
+ * then every k in order). Fractions below `snap` count as 0.
+ */
+static inline void ts_line_sample_at(const ts_line_geom *G, const float *z, long b, int k,
+                                     int k0, float snap, double *d, ts_line_sample *s)
+{
+    s->i = (int)(b + G->fl[k]);
+    s->F = G->fr[k] < snap ? 0.0f : G->fr[k];
+    s->p = G->origin + (ptrdiff_t)k * G->u_stride + (ptrdiff_t)s->i * G->v_stride;
+    s->has_next = s->F > 0.0f && s->i + 1 < G->V;
+    s->hc = z[s->p];
+    s->hn = s->has_next ? z[s->p + G->v_stride] : (float)NAN;
+    if (G->step_row) {
+        if (k > k0) {
+            int row = G->x_major ? s->i : G->u_start + k * G->u_step;
+            *d += G->step_row[row];
+        }
+    } else {
+        *d = (double)(k - k0) * G->step_m;
+    }
+    s->inside = s->F == 0.0f || s->has_next;
+    /* NaN when either cell is nodata: the sample is no occluder. */
+    s->hs = !s->inside ? (float)NAN : s->F == 0.0f ? s->hc : s->hc + s->F * (s->hn - s->hc);
+}
 
 #endif

@@ -1,0 +1,250 @@
+/*
+ * Far-field horizons and far shadows: only terrain at least a threshold
+ * distance behind a cell counts (Chajdas et al. 2015). The sweep of
+ * horizon_sweep.c, with two differences: a sample joins its line's hull
+ * only once the line has moved the threshold past it (so the hull holds
+ * exactly the far samples), and a cell's value mixes the two lines'
+ * tangents linearly (there is no near field to solve exactly).
+ * See shadow_atlas.h.
+ */
+#include <math.h>
+#include <stdlib.h>
+
+#include "line_geometry.h"
+#include "parallel.h"
+#include "shadow_atlas.h"
+#include "status_internal.h"
+
+typedef struct {
+    double d, g;
+} fpt;
+
+typedef struct {
+    const ts_grid *grid;
+    const ts_line_geom *geom;
+    double c;   /* curvature coefficient (1-k)/(2R), 0 when off */
+    double T;   /* threshold, metres */
+    float *out; /* slopes, then degrees; row stride = width */
+    ptrdiff_t o_origin, o_u_stride, o_v_stride;
+    long b0;
+    int *failed;
+} far_ctx;
+
+typedef struct {
+    fpt *hull, *raw;
+    int n, raw_n, pending;
+    ts_line_pair lo;   /* far-side slopes (float entries) */
+} far_ws;
+
+/* Push onto the upper hull (points arrive by increasing d). */
+static inline void hull_push(far_ws *w, fpt p)
+{
+    fpt *S = w->hull;
+    int n = w->n;
+    while (n >= 2 && (S[n - 2].g - p.g) * (p.d - S[n - 1].d) >=
+                         (S[n - 1].g - p.g) * (p.d - S[n - 2].d))
+        n--;
+    S[n] = p;
+    w->n = n + 1;
+}
+
+/* Largest slope (without the curvature term -2cd) from (d, g) to the hull,
+ * which lies entirely behind d: the slopes to the vertices rise and then
+ * fall, so a binary search finds the tangent vertex. */
+static inline double hull_tangent(const far_ws *w, double d, double g)
+{
+    const fpt *S = w->hull;
+    int lo = 0, hi = w->n - 1; /* answer in [lo, hi] */
+    while (lo < hi) {
+        int j = (lo + hi) / 2;
+        if ((S[j + 1].g - g) * (d - S[j].d) >= (S[j].g - g) * (d - S[j + 1].d))
+            lo = j + 1;
+        else
+            hi = j;
+    }
+    return (S[lo].g - g) / (d - S[lo].d);
+}
+
+static inline float far_query(const far_ctx *C, const far_ws *w, double d, float h)
+{
+    if (w->n == 0)
+        return -INFINITY;
+    double g = h - C->c * d * d;
+    return (float)(hull_tangent(w, d, g) - 2.0 * C->c * d);
+}
+
+/* The core sweep's rule for mixing the two lines around a cell. */
+static inline float combine(float lo, float hi, float F)
+{
+    if (F == 0.0f || isnan(lo))
+        return hi;
+    if (isnan(hi))
+        return lo;
+    if (lo == -INFINITY)
+        return hi;
+    if (hi == -INFINITY)
+        return lo;
+    return F * lo + (1.0f - F) * hi;
+}
+
+static void far_line(const far_ctx *C, far_ws *w, long b, int write)
+{
+    const ts_line_geom *G = C->geom;
+    const int pk0 = w->lo.prev_k0, pk1 = w->lo.prev_k1;
+    int k0, k1;
+    if (!ts_line_pair_next(&w->lo, G, b, &k0, &k1))
+        return;
+    const float *prev_lo = w->lo.prev;
+    float *cur_lo = w->lo.cur;
+    w->n = w->raw_n = w->pending = 0;
+    double d = 0.0;
+    for (int k = k0; k <= k1; k++) {
+        /* A diagonal's t is a hair off +/-1, which leaves F ~ 1e-16 rather
+         * than 0: the sample is on the cell. */
+        ts_line_sample s;
+        ts_line_sample_at(G, C->grid->z, b, k, k0, 1e-6f, &d, &s);
+        /* Samples at least T behind join the hull, in order. */
+        while (w->pending < w->raw_n && d - w->raw[w->pending].d >= C->T)
+            hull_push(w, w->raw[w->pending++]);
+        if (write) {
+            float s_out;
+            if (isnan(s.hc)) {
+                s_out = NAN;
+            } else {
+                float hi = s.inside ? far_query(C, w, d, s.hc) : NAN;
+                float lo = (s.F > 0.0f && k >= pk0 && k <= pk1) ? prev_lo[k] : NAN;
+                s_out = combine(lo, hi, s.F);
+            }
+            C->out[C->o_origin + (ptrdiff_t)k * C->o_u_stride +
+                   (ptrdiff_t)s.i * C->o_v_stride] = s_out;
+        }
+        cur_lo[k] = (s.has_next && !isnan(s.hn)) ? far_query(C, w, d, s.hn) : NAN;
+        if (!isnan(s.hs))
+            w->raw[w->raw_n++] = (fpt){d, s.hs - C->c * d * d};
+    }
+}
+
+static void far_range(void *ctx, int worker, long begin, long end)
+{
+    (void)worker;
+    const far_ctx *C = ctx;
+    int U = C->geom->U;
+    far_ws w = {0};
+    w.hull = malloc((size_t)(U + 1) * sizeof *w.hull);
+    w.raw = malloc((size_t)(U + 1) * sizeof *w.raw);
+    w.lo.prev = malloc((size_t)U * sizeof(float));
+    w.lo.cur = malloc((size_t)U * sizeof(float));
+    w.lo.prev_k0 = 1;
+    w.lo.prev_k1 = 0;
+    if (w.hull && w.raw && w.lo.prev && w.lo.cur) {
+        if (begin > 0)
+            far_line(C, &w, C->b0 + begin - 1, 0);
+        for (long b = C->b0 + begin; b < C->b0 + end; b++)
+            far_line(C, &w, b, 1);
+    } else {
+        __atomic_store_n(C->failed, 1, __ATOMIC_RELAXED);
+    }
+    free(w.hull);
+    free(w.raw);
+    free(w.lo.prev);
+    free(w.lo.cur);
+}
+
+static void to_degrees(void *ctx, int worker, long y0, long y1)
+{
+    (void)worker;
+    const far_ctx *C = ctx;
+    size_t W = (size_t)C->grid->width;
+    for (size_t i = (size_t)y0 * W; i < (size_t)y1 * W; i++) {
+        float s = C->out[i];
+        C->out[i] = isnan(s) ? NAN : (float)(atan((double)s) * (180.0 / M_PI));
+    }
+}
+
+/* The far-field sweep: slopes (tangents) into out, or, with `degrees`,
+ * elevation angles. */
+static ts_status far_sweep(const ts_grid *grid, double azimuth, double threshold_m,
+                           const ts_horizon_opts *opts, int degrees, float *out,
+                           ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if (!opts || !out)
+        return ts_fail(err, TS_ERR_ARG, "far-field horizon: options or output are NULL");
+    ts_horizon_opts o = *opts;
+    if (o.directions < 1)
+        o.directions = 1;
+    if ((st = ts_horizon_opts_validate(&o, err)) != TS_OK)
+        return st;
+    if (o.max_distance != 0)
+        return ts_fail(err, TS_ERR_ARG, "far-field horizons take no maximum distance "
+                       "(got %g m)", o.max_distance);
+    if (!isfinite(azimuth))
+        return ts_fail(err, TS_ERR_ARG, "azimuth must be a finite number of degrees, "
+                       "got %g", azimuth);
+    if (!(threshold_m > 0) || !isfinite(threshold_m))
+        return ts_fail(err, TS_ERR_ARG, "the far-shadow threshold must be a positive "
+                       "distance in metres, got %g", threshold_m);
+    azimuth = fmod(azimuth, 360.0);
+    if (azimuth < 0)
+        azimuth += 360.0;
+    ts_line_geom geom;
+    if ((st = ts_line_geom_init(&geom, grid, azimuth, err)) != TS_OK)
+        return st;
+    int failed = 0;
+    far_ctx C = {0};
+    C.grid = grid;
+    C.geom = &geom;
+    C.c = o.curvature ? (1.0 - o.refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
+    C.T = threshold_m;
+    C.out = out;
+    ts_line_out_strides(&geom, grid->width, &C.o_origin, &C.o_u_stride, &C.o_v_stride);
+    C.b0 = geom.b_lo;
+    C.failed = &failed;
+    long lines = geom.b_hi - geom.b_lo + 1;
+    st = ts_parallel_for(ts_thread_count(o.threads, lines), lines, far_range, &C, err);
+    if (st == TS_OK && !failed && degrees)
+        st = ts_parallel_for(ts_thread_count(o.threads, grid->height), grid->height,
+                             to_degrees, &C, err);
+    ts_line_geom_free(&geom);
+    if (st != TS_OK)
+        return st;
+    if (failed)
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the far-field sweep workspace");
+    return ts_ok(err);
+}
+
+ts_status ts_far_horizon(const ts_grid *grid, double azimuth, double threshold_m,
+                         const ts_horizon_opts *opts, float *out, ts_error *err)
+{
+    return far_sweep(grid, azimuth, threshold_m, opts, 1, out, err);
+}
+
+ts_status ts_far_shadow(const ts_grid *grid, double azimuth, double elevation,
+                        double threshold_m, const ts_horizon_opts *opts, uint8_t *out,
+                        ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if (!out)
+        return ts_fail(err, TS_ERR_ARG, "ts_far_shadow: the output is NULL");
+    if (!(elevation >= -90.0 && elevation <= 90.0))
+        return ts_fail(err, TS_ERR_ARG, "the sun's elevation must be between -90 and "
+                       "90 degrees, got %g", elevation);
+    size_t cells = (size_t)grid->width * grid->height;
+    float *s = malloc(cells * sizeof *s);
+    if (!s)
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate a far-horizon plane");
+    st = far_sweep(grid, azimuth, threshold_m, opts, 0, s, err);
+    if (st == TS_OK) {
+        /* slope > tan(elevation) <=> horizon angle > elevation */
+        double t = elevation >= 90.0 ? INFINITY : tan(elevation * (M_PI / 180.0));
+        for (size_t i = 0; i < cells; i++)
+            out[i] = isnan(s[i]) ? TS_ATLAS_NODATA : (double)s[i] > t ? 1 : 0;
+    }
+    free(s);
+    return st;
+}
+
