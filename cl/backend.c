@@ -111,8 +111,8 @@ static int want_opencl(ts_backend eff, ts_backend_report *r)
 /* After an OpenCL attempt: success, or note the fallback. */
 static int cl_done(ts_status st, const ts_error *e, ts_backend_report *r)
 {
-    if (st == TS_OK)
-        return 1;
+    if (st == TS_OK || st == TS_ERR_CANCELLED)
+        return st == TS_OK;
     r->fell_back = 1;
     snprintf(r->reason, sizeof r->reason, "%s", e->message);
     report_c(r);
@@ -146,6 +146,8 @@ ts_status ts_backend_choose(ts_backend requested, ts_backend_report *report, ts_
             st = CL_CALL;                                                                      \
             if (cl_done(st, cl_err, r))                                                        \
                 return ts_ok(err);                                                             \
+            if (st == TS_ERR_CANCELLED) /* the caller stopped: no fallback */                  \
+                return ts_fail(err, st, "%s", e.message);                                      \
         }                                                                                      \
         return C_CALL;                                                                         \
     } while (0)

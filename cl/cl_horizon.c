@@ -188,6 +188,10 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
     const cl_long cplane = (cl_long)cells;
 
     for (int first = 0; first < n && J.st == TS_OK; first += (int)A) {
+        if (ts_progress(opts, (double)first / n, err) != TS_OK) {
+            ts_cl_job_fail(&J, TS_ERR_CANCELLED, "cancelled by the caller");
+            break;
+        }
         int nb = n - first < (int)A ? n - first : (int)A;
         int items = 0, floff = 0;
         for (int a = 0; a < nb; a++) {
@@ -256,6 +260,8 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
                        "horizon planes");
     }
     ts_status st = ts_cl_job_end(&J);
+    if (st == TS_OK)
+        st = ts_progress(opts, 1.0, err);
     free(packed);
     free(ip);
     free(dp);

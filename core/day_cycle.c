@@ -600,7 +600,8 @@ ts_status ts_sun_hours(const ts_grid *grid, const ts_sun_sites *sites,
     }
     for (int k = 0; k < n; k++) {
         int dark;
-        if ((st = vis_step(&c, mid[k], vis, NULL, NULL, NULL, &dark, err)) != TS_OK)
+        if ((st = ts_progress(&o->horizon, (double)k / n, err)) != TS_OK ||
+            (st = vis_step(&c, mid[k], vis, NULL, NULL, NULL, &dark, err)) != TS_OK)
             goto done;
         if (dark)
             continue;
@@ -612,6 +613,8 @@ ts_status ts_sun_hours(const ts_grid *grid, const ts_sun_sites *sites,
             for (size_t i = 0; i < c.cells; i++)
                 acc[i] += vis[i] > 0.0f ? hrs : 0.0;
     }
+    if ((st = ts_progress(&o->horizon, 1.0, err)) != TS_OK)
+        goto done;
     for (int y = 0; y < c.H; y++)
         for (int x = 0; x < c.W; x++) {
             size_t i = (size_t)y * c.W + x;
@@ -723,7 +726,9 @@ ts_status ts_insolation(const ts_grid *grid, const ts_sun_sites *sites,
             h.directions = 1;
         for (int k = 0; k < h.directions; k++) {
             double a = ts_horizon_azimuth(&h, k);
-            if ((st = ts_horizon_sweep(grid, a, &h, c.pa, err)) != TS_OK ||
+            if ((st = ts_progress(&o->horizon, (double)k / (h.directions + n), err)) !=
+                    TS_OK ||
+                (st = ts_horizon_sweep(grid, a, &h, c.pa, err)) != TS_OK ||
                 (st = ts_sky_accumulate(grid, nx, ny, nz, c.pa, a, h.directions, NULL,
                                         sky, NULL, err)) != TS_OK)
                 goto done;
@@ -737,10 +742,13 @@ ts_status ts_insolation(const ts_grid *grid, const ts_sun_sites *sites,
             pc[(size_t)y * c.W + x] = isnan(h) ? NAN : (float)exp(-h / 8434.5);
         }
     const double tl = o->linke_turbidity;
+    const int sweeps = o->horizon.directions < 1 ? 1 : o->horizon.directions;
     for (int k = 0; k < n; k++) {
         int dark;
         ts_sun_sample ref;
-        if ((st = vis_step(&c, mid[k], vis, caz, cel, &ref, &dark, err)) != TS_OK)
+        if ((st = ts_progress(&o->horizon, (double)(sweeps + k) / (sweeps + n), err)) !=
+                TS_OK ||
+            (st = vis_step(&c, mid[k], vis, caz, cel, &ref, &dark, err)) != TS_OK)
             goto done;
         double hrs = dur[k] / 3600.0;
         double g0 = TS_SOLAR_CONSTANT / (ref.distance_au * ref.distance_au);
@@ -782,6 +790,8 @@ ts_status ts_insolation(const ts_grid *grid, const ts_sun_sites *sites,
             }
         }
     }
+    if ((st = ts_progress(&o->horizon, 1.0, err)) != TS_OK)
+        goto done;
     for (size_t i = 0; i < cells; i++) {
         int nd = isnan(pc[i]);
         total[i] = nd ? NAN : (float)(accb[i] + accd[i]);

@@ -14,6 +14,8 @@ void ts_horizon_opts_default(ts_horizon_opts *opts)
     opts->curvature = 1;
     opts->refraction = TS_DEFAULT_REFRACTION;
     opts->threads = 0;
+    opts->progress = NULL;
+    opts->progress_user = NULL;
 }
 
 ts_status ts_horizon_opts_validate(const ts_horizon_opts *opts, ts_error *err)
@@ -60,9 +62,13 @@ ts_status ts_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts, f
         return ts_fail(err, TS_ERR_NOMEM, "%d horizon planes of %d x %d cells are too large",
                        opts->directions, grid->width, grid->height);
     for (int k = 0; k < opts->directions; k++) {
+        if ((st = ts_progress(opts, (double)k / opts->directions, err)) != TS_OK)
+            return st;
         st = ts_horizon_sweep(grid, ts_horizon_azimuth(opts, k), opts, out + plane * k, err);
         if (st != TS_OK)
             return st;
     }
+    if ((st = ts_progress(opts, 1.0, err)) != TS_OK)
+        return st;
     return ts_ok(err);
 }

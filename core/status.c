@@ -12,6 +12,7 @@ const char *ts_status_name(ts_status code)
     case TS_ERR_NOMEM: return "out of memory";
     case TS_ERR_THREAD: return "cannot start thread";
     case TS_ERR_INTERNAL: return "internal error";
+    case TS_ERR_CANCELLED: return "cancelled";
     }
     return "unknown status";
 }
@@ -34,5 +35,14 @@ ts_status ts_ok(ts_error *err)
         err->code = TS_OK;
         err->message[0] = '\0';
     }
+    return TS_OK;
+}
+
+ts_status ts_progress(const ts_horizon_opts *o, double done, ts_error *err)
+{
+    if (!o || !o->progress)
+        return TS_OK;
+    if (o->progress(done < 0 ? 0 : done > 1 ? 1 : done, o->progress_user))
+        return ts_fail(err, TS_ERR_CANCELLED, "cancelled by the caller");
     return TS_OK;
 }

@@ -14,4 +14,8 @@ ts_status ts_fail(ts_error *err, ts_status code, const char *fmt, ...)
 /* Mark err as success; returns TS_OK. */
 ts_status ts_ok(ts_error *err);
 
+/* Report `done` (0..1) through the options' progress callback, if any;
+ * TS_ERR_CANCELLED (err filled) when it asks to stop, else TS_OK. */
+ts_status ts_progress(const ts_horizon_opts *o, double done, ts_error *err);
+
 #endif

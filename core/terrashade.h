@@ -33,7 +33,8 @@ typedef enum {
     TS_ERR_ARG,     /**< an argument is NULL, out of range or inconsistent */
     TS_ERR_NOMEM,   /**< an allocation failed (or the size overflows) */
     TS_ERR_THREAD,  /**< a worker thread could not be started */
-    TS_ERR_INTERNAL /**< a bug: please report it */
+    TS_ERR_INTERNAL, /**< a bug: please report it */
+    TS_ERR_CANCELLED /**< the progress callback asked to stop */
 } ts_status;
 
 /** Error detail: the code and one sentence for the user. */
@@ -104,6 +105,14 @@ static inline double ts_grid_cell_x(const ts_grid *g, int y)
 /** Default refraction coefficient k: drop = (1 - k) d^2 / (2 R). */
 #define TS_DEFAULT_REFRACTION 0.13
 
+/**
+ * Progress of a long computation: called from the calling thread between
+ * its steps (horizon azimuths, time steps of a day) with the fraction done,
+ * 0 at the start and 1 at the end. Return non-zero to stop: the computation
+ * then fails with TS_ERR_CANCELLED.
+ */
+typedef int (*ts_progress_fn)(double done, void *user);
+
 /** Options of the horizon sweep. Fill with ts_horizon_opts_default. */
 typedef struct {
     int directions;       /**< number of azimuths, >= 1 */
@@ -112,6 +121,8 @@ typedef struct {
     int curvature;        /**< 1 = apply Earth curvature and refraction */
     double refraction;    /**< k in [0, 1] */
     int threads;          /**< worker threads; 0 = number of cores */
+    ts_progress_fn progress; /**< NULL = no progress reports */
+    void *progress_user;  /**< passed to progress */
 } ts_horizon_opts;
 
 /** Defaults: 16 directions from 0 deg, unbounded, curvature on, k = 0.13. */

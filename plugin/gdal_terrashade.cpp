@@ -36,6 +36,7 @@
 #include "tsd_geodesy.h"
 #include "tsd_options.h"
 #include "tsd_product.h"
+#include "tsd_progress.h"
 #include "tsd_sun.h"
 
 namespace
@@ -238,6 +239,16 @@ CPLErr TSDataset::EnsureComputed()
                  tsd_product_name(m_sOpts.product), m_osDEM.c_str(), W, H,
                  nBands);
         const auto tStart = std::chrono::steady_clock::now();
+        // The whole product is computed here, inside the first block read,
+        // where GDAL passes no progress callback: report on stderr.
+        tsd_progress sProgress;
+        const std::string osLabel = CPLSPrintf(
+            "computing %s of %d x %d cells", tsd_product_name(m_sOpts.product), W, H);
+        tsd_progress_begin(&sProgress, m_sOpts.progress_mode, nullptr, osLabel.c_str(),
+                           CPLAtof(CPLGetConfigOption("TERRASHADE_PROGRESS_AFTER", "1")));
+        tsd_options sRun = m_sOpts;
+        sRun.progress = tsd_progress_report;
+        sRun.progress_user = &sProgress;
         ts_grid sGrid;
         GDALRasterBandH hBand = GDALGetRasterBand(m_poDEM, m_sOpts.band);
         if (tsd_dem_load(hBand, &m_sCells, m_sOpts.z_factor, &sGrid, szMsg,
@@ -260,7 +271,7 @@ CPLErr TSDataset::EnsureComputed()
             else
             {
                 tsd_backend_summary sRan{};
-                if (tsd_product_compute(&sGrid, &m_sOpts, m_bHasSun ? &m_sSun : nullptr,
+                if (tsd_product_compute(&sGrid, &sRun, m_bHasSun ? &m_sSun : nullptr,
                                         m_pafProduct, m_pabyProduct, &sRan, szMsg,
                                         sizeof szMsg) != 0)
                     m_osError = std::string("TERRASHADE: ") + szMsg;
@@ -274,6 +285,7 @@ CPLErr TSDataset::EnsureComputed()
             }
             ts_grid_free(&sGrid);
         }
+        tsd_progress_end(&sProgress, m_osError.empty());
         if (!m_osError.empty())
         {
             VSIFree(m_pafProduct);

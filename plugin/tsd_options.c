@@ -20,7 +20,7 @@ typedef enum {
     O_REFRACTION, O_SKY_WEIGHT, O_BAND, O_THREADS, O_OUTPUT_TYPE,
     O_MAX_MEMORY, O_DATETIME, O_DATE, O_TIMEZONE, O_STEP_MINUTES, O_PRESSURE,
     O_TEMPERATURE, O_DELTA_T, O_SUN_POSITION, O_LINKE_TURBIDITY, O_FAR_THRESHOLD,
-    O_ATLAS_STEPS, O_BACKEND, O_SUNHOURS_RULE, O_COUNT
+    O_ATLAS_STEPS, O_BACKEND, O_SUNHOURS_RULE, O_PROGRESS, O_COUNT
 } opt_id;
 
 typedef struct {
@@ -136,6 +136,10 @@ static const opt_def OPTS[O_COUNT] = {
      "the astronomical day length, sunrise to sunset by the upper limb) or "
      "fraction (the step times the visible fraction of the disk; on a flat "
      "plane the time the sun's centre is up)"},
+    {"PROGRESS", T_SELECT, "auto", 0, 0, 0, 0, "auto|yes|no", 0,
+     "Print the progress of the computation to stderr: yes, no, or auto "
+     "(when stderr is a terminal and the computation takes more than a "
+     "second)"},
 };
 
 static int fail(char *msg, size_t n, const char *fmt, ...)
@@ -287,6 +291,9 @@ void tsd_options_defaults(tsd_options *o)
     o->atlas_steps = 158;
     o->backend = TSD_BACKEND_AUTO;
     o->sunhours_fraction = 0;
+    o->progress_mode = TSD_PROGRESS_AUTO;
+    o->progress = NULL;
+    o->progress_user = NULL;
 }
 
 /* Copy s without surrounding blanks into buf; returns buf. */
@@ -458,6 +465,7 @@ static int set_option(tsd_options *o, int id, const char *v, char *msg, size_t n
     case O_ATLAS_STEPS: o->atlas_steps = (int)x; break;
     case O_BACKEND: o->backend = (tsd_backend)sel; break;
     case O_SUNHOURS_RULE: o->sunhours_fraction = sel; break;
+    case O_PROGRESS: o->progress_mode = (tsd_progress_mode)sel; break;
     case O_COUNT: break;
     }
     return 0;
@@ -641,6 +649,11 @@ const char *tsd_options_value(const tsd_options *o, int i, char *buf,
     case O_BACKEND: snprintf(buf, n, "%s", tsd_backend_name(o->backend)); break;
     case O_SUNHOURS_RULE:
         snprintf(buf, n, "%s", o->sunhours_fraction ? "fraction" : "visible");
+        break;
+    case O_PROGRESS:
+        snprintf(buf, n, "%s", o->progress_mode == TSD_PROGRESS_YES  ? "yes"
+                               : o->progress_mode == TSD_PROGRESS_NO ? "no"
+                                                                     : "auto");
         break;
     case O_COUNT: break;
     }

@@ -8,6 +8,8 @@
 
 #include <stddef.h>
 
+#include "terrashade.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -26,6 +28,7 @@ typedef enum {
 } tsd_product;
 
 typedef enum { TSD_SUN_CENTER = 0, TSD_SUN_PER_CELL } tsd_sun_position;
+typedef enum { TSD_PROGRESS_AUTO = 0, TSD_PROGRESS_YES, TSD_PROGRESS_NO } tsd_progress_mode;
 
 /* Longest text value of a string option (DATETIME, DATE, TIMEZONE). */
 #define TSD_TEXT_MAX 64
@@ -70,6 +73,10 @@ typedef struct {
     tsd_backend backend;     /* auto (TERRASHADE_BACKEND, then the device), opencl, c */
     int sunhours_fraction;   /* sunhours: 0 = a step counts while any of the
                                 disk is visible, 1 = weighted by the fraction */
+    tsd_progress_mode progress_mode; /* PROGRESS: auto, yes, no */
+    /* Not options: set by the dataset just before it computes. */
+    ts_progress_fn progress; /* NULL = no reports */
+    void *progress_user;
     /* which of SUN_AZIMUTH / SUN_ELEVATION were given explicitly */
     int sun_azimuth_given, sun_elevation_given;
 } tsd_options;

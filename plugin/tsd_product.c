@@ -116,6 +116,19 @@ static void horizon_opts(const tsd_options *o, ts_horizon_opts *h)
     h->curvature = o->curvature;
     h->refraction = o->refraction;
     h->threads = o->threads;
+    h->progress = o->progress;
+    h->progress_user = o->progress_user;
+}
+
+/* Report progress `done` (0..1) of a loop the plugin runs itself; -1 with
+ * msg filled when the caller cancels. */
+static int report(const tsd_options *o, double done, char *msg, size_t n)
+{
+    if (o->progress && o->progress(done, o->progress_user)) {
+        snprintf(msg, n, "cancelled by the caller");
+        return -1;
+    }
+    return 0;
 }
 
 /* Extra float planes (besides the DEM grid and the product) at the peak. */
@@ -213,9 +226,14 @@ static int sky_stream(const ts_grid *g, const normals *nm, const tsd_options *o,
         return oom(msg, n, "a horizon plane");
     float *svf = which == 0 ? acc : NULL, *sky = which == 1 ? acc : NULL,
           *open = which == 2 ? acc : NULL;
+    h.progress = NULL; /* reported here, per azimuth */
     for (int k = 0; k < h.directions; k++) {
         double az = ts_horizon_azimuth(&h, k);
         ts_backend_report rep = {0};
+        if (report(o, (double)k / h.directions, msg, n) != 0) {
+            free(plane);
+            return -1;
+        }
         /* the sweep on the backend; the accumulation is C only */
         if (NOTE(bs, ts_backend_horizon_sweep(BK(o), g, az, &h, plane, &rep, &err), rep) !=
                 TS_OK ||
@@ -254,6 +272,7 @@ static int sun_horizon(const ts_grid *g, const tsd_options *o, ts_horizon_opts *
     horizon_opts(o, h);
     h->directions = 1;
     h->start_azimuth = o->sun_azimuth;
+    h->progress = NULL; /* one sweep */
     if (NOTE(bs, ts_backend_horizon_sweep(BK(o), g, o->sun_azimuth, h, plane, &rep, &err),
              rep) != TS_OK)
         return core_fail(msg, n, &err);
@@ -370,25 +389,34 @@ static int daily(const ts_grid *g, const tsd_options *o, const tsd_sun *sun, flo
                  tsd_product_name(o->product));
         return -1;
     }
+    ts_day_opts day = sun->day; /* the core reports the day's steps */
+    day.horizon.progress = o->progress;
+    day.horizon.progress_user = o->progress_user;
     switch (o->product) {
     case TSD_PRODUCT_SUNHOURS:
-        st = ts_sun_hours(g, &sun->sites, &sun->day, sun->day_start, sun->day_length,
+        st = ts_sun_hours(g, &sun->sites, &day, sun->day_start, sun->day_length,
                           o->step_minutes * 60.0, out, &err);
         break;
     case TSD_PRODUCT_INSOLATION:
-        st = ts_insolation(g, &sun->sites, &sun->day, sun->day_start, sun->day_length,
+        st = ts_insolation(g, &sun->sites, &day, sun->day_start, sun->day_length,
                            o->step_minutes * 60.0, out, out + cells, out + 2 * cells, &err);
         break;
     case TSD_PRODUCT_DAYCYCLE:
-        for (int k = 0; k < sun->steps && st == TS_OK; k++)
+        for (int k = 0; k < sun->steps && st == TS_OK; k++) {
+            if (report(o, (double)k / sun->steps, msg, n) != 0)
+                return -1;
             st = ts_sun_visibility(g, &sun->sites, &sun->day, sun->times[k],
                                    out + (size_t)k * cells, NULL, NULL, NULL, &err);
+        }
         break;
     case TSD_PRODUCT_FARSHADOW:
-        for (int k = 0; k < sun->steps && st == TS_OK; k++)
+        for (int k = 0; k < sun->steps && st == TS_OK; k++) {
+            if (report(o, (double)k / sun->steps, msg, n) != 0)
+                return -1;
             st = ts_far_shadow(g, sun->samples[k].grid_azimuth, sun->samples[k].elevation,
                                sun->threshold_m, &sun->day.horizon,
                                bytes + (size_t)k * cells, &err);
+        }
         break;
     default:
         break;

@@ -73,9 +73,9 @@ START_TEST(test_defaults_and_names)
     o.directions = 4;
     o.start_azimuth = 350;
     ck_assert(fabs(ts_horizon_azimuth(&o, 1) - 80.0) < 1e-9);
-    ts_status codes[] = {TS_OK, TS_ERR_ARG, TS_ERR_NOMEM, TS_ERR_THREAD, TS_ERR_INTERNAL,
-                         (ts_status)99};
-    for (int i = 0; i < 6; i++)
+    ts_status codes[] = {TS_OK,           TS_ERR_ARG,       TS_ERR_NOMEM, TS_ERR_THREAD,
+                         TS_ERR_INTERNAL, TS_ERR_CANCELLED, (ts_status)99};
+    for (int i = 0; i < 7; i++)
         ck_assert(ts_status_name(codes[i]) != NULL && ts_status_name(codes[i])[0]);
     ck_assert(ts_cpu_count() >= 1);
 }
@@ -147,14 +147,14 @@ START_TEST(test_horizon_args)
     EXPECT_ARG(ts_horizon_sweep_lines(NULL, 0, &o, noop_visit, NULL, err));
 
     const struct { const char *field; ts_horizon_opts o; } bad[] = {
-        {"direction", {0, 0, 0, 1, 0.13, 0}},
-        {"direction", {-5, 0, 0, 1, 0.13, 0}},
-        {"refraction", {16, 0, 0, 1, -0.01, 0}},
-        {"refraction", {16, 0, 0, 1, 1.01, 0}},
-        {"refraction", {16, 0, 0, 1, NAN, 0}},
-        {"azimuth", {16, NAN, 0, 1, 0.13, 0}},
-        {"distance", {16, 0, -1, 1, 0.13, 0}},
-        {"distance", {16, 0, NAN, 1, 0.13, 0}},
+        {"direction", {0, 0, 0, 1, 0.13, 0, NULL, NULL}},
+        {"direction", {-5, 0, 0, 1, 0.13, 0, NULL, NULL}},
+        {"refraction", {16, 0, 0, 1, -0.01, 0, NULL, NULL}},
+        {"refraction", {16, 0, 0, 1, 1.01, 0, NULL, NULL}},
+        {"refraction", {16, 0, 0, 1, NAN, 0, NULL, NULL}},
+        {"azimuth", {16, NAN, 0, 1, 0.13, 0, NULL, NULL}},
+        {"distance", {16, 0, -1, 1, 0.13, 0, NULL, NULL}},
+        {"distance", {16, 0, NAN, 1, 0.13, 0, NULL, NULL}},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         const ts_horizon_opts *b = &bad[i].o;
@@ -272,6 +272,43 @@ START_TEST(test_no_writes_outside)
 }
 END_TEST
 
+/* Progress: reported from 0 to 1, never backwards, once per azimuth and
+ * at the end; a non-zero answer stops the computation. */
+typedef struct {
+    int calls, stop_at;
+    double last, first;
+} progress_log;
+
+static int log_progress(double done, void *user)
+{
+    progress_log *l = user;
+    if (l->calls == 0)
+        l->first = done;
+    ck_assert_msg(done >= l->last && done <= 1.0, "progress %g after %g", done, l->last);
+    l->last = done;
+    return ++l->calls == l->stop_at;
+}
+
+START_TEST(test_progress_and_cancel)
+{
+    ts_horizon_opts o = dflt();
+    o.directions = 8;
+    progress_log l = {0, -1, 0, -1};
+    o.progress = log_progress;
+    o.progress_user = &l;
+    ts_error e;
+    ck_assert(ts_horizon_compute(&G, &o, hor, &e) == TS_OK);
+    ck_assert_int_eq(l.calls, 9);
+    ck_assert(l.first == 0.0 && l.last == 1.0);
+    /* stop at the third report: cancelled, with a message */
+    l = (progress_log){0, 3, 0, -1};
+    ck_assert(ts_horizon_compute(&G, &o, hor, &e) == TS_ERR_CANCELLED);
+    ck_assert_int_eq(l.calls, 3);
+    ck_assert(e.code == TS_ERR_CANCELLED && strstr(e.message, "cancelled"));
+    printf("cancelled after 3 reports: %s (%s)\n", e.message, ts_status_name(e.code));
+}
+END_TEST
+
 int main(void)
 {
     setvbuf(stdout, NULL, _IOLBF, 0); /* lines reach the log before a failure exits */
@@ -285,6 +322,7 @@ int main(void)
     tcase_add_test(tc, test_shm_args);
     tcase_add_test(tc, test_shading_args);
     tcase_add_test(tc, test_no_writes_outside);
+    tcase_add_test(tc, test_progress_and_cancel);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

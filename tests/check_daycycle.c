@@ -243,6 +243,46 @@ START_TEST(test_flat_plane_day_length)
 }
 END_TEST
 
+/* The day products report their steps and stop when asked. */
+static int count_progress(double done, void *user)
+{
+    int *n = user;
+    ck_assert(done >= 0.0 && done <= 1.0);
+    return ++*n == 50; /* stop at the 50th report */
+}
+
+START_TEST(test_day_progress_and_cancel)
+{
+    ts_error err;
+    site p;
+    site_init(&p, 46.5, 7.9);
+    ts_day_opts o;
+    ts_day_opts_default(&o);
+    o.horizon.directions = 4;
+    int calls = 0;
+    o.horizon.progress = count_progress;
+    o.horizon.progress_user = &calls;
+    ts_grid g;
+    flat(&g, 8, 30.0, 0.0f);
+    float out[64];
+    double start = ts_local_midnight(2026, 6, 21, 120);
+    /* 60-minute steps: 24 steps + the end, under the 50 that cancel */
+    ck_assert(ts_sun_hours(&g, &p.s, &o, start, 86400, 3600, out, &err) == TS_OK);
+    ck_assert_int_eq(calls, 25);
+    calls = 0;
+    ck_assert(ts_insolation(&g, &p.s, &o, start, 86400, 3600, out, NULL, NULL, &err) ==
+              TS_OK);
+    ck_assert_int_eq(calls, 4 + 24 + 1);
+    calls = 0;
+    ck_assert(ts_sun_hours(&g, &p.s, &o, start, 86400, 300, out, &err) == TS_ERR_CANCELLED);
+    ck_assert_int_eq(calls, 50);
+    calls = 0;
+    ck_assert(ts_insolation(&g, &p.s, &o, start, 86400, 300, out, NULL, NULL, &err) ==
+              TS_ERR_CANCELLED);
+    ts_grid_free(&g);
+}
+END_TEST
+
 START_TEST(test_polar_night_and_day)
 {
     ts_error err;
@@ -629,6 +669,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_parse_date_and_offset);
     tcase_add_test(tc, test_local_day);
     tcase_add_test(tc, test_flat_plane_day_length);
+    tcase_add_test(tc, test_day_progress_and_cancel);
     tcase_add_test(tc, test_polar_night_and_day);
     tcase_add_test(tc, test_bad_sites);
     tcase_add_test(tc, test_shadows_cut_sun_hours);

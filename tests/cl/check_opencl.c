@@ -635,6 +635,19 @@ START_TEST(test_dispatch)
 }
 END_TEST
 
+static int last_progress(double done, void *user)
+{
+    *(double *)user = done;
+    return 0;
+}
+
+static int cancel_progress(double done, void *user)
+{
+    (void)done;
+    (void)user;
+    return 1;
+}
+
 /* Every product through the dispatcher, forced onto OpenCL. */
 START_TEST(test_dispatch_products)
 {
@@ -679,6 +692,20 @@ START_TEST(test_dispatch_products)
         ts_backend_shm_compute(TS_BACKEND_OPENCL, &sc.g, 77, 91, 1, 0, a, NULL, &r, &e),
         TS_ERR_ARG);
     ck_assert_ptr_nonnull(strstr(e.message, "got 91"));
+    /* progress on OpenCL ends at 1; a cancel is final, not a reason to
+     * fall back to C */
+    double last = -1;
+    ts_horizon_opts po = sc.o;
+    po.progress = last_progress;
+    po.progress_user = &last;
+    ck_assert_int_eq(ts_backend_horizon_compute(TS_BACKEND_OPENCL, &sc.g, &po, a, &r, &e),
+                     TS_OK);
+    ck_assert(last == 1.0 && r.used == TS_BACKEND_OPENCL);
+    po.progress = cancel_progress;
+    ck_assert_int_eq(ts_backend_horizon_compute(TS_BACKEND_OPENCL, &sc.g, &po, a, &r, &e),
+                     TS_ERR_CANCELLED);
+    ck_assert(!r.fell_back);
+    ck_assert_ptr_nonnull(strstr(e.message, "cancelled"));
     free(a), free(b), free(c);
     scene_free(&sc, s);
 }

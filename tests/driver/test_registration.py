@@ -66,7 +66,8 @@ class Registration(unittest.TestCase):
                           "sunhours", "insolation", "daycycle", "farshadow"])
         for name in ("DATETIME", "DATE", "TIMEZONE", "STEP_MINUTES", "PRESSURE",
                      "TEMPERATURE", "DELTA_T", "SUN_POSITION", "LINKE_TURBIDITY",
-                     "FAR_THRESHOLD", "ATLAS_STEPS", "SUNHOURS_RULE", "SHADOWS", "DEM"):
+                     "FAR_THRESHOLD", "ATLAS_STEPS", "SUNHOURS_RULE", "PROGRESS", "SHADOWS",
+                     "DEM"):
             self.assertTrue(opts[name].get("description"), name)
 
     def test_driver_metadata(self):
