@@ -56,5 +56,22 @@ run gdal_translate -q -of PNG -ot Byte -scale 0.88 1 0 255 -a_nodata none \
 run gdal_translate -q -of PNG -ot Byte -b 4 -scale -5 25 0 255 -a_nodata none \
     "TERRASHADE:PRODUCT=horizon,DIRECTIONS=8:$DEM" "$OUT/horizon_135.png"
 
+# 6. hours of sun on the winter solstice (local day at -05:00, 10-minute
+#    steps), coloured: dark blue 0 h, through green, to yellow at 9.7 h (the
+#    day length on open ground)
+run gdal_translate -q -oo PRODUCT=sunhours -oo DATE=2026-12-21 -oo TIMEZONE=-05:00 \
+    -oo STEP_MINUTES=10 "TERRASHADE:$DEM" "$OUT/sunhours_winter.tif"
+cat > "$OUT/sunhours.ramp" <<'RAMP'
+0    20  20  80
+3    40  80 160
+6    60 160 120
+8.5 200 210  60
+9.7 255 240 120
+nv    0   0   0
+RAMP
+run gdaldem color-relief -q -of PNG "$OUT/sunhours_winter.tif" "$OUT/sunhours.ramp" \
+    "$OUT/sunhours_winter.png"
+rm -f "$OUT/sunhours_winter.tif" "$OUT/sunhours.ramp"
+
 echo "wrote:"
 ls -l "$OUT"/*.png
