@@ -180,15 +180,9 @@ static ts_status far_sweep(const ts_grid *grid, double azimuth, double threshold
     if (o.max_distance != 0)
         return ts_fail(err, TS_ERR_ARG, "far-field horizons take no maximum distance "
                        "(got %g m)", o.max_distance);
-    if (!isfinite(azimuth))
-        return ts_fail(err, TS_ERR_ARG, "azimuth must be a finite number of degrees, "
-                       "got %g", azimuth);
     if (!(threshold_m > 0) || !isfinite(threshold_m))
         return ts_fail(err, TS_ERR_ARG, "the far-shadow threshold must be a positive "
                        "distance in metres, got %g", threshold_m);
-    azimuth = fmod(azimuth, 360.0);
-    if (azimuth < 0)
-        azimuth += 360.0;
     ts_line_geom geom;
     if ((st = ts_line_geom_init(&geom, grid, azimuth, err)) != TS_OK)
         return st;

@@ -347,12 +347,6 @@ static ts_status sweep_setup(const ts_grid *grid, double azimuth,
     o.directions = o.directions < 1 ? 1 : o.directions;
     if ((st = ts_horizon_opts_validate(&o, err)) != TS_OK)
         return st;
-    if (!isfinite(azimuth))
-        return ts_fail(err, TS_ERR_ARG, "azimuth must be a finite number of degrees, got %g",
-                       azimuth);
-    azimuth = fmod(azimuth, 360.0);
-    if (azimuth < 0)
-        azimuth += 360.0;
     if ((st = ts_line_geom_init(geom, grid, azimuth, err)) != TS_OK)
         return st;
     *C = (sweep_ctx){0};

@@ -12,11 +12,17 @@ ts_status ts_line_geom_init(ts_line_geom *g, const ts_grid *grid, double azimuth
                             ts_error *err)
 {
     memset(g, 0, sizeof *g);
+    if (!isfinite(azimuth))
+        return ts_fail(err, TS_ERR_ARG, "azimuth must be a finite number of degrees, got %g",
+                       azimuth);
+    azimuth = fmod(azimuth, 360.0);
+    if (azimuth < 0)
+        azimuth += 360.0;
     int W = grid->width, H = grid->height;
     /* Direction toward the azimuth in cells (x east, y south); the line
      * direction is taken at the central row for geographic grids. */
     double cx = ts_grid_cell_x(grid, H / 2), cy = grid->cell_y;
-    double a = fmod(azimuth, 360.0) * DEG2RAD;
+    double a = azimuth * DEG2RAD;
     double s = sin(a), c = cos(a);
     /* Snap tiny components so that 0, 90, 180, 270 give exact axis lines. */
     if (fabs(s) < 1e-12) s = 0;

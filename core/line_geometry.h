@@ -33,7 +33,8 @@ typedef struct {
     double *step_row;       /* metres per step by grid row, or NULL */
 } ts_line_geom;
 
-/* Set up the lines for the horizon toward `azimuth` (degrees). */
+/* Set up the lines for the horizon toward `azimuth` (degrees, any finite
+ * value; taken modulo 360). TS_ERR_ARG for a non-finite azimuth. */
 ts_status ts_line_geom_init(ts_line_geom *g, const ts_grid *grid, double azimuth,
                             ts_error *err);
 void ts_line_geom_free(ts_line_geom *g);
