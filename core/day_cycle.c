@@ -719,14 +719,15 @@ ts_status ts_insolation(const ts_grid *grid, const ts_sun_sites *sites,
     }
     if ((st = ts_normals(grid, nx, ny, nz, err)) != TS_OK)
         goto done;
-    /* Sky term: stream the horizon planes through the accumulator. */
+    /* Sky term: stream the horizon planes through the accumulator. Progress
+     * counts its sweeps and then the time steps. */
+    const int sweeps = o->horizon.directions < 1 ? 1 : o->horizon.directions;
     {
         ts_horizon_opts h = o->horizon;
-        if (h.directions < 1)
-            h.directions = 1;
+        h.directions = sweeps;
         for (int k = 0; k < h.directions; k++) {
             double a = ts_horizon_azimuth(&h, k);
-            if ((st = ts_progress(&o->horizon, (double)k / (h.directions + n), err)) !=
+            if ((st = ts_progress(&o->horizon, (double)k / (sweeps + n), err)) !=
                     TS_OK ||
                 (st = ts_horizon_sweep(grid, a, &h, c.pa, err)) != TS_OK ||
                 (st = ts_sky_accumulate(grid, nx, ny, nz, c.pa, a, h.directions, NULL,
@@ -742,7 +743,6 @@ ts_status ts_insolation(const ts_grid *grid, const ts_sun_sites *sites,
             pc[(size_t)y * c.W + x] = isnan(h) ? NAN : (float)exp(-h / 8434.5);
         }
     const double tl = o->linke_turbidity;
-    const int sweeps = o->horizon.directions < 1 ? 1 : o->horizon.directions;
     for (int k = 0; k < n; k++) {
         int dark;
         ts_sun_sample ref;
