@@ -21,6 +21,7 @@
 #include "cl_internal.h"
 #include "line_geometry.h"
 #include "near_field.h"
+#include "arg_checks.h"
 #include "status_internal.h"
 #include "ts_cl_params.h"
 
@@ -309,17 +310,9 @@ ts_status ts_cl_horizon_sweep(const ts_grid *grid, double azimuth, const ts_hori
 ts_status ts_cl_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts, float *out,
                                 ts_error *err)
 {
-    ts_status st = ts_grid_validate(grid, err);
+    ts_status st = ts_check_horizon_compute_args(grid, opts, out, err);
     if (st != TS_OK)
         return st;
-    if ((st = ts_horizon_opts_validate(opts, err)) != TS_OK)
-        return st;
-    if (!out)
-        return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
-    size_t plane = (size_t)grid->width * (size_t)grid->height;
-    if (plane > SIZE_MAX / sizeof(float) / (size_t)opts->directions)
-        return ts_fail(err, TS_ERR_NOMEM, "%d horizon planes of %d x %d cells are too large",
-                       opts->directions, grid->width, grid->height);
     double *az = malloc((size_t)opts->directions * sizeof *az);
     if (!az)
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the azimuth list");

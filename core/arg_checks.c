@@ -1,5 +1,6 @@
 /* Argument checks shared by the C and OpenCL backends (arg_checks.h). */
 #include <math.h>
+#include <stdint.h>
 
 #include "arg_checks.h"
 #include "status_internal.h"
@@ -67,4 +68,21 @@ ts_status ts_direct_setup(const ts_grid *grid, const float *nx, const float *ny,
     if (n == 1)
         *w = 0;
     return TS_OK;
+}
+
+ts_status ts_check_horizon_compute_args(const ts_grid *grid, const ts_horizon_opts *opts,
+                                        const float *out, ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if ((st = ts_horizon_opts_validate(opts, err)) != TS_OK)
+        return st;
+    if (!out)
+        return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
+    size_t plane = (size_t)grid->width * (size_t)grid->height;
+    if (plane > SIZE_MAX / sizeof(float) / (size_t)opts->directions)
+        return ts_fail(err, TS_ERR_NOMEM, "%d horizon planes of %d x %d cells are too large",
+                       opts->directions, grid->width, grid->height);
+    return ts_ok(err);
 }

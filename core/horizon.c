@@ -2,6 +2,7 @@
 #include <math.h>
 #include <stdint.h>
 
+#include "arg_checks.h"
 #include "status_internal.h"
 
 void ts_horizon_opts_default(ts_horizon_opts *opts)
@@ -50,17 +51,10 @@ double ts_horizon_azimuth(const ts_horizon_opts *opts, int k)
 ts_status ts_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts, float *out,
                              ts_error *err)
 {
-    ts_status st = ts_grid_validate(grid, err);
+    ts_status st = ts_check_horizon_compute_args(grid, opts, out, err);
     if (st != TS_OK)
         return st;
-    if ((st = ts_horizon_opts_validate(opts, err)) != TS_OK)
-        return st;
-    if (!out)
-        return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
     size_t plane = (size_t)grid->width * (size_t)grid->height;
-    if (plane > SIZE_MAX / sizeof(float) / (size_t)opts->directions)
-        return ts_fail(err, TS_ERR_NOMEM, "%d horizon planes of %d x %d cells are too large",
-                       opts->directions, grid->width, grid->height);
     for (int k = 0; k < opts->directions; k++) {
         if ((st = ts_progress(opts, (double)k / opts->directions, err)) != TS_OK)
             return st;
