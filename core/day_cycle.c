@@ -575,6 +575,30 @@ static ts_status day_steps(double start, double length, double step, double **mi
     return ts_day_uniform_times(start, length, step, *mid, *dur, err);
 }
 
+/* The time steps of a day and the visibility context over them: what
+ * ts_sun_hours and ts_insolation both start with. Nothing to free on
+ * failure; day_end frees what it made. */
+static ts_status day_begin(const ts_grid *grid, const ts_sun_sites *sites,
+                           const ts_day_opts *o, double start, double length, double step,
+                           double **mid, double **dur, int *n, vis_ctx *c, ts_error *err)
+{
+    ts_status st = day_steps(start, length, step, mid, dur, n, err);
+    if (st == TS_OK)
+        st = vis_init(c, grid, sites, o, err);
+    if (st != TS_OK) {
+        free(*mid);
+        free(*dur);
+    }
+    return st;
+}
+
+static void day_end(double *mid, double *dur, vis_ctx *c)
+{
+    free(mid);
+    free(dur);
+    vis_free(c);
+}
+
 ts_status ts_sun_hours(const ts_grid *grid, const ts_sun_sites *sites,
                        const ts_day_opts *o, double start_unix, double length_s,
                        double step_s, float *hours, ts_error *err)
@@ -583,15 +607,11 @@ ts_status ts_sun_hours(const ts_grid *grid, const ts_sun_sites *sites,
         return ts_fail(err, TS_ERR_ARG, "ts_sun_hours: the output is NULL");
     double *mid, *dur;
     int n;
-    ts_status st = day_steps(start_unix, length_s, step_s, &mid, &dur, &n, err);
+    vis_ctx c;
+    ts_status st = day_begin(grid, sites, o, start_unix, length_s, step_s, &mid, &dur, &n,
+                             &c, err);
     if (st != TS_OK)
         return st;
-    vis_ctx c;
-    if ((st = vis_init(&c, grid, sites, o, err)) != TS_OK) {
-        free(mid);
-        free(dur);
-        return st;
-    }
     float *vis = malloc(c.cells * sizeof(float));
     double *acc = calloc(c.cells, sizeof(double));
     if (!vis || !acc) {
@@ -624,9 +644,7 @@ ts_status ts_sun_hours(const ts_grid *grid, const ts_sun_sites *sites,
 done:
     free(vis);
     free(acc);
-    free(mid);
-    free(dur);
-    vis_free(&c);
+    day_end(mid, dur, &c);
     return st;
 }
 
@@ -692,15 +710,11 @@ ts_status ts_insolation(const ts_grid *grid, const ts_sun_sites *sites,
         return ts_fail(err, TS_ERR_ARG, "ts_insolation: the output is NULL");
     double *mid, *dur;
     int n;
-    ts_status st = day_steps(start_unix, length_s, step_s, &mid, &dur, &n, err);
+    vis_ctx c;
+    ts_status st = day_begin(grid, sites, o, start_unix, length_s, step_s, &mid, &dur, &n,
+                             &c, err);
     if (st != TS_OK)
         return st;
-    vis_ctx c;
-    if ((st = vis_init(&c, grid, sites, o, err)) != TS_OK) {
-        free(mid);
-        free(dur);
-        return st;
-    }
     size_t cells = c.cells;
     float *nx = malloc(cells * sizeof(float)), *ny = malloc(cells * sizeof(float));
     float *nz = malloc(cells * sizeof(float)), *sky = calloc(cells, sizeof(float));
@@ -812,8 +826,6 @@ done:
     free(cel);
     free(accb);
     free(accd);
-    free(mid);
-    free(dur);
-    vis_free(&c);
+    day_end(mid, dur, &c);
     return st;
 }
