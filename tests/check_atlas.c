@@ -11,6 +11,7 @@
 
 #include "day_cycle.h"
 #include "shadow_atlas.h"
+#include "test_run.h"
 
 #ifndef TS_TEST_DATA
 #define TS_TEST_DATA "tests/data"
@@ -471,9 +472,5 @@ static Suite *suite(void)
 int main(void)
 {
     setvbuf(stdout, NULL, _IOLBF, 0);
-    SRunner *sr = srunner_create(suite());
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return test_run_suite(suite());
 }

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "day_cycle.h"
+#include "test_run.h"
 
 #define CK_NEAR(got, want, tol, what)                                                 \
     ck_assert_msg(fabs((double)(got) - (double)(want)) <= (tol),                      \
@@ -687,9 +688,5 @@ static Suite *suite(void)
 int main(void)
 {
     setvbuf(stdout, NULL, _IOLBF, 0);
-    SRunner *sr = srunner_create(suite());
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return test_run_suite(suite());
 }
