@@ -1,0 +1,131 @@
+#!/usr/bin/python3
+"""Checksums of every product through the driver, for refactors that must
+not change behaviour (not part of make check).
+
+For each DEM (jacksboro, lux_elev, a 512x512 fractal made here with a fixed
+seed), each backend (c, opencl) and each product variant below, the driver's
+output is read through GDAL and its bytes hashed (SHA-256, first 16 hex).
+
+    /usr/bin/python3 tests/product_checksums.py > after.txt   # from the build dir
+    diff before.txt after.txt
+    /usr/bin/python3 tests/product_checksums.py --save DIR     # also keep the arrays
+    /usr/bin/python3 tests/product_checksums.py --compare DIR  # max |difference|
+                                                               # against kept arrays
+
+Run it from the top build directory (it uses plugin/.libs in place).
+"""
+import argparse
+import hashlib
+import os
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "driver"))
+import tsdriver as T  # noqa: E402  (sets GDAL_DRIVER_PATH)
+from tsdriver import gdal, np  # noqa: E402
+
+DAY = {"DATE": "2026-06-21", "TIMEZONE": "+00:00", "STEP_MINUTES": "30"}
+
+# name -> open options (PROGRESS=no everywhere)
+VARIANTS = {
+    "shade": {},
+    "shade_f32": {"OUTPUT_TYPE": "Float32"},
+    "shade_sky": {"SKY_WEIGHT": "0.4", "DIRECTIONS": "8"},
+    "shade_lowsun": {"SUN_AZIMUTH": "135", "SUN_ELEVATION": "8", "OUTPUT_TYPE": "Float32"},
+    "shade_shm": {"METHOD": "shm", "SUN_ELEVATION": "12", "PENUMBRA_DEPTH": "20",
+                  "OUTPUT_TYPE": "Float32"},
+    "shade_datetime": {"DATETIME": "2026-12-21T09:00:00+00:00", "OUTPUT_TYPE": "Float32"},
+    "shade_percell": {"DATETIME": "2026-12-21T09:00:00+00:00", "SUN_POSITION": "per_cell",
+                      "OUTPUT_TYPE": "Float32"},
+    "shadow": {"SUN_AZIMUTH": "135", "SUN_ELEVATION": "10"},
+    "shadow_byte": {"SUN_AZIMUTH": "135", "SUN_ELEVATION": "10", "OUTPUT_TYPE": "Byte"},
+    "shadow_shm": {"METHOD": "shm", "SUN_ELEVATION": "10"},
+    "shadow_maxdist": {"SUN_ELEVATION": "5", "MAX_DISTANCE": "2000", "CURVATURE": "NO"},
+    "horizon": {"DIRECTIONS": "8", "START_AZIMUTH": "10"},
+    "svf": {"DIRECTIONS": "16"},
+    "svf_byte": {"DIRECTIONS": "16", "OUTPUT_TYPE": "Byte"},
+    "openness": {"DIRECTIONS": "16"},
+    "sky": {"DIRECTIONS": "16", "Z_FACTOR": "2"},
+    "sunhours": dict(DAY),
+    "sunhours_fraction": dict(DAY, SUNHOURS_RULE="fraction"),
+    "insolation": dict(DAY, LINKE_TURBIDITY="4"),
+    "daycycle": dict(DAY, STEP_MINUTES="120"),
+    "farshadow": dict(DAY, ATLAS_STEPS="6", FAR_THRESHOLD="32"),
+}
+
+
+def fractal_dem(path, n=512, seed=7):
+    """Spectral-synthesis fractal (beta 2.2), 30 m cells, UTM 33N."""
+    rng = np.random.default_rng(seed)
+    fx = np.fft.fftfreq(n)[:, None]
+    fy = np.fft.fftfreq(n)[None, :]
+    f = np.sqrt(fx * fx + fy * fy)
+    f[0, 0] = 1.0
+    spec = (rng.normal(size=(n, n)) + 1j * rng.normal(size=(n, n))) / f ** 1.1
+    spec[0, 0] = 0
+    z = np.real(np.fft.ifft2(spec))
+    z = (z - z.min()) / (z.max() - z.min()) * 1500.0 + 200.0
+    drv = gdal.GetDriverByName("GTiff")
+    ds = drv.Create(path, n, n, 1, gdal.GDT_Float32)
+    ds.SetGeoTransform((500000.0, 30.0, 0.0, 5200000.0, 0.0, -30.0))
+    ds.SetProjection(_utm33())
+    ds.GetRasterBand(1).WriteArray(z.astype(np.float32))
+    ds = None
+
+
+def _utm33():
+    from osgeo import osr
+    s = osr.SpatialReference()
+    s.ImportFromEPSG(32633)
+    return s.ExportToWkt()
+
+
+def read_all(ds):
+    bands = [ds.GetRasterBand(i + 1) for i in range(ds.RasterCount)]
+    return np.stack([b.ReadAsArray() for b in bands])
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--save", metavar="DIR", help="also save every array as .npy")
+    ap.add_argument("--compare", metavar="DIR", help="max |diff| against saved arrays")
+    ap.add_argument("--only", help="comma-separated variant names")
+    ap.add_argument("--backends", default="c,opencl")
+    args = ap.parse_args()
+    tmp = tempfile.mkdtemp(prefix="ts_cksum_")
+    fractal = os.path.join(tmp, "fractal.tif")
+    fractal_dem(fractal)
+    dems = {"jacksboro": T.JACKSBORO, "lux": T.LUX, "fractal": fractal}
+    names = args.only.split(",") if args.only else list(VARIANTS)
+    if args.save:
+        os.makedirs(args.save, exist_ok=True)
+    worst = 0.0
+    for dem_name, dem in dems.items():
+        for backend in args.backends.split(","):
+            for name in names:
+                oo = dict(VARIANTS[name], PRODUCT=name.split("_")[0], BACKEND=backend,
+                          PROGRESS="no")
+                ds = gdal.OpenEx("TERRASHADE:" + dem,
+                                 open_options=["%s=%s" % kv for kv in oo.items()])
+                a = read_all(ds)
+                ds = None
+                key = "%s.%s.%s" % (dem_name, backend, name)
+                h = hashlib.sha256(a.tobytes()).hexdigest()[:16]
+                line = "%-34s %s %s %s" % (key, a.dtype, "x".join(map(str, a.shape)), h)
+                if args.save:
+                    np.save(os.path.join(args.save, key + ".npy"), a)
+                if args.compare:
+                    ref = np.load(os.path.join(args.compare, key + ".npy"))
+                    d = np.abs(a.astype(np.float64) - ref.astype(np.float64))
+                    same_nan = np.array_equal(np.isnan(d), np.isnan(
+                        ref.astype(np.float64)) | np.isnan(a.astype(np.float64)))
+                    m = float(np.nanmax(d)) if np.isfinite(d).any() else 0.0
+                    worst = max(worst, m)
+                    line += "  max|diff| %.3g%s" % (m, "" if same_nan else "  NODATA DIFFERS")
+                print(line, flush=True)
+    if args.compare:
+        print("worst max|diff| %.3g" % worst)
+
+
+if __name__ == "__main__":
+    main()
