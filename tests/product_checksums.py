@@ -7,7 +7,7 @@ seed), each backend (c, opencl) and each product variant below, the driver's
 output is read through GDAL and its bytes hashed (SHA-256, first 16 hex).
 
     /usr/bin/python3 tests/product_checksums.py > after.txt   # from the build dir
-    diff before.txt after.txt
+    diff tests/product_checksums.txt after.txt   # the record, kept up to date
     /usr/bin/python3 tests/product_checksums.py --save DIR     # also keep the arrays
     /usr/bin/python3 tests/product_checksums.py --compare DIR  # max |difference|
                                                                # against kept arrays
