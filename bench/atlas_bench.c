@@ -7,7 +7,7 @@
  *               [--only jacksboro|fractal] [--out FILE]
  *
  * For jacksboro (tests/data/jacksboro.f32 + .hdr, written by
- * tests/data/make_raw.py) and an N x N fractal DEM (bench/fractal_dem.h:
+ * tests/data/make_raw.py) and an N x N fractal DEM (tests/test_dem.h:
  * fBm, Hurst 0.8, 1500 m relief, M metre cells, default 4096 and 30 m),
  * it builds the far-shadow maps of S sun positions (default 158, as in
  * the paper) between sunrise and sunset, denser near dawn and dusk, with
@@ -26,8 +26,8 @@
 #include <time.h>
 
 #include "day_cycle.h"
-#include "fractal_dem.h"
 #include "shadow_atlas.h"
+#include "test_dem.h"
 
 #ifndef TS_TEST_DATA
 #define TS_TEST_DATA "tests/data"
@@ -292,7 +292,7 @@ int main(int argc, char **argv)
         ts_grid g;
         if (ts_grid_create(&g, size, size, cell, cell, &err))
             die("grid", &err);
-        ts_fractal_fill(&g, 1, 0.8, 1500.0);
+        tdem_fbm(&g, 1, 0.8, 1500.0);
         for (int di = 0; di < ndates; di++)
             one_day("fractal", &g, lon, lat, dates[di], (int)lround(lon / 15.0) * 60, &p);
         ts_grid_free(&g);

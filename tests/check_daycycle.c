@@ -9,22 +9,13 @@
 #include <string.h>
 
 #include "day_cycle.h"
+#include "test_expect.h"
 #include "test_run.h"
 
 #define CK_NEAR(got, want, tol, what)                                                 \
     ck_assert_msg(fabs((double)(got) - (double)(want)) <= (tol),                      \
                   "%s: got %.6f, want %.6f +/- %g", what, (double)(got), (double)(want), \
                   (double)(tol))
-
-#define EXPECT_ARG(call, errp)                                                        \
-    do {                                                                              \
-        memset((errp), 0, sizeof *(errp));                                            \
-        ts_status st_ = (call);                                                       \
-        ck_assert_msg(st_ == TS_ERR_ARG, "%s returned %d, want TS_ERR_ARG", #call,    \
-                      (int)st_);                                                      \
-        ck_assert_msg((errp)->message[0] != '\0', "%s: no message", #call);           \
-        printf("%-58.58s -> %s\n", #call, (errp)->message);                           \
-    } while (0)
 
 /* One site. */
 typedef struct {
