@@ -29,10 +29,6 @@
 #include "shadow_atlas.h"
 #include "test_dem.h"
 
-#ifndef TS_TEST_DATA
-#define TS_TEST_DATA "tests/data"
-#endif
-
 static double now(void)
 {
     struct timespec ts;
@@ -44,59 +40,6 @@ static void die(const char *what, const ts_error *e)
 {
     fprintf(stderr, "atlas_bench: %s%s%s\n", what, e ? ": " : "", e ? e->message : "");
     exit(1);
-}
-
-static int load_raw(const char *name, ts_grid *g, double *lon, double *lat)
-{
-    char path[512];
-    ts_error err;
-    snprintf(path, sizeof path, "%s/%s.hdr", TS_TEST_DATA, name);
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return -1;
-    int w = 0, h = 0;
-    double cy = 0, lon0 = 0, lat0 = 0, dlon = 0, dlat = 0, *rows = NULL;
-    char key[64];
-    while (fscanf(f, "%63s", key) == 1) {
-        if (key[0] == '#') {
-            int c;
-            while ((c = fgetc(f)) != '\n' && c != EOF)
-                ;
-            continue;
-        }
-        if (!strcmp(key, "cell_x_row")) {
-            rows = malloc((size_t)h * sizeof *rows);
-            for (int i = 0; rows && i < h; i++)
-                if (fscanf(f, "%lf", &rows[i]) != 1)
-                    die("bad cell_x_row", NULL);
-            continue;
-        }
-        double v;
-        if (fscanf(f, "%lf", &v) != 1)
-            die("bad header", NULL);
-        if (!strcmp(key, "width")) w = (int)v;
-        else if (!strcmp(key, "height")) h = (int)v;
-        else if (!strcmp(key, "cell_y")) cy = v;
-        else if (!strcmp(key, "lon0")) lon0 = v;
-        else if (!strcmp(key, "lat0")) lat0 = v;
-        else if (!strcmp(key, "dlon_deg")) dlon = v;
-        else if (!strcmp(key, "dlat_deg")) dlat = v;
-    }
-    fclose(f);
-    if (w < 1 || h < 1 || !rows)
-        die("incomplete raw header", NULL);
-    if (ts_grid_create(g, w, h, rows[h / 2], cy, &err) ||
-        ts_grid_set_row_spacing(g, rows, &err))
-        die("grid", &err);
-    free(rows);
-    *lon = lon0 + dlon * (w - 1) / 2.0;
-    *lat = lat0 - dlat * (h - 1) / 2.0;
-    snprintf(path, sizeof path, "%s/%s.f32", TS_TEST_DATA, name);
-    f = fopen(path, "rb");
-    if (!f || fread(g->z, sizeof(float), (size_t)w * h, f) != (size_t)w * h)
-        die("cannot read the raw heights", NULL);
-    fclose(f);
-    return 0;
 }
 
 typedef struct {
@@ -271,9 +214,9 @@ int main(int argc, char **argv)
     if (!only || !strcmp(only, "jacksboro")) {
         ts_grid g;
         double jlon, jlat;
-        if (load_raw("jacksboro", &g, &jlon, &jlat) != 0) {
-            fprintf(stderr, "atlas_bench: no %s/jacksboro.hdr: run tests/data/make_raw.py\n",
-                    TS_TEST_DATA);
+        char msg[4200];
+        if (tdem_read(&g, "jacksboro", &jlon, &jlat, msg, sizeof msg) != 0) {
+            fprintf(stderr, "atlas_bench: %s\n", msg);
         } else {
             /* the default threshold (512 cells) exceeds most of this small
              * DEM; smaller ones show what its relief casts */

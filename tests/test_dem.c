@@ -1,7 +1,15 @@
-/* Synthetic test DEMs (see test_dem.h). */
+/* Test DEMs: the generators and the raw-file reader (see test_dem.h). */
 #include "test_dem.h"
 
 #include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef TS_TEST_DATA
+#define TS_TEST_DATA "tests/data"
+#endif
 
 static const double PI = 3.14159265358979323846;
 
@@ -201,4 +209,114 @@ void tdem_sharp(ts_grid *g, uint64_t seed)
             if (tdem_uniform(&seed) < 0.01)           /* spikes */
                 *p += (float)(20.0 + 130.0 * tdem_uniform(&seed));
         }
+}
+
+/* ------------------------------------------------------- the raw DEMs */
+
+typedef struct {
+    int w, h;
+    double cell_y, lon0, lat0, dlon, dlat;
+    double *cell_x_row; /* h values */
+} raw_header;
+
+static int fail(char *msg, size_t n, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, n, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+static FILE *open_data(const char *name, const char *ext, const char *mode, char *msg,
+                       size_t n)
+{
+    const char *dir = getenv("TS_TEST_DATA");
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s.%s", dir && *dir ? dir : TS_TEST_DATA, name, ext);
+    FILE *f = fopen(path, mode);
+    if (!f)
+        fail(msg, n, "cannot open test data %s (tests/data/make_raw.py writes it)", path);
+    return f;
+}
+
+/* "key value" lines, '#' comments, then cell_x_row and its h values. */
+static int read_header(FILE *f, const char *name, raw_header *r, char *msg, size_t n)
+{
+    char line[256], key[64];
+    double v;
+    memset(r, 0, sizeof *r);
+    while (fgets(line, sizeof line, f)) {
+        if (line[0] == '#')
+            continue;
+        if (strncmp(line, "cell_x_row", 10) == 0) {
+            if (r->w <= 0 || r->h <= 0 || !(r->cell_y > 0))
+                return fail(msg, n, "%s.hdr: bad header", name);
+            r->cell_x_row = malloc((size_t)r->h * sizeof *r->cell_x_row);
+            if (!r->cell_x_row)
+                return fail(msg, n, "%s.hdr: out of memory", name);
+            for (int y = 0; y < r->h; y++)
+                if (fscanf(f, "%lf", &r->cell_x_row[y]) != 1)
+                    return fail(msg, n, "%s.hdr: missing cell_x_row[%d]", name, y);
+            return 0;
+        }
+        if (sscanf(line, "%63s %lf", key, &v) != 2)
+            continue;
+        if (strcmp(key, "width") == 0) r->w = (int)v;
+        else if (strcmp(key, "height") == 0) r->h = (int)v;
+        else if (strcmp(key, "cell_y") == 0) r->cell_y = v;
+        else if (strcmp(key, "lon0") == 0) r->lon0 = v;
+        else if (strcmp(key, "lat0") == 0) r->lat0 = v;
+        else if (strcmp(key, "dlon_deg") == 0) r->dlon = v;
+        else if (strcmp(key, "dlat_deg") == 0) r->dlat = v;
+    }
+    return fail(msg, n, "%s.hdr: no cell_x_row", name);
+}
+
+/* Little-endian float32, assembled bytewise so the host order is moot. */
+static int read_heights(FILE *f, const char *name, ts_grid *g, char *msg, size_t n)
+{
+    unsigned char b[4];
+    for (ptrdiff_t i = 0; i < (ptrdiff_t)g->width * g->height; i++) {
+        if (fread(b, 1, 4, f) != 4)
+            return fail(msg, n, "%s.f32 is short", name);
+        uint32_t u = (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 |
+                     (uint32_t)b[3] << 24;
+        memcpy(&g->z[i], &u, 4);
+    }
+    return 0;
+}
+
+int tdem_read(ts_grid *g, const char *name, double *lon, double *lat, char *msg,
+              size_t msg_size)
+{
+    raw_header r;
+    FILE *f = open_data(name, "hdr", "r", msg, msg_size);
+    if (!f)
+        return -1;
+    int bad = read_header(f, name, &r, msg, msg_size);
+    fclose(f);
+    ts_error err;
+    if (!bad && ts_grid_create(g, r.w, r.h, r.cell_x_row[r.h / 2], r.cell_y, &err) != TS_OK) {
+        bad = fail(msg, msg_size, "%s: %s", name, err.message);
+    } else if (!bad && ts_grid_set_row_spacing(g, r.cell_x_row, &err) != TS_OK) {
+        ts_grid_free(g);
+        bad = fail(msg, msg_size, "%s: %s", name, err.message);
+    }
+    free(r.cell_x_row);
+    if (bad)
+        return -1;
+    f = open_data(name, "f32", "rb", msg, msg_size);
+    if (!f || read_heights(f, name, g, msg, msg_size) != 0) {
+        if (f)
+            fclose(f);
+        ts_grid_free(g);
+        return -1;
+    }
+    fclose(f);
+    if (lon)
+        *lon = r.lon0 + r.dlon * (r.w - 1) / 2.0;
+    if (lat)
+        *lat = r.lat0 - r.dlat * (r.h - 1) / 2.0;
+    return 0;
 }

@@ -1,11 +1,13 @@
-/* Synthetic test DEMs: every deterministic terrain generator of the check
- * programs and the benchmarks, in one module. No check framework here, so
- * that bench/ links it too; the grid must be allocated by the caller (the
- * check helpers are in test_grid.h). Each generator writes the width x
- * height cells of g (not the row padding); same arguments, same heights. */
+/* Test DEMs: every deterministic terrain generator of the check programs
+ * and the benchmarks, and the reader of the real DEMs of tests/data, in one
+ * module. No check framework here, so that bench/ links it too (the check
+ * helpers are in test_grid.h). Each generator writes the width x height
+ * cells of a grid the caller allocated (not the row padding); same
+ * arguments, same heights. */
 #ifndef TS_TEST_DEM_H
 #define TS_TEST_DEM_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "terrashade.h"
@@ -47,5 +49,12 @@ void tdem_hills(ts_grid *g, uint64_t seed, int count, double relief);
 /* Sharp features for the hull: a rough base plus single-cell spikes,
  * step edges and white noise. */
 void tdem_sharp(ts_grid *g, uint64_t seed);
+
+/* Read tests/data/NAME.{hdr,f32} (written by tests/data/make_raw.py) into a
+ * new grid with per-row spacing, from $TS_TEST_DATA if set, else the
+ * compile-time TS_TEST_DATA. lon and lat, if not NULL, receive the DEM's
+ * centre in degrees. Returns 0, or -1 with a sentence in msg and no grid. */
+int tdem_read(ts_grid *g, const char *name, double *lon, double *lat, char *msg,
+              size_t msg_size);
 
 #endif

@@ -1,7 +1,7 @@
-/* Grids and buffers for the check programs: allocation that fails the
- * running test instead of returning an error, and the raw real DEMs of
- * tests/data (see tests/data/README.md). The synthetic terrains are in
- * test_dem.h, included here. */
+/* Grids and buffers for the check programs: allocation and the reading of
+ * the real DEMs of tests/data (see tests/data/README.md) that fail the
+ * running test instead of returning an error. The test DEMs themselves are
+ * in test_dem.h, included here. */
 #ifndef TS_TEST_GRID_H
 #define TS_TEST_GRID_H
 
@@ -14,9 +14,7 @@
 void tdem_create(ts_grid *g, int width, int height, double cell_x,
                  double cell_y);
 
-/* Load tests/data/NAME.{hdr,f32} into a new grid with per-row spacing.
- * The data directory is $TS_TEST_DATA if set, else the compile-time
- * TS_TEST_DATA. Aborts the test on failure. */
+/* tdem_read (test_dem.h) that aborts the test on failure. */
 void tdem_load(ts_grid *g, const char *name);
 
 /* Allocate n floats (aborts the test on failure); free with free(). */

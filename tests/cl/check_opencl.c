@@ -29,6 +29,7 @@
 #include "terrashade_backend.h"
 #include "terrashade_cl.h"
 #include "test_grid.h"
+#include "test_run.h"
 
 #define TOL_HORIZON 1e-3 /* degrees */
 #define TOL 1e-4         /* shm, normals, direct, sky */
@@ -1004,9 +1005,5 @@ int main(int argc, char **argv)
         return child_no_platform();
     if (argc > 1 && !strcmp(argv[1], "--child-fp32"))
         return child_fp32();
-    SRunner *sr = srunner_create(opencl_suite());
-    srunner_run_all(sr, CK_VERBOSE);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return test_run_suite_mode(opencl_suite(), CK_VERBOSE);
 }
