@@ -133,9 +133,8 @@ START_TEST(test_far_shadow_bits)
 {
     ts_error err;
     ts_grid g;
-    ck_assert(ts_grid_create(&g, 64, 8, 10.0, 10.0, &err) == TS_OK);
-    for (int i = 0; i < 64 * 8; i++)
-        g.z[i] = 0;
+    tdem_create(&g, 64, 8, 10.0, 10.0);
+    tdem_fill(&g, 0.0f);
     for (int y = 0; y < 8; y++)
         g.z[y * 64 + 60] = 100.0f; /* a wall to the east */
     g.z[3 * 64 + 5] = NAN;
