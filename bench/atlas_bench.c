@@ -7,7 +7,7 @@
  *               [--only jacksboro|fractal] [--out FILE]
  *
  * For jacksboro (tests/data/jacksboro.f32 + .hdr, written by
- * tests/data/make_raw.py) and an N x N fractal DEM (bench/fractal_dem.h:
+ * tests/data/make_raw.py) and an N x N fractal DEM (tests/test_dem.h:
  * fBm, Hurst 0.8, 1500 m relief, M metre cells, default 4096 and 30 m),
  * it builds the far-shadow maps of S sun positions (default 158, as in
  * the paper) between sunrise and sunset, denser near dawn and dusk, with
@@ -26,12 +26,8 @@
 #include <time.h>
 
 #include "day_cycle.h"
-#include "fractal_dem.h"
 #include "shadow_atlas.h"
-
-#ifndef TS_TEST_DATA
-#define TS_TEST_DATA "tests/data"
-#endif
+#include "test_dem.h"
 
 static double now(void)
 {
@@ -44,59 +40,6 @@ static void die(const char *what, const ts_error *e)
 {
     fprintf(stderr, "atlas_bench: %s%s%s\n", what, e ? ": " : "", e ? e->message : "");
     exit(1);
-}
-
-static int load_raw(const char *name, ts_grid *g, double *lon, double *lat)
-{
-    char path[512];
-    ts_error err;
-    snprintf(path, sizeof path, "%s/%s.hdr", TS_TEST_DATA, name);
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return -1;
-    int w = 0, h = 0;
-    double cy = 0, lon0 = 0, lat0 = 0, dlon = 0, dlat = 0, *rows = NULL;
-    char key[64];
-    while (fscanf(f, "%63s", key) == 1) {
-        if (key[0] == '#') {
-            int c;
-            while ((c = fgetc(f)) != '\n' && c != EOF)
-                ;
-            continue;
-        }
-        if (!strcmp(key, "cell_x_row")) {
-            rows = malloc((size_t)h * sizeof *rows);
-            for (int i = 0; rows && i < h; i++)
-                if (fscanf(f, "%lf", &rows[i]) != 1)
-                    die("bad cell_x_row", NULL);
-            continue;
-        }
-        double v;
-        if (fscanf(f, "%lf", &v) != 1)
-            die("bad header", NULL);
-        if (!strcmp(key, "width")) w = (int)v;
-        else if (!strcmp(key, "height")) h = (int)v;
-        else if (!strcmp(key, "cell_y")) cy = v;
-        else if (!strcmp(key, "lon0")) lon0 = v;
-        else if (!strcmp(key, "lat0")) lat0 = v;
-        else if (!strcmp(key, "dlon_deg")) dlon = v;
-        else if (!strcmp(key, "dlat_deg")) dlat = v;
-    }
-    fclose(f);
-    if (w < 1 || h < 1 || !rows)
-        die("incomplete raw header", NULL);
-    if (ts_grid_create(g, w, h, rows[h / 2], cy, &err) ||
-        ts_grid_set_row_spacing(g, rows, &err))
-        die("grid", &err);
-    free(rows);
-    *lon = lon0 + dlon * (w - 1) / 2.0;
-    *lat = lat0 - dlat * (h - 1) / 2.0;
-    snprintf(path, sizeof path, "%s/%s.f32", TS_TEST_DATA, name);
-    f = fopen(path, "rb");
-    if (!f || fread(g->z, sizeof(float), (size_t)w * h, f) != (size_t)w * h)
-        die("cannot read the raw heights", NULL);
-    fclose(f);
-    return 0;
 }
 
 typedef struct {
@@ -271,9 +214,9 @@ int main(int argc, char **argv)
     if (!only || !strcmp(only, "jacksboro")) {
         ts_grid g;
         double jlon, jlat;
-        if (load_raw("jacksboro", &g, &jlon, &jlat) != 0) {
-            fprintf(stderr, "atlas_bench: no %s/jacksboro.hdr: run tests/data/make_raw.py\n",
-                    TS_TEST_DATA);
+        char msg[4200];
+        if (tdem_read(&g, "jacksboro", &jlon, &jlat, msg, sizeof msg) != 0) {
+            fprintf(stderr, "atlas_bench: %s\n", msg);
         } else {
             /* the default threshold (512 cells) exceeds most of this small
              * DEM; smaller ones show what its relief casts */
@@ -292,7 +235,7 @@ int main(int argc, char **argv)
         ts_grid g;
         if (ts_grid_create(&g, size, size, cell, cell, &err))
             die("grid", &err);
-        ts_fractal_fill(&g, 1, 0.8, 1500.0);
+        tdem_fbm(&g, 1, 0.8, 1500.0);
         for (int di = 0; di < ndates; di++)
             one_day("fractal", &g, lon, lat, dates[di], (int)lround(lon / 15.0) * 60, &p);
         ts_grid_free(&g);

@@ -20,9 +20,9 @@
 #include <string.h>
 #include <time.h>
 
-#include "fractal_dem.h"
 #include "terrashade.h"
 #include "terrashade_cl.h"
+#include "test_dem.h"
 
 static double now(void)
 {
@@ -134,7 +134,7 @@ int main(int argc, char **argv)
     c.threads = threads;
     if (ts_grid_create(&c.g, size, size, 10.0, 10.0, &e) != TS_OK)
         die("grid", &e);
-    ts_fractal_fill(&c.g, 42, 0.8, 1500.0);
+    tdem_fbm(&c.g, 42, 0.8, 1500.0);
     ts_horizon_opts_default(&c.o);
     c.o.directions = dirs;
     c.o.threads = threads;

@@ -16,8 +16,8 @@
 #include <sys/utsname.h>
 #include <time.h>
 
-#include "fractal_dem.h"
 #include "terrashade.h"
+#include "test_dem.h"
 
 static double now(void)
 {
@@ -99,7 +99,7 @@ int main(int argc, char **argv)
     if (ts_grid_create(&g, size, size, cell, cell, &e))
         die("grid", &e);
     double t0 = now();
-    ts_fractal_fill(&g, 1234, 0.8, 1500.0);
+    tdem_fbm(&g, 1234, 0.8, 1500.0);
     printf("DEM: %d x %d fractal (fBm value noise, Hurst 0.8, 1500 m relief), %g m cells, "
            "generated in %.2f s\n", size, size, cell, now() - t0);
     double cells = (double)size * size;

@@ -490,6 +490,7 @@ cl_mem ts_cl_job_buffer(ts_cl_job *j, cl_mem_flags flags, size_t bytes, const vo
         ts_cl_job_fail(j, TS_ERR_INTERNAL, "OpenCL job has too many buffers");
         return NULL;
     }
+    size_t host_bytes = bytes; /* what `host` holds: never read past it */
     if (bytes < 16)
         bytes = 16;
     /* Over the TERRASHADE_OPENCL_MAX_ALLOC cap: refused here. Over the
@@ -512,7 +513,7 @@ cl_mem ts_cl_job_buffer(ts_cl_job *j, cl_mem_flags flags, size_t bytes, const vo
     }
     j->mem[j->nmem++] = m;
     if (host)
-        ts_cl_job_write(j, m, 0, bytes, host, what);
+        ts_cl_job_write(j, m, 0, host_bytes, host, what);
     return j->st == TS_OK ? m : NULL;
 }
 

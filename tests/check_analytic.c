@@ -8,9 +8,9 @@
 
 #include "oracle.h"
 #include "terrashade.h"
-#include "test_dem.h"
-#include "test_stats.h"
+#include "test_grid.h"
 #include "test_run.h"
+#include "test_stats.h"
 
 static const double DEG = 3.14159265358979323846 / 180.0;
 static const double AZ[] = {0, 33.7, 45, 90, 137, 180, 222.2, 300};

@@ -7,25 +7,15 @@
 #include <string.h>
 
 #include "terrashade.h"
-#include "test_dem.h"
+#include "test_expect.h"
+#include "test_grid.h"
 #include "test_run.h"
 
-/* Assert an argument error with a non-empty message. */
-#define EXPECT_ARG(call)                                                          \
-    do {                                                                          \
-        ts_error err_;                                                            \
-        memset(&err_, 0, sizeof err_);                                            \
-        ts_error *err = &err_;                                                    \
-        ts_status st_ = (call);                                                   \
-        ck_assert_msg(st_ == TS_ERR_ARG, "%s returned %d, want TS_ERR_ARG", #call, \
-                      (int)st_);                                                  \
-        ck_assert_msg(err_.code == TS_ERR_ARG && err_.message[0] != '\0',         \
-                      "%s: no message", #call);                                   \
-        printf("%-72.72s -> %s\n", #call, err_.message);                          \
-        (void)err;                                                                \
-    } while (0)
+/* The error that EXPECT_ARG checks: the calls below pass it as err. */
+static ts_error err_buf;
+static ts_error *const err = &err_buf;
 
-/* The same with err = NULL: still the code, still no crash. */
+/* EXPECT_ARG's call with err = NULL: still the code, still no crash. */
 #define EXPECT_ARG_NOERR(call)                                                    \
     do {                                                                          \
         ts_error *err = NULL;                                                     \
@@ -84,43 +74,44 @@ END_TEST
 START_TEST(test_grid_args)
 {
     ts_grid g;
-    EXPECT_ARG(ts_grid_create(NULL, 10, 10, 1, 1, err));
-    EXPECT_ARG(ts_grid_create(&g, 0, 10, 1, 1, err));
-    EXPECT_ARG(ts_grid_create(&g, 10, -3, 1, 1, err));
-    EXPECT_ARG(ts_grid_create(&g, 10, 10, NAN, 1, err));
-    EXPECT_ARG(ts_grid_create(&g, 10, 10, 1, INFINITY, err));
-    EXPECT_ARG(ts_grid_create(&g, 10, 10, 0, 1, err));
-    EXPECT_ARG(ts_grid_create(&g, 10, 10, 1, -1, err));
+    EXPECT_ARG(ts_grid_create(NULL, 10, 10, 1, 1, err), err);
+    EXPECT_ARG(ts_grid_create(&g, 0, 10, 1, 1, err), err);
+    EXPECT_ARG(ts_grid_create(&g, 10, -3, 1, 1, err), err);
+    EXPECT_ARG(ts_grid_create(&g, 10, 10, NAN, 1, err), err);
+    EXPECT_ARG(ts_grid_create(&g, 10, 10, 1, INFINITY, err), err);
+    EXPECT_ARG(ts_grid_create(&g, 10, 10, 0, 1, err), err);
+    EXPECT_ARG(ts_grid_create(&g, 10, 10, 1, -1, err), err);
     EXPECT_ARG_NOERR(ts_grid_create(&g, 0, 0, 1, 1, err));
     double rows[10] = {1, 1, 1, 1, NAN, 1, 1, 1, 1, 1};
-    EXPECT_ARG(ts_grid_set_row_spacing(&G, NULL, err));
+    EXPECT_ARG(ts_grid_set_row_spacing(&G, NULL, err), err);
     ts_grid copy = G;
     copy.owns_memory = 0;
-    EXPECT_ARG(ts_grid_set_row_spacing(&copy, (double[10]){1, 1, 1, 1, 1, 1, 1, 1, 1, 1}, err));
-    EXPECT_ARG(ts_grid_set_row_spacing(&G, rows, err));
+    EXPECT_ARG(ts_grid_set_row_spacing(&copy, (double[10]){1, 1, 1, 1, 1, 1, 1, 1, 1, 1}, err),
+               err);
+    EXPECT_ARG(ts_grid_set_row_spacing(&G, rows, err), err);
     rows[4] = -2;
-    EXPECT_ARG(ts_grid_set_row_spacing(&G, rows, err));
-    EXPECT_ARG(ts_grid_validate(NULL, err));
+    EXPECT_ARG(ts_grid_set_row_spacing(&G, rows, err), err);
+    EXPECT_ARG(ts_grid_validate(NULL, err), err);
     ts_grid bad = G;
     bad.z = NULL;
-    EXPECT_ARG(ts_grid_validate(&bad, err));
+    EXPECT_ARG(ts_grid_validate(&bad, err), err);
     bad = G, bad.stride = 19;
-    EXPECT_ARG(ts_grid_validate(&bad, err));
+    EXPECT_ARG(ts_grid_validate(&bad, err), err);
     bad = G, bad.width = 0;
-    EXPECT_ARG(ts_grid_validate(&bad, err));
+    EXPECT_ARG(ts_grid_validate(&bad, err), err);
     bad = G, bad.cell_x = NAN;
-    EXPECT_ARG(ts_grid_validate(&bad, err));
+    EXPECT_ARG(ts_grid_validate(&bad, err), err);
     bad = G, bad.cell_y = -INFINITY;
-    EXPECT_ARG(ts_grid_validate(&bad, err));
+    EXPECT_ARG(ts_grid_validate(&bad, err), err);
     double nan_rows[10] = {1, 1, 1, 1, 1, 1, 1, 1, 1, NAN};
     bad = G, bad.cell_x_row = nan_rows;
-    EXPECT_ARG(ts_grid_validate(&bad, err));
+    EXPECT_ARG(ts_grid_validate(&bad, err), err);
     /* a grid that does not validate is refused by every entry point */
     bad = G, bad.cell_x = INFINITY;
     ts_horizon_opts o = dflt();
-    EXPECT_ARG(ts_horizon_sweep(&bad, 0, &o, out, err));
-    EXPECT_ARG(ts_shm_compute(&bad, 0, 30, 0, 1, out, NULL, err));
-    EXPECT_ARG(ts_normals(&bad, nx, ny, nz, err));
+    EXPECT_ARG(ts_horizon_sweep(&bad, 0, &o, out, err), err);
+    EXPECT_ARG(ts_shm_compute(&bad, 0, 30, 0, 1, out, NULL, err), err);
+    EXPECT_ARG(ts_normals(&bad, nx, ny, nz, err), err);
 }
 END_TEST
 
@@ -133,18 +124,18 @@ static void noop_visit(void *u, int n, const float *x, const float *y, const flo
 START_TEST(test_horizon_args)
 {
     ts_horizon_opts o = dflt();
-    EXPECT_ARG(ts_horizon_sweep(NULL, 0, &o, out, err));
-    EXPECT_ARG(ts_horizon_sweep(&G, 0, NULL, out, err));
-    EXPECT_ARG(ts_horizon_sweep(&G, 0, &o, NULL, err));
-    EXPECT_ARG(ts_horizon_sweep(&G, NAN, &o, out, err));
-    EXPECT_ARG(ts_horizon_sweep(&G, INFINITY, &o, out, err));
+    EXPECT_ARG(ts_horizon_sweep(NULL, 0, &o, out, err), err);
+    EXPECT_ARG(ts_horizon_sweep(&G, 0, NULL, out, err), err);
+    EXPECT_ARG(ts_horizon_sweep(&G, 0, &o, NULL, err), err);
+    EXPECT_ARG(ts_horizon_sweep(&G, NAN, &o, out, err), err);
+    EXPECT_ARG(ts_horizon_sweep(&G, INFINITY, &o, out, err), err);
     EXPECT_ARG_NOERR(ts_horizon_sweep(&G, NAN, &o, out, err));
-    EXPECT_ARG(ts_horizon_compute(NULL, &o, hor, err));
-    EXPECT_ARG(ts_horizon_compute(&G, NULL, hor, err));
-    EXPECT_ARG(ts_horizon_compute(&G, &o, NULL, err));
-    EXPECT_ARG(ts_horizon_sweep_lines(&G, 0, &o, NULL, NULL, err));
-    EXPECT_ARG(ts_horizon_sweep_lines(&G, NAN, &o, noop_visit, NULL, err));
-    EXPECT_ARG(ts_horizon_sweep_lines(NULL, 0, &o, noop_visit, NULL, err));
+    EXPECT_ARG(ts_horizon_compute(NULL, &o, hor, err), err);
+    EXPECT_ARG(ts_horizon_compute(&G, NULL, hor, err), err);
+    EXPECT_ARG(ts_horizon_compute(&G, &o, NULL, err), err);
+    EXPECT_ARG(ts_horizon_sweep_lines(&G, 0, &o, NULL, NULL, err), err);
+    EXPECT_ARG(ts_horizon_sweep_lines(&G, NAN, &o, noop_visit, NULL, err), err);
+    EXPECT_ARG(ts_horizon_sweep_lines(NULL, 0, &o, noop_visit, NULL, err), err);
 
     const struct { const char *field; ts_horizon_opts o; } bad[] = {
         {"direction", {0, 0, 0, 1, 0.13, 0, NULL, NULL}},
@@ -165,23 +156,23 @@ START_TEST(test_horizon_args)
         printf("opts %zu -> %s\n", i, e.message);
         ck_assert_msg(strstr(e.message, bad[i].field) != NULL,
                       "message \"%s\" does not name %s", e.message, bad[i].field);
-        EXPECT_ARG(ts_horizon_compute(&G, b, hor, err));
+        EXPECT_ARG(ts_horizon_compute(&G, b, hor, err), err);
         /* the sweep ignores directions and start_azimuth */
         if (strcmp(bad[i].field, "refraction") == 0 || strcmp(bad[i].field, "distance") == 0)
-            EXPECT_ARG(ts_horizon_sweep(&G, 0, b, out, err));
+            EXPECT_ARG(ts_horizon_sweep(&G, 0, b, out, err), err);
     }
 }
 END_TEST
 
 START_TEST(test_shm_args)
 {
-    EXPECT_ARG(ts_shm_compute(NULL, 0, 30, 0, 1, out, NULL, err));
-    EXPECT_ARG(ts_shm_compute(&G, 0, 90.5, 0, 1, out, NULL, err));
-    EXPECT_ARG(ts_shm_compute(&G, 0, -90.5, 0, 1, out, NULL, err));
-    EXPECT_ARG(ts_shm_compute(&G, 0, NAN, 0, 1, out, NULL, err));
-    EXPECT_ARG(ts_shm_compute(&G, NAN, 30, 0, 1, out, NULL, err));
-    EXPECT_ARG(ts_shm_compute(&G, 0, 30, -1, 1, out, NULL, err));
-    EXPECT_ARG(ts_shm_compute(&G, 0, 30, NAN, 1, out, NULL, err));
+    EXPECT_ARG(ts_shm_compute(NULL, 0, 30, 0, 1, out, NULL, err), err);
+    EXPECT_ARG(ts_shm_compute(&G, 0, 90.5, 0, 1, out, NULL, err), err);
+    EXPECT_ARG(ts_shm_compute(&G, 0, -90.5, 0, 1, out, NULL, err), err);
+    EXPECT_ARG(ts_shm_compute(&G, 0, NAN, 0, 1, out, NULL, err), err);
+    EXPECT_ARG(ts_shm_compute(&G, NAN, 30, 0, 1, out, NULL, err), err);
+    EXPECT_ARG(ts_shm_compute(&G, 0, 30, -1, 1, out, NULL, err), err);
+    EXPECT_ARG(ts_shm_compute(&G, 0, 30, NAN, 1, out, NULL, err), err);
     EXPECT_ARG_NOERR(ts_shm_compute(&G, 0, 95, 0, 1, out, NULL, err));
 }
 END_TEST
@@ -189,34 +180,34 @@ END_TEST
 START_TEST(test_shading_args)
 {
     ts_horizon_opts o = dflt();
-    EXPECT_ARG(ts_normals(NULL, nx, ny, nz, err));
-    EXPECT_ARG(ts_normals(&G, NULL, ny, nz, err));
-    EXPECT_ARG(ts_normals(&G, nx, ny, NULL, err));
-    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, NULL, &o, 0, 30, out, err));
-    EXPECT_ARG(ts_shade_direct(&G, NULL, ny, nz, hor, &o, 0, 30, out, err));
-    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, NULL, 0, 30, out, err));
-    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, &o, 0, 30, NULL, err));
-    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, &o, NAN, 30, out, err));
-    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, &o, 0, 95, out, err));
-    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, &o, 0, NAN, out, err));
+    EXPECT_ARG(ts_normals(NULL, nx, ny, nz, err), err);
+    EXPECT_ARG(ts_normals(&G, NULL, ny, nz, err), err);
+    EXPECT_ARG(ts_normals(&G, nx, ny, NULL, err), err);
+    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, NULL, &o, 0, 30, out, err), err);
+    EXPECT_ARG(ts_shade_direct(&G, NULL, ny, nz, hor, &o, 0, 30, out, err), err);
+    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, NULL, 0, 30, out, err), err);
+    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, &o, 0, 30, NULL, err), err);
+    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, &o, NAN, 30, out, err), err);
+    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, &o, 0, 95, out, err), err);
+    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, &o, 0, NAN, out, err), err);
     ts_horizon_opts o0 = o;
     o0.directions = 0;
-    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, &o0, 0, 30, out, err));
-    EXPECT_ARG(ts_sky_terms(NULL, nx, ny, nz, hor, &o, out, NULL, NULL, err));
-    EXPECT_ARG(ts_sky_terms(&G, nx, ny, nz, NULL, &o, out, NULL, NULL, err));
-    EXPECT_ARG(ts_sky_terms(&G, NULL, ny, nz, hor, &o, out, NULL, NULL, err));
-    EXPECT_ARG(ts_sky_terms(&G, nx, ny, nz, hor, NULL, out, NULL, NULL, err));
-    EXPECT_ARG(ts_sky_terms(&G, nx, ny, nz, hor, &o0, out, NULL, NULL, err));
-    EXPECT_ARG(ts_sky_accumulate(&G, nx, ny, nz, hor, 0, 0, out, NULL, NULL, err));
-    EXPECT_ARG(ts_sky_accumulate(&G, nx, ny, nz, hor, NAN, 16, out, NULL, NULL, err));
-    EXPECT_ARG(ts_sky_accumulate(&G, nx, ny, nz, NULL, 0, 16, out, NULL, NULL, err));
-    EXPECT_ARG(ts_sky_finish(&G, 0, out, NULL, NULL, err));
-    EXPECT_ARG(ts_sky_finish(NULL, 16, out, NULL, NULL, err));
-    EXPECT_ARG(ts_shade_combine(&G, NULL, out, 0.5, out, err));
-    EXPECT_ARG(ts_shade_combine(&G, out, NULL, 0.5, out, err));
-    EXPECT_ARG(ts_shade_combine(&G, out, out, 0.5, NULL, err));
-    EXPECT_ARG(ts_shade_combine(&G, out, out, NAN, out, err));
-    EXPECT_ARG(ts_shade_combine(NULL, out, out, 0.5, out, err));
+    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, &o0, 0, 30, out, err), err);
+    EXPECT_ARG(ts_sky_terms(NULL, nx, ny, nz, hor, &o, out, NULL, NULL, err), err);
+    EXPECT_ARG(ts_sky_terms(&G, nx, ny, nz, NULL, &o, out, NULL, NULL, err), err);
+    EXPECT_ARG(ts_sky_terms(&G, NULL, ny, nz, hor, &o, out, NULL, NULL, err), err);
+    EXPECT_ARG(ts_sky_terms(&G, nx, ny, nz, hor, NULL, out, NULL, NULL, err), err);
+    EXPECT_ARG(ts_sky_terms(&G, nx, ny, nz, hor, &o0, out, NULL, NULL, err), err);
+    EXPECT_ARG(ts_sky_accumulate(&G, nx, ny, nz, hor, 0, 0, out, NULL, NULL, err), err);
+    EXPECT_ARG(ts_sky_accumulate(&G, nx, ny, nz, hor, NAN, 16, out, NULL, NULL, err), err);
+    EXPECT_ARG(ts_sky_accumulate(&G, nx, ny, nz, NULL, 0, 16, out, NULL, NULL, err), err);
+    EXPECT_ARG(ts_sky_finish(&G, 0, out, NULL, NULL, err), err);
+    EXPECT_ARG(ts_sky_finish(NULL, 16, out, NULL, NULL, err), err);
+    EXPECT_ARG(ts_shade_combine(&G, NULL, out, 0.5, out, err), err);
+    EXPECT_ARG(ts_shade_combine(&G, out, NULL, 0.5, out, err), err);
+    EXPECT_ARG(ts_shade_combine(&G, out, out, 0.5, NULL, err), err);
+    EXPECT_ARG(ts_shade_combine(&G, out, out, NAN, out, err), err);
+    EXPECT_ARG(ts_shade_combine(NULL, out, out, 0.5, out, err), err);
 }
 END_TEST
 

@@ -11,74 +11,14 @@
 
 #include "day_cycle.h"
 #include "shadow_atlas.h"
+#include "test_expect.h"
+#include "test_grid.h"
 #include "test_run.h"
 
-#ifndef TS_TEST_DATA
-#define TS_TEST_DATA "tests/data"
-#endif
-
-#define EXPECT_ARG(call, errp)                                                        \
-    do {                                                                              \
-        memset((errp), 0, sizeof *(errp));                                            \
-        ts_status st_ = (call);                                                       \
-        ck_assert_msg(st_ == TS_ERR_ARG, "%s returned %d, want TS_ERR_ARG", #call,    \
-                      (int)st_);                                                      \
-        ck_assert_msg((errp)->message[0] != '\0', "%s: no message", #call);           \
-        printf("%-58.58s -> %s\n", #call, (errp)->message);                           \
-    } while (0)
-
+/* The noise of the synthetic DEM and of the random maps and windows; each
+ * test runs in its own process, so each starts from this state. */
 static uint32_t rng_state = 12345;
-static uint32_t rnd(void)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 17;
-    rng_state ^= rng_state << 5;
-    return rng_state;
-}
-
-/* A raw test DEM (tests/data/make_raw.py). */
-static void load_raw(const char *name, ts_grid *g)
-{
-    char path[512];
-    ts_error err;
-    snprintf(path, sizeof path, "%s/%s.hdr", TS_TEST_DATA, name);
-    FILE *f = fopen(path, "r");
-    ck_assert_msg(f != NULL, "cannot open %s (run tests/data/make_raw.py)", path);
-    int w = 0, h = 0;
-    double cy = 0;
-    char key[64];
-    double *rows = NULL;
-    while (fscanf(f, "%63s", key) == 1) {
-        if (key[0] == '#') {
-            int c;
-            while ((c = fgetc(f)) != '\n' && c != EOF)
-                ;
-        } else if (!strcmp(key, "width")) {
-            ck_assert(fscanf(f, "%d", &w) == 1);
-        } else if (!strcmp(key, "height")) {
-            ck_assert(fscanf(f, "%d", &h) == 1);
-        } else if (!strcmp(key, "cell_y")) {
-            ck_assert(fscanf(f, "%lf", &cy) == 1);
-        } else if (!strcmp(key, "cell_x_row")) {
-            rows = malloc(h * sizeof *rows);
-            for (int i = 0; i < h; i++)
-                ck_assert(fscanf(f, "%lf", &rows[i]) == 1);
-        } else {
-            double dummy;
-            ck_assert(fscanf(f, "%lf", &dummy) == 1);
-        }
-    }
-    fclose(f);
-    ck_assert(w > 0 && h > 0 && cy > 0 && rows);
-    ck_assert(ts_grid_create(g, w, h, rows[h / 2], cy, &err) == TS_OK);
-    ck_assert(ts_grid_set_row_spacing(g, rows, &err) == TS_OK);
-    free(rows);
-    snprintf(path, sizeof path, "%s/%s.f32", TS_TEST_DATA, name);
-    f = fopen(path, "rb");
-    ck_assert_msg(f != NULL, "cannot open %s", path);
-    ck_assert(fread(g->z, sizeof(float), (size_t)w * h, f) == (size_t)w * h);
-    fclose(f);
-}
+static uint32_t rnd(void) { return tdem_xorshift32(&rng_state); }
 
 /* Brute-force far horizon along a grid axis or diagonal (lines through
  * cell centres): max over samples k steps away, k step >= T. */
@@ -102,21 +42,12 @@ static double brute_far(const ts_grid *g, int x, int y, int dx, int dy, double s
     return best == -INFINITY ? -90.0 : atan(best) * 180.0 / M_PI;
 }
 
-static void random_dem(ts_grid *g, int w, int h, double cell)
-{
-    ts_error err;
-    ck_assert(ts_grid_create(g, w, h, cell, cell, &err) == TS_OK);
-    for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++)
-            g->z[y * w + x] = (float)(300.0 * sin(x * 0.21) * cos(y * 0.17) +
-                                      (rnd() % 1000) * 0.2);
-}
-
 START_TEST(test_far_horizon_brute_force)
 {
     ts_error err;
     ts_grid g;
-    random_dem(&g, 97, 83, 25.0);
+    tdem_create(&g, 97, 83, 25.0, 25.0);
+    tdem_sines_rng_noise(&g, &rng_state);
     g.z[40 * 97 + 40] = NAN; /* nodata: no occluder, NaN out */
     float *out = malloc(97 * 83 * sizeof *out);
     ts_horizon_opts o;
@@ -165,7 +96,7 @@ START_TEST(test_far_horizon_against_full)
 {
     ts_error err;
     ts_grid g;
-    load_raw("jacksboro", &g);
+    tdem_load(&g, "jacksboro");
     size_t n = (size_t)g.width * g.height;
     float *far = malloc(n * sizeof *far), *full = malloc(n * sizeof *full);
     ts_horizon_opts o;
@@ -202,9 +133,8 @@ START_TEST(test_far_shadow_bits)
 {
     ts_error err;
     ts_grid g;
-    ck_assert(ts_grid_create(&g, 64, 8, 10.0, 10.0, &err) == TS_OK);
-    for (int i = 0; i < 64 * 8; i++)
-        g.z[i] = 0;
+    tdem_create(&g, 64, 8, 10.0, 10.0);
+    tdem_fill(&g, 0.0f);
     for (int y = 0; y < 8; y++)
         g.z[y * 64 + 60] = 100.0f; /* a wall to the east */
     g.z[3 * 64 + 5] = NAN;
@@ -401,7 +331,7 @@ START_TEST(test_jacksboro_day)
 {
     ts_error err;
     ts_grid g;
-    load_raw("jacksboro", &g);
+    tdem_load(&g, "jacksboro");
     size_t n = (size_t)g.width * g.height;
     double lon = -84.245, lat = 36.589, north = 0;
     ts_sun_sites s = {1, 1, 0, 0, 0, 0, &lon, &lat, &north};

@@ -9,22 +9,14 @@
 #include <string.h>
 
 #include "day_cycle.h"
+#include "test_expect.h"
+#include "test_grid.h"
 #include "test_run.h"
 
 #define CK_NEAR(got, want, tol, what)                                                 \
     ck_assert_msg(fabs((double)(got) - (double)(want)) <= (tol),                      \
                   "%s: got %.6f, want %.6f +/- %g", what, (double)(got), (double)(want), \
                   (double)(tol))
-
-#define EXPECT_ARG(call, errp)                                                        \
-    do {                                                                              \
-        memset((errp), 0, sizeof *(errp));                                            \
-        ts_status st_ = (call);                                                       \
-        ck_assert_msg(st_ == TS_ERR_ARG, "%s returned %d, want TS_ERR_ARG", #call,    \
-                      (int)st_);                                                      \
-        ck_assert_msg((errp)->message[0] != '\0', "%s: no message", #call);           \
-        printf("%-58.58s -> %s\n", #call, (errp)->message);                           \
-    } while (0)
 
 /* One site. */
 typedef struct {
@@ -46,10 +38,8 @@ static void site_init(site *p, double lat, double lon)
 
 static void flat(ts_grid *g, int n, double cell, float z)
 {
-    ts_error err;
-    ck_assert(ts_grid_create(g, n, n, cell, cell, &err) == TS_OK);
-    for (int i = 0; i < n * n; i++)
-        g->z[i] = z;
+    tdem_create(g, n, n, cell, cell);
+    tdem_fill(g, z);
 }
 
 /* Apparent elevation at t minus `target`. */
@@ -570,7 +560,7 @@ START_TEST(test_insolation_lattice)
     ts_error err;
     const int n = 24;
     ts_grid g;
-    ck_assert(ts_grid_create(&g, n, n, 30.0, 30.0, &err) == TS_OK);
+    tdem_create(&g, n, n, 30.0, 30.0);
     for (int y = 0; y < n; y++)
         for (int x = 0; x < n; x++)
             g.z[y * n + x] = (float)(800 + 60 * sin(x * 0.4) * cos(y * 0.3) + 4 * y);
@@ -605,7 +595,7 @@ START_TEST(test_insolation_slopes)
     ts_error err;
     const int n = 48;
     ts_grid g;
-    ck_assert(ts_grid_create(&g, n, n, 30.0, 30.0, &err) == TS_OK);
+    tdem_create(&g, n, n, 30.0, 30.0);
     for (int y = 0; y < n; y++)
         for (int x = 0; x < n; x++) {
             double yy = y < n / 2 ? y : n - 1 - y; /* a roof: ridge at the middle */

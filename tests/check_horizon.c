@@ -8,9 +8,9 @@
 
 #include "oracle.h"
 #include "terrashade.h"
-#include "test_dem.h"
-#include "test_stats.h"
+#include "test_grid.h"
 #include "test_run.h"
+#include "test_stats.h"
 
 /* Axis and non-axis azimuths: the sweep's line geometry differs for each. */
 static const double AZ[] = {0, 33.7, 45, 90, 137, 180, 222.2, 300};

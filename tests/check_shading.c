@@ -5,7 +5,7 @@
 #include <stdlib.h>
 
 #include "terrashade.h"
-#include "test_dem.h"
+#include "test_grid.h"
 #include "test_run.h"
 
 static const double PI = 3.14159265358979323846;

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 
 #include "terrashade.h"
-#include "test_dem.h"
+#include "test_grid.h"
 #include "test_run.h"
 
 /* Hard shadows of the shadow height map and of the exact horizon differ

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "terrashade_sun.h"
+#include "test_expect.h"
 #include "test_run.h"
 
 #define CK_NEAR(got, want, tol, what)                                            \
@@ -19,17 +20,6 @@
                   what, (double)(got), (double)(want), (double)(tol))
 
 /* Assert an argument error with a non-empty message, and print it. */
-#define EXPECT_ARG(call, errp)                                                   \
-    do {                                                                         \
-        memset((errp), 0, sizeof *(errp));                                       \
-        ts_status st_ = (call);                                                  \
-        ck_assert_msg(st_ == TS_ERR_ARG, "%s returned %d, want TS_ERR_ARG", #call, \
-                      (int)st_);                                                 \
-        ck_assert_msg((errp)->code == TS_ERR_ARG && (errp)->message[0] != '\0',  \
-                      "%s: no message", #call);                                  \
-        printf("%-60.60s -> %s\n", #call, (errp)->message);                      \
-    } while (0)
-
 /* The paper's example site and time. */
 static void paper_input(ts_sun_input *in)
 {

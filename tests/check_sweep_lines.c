@@ -7,7 +7,7 @@
 
 #include "oracle.h"
 #include "terrashade.h"
-#include "test_dem.h"
+#include "test_grid.h"
 #include "test_run.h"
 
 static const double DEG = 3.14159265358979323846 / 180.0;

@@ -28,6 +28,8 @@
 #include "terrashade.h"
 #include "terrashade_backend.h"
 #include "terrashade_cl.h"
+#include "test_grid.h"
+#include "test_run.h"
 
 #define TOL_HORIZON 1e-3 /* degrees */
 #define TOL 1e-4         /* shm, normals, direct, sky */
@@ -44,14 +46,6 @@ static char g_self[4096]; /* this program, for the fresh-process tests */
     } while (0)
 
 /* ------------------------------------------------------------- DEMs */
-
-static double hash01(unsigned x, unsigned y, unsigned seed)
-{
-    unsigned h = x * 374761393u + y * 668265263u + seed * 2246822519u;
-    h = (h ^ (h >> 13)) * 1274126177u;
-    h ^= h >> 16;
-    return (h & 0xffffff) / (double)0xffffff;
-}
 
 typedef struct {
     int w, h;
@@ -79,20 +73,7 @@ static void make_dem(ts_grid *g, const dem_spec *s)
     } else {
         REQUIRE(ts_grid_create(g, s->w, s->h, s->cell, s->cell, &e) == TS_OK);
     }
-    for (int y = 0; y < s->h; y++)
-        for (int x = 0; x < s->w; x++) {
-            double X = x, Y = y;
-            double v = 300 + 120 * sin(0.11 * X + 0.3) * cos(0.07 * Y) +
-                       60 * sin(0.23 * X + 0.19 * Y) + 25 * sin(0.51 * X - 0.43 * Y + 1) +
-                       8 * sin(1.3 * X + 0.9 * Y) + 6 * (2 * hash01(x, y, s->seed) - 1);
-            if (s->holes) {
-                if (x >= s->w / 3 && x < s->w / 3 + 4 && y >= s->h / 2 && y < s->h / 2 + 3)
-                    v = NAN;
-                if (hash01(x, y, s->seed + 7) < 0.03)
-                    v = NAN;
-            }
-            g->z[(ptrdiff_t)y * g->stride + x] = (float)v;
-        }
+    tdem_sines_hash_noise(g, s->seed, s->holes);
     if (s->geo) {
         double *row = malloc((size_t)s->h * sizeof *row);
         REQUIRE(row);
@@ -160,13 +141,6 @@ static void expect_close(const char *what, const float *c, const float *cl, size
     ck_assert_msg(d.nan_mismatch == 0, "%s: %ld cells nodata in one backend only", what,
                   d.nan_mismatch);
     ck_assert_msg(d.max <= tol, "%s: max difference %g > %g", what, d.max, tol);
-}
-
-static float *fbuf(size_t n)
-{
-    float *p = malloc((n ? n : 1) * sizeof *p);
-    ck_assert_ptr_nonnull(p);
-    return p;
 }
 
 static void require_opencl(void)
@@ -238,7 +212,7 @@ static void horizon_case(const dem_spec *s, int dirs, double start, int curvatur
     o.max_distance = max_distance;
     o.threads = 2;
     size_t n = (size_t)s->w * s->h * dirs;
-    float *c = fbuf(n), *cl = fbuf(n);
+    float *c = tdem_floats(n), *cl = tdem_floats(n);
     ck_assert_int_eq(ts_horizon_compute(&g, &o, c, &e), TS_OK);
     ts_status st = ts_cl_horizon_compute(&g, &o, cl, &e);
     ck_assert_msg(st == TS_OK, "ts_cl_horizon_compute: %s", e.message);
@@ -290,7 +264,7 @@ START_TEST(test_horizon_sweep)
     ts_horizon_opts o;
     ts_horizon_opts_default(&o);
     size_t n = (size_t)s->w * s->h;
-    float *c = fbuf(n), *cl = fbuf(n);
+    float *c = tdem_floats(n), *cl = tdem_floats(n);
     const double az[] = {0, 360, 33.3, -45, 90, 180.0001, 270, 1e-7, 719.5};
     for (size_t k = 0; k < sizeof az / sizeof *az; k++) {
         ck_assert_int_eq(ts_horizon_sweep(&g, az[k], &o, c, &e), TS_OK);
@@ -317,7 +291,8 @@ START_TEST(test_shm)
         ts_error e;
         make_dem(&g, s);
         size_t n = (size_t)s->w * s->h;
-        float *vc = fbuf(n), *vl = fbuf(n), *sc = fbuf(n), *sl = fbuf(n);
+        float *vc = tdem_floats(n), *vl = tdem_floats(n);
+        float *sc = tdem_floats(n), *sl = tdem_floats(n);
         for (size_t a = 0; a < sizeof az / sizeof *az; a++)
             for (size_t k = 0; k < sizeof el / sizeof *el; k++) {
                 if ((a + k + (size_t)i) % 2 && s->w * s->h > 100)
@@ -362,7 +337,8 @@ START_TEST(test_shm_wide)
     ts_error e;
     make_dem(&g, &s);
     size_t n = (size_t)s.w * s.h;
-    float *vc = fbuf(n), *vl = fbuf(n), *sc = fbuf(n), *sl = fbuf(n);
+    float *vc = tdem_floats(n), *vl = tdem_floats(n);
+    float *sc = tdem_floats(n), *sl = tdem_floats(n);
     const double az[] = {10, 100, 190, 280, 45, 315, 0, 90};
     for (size_t a = 0; a < sizeof az / sizeof *az; a++) {
         ck_assert_int_eq(ts_shm_compute(&g, az[a], 7.0, 3.0, 0, vc, sc, &e), TS_OK);
@@ -388,7 +364,8 @@ START_TEST(test_normals)
         ts_error e;
         make_dem(&g, s);
         size_t n = (size_t)s->w * s->h;
-        float *c[3] = {fbuf(n), fbuf(n), fbuf(n)}, *l[3] = {fbuf(n), fbuf(n), fbuf(n)};
+        float *c[3] = {tdem_floats(n), tdem_floats(n), tdem_floats(n)};
+        float *l[3] = {tdem_floats(n), tdem_floats(n), tdem_floats(n)};
         ck_assert_int_eq(ts_normals(&g, c[0], c[1], c[2], &e), TS_OK);
         ck_assert_msg(ts_cl_normals(&g, l[0], l[1], l[2], &e) == TS_OK, "%s", e.message);
         for (int k = 0; k < 3; k++) {
@@ -419,10 +396,10 @@ static void scene_make(scene *sc, const dem_spec *s, int dirs, double start)
     sc->o.directions = dirs;
     sc->o.start_azimuth = start;
     sc->n = (size_t)s->w * s->h;
-    sc->h = fbuf(sc->n * dirs);
-    sc->nx = fbuf(sc->n);
-    sc->ny = fbuf(sc->n);
-    sc->nz = fbuf(sc->n);
+    sc->h = tdem_floats(sc->n * dirs);
+    sc->nx = tdem_floats(sc->n);
+    sc->ny = tdem_floats(sc->n);
+    sc->nz = tdem_floats(sc->n);
     ck_assert_int_eq(ts_horizon_compute(&sc->g, &sc->o, sc->h, &e), TS_OK);
     ck_assert_int_eq(ts_normals(&sc->g, sc->nx, sc->ny, sc->nz, &e), TS_OK);
 }
@@ -441,7 +418,7 @@ START_TEST(test_direct)
         const dem_spec *s = &SHAPES[i];
         scene sc;
         scene_make(&sc, s, 8, 5.0);
-        float *c = fbuf(sc.n), *l = fbuf(sc.n);
+        float *c = tdem_floats(sc.n), *l = tdem_floats(sc.n);
         ts_error e;
         for (size_t k = 0; k < sizeof sun / sizeof *sun; k++) {
             ck_assert_int_eq(ts_shade_direct(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, sun[k][0],
@@ -478,7 +455,7 @@ START_TEST(test_sky)
         scene_make(&sc, s, 16, 0.0);
         float *c[3], *l[3];
         for (int k = 0; k < 3; k++)
-            c[k] = fbuf(sc.n), l[k] = fbuf(sc.n);
+            c[k] = tdem_floats(sc.n), l[k] = tdem_floats(sc.n);
         ts_error e;
         ck_assert_int_eq(
             ts_sky_terms(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, c[0], c[1], c[2], &e), TS_OK);
@@ -510,7 +487,7 @@ START_TEST(test_arguments)
     ts_error e;
     make_dem(&g, s);
     size_t n = (size_t)s->w * s->h;
-    float *a = fbuf(n), *b = fbuf(n), *c = fbuf(n);
+    float *a = tdem_floats(n), *b = tdem_floats(n), *c = tdem_floats(n);
     ts_horizon_opts o;
     ts_horizon_opts_default(&o);
     ck_assert_int_eq(ts_cl_shm_compute(&g, 10, 95, 0, 0, a, NULL, &e), TS_ERR_ARG);
@@ -548,7 +525,8 @@ static ts_backend_report dispatch_normals(ts_backend b, const dem_spec *s)
     ts_error e;
     make_dem(&g, s);
     size_t n = (size_t)s->w * s->h;
-    float *c[3] = {fbuf(n), fbuf(n), fbuf(n)}, *l[3] = {fbuf(n), fbuf(n), fbuf(n)};
+    float *c[3] = {tdem_floats(n), tdem_floats(n), tdem_floats(n)};
+    float *l[3] = {tdem_floats(n), tdem_floats(n), tdem_floats(n)};
     ts_backend_report r;
     memset(&r, 0xff, sizeof r);
     ck_assert_int_eq(ts_normals(&g, c[0], c[1], c[2], &e), TS_OK);
@@ -616,7 +594,7 @@ START_TEST(test_dispatch)
     setenv("TERRASHADE_BACKEND", "cuda", 1);
     ts_grid g;
     make_dem(&g, s);
-    float *a = fbuf(g.width * g.height * 3);
+    float *a = tdem_floats(g.width * g.height * 3);
     ck_assert_int_eq(ts_backend_normals(TS_BACKEND_AUTO, &g, a, a + g.width * g.height,
                                         a + 2 * g.width * g.height, NULL, &e),
                      TS_ERR_ARG);
@@ -658,7 +636,7 @@ START_TEST(test_dispatch_products)
     scene_make(&sc, s, 8, 0.0);
     ts_error e;
     ts_backend_report r;
-    float *a = fbuf(sc.n * 8), *b = fbuf(sc.n * 8), *c = fbuf(sc.n);
+    float *a = tdem_floats(sc.n * 8), *b = tdem_floats(sc.n * 8), *c = tdem_floats(sc.n);
     ck_assert_int_eq(
         ts_backend_horizon_compute(TS_BACKEND_OPENCL, &sc.g, &sc.o, a, &r, &e), TS_OK);
     ck_assert_int_eq(r.used, TS_BACKEND_OPENCL);
@@ -913,7 +891,7 @@ START_TEST(test_too_large)
     /* horizons: the planes do not fit either */
     scene sc;
     scene_make(&sc, &SHAPES[4], 4, 0.0);
-    float *h = fbuf(sc.n * 4);
+    float *h = tdem_floats(sc.n * 4);
     ck_assert_int_eq(ts_cl_horizon_compute(&sc.g, &sc.o, h, &e), TS_ERR_NOMEM);
     ck_assert_int_eq(ts_backend_horizon_compute(TS_BACKEND_OPENCL, &sc.g, &sc.o, h, &r, &e),
                      TS_OK);
@@ -1027,9 +1005,5 @@ int main(int argc, char **argv)
         return child_no_platform();
     if (argc > 1 && !strcmp(argv[1], "--child-fp32"))
         return child_fp32();
-    SRunner *sr = srunner_create(opencl_suite());
-    srunner_run_all(sr, CK_VERBOSE);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return test_run_suite_mode(opencl_suite(), CK_VERBOSE);
 }
