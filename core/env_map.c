@@ -126,9 +126,11 @@ static int block_size(const panel_split *p, size_t max_texels)
     return k;
 }
 
-/* Accumulates the pixels of one block (solid-angle weighted). */
+/* Accumulates the pixels of one block: solid angle, solid-angle-weighted
+ * radiance, and the directions weighted by solid angle (dir) and by
+ * power, r + g + b times solid angle (lit_dir). */
 typedef struct {
-    double solid_angle, dir[3], rgb[3];
+    double solid_angle, dir[3], lit_dir[3], rgb[3];
     double first_dir[3];
 } block_sum;
 
@@ -152,20 +154,37 @@ static ts_status add_pixel(const env_image *img, int x, int y, block_sum *b, con
     if (b->solid_angle == 0.0)
         for (int c = 0; c < 3; c++)
             b->first_dir[c] = g.dir[c] / len;
+    double power = 0.0;
     b->solid_angle += g.solid_angle;
     for (int c = 0; c < 3; c++) {
+        double v = g.solid_angle * (px[c] > 0.0f ? (double)px[c] : 0.0);
+        b->rgb[c] += v;
+        power += v;
+    }
+    for (int c = 0; c < 3; c++) {
         b->dir[c] += g.solid_angle * g.dir[c] / len;
-        b->rgb[c] += g.solid_angle * (px[c] > 0.0f ? (double)px[c] : 0.0);
+        b->lit_dir[c] += power * g.dir[c] / len;
     }
     return TS_OK;
 }
 
-/* The block's texel: map frame -> terrain (east, north, up) = (-x, z, y),
- * then turned clockwise by the rotation (cos_r, sin_r). */
+static double norm3(const double v[3])
+{
+    return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+}
+
+/* The block's texel: its direction is where its light comes from (the
+ * power-weighted mean direction; the solid-angle-weighted one for a black
+ * block), so a bright spot keeps its place; then map frame -> terrain
+ * (east, north, up) = (-x, z, y), turned clockwise by the rotation. */
 static void block_texel(const block_sum *b, double cos_r, double sin_r, ts_env_texel *t)
 {
-    double len = sqrt(b->dir[0] * b->dir[0] + b->dir[1] * b->dir[1] + b->dir[2] * b->dir[2]);
-    const double *d = b->dir;
+    const double *d = b->lit_dir;
+    double len = norm3(d);
+    if (!(len > 0.0)) {
+        d = b->dir;
+        len = norm3(d);
+    }
     double inv = 1.0 / len;
     if (!(len > 1e-12 * b->solid_angle)) { /* a block around the whole sphere */
         d = b->first_dir;

@@ -107,8 +107,10 @@ ts_status ts_env_from_cube(const float *rgb, int face_size, double rotation_deg,
  * most max_texels texels, blocks never straddle a cube face; the edge
  * blocks may be smaller): a block's solid angle is the sum of its pixels',
  * its radiance their solid-angle-weighted mean (a box filter that keeps the
- * energy), its direction their solid-angle-weighted mean direction,
- * normalised. A hint: a cube map keeps at least 6 texels.
+ * energy), its direction the mean of theirs weighted by power (r + g + b
+ * times solid angle; by solid angle in a black block), normalised, so that
+ * a bright spot (the sun) keeps its direction. A hint: a cube map keeps at
+ * least 6 texels.
  *
  * Errors (TS_ERR_ARG, a sentence naming the file): missing or unreadable
  * file, not an OpenEXR file, damaged or truncated data, deep data, no
