@@ -6,16 +6,17 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Encode one chunk whose top-left pixel is (x0, y0). */
+/* Encode one chunk whose top-left pixel is (x0, y0), with a pipeline of
+ * its own. (OpenEXRCore 3.1.5 writes some half, ZIP, 8 x 8 tiles garbled:
+ * its C++ library reads the same NaNs back. The tests avoid that case.) */
 static exr_result_t encode_chunk(exr_context_t ctx, int part, const exr_chunk_info_t *ci,
                                  const texr_spec *s, const uint8_t *base, size_t elem, int x0,
-                                 int y0, exr_encode_pipeline_t *enc, int *started)
+                                 int y0)
 {
-    exr_result_t rv = *started ? exr_encoding_update(ctx, part, ci, enc)
-                               : exr_encoding_initialize(ctx, part, ci, enc);
+    exr_encode_pipeline_t pipe = EXR_ENCODE_PIPELINE_INITIALIZER, *enc = &pipe;
+    exr_result_t rv = exr_encoding_initialize(ctx, part, ci, enc);
     if (rv != EXR_ERR_SUCCESS)
         return rv;
-    *started = 1;
     for (int c = 0; c < enc->channel_count; c++) {
         exr_coding_channel_info_t *ch = &enc->channels[c];
         int k = 0;
@@ -30,15 +31,16 @@ static exr_result_t encode_chunk(exr_context_t ctx, int part, const exr_chunk_in
         ch->user_bytes_per_element = 4;
     }
     rv = exr_encoding_choose_default_routines(ctx, part, enc);
-    return rv != EXR_ERR_SUCCESS ? rv : exr_encoding_run(ctx, part, enc);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_encoding_run(ctx, part, enc);
+    exr_encoding_destroy(ctx, enc);
+    return rv;
 }
 
 static exr_result_t write_part(exr_context_t ctx, int part, const texr_spec *s,
                                const uint8_t *base, size_t elem)
 {
-    exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
     exr_chunk_info_t ci;
-    int started = 0;
     exr_result_t rv = EXR_ERR_SUCCESS;
     if (s->tile_size > 0) {
         int t = s->tile_size;
@@ -46,8 +48,7 @@ static exr_result_t write_part(exr_context_t ctx, int part, const texr_spec *s,
             for (int tx = 0; rv == EXR_ERR_SUCCESS && tx * t < s->width; tx++) {
                 rv = exr_write_tile_chunk_info(ctx, part, tx, ty, 0, 0, &ci);
                 if (rv == EXR_ERR_SUCCESS)
-                    rv = encode_chunk(ctx, part, &ci, s, base, elem, tx * t, ty * t, &enc,
-                                      &started);
+                    rv = encode_chunk(ctx, part, &ci, s, base, elem, tx * t, ty * t);
             }
     } else {
         int32_t lines = 1;
@@ -55,11 +56,9 @@ static exr_result_t write_part(exr_context_t ctx, int part, const texr_spec *s,
         for (int y = 0; rv == EXR_ERR_SUCCESS && y < s->height; y += lines) {
             rv = exr_write_scanline_chunk_info(ctx, part, y, &ci);
             if (rv == EXR_ERR_SUCCESS)
-                rv = encode_chunk(ctx, part, &ci, s, base, elem, 0, y, &enc, &started);
+                rv = encode_chunk(ctx, part, &ci, s, base, elem, 0, y);
         }
     }
-    if (started)
-        exr_encoding_destroy(ctx, &enc);
     return rv;
 }
 
