@@ -241,8 +241,9 @@ static ts_status read_part0(exr_context_t ctx, exr_source *src, double rotation_
                        "environment map '%s' holds deep data, not an image", src->name);
     int64_t w = (int64_t)dw.max.x - dw.min.x + 1, h = (int64_t)dw.max.y - dw.min.y + 1;
     if (w <= 0 || h <= 0)
-        return ts_fail(err, TS_ERR_ARG, "environment map '%s' has an empty data window (%lld x %lld)",
-                       src->name, (long long)(w > 0 ? w : 0), (long long)(h > 0 ? h : 0));
+        return ts_fail(err, TS_ERR_ARG,
+                       "environment map '%s' has an empty data window (%lld x %lld)", src->name,
+                       (long long)(w > 0 ? w : 0), (long long)(h > 0 ? h : 0));
     if ((uint64_t)w * (uint64_t)h > TS_ENV_MAX_PIXELS)
         return ts_fail(err, TS_ERR_ARG,
                        "environment map '%s' is %lld x %lld pixels, more than the limit of %zu",

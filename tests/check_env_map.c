@@ -92,7 +92,9 @@ static void bright_texel(int col, int row, double rotation, double *az, double *
     for (int c = 0; c < 3; c++)
         rgb[((size_t)row * W + col) * 3 + c] = 100.0f;
     static const char *const ch[] = {"R", "G", "B"};
-    texr_spec s = {W, H, ch, 3, EXR_PIXEL_FLOAT, EXR_COMPRESSION_ZIP, 0, EXR_ENVMAP_LATLONG, 0};
+    texr_spec s = {.width = W, .height = H, .channels = ch, .nchannels = 3,
+                   .type = EXR_PIXEL_FLOAT, .compression = EXR_COMPRESSION_ZIP,
+                   .envmap = EXR_ENVMAP_LATLONG};
     const char *path = tenv_tmp("bright.exr");
     ck_assert_int_eq(texr_write(path, &s, rgb), 0);
     ts_env e;

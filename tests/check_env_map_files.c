@@ -109,11 +109,20 @@ START_TEST(test_variants_latlong)
         {"float, two parts, tiled 8", EXR_PIXEL_FLOAT, EXR_COMPRESSION_PIZ, 8, 0, 1},
     };
     for (size_t k = 0; k < sizeof v / sizeof v[0]; k++) {
-        texr_spec s = {W, H, RGB, 3, v[k].type, v[k].comp, v[k].tile, -1, v[k].extra_part};
+        texr_spec s = {.width = W, .height = H, .channels = RGB, .nchannels = 3, .type = v[k].type,
+                       .compression = v[k].comp, .tile_size = v[k].tile, .envmap = -1,
+                       .extra_part = v[k].extra_part};
         if (v[k].rgba)
             s.channels = v[k].rgba == 1 ? RGBA : RGBZ, s.nchannels = 4;
         round_trip(&s, rgb, &want, 0, v[k].what);
     }
+    /* a data window away from (0, 0): positions count from its corner */
+    texr_spec moved = {.width = W, .height = H, .channels = RGB, .nchannels = 3,
+                       .type = EXR_PIXEL_HALF, .compression = EXR_COMPRESSION_ZIP, .envmap = -1,
+                       .origin_x = -5, .origin_y = 100};
+    round_trip(&moved, rgb, &want, 0, "data window at (-5, 100)");
+    moved.tile_size = 16;
+    round_trip(&moved, rgb, &want, 0, "data window at (-5, 100), tiled");
     ts_env_free(&want);
     free(rgb);
 }
@@ -132,7 +141,8 @@ START_TEST(test_variants_lossy)
     ts_env want;
     ts_error err;
     ck_assert_int_eq(ts_env_from_latlong(rgb, W, H, 0.0, &want, &err), TS_OK);
-    texr_spec s = {W, H, RGB, 3, EXR_PIXEL_FLOAT, EXR_COMPRESSION_PXR24, 0, -1, 0};
+    texr_spec s = {.width = W, .height = H, .channels = RGB, .nchannels = 3,
+                   .type = EXR_PIXEL_FLOAT, .compression = EXR_COMPRESSION_PXR24, .envmap = -1};
     round_trip(&s, rgb, &want, 2e-5, "float, PXR24 (24-bit floats)");
     s.type = EXR_PIXEL_HALF, s.compression = EXR_COMPRESSION_B44;
     round_trip(&s, rgb, &want, 5e-3, "half, B44");
@@ -155,12 +165,16 @@ START_TEST(test_variants_uint_and_grey)
     ts_error err;
     ck_assert_int_eq(ts_env_from_latlong(rgb, W, H, 0.0, &want, &err), TS_OK);
     ck_assert_int_eq(ts_env_from_latlong(grey, W, H, 0.0, &want_grey, &err), TS_OK);
-    texr_spec s = {W, H, RGB, 3, EXR_PIXEL_UINT, EXR_COMPRESSION_ZIP, 0, -1, 0};
+    texr_spec s = {.width = W, .height = H, .channels = RGB, .nchannels = 3,
+                   .type = EXR_PIXEL_UINT, .compression = EXR_COMPRESSION_ZIP, .envmap = -1};
     round_trip(&s, rgb, &want, 0, "uint, ZIP");
     static const char *const Y[] = {"Y"}, *const YA[] = {"A", "Y"};
-    texr_spec y = {W, H, Y, 1, EXR_PIXEL_HALF, EXR_COMPRESSION_PIZ, 0, -1, 0};
+    texr_spec y = {.width = W, .height = H, .channels = Y, .nchannels = 1, .type = EXR_PIXEL_HALF,
+                   .compression = EXR_COMPRESSION_PIZ, .envmap = -1};
     round_trip(&y, rgb, &want_grey, 0, "Y only, half, PIZ");
-    texr_spec ya = {W, H, YA, 2, EXR_PIXEL_FLOAT, EXR_COMPRESSION_NONE, 16, -1, 0};
+    texr_spec ya = {.width = W, .height = H, .channels = YA, .nchannels = 2,
+                    .type = EXR_PIXEL_FLOAT, .compression = EXR_COMPRESSION_NONE, .tile_size = 16,
+                    .envmap = -1};
     round_trip(&ya, rgb, &want_grey, 0, "Y + A, float, tiled");
     ts_env_free(&want);
     ts_env_free(&want_grey);
@@ -177,7 +191,9 @@ START_TEST(test_variants_cube)
     ts_env want;
     ts_error err;
     ck_assert_int_eq(ts_env_from_cube(rgb, F, 0.0, &want, &err), TS_OK);
-    texr_spec s = {F, 6 * F, RGB, 3, EXR_PIXEL_HALF, EXR_COMPRESSION_ZIP, 0, EXR_ENVMAP_CUBE, 0};
+    texr_spec s = {.width = F, .height = 6 * F, .channels = RGB, .nchannels = 3,
+                   .type = EXR_PIXEL_HALF, .compression = EXR_COMPRESSION_ZIP,
+                   .envmap = EXR_ENVMAP_CUBE};
     round_trip(&s, rgb, &want, 0, "cube, envmap attribute");
     s.envmap = -1;
     s.tile_size = 16;
@@ -257,7 +273,8 @@ static const char *small_map(const char *name, int w, int h, int envmap,
     float *px = malloc((size_t)w * h * (size_t)nch * sizeof *px);
     for (size_t i = 0; i < (size_t)w * h * (size_t)nch; i++)
         px[i] = v;
-    texr_spec s = {w, h, channels, nch, EXR_PIXEL_FLOAT, EXR_COMPRESSION_ZIP, 0, envmap, 0};
+    texr_spec s = {.width = w, .height = h, .channels = channels, .nchannels = nch,
+                   .type = EXR_PIXEL_FLOAT, .compression = EXR_COMPRESSION_ZIP, .envmap = envmap};
     ck_assert_int_eq(texr_write(path, &s, px), 0);
     free(px);
     return path;
@@ -356,7 +373,8 @@ START_TEST(test_bad_pixels)
         float *rgb = tenv_random_image(W, H, 21);
         rgb[(10 * W + 20) * 3 + 1] = bad[k].v;
         const char *path = tenv_tmp("nan.exr");
-        texr_spec s = {W, H, RGB, 3, EXR_PIXEL_FLOAT, EXR_COMPRESSION_PIZ, 0, -1, 0};
+        texr_spec s = {.width = W, .height = H, .channels = RGB, .nchannels = 3,
+                       .type = EXR_PIXEL_FLOAT, .compression = EXR_COMPRESSION_PIZ, .envmap = -1};
         ck_assert_int_eq(texr_write(path, &s, rgb), 0);
         expect_file_error(path, bad[k].word);
         free(rgb);
@@ -364,7 +382,8 @@ START_TEST(test_bad_pixels)
     float *rgb = tenv_random_image(W, H, 22);
     rgb[(10 * W + 20) * 3 + 2] = -5.0f;
     const char *path = tenv_tmp("negative.exr");
-    texr_spec s = {W, H, RGB, 3, EXR_PIXEL_HALF, EXR_COMPRESSION_ZIP, 0, -1, 0};
+    texr_spec s = {.width = W, .height = H, .channels = RGB, .nchannels = 3,
+                   .type = EXR_PIXEL_HALF, .compression = EXR_COMPRESSION_ZIP, .envmap = -1};
     ck_assert_int_eq(texr_write(path, &s, rgb), 0);
     ts_env e;
     ts_error err;

@@ -54,7 +54,7 @@ static exr_result_t write_part(exr_context_t ctx, int part, const texr_spec *s,
         int32_t lines = 1;
         rv = exr_get_scanlines_per_chunk(ctx, part, &lines);
         for (int y = 0; rv == EXR_ERR_SUCCESS && y < s->height; y += lines) {
-            rv = exr_write_scanline_chunk_info(ctx, part, y, &ci);
+            rv = exr_write_scanline_chunk_info(ctx, part, s->origin_y + y, &ci);
             if (rv == EXR_ERR_SUCCESS)
                 rv = encode_chunk(ctx, part, &ci, s, base, elem, 0, y);
         }
@@ -67,9 +67,14 @@ static exr_result_t define_part(exr_context_t ctx, const char *name, const texr_
 {
     exr_result_t rv = exr_add_part(ctx, name, s->tile_size > 0 ? EXR_STORAGE_TILED
                                                               : EXR_STORAGE_SCANLINE, part);
+    exr_attr_box2i_t box;
+    box.min.x = s->origin_x, box.min.y = s->origin_y;
+    box.max.x = s->origin_x + s->width - 1, box.max.y = s->origin_y + s->height - 1;
+    exr_attr_v2f_t centre;
+    centre.x = centre.y = 0.0f;
     if (rv == EXR_ERR_SUCCESS)
-        rv = exr_initialize_required_attr_simple(ctx, *part, s->width, s->height,
-                                                 s->compression);
+        rv = exr_initialize_required_attr(ctx, *part, &box, &box, 1.0f, &centre, 1.0f,
+                                          EXR_LINEORDER_INCREASING_Y, s->compression);
     for (int c = 0; rv == EXR_ERR_SUCCESS && c < s->nchannels; c++)
         rv = exr_add_channel(ctx, *part, s->channels[c], s->type, EXR_PERCEPTUALLY_LOGARITHMIC,
                              1, 1);
@@ -93,7 +98,7 @@ int texr_write(const char *path, const texr_spec *s, const float *pixels)
         base = (const uint8_t *)ints;
     }
     texr_spec other = *s;
-    other.width = 8, other.height = 4, other.envmap = -1;
+    other.width = 8, other.height = 4, other.envmap = -1, other.origin_x = other.origin_y = 0;
     float *other_px = malloc((size_t)8 * 4 * (size_t)s->nchannels * sizeof *other_px);
     for (size_t i = 0; i < (size_t)8 * 4 * (size_t)s->nchannels; i++)
         other_px[i] = 1000.0f;

@@ -14,6 +14,7 @@ typedef struct {
     int tile_size;               /* 0: scanline file, else square tiles */
     int envmap;                  /* -1: no attribute, else EXR_ENVMAP_LATLONG/CUBE */
     int extra_part;              /* 1: add a second part (an 8 x 4 image of 1000s) */
+    int origin_x, origin_y;      /* the data window's top-left corner */
 } texr_spec;
 
 /* Write pixels (nchannels floats per pixel, interleaved, row 0 first; for
