@@ -72,6 +72,7 @@ void ts_env_free(ts_env *env);
  *
  * Pixel values: negative values (ringing of lossy compression, filters) are
  * clamped to 0; NaN and infinity are refused with an error naming the pixel.
+ * All functions here are reentrant (no global state).
  */
 
 /** The most pixels a map may have (2^26, e.g. 8192 x 8192; a 16384 x 8192
@@ -85,16 +86,19 @@ void ts_env_free(ts_env *env);
 ts_status ts_env_from_latlong(const float *rgb, int width, int height, double rotation_deg,
                               ts_env *out, ts_error *err);
 
-/** The same from a cube-face image: face_size x (6 face_size) pixels,
- *  faces +X, -X, +Y, -Y, +Z, -Z top to bottom, three floats per pixel. */
+/** The same from a cube-face image: face_size (>= 1) x (6 face_size)
+ *  pixels, faces +X, -X, +Y, -Y, +Z, -Z top to bottom, three floats per
+ *  pixel. */
 ts_status ts_env_from_cube(const float *rgb, int face_size, double rotation_deg, ts_env *out,
                            ts_error *err);
 
 /**
  * Read an environment map from an OpenEXR file with OpenEXRCore: the first
  * part of the file (multi-part files too), scanline or tiled (level 0 of a
- * mip-map), half, float or uint channels, any compression the library
- * decodes. Colour from the channels R, G and B (A and others are ignored),
+ * mip-map), half, float or uint channels, every OpenEXR compression: what
+ * OpenEXRCore cannot decode yet (DWAA and DWAB before OpenEXR 3.2, e.g. the
+ * Blender / Poly Haven maps) is decoded by OpenEXR's C++ library instead,
+ * so a C program that calls these readers links -lstdc++. Colour from the channels R, G and B (A and others are ignored),
  * or, without them, grey from Y (a luminance-chroma image's RY/BY are
  * ignored); the channels used must not be subsampled.
  *
