@@ -97,8 +97,8 @@ ts_status ts_env_from_cube(const float *rgb, int face_size, double rotation_deg,
  * part of the file (multi-part files too), scanline or tiled (level 0 of a
  * mip-map), half, float or uint channels, every OpenEXR compression: what
  * OpenEXRCore cannot decode yet (DWAA and DWAB before OpenEXR 3.2, e.g. the
- * Blender / Poly Haven maps) is decoded by OpenEXR's C++ library instead,
- * so a C program that calls these readers links -lstdc++. Colour from the channels R, G and B (A and others are ignored),
+ * Blender / Poly Haven maps) is decoded by OpenEXR's C++ library instead
+ * (libterrashade.la lists -lstdc++ among its dependencies for it). Colour from the channels R, G and B (A and others are ignored),
  * or, without them, grey from Y (a luminance-chroma image's RY/BY are
  * ignored); the channels used must not be subsampled.
  *
