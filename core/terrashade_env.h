@@ -76,7 +76,8 @@ void ts_env_free(ts_env *env);
  */
 
 /** The most pixels a map may have (2^26, e.g. 8192 x 8192; a 16384 x 8192
- *  lat-long map is refused): reading takes 12 bytes per pixel. */
+ *  lat-long map is refused): reading takes 12 bytes a pixel, plus 28 a
+ *  texel (see max_texels). */
 #define TS_ENV_MAX_PIXELS ((size_t)1 << 26)
 
 /** An environment from a lat-long image in OpenEXR's convention (above):
