@@ -189,13 +189,15 @@ class Processing(unittest.TestCase):
         self.assertEqual(r["algorithms"], sorted("terrashade:" + a for a in ALGORITHMS))
         self.assertEqual(r["problem"], "")
         self.assertTrue(r["unloaded"])
-        # the products left out are the day products without a fixed band count
+        # the products left out are the day products whose band count follows
+        # an option (time series), and only those
         _, products = driver_declares()
-        for name in set(products) - set(ALGORITHMS):
-            p = products[name]
-            print("left out: %s (daily=%s, bands=%s)" % (name, p.get("daily"), p.get("bands")))
-            self.assertEqual(p.get("daily"), "yes", name)
-            self.assertFalse(p.get("bands").strip().isdigit(), name)
+        for name, p in products.items():
+            series = p.get("daily") == "yes" and bool(p.get("bands_option"))
+            print("%-10s daily=%-3s bands=%s %-12s -> %s" % (
+                name, p.get("daily"), p.get("bands"), p.get("bands_option", ""),
+                "left out" if series else "algorithm"))
+            self.assertEqual(name not in ALGORITHMS, series, name)
 
     def test_parameters_are_the_drivers_options(self):
         options, products = driver_declares()

@@ -176,10 +176,12 @@ class TerrashadeAlgorithm(QgsProcessingAlgorithm):
 
     def shortHelpString(self):  # noqa: N802
         p = self.product
+        bands = p.bands + (" (set by %s)" % p.bands_option if p.bands_option else "")
+        text = p.description[:1].upper() + p.description[1:]
         return ("%s.\n\nUnit: %s. Bands: %s. %s\n\nRuns the TERRASHADE GDAL driver with "
                 "PRODUCT=%s; the parameters are the driver's open options (docs/driver.md)."
-                % (p.description.rstrip("."), p.unit or "none", p.bands,
-                   BYTE_HELP.get(p.byte, ""), p.name))
+                % (text.rstrip("."), p.unit or "none", bands, BYTE_HELP.get(p.byte, ""),
+                   p.name))
 
     def initAlgorithm(self, config=None):  # noqa: N802
         self.addParameter(QgsProcessingParameterRasterLayer(

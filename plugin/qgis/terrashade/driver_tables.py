@@ -23,8 +23,10 @@ PRODUCTS_ITEM = "TERRASHADE_PRODUCTS"
 # default: the declared text, or None; minimum/maximum: floats, or None;
 # values: the choices of a "choice".
 Option = namedtuple("Option", "name kind default minimum maximum values description")
-# bands: the declared text (a count, or what the count follows); options: names.
-Product = namedtuple("Product", "name description unit bands daily byte options")
+# bands: the band count with the default options (text); bands_option: the
+# option that sets the count, or ""; options: the names of those that apply.
+Product = namedtuple("Product", "name description unit bands bands_option daily byte "
+                     "options")
 
 _KINDS = {"float": "float", "real": "float", "int": "int", "integer": "int",
           "boolean": "bool", "string-select": "choice", "string": "string"}
@@ -64,19 +66,22 @@ def parse_products(xml_text):
         names = [n.strip() for n in el.get("options", "").split(",") if n.strip()]
         products.append(Product(el.get("name"), el.get("description", ""),
                                 el.get("unit", ""), el.get("bands", ""),
-                                _yes(el.get("daily")), el.get("byte", "never"), names))
+                                el.get("bands_option", ""), _yes(el.get("daily")),
+                                el.get("byte", "never"), names))
     return products
 
 
 def single_raster(product):
-    """True for a product that is one raster of a band count known up front.
+    """True for a product that is one raster, not a time series.
 
-    A day product whose band count is not a number (one band per time step or
-    per sun position: daycycle, farshadow) is a time series of hundreds of
-    bands, or an atlas file, and stays with gdal_translate. A band count that
-    follows an option of the product (horizon: DIRECTIONS) is the user's choice.
+    A day product whose band count follows an option (one band per time step
+    or per sun position: daycycle with STEP_MINUTES, farshadow with
+    ATLAS_STEPS) is a series of hundreds of bands, or an atlas file, and stays
+    with gdal_translate. Elsewhere such an option is the user's choice of
+    bands (horizon: DIRECTIONS), and a day product with a fixed count is one
+    raster (sunhours, insolation).
     """
-    return not product.daily or product.bands.strip().isdigit()
+    return not (product.daily and product.bands_option)
 
 
 def read_driver():
