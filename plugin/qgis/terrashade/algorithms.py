@@ -11,6 +11,7 @@ TERRASHADE:dem out.tif` gives. Only presentation is written here.
 """
 import os
 import shlex
+import sys
 
 from osgeo import gdal
 from qgis.core import (QgsProcessingAlgorithm, QgsProcessingException,
@@ -20,7 +21,7 @@ from qgis.core import (QgsProcessingAlgorithm, QgsProcessingException,
                        QgsProcessingParameterRasterLayer, QgsProcessingParameterString,
                        QgsRasterFileWriter)
 
-from .driver_tables import DRIVER, read_driver, single_raster
+from .driver_tables import DRIVER, is_yes, read_driver, single_raster
 
 # Open options the provider sets itself, never parameters: the algorithm is the
 # product, and QGIS shows the progress in its own bar.
@@ -68,15 +69,11 @@ def label(option):
     return LABELS.get(option.name) or first_clause(option.description) or option.name
 
 
-def _yes(text):
-    return (text or "").strip().lower() in ("yes", "true", "on", "1")
-
-
 def default_value(option):
     """The option's declared default as the parameter's Python value."""
     d = option.default
     if option.kind == "bool":
-        return _yes(d)
+        return is_yes(d)
     if option.kind == "choice":
         return option.values.index(d) if d in option.values else None
     if d is None or d == "":
@@ -87,10 +84,8 @@ def default_value(option):
 def make_parameter(option):
     name, text, default = option.name, label(option), default_value(option)
     if option.kind in ("float", "int"):
-        bounds = [-1.7976931348623157e308, 1.7976931348623157e308]
-        for i, b in enumerate((option.minimum, option.maximum)):
-            if b is not None:
-                bounds[i] = b
+        bounds = [-sys.float_info.max if option.minimum is None else option.minimum,
+                  sys.float_info.max if option.maximum is None else option.maximum]
         p = QgsProcessingParameterNumber(
             name, text, QgsProcessingParameterNumber.Double if option.kind == "float"
             else QgsProcessingParameterNumber.Integer, default, False, *bounds)

@@ -55,7 +55,8 @@ def parse_options(xml_text):
     return options
 
 
-def _yes(text):
+def is_yes(text):
+    """GDAL's reading of a boolean option's text."""
     return (text or "").strip().lower() in ("yes", "true", "on", "1")
 
 
@@ -66,7 +67,7 @@ def parse_products(xml_text):
         names = [n.strip() for n in el.get("options", "").split(",") if n.strip()]
         products.append(Product(el.get("name"), el.get("description", ""),
                                 el.get("unit", ""), el.get("bands", ""),
-                                el.get("bands_option", ""), _yes(el.get("daily")),
+                                el.get("bands_option", ""), is_yes(el.get("daily")),
                                 el.get("byte", "never"), names))
     return products
 
