@@ -1,0 +1,94 @@
+/*
+ * tsd_dataset.h - the classes of a TERRASHADE:<dem> dataset, shared by
+ * tsd_dataset.cpp (opening, computing, blocks) and tsd_dataset_metadata.cpp
+ * (metadata and PAM).
+ */
+#ifndef TSD_DATASET_H
+#define TSD_DATASET_H
+
+#include <mutex>
+#include <string>
+
+#include "gdal_pam.h"
+#include "ogr_spatialref.h"
+
+#include "tsd_backend.h"
+#include "tsd_compute.h"
+#include "tsd_geodesy.h"
+#include "tsd_options.h"
+#include "tsd_products.h"
+#include "tsd_sun.h"
+
+namespace tsd
+{
+
+class TSRasterBand;
+
+class TSRasterBand;
+
+/** A TERRASHADE:<dem> dataset: one product of a DEM. */
+class TSDataset final : public GDALPamDataset
+{
+    friend class TSRasterBand;
+
+    GDALDataset *m_poDEM = nullptr; // open until the product is computed
+    std::string m_osDEM;
+    tsd_options m_sOpts{};                  // what the user said
+    const tsd_product_def *m_psProduct = nullptr; // its row of the product table
+    tsd_run m_sRun{};                       // the sun used (progress: while computing)
+    tsd_cells m_sCells{};
+    double m_adfGT[6] = {0, 1, 0, 0, 0, 1};
+    bool m_bHasGT = true;
+    OGRSpatialReference m_oSRS{};
+    std::mutex m_oMutex{};
+    bool m_bTried = false;
+    std::string m_osError{};      // why computing failed
+    ts_status m_eStatus = TS_OK;  // and its status
+    float *m_pafProduct = nullptr;
+    GByte *m_pabyProduct = nullptr; // PRODUCT=farshadow
+    bool m_bHasSun = false;
+    tsd_sun m_sSun{};
+    bool m_bUsesBackend = false;
+    bool m_bBackendKnown = false;     // m_sBackend filled (predicted or ran)
+    tsd_backend_summary m_sBackend{}; // predicted, then what ran
+
+    CPLErr EnsureComputed();
+    void EnsureBackendMetadata();
+    void SetupBackendMetadata();
+    void ReportBackend();
+    void SetupSunMetadata();
+    void SetupMetadata();
+    void SetupPam(const char *pszConnection);
+
+  public:
+    TSDataset() = default;
+    ~TSDataset() override;
+
+    static GDALDataset *Open(GDALOpenInfo *poOpenInfo);
+
+    CPLErr GetGeoTransform(double *padfGT) override;
+    const OGRSpatialReference *GetSpatialRef() const override;
+    char **GetMetadata(const char *pszDomain = "") override;
+    const char *GetMetadataItem(const char *pszName, const char *pszDomain = "") override;
+};
+
+/** A band of it: one plane of the product. */
+class TSRasterBand final : public GDALPamRasterBand
+{
+    int m_nPlane;
+
+  public:
+    TSRasterBand(TSDataset *poDSIn, int nBandIn, GDALDataType eType);
+
+    CPLErr IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage) override;
+    double GetNoDataValue(int *pbSuccess = nullptr) override;
+    GDALColorInterp GetColorInterpretation() override
+    {
+        return GCI_GrayIndex;
+    }
+    const char *GetUnitType() override;
+};
+
+} // namespace tsd
+
+#endif
