@@ -34,9 +34,9 @@ BASIC = ("SUN_AZIMUTH", "SUN_ELEVATION", "DATETIME", "METHOD", "SKY_WEIGHT", "DI
 LABELS = {
     "DIRECTIONS": "Number of azimuths",
     "SKY_WEIGHT": "Weight of the light of a uniform sky",
-    "DATETIME": "Date and time instead of azimuth and elevation (ISO 8601 with an "
-                "offset, e.g. 2026-06-21T07:30:00+02:00)",
+    "DATETIME": "Date and time (ISO 8601 with an offset)",
     "DATE": "Day (YYYY-MM-DD, local to the time zone)",
+    "STEP_MINUTES": "Time step (minutes)",
     "Z_FACTOR": "Z factor (multiplies the heights, e.g. 0.3048 for feet)",
     "BACKEND": "Backend",
 }
