@@ -202,10 +202,15 @@ CPLErr TSAtlasDataset::EnsureNear()
             OGRSpatialReferenceH hSRS =
                 poSRS ? OGRSpatialReference::ToHandle(const_cast<OGRSpatialReference *>(poSRS))
                       : nullptr;
-            if (tsd_cells_compute(adfGT, W, H, hSRS, &sCells, szMsg, sizeof szMsg) != 0 ||
-                tsd_dem_load(GDALRasterBand::ToHandle(poDEM->GetRasterBand(nBandDEM)),
-                             &sCells, CPLAtof(pszZ), &sGrid, szMsg, sizeof szMsg) != 0)
+            ts_status eSt = tsd_cells_compute(adfGT, W, H, hSRS, &sCells, szMsg, sizeof szMsg);
+            if (eSt == TS_OK)
+                eSt = tsd_dem_load(GDALRasterBand::ToHandle(poDEM->GetRasterBand(nBandDEM)),
+                                   &sCells, CPLAtof(pszZ), &sGrid, szMsg, sizeof szMsg);
+            if (eSt != TS_OK)
+            {
+                m_nErr = ErrorNum(eSt);
                 m_osError = std::string("SHADOWS=all: ") + szMsg;
+            }
             else
                 bGrid = true;
         }

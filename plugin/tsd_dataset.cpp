@@ -162,10 +162,10 @@ CPLErr TSDataset::EnsureComputed()
         sRun.progress_user = &sProgress;
         ts_grid sGrid;
         GDALRasterBandH hBand = GDALGetRasterBand(m_poDEM, m_sOpts.band);
-        if (tsd_dem_load(hBand, &m_sCells, m_sOpts.z_factor, &sGrid, szMsg,
-                         sizeof szMsg) != 0)
+        eStatus = tsd_dem_load(hBand, &m_sCells, m_sOpts.z_factor, &sGrid, szMsg,
+                               sizeof szMsg);
+        if (eStatus != TS_OK)
         {
-            eStatus = TS_ERR_INTERNAL;
             m_osError = szMsg;
         }
         else
@@ -265,10 +265,12 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
                              "with gdal_translate instead");
     char szMsg[1024] = "";
     tsd_connstr sConn;
-    if (tsd_connstr_parse(poOpenInfo->pszFilename, &sConn, szMsg, sizeof szMsg) != 0)
+    const ts_status eParsed =
+        tsd_connstr_parse(poOpenInfo->pszFilename, &sConn, szMsg, sizeof szMsg);
+    if (eParsed != TS_OK)
     {
         tsd_connstr_free(&sConn);
-        return tsd::FailOpen(TS_ERR_ARG, szMsg);
+        return tsd::FailOpen(eParsed, szMsg);
     }
     CPLStringList aosOptions;
     for (char **p = sConn.options; p && *p; p++)
@@ -314,9 +316,10 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
         poDS->m_oSRS = *poSRS;
     OGRSpatialReferenceH hSRS =
         poDS->m_oSRS.IsEmpty() ? nullptr : OGRSpatialReference::ToHandle(&poDS->m_oSRS);
-    if (tsd_cells_compute(poDS->m_adfGT, W, H, hSRS, &poDS->m_sCells, szMsg,
-                          sizeof szMsg) != 0)
-        return tsd::FailOpen(CPLE_AppDefined, szMsg);
+    ts_status eSt =
+        tsd_cells_compute(poDS->m_adfGT, W, H, hSRS, &poDS->m_sCells, szMsg, sizeof szMsg);
+    if (eSt != TS_OK)
+        return tsd::FailOpen(eSt, szMsg);
     if (tsd_options_sun_from_time(&sOpts))
     {
         const char *pszWhat = sOpts.datetime[0] ? "DATETIME" : "DATE";
@@ -329,17 +332,17 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
                            pszWhat, osDEM.c_str(),
                            !poDS->m_bHasGT ? "geotransform" : "CRS"));
         tsd_sites sSites;
-        if (tsd_sites_compute(poDS->m_adfGT, W, H, hSRS, &poDS->m_sCells,
-                              sOpts.sun_position == TSD_SUN_PER_CELL, &sSites, szMsg,
-                              sizeof szMsg) != 0)
-            return tsd::FailOpen(CPLE_AppDefined, CPLSPrintf("%s: %s", pszWhat, szMsg));
+        eSt = tsd_sites_compute(poDS->m_adfGT, W, H, hSRS, &poDS->m_sCells,
+                                sOpts.sun_position == TSD_SUN_PER_CELL, &sSites, szMsg,
+                                sizeof szMsg);
+        if (eSt != TS_OK)
+            return tsd::FailOpen(eSt, CPLSPrintf("%s: %s", pszWhat, szMsg));
         double dfMinCell = poDS->m_sCells.cell_y;
         for (int y = 0; y < H; y++)
             dfMinCell = std::min(dfMinCell, poDS->m_sCells.cell_x_row
                                                 ? poDS->m_sCells.cell_x_row[y]
                                                 : poDS->m_sCells.cell_x);
-        const ts_status eSt =
-            tsd_sun_setup(&sOpts, &sSites, dfMinCell, &poDS->m_sSun, szMsg, sizeof szMsg);
+        eSt = tsd_sun_setup(&sOpts, &sSites, dfMinCell, &poDS->m_sSun, szMsg, sizeof szMsg);
         if (eSt != TS_OK)
             return tsd::FailOpen(eSt, szMsg);
         poDS->m_bHasSun = true;

@@ -24,8 +24,6 @@ namespace tsd
 
 class TSRasterBand;
 
-class TSRasterBand;
-
 /** A TERRASHADE:<dem> dataset: one product of a DEM. */
 class TSDataset final : public GDALPamDataset
 {
@@ -45,7 +43,7 @@ class TSDataset final : public GDALPamDataset
     std::string m_osError{};      // why computing failed
     ts_status m_eStatus = TS_OK;  // and its status
     float *m_pafProduct = nullptr;
-    GByte *m_pabyProduct = nullptr; // PRODUCT=farshadow
+    GByte *m_pabyProduct = nullptr; // products stored as bytes (TSD_BYTE_ALWAYS)
     bool m_bHasSun = false;
     tsd_sun m_sSun{};
     bool m_bUsesBackend = false;

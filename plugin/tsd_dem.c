@@ -1,6 +1,8 @@
 /* Read a DEM band into a core grid. */
 #include "tsd_dem.h"
 
+#include "tsd_text.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,28 +36,17 @@ static void flip(ts_grid *g, int flip_x, int flip_y)
         }
 }
 
-static int gdal_fail(char *msg, size_t n, const char *what)
-{
-    const char *last = CPLGetLastErrorMsg();
-    snprintf(msg, n, "%s%s%s", what, last && *last ? ": " : "",
-             last ? last : "");
-    return -1;
-}
-
-int tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
-                 ts_grid *grid, char *msg, size_t n)
+ts_status tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
+                       ts_grid *grid, char *msg, size_t n)
 {
     ts_error err;
     int w = GDALGetRasterBandXSize(band), h = GDALGetRasterBandYSize(band);
-    if (ts_grid_create(grid, w, h, cells->cell_x, cells->cell_y, &err) != TS_OK) {
-        snprintf(msg, n, "%s", err.message);
-        return -1;
-    }
+    if (ts_grid_create(grid, w, h, cells->cell_x, cells->cell_y, &err) != TS_OK)
+        return tsd_fail_core(msg, n, NULL, &err);
     if (cells->cell_x_row &&
         ts_grid_set_row_spacing(grid, cells->cell_x_row, &err) != TS_OK) {
-        snprintf(msg, n, "%s", err.message);
         ts_grid_free(grid);
-        return -1;
+        return tsd_fail_core(msg, n, NULL, &err);
     }
     int has_scale = 0, has_offset = 0;
     double scale = GDALGetRasterScale(band, &has_scale);
@@ -71,9 +62,8 @@ int tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
     GDALRasterBandH mask = all_valid ? NULL : GDALGetMaskBand(band);
     unsigned char *m = NULL;
     if (mask && !(m = malloc((size_t)w * STRIP_ROWS))) {
-        snprintf(msg, n, "out of memory reading the DEM's mask");
         ts_grid_free(grid);
-        return -1;
+        return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory reading the DEM's mask");
     }
     for (int y0 = 0; y0 < h; y0 += STRIP_ROWS) {
         int rows = h - y0 < STRIP_ROWS ? h - y0 : STRIP_ROWS;
@@ -82,9 +72,11 @@ int tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
                          0, (int)(grid->stride * sizeof(float))) != CE_None ||
             (mask && GDALRasterIO(mask, GF_Read, 0, y0, w, rows, m, w, rows,
                                   GDT_Byte, 0, w) != CE_None)) {
+            const char *last = CPLGetLastErrorMsg();
             free(m);
             ts_grid_free(grid);
-            return gdal_fail(msg, n, "cannot read the DEM");
+            return tsd_fail(msg, n, TS_ERR_INTERNAL, "cannot read the DEM%s%s",
+                            last && *last ? ": " : "", last ? last : "");
         }
         for (int y = 0; y < rows; y++) {
             float *r = z + (ptrdiff_t)y * grid->stride;
@@ -97,5 +89,5 @@ int tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
     }
     free(m);
     flip(grid, cells->flip_x, cells->flip_y);
-    return 0;
+    return TS_OK;
 }

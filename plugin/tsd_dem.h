@@ -17,9 +17,9 @@ extern "C" {
 #endif
 
 /** Fill `grid` (created here; free with ts_grid_free) from `band`.
- * 0 on success; -1 with a sentence in msg. */
-int tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
-                 ts_grid *grid, char *msg, size_t msg_size);
+ * TS_OK, or the failure's status with a sentence in msg. */
+ts_status tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
+                       ts_grid *grid, char *msg, size_t msg_size);
 
 #ifdef __cplusplus
 }

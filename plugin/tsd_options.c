@@ -414,22 +414,26 @@ static char *trim(const char *s, size_t len, char *buf, size_t n)
     return buf;
 }
 
-/* The names of the options of `scope`: "A, B, C" or, with last_and, "A, B
- * and C". */
-static void list_names(int scope, int last_and, char *buf, size_t n)
+/* The names of the options of `scope`, "A, B, C"; for an atlas "A, B and
+ * C", its own options before those it shares with products (THREADS). */
+static void list_names(int scope, char *buf, size_t n)
 {
+    const int atlas = scope == TSD_SCOPE_ATLAS;
     size_t used = 0;
     int total = 0, k = 0;
     buf[0] = '\0';
     for (int i = 0; i < N_OPTS; i++)
         total += (OPTS[i].scope & scope) != 0;
-    for (int i = 0; i < N_OPTS && used < n; i++) {
-        if (!(OPTS[i].scope & scope))
-            continue;
-        const char *sep = k == 0 ? "" : last_and && k == total - 1 ? " and " : ", ";
-        used += (size_t)snprintf(buf + used, n - used, "%s%s", sep, OPTS[i].name);
-        k++;
-    }
+    for (int pass = atlas ? 0 : 1; pass < 2; pass++)
+        for (int i = 0; i < N_OPTS && used < n; i++) {
+            if (!(OPTS[i].scope & scope) || (pass == 0 && OPTS[i].scope != scope))
+                continue;
+            if (atlas && pass == 1 && OPTS[i].scope == scope)
+                continue; /* listed in pass 0 */
+            const char *sep = k == 0 ? "" : atlas && k == total - 1 ? " and " : ", ";
+            used += (size_t)snprintf(buf + used, n - used, "%s%s", sep, OPTS[i].name);
+            k++;
+        }
 }
 
 /* Apply "KEY=VALUE" items of a dataset of `scope`. */
@@ -451,7 +455,7 @@ static int apply_scope(tsd_options *o, const char *const *kv, int scope, char *m
             REFUSE("%s is an open option of far-shadow atlas files (.tsa), not of "
                    "TERRASHADE:<dem>", key);
         if (id < 0 || !(OPTS[id].scope & scope)) {
-            list_names(scope, scope == TSD_SCOPE_ATLAS, names, sizeof names);
+            list_names(scope, names, sizeof names);
             if (scope == TSD_SCOPE_ATLAS)
                 REFUSE("an atlas takes the open options %s, not '%s'", names, key);
             REFUSE("unknown option '%s'; the options are %s (see gdalinfo "
