@@ -268,7 +268,7 @@ CPLErr TSAtlasDataset::EnsureNear()
     }
     if (!m_osError.empty())
     {
-        FailOpen(m_nErr, m_osError.c_str());
+        Fail(m_nErr, m_osError.c_str());
         return CE_Failure;
     }
     return CE_None;
@@ -431,7 +431,7 @@ GDALDataset *TSAtlasDataset::CreateCopy(const char *pszFilename, GDALDataset *po
             return FailOpen(sErr.code, CPLSPrintf("band %d: %s", b, sErr.message));
         if (!pfnProgress(0.95 * b / nBands, nullptr, pProgressData))
         {
-            CPLError(CE_Failure, CPLE_UserInterrupt, "TERRASHADE: interrupted");
+            Fail(TS_ERR_CANCELLED, "interrupted");
             return nullptr;
         }
     }

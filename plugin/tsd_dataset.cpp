@@ -220,7 +220,7 @@ CPLErr TSDataset::EnsureComputed()
     }
     if (!m_osError.empty())
     {
-        tsd::Fail(m_eStatus, m_osError.c_str());
+        Fail(m_eStatus, m_osError.c_str());
         return CE_Failure;
     }
     return CE_None;
@@ -244,14 +244,14 @@ static bool CheckMemory(const tsd_options &sOpts, int W, int H)
     }
     if (dfPeak <= dfLimit && dfPeak < static_cast<double>(std::numeric_limits<size_t>::max()) / 2)
         return true;
-    CPLError(CE_Failure, CPLE_OutOfMemory,
-             "TERRASHADE: PRODUCT=%s with %d band(s) on this %d x %d DEM needs "
-             "about %.0f MiB while computing (%.0f MiB kept), more than the "
-             "limit of %.0f MiB (%s); crop or downsample the DEM, use fewer "
-             "DIRECTIONS, or raise MAX_MEMORY",
-             tsd_options_product_name(&sOpts), tsd_options_band_count(&sOpts), W,
-             H, dfPeak / 1048576.0, dfSteady / 1048576.0, dfLimit / 1048576.0,
-             pszWhy);
+    Fail(TS_ERR_NOMEM,
+         CPLSPrintf("PRODUCT=%s with %d band(s) on this %d x %d DEM needs "
+                    "about %.0f MiB while computing (%.0f MiB kept), more than the "
+                    "limit of %.0f MiB (%s); crop or downsample the DEM, use fewer "
+                    "DIRECTIONS, or raise MAX_MEMORY",
+                    tsd_options_product_name(&sOpts), tsd_options_band_count(&sOpts), W,
+                    H, dfPeak / 1048576.0, dfSteady / 1048576.0, dfLimit / 1048576.0,
+                    pszWhy));
     return false;
 }
 
@@ -260,7 +260,7 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     if (!tsd_connstr_matches(poOpenInfo->pszFilename))
         return nullptr;
     if (poOpenInfo->eAccess == GA_Update)
-        return tsd::FailOpen(CPLE_NotSupported,
+        return FailOpen(CPLE_NotSupported,
                              "TERRASHADE datasets are read-only; write the product "
                              "with gdal_translate instead");
     char szMsg[1024] = "";
@@ -270,7 +270,7 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     if (eParsed != TS_OK)
     {
         tsd_connstr_free(&sConn);
-        return tsd::FailOpen(eParsed, szMsg);
+        return FailOpen(eParsed, szMsg);
     }
     CPLStringList aosOptions;
     for (char **p = sConn.options; p && *p; p++)
@@ -284,20 +284,20 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     tsd_options &sOpts = poDS->m_sOpts;
     tsd_options_defaults(&sOpts);
     if (tsd_options_apply(&sOpts, aosOptions.List(), szMsg, sizeof szMsg) != 0)
-        return tsd::FailOpen(TS_ERR_ARG, szMsg);
+        return FailOpen(TS_ERR_ARG, szMsg);
     poDS->m_psProduct = tsd_product_of(&sOpts);
 
     GDALDataset *poDEM = GDALDataset::Open(
         osDEM.c_str(), GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR, nullptr, nullptr,
         nullptr);
     if (!poDEM)
-        return tsd::FailOpen(CPLE_OpenFailed,
+        return FailOpen(CPLE_OpenFailed,
                              CPLSPrintf("cannot open the DEM '%s' as a raster",
                                         osDEM.c_str()));
     poDS->m_poDEM = poDEM;
     poDS->m_osDEM = osDEM;
     if (sOpts.band > poDEM->GetRasterCount())
-        return tsd::FailOpen(TS_ERR_ARG,
+        return FailOpen(TS_ERR_ARG,
                              CPLSPrintf("BAND=%d, but the DEM '%s' has %d band(s)",
                                         sOpts.band, osDEM.c_str(),
                                         poDEM->GetRasterCount()));
@@ -319,12 +319,12 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     ts_status eSt =
         tsd_cells_compute(poDS->m_adfGT, W, H, hSRS, &poDS->m_sCells, szMsg, sizeof szMsg);
     if (eSt != TS_OK)
-        return tsd::FailOpen(eSt, szMsg);
+        return FailOpen(eSt, szMsg);
     if (tsd_options_sun_from_time(&sOpts))
     {
         const char *pszWhat = sOpts.datetime[0] ? "DATETIME" : "DATE";
         if (!poDS->m_bHasGT || !hSRS)
-            return tsd::FailOpen(
+            return FailOpen(
                 CPLE_AppDefined,
                 CPLSPrintf("%s needs a georeferenced DEM, but '%s' has no %s: the sun's "
                            "position over it is unknown. Give it one (gdal_edit.py "
@@ -336,7 +336,7 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
                                 sOpts.sun_position == TSD_SUN_PER_CELL, &sSites, szMsg,
                                 sizeof szMsg);
         if (eSt != TS_OK)
-            return tsd::FailOpen(eSt, CPLSPrintf("%s: %s", pszWhat, szMsg));
+            return FailOpen(eSt, CPLSPrintf("%s: %s", pszWhat, szMsg));
         double dfMinCell = poDS->m_sCells.cell_y;
         for (int y = 0; y < H; y++)
             dfMinCell = std::min(dfMinCell, poDS->m_sCells.cell_x_row
@@ -344,7 +344,7 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
                                                 : poDS->m_sCells.cell_x);
         eSt = tsd_sun_setup(&sOpts, &sSites, dfMinCell, &poDS->m_sSun, szMsg, sizeof szMsg);
         if (eSt != TS_OK)
-            return tsd::FailOpen(eSt, szMsg);
+            return FailOpen(eSt, szMsg);
         poDS->m_bHasSun = true;
     }
     const tsd_sun *psSun = poDS->m_bHasSun ? &poDS->m_sSun : nullptr;
@@ -359,7 +359,7 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
                            poDS->m_psProduct->uses_backend(&sOpts, psSun);
     if (poDS->m_bUsesBackend &&
         tsd_backend_check_env(&sOpts, szMsg, sizeof szMsg) != 0)
-        return tsd::FailOpen(TS_ERR_ARG, szMsg);
+        return FailOpen(TS_ERR_ARG, szMsg);
 
     poDS->nRasterXSize = W;
     poDS->nRasterYSize = H;

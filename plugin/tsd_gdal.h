@@ -43,10 +43,16 @@ inline void Fail(ts_status eStatus, const char *pszMsg)
 }
 
 /** Report a failure that no status describes (a file that cannot be read,
- * an access mode not supported); returns nullptr for Open. */
-inline GDALDataset *FailOpen(CPLErrorNum nErr, const char *pszMsg)
+ * an access mode not supported) with its own number. */
+inline void Fail(CPLErrorNum nErr, const char *pszMsg)
 {
     CPLError(CE_Failure, nErr, "TERRASHADE: %s", pszMsg);
+}
+
+/** The same; returns nullptr for Open. */
+inline GDALDataset *FailOpen(CPLErrorNum nErr, const char *pszMsg)
+{
+    Fail(nErr, pszMsg);
     return nullptr;
 }
 
