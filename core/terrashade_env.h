@@ -43,6 +43,68 @@ typedef struct {
 /** Free the texels (NULL-safe); leaves count 0. */
 void ts_env_free(ts_env *env);
 
+/* ------------------------------------------------- lat-long texel grids */
+
+/**
+ * Texels of an equal-angle grid over the whole sphere, radiance 0, for the
+ * caller to fill (standard skies, tests): `width` columns of azimuth, column
+ * c spanning [c, c + 1] * 360 / width degrees clockwise from north, and
+ * `height` rows of elevation, row 0 at the zenith, row height - 1 at the
+ * nadir. Texel (row r, column c) is texels[r * width + c]; its direction is
+ * the cell's centre in angle, its solid angle the exact area of the cell,
+ * (sin e_top - sin e_bottom) * 2 pi / width, so they sum to 4 pi.
+ * width >= 1, height >= 2, width * height <= 2^26. Free with ts_env_free.
+ */
+ts_status ts_env_sphere_grid(ts_env *env, int width, int height, ts_error *err);
+
+/* ------------------------------------------------------- standard skies */
+
+/** The standard skies (choices explained in core/env_sky.c). */
+typedef enum {
+    TS_SKY_UNIFORM = 0, /**< the same radiance everywhere above the horizontal */
+    TS_SKY_OVERCAST,    /**< CIE standard overcast sky (Moon & Spencer 1942, CIE 1955):
+                             L(Z) = Lz (1 + 2 cos Z) / 3, no sun dependence */
+    TS_SKY_CLEAR,       /**< CIE standard clear sky: general sky type 12 */
+    TS_SKY_CIE          /**< one of the 15 CIE general sky types (ISO 15469, CIE S 011) */
+} ts_sky_kind;
+
+/** Default lat-long resolution of a standard sky (ts_env_sky with 0 x 0). */
+#define TS_SKY_DEFAULT_WIDTH 1024
+#define TS_SKY_DEFAULT_HEIGHT 512
+
+/**
+ * Relative luminance L / Lz of CIE general sky `type` (1..15) at a sky
+ * element `zenith_deg` from the zenith and `sun_distance_deg` from the sun,
+ * with the sun `sun_zenith_deg` from the zenith (ISO 15469 / CIE S 011):
+ * f(chi) phi(Z) / (f(Zs) phi(0)), gradation phi(Z) = 1 + a exp(b / cos Z)
+ * (phi = 1 at and below the horizontal), indicatrix f(chi) = 1 + c (exp(d chi)
+ * - exp(d pi / 2)) + e cos^2 chi. NaN for a type out of range.
+ */
+double ts_cie_sky_relative(int type, double zenith_deg, double sun_distance_deg,
+                           double sun_zenith_deg);
+
+/**
+ * Parse a sky name: "uniform", "overcast", "clear" or "cie:N" (N in 1..15,
+ * case-insensitive). Sets *kind and *cie_type (0 unless TS_SKY_CIE).
+ */
+ts_status ts_sky_parse(const char *name, ts_sky_kind *kind, int *cie_type, ts_error *err);
+
+/**
+ * A standard sky as an environment on a width x height lat-long grid
+ * (ts_env_sphere_grid; 0 x 0 = TS_SKY_DEFAULT_WIDTH x HEIGHT), grey
+ * (R = G = B). Normalised so that the horizontal diffuse irradiance is pi
+ * (summed over the grid's own texels), i.e. a flat open plane reflects
+ * E/pi = 1, as under the uniform sky of radiance 1 and as the shade
+ * product's uniform `sky` term: skies are interchangeable at one
+ * SKY_WEIGHT. Zero below the horizontal (the ground is not a light; the
+ * terrain's horizon does the rest). The sun's disk itself is not part of the
+ * sky: the shade product's direct term adds it. cie_type is used only for
+ * TS_SKY_CIE; the sun (azimuth degrees from north, elevation in [-90, 90])
+ * only for the sun-dependent skies (ignored, but still checked, by the others).
+ */
+ts_status ts_env_sky(ts_env *env, ts_sky_kind kind, int cie_type, double sun_azimuth,
+                     double sun_elevation, int width, int height, ts_error *err);
+
 #ifdef __cplusplus
 }
 #endif
