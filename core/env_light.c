@@ -22,16 +22,40 @@ typedef struct {
     float *r, *gr, *b;
 } light_ctx;
 
+/* Cells per block of the exact form's two passes (on the stack). */
+#define LIGHT_BLOCK 256
+
 static void light_rows(void *ctx, int worker, long y0, long y1)
 {
     (void)worker;
     const light_ctx *C = ctx;
-    size_t W = (size_t)C->g->width;
-    for (size_t i = (size_t)y0 * W; i < (size_t)y1 * W; i++) {
-        float r = C->r[i], g = C->gr[i], b = C->b[i];
-        cm_env_light_sector(C->nx[i], C->ny[i], C->nz[i], C->plane[i], C->sa, C->ca, C->lp,
-                            C->nn, C->nh, &r, &g, &b);
-        C->r[i] = r, C->gr[i] = g, C->b[i] = b;
+    size_t W = (size_t)C->g->width, i0 = (size_t)y0 * W, i1 = (size_t)y1 * W;
+    if (C->nn) {
+        for (size_t i = i0; i < i1; i++) {
+            float r = C->r[i], g = C->gr[i], b = C->b[i];
+            cm_env_light_sector(C->nx[i], C->ny[i], C->nz[i], C->plane[i], C->sa, C->ca, C->lp,
+                                C->nn, C->nh, &r, &g, &b);
+            C->r[i] = r, C->gr[i] = g, C->b[i] = b;
+        }
+        return;
+    }
+    const float *restrict nx = C->nx, *restrict ny = C->ny, *restrict nz = C->nz;
+    const float *restrict plane = C->plane, *restrict lp = C->lp;
+    float *restrict R = C->r, *restrict G = C->gr, *restrict B = C->b;
+    const float sa = C->sa, ca = C->ca;
+    const int nh = C->nh;
+    int node[LIGHT_BLOCK];
+    float frac[LIGHT_BLOCK], inplane[LIGHT_BLOCK];
+    for (size_t s = i0; s < i1; s += LIGHT_BLOCK) {
+        int m = (int)(i1 - s < LIGHT_BLOCK ? i1 - s : LIGHT_BLOCK);
+        for (int q = 0; q < m; q++) /* vectorised: no table reads */
+            node[q] = cm_env_exact_place(nx[s + q], ny[s + q], nz[s + q], plane[s + q], sa, ca,
+                                         nh, &frac[q], &inplane[q]);
+        for (int q = 0; q < m; q++) {
+            float r = R[s + q], g = G[s + q], b = B[s + q];
+            cm_env_exact_add(lp, node[q], frac[q], inplane[q], nz[s + q], &r, &g, &b);
+            R[s + q] = r, G[s + q] = g, B[s + q] = b;
+        }
     }
 }
 
@@ -48,7 +72,8 @@ static ts_status check_outputs(const ts_grid *grid, const float *r, const float 
 
 static ts_status check_table(const ts_env_table *t, ts_error *err)
 {
-    if (!t || !t->lp || t->directions < 1 || t->normal_steps < 2 || t->horizon_steps < 2)
+    if (!t || !t->lp || t->directions < 1 || t->normal_steps == 1 || t->normal_steps < 0 ||
+        t->horizon_steps < 2)
         return ts_fail(err, TS_ERR_ARG, "the light table is missing or was not built");
     return TS_OK;
 }
@@ -69,7 +94,8 @@ ts_status ts_env_light_accumulate(const ts_grid *grid, const ts_env_table *table
         return ts_fail(err, TS_ERR_ARG, "sector %d is outside the light table's %d directions",
                        k, table->directions);
     double az = ts_env_table_azimuth(table, k) * DEG2RAD;
-    size_t per_sector = (size_t)table->normal_steps * table->horizon_steps * 8;
+    size_t rows = table->normal_steps ? (size_t)table->normal_steps : 1;
+    size_t per_sector = rows * table->horizon_steps * 8;
     light_ctx C = {grid, nx, ny, nz, plane, table->lp + per_sector * k,
                    (float)sin(az), (float)cos(az), table->normal_steps, table->horizon_steps,
                    r, g, b};

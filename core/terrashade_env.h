@@ -109,8 +109,13 @@ ts_status ts_env_sky(ts_env *env, ts_sky_kind kind, int cie_type, double sun_azi
 
 /* -------------------------------------------------- Timonen's L_p table */
 
-/** Default table resolutions (chosen by measurement: tests/check_env_light.c). */
-#define TS_ENV_DEFAULT_NORMAL_STEPS 65
+/**
+ * Default table resolutions, chosen by measurement (tests/check_env_light.c,
+ * bench/env_bench.c): the exact normal axis (0) is more accurate than a
+ * bilinear normal axis of 65 steps, its table is 65 times smaller and the
+ * lighting costs half as much; 1-degree horizon steps, finer gave nothing.
+ */
+#define TS_ENV_DEFAULT_NORMAL_STEPS 0
 #define TS_ENV_DEFAULT_HORIZON_STEPS 181
 
 /**
@@ -120,7 +125,8 @@ ts_status ts_env_sky(ts_env *env, ts_sky_kind kind, int cie_type, double sun_azi
 typedef struct {
     int directions;       /**< azimuth sectors, >= 1 (DIRECTIONS) */
     double start_azimuth; /**< centre of sector 0, degrees from north */
-    int normal_steps;     /**< samples of the projected normal angle over [-90, 90] deg, >= 2 */
+    int normal_steps;     /**< samples of the projected normal angle over [-90, 90] deg,
+                               >= 2 (bilinear, as Timonen), or 0: exact (see ts_env_table) */
     int horizon_steps;    /**< samples of the horizon angle over [-90, 90] deg, >= 2 */
     int ground;           /**< 0: light from below the horizontal is ignored (the sky
                                ends at the horizontal, as the `sky` product);
@@ -142,6 +148,12 @@ void ts_env_table_opts_default(ts_env_table_opts *opts);
  * A per colour (RGB), m = 4..6 B per colour, 3 and 7 padding; node i at
  * theta_n = -90 + 180 i / (normal_steps - 1), node j at h = -90 + 180 j /
  * (horizon_steps - 1) degrees.
+ *
+ * A texel is lit when its elevation exceeds max(h, -theta_n), so A and B
+ * depend on theta_n only through that cut. With normal_steps 0 the table
+ * keeps one row per sector (i = 0, no cut) and each cell reads it at its own
+ * max(h, -theta_n): L_p(theta_n, h) = cos theta_n A(max(h, -theta_n)) +
+ * sin theta_n B(max(h, -theta_n)), exact in theta_n, linear in the cut.
  */
 typedef struct {
     int directions;
@@ -152,8 +164,8 @@ typedef struct {
 } ts_env_table;
 
 /**
- * Build the table from an environment: O(texels * normal_steps +
- * directions * normal_steps * horizon_steps), independent of any DEM.
+ * Build the table from an environment: O(texels + directions *
+ * max(normal_steps, 1) * horizon_steps), independent of any DEM.
  * Texels with zero radiance are skipped. Free with ts_env_table_free.
  */
 ts_status ts_env_table_build(const ts_env *env, const ts_env_table_opts *opts,
@@ -168,7 +180,8 @@ double ts_env_table_azimuth(const ts_env_table *table, int k);
 /**
  * Environment light, one horizon plane at a time (Timonen eq. 6): add
  * |N_p| L_p(k, theta_n, h) = nz A + (N . u_k) B per colour, A and B bilinear
- * in both table axes, to the
+ * in both table axes (or, with normal_steps 0, linear at the cell's own cut),
+ * to the
  * accumulators r, g, b (width*height floats, zeroed before sector 0) for
  * sector k, whose horizon plane (ts_horizon_sweep at ts_env_table_azimuth(k))
  * is `plane`. Normals from ts_normals (nz > 0). Nodata (NaN normal or

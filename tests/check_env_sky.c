@@ -220,6 +220,7 @@ static Suite *env_sky_suite(void)
 {
     Suite *s = suite_create("env_sky");
     TCase *tc = tcase_create("skies");
+    tcase_set_timeout(tc, 120);
     tcase_add_test(tc, test_cie_formula_points);
     tcase_add_test(tc, test_cie_published);
     tcase_add_test(tc, test_sphere_grid);
