@@ -112,14 +112,17 @@ static void bench_size(int size, int dirs, int limit, const ts_env *env,
     double t_finish = seconds() - t0;
     c_on_top += c_light + cpu_seconds() - c0;
     double on_top = t_normals + t_light + t_finish;
-    printf("DEM %d x %d: table build %.3f s (%d x %d x %d, %.1f MiB); %d of %d azimuths: "
+    printf("DEM %d x %d: table build %.3f s (%d directions x %d normal steps (0 = exact) x %d, "
+           "%.2f MiB); %d of %d azimuths: "
            "sweeps %.2f s (%.1f M pixel-directions/s), lighting %.2f s "
            "(normals %.2f + accumulate %.2f + finish %.3f) = %.1f %% on top of the sweeps; "
            "CPU time: sweeps %.2f s, lighting %.2f s = %.1f %%\n",
            size, size, t_table, t.directions, t.normal_steps, t.horizon_steps,
-           (double)t.directions * t.normal_steps * t.horizon_steps * 8 * 4 / 1048576.0, limit,
+           (double)t.directions * (t.normal_steps ? t.normal_steps : 1) * t.horizon_steps * 8 *
+               4 / 1048576.0, limit,
            dirs, t_sweep, (double)n * limit / t_sweep / 1e6, on_top, t_normals, t_light,
            t_finish, 100.0 * on_top / t_sweep, c_sweep, c_on_top, 100.0 * c_on_top / c_sweep);
+    fflush(stdout);
     ts_env_table_free(&t);
     free(plane), free(nx), free(ny), free(nz), free(r), free(gr), free(b);
     ts_grid_free(&g);

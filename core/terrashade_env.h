@@ -113,7 +113,8 @@ ts_status ts_env_sky(ts_env *env, ts_sky_kind kind, int cie_type, double sun_azi
  * Default table resolutions, chosen by measurement (tests/check_env_light.c,
  * bench/env_bench.c): the exact normal axis (0) is more accurate than a
  * bilinear normal axis of 65 steps, its table is 65 times smaller and the
- * lighting costs half as much; 1-degree horizon steps, finer gave nothing.
+ * lighting costs less than half as much; 1-degree horizon steps (finer ones
+ * gave nothing against the brute-force reference).
  */
 #define TS_ENV_DEFAULT_NORMAL_STEPS 0
 #define TS_ENV_DEFAULT_HORIZON_STEPS 181
@@ -151,7 +152,8 @@ void ts_env_table_opts_default(ts_env_table_opts *opts);
  *
  * A texel is lit when its elevation exceeds max(h, -theta_n), so A and B
  * depend on theta_n only through that cut. With normal_steps 0 the table
- * keeps one row per sector (i = 0, no cut) and each cell reads it at its own
+ * keeps one row per sector (lp[(k * horizon_steps + j) * 8 + m], no cut)
+ * and each cell reads it at its own
  * max(h, -theta_n): L_p(theta_n, h) = cos theta_n A(max(h, -theta_n)) +
  * sin theta_n B(max(h, -theta_n)), exact in theta_n, linear in the cut.
  */
@@ -181,8 +183,7 @@ double ts_env_table_azimuth(const ts_env_table *table, int k);
  * Environment light, one horizon plane at a time (Timonen eq. 6): add
  * |N_p| L_p(k, theta_n, h) = nz A + (N . u_k) B per colour, A and B bilinear
  * in both table axes (or, with normal_steps 0, linear at the cell's own cut),
- * to the
- * accumulators r, g, b (width*height floats, zeroed before sector 0) for
+ * to the accumulators r, g, b (width*height floats, zeroed before sector 0) for
  * sector k, whose horizon plane (ts_horizon_sweep at ts_env_table_azimuth(k))
  * is `plane`. Normals from ts_normals (nz > 0). Nodata (NaN normal or
  * horizon) gives NaN. Then ts_env_light_finish.
