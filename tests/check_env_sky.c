@@ -124,6 +124,17 @@ START_TEST(test_skies_normalised_grey_and_dark_below)
         }
         ts_env_free(&env);
     }
+    /* The formula continued for a sun below the horizon (dusk) stays positive. */
+    for (int type = 1; type <= 15; type++) {
+        ts_env env;
+        ts_error err;
+        ck_assert(ts_env_sky(&env, TS_SKY_CIE, type, 250, -12, 128, 64, &err) == TS_OK);
+        ck_assert(fabs(horizontal_irradiance(&env) - PI) < 1e-4);
+        for (size_t i = 0; i < env.count; i++)
+            ck_assert(env.texels[i].dir[2] > 0 ? env.texels[i].rgb[0] > 0
+                                               : env.texels[i].rgb[0] == 0);
+        ts_env_free(&env);
+    }
 }
 END_TEST
 
