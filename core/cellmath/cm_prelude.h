@@ -1,6 +1,6 @@
 /*
- * cm_prelude.h - what the shared per-cell formulas (the headers in core/cellmath/)
- * need to compile both as C11, included by the C files of core/, and as OpenCL C 1.2,
+ * cm_prelude.h - what the shared per-cell formulas (core/cellmath/*.h)
+ * need to compile both as C11, included by core/*.c, and as OpenCL C 1.2,
  * embedded into the kernels by cl/embed.sh (which drops their #include
  * lines, so each header lists its own dependencies and embed order matters).
  *
