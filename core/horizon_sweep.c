@@ -19,7 +19,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "fastmath.h"
+#include "cellmath/cm_fastmath.h"
 #include "line_geometry.h"
 #include "near_field.h"
 #include "parallel.h"

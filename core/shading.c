@@ -2,7 +2,7 @@
 #include <math.h>
 
 #include "arg_checks.h"
-#include "fastmath.h"
+#include "cellmath/cm_fastmath.h"
 #include "parallel.h"
 #include "status_internal.h"
 

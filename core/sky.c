@@ -8,7 +8,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "fastmath.h"
+#include "cellmath/cm_fastmath.h"
 #include "parallel.h"
 #include "status_internal.h"
 
