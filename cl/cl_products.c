@@ -243,10 +243,11 @@ ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *
     ts_cl_job_arg(&J, k, 7, sizeof lx, &lx);
     ts_cl_job_arg(&J, k, 8, sizeof ly, &ly);
     ts_cl_job_arg(&J, k, 9, sizeof lz, &lz);
-    ts_cl_job_arg_real(&J, k, 10, sun_elevation);
-    ts_cl_job_arg_real(&J, k, 11, TS_SUN_RADIUS_DEG);
-    ts_cl_job_arg_real(&J, k, 12, M_PI);
-    ts_cl_job_arg(&J, k, 13, sizeof ob, &ob);
+    /* as core/shading.c */
+    const cl_float el_deg = (float)sun_elevation, inv_r = (float)(1.0 / TS_SUN_RADIUS_DEG);
+    ts_cl_job_arg(&J, k, 10, sizeof el_deg, &el_deg);
+    ts_cl_job_arg(&J, k, 11, sizeof inv_r, &inv_r);
+    ts_cl_job_arg(&J, k, 12, sizeof ob, &ob);
     size_t L = ts_cl_job_wg(&J, k, 256), global = ts_cl_round_up(cells, L);
     ts_cl_job_run(&J, k, 1, &global, &L, "ts_direct");
     ts_cl_job_read(&J, ob, 0, bytes, out, "direct light");

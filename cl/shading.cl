@@ -42,34 +42,18 @@ __kernel void ts_normals(__global const float *z, const int W, const int H,
 }
 
 /* Direct sun: h0, h1 are the two horizon planes around the sun's azimuth,
- * mixed with weight w, and the visible fraction of the sun's disk
- * (ts_sun_disk_fraction); pi: the host's M_PI. */
+ * mixed with weight w; el: the sun's elevation in degrees, inv_r: 1 / its
+ * angular radius in degrees. */
 __kernel void ts_direct(__global const float *nx, __global const float *ny,
                         __global const float *nz, __global const float *h0,
                         __global const float *h1, const long cells, const float w,
-                        const float lx, const float ly, const float lz, const real sun_el,
-                        const real radius, const real pi, __global float *out)
+                        const float lx, const float ly, const float lz, const float el,
+                        const float inv_r, __global float *out)
 {
     const long i = get_global_id(0);
     if (i >= cells)
         return;
-    float hz = (1.0f - w) * h0[i] + w * h1[i];
-    float ndotl = nx[i] * lx + ny[i] * ly + nz[i] * lz;
-    if (isnan(hz) || isnan(ndotl)) {
-        out[i] = NAN;
-        return;
-    }
-    real frac;
-    {
-        real u = (sun_el - (real)hz) / radius;
-        if (u >= 1)
-            frac = 1;
-        else if (u <= -1)
-            frac = 0;
-        else
-            frac = RC(0.5) + (u * sqrt(1 - u * u) + asin(u)) / pi;
-    }
-    out[i] = ndotl > 0 ? ndotl * (float)frac : 0.0f;
+    out[i] = cm_direct_sun(nx[i], ny[i], nz[i], h0[i], h1[i], w, lx, ly, lz, el, inv_r);
 }
 
 /* One swath of eq. 5 (sky.c). */

@@ -2,7 +2,7 @@
 #include <math.h>
 
 #include "arg_checks.h"
-#include "cellmath/cm_fastmath.h"
+#include "cellmath/cm_sun.h"
 #include "parallel.h"
 #include "status_internal.h"
 
@@ -28,8 +28,7 @@ typedef struct {
     float *out;
 } direct_ctx;
 
-/* Branch-free per cell so that the loop vectorises (fastmath.h's asin
- * instead of libm's); NaN flows through. */
+/* cm_direct_sun is branch-free, so that this loop vectorises. */
 static void direct_range(void *ctx, int worker, long begin, long end)
 {
     (void)worker;
@@ -39,13 +38,8 @@ static void direct_range(void *ctx, int worker, long begin, long end)
     float *restrict out = C->out;
     const float w = C->w, lx = C->lx, ly = C->ly, lz = C->lz;
     const float el = (float)C->sun_el, inv_r = (float)(1.0 / TS_SUN_RADIUS_DEG);
-    for (long i = begin; i < end; i++) {
-        float hz = (1.0f - w) * h0[i] + w * h1[i];
-        float ndotl = nx[i] * lx + ny[i] * ly + nz[i] * lz;
-        float lit = ts_disk_fraction_u((el - hz) * inv_r);
-        float v = (ndotl > 0.0f ? ndotl : 0.0f) * lit;
-        out[i] = v + (hz - hz) + (ndotl - ndotl); /* NaN stays NaN */
-    }
+    for (long i = begin; i < end; i++)
+        out[i] = cm_direct_sun(nx[i], ny[i], nz[i], h0[i], h1[i], w, lx, ly, lz, el, inv_r);
 }
 
 ts_status ts_shade_direct(const ts_grid *grid, const float *nx, const float *ny,

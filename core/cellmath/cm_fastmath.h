@@ -63,16 +63,4 @@ CM_FN void ts_sincos_0_pi(float x, float *s, float *c)
     *c = -sy;
 }
 
-/* Visible fraction of the sun's disk for u = (elevation - horizon) / radius:
- * the area of a unit disk above a chord at height -u, over pi. */
-CM_FN float ts_disk_fraction_u(float u)
-{
-    float uc = u > 1.0f ? 1.0f : u < -1.0f ? -1.0f : u;
-    float r = CM_SQRTF(1.0f - uc * uc);
-    /* asin(uc) = atan(uc / r), and +-pi/2 where r is 0 */
-    float q = uc / (r > 0.0f ? r : 1.0f);
-    float as = r > 0.0f ? ts_atanf(q) : CM_COPYSIGNF(TS_PI_2_F, uc);
-    return 0.5f + (uc * r + as) * 0.318309886f;
-}
-
 #endif
