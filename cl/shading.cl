@@ -3,15 +3,6 @@
  * core/shading.c and core/sky.c, one work-item per cell.
  */
 
-/* Height of a neighbour, the centre's where it is outside or nodata. */
-float ts_nb(__global const float *z, int W, int H, int x, int y, float centre)
-{
-    if (x < 0 || y < 0 || x >= W || y >= H)
-        return centre;
-    float v = z[(long)y * W + x];
-    return isnan(v) ? centre : v;
-}
-
 /* Horn normals; cxr: per-row east-west cell sizes when has_cxr. */
 __kernel void ts_normals(__global const float *z, const int W, const int H,
                          __global const real *cxr, const int has_cxr, const real cell_x,
@@ -22,23 +13,12 @@ __kernel void ts_normals(__global const float *z, const int W, const int H,
     if (o >= (long)W * H)
         return;
     const int y = (int)(o / W), x = (int)(o - (long)y * W);
-    const float e = z[o];
-    if (isnan(e)) {
-        nx[o] = ny[o] = nz[o] = NAN;
-        return;
-    }
-    real ew = (real)8 * (has_cxr ? cxr[y] : cell_x), ns = (real)8 * cell_y;
-    real a = ts_nb(z, W, H, x - 1, y - 1, e), b = ts_nb(z, W, H, x, y - 1, e);
-    real cc = ts_nb(z, W, H, x + 1, y - 1, e);
-    real d = ts_nb(z, W, H, x - 1, y, e), f = ts_nb(z, W, H, x + 1, y, e);
-    real gg = ts_nb(z, W, H, x - 1, y + 1, e), h = ts_nb(z, W, H, x, y + 1, e);
-    real i = ts_nb(z, W, H, x + 1, y + 1, e);
-    real dzdx = ((cc + 2 * f + i) - (a + 2 * d + gg)) / ew;
-    real dzdy = ((gg + 2 * h + i) - (a + 2 * b + cc)) / ns;
-    real inv = (real)1 / sqrt((real)1 + dzdx * dzdx + dzdy * dzdy);
-    nx[o] = (float)(-dzdx * inv);
-    ny[o] = (float)(dzdy * inv);
-    nz[o] = (float)inv;
+    float a, b, c;
+    cm_horn_normal(z, W, W, H, x, y, (real)8 * (has_cxr ? cxr[y] : cell_x), (real)8 * cell_y,
+                   &a, &b, &c);
+    nx[o] = a;
+    ny[o] = b;
+    nz[o] = c;
 }
 
 /* Direct sun: h0, h1 are the two horizon planes around the sun's azimuth,
