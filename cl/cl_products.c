@@ -308,8 +308,7 @@ ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
     }
     cl_kernel k = ts_cl_job_kernel(&J, "ts_sky");
     const cl_long ccells = (cl_long)cells;
-    const cl_float w1 = (float)(1.0 / n), w2 = (float)(sin(M_PI / n) / M_PI);
-    const cl_float half_pi = (float)(M_PI / 2), d2r = (float)DEG2RAD, fn = (float)n;
+    const cl_float w1 = (float)(1.0 / n), w2 = (float)(sin(M_PI / n) / M_PI), fn = (float)n;
     ts_cl_job_arg(&J, k, 0, sizeof xb, &xb);
     ts_cl_job_arg(&J, k, 1, sizeof yb, &yb);
     ts_cl_job_arg(&J, k, 2, sizeof zb, &zb);
@@ -317,13 +316,11 @@ ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
     ts_cl_job_arg(&J, k, 5, sizeof ccells, &ccells);
     ts_cl_job_arg(&J, k, 8, sizeof w1, &w1);
     ts_cl_job_arg(&J, k, 9, sizeof w2, &w2);
-    ts_cl_job_arg(&J, k, 10, sizeof half_pi, &half_pi);
-    ts_cl_job_arg(&J, k, 11, sizeof d2r, &d2r);
-    ts_cl_job_arg(&J, k, 12, sizeof want, &want);
-    ts_cl_job_arg(&J, k, 14, sizeof fn, &fn);
-    ts_cl_job_arg(&J, k, 15, sizeof acc[0], &acc[0]);
-    ts_cl_job_arg(&J, k, 16, sizeof acc[1], &acc[1]);
-    ts_cl_job_arg(&J, k, 17, sizeof acc[2], &acc[2]);
+    ts_cl_job_arg(&J, k, 10, sizeof want, &want);
+    ts_cl_job_arg(&J, k, 12, sizeof fn, &fn);
+    ts_cl_job_arg(&J, k, 13, sizeof acc[0], &acc[0]);
+    ts_cl_job_arg(&J, k, 14, sizeof acc[1], &acc[1]);
+    ts_cl_job_arg(&J, k, 15, sizeof acc[2], &acc[2]);
     size_t L = ts_cl_job_wg(&J, k, 256), global = ts_cl_round_up(cells, L);
     for (int first = 0; first < n && J.st == TS_OK; first += (int)A) {
         const cl_int nb = n - first < (int)A ? n - first : (int)A;
@@ -337,7 +334,7 @@ ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
         ts_cl_job_arg(&J, k, 4, sizeof nb, &nb);
         ts_cl_job_arg(&J, k, 6, sizeof sab, &sab);
         ts_cl_job_arg(&J, k, 7, sizeof cab, &cab);
-        ts_cl_job_arg(&J, k, 13, sizeof finish, &finish);
+        ts_cl_job_arg(&J, k, 11, sizeof finish, &finish);
         ts_cl_job_run(&J, k, 1, &global, &L, "ts_sky");
     }
     float *outs[3] = {svf, sky, openness};

@@ -1,6 +1,7 @@
 /*
- * Normals, direct sun and sky terms: ports of core/normals.c,
- * core/shading.c and core/sky.c, one work-item per cell.
+ * Normals, direct sun and sky terms: the loops of core/normals.c,
+ * core/shading.c and core/sky.c, one work-item per cell; the formulas are
+ * core/cellmath/cm_normals.h, cm_sun.h and cm_sky.h.
  */
 
 /* Horn normals; cxr: per-row east-west cell sizes when has_cxr. */
@@ -36,23 +37,16 @@ __kernel void ts_direct(__global const float *nx, __global const float *ny,
     out[i] = cm_direct_sun(nx[i], ny[i], nz[i], h0[i], h1[i], w, lx, ly, lz, el, inv_r);
 }
 
-/* One swath of eq. 5 (sky.c). */
-float ts_swath(float nz, float a, float theta, float w1, float w2)
-{
-    float s = sin(theta), c = cos(theta);
-    return w1 * nz * s * s + w2 * (theta - s * c) * a;
-}
-
 /*
  * Sky terms: accumulate nplanes horizon planes (directions with sines and
  * cosines sa[k], ca[k]) onto the accumulators, then, when `finish`, clamp
- * and average as ts_sky_finish. want: bit 0 svf, 1 sky, 2 openness.
+ * and average as ts_sky_finish. want: bit 0 svf, 1 sky, 2 openness; w1,
+ * w2: 1/n and sin(pi/n)/pi.
  */
 __kernel void ts_sky(__global const float *nx, __global const float *ny,
                      __global const float *nz, __global const float *planes,
                      const int nplanes, const long cells, __global const float *sa,
-                     __global const float *ca, const float w1, const float w2,
-                     const float half_pi, const float deg2rad, const int want,
+                     __global const float *ca, const float w1, const float w2, const int want,
                      const int finish, const float directions, __global float *svf,
                      __global float *sky, __global float *open)
 {
@@ -64,23 +58,14 @@ __kernel void ts_sky(__global const float *nx, __global const float *ny,
     float ao = (want & 4) ? open[i] : 0.0f;
     const float nzi = nz[i], nxi = nx[i], nyi = ny[i];
     for (int k = 0; k < nplanes; k++) {
-        float h = planes[k * cells + i];
-        if (isnan(h) || isnan(nzi)) {
-            as = ak = ao = NAN;
-            continue;
-        }
-        float a = nxi * sa[k] + nyi * ca[k];
-        float theta_n = half_pi + atan(a / nzi);
-        float theta_h = half_pi - h * deg2rad;
-        as += ts_swath(nzi, a, fmin(theta_h, theta_n), w1, w2);
-        ak += ts_swath(nzi, a, fmin(fmin(theta_h, half_pi), theta_n), w1, w2);
-        ao += 90.0f - h;
+        const float h = planes[k * cells + i];
+        as += cm_sky_term(nxi, nyi, nzi, h, sa[k], ca[k], w1, w2, 0);
+        ak += cm_sky_term(nxi, nyi, nzi, h, sa[k], ca[k], w1, w2, 1);
+        ao += cm_openness_term(h, nzi);
     }
     if (finish) {
-        if (as > 1.0f)
-            as = 1.0f;
-        if (ak > 1.0f)
-            ak = 1.0f;
+        as = cm_sky_clamp(as);
+        ak = cm_sky_clamp(ak);
         ao /= directions;
     }
     if (want & 1)
