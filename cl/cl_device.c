@@ -297,15 +297,13 @@ static ts_cl_dev *make_device(int i, ts_error *err)
         sscanf(cver, "OpenCL C %d.%d", &major, &minor);
         cl_device_fp_config sp = 0;
         clGetDeviceInfo(r->id, CL_DEVICE_SINGLE_FP_CONFIG, sizeof sp, &sp, NULL);
-        snprintf(opts, sizeof opts,
-                 "%s%s%s-DTS_NEAR_EXACT=%d -DTS_NEAR_STEPS=%d -DTS_NEAR_MAX_PIECES=%d "
-                 "-DTS_NEAR_MARGIN=%d",
+        /* TS_NEAR_* come with the embedded core/cellmath/cm_near_field.h */
+        snprintf(opts, sizeof opts, "%s%s%s",
                  (major > 1 || (major == 1 && minor >= 2)) ? "-cl-std=CL1.2 " : "",
                  d->info.fp64 ? "-DTS_FP64=1 " : "",
                  (sp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT)
-                     ? "-cl-fp32-correctly-rounded-divide-sqrt "
-                     : "",
-                 TS_NEAR_EXACT, TS_NEAR_STEPS, TS_NEAR_MAX_PIECES, TS_NEAR_MARGIN);
+                     ? "-cl-fp32-correctly-rounded-divide-sqrt"
+                     : "");
         e = clBuildProgram(d->prog, 1, &r->id, opts, NULL, NULL);
         if (e == CL_SUCCESS && getenv("TERRASHADE_OPENCL_VERBOSE")) {
             char log[4096] = "";

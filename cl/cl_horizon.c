@@ -56,10 +56,10 @@ static int fill_azimuth(const ts_grid *pg, double azimuth, int a, int line0, int
     I[TS_CLI_PLANE] = a;
     I[TS_CLI_NPIECES] = NP.npieces;
     for (int n = 0; n < NP.npieces; n++) {
-        I[TS_CLI_PDU + n] = NP.piece[n].du;
-        I[TS_CLI_PDV + n] = NP.piece[n].dv;
-        Dp[TS_CLD_PSA + n] = NP.piece[n].sa;
-        Dp[TS_CLD_PSB + n] = NP.piece[n].sb;
+        I[TS_CLI_PDU + n] = NP.piece_du[n];
+        I[TS_CLI_PDV + n] = NP.piece_dv[n];
+        Dp[TS_CLD_PSA + n] = NP.piece_sa[n];
+        Dp[TS_CLD_PSB + n] = NP.piece_sb[n];
     }
     for (int j = 0; j <= TS_NEAR_STEPS; j++) {
         I[TS_CLI_SDV + j] = NP.sample_dv[j];

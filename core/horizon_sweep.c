@@ -87,21 +87,8 @@ static occluder hull_query(const sweep_ctx *C, const sweep_ws *w, int far, doubl
 static inline float ray_slope(const sweep_ctx *C, int k, int i, float h, int dk, float dd)
 {
     const ts_line_geom *G = C->geom;
-    int kk = k - dk;
-    if (dk <= 0 || kk < 0 || dd <= 0.0f)
-        return -INFINITY;
-    double pv = -G->t * dk, o = floor(pv);
-    int r0 = i + (int)o;
-    float f = (float)(pv - o);
-    if (r0 < 0 || r0 > G->V - 1 || (f > 0.0f && r0 + 1 > G->V - 1))
-        return -INFINITY;
-    const float *z = C->grid->z + G->origin + (ptrdiff_t)kk * G->u_stride +
-                     (ptrdiff_t)r0 * G->v_stride;
-    float a = z[0], b = f > 0.0f ? z[G->v_stride] : a;
-    float hz = a + f * (b - a);
-    if (isnan(hz))
-        return -INFINITY;
-    return (hz - h) / dd - (float)C->c * dd;
+    const cm_ray_grid r = {C->grid->z, G->V, G->t, G->origin, G->u_stride, G->v_stride};
+    return cm_ray_slope(&r, k, i, h, dk, dd, (float)C->c);
 }
 
 /* Steps on either side of a line's occluder at which the cell's ray is
