@@ -25,44 +25,6 @@
  * two, in degrees.
  */
 
-/* ---------------------------------------------------------- line geometry */
-
-/* Smallest k with the predicate true (port of first_k, line_geometry.c). */
-int ts_first_k(__global const int *fl, int U, int asc, long lim, int want_ge)
-{
-    int lo = 0, hi = U;
-    while (lo < hi) {
-        int mid = lo + (hi - lo) / 2;
-        long v = fl[mid];
-        int p = want_ge ? (asc ? v >= lim : v <= lim) : (asc ? v > lim : v < lim);
-        if (p)
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
-    return lo;
-}
-
-/* ts_line_k_range. */
-int ts_k_range(__global const int *fl, int U, int V, real t, long b, int *k0, int *k1)
-{
-    int asc = t >= 0;
-    long lo = -b, hi = (long)V - 1 - b;
-    int a, z;
-    if (asc) {
-        a = ts_first_k(fl, U, 1, lo, 1);
-        z = ts_first_k(fl, U, 1, hi, 0) - 1;
-    } else {
-        a = ts_first_k(fl, U, 0, hi, 1);
-        z = ts_first_k(fl, U, 0, lo, 0) - 1;
-    }
-    if (a > z || a >= U || z < 0)
-        return 0;
-    *k0 = a;
-    *k1 = z;
-    return 1;
-}
-
 /* ------------------------------------------------------------------ hull */
 
 /* hull_query: the far-field occluder of (d, h) among hull points 0..far:
@@ -118,7 +80,7 @@ __kernel void ts_sweep_lines(__global const float *z, const int W, const int naz
     const real t = Q[TS_CLD_T], step_m = Q[TS_CLD_STEPM], near_skip = Q[TS_CLD_NEARSKIP];
     const long b = (long)P[TS_CLI_BLO] + (item - P[TS_CLI_LINE0]);
     int k0, k1;
-    if (!ts_k_range(fl, U, V, t, b, &k0, &k1))
+    if (!cm_line_k_range(fl, U, V, t >= 0, b, &k0, &k1))
         return;
     __global int2 *oh = hi + P[TS_CLI_PLANE] * plane;
     __global int2 *ol = lo + P[TS_CLI_PLANE] * plane;
