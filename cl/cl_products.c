@@ -41,13 +41,10 @@ ts_status ts_cl_shm_compute(const ts_grid *grid, double azimuth, double elevatio
                             double penumbra_depth, int threads, float *vis, float *shadow_height,
                             ts_error *err)
 {
-    ts_status st = ts_check_shm_args(grid, azimuth, elevation, penumbra_depth, threads, vis,
+    ts_status st = ts_check_shm_args(grid, &azimuth, elevation, penumbra_depth, threads, vis,
                                      shadow_height, err);
     if (st != TS_OK)
         return st;
-    azimuth = fmod(azimuth, 360.0);
-    if (azimuth < 0)
-        azimuth += 360.0;
 
     const int W = grid->width, H = grid->height;
     const size_t cells = (size_t)W * H;
@@ -155,11 +152,9 @@ ts_status ts_cl_shm_compute(const ts_grid *grid, double azimuth, double elevatio
 
 ts_status ts_cl_normals(const ts_grid *grid, float *nx, float *ny, float *nz, ts_error *err)
 {
-    ts_status st = ts_grid_validate(grid, err);
+    ts_status st = ts_check_normals_args(grid, nx, ny, nz, err);
     if (st != TS_OK)
         return st;
-    if (!nx || !ny || !nz)
-        return ts_fail(err, TS_ERR_ARG, "normal output buffers must not be NULL");
     const int W = grid->width, H = grid->height;
     const size_t cells = (size_t)W * H, bytes = cells * sizeof(float);
     ts_cl_job J;
@@ -210,14 +205,12 @@ ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *
 {
     int k0, k1;
     double w;
+    cl_float light[3];
     ts_status st = ts_direct_setup(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
-                                   out, &k0, &k1, &w, err);
+                                   out, &k0, &k1, &w, light, err);
     if (st != TS_OK)
         return st;
     const size_t cells = (size_t)grid->width * grid->height, bytes = cells * sizeof(float);
-    double az = sun_azimuth * DEG2RAD, el = sun_elevation * DEG2RAD;
-    const cl_float lx = (float)(sin(az) * cos(el)), ly = (float)(cos(az) * cos(el)),
-                   lz = (float)sin(el);
     ts_cl_job J;
     if (ts_cl_job_begin(&J, err) != TS_OK)
         return J.st;
@@ -240,9 +233,8 @@ ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *
     ts_cl_job_arg(&J, k, 5, sizeof ccells, &ccells);
     const cl_float fw = (float)w;
     ts_cl_job_arg(&J, k, 6, sizeof fw, &fw);
-    ts_cl_job_arg(&J, k, 7, sizeof lx, &lx);
-    ts_cl_job_arg(&J, k, 8, sizeof ly, &ly);
-    ts_cl_job_arg(&J, k, 9, sizeof lz, &lz);
+    for (int j = 0; j < 3; j++)
+        ts_cl_job_arg(&J, k, 7 + j, sizeof light[j], &light[j]);
     /* as core/shading.c */
     const cl_float el_deg = (float)sun_elevation, inv_r = (float)(1.0 / TS_SUN_RADIUS_DEG);
     ts_cl_job_arg(&J, k, 10, sizeof el_deg, &el_deg);
@@ -260,15 +252,9 @@ ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
                           const float *horizons, const ts_horizon_opts *opts, float *svf,
                           float *sky, float *openness, ts_error *err)
 {
-    ts_status st = ts_horizon_opts_validate(opts, err);
+    ts_status st = ts_check_sky_terms_args(grid, nx, ny, nz, horizons, opts, err);
     if (st != TS_OK)
         return st;
-    if ((st = ts_grid_validate(grid, err)) != TS_OK)
-        return st;
-    if (!nx || !ny || !nz)
-        return ts_fail(err, TS_ERR_ARG, "normals must not be NULL");
-    if (!horizons)
-        return ts_fail(err, TS_ERR_ARG, "horizons must not be NULL");
     const int n = opts->directions;
     const cl_int want = (svf ? 1 : 0) | (sky ? 2 : 0) | (openness ? 4 : 0);
     if (!want)

@@ -19,6 +19,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "arg_checks.h"
 #include "cellmath/cm_fastmath.h"
 #include "line_geometry.h"
 #include "near_field.h"
@@ -325,14 +326,8 @@ static ts_status sweep_setup(const ts_grid *grid, double azimuth,
                              const ts_horizon_opts *opts, ts_line_geom *geom,
                              sweep_ctx *C, ts_error *err)
 {
-    ts_status st = ts_grid_validate(grid, err);
+    ts_status st = ts_check_sweep_args(grid, &azimuth, opts, err);
     if (st != TS_OK)
-        return st;
-    if (!opts)
-        return ts_fail(err, TS_ERR_ARG, "horizon options are NULL");
-    ts_horizon_opts o = *opts;
-    o.directions = o.directions < 1 ? 1 : o.directions;
-    if ((st = ts_horizon_opts_validate(&o, err)) != TS_OK)
         return st;
     if ((st = ts_line_geom_init(geom, grid, azimuth, err)) != TS_OK)
         return st;

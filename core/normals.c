@@ -2,6 +2,7 @@
  * (core/cellmath/cm_normals.h). */
 #include <math.h>
 
+#include "arg_checks.h"
 #include "cellmath/cm_normals.h"
 #include "parallel.h"
 #include "status_internal.h"
@@ -28,11 +29,9 @@ static void normals_rows(void *ctx, int worker, long y0, long y1)
 
 ts_status ts_normals(const ts_grid *grid, float *nx, float *ny, float *nz, ts_error *err)
 {
-    ts_status st = ts_grid_validate(grid, err);
+    ts_status st = ts_check_normals_args(grid, nx, ny, nz, err);
     if (st != TS_OK)
         return st;
-    if (!nx || !ny || !nz)
-        return ts_fail(err, TS_ERR_ARG, "normal output buffers must not be NULL");
     normals_ctx C = {grid, nx, ny, nz};
     return ts_parallel_for(ts_thread_count(0, grid->height), grid->height, normals_rows, &C, err);
 }

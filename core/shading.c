@@ -6,8 +6,6 @@
 #include "parallel.h"
 #include "status_internal.h"
 
-#define DEG2RAD (M_PI / 180.0)
-
 double ts_sun_disk_fraction(double sun_elevation, double horizon)
 {
     if (isnan(sun_elevation) || isnan(horizon))
@@ -49,15 +47,14 @@ ts_status ts_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
 {
     int k0, k1;
     double w;
+    float light[3];
     ts_status st = ts_direct_setup(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
-                                   out, &k0, &k1, &w, err);
+                                   out, &k0, &k1, &w, light, err);
     if (st != TS_OK)
         return st;
     size_t plane = (size_t)grid->width * grid->height;
-    double az = sun_azimuth * DEG2RAD, el = sun_elevation * DEG2RAD;
     direct_ctx C = {nx, ny, nz, horizons + plane * k0, horizons + plane * k1, (float)w,
-                    (float)(sin(az) * cos(el)), (float)(cos(az) * cos(el)), (float)sin(el),
-                    sun_elevation, out};
+                    light[0], light[1], light[2], sun_elevation, out};
     return ts_parallel_for(ts_thread_count(0, (long)(plane >> 16) + 1), (long)plane,
                            direct_range, &C, err);
 }

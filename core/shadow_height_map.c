@@ -204,13 +204,10 @@ ts_status ts_shm_compute(const ts_grid *grid, double azimuth, double elevation,
                          double penumbra_depth, int threads, float *vis,
                          float *shadow_height, ts_error *err)
 {
-    ts_status st = ts_check_shm_args(grid, azimuth, elevation, penumbra_depth, threads, vis,
+    ts_status st = ts_check_shm_args(grid, &azimuth, elevation, penumbra_depth, threads, vis,
                                      shadow_height, err);
     if (st != TS_OK)
         return st;
-    azimuth = fmod(azimuth, 360.0);
-    if (azimuth < 0)
-        azimuth += 360.0;
     ts_line_geom G;
     if ((st = ts_line_geom_init(&G, grid, azimuth, err)) != TS_OK)
         return st;

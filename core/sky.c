@@ -8,6 +8,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "arg_checks.h"
 #include "cellmath/cm_sky.h"
 #include "parallel.h"
 #include "status_internal.h"
@@ -47,25 +48,12 @@ static void sky_rows(void *ctx, int worker, long y0, long y1)
     }
 }
 
-static ts_status check_common(const ts_grid *grid, const float *nx, const float *ny,
-                              const float *nz, int directions, ts_error *err)
-{
-    ts_status st = ts_grid_validate(grid, err);
-    if (st != TS_OK)
-        return st;
-    if (!nx || !ny || !nz)
-        return ts_fail(err, TS_ERR_ARG, "normals must not be NULL");
-    if (directions < 1)
-        return ts_fail(err, TS_ERR_ARG, "directions must be at least 1, got %d", directions);
-    return TS_OK;
-}
-
 ts_status ts_sky_accumulate(const ts_grid *grid, const float *nx, const float *ny,
                             const float *nz, const float *plane, double azimuth,
                             int directions, float *svf_acc, float *sky_acc,
                             float *openness_acc, ts_error *err)
 {
-    ts_status st = check_common(grid, nx, ny, nz, directions, err);
+    ts_status st = ts_check_sky_args(grid, nx, ny, nz, directions, err);
     if (st != TS_OK)
         return st;
     if (!plane)
@@ -105,13 +93,9 @@ ts_status ts_sky_terms(const ts_grid *grid, const float *nx, const float *ny, co
                        const float *horizons, const ts_horizon_opts *opts, float *svf,
                        float *sky, float *openness, ts_error *err)
 {
-    ts_status st = ts_horizon_opts_validate(opts, err);
+    ts_status st = ts_check_sky_terms_args(grid, nx, ny, nz, horizons, opts, err);
     if (st != TS_OK)
         return st;
-    if ((st = check_common(grid, nx, ny, nz, opts->directions, err)) != TS_OK)
-        return st;
-    if (!horizons)
-        return ts_fail(err, TS_ERR_ARG, "horizons must not be NULL");
     size_t n = (size_t)grid->width * grid->height;
     float *acc[3] = {svf, sky, openness};
     for (int j = 0; j < 3; j++)
