@@ -52,6 +52,7 @@ typedef struct {
     int *alloc_failed;  /* set by a worker that cannot get its workspace */
     ts_near_plan near;
     double near_skip;   /* hull points closer than this are near field */
+    cm_ray_grid ray;    /* the grid as the geometry sees it, for cm_ray_slope */
 } sweep_ctx;
 
 typedef struct {
@@ -87,9 +88,7 @@ static occluder hull_query(const sweep_ctx *C, const sweep_ws *w, int far, doubl
  * the grid there or touches nodata. */
 static inline float ray_slope(const sweep_ctx *C, int k, int i, float h, int dk, float dd)
 {
-    const ts_line_geom *G = C->geom;
-    const cm_ray_grid r = {C->grid->z, G->V, G->t, G->origin, G->u_stride, G->v_stride};
-    return cm_ray_slope(&r, k, i, h, dk, dd, (float)C->c);
+    return cm_ray_slope(&C->ray, k, i, h, dk, dd, (float)C->c);
 }
 
 /* Steps on either side of a line's occluder at which the cell's ray is
@@ -334,6 +333,8 @@ static ts_status sweep_setup(const ts_grid *grid, double azimuth,
     *C = (sweep_ctx){0};
     C->grid = grid;
     C->geom = geom;
+    C->ray = (cm_ray_grid){grid->z, geom->V, geom->t, geom->origin, geom->u_stride,
+                           geom->v_stride};
     C->c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
     C->cap = opts->max_distance;
     ts_line_out_strides(geom, grid->width, &C->o_origin, &C->o_u_stride, &C->o_v_stride);
