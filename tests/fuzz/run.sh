@@ -38,6 +38,7 @@ for t in $targets; do
     seeds="$SRC/tests/fuzz/corpus/$t"
     mkdir -p "$scratch/$t" "$seeds"
     log="$scratch/$t.log"
+    touch "$scratch/$t.start"
     # -timeout: one input taking 10 s is a hang; -rss_limit_mb: the machine
     # is shared, an input that needs 2 GiB is a finding.
     "$BUILD/$t" -max_total_time="$SECONDS_PER_TARGET" -timeout=10 \
@@ -55,7 +56,11 @@ for t in $targets; do
         failed=1
         echo "fuzz: $t: FAILED (exit $rc) after ${runs:-?} runs; last lines of its log:"
         tail -n 60 "$log"
-        ls "$ARTIFACTS"/"$t"-* 2>/dev/null | sed 's/^/fuzz: input: /'
+        # The input itself, so that a CI log is enough to reproduce it.
+        find "$ARTIFACTS" -name "$t-*" -newer "$scratch/$t.start" | while read -r a; do
+            echo "fuzz: input: $a ($(wc -c <"$a") bytes), base64:"
+            head -c 4096 "$a" | base64
+        done
     fi
 done
 exit $failed
