@@ -312,21 +312,59 @@ static ts_status xz_compress(const uint8_t *in, size_t n, int word, uint8_t **ou
     return TS_OK;
 }
 
-static ts_status xz_decompress(const uint8_t *in, size_t n, uint8_t *out, size_t expect,
+/* Decode one .xz section that must hold exactly `expect` bytes into a new
+ * buffer (*out, free with free()). The buffer grows with what the stream
+ * really decodes to, so a damaged header announcing gigabytes costs no more
+ * memory than the section's real contents. */
+static ts_status xz_decompress(const uint8_t *in, size_t n, size_t expect, uint8_t **out,
                                const char *what, ts_error *err)
 {
-    uint64_t memlimit = (uint64_t)1 << 30; /* a damaged header cannot ask for more */
-    size_t in_pos = 0, out_pos = 0;
-    lzma_ret r = lzma_stream_buffer_decode(&memlimit, 0, NULL, in, &in_pos, n, out,
-                                           &out_pos, expect);
-    if (r == LZMA_MEM_ERROR)
+    lzma_stream s = LZMA_STREAM_INIT;
+    *out = NULL;
+    /* 1 GiB: a damaged header cannot ask for more decoder memory */
+    if (lzma_stream_decoder(&s, (uint64_t)1 << 30, 0) != LZMA_OK)
         return ts_fail(err, TS_ERR_NOMEM, "out of memory decompressing the atlas's %s",
                        what);
-    if (r != LZMA_OK || in_pos != n || out_pos != expect)
+    /* one byte past `expect`: room to see a stream that decodes to more */
+    size_t cap = expect < 65536 ? expect + 1 : 65536;
+    uint8_t *buf = malloc(cap);
+    lzma_ret r = buf ? LZMA_OK : LZMA_MEM_ERROR;
+    s.next_in = in;
+    s.avail_in = n;
+    s.next_out = buf;
+    s.avail_out = cap;
+    while (r == LZMA_OK) {
+        r = lzma_code(&s, LZMA_FINISH);
+        if (r == LZMA_OK && s.avail_out == 0) {
+            if (cap > expect)
+                break; /* already more than announced */
+            size_t grown = cap > (expect + 1) / 2 ? expect + 1 : 2 * cap;
+            uint8_t *b = realloc(buf, grown);
+            if (!b) {
+                r = LZMA_MEM_ERROR;
+                break;
+            }
+            buf = b;
+            s.next_out = buf + cap;
+            s.avail_out = grown - cap;
+            cap = grown;
+        }
+    }
+    size_t in_pos = (size_t)s.total_in, out_pos = (size_t)s.total_out;
+    lzma_end(&s);
+    if (r == LZMA_MEM_ERROR) {
+        free(buf);
+        return ts_fail(err, TS_ERR_NOMEM, "out of memory decompressing the atlas's %s",
+                       what);
+    }
+    if (r != LZMA_STREAM_END || in_pos != n || out_pos != expect) {
+        free(buf);
         return ts_fail(err, TS_ERR_ARG,
                        "the atlas is damaged: its %s (LZMA) do not decode to the "
                        "%zu bytes the header announces (liblzma %d, %zu of %zu bytes "
                        "read, %zu written)", what, expect, (int)r, in_pos, n, out_pos);
+    }
+    *out = buf;
     return TS_OK;
 }
 
@@ -553,21 +591,14 @@ ts_status ts_atlas_open(const uint8_t *b, size_t n, ts_atlas **out, ts_error *er
     size_t idx_raw = planes * a->tiles * ib;
     a->text = malloc(tn + 1);
     a->steps = malloc(steps * sizeof *a->steps);
-    a->dict = malloc((size_t)ntiles * sizeof *a->dict);
-    a->index = malloc(idx_raw);
-    uint8_t *dict_raw = malloc((size_t)ntiles * 8);
-    if (!a->text || !a->steps || !a->dict || !a->index || !dict_raw) {
-        free(dict_raw);
-        st = ts_fail(err, TS_ERR_NOMEM, "cannot allocate %zu bytes for the atlas's index "
-                     "maps", idx_raw);
+    if (!a->text || !a->steps) {
+        st = ts_fail(err, TS_ERR_NOMEM, "cannot allocate the atlas's %u map records", steps);
         goto fail;
     }
     memcpy(a->text, b + to, tn);
     a->text[tn] = '\0';
-    if (memchr(a->text, '\0', tn)) {
-        free(dict_raw);
+    if (memchr(a->text, '\0', tn))
         BAD("the atlas's metadata text is damaged (it holds a NUL byte)");
-    }
     a->info.metadata = a->text;
     for (uint32_t s = 0; s < steps; s++) {
         const uint8_t *r = b + so + (size_t)s * TS_ATLAS_STEP_SIZE;
@@ -577,14 +608,20 @@ ts_status ts_atlas_open(const uint8_t *b, size_t n, ts_atlas **out, ts_error *er
         a->steps[s].elevation = getf64(r + 24);
         a->steps[s].utc_offset_minutes = (int32_t)get32(r + 32);
     }
-    st = xz_decompress(b + dof, dn, dict_raw, (size_t)ntiles * 8, "tile dictionary words", err);
+    uint8_t *dict_raw = NULL;
+    st = xz_decompress(b + dof, dn, (size_t)ntiles * 8, &dict_raw, "tile dictionary words",
+                       err);
+    /* allocated once the section really holds that many tiles */
+    if (st == TS_OK && !(a->dict = malloc((size_t)ntiles * sizeof *a->dict)))
+        st = ts_fail(err, TS_ERR_NOMEM, "cannot allocate the atlas's %u-tile dictionary",
+                     ntiles);
     if (st == TS_OK)
         for (uint32_t i = 0; i < ntiles; i++)
             a->dict[i] = get64(dict_raw + 8 * (size_t)i);
     free(dict_raw);
     if (st != TS_OK)
         goto fail;
-    if ((st = xz_decompress(b + io, in, a->index, idx_raw, "index maps", err)) != TS_OK)
+    if ((st = xz_decompress(b + io, in, idx_raw, &a->index, "index maps", err)) != TS_OK)
         goto fail;
     for (size_t p = 0; p < planes; p++)
         for (size_t t = 0; t < a->tiles; t++)
