@@ -220,6 +220,7 @@ def compute(client, out, source, task_options, tile, quiet):
     wins = W.windows(out.RasterXSize, out.RasterYSize, tile)
     futures = [client.submit(W.read_window, source, task_options, w, pure=False)
                for w in wins]
+    window_of = dict(zip((f.key for f in futures), wins))
     bar = None
     if not quiet:
         bar = threading.Thread(target=_progress_bar, args=(futures,), daemon=True)
@@ -229,8 +230,9 @@ def compute(client, out, source, task_options, tile, quiet):
             try:
                 (xoff, yoff, _, _), a = fut.result()
             except Exception as e:
-                raise Failure("a window of %s failed: %s: %s"
-                              % (source, type(e).__name__, e))
+                raise Failure("the window (xoff, yoff, xsize, ysize) = %r of %s "
+                              "failed: %s: %s" % (window_of[fut.key], source,
+                                                  type(e).__name__, e))
             for i in range(out.RasterCount):
                 out.GetRasterBand(i + 1).WriteArray(a[i], xoff, yoff)
             fut.release()

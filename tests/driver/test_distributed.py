@@ -9,11 +9,14 @@ dask.distributed equals gdal_translate of the same source, bit for bit.
 - a worker process that dies on its first task (a test hook in
   terrashade/windows.py, once per run) is replaced, Dask retries the window,
   and the result is still identical;
+- a window that fails (no retries allowed) fails the run: exit 1, the
+  older DEST untouched, no DEST.partial;
 - bad input (an unreachable scheduler, an unwritable destination, a SOURCE
   the driver refuses, bad tile sizes): a clear message, a non-zero exit and
   neither DEST nor DEST.partial left behind.
 """
 import os
+import re
 import socket
 import sys
 import unittest
@@ -118,6 +121,24 @@ class Distributed(unittest.TestCase):
                     + [T.conn(self.dem), dest], TERRASHADE_DISTRIBUTED_CRASH_ONCE=flag)
         self.assertTrue(os.path.exists(flag), "no worker was killed")
         self.assert_identical(dest, self.reference(HORIZON, "ref_retried.tif"))
+
+    def test_failed_window_leaves_nothing(self):
+        # no retries allowed: the killed worker's window fails the run
+        dest = self.path("failed.tif")
+        with open(dest, "w") as f:
+            f.write("an older result")
+        p = distributed(["--workers", 2, "--tile-size", 64] + T.oo_args(HORIZON)
+                        + [T.conn(self.dem), dest], ok=False,
+                        TERRASHADE_DISTRIBUTED_CRASH_ONCE=self.path("crashed_once"),
+                        DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES=0)
+        self.assertEqual(p.returncode, 1, p.stderr)
+        self.assertRegex(p.stderr, r"terrashade.distributed: error: the window "
+                         r"\(xoff, yoff, xsize, ysize\) = \(\d+, \d+, \d+, \d+\) of "
+                         + re.escape(T.conn(self.dem)) + " failed: KilledWorker")
+        with open(dest) as f:
+            self.assertEqual(f.read(), "an older result")  # DEST untouched
+        os.remove(dest)
+        self.assert_nothing_left(dest)
 
     def test_unreachable_scheduler(self):
         with socket.socket() as s:  # a port nobody listens on
