@@ -313,6 +313,10 @@ def main(argv=None):
     except Failure as e:
         print("%s: error: %s" % (PROG, e), file=sys.stderr)
         return e.code
+    except Exception as e:  # GDAL or Dask, unforeseen: a sentence, not a traceback
+        print("%s: error: %s: %s (nothing written to %s)"
+              % (PROG, type(e).__name__, e, args.dest), file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("%s: interrupted; nothing written to %s" % (PROG, args.dest), file=sys.stderr)
         return 130

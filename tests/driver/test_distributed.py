@@ -86,6 +86,19 @@ class Distributed(unittest.TestCase):
         for p in (dest, dest + ".partial", dest + ".tiles.partial"):
             self.assertFalse(os.path.exists(p), "%s was left behind" % p)
 
+    def test_windows_and_internal_tiles(self):
+        from terrashade import distributed as D, windows as W
+        for width, height, tile in ((200, 150, 64), (1024, 1024, 1024), (1, 1, 16),
+                                    (5000, 33, 1040)):
+            cover = np.zeros((height, width), np.int32)
+            for x, y, w, h in W.windows(width, height, tile):
+                self.assertTrue(0 < w <= tile and 0 < h <= tile)
+                cover[y:y + h, x:x + w] += 1
+            self.assertTrue((cover == 1).all(), "windows of %d miss or overlap" % tile)
+        # the output's tiles divide the window: a window covers whole tiles
+        self.assertEqual([D.block_size(t) for t in (16, 64, 496, 512, 1024, 1040, 3072)],
+                         [16, 64, 496, 512, 512, 16, 512])
+
     def test_local_cluster_shade_and_horizon(self):
         for name, options in (("shade", SHADE), ("horizon", HORIZON)):
             with self.subTest(product=name):
