@@ -301,8 +301,9 @@ def run(args):
             cluster.close()
     if not args.quiet:
         print("%s: wrote %s (%d x %d, %d bands, %s) from %d windows of %d on %d "
-              "workers in %.1f s" % (PROG, args.dest, size[0], size[1], size[2], fmt,
-                                      n, args.tile_size, nworkers, time.time() - t0),
+              "worker%s in %.1f s" % (PROG, args.dest, size[0], size[1], size[2], fmt, n,
+                                       args.tile_size, nworkers, "s"[:nworkers > 1],
+                                       time.time() - t0),
               file=sys.stderr)
 
 
