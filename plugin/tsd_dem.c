@@ -118,12 +118,17 @@ ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
     int all_valid = GDALGetMaskFlags(band) == GMF_ALL_VALID || nodata_in_values(band, w, h);
     GDALRasterBandH mask = all_valid ? NULL : GDALGetMaskBand(band);
     unsigned char *m = NULL;
-    if (mask && !(m = malloc((size_t)w * STRIP_ROWS))) {
+    /* resampled: one request for the whole grid, as gdal_translate -outsize
+     * makes for a level of this size (where a request's edge falls changes
+     * GDAL's average next to nodata) */
+    const int strip =
+        w == GDALGetRasterBandXSize(band) && h == GDALGetRasterBandYSize(band) ? STRIP_ROWS : h;
+    if (mask && !(m = malloc((size_t)w * strip))) {
         ts_grid_free(grid);
         return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory reading the DEM's mask");
     }
-    for (int y0 = 0; y0 < h; y0 += STRIP_ROWS) {
-        int rows = h - y0 < STRIP_ROWS ? h - y0 : STRIP_ROWS;
+    for (int y0 = 0; y0 < h; y0 += strip) {
+        int rows = h - y0 < strip ? h - y0 : strip;
         float *z = grid->z + (ptrdiff_t)y0 * grid->stride;
         if (read_rows(band, y0, rows, w, h, z, grid->stride, GDT_Float32) != CE_None ||
             (mask && read_rows(mask, y0, rows, w, h, m, w, GDT_Byte) != CE_None)) {
