@@ -154,8 +154,11 @@ class Overviews(unittest.TestCase):
         try:
             ds = open_ds(self.dem, PRODUCT="svf", DIRECTIONS=4, BACKEND="c")
             rb = ds.GetRasterBand(1)
-            self.assertEqual(msgs, [])  # opening and listing compute nothing
             ov = rb.GetOverview(1)
+            sizes = [(rb.GetOverview(i).XSize, rb.GetOverview(i).YSize)
+                     for i in range(rb.GetOverviewCount())]
+            self.assertEqual(msgs, [])  # opening and listing compute nothing
+            self.assertEqual(sizes, expected_sizes(600, 517))
             a = ov.ReadAsArray()
             b = ov.ReadAsArray(10, 20, 50, 40)
             ov.FlushCache()
