@@ -344,32 +344,32 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
         m_oSRS.IsEmpty() ? nullptr : OGRSpatialReference::ToHandle(&m_oSRS);
     ts_status eSt = tsd_cells_compute(m_adfGT, W, H, hSRS, &m_sCells, szMsg, sizeof szMsg);
     if (eSt != TS_OK)
-        return FailOpen(eSt, szMsg) != nullptr;
+        return Fail(eSt, szMsg), false;
     if (tsd_options_sun_from_time(&sOpts))
     {
         const char *pszWhat = sOpts.datetime[0] ? "DATETIME" : "DATE";
         if (!m_bHasGT || !hSRS)
-            return FailOpen(
+            return Fail(
                        CPLE_AppDefined,
                        CPLSPrintf("%s needs a georeferenced DEM, but '%s' has no %s: the "
                                   "sun's position over it is unknown. Give it one "
                                   "(gdal_edit.py -a_srs / -a_ullr) or use SUN_AZIMUTH "
                                   "and SUN_ELEVATION",
                                   pszWhat, m_osDEM.c_str(),
-                                  !m_bHasGT ? "geotransform" : "CRS")) != nullptr;
+                                  !m_bHasGT ? "geotransform" : "CRS")), false;
         tsd_sites sSites;
         eSt = tsd_sites_compute(m_adfGT, W, H, hSRS, &m_sCells,
                                 sOpts.sun_position == TSD_SUN_PER_CELL, &sSites, szMsg,
                                 sizeof szMsg);
         if (eSt != TS_OK)
-            return FailOpen(eSt, CPLSPrintf("%s: %s", pszWhat, szMsg)) != nullptr;
+            return Fail(eSt, CPLSPrintf("%s: %s", pszWhat, szMsg)), false;
         double dfMinCell = m_sCells.cell_y;
         for (int y = 0; y < H; y++)
             dfMinCell = std::min(dfMinCell, m_sCells.cell_x_row ? m_sCells.cell_x_row[y]
                                                                 : m_sCells.cell_x);
         eSt = tsd_sun_setup(&sOpts, &sSites, dfMinCell, &m_sSun, szMsg, sizeof szMsg);
         if (eSt != TS_OK)
-            return FailOpen(eSt, szMsg) != nullptr;
+            return Fail(eSt, szMsg), false;
         m_bHasSun = true;
     }
     const tsd_sun *psSun = m_bHasSun ? &m_sSun : nullptr;
@@ -381,7 +381,7 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     /* a bad TERRASHADE_BACKEND is an error here (without probing OpenCL) */
     m_bUsesBackend = m_psProduct->uses_backend && m_psProduct->uses_backend(&sOpts, psSun);
     if (m_bUsesBackend && tsd_backend_check_env(&sOpts, szMsg, sizeof szMsg) != 0)
-        return FailOpen(TS_ERR_ARG, szMsg) != nullptr;
+        return Fail(TS_ERR_ARG, szMsg), false;
 
     nRasterXSize = W;
     nRasterYSize = H;
