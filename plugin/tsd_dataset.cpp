@@ -7,7 +7,8 @@
  * A dataset computes its whole product once, lazily on the first block read
  * (under a mutex), keeps it in memory as float planes (bytes for the
  * products stored as bytes, PRODUCT=farshadow) and copies 256 x 256 blocks
- * out of it.
+ * out of it. Its overview levels (tsd_overview.cpp) are datasets of this
+ * class too, set up by the same Setup at their size.
  */
 #include <algorithm>
 #include <chrono>
@@ -147,8 +148,8 @@ CPLErr TSDataset::EnsureComputed()
         const int W = nRasterXSize, H = nRasterYSize;
         const size_t nCells = static_cast<size_t>(W) * H;
         const int nBands = tsd_options_band_count(&m_sOpts);
-        CPLDebug(DRIVER, "computing PRODUCT=%s of %s (%d x %d, %d band(s))",
-                 pszName, m_osDEM.c_str(), W, H, nBands);
+        CPLDebug(DRIVER, "computing PRODUCT=%s of %s (%d x %d, %d band(s), level %d)",
+                 pszName, m_osDEM.c_str(), W, H, nBands, m_nLevel);
         const auto tStart = std::chrono::steady_clock::now();
         // The whole product is computed here, inside the first block read,
         // where GDAL passes no progress callback: report on stderr.
@@ -161,9 +162,18 @@ CPLErr TSDataset::EnsureComputed()
         sRun.progress = tsd_progress_report;
         sRun.progress_user = &sProgress;
         ts_grid sGrid;
-        GDALRasterBandH hBand = GDALGetRasterBand(m_poDEM, m_sOpts.band);
-        eStatus = tsd_dem_load(hBand, &m_sCells, m_sOpts.z_factor, &sGrid, szMsg,
-                               sizeof szMsg);
+        if (!m_poDEM) // an overview level: the DEM again, read at its size
+            m_poDEM = GDALDataset::Open(m_osDEM.c_str(), GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR);
+        if (!m_poDEM)
+        {
+            eStatus = TS_ERR_INTERNAL;
+            snprintf(szMsg, sizeof szMsg, "cannot open the DEM '%s' again for overview "
+                     "level %d", m_osDEM.c_str(), m_nLevel);
+        }
+        else
+            eStatus = tsd_dem_load_resampled(
+                GDALGetRasterBand(m_poDEM, m_sOpts.band), &m_sCells, m_sOpts.z_factor, W, H,
+                &sGrid, szMsg, sizeof szMsg);
         if (eStatus != TS_OK)
         {
             m_osError = szMsg;
@@ -210,7 +220,8 @@ CPLErr TSDataset::EnsureComputed()
             VSIFree(m_pabyProduct);
             m_pabyProduct = nullptr;
         }
-        GDALClose(m_poDEM);
+        if (m_poDEM)
+            GDALClose(m_poDEM);
         m_poDEM = nullptr;
         const std::chrono::duration<double> dfSec =
             std::chrono::steady_clock::now() - tStart;
@@ -314,61 +325,78 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     }
     if (const OGRSpatialReference *poSRS = poDEM->GetSpatialRef())
         poDS->m_oSRS = *poSRS;
+    if (!poDS->Setup(poOpenInfo->pszFilename, W, H))
+        return nullptr;
+    poDS->m_nOverviews = OverviewCount(poDS->m_psProduct, W, H);
+    return poDS.release();
+}
+
+/* Everything that follows from the georeferencing (m_adfGT, m_bHasGT,
+ * m_oSRS) of a W x H grid and the options: the cells, the sun, the memory
+ * check, the bands, the metadata and (level 0) PAM. Shared by the DEM's
+ * own resolution and its overview levels, so that a level is set up as a
+ * DEM of its size would be. false with the error reported. */
+bool TSDataset::Setup(const char *pszConnection, int W, int H)
+{
+    char szMsg[1024] = "";
+    const tsd_options &sOpts = m_sOpts;
     OGRSpatialReferenceH hSRS =
-        poDS->m_oSRS.IsEmpty() ? nullptr : OGRSpatialReference::ToHandle(&poDS->m_oSRS);
-    ts_status eSt =
-        tsd_cells_compute(poDS->m_adfGT, W, H, hSRS, &poDS->m_sCells, szMsg, sizeof szMsg);
+        m_oSRS.IsEmpty() ? nullptr : OGRSpatialReference::ToHandle(&m_oSRS);
+    ts_status eSt = tsd_cells_compute(m_adfGT, W, H, hSRS, &m_sCells, szMsg, sizeof szMsg);
     if (eSt != TS_OK)
-        return FailOpen(eSt, szMsg);
+        return Fail(eSt, szMsg), false;
     if (tsd_options_sun_from_time(&sOpts))
     {
         const char *pszWhat = sOpts.datetime[0] ? "DATETIME" : "DATE";
-        if (!poDS->m_bHasGT || !hSRS)
-            return FailOpen(
-                CPLE_AppDefined,
-                CPLSPrintf("%s needs a georeferenced DEM, but '%s' has no %s: the sun's "
-                           "position over it is unknown. Give it one (gdal_edit.py "
-                           "-a_srs / -a_ullr) or use SUN_AZIMUTH and SUN_ELEVATION",
-                           pszWhat, osDEM.c_str(),
-                           !poDS->m_bHasGT ? "geotransform" : "CRS"));
+        if (!m_bHasGT || !hSRS)
+            return Fail(
+                       CPLE_AppDefined,
+                       CPLSPrintf("%s needs a georeferenced DEM, but '%s' has no %s: the "
+                                  "sun's position over it is unknown. Give it one "
+                                  "(gdal_edit.py -a_srs / -a_ullr) or use SUN_AZIMUTH "
+                                  "and SUN_ELEVATION",
+                                  pszWhat, m_osDEM.c_str(),
+                                  !m_bHasGT ? "geotransform" : "CRS")), false;
         tsd_sites sSites;
-        eSt = tsd_sites_compute(poDS->m_adfGT, W, H, hSRS, &poDS->m_sCells,
+        eSt = tsd_sites_compute(m_adfGT, W, H, hSRS, &m_sCells,
                                 sOpts.sun_position == TSD_SUN_PER_CELL, &sSites, szMsg,
                                 sizeof szMsg);
         if (eSt != TS_OK)
-            return FailOpen(eSt, CPLSPrintf("%s: %s", pszWhat, szMsg));
-        double dfMinCell = poDS->m_sCells.cell_y;
+            return Fail(eSt, CPLSPrintf("%s: %s", pszWhat, szMsg)), false;
+        double dfMinCell = m_sCells.cell_y;
         for (int y = 0; y < H; y++)
-            dfMinCell = std::min(dfMinCell, poDS->m_sCells.cell_x_row
-                                                ? poDS->m_sCells.cell_x_row[y]
-                                                : poDS->m_sCells.cell_x);
-        eSt = tsd_sun_setup(&sOpts, &sSites, dfMinCell, &poDS->m_sSun, szMsg, sizeof szMsg);
+            dfMinCell = std::min(dfMinCell, m_sCells.cell_x_row ? m_sCells.cell_x_row[y]
+                                                                : m_sCells.cell_x);
+        eSt = tsd_sun_setup(&sOpts, &sSites, dfMinCell, &m_sSun, szMsg, sizeof szMsg);
         if (eSt != TS_OK)
-            return FailOpen(eSt, szMsg);
-        poDS->m_bHasSun = true;
+            return Fail(eSt, szMsg), false;
+        m_bHasSun = true;
     }
-    const tsd_sun *psSun = poDS->m_bHasSun ? &poDS->m_sSun : nullptr;
-    tsd_run_init(&poDS->m_sRun, &sOpts, psSun);
-    if (poDS->m_sCells.warning[0])
-        CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s",
-                 poDS->m_sCells.warning);
+    const tsd_sun *psSun = m_bHasSun ? &m_sSun : nullptr;
+    tsd_run_init(&m_sRun, &sOpts, psSun);
+    if (m_sCells.warning[0] && m_nLevel == 0) // said once, for the DEM itself
+        CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", m_sCells.warning);
     if (!CheckMemory(sOpts, W, H))
-        return nullptr;
+        return false;
     /* a bad TERRASHADE_BACKEND is an error here (without probing OpenCL) */
-    poDS->m_bUsesBackend = poDS->m_psProduct->uses_backend &&
-                           poDS->m_psProduct->uses_backend(&sOpts, psSun);
-    if (poDS->m_bUsesBackend &&
-        tsd_backend_check_env(&sOpts, szMsg, sizeof szMsg) != 0)
-        return FailOpen(TS_ERR_ARG, szMsg);
+    m_bUsesBackend = m_psProduct->uses_backend && m_psProduct->uses_backend(&sOpts, psSun);
+    if (m_bUsesBackend && tsd_backend_check_env(&sOpts, szMsg, sizeof szMsg) != 0)
+        return Fail(TS_ERR_ARG, szMsg), false;
 
-    poDS->nRasterXSize = W;
-    poDS->nRasterYSize = H;
+    nRasterXSize = W;
+    nRasterYSize = H;
     const GDALDataType eType = tsd_options_output_byte(&sOpts) ? GDT_Byte : GDT_Float32;
     for (int i = 1; i <= tsd_options_band_count(&sOpts); i++)
-        poDS->SetBand(i, new TSRasterBand(poDS.get(), i, eType));
-    poDS->SetupMetadata();
-    poDS->SetupPam(poOpenInfo->pszFilename);
-    return poDS.release();
+        SetBand(i, new TSRasterBand(this, i, eType));
+    SetupMetadata();
+    if (m_nLevel == 0)
+        SetupPam(pszConnection);
+    else
+    {
+        SetDescription(pszConnection);
+        nPamFlags |= GPF_DISABLED; // a level's statistics are its parent's business
+    }
+    return true;
 }
 
 int IdentifyProduct(GDALOpenInfo *poOpenInfo)

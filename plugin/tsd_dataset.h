@@ -6,8 +6,10 @@
 #ifndef TSD_DATASET_H
 #define TSD_DATASET_H
 
+#include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "gdal_pam.h"
 #include "ogr_spatialref.h"
@@ -46,11 +48,21 @@ class TSDataset final : public GDALPamDataset
     GByte *m_pabyProduct = nullptr; // products stored as bytes (TSD_BYTE_ALWAYS)
     bool m_bHasSun = false;
     tsd_sun m_sSun{};
+    /* overviews (tsd_overview.cpp): level 0 is the DEM's own resolution; a
+     * level k > 0 dataset is the product of the DEM read at its size (the
+     * DEM reopened by name when it computes) */
+    int m_nLevel = 0;
+    int m_nOverviews = 0;   // levels offered (level 0 only)
+    std::mutex m_oOvrMutex{};
+    std::vector<std::unique_ptr<TSDataset>> m_apoOverviews{}; // made on first use
     bool m_bUsesBackend = false;
     bool m_bBackendKnown = false;     // m_sBackend filled (predicted or ran)
     tsd_backend_summary m_sBackend{}; // predicted, then what ran
 
     CPLErr EnsureComputed();
+    bool Setup(const char *pszConnection, int W, int H);
+    TSDataset *Overview(int i);
+    TSDataset *MakeOverview(int nLevel);
     void EnsureBackendMetadata();
     void SetupBackendMetadata();
     void ReportBackend();
@@ -63,6 +75,11 @@ class TSDataset final : public GDALPamDataset
     ~TSDataset() override;
 
     static GDALDataset *Open(GDALOpenInfo *poOpenInfo);
+
+    /** The number of overview levels of a W x H product: 2x, 4x, ... while
+     * the previous level's longer side exceeds OVERVIEW_MIN_SIDE, and never
+     * for PRODUCT=farshadow. */
+    static int OverviewCount(const tsd_product_def *psProduct, int W, int H);
 
     CPLErr GetGeoTransform(double *padfGT) override;
     const OGRSpatialReference *GetSpatialRef() const override;
@@ -85,6 +102,8 @@ class TSRasterBand final : public GDALPamRasterBand
         return GCI_GrayIndex;
     }
     const char *GetUnitType() override;
+    int GetOverviewCount() override;
+    GDALRasterBand *GetOverview(int i) override;
 };
 
 } // namespace tsd

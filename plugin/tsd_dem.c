@@ -36,11 +36,68 @@ static void flip(ts_grid *g, int flip_x, int flip_y)
         }
 }
 
+/* 1 if the band's validity read at w x h cells is in its values: a nodata
+ * band resampled, where GDAL's average leaves the nodata value in a coarse
+ * cell none of whose cells is valid (averaging its mask band instead would
+ * round a cell with few valid cells to 0 at deep levels). */
+static int nodata_in_values(GDALRasterBandH band, int w, int h)
+{
+    return (GDALGetRasterBandXSize(band) != w || GDALGetRasterBandYSize(band) != h) &&
+           GDALGetMaskFlags(band) == GMF_NODATA;
+}
+
+/* Rows y0 .. y0 + rows - 1 of the band read at w x h cells: as they are at
+ * the band's own size, else averaged over each coarse cell's footprint
+ * (GDAL's average resampling, over the valid cells only) through a
+ * fractional source window, as a VRT made by gdal_translate -outsize reads
+ * it. */
+static CPLErr read_rows(GDALRasterBandH band, int y0, int rows, int w, int h, void *buf,
+                        size_t stride, GDALDataType type)
+{
+    const int sw = GDALGetRasterBandXSize(band), sh = GDALGetRasterBandYSize(band);
+    const int line = (int)(stride * GDALGetDataTypeSizeBytes(type));
+    if (sw == w && sh == h)
+        return GDALRasterIO(band, GF_Read, 0, y0, w, rows, buf, w, rows, type, 0, line);
+    GDALRasterIOExtraArg extra;
+    INIT_RASTERIO_EXTRA_ARG(extra);
+    extra.eResampleAlg = GRIORA_Average;
+    extra.bFloatingPointWindowValidity = TRUE;
+    const double fy = (double)sh / h;
+    extra.dfXOff = 0;
+    extra.dfXSize = sw;
+    extra.dfYOff = y0 * fy;
+    extra.dfYSize = rows * fy;
+    int yoff = (int)extra.dfYOff;
+    int yend = (int)ceil(extra.dfYOff + extra.dfYSize - 1e-10);
+    if (yend > sh)
+        yend = sh;
+    if (GDALRasterIOEx(band, GF_Read, 0, yoff, sw, yend - yoff, buf, w, rows, type, 0,
+                       line, &extra) != CE_None)
+        return CE_Failure;
+    int has_nodata = 0;
+    const float nodata = (float)GDALGetRasterNoDataValue(band, &has_nodata);
+    if (type == GDT_Float32 && has_nodata && nodata_in_values(band, w, h))
+        for (int y = 0; y < rows; y++) {
+            float *r = (float *)buf + (size_t)y * stride;
+            for (int x = 0; x < w; x++)
+                if (r[x] == nodata)
+                    r[x] = NAN;
+        }
+    return CE_None;
+}
+
 ts_status tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
                        ts_grid *grid, char *msg, size_t n)
 {
+    return tsd_dem_load_resampled(band, cells, z_factor, GDALGetRasterBandXSize(band),
+                                  GDALGetRasterBandYSize(band), grid, msg, n);
+}
+
+ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
+                                 double z_factor, int w, int h, ts_grid *grid, char *msg,
+                                 size_t n)
+{
     ts_error err;
-    int w = GDALGetRasterBandXSize(band), h = GDALGetRasterBandYSize(band);
     if (ts_grid_create(grid, w, h, cells->cell_x, cells->cell_y, &err) != TS_OK)
         return tsd_fail_core(msg, n, NULL, &err);
     if (cells->cell_x_row &&
@@ -58,20 +115,23 @@ ts_status tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_fa
     scale *= z_factor;
     offset *= z_factor;
 
-    int all_valid = GDALGetMaskFlags(band) == GMF_ALL_VALID;
+    int all_valid = GDALGetMaskFlags(band) == GMF_ALL_VALID || nodata_in_values(band, w, h);
     GDALRasterBandH mask = all_valid ? NULL : GDALGetMaskBand(band);
     unsigned char *m = NULL;
-    if (mask && !(m = malloc((size_t)w * STRIP_ROWS))) {
+    /* resampled: one request for the whole grid, as gdal_translate -outsize
+     * makes for a level of this size (where a request's edge falls changes
+     * GDAL's average next to nodata) */
+    const int strip =
+        w == GDALGetRasterBandXSize(band) && h == GDALGetRasterBandYSize(band) ? STRIP_ROWS : h;
+    if (mask && !(m = malloc((size_t)w * strip))) {
         ts_grid_free(grid);
         return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory reading the DEM's mask");
     }
-    for (int y0 = 0; y0 < h; y0 += STRIP_ROWS) {
-        int rows = h - y0 < STRIP_ROWS ? h - y0 : STRIP_ROWS;
+    for (int y0 = 0; y0 < h; y0 += strip) {
+        int rows = h - y0 < strip ? h - y0 : strip;
         float *z = grid->z + (ptrdiff_t)y0 * grid->stride;
-        if (GDALRasterIO(band, GF_Read, 0, y0, w, rows, z, w, rows, GDT_Float32,
-                         0, (int)(grid->stride * sizeof(float))) != CE_None ||
-            (mask && GDALRasterIO(mask, GF_Read, 0, y0, w, rows, m, w, rows,
-                                  GDT_Byte, 0, w) != CE_None)) {
+        if (read_rows(band, y0, rows, w, h, z, grid->stride, GDT_Float32) != CE_None ||
+            (mask && read_rows(mask, y0, rows, w, h, m, w, GDT_Byte) != CE_None)) {
             const char *last = CPLGetLastErrorMsg();
             free(m);
             ts_grid_free(grid);

@@ -21,6 +21,15 @@ extern "C" {
 ts_status tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
                        ts_grid *grid, char *msg, size_t msg_size);
 
+/** The same at w x h cells (an overview level): each coarse cell is the
+ * average of the valid cells under it (GDAL's average resampling through
+ * RasterIO, which uses the band's own overviews where it has them); a
+ * coarse cell none of whose cells is valid is NaN. `cells` are those of
+ * the w x h grid. At the band's own size, tsd_dem_load. */
+ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
+                                 double z_factor, int w, int h, ts_grid *grid, char *msg,
+                                 size_t msg_size);
+
 #ifdef __cplusplus
 }
 #endif

@@ -17,6 +17,9 @@ namespace tsd
 {
 
 constexpr int BLOCK = 256;
+/** Overview levels stop at the first one whose longer side is at most
+ * this many cells (as gdaladdo's default). */
+constexpr int OVERVIEW_MIN_SIDE = 256;
 constexpr const char *DRIVER = "TERRASHADE";
 
 /** The GDAL error number of a status: out of memory, cancelled by the
