@@ -21,7 +21,7 @@
 #include <sys/utsname.h>
 #include <time.h>
 
-#include "fractal_dem.h"
+#include "test_dem.h"
 #include "terrashade_env.h"
 
 static double clock_s(clockid_t id)
@@ -73,7 +73,7 @@ static void bench_size(int size, int dirs, int limit, const ts_env *env,
     ts_grid g;
     if (ts_grid_create(&g, size, size, 10.0, 10.0, &e))
         fail("grid", &e);
-    ts_fractal_fill(&g, 1234, 0.8, 1500.0);
+    tdem_fbm(&g, 1234, 0.8, 1500.0);
     size_t n = (size_t)size * size;
     float *plane = malloc(n * sizeof *plane), *nx = malloc(n * sizeof *nx);
     float *ny = malloc(n * sizeof *ny), *nz = malloc(n * sizeof *nz);
