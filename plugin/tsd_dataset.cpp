@@ -117,6 +117,7 @@ TSDataset::~TSDataset()
         GDALClose(m_poDEM);
     tsd_cells_free(&m_sCells);
     tsd_sun_free(&m_sSun);
+    tsd_environment_free(&m_sEnv);
     VSIFree(m_pafProduct);
     VSIFree(m_pabyProduct);
 }
@@ -349,6 +350,8 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     }
     const tsd_sun *psSun = poDS->m_bHasSun ? &poDS->m_sSun : nullptr;
     tsd_run_init(&poDS->m_sRun, &sOpts, psSun);
+    if (!poDS->SetupEnvironment())
+        return nullptr;
     if (poDS->m_sCells.warning[0])
         CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s",
                  poDS->m_sCells.warning);
