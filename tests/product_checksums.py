@@ -53,6 +53,22 @@ VARIANTS = {
     "farshadow": dict(DAY, ATLAS_STEPS="6", FAR_THRESHOLD="32"),
 }
 
+# Environment light (docs/envlight.md): printed after all the above, so that
+# the earlier lines keep their places.
+ENVMAPS = os.path.join(T.DATA, "envmaps")
+SUNSET = os.path.join(ENVMAPS, "sunset.exr")
+ENV_VARIANTS = {
+    "envlight_sky": {"SKY": "cie:7", "SUN_AZIMUTH": "120", "SUN_ELEVATION": "25",
+                     "DIRECTIONS": "8"},
+    "envlight_map": {"ENV_MAP": SUNSET, "ENV_ROTATION": "45", "DIRECTIONS": "8"},
+    "envlight_cube": {"ENV_MAP": os.path.join(ENVMAPS, "sunset_cube128.exr"),
+                      "DIRECTIONS": "8", "ENV_NORMAL_STEPS": "33"},
+    "envlight_byte": {"ENV_MAP": SUNSET, "OUTPUT_TYPE": "Byte", "DIRECTIONS": "8"},
+    "shade_clearsky": {"SKY": "clear", "SKY_WEIGHT": "0.5", "DIRECTIONS": "8",
+                       "DATETIME": "2026-06-21T08:00:00-05:00", "OUTPUT_TYPE": "Float32"},
+    "shade_envmap": {"ENV_MAP": SUNSET, "SKY_WEIGHT": "0.3", "DIRECTIONS": "8"},
+}
+
 
 def fractal_dem(path, n=512, seed=7):
     """Spectral-synthesis fractal (beta 2.2), 30 m cells, UTM 33N."""
@@ -96,33 +112,36 @@ def main():
     fractal = os.path.join(tmp, "fractal.tif")
     fractal_dem(fractal)
     dems = {"jacksboro": T.JACKSBORO, "lux": T.LUX, "fractal": fractal}
-    names = args.only.split(",") if args.only else list(VARIANTS)
+    variants = dict(VARIANTS, **ENV_VARIANTS)
+    names = args.only.split(",") if args.only else list(variants)
     if args.save:
         os.makedirs(args.save, exist_ok=True)
     worst = 0.0
-    for dem_name, dem in dems.items():
-        for backend in args.backends.split(","):
-            for name in names:
-                oo = dict(VARIANTS[name], PRODUCT=name.split("_")[0], BACKEND=backend,
-                          PROGRESS="no")
-                ds = gdal.OpenEx("TERRASHADE:" + dem,
-                                 open_options=["%s=%s" % kv for kv in oo.items()])
-                a = read_all(ds)
-                ds = None
-                key = "%s.%s.%s" % (dem_name, backend, name)
-                h = hashlib.sha256(a.tobytes()).hexdigest()[:16]
-                line = "%-34s %s %s %s" % (key, a.dtype, "x".join(map(str, a.shape)), h)
-                if args.save:
-                    np.save(os.path.join(args.save, key + ".npy"), a)
-                if args.compare:
-                    ref = np.load(os.path.join(args.compare, key + ".npy"))
-                    d = np.abs(a.astype(np.float64) - ref.astype(np.float64))
-                    same_nan = np.array_equal(np.isnan(d), np.isnan(
-                        ref.astype(np.float64)) | np.isnan(a.astype(np.float64)))
-                    m = float(np.nanmax(d)) if np.isfinite(d).any() else 0.0
-                    worst = max(worst, m)
-                    line += "  max|diff| %.3g%s" % (m, "" if same_nan else "  NODATA DIFFERS")
-                print(line, flush=True)
+    runs = [(d, b, [n for n in names if n in group]) for group in (VARIANTS, ENV_VARIANTS)
+            for d in dems for b in args.backends.split(",")]
+    for dem_name, backend, group_names in runs:
+        dem = dems[dem_name]
+        for name in group_names:
+            oo = dict(variants[name], PRODUCT=name.split("_")[0], BACKEND=backend,
+                      PROGRESS="no")
+            ds = gdal.OpenEx("TERRASHADE:" + dem,
+                             open_options=["%s=%s" % kv for kv in oo.items()])
+            a = read_all(ds)
+            ds = None
+            key = "%s.%s.%s" % (dem_name, backend, name)
+            h = hashlib.sha256(a.tobytes()).hexdigest()[:16]
+            line = "%-34s %s %s %s" % (key, a.dtype, "x".join(map(str, a.shape)), h)
+            if args.save:
+                np.save(os.path.join(args.save, key + ".npy"), a)
+            if args.compare:
+                ref = np.load(os.path.join(args.compare, key + ".npy"))
+                d = np.abs(a.astype(np.float64) - ref.astype(np.float64))
+                same_nan = np.array_equal(np.isnan(d), np.isnan(
+                    ref.astype(np.float64)) | np.isnan(a.astype(np.float64)))
+                m = float(np.nanmax(d)) if np.isfinite(d).any() else 0.0
+                worst = max(worst, m)
+                line += "  max|diff| %.3g%s" % (m, "" if same_nan else "  NODATA DIFFERS")
+            print(line, flush=True)
     if args.compare:
         print("worst max|diff| %.3g" % worst)
 
