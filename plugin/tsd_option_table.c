@@ -144,7 +144,7 @@ const opt_def TSD_OPTION_ROWS[] = {
     {"ENV_ROTATION", K_FLOAT, FIELD(env_rotation), "0", 0, 360, 0, 1, NULL, 1, P, LISTED,
      NULL,
      "ENV_MAP: degrees by which the environment turns clockwise seen from "
-     "above; at 0 the map's centre column is grid north, its left half east"},
+     "above; at 0 the map's centre column is grid north, east to its right"},
     {"SKY", K_TEXT, FIELD(sky), "", 0, 0, 0, 0, NULL, 1, P, LISTED, check_sky,
      "A standard sky lighting envlight (or the sky term of shade): uniform, "
      "overcast (CIE standard overcast), clear (CIE standard clear) or cie:N "
