@@ -237,10 +237,16 @@ class EnvLight(unittest.TestCase):
         text = self.path("text.exr")
         with open(text, "w") as f:
             f.write("this is not an OpenEXR file\n")
+        nan = np.ones((16, 32, 3))
+        nan[3, 5, 1] = np.nan
+        nan = write_exr(self.path("nan.exr"), nan)
+        wide = write_exr(self.path("wide.exr"), np.ones((10, 30, 3)))
         cases = [
             ("missing map", dict(ENV_MAP=self.path("nowhere.exr")), "no such file"),
             ("truncated map", dict(ENV_MAP=truncated), "damaged or truncated"),
             ("text named .exr", dict(ENV_MAP=text), "not a readable OpenEXR file"),
+            ("a NaN pixel", dict(ENV_MAP=nan), "NaN"),
+            ("3:1 without envmap", dict(ENV_MAP=wide), "neither 2:1 (lat-long) nor 1:6"),
             ("ENV_MAP with SKY", dict(ENV_MAP=SUNSET, SKY="clear"),
              "SKY=clear excludes ENV_MAP"),
             ("cie:16", dict(SKY="cie:16"), "SKY"),
