@@ -10,6 +10,7 @@
 
 #include "terrashade_env.h"
 #include "test_dem.h"
+#include "test_grid.h"
 #include "test_run.h"
 
 static const double PI = 3.14159265358979323846;
