@@ -226,7 +226,8 @@ static exr_result_t decode_pixels(exr_context_t ctx, exr_storage_t storage, int 
 
 /* Everything after the header was parsed; ctx is finished by the caller. */
 static ts_status read_part0(exr_context_t ctx, exr_source *src, double rotation_deg,
-                            size_t max_texels, ts_env *out, ts_error *err)
+                            size_t max_texels, ts_env *out, ts_env_map_info *info,
+                            ts_error *err)
 {
     exr_storage_t storage;
     exr_attr_box2i_t dw;
@@ -255,6 +256,13 @@ static ts_status read_part0(exr_context_t ctx, exr_source *src, double rotation_
         st = plan_layout(ctx, src, w, h, &layout, err);
     if (st != TS_OK)
         return st;
+    if (info) { /* the header is all that was asked for */
+        info->cube = layout == ENV_CUBE;
+        info->grey = plan.grey;
+        info->width = (int)w;
+        info->height = (int)h;
+        return TS_OK;
+    }
 
     float *rgb = calloc((size_t)w * (size_t)h * 3, sizeof *rgb);
     if (!rgb)
@@ -287,7 +295,7 @@ static ts_status read_part0(exr_context_t ctx, exr_source *src, double rotation_
 }
 
 static ts_status read_source(exr_source *src, double rotation_deg, size_t max_texels,
-                             ts_env *out, ts_error *err)
+                             ts_env *out, ts_env_map_info *info, ts_error *err)
 {
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.user_data = src;
@@ -301,7 +309,7 @@ static ts_status read_source(exr_source *src, double rotation_deg, size_t max_te
         return ts_fail(err, TS_ERR_ARG, "environment map '%s' is not a readable OpenEXR file (%s)",
                        src->name, lib_message(src, rv));
     }
-    ts_status st = read_part0(ctx, src, rotation_deg, max_texels, out, err);
+    ts_status st = read_part0(ctx, src, rotation_deg, max_texels, out, info, err);
     exr_finish(&ctx);
     return st;
 }
@@ -333,7 +341,7 @@ ts_status ts_env_load_exr_file(const char *path, double rotation_deg, size_t max
         return ts_fail(err, TS_ERR_ARG, "environment map '%s' is not a regular file", path);
     }
     src.size = (uint64_t)sb.st_size;
-    ts_status st = read_source(&src, rotation_deg, max_texels, out, err);
+    ts_status st = read_source(&src, rotation_deg, max_texels, out, NULL, err);
     close(src.fd);
     return st;
 }
@@ -349,5 +357,19 @@ ts_status ts_env_load_exr_memory(const void *buf, size_t size, const char *name,
     if (!buf && size > 0)
         return ts_fail(err, TS_ERR_ARG, "environment map '%s': no buffer (NULL)", name);
     exr_source src = {name, -1, buf, size, ""};
-    return read_source(&src, rotation_deg, max_texels, out, err);
+    return read_source(&src, rotation_deg, max_texels, out, NULL, err);
+}
+
+ts_status ts_env_exr_info(const void *buf, size_t size, const char *name,
+                          ts_env_map_info *info, ts_error *err)
+{
+    if (!info)
+        return ts_fail(err, TS_ERR_ARG, "no map description to fill (info is NULL)");
+    memset(info, 0, sizeof *info);
+    if (!name || !name[0])
+        name = "(memory)";
+    if (!buf && size > 0)
+        return ts_fail(err, TS_ERR_ARG, "environment map '%s': no buffer (NULL)", name);
+    exr_source src = {name, -1, buf, size, ""};
+    return read_source(&src, 0.0, 0, NULL, info, err);
 }

@@ -132,6 +132,19 @@ ts_status ts_env_load_exr_memory(const void *buf, size_t size, const char *name,
                                  double rotation_deg, size_t max_texels, ts_env *out,
                                  ts_error *err);
 
+/** What an EXR environment map is, from its header (ts_env_exr_info). */
+typedef struct {
+    int cube;          /**< 1: cube faces, 0: lat-long */
+    int grey;          /**< 1: grey from Y, 0: colour from R, G, B */
+    int width, height; /**< of the data window, pixels */
+} ts_env_map_info;
+
+/** The layout, channels and size ts_env_load_exr_memory would use, from the
+ *  header only (no pixels decoded); the same errors for what the header
+ *  shows (not an EXR, no usable channel, bad size or aspect). */
+ts_status ts_env_exr_info(const void *buf, size_t size, const char *name,
+                          ts_env_map_info *info, ts_error *err);
+
 /* ------------------------------------------------- lat-long texel grids */
 
 /**

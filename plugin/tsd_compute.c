@@ -2,6 +2,7 @@
  * order; and the dispatcher. The day products are in tsd_compute_day.c. */
 #include "tsd_compute.h"
 
+#include "tsd_compute_env.h"
 #include "tsd_products.h"
 #include "tsd_text.h"
 
@@ -9,10 +10,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-typedef struct {
-    float *nx, *ny, *nz;
-} normals;
 
 void tsd_region_whole(tsd_region *r, const ts_grid *dem)
 {
@@ -79,14 +76,14 @@ static ts_status note(tsd_backend_summary *bs, ts_status st, const ts_backend_re
     return st;
 }
 
-static void free_normals(normals *nm)
+void tsd_normals_free(tsd_normals *nm)
 {
     free(nm->nx);
     free(nm->ny);
     free(nm->nz);
 }
 
-static ts_status make_normals(const tsd_compute_ctx *c, const ts_grid *g, normals *nm)
+ts_status tsd_normals_make(const tsd_compute_ctx *c, const ts_grid *g, tsd_normals *nm)
 {
     size_t cells = (size_t)g->width * g->height;
     ts_error err;
@@ -102,10 +99,8 @@ static ts_status make_normals(const tsd_compute_ctx *c, const ts_grid *g, normal
     return TS_OK;
 }
 
-/* Stream the DIRECTIONS horizon planes into one sky accumulator; `which`:
- * 0 = svf, 1 = sky, 2 = openness. acc must be zeroed. */
-static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const normals *nm,
-                            int which, float *acc)
+ts_status tsd_compute_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_plane_fn add,
+                             void *user)
 {
     size_t cells = (size_t)g->width * g->height;
     ts_horizon_opts h;
@@ -115,8 +110,6 @@ static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const no
     float *plane = malloc(cells * sizeof(float));
     if (!plane)
         return oom(c, "a horizon plane");
-    float *svf = which == 0 ? acc : NULL, *sky = which == 1 ? acc : NULL,
-          *open = which == 2 ? acc : NULL;
     h.progress = NULL; /* reported here, per azimuth */
     for (int k = 0; k < h.directions; k++) {
         double az = ts_horizon_azimuth(&h, k);
@@ -128,14 +121,43 @@ static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const no
         /* the sweep on the backend; the accumulation is C only */
         if (NOTE(c, ts_backend_horizon_sweep(BK(c), g, az, &h, plane, &rep, &err), rep) !=
                 TS_OK ||
-            ts_sky_accumulate(g, nm->nx, nm->ny, nm->nz, plane, az, h.directions,
-                              svf, sky, open, &err) != TS_OK) {
+            add(user, g, k, az, plane, &err) != TS_OK) {
             free(plane);
             return core_fail(c, &err);
         }
     }
     free(plane);
-    if (ts_sky_finish(g, h.directions, svf, sky, open, &err) != TS_OK)
+    return TS_OK;
+}
+
+/* The sky products' accumulator of sky_stream. */
+typedef struct {
+    const tsd_normals *nm;
+    int directions;
+    float *svf, *sky, *open;
+} sky_acc;
+
+static ts_status sky_add(void *user, const ts_grid *g, int k, double azimuth,
+                         const float *plane, ts_error *err)
+{
+    (void)k;
+    const sky_acc *a = user;
+    return ts_sky_accumulate(g, a->nm->nx, a->nm->ny, a->nm->nz, plane, azimuth,
+                             a->directions, a->svf, a->sky, a->open, err);
+}
+
+/* Stream the DIRECTIONS horizon planes into one sky accumulator; `which`:
+ * 0 = svf, 1 = sky, 2 = openness. acc must be zeroed. */
+static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const tsd_normals *nm,
+                            int which, float *acc)
+{
+    ts_error err;
+    ts_status st;
+    sky_acc a = {nm, c->opts->directions, which == 0 ? acc : NULL, which == 1 ? acc : NULL,
+                 which == 2 ? acc : NULL};
+    if ((st = tsd_compute_stream(c, g, sky_add, &a)) != TS_OK)
+        return st;
+    if (ts_sky_finish(g, a.directions, a.svf, a.sky, a.open, &err) != TS_OK)
         return core_fail(c, &err);
     return TS_OK;
 }
@@ -193,7 +215,7 @@ static ts_status sun_per_cell(const tsd_compute_ctx *c, const ts_grid *g, float 
 }
 
 /* The direct sun of shade into out; work is a plane. */
-static ts_status shade_direct(const tsd_compute_ctx *c, const ts_grid *g, const normals *nm,
+static ts_status shade_direct(const tsd_compute_ctx *c, const ts_grid *g, const tsd_normals *nm,
                               float *work, float *out)
 {
     size_t cells = (size_t)g->width * g->height;
@@ -241,21 +263,23 @@ TSD_COMPUTE_FN(tsd_compute_shade)
     (void)bytes;
     const ts_grid *g = r->dem;
     size_t cells = (size_t)g->width * g->height;
-    normals nm = {0};
+    tsd_normals nm = {0};
     ts_error err;
     ts_status st;
     float *work = malloc(cells * sizeof(float));
     if (!work)
         st = oom(c, "a horizon plane");
-    else if ((st = make_normals(c, g, &nm)) == TS_OK &&
+    else if ((st = tsd_normals_make(c, g, &nm)) == TS_OK &&
              (st = shade_direct(c, g, &nm, work, out)) == TS_OK && c->opts->sky_weight > 0) {
         memset(work, 0, cells * sizeof(float));
-        if ((st = sky_stream(c, g, &nm, 1, work)) == TS_OK &&
+        /* the uniform sky, or that of SKY / ENV_MAP (tsd_compute_env.c) */
+        st = c->run->env ? tsd_env_sky_term(c, g, &nm, work) : sky_stream(c, g, &nm, 1, work);
+        if (st == TS_OK &&
             ts_shade_combine(g, out, work, c->opts->sky_weight, out, &err) != TS_OK)
             st = core_fail(c, &err);
     }
     free(work);
-    free_normals(&nm);
+    tsd_normals_free(&nm);
     return st;
 }
 
@@ -293,12 +317,12 @@ TSD_COMPUTE_FN(tsd_compute_horizon)
 static ts_status sky_product(const tsd_compute_ctx *c, const tsd_region *r, int which,
                              float *out)
 {
-    normals nm = {0};
+    tsd_normals nm = {0};
     ts_status st;
     memset(out, 0, (size_t)r->width * r->height * sizeof(float));
-    if ((st = make_normals(c, r->dem, &nm)) == TS_OK)
+    if ((st = tsd_normals_make(c, r->dem, &nm)) == TS_OK)
         st = sky_stream(c, r->dem, &nm, which, out);
-    free_normals(&nm);
+    tsd_normals_free(&nm);
     return st;
 }
 

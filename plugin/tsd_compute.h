@@ -39,6 +39,9 @@ typedef struct {
 /** The region of the whole of `dem`, no margin. */
 void tsd_region_whole(tsd_region *r, const ts_grid *dem);
 
+/* The light of ENV_MAP or SKY (tsd_compute_env.h). */
+typedef struct tsd_environment tsd_environment;
+
 /**
  * What the driver derives when it computes, apart from what the user said
  * (tsd_options): the sun that shade and shadow use (SUN_AZIMUTH and
@@ -49,6 +52,7 @@ typedef struct {
     double sun_azimuth;      /* grid azimuth, degrees from north */
     double sun_elevation;    /* degrees above the horizontal */
     const tsd_sun *sun;      /* from tsd_sun_setup, or NULL */
+    const tsd_environment *env; /* ENV_MAP or SKY (tsd_environment_setup), or NULL */
     ts_progress_fn progress; /* NULL = no reports */
     void *progress_user;
 } tsd_run;
@@ -100,12 +104,30 @@ TSD_COMPUTE_FN(tsd_compute_sunhours);
 TSD_COMPUTE_FN(tsd_compute_insolation);
 TSD_COMPUTE_FN(tsd_compute_daycycle);
 TSD_COMPUTE_FN(tsd_compute_farshadow);
+TSD_COMPUTE_FN(tsd_compute_envlight);
 
 /* Shared by the compute files: the core's horizon options of the options
  * and run state, and a progress report of a loop the plugin runs itself
  * (TS_ERR_CANCELLED with ctx->msg when the caller cancels). */
 void tsd_compute_horizon_opts(const tsd_compute_ctx *c, ts_horizon_opts *h);
 ts_status tsd_compute_report(const tsd_compute_ctx *c, double done);
+
+/* Surface normals of a grid, computed on the backend. */
+typedef struct {
+    float *nx, *ny, *nz;
+} tsd_normals;
+ts_status tsd_normals_make(const tsd_compute_ctx *c, const ts_grid *g, tsd_normals *nm);
+void tsd_normals_free(tsd_normals *nm);
+
+/* What each horizon plane of tsd_compute_stream is added to: sector k of
+ * DIRECTIONS, at `azimuth` degrees. */
+typedef ts_status (*tsd_plane_fn)(void *user, const ts_grid *g, int k, double azimuth,
+                                  const float *plane, ts_error *err);
+
+/* Sweep the DIRECTIONS horizon planes one at a time on the backend (with
+ * progress per azimuth) and hand each to `add`. */
+ts_status tsd_compute_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_plane_fn add,
+                             void *user);
 
 #ifdef __cplusplus
 }

@@ -118,6 +118,7 @@ TSDataset::~TSDataset()
         GDALClose(m_poDEM);
     tsd_cells_free(&m_sCells);
     tsd_sun_free(&m_sSun);
+    tsd_environment_free(&m_sEnv);
     VSIFree(m_pafProduct);
     VSIFree(m_pabyProduct);
 }
@@ -374,6 +375,8 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     }
     const tsd_sun *psSun = m_bHasSun ? &m_sSun : nullptr;
     tsd_run_init(&m_sRun, &sOpts, psSun);
+    if (!SetupEnvironment())
+        return false;
     if (m_sCells.warning[0] && m_nLevel == 0) // said once, for the DEM itself
         CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", m_sCells.warning);
     if (!CheckMemory(sOpts, W, H))

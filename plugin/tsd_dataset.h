@@ -16,6 +16,7 @@
 
 #include "tsd_backend.h"
 #include "tsd_compute.h"
+#include "tsd_compute_env.h"
 #include "tsd_geodesy.h"
 #include "tsd_options.h"
 #include "tsd_products.h"
@@ -58,6 +59,7 @@ class TSDataset final : public GDALPamDataset
     bool m_bUsesBackend = false;
     bool m_bBackendKnown = false;     // m_sBackend filled (predicted or ran)
     tsd_backend_summary m_sBackend{}; // predicted, then what ran
+    tsd_environment m_sEnv{};         // ENV_MAP or SKY (tsd_dataset_env.cpp)
 
     CPLErr EnsureComputed();
     bool Setup(const char *pszConnection, int W, int H);
@@ -69,6 +71,8 @@ class TSDataset final : public GDALPamDataset
     void SetupSunMetadata();
     void SetupMetadata();
     void SetupPam(const char *pszConnection);
+    bool SetupEnvironment();
+    void SetupEnvironmentMetadata();
 
   public:
     TSDataset() = default;
@@ -91,6 +95,7 @@ class TSDataset final : public GDALPamDataset
 class TSRasterBand final : public GDALPamRasterBand
 {
     int m_nPlane;
+    GDALColorInterp m_eColor = GCI_GrayIndex;
 
   public:
     TSRasterBand(TSDataset *poDSIn, int nBandIn, GDALDataType eType);
@@ -99,7 +104,11 @@ class TSRasterBand final : public GDALPamRasterBand
     double GetNoDataValue(int *pbSuccess = nullptr) override;
     GDALColorInterp GetColorInterpretation() override
     {
-        return GCI_GrayIndex;
+        return m_eColor;
+    }
+    void SetColor(GDALColorInterp eColor)
+    {
+        m_eColor = eColor;
     }
     const char *GetUnitType() override;
     int GetOverviewCount() override;

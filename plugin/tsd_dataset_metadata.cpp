@@ -115,7 +115,11 @@ void TSDataset::SetupMetadata()
         poBand->GDALMajorObject::SetDescription(sInfo.description);
         if (sInfo.key)
             poBand->GDALMajorObject::SetMetadataItem(sInfo.key, sInfo.value);
+        if (sInfo.color)
+            static_cast<TSRasterBand *>(poBand)->SetColor(
+                GDALGetColorInterpretationByName(sInfo.color));
     }
+    SetupEnvironmentMetadata();
     if (m_bHasSun)
         SetupSunMetadata();
     SetupBackendMetadata();

@@ -2,6 +2,8 @@
 #include "tsd_option_table.h"
 
 #include "day_cycle.h"
+#include "terrashade_env.h"
+#include "tsd_compute_env.h"
 #include "tsd_datetime.h"
 #include "tsd_text.h"
 
@@ -14,6 +16,8 @@
 static int check_datetime(const char *v, char *msg, size_t n);
 static int check_date(const char *v, char *msg, size_t n);
 static int check_timezone(const char *v, char *msg, size_t n);
+static int check_sky(const char *v, char *msg, size_t n);
+static int check_exposure(const char *v, char *msg, size_t n);
 
 const opt_def TSD_OPTION_ROWS[] = {
     {"PRODUCT", K_PRODUCT, FIELD(product), "shade", 0, 0, 0, 0, NULL, 1, P,
@@ -132,6 +136,34 @@ const opt_def TSD_OPTION_ROWS[] = {
      "Print the progress of the computation to stderr: yes, no, or auto "
      "(when stderr is a terminal and the computation takes more than a "
      "second)"},
+    /* environment light (tsd_compute_env.c, docs/envlight.md) */
+    {"ENV_MAP", K_TEXT, FIELD(env_map), "", 0, 0, 0, 0, NULL, 1, P, LISTED, NULL,
+     "OpenEXR environment map lighting envlight (or the sky term of shade): a "
+     "lat-long (2:1) or cube-face (1:6) map, any GDAL path (/vsicurl/, "
+     "/vsimem/...); not with SKY"},
+    {"ENV_ROTATION", K_FLOAT, FIELD(env_rotation), "0", 0, 360, 0, 1, NULL, 1, P, LISTED,
+     NULL,
+     "ENV_MAP: degrees by which the environment turns clockwise seen from "
+     "above; at 0 the map's centre column is grid north, east to its right"},
+    {"SKY", K_TEXT, FIELD(sky), "", 0, 0, 0, 0, NULL, 1, P, LISTED, check_sky,
+     "A standard sky lighting envlight (or the sky term of shade): uniform, "
+     "overcast (CIE standard overcast), clear (CIE standard clear) or cie:N "
+     "(CIE general sky type N, 1..15), the sun from SUN_AZIMUTH and "
+     "SUN_ELEVATION or DATETIME; not with ENV_MAP"},
+    {"ENV_HORIZON_STEPS", K_INT, FIELD(env_horizon_steps),
+     TSD_XSTR(TS_ENV_DEFAULT_HORIZON_STEPS), 2, 3601, 0, 1, NULL, 1, P, LISTED, NULL,
+     "ENV_MAP, SKY: nodes of the light table's horizon-angle axis over -90..90 "
+     "degrees (181: one degree)"},
+    {"ENV_NORMAL_STEPS", K_INT, FIELD(env_normal_steps),
+     TSD_XSTR(TS_ENV_DEFAULT_NORMAL_STEPS), 0, 1025, 0, 1, NULL, 1, P, LISTED, NULL,
+     "ENV_MAP, SKY: nodes of the light table's normal-angle axis (2 or more, "
+     "bilinear as Timonen), or 0: exact in the normal angle (more accurate, "
+     "smaller, faster)"},
+    {"EXPOSURE", K_TEXT, FIELD(exposure), "", 0, 0, 0, 0, NULL, 1, P, LISTED,
+     check_exposure,
+     "envlight with OUTPUT_TYPE=Byte: stops by which the light is scaled (x "
+     "2^EXPOSURE) before the sRGB curve; empty or AUTO: the brightest "
+     "unshadowed surface of any slope and aspect maps to 255"},
     /* options of atlas files (*.tsa) only */
     {"SHADOWS", K_SELECT, FIELD(shadows_all), "far", 0, 0, 0, 0, "far|all", 0, A, LISTED,
      NULL,
@@ -181,5 +213,26 @@ static int check_timezone(const char *v, char *msg, size_t n)
     ts_error err;
     if (ts_parse_utc_offset(v, &off, &err) != TS_OK)
         return (tsd_fail_core(msg, n, "TIMEZONE", &err), -1);
+    return 0;
+}
+
+static int check_sky(const char *v, char *msg, size_t n)
+{
+    ts_sky_kind kind;
+    int type;
+    ts_error err;
+    if (ts_sky_parse(v, &kind, &type, &err) != TS_OK)
+        return (tsd_fail_core(msg, n, "SKY", &err), -1);
+    return 0;
+}
+
+static int check_exposure(const char *v, char *msg, size_t n)
+{
+    double stops;
+    if (tsd_exposure_parse(v, &stops) < 0)
+        return (tsd_fail(msg, n, TS_ERR_ARG,
+                         "EXPOSURE must be AUTO or a number of stops between %g and %g, "
+                         "got '%s'", -TSD_EXPOSURE_MAX, TSD_EXPOSURE_MAX, v),
+                -1);
     return 0;
 }

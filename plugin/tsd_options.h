@@ -75,6 +75,13 @@ typedef struct {
     int sunhours_fraction;   /* sunhours: 0 = a step counts while any of the
                                 disk is visible, 1 = weighted by the fraction */
     tsd_progress_mode progress_mode; /* PROGRESS: auto, yes, no */
+    /* environment light: PRODUCT=envlight, and the sky term of shade */
+    char env_map[TSD_PATH_MAX];  /* ENV_MAP: an OpenEXR map (a GDAL path), "" = none */
+    double env_rotation;         /* ENV_ROTATION: degrees, clockwise seen from above */
+    char sky[TSD_TEXT_MAX];      /* SKY: uniform, overcast, clear, cie:N; "" = none */
+    int env_horizon_steps;       /* ENV_HORIZON_STEPS: the L_p table's horizon axis */
+    int env_normal_steps;        /* ENV_NORMAL_STEPS: its normal axis, 0 = exact */
+    char exposure[TSD_TEXT_MAX]; /* EXPOSURE: stops (Byte), "" or AUTO = automatic */
     /* options of far-shadow atlas files (*.tsa) */
     int shadows_all;         /* SHADOWS: 0 = far, 1 = all */
     char dem[TSD_PATH_MAX];  /* DEM: "" = the atlas's SOURCE_DEM */

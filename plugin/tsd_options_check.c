@@ -47,6 +47,46 @@ static void byte_products(char *buf, size_t n)
 /* Refuse the combination with a sentence. */
 #define REFUSE(...) return (tsd_fail(msg, n, TS_ERR_ARG, __VA_ARGS__), -1)
 
+/* The options of environment light (ENV_MAP, SKY and theirs). */
+static int check_environment(const tsd_options *o, char *msg, size_t n)
+{
+    static const char *const own[] = {"ENV_MAP", "SKY", "ENV_ROTATION", "ENV_HORIZON_STEPS",
+                                      "ENV_NORMAL_STEPS", "EXPOSURE"};
+    const tsd_product_def *p = tsd_product_of(o);
+    const int envlight = tsd_product_takes(p, tsd_option_find("EXPOSURE"));
+    char list[256];
+    for (size_t i = 0; i < sizeof own / sizeof own[0]; i++) {
+        int id = tsd_option_find(own[i]);
+        if (tsd_options_given(o, own[i]) && !tsd_product_takes(p, id)) {
+            tsd_products_taking(id, "PRODUCT=", " and ", list, sizeof list);
+            REFUSE("%s applies to %s, not to PRODUCT=%s", own[i], list, p->name);
+        }
+    }
+    if (o->env_map[0] && o->sky[0])
+        REFUSE("give ENV_MAP or SKY, not both: both are the light of the sky (SKY=%s "
+               "excludes ENV_MAP=%s)", o->sky, o->env_map);
+    if (envlight && !o->env_map[0] && !o->sky[0])
+        REFUSE("PRODUCT=%s needs a light: ENV_MAP=<an OpenEXR map> or "
+               "SKY=uniform|overcast|clear|cie:N", p->name);
+    if (o->env_map[0] && envlight && (tsd_options_given(o, "SUN_AZIMUTH") ||
+                                      tsd_options_given(o, "SUN_ELEVATION") ||
+                                      o->datetime[0]))
+        REFUSE("PRODUCT=%s with ENV_MAP is lit by the map alone: SUN_AZIMUTH, "
+               "SUN_ELEVATION and DATETIME place the sun of a SKY", p->name);
+    if (o->env_rotation != 0 && !o->env_map[0])
+        REFUSE("ENV_ROTATION turns ENV_MAP; a SKY turns with its sun (SUN_AZIMUTH or "
+               "DATETIME)");
+    if (!envlight && (o->env_map[0] || o->sky[0]) && !(o->sky_weight > 0))
+        REFUSE("%s sets the sky term of PRODUCT=%s, which SKY_WEIGHT=0 leaves out: give "
+               "SKY_WEIGHT > 0", o->env_map[0] ? "ENV_MAP" : "SKY", p->name);
+    if (o->env_normal_steps == 1)
+        REFUSE("ENV_NORMAL_STEPS must be 0 (exact) or at least 2, got 1");
+    if (o->exposure[0] && !tsd_options_output_byte(o))
+        REFUSE("EXPOSURE applies to OUTPUT_TYPE=Byte (the display image); Float32 "
+               "keeps the light's own values");
+    return 0;
+}
+
 int tsd_options_check(const tsd_options *o, char *msg, size_t n)
 {
     const tsd_product_def *p = tsd_product_of(o);
@@ -103,5 +143,5 @@ int tsd_options_check(const tsd_options *o, char *msg, size_t n)
                     "start at FAR_THRESHOLD cells and have no end)", pn);
     if (o->sun_position == TSD_SUN_PER_CELL && !from_time)
         REFUSE("SUN_POSITION=per_cell needs the sun from DATETIME or DATE");
-    return 0;
+    return check_environment(o, msg, n);
 }

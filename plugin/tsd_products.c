@@ -68,6 +68,24 @@ static void band_insolation(const tsd_product_def *p, const tsd_options *o, int 
              k >= 0 && k < N_INSOLATION_BANDS ? INSOLATION_BANDS[k] : "?");
 }
 
+static const char *const COLOUR_BANDS[] = {"Red", "Green", "Blue"};
+
+static int colour_bands(const tsd_options *o)
+{
+    (void)o;
+    return 3;
+}
+
+/* "envlight red", colour interpretation Red */
+static void band_colour(const tsd_product_def *p, const tsd_options *o, int k,
+                        tsd_band_info *info)
+{
+    (void)o;
+    info->color = k >= 0 && k < 3 ? COLOUR_BANDS[k] : NULL;
+    snprintf(info->description, sizeof info->description, "%s %s", p->name,
+             k == 0 ? "red" : k == 1 ? "green" : k == 2 ? "blue" : "?");
+}
+
 static int backend_always(const tsd_options *o, const tsd_sun *sun)
 {
     (void)o;
@@ -88,13 +106,14 @@ static int shadow_uses_backend(const tsd_options *o, const tsd_sun *sun)
 #define SUN_OPTS "SUN_AZIMUTH SUN_ELEVATION METHOD PENUMBRA_DEPTH " SUN_TIME "SUN_POSITION "
 #define SWEEP "DIRECTIONS START_AZIMUTH MAX_DISTANCE "
 #define DAY "DATE TIMEZONE " SUN_TIME
+#define ENV "ENV_MAP ENV_ROTATION SKY ENV_HORIZON_STEPS ENV_NORMAL_STEPS "
 
 static const tsd_product_def PRODUCTS[] = {
     {"shade", "sun-lit relief with cast shadows", "", "0..1", one_band, NULL, band_named,
      TSD_BYTE_AUTO, 0, 0, TSD_STEPS_NONE,
      /* normals, a horizon plane or the SHM visibility; the sky accumulator
       * and its horizon plane; the per-cell sun */
-     4, 2, 7, backend_always, SUN_OPTS SWEEP "SKY_WEIGHT OUTPUT_TYPE BACKEND", NULL, NULL,
+     4, 2, 7, backend_always, SUN_OPTS SWEEP ENV "SKY_WEIGHT OUTPUT_TYPE BACKEND", NULL, NULL,
      tsd_compute_shade},
     {"shadow", "visible fraction of the sun's disk, 0..1", "", "0..1", one_band, NULL,
      band_named, TSD_BYTE_ALLOWED, 0, 0, TSD_STEPS_NONE, 0, 0, 7, shadow_uses_backend,
@@ -135,6 +154,12 @@ static const tsd_product_def PRODUCTS[] = {
     {"farshadow", "binary far-shadow maps of ATLAS_STEPS sun positions", "", "0, 1",
      per_atlas_step, "ATLAS_STEPS", NULL, TSD_BYTE_ALWAYS, 255, 1, TSD_STEPS_ATLAS, 1, 0, 0,
      NULL, DAY "FAR_THRESHOLD ATLAS_STEPS", NULL, NULL, tsd_compute_farshadow},
+    /* normals and one horizon plane (docs/envlight.md) */
+    {"envlight", "light of an HDR environment map (ENV_MAP) or a standard sky (SKY) on a "
+     "white Lambertian surface, E/pi per colour: red, green, blue", "", "E/pi", colour_bands,
+     NULL, band_colour, TSD_BYTE_ALLOWED, 0, 0, TSD_STEPS_NONE, 4, 0, 0, backend_always,
+     SWEEP ENV "EXPOSURE OUTPUT_TYPE BACKEND SUN_AZIMUTH SUN_ELEVATION " SUN_TIME, NULL, NULL,
+     tsd_compute_envlight},
 };
 
 #define N_PRODUCTS ((int)(sizeof PRODUCTS / sizeof PRODUCTS[0]))
@@ -213,7 +238,9 @@ double tsd_product_peak_bytes(const tsd_options *o, int width, int height, doubl
     double bands = tsd_options_band_count(o);
     /* bytes are a quarter of a float plane per band */
     double kept = p->byte == TSD_BYTE_ALWAYS ? bands / 4 : bands;
-    int extra = p->planes + (o->sky_weight > 0 ? p->sky_planes : 0) +
+    /* shade's sky term from SKY or ENV_MAP: two more colour accumulators */
+    int env_sky = o->sky_weight > 0 && p->sky_planes > 0 && (o->sky[0] || o->env_map[0]);
+    int extra = p->planes + (o->sky_weight > 0 ? p->sky_planes : 0) + 2 * env_sky +
                 (o->sun_position == TSD_SUN_PER_CELL ? p->per_cell_planes : 0);
     if (steady)
         *steady = kept * plane;

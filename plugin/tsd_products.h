@@ -36,12 +36,14 @@ typedef enum {
     TSD_STEPS_ATLAS    /* ATLAS_STEPS sun positions, denser near dawn and dusk */
 } tsd_day_steps;
 
-/** The description of one band, and one metadata item of it (key NULL =
- * none). */
+/** The description of one band, one metadata item of it (key NULL =
+ * none) and its colour interpretation (GDAL's name, e.g. "Red"; NULL =
+ * grey). */
 typedef struct {
     char description[64];
     const char *key;
     char value[32];
+    const char *color;
 } tsd_band_info;
 
 typedef struct tsd_product_def tsd_product_def;

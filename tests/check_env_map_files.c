@@ -280,6 +280,36 @@ static const char *small_map(const char *name, int w, int h, int envmap,
     return path;
 }
 
+/* ts_env_exr_info: the layout, channels and size from the header alone,
+ * and the same refusals as the reader for what the header shows. */
+START_TEST(test_header_info)
+{
+    static const struct {
+        const char *file;
+        int cube, width, height;
+    } maps[] = {{"sunset.exr", 0, 1024, 512}, {"sunset_cube128.exr", 1, 128, 768}};
+    ts_error err;
+    ts_env_map_info info;
+    for (size_t k = 0; k < sizeof maps / sizeof maps[0]; k++) {
+        char path[512];
+        size_t n;
+        snprintf(path, sizeof path, "%s/envmaps/%s", TS_TEST_DATA, maps[k].file);
+        unsigned char *b = read_all(path, &n);
+        ck_assert_msg(ts_env_exr_info(b, n, maps[k].file, &info, &err) == TS_OK, "%s",
+                      err.message);
+        printf("%-20s cube %d grey %d, %d x %d\n", maps[k].file, info.cube, info.grey,
+               info.width, info.height);
+        ck_assert(info.cube == maps[k].cube && info.grey == 0);
+        ck_assert(info.width == maps[k].width && info.height == maps[k].height);
+        free(b);
+    }
+    static const char words[] = "not an OpenEXR file";
+    expect_error(ts_env_exr_info(words, sizeof words, "words.exr", &info, &err), &err,
+                 "words.exr", "not a readable OpenEXR file");
+    ck_assert_int_eq(ts_env_exr_info(words, sizeof words, "x", NULL, &err), TS_ERR_ARG);
+}
+END_TEST
+
 START_TEST(test_bad_files)
 {
     expect_file_error("/nonexistent/envmaps/missing.exr", "No such file");
@@ -404,6 +434,7 @@ int main(void)
     tcase_add_test(ok, test_variants_uint_and_grey);
     tcase_add_test(ok, test_variants_cube);
     tcase_add_test(ok, test_dwa_from_memory);
+    tcase_add_test(ok, test_header_info);
     suite_add_tcase(s, ok);
     TCase *bad = tcase_create("bad input");
     tcase_add_test(bad, test_bad_files);

@@ -57,6 +57,22 @@ VARIANTS = {
     "farshadow": dict(DAY, ATLAS_STEPS="6", FAR_THRESHOLD="32"),
 }
 
+# Environment light (docs/envlight.md): printed after all the above, so that
+# the earlier lines keep their places.
+ENVMAPS = os.path.join(T.DATA, "envmaps")
+SUNSET = os.path.join(ENVMAPS, "sunset.exr")
+ENV_VARIANTS = {
+    "envlight_sky": {"SKY": "cie:7", "SUN_AZIMUTH": "120", "SUN_ELEVATION": "25",
+                     "DIRECTIONS": "8"},
+    "envlight_map": {"ENV_MAP": SUNSET, "ENV_ROTATION": "45", "DIRECTIONS": "8"},
+    "envlight_cube": {"ENV_MAP": os.path.join(ENVMAPS, "sunset_cube128.exr"),
+                      "DIRECTIONS": "8", "ENV_NORMAL_STEPS": "33"},
+    "envlight_byte": {"ENV_MAP": SUNSET, "OUTPUT_TYPE": "Byte", "DIRECTIONS": "8"},
+    "shade_clearsky": {"SKY": "clear", "SKY_WEIGHT": "0.5", "DIRECTIONS": "8",
+                       "DATETIME": "2026-06-21T08:00:00-05:00", "OUTPUT_TYPE": "Float32"},
+    "shade_envmap": {"ENV_MAP": SUNSET, "SKY_WEIGHT": "0.3", "DIRECTIONS": "8"},
+}
+
 
 def fractal_dem(path, n=512, seed=7):
     """Spectral-synthesis fractal (beta 2.2), 30 m cells, UTM 33N."""
@@ -134,38 +150,44 @@ def main():
     fractal = os.path.join(tmp, "fractal.tif")
     fractal_dem(fractal)
     dems = {"jacksboro": T.JACKSBORO, "lux": T.LUX, "fractal": fractal}
-    names = args.only.split(",") if args.only else list(VARIANTS)
+    variants = dict(VARIANTS, **ENV_VARIANTS)
+    names = args.only.split(",") if args.only else list(variants)
     if args.save:
         os.makedirs(args.save, exist_ok=True)
     worst = 0.0
     crossed = []
-    for dem_name, dem in dems.items():
-        kept = {}
-        for backend in args.backends.split(","):
-            for name in names:
-                oo = dict(VARIANTS[name], PRODUCT=name.split("_")[0], BACKEND=backend,
-                          PROGRESS="no")
-                ds = gdal.OpenEx("TERRASHADE:" + dem,
-                                 open_options=["%s=%s" % kv for kv in oo.items()])
-                a = read_all(ds)
-                ds = None
-                key = "%s.%s.%s" % (dem_name, backend, name)
-                h = hashlib.sha256(a.tobytes()).hexdigest()[:16]
-                line = "%-34s %s %s %s" % (key, a.dtype, "x".join(map(str, a.shape)), h)
-                if args.save:
-                    np.save(os.path.join(args.save, key + ".npy"), a)
-                if args.compare:
-                    ref = np.load(os.path.join(args.compare, key + ".npy"))
-                    m, same_nan = max_abs_diff(a, ref)
-                    worst = max(worst, m)
-                    line += "  max|diff| %.3g%s" % (m, "" if same_nan else "  NODATA DIFFERS")
-                if args.cross:
-                    kept[(backend, name)] = a
-                print(line, flush=True)
-        if args.cross:
-            crossed += [cross_line("%s.%s" % (dem_name, name), kept[("c", name)],
-                                   kept[("opencl", name)])
-                        for name in names if ("c", name) in kept and ("opencl", name) in kept]
+    # the variants of the first group come first in the record, each group
+    # DEM by DEM, so that added groups append lines to it
+    for group in (VARIANTS, ENV_VARIANTS):
+        for dem_name, dem in dems.items():
+            kept = {}
+            for backend in args.backends.split(","):
+                for name in [n for n in names if n in group]:
+                    oo = dict(variants[name], PRODUCT=name.split("_")[0], BACKEND=backend,
+                              PROGRESS="no")
+                    ds = gdal.OpenEx("TERRASHADE:" + dem,
+                                     open_options=["%s=%s" % kv for kv in oo.items()])
+                    a = read_all(ds)
+                    ds = None
+                    key = "%s.%s.%s" % (dem_name, backend, name)
+                    h = hashlib.sha256(a.tobytes()).hexdigest()[:16]
+                    line = "%-34s %s %s %s" % (key, a.dtype, "x".join(map(str, a.shape)), h)
+                    if args.save:
+                        np.save(os.path.join(args.save, key + ".npy"), a)
+                    if args.compare:
+                        ref = np.load(os.path.join(args.compare, key + ".npy"))
+                        m, same_nan = max_abs_diff(a, ref)
+                        worst = max(worst, m)
+                        line += "  max|diff| %.3g%s" % (m, "" if same_nan else
+                                                         "  NODATA DIFFERS")
+                    if args.cross:
+                        kept[(backend, name)] = a
+                    print(line, flush=True)
+            if args.cross:
+                crossed += [cross_line("%s.%s" % (dem_name, name), kept[("c", name)],
+                                       kept[("opencl", name)])
+                            for name in names
+                            if ("c", name) in kept and ("opencl", name) in kept]
     for line in crossed:
         print(line)
     if args.compare:

@@ -131,7 +131,7 @@ static void check_sentences(void)
                     "TERRASHADE:<dem>");
     expect_sentence(0, "PRODUCT=x",
                     "PRODUCT must be one of shade, shadow, horizon, svf, openness, sky, "
-                    "sunhours, insolation, daycycle, farshadow, got 'x'");
+                    "sunhours, insolation, daycycle, farshadow, envlight, got 'x'");
     expect_sentence(0, "SUN_AZIMUT=1",
                     "unknown option 'SUN_AZIMUT'; the options are PRODUCT, SUN_AZIMUTH, "
                     "SUN_ELEVATION, DIRECTIONS, START_AZIMUTH, METHOD, PENUMBRA_DEPTH, "
@@ -139,7 +139,8 @@ static void check_sentences(void)
                     "THREADS, OUTPUT_TYPE, MAX_MEMORY, DATETIME, DATE, TIMEZONE, "
                     "STEP_MINUTES, PRESSURE, TEMPERATURE, DELTA_T, SUN_POSITION, "
                     "LINKE_TURBIDITY, FAR_THRESHOLD, ATLAS_STEPS, BACKEND, SUNHOURS_RULE, "
-                    "PROGRESS (see gdalinfo --format TERRASHADE)");
+                    "PROGRESS, ENV_MAP, ENV_ROTATION, SKY, ENV_HORIZON_STEPS, "
+                    "ENV_NORMAL_STEPS, EXPOSURE (see gdalinfo --format TERRASHADE)");
     expect_sentence(0, "Z_FACTOR=0", "Z_FACTOR must be greater than 0 and at most 1e+06, got 0");
     expect_sentence(0, "SUN_POSITION=per_cell",
                     "SUN_POSITION=per_cell needs the sun from DATETIME or DATE");

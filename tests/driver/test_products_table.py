@@ -38,10 +38,19 @@ def open_options():
     return {o.get("name"): o for o in root.findall("Option")}
 
 
+def needs_light(p):
+    """The products of environment light (those that take EXPOSURE) need
+    ENV_MAP or SKY."""
+    return "EXPOSURE" in p["options"].split(",")
+
+
 def open_product(name, extra=()):
-    """Open PRODUCT=name on jacksboro (with a day for the day products)."""
+    """Open PRODUCT=name on jacksboro (with a day for the day products, a
+    sky for envlight)."""
     p = {q["name"]: q for q in products()}[name]
     opts = ["PRODUCT=" + name] + (DAY if p["daily"] == "yes" else []) + list(extra)
+    if needs_light(p) and not any(o.startswith(("SKY=", "ENV_MAP=")) for o in opts):
+        opts.append("SKY=uniform")
     return gdal.OpenEx(T.conn(T.JACKSBORO), open_options=opts)
 
 
@@ -105,6 +114,11 @@ class ProductsItem(unittest.TestCase):
                         gdal.OpenEx(T.conn(T.JACKSBORO),
                                     open_options=["PRODUCT=" + p["name"]])
                     self.assertIn("needs a day", str(e.exception))
+                if needs_light(p):
+                    with self.assertRaises(RuntimeError) as e:
+                        gdal.OpenEx(T.conn(T.JACKSBORO),
+                                    open_options=["PRODUCT=" + p["name"]])
+                    self.assertIn("needs a light", str(e.exception))
 
     def test_options_left_out_are_refused(self):
         listed = {p["name"]: p["options"].split(",") for p in products()}
@@ -113,7 +127,8 @@ class ProductsItem(unittest.TestCase):
                  ("DATETIME", "shade", "horizon", ["DATETIME=2026-06-21T12:00:00-05:00"],
                   "DATETIME applies to"),
                  ("MAX_DISTANCE", "sunhours", "farshadow", ["MAX_DISTANCE=100"],
-                  "MAX_DISTANCE does not apply")]
+                  "MAX_DISTANCE does not apply"),
+                 ("SKY", "envlight", "svf", ["SKY=overcast"], "SKY applies to")]
         for option, takes, refuses, values, text in cases:
             with self.subTest(option):
                 self.assertIn(option, listed[takes])

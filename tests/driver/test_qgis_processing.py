@@ -30,7 +30,13 @@ from tsdriver import np
 
 PLUGINS = os.path.join(T.SRCDIR, "plugin", "qgis")
 ALGORITHMS = ["shade", "shadow", "horizon", "svf", "openness", "sky", "sunhours",
-              "insolation"]
+              "insolation", "envlight"]
+# The provider's presentation rules (algorithms.py): a text option that is a
+# file, and one picked from a list (its first entry leaves it unset).
+FILE_OPTIONS = {"ENV_MAP"}
+PICKED = {"SKY": ["(none)", "uniform", "overcast", "clear"] + ["cie:%d" % n
+                                                             for n in range(1, 16)]}
+SUNSET = os.path.join(T.DATA, "envmaps", "sunset.exr")
 SET_BY_PROVIDER = {"PRODUCT", "PROGRESS"}  # the algorithm's product; QGIS's progress bar
 DBL_MAX = 1.7976931348623157e308  # QgsProcessingParameterNumber's bounds when unbounded
 
@@ -115,6 +121,12 @@ CASES = [
      {"PRODUCT": "horizon", "DIRECTIONS": 4}),
     ("sunhours", "terrashade:sunhours", dict(DAY, INPUT=J),
      dict(DAY, PRODUCT="sunhours")),
+    ("envlight", "terrashade:envlight",  # a file, a rotation
+     {"INPUT": J, "ENV_MAP": SUNSET, "ENV_ROTATION": 30, "DIRECTIONS": 8},
+     {"PRODUCT": "envlight", "ENV_MAP": SUNSET, "ENV_ROTATION": 30, "DIRECTIONS": 8}),
+    ("shade_sky", "terrashade:shade",  # a sky picked from the list: cie:9
+     {"INPUT": J, "SKY": 12, "SKY_WEIGHT": 0.5, "DIRECTIONS": 8},
+     {"PRODUCT": "shade", "SKY": "cie:9", "SKY_WEIGHT": 0.5, "DIRECTIONS": 8}),
 ]
 BAD = [
     ("no_date", "terrashade:sunhours", {"INPUT": J, "TIMEZONE": "-05:00"}),
@@ -142,6 +154,10 @@ def driver_declares():
 def expected_parameter(option):
     """What describe() in CHILD must say of the parameter of this <Option>."""
     kind, default = option.get("type"), option.get("default")
+    if option.get("name") in FILE_OPTIONS:
+        return {"type": "file", "default": None}
+    if option.get("name") in PICKED:
+        return {"type": "enum", "options": PICKED[option.get("name")], "default": 0}
     if kind in ("float", "int"):
         return {"type": "number", "integer": kind == "int",
                 "minimum": float(option.get("min", -DBL_MAX)),

@@ -63,7 +63,7 @@ class Registration(unittest.TestCase):
         self.assertEqual(opts["SUN_ELEVATION"].get("default"), "45")
         self.assertEqual([v.text for v in opts["PRODUCT"]],
                          ["shade", "shadow", "horizon", "svf", "openness", "sky",
-                          "sunhours", "insolation", "daycycle", "farshadow"])
+                          "sunhours", "insolation", "daycycle", "farshadow", "envlight"])
         for name in ("DATETIME", "DATE", "TIMEZONE", "STEP_MINUTES", "PRESSURE",
                      "TEMPERATURE", "DELTA_T", "SUN_POSITION", "LINKE_TURBIDITY",
                      "FAR_THRESHOLD", "ATLAS_STEPS", "SUNHOURS_RULE", "PROGRESS", "SHADOWS",

@@ -16,7 +16,8 @@ import sys
 from osgeo import gdal
 from qgis.core import (QgsProcessingAlgorithm, QgsProcessingException,
                        QgsProcessingParameterBoolean, QgsProcessingParameterDefinition,
-                       QgsProcessingParameterEnum, QgsProcessingParameterNumber,
+                       QgsProcessingParameterEnum, QgsProcessingParameterFile,
+                       QgsProcessingParameterNumber,
                        QgsProcessingParameterRasterDestination,
                        QgsProcessingParameterRasterLayer, QgsProcessingParameterString,
                        QgsRasterFileWriter)
@@ -29,7 +30,13 @@ FIXED = ("PRODUCT", "PROGRESS")
 # Options shown outside "Advanced parameters"; every other one (a new one too)
 # is advanced.
 BASIC = ("SUN_AZIMUTH", "SUN_ELEVATION", "DATETIME", "METHOD", "SKY_WEIGHT", "DIRECTIONS",
-         "DATE", "TIMEZONE", "STEP_MINUTES", "LINKE_TURBIDITY")
+         "DATE", "TIMEZONE", "STEP_MINUTES", "LINKE_TURBIDITY", "ENV_MAP", "SKY",
+         "ENV_ROTATION")
+# Text options better picked than typed: a file (its filter), and a list of
+# values (a choice whose first entry, NONE, leaves the option unset).
+FILES = {"ENV_MAP": "OpenEXR environment maps (*.exr *.EXR)"}
+NONE = "(none)"
+PICKS = {"SKY": ["uniform", "overcast", "clear"] + ["cie:%d" % n for n in range(1, 16)]}
 # Short labels where the description's first clause is too long (see label()).
 LABELS = {
     "DIRECTIONS": "Number of azimuths",
@@ -39,12 +46,14 @@ LABELS = {
     "STEP_MINUTES": "Time step (minutes)",
     "Z_FACTOR": "Z factor (multiplies the heights, e.g. 0.3048 for feet)",
     "BACKEND": "Backend",
+    "ENV_MAP": "Environment map (OpenEXR, lat-long or cube)",
+    "SKY": "Standard sky (CIE)",
 }
 # Titles of the algorithms; a product not here is titled by its description.
 TITLES = {"shade": "Hillshade with cast shadows", "shadow": "Cast shadows",
           "horizon": "Horizon angles", "svf": "Sky-view factor",
           "openness": "Positive openness", "sky": "Sky light", "sunhours": "Hours of sun",
-          "insolation": "Clear-sky insolation"}
+          "insolation": "Clear-sky insolation", "envlight": "Environment light"}
 BYTE_HELP = {
     "auto": "Byte 1..255 by default (0 = nodata); OUTPUT_TYPE=Float32 for the values.",
     "allowed": "Float32 by default; OUTPUT_TYPE=Byte scales it to 1..255 (0 = nodata).",
@@ -93,6 +102,11 @@ def make_parameter(option):
         p = QgsProcessingParameterBoolean(name, text, default)
     elif option.kind == "choice":
         p = QgsProcessingParameterEnum(name, text, option.values, False, default)
+    elif name in FILES:
+        p = QgsProcessingParameterFile(name, text, QgsProcessingParameterFile.File, "", None,
+                                       True, FILES[name])
+    elif name in PICKS:
+        p = QgsProcessingParameterEnum(name, text, [NONE] + PICKS[name], False, 0, True)
     else:  # empty text: the option is not given
         p = QgsProcessingParameterString(name, text, default, False, True)
     p.setHelp(option.description)
@@ -189,6 +203,12 @@ class TerrashadeAlgorithm(QgsProcessingAlgorithm):
     def option_text(self, option, parameters, context):
         """The open option a parameter stands for, or None for the driver's default."""
         name, kind = option.name, option.kind
+        if name in PICKS:
+            v = self.parameterAsEnum(parameters, name, context)
+            return PICKS[name][v - 1] if v > 0 else None
+        if name in FILES:
+            text = (self.parameterAsFile(parameters, name, context) or "").strip()
+            return text or None
         if kind == "choice":
             v = self.parameterAsEnum(parameters, name, context)
             text = option.values[v]
