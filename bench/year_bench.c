@@ -97,6 +97,7 @@ static double mean_of(const float *v, size_t n)
 
 int main(int argc, char **argv)
 {
+    setvbuf(stdout, NULL, _IOLBF, 0); /* lines as they come, when redirected */
     int size = 4096, year = 2026, interval = TS_RANGE_DAY_INTERVAL, threads = 0, insol = 1;
     double cell = 30, step = TS_RANGE_STEP_MINUTES, lat = 46.5, lon = 7.9;
     const char *dirs = NULL, *day = "2026-03-20";
