@@ -114,10 +114,12 @@ static range_error compare(const ts_grid *g, const site *p, const ts_day_opts *o
  * default: mean error under mean_tol (relative to the mean), max under
  * max_tol (relative to the mean). */
 static void against_exact(const char *what, const ts_grid *g, const site *p, int insolation,
-                          ts_date_range *r, double mean_tol, double max_tol)
+                          ts_sun_hours_rule rule, ts_date_range *r, double mean_tol,
+                          double max_tol)
 {
     ts_day_opts o;
     ts_day_opts_default(&o);
+    o.sun_hours_rule = rule;
     size_t n = (size_t)g->width * g->height;
     double *ref = malloc(n * sizeof *ref);
     ck_assert(ref);
@@ -129,7 +131,11 @@ static void against_exact(const char *what, const ts_grid *g, const site *p, int
         range_error e = compare(g, p, &o, r, insolation, ref);
         printf("%s %s, HORIZON_DIRECTIONS %3d: mean |error| %.4f (%.3f%% of the mean %.3f), "
                "max %.4f %s (%.2f%% of the mean)\n",
-               what, insolation ? "insolation" : "sun hours", dirs[k], e.mean_abs,
+               what,
+               insolation ? "insolation"
+               : rule == TS_SUN_HOURS_DISK_FRACTION ? "sun hours (fraction)"
+                                                    : "sun hours",
+               dirs[k], e.mean_abs,
                100 * e.mean_abs / e.mean_ref, e.mean_ref, e.max_abs,
                insolation ? "Wh/m2" : "h", 100 * e.max_abs / e.mean_ref);
         if (dirs[k] == TS_RANGE_HORIZON_DIRECTIONS)
@@ -154,8 +160,9 @@ START_TEST(test_fractal_against_exact)
     site_init(&p, 46.5, 7.4);
     ts_date_range r;
     range_set(&r, 2026, 11, 20, 2026, 11, 22, 60, 1);
-    against_exact("fractal 64x64", &g, &p, 0, &r, 0.006, 0.13);
-    against_exact("fractal 64x64", &g, &p, 1, &r, 0.002, 0.07);
+    against_exact("fractal 64x64", &g, &p, 0, TS_SUN_HOURS_VISIBLE, &r, 0.006, 0.13);
+    against_exact("fractal 64x64", &g, &p, 1, TS_SUN_HOURS_VISIBLE, &r, 0.002, 0.07);
+    against_exact("fractal 64x64", &g, &p, 0, TS_SUN_HOURS_DISK_FRACTION, &r, 0.006, 0.11);
     ts_grid_free(&g);
 }
 END_TEST
@@ -176,8 +183,8 @@ START_TEST(test_jacksboro_against_exact)
     site_init(&p, 36.589, -84.245);
     ts_date_range r;
     range_set(&r, 2026, 3, 19, 2026, 3, 21, -300, 1);
-    against_exact("jacksboro 100x80", &g, &p, 0, &r, 0.002, 0.06);
-    against_exact("jacksboro 100x80", &g, &p, 1, &r, 0.0002, 0.02);
+    against_exact("jacksboro 100x80", &g, &p, 0, TS_SUN_HOURS_VISIBLE, &r, 0.002, 0.06);
+    against_exact("jacksboro 100x80", &g, &p, 1, TS_SUN_HOURS_VISIBLE, &r, 0.0002, 0.02);
     ts_grid_free(&full);
 }
 END_TEST
