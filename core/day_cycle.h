@@ -1,7 +1,8 @@
 /*
  * day_cycle.h - the sun over a day: sampling times, per-cell sun
  * visibility at an instant, hours of direct sun, clear-sky irradiation
- * (insolation) over a local day, and the dawn/dusk-weighted times of the
+ * (insolation) over a local day or summed over a range of days (from
+ * horizons at fixed azimuths), and the dawn/dusk-weighted times of the
  * far-shadow atlas (Chajdas et al. 2015). No GDAL, no global state.
  *
  * Where the sun is seen from: a `ts_sun_sites` is one site (the DEM's
