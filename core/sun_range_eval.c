@@ -7,7 +7,6 @@
 #include <math.h>
 #include <string.h>
 
-#include "fastmath.h"
 #include "sun_range_internal.h"
 
 #define BLOCK 256
