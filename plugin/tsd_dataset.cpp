@@ -301,6 +301,11 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
                              CPLSPrintf("BAND=%d, but the DEM '%s' has %d band(s)",
                                         sOpts.band, osDEM.c_str(),
                                         poDEM->GetRasterCount()));
+    // Z_FACTOR=AUTO becomes the factor of the DEM's vertical unit here, so
+    // that the metadata and the auxiliary-file key say the number used
+    char szZWhy[256];
+    sOpts.z_factor = tsd_dem_z_factor(GDALRasterBand::ToHandle(poDEM->GetRasterBand(sOpts.band)),
+                                      sOpts.z_factor, szZWhy, sizeof szZWhy);
     const int W = poDEM->GetRasterXSize(), H = poDEM->GetRasterYSize();
     if (poDEM->GetGeoTransform(poDS->m_adfGT) != CE_None)
     {
@@ -367,6 +372,7 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     for (int i = 1; i <= tsd_options_band_count(&sOpts); i++)
         poDS->SetBand(i, new TSRasterBand(poDS.get(), i, eType));
     poDS->SetupMetadata();
+    poDS->GDALDataset::SetMetadataItem("Z_FACTOR_SOURCE", szZWhy);
     poDS->SetupPam(poOpenInfo->pszFilename);
     return poDS.release();
 }

@@ -42,9 +42,12 @@ const opt_def TSD_OPTION_ROWS[] = {
      LISTED, NULL,
      "METHOD=shm: metres below the shadow height over which light fades; "
      "0 = hard shadows"},
-    {"Z_FACTOR", K_FLOAT, FIELD(z_factor), "1", 0, 1e6, 1, 1, NULL, 1, P, ALL, NULL,
-     "Multiplies the heights (> 0), e.g. 0.3048 for heights in feet; the "
-     "band's scale and offset are applied first"},
+    {"Z_FACTOR", K_FLOAT_AUTO, FIELD(z_factor), "AUTO", 0, 1e6, 1, 1, "AUTO", 1, P, ALL,
+     NULL,
+     "Multiplies the heights: AUTO (from the vertical unit of the DEM's CRS, "
+     "else the band's unit: 0.3048 for feet, 1200/3937 for US survey feet, "
+     "1 for metres or no unit) or a number > 0 and <= 1e6; the band's scale "
+     "and offset are applied first"},
     {"MAX_DISTANCE", K_FLOAT, FIELD(max_distance), "0", 0, 1e8, 0, 1, NULL, 1, P, LISTED,
      NULL,
      "Largest distance in metres at which terrain can cast a shadow or "
