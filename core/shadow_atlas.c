@@ -344,6 +344,9 @@ ts_status ts_atlas_writer_finish(ts_atlas_writer *w, const ts_atlas_info *info,
     *size = 0;
     if (w->steps < 1)
         return ts_fail(err, TS_ERR_ARG, "an atlas needs at least one map");
+    ts_status checked = ts_atlas_check_steps(w->rec, w->steps, "cannot write the atlas", err);
+    if (checked != TS_OK)
+        return checked;
     int has_nodata = 0;
     for (size_t i = 0; i < w->tiles && !has_nodata; i++)
         has_nodata = w->mask[i] != 0;
@@ -417,7 +420,9 @@ ts_status ts_atlas_writer_finish(ts_atlas_writer *w, const ts_atlas_info *info,
         put32(h + 36, (uint32_t)ib);
         put32(h + 40, (uint32_t)w->used);
         put32(h + 44, info && info->threshold_cells > 0 ? (uint32_t)info->threshold_cells : 0);
-        putf64(h + 48, info ? info->threshold_m : NAN);
+        putf64(h + 48, info && isfinite(info->threshold_m) && info->threshold_m > 0
+                           ? info->threshold_m
+                           : NAN); /* 0 (a zeroed info) = unknown */
         for (int i = 0; i < 6; i++)
             putf64(h + 56 + 8 * i, info && info->has_geotransform ? info->geotransform[i]
                                                                   : (i == 1 || i == 5 ? 1.0 : 0.0));
@@ -429,7 +434,6 @@ ts_status ts_atlas_writer_finish(ts_atlas_writer *w, const ts_atlas_info *info,
         put64(h + 144, idx_off);
         put64(h + 152, idx_zn);
         put32(h + 160, lzma_crc32(h, 160, 0));
-        put32(h + 164, 0);
         for (int s = 0; s < w->steps; s++) {
             uint8_t *r = file + steps_off + (size_t)s * TS_ATLAS_STEP_SIZE;
             putf64(r, w->rec[s].unix_time);
@@ -440,6 +444,10 @@ ts_status ts_atlas_writer_finish(ts_atlas_writer *w, const ts_atlas_info *info,
             put32(r + 36, 0);
         }
         memcpy(file + text_off, text, text_n);
+        /* version 2: the step table and the text under their own CRC */
+        put32(h + 164, lzma_crc32(file + text_off, text_n,
+                                  lzma_crc32(file + steps_off,
+                                             (size_t)w->steps * TS_ATLAS_STEP_SIZE, 0)));
         memcpy(file + dict_off, dict_z, dict_zn);
         memcpy(file + idx_off, idx_z, idx_zn);
         *bytes = file;
@@ -504,13 +512,18 @@ ts_status ts_atlas_open(const uint8_t *b, size_t n, ts_atlas **out, ts_error *er
         BAD("the atlas is truncated: %zu bytes, the header alone has %d", n,
             TS_ATLAS_HEADER_SIZE);
     uint32_t version = get32(b + 8), hsize = get32(b + 12);
+    if (version == 1)
+        BAD("the atlas has format version 1, whose metadata and step table carry no "
+            "checksum and cannot be validated; this terrashade reads version %d: "
+            "recreate the atlas (gdal_translate -of TERRASHADE from PRODUCT=farshadow)",
+            TS_ATLAS_VERSION);
     if (version != TS_ATLAS_VERSION)
         BAD("the atlas has format version %u; this terrashade reads version %d",
             version, TS_ATLAS_VERSION);
     if (hsize < TS_ATLAS_HEADER_SIZE || n < hsize)
         BAD("the atlas is truncated or its header is damaged (header of %u bytes in a "
             "%zu-byte file)", hsize, n);
-    if (lzma_crc32(b, 160, 0) != get32(b + 160) || get32(b + 164) != 0)
+    if (lzma_crc32(b, 160, 0) != get32(b + 160))
         BAD("the atlas's header is damaged (CRC32 mismatch)");
     uint32_t W = get32(b + 16), H = get32(b + 20), steps = get32(b + 24);
     uint32_t tile = get32(b + 28), flags = get32(b + 32), ib = get32(b + 36);
@@ -530,6 +543,8 @@ ts_status ts_atlas_open(const uint8_t *b, size_t n, ts_atlas **out, ts_error *er
             BAD("the atlas is truncated: a section at byte %llu of %llu bytes lies "
                 "beyond the end of the %zu-byte file",
                 (unsigned long long)secs[i][0], (unsigned long long)secs[i][1], n);
+    if (lzma_crc32(b + to, (size_t)tn, lzma_crc32(b + so, (size_t)sn, 0)) != get32(b + 164))
+        BAD("the atlas's step table or metadata text is damaged (CRC32 mismatch)");
     a->info.width = (int)W;
     a->info.height = (int)H;
     a->info.steps = (int)steps;
@@ -538,7 +553,11 @@ ts_status ts_atlas_open(const uint8_t *b, size_t n, ts_atlas **out, ts_error *er
     a->info.has_geotransform = flags & 1;
     a->info.has_nodata = (flags & 2) != 0;
     for (int i = 0; i < 6; i++)
-        a->info.geotransform[i] = getf64(b + 56 + 8 * i);
+        if (!isfinite(a->info.geotransform[i] = getf64(b + 56 + 8 * i)))
+            BAD("the atlas's geotransform is invalid (%g in place %d)",
+                a->info.geotransform[i], i);
+    if (!isnan(a->info.threshold_m) && !(isfinite(a->info.threshold_m) && a->info.threshold_m > 0))
+        BAD("the atlas's far threshold (%g m) is not a distance", a->info.threshold_m);
     a->info.dictionary_tiles = ntiles;
     a->info.index_bytes = (int)ib;
     a->info.dictionary_bytes = dn;
@@ -576,6 +595,11 @@ ts_status ts_atlas_open(const uint8_t *b, size_t n, ts_atlas **out, ts_error *er
         a->steps[s].grid_azimuth = getf64(r + 16);
         a->steps[s].elevation = getf64(r + 24);
         a->steps[s].utc_offset_minutes = (int32_t)get32(r + 32);
+    }
+    if ((st = ts_atlas_check_steps(a->steps, (int)steps, "the atlas's step table is invalid",
+                                   err)) != TS_OK) {
+        free(dict_raw);
+        goto fail;
     }
     st = xz_decompress(b + dof, dn, dict_raw, (size_t)ntiles * 8, "tile dictionary words", err);
     if (st == TS_OK)
