@@ -43,6 +43,78 @@ static CPLStringList AtlasMetadata(const char *pszText)
     return aosOut;
 }
 
+/*
+ * The metadata of an atlas (read from a .tsa, or of the source of one) as
+ * the options of the PRODUCT=farshadow dataset it was written from: every
+ * item that is an option goes through the option table (ranges, the
+ * combination), as the options of a dataset do; BACKEND says what ran,
+ * not the option. Fills *psOpts; returns "" or the cause.
+ */
+static std::string CheckAtlasMetadata(const CPLStringList &aosMeta, int nMaps,
+                                      tsd_options *psOpts)
+{
+    CPLStringList aosOpts;
+    for (int i = 0; i < aosMeta.size(); i++)
+    {
+        char *pszKey = nullptr;
+        CPLParseNameValue(aosMeta[i], &pszKey);
+        if (pszKey && tsd_option_find(pszKey) >= 0 && !EQUAL(pszKey, "BACKEND"))
+            aosOpts.AddString(aosMeta[i]);
+        CPLFree(pszKey);
+    }
+    const char *pszProduct = aosMeta.FetchNameValue("PRODUCT");
+    if (!pszProduct)
+        return "PRODUCT is missing (an atlas holds the maps of PRODUCT=farshadow "
+               "and says so)";
+    if (!EQUAL(pszProduct, "farshadow")) // before the combination, which it decides
+        return CPLSPrintf("PRODUCT must be farshadow, got '%s': an atlas holds the "
+                          "far-shadow maps of a day", pszProduct);
+    char szMsg[1024];
+    tsd_options_defaults(psOpts);
+    if (tsd_options_apply(psOpts, aosOpts.List(), szMsg, sizeof szMsg) != 0)
+        return szMsg;
+    if (tsd_options_band_count(psOpts) != nMaps)
+        return CPLSPrintf("ATLAS_STEPS=%d, but there are %d map(s)", psOpts->atlas_steps,
+                          nMaps);
+    if (const char *pszOffset = aosMeta.FetchNameValue("UTC_OFFSET_MINUTES"))
+    {
+        char *pszEnd = nullptr;
+        const long nOffset = strtol(pszOffset, &pszEnd, 10);
+        if (pszEnd == pszOffset || *pszEnd || nOffset < -1439 || nOffset > 1439)
+            return CPLSPrintf("UTC_OFFSET_MINUTES must be a whole number of minutes "
+                              "between -1439 and 1439, got '%s'", pszOffset);
+    }
+    if (const char *pszFar = aosMeta.FetchNameValue("FAR_THRESHOLD_M"))
+    {
+        char *pszEnd = nullptr;
+        const double dfFar = CPLStrtod(pszFar, &pszEnd);
+        if (pszEnd == pszFar || *pszEnd || !(std::isfinite(dfFar) && dfFar > 0))
+            return CPLSPrintf("FAR_THRESHOLD_M must be a distance in metres (> 0), got "
+                              "'%s'", pszFar);
+    }
+    return std::string();
+}
+
+/* 1 if the file `pszName` is a far-shadow atlas (its magic). */
+static bool IsAtlasFile(const char *pszName)
+{
+    VSILFILE *fp = VSIFOpenL(pszName, "rb");
+    if (!fp)
+        return false;
+    GByte abyHead[8] = {0};
+    const size_t nRead = VSIFReadL(abyHead, 1, sizeof abyHead, fp);
+    VSIFCloseL(fp);
+    return ts_atlas_identify(abyHead, nRead) != 0;
+}
+
+/* The sentence for an atlas named as its own DEM. */
+static std::string AtlasAsDEM(const std::string &osDEM, bool bGiven)
+{
+    return CPLSPrintf("SHADOWS=all: the DEM '%s'%s is a far-shadow atlas (.tsa), not "
+                      "a DEM: name the DEM the atlas was made from with the open option "
+                      "DEM=...", osDEM.c_str(), bGiven ? "" : " (the atlas's SOURCE_DEM)");
+}
+
 class TSAtlasBand;
 
 class TSAtlasDataset final : public GDALPamDataset
@@ -56,7 +128,9 @@ class TSAtlasDataset final : public GDALPamDataset
     bool m_bAll = false; // SHADOWS=all: far | near, near recomputed from the DEM
     std::string m_osDEM{};
     int m_nThreads = 0;
+    bool m_bDEMGiven = false;           // DEM= given, not the SOURCE_DEM
     CPLStringList m_aosMeta{};
+    tsd_options m_sMetaOpts{};          // the metadata, validated as options
     std::mutex m_oMutex{};
     bool m_bTried = false;
     std::string m_osError{};            // why SHADOWS=all failed
@@ -170,13 +244,11 @@ CPLErr TSAtlasDataset::EnsureNear()
         ts_grid sGrid{};
         bool bGrid = false;
         float *pafPlane = nullptr;
-        const char *pszZ = m_aosMeta.FetchNameValueDef("Z_FACTOR", "1");
-        const int nBandDEM = atoi(m_aosMeta.FetchNameValueDef("BAND", "1"));
+        const int nBandDEM = m_sMetaOpts.band;
         ts_horizon_opts sH;
         ts_horizon_opts_default(&sH);
-        sH.curvature = CPLTestBool(m_aosMeta.FetchNameValueDef("CURVATURE", "YES"));
-        sH.refraction = CPLAtof(
-            m_aosMeta.FetchNameValueDef("REFRACTION", TSD_XSTR(TSD_REFRACTION_DEFAULT)));
+        sH.curvature = m_sMetaOpts.curvature;
+        sH.refraction = m_sMetaOpts.refraction;
         sH.threads = m_nThreads;
         sH.directions = 1;
         sH.max_distance = psInfo->threshold_m;
@@ -189,11 +261,16 @@ CPLErr TSAtlasDataset::EnsureNear()
             m_osError = CPLSPrintf("SHADOWS=all cannot open the DEM '%s' "
                                    "(give it with the open option DEM=...)",
                                    m_osDEM.c_str());
-        else if (poDEM->GetRasterXSize() != W || poDEM->GetRasterYSize() != H ||
-                 nBandDEM < 1 || nBandDEM > poDEM->GetRasterCount())
+        else if (dynamic_cast<TSAtlasDataset *>(poDEM))
+            m_osError = AtlasAsDEM(m_osDEM, m_bDEMGiven);
+        else if (poDEM->GetRasterXSize() != W || poDEM->GetRasterYSize() != H)
             m_osError = CPLSPrintf("SHADOWS=all: the DEM '%s' (%d x %d) does "
                                    "not match the %d x %d atlas", m_osDEM.c_str(),
                                    poDEM->GetRasterXSize(), poDEM->GetRasterYSize(), W, H);
+        else if (nBandDEM > poDEM->GetRasterCount())
+            m_osError = CPLSPrintf("SHADOWS=all: the atlas's metadata says BAND=%d, but the "
+                                   "DEM '%s' has %d band(s)", nBandDEM, m_osDEM.c_str(),
+                                   poDEM->GetRasterCount());
         else if (poDEM->GetGeoTransform(adfGT) != CE_None)
             m_osError = "SHADOWS=all: the DEM has no geotransform";
         else
@@ -205,7 +282,7 @@ CPLErr TSAtlasDataset::EnsureNear()
             ts_status eSt = tsd_cells_compute(adfGT, W, H, hSRS, &sCells, szMsg, sizeof szMsg);
             if (eSt == TS_OK)
                 eSt = tsd_dem_load(GDALRasterBand::ToHandle(poDEM->GetRasterBand(nBandDEM)),
-                                   &sCells, CPLAtof(pszZ), &sGrid, szMsg, sizeof szMsg);
+                                   &sCells, m_sMetaOpts.z_factor, &sGrid, szMsg, sizeof szMsg);
             if (eSt != TS_OK)
             {
                 m_nErr = ErrorNum(eSt);
@@ -322,14 +399,28 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
     poDS->m_bHasGT = psInfo->has_geotransform;
     memcpy(poDS->m_adfGT, psInfo->geotransform, sizeof poDS->m_adfGT);
     poDS->m_aosMeta = AtlasMetadata(psInfo->metadata);
+    const std::string osCause =
+        CheckAtlasMetadata(poDS->m_aosMeta, psInfo->steps, &poDS->m_sMetaOpts);
+    if (!osCause.empty())
+        return FailOpen(TS_ERR_ARG, CPLSPrintf("'%s': atlas metadata: %s",
+                                                 poOpenInfo->pszFilename, osCause.c_str()));
+    for (int k = 0; k < psInfo->steps; k++)
+        if (!std::isfinite(ts_atlas_get_step(psAtlas, k)->unix_time))
+            return FailOpen(TS_ERR_ARG,
+                            CPLSPrintf("'%s': atlas step table: map %d has no time, but "
+                                       "every map of PRODUCT=farshadow has one",
+                                       poOpenInfo->pszFilename, k + 1));
     poDS->m_bAll = bAll;
     poDS->m_nThreads = nThreads;
+    poDS->m_bDEMGiven = !osDEM.empty();
     poDS->m_osDEM = !osDEM.empty() ? osDEM
                                    : poDS->m_aosMeta.FetchNameValueDef("SOURCE_DEM", "");
     if (bAll && poDS->m_osDEM.empty())
         return FailOpen(TS_ERR_ARG,
                           "SHADOWS=all recomputes the near shadows from the DEM, but the "
                           "atlas names none: give it with the open option DEM=...");
+    if (bAll && IsAtlasFile(poDS->m_osDEM.c_str()))
+        return FailOpen(TS_ERR_ARG, AtlasAsDEM(poDS->m_osDEM, poDS->m_bDEMGiven).c_str());
     int nOffset = atoi(poDS->m_aosMeta.FetchNameValueDef("UTC_OFFSET_MINUTES", "0"));
     for (int i = 0; i < poDS->m_aosMeta.size(); i++)
     {
@@ -340,7 +431,13 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
             if (EQUAL(pszKey, "SRS_WKT"))
             {
                 poDS->m_oSRS.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-                poDS->m_oSRS.importFromWkt(pszValue);
+                if (poDS->m_oSRS.importFromWkt(pszValue) != OGRERR_NONE)
+                {
+                    CPLFree(pszKey);
+                    return FailOpen(TS_ERR_ARG,
+                                    CPLSPrintf("'%s': atlas metadata: SRS_WKT is not a CRS "
+                                               "GDAL can read", poOpenInfo->pszFilename));
+                }
             }
             else
                 poDS->GDALDataset::SetMetadataItem(pszKey, pszValue);
@@ -374,6 +471,32 @@ GDALDataset *TSAtlasDataset::CreateCopy(const char *pszFilename, GDALDataset *po
     const int nBands = poSrcDS->GetRasterCount();
     if (nBands < 1)
         return FailOpen(CPLE_NotSupported, "an atlas needs at least one band");
+    for (int b = 1; b <= nBands; b++)
+    {
+        const GDALDataType eType = poSrcDS->GetRasterBand(b)->GetRasterDataType();
+        if (GDALDataTypeIsComplex(eType))
+            return FailOpen(CPLE_NotSupported,
+                            CPLSPrintf("band %d of the source is complex (%s): an atlas "
+                                       "stores the binary far-shadow maps of "
+                                       "PRODUCT=farshadow", b, GDALGetDataTypeName(eType)));
+    }
+    {
+        /* the source must be a far-shadow product (or a copy of one) */
+        tsd_options sSrcOpts;
+        const CPLStringList aosSrcMeta(CSLDuplicate(poSrcDS->GetMetadata()));
+        const std::string osCause = CheckAtlasMetadata(aosSrcMeta, nBands, &sSrcOpts);
+        if (!osCause.empty())
+            return FailOpen(CPLE_NotSupported,
+                            CPLSPrintf("the source is not a far-shadow product (an "
+                                       "atlas stores the maps of TERRASHADE:PRODUCT="
+                                       "farshadow,...:<dem>, or of a copy of one): its "
+                                       "metadata: %s", osCause.c_str()));
+        for (int b = 1; b <= nBands; b++)
+            if (!poSrcDS->GetRasterBand(b)->GetMetadataItem("UNIX_TIME"))
+                return FailOpen(CPLE_NotSupported,
+                                CPLSPrintf("band %d of the source has no UNIX_TIME: every "
+                                           "map of PRODUCT=farshadow has its time", b));
+    }
     if (!pfnProgress)
         pfnProgress = GDALDummyProgress;
     ts_error sErr;
