@@ -80,6 +80,15 @@ class VerticalUnits(unittest.TestCase):
         self.check(self.ftus, FT_US, "vertical unit US survey foot, from the CRS",
                    self.m_ftus, Z_FACTOR="auto")
 
+    def test_sample_dems_stay_in_metres(self):
+        """jacksboro and lux_elev say no vertical unit: factor 1, as before."""
+        for dem in (T.JACKSBORO, T.LUX):
+            ds = opened(dem)
+            self.assertEqual(ds.GetMetadataItem("Z_FACTOR"), "1")
+            self.assertEqual(ds.GetMetadataItem("Z_FACTOR_SOURCE"),
+                             "no vertical unit in the CRS or the band: heights taken as metres")
+            ds = None
+
     def test_not_a_number(self):
         with self.assertRaises(RuntimeError) as e:
             opened(self.plain, Z_FACTOR="feet")
