@@ -22,6 +22,7 @@
 #include "ogr_spatialref.h"
 
 #include "shadow_atlas.h"
+#include "tsd_atlas_check.h"
 #include "tsd_dem.h"
 #include "tsd_gdal.h"
 #include "tsd_geodesy.h"
@@ -56,7 +57,9 @@ class TSAtlasDataset final : public GDALPamDataset
     bool m_bAll = false; // SHADOWS=all: far | near, near recomputed from the DEM
     std::string m_osDEM{};
     int m_nThreads = 0;
+    bool m_bDEMGiven = false;           // DEM= given, not the SOURCE_DEM
     CPLStringList m_aosMeta{};
+    tsd_options m_sMetaOpts{};          // the metadata, validated as options
     std::mutex m_oMutex{};
     bool m_bTried = false;
     std::string m_osError{};            // why SHADOWS=all failed
@@ -170,13 +173,11 @@ CPLErr TSAtlasDataset::EnsureNear()
         ts_grid sGrid{};
         bool bGrid = false;
         float *pafPlane = nullptr;
-        const char *pszZ = m_aosMeta.FetchNameValueDef("Z_FACTOR", "1");
-        const int nBandDEM = atoi(m_aosMeta.FetchNameValueDef("BAND", "1"));
+        const int nBandDEM = m_sMetaOpts.band;
         ts_horizon_opts sH;
         ts_horizon_opts_default(&sH);
-        sH.curvature = CPLTestBool(m_aosMeta.FetchNameValueDef("CURVATURE", "YES"));
-        sH.refraction = CPLAtof(
-            m_aosMeta.FetchNameValueDef("REFRACTION", TSD_XSTR(TSD_REFRACTION_DEFAULT)));
+        sH.curvature = m_sMetaOpts.curvature;
+        sH.refraction = m_sMetaOpts.refraction;
         sH.threads = m_nThreads;
         sH.directions = 1;
         sH.max_distance = psInfo->threshold_m;
@@ -189,11 +190,16 @@ CPLErr TSAtlasDataset::EnsureNear()
             m_osError = CPLSPrintf("SHADOWS=all cannot open the DEM '%s' "
                                    "(give it with the open option DEM=...)",
                                    m_osDEM.c_str());
-        else if (poDEM->GetRasterXSize() != W || poDEM->GetRasterYSize() != H ||
-                 nBandDEM < 1 || nBandDEM > poDEM->GetRasterCount())
+        else if (dynamic_cast<TSAtlasDataset *>(poDEM))
+            m_osError = AtlasAsDEM(m_osDEM, m_bDEMGiven);
+        else if (poDEM->GetRasterXSize() != W || poDEM->GetRasterYSize() != H)
             m_osError = CPLSPrintf("SHADOWS=all: the DEM '%s' (%d x %d) does "
                                    "not match the %d x %d atlas", m_osDEM.c_str(),
                                    poDEM->GetRasterXSize(), poDEM->GetRasterYSize(), W, H);
+        else if (nBandDEM > poDEM->GetRasterCount())
+            m_osError = CPLSPrintf("SHADOWS=all: the atlas's metadata says BAND=%d, but the "
+                                   "DEM '%s' has %d band(s)", nBandDEM, m_osDEM.c_str(),
+                                   poDEM->GetRasterCount());
         else if (poDEM->GetGeoTransform(adfGT) != CE_None)
             m_osError = "SHADOWS=all: the DEM has no geotransform";
         else
@@ -205,7 +211,7 @@ CPLErr TSAtlasDataset::EnsureNear()
             ts_status eSt = tsd_cells_compute(adfGT, W, H, hSRS, &sCells, szMsg, sizeof szMsg);
             if (eSt == TS_OK)
                 eSt = tsd_dem_load(GDALRasterBand::ToHandle(poDEM->GetRasterBand(nBandDEM)),
-                                   &sCells, CPLAtof(pszZ), &sGrid, szMsg, sizeof szMsg);
+                                   &sCells, m_sMetaOpts.z_factor, &sGrid, szMsg, sizeof szMsg);
             if (eSt != TS_OK)
             {
                 m_nErr = ErrorNum(eSt);
@@ -322,14 +328,28 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
     poDS->m_bHasGT = psInfo->has_geotransform;
     memcpy(poDS->m_adfGT, psInfo->geotransform, sizeof poDS->m_adfGT);
     poDS->m_aosMeta = AtlasMetadata(psInfo->metadata);
+    const std::string osCause =
+        CheckAtlasMetadata(poDS->m_aosMeta, psInfo->steps, &poDS->m_sMetaOpts);
+    if (!osCause.empty())
+        return FailOpen(TS_ERR_ARG, CPLSPrintf("'%s': atlas metadata: %s",
+                                                 poOpenInfo->pszFilename, osCause.c_str()));
+    for (int k = 0; k < psInfo->steps; k++)
+        if (!std::isfinite(ts_atlas_get_step(psAtlas, k)->unix_time))
+            return FailOpen(TS_ERR_ARG,
+                            CPLSPrintf("'%s': atlas step table: map %d has no time, but "
+                                       "every map of PRODUCT=farshadow has one",
+                                       poOpenInfo->pszFilename, k + 1));
     poDS->m_bAll = bAll;
     poDS->m_nThreads = nThreads;
+    poDS->m_bDEMGiven = !osDEM.empty();
     poDS->m_osDEM = !osDEM.empty() ? osDEM
                                    : poDS->m_aosMeta.FetchNameValueDef("SOURCE_DEM", "");
     if (bAll && poDS->m_osDEM.empty())
         return FailOpen(TS_ERR_ARG,
                           "SHADOWS=all recomputes the near shadows from the DEM, but the "
                           "atlas names none: give it with the open option DEM=...");
+    if (bAll && IsAtlasFile(poDS->m_osDEM.c_str()))
+        return FailOpen(TS_ERR_ARG, AtlasAsDEM(poDS->m_osDEM, poDS->m_bDEMGiven).c_str());
     int nOffset = atoi(poDS->m_aosMeta.FetchNameValueDef("UTC_OFFSET_MINUTES", "0"));
     for (int i = 0; i < poDS->m_aosMeta.size(); i++)
     {
@@ -340,7 +360,13 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
             if (EQUAL(pszKey, "SRS_WKT"))
             {
                 poDS->m_oSRS.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-                poDS->m_oSRS.importFromWkt(pszValue);
+                if (poDS->m_oSRS.importFromWkt(pszValue) != OGRERR_NONE)
+                {
+                    CPLFree(pszKey);
+                    return FailOpen(TS_ERR_ARG,
+                                    CPLSPrintf("'%s': atlas metadata: SRS_WKT is not a CRS "
+                                               "GDAL can read", poOpenInfo->pszFilename));
+                }
             }
             else
                 poDS->GDALDataset::SetMetadataItem(pszKey, pszValue);
@@ -374,6 +400,9 @@ GDALDataset *TSAtlasDataset::CreateCopy(const char *pszFilename, GDALDataset *po
     const int nBands = poSrcDS->GetRasterCount();
     if (nBands < 1)
         return FailOpen(CPLE_NotSupported, "an atlas needs at least one band");
+    const std::string osNotShadow = CheckAtlasSource(poSrcDS);
+    if (!osNotShadow.empty())
+        return FailOpen(CPLE_NotSupported, osNotShadow.c_str());
     if (!pfnProgress)
         pfnProgress = GDALDummyProgress;
     ts_error sErr;

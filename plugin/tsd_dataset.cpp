@@ -313,6 +313,11 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
                              CPLSPrintf("BAND=%d, but the DEM '%s' has %d band(s)",
                                         sOpts.band, osDEM.c_str(),
                                         poDEM->GetRasterCount()));
+    // Z_FACTOR=AUTO becomes the factor of the DEM's vertical unit here, so
+    // that the metadata and the auxiliary-file key say the number used
+    char szZWhy[256];
+    sOpts.z_factor = tsd_dem_z_factor(GDALRasterBand::ToHandle(poDEM->GetRasterBand(sOpts.band)),
+                                      sOpts.z_factor, szZWhy, sizeof szZWhy);
     const int W = poDEM->GetRasterXSize(), H = poDEM->GetRasterYSize();
     if (poDEM->GetGeoTransform(poDS->m_adfGT) != CE_None)
     {
@@ -328,6 +333,8 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
         poDS->m_oSRS = *poSRS;
     if (!poDS->Setup(poOpenInfo->pszFilename, W, H))
         return nullptr;
+    // not through PAM: it is derived, like the rest of the metadata
+    poDS->GDALDataset::SetMetadataItem("Z_FACTOR_SOURCE", szZWhy);
     poDS->m_nOverviews = OverviewCount(poDS->m_psProduct, W, H);
     return poDS.release();
 }

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "cpl_error.h"
 
@@ -112,6 +113,8 @@ ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
         scale = 1;
     if (!has_offset)
         offset = 0;
+    if (isnan(z_factor))
+        z_factor = tsd_dem_z_factor(band, z_factor, NULL, 0);
     scale *= z_factor;
     offset *= z_factor;
 
@@ -150,4 +153,61 @@ ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
     free(m);
     flip(grid, cells->flip_x, cells->flip_y);
     return TS_OK;
+}
+
+/* Metres per unit of a unit's name (GDAL's band unit types, PROJ's and
+ * GeoTIFF's names), or 0 if not known. */
+static double metres_per_unit(const char *unit)
+{
+    static const struct {
+        const char *name;
+        double metres;
+    } units[] = {
+        {"m", 1.0}, {"metre", 1.0}, {"meter", 1.0}, {"metres", 1.0}, {"meters", 1.0},
+        {"ft", 0.3048}, {"foot", 0.3048}, {"feet", 0.3048}, {"international foot", 0.3048},
+        {"US survey foot", 1200.0 / 3937.0}, {"US survey feet", 1200.0 / 3937.0},
+        {"ftUS", 1200.0 / 3937.0}, {"us-ft", 1200.0 / 3937.0},
+        {"foot_us", 1200.0 / 3937.0}, {"Foot_US", 1200.0 / 3937.0},
+    };
+    for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
+        if (strcasecmp(unit, units[i].name) == 0)
+            return units[i].metres;
+    return 0.0;
+}
+
+double tsd_dem_z_factor(GDALRasterBandH band, double requested, char *why, size_t n)
+{
+    char scratch[8];
+    if (!why) {
+        why = scratch;
+        n = sizeof scratch;
+    }
+    if (!isnan(requested)) {
+        snprintf(why, n, "given as Z_FACTOR");
+        return requested;
+    }
+    /* the vertical CRS of a compound (or vertical) CRS: its axis unit */
+    GDALDatasetH ds = GDALGetBandDataset(band);
+    OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
+    if (srs && (OSRIsCompound(srs) || OSRIsVertical(srs))) {
+        char *name = NULL;
+        double metres = OSRGetTargetLinearUnits(srs, "VERT_CS", &name);
+        if (metres > 0 && isfinite(metres)) {
+            snprintf(why, n, "vertical unit %s, from the CRS", name ? name : "?");
+            return metres;
+        }
+    }
+    const char *unit = GDALGetRasterUnitType(band);
+    if (unit && unit[0]) {
+        double metres = metres_per_unit(unit);
+        if (metres > 0) {
+            snprintf(why, n, "band unit %s", unit);
+            return metres;
+        }
+        snprintf(why, n, "band unit '%s' not a length terrashade knows: heights taken "
+                         "as metres", unit);
+        return 1.0;
+    }
+    snprintf(why, n, "no vertical unit in the CRS or the band: heights taken as metres");
+    return 1.0;
 }

@@ -46,9 +46,12 @@ const opt_def TSD_OPTION_ROWS[] = {
      LISTED, NULL,
      "METHOD=shm: metres below the shadow height over which light fades; "
      "0 = hard shadows"},
-    {"Z_FACTOR", K_FLOAT, FIELD(z_factor), "1", 0, 1e6, 1, 1, NULL, 1, P, ALL, NULL,
-     "Multiplies the heights (> 0), e.g. 0.3048 for heights in feet; the "
-     "band's scale and offset are applied first"},
+    {"Z_FACTOR", K_FLOAT_AUTO, FIELD(z_factor), "AUTO", 0, 1e6, 1, 1, "AUTO", 1, P, ALL,
+     NULL,
+     "Multiplies the heights: AUTO (from the vertical unit of the DEM's CRS, "
+     "else the band's unit: 0.3048 for feet, 1200/3937 for US survey feet, "
+     "1 for metres or no unit) or a number > 0 and <= 1e6; the band's scale "
+     "and offset are applied first"},
     {"MAX_DISTANCE", K_FLOAT, FIELD(max_distance), "0", 0, 1e8, 0, 1, NULL, 1, P, LISTED,
      NULL,
      "Largest distance in metres at which terrain can cast a shadow or "
@@ -90,12 +93,17 @@ const opt_def TSD_OPTION_ROWS[] = {
      "needed with DATE; with DATETIME it defaults to DATETIME's offset"},
     {"STEP_MINUTES", K_INT, FIELD(step_minutes), "5", 1, 240, 0, 1, NULL, 1, P, LISTED,
      NULL, "Time step of sunhours, insolation and daycycle, minutes"},
-    {"PRESSURE", K_FLOAT, FIELD(pressure), "1013.25", 0, 5000, 1, 1, NULL, 1, P, LISTED,
-     NULL, "Mean air pressure at the DEM, hPa (atmospheric refraction of the sun)"},
-    {"TEMPERATURE", K_FLOAT, FIELD(temperature), "15", -273, 6000, 1, 1, NULL, 1, P,
+    /* the ranges where the SPA's refraction (Bennett / Saemundsson form)
+     * holds: the air at the Earth's surface (docs/driver.md) */
+    {"PRESSURE", K_FLOAT, FIELD(pressure), "1013.25", 300, 1100, 0, 1, NULL, 1, P, LISTED,
+     NULL,
+     "Mean air pressure at the DEM, hPa (atmospheric refraction of the sun); "
+     "300 (above Everest's summit) to 1100 (the highest recorded at sea level)"},
+    {"TEMPERATURE", K_FLOAT, FIELD(temperature), "15", -90, 60, 0, 1, NULL, 1, P,
      LISTED, NULL,
      "Mean air temperature at the DEM, degrees Celsius (atmospheric "
-     "refraction of the sun)"},
+     "refraction of the sun); -90 to 60, the recorded extremes at the "
+     "Earth's surface"},
     {"DELTA_T", K_FLOAT, FIELD(delta_t), "69", -8000, 8000, 0, 1, NULL, 1, P, LISTED, NULL,
      "TT - UT in seconds (about 69 in the 2020s)"},
     {"SUN_POSITION", K_SELECT, FIELD(sun_position), "center", 0, 0, 0, 0,

@@ -13,8 +13,9 @@
 
 /* How an option's text becomes its field: K_SELECT and K_PRODUCT store the
  * index of the value (int or enum field), K_BOOL 0/1 (int), K_INT an int,
- * K_FLOAT a double, K_TEXT a char array. */
-typedef enum { K_SELECT, K_FLOAT, K_INT, K_BOOL, K_TEXT, K_PRODUCT } opt_kind;
+ * K_FLOAT a double, K_TEXT a char array, K_FLOAT_AUTO a double or, for
+ * the word in `values` (e.g. AUTO: decided from the data), NAN. */
+typedef enum { K_SELECT, K_FLOAT, K_INT, K_BOOL, K_TEXT, K_PRODUCT, K_FLOAT_AUTO } opt_kind;
 
 /* A check of a text option's value beyond its kind: 0, or -1 with msg. */
 typedef int (*opt_validate_fn)(const char *value, char *msg, size_t n);
@@ -27,7 +28,7 @@ typedef struct {
     double min, max;       /* inclusive range (numbers) */
     int min_exclusive;     /* value must be > min */
     int has_max;           /* 0: no upper bound */
-    const char *values;    /* K_SELECT: '|'-separated */
+    const char *values;    /* K_SELECT: '|'-separated; K_FLOAT_AUTO: the word */
     int affects_pixels;    /* part of the canonical string */
     int scope;             /* TSD_SCOPE_* */
     tsd_applies applies;

@@ -82,6 +82,8 @@ static int parse_number(const opt_def *d, const char *v, double *out, char *msg,
         *out = (double)l;
     } else {
         double x = strtod(v, &end);
+        if ((end == v || *end || !isfinite(x)) && d->kind == K_FLOAT_AUTO)
+            REFUSE("%s must be %s or a number, got '%s'", d->name, d->values, v);
         if (end == v || *end || !isfinite(x))
             REFUSE("%s must be a number, got '%s'", d->name, v);
         *out = x;
@@ -136,6 +138,13 @@ static int set_option(tsd_options *o, int id, const char *v, char *msg, size_t n
         }
         memcpy(field, &k, sizeof k);
         return 0;
+    case K_FLOAT_AUTO:
+        if (strcasecmp(v, d->values) == 0) {
+            x = NAN;
+            memcpy(field, &x, sizeof x);
+            return 0;
+        }
+        /* fall through - a number */
     case K_FLOAT:
     case K_INT:
         if (parse_number(d, v, &x, msg, n) != 0)

@@ -50,7 +50,8 @@ typedef struct {
     double start_azimuth;    /* first of those azimuths */
     tsd_method method;       /* exact horizon or shadow height map */
     double penumbra_depth;   /* metres, METHOD=shm only */
-    double z_factor;         /* multiplies the DEM's heights */
+    double z_factor;         /* multiplies the DEM's heights; NAN = AUTO, decided
+                                from the DEM (tsd_dem_z_factor) */
     double max_distance;     /* metres, 0 = unbounded */
     int curvature;           /* Earth curvature and refraction on/off */
     double refraction;       /* k */

@@ -5,6 +5,7 @@
 #include "tsd_products.h"
 #include "tsd_text.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -66,8 +67,12 @@ const char *tsd_options_value(const tsd_options *o, int i, char *buf, size_t n)
         snprintf(buf, n, "%d", k);
         break;
     case K_FLOAT:
+    case K_FLOAT_AUTO:
         memcpy(&x, field, sizeof x);
-        snprintf(buf, n, "%.10g", x);
+        if (d->kind == K_FLOAT_AUTO && isnan(x))
+            snprintf(buf, n, "%s", d->values); /* not decided yet */
+        else
+            snprintf(buf, n, "%.10g", x);
         break;
     case K_TEXT:
         snprintf(buf, n, "%s", field);
@@ -98,8 +103,9 @@ int tsd_options_canonical(const tsd_options *o, char *buf, size_t n)
 
 char *tsd_options_xml(void)
 {
-    static const char *const type_names[] = {"string-select", "float", "int",
-                                             "boolean", "string", "string-select"};
+    /* K_FLOAT_AUTO: a string for GDAL, which has no type "number or word" */
+    static const char *const type_names[] = {"string-select", "float", "int", "boolean",
+                                             "string", "string-select", "string"};
     tsd_strbuf b = {0};
     tsd_strbuf_add(&b, "<OpenOptionList>");
     for (int i = 0; i < TSD_OPTION_COUNT; i++) {

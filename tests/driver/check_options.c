@@ -142,6 +142,7 @@ static void check_sentences(void)
                     "PROGRESS, ENV_MAP, ENV_ROTATION, SKY, ENV_HORIZON_STEPS, "
                     "ENV_NORMAL_STEPS, EXPOSURE (see gdalinfo --format TERRASHADE)");
     expect_sentence(0, "Z_FACTOR=0", "Z_FACTOR must be greater than 0 and at most 1e+06, got 0");
+    expect_sentence(0, "Z_FACTOR=feet", "Z_FACTOR must be AUTO or a number, got 'feet'");
     expect_sentence(0, "SUN_POSITION=per_cell",
                     "SUN_POSITION=per_cell needs the sun from DATETIME or DATE");
 }
@@ -165,7 +166,8 @@ int main(void)
            d.sun_azimuth, d.sun_elevation);
     EXPECT(strcmp(tsd_product_of(&d)->name, "shade") == 0, "PRODUCT default %s",
            tsd_product_of(&d)->name);
-    EXPECT(d.curvature == 1 && d.z_factor == 1 && d.band == 1 && d.directions == 16,
+    /* Z_FACTOR=AUTO: NAN until the DEM's vertical unit decides it */
+    EXPECT(d.curvature == 1 && isnan(d.z_factor) && d.band == 1 && d.directions == 16,
            "curvature %d, z %g, band %d, directions %d", d.curvature, d.z_factor, d.band,
            d.directions);
     printf("%s: %d option(s), %d failure(s)\n", failures ? "FAIL" : "PASS",
