@@ -103,7 +103,8 @@ static ts_status make_normals(const tsd_compute_ctx *c, const ts_grid *g, normal
 }
 
 /* Stream the DIRECTIONS horizon planes into one sky accumulator; `which`:
- * 0 = svf, 1 = sky, 2 = openness. acc must be zeroed. */
+ * 0 = svf (of SVF_MODEL), 1 = sky, 2 = openness (the horizons of g: pass
+ * the negated DEM for negative openness). acc must be zeroed. */
 static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const normals *nm,
                             int which, float *acc)
 {
@@ -117,7 +118,12 @@ static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const no
         return oom(c, "a horizon plane");
     float *svf = which == 0 ? acc : NULL, *sky = which == 1 ? acc : NULL,
           *open = which == 2 ? acc : NULL;
+    ts_svf_model model = which == 0 ? (ts_svf_model)c->opts->svf_model : TS_SVF_RADIATIVE;
     h.progress = NULL; /* reported here, per azimuth */
+    /* Curvature lowers far terrain; on the negated DEM it would raise it,
+     * so the sweep over the negated DEM (negative openness) runs without. */
+    if (which == 2 && c->opts->openness_negative)
+        h.curvature = 0;
     for (int k = 0; k < h.directions; k++) {
         double az = ts_horizon_azimuth(&h, k);
         ts_backend_report rep = {0};
@@ -128,8 +134,8 @@ static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const no
         /* the sweep on the backend; the accumulation is C only */
         if (NOTE(c, ts_backend_horizon_sweep(BK(c), g, az, &h, plane, &rep, &err), rep) !=
                 TS_OK ||
-            ts_sky_accumulate(g, nm->nx, nm->ny, nm->nz, plane, az, h.directions,
-                              svf, sky, open, &err) != TS_OK) {
+            ts_sky_accumulate_model(g, nm->nx, nm->ny, nm->nz, plane, az, h.directions, model,
+                                    svf, sky, open, &err) != TS_OK) {
             free(plane);
             return core_fail(c, &err);
         }
@@ -290,14 +296,36 @@ TSD_COMPUTE_FN(tsd_compute_horizon)
     return TS_OK;
 }
 
+/* A copy of `dem` with its heights negated (NaN stays NaN), the surface
+ * whose openness is the negative openness (Yokoyama et al. 2002, as RVT_py
+ * computes it); free its z. */
+static ts_status negated_dem(const tsd_compute_ctx *c, const ts_grid *dem, ts_grid *neg)
+{
+    *neg = *dem;
+    neg->stride = dem->width;
+    neg->owns_memory = 0;
+    neg->z = malloc((size_t)dem->width * dem->height * sizeof(float));
+    if (!neg->z)
+        return oom(c, "the negated DEM of negative openness");
+    for (int y = 0; y < dem->height; y++)
+        for (int x = 0; x < dem->width; x++)
+            neg->z[(size_t)y * dem->width + x] = -dem->z[(ptrdiff_t)y * dem->stride + x];
+    return TS_OK;
+}
+
 static ts_status sky_product(const tsd_compute_ctx *c, const tsd_region *r, int which,
                              float *out)
 {
     normals nm = {0};
+    ts_grid neg = {0};
     ts_status st;
+    const int negative = which == 2 && c->opts->openness_negative;
     memset(out, 0, (size_t)r->width * r->height * sizeof(float));
-    if ((st = make_normals(c, r->dem, &nm)) == TS_OK)
-        st = sky_stream(c, r->dem, &nm, which, out);
+    if ((st = make_normals(c, r->dem, &nm)) == TS_OK && negative)
+        st = negated_dem(c, r->dem, &neg);
+    if (st == TS_OK)
+        st = sky_stream(c, negative ? &neg : r->dem, &nm, which, out);
+    free(neg.z);
     free_normals(&nm);
     return st;
 }

@@ -75,6 +75,8 @@ typedef struct {
     int sunhours_fraction;   /* sunhours: 0 = a step counts while any of the
                                 disk is visible, 1 = weighted by the fraction */
     tsd_progress_mode progress_mode; /* PROGRESS: auto, yes, no */
+    int svf_model;           /* SVF_MODEL: a ts_svf_model (0 radiative, 1 solid_angle) */
+    int openness_negative;   /* OPENNESS: 0 = positive, 1 = negative */
     /* options of far-shadow atlas files (*.tsa) */
     int shadows_all;         /* SHADOWS: 0 = far, 1 = all */
     char dem[TSD_PATH_MAX];  /* DEM: "" = the atlas's SOURCE_DEM */
