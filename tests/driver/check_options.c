@@ -139,7 +139,7 @@ static void check_sentences(void)
                     "THREADS, OUTPUT_TYPE, MAX_MEMORY, DATETIME, DATE, TIMEZONE, "
                     "STEP_MINUTES, PRESSURE, TEMPERATURE, DELTA_T, SUN_POSITION, "
                     "LINKE_TURBIDITY, FAR_THRESHOLD, ATLAS_STEPS, BACKEND, SUNHOURS_RULE, "
-                    "PROGRESS (see gdalinfo --format TERRASHADE)");
+                    "PROGRESS, SVF_MODEL, OPENNESS (see gdalinfo --format TERRASHADE)");
     expect_sentence(0, "Z_FACTOR=0", "Z_FACTOR must be greater than 0 and at most 1e+06, got 0");
     expect_sentence(0, "SUN_POSITION=per_cell",
                     "SUN_POSITION=per_cell needs the sun from DATETIME or DATE");

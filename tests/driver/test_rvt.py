@@ -123,5 +123,46 @@ class AgainstRVT(unittest.TestCase):
         self.agree("openness negative (deg)", on, self.rvt["neg_opns"], GOAL_OPNS)
 
 
+class Options(unittest.TestCase):
+    """SVF_MODEL and OPENNESS: their effect on a cone, and bad values."""
+
+    def test_cone(self):
+        """Closed forms at a cone's tip, along the grid's axes (DIRECTIONS=4:
+        the sweep's lines run through the cells; on other azimuths they
+        interpolate across the tip's kink)."""
+        n, mid, cell, slope = 61, 30, 10.0, 25.0
+        yy, xx = np.mgrid[0:n, 0:n]
+        pit = (np.hypot(xx - mid, yy - mid) * cell * np.tan(np.radians(slope))).astype(np.float32)
+        opts = {"DIRECTIONS": 4, "CURVATURE": "NO", "MAX_DISTANCE": 200, "BACKEND": "c"}
+        with T.TempDir() as d:
+            for name, z in (("pit", pit), ("peak", -pit)):
+                path = T.write_tif(os.path.join(d, name + ".tif"), z,
+                                   (500000, cell, 0, 4000000, 0, -cell), 32633)
+                got = {}
+                for key, o in (("radiative", {"PRODUCT": "svf"}),
+                               ("solid", {"PRODUCT": "svf", "SVF_MODEL": "solid_angle"}),
+                               ("pos", {"PRODUCT": "openness", "OPENNESS": "positive"}),
+                               ("neg", {"PRODUCT": "openness", "OPENNESS": "negative"})):
+                    got[key] = T.read(T.conn(path), band=1, options=dict(opts, **o))[mid, mid]
+                print(name, got)
+                b = slope if name == "pit" else -slope
+                self.assertAlmostEqual(got["solid"], 1 - np.sin(np.radians(max(b, 0))), delta=1e-4)
+                self.assertAlmostEqual(got["pos"], 90 - b, delta=1e-3)
+                self.assertAlmostEqual(got["neg"], 90 + b, delta=1e-3)
+                if name == "pit":
+                    # radiative at the bottom of the pit: the flat-cell form 1 - mean sin^2
+                    self.assertAlmostEqual(got["radiative"], 1 - np.sin(np.radians(b)) ** 2,
+                                           delta=1e-4)
+
+    def test_bad_values(self):
+        for opt, value, sentence in (
+                ("SVF_MODEL", "zaksek", "SVF_MODEL must be one of radiative, solid_angle, "
+                                        "got 'zaksek'"),
+                ("OPENNESS", "both", "OPENNESS must be one of positive, negative, got 'both'")):
+            p = T.run(["gdal_translate", "-q", "-oo", "PRODUCT=svf", "-oo",
+                       "%s=%s" % (opt, value), T.conn(T.LUX), "/vsimem/x.tif"], ok=False)
+            self.assertIn(sentence, p.stderr)
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)
