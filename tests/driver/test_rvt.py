@@ -162,6 +162,14 @@ class Options(unittest.TestCase):
             p = T.run(["gdal_translate", "-q", "-oo", "PRODUCT=svf", "-oo",
                        "%s=%s" % (opt, value), T.conn(T.LUX), "/vsimem/x.tif"], ok=False)
             self.assertIn(sentence, p.stderr)
+        for product, opt, sentence in (
+                ("shade", "SVF_MODEL=solid_angle",
+                 "SVF_MODEL=solid_angle applies to PRODUCT=svf only, not to PRODUCT=shade"),
+                ("svf", "OPENNESS=negative",
+                 "OPENNESS=negative applies to PRODUCT=openness only, not to PRODUCT=svf")):
+            p = T.run(["gdal_translate", "-q", "-oo", "PRODUCT=" + product, "-oo", opt,
+                       T.conn(T.LUX), "/vsimem/x.tif"], ok=False)
+            self.assertIn(sentence, p.stderr)
 
 
 if __name__ == "__main__":
