@@ -1,9 +1,10 @@
 /*
  * Sky terms from horizons: sky-view factor with the surface normal and
  * uniform-sky light (Timonen & Westerholm 2010, eq. 4-5 with c = 1), the
- * solid-angle sky-view factor (Zaksek et al. 2011), and openness. Each azimuth k is a swath of 360/n degrees; inside it
- * the sky is visible from zenith down to theta_k = min(horizon zenith
- * angle, the zenith angle where the tangent plane cuts azimuth k).
+ * solid-angle sky-view factor (Zaksek et al. 2011), and openness. Each
+ * azimuth k is a swath of 360/n degrees; inside it the sky is visible from
+ * zenith down to theta_k = min(horizon zenith angle, the zenith angle where
+ * the tangent plane cuts azimuth k).
  */
 #include <math.h>
 #include <string.h>
