@@ -79,3 +79,12 @@ ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
     (void)svf, (void)sky, (void)openness;
     return NOT_BUILT(err);
 }
+
+ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
+                                const float *nz, const float *horizons,
+                                const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
+                                float *sky, float *openness, ts_error *err)
+{
+    (void)svf_model;
+    return ts_cl_sky_terms(grid, nx, ny, nz, horizons, opts, svf, sky, openness, err);
+}

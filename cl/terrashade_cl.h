@@ -104,6 +104,11 @@ ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
                           const float *nz, const float *horizons,
                           const ts_horizon_opts *opts, float *svf, float *sky,
                           float *openness, ts_error *err);
+/** ts_sky_terms_model on the device. */
+ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
+                                const float *nz, const float *horizons,
+                                const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
+                                float *sky, float *openness, ts_error *err);
 
 #ifdef __cplusplus
 }

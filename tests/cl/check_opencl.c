@@ -472,6 +472,24 @@ START_TEST(test_sky)
         ck_assert_int_eq(
             ts_cl_sky_terms(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, NULL, l[1], NULL, &e), TS_OK);
         expect_close("sky alone", c[1], l[1], sc.n, TOL);
+        /* the solid-angle svf (Zaksek et al. 2011), with and without the others */
+        ck_assert_int_eq(ts_sky_terms_model(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o,
+                                            TS_SVF_SOLID_ANGLE, c[0], NULL, NULL, &e),
+                         TS_OK);
+        ck_assert_msg(ts_cl_sky_terms_model(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o,
+                                            TS_SVF_SOLID_ANGLE, l[0], l[1], l[2], &e) == TS_OK,
+                      "%s", e.message);
+        char name[192], sh[64];
+        snprintf(name, sizeof name, "svf solid_angle %s", shape_name(s, sh, sizeof sh));
+        expect_close(name, c[0], l[0], sc.n, TOL);
+        expect_close("sky beside svf solid_angle", c[1], l[1], sc.n, TOL);
+        ck_assert_int_eq(ts_cl_sky_terms_model(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o,
+                                               TS_SVF_SOLID_ANGLE, l[0], NULL, NULL, &e),
+                         TS_OK);
+        expect_close("svf solid_angle alone", c[0], l[0], sc.n, TOL);
+        ck_assert_int_eq(ts_cl_sky_terms_model(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o,
+                                               (ts_svf_model)5, l[0], NULL, NULL, &e),
+                         TS_ERR_ARG);
         for (int k = 0; k < 3; k++)
             free(c[k]), free(l[k]);
         scene_free(&sc, s);
