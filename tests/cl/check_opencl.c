@@ -676,6 +676,34 @@ START_TEST(test_env_light_dispatch)
         ck_assert_ptr_null(st.cl);
     }
     clear_env();
+    /* A fallback in the middle: planes 0..3 on OpenCL; then copies of the
+     * normals make the dispatcher reopen its session, which the cap refuses,
+     * so planes 4..7 run C from the sums so far (and stay on C). */
+    float *nc = tdem_floats(3 * n);
+    memcpy(nc, sc.nx, n * sizeof *nc);
+    memcpy(nc + n, sc.ny, n * sizeof *nc);
+    memcpy(nc + 2 * n, sc.nz, n * sizeof *nc);
+    ts_backend_env_light st = {0};
+    memset(l, 0, 3 * n * sizeof *l);
+    for (int k = 0; k < 8; k++) {
+        if (k == 4)
+            setenv("TERRASHADE_OPENCL_MAX_ALLOC", "4k", 1);
+        const float *x = k < 4 ? sc.nx : nc, *y = k < 4 ? sc.ny : nc + n;
+        const float *z = k < 4 ? sc.nz : nc + 2 * n;
+        ck_assert_int_eq(ts_backend_env_light_accumulate(TS_BACKEND_OPENCL, &st, &sc.g, &t, k, x,
+                                                         y, z, sc.h + n * k, l, l + n, l + 2 * n,
+                                                         &r, &e),
+                         TS_OK);
+        ck_assert_int_eq(r.used, k < 4 ? TS_BACKEND_OPENCL : TS_BACKEND_C);
+        ck_assert_int_eq(r.fell_back, k >= 4);
+    }
+    ts_backend_env_light_release(&st);
+    long mid_nan = 0;
+    double mid = env_rel_diff(c, l, 3 * n, &mid_nan);
+    printf("  envlight OpenCL then C from plane 4: max |C - mixed| / C = %.3g\n", mid);
+    ck_assert(mid <= TOL_ENV_REL && mid_nan == 0);
+    free(nc);
+    clear_env();
     /* argument errors: the C function's */
     ck_assert_int_eq(ts_backend_env_light_accumulate(TS_BACKEND_OPENCL, NULL, &sc.g, &t, 8, sc.nx,
                                                      sc.ny, sc.nz, sc.h, l, l + n, l + 2 * n, &r,
