@@ -7,7 +7,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "fastmath.h"
+#include "cellmath/cm_sun.h"
 #include "sun_range_internal.h"
 
 #define BLOCK 256
