@@ -65,7 +65,6 @@ int tsd_options_step_minutes(const tsd_options *o)
  * sunhours and insolation; the core checks the range itself. */
 static int check_range(const tsd_options *o, char *msg, size_t n)
 {
-    static const char *const own[] = {"DAY_INTERVAL", "HORIZON_DIRECTIONS"};
     const tsd_product_def *p = tsd_product_of(o);
     const int o_start = tsd_option_find("START_DATE");
     char list[256];
@@ -73,10 +72,13 @@ static int check_range(const tsd_options *o, char *msg, size_t n)
     if (o->end_date[0] && !o->start_date[0])
         REFUSE("END_DATE=%s needs START_DATE, the first day of the range (for one day "
                "give DATE)", o->end_date);
-    for (size_t i = 0; i < sizeof own / sizeof own[0]; i++)
-        if (tsd_options_given(o, own[i]) && !o->start_date[0])
-            REFUSE("%s applies to a date range (START_DATE, END_DATE) of %s; one day "
-                   "(DATE or DATETIME) has none", own[i], list);
+    /* as ENV_ROTATION: a value other than the default that would do nothing */
+    if (!o->start_date[0] && (o->day_interval != TS_RANGE_DAY_INTERVAL ||
+                              o->horizon_directions != TS_RANGE_HORIZON_DIRECTIONS))
+        REFUSE("%s applies to a date range (START_DATE, END_DATE) of %s; one day "
+               "(DATE or DATETIME) has none",
+               o->day_interval != TS_RANGE_DAY_INTERVAL ? "DAY_INTERVAL" : "HORIZON_DIRECTIONS",
+               list);
     if (!o->start_date[0])
         return 0;
     if (!tsd_product_takes(p, o_start))
