@@ -204,6 +204,13 @@ class Year(unittest.TestCase):
                 self.assertIn("TERRASHADE", p.stderr)
             if os.path.exists(out):
                 os.remove(out)
+        # a DEM without a geotransform: the sentence names START_DATE
+        nogt = os.path.join(self.dir, "nogt.tif")
+        ds = gdal.GetDriverByName("GTiff").Create(nogt, 8, 8, 1, gdal.GDT_Float32)
+        ds = None
+        p = T.run(["gdal_translate", "-q", "-oo", "PRODUCT=sunhours", "-oo",
+                   "START_DATE=2026-03-19", "-oo", "TIMEZONE=Z", T.conn(nogt), out], ok=False)
+        self.assertIn("START_DATE needs a georeferenced DEM", p.stderr)
 
 
 if __name__ == "__main__":
