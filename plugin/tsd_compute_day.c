@@ -31,6 +31,8 @@ static ts_status done(const tsd_compute_ctx *c, ts_status st, const ts_error *er
     return st == TS_OK ? TS_OK : tsd_fail_core(c->msg, c->msg_size, NULL, err);
 }
 
+/* sunhours and insolation: one day swept at each step, or a date range
+ * (START_DATE) from horizons swept once (core/sun_range.c) */
 TSD_COMPUTE_FN(tsd_compute_sunhours)
 {
     (void)bytes;
@@ -39,9 +41,12 @@ TSD_COMPUTE_FN(tsd_compute_sunhours)
     if (!sun)
         return TS_ERR_INTERNAL;
     ts_day_opts day = day_opts(c, sun);
+    if (sun->is_range)
+        return done(c, ts_sun_hours_range(r->dem, &sun->sites, &day, &sun->range, out, &err),
+                    &err);
     return done(c,
                 ts_sun_hours(r->dem, &sun->sites, &day, sun->day_start, sun->day_length,
-                             c->opts->step_minutes * 60.0, out, &err),
+                             tsd_options_step_minutes(c->opts) * 60.0, out, &err),
                 &err);
 }
 
@@ -54,9 +59,14 @@ TSD_COMPUTE_FN(tsd_compute_insolation)
     if (!sun)
         return TS_ERR_INTERNAL;
     ts_day_opts day = day_opts(c, sun);
+    if (sun->is_range)
+        return done(c,
+                    ts_insolation_range(r->dem, &sun->sites, &day, &sun->range, out,
+                                        out + cells, out + 2 * cells, &err),
+                    &err);
     return done(c,
                 ts_insolation(r->dem, &sun->sites, &day, sun->day_start, sun->day_length,
-                              c->opts->step_minutes * 60.0, out, out + cells,
+                              tsd_options_step_minutes(c->opts) * 60.0, out, out + cells,
                               out + 2 * cells, &err),
                 &err);
 }

@@ -355,7 +355,9 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
         return Fail(eSt, szMsg), false;
     if (tsd_options_sun_from_time(&sOpts))
     {
-        const char *pszWhat = sOpts.datetime[0] ? "DATETIME" : "DATE";
+        const char *pszWhat = sOpts.datetime[0]     ? "DATETIME"
+                              : sOpts.start_date[0] ? "START_DATE"
+                                                    : "DATE";
         if (!m_bHasGT || !hSRS)
             return Fail(
                        CPLE_AppDefined,

@@ -182,6 +182,20 @@ void TSDataset::SetupSunMetadata()
     tsd_format_time(s.day_start + s.day_length, s.offset_minutes, szTime, sizeof szTime);
     GDALDataset::SetMetadataItem("DAY_END", szTime);
     GDALDataset::SetMetadataItem("UTC_OFFSET_MINUTES", CPLSPrintf("%d", s.offset_minutes));
+    if (s.is_range)
+    {
+        /* the range used: its last day, length, days computed, and the step
+         * (30 minutes when STEP_MINUTES is not given) */
+        const ts_date_range &r = s.range;
+        GDALDataset::SetMetadataItem(
+            "END_DATE", CPLSPrintf("%04d-%02d-%02d", r.last_year, r.last_month, r.last_day));
+        GDALDataset::SetMetadataItem("STEP_MINUTES", CPLSPrintf("%.10g", r.step_minutes));
+        GDALDataset::SetMetadataItem("RANGE_DAYS", CPLSPrintf("%d", s.range_days));
+        GDALDataset::SetMetadataItem("RANGE_SAMPLED_DAYS", CPLSPrintf("%d", s.range_sampled));
+        GDALDataset::SetMetadataItem("RANGE_DAY_WEIGHT",
+                                     "each computed day counts min(DAY_INTERVAL, days from "
+                                     "it to END_DATE) times");
+    }
     if (m_psProduct->model_key)
         GDALDataset::SetMetadataItem(m_psProduct->model_key, m_psProduct->model);
     if (m_psProduct->steps == TSD_STEPS_ATLAS)
@@ -204,6 +218,7 @@ void TSDataset::SetupPam(const char *pszConnection)
     tsd_options sKey = m_sOpts;
     sKey.sun_azimuth = m_sRun.sun_azimuth;
     sKey.sun_elevation = m_sRun.sun_elevation;
+    sKey.step_minutes = tsd_options_step_minutes(&m_sOpts); // a range's 30 when not given
     if (papszFiles && papszFiles[0] &&
         tsd_options_canonical(&sKey, szCanon, sizeof szCanon) == 0)
     {

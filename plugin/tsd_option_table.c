@@ -15,6 +15,8 @@
 
 static int check_datetime(const char *v, char *msg, size_t n);
 static int check_date(const char *v, char *msg, size_t n);
+static int check_start_date(const char *v, char *msg, size_t n);
+static int check_end_date(const char *v, char *msg, size_t n);
 static int check_timezone(const char *v, char *msg, size_t n);
 static int check_sky(const char *v, char *msg, size_t n);
 static int check_exposure(const char *v, char *msg, size_t n);
@@ -87,12 +89,30 @@ const opt_def TSD_OPTION_ROWS[] = {
     {"DATE", K_TEXT, FIELD(date), "", 0, 0, 0, 0, NULL, 1, P, LISTED, check_date,
      "Day of sunhours, insolation, daycycle and farshadow: YYYY-MM-DD, local "
      "to TIMEZONE"},
+    {"START_DATE", K_TEXT, FIELD(start_date), "", 0, 0, 0, 0, NULL, 1, P, LISTED,
+     check_start_date,
+     "sunhours, insolation: first day of a date range, YYYY-MM-DD local to "
+     "TIMEZONE; the product is the total over the range (not with DATE)"},
+    {"END_DATE", K_TEXT, FIELD(end_date), "", 0, 0, 0, 0, NULL, 1, P, LISTED,
+     check_end_date,
+     "sunhours, insolation: last day of the date range, inclusive; default "
+     "START_DATE"},
     {"TIMEZONE", K_TEXT, FIELD(timezone), "", 0, 0, 0, 0, NULL, 1, P, LISTED,
      check_timezone,
      "Fixed offset from UTC of the local day: Z, +hh:mm, -hh:mm, +hhmm; "
      "needed with DATE; with DATETIME it defaults to DATETIME's offset"},
     {"STEP_MINUTES", K_INT, FIELD(step_minutes), "5", 1, 240, 0, 1, NULL, 1, P, LISTED,
-     NULL, "Time step of sunhours, insolation and daycycle, minutes"},
+     NULL,
+     "Time step of sunhours, insolation and daycycle, minutes; default 5 for "
+     "one day, 30 for a date range (START_DATE)"},
+    {"DAY_INTERVAL", K_INT, FIELD(day_interval), TSD_XSTR(TS_RANGE_DAY_INTERVAL), 1, 366, 0,
+     1, NULL, 1, P, LISTED, NULL,
+     "Date range (START_DATE): every DAY_INTERVAL-th day is computed and "
+     "stands for itself and the days up to the next one (or the range's end)"},
+    {"HORIZON_DIRECTIONS", K_INT, FIELD(horizon_directions),
+     TSD_XSTR(TS_RANGE_HORIZON_DIRECTIONS), 4, 3600, 0, 1, NULL, 1, P, LISTED, NULL,
+     "Date range (START_DATE): azimuths at which the horizons are swept once; "
+     "each sun position uses the two nearest"},
     /* the ranges where the SPA's refraction (Bennett / Saemundsson form)
      * holds: the air at the Earth's surface (docs/driver.md) */
     {"PRESSURE", K_FLOAT, FIELD(pressure), "1013.25", 300, 1100, 0, 1, NULL, 1, P, LISTED,
@@ -219,13 +239,29 @@ static int check_datetime(const char *v, char *msg, size_t n)
     return 0;
 }
 
-static int check_date(const char *v, char *msg, size_t n)
+/* A date option's value, its name in the sentence. */
+static int check_named_date(const char *name, const char *v, char *msg, size_t n)
 {
     int y, m, d;
     ts_error err;
     if (ts_parse_date(v, &y, &m, &d, &err) != TS_OK)
-        return (tsd_fail_core(msg, n, "DATE", &err), -1);
+        return (tsd_fail_core(msg, n, name, &err), -1);
     return 0;
+}
+
+static int check_date(const char *v, char *msg, size_t n)
+{
+    return check_named_date("DATE", v, msg, n);
+}
+
+static int check_start_date(const char *v, char *msg, size_t n)
+{
+    return check_named_date("START_DATE", v, msg, n);
+}
+
+static int check_end_date(const char *v, char *msg, size_t n)
+{
+    return check_named_date("END_DATE", v, msg, n);
 }
 
 static int check_timezone(const char *v, char *msg, size_t n)

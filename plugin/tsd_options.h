@@ -64,7 +64,13 @@ typedef struct {
     char datetime[TSD_TEXT_MAX]; /* ISO 8601 with an offset, "" = not given */
     char date[TSD_TEXT_MAX];     /* YYYY-MM-DD, "" = not given */
     char timezone[TSD_TEXT_MAX]; /* fixed UTC offset, "" = not given */
-    int step_minutes;        /* sampling step of the day products */
+    int step_minutes;        /* sampling step of the day products; a date
+                                range's when given (tsd_options_step_minutes) */
+    /* a date range of sunhours and insolation (START_DATE given) */
+    char start_date[TSD_TEXT_MAX]; /* YYYY-MM-DD, "" = one day (DATE) */
+    char end_date[TSD_TEXT_MAX];   /* YYYY-MM-DD, "" = START_DATE */
+    int day_interval;        /* every day_interval-th day is computed */
+    int horizon_directions;  /* azimuths of the range's horizon planes */
     double pressure;         /* hPa, for the refraction */
     double temperature;      /* degrees C, for the refraction */
     double delta_t;          /* TT - UT, seconds */
@@ -130,6 +136,14 @@ int tsd_options_check(const tsd_options *o, char *msg, size_t msg_size);
 /** 1 if the options place the sun from a date and time (DATETIME with
  * shade or shadow, or a daily product). */
 int tsd_options_sun_from_time(const tsd_options *o);
+
+/** 1 if the options ask for a date range (START_DATE given). */
+int tsd_options_is_range(const tsd_options *o);
+
+/** The time step of the day products in minutes: STEP_MINUTES as given, or
+ * its default, 5 for one day and TS_RANGE_STEP_MINUTES (30) for a date
+ * range (the table declares 5). */
+int tsd_options_step_minutes(const tsd_options *o);
 
 /** 1 if option `name` was given by the user. */
 int tsd_options_given(const tsd_options *o, const char *name);

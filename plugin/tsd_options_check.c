@@ -1,7 +1,9 @@
 /* The options that depend on each other and on the product's table row. */
 #include "tsd_options.h"
 
+#include "day_cycle.h"
 #include "tsd_products.h"
+#include "tsd_sun.h"
 #include "tsd_text.h"
 
 #include <stdio.h>
@@ -46,6 +48,53 @@ static void byte_products(char *buf, size_t n)
 
 /* Refuse the combination with a sentence. */
 #define REFUSE(...) return (tsd_fail(msg, n, TS_ERR_ARG, __VA_ARGS__), -1)
+
+int tsd_options_is_range(const tsd_options *o)
+{
+    return o->start_date[0] != '\0';
+}
+
+int tsd_options_step_minutes(const tsd_options *o)
+{
+    if (tsd_options_is_range(o) && !tsd_options_given(o, "STEP_MINUTES"))
+        return (int)TS_RANGE_STEP_MINUTES;
+    return o->step_minutes;
+}
+
+/* A date range (START_DATE, END_DATE, DAY_INTERVAL, HORIZON_DIRECTIONS) of
+ * sunhours and insolation; the core checks the range itself. */
+static int check_range(const tsd_options *o, char *msg, size_t n)
+{
+    const tsd_product_def *p = tsd_product_of(o);
+    const int o_start = tsd_option_find("START_DATE");
+    char list[256];
+    tsd_products_taking(o_start, "PRODUCT=", " and ", list, sizeof list);
+    if (o->end_date[0] && !o->start_date[0])
+        REFUSE("END_DATE=%s needs START_DATE, the first day of the range (for one day "
+               "give DATE)", o->end_date);
+    /* as ENV_ROTATION: a value other than the default that would do nothing */
+    if (!o->start_date[0] && (o->day_interval != TS_RANGE_DAY_INTERVAL ||
+                              o->horizon_directions != TS_RANGE_HORIZON_DIRECTIONS))
+        REFUSE("%s applies to a date range (START_DATE, END_DATE) of %s; one day "
+               "(DATE or DATETIME) has none",
+               o->day_interval != TS_RANGE_DAY_INTERVAL ? "DAY_INTERVAL" : "HORIZON_DIRECTIONS",
+               list);
+    if (!o->start_date[0])
+        return 0;
+    if (!tsd_product_takes(p, o_start))
+        REFUSE("a date range (START_DATE, END_DATE) applies to %s, not to PRODUCT=%s%s",
+               list, p->name, p->daily ? ": give its day as DATE" : "");
+    if (o->date[0])
+        REFUSE("give DATE (one day) or START_DATE (a date range), not both");
+    if (o->datetime[0])
+        REFUSE("give DATETIME (its day) or START_DATE (a date range), not both");
+    if (!o->timezone[0])
+        REFUSE("START_DATE=%s needs TIMEZONE, the offset from UTC of its local days (e.g. "
+               "TIMEZONE=+02:00, or Z for UTC): without it the days' start is unknown",
+               o->start_date);
+    ts_date_range r;
+    return tsd_sun_date_range(o, &r, NULL, NULL, msg, n) == TS_OK ? 0 : -1;
+}
 
 /* The options of environment light (ENV_MAP, SKY and theirs). */
 static int check_environment(const tsd_options *o, char *msg, size_t n)
@@ -124,19 +173,24 @@ int tsd_options_check(const tsd_options *o, char *msg, size_t n)
     }
     if (o->date[0] && o->datetime[0])
         REFUSE("give DATE (with TIMEZONE) or DATETIME, not both: both name the day");
-    if (p->daily && !o->date[0] && !o->datetime[0])
+    if (check_range(o, msg, n) != 0)
+        return -1;
+    if (p->daily && !o->date[0] && !o->datetime[0] && !o->start_date[0])
         REFUSE("PRODUCT=%s needs a day: DATE=YYYY-MM-DD with TIMEZONE (e.g. "
-                    "+02:00), or DATETIME with an offset", pn);
+                    "+02:00), or DATETIME with an offset%s", pn,
+               tsd_product_takes(p, tsd_option_find("START_DATE"))
+                   ? "; or days: START_DATE (and END_DATE) with TIMEZONE"
+                   : "");
     if (o->date[0] && !o->timezone[0])
         REFUSE("DATE=%s needs TIMEZONE, the offset from UTC of its local day (e.g. "
                     "TIMEZONE=+02:00, or Z for UTC): without it the day's start is "
                     "unknown", o->date);
-    if (o->timezone[0] && !o->date[0] && !(o->datetime[0] && p->daily))
+    if (o->timezone[0] && !o->date[0] && !o->start_date[0] && !(o->datetime[0] && p->daily))
         REFUSE("TIMEZONE applies with DATE (or DATETIME) to the day products only");
     if (from_time && (tsd_options_given(o, "SUN_AZIMUTH") ||
                       tsd_options_given(o, "SUN_ELEVATION")))
         REFUSE("%s places the sun: do not give %s with it",
-                    o->datetime[0] ? "DATETIME" : "DATE",
+                    o->datetime[0] ? "DATETIME" : o->start_date[0] ? "START_DATE" : "DATE",
                     tsd_options_given(o, "SUN_AZIMUTH") ? "SUN_AZIMUTH" : "SUN_ELEVATION");
     if (p->daily && o->sun_position == TSD_SUN_PER_CELL &&
         !tsd_product_takes(p, tsd_option_find("SUN_POSITION")))

@@ -106,6 +106,7 @@ static int shadow_uses_backend(const tsd_options *o, const tsd_sun *sun)
 #define SUN_OPTS "SUN_AZIMUTH SUN_ELEVATION METHOD PENUMBRA_DEPTH " SUN_TIME "SUN_POSITION "
 #define SWEEP "DIRECTIONS START_AZIMUTH MAX_DISTANCE "
 #define DAY "DATE TIMEZONE " SUN_TIME
+#define RANGE "START_DATE END_DATE DAY_INTERVAL HORIZON_DIRECTIONS"
 #define ENV "ENV_MAP ENV_ROTATION SKY ENV_HORIZON_STEPS ENV_NORMAL_STEPS "
 
 static const tsd_product_def PRODUCTS[] = {
@@ -133,17 +134,20 @@ static const tsd_product_def PRODUCTS[] = {
     {"sky", "uniform-sky irradiance 0..1", "", "0..1", one_band, NULL, band_named,
      TSD_BYTE_ALLOWED, 0, 0, TSD_STEPS_NONE, 4, 0, 0, backend_always,
      SWEEP "OUTPUT_TYPE BACKEND", NULL, NULL, tsd_compute_sky},
-    /* Earth horizon, horizon plane, visibility, double accumulator */
-    {"sunhours", "hours of direct sun on DATE", "hour", "hours", one_band, NULL, band_named,
-     TSD_BYTE_NEVER, 0, 1, TSD_STEPS_NONE, 5, 0, 3, NULL,
-     "MAX_DISTANCE " DAY "STEP_MINUTES SUN_POSITION SUNHOURS_RULE", NULL, NULL,
-     tsd_compute_sunhours},
+    /* Earth horizon, horizon plane, visibility, double accumulator; over a
+     * date range Earth horizon, three horizon planes, double accumulator */
+    {"sunhours", "hours of direct sun on DATE, or in total from START_DATE to END_DATE",
+     "hour", "hours", one_band, NULL, band_named, TSD_BYTE_NEVER, 0, 1, TSD_STEPS_NONE, 6, 0,
+     3, NULL, "MAX_DISTANCE " DAY "STEP_MINUTES SUN_POSITION SUNHOURS_RULE " RANGE, NULL,
+     NULL, tsd_compute_sunhours},
     /* normals, sky, visibility, pressure factor, two double accumulators,
-     * Earth horizon, horizon plane */
-    {"insolation", "clear-sky irradiation on DATE, Wh/m2: total, beam, diffuse", "Wh/m2",
+     * Earth horizon, horizon plane (a date range: three horizon planes,
+     * one double accumulator) */
+    {"insolation", "clear-sky irradiation on DATE, or in total from START_DATE to "
+     "END_DATE, Wh/m2: total, beam, diffuse", "Wh/m2",
      "Wh/m2", insolation_bands, NULL, band_insolation, TSD_BYTE_NEVER, 0, 1,
      TSD_STEPS_NONE, 12, 0, 5, NULL,
-     SWEEP DAY "STEP_MINUTES SUN_POSITION LINKE_TURBIDITY", "CLEAR_SKY_MODEL",
+     SWEEP DAY "STEP_MINUTES SUN_POSITION LINKE_TURBIDITY " RANGE, "CLEAR_SKY_MODEL",
      "ESRA (Rigollier et al. 2000): beam on the tilted surface x visible "
      "fraction of the sun + diffuse horizontal x sky-view factor (sky term)",
      tsd_compute_insolation},

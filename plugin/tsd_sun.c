@@ -53,6 +53,32 @@ void tsd_sun_free(tsd_sun *s)
     memset(s, 0, sizeof *s);
 }
 
+ts_status tsd_sun_date_range(const tsd_options *o, ts_date_range *r, int *days, int *sampled,
+                             char *msg, size_t n)
+{
+    ts_error err;
+    const char *last = o->end_date[0] ? o->end_date : o->start_date;
+    ts_date_range_default(r);
+    if (ts_parse_date(o->start_date, &r->first_year, &r->first_month, &r->first_day, &err) !=
+        TS_OK)
+        return tsd_fail_core(msg, n, "START_DATE", &err);
+    if (ts_parse_date(last, &r->last_year, &r->last_month, &r->last_day, &err) != TS_OK)
+        return tsd_fail_core(msg, n, "END_DATE", &err);
+    if (ts_parse_utc_offset(o->timezone, &r->utc_offset_minutes, &err) != TS_OK)
+        return tsd_fail_core(msg, n, "TIMEZONE", &err);
+    if (ts_days_from_civil(r->last_year, r->last_month, r->last_day) <
+        ts_days_from_civil(r->first_year, r->first_month, r->first_day))
+        return tsd_fail(msg, n, TS_ERR_ARG,
+                        "END_DATE=%s is before START_DATE=%s: the range runs from START_DATE "
+                        "to END_DATE, both included", o->end_date, o->start_date);
+    r->day_interval = o->day_interval;
+    r->step_minutes = tsd_options_step_minutes(o);
+    r->horizon_directions = o->horizon_directions;
+    if (ts_date_range_check(r, days, sampled, &err) != TS_OK)
+        return tsd_fail_core(msg, n, "START_DATE to END_DATE", &err);
+    return TS_OK;
+}
+
 ts_status tsd_sun_setup(const tsd_options *o, tsd_sites *sites, double min_cell_m,
                         tsd_sun *s, char *msg, size_t n)
 {
@@ -104,8 +130,16 @@ ts_status tsd_sun_setup(const tsd_options *o, tsd_sites *sites, double min_cell_
         return TS_OK;
     }
 
-    /* the local day */
-    if (o->date[0]) {
+    /* the local day, or the first of a range */
+    if (tsd_options_is_range(o)) {
+        ts_status st = tsd_sun_date_range(o, &s->range, &s->range_days, &s->range_sampled,
+                                          msg, n);
+        if (st != TS_OK)
+            return st;
+        s->is_range = 1;
+        s->day_start = ts_local_midnight(s->range.first_year, s->range.first_month,
+                                         s->range.first_day, s->offset_minutes);
+    } else if (o->date[0]) {
         int y, m, d;
         if (ts_parse_date(o->date, &y, &m, &d, &err) != TS_OK)
             return tsd_fail_core(msg, n, "DATE", &err);
@@ -113,10 +147,12 @@ ts_status tsd_sun_setup(const tsd_options *o, tsd_sites *sites, double min_cell_
     } else {
         s->day_start = ts_local_day_start(s->instant, s->offset_minutes);
     }
-    s->day_length = 86400.0;
-    /* the SPA's range of years, checked once here */
+    s->day_length = 86400.0 * (s->is_range ? s->range_days : 1);
+    /* the SPA's range of years, checked once here (at both ends of a range) */
     ts_sun_sample probe;
-    if (ts_sun_at_site(&s->sites, &s->day, s->day_start, &probe, &err) != TS_OK)
+    if (ts_sun_at_site(&s->sites, &s->day, s->day_start, &probe, &err) != TS_OK ||
+        (s->is_range && ts_sun_at_site(&s->sites, &s->day, s->day_start + s->day_length,
+                                       &probe, &err) != TS_OK))
         return tsd_fail_core(msg, n, "cannot compute the sun's position", &err);
 
     if (p->steps != TSD_STEPS_NONE) {

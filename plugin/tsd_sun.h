@@ -1,9 +1,9 @@
 /*
  * tsd_sun.h - the sun of a TERRASHADE dataset from DATETIME / DATE /
- * TIMEZONE: the instant or the local day, the time steps of the day
- * products (uniform every STEP_MINUTES, or the atlas's dawn/dusk-weighted
- * positions), the sun at each step, and the core's day options. Plain C,
- * no GDAL.
+ * TIMEZONE: the instant or the local day (or, from START_DATE and END_DATE,
+ * a range of days), the time steps of the day products (uniform every
+ * STEP_MINUTES, or the atlas's dawn/dusk-weighted positions), the sun at
+ * each step, and the core's day options. Plain C, no GDAL.
  */
 #ifndef TSD_SUN_H
 #define TSD_SUN_H
@@ -32,7 +32,23 @@ typedef struct {
     double *durations;      /* daycycle: their lengths, seconds */
     ts_sun_sample *samples; /* the sun at the centre at each step */
     double threshold_m;     /* farshadow: FAR_THRESHOLD in metres */
+    /* a date range (START_DATE): is_range 1, the core's range; day_start is
+     * the first day's start, day_length the whole range's */
+    int is_range;
+    ts_date_range range;
+    int range_days, range_sampled; /* days in the range, days computed */
 } tsd_sun;
+
+/**
+ * The core's date range of options `o` (START_DATE, END_DATE, TIMEZONE,
+ * DAY_INTERVAL, the step of tsd_options_step_minutes, HORIZON_DIRECTIONS),
+ * checked by the core (ts_date_range_check); *days and *sampled (may be
+ * NULL) receive its length and the number of days computed. TS_OK, or
+ * TS_ERR_ARG with a sentence naming the options. START_DATE and TIMEZONE
+ * must be given.
+ */
+ts_status tsd_sun_date_range(const tsd_options *o, ts_date_range *r, int *days, int *sampled,
+                             char *msg, size_t msg_size);
 
 /**
  * Set up the sun of options `o` (tsd_options_sun_from_time(o) must be

@@ -75,6 +75,15 @@ ENV_VARIANTS = {
     "shade_envmap": {"ENV_MAP": SUNSET, "SKY_WEIGHT": "0.3", "DIRECTIONS": "8"},
 }
 
+# Date ranges (docs/day-cycle.md, "date ranges"): printed after the above.
+YEAR_VARIANTS = {
+    "sunhours_range": {"START_DATE": "2026-06-01", "END_DATE": "2026-06-30",
+                       "TIMEZONE": "+00:00"},
+    "insolation_range": {"START_DATE": "2026-03-01", "END_DATE": "2026-03-21",
+                         "TIMEZONE": "+00:00", "DAY_INTERVAL": "7",
+                         "HORIZON_DIRECTIONS": "32"},
+}
+
 
 def fractal_dem(path, n=512, seed=7):
     """Spectral-synthesis fractal (beta 2.2), 30 m cells, UTM 33N."""
@@ -152,7 +161,7 @@ def main():
     fractal = os.path.join(tmp, "fractal.tif")
     fractal_dem(fractal)
     dems = {"jacksboro": T.JACKSBORO, "lux": T.LUX, "fractal": fractal}
-    variants = dict(VARIANTS, **ENV_VARIANTS)
+    variants = dict(VARIANTS, **ENV_VARIANTS, **YEAR_VARIANTS)
     names = args.only.split(",") if args.only else list(variants)
     if args.save:
         os.makedirs(args.save, exist_ok=True)
@@ -160,7 +169,7 @@ def main():
     crossed = []
     # the variants of the first group come first in the record, each group
     # DEM by DEM, so that added groups append lines to it
-    for group in (VARIANTS, ENV_VARIANTS):
+    for group in (VARIANTS, ENV_VARIANTS, YEAR_VARIANTS):
         for dem_name, dem in dems.items():
             kept = {}
             for backend in args.backends.split(","):
