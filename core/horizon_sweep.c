@@ -15,6 +15,12 @@
  *  - the far field: the weighted mean (weights = 1 - distance to the line)
  *    of the slopes from the cell's own height to the hull points of the two
  *    neighbouring lines that lie beyond the near field.
+ *
+ * With a maximum distance, each line keeps the hull of a sliding window of
+ * its samples instead (window_hull.h): those beyond the near field and
+ * within the distance, in amortised O(1) per sample like the unbounded
+ * hull; the near field is cut at the distance, and the last part of a step
+ * before it is solved exactly on each cell's ray.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -24,11 +30,9 @@
 #include "near_field.h"
 #include "parallel.h"
 #include "status_internal.h"
+#include "window_hull.h"
 
-typedef struct {
-    double d, g;
-    int k;              /* step index of the sample on its line */
-} hull_pt;
+typedef ts_hull_pt hull_pt;
 
 /* The far-field occluder a hull query found: its step index on the line and
  * its distance from the query point; k < 0 when there is none. */
@@ -51,13 +55,16 @@ typedef struct {
     int *alloc_failed;  /* set by a worker that cannot get its workspace */
     ts_near_plan near;
     double near_skip;   /* hull points closer than this are near field */
+    int near_only;      /* the distance ends inside the near field: no lines */
 } sweep_ctx;
 
 typedef struct {
     hull_pt *stack;
     int n;
-    hull_pt *raw;       /* every pushed sample: the capped line slopes of the visitor */
+    hull_pt *raw;       /* with a maximum distance: the line's valid samples */
     int raw_n;
+    ts_window_hull win; /* with a maximum distance: the far-field window */
+    ts_window_hull vwin; /* and the visitor's (all samples within the distance) */
     ts_line_pair lo;    /* occluders of the far side (occluder entries) */
     /* visitor buffers */
     float *vx, *vy, *vh, *vs;
@@ -67,14 +74,18 @@ typedef struct {
 /* The far-field occluder of a point at distance d, height h, among the
  * hull points 0..far (those beyond the near field): walk to farther points
  * while the slope grows (the slopes to an upper convex hull from a point
- * beyond it are unimodal). */
+ * beyond it are unimodal). With a maximum distance, the window's. */
 static occluder hull_query(const sweep_ctx *C, const sweep_ws *w, int far, double d, float h)
 {
     occluder none = {-1, 0.0f};
+    double g = h - C->c * d * d;
+    if (C->cap > 0) {
+        const hull_pt *p = ts_window_hull_query(&w->win, d, g);
+        return p ? (occluder){p->k, (float)(d - p->d)} : none;
+    }
     if (far < 0)
         return none;
     const hull_pt *S = w->stack;
-    double g = h - C->c * d * d;
     int j = far;
     while (j > 0 && (S[j - 1].g - g) * (d - S[j].d) >= (S[j].g - g) * (d - S[j - 1].d))
         j--;
@@ -119,13 +130,11 @@ static float far_field(const sweep_ctx *C, int k, int i, float h, occluder lo, o
                        double step)
 {
     float best = -INFINITY;
-    int beyond_cap = 0;
     const occluder cand[2] = {lo, hi};
     for (int c = 0; c < 2; c++) {
         if (cand[c].k < 0 || (c == 1 && cand[1].k == cand[0].k))
             continue;
         int dk = k - cand[c].k;
-        beyond_cap |= C->cap > 0 && cand[c].dd > C->cap;
         for (int e = -FAR_SPREAD; e <= FAR_SPREAD; e++) {
             if (dk + e <= TS_NEAR_STEPS)
                 continue;
@@ -133,14 +142,7 @@ static float far_field(const sweep_ctx *C, int k, int i, float h, occluder lo, o
             best = s > best ? s : best;
         }
     }
-    if (!beyond_cap)
-        return best;
-    /* An occluder lies past the maximum distance: march the cell's ray over
-     * the far part of the radius instead, and never rise above the
-     * unbounded horizon (a smaller radius cannot raise it). */
-    const ts_line_geom *G = C->geom;
-    float win = ts_ray_exact(G, C->grid->z, k, i, h, TS_NEAR_EXACT, C->cap / step, step, C->c);
-    return win;
+    return best;
 }
 
 #ifndef PREFETCH_AHEAD
@@ -159,6 +161,8 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
     occluder *cur_lo = w->lo.cur;
     w->n = 0;
     w->raw_n = 0;
+    ts_window_hull_reset(&w->win);
+    ts_window_hull_reset(&w->vwin);
     const double c = C->c;
     double d = 0.0;
     int nv = 0;
@@ -181,23 +185,28 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
 
         int pushed = 0;
         float slope = -INFINITY;
-        if (!isnan(hs)) {
+        if (C->cap > 0) {
+            if (!isnan(hs)) {
+                double gs = hs - c * d * d;
+                if (w->vs) {
+                    ts_window_hull_slide(&w->vwin, w->raw, w->raw_n, d, 0.0, C->cap);
+                    const hull_pt *p = ts_window_hull_query(&w->vwin, d, gs);
+                    if (p)
+                        slope = (float)((p->g - gs) / (d - p->d) - 2.0 * c * d);
+                }
+                w->raw[w->raw_n++] = (hull_pt){d, gs, k};
+            }
+            ts_window_hull_slide(&w->win, w->raw, w->raw_n, d, C->near_skip, C->cap);
+            pushed = 1;
+        } else if (!isnan(hs)) {
             double gs = hs - c * d * d;
             hull_pt *S = w->stack;
             int n = w->n;
             while (n >= 2 &&
                    (S[n - 2].g - gs) * (d - S[n - 1].d) >= (S[n - 1].g - gs) * (d - S[n - 2].d))
                 n--;
-            if (w->vs && n > 0) {
-                double s = -INFINITY;
-                if (C->cap > 0 && d - S[n - 1].d > C->cap) {
-                    for (int j = w->raw_n - 1; j >= 0 && d - w->raw[j].d <= C->cap; j--)
-                        s = fmax(s, (w->raw[j].g - gs) / (d - w->raw[j].d));
-                } else {
-                    s = (S[n - 1].g - gs) / (d - S[n - 1].d);
-                }
-                slope = (float)(s - 2.0 * c * d);
-            }
+            if (w->vs && n > 0)
+                slope = (float)((S[n - 1].g - gs) / (d - S[n - 1].d) - 2.0 * c * d);
             /* Hull points 0..far lie beyond the near field; pops only take
              * from the top, and d only grows, so far moves in O(1) amortised. */
             if (far > n - 1)
@@ -208,8 +217,6 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
             S[n].g = gs;
             S[n].k = k;
             w->n = n + 1;
-            if (w->raw)
-                w->raw[w->raw_n++] = S[n];
             pushed = 1;
         }
         if (!pushed)
@@ -245,6 +252,8 @@ static void ws_free(sweep_ws *w)
 {
     free(w->stack);
     free(w->raw);
+    ts_window_hull_free(&w->win);
+    ts_window_hull_free(&w->vwin);
     free(w->lo.prev);
     free(w->lo.cur);
     free(w->vx);
@@ -254,16 +263,20 @@ static void ws_free(sweep_ws *w)
     free(w->vd);
 }
 
-static int ws_init(sweep_ws *w, int U, int need_raw, int need_visit)
+static int ws_init(sweep_ws *w, int U, int capped, int need_visit)
 {
     *w = (sweep_ws){0};
+    int ok = 1;
+    if (capped) {
+        w->raw = malloc((size_t)(U + 1) * sizeof *w->raw);
+        ok = w->raw && ts_window_hull_alloc(&w->win, U) &&
+             (!need_visit || ts_window_hull_alloc(&w->vwin, U));
+    }
     w->stack = malloc((size_t)(U + 1) * sizeof *w->stack);
     w->lo.prev = malloc((size_t)U * sizeof(occluder));
     w->lo.cur = malloc((size_t)U * sizeof(occluder));
     w->lo.prev_k0 = 1;
     w->lo.prev_k1 = 0;
-    if (need_raw)
-        w->raw = malloc((size_t)(U + 1) * sizeof *w->raw);
     if (need_visit) {
         w->vx = malloc((size_t)U * sizeof(float));
         w->vy = malloc((size_t)U * sizeof(float));
@@ -271,7 +284,7 @@ static int ws_init(sweep_ws *w, int U, int need_raw, int need_visit)
         w->vs = malloc((size_t)U * sizeof(float));
         w->vd = malloc((size_t)U * sizeof(double));
     }
-    return w->stack && w->lo.prev && w->lo.cur && (!need_raw || w->raw) &&
+    return ok && w->stack && w->lo.prev && w->lo.cur &&
            (!need_visit || (w->vx && w->vy && w->vh && w->vs && w->vd));
 }
 
@@ -281,7 +294,7 @@ static void sweep_range(void *ctx, int worker, long begin, long end)
     (void)worker;
     const sweep_ctx *C = ctx;
     sweep_ws w;
-    if (!ws_init(&w, C->geom->U, C->cap > 0 && C->visit, C->visit != NULL)) {
+    if (!ws_init(&w, C->geom->U, C->cap > 0, C->visit != NULL)) {
         ws_free(&w);
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
         return;
@@ -291,6 +304,26 @@ static void sweep_range(void *ctx, int worker, long begin, long end)
     for (long b = C->b0 + begin; b < C->b0 + end; b++)
         process_line(C, &w, b, 1);
     ws_free(&w);
+}
+
+/* The near field and the lines sample whole steps past TS_NEAR_EXACT: the
+ * part of a step before the maximum distance ends is solved exactly on each
+ * cell's own ray (there the horizon is often at the distance itself). */
+static void cap_tail(const sweep_ctx *C, int y, const float *zrow, float *orow, double step)
+{
+    const ts_line_geom *G = C->geom;
+    double smax = C->cap / step, s0 = floor(smax);
+    s0 = s0 > TS_NEAR_EXACT ? s0 : TS_NEAR_EXACT;
+    if (!(s0 < smax))
+        return;
+    for (int x = 0; x < C->grid->width; x++) {
+        if (isnan(zrow[x]))
+            continue;
+        int u = G->x_major ? x : y, v = G->x_major ? y : x;
+        float t = ts_ray_exact(G, C->grid->z, (u - G->u_start) * G->u_step, v, zrow[x], s0, smax,
+                               step, C->c);
+        orow[x] = t > orow[x] ? t : orow[x];
+    }
 }
 
 /* Rows [y0, y1): add each cell's near field to the far-field slope the
@@ -307,8 +340,13 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
         const float *zrow = grid->z + y * grid->stride;
         float *orow = C->out + y * W;
         double step = G->step_row ? G->step_row[y] : G->step_m;
-        /* The vectorised pass has no distance cap. */
-        int interior = scratch && C->cap == 0 && y >= m && y < H - m && W > 2 * m;
+        if (C->near_only) /* no lines wrote the far field */
+            for (int x = 0; x < W; x++)
+                orow[x] = isnan(zrow[x]) ? NAN : -INFINITY;
+        /* The vectorised pass has no distance cap: it serves a distance
+         * that ends beyond the near field, where the cap changes nothing. */
+        int uncut = C->cap == 0 || C->cap / step >= TS_NEAR_STEPS;
+        int interior = scratch && uncut && y >= m && y < H - m && W > 2 * m;
         int xa = interior ? m : W, xb = interior ? W - m : W;
         if (interior)
             ts_near_row(&C->near, G, grid->z, zrow, (int)y, xa, xb, step, C->c, orow, scratch);
@@ -325,6 +363,8 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
                                      zrow[x], step, C->c, C->cap, &left);
             orow[x] = left ? nf : fmaxf(nf, orow[x]);
         }
+        if (C->cap > 0)
+            cap_tail(C, (int)y, zrow, orow, step);
         for (int x = 0; x < W; x++)
             orow[x] = ts_atan_deg(orow[x]);
     }
@@ -353,11 +393,21 @@ static ts_status sweep_setup(const ts_grid *grid, double azimuth,
     C->grid = grid;
     C->geom = geom;
     C->c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
-    C->cap = opts->max_distance;
     ts_line_out_strides(geom, grid->width, &C->o_origin, &C->o_u_stride, &C->o_v_stride);
     C->b0 = geom->b_lo;
     ts_near_plan_init(&C->near, geom);
     C->near_skip = (TS_NEAR_STEPS + 0.5) * geom->step_m;
+    /* A distance no two samples of a line (nor a ray on the grid) are
+     * apart is no distance: the unbounded sweep, bit for bit. */
+    double longest = geom->step_m, shortest = geom->step_m;
+    if (geom->step_row)
+        for (int y = 0; y < grid->height; y++) {
+            longest = geom->step_row[y] > longest ? geom->step_row[y] : longest;
+            shortest = geom->step_row[y] < shortest ? geom->step_row[y] : shortest;
+        }
+    C->cap = opts->max_distance > longest * geom->U ? 0.0 : opts->max_distance;
+    /* Within the near field of every row, the near field is all there is. */
+    C->near_only = C->cap > 0 && C->cap <= TS_NEAR_STEPS * shortest;
     return TS_OK;
 }
 
@@ -377,7 +427,8 @@ ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
     long lines = geom.b_hi - geom.b_lo + 1;
     /* One chunk per thread: each chunk re-primes one line. */
     int threads = ts_thread_count(opts->threads, lines);
-    st = ts_parallel_for(threads, lines, sweep_range, &C, err);
+    if (!C.near_only)
+        st = ts_parallel_for(threads, lines, sweep_range, &C, err);
     if (st == TS_OK && !failed)
         st = ts_parallel_for(ts_thread_count(opts->threads, grid->height), grid->height,
                              finish_rows, &C, err);
