@@ -139,29 +139,35 @@ int main(int argc, char **argv)
             fprintf(stderr, "ts_bench: cannot allocate %d horizon planes\n", o.directions);
             return 1;
         }
-        double unbounded = 0.0;
-        for (int m = 0; m < ndist; m++) {
-            o.max_distance = dists[m];
-            double best = INFINITY;
-            for (int r = 0; r < repeat; r++) {
+        /* Distances interleaved within each repeat, so that all see the
+         * same load on a shared machine. */
+        double best[16];
+        for (int m = 0; m < ndist; m++)
+            best[m] = INFINITY;
+        for (int r = 0; r < repeat; r++)
+            for (int m = 0; m < ndist; m++) {
+                o.max_distance = dists[m];
                 t0 = now();
                 if (ts_horizon_compute(&g, &o, out, &e))
                     die("horizon", &e);
                 double dt = now() - t0;
-                best = dt < best ? dt : best;
+                best[m] = dt < best[m] ? dt : best[m];
             }
+        double unbounded = 0.0;
+        for (int m = 0; m < ndist; m++)
             if (dists[m] == 0)
-                unbounded = best;
+                unbounded = best[m];
+        for (int m = 0; m < ndist; m++) {
             double out_mib = cells * o.directions * 4 / 1048576.0;
             printf("horizon %3d directions, max distance %8g m: %.3f s best of %d, "
-                   "%8.1f M pixel-directions/s", o.directions, dists[m], best, repeat,
-                   cells * o.directions / best / 1e6);
+                   "%8.1f M pixel-directions/s", o.directions, dists[m], best[m], repeat,
+                   cells * o.directions / best[m] / 1e6);
             if (unbounded > 0 && dists[m] > 0)
-                printf(", %.2fx the unbounded sweep", best / unbounded);
+                printf(", %.2fx the unbounded sweep", best[m] / unbounded);
             printf("; peak RSS %.0f MiB = DEM %.0f + outputs %.0f + %.0f other\n", peak_mib(),
                    dem_mib, out_mib, peak_mib() - dem_mib - out_mib);
-            fflush(stdout);
         }
+        fflush(stdout);
         free(out);
     }
 

@@ -306,23 +306,63 @@ static void sweep_range(void *ctx, int worker, long begin, long end)
     ws_free(&w);
 }
 
-/* The near field and the lines sample whole steps past TS_NEAR_EXACT: the
- * part of a step before the maximum distance ends is solved exactly on each
- * cell's own ray (there the horizon is often at the distance itself). */
+/* An upper bound of the slope from cell (k, i) at height h to its ray
+ * between whole steps j and j + 1: the highest corner of the patches it
+ * crosses there; INFINITY if one is nodata or off the grid (then solve). */
+static float between_steps_bound(const ts_line_geom *G, const float *z, int k, int i, float h,
+                                 int j, double step, double c)
+{
+    double va = i - G->t * j, vb = i - G->t * (j + 1);
+    int r0 = (int)floor(fmin(va, vb)), r1 = (int)ceil(fmax(va, vb)), k0 = k - j - 1;
+    if (k0 < 0 || r0 < 0 || r1 > G->V - 1)
+        return INFINITY;
+    float hmax = -INFINITY;
+    for (int r = r0; r <= r1; r++) {
+        const float *p = z + G->origin + (ptrdiff_t)k0 * G->u_stride + (ptrdiff_t)r * G->v_stride;
+        if (isnan(p[0]) || isnan(p[G->u_stride]))
+            return INFINITY;
+        hmax = fmaxf(hmax, fmaxf(p[0], p[G->u_stride]));
+    }
+    double dh = (double)hmax - h;
+    return (float)(dh / ((dh > 0 ? j : j + 1) * step) - c * j * step);
+}
+
+/*
+ * What the near field and the lines leave out within a maximum distance,
+ * solved exactly on each cell's own ray: a capped horizon is often near,
+ * often at the distance itself.
+ *  - Between the near field's whole steps (TS_NEAR_EXACT..TS_NEAR_STEPS)
+ *    the bilinear surface can rise above both steps (not along an axis,
+ *    where it is linear there); a step is solved where a bound says it may
+ *    raise the horizon.
+ *  - The part of a step before the distance ends.
+ */
 static void cap_tail(const sweep_ctx *C, int y, const float *zrow, float *orow, double step)
 {
     const ts_line_geom *G = C->geom;
+    const float *z = C->grid->z;
     double smax = C->cap / step, s0 = floor(smax);
+    double send = smax < TS_NEAR_STEPS ? smax : TS_NEAR_STEPS;
+    int axis = fabs(G->t) <= 1e-12;
     s0 = s0 > TS_NEAR_EXACT ? s0 : TS_NEAR_EXACT;
-    if (!(s0 < smax))
-        return;
+    int tail = s0 < smax && (axis || smax > TS_NEAR_STEPS);
     for (int x = 0; x < C->grid->width; x++) {
         if (isnan(zrow[x]))
             continue;
-        int u = G->x_major ? x : y, v = G->x_major ? y : x;
-        float t = ts_ray_exact(G, C->grid->z, (u - G->u_start) * G->u_step, v, zrow[x], s0, smax,
-                               step, C->c);
-        orow[x] = t > orow[x] ? t : orow[x];
+        int u = G->x_major ? x : y, i = G->x_major ? y : x;
+        int k = (u - G->u_start) * G->u_step;
+        float h = zrow[x], best = orow[x];
+        for (int j = TS_NEAR_EXACT; !axis && j < send; j++) {
+            if (between_steps_bound(G, z, k, i, h, j, step, C->c) < best)
+                continue;
+            float e = ts_ray_exact(G, z, k, i, h, j, j + 1 < send ? j + 1 : send, step, C->c);
+            best = e > best ? e : best;
+        }
+        if (tail) {
+            float e = ts_ray_exact(G, z, k, i, h, s0, smax, step, C->c);
+            best = e > best ? e : best;
+        }
+        orow[x] = best;
     }
 }
 
