@@ -65,6 +65,7 @@ typedef struct {
     int raw_n;
     ts_window_hull win; /* with a maximum distance: the far-field window */
     ts_window_hull vwin; /* and the visitor's (all samples within the distance) */
+    int finger[3][2];   /* where the window queries of each kind last ended */
     ts_line_pair lo;    /* occluders of the far side (occluder entries) */
     /* visitor buffers */
     float *vx, *vy, *vh, *vs;
@@ -75,12 +76,13 @@ typedef struct {
  * hull points 0..far (those beyond the near field): walk to farther points
  * while the slope grows (the slopes to an upper convex hull from a point
  * beyond it are unimodal). With a maximum distance, the window's. */
-static occluder hull_query(const sweep_ctx *C, const sweep_ws *w, int far, double d, float h)
+static occluder hull_query(const sweep_ctx *C, sweep_ws *w, int far, double d, float h,
+                           int finger[2])
 {
     occluder none = {-1, 0.0f};
     double g = h - C->c * d * d;
     if (C->cap > 0) {
-        const hull_pt *p = ts_window_hull_query(&w->win, d, g);
+        const hull_pt *p = ts_window_hull_query(&w->win, d, g, finger);
         return p ? (occluder){p->k, (float)(d - p->d)} : none;
     }
     if (far < 0)
@@ -190,7 +192,7 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
                 double gs = hs - c * d * d;
                 if (w->vs) {
                     ts_window_hull_slide(&w->vwin, w->raw, w->raw_n, d, 0.0, C->cap);
-                    const hull_pt *p = ts_window_hull_query(&w->vwin, d, gs);
+                    const hull_pt *p = ts_window_hull_query(&w->vwin, d, gs, w->finger[2]);
                     if (p)
                         slope = (float)((p->g - gs) / (d - p->d) - 2.0 * c * d);
                 }
@@ -226,7 +228,7 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
         if (write) {
             float s_out = NAN;
             if (!isnan(hc)) {
-                occluder hi = inside ? hull_query(C, w, far, d, hc) : none;
+                occluder hi = inside ? hull_query(C, w, far, d, hc, w->finger[0]) : none;
                 occluder lo = (F > 0.0f && k >= pk0 && k <= pk1) ? prev_lo[k] : none;
                 int row = G->x_major ? i : G->u_start + k * G->u_step;
                 double step = G->step_row ? G->step_row[row] : G->step_m;
@@ -234,7 +236,7 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
             }
             C->out[C->o_origin + (ptrdiff_t)k * C->o_u_stride + (ptrdiff_t)i * C->o_v_stride] = s_out;
         }
-        cur_lo[k] = (has_next && !isnan(hn)) ? hull_query(C, w, far, d, hn) : none;
+        cur_lo[k] = (has_next && !isnan(hn)) ? hull_query(C, w, far, d, hn, w->finger[1]) : none;
         if (w->vs) {
             w->vx[nv] = G->x_major ? (float)(G->u_start + k * G->u_step) : (float)i + F;
             w->vy[nv] = G->x_major ? (float)i + F : (float)(G->u_start + k * G->u_step);

@@ -83,26 +83,36 @@ static inline void ts_window_hull_slide(ts_window_hull *w, const ts_hull_pt *pts
     }
 }
 
-/* The window's sample of largest slope (g_p - g) / (d - d_p) seen from
- * the point (d, g), or NULL if the window is empty; of two equal slopes
- * the farther sample. */
-static inline const ts_hull_pt *ts_window_hull_query(const ts_window_hull *w, double d, double g)
+/* The hull point of largest slope seen from (d, g) among P[0, n), n > 0,
+ * found by climbing from P[j] (the slopes along a hull are unimodal, and a
+ * query from the next sample's point has its tangent nearby). */
+static inline int ts_hull_climb(const ts_hull_pt *P, int n, int j, double d, double g)
+{
+    j = j < n ? j : n - 1;
+    while (j + 1 < n && (P[j + 1].g - g) * (d - P[j].d) >= (P[j].g - g) * (d - P[j + 1].d))
+        j++;
+    while (j > 0 && (P[j - 1].g - g) * (d - P[j].d) > (P[j].g - g) * (d - P[j - 1].d))
+        j--;
+    return j;
+}
+
+/* The window's sample of largest slope (g_p - g) / (d - d_p) seen from the
+ * point (d, g), or NULL if the window is empty. finger[2] holds where the
+ * last query of the same kind ended on each hull (any values will do: they
+ * only make the search shorter). */
+static inline const ts_hull_pt *ts_window_hull_query(const ts_window_hull *w, double d, double g,
+                                                     int finger[2])
 {
     const ts_hull_pt *best = NULL;
     if (w->nf > 0) {
-        const ts_hull_pt *F = w->front;
-        int j = 0;
-        while (j + 1 < w->nf && (F[j + 1].g - g) * (d - F[j].d) >= (F[j].g - g) * (d - F[j + 1].d))
-            j++;
-        best = &F[j];
+        finger[0] = ts_hull_climb(w->front, w->nf, finger[0], d, g);
+        best = &w->front[finger[0]];
     }
     if (w->nb > 0) {
-        const ts_hull_pt *B = w->back;
-        int j = w->nb - 1;
-        while (j > 0 && (B[j - 1].g - g) * (d - B[j].d) >= (B[j].g - g) * (d - B[j - 1].d))
-            j--;
-        if (!best || (B[j].g - g) * (d - best->d) > (best->g - g) * (d - B[j].d))
-            best = &B[j];
+        finger[1] = ts_hull_climb(w->back, w->nb, finger[1], d, g);
+        const ts_hull_pt *b = &w->back[finger[1]];
+        if (!best || (b->g - g) * (d - best->d) > (best->g - g) * (d - b->d))
+            best = b;
     }
     return best;
 }
