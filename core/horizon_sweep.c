@@ -315,15 +315,18 @@ static float between_steps_bound(const ts_line_geom *G, const float *z, int k, i
                                  int j, double step, double c)
 {
     double va = i - G->t * j, vb = i - G->t * (j + 1);
-    int r0 = (int)floor(fmin(va, vb)), r1 = (int)ceil(fmax(va, vb)), k0 = k - j - 1;
+    double lo = va < vb ? va : vb, hi = va < vb ? vb : va;
+    int r0 = (int)floor(lo), r1 = (int)ceil(hi), k0 = k - j - 1;
     if (k0 < 0 || r0 < 0 || r1 > G->V - 1)
         return INFINITY;
     float hmax = -INFINITY;
-    for (int r = r0; r <= r1; r++) {
-        const float *p = z + G->origin + (ptrdiff_t)k0 * G->u_stride + (ptrdiff_t)r * G->v_stride;
-        if (isnan(p[0]) || isnan(p[G->u_stride]))
+    const float *p = z + G->origin + (ptrdiff_t)k0 * G->u_stride + (ptrdiff_t)r0 * G->v_stride;
+    for (int r = r0; r <= r1; r++, p += G->v_stride) {
+        float a = p[0], b = p[G->u_stride];
+        if (a != a || b != b)
             return INFINITY;
-        hmax = fmaxf(hmax, fmaxf(p[0], p[G->u_stride]));
+        hmax = a > hmax ? a : hmax;
+        hmax = b > hmax ? b : hmax;
     }
     double dh = (double)hmax - h;
     return (float)(dh / ((dh > 0 ? j : j + 1) * step) - c * j * step);
@@ -337,7 +340,8 @@ static float between_steps_bound(const ts_line_geom *G, const float *z, int k, i
  *    the bilinear surface can rise above both steps (not along an axis,
  *    where it is linear there); a step is solved where a bound says it may
  *    raise the horizon.
- *  - The part of a step before the distance ends.
+ *  - The part of a step before the distance ends, where the same bound
+ *    says it may.
  */
 static void cap_tail(const sweep_ctx *C, int y, const float *zrow, float *orow, double step)
 {
@@ -360,7 +364,7 @@ static void cap_tail(const sweep_ctx *C, int y, const float *zrow, float *orow, 
             float e = ts_ray_exact(G, z, k, i, h, j, j + 1 < send ? j + 1 : send, step, C->c);
             best = e > best ? e : best;
         }
-        if (tail) {
+        if (tail && between_steps_bound(G, z, k, i, h, (int)s0, step, C->c) >= best) {
             float e = ts_ray_exact(G, z, k, i, h, s0, smax, step, C->c);
             best = e > best ? e : best;
         }
