@@ -56,10 +56,10 @@ static int fill_azimuth(const ts_grid *pg, double azimuth, int a, int line0, int
     I[TS_CLI_PLANE] = a;
     I[TS_CLI_NPIECES] = NP.npieces;
     for (int n = 0; n < NP.npieces; n++) {
-        I[TS_CLI_PDU + n] = NP.piece[n].du;
-        I[TS_CLI_PDV + n] = NP.piece[n].dv;
-        Dp[TS_CLD_PSA + n] = NP.piece[n].sa;
-        Dp[TS_CLD_PSB + n] = NP.piece[n].sb;
+        I[TS_CLI_PDU + n] = NP.piece_du[n];
+        I[TS_CLI_PDV + n] = NP.piece_dv[n];
+        Dp[TS_CLD_PSA + n] = NP.piece_sa[n];
+        Dp[TS_CLD_PSB + n] = NP.piece_sb[n];
     }
     for (int j = 0; j <= TS_NEAR_STEPS; j++) {
         I[TS_CLI_SDV + j] = NP.sample_dv[j];
@@ -274,34 +274,12 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
     return st;
 }
 
-/* Argument checks of sweep_setup (horizon_sweep.c); normalises azimuth. */
-static ts_status check_sweep(const ts_grid *grid, double *azimuth, const ts_horizon_opts *opts,
-                             ts_error *err)
-{
-    ts_status st = ts_grid_validate(grid, err);
-    if (st != TS_OK)
-        return st;
-    if (!opts)
-        return ts_fail(err, TS_ERR_ARG, "horizon options are NULL");
-    ts_horizon_opts o = *opts;
-    o.directions = o.directions < 1 ? 1 : o.directions;
-    if ((st = ts_horizon_opts_validate(&o, err)) != TS_OK)
-        return st;
-    if (!isfinite(*azimuth))
-        return ts_fail(err, TS_ERR_ARG, "azimuth must be a finite number of degrees, got %g",
-                       *azimuth);
-    *azimuth = fmod(*azimuth, 360.0);
-    if (*azimuth < 0)
-        *azimuth += 360.0;
-    return TS_OK;
-}
-
 ts_status ts_cl_horizon_sweep(const ts_grid *grid, double azimuth, const ts_horizon_opts *opts,
                               float *out, ts_error *err)
 {
     if (!out)
         return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
-    ts_status st = check_sweep(grid, &azimuth, opts, err);
+    ts_status st = ts_check_sweep_args(grid, &azimuth, opts, err);
     if (st != TS_OK)
         return st;
     return horizon_run(grid, opts, &azimuth, 1, out, err);

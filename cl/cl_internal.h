@@ -32,6 +32,13 @@ ts_status ts_cl_device(ts_cl_dev **dev, ts_error *err);
  * buffer only for those: not re-entrant for unknown codes). */
 const char *ts_cl_error_name(cl_int code);
 
+/* The status of an OpenCL error: TS_ERR_NOMEM for device memory, else
+ * TS_ERR_INTERNAL. */
+ts_status ts_cl_status_of(cl_int e);
+
+/* TERRASHADE_OPENCL_MAX_ALLOC in bytes (k, M, G suffixes), 0 when unset. */
+ts_status ts_cl_env_max_alloc(unsigned long long *limit, ts_error *err);
+
 #define TS_CL_JOB_MEM 24
 #define TS_CL_JOB_KERNELS 4
 

@@ -41,13 +41,10 @@ ts_status ts_cl_shm_compute(const ts_grid *grid, double azimuth, double elevatio
                             double penumbra_depth, int threads, float *vis, float *shadow_height,
                             ts_error *err)
 {
-    ts_status st = ts_check_shm_args(grid, azimuth, elevation, penumbra_depth, threads, vis,
+    ts_status st = ts_check_shm_args(grid, &azimuth, elevation, penumbra_depth, threads, vis,
                                      shadow_height, err);
     if (st != TS_OK)
         return st;
-    azimuth = fmod(azimuth, 360.0);
-    if (azimuth < 0)
-        azimuth += 360.0;
 
     const int W = grid->width, H = grid->height;
     const size_t cells = (size_t)W * H;
@@ -155,11 +152,9 @@ ts_status ts_cl_shm_compute(const ts_grid *grid, double azimuth, double elevatio
 
 ts_status ts_cl_normals(const ts_grid *grid, float *nx, float *ny, float *nz, ts_error *err)
 {
-    ts_status st = ts_grid_validate(grid, err);
+    ts_status st = ts_check_normals_args(grid, nx, ny, nz, err);
     if (st != TS_OK)
         return st;
-    if (!nx || !ny || !nz)
-        return ts_fail(err, TS_ERR_ARG, "normal output buffers must not be NULL");
     const int W = grid->width, H = grid->height;
     const size_t cells = (size_t)W * H, bytes = cells * sizeof(float);
     ts_cl_job J;
@@ -210,14 +205,12 @@ ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *
 {
     int k0, k1;
     double w;
+    cl_float light[3];
     ts_status st = ts_direct_setup(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
-                                   out, &k0, &k1, &w, err);
+                                   out, &k0, &k1, &w, light, err);
     if (st != TS_OK)
         return st;
     const size_t cells = (size_t)grid->width * grid->height, bytes = cells * sizeof(float);
-    double az = sun_azimuth * DEG2RAD, el = sun_elevation * DEG2RAD;
-    const cl_float lx = (float)(sin(az) * cos(el)), ly = (float)(cos(az) * cos(el)),
-                   lz = (float)sin(el);
     ts_cl_job J;
     if (ts_cl_job_begin(&J, err) != TS_OK)
         return J.st;
@@ -240,13 +233,13 @@ ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *
     ts_cl_job_arg(&J, k, 5, sizeof ccells, &ccells);
     const cl_float fw = (float)w;
     ts_cl_job_arg(&J, k, 6, sizeof fw, &fw);
-    ts_cl_job_arg(&J, k, 7, sizeof lx, &lx);
-    ts_cl_job_arg(&J, k, 8, sizeof ly, &ly);
-    ts_cl_job_arg(&J, k, 9, sizeof lz, &lz);
-    ts_cl_job_arg_real(&J, k, 10, sun_elevation);
-    ts_cl_job_arg_real(&J, k, 11, TS_SUN_RADIUS_DEG);
-    ts_cl_job_arg_real(&J, k, 12, M_PI);
-    ts_cl_job_arg(&J, k, 13, sizeof ob, &ob);
+    for (int j = 0; j < 3; j++)
+        ts_cl_job_arg(&J, k, 7 + j, sizeof light[j], &light[j]);
+    /* as core/shading.c */
+    const cl_float el_deg = (float)sun_elevation, inv_r = (float)(1.0 / TS_SUN_RADIUS_DEG);
+    ts_cl_job_arg(&J, k, 10, sizeof el_deg, &el_deg);
+    ts_cl_job_arg(&J, k, 11, sizeof inv_r, &inv_r);
+    ts_cl_job_arg(&J, k, 12, sizeof ob, &ob);
     size_t L = ts_cl_job_wg(&J, k, 256), global = ts_cl_round_up(cells, L);
     ts_cl_job_run(&J, k, 1, &global, &L, "ts_direct");
     ts_cl_job_read(&J, ob, 0, bytes, out, "direct light");
@@ -259,15 +252,9 @@ ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
                           const float *horizons, const ts_horizon_opts *opts, float *svf,
                           float *sky, float *openness, ts_error *err)
 {
-    ts_status st = ts_horizon_opts_validate(opts, err);
+    ts_status st = ts_check_sky_terms_args(grid, nx, ny, nz, horizons, opts, err);
     if (st != TS_OK)
         return st;
-    if ((st = ts_grid_validate(grid, err)) != TS_OK)
-        return st;
-    if (!nx || !ny || !nz)
-        return ts_fail(err, TS_ERR_ARG, "normals must not be NULL");
-    if (!horizons)
-        return ts_fail(err, TS_ERR_ARG, "horizons must not be NULL");
     const int n = opts->directions;
     const cl_int want = (svf ? 1 : 0) | (sky ? 2 : 0) | (openness ? 4 : 0);
     if (!want)
@@ -307,8 +294,7 @@ ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
     }
     cl_kernel k = ts_cl_job_kernel(&J, "ts_sky");
     const cl_long ccells = (cl_long)cells;
-    const cl_float w1 = (float)(1.0 / n), w2 = (float)(sin(M_PI / n) / M_PI);
-    const cl_float half_pi = (float)(M_PI / 2), d2r = (float)DEG2RAD, fn = (float)n;
+    const cl_float w1 = (float)(1.0 / n), w2 = (float)(sin(M_PI / n) / M_PI), fn = (float)n;
     ts_cl_job_arg(&J, k, 0, sizeof xb, &xb);
     ts_cl_job_arg(&J, k, 1, sizeof yb, &yb);
     ts_cl_job_arg(&J, k, 2, sizeof zb, &zb);
@@ -316,13 +302,11 @@ ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
     ts_cl_job_arg(&J, k, 5, sizeof ccells, &ccells);
     ts_cl_job_arg(&J, k, 8, sizeof w1, &w1);
     ts_cl_job_arg(&J, k, 9, sizeof w2, &w2);
-    ts_cl_job_arg(&J, k, 10, sizeof half_pi, &half_pi);
-    ts_cl_job_arg(&J, k, 11, sizeof d2r, &d2r);
-    ts_cl_job_arg(&J, k, 12, sizeof want, &want);
-    ts_cl_job_arg(&J, k, 14, sizeof fn, &fn);
-    ts_cl_job_arg(&J, k, 15, sizeof acc[0], &acc[0]);
-    ts_cl_job_arg(&J, k, 16, sizeof acc[1], &acc[1]);
-    ts_cl_job_arg(&J, k, 17, sizeof acc[2], &acc[2]);
+    ts_cl_job_arg(&J, k, 10, sizeof want, &want);
+    ts_cl_job_arg(&J, k, 12, sizeof fn, &fn);
+    ts_cl_job_arg(&J, k, 13, sizeof acc[0], &acc[0]);
+    ts_cl_job_arg(&J, k, 14, sizeof acc[1], &acc[1]);
+    ts_cl_job_arg(&J, k, 15, sizeof acc[2], &acc[2]);
     size_t L = ts_cl_job_wg(&J, k, 256), global = ts_cl_round_up(cells, L);
     for (int first = 0; first < n && J.st == TS_OK; first += (int)A) {
         const cl_int nb = n - first < (int)A ? n - first : (int)A;
@@ -336,7 +320,7 @@ ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
         ts_cl_job_arg(&J, k, 4, sizeof nb, &nb);
         ts_cl_job_arg(&J, k, 6, sizeof sab, &sab);
         ts_cl_job_arg(&J, k, 7, sizeof cab, &cab);
-        ts_cl_job_arg(&J, k, 13, sizeof finish, &finish);
+        ts_cl_job_arg(&J, k, 11, sizeof finish, &finish);
         ts_cl_job_run(&J, k, 1, &global, &L, "ts_sky");
     }
     float *outs[3] = {svf, sky, openness};

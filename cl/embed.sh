@@ -2,6 +2,9 @@
 # Embed OpenCL C sources in the library: writes, on stdout, a C file that
 # defines ts_cl_source[] (one string per source line, a #line directive
 # before each file, so that build logs name the file) and ts_cl_source_count.
+# #include lines are dropped (as blank lines, so that line numbers hold):
+# the shared formula headers of core/cellmath include each other for C,
+# while the kernels get each of them once, in the order given.
 # Usage: embed.sh SRCDIR FILE...   (FILE relative to SRCDIR). Needs only sed.
 set -e
 srcdir=$1
@@ -13,7 +16,9 @@ echo 'extern const size_t ts_cl_source_count;'
 echo 'const char *const ts_cl_source[] = {'
 for f in "$@"; do
     printf '    "#line 1 \\"%s\\"\\n",\n' "$f"
-    sed -e 's/\\/\\\\/g' -e 's/"/\\"/g' -e 's/	/\\t/g' -e 's/^/    "/' -e 's/$/\\n",/' "$srcdir/$f"
+    sed -e 's/^[ 	]*#[ 	]*include[ 	].*$//' \
+        -e 's/\\/\\\\/g' -e 's/"/\\"/g' -e 's/	/\\t/g' -e 's/^/    "/' -e 's/$/\\n",/' \
+        "$srcdir/$f"
 done
 echo '};'
 echo 'const size_t ts_cl_source_count = sizeof ts_cl_source / sizeof *ts_cl_source;'

@@ -1,5 +1,7 @@
 /*
- * Exact horizon sweep: a port of core/horizon_sweep.c and core/near_field.c.
+ * Exact horizon sweep: the loops of core/horizon_sweep.c and
+ * core/near_field.c, one work-item per line or cell; the per-cell formulas
+ * are core/cellmath/cm_near_field.h.
  *
  * Pass 1 (ts_sweep_lines): one work-item per sweep line, lines of several
  * azimuths in one launch. Each keeps its convex hull in a stack of (d, g)
@@ -17,49 +19,11 @@
  * Pass 2 (ts_sweep_finish): one work-item per cell and azimuth: the far
  * field (the cell's own ray sampled at both occluders and TS_FAR_SPREAD
  * steps beside them; past the distance cap, the exact march of
- * ts_ray_exact), the exact near field (the float fast path of ts_near_row
- * for interior cells without a distance cap, ts_near_field in `real`
+ * cm_ray_exact), the exact near field (the float fast path of ts_near_row
+ * for interior cells without a distance cap, cm_near_exact in `real`
  * elsewhere and for cells whose fast path met nodata), the larger of the
  * two, in degrees.
  */
-
-/* ---------------------------------------------------------- line geometry */
-
-/* Smallest k with the predicate true (port of first_k, line_geometry.c). */
-int ts_first_k(__global const int *fl, int U, int asc, long lim, int want_ge)
-{
-    int lo = 0, hi = U;
-    while (lo < hi) {
-        int mid = lo + (hi - lo) / 2;
-        long v = fl[mid];
-        int p = want_ge ? (asc ? v >= lim : v <= lim) : (asc ? v > lim : v < lim);
-        if (p)
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
-    return lo;
-}
-
-/* ts_line_k_range. */
-int ts_k_range(__global const int *fl, int U, int V, real t, long b, int *k0, int *k1)
-{
-    int asc = t >= 0;
-    long lo = -b, hi = (long)V - 1 - b;
-    int a, z;
-    if (asc) {
-        a = ts_first_k(fl, U, 1, lo, 1);
-        z = ts_first_k(fl, U, 1, hi, 0) - 1;
-    } else {
-        a = ts_first_k(fl, U, 0, hi, 1);
-        z = ts_first_k(fl, U, 0, lo, 0) - 1;
-    }
-    if (a > z || a >= U || z < 0)
-        return 0;
-    *k0 = a;
-    *k1 = z;
-    return 1;
-}
 
 /* ------------------------------------------------------------------ hull */
 
@@ -116,7 +80,7 @@ __kernel void ts_sweep_lines(__global const float *z, const int W, const int naz
     const real t = Q[TS_CLD_T], step_m = Q[TS_CLD_STEPM], near_skip = Q[TS_CLD_NEARSKIP];
     const long b = (long)P[TS_CLI_BLO] + (item - P[TS_CLI_LINE0]);
     int k0, k1;
-    if (!ts_k_range(fl, U, V, t, b, &k0, &k1))
+    if (!cm_line_k_range(fl, U, V, t >= 0, b, &k0, &k1))
         return;
     __global int2 *oh = hi + P[TS_CLI_PLANE] * plane;
     __global int2 *ol = lo + P[TS_CLI_PLANE] * plane;
@@ -185,41 +149,14 @@ __kernel void ts_sweep_lines(__global const float *z, const int W, const int naz
 #define TS_FAR_SPREAD 0
 #endif
 
-float ts_ray_exact(__global const float *z, int V, real t, long origin, long u_stride,
-                   long v_stride, int k, int i, float h, real s_from, real s_to, real step,
-                   real c);
-
-/* ray_slope: slope from cell (k, i) at height h to its own ray dk steps
- * back (distance dd); -inf off the grid or on nodata. */
-float ts_ray_slope(__global const float *z, int V, real t, long origin, long u_stride,
-                   long v_stride, int k, int i, float h, int dk, float dd, float cf)
-{
-    int kk = k - dk;
-    if (dk <= 0 || kk < 0 || dd <= 0.0f)
-        return -INFINITY;
-    real pv = -t * dk, o = floor(pv);
-    int r0 = i + (int)o;
-    float f = (float)(pv - o);
-    if (r0 < 0 || r0 > V - 1 || (f > 0.0f && r0 + 1 > V - 1))
-        return -INFINITY;
-    __global const float *zz = z + origin + (long)kk * u_stride + (long)r0 * v_stride;
-    float a = zz[0], b = f > 0.0f ? zz[v_stride] : a;
-    float hz = a + f * (b - a);
-    if (isnan(hz))
-        return -INFINITY;
-    return (hz - h) / dd - cf * dd;
-}
-
 /* far_field: the cell's own ray at and beside the two lines' occluders;
  * when one lies past the distance cap, the exact ray over the far part of
- * the radius instead (ts_ray_exact). */
-float ts_far_field(__global const float *z, int V, real t, long origin, long u_stride,
-                   long v_stride, int k, int i, float h, int2 lo, int2 hi, real step, real c,
-                   real cap)
+ * the radius instead (cm_ray_exact). */
+float ts_far_field(const cm_ray_grid *r, int k, int i, float h, int2 lo, int2 hi, real step,
+                   real c, real cap)
 {
     float best = -INFINITY;
     int beyond_cap = 0;
-    const float cf = (float)c;
     for (int cc = 0; cc < 2; cc++) {
         int2 cand = cc ? hi : lo;
         if (cand.x < 0 || (cc == 1 && hi.x == lo.x))
@@ -229,249 +166,51 @@ float ts_far_field(__global const float *z, int V, real t, long origin, long u_s
         for (int e = -TS_FAR_SPREAD; e <= TS_FAR_SPREAD; e++) {
             if (dk + e <= TS_NEAR_STEPS)
                 continue;
-            float s = ts_ray_slope(z, V, t, origin, u_stride, v_stride, k, i, h, dk + e,
-                                   as_float(cand.y) + (float)(e * step), cf);
+            float s = cm_ray_slope(r, k, i, h, dk + e, as_float(cand.y) + (float)(e * step),
+                                   (float)c);
             best = s > best ? s : best;
         }
     }
     if (!beyond_cap)
         return best;
-    return ts_ray_exact(z, V, t, origin, u_stride, v_stride, k, i, h, TS_NEAR_EXACT,
-                        cap / step, step, c);
+    return cm_ray_exact(r, k, i, h, TS_NEAR_EXACT, cap / step, step, c);
 }
 
 /* ------------------------------------------------------------ near field */
 
-/* edge_height of near_field.c: bilinear height at (a, b) from the corners
- * that weigh something there; NaN if one of those is nodata. */
-real ts_edge_height(float h0, float h1, float h2, float h3, real a, real b)
+/* The near-field tables of an azimuth's parameter rows (cm_near_field.h). */
+cm_near_tables ts_near_tables(__global const int *P, __global const real *Q)
 {
-    const real eps = RC(1e-9);
-    a = a < eps ? (real)0 : a > 1 - eps ? (real)1 : a;
-    b = b < eps ? (real)0 : b > 1 - eps ? (real)1 : b;
-    const real w0 = (1 - a) * (1 - b), w1 = a * (1 - b), w2 = (1 - a) * b, w3 = a * b;
-    real sum = 0;
-    if (w0 > 0)
-        sum += w0 * h0; /* a NaN corner makes the sum NaN */
-    if (w1 > 0)
-        sum += w1 * h1;
-    if (w2 > 0)
-        sum += w2 * h2;
-    if (w3 > 0)
-        sum += w3 * h3;
-    return sum;
+    cm_near_tables q = {P[TS_CLI_NPIECES], P + TS_CLI_PDU, P + TS_CLI_PDV, Q + TS_CLD_PSA,
+                        Q + TS_CLD_PSB, P + TS_CLI_SDV, Q + TS_CLD_SFV};
+    return q;
 }
 
-real ts_slope_at(real P, real beta, real gamma, real s, real L, real c)
-{
-    return (P + beta * s + gamma * s * s) / (s * L) - c * s * L;
-}
-
-/* ts_near_field: exact near field of cell (k, i) at height h, within the
- * distance cap (0 = none). */
-float ts_near_exact(__global const float *z, __global const int *P, __global const real *Q,
-                    long origin, long u_stride, long v_stride, int k, int i, float h,
-                    real step, real c, real cap, int *left)
-{
-    const real smax = cap > 0 ? cap / step : (real)INFINITY; /* in steps */
-    real best = -INFINITY;
-    *left = 0;
-    const int V = P[TS_CLI_V];
-    const real pt = Q[TS_CLD_T];
-    const int npieces = P[TS_CLI_NPIECES];
-    for (int n = 0; n < npieces; n++) {
-        const int du = P[TS_CLI_PDU + n], dv = P[TS_CLI_PDV + n];
-        const real sa = Q[TS_CLD_PSA + n], sb = Q[TS_CLD_PSB + n];
-        int k0 = k + du, r0 = i + dv;
-        int flat_v = fabs(pt) <= RC(1e-12);
-        if (k0 < 0 || r0 < 0 || r0 > V - 1 || (!flat_v && r0 + 1 > V - 1)) {
-            *left = 1;
-            break;
-        }
-        long o = origin + (long)k0 * u_stride + (long)r0 * v_stride;
-        if (sa >= smax)
-            break;
-        /* along a grid line (t = 0) the 01 and 11 corners weigh nothing */
-        int use_r1 = !flat_v && r0 + 1 <= V - 1;
-        float hc0 = z[o], hc1 = z[o + u_stride];
-        float hc2 = use_r1 ? z[o + v_stride] : z[o];
-        float hc3 = use_r1 ? z[o + u_stride + v_stride] : z[o + u_stride];
-        const real sbc = sb < smax ? sb : smax;
-        real a0 = -du, b0 = flat_v ? (real)0 : (real)-dv;
-        /* nodata is no terrain: a patch touching it is skipped, but for its
-         * end points on a grid line, whose only corners may be valid */
-        if (isnan(hc0) || isnan(hc1) || isnan(hc2) || isnan(hc3)) {
-            for (int e = 0; e < 2; e++) {
-                const real se = e ? sbc : sa;
-                if (se <= 0)
-                    continue;
-                real he = ts_edge_height(hc0, hc1, hc2, hc3, a0 - se,
-                                         b0 - (flat_v ? (real)0 : pt) * se);
-                if (!isnan(he)) {
-                    real sl = (he - h) / (se * step) - c * se * step;
-                    best = sl > best ? sl : best;
-                }
-            }
-            continue;
-        }
-        real A = hc1 - hc0, B = hc2 - hc0, X = hc3 - hc1 - hc2 + hc0;
-        real t = flat_v ? (real)0 : pt;
-        real alpha = hc0 + A * a0 + B * b0 + X * a0 * b0;
-        real beta = -(A + B * t + X * (a0 * t + b0));
-        real gamma = X * t;
-        real Pp = alpha - h;
-        real L = step;
-        real fb = ts_slope_at(Pp, beta, gamma, sbc, L, c);
-        real fa = sa > 0 ? ts_slope_at(Pp, beta, gamma, sa, L, c) : beta / L;
-        real m = fa > fb ? fa : fb;
-        real g2 = gamma - c * L * L;
-        if (sa > 0 && Pp < 0 && g2 < 0) {
-            real ss = sqrt(Pp / g2);
-            if (ss > sa && ss < sbc) {
-                real fs = ts_slope_at(Pp, beta, gamma, ss, L, c);
-                m = fs > m ? fs : m;
-            }
-        }
-        best = m > best ? m : best;
-    }
-    if (*left)
-        return (float)best;
-    for (int j = TS_NEAR_EXACT + 1; j <= TS_NEAR_STEPS && j <= smax; j++) {
-        int kk = k - j, r0 = i + P[TS_CLI_SDV + j];
-        float f = (float)Q[TS_CLD_SFV + j];
-        if (kk < 0 || r0 < 0 || r0 > V - 1 || (f > 0.0f && r0 + 1 > V - 1)) {
-            *left = 1;
-            break;
-        }
-        long o = origin + (long)kk * u_stride + (long)r0 * v_stride;
-        float va = z[o], vb = f > 0.0f ? z[o + v_stride] : va;
-        float hj = va + f * (vb - va); /* NaN if either cell is nodata */
-        if (isnan(hj))
-            continue;
-        real d = j * step;
-        real s = (hj - h) / d - c * d;
-        best = s > best ? s : best;
-    }
-    return (float)best;
-}
-
-/* piece_max of near_field.c: max over s in [sa, sb] of the slope to a
- * patch's quadratic along the ray. */
-real ts_piece_max(real P, real beta, real gamma, real sa, real sb, real L, real c)
-{
-    real fa = ts_slope_at(P, beta, gamma, sa, L, c), fb = ts_slope_at(P, beta, gamma, sb, L, c);
-    real m = fa > fb ? fa : fb;
-    real g2 = gamma - c * L * L;
-    if (P < 0 && g2 < 0) {
-        real ss = sqrt(P / g2);
-        if (ss > sa && ss < sb) {
-            real fs = ts_slope_at(P, beta, gamma, ss, L, c);
-            m = fs > m ? fs : m;
-        }
-    }
-    return m;
-}
-
-/* ts_ray_exact: the largest slope from cell (k, i) at height h over its ray
- * between s_from and s_to steps, on the exact bilinear surface, patch by
- * patch; -inf if nothing there. */
-float ts_ray_exact(__global const float *z, int V, real t, long origin, long u_stride,
-                   long v_stride, int k, int i, float h, real s_from, real s_to, real step,
-                   real c)
-{
-    const real at = fabs(t);
-    real best = -INFINITY;
-    real s = s_from;
-    while (s < s_to - RC(1e-12)) {
-        real nxt = floor(s + RC(1e-9)) + 1;
-        if (at > RC(1e-12)) {
-            real v = i - t * s;
-            real vb = t > 0 ? ceil(v - RC(1e-9)) - 1 : floor(v + RC(1e-9)) + 1;
-            real sv = (i - vb) / t;
-            if (sv > s + RC(1e-9) && sv < nxt)
-                nxt = sv;
-        }
-        real se = nxt < s_to ? nxt : s_to, mid = RC(0.5) * (s + se);
-        int k0 = (int)floor(k - mid), r0 = at > RC(1e-12) ? (int)floor(i - t * mid) : i;
-        int use_r1 = at > RC(1e-12);
-        if (k0 < 0 || r0 < 0 || r0 > V - 1 || (use_r1 && r0 + 1 > V - 1))
-            break; /* the ray leaves the grid */
-        long o = origin + (long)k0 * u_stride + (long)r0 * v_stride;
-        real h00 = z[o], h10 = z[o + u_stride];
-        real h01 = use_r1 ? (real)z[o + v_stride] : h00;
-        real h11 = use_r1 ? (real)z[o + u_stride + v_stride] : h10;
-        if (!isnan(h00 + h10 + h01 + h11)) {
-            real a0 = k - k0, b0 = use_r1 ? (real)(i - r0) : (real)0, tt = use_r1 ? t : (real)0;
-            real A = h10 - h00, B = h01 - h00, X = h11 - h10 - h01 + h00;
-            real alpha = h00 + A * a0 + B * b0 + X * a0 * b0;
-            real beta = -(A + B * tt + X * (a0 * tt + b0)), gamma = X * tt;
-            real m = ts_piece_max(alpha - h, beta, gamma, s > 0 ? s : RC(1e-9), se, step, c);
-            best = m > best ? m : best;
-        } else {
-            /* nodata patch: only its valid end points on grid lines */
-            for (int e = 0; e < 2; e++) {
-                real end = e ? se : s;
-                if (end <= 0)
-                    continue;
-                real he = ts_edge_height((float)h00, (float)h10, (float)h01, (float)h11,
-                                         (k - end) - k0, use_r1 ? (i - t * end) - r0 : (real)0);
-                if (!isnan(he)) {
-                    real sl = (he - h) / (end * step) - c * end * step;
-                    best = sl > best ? sl : best;
-                }
-            }
-        }
-        s = se;
-    }
-    return (float)best;
-}
-
-/* The float fast path of near_run (near_field.c) for one interior cell:
- * same expressions in the same order. *flag: a NaN was met. */
+/* The float fast path of near_run (near_field.c) for one interior cell zc
+ * at height h, piece by piece then sample by sample as there. *flag: a
+ * NaN was met (the cell is then redone by cm_near_exact). */
 float ts_near_fast(__global const float *zc, __global const int *P, __global const real *Q,
                    long u_stride, long v_stride, float h, float L, float c, int *flag)
 {
     float best = -INFINITY, nans = 0.0f;
     const real pt = Q[TS_CLD_T];
     const float t = (float)pt;
-    const int npieces = P[TS_CLI_NPIECES];
-    for (int n = 0; n < npieces; n++) {
-        const int du = P[TS_CLI_PDU + n], dv = P[TS_CLI_PDV + n];
-        long o = (long)du * u_stride + (long)dv * v_stride;
-        float c00 = zc[o], c10 = zc[o + u_stride], c01 = zc[o + v_stride];
-        float c11 = zc[o + u_stride + v_stride];
-        const float a0 = (float)-du, b0 = fabs(pt) <= RC(1e-12) ? 0.0f : (float)-dv;
-        const float sa = (float)Q[TS_CLD_PSA + n], sb = (float)Q[TS_CLD_PSB + n];
-        const float inv_b = 1.0f / (sb * L), cb = c * sb * L, cLL = c * L * L, invL = 1.0f / L;
-        const int has_sa = sa > 0;
-        const float ka = has_sa ? 1.0f / (sa * L) : 0.0f;
-        const float kb = has_sa ? sa * ka : invL, kc = has_sa ? sa * sa * ka : 0.0f;
-        const float ca = has_sa ? c * sa * L : 0.0f;
-        float A = c10 - c00, B = c01 - c00;
-        float X = c11 - c10 - c01 + c00;
-        float alpha = c00 + A * a0 + B * b0 + X * a0 * b0;
-        float beta = -(A + B * t + X * (a0 * t + b0));
-        float gamma = X * t;
-        float Pp = alpha - h;
-        float fb = (Pp + beta * sb + gamma * sb * sb) * inv_b - cb;
-        float fa = Pp * ka + beta * kb + gamma * kc - ca;
-        float m = fa > fb ? fa : fb;
-        float g2 = gamma - cLL;
-        float r = Pp / g2;
-        float ss = sqrt(r > 0.0f ? r : 0.0f);
-        float sd = ss > 0.0f ? ss : 1.0f;
-        float fs = (Pp / sd + beta + gamma * ss) * invL - c * ss * L;
-        int inner = has_sa & (Pp < 0.0f) & (g2 < 0.0f) & (ss > sa) & (ss < sb) & (fs > m);
-        m = inner ? fs : m;
+    const int flat_v = fabs(pt) <= RC(1e-12);
+    for (int n = 0; n < P[TS_CLI_NPIECES]; n++) {
+        __global const float *q0 =
+            zc + (long)P[TS_CLI_PDU + n] * u_stride + (long)P[TS_CLI_PDV + n] * v_stride;
+        cm_fast_piece q = cm_fast_piece_init(P[TS_CLI_PDU + n], P[TS_CLI_PDV + n], flat_v,
+                                             Q[TS_CLD_PSA + n], Q[TS_CLD_PSB + n], L, c);
+        float m = cm_fast_piece_slope(q, t, q0[0], q0[u_stride], q0[v_stride],
+                                      q0[u_stride + v_stride], h, L, c);
         best = m > best ? m : best;
         nans += (m != m) ? 1.0f : 0.0f;
     }
     for (int j = TS_NEAR_EXACT + 1; j <= TS_NEAR_STEPS; j++) {
-        long o0 = -(long)j * u_stride + (long)P[TS_CLI_SDV + j] * v_stride;
-        const float f = (float)Q[TS_CLD_SFV + j], d = (float)j * L, invd = 1.0f / d, cd = c * d;
-        float va = zc[o0], vb = zc[o0 + v_stride];
-        float hj = va + f * (vb - va);
-        float s = (hj - h) * invd - cd;
+        __global const float *q0 = zc - (long)j * u_stride + (long)P[TS_CLI_SDV + j] * v_stride;
+        const float d = (float)j * L;
+        float s = cm_fast_sample_slope(q0[0], q0[v_stride], (float)Q[TS_CLD_SFV + j], h,
+                                       1.0f / d, c * d);
         best = s > best ? s : best;
         nans += (s != s) ? 1.0f : 0.0f;
     }
@@ -511,8 +250,9 @@ __kernel void ts_sweep_finish(__global const float *z, const int W, const int H,
     const int2 olo = (F > 0.0f && v >= 1) ? lo[po] : none;
     const int sroff = P[TS_CLI_SROFF];
     const real step = sroff >= 0 ? sr_all[sroff + y] : Q[TS_CLD_STEPM];
-    const float farf = ts_far_field(z, V, Q[TS_CLD_T], origin, u_stride, v_stride, k, v, hc,
-                                    olo, ohi, step, c, cap);
+    const cm_ray_grid r = {z, V, Q[TS_CLD_T], origin, u_stride, v_stride};
+    const cm_near_tables nt = ts_near_tables(P, Q);
+    const float farf = ts_far_field(&r, k, v, hc, olo, ohi, step, c, cap);
     const int m = TS_NEAR_MARGIN;
     const int interior =
         cap == 0 && y >= m && y < H - m && W > 2 * m && x >= m && x < W - m;
@@ -523,12 +263,10 @@ __kernel void ts_sweep_finish(__global const float *z, const int W, const int H,
         float nf = ts_near_fast(z + cell, P, Q, u_stride, v_stride, hc, (float)step, (float)c,
                                 &flagged);
         if (flagged)
-            nf = ts_near_exact(z, P, Q, origin, u_stride, v_stride, k, v, hc, step, c, 0,
-                               &left);
+            nf = cm_near_exact(&r, &nt, k, v, hc, step, c, 0, &left);
         res = nf > farf ? nf : farf;
     } else {
-        float nf =
-            ts_near_exact(z, P, Q, origin, u_stride, v_stride, k, v, hc, step, c, cap, &left);
+        float nf = cm_near_exact(&r, &nt, k, v, hc, step, c, cap, &left);
         res = left ? nf : fmax(nf, farf);
     }
     out[po] = ts_atan_deg(res);

@@ -1,16 +1,8 @@
 /*
- * Normals, direct sun and sky terms: ports of core/normals.c,
- * core/shading.c and core/sky.c, one work-item per cell.
+ * Normals, direct sun and sky terms: the loops of core/normals.c,
+ * core/shading.c and core/sky.c, one work-item per cell; the formulas are
+ * core/cellmath/cm_normals.h, cm_sun.h and cm_sky.h.
  */
-
-/* Height of a neighbour, the centre's where it is outside or nodata. */
-float ts_nb(__global const float *z, int W, int H, int x, int y, float centre)
-{
-    if (x < 0 || y < 0 || x >= W || y >= H)
-        return centre;
-    float v = z[(long)y * W + x];
-    return isnan(v) ? centre : v;
-}
 
 /* Horn normals; cxr: per-row east-west cell sizes when has_cxr. */
 __kernel void ts_normals(__global const float *z, const int W, const int H,
@@ -22,73 +14,39 @@ __kernel void ts_normals(__global const float *z, const int W, const int H,
     if (o >= (long)W * H)
         return;
     const int y = (int)(o / W), x = (int)(o - (long)y * W);
-    const float e = z[o];
-    if (isnan(e)) {
-        nx[o] = ny[o] = nz[o] = NAN;
-        return;
-    }
-    real ew = (real)8 * (has_cxr ? cxr[y] : cell_x), ns = (real)8 * cell_y;
-    real a = ts_nb(z, W, H, x - 1, y - 1, e), b = ts_nb(z, W, H, x, y - 1, e);
-    real cc = ts_nb(z, W, H, x + 1, y - 1, e);
-    real d = ts_nb(z, W, H, x - 1, y, e), f = ts_nb(z, W, H, x + 1, y, e);
-    real gg = ts_nb(z, W, H, x - 1, y + 1, e), h = ts_nb(z, W, H, x, y + 1, e);
-    real i = ts_nb(z, W, H, x + 1, y + 1, e);
-    real dzdx = ((cc + 2 * f + i) - (a + 2 * d + gg)) / ew;
-    real dzdy = ((gg + 2 * h + i) - (a + 2 * b + cc)) / ns;
-    real inv = (real)1 / sqrt((real)1 + dzdx * dzdx + dzdy * dzdy);
-    nx[o] = (float)(-dzdx * inv);
-    ny[o] = (float)(dzdy * inv);
-    nz[o] = (float)inv;
+    float a, b, c;
+    cm_horn_normal(z, W, W, H, x, y, (real)8 * (has_cxr ? cxr[y] : cell_x), (real)8 * cell_y,
+                   &a, &b, &c);
+    nx[o] = a;
+    ny[o] = b;
+    nz[o] = c;
 }
 
 /* Direct sun: h0, h1 are the two horizon planes around the sun's azimuth,
- * mixed with weight w, and the visible fraction of the sun's disk
- * (ts_sun_disk_fraction); pi: the host's M_PI. */
+ * mixed with weight w; el: the sun's elevation in degrees, inv_r: 1 / its
+ * angular radius in degrees. */
 __kernel void ts_direct(__global const float *nx, __global const float *ny,
                         __global const float *nz, __global const float *h0,
                         __global const float *h1, const long cells, const float w,
-                        const float lx, const float ly, const float lz, const real sun_el,
-                        const real radius, const real pi, __global float *out)
+                        const float lx, const float ly, const float lz, const float el,
+                        const float inv_r, __global float *out)
 {
     const long i = get_global_id(0);
     if (i >= cells)
         return;
-    float hz = (1.0f - w) * h0[i] + w * h1[i];
-    float ndotl = nx[i] * lx + ny[i] * ly + nz[i] * lz;
-    if (isnan(hz) || isnan(ndotl)) {
-        out[i] = NAN;
-        return;
-    }
-    real frac;
-    {
-        real u = (sun_el - (real)hz) / radius;
-        if (u >= 1)
-            frac = 1;
-        else if (u <= -1)
-            frac = 0;
-        else
-            frac = RC(0.5) + (u * sqrt(1 - u * u) + asin(u)) / pi;
-    }
-    out[i] = ndotl > 0 ? ndotl * (float)frac : 0.0f;
-}
-
-/* One swath of eq. 5 (sky.c). */
-float ts_swath(float nz, float a, float theta, float w1, float w2)
-{
-    float s = sin(theta), c = cos(theta);
-    return w1 * nz * s * s + w2 * (theta - s * c) * a;
+    out[i] = cm_direct_sun(nx[i], ny[i], nz[i], h0[i], h1[i], w, lx, ly, lz, el, inv_r);
 }
 
 /*
  * Sky terms: accumulate nplanes horizon planes (directions with sines and
  * cosines sa[k], ca[k]) onto the accumulators, then, when `finish`, clamp
- * and average as ts_sky_finish. want: bit 0 svf, 1 sky, 2 openness.
+ * and average as ts_sky_finish. want: bit 0 svf, 1 sky, 2 openness; w1,
+ * w2: 1/n and sin(pi/n)/pi.
  */
 __kernel void ts_sky(__global const float *nx, __global const float *ny,
                      __global const float *nz, __global const float *planes,
                      const int nplanes, const long cells, __global const float *sa,
-                     __global const float *ca, const float w1, const float w2,
-                     const float half_pi, const float deg2rad, const int want,
+                     __global const float *ca, const float w1, const float w2, const int want,
                      const int finish, const float directions, __global float *svf,
                      __global float *sky, __global float *open)
 {
@@ -100,23 +58,14 @@ __kernel void ts_sky(__global const float *nx, __global const float *ny,
     float ao = (want & 4) ? open[i] : 0.0f;
     const float nzi = nz[i], nxi = nx[i], nyi = ny[i];
     for (int k = 0; k < nplanes; k++) {
-        float h = planes[k * cells + i];
-        if (isnan(h) || isnan(nzi)) {
-            as = ak = ao = NAN;
-            continue;
-        }
-        float a = nxi * sa[k] + nyi * ca[k];
-        float theta_n = half_pi + atan(a / nzi);
-        float theta_h = half_pi - h * deg2rad;
-        as += ts_swath(nzi, a, fmin(theta_h, theta_n), w1, w2);
-        ak += ts_swath(nzi, a, fmin(fmin(theta_h, half_pi), theta_n), w1, w2);
-        ao += 90.0f - h;
+        const float h = planes[k * cells + i];
+        as += cm_sky_term(nxi, nyi, nzi, h, sa[k], ca[k], w1, w2, 0);
+        ak += cm_sky_term(nxi, nyi, nzi, h, sa[k], ca[k], w1, w2, 1);
+        ao += cm_openness_term(h, nzi);
     }
     if (finish) {
-        if (as > 1.0f)
-            as = 1.0f;
-        if (ak > 1.0f)
-            ak = 1.0f;
+        as = cm_sky_clamp(as);
+        ak = cm_sky_clamp(ak);
         ao /= directions;
     }
     if (want & 1)

@@ -1,5 +1,6 @@
 /*
- * Shadow height map (Lee & Kim): a port of core/shadow_height_map.c.
+ * Shadow height map (Lee & Kim): the recurrence of
+ * core/shadow_height_map.c, its step and light in core/cellmath/cm_shm.h.
  *
  * S(k, v) = max(h, S(k - 1, v + off + F) - drop) walks along the light's
  * major axis u (k = step index); a u-row depends on the previous one at v +
@@ -44,47 +45,27 @@ __kernel void ts_shm_rows(__global const float *z, const int W, const int xm, co
             }
             const long p = rowoff + (long)v * v_stride;
             const float h = z[p];
-            float pv = NAN;
+            float pa = NAN, pb = NAN; /* NaN: nothing toward the light */
             if (k > 0) {
-                const float drop = drop_row[xm ? v : u];
                 const int a = v + off, b = a + 1;
                 /* off the grid toward the light nothing casts a shadow */
                 const int off_grid = a < 0 || a >= V || (F > 0.0f && (b < 0 || b >= V));
-                if (!off_grid) {
-                    float pa, pb;
-                    if (j == 0) {
-                        pa = state_in[a];
-                        pb = F > 0.0f ? state_in[b] : NAN;
-                    } else {
-                        /* outside the local cells only in the stale part
-                         * of the halo, which the band never reads */
-                        const int ea = a - e_lo, eb = ea + 1;
-                        pa = (ea >= 0 && ea < E) ? prev[ea] : NAN;
-                        pb = (F > 0.0f && eb >= 0 && eb < E) ? prev[eb] : NAN;
-                    }
-                    if (F == 0.0f || isnan(pb))
-                        pv = pa;
-                    else if (isnan(pa))
-                        pv = pb;
-                    else
-                        pv = pa + F * (pb - pa);
-                    pv -= drop;
+                if (!off_grid && j == 0) {
+                    pa = state_in[a];
+                    pb = F > 0.0f ? state_in[b] : NAN;
+                } else if (!off_grid) {
+                    /* outside the local cells only in the stale part of
+                     * the halo, which the band never reads */
+                    const int ea = a - e_lo, eb = ea + 1;
+                    pa = (ea >= 0 && ea < E) ? prev[ea] : NAN;
+                    pb = (F > 0.0f && eb >= 0 && eb < E) ? prev[eb] : NAN;
                 }
             }
-            const float s = isnan(h) ? pv : ((isnan(pv) || h >= pv) ? h : pv);
+            const float s = cm_shm_step(pa, pb, F, k > 0 ? drop_row[xm ? v : u] : 0.0f, h);
             cur[e] = s;
             if (e >= halo_lo && e < halo_lo + B) {
-                if (want_vis) {
-                    const float under = s - h;
-                    float lit;
-                    if (depth <= 0.0f) {
-                        lit = under > 0.0f ? 0.0f : 1.0f;
-                    } else {
-                        const float q = under / depth;
-                        lit = 1.0f - (q < 0.0f ? 0.0f : q > 1.0f ? 1.0f : q);
-                    }
-                    vis[p] = isnan(h) ? NAN : lit;
-                }
+                if (want_vis)
+                    vis[p] = cm_shm_lit(s, h, depth);
                 if (want_sh)
                     sh[p] = s;
                 if (j == nrows - 1)

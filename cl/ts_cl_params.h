@@ -4,7 +4,7 @@
  * piece of the embedded kernel source). Integers go to an int table, reals
  * (double on devices with cl_khr_fp64, else float) to a real table, one row
  * of TS_CLI_N / TS_CLD_N entries per azimuth. TS_NEAR_* come from
- * core/near_field.h (on the device: build options).
+ * core/cellmath/cm_near_field.h (embedded before this file).
  */
 #ifndef TS_CL_PARAMS_H
 #define TS_CL_PARAMS_H

@@ -5,16 +5,26 @@
 #include "arg_checks.h"
 #include "status_internal.h"
 
-ts_status ts_check_shm_args(const ts_grid *grid, double azimuth, double elevation,
+#define DEG2RAD (M_PI / 180.0)
+
+/* A finite azimuth in degrees, reduced to [0, 360). */
+static void reduce_azimuth(double *azimuth)
+{
+    *azimuth = fmod(*azimuth, 360.0);
+    if (*azimuth < 0)
+        *azimuth += 360.0;
+}
+
+ts_status ts_check_shm_args(const ts_grid *grid, double *azimuth, double elevation,
                             double penumbra_depth, int threads, const float *vis,
                             const float *shadow_height, ts_error *err)
 {
     ts_status st = ts_grid_validate(grid, err);
     if (st != TS_OK)
         return st;
-    if (!isfinite(azimuth))
+    if (!isfinite(*azimuth))
         return ts_fail(err, TS_ERR_ARG, "sun azimuth must be a finite number of degrees, got %g",
-                       azimuth);
+                       *azimuth);
     if (!(elevation >= -90 && elevation <= 90))
         return ts_fail(err, TS_ERR_ARG, "sun elevation must be between -90 and 90, got %g",
                        elevation);
@@ -26,6 +36,64 @@ ts_status ts_check_shm_args(const ts_grid *grid, double azimuth, double elevatio
         return ts_fail(err, TS_ERR_ARG, "threads must be 0 (all cores) or more, got %d", threads);
     if (!vis && !shadow_height)
         return ts_fail(err, TS_ERR_ARG, "both outputs are NULL");
+    reduce_azimuth(azimuth);
+    return TS_OK;
+}
+
+ts_status ts_check_sweep_args(const ts_grid *grid, double *azimuth,
+                              const ts_horizon_opts *opts, ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if (!opts)
+        return ts_fail(err, TS_ERR_ARG, "horizon options are NULL");
+    ts_horizon_opts o = *opts; /* one azimuth: the number of directions is not used */
+    o.directions = o.directions < 1 ? 1 : o.directions;
+    if ((st = ts_horizon_opts_validate(&o, err)) != TS_OK)
+        return st;
+    if (!isfinite(*azimuth))
+        return ts_fail(err, TS_ERR_ARG, "azimuth must be a finite number of degrees, got %g",
+                       *azimuth);
+    reduce_azimuth(azimuth);
+    return TS_OK;
+}
+
+ts_status ts_check_normals_args(const ts_grid *grid, const float *nx, const float *ny,
+                                const float *nz, ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if (!nx || !ny || !nz)
+        return ts_fail(err, TS_ERR_ARG, "normal output buffers must not be NULL");
+    return TS_OK;
+}
+
+ts_status ts_check_sky_args(const ts_grid *grid, const float *nx, const float *ny,
+                            const float *nz, int directions, ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if (!nx || !ny || !nz)
+        return ts_fail(err, TS_ERR_ARG, "normals must not be NULL");
+    if (directions < 1)
+        return ts_fail(err, TS_ERR_ARG, "directions must be at least 1, got %d", directions);
+    return TS_OK;
+}
+
+ts_status ts_check_sky_terms_args(const ts_grid *grid, const float *nx, const float *ny,
+                                  const float *nz, const float *horizons,
+                                  const ts_horizon_opts *opts, ts_error *err)
+{
+    ts_status st = ts_horizon_opts_validate(opts, err);
+    if (st != TS_OK)
+        return st;
+    if ((st = ts_check_sky_args(grid, nx, ny, nz, opts->directions, err)) != TS_OK)
+        return st;
+    if (!horizons)
+        return ts_fail(err, TS_ERR_ARG, "horizons must not be NULL");
     return TS_OK;
 }
 
@@ -33,7 +101,7 @@ ts_status ts_direct_setup(const ts_grid *grid, const float *nx, const float *ny,
                           const float *nz, const float *horizons,
                           const ts_horizon_opts *opts, double sun_azimuth,
                           double sun_elevation, const float *out, int *k0, int *k1,
-                          double *w, ts_error *err)
+                          double *w, float light[3], ts_error *err)
 {
     ts_status st = ts_grid_validate(grid, err);
     if (st != TS_OK)
@@ -67,6 +135,10 @@ ts_status ts_direct_setup(const ts_grid *grid, const float *nx, const float *ny,
                        opts->start_azimuth, sun_azimuth);
     if (n == 1)
         *w = 0;
+    double az = sun_azimuth * DEG2RAD, el = sun_elevation * DEG2RAD;
+    light[0] = (float)(sin(az) * cos(el));
+    light[1] = (float)(cos(az) * cos(el));
+    light[2] = (float)sin(el);
     return TS_OK;
 }
 

@@ -1,7 +1,8 @@
 /*
  * day_cycle.h - the sun over a day: sampling times, per-cell sun
  * visibility at an instant, hours of direct sun, clear-sky irradiation
- * (insolation) over a local day, and the dawn/dusk-weighted times of the
+ * (insolation) over a local day or summed over a range of days (from
+ * horizons at fixed azimuths), and the dawn/dusk-weighted times of the
  * far-shadow atlas (Chajdas et al. 2015). No GDAL, no global state.
  *
  * Where the sun is seen from: a `ts_sun_sites` is one site (the DEM's
@@ -225,6 +226,74 @@ ts_status ts_insolation(const ts_grid *grid, const ts_sun_sites *sites,
                         const ts_day_opts *o, double start_unix,
                         double length_s, double step_s, float *total,
                         float *beam, float *diffuse, ts_error *err);
+
+/* ---------------------------------------------------------- date ranges */
+
+/** ArcGIS Area Solar Radiation's defaults for date ranges. */
+#define TS_RANGE_DAY_INTERVAL 14
+#define TS_RANGE_STEP_MINUTES 30.0
+/** Horizon azimuths of the range products by default: the error it gives
+ * against per-step exact sweeps is measured in docs/day-cycle.md. */
+#define TS_RANGE_HORIZON_DIRECTIONS 64
+
+/**
+ * A range of local days, first to last inclusive, at a fixed UTC offset;
+ * every `day_interval`-th day from the first is sampled, each cut into
+ * steps of `step_minutes` as ts_sun_hours does with one day. Sampled day i
+ * (first + i x day_interval) stands for min(day_interval, days left from
+ * it to the last day) days, so the weights add up to the range's length
+ * and day_interval = 1 gives the exact sum over every day.
+ */
+typedef struct {
+    int first_year, first_month, first_day;
+    int last_year, last_month, last_day;
+    int utc_offset_minutes;  /**< east of UTC, |offset| < 24 h */
+    int day_interval;        /**< days between sampled days, 1..366 */
+    double step_minutes;     /**< time step within a day, 1..1440 */
+    int horizon_directions;  /**< horizon azimuths the sun's positions are
+                                  interpolated between, 4..3600 */
+} ts_date_range;
+
+/** Defaults: TS_RANGE_DAY_INTERVAL, TS_RANGE_STEP_MINUTES,
+ * TS_RANGE_HORIZON_DIRECTIONS, offset 0, and no dates (all 0: set them). */
+void ts_date_range_default(ts_date_range *r);
+
+/**
+ * Check a range; *days (may be NULL) receives its length in days and
+ * *sampled (may be NULL) the number of sampled days. The message says what
+ * is wrong (a date that does not exist, the last day before the first, an
+ * interval, step or direction count out of range).
+ */
+ts_status ts_date_range_check(const ts_date_range *r, int *days, int *sampled,
+                              ts_error *err);
+
+/**
+ * Hours of direct sun over a date range: the sum over the sampled days,
+ * weighted as described at ts_date_range, of what ts_sun_hours gives for
+ * that local day (same steps, same o->sun_hours_rule, same Earth horizon),
+ * except that the horizon toward the sun is not swept at each sun position:
+ * the horizons are swept once for r->horizon_directions azimuths
+ * (ts_horizon_azimuth with o->horizon.start_azimuth) and the horizon at
+ * the sun's azimuth interpolated linearly between the two nearest. Planes
+ * are streamed (three at most in memory). Progress through
+ * o->horizon.progress. One sun site only: a lattice is refused
+ * (TS_ERR_ARG). `hours` width*height, NaN for nodata.
+ */
+ts_status ts_sun_hours_range(const ts_grid *grid, const ts_sun_sites *sites,
+                             const ts_day_opts *o, const ts_date_range *r,
+                             float *hours, ts_error *err);
+
+/**
+ * Clear-sky irradiation over a date range in Wh/m^2, weighted as
+ * ts_sun_hours_range: what ts_insolation gives for each sampled day, with
+ * the horizons interpolated as in ts_sun_hours_range. The sky term uses
+ * o->horizon.directions azimuths as ts_insolation does. `total` (may not be
+ * NULL), `beam` and `diffuse` (may be NULL) width*height, NaN for nodata.
+ */
+ts_status ts_insolation_range(const ts_grid *grid, const ts_sun_sites *sites,
+                              const ts_day_opts *o, const ts_date_range *r,
+                              float *total, float *beam, float *diffuse,
+                              ts_error *err);
 
 #ifdef __cplusplus
 }

@@ -25,7 +25,8 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "fastmath.h"
+#include "arg_checks.h"
+#include "cellmath/cm_fastmath.h"
 #include "line_geometry.h"
 #include "near_field.h"
 #include "parallel.h"
@@ -56,6 +57,7 @@ typedef struct {
     ts_near_plan near;
     double near_skip;   /* hull points closer than this are near field */
     int near_only;      /* the distance ends inside the near field: no lines */
+    cm_ray_grid ray;    /* the grid as the geometry sees it, for cm_ray_slope */
 } sweep_ctx;
 
 typedef struct {
@@ -99,22 +101,7 @@ static occluder hull_query(const sweep_ctx *C, sweep_ws *w, int far, double d, f
  * the grid there or touches nodata. */
 static inline float ray_slope(const sweep_ctx *C, int k, int i, float h, int dk, float dd)
 {
-    const ts_line_geom *G = C->geom;
-    int kk = k - dk;
-    if (dk <= 0 || kk < 0 || dd <= 0.0f)
-        return -INFINITY;
-    double pv = -G->t * dk, o = floor(pv);
-    int r0 = i + (int)o;
-    float f = (float)(pv - o);
-    if (r0 < 0 || r0 > G->V - 1 || (f > 0.0f && r0 + 1 > G->V - 1))
-        return -INFINITY;
-    const float *z = C->grid->z + G->origin + (ptrdiff_t)kk * G->u_stride +
-                     (ptrdiff_t)r0 * G->v_stride;
-    float a = z[0], b = f > 0.0f ? z[G->v_stride] : a;
-    float hz = a + f * (b - a);
-    if (isnan(hz))
-        return -INFINITY;
-    return (hz - h) / dd - (float)C->c * dd;
+    return cm_ray_slope(&C->ray, k, i, h, dk, dd, (float)C->c);
 }
 
 /* Steps on either side of a line's occluder at which the cell's ray is
@@ -424,20 +411,16 @@ static ts_status sweep_setup(const ts_grid *grid, double azimuth,
                              const ts_horizon_opts *opts, ts_line_geom *geom,
                              sweep_ctx *C, ts_error *err)
 {
-    ts_status st = ts_grid_validate(grid, err);
+    ts_status st = ts_check_sweep_args(grid, &azimuth, opts, err);
     if (st != TS_OK)
-        return st;
-    if (!opts)
-        return ts_fail(err, TS_ERR_ARG, "horizon options are NULL");
-    ts_horizon_opts o = *opts;
-    o.directions = o.directions < 1 ? 1 : o.directions;
-    if ((st = ts_horizon_opts_validate(&o, err)) != TS_OK)
         return st;
     if ((st = ts_line_geom_init(geom, grid, azimuth, err)) != TS_OK)
         return st;
     *C = (sweep_ctx){0};
     C->grid = grid;
     C->geom = geom;
+    C->ray = (cm_ray_grid){grid->z, geom->V, geom->t, geom->origin, geom->u_stride,
+                           geom->v_stride};
     C->c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
     ts_line_out_strides(geom, grid->width, &C->o_origin, &C->o_u_stride, &C->o_v_stride);
     C->b0 = geom->b_lo;

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cellmath/cm_line.h"
 #include "line_geometry.h"
 #include "status_internal.h"
 
@@ -92,42 +93,9 @@ void ts_line_geom_free(ts_line_geom *g)
     memset(g, 0, sizeof *g);
 }
 
-/* fl is monotone in k (non-decreasing for t >= 0, non-increasing for t < 0),
- * so the k range where lo <= b + fl[k] <= hi is found by binary search. */
-static int first_k(const ts_line_geom *g, int ascending, long lim, int want_ge)
-{
-    /* Smallest k with predicate true, predicate monotone false->true. */
-    int lo = 0, hi = g->U; /* answer in [lo, hi], hi = none */
-    while (lo < hi) {
-        int mid = lo + (hi - lo) / 2;
-        long v = g->fl[mid];
-        int p = want_ge ? (ascending ? v >= lim : v <= lim) : (ascending ? v > lim : v < lim);
-        if (p)
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
-    return lo;
-}
-
 int ts_line_k_range(const ts_line_geom *g, long b, int *k0, int *k1)
 {
-    int asc = g->t >= 0;
-    /* Rows b + fl[k] in [0, V-1]  <=>  fl[k] in [-b, V-1-b]. */
-    long lo = -b, hi = (long)g->V - 1 - b;
-    int a, z;
-    if (asc) {
-        a = first_k(g, 1, lo, 1);      /* first fl >= lo */
-        z = first_k(g, 1, hi, 0) - 1;  /* last fl <= hi */
-    } else {
-        a = first_k(g, 0, hi, 1);      /* first fl <= hi */
-        z = first_k(g, 0, lo, 0) - 1;  /* last fl >= lo */
-    }
-    if (a > z || a >= g->U || z < 0)
-        return 0;
-    *k0 = a;
-    *k1 = z;
-    return 1;
+    return cm_line_k_range(g->fl, g->U, g->V, g->t >= 0, b, k0, k1);
 }
 
 void ts_line_out_strides(const ts_line_geom *g, int width, ptrdiff_t *origin,

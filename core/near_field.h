@@ -11,35 +11,25 @@
 #ifndef TS_NEAR_FIELD_H
 #define TS_NEAR_FIELD_H
 
+#include "cellmath/cm_near_field.h"
 #include "line_geometry.h"
 
-/* Cells of the ray solved exactly, then whole-step samples up to
- * TS_NEAR_STEPS; the sweep's hulls cover what lies beyond. */
-#define TS_NEAR_EXACT 4
-#define TS_NEAR_STEPS 10
-#define TS_NEAR_MAX_PIECES (2 * TS_NEAR_EXACT + 2)
-
-typedef struct {
-    int du, dv;      /* patch corner (k + du, i + dv) */
-    double sa, sb;   /* piece of the ray, in steps */
-} ts_near_piece;
-
+/* Piece n of the ray, [piece_sa[n], piece_sb[n]] steps, lies in the patch
+ * with corner (k + piece_du[n], i + piece_dv[n]); whole step j is
+ * interpolated at v offset sample_dv[j] + sample_fv[j] (a float's value). */
 typedef struct {
     double t;                              /* v per step, as the geometry */
     int npieces;
-    ts_near_piece piece[TS_NEAR_MAX_PIECES];
-    int sample_dv[TS_NEAR_STEPS + 1];      /* whole step j: v offset */
-    float sample_fv[TS_NEAR_STEPS + 1];
+    int piece_du[TS_NEAR_MAX_PIECES], piece_dv[TS_NEAR_MAX_PIECES];
+    double piece_sa[TS_NEAR_MAX_PIECES], piece_sb[TS_NEAR_MAX_PIECES];
+    int sample_dv[TS_NEAR_STEPS + 1];
+    double sample_fv[TS_NEAR_STEPS + 1];
     /* Element offsets from the cell, for the vectorised interior pass:
      * corners 00, 10, 01, 11 of each piece, and the two cells of each whole
      * step sample. */
     ptrdiff_t piece_off[TS_NEAR_MAX_PIECES][4];
     ptrdiff_t sample_off[TS_NEAR_STEPS + 1][2];
 } ts_near_plan;
-
-/* Cells at least this far from every edge have their whole near field on
- * the grid. */
-#define TS_NEAR_MARGIN (TS_NEAR_STEPS + 2)
 
 /* Pieces and samples for the geometry's direction. */
 void ts_near_plan_init(ts_near_plan *p, const ts_line_geom *g);

@@ -2,11 +2,9 @@
 #include <math.h>
 
 #include "arg_checks.h"
-#include "fastmath.h"
+#include "cellmath/cm_sun.h"
 #include "parallel.h"
 #include "status_internal.h"
-
-#define DEG2RAD (M_PI / 180.0)
 
 double ts_sun_disk_fraction(double sun_elevation, double horizon)
 {
@@ -28,8 +26,7 @@ typedef struct {
     float *out;
 } direct_ctx;
 
-/* Branch-free per cell so that the loop vectorises (fastmath.h's asin
- * instead of libm's); NaN flows through. */
+/* cm_direct_sun is branch-free, so that this loop vectorises. */
 static void direct_range(void *ctx, int worker, long begin, long end)
 {
     (void)worker;
@@ -39,13 +36,8 @@ static void direct_range(void *ctx, int worker, long begin, long end)
     float *restrict out = C->out;
     const float w = C->w, lx = C->lx, ly = C->ly, lz = C->lz;
     const float el = (float)C->sun_el, inv_r = (float)(1.0 / TS_SUN_RADIUS_DEG);
-    for (long i = begin; i < end; i++) {
-        float hz = (1.0f - w) * h0[i] + w * h1[i];
-        float ndotl = nx[i] * lx + ny[i] * ly + nz[i] * lz;
-        float lit = ts_disk_fraction_u((el - hz) * inv_r);
-        float v = (ndotl > 0.0f ? ndotl : 0.0f) * lit;
-        out[i] = v + (hz - hz) + (ndotl - ndotl); /* NaN stays NaN */
-    }
+    for (long i = begin; i < end; i++)
+        out[i] = cm_direct_sun(nx[i], ny[i], nz[i], h0[i], h1[i], w, lx, ly, lz, el, inv_r);
 }
 
 ts_status ts_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
@@ -55,15 +47,14 @@ ts_status ts_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
 {
     int k0, k1;
     double w;
+    float light[3];
     ts_status st = ts_direct_setup(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
-                                   out, &k0, &k1, &w, err);
+                                   out, &k0, &k1, &w, light, err);
     if (st != TS_OK)
         return st;
     size_t plane = (size_t)grid->width * grid->height;
-    double az = sun_azimuth * DEG2RAD, el = sun_elevation * DEG2RAD;
     direct_ctx C = {nx, ny, nz, horizons + plane * k0, horizons + plane * k1, (float)w,
-                    (float)(sin(az) * cos(el)), (float)(cos(az) * cos(el)), (float)sin(el),
-                    sun_elevation, out};
+                    light[0], light[1], light[2], sun_elevation, out};
     return ts_parallel_for(ts_thread_count(0, (long)(plane >> 16) + 1), (long)plane,
                            direct_range, &C, err);
 }

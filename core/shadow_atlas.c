@@ -2,7 +2,7 @@
  * The far-shadow atlas (Chajdas et al. 2015): a day's binary far-shadow
  * maps as a dictionary of 8 x 8 tiles and LZMA-compressed index maps; see
  * shadow_atlas.h and docs/atlas-format.md. The maps come from
- * far_horizon.c.
+ * far_horizon.c. This file writes atlases; shadow_atlas_read.c reads them.
  */
 #include <lzma.h>
 #include <math.h>
@@ -10,13 +10,12 @@
 #include <string.h>
 
 #include "shadow_atlas.h"
+#include "shadow_atlas_internal.h"
 #include "status_internal.h"
 
 /* ================================================================ atlas */
 
-static const uint8_t MAGIC[8] = {0x89, 'T', 'S', 'A', 'T', 'L', 'A', 'S'};
-
-/* Little-endian writing and reading. */
+/* Little-endian writing. */
 static void put32(uint8_t *p, uint32_t v)
 {
     for (int i = 0; i < 4; i++)
@@ -34,30 +33,6 @@ static void putf64(uint8_t *p, double v)
     uint64_t u;
     memcpy(&u, &v, 8);
     put64(p, u);
-}
-
-static uint32_t get32(const uint8_t *p)
-{
-    uint32_t v = 0;
-    for (int i = 0; i < 4; i++)
-        v |= (uint32_t)p[i] << (8 * i);
-    return v;
-}
-
-static uint64_t get64(const uint8_t *p)
-{
-    uint64_t v = 0;
-    for (int i = 0; i < 8; i++)
-        v |= (uint64_t)p[i] << (8 * i);
-    return v;
-}
-
-static double getf64(const uint8_t *p)
-{
-    uint64_t u = get64(p);
-    double v;
-    memcpy(&v, &u, 8);
-    return v;
 }
 
 /* Tile (tx, ty) of a plane as 64 bits: bit 8 r + c is cell (8 tx + c,
@@ -312,29 +287,6 @@ static ts_status xz_compress(const uint8_t *in, size_t n, int word, uint8_t **ou
     return TS_OK;
 }
 
-static ts_status xz_decompress(const uint8_t *in, size_t n, uint8_t *out, size_t expect,
-                               const char *what, ts_error *err)
-{
-    uint64_t memlimit = (uint64_t)1 << 30; /* a damaged header cannot ask for more */
-    size_t in_pos = 0, out_pos = 0;
-    lzma_ret r = lzma_stream_buffer_decode(&memlimit, 0, NULL, in, &in_pos, n, out,
-                                           &out_pos, expect);
-    if (r == LZMA_MEM_ERROR)
-        return ts_fail(err, TS_ERR_NOMEM, "out of memory decompressing the atlas's %s",
-                       what);
-    if (r != LZMA_OK || in_pos != n || out_pos != expect)
-        return ts_fail(err, TS_ERR_ARG,
-                       "the atlas is damaged: its %s (LZMA) do not decode to the "
-                       "%zu bytes the header announces (liblzma %d, %zu of %zu bytes "
-                       "read, %zu written)", what, expect, (int)r, in_pos, n, out_pos);
-    return TS_OK;
-}
-
-int ts_atlas_identify(const uint8_t *head, size_t n)
-{
-    return head && n >= sizeof MAGIC && memcmp(head, MAGIC, sizeof MAGIC) == 0;
-}
-
 ts_status ts_atlas_writer_finish(ts_atlas_writer *w, const ts_atlas_info *info,
                                  uint8_t **bytes, size_t *size, ts_error *err)
 {
@@ -344,6 +296,9 @@ ts_status ts_atlas_writer_finish(ts_atlas_writer *w, const ts_atlas_info *info,
     *size = 0;
     if (w->steps < 1)
         return ts_fail(err, TS_ERR_ARG, "an atlas needs at least one map");
+    ts_status checked = ts_atlas_check_steps(w->rec, w->steps, "cannot write the atlas", err);
+    if (checked != TS_OK)
+        return checked;
     int has_nodata = 0;
     for (size_t i = 0; i < w->tiles && !has_nodata; i++)
         has_nodata = w->mask[i] != 0;
@@ -405,7 +360,7 @@ ts_status ts_atlas_writer_finish(ts_atlas_writer *w, const ts_atlas_info *info,
             goto done;
         }
         uint8_t *h = file;
-        memcpy(h, MAGIC, 8);
+        memcpy(h, TS_ATLAS_MAGIC, 8);
         put32(h + 8, TS_ATLAS_VERSION);
         put32(h + 12, TS_ATLAS_HEADER_SIZE);
         put32(h + 16, (uint32_t)w->W);
@@ -417,7 +372,9 @@ ts_status ts_atlas_writer_finish(ts_atlas_writer *w, const ts_atlas_info *info,
         put32(h + 36, (uint32_t)ib);
         put32(h + 40, (uint32_t)w->used);
         put32(h + 44, info && info->threshold_cells > 0 ? (uint32_t)info->threshold_cells : 0);
-        putf64(h + 48, info ? info->threshold_m : NAN);
+        putf64(h + 48, info && isfinite(info->threshold_m) && info->threshold_m > 0
+                           ? info->threshold_m
+                           : NAN); /* 0 (a zeroed info) = unknown */
         for (int i = 0; i < 6; i++)
             putf64(h + 56 + 8 * i, info && info->has_geotransform ? info->geotransform[i]
                                                                   : (i == 1 || i == 5 ? 1.0 : 0.0));
@@ -429,7 +386,6 @@ ts_status ts_atlas_writer_finish(ts_atlas_writer *w, const ts_atlas_info *info,
         put64(h + 144, idx_off);
         put64(h + 152, idx_zn);
         put32(h + 160, lzma_crc32(h, 160, 0));
-        put32(h + 164, 0);
         for (int s = 0; s < w->steps; s++) {
             uint8_t *r = file + steps_off + (size_t)s * TS_ATLAS_STEP_SIZE;
             putf64(r, w->rec[s].unix_time);
@@ -440,6 +396,10 @@ ts_status ts_atlas_writer_finish(ts_atlas_writer *w, const ts_atlas_info *info,
             put32(r + 36, 0);
         }
         memcpy(file + text_off, text, text_n);
+        /* version 2: the step table and the text under their own CRC */
+        put32(h + 164, lzma_crc32(file + text_off, text_n,
+                                  lzma_crc32(file + steps_off,
+                                             (size_t)w->steps * TS_ATLAS_STEP_SIZE, 0)));
         memcpy(file + dict_off, dict_z, dict_zn);
         memcpy(file + idx_off, idx_z, idx_zn);
         *bytes = file;
@@ -455,192 +415,4 @@ done:
     free(idx_z);
     free(file);
     return st;
-}
-
-/* ------------------------------------------------------------- reading */
-
-struct ts_atlas {
-    ts_atlas_info info;
-    char *text;
-    ts_atlas_step *steps;
-    uint64_t *dict;
-    uint8_t *index; /* planes x tiles little-endian words */
-    int tx, ty;
-    size_t tiles;
-};
-
-void ts_atlas_free(ts_atlas *a)
-{
-    if (!a)
-        return;
-    free(a->text);
-    free(a->steps);
-    free(a->dict);
-    free(a->index);
-    free(a);
-}
-
-static inline uint32_t index_at(const ts_atlas *a, size_t plane, size_t tile)
-{
-    const uint8_t *p = a->index + (plane * a->tiles + tile) * (size_t)a->info.index_bytes;
-    return a->info.index_bytes == 2 ? (uint32_t)p[0] | (uint32_t)p[1] << 8 : get32(p);
-}
-
-#define BAD(...) do { st = ts_fail(err, TS_ERR_ARG, __VA_ARGS__); goto fail; } while (0)
-
-ts_status ts_atlas_open(const uint8_t *b, size_t n, ts_atlas **out, ts_error *err)
-{
-    if (!out)
-        return ts_fail(err, TS_ERR_ARG, "ts_atlas_open: the output is NULL");
-    *out = NULL;
-    if (!b || !ts_atlas_identify(b, n))
-        return ts_fail(err, TS_ERR_ARG, "not a terrashade atlas (the file does not start "
-                       "with the atlas magic \\x89TSATLAS)");
-    ts_status st;
-    ts_atlas *a = calloc(1, sizeof *a);
-    if (!a)
-        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the atlas");
-    if (n < 16)
-        BAD("the atlas is truncated: %zu bytes, the header alone has %d", n,
-            TS_ATLAS_HEADER_SIZE);
-    uint32_t version = get32(b + 8), hsize = get32(b + 12);
-    if (version != TS_ATLAS_VERSION)
-        BAD("the atlas has format version %u; this terrashade reads version %d",
-            version, TS_ATLAS_VERSION);
-    if (hsize < TS_ATLAS_HEADER_SIZE || n < hsize)
-        BAD("the atlas is truncated or its header is damaged (header of %u bytes in a "
-            "%zu-byte file)", hsize, n);
-    if (lzma_crc32(b, 160, 0) != get32(b + 160) || get32(b + 164) != 0)
-        BAD("the atlas's header is damaged (CRC32 mismatch)");
-    uint32_t W = get32(b + 16), H = get32(b + 20), steps = get32(b + 24);
-    uint32_t tile = get32(b + 28), flags = get32(b + 32), ib = get32(b + 36);
-    uint32_t ntiles = get32(b + 40);
-    if (W < 1 || H < 1 || W > INT32_MAX / 2 || H > INT32_MAX / 2 || steps < 1 ||
-        steps > INT32_MAX / 2 || tile != TS_ATLAS_TILE || (ib != 2 && ib != 4) ||
-        ntiles < 1 || (ib == 2 && ntiles > 65536))
-        BAD("the atlas's header is inconsistent (%u x %u cells, %u maps, tile %u, "
-            "%u-byte indices, %u tiles)", W, H, steps, tile, ib, ntiles);
-    uint64_t so = get64(b + 104), to = get64(b + 112), tn = get64(b + 120),
-             dof = get64(b + 128), dn = get64(b + 136), io = get64(b + 144),
-             in = get64(b + 152);
-    uint64_t sn = (uint64_t)steps * TS_ATLAS_STEP_SIZE;
-    uint64_t secs[4][2] = {{so, sn}, {to, tn}, {dof, dn}, {io, in}};
-    for (int i = 0; i < 4; i++)
-        if (secs[i][0] < hsize || secs[i][0] > n || secs[i][1] > n - secs[i][0])
-            BAD("the atlas is truncated: a section at byte %llu of %llu bytes lies "
-                "beyond the end of the %zu-byte file",
-                (unsigned long long)secs[i][0], (unsigned long long)secs[i][1], n);
-    a->info.width = (int)W;
-    a->info.height = (int)H;
-    a->info.steps = (int)steps;
-    a->info.threshold_cells = (int)(get32(b + 44) > INT32_MAX ? 0 : get32(b + 44));
-    a->info.threshold_m = getf64(b + 48);
-    a->info.has_geotransform = flags & 1;
-    a->info.has_nodata = (flags & 2) != 0;
-    for (int i = 0; i < 6; i++)
-        a->info.geotransform[i] = getf64(b + 56 + 8 * i);
-    a->info.dictionary_tiles = ntiles;
-    a->info.index_bytes = (int)ib;
-    a->info.dictionary_bytes = dn;
-    a->info.index_bytes_total = in;
-    a->info.file_bytes = n;
-    a->tx = (int)((W + TS_ATLAS_TILE - 1) / TS_ATLAS_TILE);
-    a->ty = (int)((H + TS_ATLAS_TILE - 1) / TS_ATLAS_TILE);
-    a->tiles = (size_t)a->tx * a->ty;
-    size_t planes = steps + (a->info.has_nodata ? 1 : 0);
-    if (a->tiles > SIZE_MAX / 4 / planes)
-        BAD("the atlas is too large for this machine");
-    size_t idx_raw = planes * a->tiles * ib;
-    a->text = malloc(tn + 1);
-    a->steps = malloc(steps * sizeof *a->steps);
-    a->dict = malloc((size_t)ntiles * sizeof *a->dict);
-    a->index = malloc(idx_raw);
-    uint8_t *dict_raw = malloc((size_t)ntiles * 8);
-    if (!a->text || !a->steps || !a->dict || !a->index || !dict_raw) {
-        free(dict_raw);
-        st = ts_fail(err, TS_ERR_NOMEM, "cannot allocate %zu bytes for the atlas's index "
-                     "maps", idx_raw);
-        goto fail;
-    }
-    memcpy(a->text, b + to, tn);
-    a->text[tn] = '\0';
-    if (memchr(a->text, '\0', tn)) {
-        free(dict_raw);
-        BAD("the atlas's metadata text is damaged (it holds a NUL byte)");
-    }
-    a->info.metadata = a->text;
-    for (uint32_t s = 0; s < steps; s++) {
-        const uint8_t *r = b + so + (size_t)s * TS_ATLAS_STEP_SIZE;
-        a->steps[s].unix_time = getf64(r);
-        a->steps[s].azimuth = getf64(r + 8);
-        a->steps[s].grid_azimuth = getf64(r + 16);
-        a->steps[s].elevation = getf64(r + 24);
-        a->steps[s].utc_offset_minutes = (int32_t)get32(r + 32);
-    }
-    st = xz_decompress(b + dof, dn, dict_raw, (size_t)ntiles * 8, "tile dictionary words", err);
-    if (st == TS_OK)
-        for (uint32_t i = 0; i < ntiles; i++)
-            a->dict[i] = get64(dict_raw + 8 * (size_t)i);
-    free(dict_raw);
-    if (st != TS_OK)
-        goto fail;
-    if ((st = xz_decompress(b + io, in, a->index, idx_raw, "index maps", err)) != TS_OK)
-        goto fail;
-    for (size_t p = 0; p < planes; p++)
-        for (size_t t = 0; t < a->tiles; t++)
-            if (index_at(a, p, t) >= ntiles)
-                BAD("the atlas's index maps are damaged: tile %zu of map %zu points past "
-                    "the %u-tile dictionary", t, p, ntiles);
-    *out = a;
-    return ts_ok(err);
-fail:
-    ts_atlas_free(a);
-    return st;
-}
-#undef BAD
-
-const ts_atlas_info *ts_atlas_get_info(const ts_atlas *a)
-{
-    return a ? &a->info : NULL;
-}
-
-const ts_atlas_step *ts_atlas_get_step(const ts_atlas *a, int step)
-{
-    return a && step >= 0 && step < a->info.steps ? &a->steps[step] : NULL;
-}
-
-ts_status ts_atlas_read(const ts_atlas *a, int step, int x0, int y0, int w, int h,
-                        uint8_t *out, ptrdiff_t stride, ts_error *err)
-{
-    if (!a || !out)
-        return ts_fail(err, TS_ERR_ARG, "ts_atlas_read: NULL argument");
-    if (step < 0 || step >= a->info.steps)
-        return ts_fail(err, TS_ERR_ARG, "the atlas has maps 1 to %d, not %d",
-                       a->info.steps, step + 1);
-    if (w < 0 || h < 0 || x0 < 0 || y0 < 0 || x0 > a->info.width - w ||
-        y0 > a->info.height - h || stride < w)
-        return ts_fail(err, TS_ERR_ARG, "window %d,%d %dx%d lies outside the %d x %d atlas",
-                       x0, y0, w, h, a->info.width, a->info.height);
-    size_t plane = (size_t)step + (a->info.has_nodata ? 1 : 0);
-    for (int y = y0; y < y0 + h; y++) {
-        uint8_t *row = out + (ptrdiff_t)(y - y0) * stride;
-        int ty = y / TS_ATLAS_TILE, r = y % TS_ATLAS_TILE;
-        int x = x0;
-        while (x < x0 + w) {
-            int tx = x / TS_ATLAS_TILE;
-            size_t t = (size_t)ty * a->tx + tx;
-            unsigned bits = (unsigned)(a->dict[index_at(a, plane, t)] >> (8 * r)) & 0xffu;
-            unsigned nd = a->info.has_nodata
-                              ? (unsigned)(a->dict[index_at(a, 0, t)] >> (8 * r)) & 0xffu
-                              : 0u;
-            int end = (tx + 1) * TS_ATLAS_TILE;
-            if (end > x0 + w)
-                end = x0 + w;
-            for (; x < end; x++) {
-                int c = x % TS_ATLAS_TILE;
-                row[x - x0] = (nd >> c) & 1u ? TS_ATLAS_NODATA : (uint8_t)((bits >> c) & 1u);
-            }
-        }
-    }
-    return ts_ok(err);
 }

@@ -31,9 +31,10 @@ extern "C" {
 #define TS_ATLAS_NODATA 255
 /** Side of the tiles of the dictionary. */
 #define TS_ATLAS_TILE 8
-/** Version of the file format written. */
-#define TS_ATLAS_VERSION 1
-/** Size of the fixed header of version 1, bytes. */
+/** Version of the file format written and read (2: the step table and
+ * the metadata text under a CRC-32; version 1 files are refused). */
+#define TS_ATLAS_VERSION 2
+/** Size of the fixed header (versions 1 and 2), bytes. */
 #define TS_ATLAS_HEADER_SIZE 168
 /** Size of one step record, bytes. */
 #define TS_ATLAS_STEP_SIZE 40
@@ -113,6 +114,17 @@ ts_status ts_atlas_writer_finish(ts_atlas_writer *w, const ts_atlas_info *info,
 
 void ts_atlas_writer_free(ts_atlas_writer *w);
 
+/**
+ * Check a step table of n maps: each time NaN (none) or an instant between
+ * the years -2000 and 6000, every map with a time or none, times
+ * increasing and within one day (less than 24 h from the first to the
+ * last), azimuths NaN or 0..360, elevations NaN or -90..90, UTC offsets
+ * within +/-23:59. `what` begins the message ("the atlas's step table is
+ * invalid"). The writer and the reader both apply it.
+ */
+ts_status ts_atlas_check_steps(const ts_atlas_step *steps, int n, const char *what,
+                               ts_error *err);
+
 /** 1 if the first n bytes start like an atlas file (the magic). */
 int ts_atlas_identify(const uint8_t *head, size_t n);
 
@@ -120,9 +132,11 @@ typedef struct ts_atlas ts_atlas;
 
 /**
  * Read an atlas file from memory (the bytes are copied where needed; the
- * caller may free them afterwards). Checks the magic, version, header
- * CRC, sizes and every index; a damaged or truncated file is an error
- * that says what is wrong.
+ * caller may free them afterwards). Checks the magic, version (1 is
+ * refused: recreate the atlas), the header's CRC, the CRC of the step table
+ * and metadata text, the steps (ts_atlas_check_steps), sizes and every
+ * index; a damaged, truncated or forged file is an error that says what is
+ * wrong.
  */
 ts_status ts_atlas_open(const uint8_t *bytes, size_t size, ts_atlas **out,
                         ts_error *err);

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 
 #include "arg_checks.h"
+#include "cellmath/cm_shm.h"
 #include "line_geometry.h"
 #include "parallel.h"
 #include "status_internal.h"
@@ -34,28 +35,20 @@ typedef struct {
     ptrdiff_t o_origin, o_u_stride, o_v_stride;
 } shm_ctx;
 
-/* S of one cell from its height and the previous u-row. */
+/* S of one cell from its height and the previous u-row, where the
+ * interpolation may reach past the grid's edge. */
 static inline float shm_cell(const float *prev, int v, int V, int off, float F, float h,
                              float drop, int first)
 {
-    float p = NAN;
+    float pa = NAN, pb = NAN;
     int a = v + off, b = a + 1;
     /* Off the grid toward the light there is nothing to cast a shadow. */
     int off_grid = a < 0 || a >= V || (F > 0.0f && (b < 0 || b >= V));
     if (!first && !off_grid) {
-        float pa = prev[a];
-        float pb = F > 0.0f ? prev[b] : NAN;
-        if (F == 0.0f || isnan(pb))
-            p = pa;
-        else if (isnan(pa))
-            p = pb;
-        else
-            p = pa + F * (pb - pa);
-        p -= drop;
+        pa = prev[a];
+        pb = F > 0.0f ? prev[b] : NAN;
     }
-    if (isnan(h))
-        return p;              /* nodata is no occluder: the shadow passes */
-    return (isnan(p) || h >= p) ? h : p;
+    return cm_shm_step(pa, pb, F, drop, h);
 }
 
 static void wait_for(atomic_long *p, long step)
@@ -86,25 +79,12 @@ static void shm_row(const float *restrict prev, float *restrict cur, const float
     for (int v = hi; v < v1; v++)
         cur[v] = shm_cell(prev, v, V, off, F, h[v], dropv ? dropv[v] : drop, first);
     const float *restrict pa_ = prev + off, *restrict pb_ = prev + off + 1;
-    for (int v = lo; v < hi; v++) {
-        float pa = pa_[v], pb = F > 0.0f ? pb_[v] : pa;
-        float a = pa != pa ? pb : pa, b = pb != pb ? pa : pb;
-        float p = a + F * (b - a) - (dropv ? dropv[v] : drop);
-        float hv = h[v];
-        float s = (hv >= p) | (p != p) ? hv : p;
-        cur[v] = hv != hv ? p : s;
-    }
+    for (int v = lo; v < hi; v++)
+        cur[v] = cm_shm_step(pa_[v], F > 0.0f ? pb_[v] : pa_[v], F,
+                             dropv ? dropv[v] : drop, h[v]);
     for (int v = v0; v < v1; v++) {
-        float hv = h[v], under = cur[v] - hv;
-        float lit;
-        if (depth <= 0.0f) {
-            lit = under > 0.0f ? 0.0f : 1.0f;
-        } else {
-            float q = under / depth;
-            lit = 1.0f - (q < 0.0f ? 0.0f : q > 1.0f ? 1.0f : q);
-        }
         if (vis)
-            vis[v] = hv != hv ? NAN : lit;
+            vis[v] = cm_shm_lit(cur[v], h[v], depth);
         if (sh)
             sh[v] = cur[v];
     }
@@ -224,13 +204,10 @@ ts_status ts_shm_compute(const ts_grid *grid, double azimuth, double elevation,
                          double penumbra_depth, int threads, float *vis,
                          float *shadow_height, ts_error *err)
 {
-    ts_status st = ts_check_shm_args(grid, azimuth, elevation, penumbra_depth, threads, vis,
+    ts_status st = ts_check_shm_args(grid, &azimuth, elevation, penumbra_depth, threads, vis,
                                      shadow_height, err);
     if (st != TS_OK)
         return st;
-    azimuth = fmod(azimuth, 360.0);
-    if (azimuth < 0)
-        azimuth += 360.0;
     ts_line_geom G;
     if ((st = ts_line_geom_init(&G, grid, azimuth, err)) != TS_OK)
         return st;

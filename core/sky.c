@@ -8,7 +8,8 @@
 #include <math.h>
 #include <string.h>
 
-#include "fastmath.h"
+#include "arg_checks.h"
+#include "cellmath/cm_sky.h"
 #include "parallel.h"
 #include "status_internal.h"
 
@@ -22,32 +23,8 @@ typedef struct {
     float *svf, *sky, *open;
 } sky_ctx;
 
-/* One swath's share of eq. 5 for zenith limit theta. */
-static inline float swath(float nz, float a, float theta, float w1, float w2)
-{
-    float s, c;
-    ts_sincos_0_pi(theta, &s, &c);
-    return w1 * nz * s * s + w2 * (theta - s * c) * a;
-}
-
-/* Zenith limit of one swath at a cell: the horizon's zenith angle, raised
- * to at most pi/2 (the horizontal) for sky light, and never below the
- * tangent plane. Branch-free, so that the loops vectorise. */
-static inline float swath_theta(float nx, float ny, float nz, float h, float sa, float ca,
-                                int sky_only, float *a_out)
-{
-    const float half_pi = (float)(M_PI / 2), d2r = (float)DEG2RAD;
-    float a = nx * sa + ny * ca;
-    float theta_n = half_pi + ts_atanf(a / nz);
-    float theta_h = half_pi - h * d2r;
-    if (sky_only)
-        theta_h = theta_h < half_pi ? theta_h : half_pi;
-    *a_out = a;
-    return theta_h < theta_n ? theta_h : theta_n;
-}
-
-/* One loop per term, each vectorised; NaN (nodata) is carried explicitly
- * because the comparisons drop it. */
+/* One loop per term, each vectorised (cm_sky.h carries NaN explicitly,
+ * because the comparisons drop it). */
 static void sky_rows(void *ctx, int worker, long y0, long y1)
 {
     (void)worker;
@@ -61,30 +38,14 @@ static void sky_rows(void *ctx, int worker, long y0, long y1)
         float *restrict out = acc[term];
         if (!out)
             continue;
-        for (size_t i = i0; i < i1; i++) {
-            float a, h = plane[i], z = nz[i];
-            float th = swath_theta(nx[i], ny[i], z, h, sa, ca, term == 1, &a);
-            out[i] += swath(z, a, th, w1, w2) + (h - h) + (z - z);
-        }
+        for (size_t i = i0; i < i1; i++)
+            out[i] += cm_sky_term(nx[i], ny[i], nz[i], plane[i], sa, ca, w1, w2, term == 1);
     }
     if (C->open) {
         float *restrict open = C->open;
         for (size_t i = i0; i < i1; i++)
-            open[i] += 90.0f - plane[i] + (nz[i] - nz[i]);
+            open[i] += cm_openness_term(plane[i], nz[i]);
     }
-}
-
-static ts_status check_common(const ts_grid *grid, const float *nx, const float *ny,
-                              const float *nz, int directions, ts_error *err)
-{
-    ts_status st = ts_grid_validate(grid, err);
-    if (st != TS_OK)
-        return st;
-    if (!nx || !ny || !nz)
-        return ts_fail(err, TS_ERR_ARG, "normals must not be NULL");
-    if (directions < 1)
-        return ts_fail(err, TS_ERR_ARG, "directions must be at least 1, got %d", directions);
-    return TS_OK;
 }
 
 ts_status ts_sky_accumulate(const ts_grid *grid, const float *nx, const float *ny,
@@ -92,7 +53,7 @@ ts_status ts_sky_accumulate(const ts_grid *grid, const float *nx, const float *n
                             int directions, float *svf_acc, float *sky_acc,
                             float *openness_acc, ts_error *err)
 {
-    ts_status st = check_common(grid, nx, ny, nz, directions, err);
+    ts_status st = ts_check_sky_args(grid, nx, ny, nz, directions, err);
     if (st != TS_OK)
         return st;
     if (!plane)
@@ -118,10 +79,10 @@ ts_status ts_sky_finish(const ts_grid *grid, int directions, float *svf_acc, flo
     size_t n = (size_t)grid->width * grid->height;
     /* Discretisation can overshoot 1 by ~1e-4 on steep open slopes. */
     for (size_t i = 0; i < n; i++) {
-        if (svf_acc && svf_acc[i] > 1.0f)
-            svf_acc[i] = 1.0f;
-        if (sky_acc && sky_acc[i] > 1.0f)
-            sky_acc[i] = 1.0f;
+        if (svf_acc)
+            svf_acc[i] = cm_sky_clamp(svf_acc[i]);
+        if (sky_acc)
+            sky_acc[i] = cm_sky_clamp(sky_acc[i]);
         if (openness_acc)
             openness_acc[i] /= (float)directions;
     }
@@ -132,13 +93,9 @@ ts_status ts_sky_terms(const ts_grid *grid, const float *nx, const float *ny, co
                        const float *horizons, const ts_horizon_opts *opts, float *svf,
                        float *sky, float *openness, ts_error *err)
 {
-    ts_status st = ts_horizon_opts_validate(opts, err);
+    ts_status st = ts_check_sky_terms_args(grid, nx, ny, nz, horizons, opts, err);
     if (st != TS_OK)
         return st;
-    if ((st = check_common(grid, nx, ny, nz, opts->directions, err)) != TS_OK)
-        return st;
-    if (!horizons)
-        return ts_fail(err, TS_ERR_ARG, "horizons must not be NULL");
     size_t n = (size_t)grid->width * grid->height;
     float *acc[3] = {svf, sky, openness};
     for (int j = 0; j < 3; j++)

@@ -572,6 +572,17 @@ ts_status ts_sun_position_detail(const ts_sun_input *in, ts_sun_output *out,
     if (!isfinite(d.delta_e)) /* e0 = -5.11 exactly, reachable with a large atmos_refraction */
         d.delta_e = 0.0;
     d.e = d.e0 + d.delta_e;                        /* eq. 43 */
+    /* eq. 42 holds for the air at the Earth's surface; far outside it (a
+     * temperature near -273 C, a large atmos_refraction) its tangent can
+     * blow up: no sun leaves [-90, 90] */
+    if (!(d.e >= -90.0 && d.e <= 90.0))
+        return ts_fail(err, TS_ERR_ARG,
+                       "The refracted sun elevation would be %g degrees, outside -90 "
+                       "to 90: the refraction model does not hold for pressure %g hPa, "
+                       "temperature %g degrees Celsius and atmos_refraction %g (it "
+                       "holds for the air at the Earth's surface, about 300 to 1100 "
+                       "hPa and -90 to 60 degrees Celsius).",
+                       d.e, in->pressure, in->temperature, in->atmos_refraction);
     d.zenith = 90.0 - d.e;                         /* eq. 44 */
 
     /* 3.15 Topocentric azimuth. */

@@ -1,6 +1,8 @@
 /* TERRASHADE connection strings: inline options and the DEM's name. */
 #include "tsd_connstr.h"
 
+#include "tsd_text.h"
+
 #include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -53,29 +55,21 @@ static char *dup_range(const char *s, size_t len)
     return d;
 }
 
-static int fail(char *msg, size_t n, const char *text, const char *arg)
-{
-    if (msg && n)
-        snprintf(msg, n, text, arg);
-    return -1;
-}
-
-int tsd_connstr_parse(const char *name, tsd_connstr *out, char *msg,
-                      size_t msg_size)
+ts_status tsd_connstr_parse(const char *name, tsd_connstr *out, char *msg,
+                            size_t msg_size)
 {
     out->options = NULL;
     out->dem = NULL;
     if (!tsd_connstr_matches(name))
-        return fail(msg, msg_size, "'%s' does not start with " TSD_PREFIX,
-                    name ? name : "");
+        return tsd_fail(msg, msg_size, TS_ERR_ARG, "'%s' does not start with " TSD_PREFIX,
+                        name ? name : "");
     const char *rest = name + strlen(TSD_PREFIX);
     const char *colon = strchr(rest, ':');
     size_t seg_len = colon ? (size_t)(colon - rest) : strlen(rest);
     int n_items = 0;
     if (is_option_segment(rest, seg_len)) {
         if (!colon)
-            return fail(msg, msg_size,
-                        "'%s' names no DEM: write TERRASHADE:KEY=VALUE,...:<dem> "
+            return tsd_fail(msg, msg_size, TS_ERR_ARG, "'%s' names no DEM: write TERRASHADE:KEY=VALUE,...:<dem> "
                         "(quote a DEM name that contains '=' before any ':')",
                         name);
         n_items = 1;
@@ -87,7 +81,7 @@ int tsd_connstr_parse(const char *name, tsd_connstr *out, char *msg,
     }
     out->options = calloc((size_t)n_items + 1, sizeof *out->options);
     if (!out->options)
-        return fail(msg, msg_size, "%s", "out of memory");
+        return tsd_fail(msg, msg_size, TS_ERR_NOMEM, "out of memory");
     const char *p = rest;
     for (int k = 0; k < n_items; k++) {
         const char *end = memchr(p, ',', (size_t)(rest + seg_len - p));
@@ -95,7 +89,7 @@ int tsd_connstr_parse(const char *name, tsd_connstr *out, char *msg,
             end = rest + seg_len;
         out->options[k] = dup_range(p, (size_t)(end - p));
         if (!out->options[k])
-            return fail(msg, msg_size, "%s", "out of memory");
+            return tsd_fail(msg, msg_size, TS_ERR_NOMEM, "out of memory");
         p = end + 1;
     }
     const char *dem = colon ? colon + 1 : rest;
@@ -105,13 +99,12 @@ int tsd_connstr_parse(const char *name, tsd_connstr *out, char *msg,
         dem_len -= 2;
     }
     if (dem_len == 0)
-        return fail(msg, msg_size,
-                    "'%s' names no DEM: write TERRASHADE:<dem> or "
+        return tsd_fail(msg, msg_size, TS_ERR_ARG, "'%s' names no DEM: write TERRASHADE:<dem> or "
                     "TERRASHADE:KEY=VALUE,...:<dem>", name);
     out->dem = dup_range(dem, dem_len);
     if (!out->dem)
-        return fail(msg, msg_size, "%s", "out of memory");
-    return 0;
+        return tsd_fail(msg, msg_size, TS_ERR_NOMEM, "out of memory");
+    return TS_OK;
 }
 
 void tsd_connstr_free(tsd_connstr *c)

@@ -18,6 +18,8 @@
 
 #include <stddef.h>
 
+#include "terrashade.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -32,9 +34,9 @@ typedef struct {
 /** 1 if name starts with TERRASHADE: (case-insensitive). Cheap, silent. */
 int tsd_connstr_matches(const char *name);
 
-/** Parse; 0 on success, -1 with a sentence in msg. Free with
+/** Parse; TS_OK, or the failure's status with a sentence in msg. Free with
  * tsd_connstr_free (also after a failure). */
-int tsd_connstr_parse(const char *name, tsd_connstr *out, char *msg,
+ts_status tsd_connstr_parse(const char *name, tsd_connstr *out, char *msg,
                       size_t msg_size);
 
 void tsd_connstr_free(tsd_connstr *c);

@@ -1,10 +1,13 @@
 /* Read a DEM band into a core grid. */
 #include "tsd_dem.h"
 
+#include "tsd_text.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "cpl_error.h"
 
@@ -34,28 +37,74 @@ static void flip(ts_grid *g, int flip_x, int flip_y)
         }
 }
 
-static int gdal_fail(char *msg, size_t n, const char *what)
+/* 1 if the band's validity read at w x h cells is in its values: a nodata
+ * band resampled, where GDAL's average leaves the nodata value in a coarse
+ * cell none of whose cells is valid (averaging its mask band instead would
+ * round a cell with few valid cells to 0 at deep levels). */
+static int nodata_in_values(GDALRasterBandH band, int w, int h)
 {
-    const char *last = CPLGetLastErrorMsg();
-    snprintf(msg, n, "%s%s%s", what, last && *last ? ": " : "",
-             last ? last : "");
-    return -1;
+    return (GDALGetRasterBandXSize(band) != w || GDALGetRasterBandYSize(band) != h) &&
+           GDALGetMaskFlags(band) == GMF_NODATA;
 }
 
-int tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
-                 ts_grid *grid, char *msg, size_t n)
+/* Rows y0 .. y0 + rows - 1 of the band read at w x h cells: as they are at
+ * the band's own size, else averaged over each coarse cell's footprint
+ * (GDAL's average resampling, over the valid cells only) through a
+ * fractional source window, as a VRT made by gdal_translate -outsize reads
+ * it. */
+static CPLErr read_rows(GDALRasterBandH band, int y0, int rows, int w, int h, void *buf,
+                        size_t stride, GDALDataType type)
+{
+    const int sw = GDALGetRasterBandXSize(band), sh = GDALGetRasterBandYSize(band);
+    const int line = (int)(stride * GDALGetDataTypeSizeBytes(type));
+    if (sw == w && sh == h)
+        return GDALRasterIO(band, GF_Read, 0, y0, w, rows, buf, w, rows, type, 0, line);
+    GDALRasterIOExtraArg extra;
+    INIT_RASTERIO_EXTRA_ARG(extra);
+    extra.eResampleAlg = GRIORA_Average;
+    extra.bFloatingPointWindowValidity = TRUE;
+    const double fy = (double)sh / h;
+    extra.dfXOff = 0;
+    extra.dfXSize = sw;
+    extra.dfYOff = y0 * fy;
+    extra.dfYSize = rows * fy;
+    int yoff = (int)extra.dfYOff;
+    int yend = (int)ceil(extra.dfYOff + extra.dfYSize - 1e-10);
+    if (yend > sh)
+        yend = sh;
+    if (GDALRasterIOEx(band, GF_Read, 0, yoff, sw, yend - yoff, buf, w, rows, type, 0,
+                       line, &extra) != CE_None)
+        return CE_Failure;
+    int has_nodata = 0;
+    const float nodata = (float)GDALGetRasterNoDataValue(band, &has_nodata);
+    if (type == GDT_Float32 && has_nodata && nodata_in_values(band, w, h))
+        for (int y = 0; y < rows; y++) {
+            float *r = (float *)buf + (size_t)y * stride;
+            for (int x = 0; x < w; x++)
+                if (r[x] == nodata)
+                    r[x] = NAN;
+        }
+    return CE_None;
+}
+
+ts_status tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
+                       ts_grid *grid, char *msg, size_t n)
+{
+    return tsd_dem_load_resampled(band, cells, z_factor, GDALGetRasterBandXSize(band),
+                                  GDALGetRasterBandYSize(band), grid, msg, n);
+}
+
+ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
+                                 double z_factor, int w, int h, ts_grid *grid, char *msg,
+                                 size_t n)
 {
     ts_error err;
-    int w = GDALGetRasterBandXSize(band), h = GDALGetRasterBandYSize(band);
-    if (ts_grid_create(grid, w, h, cells->cell_x, cells->cell_y, &err) != TS_OK) {
-        snprintf(msg, n, "%s", err.message);
-        return -1;
-    }
+    if (ts_grid_create(grid, w, h, cells->cell_x, cells->cell_y, &err) != TS_OK)
+        return tsd_fail_core(msg, n, NULL, &err);
     if (cells->cell_x_row &&
         ts_grid_set_row_spacing(grid, cells->cell_x_row, &err) != TS_OK) {
-        snprintf(msg, n, "%s", err.message);
         ts_grid_free(grid);
-        return -1;
+        return tsd_fail_core(msg, n, NULL, &err);
     }
     int has_scale = 0, has_offset = 0;
     double scale = GDALGetRasterScale(band, &has_scale);
@@ -64,27 +113,33 @@ int tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
         scale = 1;
     if (!has_offset)
         offset = 0;
+    if (isnan(z_factor))
+        z_factor = tsd_dem_z_factor(band, z_factor, NULL, 0);
     scale *= z_factor;
     offset *= z_factor;
 
-    int all_valid = GDALGetMaskFlags(band) == GMF_ALL_VALID;
+    int all_valid = GDALGetMaskFlags(band) == GMF_ALL_VALID || nodata_in_values(band, w, h);
     GDALRasterBandH mask = all_valid ? NULL : GDALGetMaskBand(band);
     unsigned char *m = NULL;
-    if (mask && !(m = malloc((size_t)w * STRIP_ROWS))) {
-        snprintf(msg, n, "out of memory reading the DEM's mask");
+    /* resampled: one request for the whole grid, as gdal_translate -outsize
+     * makes for a level of this size (where a request's edge falls changes
+     * GDAL's average next to nodata) */
+    const int strip =
+        w == GDALGetRasterBandXSize(band) && h == GDALGetRasterBandYSize(band) ? STRIP_ROWS : h;
+    if (mask && !(m = malloc((size_t)w * strip))) {
         ts_grid_free(grid);
-        return -1;
+        return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory reading the DEM's mask");
     }
-    for (int y0 = 0; y0 < h; y0 += STRIP_ROWS) {
-        int rows = h - y0 < STRIP_ROWS ? h - y0 : STRIP_ROWS;
+    for (int y0 = 0; y0 < h; y0 += strip) {
+        int rows = h - y0 < strip ? h - y0 : strip;
         float *z = grid->z + (ptrdiff_t)y0 * grid->stride;
-        if (GDALRasterIO(band, GF_Read, 0, y0, w, rows, z, w, rows, GDT_Float32,
-                         0, (int)(grid->stride * sizeof(float))) != CE_None ||
-            (mask && GDALRasterIO(mask, GF_Read, 0, y0, w, rows, m, w, rows,
-                                  GDT_Byte, 0, w) != CE_None)) {
+        if (read_rows(band, y0, rows, w, h, z, grid->stride, GDT_Float32) != CE_None ||
+            (mask && read_rows(mask, y0, rows, w, h, m, w, GDT_Byte) != CE_None)) {
+            const char *last = CPLGetLastErrorMsg();
             free(m);
             ts_grid_free(grid);
-            return gdal_fail(msg, n, "cannot read the DEM");
+            return tsd_fail(msg, n, TS_ERR_INTERNAL, "cannot read the DEM%s%s",
+                            last && *last ? ": " : "", last ? last : "");
         }
         for (int y = 0; y < rows; y++) {
             float *r = z + (ptrdiff_t)y * grid->stride;
@@ -97,5 +152,62 @@ int tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
     }
     free(m);
     flip(grid, cells->flip_x, cells->flip_y);
-    return 0;
+    return TS_OK;
+}
+
+/* Metres per unit of a unit's name (GDAL's band unit types, PROJ's and
+ * GeoTIFF's names), or 0 if not known. */
+static double metres_per_unit(const char *unit)
+{
+    static const struct {
+        const char *name;
+        double metres;
+    } units[] = {
+        {"m", 1.0}, {"metre", 1.0}, {"meter", 1.0}, {"metres", 1.0}, {"meters", 1.0},
+        {"ft", 0.3048}, {"foot", 0.3048}, {"feet", 0.3048}, {"international foot", 0.3048},
+        {"US survey foot", 1200.0 / 3937.0}, {"US survey feet", 1200.0 / 3937.0},
+        {"ftUS", 1200.0 / 3937.0}, {"us-ft", 1200.0 / 3937.0},
+        {"foot_us", 1200.0 / 3937.0}, {"Foot_US", 1200.0 / 3937.0},
+    };
+    for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
+        if (strcasecmp(unit, units[i].name) == 0)
+            return units[i].metres;
+    return 0.0;
+}
+
+double tsd_dem_z_factor(GDALRasterBandH band, double requested, char *why, size_t n)
+{
+    char scratch[8];
+    if (!why) {
+        why = scratch;
+        n = sizeof scratch;
+    }
+    if (!isnan(requested)) {
+        snprintf(why, n, "given as Z_FACTOR");
+        return requested;
+    }
+    /* the vertical CRS of a compound (or vertical) CRS: its axis unit */
+    GDALDatasetH ds = GDALGetBandDataset(band);
+    OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
+    if (srs && (OSRIsCompound(srs) || OSRIsVertical(srs))) {
+        char *name = NULL;
+        double metres = OSRGetTargetLinearUnits(srs, "VERT_CS", &name);
+        if (metres > 0 && isfinite(metres)) {
+            snprintf(why, n, "vertical unit %s, from the CRS", name ? name : "?");
+            return metres;
+        }
+    }
+    const char *unit = GDALGetRasterUnitType(band);
+    if (unit && unit[0]) {
+        double metres = metres_per_unit(unit);
+        if (metres > 0) {
+            snprintf(why, n, "band unit %s", unit);
+            return metres;
+        }
+        snprintf(why, n, "band unit '%s' not a length terrashade knows: heights taken "
+                         "as metres", unit);
+        return 1.0;
+    }
+    snprintf(why, n, "no vertical unit in the CRS or the band: heights taken as metres");
+    return 1.0;
 }

@@ -9,6 +9,7 @@
 #include <stddef.h>
 
 #include "gdal.h"
+#include "ogr_srs_api.h"
 #include "terrashade.h"
 #include "tsd_geodesy.h"
 
@@ -16,10 +17,31 @@
 extern "C" {
 #endif
 
-/** Fill `grid` (created here; free with ts_grid_free) from `band`.
- * 0 on success; -1 with a sentence in msg. */
-int tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
-                 ts_grid *grid, char *msg, size_t msg_size);
+/** Fill `grid` (created here; free with ts_grid_free) from `band`, its
+ * heights times z_factor (NAN: AUTO, as tsd_dem_z_factor decides).
+ * TS_OK, or the failure's status with a sentence in msg. */
+ts_status tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
+                       ts_grid *grid, char *msg, size_t msg_size);
+
+/** The same at w x h cells (an overview level): each coarse cell is the
+ * average of the valid cells under it (GDAL's average resampling through
+ * RasterIO, which uses the band's own overviews where it has them); a
+ * coarse cell none of whose cells is valid is NaN. `cells` are those of
+ * the w x h grid. At the band's own size, tsd_dem_load. */
+ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
+                                 double z_factor, int w, int h, ts_grid *grid, char *msg,
+                                 size_t msg_size);
+
+/**
+ * The Z_FACTOR that turns `band`'s heights (after its scale and offset)
+ * into metres. A finite `requested` is the user's number and is kept; NAN
+ * (AUTO) takes the vertical unit of the dataset's CRS (a compound or
+ * vertical CRS), else the band's unit type ("m", "metre", "ft", "foot",
+ * "US survey foot", "ftUS"...), else 1 (no information: metres). Writes
+ * why to `why` ("vertical unit US survey foot, from the CRS") and returns
+ * the factor.
+ */
+double tsd_dem_z_factor(GDALRasterBandH band, double requested, char *why, size_t why_size);
 
 #ifdef __cplusplus
 }

@@ -1,47 +1,34 @@
 /* Cell sizes in metres from a geotransform and a CRS. */
 #include "tsd_geodesy.h"
 
+#include "tsd_text.h"
+
 #include <geodesic.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 3, 4)))
-#endif
-static int fail(char *msg, size_t n, const char *fmt, ...)
-{
-    if (msg && n) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(msg, n, fmt, ap);
-        va_end(ap);
-    }
-    return -1;
-}
-
 /* Geodesic cell sizes of a geographic DEM; gt in degrees. */
-static int geographic(const double gt[6], int width, int height, double a,
+static ts_status geographic(const double gt[6], int width, int height, double a,
                       double invf, tsd_cells *c, char *msg, size_t n)
 {
     struct geod_geodesic g;
     double top = gt[3], bottom = gt[3] + height * gt[5];
     double dlon = fabs(gt[1]);
     if (fabs(top) > 90 + 1e-9 || fabs(bottom) > 90 + 1e-9)
-        return fail(msg, n,
+        return tsd_fail(msg, n, TS_ERR_ARG,
                     "the DEM reaches beyond the poles (latitudes %g to %g); its "
                     "geotransform is not in degrees of a geographic CRS",
                     bottom, top);
     if (width * dlon > 360 + 1e-9)
-        return fail(msg, n,
+        return tsd_fail(msg, n, TS_ERR_ARG,
                     "the DEM spans %g degrees of longitude (cell %g degrees), "
                     "more than the whole Earth", width * dlon, dlon);
     geod_init(&g, a, invf != 0 ? 1.0 / invf : 0.0);
     c->cell_x_row = malloc((size_t)height * sizeof *c->cell_x_row);
     if (!c->cell_x_row)
-        return fail(msg, n, "out of memory for %d rows", height);
+        return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory for %d rows", height);
     double lon0 = gt[0] + 0.5 * width * gt[1];
     for (int y = 0; y < height; y++) {
         double lat = gt[3] + (y + 0.5) * gt[5];
@@ -57,29 +44,29 @@ static int geographic(const double gt[6], int width, int height, double a,
     c->cell_y = ns / height;
     c->cell_x = c->cell_x_row[height / 2];
     if (!(c->cell_y > 0))
-        return fail(msg, n, "cannot compute the north-south cell size "
+        return tsd_fail(msg, n, TS_ERR_ARG, "cannot compute the north-south cell size "
                     "(latitudes %g to %g)", bottom, top);
-    return 0;
+    return TS_OK;
 }
 
-int tsd_cells_compute(const double gt[6], int width, int height,
+ts_status tsd_cells_compute(const double gt[6], int width, int height,
                       OGRSpatialReferenceH srs, tsd_cells *c, char *msg,
                       size_t n)
 {
     memset(c, 0, sizeof *c);
     if (width < 1 || height < 1)
-        return fail(msg, n, "the DEM has no cells (%d x %d)", width, height);
+        return tsd_fail(msg, n, TS_ERR_ARG, "the DEM has no cells (%d x %d)", width, height);
     for (int i = 0; i < 6; i++)
         if (!isfinite(gt[i]))
-            return fail(msg, n, "the DEM's geotransform is not finite");
+            return tsd_fail(msg, n, TS_ERR_ARG, "the DEM's geotransform is not finite");
     double scale = fmax(fabs(gt[1]), fabs(gt[5]));
     if (fabs(gt[2]) > 1e-9 * scale || fabs(gt[4]) > 1e-9 * scale)
-        return fail(msg, n,
+        return tsd_fail(msg, n, TS_ERR_ARG,
                     "the DEM's geotransform is rotated or sheared (GT[2] = %g, "
                     "GT[4] = %g); terrashade needs a north-up grid: warp it first, "
                     "e.g. gdalwarp dem.tif north_up.tif", gt[2], gt[4]);
     if (gt[1] == 0 || gt[5] == 0)
-        return fail(msg, n,
+        return tsd_fail(msg, n, TS_ERR_ARG,
                     "the DEM's pixel size is zero (GT[1] = %g, GT[5] = %g)",
                     gt[1], gt[5]);
     c->flip_x = gt[1] < 0;
@@ -91,7 +78,7 @@ int tsd_cells_compute(const double gt[6], int width, int height,
         double invf = OSRGetInvFlattening(srs, &e2);
         double rad = OSRGetAngularUnits(srs, NULL); /* radians per unit */
         if (e1 != OGRERR_NONE || e2 != OGRERR_NONE || !(a > 0) || !(rad > 0))
-            return fail(msg, n, "cannot read the ellipsoid of the DEM's "
+            return tsd_fail(msg, n, TS_ERR_ARG, "cannot read the ellipsoid of the DEM's "
                         "geographic CRS (a = %g, 1/f = %g)", a, invf);
         double deg = rad * 180.0 / M_PI, g[6];
         for (int i = 0; i < 6; i++)
@@ -108,10 +95,10 @@ int tsd_cells_compute(const double gt[6], int width, int height,
         c->kind = TSD_CRS_PROJECTED;
         c->unit_to_m = OSRGetLinearUnits(srs, NULL);
         if (!(c->unit_to_m > 0))
-            return fail(msg, n, "the DEM's CRS has an invalid linear unit "
+            return tsd_fail(msg, n, TS_ERR_ARG, "the DEM's CRS has an invalid linear unit "
                         "(%g metres)", c->unit_to_m);
     } else if (srs && OSRIsGeocentric(srs)) {
-        return fail(msg, n, "the DEM's CRS is neither projected nor geographic "
+        return tsd_fail(msg, n, TS_ERR_ARG, "the DEM's CRS is neither projected nor geographic "
                     "(it is geocentric); warp it to a projected CRS first");
     } else {
         c->kind = TSD_CRS_NONE;
@@ -121,7 +108,7 @@ int tsd_cells_compute(const double gt[6], int width, int height,
     }
     c->cell_x = fabs(gt[1]) * c->unit_to_m;
     c->cell_y = fabs(gt[5]) * c->unit_to_m;
-    return 0;
+    return TS_OK;
 }
 
 void tsd_cells_free(tsd_cells *c)
@@ -143,18 +130,18 @@ static double wrap_lon(double lon)
     return lon - 180.0;
 }
 
-int tsd_sites_compute(const double gt[6], int width, int height,
+ts_status tsd_sites_compute(const double gt[6], int width, int height,
                       OGRSpatialReferenceH srs, const tsd_cells *cells, int per_cell,
                       tsd_sites *s, char *msg, size_t n)
 {
     memset(s, 0, sizeof *s);
     if (!srs)
-        return fail(msg, n, "the DEM has no CRS, so the sun's position over it is "
+        return tsd_fail(msg, n, TS_ERR_ARG, "the DEM has no CRS, so the sun's position over it is "
                     "unknown: give it a CRS (gdal_edit.py -a_srs) or use "
                     "SUN_AZIMUTH and SUN_ELEVATION");
     int geographic = OSRIsGeographic(srs);
     if (!geographic && !OSRIsProjected(srs))
-        return fail(msg, n, "the DEM's CRS is neither geographic nor projected (a "
+        return tsd_fail(msg, n, TS_ERR_ARG, "the DEM's CRS is neither geographic nor projected (a "
                     "local or engineering CRS), so its longitudes and latitudes are "
                     "unknown; use SUN_AZIMUTH and SUN_ELEVATION instead");
     /* lattice: every 32 cells or so, at most 65 nodes a side */
@@ -176,7 +163,7 @@ int tsd_sites_compute(const double gt[6], int width, int height,
     s->north = malloc(nodes * sizeof *s->north);
     if (!s->lon || !s->lat || !s->north) {
         tsd_sites_free(s);
-        return fail(msg, n, "out of memory for %zu sun sites", nodes);
+        return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory for %zu sun sites", nodes);
     }
     OGRSpatialReferenceH geo = NULL;
     OGRCoordinateTransformationH fwd = NULL, inv = NULL;
@@ -195,12 +182,12 @@ int tsd_sites_compute(const double gt[6], int width, int height,
             if (inv) OCTDestroyCoordinateTransformation(inv);
             if (geo) OSRDestroySpatialReference(geo);
             tsd_sites_free(s);
-            return fail(msg, n, "PROJ cannot transform the DEM's CRS to longitude and "
+            return tsd_fail(msg, n, TS_ERR_ARG, "PROJ cannot transform the DEM's CRS to longitude and "
                         "latitude, so the sun's position over it is unknown");
         }
     }
     double deg = geographic ? OSRGetAngularUnits(srs, NULL) * 180.0 / M_PI : 1.0;
-    int rc = 0;
+    ts_status rc = TS_OK;
     for (int j = 0; j < s->ny && rc == 0; j++)
         for (int i = 0; i < s->nx && rc == 0; i++) {
             /* core pixel -> DEM pixel -> georeferenced */
@@ -216,7 +203,7 @@ int tsd_sites_compute(const double gt[6], int width, int height,
             } else {
                 double x = X, y = Y, z = 0;
                 if (!OCTTransform(fwd, 1, &x, &y, &z) || !isfinite(x) || !isfinite(y)) {
-                    rc = fail(msg, n, "PROJ cannot find the longitude and latitude of "
+                    rc = tsd_fail(msg, n, TS_ERR_ARG, "PROJ cannot find the longitude and latitude of "
                               "the DEM's point (%.10g, %.10g), so the sun's position "
                               "over it is unknown", X, Y);
                     break;
@@ -227,7 +214,7 @@ int tsd_sites_compute(const double gt[6], int width, int height,
                 double step = lat + 1e-4 <= 90.0 ? 1e-4 : -1e-4;
                 double x2 = lon, y2 = lat + step, z2 = 0;
                 if (!OCTTransform(inv, 1, &x2, &y2, &z2) || !isfinite(x2) || !isfinite(y2)) {
-                    rc = fail(msg, n, "PROJ cannot transform a point north of (%.8g, "
+                    rc = tsd_fail(msg, n, TS_ERR_ARG, "PROJ cannot transform a point north of (%.8g, "
                               "%.8g) back into the DEM's CRS", lon, lat);
                     break;
                 }
@@ -235,7 +222,7 @@ int tsd_sites_compute(const double gt[6], int width, int height,
                 north = atan2(dx, dy) * 180.0 / M_PI;
             }
             if (!isfinite(lat) || lat < -90.0 - 1e-9 || lat > 90.0 + 1e-9) {
-                rc = fail(msg, n, "the DEM's georeferencing puts a point at latitude %g, "
+                rc = tsd_fail(msg, n, TS_ERR_ARG, "the DEM's georeferencing puts a point at latitude %g, "
                           "beyond +/-90 degrees: the geotransform or the CRS is wrong",
                           lat);
                 break;

@@ -18,6 +18,7 @@
 #include <stddef.h>
 
 #include "ogr_srs_api.h"
+#include "terrashade.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -39,9 +40,9 @@ typedef struct {
 
 /**
  * Compute the cell sizes of a width x height DEM. srs may be NULL (no CRS).
- * 0 on success; -1 with a sentence in msg. Free with tsd_cells_free.
+ * TS_OK, or the failure's status with a sentence in msg. Free with tsd_cells_free.
  */
-int tsd_cells_compute(const double gt[6], int width, int height,
+ts_status tsd_cells_compute(const double gt[6], int width, int height,
                       OGRSpatialReferenceH srs, tsd_cells *out, char *msg,
                       size_t msg_size);
 
@@ -65,11 +66,11 @@ typedef struct {
 
 /**
  * Compute the sites of a width x height DEM with geotransform gt and CRS
- * srs (not NULL). 0 on success; -1 with a sentence in msg: no CRS usable
+ * srs (not NULL). TS_OK, or the failure's status with a sentence in msg: no CRS usable
  * for geographic coordinates, a transformation PROJ cannot do, a latitude
  * beyond +/-90.
  */
-int tsd_sites_compute(const double gt[6], int width, int height,
+ts_status tsd_sites_compute(const double gt[6], int width, int height,
                       OGRSpatialReferenceH srs, const tsd_cells *cells,
                       int per_cell, tsd_sites *out, char *msg, size_t msg_size);
 

@@ -1,7 +1,13 @@
 /*
- * tsd_options.h - the TERRASHADE driver's options: one table that both
- * documents them (the GDAL open-option list) and parses and validates them.
- * Plain C, no GDAL.
+ * tsd_options.h - the TERRASHADE driver's options: one table whose rows say
+ * each option's name, kind, range, declared default, description and the
+ * field of tsd_options it fills (offsetof). The open-option list (XML),
+ * parsing, validation, the defaults, the metadata values and the canonical
+ * PAM key are all derived from it. Plain C, no GDAL.
+ *
+ * tsd_options holds only what the user said (or the declared defaults);
+ * what the driver derives when it computes (the sun placed by DATETIME,
+ * progress) lives in tsd_run (tsd_compute.h).
  */
 #ifndef TSD_OPTIONS_H
 #define TSD_OPTIONS_H
@@ -14,42 +20,38 @@
 extern "C" {
 #endif
 
-typedef enum {
-    TSD_PRODUCT_SHADE = 0,
-    TSD_PRODUCT_SHADOW,
-    TSD_PRODUCT_HORIZON,
-    TSD_PRODUCT_SVF,
-    TSD_PRODUCT_OPENNESS,
-    TSD_PRODUCT_SKY,
-    TSD_PRODUCT_SUNHOURS,   /* hours of direct sun over a local day */
-    TSD_PRODUCT_INSOLATION, /* clear-sky irradiation over a day: total, beam, diffuse */
-    TSD_PRODUCT_DAYCYCLE,   /* visible fraction of the sun, one band per time step */
-    TSD_PRODUCT_FARSHADOW   /* binary far-shadow maps of the atlas, one per sun position */
-} tsd_product;
+/* Refraction coefficient k of the curvature correction, by default: the one
+ * place the plugin writes it (the option table's default string is made
+ * from it by TSD_XSTR). */
+#define TSD_REFRACTION_DEFAULT 0.13
+#define TSD_STR(x) #x
+#define TSD_XSTR(x) TSD_STR(x)
 
 typedef enum { TSD_SUN_CENTER = 0, TSD_SUN_PER_CELL } tsd_sun_position;
 typedef enum { TSD_PROGRESS_AUTO = 0, TSD_PROGRESS_YES, TSD_PROGRESS_NO } tsd_progress_mode;
-
-/* Longest text value of a string option (DATETIME, DATE, TIMEZONE). */
-#define TSD_TEXT_MAX 64
-
 typedef enum { TSD_METHOD_EXACT = 0, TSD_METHOD_SHM } tsd_method;
-
 typedef enum { TSD_OUT_AUTO = 0, TSD_OUT_BYTE, TSD_OUT_FLOAT32 } tsd_output_type;
-
 /* BACKEND: where the heavy core calls run (cl/terrashade_backend.h). */
 typedef enum { TSD_BACKEND_AUTO = 0, TSD_BACKEND_OPENCL, TSD_BACKEND_C } tsd_backend;
 
-/** Every option of a TERRASHADE dataset, with its effective value. */
+/* Longest text value of a string option (DATETIME, DATE, TIMEZONE). */
+#define TSD_TEXT_MAX 64
+/* Longest path of the atlas option DEM. */
+#define TSD_PATH_MAX 4096
+
+/** Every option of a TERRASHADE dataset, with its value: as given, or the
+ * declared default. Select options hold the index of their value in the
+ * option's list (the enums above follow those lists). */
 typedef struct {
-    tsd_product product;
+    int product;             /* index into the product table (tsd_products.h) */
     double sun_azimuth;      /* degrees from north */
     double sun_elevation;    /* degrees above the horizontal */
     int directions;          /* azimuths of the sky / horizon products */
     double start_azimuth;    /* first of those azimuths */
     tsd_method method;       /* exact horizon or shadow height map */
     double penumbra_depth;   /* metres, METHOD=shm only */
-    double z_factor;         /* multiplies the DEM's heights */
+    double z_factor;         /* multiplies the DEM's heights; NAN = AUTO, decided
+                                from the DEM (tsd_dem_z_factor) */
     double max_distance;     /* metres, 0 = unbounded */
     int curvature;           /* Earth curvature and refraction on/off */
     double refraction;       /* k */
@@ -74,71 +76,103 @@ typedef struct {
     int sunhours_fraction;   /* sunhours: 0 = a step counts while any of the
                                 disk is visible, 1 = weighted by the fraction */
     tsd_progress_mode progress_mode; /* PROGRESS: auto, yes, no */
-    /* Not options: set by the dataset just before it computes. */
-    ts_progress_fn progress; /* NULL = no reports */
-    void *progress_user;
-    /* which of SUN_AZIMUTH / SUN_ELEVATION were given explicitly */
-    int sun_azimuth_given, sun_elevation_given;
+    /* environment light: PRODUCT=envlight, and the sky term of shade */
+    char env_map[TSD_PATH_MAX];  /* ENV_MAP: an OpenEXR map (a GDAL path), "" = none */
+    double env_rotation;         /* ENV_ROTATION: degrees, clockwise seen from above */
+    char sky[TSD_TEXT_MAX];      /* SKY: uniform, overcast, clear, cie:N; "" = none */
+    int env_horizon_steps;       /* ENV_HORIZON_STEPS: the L_p table's horizon axis */
+    int env_normal_steps;        /* ENV_NORMAL_STEPS: its normal axis, 0 = exact */
+    char exposure[TSD_TEXT_MAX]; /* EXPOSURE: stops (Byte), "" or AUTO = automatic */
+    /* options of far-shadow atlas files (*.tsa) */
+    int shadows_all;         /* SHADOWS: 0 = far, 1 = all */
+    char dem[TSD_PATH_MAX];  /* DEM: "" = the atlas's SOURCE_DEM */
+    /* which options the user gave (bit i = option i of the table): what
+     * the user said, e.g. SUN_AZIMUTH given with DATETIME is an error */
+    unsigned long long given;
 } tsd_options;
 
-/** 1 if the product takes its sun from DATE / DATETIME over a whole day. */
-int tsd_product_is_daily(tsd_product p);
+/** Which datasets an option is an open option of (bit flags). */
+enum { TSD_SCOPE_PRODUCT = 1, TSD_SCOPE_ATLAS = 2 };
+
+/** Which products an option applies to (TERRASHADE_PRODUCTS, QGIS). */
+typedef enum {
+    TSD_APPLIES_SELECTOR = 0, /* PRODUCT itself: it chooses the product */
+    TSD_APPLIES_ALL,          /* every product */
+    TSD_APPLIES_LISTED        /* the products whose row lists it */
+} tsd_applies;
+
+/** Fill `o` with the declared defaults (parsed from the table's default
+ * strings; sun at 315 / 45 degrees as gdaldem). */
+void tsd_options_defaults(tsd_options *o);
+
+/**
+ * Apply a NULL-terminated list of "KEY=VALUE" strings of a TERRASHADE:<dem>
+ * dataset (keys are case-insensitive). A key given twice with different
+ * values, an unknown key, a malformed or out-of-range value are errors:
+ * returns -1 with a sentence in msg. Returns 0 on success. Then checks the
+ * combination (tsd_options_check).
+ */
+int tsd_options_apply(tsd_options *o, const char *const *kv, char *msg,
+                      size_t msg_size);
+
+/** The same for the open options of a far-shadow atlas (*.tsa): SHADOWS,
+ * DEM and THREADS. */
+int tsd_options_apply_atlas(tsd_options *o, const char *const *kv, char *msg,
+                            size_t msg_size);
+
+/** Check options that depend on each other; -1 with msg on error
+ * (tsd_options_check.c). */
+int tsd_options_check(const tsd_options *o, char *msg, size_t msg_size);
 
 /** 1 if the options place the sun from a date and time (DATETIME with
  * shade or shadow, or a daily product). */
 int tsd_options_sun_from_time(const tsd_options *o);
 
-/**
- * Normalise an ISO 8601 date and time written without colons (basic
- * format, which inline options need: 2026-06-21T073000+0200 or
- * 20260621T0730Z) into the extended form ts_parse_iso8601 reads
- * (2026-06-21T07:30:00+02:00). Other text is copied unchanged.
- */
-void tsd_datetime_normalise(const char *in, char *out, size_t out_size);
+/** 1 if option `name` was given by the user. */
+int tsd_options_given(const tsd_options *o, const char *name);
 
-/** Fill `o` with the defaults (sun at 315 / 45 degrees as gdaldem). */
-void tsd_options_defaults(tsd_options *o);
-
-/**
- * Apply a NULL-terminated list of "KEY=VALUE" strings (keys are
- * case-insensitive). A key given twice with different values, an unknown
- * key, a malformed or out-of-range value are errors: returns -1 with a
- * sentence in msg. Returns 0 on success. Then checks the combination
- * (tsd_options_check).
- */
-int tsd_options_apply(tsd_options *o, const char *const *kv, char *msg,
-                      size_t msg_size);
-
-/** Check options that depend on each other; -1 with msg on error. */
-int tsd_options_check(const tsd_options *o, char *msg, size_t msg_size);
-
-/** 1 if the product is written as Byte (1..255, 0 = nodata). */
+/** 1 if the product is written as Byte. */
 int tsd_options_output_byte(const tsd_options *o);
 
 /** Number of output bands. */
 int tsd_options_band_count(const tsd_options *o);
 
-/** Name of a product, e.g. "shade". */
-const char *tsd_product_name(tsd_product p);
+/** Name of the options' product, e.g. "shade". */
+const char *tsd_options_product_name(const tsd_options *o);
 
-/** Name of a method, e.g. "exact". */
-const char *tsd_method_name(tsd_method m);
+/* ------------------------------------------------------------ the table */
 
-/** Name of a BACKEND value: "auto", "opencl" or "c". */
-const char *tsd_backend_name(tsd_backend b);
+/** Number of options in the table (product and atlas options). */
+int tsd_options_count(void);
+
+/** Name of option i, or NULL past the end. */
+const char *tsd_option_name(int i);
+
+/** Index of the option named `name` (case-insensitive), or -1. */
+int tsd_option_find(const char *name);
+
+/** Scope bits of option i (TSD_SCOPE_*). */
+int tsd_option_scope(int i);
+
+/** Which products option i applies to. */
+tsd_applies tsd_option_applies(int i);
+
+/** The declared default of option i, as written in the option list. */
+const char *tsd_option_default(int i);
+
+/**
+ * The value of option i in `o` written to buf ("315", "YES", "shade"...;
+ * OUTPUT_TYPE: the type written, Byte or Float32). Returns the option's
+ * name, NULL past the end.
+ */
+const char *tsd_options_value(const tsd_options *o, int i, char *buf,
+                              size_t buf_size);
 
 /**
  * The GDAL open-option list (XML) describing every option with its type,
  * default, range and description. Caller frees with free().
  */
 char *tsd_options_xml(void);
-
-/** Number of options in the table, and the name/effective value of option i
- * ("315", "YES", "shade"...) written to buf. Returns the name, NULL past the
- * end. */
-int tsd_options_count(void);
-const char *tsd_options_value(const tsd_options *o, int i, char *buf,
-                              size_t buf_size);
 
 /**
  * A canonical, comma-separated "KEY=VALUE,..." string of all the options

@@ -1,16 +1,15 @@
 /* The sun from DATETIME / DATE / TIMEZONE; see tsd_sun.h. */
 #include "tsd_sun.h"
 
+#include "tsd_datetime.h"
+#include "tsd_products.h"
+#include "tsd_text.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-static int fail(char *msg, size_t n, const char *what, const ts_error *err)
-{
-    snprintf(msg, n, "%s%s%s", what, err ? ": " : "", err ? err->message : "");
-    return -1;
-}
 
 void tsd_format_time(double t, int offset, char *buf, size_t n)
 {
@@ -54,9 +53,10 @@ void tsd_sun_free(tsd_sun *s)
     memset(s, 0, sizeof *s);
 }
 
-int tsd_sun_setup(tsd_options *o, tsd_sites *sites, double min_cell_m, tsd_sun *s,
-                  char *msg, size_t n)
+ts_status tsd_sun_setup(const tsd_options *o, tsd_sites *sites, double min_cell_m,
+                        tsd_sun *s, char *msg, size_t n)
 {
+    const tsd_product_def *p = tsd_product_of(o);
     memset(s, 0, sizeof *s);
     s->sites_owned = *sites;
     memset(sites, 0, sizeof *sites);
@@ -87,30 +87,28 @@ int tsd_sun_setup(tsd_options *o, tsd_sites *sites, double min_cell_m, tsd_sun *
 
     ts_error err;
     if (ts_sun_sites_validate(&s->sites, &err) != TS_OK)
-        return fail(msg, n, "cannot place the sun over the DEM", &err);
+        return tsd_fail_core(msg, n, "cannot place the sun over the DEM", &err);
     if (o->datetime[0]) {
         char norm[2 * TSD_TEXT_MAX];
         tsd_datetime_normalise(o->datetime, norm, sizeof norm);
         if (ts_parse_iso8601(norm, &s->instant, &s->offset_minutes, &err) != TS_OK)
-            return fail(msg, n, "DATETIME", &err);
+            return tsd_fail_core(msg, n, "DATETIME", &err);
     }
     if (o->timezone[0] && ts_parse_utc_offset(o->timezone, &s->offset_minutes, &err) != TS_OK)
-        return fail(msg, n, "TIMEZONE", &err);
+        return tsd_fail_core(msg, n, "TIMEZONE", &err);
 
-    if (!tsd_product_is_daily(o->product)) {
-        /* shade, shadow: the sun at DATETIME */
+    if (!p->daily) {
+        /* shade, shadow: the sun at DATETIME (tsd_run_init uses it) */
         if (ts_sun_at_site(&s->sites, &s->day, s->instant, &s->sun, &err) != TS_OK)
-            return fail(msg, n, "cannot compute the sun's position", &err);
-        o->sun_azimuth = s->sun.grid_azimuth;
-        o->sun_elevation = s->sun.elevation;
-        return 0;
+            return tsd_fail_core(msg, n, "cannot compute the sun's position", &err);
+        return TS_OK;
     }
 
     /* the local day */
     if (o->date[0]) {
         int y, m, d;
         if (ts_parse_date(o->date, &y, &m, &d, &err) != TS_OK)
-            return fail(msg, n, "DATE", &err);
+            return tsd_fail_core(msg, n, "DATE", &err);
         s->day_start = ts_local_midnight(y, m, d, s->offset_minutes);
     } else {
         s->day_start = ts_local_day_start(s->instant, s->offset_minutes);
@@ -119,33 +117,32 @@ int tsd_sun_setup(tsd_options *o, tsd_sites *sites, double min_cell_m, tsd_sun *
     /* the SPA's range of years, checked once here */
     ts_sun_sample probe;
     if (ts_sun_at_site(&s->sites, &s->day, s->day_start, &probe, &err) != TS_OK)
-        return fail(msg, n, "cannot compute the sun's position", &err);
+        return tsd_fail_core(msg, n, "cannot compute the sun's position", &err);
 
-    if (o->product == TSD_PRODUCT_DAYCYCLE || o->product == TSD_PRODUCT_FARSHADOW) {
+    if (p->steps != TSD_STEPS_NONE) {
         int steps = tsd_options_band_count(o);
         s->times = malloc((size_t)steps * sizeof *s->times);
         s->durations = malloc((size_t)steps * sizeof *s->durations);
         s->samples = malloc((size_t)steps * sizeof *s->samples);
         if (!s->times || !s->durations || !s->samples)
-            return fail(msg, n, "out of memory for the time steps", NULL);
-        if (o->product == TSD_PRODUCT_DAYCYCLE) {
+            return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory for the time steps");
+        if (p->steps == TSD_STEPS_UNIFORM) {
             if (ts_day_uniform_times(s->day_start, s->day_length, o->step_minutes * 60.0,
                                      s->times, s->durations, &err) != TS_OK)
-                return fail(msg, n, "cannot lay out the day's steps", &err);
+                return tsd_fail_core(msg, n, "cannot lay out the day's steps", &err);
         } else {
             int got = 0;
             if (ts_day_atlas_times(&s->sites, &s->day, s->day_start, s->day_length, steps,
                                    s->times, &got, &err) != TS_OK)
-                return fail(msg, n, "cannot lay out the atlas's sun positions", &err);
+                return tsd_fail_core(msg, n, "cannot lay out the atlas's sun positions", &err);
             if (got == 0) {
                 char day[40];
                 tsd_format_time(s->day_start, s->offset_minutes, day, sizeof day);
-                snprintf(msg, n,
-                         "the sun does not rise on the day starting %s at latitude %.4g "
-                         "(polar night): PRODUCT=farshadow has no sun positions to map; "
-                         "PRODUCT=sunhours gives 0 hours there",
-                         day, s->sites.latitude[0]);
-                return -1;
+                return tsd_fail(msg, n, TS_ERR_ARG,
+                                "the sun does not rise on the day starting %s at latitude "
+                                "%.4g (polar night): PRODUCT=%s has no sun positions to "
+                                "map; PRODUCT=sunhours gives 0 hours there",
+                                day, s->sites.latitude[0], p->name);
             }
             for (int k = 0; k < steps; k++)
                 s->durations[k] = NAN;
@@ -154,7 +151,7 @@ int tsd_sun_setup(tsd_options *o, tsd_sites *sites, double min_cell_m, tsd_sun *
         s->steps = steps;
         for (int k = 0; k < steps; k++)
             if (ts_sun_at_site(&s->sites, &s->day, s->times[k], &s->samples[k], &err) != TS_OK)
-                return fail(msg, n, "cannot compute the sun's position", &err);
+                return tsd_fail_core(msg, n, "cannot compute the sun's position", &err);
     }
-    return 0;
+    return TS_OK;
 }

@@ -37,13 +37,13 @@ typedef struct {
 /**
  * Set up the sun of options `o` (tsd_options_sun_from_time(o) must be
  * true) over a grid whose smallest cell side is `min_cell_m` metres;
- * takes ownership of *sites (even on failure). For shade and shadow, sets
- * o->sun_azimuth (grid azimuth) and o->sun_elevation to the sun at
- * DATETIME. 0, or -1 with a sentence in msg (e.g. the sun never rises on
- * that day for PRODUCT=farshadow).
+ * takes ownership of *sites (even on failure). For shade and shadow, `sun`
+ * is the sun at DATETIME (tsd_run_init places the run's sun there). TS_OK,
+ * or the failure's status with a sentence in msg (e.g. the sun never rises
+ * on that day for PRODUCT=farshadow).
  */
-int tsd_sun_setup(tsd_options *o, tsd_sites *sites, double min_cell_m,
-                  tsd_sun *s, char *msg, size_t msg_size);
+ts_status tsd_sun_setup(const tsd_options *o, tsd_sites *sites, double min_cell_m,
+                        tsd_sun *s, char *msg, size_t msg_size);
 
 void tsd_sun_free(tsd_sun *s);
 

@@ -7,11 +7,12 @@
 # The plugin is taken from $BUILDDIR/plugin/.libs (BUILDDIR defaults to the
 # current directory, so run it from the build tree after make), else from
 # wherever GDAL finds it (GDAL_DRIVER_PATH, or the installed plugin).
-# Reads only jacksboro.tif beside this script.
+# Reads only jacksboro.tif and envmaps/*.exr beside this script.
 set -eu
 
 HERE=$(cd "$(dirname "$0")" && pwd)
 DEM="$HERE/jacksboro.tif"
+MAPS="$HERE/envmaps"
 OUT=${1:-$HERE/out}
 BUILDDIR=${BUILDDIR:-$(pwd)}
 if [ -f "$BUILDDIR/plugin/.libs/gdal_TERRASHADE.so" ]; then
@@ -72,6 +73,27 @@ RAMP
 run gdaldem color-relief -q -of PNG "$OUT/sunhours_winter.tif" "$OUT/sunhours.ramp" \
     "$OUT/sunhours_winter.png"
 rm -f "$OUT/sunhours_winter.tif" "$OUT/sunhours.ramp"
+
+# 7. environment light (docs/envlight.md), 32 directions, Byte: the automatic
+#    exposure (the brightest unshadowed surface -> 255) and the sRGB curve.
+#    Under the two HDR maps, the CIE standard overcast sky, the CIE clear sky
+#    with the sun of 8 am on the summer solstice (local time -05:00), and the
+#    uniform sky (the sky product's light) to compare with.
+envlight() {
+    name=$1
+    shift
+    run gdal_translate -q -of PNG -oo PRODUCT=envlight -oo DIRECTIONS=32 \
+        -oo OUTPUT_TYPE=Byte "$@" "TERRASHADE:$DEM" "$OUT/envlight_$name.png"
+}
+envlight sunset -oo ENV_MAP="$MAPS/sunset.exr"
+envlight forest -oo ENV_MAP="$MAPS/forest.exr"
+envlight overcast -oo SKY=overcast
+envlight clear_8am -oo SKY=clear -oo DATETIME=2026-06-21T08:00:00-05:00
+envlight uniform -oo SKY=uniform
+
+# 8. shade: the sun and a CIE clear sky at 8 am on the solstice, one command
+run gdal_translate -q -of PNG -oo DATETIME=2026-06-21T08:00:00-05:00 -oo SKY=clear \
+    -oo SKY_WEIGHT=0.4 -oo DIRECTIONS=32 "TERRASHADE:$DEM" "$OUT/shade_clear_sky_8am.png"
 
 echo "wrote:"
 ls -l "$OUT"/*.png

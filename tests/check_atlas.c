@@ -3,6 +3,7 @@
  * file round trip (lossless, any size, with nodata, 2- and 4-byte
  * indices), damaged files, and a day's far-shadow atlas of jacksboro. */
 #include <check.h>
+#include <lzma.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -298,30 +299,145 @@ START_TEST(test_bad_maps_and_files)
         memcpy(copy, file, size);
         copy[i] ^= 0x10;
         ts_status st = ts_atlas_open(copy, size, &a, &err);
-        if (st == TS_OK) {
-            /* a flip in a step record or the metadata text is not checked;
-             * reading must still be safe */
-            uint8_t out[256];
-            ck_assert(ts_atlas_read(a, 0, 0, 0, 16, 16, out, 16, &err) == TS_OK);
+        if (st == TS_OK)
             ts_atlas_free(a);
-        } else {
-            ck_assert(st == TS_ERR_ARG);
-            caught++;
-        }
+        else
+            caught += st == TS_ERR_ARG;
         total++;
         free(copy);
     }
-    printf("damaged atlas (%zu bytes): %d of %d single-bit flips refused (the rest lie in "
-           "the step records and metadata text)\n", size, caught, total);
-    ck_assert(caught >= total - TS_ATLAS_STEP_SIZE);
+    /* version 2: the step records and the metadata text are under a CRC too */
+    printf("damaged atlas (%zu bytes): %d of %d single-bit flips refused\n", size, caught,
+           total);
+    ck_assert_int_eq(caught, total);
     /* not an atlas */
     EXPECT_ARG(ts_atlas_open((const uint8_t *)"GIF89a..........", 16, &a, &err), &err);
     ck_assert(!ts_atlas_identify((const uint8_t *)"\x89PNG", 4));
     /* a future version */
-    file[8] = 2;
+    file[8] = 3;
     EXPECT_ARG(ts_atlas_open(file, size, &a, &err), &err);
-    ck_assert(strstr(err.message, "version 2"));
+    ck_assert(strstr(err.message, "version 3"));
+    /* version 1 (no checksum over the steps and the text): recreate it */
+    file[8] = 1;
+    uint32_t crc = lzma_crc32(file, 160, 0);
+    for (int i = 0; i < 4; i++)
+        file[160 + i] = (uint8_t)(crc >> (8 * i));
+    EXPECT_ARG(ts_atlas_open(file, size, &a, &err), &err);
+    ck_assert(strstr(err.message, "version 1") && strstr(err.message, "recreate"));
     free(file);
+}
+END_TEST
+
+/* A valid 3-map atlas of 16 x 16 cells, its steps 10 minutes apart. */
+static uint8_t *small_atlas(size_t *size)
+{
+    ts_error err;
+    ts_atlas_writer *w;
+    uint8_t plane[16 * 16];
+    memset(plane, 0, sizeof plane);
+    ck_assert(ts_atlas_writer_new(16, 16, &w, &err) == TS_OK);
+    for (int s = 0; s < 3; s++) {
+        ts_atlas_step rec = {1.75e9 + 600.0 * s, 100.0 + s, 101.0 + s, 10.0 + s, 120};
+        ck_assert(ts_atlas_writer_add(w, plane, 16, &rec, &err) == TS_OK);
+    }
+    ts_atlas_info info;
+    memset(&info, 0, sizeof info);
+    info.metadata = "PRODUCT=farshadow\nBAND=1\n";
+    uint8_t *file;
+    ck_assert(ts_atlas_writer_finish(w, &info, &file, size, &err) == TS_OK);
+    ts_atlas_writer_free(w);
+    return file;
+}
+
+static void put_le(uint8_t *p, uint64_t v, int bytes)
+{
+    for (int i = 0; i < bytes; i++)
+        p[i] = (uint8_t)(v >> (8 * i));
+}
+
+/* Forge field `at` (byte offset in the record) of map k's step record, and
+ * the CRC that covers it, as a hostile writer would. */
+static void forge_step(uint8_t *file, int k, int at, double value, int32_t offset)
+{
+    uint8_t *r = file + TS_ATLAS_HEADER_SIZE + (size_t)k * TS_ATLAS_STEP_SIZE;
+    if (at == 32) {
+        put_le(r + 32, (uint32_t)offset, 4);
+    } else {
+        uint64_t u;
+        memcpy(&u, &value, 8);
+        put_le(r + at, u, 8);
+    }
+    uint64_t text_off = 0, text_n = 0;
+    for (int i = 7; i >= 0; i--) {
+        text_off = text_off << 8 | file[112 + i];
+        text_n = text_n << 8 | file[120 + i];
+    }
+    uint32_t crc = lzma_crc32(file + TS_ATLAS_HEADER_SIZE, 3 * TS_ATLAS_STEP_SIZE, 0);
+    put_le(file + 164, lzma_crc32(file + text_off, text_n, crc), 4);
+}
+
+/* A step table whose records hold garbage is refused with its cause, on
+ * reading (a forged file with a valid CRC) and on writing. */
+START_TEST(test_bad_step_tables)
+{
+    const struct {
+        int map, at;
+        double value;
+        int32_t offset;
+        const char *cause;
+    } cases[] = {
+        {1, 0, NAN, 0, "either every map has one or none has"},
+        {2, 0, 1.75e9, 0, "is not after map 2's"},
+        {0, 0, -9.2e18, 0, "between the years -2000 and 6000"},
+        {0, 0, INFINITY, 0, "between the years -2000 and 6000"},
+        {0, 0, 1.75e9 - 90000.0, 0, "more than the one day"},
+        {1, 24, 95.0, 0, "elevation (95) lies outside -90 to 90"},
+        {1, 24, NAN, 0, NULL}, /* an unknown elevation is allowed */
+        {2, 8, 400.0, 0, "azimuth (400 true"},
+        {2, 16, -1.0, 0, "-1 grid) lies outside 0 to 360"},
+        {0, 32, 0, 5000, "offset from UTC (5000 minutes)"},
+        {0, 32, 0, INT32_MIN, "lies outside -23:59 to +23:59"},
+    };
+    ts_error err;
+    ts_atlas *a;
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        size_t size;
+        uint8_t *file = small_atlas(&size);
+        forge_step(file, cases[i].map, cases[i].at, cases[i].value, cases[i].offset);
+        ts_status st = ts_atlas_open(file, size, &a, &err);
+        if (!cases[i].cause) {
+            ck_assert_msg(st == TS_OK, "%s", err.message);
+            ts_atlas_free(a);
+        } else {
+            ck_assert_msg(st == TS_ERR_ARG && err.code == TS_ERR_ARG, "case %zu: status %d", i,
+                          (int)st);
+            printf("forged step table, case %zu -> %s\n", i, err.message);
+            ck_assert_msg(strstr(err.message, "the atlas's step table is invalid: ") == err.message &&
+                              strstr(err.message, cases[i].cause),
+                          "case %zu: %s", i, err.message);
+        }
+        free(file);
+    }
+    /* the metadata text changed without its CRC */
+    size_t size;
+    uint8_t *file = small_atlas(&size);
+    uint8_t *text = memchr(file, '=', size);
+    ck_assert(text != NULL);
+    text[1] = 'x';
+    EXPECT_ARG(ts_atlas_open(file, size, &a, &err), &err);
+    ck_assert(strstr(err.message, "step table or metadata text is damaged"));
+    free(file);
+    /* the writer refuses what the reader would */
+    ts_atlas_writer *w;
+    uint8_t plane[4] = {0, 1, 0, 1};
+    ck_assert(ts_atlas_writer_new(2, 2, &w, &err) == TS_OK);
+    ts_atlas_step late = {2e9, 10, 10, 10, 0}, early = {1e9, 10, 10, 10, 0};
+    ck_assert(ts_atlas_writer_add(w, plane, 2, &late, &err) == TS_OK);
+    ck_assert(ts_atlas_writer_add(w, plane, 2, &early, &err) == TS_OK);
+    uint8_t *bytes;
+    EXPECT_ARG(ts_atlas_writer_finish(w, NULL, &bytes, &size, &err), &err);
+    ck_assert(strstr(err.message, "cannot write the atlas: map 2's time"));
+    ts_atlas_writer_free(w);
 }
 END_TEST
 
@@ -394,6 +510,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_far_shadow_bits);
     tcase_add_test(tc, test_round_trip);
     tcase_add_test(tc, test_bad_maps_and_files);
+    tcase_add_test(tc, test_bad_step_tables);
     tcase_add_test(tc, test_jacksboro_day);
     suite_add_tcase(s, tc);
     return s;

@@ -470,6 +470,62 @@ START_TEST(test_refraction)
 }
 END_TEST
 
+/* The refraction over the physical ranges of the driver (300..1100 hPa,
+ * -90..60 C): at most about a degree, and the elevation stays in
+ * [-90, 90]; outside them (near absolute zero) the core refuses with a
+ * sentence instead of returning an elevation of thousands of degrees. */
+START_TEST(test_refraction_bounds)
+{
+    ts_sun_input in;
+    ts_sun_output out;
+    ts_sun_detail d;
+    ts_error err;
+    ts_sun_input_default(&in);
+    double sunrise = unix_of("2026-03-20T06:00:00Z"), noon = unix_of("2026-03-20T12:00:00Z");
+    const double pressures[] = {300.0, 1013.25, 1100.0}, temps[] = {-90.0, 15.0, 60.0};
+    for (int p = 0; p < 3; p++)
+        for (int k = 0; k < 3; k++)
+            for (int s = -1800; s <= 1800; s += 30) {
+                in.pressure = pressures[p];
+                in.temperature = temps[k];
+                in.latitude = 0.0;
+                in.longitude = 0.0;
+                in.jd = ts_julian_day_from_unix(sunrise + s);
+                ck_assert_msg(ts_sun_position_detail(&in, &out, &d, &err) == TS_OK, "%s",
+                              err.message);
+                ck_assert(out.elevation >= -90.0 && out.elevation <= 90.0);
+                ck_assert_msg(d.delta_e >= 0.0 && d.delta_e < 1.1, "refraction %g at %g hPa, %g C",
+                              d.delta_e, in.pressure, in.temperature);
+                /* near the zenith (noon at the equator, equinox): a few thousandths */
+                in.jd = ts_julian_day_from_unix(noon + s / 10.0);
+                in.longitude = -0.1;
+                ck_assert(ts_sun_position_detail(&in, &out, &d, &err) == TS_OK);
+                ck_assert(out.elevation >= -90.0 && out.elevation <= 90.0);
+                ck_assert(out.elevation > 85.0 && fabs(d.delta_e) < 0.01);
+            }
+    /* TEMPERATURE=-272.999: the formula would give a sun thousands of
+     * degrees high */
+    ts_sun_input_default(&in);
+    in.temperature = -272.999;
+    in.jd = ts_julian_day_from_unix(sunrise + 600); /* the sun 1 degree up */
+    EXPECT_ARG(ts_sun_position(&in, &out, &err), &err);
+    ck_assert_msg(strstr(err.message, "outside -90 to 90") &&
+                      strstr(err.message, "refraction model does not hold"),
+                  "%s", err.message);
+    /* a large atmos_refraction reaches the pole of eq. 42 (e0 = -5.11):
+     * either a sun in range or the same refusal, never anything else */
+    ts_sun_input_default(&in);
+    in.atmos_refraction = 5.0;
+    for (int s = 0; s <= 3600; s += 5) {
+        in.jd = ts_julian_day_from_unix(sunrise - s);
+        ts_status st = ts_sun_position(&in, &out, &err);
+        ck_assert(st == TS_OK || st == TS_ERR_ARG);
+        if (st == TS_OK)
+            ck_assert(out.elevation >= -90.0 && out.elevation <= 90.0);
+    }
+}
+END_TEST
+
 /* Every azimuth and zenith in range over a coarse grid of places and times. */
 START_TEST(test_ranges)
 {
@@ -574,6 +630,7 @@ int main(void)
     tcase_add_test(spa, test_polar_day_night);
     tcase_add_test(spa, test_equinox_sunrise);
     tcase_add_test(spa, test_refraction);
+    tcase_add_test(spa, test_refraction_bounds);
     tcase_add_test(spa, test_ranges);
     tcase_add_test(spa, test_input_errors);
     suite_add_tcase(s, spa);

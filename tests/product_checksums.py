@@ -11,6 +11,10 @@ output is read through GDAL and its bytes hashed (SHA-256, first 16 hex).
     /usr/bin/python3 tests/product_checksums.py --save DIR     # also keep the arrays
     /usr/bin/python3 tests/product_checksums.py --compare DIR  # max |difference|
                                                                # against kept arrays
+    /usr/bin/python3 tests/product_checksums.py --cross        # also max |C - OpenCL|
+                                                               # per DEM and variant
+    /usr/bin/python3 tests/product_checksums.py --cross-saved DIR  # the same, from
+                                                               # arrays kept by --save
 
 Run it from the top build directory (it uses plugin/.libs in place).
 """
@@ -53,6 +57,22 @@ VARIANTS = {
     "farshadow": dict(DAY, ATLAS_STEPS="6", FAR_THRESHOLD="32"),
 }
 
+# Environment light (docs/envlight.md): printed after all the above, so that
+# the earlier lines keep their places.
+ENVMAPS = os.path.join(T.DATA, "envmaps")
+SUNSET = os.path.join(ENVMAPS, "sunset.exr")
+ENV_VARIANTS = {
+    "envlight_sky": {"SKY": "cie:7", "SUN_AZIMUTH": "120", "SUN_ELEVATION": "25",
+                     "DIRECTIONS": "8"},
+    "envlight_map": {"ENV_MAP": SUNSET, "ENV_ROTATION": "45", "DIRECTIONS": "8"},
+    "envlight_cube": {"ENV_MAP": os.path.join(ENVMAPS, "sunset_cube128.exr"),
+                      "DIRECTIONS": "8", "ENV_NORMAL_STEPS": "33"},
+    "envlight_byte": {"ENV_MAP": SUNSET, "OUTPUT_TYPE": "Byte", "DIRECTIONS": "8"},
+    "shade_clearsky": {"SKY": "clear", "SKY_WEIGHT": "0.5", "DIRECTIONS": "8",
+                       "DATETIME": "2026-06-21T08:00:00-05:00", "OUTPUT_TYPE": "Float32"},
+    "shade_envmap": {"ENV_MAP": SUNSET, "SKY_WEIGHT": "0.3", "DIRECTIONS": "8"},
+}
+
 
 def fractal_dem(path, n=512, seed=7):
     """Spectral-synthesis fractal (beta 2.2), 30 m cells, UTM 33N."""
@@ -85,44 +105,91 @@ def read_all(ds):
     return np.stack([b.ReadAsArray() for b in bands])
 
 
+def max_abs_diff(a, b):
+    """Largest |a - b| over the cells valid in both, and whether nodata
+    (NaN) falls on the same cells."""
+    a = a.astype(np.float64)
+    b = b.astype(np.float64)
+    same_nan = np.array_equal(np.isnan(a), np.isnan(b))
+    d = np.abs(a - b)
+    return (float(np.nanmax(d)) if np.isfinite(d).any() else 0.0), same_nan
+
+
+def cross_line(key, c, cl):
+    m, same_nan = max_abs_diff(c, cl)
+    return "%-28s max|C - OpenCL| %.3g%s" % (key, m, "" if same_nan else "  NODATA DIFFERS")
+
+
+def cross_saved(path):
+    """--cross-saved: max |C - OpenCL| from arrays kept by --save."""
+    for f in sorted(os.listdir(path)):
+        parts = f[:-len(".npy")].split(".")
+        if not f.endswith(".npy") or len(parts) != 3 or parts[1] != "c":
+            continue
+        other = os.path.join(path, "%s.opencl.%s.npy" % (parts[0], parts[2]))
+        if os.path.exists(other):
+            print(cross_line("%s.%s" % (parts[0], parts[2]),
+                             np.load(os.path.join(path, f)), np.load(other)), flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--save", metavar="DIR", help="also save every array as .npy")
     ap.add_argument("--compare", metavar="DIR", help="max |diff| against saved arrays")
     ap.add_argument("--only", help="comma-separated variant names")
     ap.add_argument("--backends", default="c,opencl")
+    ap.add_argument("--cross", action="store_true",
+                    help="also print max |C - OpenCL| per DEM and variant")
+    ap.add_argument("--cross-saved", metavar="DIR",
+                    help="only print max |C - OpenCL| from arrays kept by --save")
     args = ap.parse_args()
+    if args.cross_saved:
+        cross_saved(args.cross_saved)
+        return
     tmp = tempfile.mkdtemp(prefix="ts_cksum_")
     fractal = os.path.join(tmp, "fractal.tif")
     fractal_dem(fractal)
     dems = {"jacksboro": T.JACKSBORO, "lux": T.LUX, "fractal": fractal}
-    names = args.only.split(",") if args.only else list(VARIANTS)
+    variants = dict(VARIANTS, **ENV_VARIANTS)
+    names = args.only.split(",") if args.only else list(variants)
     if args.save:
         os.makedirs(args.save, exist_ok=True)
     worst = 0.0
-    for dem_name, dem in dems.items():
-        for backend in args.backends.split(","):
-            for name in names:
-                oo = dict(VARIANTS[name], PRODUCT=name.split("_")[0], BACKEND=backend,
-                          PROGRESS="no")
-                ds = gdal.OpenEx("TERRASHADE:" + dem,
-                                 open_options=["%s=%s" % kv for kv in oo.items()])
-                a = read_all(ds)
-                ds = None
-                key = "%s.%s.%s" % (dem_name, backend, name)
-                h = hashlib.sha256(a.tobytes()).hexdigest()[:16]
-                line = "%-34s %s %s %s" % (key, a.dtype, "x".join(map(str, a.shape)), h)
-                if args.save:
-                    np.save(os.path.join(args.save, key + ".npy"), a)
-                if args.compare:
-                    ref = np.load(os.path.join(args.compare, key + ".npy"))
-                    d = np.abs(a.astype(np.float64) - ref.astype(np.float64))
-                    same_nan = np.array_equal(np.isnan(d), np.isnan(
-                        ref.astype(np.float64)) | np.isnan(a.astype(np.float64)))
-                    m = float(np.nanmax(d)) if np.isfinite(d).any() else 0.0
-                    worst = max(worst, m)
-                    line += "  max|diff| %.3g%s" % (m, "" if same_nan else "  NODATA DIFFERS")
-                print(line, flush=True)
+    crossed = []
+    # the variants of the first group come first in the record, each group
+    # DEM by DEM, so that added groups append lines to it
+    for group in (VARIANTS, ENV_VARIANTS):
+        for dem_name, dem in dems.items():
+            kept = {}
+            for backend in args.backends.split(","):
+                for name in [n for n in names if n in group]:
+                    oo = dict(variants[name], PRODUCT=name.split("_")[0], BACKEND=backend,
+                              PROGRESS="no")
+                    ds = gdal.OpenEx("TERRASHADE:" + dem,
+                                     open_options=["%s=%s" % kv for kv in oo.items()])
+                    a = read_all(ds)
+                    ds = None
+                    key = "%s.%s.%s" % (dem_name, backend, name)
+                    h = hashlib.sha256(a.tobytes()).hexdigest()[:16]
+                    line = "%-34s %s %s %s" % (key, a.dtype, "x".join(map(str, a.shape)), h)
+                    if args.save:
+                        np.save(os.path.join(args.save, key + ".npy"), a)
+                    if args.compare:
+                        ref = np.load(os.path.join(args.compare, key + ".npy"))
+                        m, same_nan = max_abs_diff(a, ref)
+                        worst = max(worst, m)
+                        line += "  max|diff| %.3g%s" % (m, "" if same_nan else
+                                                         "  NODATA DIFFERS")
+                    if args.cross:
+                        kept[(backend, name)] = a
+                    print(line, flush=True)
+            if args.cross:
+                crossed += [cross_line("%s.%s" % (dem_name, name), kept[("c", name)],
+                                       kept[("opencl", name)])
+                            for name in names
+                            if ("c", name) in kept and ("opencl", name) in kept]
+    for line in crossed:
+        print(line)
     if args.compare:
         print("worst max|diff| %.3g" % worst)
 

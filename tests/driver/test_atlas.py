@@ -13,7 +13,9 @@
 """
 import datetime
 import os
+import struct
 import unittest
+import zlib
 
 import tsdriver as T
 from tsdriver import gdal, np
@@ -24,6 +26,30 @@ DAY = {"PRODUCT": "farshadow", "DATE": "2026-12-21", "TIMEZONE": "-05:00",
 
 def oo(d):
     return ["%s=%s" % kv for kv in d.items()]
+
+
+def forge(data, text=None, step=None, version=None):
+    """An atlas rewritten as a hostile or careless writer would, with valid
+    CRCs (docs/atlas-format.md): another metadata text (str), step record
+    `step` = (k, field offset, struct format, value), or version."""
+    h = bytearray(data[:168])
+    n = struct.unpack_from("<I", h, 24)[0]
+    so, to, tn, do, dn, io, inn = struct.unpack_from("<7Q", h, 104)
+    steps = bytearray(data[so:so + 40 * n])
+    old_text = data[to:to + tn]
+    new_text = old_text if text is None else text.encode()
+    if step is not None:
+        k, at, fmt, value = step
+        struct.pack_into(fmt, steps, 40 * k + at, value)
+    if version is not None:
+        struct.pack_into("<I", h, 8, version)
+    rest = data[do:do + dn] + data[io:io + inn]
+    to = 168 + len(steps)
+    do = to + len(new_text)
+    struct.pack_into("<7Q", h, 104, 168, to, len(new_text), do, dn, do + dn, inn)
+    struct.pack_into("<I", h, 160, zlib.crc32(bytes(h[:160])))
+    struct.pack_into("<I", h, 164, zlib.crc32(new_text, zlib.crc32(bytes(steps))))
+    return bytes(h) + bytes(steps) + new_text + rest
 
 
 def band_metadata(ds):
@@ -185,7 +211,17 @@ class Atlas(unittest.TestCase):
         out = os.path.join(self.dir, "bad.tsa")
         p = T.run(["gdal_translate", "-of", "TERRASHADE", T.JACKSBORO, out], ok=False)
         print(p.stderr.strip().splitlines()[-1])
-        self.assertIn("holds the value", p.stderr)
+        self.assertIn("the source is not a far-shadow product", p.stderr)
+        self.assertIn("PRODUCT is missing", p.stderr)
+        self.assertFalse(os.path.exists(out))
+        # a far-shadow product whose values were changed
+        tif = os.path.join(self.dir, "edited.tif")
+        T.run(["gdal_translate", "-q", self.tsa, tif])
+        ds = gdal.Open(tif, gdal.GA_Update)
+        ds.GetRasterBand(3).WriteArray(np.full((2, 2), 7, np.uint8), 10, 20)
+        ds = None
+        p = T.run(["gdal_translate", "-of", "TERRASHADE", tif, out], ok=False)
+        self.assertIn("band 3 holds the value 7 at column 10, row 20", p.stderr)
         self.assertIn("binary maps", p.stderr)
         self.assertFalse(os.path.exists(out))
         with open(self.tsa, "rb") as f:
@@ -212,6 +248,130 @@ class Atlas(unittest.TestCase):
         with self.assertRaises(RuntimeError) as e:
             gdal.Open(self.tsa, gdal.GA_Update)
         self.assertIn("read-only", str(e.exception))
+
+    def write(self, name, blob):
+        path = os.path.join(self.dir, name)
+        with open(path, "wb") as f:
+            f.write(blob)
+        return path
+
+    def refused(self, path, sentence, options=()):
+        with self.assertRaises(RuntimeError) as e:
+            ds = gdal.OpenEx(path, open_options=list(options))
+            ds.GetRasterBand(1).ReadAsArray()
+        print("%-18s -> %s" % (os.path.basename(path), e.exception))
+        self.assertIn(sentence, str(e.exception))
+        return str(e.exception)
+
+    def test_metadata_validated_like_options(self):
+        """Each value of the metadata text goes through the option table; the
+        message gives the real cause."""
+        with open(self.tsa, "rb") as f:
+            data = f.read()
+        text = gdal.Open(self.tsa).GetMetadata()
+        lines = ["%s=%s" % kv for kv in text.items()]
+
+        def with_item(key, value):
+            return "\n".join([l for l in lines if not l.startswith(key + "=")]
+                             + ["%s=%s" % (key, value)]) + "\n"
+        cases = [
+            ("Z_FACTOR", "nan", "Z_FACTOR must be AUTO or a number, got 'nan'"),
+            ("Z_FACTOR", "-1", "Z_FACTOR must be greater than 0 and at most 1e+06, got -1"),
+            ("BAND", "0", "BAND must be between 1 and 65536, got 0"),
+            ("CURVATURE", "maybe", "CURVATURE must be YES or NO, got 'maybe'"),
+            ("THREADS", "abc", "THREADS must be a whole number, got 'abc'"),
+            ("REFRACTION", "7", "REFRACTION must be between 0 and 1, got 7"),
+            ("PRODUCT", "shade", "PRODUCT must be farshadow, got 'shade'"),
+            ("ATLAS_STEPS", "5", "ATLAS_STEPS=5, but there are 32 map(s)"),
+            ("DATE", "2026-13-45", "DATE: "),
+            ("UTC_OFFSET_MINUTES", "abc", "UTC_OFFSET_MINUTES must be a whole number"),
+            ("FAR_THRESHOLD_M", "-3", "FAR_THRESHOLD_M must be a distance in metres"),
+            ("SRS_WKT", "not a crs", "SRS_WKT is not a CRS GDAL can read"),
+        ]
+        for key, value, sentence in cases:
+            with self.subTest(key=key, value=value):
+                path = self.write("meta_%s.tsa" % key.lower(), forge(data, with_item(key, value)))
+                msg = self.refused(path, "atlas metadata: " + sentence)
+                self.assertNotIn("does not match", msg)
+        # no PRODUCT at all
+        path = self.write("noproduct.tsa", forge(
+            data, "\n".join(l for l in lines if not l.startswith("PRODUCT=")) + "\n"))
+        self.refused(path, "atlas metadata: PRODUCT is missing")
+        # BAND=99 is a valid option, but not of this DEM: said so, not a size mismatch
+        path = self.write("band99.tsa", forge(data, with_item("BAND", "99")))
+        forged, kept = gdal.Open(path), gdal.Open(self.tsa)
+        self.assertEqual(forged.GetRasterBand(1).Checksum(), kept.GetRasterBand(1).Checksum())
+        forged = kept = None
+        self.refused(path, "SHADOWS=all: the atlas's metadata says BAND=99, but the DEM '%s' "
+                     "has 1 band(s)" % T.JACKSBORO, ["SHADOWS=all"])
+        # the text changed without its CRC
+        bad = bytearray(data)
+        at = data.index(b"CURVATURE=YES") + len("CURVATURE=")
+        bad[at:at + 3] = b"NO\n"
+        self.refused(self.write("nocrc.tsa", bytes(bad)),
+                     "step table or metadata text is damaged (CRC32 mismatch)")
+
+    def test_step_table_validated(self):
+        with open(self.tsa, "rb") as f:
+            data = f.read()
+        cases = [
+            ("time_garbage", (4, 0, "<d", -9.2e18), "map 5's time, -9.2e+18 Unix seconds, "
+             "is not an instant between the years -2000 and 6000"),
+            ("time_back", (4, 0, "<d", 1.7e9), "map 5's time (1700000000.000) is not after"),
+            ("time_nan", (0, 0, "<d", float("nan")), "map 2 has a time but map 1 has none: "
+             "either every map has one or none has"),
+            ("elevation", (2, 24, "<d", 123.0), "map 3's sun elevation (123) lies outside"),
+            ("offset", (1, 32, "<i", 99999), "map 2's offset from UTC (99999 minutes)"),
+        ]
+        for name, step, sentence in cases:
+            with self.subTest(name):
+                path = self.write("step_%s.tsa" % name, forge(data, step=step))
+                self.refused(path, "the atlas's step table is invalid: " + sentence)
+        # every time missing: allowed by the format, not by a far-shadow atlas
+        blob = data
+        for k in range(32):
+            blob = forge(blob, step=(k, 0, "<d", float("nan")))
+        self.refused(self.write("step_none.tsa", blob),
+                     "atlas step table: map 1 has no time, but every map of "
+                     "PRODUCT=farshadow has one")
+
+    def test_version_1_is_refused(self):
+        with open(self.tsa, "rb") as f:
+            data = f.read()
+        msg = self.refused(self.write("v1.tsa", forge(data, version=1)),
+                           "format version 1, whose metadata and step table carry no "
+                           "checksum")
+        self.assertIn("recreate the atlas", msg)
+
+    def test_atlas_as_its_own_dem(self):
+        self.refused(self.tsa, "SHADOWS=all: the DEM '%s' is a far-shadow atlas (.tsa), not "
+                     "a DEM" % self.tsa, ["SHADOWS=all", "DEM=" + self.tsa])
+        with open(self.tsa, "rb") as f:
+            data = f.read()
+        text = ["%s=%s" % kv for kv in gdal.Open(self.tsa).GetMetadata().items()
+                if kv[0] != "SOURCE_DEM"] + ["SOURCE_DEM=" + self.tsa]
+        path = self.write("self.tsa", forge(data, "\n".join(text) + "\n"))
+        self.refused(path, "(the atlas's SOURCE_DEM) is a far-shadow atlas (.tsa), not a DEM",
+                     ["SHADOWS=all"])
+
+    def test_createcopy_refuses_other_sources(self):
+        out = os.path.join(self.dir, "refused.tsa")
+        # complex bands
+        cpx = os.path.join(self.dir, "complex.tif")
+        ds = gdal.GetDriverByName("GTiff").Create(cpx, 16, 16, 1, gdal.GDT_CFloat32)
+        ds.SetMetadata(gdal.Open(self.tsa).GetMetadata())
+        ds = None
+        p = T.run(["gdal_translate", "-of", "TERRASHADE", cpx, out], ok=False)
+        self.assertIn("band 1 of the source is complex (CFloat32)", p.stderr)
+        # a far-shadow product cut to fewer bands: not what its metadata says
+        p = T.run(["gdal_translate", "-of", "TERRASHADE", "-b", "1", self.tsa, out], ok=False)
+        self.assertIn("the source is not a far-shadow product", p.stderr)
+        self.assertIn("ATLAS_STEPS=32, but there are 1 map(s)", p.stderr)
+        # another product of the DEM
+        p = T.run(["gdal_translate", "-of", "TERRASHADE", "-oo", "PRODUCT=shadow",
+                   T.conn(T.JACKSBORO), out], ok=False)
+        self.assertIn("PRODUCT must be farshadow, got 'shadow'", p.stderr)
+        self.assertFalse(os.path.exists(out))
 
 
 if __name__ == "__main__":

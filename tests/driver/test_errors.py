@@ -27,7 +27,7 @@ CASES = [
      "Z_FACTOR must be greater than 0"),
     ("bad product", T.conn(DEM), ["PRODUCT=hillshade"],
      "PRODUCT must be one of shade, shadow, horizon, svf, openness, sky, sunhours, "
-     "insolation, daycycle, farshadow, got 'hillshade'"),
+     "insolation, daycycle, farshadow, envlight, got 'hillshade'"),
     ("bad boolean", T.conn(DEM), ["CURVATURE=maybe"],
      "CURVATURE must be YES or NO"),
     ("empty value", T.conn(DEM), ["SUN_AZIMUTH="], "SUN_AZIMUTH needs a value"),

@@ -168,6 +168,32 @@ class Options(unittest.TestCase):
         print(e.exception)
         self.assertIn("MAX_MEMORY", str(e.exception))
 
+    def test_refraction_ranges(self):
+        """PRESSURE and TEMPERATURE stay where the SPA's refraction holds
+        (docs/driver.md): TEMPERATURE=-272.999 once gave a sun 16237 degrees
+        high; now it is refused with the range, as are its neighbours."""
+        day = ["PRODUCT=sunhours", "DATE=2026-06-21", "TIMEZONE=-05:00",
+               "STEP_MINUTES=120"]
+        cases = [
+            ("TEMPERATURE=-272.999", "TEMPERATURE must be between -90 and 60, got -272.999"),
+            ("TEMPERATURE=-90.5", "TEMPERATURE must be between -90 and 60, got -90.5"),
+            ("TEMPERATURE=61", "TEMPERATURE must be between -90 and 60, got 61"),
+            ("PRESSURE=299", "PRESSURE must be between 300 and 1100, got 299"),
+            ("PRESSURE=1101", "PRESSURE must be between 300 and 1100, got 1101"),
+        ]
+        for item, sentence in cases:
+            with self.subTest(item=item):
+                with self.assertRaises(RuntimeError) as e:
+                    gdal.OpenEx(T.conn(self.dem), open_options=day + [item])
+                self.assertEqual(str(e.exception), "TERRASHADE: " + sentence)
+        # the bounds themselves are accepted, and the sun stays in the sky
+        for extreme in (["TEMPERATURE=-90", "PRESSURE=1100"], ["TEMPERATURE=60", "PRESSURE=300"]):
+            ds = gdal.OpenEx(T.conn(self.dem), open_options=[
+                "DATETIME=2026-06-21T06:00:00-04:00", "OUTPUT_TYPE=Float32"] + extreme)
+            el = float(ds.GetMetadataItem("SUN_ELEVATION"))
+            self.assertTrue(-90 <= el <= 90, el)
+            ds = None
+
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)

@@ -1,10 +1,16 @@
 """The QGIS Processing provider (plugin/qgis/terrashade), headless.
 
-- the plugin's classFactory registers the provider with every product;
+- the plugin's classFactory registers the provider with an algorithm per
+  single-raster product, under the ids users' scripts know;
+- every algorithm's parameters are the driver's: each open option that the
+  driver's product table (metadata TERRASHADE_PRODUCTS) lists for the
+  product is a parameter with the type, range, default and choices of the
+  driver's open-option list (DMD_OPENOPTIONLIST), and there is no other;
 - each algorithm writes what gdal_translate writes with the same options
-  (shade from an azimuth and from a date and time, svf, horizon, sunhours);
-- bad input gives a QgsProcessingException: QGIS's own for a missing
-  mandatory parameter, else the driver's sentence;
+  (shade from an azimuth and from a date and time, shadow with a choice and a
+  boolean, svf, horizon, sunhours), and the gdal_translate command it logs
+  writes the same pixels;
+- bad input gives a QgsProcessingException with the driver's sentence;
 - qgis_process, QGIS's command line, finds the plugin through
   QGIS_PLUGINPATH, lists its algorithms and runs one.
 
@@ -13,21 +19,34 @@ folder, so no user profile is read or written.
 """
 import json
 import os
+import shlex
 import subprocess
 import sys
 import unittest
+import xml.etree.ElementTree as ET
 
 import tsdriver as T
 from tsdriver import np
 
 PLUGINS = os.path.join(T.SRCDIR, "plugin", "qgis")
+ALGORITHMS = ["shade", "shadow", "horizon", "svf", "openness", "sky", "sunhours",
+              "insolation", "envlight"]
+# The provider's presentation rules (algorithms.py): a text option that is a
+# file, and one picked from a list (its first entry leaves it unset).
+FILE_OPTIONS = {"ENV_MAP"}
+PICKED = {"SKY": ["(none)", "uniform", "overcast", "clear"] + ["cie:%d" % n
+                                                             for n in range(1, 16)]}
+SUNSET = os.path.join(T.DATA, "envmaps", "sunset.exr")
+SET_BY_PROVIDER = {"PRODUCT", "PROGRESS"}  # the algorithm's product; QGIS's progress bar
+DBL_MAX = 1.7976931348623157e308  # QgsProcessingParameterNumber's bounds when unbounded
 
 CHILD = r"""
 import json, os, sys
 os.environ["QT_QPA_PLATFORM"] = "offscreen"
 sys.path.insert(0, sys.argv[1])
 sys.path.insert(0, "/usr/share/qgis/python/plugins")  # QGIS's own processing
-from qgis.core import (QgsApplication, QgsProcessingException, QgsProcessingFeedback)
+from qgis.core import (QgsApplication, QgsProcessingException, QgsProcessingFeedback,
+                       QgsProcessingParameterDefinition, QgsProcessingParameterNumber)
 app = QgsApplication([], False)
 app.setPrefixPath("/usr", True)
 app.initQgis()
@@ -38,12 +57,38 @@ import terrashade
 plugin = terrashade.classFactory(None)
 plugin.initProcessing()
 reg = QgsApplication.processingRegistry()
-result = {"algorithms": sorted(a.id() for a in reg.providerById("terrashade").algorithms())}
+provider = reg.providerById("terrashade")
+
+
+def describe(p):
+    d = {"type": p.type(), "default": p.defaultValue(),
+         "advanced": bool(p.flags() & QgsProcessingParameterDefinition.FlagAdvanced)}
+    if p.type() == "number":
+        d.update(minimum=p.minimum(), maximum=p.maximum(),
+                 integer=p.dataType() == QgsProcessingParameterNumber.Integer)
+    if p.type() == "enum":
+        d["options"] = p.options()
+    return d
+
+
+class Log(QgsProcessingFeedback):
+    def __init__(self):
+        super().__init__()
+        self.lines = []
+
+    def pushInfo(self, info):
+        self.lines.append(info)
+
+
+result = {"algorithms": sorted(a.id() for a in provider.algorithms()),
+          "problem": provider.warningMessage(),
+          "parameters": {a.name(): {p.name(): describe(p) for p in a.parameterDefinitions()}
+                         for a in provider.algorithms()}}
 for name, alg, params in json.loads(sys.argv[2]):
-    fb = QgsProcessingFeedback()
+    fb = Log()
     try:
         out = processing.run(alg, params, feedback=fb)
-        result[name] = {"output": out["OUTPUT"]}
+        result[name] = {"output": out["OUTPUT"], "log": fb.lines}
     except QgsProcessingException as e:
         result[name] = {"error": str(e)}
 plugin.unload()
@@ -53,10 +98,77 @@ sys.stdout.flush()
 os._exit(0)
 """
 
+J = T.JACKSBORO
+DAY = {"DATE": "2026-12-21", "TIMEZONE": "-05:00", "STEP_MINUTES": 30}
+# name, algorithm, its parameters, the same as gdal_translate's open options
+CASES = [
+    ("shade", "terrashade:shade",
+     {"INPUT": J, "SUN_AZIMUTH": 135, "SUN_ELEVATION": 20},
+     {"PRODUCT": "shade", "SUN_AZIMUTH": 135, "SUN_ELEVATION": 20}),
+    ("shade_time", "terrashade:shade",
+     {"INPUT": J, "DATETIME": "2026-12-21T09:00:00-05:00", "SKY_WEIGHT": 0.3,
+      "DIRECTIONS": 8},
+     {"PRODUCT": "shade", "DATETIME": "2026-12-21T09:00:00-05:00",
+      "SKY_WEIGHT": 0.3, "DIRECTIONS": 8}),
+    ("shadow_shm", "terrashade:shadow",  # a choice by its index, a boolean
+     {"INPUT": J, "SUN_ELEVATION": 15, "METHOD": 1, "PENUMBRA_DEPTH": 5,
+      "CURVATURE": False},
+     {"PRODUCT": "shadow", "SUN_ELEVATION": 15, "METHOD": "shm", "PENUMBRA_DEPTH": 5,
+      "CURVATURE": "NO"}),
+    ("svf", "terrashade:svf", {"INPUT": J, "DIRECTIONS": 8},
+     {"PRODUCT": "svf", "DIRECTIONS": 8}),
+    ("horizon", "terrashade:horizon", {"INPUT": J, "DIRECTIONS": 4},
+     {"PRODUCT": "horizon", "DIRECTIONS": 4}),
+    ("sunhours", "terrashade:sunhours", dict(DAY, INPUT=J),
+     dict(DAY, PRODUCT="sunhours")),
+    ("envlight", "terrashade:envlight",  # a file, a rotation
+     {"INPUT": J, "ENV_MAP": SUNSET, "ENV_ROTATION": 30, "DIRECTIONS": 8},
+     {"PRODUCT": "envlight", "ENV_MAP": SUNSET, "ENV_ROTATION": 30, "DIRECTIONS": 8}),
+    ("shade_sky", "terrashade:shade",  # a sky picked from the list: cie:9
+     {"INPUT": J, "SKY": 12, "SKY_WEIGHT": 0.5, "DIRECTIONS": 8},
+     {"PRODUCT": "shade", "SKY": "cie:9", "SKY_WEIGHT": 0.5, "DIRECTIONS": 8}),
+]
+BAD = [
+    ("no_date", "terrashade:sunhours", {"INPUT": J, "TIMEZONE": "-05:00"}),
+    ("bad_time", "terrashade:shade", {"INPUT": J, "DATETIME": "2026-12-21T09:00"}),
+]
+
 
 def qgis_env(home):
     return T.env(HOME=home, XDG_RUNTIME_DIR=home, QT_QPA_PLATFORM="offscreen",
                  QGIS_PLUGINPATH=PLUGINS)
+
+
+def driver_declares():
+    """({option: <Option> element}, {product: <Product> element}) of the driver,
+    read here from its metadata, independently of the plugin's reader."""
+    drv = T.gdal.GetDriverByName("TERRASHADE")
+    products = drv.GetMetadataItem("TERRASHADE_PRODUCTS")
+    if not products:
+        raise AssertionError("the driver has no metadata item TERRASHADE_PRODUCTS")
+    return ({e.get("name"): e for e in
+             ET.fromstring(drv.GetMetadataItem("DMD_OPENOPTIONLIST")).iter("Option")},
+            {e.get("name"): e for e in ET.fromstring(products).iter("Product")})
+
+
+def expected_parameter(option):
+    """What describe() in CHILD must say of the parameter of this <Option>."""
+    kind, default = option.get("type"), option.get("default")
+    if option.get("name") in FILE_OPTIONS:
+        return {"type": "file", "default": None}
+    if option.get("name") in PICKED:
+        return {"type": "enum", "options": PICKED[option.get("name")], "default": 0}
+    if kind in ("float", "int"):
+        return {"type": "number", "integer": kind == "int",
+                "minimum": float(option.get("min", -DBL_MAX)),
+                "maximum": float(option.get("max", DBL_MAX)),
+                "default": None if default in (None, "") else float(default)}
+    if kind == "boolean":
+        return {"type": "boolean", "default": default.upper() in ("YES", "TRUE", "ON", "1")}
+    if kind == "string-select":
+        values = [v.text for v in option.iter("Value")]
+        return {"type": "enum", "options": values, "default": values.index(default)}
+    return {"type": "string", "default": default or ""}
 
 
 class Processing(unittest.TestCase):
@@ -66,62 +178,83 @@ class Processing(unittest.TestCase):
         cls.dir = cls.tmp.__enter__()
         cls.home = os.path.join(cls.dir, "home")
         os.mkdir(cls.home, 0o700)
+        runs = [(n, a, dict(p, OUTPUT=cls.out(n))) for n, a, p, _ in CASES]
+        runs += [(n, a, dict(p, OUTPUT=cls.out(n))) for n, a, p in BAD]
+        p = subprocess.run([sys.executable, "-c", CHILD, PLUGINS, json.dumps(runs)],
+                           capture_output=True, text=True, timeout=600,
+                           env=qgis_env(cls.home))
+        lines = [l for l in p.stdout.splitlines() if l.startswith("RESULT ")]
+        cls.result = json.loads(lines[-1][len("RESULT "):]) if lines else None
+        cls.child = "QGIS produced no result (exit %d):\n%s\n%s" % (
+            p.returncode, p.stdout, p.stderr)
 
     @classmethod
     def tearDownClass(cls):
         cls.tmp.__exit__(None, None, None)
 
-    def out(self, name):
-        return os.path.join(self.dir, name + ".tif")
+    @classmethod
+    def out(cls, name):
+        return os.path.join(cls.dir, name + ".tif")
+
+    def setUp(self):
+        self.assertIsNotNone(self.result, self.child)
+
+    def test_algorithms_are_the_products(self):
+        r = self.result
+        print("algorithms:", r["algorithms"], r["problem"])
+        self.assertEqual(r["algorithms"], sorted("terrashade:" + a for a in ALGORITHMS))
+        self.assertEqual(r["problem"], "")
+        self.assertTrue(r["unloaded"])
+        # the products left out are the day products whose band count follows
+        # an option (time series), and only those
+        _, products = driver_declares()
+        for name, p in products.items():
+            series = p.get("daily") == "yes" and bool(p.get("bands_option"))
+            print("%-10s daily=%-3s bands=%s %-12s -> %s" % (
+                name, p.get("daily"), p.get("bands"), p.get("bands_option", ""),
+                "left out" if series else "algorithm"))
+            self.assertEqual(name not in ALGORITHMS, series, name)
+
+    def test_parameters_are_the_drivers_options(self):
+        options, products = driver_declares()
+        for alg in ALGORITHMS:
+            params = self.result["parameters"][alg]
+            listed = [n.strip() for n in products[alg].get("options").split(",") if n.strip()]
+            wanted = [n for n in listed if n not in SET_BY_PROVIDER]
+            with self.subTest(algorithm=alg):
+                self.assertEqual(sorted(set(wanted) - set(params)), [],
+                                 "options of the driver missing from terrashade:" + alg)
+                self.assertEqual(sorted(set(params) - set(wanted) - {"INPUT", "OUTPUT"}), [],
+                                 "parameters the driver does not list for " + alg)
+                for name in wanted:
+                    got = {k: params[name][k] for k in expected_parameter(options[name])}
+                    self.assertEqual(got, expected_parameter(options[name]),
+                                     "%s of terrashade:%s" % (name, alg))
+            print("%-10s %2d parameters = the driver's options, %d advanced" % (
+                alg, len(wanted), sum(params[n]["advanced"] for n in wanted if n in params)))
 
     def test_algorithms_equal_gdal_translate(self):
-        J = T.JACKSBORO
-        day = {"DATE": "2026-12-21", "TIMEZONE": "-05:00", "STEP_MINUTES": 30}
-        cases = [
-            ("shade", "terrashade:shade",
-             {"INPUT": J, "SUN_AZIMUTH": 135, "SUN_ELEVATION": 20},
-             {"PRODUCT": "shade", "SUN_AZIMUTH": 135, "SUN_ELEVATION": 20}),
-            ("shade_time", "terrashade:shade",
-             {"INPUT": J, "DATETIME": "2026-12-21T09:00:00-05:00", "SKY_WEIGHT": 0.3,
-              "DIRECTIONS": 8},
-             {"PRODUCT": "shade", "DATETIME": "2026-12-21T09:00:00-05:00",
-              "SKY_WEIGHT": 0.3, "DIRECTIONS": 8}),
-            ("svf", "terrashade:svf", {"INPUT": J, "DIRECTIONS": 8},
-             {"PRODUCT": "svf", "DIRECTIONS": 8}),
-            ("horizon", "terrashade:horizon", {"INPUT": J, "DIRECTIONS": 4},
-             {"PRODUCT": "horizon", "DIRECTIONS": 4}),
-            ("sunhours", "terrashade:sunhours", dict(day, INPUT=J),
-             dict(day, PRODUCT="sunhours")),
-        ]
-        bad = [
-            ("no_date", "terrashade:sunhours", {"INPUT": J, "TIMEZONE": "-05:00"}),
-            ("bad_time", "terrashade:shade", {"INPUT": J, "DATETIME": "2026-12-21T09:00"}),
-        ]
-        runs = [(n, a, dict(p, OUTPUT=self.out(n))) for n, a, p, _ in cases]
-        runs += [(n, a, dict(p, OUTPUT=self.out(n))) for n, a, p in bad]
-        p = subprocess.run([sys.executable, "-c", CHILD, PLUGINS, json.dumps(runs)],
-                           capture_output=True, text=True, timeout=600,
-                           env=qgis_env(self.home))
-        lines = [l for l in p.stdout.splitlines() if l.startswith("RESULT ")]
-        self.assertTrue(lines, "QGIS produced no result (exit %d):\n%s\n%s" % (
-            p.returncode, p.stdout, p.stderr))
-        result = json.loads(lines[-1][len("RESULT "):])
-        print("algorithms:", result["algorithms"])
-        self.assertEqual(result["algorithms"], sorted(
-            "terrashade:" + a for a in ("shade", "shadow", "horizon", "svf", "openness",
-                                        "sky", "sunhours", "insolation")))
-        self.assertTrue(result["unloaded"])
-        for name, _, _, options in cases:
+        result = self.result
+        for name, _, _, options in CASES:
             with self.subTest(case=name):
                 self.assertIn("output", result[name], result[name].get("error"))
                 got = T.read(result[name]["output"])
                 ref = T.read(T.translate(J, self.out(name + "_ref"), options))
-                print("%-10s %s, equal to gdal_translate" % (name, got.shape))
                 np.testing.assert_array_equal(got, ref)
-        for name, _, _ in bad:
+                # the command in the log, run as it is written, writes the same
+                same = [l for l in result[name]["log"] if l.startswith("Same as: ")]
+                self.assertEqual(len(same), 1, result[name]["log"])
+                args = shlex.split(same[0][len("Same as: "):])
+                self.assertEqual(args[-1], result[name]["output"])
+                T.run(args[:-1] + [self.out(name + "_log")])
+                np.testing.assert_array_equal(T.read(self.out(name + "_log")), ref)
+                print("%-10s %s, equal to gdal_translate and to: %s" % (
+                    name, got.shape, same[0][len("Same as: "):]))
+        for name, _, _ in BAD:
             print("%-10s -> %s" % (name, result[name].get("error")))
-        # a missing day: QGIS itself names the mandatory parameter
-        self.assertIn("DATE", result["no_date"].get("error", ""))
+        # no day: the driver's sentence names DATE (and DATETIME)
+        self.assertIn("TERRASHADE", result["no_date"].get("error", ""))
+        self.assertIn("DATE=YYYY-MM-DD", result["no_date"]["error"])
         # a time without an offset: the driver's sentence
         self.assertIn("TERRASHADE", result["bad_time"].get("error", ""))
         self.assertIn("offset", result["bad_time"]["error"])

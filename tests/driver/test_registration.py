@@ -53,17 +53,19 @@ class Registration(unittest.TestCase):
             o = opts[name]
             self.assertTrue(o.get("description"), name)
             self.assertIsNotNone(o.get("default"), name)
-            self.assertIn(o.get("type"), ("float", "int", "boolean",
-                                          "string-select"), name)
+            # Z_FACTOR: AUTO or a number, a string for GDAL
+            self.assertIn(o.get("type"), ("float", "int", "boolean", "string-select")
+                          + (("string",) if name == "Z_FACTOR" else ()), name)
             if o.get("type") in ("float", "int"):
                 self.assertIsNotNone(o.get("min"), name)
             if o.get("type") == "string-select":
                 self.assertIn(o.get("default"), [v.text for v in o], name)
         self.assertEqual(opts["SUN_AZIMUTH"].get("default"), "315")
         self.assertEqual(opts["SUN_ELEVATION"].get("default"), "45")
+        self.assertEqual(opts["Z_FACTOR"].get("default"), "AUTO")
         self.assertEqual([v.text for v in opts["PRODUCT"]],
                          ["shade", "shadow", "horizon", "svf", "openness", "sky",
-                          "sunhours", "insolation", "daycycle", "farshadow"])
+                          "sunhours", "insolation", "daycycle", "farshadow", "envlight"])
         for name in ("DATETIME", "DATE", "TIMEZONE", "STEP_MINUTES", "PRESSURE",
                      "TEMPERATURE", "DELTA_T", "SUN_POSITION", "LINKE_TURBIDITY",
                      "FAR_THRESHOLD", "ATLAS_STEPS", "SUNHOURS_RULE", "PROGRESS", "SHADOWS",

@@ -378,7 +378,7 @@ class Sun(unittest.TestCase):
             (J, ["PRODUCT=sunhours", "OUTPUT_TYPE=Byte"] + day, "in hours"),
             (J, ["PRODUCT=farshadow", "SUN_POSITION=per_cell"] + day, "SUN_POSITION=center"),
             (J, ["PRODUCT=shadow", "SUN_POSITION=per_cell"], "needs the sun from DATETIME"),
-            (J, ["PRODUCT=sunhours", "PRESSURE=0"] + day, "PRESSURE must be greater than 0"),
+            (J, ["PRODUCT=sunhours", "PRESSURE=0"] + day, "PRESSURE must be between 300 and 1100"),
             (J, ["PRODUCT=sunhours", "TEMPERATURE=-300"] + day, "TEMPERATURE must be"),
             (J, ["PRODUCT=sunhours", "DELTA_T=9000"] + day, "DELTA_T must be between"),
             (J, ["PRODUCT=sunhours", "STEP_MINUTES=0"] + day, "STEP_MINUTES must be between"),

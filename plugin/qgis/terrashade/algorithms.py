@@ -1,119 +1,123 @@
-"""Processing algorithms: one per TERRASHADE product.
+"""Processing algorithms: one per single-raster TERRASHADE product.
 
-Each algorithm turns its parameters into the driver's open options, opens
-TERRASHADE:<dem> through GDAL and writes the result with gdal.Translate, so
-it gives exactly what `gdal_translate -oo ... TERRASHADE:dem out.tif` gives.
-The options, their ranges and their meaning are the driver's
-(docs/driver.md); the tables below only say which product shows which.
+The algorithms and their parameters are built when the provider loads, from
+what the driver declares (driver_tables.py): a product of the driver's
+product table is an algorithm terrashade:<product>, and each open option the
+table lists for it is a parameter with the option's name, type, range,
+default, choices and description. Each algorithm turns its parameters back
+into open options, opens TERRASHADE:<dem> through GDAL and writes the result
+with gdal.Translate, so it gives exactly what `gdal_translate -oo ...
+TERRASHADE:dem out.tif` gives. Only presentation is written here.
 """
 import os
 import shlex
+import sys
 
 from osgeo import gdal
-from qgis.core import (QgsProcessing, QgsProcessingAlgorithm, QgsProcessingException,
+from qgis.core import (QgsProcessingAlgorithm, QgsProcessingException,
                        QgsProcessingParameterBoolean, QgsProcessingParameterDefinition,
-                       QgsProcessingParameterEnum, QgsProcessingParameterNumber,
+                       QgsProcessingParameterEnum, QgsProcessingParameterFile,
+                       QgsProcessingParameterNumber,
                        QgsProcessingParameterRasterDestination,
                        QgsProcessingParameterRasterLayer, QgsProcessingParameterString,
                        QgsRasterFileWriter)
 
-DRIVER = "TERRASHADE"
+from .driver_tables import DRIVER, is_yes, read_driver, single_raster
 
-# name: (kind, label, default, extra, advanced)
-#   kind "float"/"int": extra = (minimum, maximum); "enum": extra = values
-#   (the first is the default); "text": extra = optional (True: may be empty)
-OPTIONS = {
-    "SUN_AZIMUTH": ("float", "Sun azimuth (degrees clockwise from north)", 315.0,
-                    (0.0, 360.0), False),
-    "SUN_ELEVATION": ("float", "Sun elevation (degrees above the horizontal)", 45.0,
-                      (-90.0, 90.0), False),
-    "DATETIME": ("text", "Date and time instead of azimuth and elevation (ISO 8601 with "
-                 "an offset, e.g. 2026-06-21T07:30:00+02:00)", "", True, False),
-    "METHOD": ("enum", "Shadow method", None, ["exact", "shm"], False),
-    "PENUMBRA_DEPTH": ("float", "Penumbra depth of METHOD=shm (metres, 0 = hard)", 0.0,
-                       (0.0, 1e6), True),
-    "SKY_WEIGHT": ("float", "Weight of the light of a uniform sky", 0.0, (0.0, 1.0), False),
-    "DIRECTIONS": ("int", "Number of azimuths", 16, (1, 3600), False),
-    "START_AZIMUTH": ("float", "First azimuth (degrees from north)", 0.0, (0.0, 360.0),
-                      True),
-    "OUTPUT_TYPE": ("enum", "Data type", None, ["AUTO", "Byte", "Float32"], True),
-    "DATE": ("text", "Day (YYYY-MM-DD, local to the time zone)", "", False, False),
-    "TIMEZONE": ("text", "Offset from UTC of the local day (e.g. +02:00, -05:00, Z)", "",
-                 False, False),
-    "STEP_MINUTES": ("int", "Time step (minutes)", 5, (1, 240), False),
-    "SUNHOURS_RULE": ("enum", "What a time step counts", None, ["visible", "fraction"],
-                      True),
-    "LINKE_TURBIDITY": ("float", "Linke turbidity of the clear sky", 3.0, (1.0, 10.0),
-                        False),
-    "SUN_POSITION": ("enum", "Where the sun is computed from", None, ["center", "per_cell"],
-                     True),
-    "PRESSURE": ("float", "Mean air pressure (hPa, refraction of the sun)", 1013.25,
-                 (1.0, 5000.0), True),
-    "TEMPERATURE": ("float", "Mean air temperature (degrees Celsius, refraction)", 15.0,
-                    (-272.0, 6000.0), True),
-    # common to every product
-    "BAND": ("int", "DEM band holding the heights", 1, (1, 65536), True),
-    "Z_FACTOR": ("float", "Z factor (multiplies the heights, e.g. 0.3048 for feet)", 1.0,
-                 (1e-9, 1e6), True),
-    "MAX_DISTANCE": ("float", "Largest shadow-casting distance (metres, 0 = unbounded)", 0.0,
-                     (0.0, 1e8), True),
-    "CURVATURE": ("bool", "Earth curvature and refraction", True, None, True),
-    "REFRACTION": ("float", "Refraction coefficient k", 0.13, (0.0, 1.0), True),
-    "THREADS": ("int", "Worker threads (0 = one per core)", 0, (0, 1024), True),
-    "BACKEND": ("enum", "Backend", None, ["auto", "opencl", "c"], True),
+# Open options the provider sets itself, never parameters: the algorithm is the
+# product, and QGIS shows the progress in its own bar.
+FIXED = ("PRODUCT", "PROGRESS")
+# Options shown outside "Advanced parameters"; every other one (a new one too)
+# is advanced.
+BASIC = ("SUN_AZIMUTH", "SUN_ELEVATION", "DATETIME", "METHOD", "SKY_WEIGHT", "DIRECTIONS",
+         "DATE", "TIMEZONE", "STEP_MINUTES", "LINKE_TURBIDITY", "ENV_MAP", "SKY",
+         "ENV_ROTATION")
+# Text options better picked than typed: a file (its filter), and a list of
+# values (a choice whose first entry, NONE, leaves the option unset).
+FILES = {"ENV_MAP": "OpenEXR environment maps (*.exr *.EXR)"}
+NONE = "(none)"
+PICKS = {"SKY": ["uniform", "overcast", "clear"] + ["cie:%d" % n for n in range(1, 16)]}
+# Short labels where the description's first clause is too long (see label()).
+LABELS = {
+    "DIRECTIONS": "Number of azimuths",
+    "SKY_WEIGHT": "Weight of the light of a uniform sky",
+    "DATETIME": "Date and time (ISO 8601 with an offset)",
+    "DATE": "Day (YYYY-MM-DD, local to the time zone)",
+    "STEP_MINUTES": "Time step (minutes)",
+    "Z_FACTOR": "Z factor (multiplies the heights, e.g. 0.3048 for feet)",
+    "BACKEND": "Backend",
+    "ENV_MAP": "Environment map (OpenEXR, lat-long or cube)",
+    "SKY": "Standard sky (CIE)",
 }
-COMMON = ["BAND", "Z_FACTOR", "MAX_DISTANCE", "CURVATURE", "REFRACTION", "THREADS",
-          "BACKEND"]
-SUN = ["SUN_AZIMUTH", "SUN_ELEVATION", "DATETIME", "PRESSURE", "TEMPERATURE"]
-DAY = ["DATE", "TIMEZONE", "STEP_MINUTES", "SUN_POSITION", "PRESSURE", "TEMPERATURE"]
-
-# product: (display name, help, option names)
-PRODUCTS = [
-    ("shade", "Hillshade with cast shadows",
-     "Sun-lit relief as gdaldem hillshade (Horn normals, Lambert), times the visible "
-     "fraction of the sun's disk above each cell's exact horizon: real cast shadows with "
-     "penumbrae. Byte 1..255 by default (0 = nodata).",
-     SUN + ["METHOD", "SKY_WEIGHT", "DIRECTIONS", "OUTPUT_TYPE"]),
-    ("shadow", "Cast shadows",
-     "Visible fraction of the sun's disk, 0 (full shadow) to 1 (lit).",
-     SUN + ["METHOD", "PENUMBRA_DEPTH", "OUTPUT_TYPE"]),
-    ("horizon", "Horizon angles",
-     "One band per azimuth: the elevation angle of the horizon in degrees.",
-     ["DIRECTIONS", "START_AZIMUTH"]),
-    ("svf", "Sky-view factor",
-     "Cosine-weighted visible fraction of the sky, 0..1 (1 on an open plane).",
-     ["DIRECTIONS", "START_AZIMUTH", "OUTPUT_TYPE"]),
-    ("openness", "Positive openness",
-     "Mean of 90 degrees minus the horizon angle over the azimuths, degrees.",
-     ["DIRECTIONS", "START_AZIMUTH"]),
-    ("sky", "Sky light",
-     "Irradiance from a uniform sky of unit radiance, 0..1.",
-     ["DIRECTIONS", "START_AZIMUTH", "OUTPUT_TYPE"]),
-    ("sunhours", "Hours of sun",
-     "Hours of direct sun on a day, cast shadows included: on a flat open plane the "
-     "astronomical day length.",
-     DAY + ["SUNHOURS_RULE"]),
-    ("insolation", "Clear-sky insolation",
-     "Clear-sky irradiation of a day in Wh/m2 on each cell's own slope (ESRA model): "
-     "band 1 global, band 2 beam, band 3 diffuse.",
-     DAY + ["LINKE_TURBIDITY", "DIRECTIONS"]),
-]
+# Titles of the algorithms; a product not here is titled by its description.
+TITLES = {"shade": "Hillshade with cast shadows", "shadow": "Cast shadows",
+          "horizon": "Horizon angles", "svf": "Sky-view factor",
+          "openness": "Positive openness", "sky": "Sky light", "sunhours": "Hours of sun",
+          "insolation": "Clear-sky insolation", "envlight": "Environment light"}
+BYTE_HELP = {
+    "auto": "Byte 1..255 by default (0 = nodata); OUTPUT_TYPE=Float32 for the values.",
+    "allowed": "Float32 by default; OUTPUT_TYPE=Byte scales it to 1..255 (0 = nodata).",
+    "always": "Byte.",
+    "never": "Float32.",
+}
 
 
-def driver_loaded():
-    return gdal.GetDriverByName(DRIVER) is not None
+def first_clause(text):
+    """The description up to its first ';', ': ' or ', e.g.', without a short
+    scope prefix such as 'shade only: ' or 'METHOD=shm: ', capitalised."""
+    head = text.split("; ")[0]
+    parts = head.split(": ")
+    scope = parts[0]
+    if len(parts) > 1 and len(scope.split()) <= 2 and (scope[:1].islower() or "=" in scope):
+        parts = parts[1:]
+    clause = parts[0].split(", e.g.")[0].strip()
+    return clause[:1].upper() + clause[1:]
 
 
-def option_text(kind, value, extra):
-    if kind == "bool":
-        return "YES" if value else "NO"
-    if kind == "enum":
-        return extra[value]
-    if kind == "int":
-        return str(int(value))
-    if kind == "float":
-        return repr(float(value))
-    return str(value).strip()
+def label(option):
+    return LABELS.get(option.name) or first_clause(option.description) or option.name
+
+
+def default_value(option):
+    """The option's declared default as the parameter's Python value."""
+    d = option.default
+    if option.kind == "bool":
+        return is_yes(d)
+    if option.kind == "choice":
+        return option.values.index(d) if d in option.values else None
+    if d is None or d == "":
+        return None if option.kind in ("float", "int") else ""
+    return {"float": float, "int": int}.get(option.kind, str)(d)
+
+
+def make_parameter(option):
+    name, text, default = option.name, label(option), default_value(option)
+    if option.kind in ("float", "int"):
+        bounds = [-sys.float_info.max if option.minimum is None else option.minimum,
+                  sys.float_info.max if option.maximum is None else option.maximum]
+        p = QgsProcessingParameterNumber(
+            name, text, QgsProcessingParameterNumber.Double if option.kind == "float"
+            else QgsProcessingParameterNumber.Integer, default, False, *bounds)
+    elif option.kind == "bool":
+        p = QgsProcessingParameterBoolean(name, text, default)
+    elif option.kind == "choice":
+        p = QgsProcessingParameterEnum(name, text, option.values, False, default)
+    elif name in FILES:
+        p = QgsProcessingParameterFile(name, text, QgsProcessingParameterFile.File, "", None,
+                                       True, FILES[name])
+    elif name in PICKS:
+        p = QgsProcessingParameterEnum(name, text, [NONE] + PICKS[name], False, 0, True)
+    else:  # empty text: the option is not given
+        p = QgsProcessingParameterString(name, text, default, False, True)
+    p.setHelp(option.description)
+    if name not in BASIC:
+        p.setFlags(p.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
+    return p
+
+
+def number_text(value):
+    text = repr(float(value))
+    return text[:-2] if text.endswith(".0") else text
 
 
 def command_line(dem, options, out):
@@ -128,11 +132,8 @@ def command_line(dem, options, out):
 def translate(dem, options, out, feedback=None):
     """gdal_translate -oo ... TERRASHADE:dem out, with the feedback's
     progress and cancellation; raises QgsProcessingException on failure."""
-    if not driver_loaded():
-        raise QgsProcessingException(
-            "The TERRASHADE GDAL driver is not loaded. Install gdal_TERRASHADE.so into "
-            "GDAL's plugin folder (make install), or start QGIS with GDAL_DRIVER_PATH "
-            "set to the folder that holds it.")
+    if gdal.GetDriverByName(DRIVER) is None:
+        raise QgsProcessingException("The TERRASHADE GDAL driver is not loaded any more.")
     gdal.ErrorReset()
     ds = gdal.OpenEx("%s:%s" % (DRIVER, dem), gdal.OF_RASTER,
                      open_options=["%s=%s" % kv for kv in options.items()])
@@ -162,70 +163,77 @@ def translate(dem, options, out, feedback=None):
 
 
 class TerrashadeAlgorithm(QgsProcessingAlgorithm):
-    def __init__(self, product, title, help_text, names):
+    def __init__(self, product, options):
+        """product: a driver_tables.Product; options: its Options, in order."""
         super().__init__()
-        self.product, self.title, self.help_text = product, title, help_text
-        self.names = list(dict.fromkeys(names + COMMON))  # once each, in order
+        self.product, self.options_used = product, options
 
     def createInstance(self):  # noqa: N802 (QGIS's names from here on)
-        return TerrashadeAlgorithm(self.product, self.title, self.help_text, self.names)
+        return TerrashadeAlgorithm(self.product, self.options_used)
 
     def name(self):
-        return self.product
+        return self.product.name
 
     def displayName(self):  # noqa: N802
-        return self.title
+        return TITLES.get(self.product.name) or first_clause(self.product.description)
 
     def group(self):
-        return "Sun and time" if self.product in ("sunhours", "insolation") else "Terrain"
+        return "Sun and time" if self.product.daily else "Terrain"
 
     def groupId(self):  # noqa: N802
-        return "day" if self.product in ("sunhours", "insolation") else "terrain"
+        return "day" if self.product.daily else "terrain"
 
     def shortHelpString(self):  # noqa: N802
-        return (self.help_text + "\n\nRuns the TERRASHADE GDAL driver with PRODUCT=%s; "
-                "the options are the driver's (docs/driver.md)." % self.product)
+        p = self.product
+        bands = p.bands + (" (set by %s)" % p.bands_option if p.bands_option else "")
+        text = p.description[:1].upper() + p.description[1:]
+        return ("%s.\n\nUnit: %s. Bands: %s. %s\n\nRuns the TERRASHADE GDAL driver with "
+                "PRODUCT=%s; the parameters are the driver's open options (docs/driver.md)."
+                % (text.rstrip("."), p.unit or "none", bands, BYTE_HELP.get(p.byte, ""),
+                   p.name))
 
     def initAlgorithm(self, config=None):  # noqa: N802
         self.addParameter(QgsProcessingParameterRasterLayer(
             "INPUT", "Elevation model (DEM)"))
-        for name in self.names:
-            kind, label, default, extra, advanced = OPTIONS[name]
-            if kind in ("float", "int"):
-                p = QgsProcessingParameterNumber(
-                    name, label, QgsProcessingParameterNumber.Double if kind == "float"
-                    else QgsProcessingParameterNumber.Integer, default, False, *extra)
-            elif kind == "bool":
-                p = QgsProcessingParameterBoolean(name, label, default)
-            elif kind == "enum":
-                p = QgsProcessingParameterEnum(name, label, extra, False, 0)
-            else:
-                p = QgsProcessingParameterString(name, label, default, False, extra)
-            if advanced:
-                p.setFlags(p.flags() | QgsProcessingParameterDefinition.FlagAdvanced)
-            self.addParameter(p)
-        self.addParameter(QgsProcessingParameterRasterDestination("OUTPUT", self.title))
+        for option in self.options_used:
+            self.addParameter(make_parameter(option))
+        self.addParameter(QgsProcessingParameterRasterDestination(
+            "OUTPUT", self.displayName()))
 
-    def options(self, parameters, context):
+    def option_text(self, option, parameters, context):
+        """The open option a parameter stands for, or None for the driver's default."""
+        name, kind = option.name, option.kind
+        if name in PICKS:
+            v = self.parameterAsEnum(parameters, name, context)
+            return PICKS[name][v - 1] if v > 0 else None
+        if name in FILES:
+            text = (self.parameterAsFile(parameters, name, context) or "").strip()
+            return text or None
+        if kind == "choice":
+            v = self.parameterAsEnum(parameters, name, context)
+            text = option.values[v]
+        elif kind == "bool":
+            v = self.parameterAsBool(parameters, name, context)
+            text = "YES" if v else "NO"
+        elif kind == "float":
+            v = self.parameterAsDouble(parameters, name, context)
+            text = number_text(v)
+        elif kind == "int":
+            v = self.parameterAsInt(parameters, name, context)
+            text = str(v)
+        else:
+            v = text = (self.parameterAsString(parameters, name, context) or "").strip()
+            if not text:
+                return None
+        return None if v == default_value(option) else text
+
+    def open_options(self, parameters, context):
         """The driver's open options these parameters stand for."""
-        opts = {"PRODUCT": self.product, "PROGRESS": "no"}
-        for name in self.names:
-            kind, _, _, extra, _ = OPTIONS[name]
-            if kind == "float":
-                v = self.parameterAsDouble(parameters, name, context)
-            elif kind == "int":
-                v = self.parameterAsInt(parameters, name, context)
-            elif kind == "bool":
-                v = self.parameterAsBool(parameters, name, context)
-            elif kind == "enum":
-                v = self.parameterAsEnum(parameters, name, context)
-            else:
-                v = self.parameterAsString(parameters, name, context)
-                if not v or not v.strip():
-                    continue
-            if (v == 0 if kind == "enum" else v == OPTIONS[name][2]):
-                continue  # the driver's default: no need to say it
-            opts[name] = option_text(kind, v, extra)
+        opts = {"PRODUCT": self.product.name, "PROGRESS": "no"}
+        for option in self.options_used:
+            text = self.option_text(option, parameters, context)
+            if text is not None:
+                opts[option.name] = text
         if "DATETIME" in opts:  # the date and time place the sun
             opts.pop("SUN_AZIMUTH", None)
             opts.pop("SUN_ELEVATION", None)
@@ -241,13 +249,18 @@ class TerrashadeAlgorithm(QgsProcessingAlgorithm):
                 "The elevation model must be a raster file read through GDAL (got %s, "
                 "provider %s)." % (dem, layer.providerType()))
         out = self.parameterAsOutputLayer(parameters, "OUTPUT", context)
-        opts = self.options(parameters, context)
+        opts = self.open_options(parameters, context)
         feedback.pushInfo("Same as: " + command_line(dem, opts, out))
         feedback.pushInfo("Computing %s on the whole DEM first; the progress bar moves "
-                          "while the result is written." % self.product)
+                          "while the result is written." % self.product.name)
         translate(dem, opts, out, feedback)
         return {"OUTPUT": out}
 
 
 def make_algorithms():
-    return [TerrashadeAlgorithm(*p) for p in PRODUCTS]
+    """One algorithm per single-raster product of the loaded driver; raises
+    DriverError when the driver is missing or does not describe itself."""
+    options, products = read_driver()
+    return [TerrashadeAlgorithm(p, [options[n] for n in p.options if n not in FIXED])
+            for p in products if single_raster(p)]
+

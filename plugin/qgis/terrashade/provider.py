@@ -1,10 +1,15 @@
-"""The terrashade Processing provider: one algorithm per product."""
-from qgis.core import QgsProcessingProvider
+"""The terrashade Processing provider: one algorithm per product of the driver."""
+from qgis.core import Qgis, QgsMessageLog, QgsProcessingProvider
 
 from .algorithms import make_algorithms
+from .driver_tables import DriverError
 
 
 class TerrashadeProvider(QgsProcessingProvider):
+    def __init__(self):
+        super().__init__()
+        self.problem = ""  # why no algorithm could be built, if so
+
     def id(self):
         return "terrashade"
 
@@ -14,6 +19,16 @@ class TerrashadeProvider(QgsProcessingProvider):
     def longName(self):  # noqa: N802 (QGIS's name)
         return "terrashade: terrain shading with cast shadows"
 
+    def warningMessage(self):  # noqa: N802
+        return self.problem
+
     def loadAlgorithms(self):  # noqa: N802
-        for alg in make_algorithms():
+        try:
+            algorithms = make_algorithms()
+        except DriverError as e:  # QGIS starts anyway; the log says what to do
+            self.problem = str(e)
+            QgsMessageLog.logMessage(self.problem, "terrashade", Qgis.Warning)
+            return
+        self.problem = ""
+        for alg in algorithms:
             self.addAlgorithm(alg)

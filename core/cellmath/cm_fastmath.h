@@ -1,18 +1,22 @@
-/* Small branch-free math that the compiler can vectorise (glibc's libm
- * calls cannot be). Accuracy is stated per function. */
-#ifndef TS_FASTMATH_H
-#define TS_FASTMATH_H
+/*
+ * cm_fastmath.h - small branch-free math, the same in both backends: the C
+ * compiler vectorises it (glibc's libm calls cannot be), and the kernels
+ * round exactly as the C code. Accuracy is stated per function.
+ */
+#ifndef TS_CM_FASTMATH_H
+#define TS_CM_FASTMATH_H
 
-#include <math.h>
+#include "cm_prelude.h"
 
 #define TS_RAD2DEG_F 57.295779513082321f
+#define TS_DEG2RAD_F 0.017453292519943295f
 #define TS_PI_2_F 1.57079632679f
 
 /* atan(s) in radians, max error 5e-8 rad; +-inf -> +-pi/2, NaN -> NaN.
  * Odd least-squares polynomial on [0, 1], atan(1/x) identity beyond. */
-static inline float ts_atanf(float s)
+CM_FN float ts_atanf(float s)
 {
-    float a = fabsf(s);
+    float a = CM_FABSF(s);
     int big = a > 1.0f;
     float inv = 1.0f / a; /* always computed: a select, not a branch */
     float x = big ? inv : a;
@@ -27,11 +31,11 @@ static inline float ts_atanf(float s)
     p = p * x2 + 9.999993225e-01f;
     p *= x;
     p = big ? TS_PI_2_F - p : p;
-    return copysignf(p, s);
+    return CM_COPYSIGNF(p, s);
 }
 
 /* atan(s) in degrees, max error 3e-6 deg. */
-static inline float ts_atan_deg(float s)
+CM_FN float ts_atan_deg(float s)
 {
     return ts_atanf(s) * TS_RAD2DEG_F;
 }
@@ -39,7 +43,7 @@ static inline float ts_atan_deg(float s)
 /* sin and cos of x in [0, pi] (zenith angles), max error 1e-7, from
  * polynomials in y = x - pi/2 on [-pi/2, pi/2]: sin x = cos y,
  * cos x = -sin y. */
-static inline void ts_sincos_0_pi(float x, float *s, float *c)
+CM_FN void ts_sincos_0_pi(float x, float *s, float *c)
 {
     float y = x - TS_PI_2_F, y2 = y * y;
     float sy = -2.3843565983e-08f;
@@ -57,18 +61,6 @@ static inline void ts_sincos_0_pi(float x, float *s, float *c)
     cy = cy * y2 + 1.0f;
     *s = cy;
     *c = -sy;
-}
-
-/* Visible fraction of the sun's disk for u = (elevation - horizon) / radius:
- * the area of a unit disk above a chord at height -u, over pi. */
-static inline float ts_disk_fraction_u(float u)
-{
-    float uc = u > 1.0f ? 1.0f : u < -1.0f ? -1.0f : u;
-    float r = sqrtf(1.0f - uc * uc);
-    /* asin(uc) = atan(uc / r), and +-pi/2 where r is 0 */
-    float q = uc / (r > 0.0f ? r : 1.0f);
-    float as = r > 0.0f ? ts_atanf(q) : copysignf(TS_PI_2_F, uc);
-    return 0.5f + (uc * r + as) * 0.318309886f;
 }
 
 #endif

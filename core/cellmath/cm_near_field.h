@@ -1,0 +1,323 @@
+/*
+ * cm_near_field.h - the exact near field of a cell's horizon, on the
+ * bilinear surface through the cell centres (see core/near_field.h): along
+ * a straight ray the surface is quadratic in the distance s inside each
+ * cell patch, so the largest slope per patch has a closed form. Distances
+ * s are in steps along the sweep's major axis u; the ray from cell (k, i)
+ * passes (k - s, i - t s) in (u, v).
+ */
+#ifndef TS_CM_NEAR_FIELD_H
+#define TS_CM_NEAR_FIELD_H
+
+#include "cm_prelude.h"
+
+/* Cells of the ray solved exactly, then whole-step samples up to
+ * TS_NEAR_STEPS; the sweep's hulls cover what lies beyond. */
+#define TS_NEAR_EXACT 4
+#define TS_NEAR_STEPS 10
+#define TS_NEAR_MAX_PIECES (2 * TS_NEAR_EXACT + 2)
+/* Cells at least this far from every edge have their whole near field on
+ * the grid. */
+#define TS_NEAR_MARGIN (TS_NEAR_STEPS + 2)
+
+/* The grid as a sweep direction sees it: element (u, v) of the direction
+ * is z[origin + k u_stride + v v_stride] for step k; t: v per step. */
+typedef struct {
+    const CM_GLOBAL float *z;
+    int V;
+    cm_real t;
+    long origin, u_stride, v_stride;
+} cm_ray_grid;
+
+/* One direction's near-field plan (ts_near_plan_init): piece n of the ray,
+ * [sa[n], sb[n]] steps, lies in the patch with corner (k + du[n],
+ * i + dv[n]); whole step j is interpolated at v offset sdv[j] + sfv[j]. */
+typedef struct {
+    int npieces;
+    const CM_GLOBAL int *du, *dv;
+    const CM_GLOBAL cm_real *sa, *sb;
+    const CM_GLOBAL int *sdv;
+    const CM_GLOBAL cm_real *sfv;
+} cm_near_tables;
+
+/* Bilinear height at (a, b) of a patch (corners 00, 10, 01, 11) from the
+ * corners that weigh something there; NaN if one of those is nodata. */
+CM_FN cm_real cm_edge_height(float h0, float h1, float h2, float h3, cm_real a, cm_real b)
+{
+    const cm_real eps = CM_R(1e-9);
+    a = a < eps ? 0 : a > 1 - eps ? 1 : a;
+    b = b < eps ? 0 : b > 1 - eps ? 1 : b;
+    const cm_real w0 = (1 - a) * (1 - b), w1 = a * (1 - b), w2 = (1 - a) * b, w3 = a * b;
+    cm_real sum = 0;
+    if (w0 > 0)
+        sum += w0 * h0; /* a NaN corner makes the sum NaN */
+    if (w1 > 0)
+        sum += w1 * h1;
+    if (w2 > 0)
+        sum += w2 * h2;
+    if (w3 > 0)
+        sum += w3 * h3;
+    return sum;
+}
+
+/* Slope (with the curvature term -c d) to h(s) = h0 + P + beta s +
+ * gamma s^2 at s steps of L metres. */
+CM_FN cm_real cm_slope_at(cm_real P, cm_real beta, cm_real gamma, cm_real s, cm_real L,
+                          cm_real c)
+{
+    return (P + beta * s + gamma * s * s) / (s * L) - c * s * L;
+}
+
+/* Largest slope over s in [sa, sb]; at sa = 0 the limit beta / L. */
+CM_FN cm_real cm_piece_max(cm_real P, cm_real beta, cm_real gamma, cm_real sa, cm_real sb,
+                           cm_real L, cm_real c)
+{
+    cm_real fb = cm_slope_at(P, beta, gamma, sb, L, c);
+    cm_real fa = sa > 0 ? cm_slope_at(P, beta, gamma, sa, L, c) : beta / L;
+    cm_real m = fa > fb ? fa : fb;
+    cm_real g2 = gamma - c * L * L;
+    if (sa > 0 && P < 0 && g2 < 0) {
+        cm_real ss = sqrt(P / g2);
+        if (ss > sa && ss < sb) {
+            cm_real fs = cm_slope_at(P, beta, gamma, ss, L, c);
+            m = fs > m ? fs : m;
+        }
+    }
+    return m;
+}
+
+/* h(s) = alpha + beta s + gamma s^2 along the ray in a patch with corner
+ * height h00 and A = h10 - h00, B = h01 - h00, X = h11 - h10 - h01 + h00,
+ * the cell at local coordinates (a0, b0), t: v per step. */
+CM_FN void cm_patch_poly(cm_real h00, cm_real A, cm_real B, cm_real X, cm_real a0, cm_real b0,
+                         cm_real t, cm_real *alpha, cm_real *beta, cm_real *gamma)
+{
+    *alpha = h00 + A * a0 + B * b0 + X * a0 * b0;
+    *beta = -(A + B * t + X * (a0 * t + b0));
+    *gamma = X * t;
+}
+
+/* Largest slope from a cell at height h over the piece [sa, sb] of its ray
+ * in the patch with corners hc0..hc3 (00, 10, 01, 11), the cell at local
+ * (a0, b0). A patch touching nodata is no terrain, but for its end points
+ * on a grid line, whose only corners may be valid; -inf if nothing. */
+CM_FN cm_real cm_near_piece(float hc0, float hc1, float hc2, float hc3, cm_real a0, cm_real b0,
+                            cm_real t, cm_real sa, cm_real sb, float h, cm_real L, cm_real c)
+{
+    if (isnan(hc0) || isnan(hc1) || isnan(hc2) || isnan(hc3)) {
+        cm_real best = -INFINITY;
+        for (int e = 0; e < 2; e++) {
+            cm_real se = e ? sb : sa;
+            if (se <= 0)
+                continue;
+            cm_real he = cm_edge_height(hc0, hc1, hc2, hc3, a0 - se, b0 - t * se);
+            cm_real sl = (he - h) / (se * L) - c * se * L; /* NaN on nodata */
+            best = sl > best ? sl : best;
+        }
+        return best;
+    }
+    float A = hc1 - hc0, B = hc2 - hc0, X = hc3 - hc1 - hc2 + hc0;
+    cm_real alpha, beta, gamma;
+    cm_patch_poly(hc0, A, B, X, a0, b0, t, &alpha, &beta, &gamma);
+    return cm_piece_max(alpha - h, beta, gamma, sa, sb, L, c);
+}
+
+/* Slope to a whole-step sample between heights va and vb (fraction f) at
+ * d metres; NaN if either is nodata. */
+CM_FN cm_real cm_sample_slope(float va, float vb, float f, float h, cm_real d, cm_real c)
+{
+    float hj = va + f * (vb - va);
+    return (hj - h) / d - c * d;
+}
+
+/*
+ * Exact near field of cell (k, i) at height h: the largest slope over its
+ * pieces, then its whole-step samples, within cap metres (0 = none); step:
+ * metres per step; -inf if none. *left: the ray leaves the grid inside the
+ * near field (what was found up to there is returned).
+ */
+CM_FN float cm_near_exact(const cm_ray_grid *r, const cm_near_tables *q, int k, int i, float h,
+                          cm_real step, cm_real c, cm_real cap, int *left)
+{
+    const cm_real smax = cap > 0 ? cap / step : (cm_real)INFINITY; /* in steps */
+    const int V = r->V, flat_v = fabs(r->t) <= CM_R(1e-12); /* flat: along a grid line */
+    const cm_real t = flat_v ? 0 : r->t;
+    cm_real best = -INFINITY;
+    *left = 0;
+    for (int n = 0; n < q->npieces; n++) {
+        int k0 = k + q->du[n], r0 = i + q->dv[n];
+        if (k0 < 0 || r0 < 0 || r0 > V - 1 || (!flat_v && r0 + 1 > V - 1)) {
+            *left = 1;
+            return (float)best;
+        }
+        if (q->sa[n] >= smax)
+            break;
+        const CM_GLOBAL float *zz = r->z + r->origin + (long)k0 * r->u_stride +
+                                    (long)r0 * r->v_stride;
+        /* along a grid line (t = 0) the 01 and 11 corners weigh nothing */
+        int use_r1 = !flat_v && r0 + 1 <= V - 1;
+        float hc0 = zz[0], hc1 = zz[r->u_stride];
+        float hc2 = use_r1 ? zz[r->v_stride] : hc0;
+        float hc3 = use_r1 ? zz[r->u_stride + r->v_stride] : hc1;
+        cm_real sb = q->sb[n] < smax ? q->sb[n] : smax;
+        cm_real m = cm_near_piece(hc0, hc1, hc2, hc3, -q->du[n], flat_v ? 0 : -q->dv[n], t,
+                                  q->sa[n], sb, h, step, c);
+        best = m > best ? m : best;
+    }
+    /* Whole steps beyond the exact cells: linear along the column. */
+    for (int j = TS_NEAR_EXACT + 1; j <= TS_NEAR_STEPS && j <= smax; j++) {
+        int kk = k - j, r0 = i + q->sdv[j];
+        float f = (float)q->sfv[j];
+        if (kk < 0 || r0 < 0 || r0 > V - 1 || (f > 0.0f && r0 + 1 > V - 1)) {
+            *left = 1;
+            break;
+        }
+        const CM_GLOBAL float *zz = r->z + r->origin + (long)kk * r->u_stride +
+                                    (long)r0 * r->v_stride;
+        cm_real s = cm_sample_slope(zz[0], f > 0.0f ? zz[r->v_stride] : zz[0], f, h, j * step, c);
+        best = s > best ? s : best;
+    }
+    return (float)best;
+}
+
+/* Largest slope from cell (k, i) at height h over its ray between s_from
+ * and s_to steps (exclusive, inclusive), patch by patch until the ray
+ * leaves the grid: the brute force the near field is a table-driven case
+ * of. -inf if nothing there. */
+CM_FN float cm_ray_exact(const cm_ray_grid *r, int k, int i, float h, cm_real s_from,
+                         cm_real s_to, cm_real step, cm_real c)
+{
+    const cm_real t = r->t, at = fabs(t);
+    const int use_r1 = at > CM_R(1e-12);
+    cm_real best = -INFINITY;
+    cm_real s = s_from;
+    while (s < s_to - CM_R(1e-12)) {
+        /* next break point: a whole step, or v crossing an integer */
+        cm_real nxt = floor(s + CM_R(1e-9)) + 1;
+        if (use_r1) {
+            cm_real v = i - t * s;
+            cm_real vb = t > 0 ? ceil(v - CM_R(1e-9)) - 1 : floor(v + CM_R(1e-9)) + 1;
+            cm_real sv = (i - vb) / t;
+            if (sv > s + CM_R(1e-9) && sv < nxt)
+                nxt = sv;
+        }
+        cm_real se = nxt < s_to ? nxt : s_to, mid = CM_R(0.5) * (s + se);
+        int k0 = (int)floor(k - mid), r0 = use_r1 ? (int)floor(i - t * mid) : i;
+        if (k0 < 0 || r0 < 0 || r0 > r->V - 1 || (use_r1 && r0 + 1 > r->V - 1))
+            break; /* the ray leaves the grid */
+        const CM_GLOBAL float *zz = r->z + r->origin + (long)k0 * r->u_stride +
+                                    (long)r0 * r->v_stride;
+        cm_real h00 = zz[0], h10 = zz[r->u_stride];
+        cm_real h01 = use_r1 ? (cm_real)zz[r->v_stride] : h00;
+        cm_real h11 = use_r1 ? (cm_real)zz[r->u_stride + r->v_stride] : h10;
+        if (!isnan(h00 + h10 + h01 + h11)) {
+            cm_real a0 = k - k0, b0 = use_r1 ? (cm_real)(i - r0) : 0, tt = use_r1 ? t : 0;
+            cm_real alpha, beta, gamma;
+            cm_patch_poly(h00, h10 - h00, h01 - h00, h11 - h10 - h01 + h00, a0, b0, tt, &alpha,
+                          &beta, &gamma);
+            cm_real m = cm_piece_max(alpha - h, beta, gamma, s > 0 ? s : CM_R(1e-9), se, step, c);
+            best = m > best ? m : best;
+        } else {
+            /* nodata patch: only its valid end points on grid lines */
+            for (int e = 0; e < 2; e++) {
+                cm_real end = e ? se : s;
+                if (end <= 0)
+                    continue;
+                cm_real he = cm_edge_height((float)h00, (float)h10, (float)h01, (float)h11,
+                                            (k - end) - k0, use_r1 ? (i - t * end) - r0 : 0);
+                cm_real sl = (he - h) / (end * step) - c * end * step; /* NaN on nodata */
+                best = sl > best ? sl : best;
+            }
+        }
+        s = se;
+    }
+    return (float)best;
+}
+
+/* Far field: the slope from cell (k, i) at height h to its own ray dk
+ * steps back, at distance dd metres, interpolated between the two cells
+ * around it; cf: the curvature coefficient; -inf off the grid or on
+ * nodata. */
+CM_FN float cm_ray_slope(const cm_ray_grid *r, int k, int i, float h, int dk, float dd, float cf)
+{
+    int kk = k - dk;
+    if (dk <= 0 || kk < 0 || dd <= 0.0f)
+        return -INFINITY;
+    cm_real pv = -r->t * dk, o = floor(pv);
+    int r0 = i + (int)o;
+    float f = (float)(pv - o);
+    if (r0 < 0 || r0 > r->V - 1 || (f > 0.0f && r0 + 1 > r->V - 1))
+        return -INFINITY;
+    const CM_GLOBAL float *zz = r->z + r->origin + (long)kk * r->u_stride + (long)r0 * r->v_stride;
+    float a = zz[0], b = f > 0.0f ? zz[r->v_stride] : a;
+    float hz = a + f * (b - a);
+    if (isnan(hz))
+        return -INFINITY;
+    return (hz - h) / dd - cf * dd;
+}
+
+/*
+ * The float fast path for interior cells whose near field has no nodata:
+ * per piece, constants that depend only on the direction (cm_fast_piece),
+ * then per cell the piece's largest slope; NaN where a corner is nodata
+ * (the caller then redoes the cell with cm_near_exact).
+ */
+typedef struct {
+    float a0, b0, sa, sb, inv_b, cb, cLL, invL, ka, kb, kc, ca;
+    int has_sa;
+} cm_fast_piece;
+
+CM_FN cm_fast_piece cm_fast_piece_init(int du, int dv, int flat_v, cm_real sa, cm_real sb,
+                                       float L, float c)
+{
+    cm_fast_piece q;
+    q.a0 = (float)-du;
+    q.b0 = flat_v ? 0.0f : (float)-dv;
+    q.sa = (float)sa;
+    q.sb = (float)sb;
+    q.inv_b = 1.0f / (q.sb * L);
+    q.cb = c * q.sb * L;
+    q.cLL = c * L * L;
+    q.invL = 1.0f / L;
+    /* fa = P ka + beta kb + gamma kc - ca; at s = 0 it is the limit
+     * beta / L, since P is 0 there. */
+    q.has_sa = q.sa > 0;
+    q.ka = q.has_sa ? 1.0f / (q.sa * L) : 0.0f;
+    q.kb = q.has_sa ? q.sa * q.ka : q.invL;
+    q.kc = q.has_sa ? q.sa * q.sa * q.ka : 0.0f;
+    q.ca = q.has_sa ? c * q.sa * L : 0.0f;
+    return q;
+}
+
+/* The piece's largest slope from a cell at height h, corners c00..c11;
+ * branch-free, so that loops over cells vectorise. */
+CM_FN float cm_fast_piece_slope(cm_fast_piece q, float t, float c00, float c10, float c01,
+                                float c11, float h, float L, float c)
+{
+    float A = c10 - c00, B = c01 - c00;
+    float X = c11 - c10 - c01 + c00;
+    float alpha = c00 + A * q.a0 + B * q.b0 + X * q.a0 * q.b0;
+    float beta = -(A + B * t + X * (q.a0 * t + q.b0));
+    float gamma = X * t;
+    float P = alpha - h;
+    float fb = (P + beta * q.sb + gamma * q.sb * q.sb) * q.inv_b - q.cb;
+    float fa = P * q.ka + beta * q.kb + gamma * q.kc - q.ca;
+    float m = fa > fb ? fa : fb;
+    float g2 = gamma - q.cLL;
+    float r = P / g2;
+    float ss = CM_SQRTF(r > 0.0f ? r : 0.0f);
+    float sd = ss > 0.0f ? ss : 1.0f;
+    float fs = (P / sd + beta + gamma * ss) * q.invL - c * ss * L;
+    int inner = q.has_sa & (P < 0.0f) & (g2 < 0.0f) & (ss > q.sa) & (ss < q.sb) & (fs > m);
+    return inner ? fs : m;
+}
+
+/* Slope to whole-step sample between va and vb (fraction f), invd = 1 /
+ * its distance d, cd = c d. */
+CM_FN float cm_fast_sample_slope(float va, float vb, float f, float h, float invd, float cd)
+{
+    float hj = va + f * (vb - va);
+    return (hj - h) * invd - cd;
+}
+
+#endif

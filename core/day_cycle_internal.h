@@ -1,0 +1,36 @@
+/*
+ * Internal helpers shared by the day products (day_sun.c, day_cycle.c,
+ * clear_sky.c, sun_range.c). Not part of the public API.
+ */
+#ifndef TS_DAY_CYCLE_INTERNAL_H
+#define TS_DAY_CYCLE_INTERNAL_H
+
+#include "day_cycle.h"
+
+/* Check the day options (horizon options with any direction count, Linke
+ * turbidity, sun-hours rule); the message names what is wrong. */
+ts_status ts_day_opts_check(const ts_day_opts *o, ts_error *err);
+
+/* The sun (SPA) at lattice node i of s at unix time t. */
+ts_status ts_day_node_sun(const ts_sun_sites *s, const ts_day_opts *o, int i,
+                          double t, ts_sun_sample *out, ts_error *err);
+
+/* Index of the reference node: the single site, or the lattice's middle. */
+int ts_day_ref_node(const ts_sun_sites *s);
+
+/* The Earth's horizon of every cell (ts_earth_horizon of its height, NaN
+ * for nodata) into floor (width*height); returns the lowest, at most 0. */
+double ts_day_earth_floor(const ts_grid *g, const ts_horizon_opts *o, float *floor);
+
+/* Angles wrapped to [0, 360) and to (-180, 180]. */
+double ts_wrap360(double a);
+double ts_wrap180(double a);
+
+/* ESRA pieces (clear_sky.c): Kasten & Young air mass at sea level for an
+ * apparent elevation h > 0 (degrees); beam transmittance at air mass m;
+ * diffuse transmittance times its angular function at sin(elevation). */
+double ts_esra_air_mass(double h);
+double ts_esra_beam_transmittance(double m, double linke);
+double ts_esra_diffuse_factor(double linke, double sin_h);
+
+#endif

@@ -1,0 +1,535 @@
+/*
+ * tsd_atlas_dataset.cpp - far-shadow atlases (*.tsa, docs/atlas-format.md):
+ * CreateCopy stores any raster of binary bands (0, 1, nodata), typically
+ * PRODUCT=farshadow, and Open recognises the file by its magic and decodes
+ * blocks lazily. Its open options (SHADOWS, DEM, THREADS) are rows of the
+ * driver's option table (tsd_options.h).
+ */
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "cpl_conv.h"
+#include "cpl_string.h"
+#include "gdal_pam.h"
+#include "gdal_priv.h"
+#include "ogr_spatialref.h"
+
+#include "shadow_atlas.h"
+#include "tsd_atlas_check.h"
+#include "tsd_dem.h"
+#include "tsd_gdal.h"
+#include "tsd_geodesy.h"
+#include "tsd_options.h"
+
+namespace tsd
+{
+namespace
+{
+
+/* KEY=VALUE lines of an atlas's metadata text. */
+static CPLStringList AtlasMetadata(const char *pszText)
+{
+    CPLStringList aosOut;
+    const CPLStringList aosLines(CSLTokenizeStringComplex(pszText, "\n", FALSE, FALSE));
+    for (int i = 0; i < aosLines.size(); i++)
+        if (strchr(aosLines[i], '='))
+            aosOut.AddString(aosLines[i]);
+    return aosOut;
+}
+
+class TSAtlasBand;
+
+class TSAtlasDataset final : public GDALPamDataset
+{
+    friend class TSAtlasBand;
+
+    ts_atlas *m_psAtlas = nullptr;
+    OGRSpatialReference m_oSRS{};
+    double m_adfGT[6] = {0, 1, 0, 0, 0, 1};
+    bool m_bHasGT = false;
+    bool m_bAll = false; // SHADOWS=all: far | near, near recomputed from the DEM
+    std::string m_osDEM{};
+    int m_nThreads = 0;
+    bool m_bDEMGiven = false;           // DEM= given, not the SOURCE_DEM
+    CPLStringList m_aosMeta{};
+    tsd_options m_sMetaOpts{};          // the metadata, validated as options
+    std::mutex m_oMutex{};
+    bool m_bTried = false;
+    std::string m_osError{};            // why SHADOWS=all failed
+    CPLErrorNum m_nErr = CPLE_AppDefined; // and its error number
+    GByte *m_pabyNear = nullptr; // near-shadow bits, raster order, one plane per map
+
+    CPLErr EnsureNear();
+
+  public:
+    TSAtlasDataset() = default;
+    ~TSAtlasDataset() override;
+
+    static GDALDataset *Open(GDALOpenInfo *poOpenInfo);
+    static GDALDataset *CreateCopy(const char *pszFilename, GDALDataset *poSrcDS,
+                                   int bStrict, char **papszOptions,
+                                   GDALProgressFunc pfnProgress, void *pProgressData);
+
+    CPLErr GetGeoTransform(double *padfGT) override
+    {
+        if (!m_bHasGT)
+            return GDALPamDataset::GetGeoTransform(padfGT);
+        memcpy(padfGT, m_adfGT, sizeof m_adfGT);
+        return CE_None;
+    }
+    const OGRSpatialReference *GetSpatialRef() const override
+    {
+        return m_oSRS.IsEmpty() ? nullptr : &m_oSRS;
+    }
+};
+
+class TSAtlasBand final : public GDALPamRasterBand
+{
+    int m_nStep;
+
+  public:
+    TSAtlasBand(TSAtlasDataset *poDSIn, int nBandIn) : m_nStep(nBandIn - 1)
+    {
+        poDS = poDSIn;
+        nBand = nBandIn;
+        eDataType = GDT_Byte;
+        nBlockXSize = std::min(BLOCK, poDSIn->GetRasterXSize());
+        nBlockYSize = std::min(BLOCK, poDSIn->GetRasterYSize());
+    }
+
+    CPLErr IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage) override;
+    double GetNoDataValue(int *pbSuccess = nullptr) override
+    {
+        // as PRODUCT=farshadow, whether or not the maps have nodata cells
+        if (pbSuccess)
+            *pbSuccess = TRUE;
+        return TS_ATLAS_NODATA;
+    }
+    GDALColorInterp GetColorInterpretation() override
+    {
+        return GCI_GrayIndex;
+    }
+};
+
+TSAtlasDataset::~TSAtlasDataset()
+{
+    TSAtlasDataset::FlushCache(true);
+    ts_atlas_free(m_psAtlas);
+    VSIFree(m_pabyNear);
+}
+
+CPLErr TSAtlasBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
+{
+    TSAtlasDataset *ds = static_cast<TSAtlasDataset *>(poDS);
+    if (ds->m_bAll && ds->EnsureNear() != CE_None)
+        return CE_Failure;
+    const int W = nRasterXSize, H = nRasterYSize;
+    const int x0 = nBlockXOff * nBlockXSize, y0 = nBlockYOff * nBlockYSize;
+    const int w = std::min(nBlockXSize, W - x0), h = std::min(nBlockYSize, H - y0);
+    GByte *pabyOut = static_cast<GByte *>(pImage);
+    memset(pabyOut, TS_ATLAS_NODATA, static_cast<size_t>(nBlockXSize) * nBlockYSize);
+    ts_error sErr;
+    if (ts_atlas_read(ds->m_psAtlas, m_nStep, x0, y0, w, h, pabyOut, nBlockXSize, &sErr) !=
+        TS_OK)
+    {
+        Fail(sErr.code, sErr.message);
+        return CE_Failure;
+    }
+    if (ds->m_bAll)
+    {
+        const GByte *near = ds->m_pabyNear + static_cast<size_t>(m_nStep) * W * H;
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++)
+            {
+                GByte &v = pabyOut[static_cast<size_t>(y) * nBlockXSize + x];
+                if (v != TS_ATLAS_NODATA)
+                    v |= near[static_cast<size_t>(y0 + y) * W + x0 + x];
+            }
+    }
+    return CE_None;
+}
+
+/* SHADOWS=all: near shadows (occluders within the far threshold) of every
+ * map, from the DEM, with the exact horizon sweep capped at the
+ * threshold. */
+CPLErr TSAtlasDataset::EnsureNear()
+{
+    std::lock_guard<std::mutex> oLock(m_oMutex);
+    if (!m_bTried)
+    {
+        m_bTried = true;
+        const ts_atlas_info *psInfo = ts_atlas_get_info(m_psAtlas);
+        const int W = psInfo->width, H = psInfo->height;
+        char szMsg[1024] = "";
+        GDALDataset *poDEM = nullptr;
+        tsd_cells sCells{};
+        ts_grid sGrid{};
+        bool bGrid = false;
+        float *pafPlane = nullptr;
+        const int nBandDEM = m_sMetaOpts.band;
+        ts_horizon_opts sH;
+        ts_horizon_opts_default(&sH);
+        sH.curvature = m_sMetaOpts.curvature;
+        sH.refraction = m_sMetaOpts.refraction;
+        sH.threads = m_nThreads;
+        sH.directions = 1;
+        sH.max_distance = psInfo->threshold_m;
+        double adfGT[6];
+        if (!(std::isfinite(psInfo->threshold_m) && psInfo->threshold_m > 0))
+            m_osError = "SHADOWS=all needs the atlas's far threshold in "
+                        "metres, which this atlas does not record";
+        else if (!(poDEM = GDALDataset::Open(m_osDEM.c_str(),
+                                             GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR)))
+            m_osError = CPLSPrintf("SHADOWS=all cannot open the DEM '%s' "
+                                   "(give it with the open option DEM=...)",
+                                   m_osDEM.c_str());
+        else if (dynamic_cast<TSAtlasDataset *>(poDEM))
+            m_osError = AtlasAsDEM(m_osDEM, m_bDEMGiven);
+        else if (poDEM->GetRasterXSize() != W || poDEM->GetRasterYSize() != H)
+            m_osError = CPLSPrintf("SHADOWS=all: the DEM '%s' (%d x %d) does "
+                                   "not match the %d x %d atlas", m_osDEM.c_str(),
+                                   poDEM->GetRasterXSize(), poDEM->GetRasterYSize(), W, H);
+        else if (nBandDEM > poDEM->GetRasterCount())
+            m_osError = CPLSPrintf("SHADOWS=all: the atlas's metadata says BAND=%d, but the "
+                                   "DEM '%s' has %d band(s)", nBandDEM, m_osDEM.c_str(),
+                                   poDEM->GetRasterCount());
+        else if (poDEM->GetGeoTransform(adfGT) != CE_None)
+            m_osError = "SHADOWS=all: the DEM has no geotransform";
+        else
+        {
+            const OGRSpatialReference *poSRS = poDEM->GetSpatialRef();
+            OGRSpatialReferenceH hSRS =
+                poSRS ? OGRSpatialReference::ToHandle(const_cast<OGRSpatialReference *>(poSRS))
+                      : nullptr;
+            ts_status eSt = tsd_cells_compute(adfGT, W, H, hSRS, &sCells, szMsg, sizeof szMsg);
+            if (eSt == TS_OK)
+                eSt = tsd_dem_load(GDALRasterBand::ToHandle(poDEM->GetRasterBand(nBandDEM)),
+                                   &sCells, m_sMetaOpts.z_factor, &sGrid, szMsg, sizeof szMsg);
+            if (eSt != TS_OK)
+            {
+                m_nErr = ErrorNum(eSt);
+                m_osError = std::string("SHADOWS=all: ") + szMsg;
+            }
+            else
+                bGrid = true;
+        }
+        const size_t nCells = static_cast<size_t>(W) * H;
+        if (bGrid)
+        {
+            m_pabyNear = static_cast<GByte *>(VSI_MALLOC2_VERBOSE(nCells, psInfo->steps));
+            pafPlane = static_cast<float *>(VSI_MALLOC2_VERBOSE(nCells, sizeof(float)));
+            if (!m_pabyNear || !pafPlane)
+            {
+                m_nErr = ErrorNum(TS_ERR_NOMEM);
+                m_osError = "out of memory for the near shadows";
+            }
+        }
+        for (int k = 0; bGrid && m_osError.empty() && k < psInfo->steps; k++)
+        {
+            const ts_atlas_step *psStep = ts_atlas_get_step(m_psAtlas, k);
+            ts_error sErr;
+            GByte *pabyOut = m_pabyNear + static_cast<size_t>(k) * nCells;
+            if (!std::isfinite(psStep->grid_azimuth) || !std::isfinite(psStep->elevation))
+            {
+                m_osError = CPLSPrintf("SHADOWS=all: map %d of the atlas "
+                                       "records no sun position", k + 1);
+                break;
+            }
+            if (ts_horizon_sweep(&sGrid, psStep->grid_azimuth, &sH, pafPlane, &sErr) != TS_OK)
+            {
+                m_nErr = ErrorNum(sErr.code);
+                m_osError = sErr.message;
+                break;
+            }
+            const float fEl = static_cast<float>(psStep->elevation);
+            for (int y = 0; y < H; y++)
+            {
+                const int gy = sCells.flip_y ? H - 1 - y : y;
+                for (int x = 0; x < W; x++)
+                {
+                    const int gx = sCells.flip_x ? W - 1 - x : x;
+                    const float v = pafPlane[static_cast<size_t>(gy) * W + gx];
+                    pabyOut[static_cast<size_t>(y) * W + x] = v > fEl ? 1 : 0;
+                }
+            }
+        }
+        VSIFree(pafPlane);
+        if (bGrid)
+            ts_grid_free(&sGrid);
+        tsd_cells_free(&sCells);
+        if (poDEM)
+            GDALClose(poDEM);
+        if (!m_osError.empty())
+        {
+            VSIFree(m_pabyNear);
+            m_pabyNear = nullptr;
+        }
+    }
+    if (!m_osError.empty())
+    {
+        Fail(m_nErr, m_osError.c_str());
+        return CE_Failure;
+    }
+    return CE_None;
+}
+
+GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
+{
+    if (poOpenInfo->eAccess == GA_Update)
+        return FailOpen(CPLE_NotSupported,
+                        "far-shadow atlases are read-only; write a new one with "
+                        "gdal_translate -of TERRASHADE");
+    tsd_options sOpts;
+    char szMsg[1024];
+    tsd_options_defaults(&sOpts);
+    if (tsd_options_apply_atlas(&sOpts, poOpenInfo->papszOpenOptions, szMsg,
+                                sizeof szMsg) != 0)
+        return FailOpen(TS_ERR_ARG, szMsg);
+    const bool bAll = sOpts.shadows_all != 0;
+    const std::string osDEM = sOpts.dem;
+    const int nThreads = sOpts.threads;
+    VSILFILE *fp = VSIFOpenL(poOpenInfo->pszFilename, "rb");
+    if (!fp)
+        return FailOpen(CPLE_OpenFailed, CPLSPrintf("cannot open the atlas '%s'",
+                                                      poOpenInfo->pszFilename));
+    VSIFSeekL(fp, 0, SEEK_END);
+    const vsi_l_offset nSize = VSIFTellL(fp);
+    VSIFSeekL(fp, 0, SEEK_SET);
+    GByte *pabyFile = nSize < (static_cast<vsi_l_offset>(1) << 40)
+                          ? static_cast<GByte *>(VSI_MALLOC_VERBOSE(static_cast<size_t>(nSize)))
+                          : nullptr;
+    const bool bRead = pabyFile && VSIFReadL(pabyFile, 1, static_cast<size_t>(nSize), fp) ==
+                                       static_cast<size_t>(nSize);
+    VSIFCloseL(fp);
+    ts_atlas *psAtlas = nullptr;
+    ts_error sErr;
+    if (!bRead)
+    {
+        VSIFree(pabyFile);
+        return FailOpen(CPLE_FileIO, CPLSPrintf("cannot read the atlas '%s'",
+                                                  poOpenInfo->pszFilename));
+    }
+    const ts_status eSt = ts_atlas_open(pabyFile, static_cast<size_t>(nSize), &psAtlas, &sErr);
+    VSIFree(pabyFile);
+    if (eSt != TS_OK)
+        return FailOpen(eSt, CPLSPrintf("'%s': %s", poOpenInfo->pszFilename, sErr.message));
+    auto poDS = std::unique_ptr<TSAtlasDataset>(new TSAtlasDataset());
+    poDS->m_psAtlas = psAtlas;
+    const ts_atlas_info *psInfo = ts_atlas_get_info(psAtlas);
+    poDS->nRasterXSize = psInfo->width;
+    poDS->nRasterYSize = psInfo->height;
+    poDS->m_bHasGT = psInfo->has_geotransform;
+    memcpy(poDS->m_adfGT, psInfo->geotransform, sizeof poDS->m_adfGT);
+    poDS->m_aosMeta = AtlasMetadata(psInfo->metadata);
+    const std::string osCause =
+        CheckAtlasMetadata(poDS->m_aosMeta, psInfo->steps, &poDS->m_sMetaOpts);
+    if (!osCause.empty())
+        return FailOpen(TS_ERR_ARG, CPLSPrintf("'%s': atlas metadata: %s",
+                                                 poOpenInfo->pszFilename, osCause.c_str()));
+    for (int k = 0; k < psInfo->steps; k++)
+        if (!std::isfinite(ts_atlas_get_step(psAtlas, k)->unix_time))
+            return FailOpen(TS_ERR_ARG,
+                            CPLSPrintf("'%s': atlas step table: map %d has no time, but "
+                                       "every map of PRODUCT=farshadow has one",
+                                       poOpenInfo->pszFilename, k + 1));
+    poDS->m_bAll = bAll;
+    poDS->m_nThreads = nThreads;
+    poDS->m_bDEMGiven = !osDEM.empty();
+    poDS->m_osDEM = !osDEM.empty() ? osDEM
+                                   : poDS->m_aosMeta.FetchNameValueDef("SOURCE_DEM", "");
+    if (bAll && poDS->m_osDEM.empty())
+        return FailOpen(TS_ERR_ARG,
+                          "SHADOWS=all recomputes the near shadows from the DEM, but the "
+                          "atlas names none: give it with the open option DEM=...");
+    if (bAll && IsAtlasFile(poDS->m_osDEM.c_str()))
+        return FailOpen(TS_ERR_ARG, AtlasAsDEM(poDS->m_osDEM, poDS->m_bDEMGiven).c_str());
+    int nOffset = atoi(poDS->m_aosMeta.FetchNameValueDef("UTC_OFFSET_MINUTES", "0"));
+    for (int i = 0; i < poDS->m_aosMeta.size(); i++)
+    {
+        char *pszKey = nullptr;
+        const char *pszValue = CPLParseNameValue(poDS->m_aosMeta[i], &pszKey);
+        if (pszKey && pszValue)
+        {
+            if (EQUAL(pszKey, "SRS_WKT"))
+            {
+                poDS->m_oSRS.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+                if (poDS->m_oSRS.importFromWkt(pszValue) != OGRERR_NONE)
+                {
+                    CPLFree(pszKey);
+                    return FailOpen(TS_ERR_ARG,
+                                    CPLSPrintf("'%s': atlas metadata: SRS_WKT is not a CRS "
+                                               "GDAL can read", poOpenInfo->pszFilename));
+                }
+            }
+            else
+                poDS->GDALDataset::SetMetadataItem(pszKey, pszValue);
+        }
+        CPLFree(pszKey);
+    }
+    for (int k = 0; k < psInfo->steps; k++)
+    {
+        auto poBand = new TSAtlasBand(poDS.get(), k + 1);
+        poDS->SetBand(k + 1, poBand);
+        const ts_atlas_step *r = ts_atlas_get_step(psAtlas, k);
+        SetStepMetadata(poBand, r->unix_time, std::isfinite(r->unix_time)
+                                                  ? r->utc_offset_minutes : nOffset,
+                        r->azimuth, r->grid_azimuth, r->elevation,
+                        std::numeric_limits<double>::quiet_NaN());
+        if (!std::isfinite(r->unix_time))
+            poBand->GDALMajorObject::SetDescription(CPLSPrintf("map %d", k + 1));
+    }
+    poDS->SetDescription(poOpenInfo->pszFilename);
+    poDS->TryLoadXML();
+    poDS->nPamFlags &= ~GPF_DIRTY;
+    return poDS.release();
+}
+
+/* Store the bands of any raster whose values are 0, 1 or nodata. */
+GDALDataset *TSAtlasDataset::CreateCopy(const char *pszFilename, GDALDataset *poSrcDS,
+                                        int /*bStrict*/, char ** /*papszOptions*/,
+                                        GDALProgressFunc pfnProgress, void *pProgressData)
+{
+    const int W = poSrcDS->GetRasterXSize(), H = poSrcDS->GetRasterYSize();
+    const int nBands = poSrcDS->GetRasterCount();
+    if (nBands < 1)
+        return FailOpen(CPLE_NotSupported, "an atlas needs at least one band");
+    const std::string osNotShadow = CheckAtlasSource(poSrcDS);
+    if (!osNotShadow.empty())
+        return FailOpen(CPLE_NotSupported, osNotShadow.c_str());
+    if (!pfnProgress)
+        pfnProgress = GDALDummyProgress;
+    ts_error sErr;
+    ts_atlas_writer *psW = nullptr;
+    if (ts_atlas_writer_new(W, H, &psW, &sErr) != TS_OK)
+        return FailOpen(sErr.code, sErr.message);
+    std::unique_ptr<ts_atlas_writer, void (*)(ts_atlas_writer *)> oW(psW, ts_atlas_writer_free);
+    const size_t nCells = static_cast<size_t>(W) * H;
+    std::vector<GByte> abyPlane;
+    std::vector<double> adfRow;
+    try
+    {
+        abyPlane.resize(nCells);
+        adfRow.resize(static_cast<size_t>(W));
+    }
+    catch (const std::bad_alloc &)
+    {
+        return FailOpen(TS_ERR_NOMEM, "out of memory for one map of the atlas");
+    }
+    const int nOffset =
+        atoi(CSLFetchNameValueDef(poSrcDS->GetMetadata(), "UTC_OFFSET_MINUTES", "0"));
+    for (int b = 1; b <= nBands; b++)
+    {
+        GDALRasterBand *poBand = poSrcDS->GetRasterBand(b);
+        int bHasNoData = FALSE;
+        const double dfNoData = poBand->GetNoDataValue(&bHasNoData);
+        for (int y = 0; y < H; y++)
+        {
+            if (poBand->RasterIO(GF_Read, 0, y, W, 1, adfRow.data(), W, 1, GDT_Float64, 0, 0,
+                                 nullptr) != CE_None)
+                return nullptr; // GDAL has said why
+            GByte *row = abyPlane.data() + static_cast<size_t>(y) * W;
+            for (int x = 0; x < W; x++)
+            {
+                const double v = adfRow[x];
+                if (std::isnan(v) || (bHasNoData && v == dfNoData))
+                    row[x] = TS_ATLAS_NODATA;
+                else if (v == 0 || v == 1)
+                    row[x] = static_cast<GByte>(v);
+                else
+                    return FailOpen(
+                        CPLE_NotSupported,
+                        CPLSPrintf("band %d holds the value %g at column %d, row %d: an "
+                                   "atlas stores binary maps (0, 1 and nodata), such as "
+                                   "PRODUCT=farshadow", b, v, x, y));
+            }
+        }
+        auto fetch = [poBand](const char *pszKey) {
+            const char *v = poBand->GetMetadataItem(pszKey);
+            return v ? CPLAtof(v) : std::numeric_limits<double>::quiet_NaN();
+        };
+        ts_atlas_step sStep{fetch("UNIX_TIME"), fetch("SUN_AZIMUTH_TRUE"),
+                            fetch("SUN_AZIMUTH"), fetch("SUN_ELEVATION"), nOffset};
+        if (ts_atlas_writer_add(psW, abyPlane.data(), W, &sStep, &sErr) != TS_OK)
+            return FailOpen(sErr.code, CPLSPrintf("band %d: %s", b, sErr.message));
+        if (!pfnProgress(0.95 * b / nBands, nullptr, pProgressData))
+        {
+            Fail(TS_ERR_CANCELLED, "interrupted");
+            return nullptr;
+        }
+    }
+    /* metadata text: the source's metadata, its CRS, its threshold */
+    std::string osText;
+    for (char **p = poSrcDS->GetMetadata(); p && *p; p++)
+    {
+        std::string osLine = *p;
+        std::replace(osLine.begin(), osLine.end(), '\n', ' ');
+        std::replace(osLine.begin(), osLine.end(), '\r', ' ');
+        if (!STARTS_WITH_CI(osLine.c_str(), "SRS_WKT="))
+            osText += osLine + "\n";
+    }
+    if (const OGRSpatialReference *poSRS = poSrcDS->GetSpatialRef())
+    {
+        char *pszWKT = nullptr;
+        const char *apszOpts[] = {"FORMAT=WKT2_2019", "MULTILINE=NO", nullptr};
+        if (poSRS->exportToWkt(&pszWKT, apszOpts) == OGRERR_NONE && pszWKT)
+            osText += std::string("SRS_WKT=") + pszWKT + "\n";
+        CPLFree(pszWKT);
+    }
+    ts_atlas_info sInfo{};
+    sInfo.has_geotransform = poSrcDS->GetGeoTransform(sInfo.geotransform) == CE_None;
+    const char *pszT = poSrcDS->GetMetadataItem("FAR_THRESHOLD");
+    const char *pszTm = poSrcDS->GetMetadataItem("FAR_THRESHOLD_M");
+    sInfo.threshold_cells = pszT ? atoi(pszT) : 0;
+    sInfo.threshold_m = pszTm ? CPLAtof(pszTm) : std::numeric_limits<double>::quiet_NaN();
+    sInfo.metadata = osText.c_str();
+    uint8_t *pabyFile = nullptr;
+    size_t nSize = 0;
+    if (ts_atlas_writer_finish(psW, &sInfo, &pabyFile, &nSize, &sErr) != TS_OK)
+        return FailOpen(sErr.code, sErr.message);
+    VSILFILE *fp = VSIFOpenL(pszFilename, "wb");
+    bool bOK = fp && VSIFWriteL(pabyFile, 1, nSize, fp) == nSize;
+    if (fp && VSIFCloseL(fp) != 0)
+        bOK = false;
+    free(pabyFile);
+    if (!bOK)
+    {
+        VSIUnlink(pszFilename);
+        return FailOpen(CPLE_FileIO, CPLSPrintf("cannot write the atlas '%s'", pszFilename));
+    }
+    CPLDebug(DRIVER, "wrote the atlas %s: %d maps of %d x %d, %zu bytes (%.4f bits per cell)",
+             pszFilename, nBands, W, H, nSize, nSize * 8.0 / nCells);
+    pfnProgress(1.0, nullptr, pProgressData);
+    GDALOpenInfo oOpenInfo(pszFilename, GA_ReadOnly);
+    return TSAtlasDataset::Open(&oOpenInfo);
+}
+
+} // namespace
+
+int IdentifyAtlas(GDALOpenInfo *poOpenInfo)
+{
+    return poOpenInfo->nHeaderBytes >= 8 &&
+           ts_atlas_identify(poOpenInfo->pabyHeader,
+                             static_cast<size_t>(poOpenInfo->nHeaderBytes));
+}
+
+GDALDataset *OpenAtlas(GDALOpenInfo *poOpenInfo)
+{
+    return TSAtlasDataset::Open(poOpenInfo);
+}
+
+GDALDataset *CreateAtlasCopy(const char *pszFilename, GDALDataset *poSrcDS, int bStrict,
+                             char **papszOptions, GDALProgressFunc pfnProgress,
+                             void *pProgressData)
+{
+    return TSAtlasDataset::CreateCopy(pszFilename, poSrcDS, bStrict, papszOptions,
+                                      pfnProgress, pProgressData);
+}
+
+} // namespace tsd

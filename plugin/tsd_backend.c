@@ -1,0 +1,74 @@
+/* What the backend dispatcher ran for a product; see tsd_backend.h. */
+#include "tsd_backend.h"
+
+#include "tsd_text.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+ts_backend tsd_backend_to_ts(tsd_backend b)
+{
+    return b == TSD_BACKEND_OPENCL ? TS_BACKEND_OPENCL
+           : b == TSD_BACKEND_C    ? TS_BACKEND_C
+                                   : TS_BACKEND_AUTO;
+}
+
+void tsd_backend_summary_add(tsd_backend_summary *s, const ts_backend_report *r)
+{
+    if (!s->calls)
+        s->requested = r->requested;
+    s->calls++;
+    if (r->used == TS_BACKEND_OPENCL) {
+        s->opencl_calls++;
+        snprintf(s->device_opencl, sizeof s->device_opencl, "%s", r->device);
+        return;
+    }
+    s->c_calls++;
+    snprintf(s->device_c, sizeof s->device_c, "%s", r->device);
+    /* the first reason; the first failure wins over a choice (auto on a CPU) */
+    if (r->requested != TS_BACKEND_C && r->reason[0] &&
+        (!s->reason[0] || (r->fell_back && !s->fell_back)))
+        snprintf(s->reason, sizeof s->reason, "%s", r->reason);
+    s->fell_back |= r->fell_back;
+}
+
+int tsd_backend_predict(const tsd_options *o, tsd_backend_summary *s, char *msg,
+                        size_t n)
+{
+    ts_backend_report r;
+    ts_error err;
+    memset(s, 0, sizeof *s);
+    if (ts_backend_choose(tsd_backend_to_ts(o->backend), &r, &err) != TS_OK)
+        return (tsd_fail_core(msg, n, NULL, &err), -1);
+    tsd_backend_summary_add(s, &r);
+    return 0;
+}
+
+int tsd_backend_check_env(const tsd_options *o, char *msg, size_t n)
+{
+    const char *env = getenv("TERRASHADE_BACKEND");
+    ts_backend b;
+    ts_error err;
+    if (o->backend != TSD_BACKEND_AUTO || !env || !*env ||
+        ts_backend_parse(env, &b, &err) == TS_OK)
+        return 0;
+    return (tsd_fail(msg, n, TS_ERR_ARG,
+                     "TERRASHADE_BACKEND must be auto, c or opencl, got '%.40s'", env),
+            -1);
+}
+
+void tsd_backend_summary_text(const tsd_backend_summary *s, char *backend, size_t bn,
+                              char *device, size_t dn)
+{
+    if (s->opencl_calls && s->c_calls) {
+        snprintf(backend, bn, "mixed");
+        snprintf(device, dn, "opencl: %s; c: %s", s->device_opencl, s->device_c);
+    } else if (s->opencl_calls) {
+        snprintf(backend, bn, "opencl");
+        snprintf(device, dn, "%s", s->device_opencl);
+    } else {
+        snprintf(backend, bn, "c");
+        snprintf(device, dn, "%s", s->device_c);
+    }
+}

@@ -1,0 +1,63 @@
+/*
+ * tsd_backend.h - the BACKEND option and what the backend dispatcher
+ * (cl/terrashade_backend.h) ran for a product's heavy calls, summed up for
+ * the metadata items BACKEND, BACKEND_DEVICE and BACKEND_FALLBACK_REASON.
+ * Plain C, no GDAL.
+ */
+#ifndef TSD_BACKEND_H
+#define TSD_BACKEND_H
+
+#include <stddef.h>
+
+#include "terrashade_backend.h"
+#include "tsd_options.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/**
+ * What the backend dispatcher ran for the heavy calls of a product (the
+ * ts_backend_* reports of its calls, summed up). Zero it before use.
+ */
+typedef struct {
+    int calls;                /* dispatcher calls */
+    int opencl_calls, c_calls;
+    ts_backend requested;     /* after TERRASHADE_BACKEND (first call) */
+    int fell_back;            /* a call tried OpenCL, failed and ran C */
+    char device_opencl[192];  /* the device of the OpenCL calls */
+    char device_c[192];       /* the device of the C calls */
+    char reason[256];         /* why OpenCL did not run, when it was wanted
+                                 (requested not c) and C ran; "" otherwise */
+} tsd_backend_summary;
+
+/** The ts_backend of a BACKEND option value. */
+ts_backend tsd_backend_to_ts(tsd_backend b);
+
+/** Add one call's report to a summary. */
+void tsd_backend_summary_add(tsd_backend_summary *s, const ts_backend_report *r);
+
+/**
+ * Predict, without computing, the summary of the product's calls
+ * (ts_backend_choose: probes the OpenCL device). 0, or -1 with a sentence
+ * in msg (a bad TERRASHADE_BACKEND).
+ */
+int tsd_backend_predict(const tsd_options *o, tsd_backend_summary *s, char *msg,
+                        size_t msg_size);
+
+/** With BACKEND=auto: -1 with a sentence in msg if TERRASHADE_BACKEND is
+ * not auto, c or opencl (probes nothing); else 0. */
+int tsd_backend_check_env(const tsd_options *o, char *msg, size_t msg_size);
+
+/**
+ * The metadata values of a summary: backend "c", "opencl" or "mixed" (some
+ * calls on each), device (both, "opencl: ...; c: ..." when mixed).
+ */
+void tsd_backend_summary_text(const tsd_backend_summary *s, char *backend,
+                              size_t backend_size, char *device, size_t device_size);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

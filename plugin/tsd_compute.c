@@ -1,0 +1,367 @@
+/* The products of an instant and of the sky: which core calls, in which
+ * order; and the dispatcher. The day products are in tsd_compute_day.c. */
+#include "tsd_compute.h"
+
+#include "tsd_compute_env.h"
+#include "tsd_products.h"
+#include "tsd_text.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void tsd_region_whole(tsd_region *r, const ts_grid *dem)
+{
+    r->dem = dem;
+    r->x0 = r->y0 = 0;
+    r->width = dem->width;
+    r->height = dem->height;
+    r->margin = 0;
+}
+
+void tsd_run_init(tsd_run *run, const tsd_options *o, const tsd_sun *sun)
+{
+    memset(run, 0, sizeof *run);
+    run->sun = sun;
+    run->sun_azimuth = o->sun_azimuth;
+    run->sun_elevation = o->sun_elevation;
+    if (sun && isfinite(sun->instant) && !tsd_product_of(o)->daily) {
+        /* shade, shadow: the sun at DATETIME */
+        run->sun_azimuth = sun->sun.grid_azimuth;
+        run->sun_elevation = sun->sun.elevation;
+    }
+}
+
+static ts_status oom(const tsd_compute_ctx *c, const char *what)
+{
+    return tsd_fail(c->msg, c->msg_size, TS_ERR_NOMEM, "out of memory for %s", what);
+}
+
+static ts_status core_fail(const tsd_compute_ctx *c, const ts_error *err)
+{
+    return tsd_fail_core(c->msg, c->msg_size, NULL, err);
+}
+
+void tsd_compute_horizon_opts(const tsd_compute_ctx *c, ts_horizon_opts *h)
+{
+    const tsd_options *o = c->opts;
+    ts_horizon_opts_default(h);
+    h->directions = o->directions;
+    h->start_azimuth = o->start_azimuth;
+    h->max_distance = o->max_distance;
+    h->curvature = o->curvature;
+    h->refraction = o->refraction;
+    h->threads = o->threads;
+    h->progress = c->run->progress;
+    h->progress_user = c->run->progress_user;
+}
+
+ts_status tsd_compute_report(const tsd_compute_ctx *c, double done)
+{
+    if (c->run->progress && c->run->progress(done, c->run->progress_user))
+        return tsd_fail(c->msg, c->msg_size, TS_ERR_CANCELLED, "cancelled by the caller");
+    return TS_OK;
+}
+
+/* The backend of the options, and the report of a call added to the summary. */
+#define BK(c) tsd_backend_to_ts((c)->opts->backend)
+#define NOTE(c, call, rep) note((c)->backend, (call), &(rep))
+
+/* After a ts_backend_* call (its status st): add its report, if filled. */
+static ts_status note(tsd_backend_summary *bs, ts_status st, const ts_backend_report *r)
+{
+    if (bs && r->backend[0])
+        tsd_backend_summary_add(bs, r);
+    return st;
+}
+
+void tsd_normals_free(tsd_normals *nm)
+{
+    free(nm->nx);
+    free(nm->ny);
+    free(nm->nz);
+}
+
+ts_status tsd_normals_make(const tsd_compute_ctx *c, const ts_grid *g, tsd_normals *nm)
+{
+    size_t cells = (size_t)g->width * g->height;
+    ts_error err;
+    ts_backend_report rep = {0};
+    nm->nx = malloc(cells * sizeof(float));
+    nm->ny = malloc(cells * sizeof(float));
+    nm->nz = malloc(cells * sizeof(float));
+    if (!nm->nx || !nm->ny || !nm->nz)
+        return oom(c, "the surface normals");
+    if (NOTE(c, ts_backend_normals(BK(c), g, nm->nx, nm->ny, nm->nz, &rep, &err), rep) !=
+        TS_OK)
+        return core_fail(c, &err);
+    return TS_OK;
+}
+
+ts_status tsd_compute_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_plane_fn add,
+                             void *user)
+{
+    size_t cells = (size_t)g->width * g->height;
+    ts_horizon_opts h;
+    ts_error err;
+    ts_status st;
+    tsd_compute_horizon_opts(c, &h);
+    float *plane = malloc(cells * sizeof(float));
+    if (!plane)
+        return oom(c, "a horizon plane");
+    h.progress = NULL; /* reported here, per azimuth */
+    for (int k = 0; k < h.directions; k++) {
+        double az = ts_horizon_azimuth(&h, k);
+        ts_backend_report rep = {0};
+        if ((st = tsd_compute_report(c, (double)k / h.directions)) != TS_OK) {
+            free(plane);
+            return st;
+        }
+        /* the sweep on the backend; the accumulation is C only */
+        if (NOTE(c, ts_backend_horizon_sweep(BK(c), g, az, &h, plane, &rep, &err), rep) !=
+                TS_OK ||
+            add(user, g, k, az, plane, &err) != TS_OK) {
+            free(plane);
+            return core_fail(c, &err);
+        }
+    }
+    free(plane);
+    return TS_OK;
+}
+
+/* The sky products' accumulator of sky_stream. */
+typedef struct {
+    const tsd_normals *nm;
+    int directions;
+    float *svf, *sky, *open;
+} sky_acc;
+
+static ts_status sky_add(void *user, const ts_grid *g, int k, double azimuth,
+                         const float *plane, ts_error *err)
+{
+    (void)k;
+    const sky_acc *a = user;
+    return ts_sky_accumulate(g, a->nm->nx, a->nm->ny, a->nm->nz, plane, azimuth,
+                             a->directions, a->svf, a->sky, a->open, err);
+}
+
+/* Stream the DIRECTIONS horizon planes into one sky accumulator; `which`:
+ * 0 = svf, 1 = sky, 2 = openness. acc must be zeroed. */
+static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const tsd_normals *nm,
+                            int which, float *acc)
+{
+    ts_error err;
+    ts_status st;
+    sky_acc a = {nm, c->opts->directions, which == 0 ? acc : NULL, which == 1 ? acc : NULL,
+                 which == 2 ? acc : NULL};
+    if ((st = tsd_compute_stream(c, g, sky_add, &a)) != TS_OK)
+        return st;
+    if (ts_sky_finish(g, a.directions, a.svf, a.sky, a.open, &err) != TS_OK)
+        return core_fail(c, &err);
+    return TS_OK;
+}
+
+/* Shadow height map visibility of the sun into vis. */
+static ts_status shm_visibility(const tsd_compute_ctx *c, const ts_grid *g, float *vis)
+{
+    ts_error err;
+    ts_backend_report rep = {0};
+    if (NOTE(c, ts_backend_shm_compute(BK(c), g, c->run->sun_azimuth, c->run->sun_elevation,
+                                       c->opts->penumbra_depth, c->opts->threads, vis, NULL,
+                                       &rep, &err),
+             rep) != TS_OK)
+        return core_fail(c, &err);
+    return TS_OK;
+}
+
+/* Exact horizon at the sun's azimuth into plane; *h describes it. */
+static ts_status sun_horizon(const tsd_compute_ctx *c, const ts_grid *g, ts_horizon_opts *h,
+                             float *plane)
+{
+    ts_error err;
+    ts_backend_report rep = {0};
+    tsd_compute_horizon_opts(c, h);
+    h->directions = 1;
+    h->start_azimuth = c->run->sun_azimuth;
+    h->progress = NULL; /* one sweep */
+    if (NOTE(c, ts_backend_horizon_sweep(BK(c), g, c->run->sun_azimuth, h, plane, &rep, &err),
+             rep) != TS_OK)
+        return core_fail(c, &err);
+    return TS_OK;
+}
+
+/* 1 if the sun is computed per cell (SUN_POSITION=per_cell: a lattice). */
+static int sun_lattice(const tsd_compute_ctx *c)
+{
+    const tsd_sun *sun = c->run->sun;
+    return sun && sun->sites.nx * sun->sites.ny > 1;
+}
+
+/* Per-cell sun (SUN_POSITION=per_cell): visibility of the disk, and the
+ * sun's grid azimuth and elevation per cell; terrain only, as the
+ * classic shade and shadow. */
+static ts_status sun_per_cell(const tsd_compute_ctx *c, const ts_grid *g, float *vis,
+                              float *az, float *el)
+{
+    ts_error err;
+    const tsd_sun *sun = c->run->sun;
+    ts_day_opts d = sun->day;
+    d.earth_horizon = 0;
+    if (ts_sun_visibility(g, &sun->sites, &d, sun->instant, vis, az, el, NULL, &err) !=
+        TS_OK)
+        return core_fail(c, &err);
+    return TS_OK;
+}
+
+/* The direct sun of shade into out; work is a plane. */
+static ts_status shade_direct(const tsd_compute_ctx *c, const ts_grid *g, const tsd_normals *nm,
+                              float *work, float *out)
+{
+    size_t cells = (size_t)g->width * g->height;
+    ts_status st;
+    if (sun_lattice(c)) {
+        float *az = malloc(cells * sizeof(float));
+        float *el = malloc(cells * sizeof(float));
+        st = !az || !el ? oom(c, "a horizon plane") : sun_per_cell(c, g, work, az, el);
+        for (size_t i = 0; st == TS_OK && i < cells; i++) {
+            double a = az[i] * M_PI / 180, e = el[i] * M_PI / 180;
+            double d = nm->nx[i] * sin(a) * cos(e) + nm->ny[i] * cos(a) * cos(e) +
+                       nm->nz[i] * sin(e);
+            out[i] = (float)((d > 0 ? d : 0) * work[i]); /* NaN stays NaN */
+        }
+        free(az);
+        free(el);
+        return st;
+    }
+    if (c->opts->method == TSD_METHOD_EXACT) {
+        ts_horizon_opts h;
+        ts_backend_report rep = {0};
+        ts_error err;
+        if ((st = sun_horizon(c, g, &h, work)) != TS_OK)
+            return st;
+        if (NOTE(c, ts_backend_shade_direct(BK(c), g, nm->nx, nm->ny, nm->nz, work, &h,
+                                            c->run->sun_azimuth, c->run->sun_elevation, out,
+                                            &rep, &err),
+                 rep) != TS_OK)
+            return core_fail(c, &err);
+        return TS_OK;
+    }
+    if ((st = shm_visibility(c, g, work)) != TS_OK)
+        return st;
+    double az0 = c->run->sun_azimuth * M_PI / 180, el0 = c->run->sun_elevation * M_PI / 180;
+    double lx = sin(az0) * cos(el0), ly = cos(az0) * cos(el0), lz = sin(el0);
+    for (size_t i = 0; i < cells; i++) {
+        double d = nm->nx[i] * lx + nm->ny[i] * ly + nm->nz[i] * lz;
+        out[i] = (float)((d > 0 ? d : 0) * work[i]); /* NaN stays NaN */
+    }
+    return TS_OK;
+}
+
+TSD_COMPUTE_FN(tsd_compute_shade)
+{
+    (void)bytes;
+    const ts_grid *g = r->dem;
+    size_t cells = (size_t)g->width * g->height;
+    tsd_normals nm = {0};
+    ts_error err;
+    ts_status st;
+    float *work = malloc(cells * sizeof(float));
+    if (!work)
+        st = oom(c, "a horizon plane");
+    else if ((st = tsd_normals_make(c, g, &nm)) == TS_OK &&
+             (st = shade_direct(c, g, &nm, work, out)) == TS_OK && c->opts->sky_weight > 0) {
+        memset(work, 0, cells * sizeof(float));
+        /* the uniform sky, or that of SKY / ENV_MAP (tsd_compute_env.c) */
+        st = c->run->env ? tsd_env_sky_term(c, g, &nm, work) : sky_stream(c, g, &nm, 1, work);
+        if (st == TS_OK &&
+            ts_shade_combine(g, out, work, c->opts->sky_weight, out, &err) != TS_OK)
+            st = core_fail(c, &err);
+    }
+    free(work);
+    tsd_normals_free(&nm);
+    return st;
+}
+
+TSD_COMPUTE_FN(tsd_compute_shadow)
+{
+    (void)bytes;
+    const ts_grid *g = r->dem;
+    size_t cells = (size_t)g->width * g->height;
+    ts_status st;
+    if (sun_lattice(c) && c->opts->method == TSD_METHOD_EXACT)
+        return sun_per_cell(c, g, out, NULL, NULL);
+    if (c->opts->method == TSD_METHOD_SHM)
+        return shm_visibility(c, g, out);
+    ts_horizon_opts h;
+    if ((st = sun_horizon(c, g, &h, out)) != TS_OK)
+        return st;
+    for (size_t i = 0; i < cells; i++)
+        if (out[i] == out[i])
+            out[i] = (float)ts_sun_disk_fraction(c->run->sun_elevation, out[i]);
+    return TS_OK;
+}
+
+TSD_COMPUTE_FN(tsd_compute_horizon)
+{
+    (void)bytes;
+    ts_horizon_opts h;
+    ts_error err;
+    ts_backend_report rep = {0};
+    tsd_compute_horizon_opts(c, &h);
+    if (NOTE(c, ts_backend_horizon_compute(BK(c), r->dem, &h, out, &rep, &err), rep) != TS_OK)
+        return core_fail(c, &err);
+    return TS_OK;
+}
+
+static ts_status sky_product(const tsd_compute_ctx *c, const tsd_region *r, int which,
+                             float *out)
+{
+    tsd_normals nm = {0};
+    ts_status st;
+    memset(out, 0, (size_t)r->width * r->height * sizeof(float));
+    if ((st = tsd_normals_make(c, r->dem, &nm)) == TS_OK)
+        st = sky_stream(c, r->dem, &nm, which, out);
+    tsd_normals_free(&nm);
+    return st;
+}
+
+TSD_COMPUTE_FN(tsd_compute_svf)
+{
+    (void)bytes;
+    return sky_product(c, r, 0, out);
+}
+
+TSD_COMPUTE_FN(tsd_compute_sky)
+{
+    (void)bytes;
+    return sky_product(c, r, 1, out);
+}
+
+TSD_COMPUTE_FN(tsd_compute_openness)
+{
+    (void)bytes;
+    return sky_product(c, r, 2, out);
+}
+
+ts_status tsd_product_compute(const tsd_compute_ctx *c, const tsd_region *r, float *out,
+                              uint8_t *bytes)
+{
+    ts_error err;
+    ts_horizon_opts h;
+    if (c->backend)
+        memset(c->backend, 0, sizeof *c->backend);
+    if (ts_grid_validate(r->dem, &err) != TS_OK)
+        return core_fail(c, &err);
+    /* windows come later: today the region is the whole DEM */
+    if (r->x0 != 0 || r->y0 != 0 || r->margin != 0 || r->width != r->dem->width ||
+        r->height != r->dem->height)
+        return tsd_fail(c->msg, c->msg_size, TS_ERR_ARG,
+                        "a product is computed over the whole DEM, not over a %d x %d "
+                        "window at (%d, %d) with a margin of %d cells",
+                        r->width, r->height, r->x0, r->y0, r->margin);
+    tsd_compute_horizon_opts(c, &h);
+    if (ts_horizon_opts_validate(&h, &err) != TS_OK)
+        return core_fail(c, &err);
+    return tsd_product_of(c->opts)->compute(c, r, out, bytes);
+}

@@ -1,0 +1,236 @@
+/* Environment light in the driver; see tsd_compute_env.h. */
+#include "tsd_compute_env.h"
+
+#include "tsd_products.h"
+#include "tsd_text.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+/* Rec. 709 / sRGB luminance of linear RGB. */
+#define LUMA(r, g, b) (0.2126 * (r) + 0.7152 * (g) + 0.0722 * (b))
+
+/* The unshadowed surfaces sampled for the automatic exposure: every
+ * PEAK_STEP degrees of aspect, and of slope from 0 (flat) to below 90. */
+#define PEAK_STEP 5
+#define PEAK_ASPECTS (360 / PEAK_STEP)
+#define PEAK_SLOPES (90 / PEAK_STEP)
+
+int tsd_options_env(const tsd_options *o)
+{
+    return o->env_map[0] || o->sky[0];
+}
+
+int tsd_exposure_parse(const char *text, double *stops)
+{
+    if (!text[0] || strcasecmp(text, "auto") == 0)
+        return 1;
+    char *end = NULL;
+    double x = strtod(text, &end);
+    if (end == text || *end || !isfinite(x) || fabs(x) > TSD_EXPOSURE_MAX)
+        return -1;
+    *stops = x;
+    return 0;
+}
+
+const char *tsd_environment_layout(const tsd_environment *e)
+{
+    return e->map.cube ? "cube" : "lat-long";
+}
+
+void tsd_environment_free(tsd_environment *e)
+{
+    if (!e)
+        return;
+    ts_env_free(&e->env);
+    ts_env_table_free(&e->table);
+    memset(e, 0, sizeof *e);
+}
+
+/* The light of unshadowed surfaces of every sampled slope and aspect (no
+ * horizon above the tangent plane) through the table: e->flat from the flat
+ * one, e->peak the largest channel of any. */
+static ts_status sample_surfaces(tsd_environment *e, ts_error *err)
+{
+    ts_grid g;
+    ts_status st = ts_grid_create(&g, PEAK_ASPECTS, PEAK_SLOPES, 1.0, 1.0, err);
+    if (st != TS_OK)
+        return st;
+    size_t n = (size_t)PEAK_ASPECTS * PEAK_SLOPES;
+    float *buf = calloc(n * 7, sizeof *buf);
+    if (!buf) {
+        ts_grid_free(&g);
+        return TS_ERR_NOMEM;
+    }
+    float *nx = buf, *ny = buf + n, *nz = buf + 2 * n, *plane = buf + 3 * n;
+    float *r = buf + 4 * n, *gr = buf + 5 * n, *b = buf + 6 * n;
+    for (int s = 0; s < PEAK_SLOPES; s++)
+        for (int a = 0; a < PEAK_ASPECTS; a++) {
+            size_t i = (size_t)s * PEAK_ASPECTS + a;
+            double t = s * PEAK_STEP * M_PI / 180, az = a * PEAK_STEP * M_PI / 180;
+            nx[i] = (float)(sin(t) * sin(az));
+            ny[i] = (float)(sin(t) * cos(az));
+            nz[i] = (float)cos(t);
+            plane[i] = -90.0f; /* nothing above the tangent plane */
+        }
+    for (int k = 0; st == TS_OK && k < e->table.directions; k++)
+        st = ts_env_light_accumulate(&g, &e->table, k, nx, ny, nz, plane, r, gr, b, err);
+    if (st == TS_OK)
+        st = ts_env_light_finish(&g, r, gr, b, err);
+    if (st == TS_OK) {
+        e->flat[0] = r[0], e->flat[1] = gr[0], e->flat[2] = b[0];
+        e->peak = 0;
+        for (size_t i = 0; i < n; i++) {
+            double m = fmax(r[i], fmax(gr[i], b[i]));
+            e->peak = m > e->peak ? m : e->peak;
+        }
+    }
+    free(buf);
+    ts_grid_free(&g);
+    return st;
+}
+
+/* The texels of ENV_MAP, or of SKY with the run's sun. */
+static ts_status load_environment(const tsd_options *o, const tsd_run *run, const void *map,
+                                  size_t map_size, tsd_environment *e, char *msg, size_t n)
+{
+    ts_error err;
+    if (o->env_map[0]) {
+        e->has_map = 1;
+        if (ts_env_exr_info(map, map_size, o->env_map, &e->map, &err) != TS_OK ||
+            ts_env_load_exr_memory(map, map_size, o->env_map, o->env_rotation,
+                                   TSD_ENV_MAX_TEXELS, &e->env, &err) != TS_OK)
+            return tsd_fail_core(msg, n, "ENV_MAP", &err);
+        return TS_OK;
+    }
+    ts_sky_kind kind;
+    int type;
+    if (ts_sky_parse(o->sky, &kind, &type, &err) != TS_OK ||
+        ts_env_sky(&e->env, kind, type, run->sun_azimuth, run->sun_elevation, 0, 0, &err) !=
+            TS_OK)
+        return tsd_fail_core(msg, n, "SKY", &err);
+    return TS_OK;
+}
+
+ts_status tsd_environment_setup(const tsd_options *o, const tsd_run *run, const void *map,
+                                size_t map_size, tsd_environment *e, char *msg, size_t n)
+{
+    ts_error err;
+    ts_status st;
+    memset(e, 0, sizeof *e);
+    double table_bytes = (double)o->directions * (o->env_normal_steps ? o->env_normal_steps : 1) *
+                         o->env_horizon_steps * 8 * sizeof(float);
+    if (table_bytes > TSD_ENV_MAX_TABLE_BYTES)
+        return tsd_fail(msg, n, TS_ERR_ARG,
+                        "the light table of DIRECTIONS=%d, ENV_NORMAL_STEPS=%d and "
+                        "ENV_HORIZON_STEPS=%d would take %.0f MiB, more than %.0f MiB: use "
+                        "ENV_NORMAL_STEPS=0 (exact) or fewer steps",
+                        o->directions, o->env_normal_steps, o->env_horizon_steps,
+                        table_bytes / 1048576, TSD_ENV_MAX_TABLE_BYTES / 1048576);
+    if ((st = load_environment(o, run, map, map_size, e, msg, n)) != TS_OK) {
+        tsd_environment_free(e);
+        return st;
+    }
+    ts_env_table_opts to;
+    ts_env_table_opts_default(&to);
+    to.directions = o->directions;
+    to.start_azimuth = o->start_azimuth;
+    to.normal_steps = o->env_normal_steps;
+    to.horizon_steps = o->env_horizon_steps;
+    to.ground = 0; /* the sky ends at the horizontal, as the sky product's */
+    if ((st = ts_env_table_build(&e->env, &to, &e->table, &err)) != TS_OK ||
+        (st = sample_surfaces(e, &err)) != TS_OK) {
+        tsd_environment_free(e);
+        return st == TS_ERR_NOMEM ? tsd_fail(msg, n, st, "out of memory for the light table")
+                                  : tsd_fail_core(msg, n, NULL, &err);
+    }
+    e->exposure_auto = tsd_exposure_parse(o->exposure, &e->exposure) == 1;
+    if (e->exposure_auto)
+        e->exposure = e->peak > 0 ? -log2(e->peak) : 0.0;
+    return TS_OK;
+}
+
+/* The environment light of sector k added to three accumulators. */
+typedef struct {
+    const tsd_environment *e;
+    const tsd_normals *nm;
+    float *r, *g, *b;
+} env_acc;
+
+static ts_status env_add(void *user, const ts_grid *g, int k, double azimuth,
+                         const float *plane, ts_error *err)
+{
+    (void)azimuth; /* the table's sector k is the sweep's azimuth k */
+    const env_acc *a = user;
+    return ts_env_light_accumulate(g, &a->e->table, k, a->nm->nx, a->nm->ny, a->nm->nz, plane,
+                                   a->r, a->g, a->b, err);
+}
+
+/* E/pi per colour into the zeroed planes r, g, b. */
+static ts_status env_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd_normals *nm,
+                           float *r, float *gr, float *b)
+{
+    ts_error err;
+    ts_status st;
+    env_acc a = {c->run->env, nm, r, gr, b};
+    if ((st = tsd_compute_stream(c, g, env_add, &a)) != TS_OK)
+        return st;
+    if (ts_env_light_finish(g, r, gr, b, &err) != TS_OK)
+        return tsd_fail_core(c->msg, c->msg_size, NULL, &err);
+    return TS_OK;
+}
+
+/* The sRGB transfer curve (IEC 61966-2-1) of a linear value in 0..1. */
+static float srgb_encode(double x)
+{
+    x = x < 0 ? 0 : x > 1 ? 1 : x;
+    return (float)(x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1 / 2.4) - 0.055);
+}
+
+TSD_COMPUTE_FN(tsd_compute_envlight)
+{
+    (void)bytes;
+    const ts_grid *g = r->dem;
+    size_t cells = (size_t)g->width * g->height;
+    tsd_normals nm = {0};
+    ts_status st;
+    if (!c->run->env)
+        return tsd_fail(c->msg, c->msg_size, TS_ERR_ARG,
+                        "PRODUCT=envlight has no environment (ENV_MAP or SKY)");
+    memset(out, 0, 3 * cells * sizeof(float));
+    if ((st = tsd_normals_make(c, g, &nm)) == TS_OK)
+        st = env_light(c, g, &nm, out, out + cells, out + 2 * cells);
+    tsd_normals_free(&nm);
+    if (st != TS_OK || !tsd_options_output_byte(c->opts))
+        return st;
+    /* Byte: exposure, then the sRGB curve; tsd_to_byte maps 0..1 to 1..255 */
+    const double scale = exp2(c->run->env->exposure);
+    for (size_t i = 0; i < 3 * cells; i++)
+        if (out[i] == out[i])
+            out[i] = srgb_encode(out[i] * scale);
+    return TS_OK;
+}
+
+ts_status tsd_env_sky_term(const tsd_compute_ctx *c, const ts_grid *g, const tsd_normals *nm,
+                           float *sky)
+{
+    const tsd_environment *e = c->run->env;
+    size_t cells = (size_t)g->width * g->height;
+    double flat = LUMA(e->flat[0], e->flat[1], e->flat[2]);
+    if (!(flat > 0))
+        return tsd_fail(c->msg, c->msg_size, TS_ERR_ARG,
+                        "the environment has no light above the horizontal, so it cannot "
+                        "be the sky term of shade (normalised by an open flat plane's light)");
+    float *gr = calloc(cells, sizeof *gr), *b = calloc(cells, sizeof *b);
+    ts_status st = !gr || !b ? tsd_fail(c->msg, c->msg_size, TS_ERR_NOMEM,
+                                        "out of memory for the environment light")
+                             : env_light(c, g, nm, sky, gr, b);
+    for (size_t i = 0; st == TS_OK && i < cells; i++)
+        sky[i] = (float)(LUMA(sky[i], gr[i], b[i]) / flat); /* NaN stays NaN */
+    free(gr);
+    free(b);
+    return st;
+}

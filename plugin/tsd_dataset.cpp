@@ -1,0 +1,422 @@
+/*
+ * tsd_dataset.cpp - a TERRASHADE:<dem> dataset: a thin C++ layer over the
+ * C option parser (tsd_options, tsd_connstr), the product table
+ * (tsd_products), the geodesy (tsd_geodesy), the sun (tsd_sun), the DEM
+ * reader (tsd_dem) and the compute functions (tsd_compute).
+ *
+ * A dataset computes its whole product once, lazily on the first block read
+ * (under a mutex), keeps it in memory as float planes (bytes for the
+ * products stored as bytes, PRODUCT=farshadow) and copies 256 x 256 blocks
+ * out of it. Its overview levels (tsd_overview.cpp) are datasets of this
+ * class too, set up by the same Setup at their size.
+ */
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "cpl_conv.h"
+#include "cpl_string.h"
+#include "gdal_priv.h"
+
+#include "tsd_connstr.h"
+#include "tsd_dataset.h"
+#include "tsd_dem.h"
+#include "tsd_gdal.h"
+#include "tsd_progress.h"
+
+namespace tsd
+{
+
+/* ---------------------------------------------------------------- band */
+
+TSRasterBand::TSRasterBand(TSDataset *poDSIn, int nBandIn, GDALDataType eType)
+    : m_nPlane(nBandIn - 1)
+{
+    poDS = poDSIn;
+    nBand = nBandIn;
+    eDataType = eType;
+    nBlockXSize = std::min(BLOCK, poDSIn->GetRasterXSize());
+    nBlockYSize = std::min(BLOCK, poDSIn->GetRasterYSize());
+}
+
+double TSRasterBand::GetNoDataValue(int *pbSuccess)
+{
+    if (pbSuccess)
+        *pbSuccess = TRUE;
+    if (eDataType != GDT_Byte)
+        return std::numeric_limits<double>::quiet_NaN();
+    return static_cast<TSDataset *>(poDS)->m_psProduct->byte_nodata;
+}
+
+const char *TSRasterBand::GetUnitType()
+{
+    return static_cast<TSDataset *>(poDS)->m_psProduct->unit;
+}
+
+CPLErr TSRasterBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
+{
+    TSDataset *ds = static_cast<TSDataset *>(poDS);
+    if (ds->EnsureComputed() != CE_None)
+        return CE_Failure;
+    const int W = nRasterXSize, H = nRasterYSize;
+    const int x0 = nBlockXOff * nBlockXSize, y0 = nBlockYOff * nBlockYSize;
+    const bool bByte = eDataType == GDT_Byte;
+    GByte *pabyOut = static_cast<GByte *>(pImage);
+    if (ds->m_pabyProduct)
+    {
+        const GByte *bplane = ds->m_pabyProduct + static_cast<size_t>(m_nPlane) * W * H;
+        for (int by = 0; by < nBlockYSize; by++)
+        {
+            const int y = y0 + by;
+            const int gy = ds->m_sCells.flip_y ? H - 1 - y : y;
+            for (int bx = 0; bx < nBlockXSize; bx++)
+            {
+                const int x = x0 + bx;
+                const int gx = ds->m_sCells.flip_x ? W - 1 - x : x;
+                pabyOut[static_cast<size_t>(by) * nBlockXSize + bx] =
+                    y < H && x < W ? bplane[static_cast<size_t>(gy) * W + gx]
+                                   : static_cast<GByte>(ds->m_psProduct->byte_nodata);
+            }
+        }
+        return CE_None;
+    }
+    const float *plane = ds->m_pafProduct + static_cast<size_t>(m_nPlane) * W * H;
+    float *pafOut = static_cast<float *>(pImage);
+    const float fNaN = std::numeric_limits<float>::quiet_NaN();
+    for (int by = 0; by < nBlockYSize; by++)
+    {
+        const int y = y0 + by;
+        const int gy = ds->m_sCells.flip_y ? H - 1 - y : y;
+        const float *row = y < H ? plane + static_cast<size_t>(gy) * W : nullptr;
+        for (int bx = 0; bx < nBlockXSize; bx++)
+        {
+            const int x = x0 + bx;
+            const int gx = ds->m_sCells.flip_x ? W - 1 - x : x;
+            const float v = row && x < W ? row[gx] : fNaN;
+            const size_t i = static_cast<size_t>(by) * nBlockXSize + bx;
+            if (bByte)
+                pabyOut[i] = tsd_to_byte(v);
+            else
+                pafOut[i] = v;
+        }
+    }
+    return CE_None;
+}
+
+/* ------------------------------------------------------------- dataset */
+
+TSDataset::~TSDataset()
+{
+    TSDataset::FlushCache(true);
+    if (m_poDEM)
+        GDALClose(m_poDEM);
+    tsd_cells_free(&m_sCells);
+    tsd_sun_free(&m_sSun);
+    tsd_environment_free(&m_sEnv);
+    VSIFree(m_pafProduct);
+    VSIFree(m_pabyProduct);
+}
+
+CPLErr TSDataset::GetGeoTransform(double *padfGT)
+{
+    if (!m_bHasGT)
+        return GDALPamDataset::GetGeoTransform(padfGT);
+    memcpy(padfGT, m_adfGT, sizeof m_adfGT);
+    return CE_None;
+}
+
+const OGRSpatialReference *TSDataset::GetSpatialRef() const
+{
+    return m_oSRS.IsEmpty() ? nullptr : &m_oSRS;
+}
+
+/* Compute the product once; later calls return the same outcome. */
+CPLErr TSDataset::EnsureComputed()
+{
+    std::lock_guard<std::mutex> oLock(m_oMutex);
+    if (!m_bTried)
+    {
+        m_bTried = true;
+        char szMsg[1024] = "";
+        ts_status eStatus = TS_OK;
+        const char *pszName = m_psProduct->name;
+        const int W = nRasterXSize, H = nRasterYSize;
+        const size_t nCells = static_cast<size_t>(W) * H;
+        const int nBands = tsd_options_band_count(&m_sOpts);
+        CPLDebug(DRIVER, "computing PRODUCT=%s of %s (%d x %d, %d band(s), level %d)",
+                 pszName, m_osDEM.c_str(), W, H, nBands, m_nLevel);
+        const auto tStart = std::chrono::steady_clock::now();
+        // The whole product is computed here, inside the first block read,
+        // where GDAL passes no progress callback: report on stderr.
+        tsd_progress sProgress;
+        const std::string osLabel =
+            CPLSPrintf("computing %s of %d x %d cells", pszName, W, H);
+        tsd_progress_begin(&sProgress, m_sOpts.progress_mode, nullptr, osLabel.c_str(),
+                           CPLAtof(CPLGetConfigOption("TERRASHADE_PROGRESS_AFTER", "1")));
+        tsd_run sRun = m_sRun;
+        sRun.progress = tsd_progress_report;
+        sRun.progress_user = &sProgress;
+        ts_grid sGrid;
+        if (!m_poDEM) // an overview level: the DEM again, read at its size
+            m_poDEM = GDALDataset::Open(m_osDEM.c_str(), GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR);
+        if (!m_poDEM)
+        {
+            eStatus = TS_ERR_INTERNAL;
+            snprintf(szMsg, sizeof szMsg, "cannot open the DEM '%s' again for overview "
+                     "level %d", m_osDEM.c_str(), m_nLevel);
+        }
+        else
+            eStatus = tsd_dem_load_resampled(
+                GDALGetRasterBand(m_poDEM, m_sOpts.band), &m_sCells, m_sOpts.z_factor, W, H,
+                &sGrid, szMsg, sizeof szMsg);
+        if (eStatus != TS_OK)
+        {
+            m_osError = szMsg;
+        }
+        else
+        {
+            const std::chrono::duration<double> dfRead =
+                std::chrono::steady_clock::now() - tStart;
+            CPLDebug(DRIVER, "read the DEM in %.3f s", dfRead.count());
+            if (m_psProduct->byte == TSD_BYTE_ALWAYS)
+                m_pabyProduct = static_cast<GByte *>(VSI_MALLOC2_VERBOSE(nCells, nBands));
+            else
+                m_pafProduct = static_cast<float *>(
+                    VSI_MALLOC3_VERBOSE(nCells, nBands, sizeof(float)));
+            if (!m_pafProduct && !m_pabyProduct)
+            {
+                eStatus = TS_ERR_NOMEM;
+                m_osError = "out of memory for the product";
+            }
+            else
+            {
+                tsd_backend_summary sRan{};
+                tsd_region sRegion;
+                tsd_region_whole(&sRegion, &sGrid);
+                const tsd_compute_ctx sCtx{&m_sOpts, &sRun, &sRan, szMsg, sizeof szMsg};
+                eStatus = tsd_product_compute(&sCtx, &sRegion, m_pafProduct, m_pabyProduct);
+                if (eStatus != TS_OK)
+                    m_osError = szMsg;
+                else if (sRan.calls > 0)
+                {
+                    m_sBackend = sRan;
+                    m_bBackendKnown = true;
+                    SetupBackendMetadata();
+                    ReportBackend();
+                }
+            }
+            ts_grid_free(&sGrid);
+        }
+        tsd_progress_end(&sProgress, m_osError.empty());
+        if (!m_osError.empty())
+        {
+            VSIFree(m_pafProduct);
+            m_pafProduct = nullptr;
+            VSIFree(m_pabyProduct);
+            m_pabyProduct = nullptr;
+        }
+        if (m_poDEM)
+            GDALClose(m_poDEM);
+        m_poDEM = nullptr;
+        const std::chrono::duration<double> dfSec =
+            std::chrono::steady_clock::now() - tStart;
+        CPLDebug(DRIVER, "computed PRODUCT=%s in %.3f s%s", pszName, dfSec.count(),
+                 m_osError.empty() ? "" : " (failed)");
+        m_eStatus = eStatus;
+    }
+    if (!m_osError.empty())
+    {
+        Fail(m_eStatus, m_osError.c_str());
+        return CE_Failure;
+    }
+    return CE_None;
+}
+
+/* Refuse products that cannot fit, with a sentence saying what to do. */
+static bool CheckMemory(const tsd_options &sOpts, int W, int H)
+{
+    double dfSteady = 0;
+    const double dfPeak = tsd_product_peak_bytes(&sOpts, W, H, &dfSteady);
+    double dfLimit = 0;
+    const char *pszWhy = "MAX_MEMORY";
+    if (sOpts.max_memory_mb > 0)
+        dfLimit = sOpts.max_memory_mb * 1048576.0;
+    else
+    {
+        dfLimit = 0.75 * static_cast<double>(CPLGetUsablePhysicalRAM());
+        pszWhy = "three quarters of the physical memory; set MAX_MEMORY to change";
+        if (dfLimit <= 0)
+            dfLimit = static_cast<double>(std::numeric_limits<size_t>::max()) / 2;
+    }
+    if (dfPeak <= dfLimit && dfPeak < static_cast<double>(std::numeric_limits<size_t>::max()) / 2)
+        return true;
+    Fail(TS_ERR_NOMEM,
+         CPLSPrintf("PRODUCT=%s with %d band(s) on this %d x %d DEM needs "
+                    "about %.0f MiB while computing (%.0f MiB kept), more than the "
+                    "limit of %.0f MiB (%s); crop or downsample the DEM, use fewer "
+                    "DIRECTIONS, or raise MAX_MEMORY",
+                    tsd_options_product_name(&sOpts), tsd_options_band_count(&sOpts), W,
+                    H, dfPeak / 1048576.0, dfSteady / 1048576.0, dfLimit / 1048576.0,
+                    pszWhy));
+    return false;
+}
+
+GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
+{
+    if (!tsd_connstr_matches(poOpenInfo->pszFilename))
+        return nullptr;
+    if (poOpenInfo->eAccess == GA_Update)
+        return FailOpen(CPLE_NotSupported,
+                             "TERRASHADE datasets are read-only; write the product "
+                             "with gdal_translate instead");
+    char szMsg[1024] = "";
+    tsd_connstr sConn;
+    const ts_status eParsed =
+        tsd_connstr_parse(poOpenInfo->pszFilename, &sConn, szMsg, sizeof szMsg);
+    if (eParsed != TS_OK)
+    {
+        tsd_connstr_free(&sConn);
+        return FailOpen(eParsed, szMsg);
+    }
+    CPLStringList aosOptions;
+    for (char **p = sConn.options; p && *p; p++)
+        aosOptions.AddString(*p);
+    for (char **p = poOpenInfo->papszOpenOptions; p && *p; p++)
+        aosOptions.AddString(*p);
+    const std::string osDEM = sConn.dem;
+    tsd_connstr_free(&sConn);
+
+    auto poDS = std::unique_ptr<TSDataset>(new TSDataset());
+    tsd_options &sOpts = poDS->m_sOpts;
+    tsd_options_defaults(&sOpts);
+    if (tsd_options_apply(&sOpts, aosOptions.List(), szMsg, sizeof szMsg) != 0)
+        return FailOpen(TS_ERR_ARG, szMsg);
+    poDS->m_psProduct = tsd_product_of(&sOpts);
+
+    GDALDataset *poDEM = GDALDataset::Open(
+        osDEM.c_str(), GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR, nullptr, nullptr,
+        nullptr);
+    if (!poDEM)
+        return FailOpen(CPLE_OpenFailed,
+                             CPLSPrintf("cannot open the DEM '%s' as a raster",
+                                        osDEM.c_str()));
+    poDS->m_poDEM = poDEM;
+    poDS->m_osDEM = osDEM;
+    if (sOpts.band > poDEM->GetRasterCount())
+        return FailOpen(TS_ERR_ARG,
+                             CPLSPrintf("BAND=%d, but the DEM '%s' has %d band(s)",
+                                        sOpts.band, osDEM.c_str(),
+                                        poDEM->GetRasterCount()));
+    // Z_FACTOR=AUTO becomes the factor of the DEM's vertical unit here, so
+    // that the metadata and the auxiliary-file key say the number used
+    char szZWhy[256];
+    sOpts.z_factor = tsd_dem_z_factor(GDALRasterBand::ToHandle(poDEM->GetRasterBand(sOpts.band)),
+                                      sOpts.z_factor, szZWhy, sizeof szZWhy);
+    const int W = poDEM->GetRasterXSize(), H = poDEM->GetRasterYSize();
+    if (poDEM->GetGeoTransform(poDS->m_adfGT) != CE_None)
+    {
+        // no georeferencing: row 0 is the top (north), cells 1 x 1 metre
+        poDS->m_bHasGT = false;
+        const double adfTopDown[6] = {0, 1, 0, 0, 0, -1};
+        memcpy(poDS->m_adfGT, adfTopDown, sizeof adfTopDown);
+        CPLError(CE_Warning, CPLE_AppDefined,
+                 "TERRASHADE: the DEM '%s' has no geotransform: its cells are "
+                 "taken as 1 x 1 metre, row 0 north", osDEM.c_str());
+    }
+    if (const OGRSpatialReference *poSRS = poDEM->GetSpatialRef())
+        poDS->m_oSRS = *poSRS;
+    if (!poDS->Setup(poOpenInfo->pszFilename, W, H))
+        return nullptr;
+    // not through PAM: it is derived, like the rest of the metadata
+    poDS->GDALDataset::SetMetadataItem("Z_FACTOR_SOURCE", szZWhy);
+    poDS->m_nOverviews = OverviewCount(poDS->m_psProduct, W, H);
+    return poDS.release();
+}
+
+/* Everything that follows from the georeferencing (m_adfGT, m_bHasGT,
+ * m_oSRS) of a W x H grid and the options: the cells, the sun, the memory
+ * check, the bands, the metadata and (level 0) PAM. Shared by the DEM's
+ * own resolution and its overview levels, so that a level is set up as a
+ * DEM of its size would be. false with the error reported. */
+bool TSDataset::Setup(const char *pszConnection, int W, int H)
+{
+    char szMsg[1024] = "";
+    const tsd_options &sOpts = m_sOpts;
+    OGRSpatialReferenceH hSRS =
+        m_oSRS.IsEmpty() ? nullptr : OGRSpatialReference::ToHandle(&m_oSRS);
+    ts_status eSt = tsd_cells_compute(m_adfGT, W, H, hSRS, &m_sCells, szMsg, sizeof szMsg);
+    if (eSt != TS_OK)
+        return Fail(eSt, szMsg), false;
+    if (tsd_options_sun_from_time(&sOpts))
+    {
+        const char *pszWhat = sOpts.datetime[0] ? "DATETIME" : "DATE";
+        if (!m_bHasGT || !hSRS)
+            return Fail(
+                       CPLE_AppDefined,
+                       CPLSPrintf("%s needs a georeferenced DEM, but '%s' has no %s: the "
+                                  "sun's position over it is unknown. Give it one "
+                                  "(gdal_edit.py -a_srs / -a_ullr) or use SUN_AZIMUTH "
+                                  "and SUN_ELEVATION",
+                                  pszWhat, m_osDEM.c_str(),
+                                  !m_bHasGT ? "geotransform" : "CRS")), false;
+        tsd_sites sSites;
+        eSt = tsd_sites_compute(m_adfGT, W, H, hSRS, &m_sCells,
+                                sOpts.sun_position == TSD_SUN_PER_CELL, &sSites, szMsg,
+                                sizeof szMsg);
+        if (eSt != TS_OK)
+            return Fail(eSt, CPLSPrintf("%s: %s", pszWhat, szMsg)), false;
+        double dfMinCell = m_sCells.cell_y;
+        for (int y = 0; y < H; y++)
+            dfMinCell = std::min(dfMinCell, m_sCells.cell_x_row ? m_sCells.cell_x_row[y]
+                                                                : m_sCells.cell_x);
+        eSt = tsd_sun_setup(&sOpts, &sSites, dfMinCell, &m_sSun, szMsg, sizeof szMsg);
+        if (eSt != TS_OK)
+            return Fail(eSt, szMsg), false;
+        m_bHasSun = true;
+    }
+    const tsd_sun *psSun = m_bHasSun ? &m_sSun : nullptr;
+    tsd_run_init(&m_sRun, &sOpts, psSun);
+    if (!SetupEnvironment())
+        return false;
+    if (m_sCells.warning[0] && m_nLevel == 0) // said once, for the DEM itself
+        CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", m_sCells.warning);
+    if (!CheckMemory(sOpts, W, H))
+        return false;
+    /* a bad TERRASHADE_BACKEND is an error here (without probing OpenCL) */
+    m_bUsesBackend = m_psProduct->uses_backend && m_psProduct->uses_backend(&sOpts, psSun);
+    if (m_bUsesBackend && tsd_backend_check_env(&sOpts, szMsg, sizeof szMsg) != 0)
+        return Fail(TS_ERR_ARG, szMsg), false;
+
+    nRasterXSize = W;
+    nRasterYSize = H;
+    const GDALDataType eType = tsd_options_output_byte(&sOpts) ? GDT_Byte : GDT_Float32;
+    for (int i = 1; i <= tsd_options_band_count(&sOpts); i++)
+        SetBand(i, new TSRasterBand(this, i, eType));
+    SetupMetadata();
+    if (m_nLevel == 0)
+        SetupPam(pszConnection);
+    else
+    {
+        SetDescription(pszConnection);
+        nPamFlags |= GPF_DISABLED; // a level's statistics are its parent's business
+    }
+    return true;
+}
+
+int IdentifyProduct(GDALOpenInfo *poOpenInfo)
+{
+    return tsd_connstr_matches(poOpenInfo->pszFilename);
+}
+
+GDALDataset *OpenProduct(GDALOpenInfo *poOpenInfo)
+{
+    return TSDataset::Open(poOpenInfo);
+}
+
+} // namespace tsd

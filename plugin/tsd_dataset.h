@@ -1,0 +1,120 @@
+/*
+ * tsd_dataset.h - the classes of a TERRASHADE:<dem> dataset, shared by
+ * tsd_dataset.cpp (opening, computing, blocks) and tsd_dataset_metadata.cpp
+ * (metadata and PAM).
+ */
+#ifndef TSD_DATASET_H
+#define TSD_DATASET_H
+
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "gdal_pam.h"
+#include "ogr_spatialref.h"
+
+#include "tsd_backend.h"
+#include "tsd_compute.h"
+#include "tsd_compute_env.h"
+#include "tsd_geodesy.h"
+#include "tsd_options.h"
+#include "tsd_products.h"
+#include "tsd_sun.h"
+
+namespace tsd
+{
+
+class TSRasterBand;
+
+/** A TERRASHADE:<dem> dataset: one product of a DEM. */
+class TSDataset final : public GDALPamDataset
+{
+    friend class TSRasterBand;
+
+    GDALDataset *m_poDEM = nullptr; // open until the product is computed
+    std::string m_osDEM;
+    tsd_options m_sOpts{};                  // what the user said
+    const tsd_product_def *m_psProduct = nullptr; // its row of the product table
+    tsd_run m_sRun{};                       // the sun used (progress: while computing)
+    tsd_cells m_sCells{};
+    double m_adfGT[6] = {0, 1, 0, 0, 0, 1};
+    bool m_bHasGT = true;
+    OGRSpatialReference m_oSRS{};
+    std::mutex m_oMutex{};
+    bool m_bTried = false;
+    std::string m_osError{};      // why computing failed
+    ts_status m_eStatus = TS_OK;  // and its status
+    float *m_pafProduct = nullptr;
+    GByte *m_pabyProduct = nullptr; // products stored as bytes (TSD_BYTE_ALWAYS)
+    bool m_bHasSun = false;
+    tsd_sun m_sSun{};
+    /* overviews (tsd_overview.cpp): level 0 is the DEM's own resolution; a
+     * level k > 0 dataset is the product of the DEM read at its size (the
+     * DEM reopened by name when it computes) */
+    int m_nLevel = 0;
+    int m_nOverviews = 0;   // levels offered (level 0 only)
+    std::mutex m_oOvrMutex{};
+    std::vector<std::unique_ptr<TSDataset>> m_apoOverviews{}; // made on first use
+    bool m_bUsesBackend = false;
+    bool m_bBackendKnown = false;     // m_sBackend filled (predicted or ran)
+    tsd_backend_summary m_sBackend{}; // predicted, then what ran
+    tsd_environment m_sEnv{};         // ENV_MAP or SKY (tsd_dataset_env.cpp)
+
+    CPLErr EnsureComputed();
+    bool Setup(const char *pszConnection, int W, int H);
+    TSDataset *Overview(int i);
+    TSDataset *MakeOverview(int nLevel);
+    void EnsureBackendMetadata();
+    void SetupBackendMetadata();
+    void ReportBackend();
+    void SetupSunMetadata();
+    void SetupMetadata();
+    void SetupPam(const char *pszConnection);
+    bool SetupEnvironment();
+    void SetupEnvironmentMetadata();
+
+  public:
+    TSDataset() = default;
+    ~TSDataset() override;
+
+    static GDALDataset *Open(GDALOpenInfo *poOpenInfo);
+
+    /** The number of overview levels of a W x H product: 2x, 4x, ... while
+     * the previous level's longer side exceeds OVERVIEW_MIN_SIDE, and never
+     * for PRODUCT=farshadow. */
+    static int OverviewCount(const tsd_product_def *psProduct, int W, int H);
+
+    CPLErr GetGeoTransform(double *padfGT) override;
+    const OGRSpatialReference *GetSpatialRef() const override;
+    char **GetMetadata(const char *pszDomain = "") override;
+    const char *GetMetadataItem(const char *pszName, const char *pszDomain = "") override;
+};
+
+/** A band of it: one plane of the product. */
+class TSRasterBand final : public GDALPamRasterBand
+{
+    int m_nPlane;
+    GDALColorInterp m_eColor = GCI_GrayIndex;
+
+  public:
+    TSRasterBand(TSDataset *poDSIn, int nBandIn, GDALDataType eType);
+
+    CPLErr IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage) override;
+    double GetNoDataValue(int *pbSuccess = nullptr) override;
+    GDALColorInterp GetColorInterpretation() override
+    {
+        return m_eColor;
+    }
+    void SetColor(GDALColorInterp eColor)
+    {
+        m_eColor = eColor;
+    }
+    const char *GetUnitType() override;
+    int GetOverviewCount() override;
+    GDALRasterBand *GetOverview(int i) override;
+};
+
+} // namespace tsd
+
+#endif

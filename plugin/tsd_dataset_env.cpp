@@ -1,0 +1,142 @@
+/*
+ * tsd_dataset_env.cpp - the environment of a TERRASHADE:<dem> dataset
+ * (ENV_MAP or SKY, tsd_compute_env.h), set up when the dataset opens so that
+ * a bad map fails the open with its sentence: ENV_MAP is read through GDAL's
+ * VSI into memory (so /vsimem/, /vsicurl/, /vsizip/... paths work) and
+ * decoded by the core's OpenEXR reader. And its metadata.
+ */
+#include <cerrno>
+#include <string>
+#include <vector>
+
+#include "cpl_conv.h"
+#include "cpl_string.h"
+#include "cpl_vsi.h"
+
+#include "tsd_dataset.h"
+#include "tsd_gdal.h"
+
+namespace tsd
+{
+
+/* Larger files are refused: far beyond any map the reader accepts
+ * (TS_ENV_MAX_PIXELS of float RGBA, uncompressed, is 1 GiB). */
+constexpr vsi_l_offset MAX_MAP_BYTES = static_cast<vsi_l_offset>(2) << 30;
+
+/* The bytes of the file at pszPath (any GDAL path) into oBytes; false with
+ * a sentence in osError. */
+static bool ReadWholeFile(const char *pszPath, std::vector<GByte> &oBytes,
+                          std::string &osError)
+{
+    VSIStatBufL sStat;
+    if (VSIStatExL(pszPath, &sStat, VSI_STAT_EXISTS_FLAG | VSI_STAT_NATURE_FLAG) != 0)
+    {
+        osError = CPLSPrintf("cannot open ENV_MAP '%s': no such file", pszPath);
+        return false;
+    }
+    if (VSI_ISDIR(sStat.st_mode))
+    {
+        osError = CPLSPrintf("ENV_MAP '%s' is a directory, not an OpenEXR file", pszPath);
+        return false;
+    }
+    VSILFILE *fp = VSIFOpenL(pszPath, "rb");
+    if (!fp)
+    {
+        osError = CPLSPrintf("cannot open ENV_MAP '%s': %s", pszPath, VSIStrerror(errno));
+        return false;
+    }
+    // read to the end, whatever the size the file system reports
+    constexpr size_t CHUNK = 1 << 20;
+    size_t nUsed = 0;
+    bool bOk = true;
+    for (;;)
+    {
+        if (nUsed + CHUNK > MAX_MAP_BYTES)
+        {
+            osError = CPLSPrintf("ENV_MAP '%s' is larger than %d GiB: not an environment "
+                                 "map this driver reads",
+                                 pszPath, static_cast<int>(MAX_MAP_BYTES >> 30));
+            bOk = false;
+            break;
+        }
+        try
+        {
+            oBytes.resize(nUsed + CHUNK);
+        }
+        catch (const std::bad_alloc &)
+        {
+            osError = CPLSPrintf("out of memory reading ENV_MAP '%s'", pszPath);
+            bOk = false;
+            break;
+        }
+        const size_t nGot = VSIFReadL(oBytes.data() + nUsed, 1, CHUNK, fp);
+        nUsed += nGot;
+        if (nGot < CHUNK)
+        {
+            if (!VSIFEofL(fp))
+            {
+                osError = CPLSPrintf("cannot read ENV_MAP '%s'", pszPath);
+                bOk = false;
+            }
+            break;
+        }
+    }
+    VSIFCloseL(fp);
+    oBytes.resize(bOk ? nUsed : 0);
+    return bOk;
+}
+
+bool TSDataset::SetupEnvironment()
+{
+    if (!tsd_options_env(&m_sOpts))
+        return true;
+    std::vector<GByte> oMap;
+    std::string osError;
+    if (m_sOpts.env_map[0] && !ReadWholeFile(m_sOpts.env_map, oMap, osError))
+    {
+        Fail(CPLE_OpenFailed, osError.c_str());
+        return false;
+    }
+    char szMsg[1024] = "";
+    const ts_status eSt = tsd_environment_setup(&m_sOpts, &m_sRun, oMap.data(), oMap.size(),
+                                                &m_sEnv, szMsg, sizeof szMsg);
+    if (eSt != TS_OK)
+    {
+        Fail(eSt, szMsg);
+        return false;
+    }
+    m_sRun.env = &m_sEnv;
+    CPLDebug(DRIVER, "environment: %zu texels, flat plane E/pi %g %g %g, peak %g",
+             m_sEnv.env.count, m_sEnv.flat[0], m_sEnv.flat[1], m_sEnv.flat[2], m_sEnv.peak);
+    return true;
+}
+
+/* The map (its full path, layout, channels, size), the light of an open
+ * flat plane, and the exposure of a Byte envlight. */
+void TSDataset::SetupEnvironmentMetadata()
+{
+    if (!m_sRun.env)
+        return;
+    const tsd_environment &e = m_sEnv;
+    if (e.has_map)
+    {
+        GDALDataset::SetMetadataItem("ENV_MAP", m_sOpts.env_map); // not truncated
+        GDALDataset::SetMetadataItem("ENV_MAP_LAYOUT", tsd_environment_layout(&e));
+        GDALDataset::SetMetadataItem("ENV_MAP_CHANNELS", e.map.grey ? "Y" : "R,G,B");
+        GDALDataset::SetMetadataItem("ENV_MAP_SIZE",
+                                     CPLSPrintf("%d x %d", e.map.width, e.map.height));
+    }
+    GDALDataset::SetMetadataItem(
+        "ENV_FLAT_LIGHT", CPLSPrintf("%.6g,%.6g,%.6g", e.flat[0], e.flat[1], e.flat[2]));
+    if (m_psProduct->compute == tsd_compute_envlight && tsd_options_output_byte(&m_sOpts))
+    {
+        GDALDataset::SetMetadataItem("EXPOSURE", CPLSPrintf("%.6g", e.exposure));
+        GDALDataset::SetMetadataItem("EXPOSURE_RULE",
+                                     e.exposure_auto ? "auto: the brightest unshadowed "
+                                                       "surface maps to 255"
+                                                     : "given");
+        GDALDataset::SetMetadataItem("TRANSFER", "sRGB (IEC 61966-2-1)");
+    }
+}
+
+} // namespace tsd

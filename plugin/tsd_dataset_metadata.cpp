@@ -1,0 +1,221 @@
+/*
+ * tsd_dataset_metadata.cpp - the metadata of a TERRASHADE:<dem> dataset:
+ * the options used, the cells, the bands (from the product table), where
+ * and when the sun was placed, the backend that ran (asked for lazily, so
+ * that opening costs no OpenCL initialisation), and PAM next to the DEM.
+ */
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "cpl_conv.h"
+#include "cpl_string.h"
+
+#include "tsd_dataset.h"
+#include "tsd_gdal.h"
+
+namespace tsd
+{
+
+/* The BACKEND items asked for before the product is computed (gdalinfo;
+ * gdal_translate copies the metadata before reading): the dispatcher's
+ * choice, which probes the OpenCL device. Not done at open, so that opening
+ * costs no OpenCL initialisation. */
+void TSDataset::EnsureBackendMetadata()
+{
+    std::lock_guard<std::mutex> oLock(m_oMutex);
+    if (!m_bUsesBackend || m_bBackendKnown || m_bTried)
+        return;
+    char szMsg[256];
+    if (tsd_backend_predict(&m_sOpts, &m_sBackend, szMsg, sizeof szMsg) != 0)
+        return; // TERRASHADE_BACKEND changed since open: computing will say
+    m_bBackendKnown = true;
+    SetupBackendMetadata();
+}
+
+char **TSDataset::GetMetadata(const char *pszDomain)
+{
+    if (!pszDomain || !*pszDomain)
+        EnsureBackendMetadata();
+    return GDALPamDataset::GetMetadata(pszDomain);
+}
+
+const char *TSDataset::GetMetadataItem(const char *pszName, const char *pszDomain)
+{
+    if ((!pszDomain || !*pszDomain) && pszName && STARTS_WITH_CI(pszName, "BACKEND"))
+        EnsureBackendMetadata();
+    return GDALPamDataset::GetMetadataItem(pszName, pszDomain);
+}
+
+/* BACKEND, BACKEND_DEVICE, BACKEND_FALLBACK_REASON of m_sBackend. */
+void TSDataset::SetupBackendMetadata()
+{
+    if (!m_bUsesBackend || !m_bBackendKnown)
+        return;
+    char szBackend[16], szDevice[512];
+    tsd_backend_summary_text(&m_sBackend, szBackend, sizeof szBackend, szDevice,
+                             sizeof szDevice);
+    GDALDataset::SetMetadataItem("BACKEND", szBackend);
+    GDALDataset::SetMetadataItem("BACKEND_DEVICE", szDevice);
+    GDALDataset::SetMetadataItem("BACKEND_FALLBACK_REASON",
+                                 m_sBackend.reason[0] ? m_sBackend.reason : nullptr);
+}
+
+/* After computing: say where it ran; a warning when OpenCL was asked for
+ * (BACKEND=opencl or TERRASHADE_BACKEND=opencl) and C ran. */
+void TSDataset::ReportBackend()
+{
+    const tsd_backend_summary &s = m_sBackend;
+    char szBackend[16], szDevice[512];
+    tsd_backend_summary_text(&s, szBackend, sizeof szBackend, szDevice, sizeof szDevice);
+    if (s.requested == TS_BACKEND_OPENCL && s.c_calls > 0)
+        CPLError(CE_Warning, CPLE_AppDefined,
+                 "TERRASHADE: BACKEND=opencl was requested, but %d of %d computation(s) "
+                 "ran on the C backend instead: %s",
+                 s.c_calls, s.calls, s.reason[0] ? s.reason : "(no reason given)");
+    else if (s.c_calls > 0 && s.reason[0])
+        CPLDebug(DRIVER, "backend %s (%s) requested, C ran: %s",
+                 ts_backend_name(s.requested), szDevice, s.reason);
+    CPLDebug(DRIVER, "backend: %s on %s (%d call(s): %d OpenCL, %d C)", szBackend,
+             szDevice, s.calls, s.opencl_calls, s.c_calls);
+}
+
+void TSDataset::SetupMetadata()
+{
+    char szValue[128];
+    const int nBands = GetRasterCount();
+    for (int i = 0; i < tsd_options_count(); i++)
+    {
+        const char *pszName = tsd_options_value(&m_sOpts, i, szValue, sizeof szValue);
+        if (!(tsd_option_scope(i) & TSD_SCOPE_PRODUCT) || EQUAL(pszName, "THREADS") || EQUAL(pszName, "MAX_MEMORY") ||
+            EQUAL(pszName, "BACKEND") || !szValue[0])
+            continue; // BACKEND: what ran (SetupBackendMetadata)
+        GDALDataset::SetMetadataItem(pszName, szValue);
+    }
+    GDALDataset::SetMetadataItem("SOURCE_DEM", m_osDEM.c_str());
+    const char *pszKind = m_sCells.kind == TSD_CRS_GEOGRAPHIC  ? "geographic"
+                          : m_sCells.kind == TSD_CRS_PROJECTED ? "projected"
+                                                               : "none";
+    GDALDataset::SetMetadataItem("SOURCE_CRS_KIND", pszKind);
+    GDALDataset::SetMetadataItem("CELL_SIZE_X", CPLSPrintf("%.6f", m_sCells.cell_x));
+    GDALDataset::SetMetadataItem("CELL_SIZE_Y", CPLSPrintf("%.6f", m_sCells.cell_y));
+    if (m_sCells.cell_x_row)
+    {
+        GDALDataset::SetMetadataItem(
+            "CELL_SIZE_X_NORTH", CPLSPrintf("%.6f", m_sCells.cell_x_row[0]));
+        GDALDataset::SetMetadataItem(
+            "CELL_SIZE_X_SOUTH",
+            CPLSPrintf("%.6f", m_sCells.cell_x_row[nRasterYSize - 1]));
+    }
+    for (int k = 0; m_psProduct->describe_band && k < nBands; k++)
+    {
+        tsd_band_info sInfo{};
+        m_psProduct->describe_band(m_psProduct, &m_sOpts, k, &sInfo);
+        GDALRasterBand *poBand = GetRasterBand(k + 1);
+        poBand->GDALMajorObject::SetDescription(sInfo.description);
+        if (sInfo.key)
+            poBand->GDALMajorObject::SetMetadataItem(sInfo.key, sInfo.value);
+        if (sInfo.color)
+            static_cast<TSRasterBand *>(poBand)->SetColor(
+                GDALGetColorInterpretationByName(sInfo.color));
+    }
+    SetupEnvironmentMetadata();
+    if (m_bHasSun)
+        SetupSunMetadata();
+    SetupBackendMetadata();
+}
+
+void SetStepMetadata(GDALMajorObject *poObj, double dfTime, int nOffset,
+                          double dfAzTrue, double dfAzGrid, double dfEl, double dfDuration)
+{
+    if (std::isfinite(dfTime))
+    {
+        char szTime[64];
+        tsd_format_time(dfTime, nOffset, szTime, sizeof szTime);
+        poObj->SetDescription(szTime);
+        poObj->SetMetadataItem("TIME", szTime);
+        poObj->SetMetadataItem("UNIX_TIME", CPLSPrintf("%.3f", dfTime));
+    }
+    if (std::isfinite(dfDuration))
+        poObj->SetMetadataItem("DURATION_MINUTES", CPLSPrintf("%.10g", dfDuration / 60));
+    if (std::isfinite(dfAzGrid))
+        poObj->SetMetadataItem("SUN_AZIMUTH", CPLSPrintf("%.6f", dfAzGrid));
+    if (std::isfinite(dfAzTrue))
+        poObj->SetMetadataItem("SUN_AZIMUTH_TRUE", CPLSPrintf("%.6f", dfAzTrue));
+    if (std::isfinite(dfEl))
+        poObj->SetMetadataItem("SUN_ELEVATION", CPLSPrintf("%.6f", dfEl));
+}
+
+/* Where and when the sun was placed, with the names of the values used. */
+void TSDataset::SetupSunMetadata()
+{
+    const tsd_sun &s = m_sSun;
+    const int nRef = (s.sites.ny / 2) * s.sites.nx + s.sites.nx / 2;
+    const double dfNorth = s.sites.north_azimuth[nRef];
+    GDALDataset::SetMetadataItem("SUN_SITE_LONGITUDE",
+                                 CPLSPrintf("%.8f", s.sites.longitude[nRef]));
+    GDALDataset::SetMetadataItem("SUN_SITE_LATITUDE",
+                                 CPLSPrintf("%.8f", s.sites.latitude[nRef]));
+    GDALDataset::SetMetadataItem("MERIDIAN_CONVERGENCE", CPLSPrintf("%.6f", -dfNorth));
+    GDALDataset::SetMetadataItem("SUN_MODEL", "SPA (Reda & Andreas 2004), apparent "
+                                              "elevation with refraction");
+    char szTime[64];
+    if (!m_psProduct->daily)
+    {
+        tsd_format_time(s.instant, s.offset_minutes, szTime, sizeof szTime);
+        GDALDataset::SetMetadataItem("SUN_TIME", szTime);
+        GDALDataset::SetMetadataItem("SUN_AZIMUTH", CPLSPrintf("%.6f", s.sun.grid_azimuth));
+        GDALDataset::SetMetadataItem("SUN_AZIMUTH_TRUE", CPLSPrintf("%.6f", s.sun.azimuth));
+        GDALDataset::SetMetadataItem("SUN_ELEVATION", CPLSPrintf("%.6f", s.sun.elevation));
+        return;
+    }
+    /* a day: the sun's azimuth and elevation change; SUN_AZIMUTH and
+     * SUN_ELEVATION of the options do not apply */
+    GDALDataset::SetMetadataItem("SUN_AZIMUTH", nullptr);
+    GDALDataset::SetMetadataItem("SUN_ELEVATION", nullptr);
+    tsd_format_time(s.day_start, s.offset_minutes, szTime, sizeof szTime);
+    GDALDataset::SetMetadataItem("DAY_START", szTime);
+    tsd_format_time(s.day_start + s.day_length, s.offset_minutes, szTime, sizeof szTime);
+    GDALDataset::SetMetadataItem("DAY_END", szTime);
+    GDALDataset::SetMetadataItem("UTC_OFFSET_MINUTES", CPLSPrintf("%d", s.offset_minutes));
+    if (m_psProduct->model_key)
+        GDALDataset::SetMetadataItem(m_psProduct->model_key, m_psProduct->model);
+    if (m_psProduct->steps == TSD_STEPS_ATLAS)
+        GDALDataset::SetMetadataItem("FAR_THRESHOLD_M", CPLSPrintf("%.6f", s.threshold_m));
+    for (int k = 0; k < s.steps; k++)
+        SetStepMetadata(GetRasterBand(k + 1), s.times[k], s.offset_minutes,
+                        s.samples[k].azimuth, s.samples[k].grid_azimuth,
+                        s.samples[k].elevation, s.durations[k]);
+}
+
+/* Auxiliary metadata (statistics...) goes next to the DEM's file, in a
+ * subdataset entry per set of options, never into the current directory. */
+void TSDataset::SetupPam(const char *pszConnection)
+{
+    SetDescription(pszConnection);
+    char **papszFiles = m_poDEM->GetFileList();
+    char szCanon[1024];
+    // The key names the sun used (placed by DATETIME, if given), as it
+    // always has, so that earlier .aux.xml entries are found again.
+    tsd_options sKey = m_sOpts;
+    sKey.sun_azimuth = m_sRun.sun_azimuth;
+    sKey.sun_elevation = m_sRun.sun_elevation;
+    if (papszFiles && papszFiles[0] &&
+        tsd_options_canonical(&sKey, szCanon, sizeof szCanon) == 0)
+    {
+        std::string osSub = std::string(DRIVER) + ":" + szCanon;
+        if (m_osDEM != papszFiles[0])
+            osSub += ":" + m_osDEM;
+        SetPhysicalFilename(papszFiles[0]);
+        SetSubdatasetName(osSub.c_str());
+        TryLoadXML();
+    }
+    else
+    {
+        nPamFlags |= GPF_DISABLED; // no file to put it next to
+    }
+    CSLDestroy(papszFiles);
+    nPamFlags &= ~GPF_DIRTY;
+}
+
+} // namespace tsd

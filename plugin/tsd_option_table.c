@@ -1,0 +1,246 @@
+/* The rows of the option table: one per option, with the field it fills. */
+#include "tsd_option_table.h"
+
+#include "day_cycle.h"
+#include "terrashade_env.h"
+#include "tsd_compute_env.h"
+#include "tsd_datetime.h"
+#include "tsd_text.h"
+
+#define FIELD(f) offsetof(tsd_options, f), sizeof(((tsd_options *)0)->f)
+#define P TSD_SCOPE_PRODUCT
+#define A TSD_SCOPE_ATLAS
+#define ALL TSD_APPLIES_ALL
+#define LISTED TSD_APPLIES_LISTED
+
+static int check_datetime(const char *v, char *msg, size_t n);
+static int check_date(const char *v, char *msg, size_t n);
+static int check_timezone(const char *v, char *msg, size_t n);
+static int check_sky(const char *v, char *msg, size_t n);
+static int check_exposure(const char *v, char *msg, size_t n);
+
+const opt_def TSD_OPTION_ROWS[] = {
+    {"PRODUCT", K_PRODUCT, FIELD(product), "shade", 0, 0, 0, 0, NULL, 1, P,
+     TSD_APPLIES_SELECTOR, NULL,
+     "What to compute: " /* then each product's name (description) */},
+    {"SUN_AZIMUTH", K_FLOAT, FIELD(sun_azimuth), "315", 0, 360, 0, 1, NULL, 1, P, LISTED,
+     NULL,
+     "Sun azimuth in degrees clockwise from (grid) north (as gdaldem -az); "
+     "not with DATETIME"},
+    {"SUN_ELEVATION", K_FLOAT, FIELD(sun_elevation), "45", -90, 90, 0, 1, NULL, 1, P,
+     LISTED, NULL,
+     "Sun elevation in degrees above the horizontal (as gdaldem -alt); not "
+     "with DATETIME"},
+    {"DIRECTIONS", K_INT, FIELD(directions), "16", 1, 3600, 0, 1, NULL, 1, P, LISTED, NULL,
+     "Number of azimuths of the horizon, svf, openness and sky products "
+     "and of the sky term of shade"},
+    {"START_AZIMUTH", K_FLOAT, FIELD(start_azimuth), "0", 0, 360, 0, 1, NULL, 1, P, LISTED,
+     NULL,
+     "First of the DIRECTIONS azimuths, degrees from north; the others "
+     "follow every 360/DIRECTIONS degrees"},
+    {"METHOD", K_SELECT, FIELD(method), "exact", 0, 0, 0, 0, "exact|shm", 1, P, LISTED,
+     NULL,
+     "Shadow method of shade and shadow: exact (horizon sweep, penumbra "
+     "from the sun's disk) or shm (shadow height map, faster, approximate)"},
+    {"PENUMBRA_DEPTH", K_FLOAT, FIELD(penumbra_depth), "0", 0, 1e6, 0, 1, NULL, 1, P,
+     LISTED, NULL,
+     "METHOD=shm: metres below the shadow height over which light fades; "
+     "0 = hard shadows"},
+    {"Z_FACTOR", K_FLOAT_AUTO, FIELD(z_factor), "AUTO", 0, 1e6, 1, 1, "AUTO", 1, P, ALL,
+     NULL,
+     "Multiplies the heights: AUTO (from the vertical unit of the DEM's CRS, "
+     "else the band's unit: 0.3048 for feet, 1200/3937 for US survey feet, "
+     "1 for metres or no unit) or a number > 0 and <= 1e6; the band's scale "
+     "and offset are applied first"},
+    {"MAX_DISTANCE", K_FLOAT, FIELD(max_distance), "0", 0, 1e8, 0, 1, NULL, 1, P, LISTED,
+     NULL,
+     "Largest distance in metres at which terrain can cast a shadow or "
+     "raise the horizon; 0 = unbounded"},
+    {"CURVATURE", K_BOOL, FIELD(curvature), "YES", 0, 0, 0, 0, NULL, 1, P, ALL, NULL,
+     "Take Earth curvature (with refraction) into account"},
+    {"REFRACTION", K_FLOAT, FIELD(refraction), TSD_XSTR(TSD_REFRACTION_DEFAULT), 0, 1, 0, 1,
+     NULL, 1, P, ALL, NULL,
+     "Refraction coefficient k of the curvature correction: drop = (1-k) "
+     "d^2 / 2R"},
+    {"SKY_WEIGHT", K_FLOAT, FIELD(sky_weight), "0", 0, 1, 0, 1, NULL, 1, P, LISTED, NULL,
+     "shade only: weight of the light of a uniform sky added to the direct "
+     "sun (shade = direct + SKY_WEIGHT * sky); 0 = sun only, as gdaldem"},
+    {"BAND", K_INT, FIELD(band), "1", 1, 65536, 0, 1, NULL, 1, P, ALL, NULL,
+     "Band of the DEM holding the heights"},
+    {"THREADS", K_INT, FIELD(threads), "0", 0, 1024, 0, 1, NULL, 0, P | A, ALL, NULL,
+     "Worker threads; 0 = one per CPU core"},
+    {"OUTPUT_TYPE", K_SELECT, FIELD(output_type), "AUTO", 0, 0, 0, 0, "AUTO|Byte|Float32",
+     1, P, LISTED, NULL,
+     "Data type: Byte (1..255, 0 = nodata, as gdaldem) or Float32 (0..1 or "
+     "degrees, NaN = nodata); AUTO = Byte for shade, Float32 otherwise. "
+     "Byte only for the 0..1 products (shade, shadow, svf, sky)"},
+    {"MAX_MEMORY", K_INT, FIELD(max_memory_mb), "0", 0, 1 << 30, 0, 1, NULL, 0, P, ALL,
+     NULL,
+     "Refuse to compute a product needing more than this many MiB; 0 = "
+     "three quarters of the physical memory"},
+    {"DATETIME", K_TEXT, FIELD(datetime), "", 0, 0, 0, 0, NULL, 1, P, LISTED,
+     check_datetime,
+     "Place the sun by date and time (SPA) instead of SUN_AZIMUTH and "
+     "SUN_ELEVATION: ISO 8601 with an offset, e.g. 2026-06-21T07:30:00+02:00 "
+     "or 2026-06-21T05:30Z (inline: 2026-06-21T073000+0200). With the day "
+     "products: the local day that contains it"},
+    {"DATE", K_TEXT, FIELD(date), "", 0, 0, 0, 0, NULL, 1, P, LISTED, check_date,
+     "Day of sunhours, insolation, daycycle and farshadow: YYYY-MM-DD, local "
+     "to TIMEZONE"},
+    {"TIMEZONE", K_TEXT, FIELD(timezone), "", 0, 0, 0, 0, NULL, 1, P, LISTED,
+     check_timezone,
+     "Fixed offset from UTC of the local day: Z, +hh:mm, -hh:mm, +hhmm; "
+     "needed with DATE; with DATETIME it defaults to DATETIME's offset"},
+    {"STEP_MINUTES", K_INT, FIELD(step_minutes), "5", 1, 240, 0, 1, NULL, 1, P, LISTED,
+     NULL, "Time step of sunhours, insolation and daycycle, minutes"},
+    /* the ranges where the SPA's refraction (Bennett / Saemundsson form)
+     * holds: the air at the Earth's surface (docs/driver.md) */
+    {"PRESSURE", K_FLOAT, FIELD(pressure), "1013.25", 300, 1100, 0, 1, NULL, 1, P, LISTED,
+     NULL,
+     "Mean air pressure at the DEM, hPa (atmospheric refraction of the sun); "
+     "300 (above Everest's summit) to 1100 (the highest recorded at sea level)"},
+    {"TEMPERATURE", K_FLOAT, FIELD(temperature), "15", -90, 60, 0, 1, NULL, 1, P,
+     LISTED, NULL,
+     "Mean air temperature at the DEM, degrees Celsius (atmospheric "
+     "refraction of the sun); -90 to 60, the recorded extremes at the "
+     "Earth's surface"},
+    {"DELTA_T", K_FLOAT, FIELD(delta_t), "69", -8000, 8000, 0, 1, NULL, 1, P, LISTED, NULL,
+     "TT - UT in seconds (about 69 in the 2020s)"},
+    {"SUN_POSITION", K_SELECT, FIELD(sun_position), "center", 0, 0, 0, 0,
+     "center|per_cell", 1, P, LISTED, NULL,
+     "Where the sun is computed from: the DEM's centre (center), or every "
+     "cell (per_cell: the SPA on a lattice over the DEM, interpolated), for "
+     "extents of a few degrees or more"},
+    {"LINKE_TURBIDITY", K_FLOAT, FIELD(linke_turbidity), "3", 1, 10, 0, 1, NULL, 1, P,
+     LISTED, NULL,
+     "Linke turbidity factor of the clear-sky model of insolation (2 very "
+     "clear, 3 clear, 5 hazy)"},
+    {"FAR_THRESHOLD", K_INT, FIELD(far_threshold), "512", 1, 1000000, 0, 1, NULL, 1, P,
+     LISTED, NULL,
+     "farshadow: occluders nearer than this many cells are left out (they "
+     "are recomputed on read)"},
+    {"ATLAS_STEPS", K_INT, FIELD(atlas_steps), "158", 1, 1024, 0, 1, NULL, 1, P, LISTED,
+     NULL,
+     "farshadow: number of sun positions between sunrise and sunset, denser "
+     "near dawn and dusk"},
+    {"BACKEND", K_SELECT, FIELD(backend), "auto", 0, 0, 0, 0, "auto|opencl|c", 0, P,
+     LISTED, NULL,
+     "Where the horizon sweeps, shadow height maps, normals and direct sun "
+     "of shade, shadow, horizon, svf, openness and sky run: opencl (falls "
+     "back to c, with a warning, when OpenCL cannot run), c (the "
+     "multithreaded C core), or auto (the environment variable "
+     "TERRASHADE_BACKEND, else OpenCL on a GPU or accelerator or on a device "
+     "named by TERRASHADE_OPENCL_DEVICE, else c). The metadata item BACKEND "
+     "says what ran"},
+    {"SUNHOURS_RULE", K_SELECT, FIELD(sunhours_fraction), "visible", 0, 0, 0, 0,
+     "visible|fraction", 1, P, LISTED, NULL,
+     "sunhours: what a time step counts: visible (the whole step while any "
+     "part of the sun's disk is above the cell's horizon; on a flat plane "
+     "the astronomical day length, sunrise to sunset by the upper limb) or "
+     "fraction (the step times the visible fraction of the disk; on a flat "
+     "plane the time the sun's centre is up)"},
+    {"PROGRESS", K_SELECT, FIELD(progress_mode), "auto", 0, 0, 0, 0, "auto|yes|no", 0, P,
+     ALL, NULL,
+     "Print the progress of the computation to stderr: yes, no, or auto "
+     "(when stderr is a terminal and the computation takes more than a "
+     "second)"},
+    /* environment light (tsd_compute_env.c, docs/envlight.md) */
+    {"ENV_MAP", K_TEXT, FIELD(env_map), "", 0, 0, 0, 0, NULL, 1, P, LISTED, NULL,
+     "OpenEXR environment map lighting envlight (or the sky term of shade): a "
+     "lat-long (2:1) or cube-face (1:6) map, any GDAL path (/vsicurl/, "
+     "/vsimem/...); not with SKY"},
+    {"ENV_ROTATION", K_FLOAT, FIELD(env_rotation), "0", 0, 360, 0, 1, NULL, 1, P, LISTED,
+     NULL,
+     "ENV_MAP: degrees by which the environment turns clockwise seen from "
+     "above; at 0 the map's centre column is grid north, east to its right"},
+    {"SKY", K_TEXT, FIELD(sky), "", 0, 0, 0, 0, NULL, 1, P, LISTED, check_sky,
+     "A standard sky lighting envlight (or the sky term of shade): uniform, "
+     "overcast (CIE standard overcast), clear (CIE standard clear) or cie:N "
+     "(CIE general sky type N, 1..15), the sun from SUN_AZIMUTH and "
+     "SUN_ELEVATION or DATETIME; not with ENV_MAP"},
+    {"ENV_HORIZON_STEPS", K_INT, FIELD(env_horizon_steps),
+     TSD_XSTR(TS_ENV_DEFAULT_HORIZON_STEPS), 2, 3601, 0, 1, NULL, 1, P, LISTED, NULL,
+     "ENV_MAP, SKY: nodes of the light table's horizon-angle axis over -90..90 "
+     "degrees (181: one degree)"},
+    {"ENV_NORMAL_STEPS", K_INT, FIELD(env_normal_steps),
+     TSD_XSTR(TS_ENV_DEFAULT_NORMAL_STEPS), 0, 1025, 0, 1, NULL, 1, P, LISTED, NULL,
+     "ENV_MAP, SKY: nodes of the light table's normal-angle axis (2 or more, "
+     "bilinear as Timonen), or 0: exact in the normal angle (more accurate, "
+     "smaller, faster)"},
+    {"EXPOSURE", K_TEXT, FIELD(exposure), "", 0, 0, 0, 0, NULL, 1, P, LISTED,
+     check_exposure,
+     "envlight with OUTPUT_TYPE=Byte: stops by which the light is scaled (x "
+     "2^EXPOSURE) before the sRGB curve; empty or AUTO: the brightest "
+     "unshadowed surface of any slope and aspect maps to 255"},
+    /* options of atlas files (*.tsa) only */
+    {"SHADOWS", K_SELECT, FIELD(shadows_all), "far", 0, 0, 0, 0, "far|all", 0, A, LISTED,
+     NULL,
+     "Atlas files (.tsa) only: far (the stored far shadows) or all (far "
+     "shadows OR near shadows recomputed from the DEM on read)"},
+    {"DEM", K_TEXT, FIELD(dem), "", 0, 0, 0, 0, NULL, 0, A, LISTED, NULL,
+     "Atlas files (.tsa) with SHADOWS=all: the DEM to recompute the near "
+     "shadows from (default: the SOURCE_DEM the atlas records)"},
+};
+
+
+const int TSD_OPTION_COUNT = (int)(sizeof TSD_OPTION_ROWS / sizeof TSD_OPTION_ROWS[0]);
+
+
+/* tsd_options.given has a bit per option */
+_Static_assert(sizeof TSD_OPTION_ROWS / sizeof TSD_OPTION_ROWS[0] <= 64, "too many options for tsd_options.given");
+/* select fields are enums written through int pointers */
+_Static_assert(sizeof(tsd_method) == sizeof(int) && sizeof(tsd_output_type) == sizeof(int) &&
+                   sizeof(tsd_sun_position) == sizeof(int) &&
+                   sizeof(tsd_backend) == sizeof(int) &&
+                   sizeof(tsd_progress_mode) == sizeof(int),
+               "enum options are int-sized");
+
+static int check_datetime(const char *v, char *msg, size_t n)
+{
+    char norm[TSD_TEXT_MAX * 2];
+    double t;
+    ts_error err;
+    tsd_datetime_normalise(v, norm, sizeof norm);
+    if (ts_parse_iso8601(norm, &t, NULL, &err) != TS_OK)
+        return (tsd_fail_core(msg, n, "DATETIME", &err), -1);
+    return 0;
+}
+
+static int check_date(const char *v, char *msg, size_t n)
+{
+    int y, m, d;
+    ts_error err;
+    if (ts_parse_date(v, &y, &m, &d, &err) != TS_OK)
+        return (tsd_fail_core(msg, n, "DATE", &err), -1);
+    return 0;
+}
+
+static int check_timezone(const char *v, char *msg, size_t n)
+{
+    int off;
+    ts_error err;
+    if (ts_parse_utc_offset(v, &off, &err) != TS_OK)
+        return (tsd_fail_core(msg, n, "TIMEZONE", &err), -1);
+    return 0;
+}
+
+static int check_sky(const char *v, char *msg, size_t n)
+{
+    ts_sky_kind kind;
+    int type;
+    ts_error err;
+    if (ts_sky_parse(v, &kind, &type, &err) != TS_OK)
+        return (tsd_fail_core(msg, n, "SKY", &err), -1);
+    return 0;
+}
+
+static int check_exposure(const char *v, char *msg, size_t n)
+{
+    double stops;
+    if (tsd_exposure_parse(v, &stops) < 0)
+        return (tsd_fail(msg, n, TS_ERR_ARG,
+                         "EXPOSURE must be AUTO or a number of stops between %g and %g, "
+                         "got '%s'", -TSD_EXPOSURE_MAX, TSD_EXPOSURE_MAX, v),
+                -1);
+    return 0;
+}

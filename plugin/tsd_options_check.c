@@ -1,0 +1,147 @@
+/* The options that depend on each other and on the product's table row. */
+#include "tsd_options.h"
+
+#include "tsd_products.h"
+#include "tsd_text.h"
+
+#include <stdio.h>
+
+const char *tsd_options_product_name(const tsd_options *o)
+{
+    return tsd_product_of(o)->name;
+}
+
+int tsd_options_band_count(const tsd_options *o)
+{
+    return tsd_product_of(o)->band_count(o);
+}
+
+int tsd_options_output_byte(const tsd_options *o)
+{
+    switch (tsd_product_of(o)->byte) {
+    case TSD_BYTE_ALWAYS: return 1;
+    case TSD_BYTE_AUTO: return o->output_type != TSD_OUT_FLOAT32;
+    default: return o->output_type == TSD_OUT_BYTE;
+    }
+}
+
+int tsd_options_sun_from_time(const tsd_options *o)
+{
+    const tsd_product_def *p = tsd_product_of(o);
+    return p->daily || (o->datetime[0] && tsd_product_takes(p, tsd_option_find("DATETIME")));
+}
+
+/* "shade, shadow, svf, sky, daycycle": the products that may be Byte. */
+static void byte_products(char *buf, size_t n)
+{
+    size_t used = 0;
+    buf[0] = '\0';
+    for (int i = 0; i < tsd_product_count() && used < n; i++) {
+        const tsd_product_def *p = tsd_product_at(i);
+        if (p->byte == TSD_BYTE_AUTO || p->byte == TSD_BYTE_ALLOWED)
+            used += (size_t)snprintf(buf + used, n - used, "%s%s", used ? ", " : "",
+                                     p->name);
+    }
+}
+
+/* Refuse the combination with a sentence. */
+#define REFUSE(...) return (tsd_fail(msg, n, TS_ERR_ARG, __VA_ARGS__), -1)
+
+/* The options of environment light (ENV_MAP, SKY and theirs). */
+static int check_environment(const tsd_options *o, char *msg, size_t n)
+{
+    static const char *const own[] = {"ENV_MAP", "SKY", "ENV_ROTATION", "ENV_HORIZON_STEPS",
+                                      "ENV_NORMAL_STEPS", "EXPOSURE"};
+    const tsd_product_def *p = tsd_product_of(o);
+    const int envlight = tsd_product_takes(p, tsd_option_find("EXPOSURE"));
+    char list[256];
+    for (size_t i = 0; i < sizeof own / sizeof own[0]; i++) {
+        int id = tsd_option_find(own[i]);
+        if (tsd_options_given(o, own[i]) && !tsd_product_takes(p, id)) {
+            tsd_products_taking(id, "PRODUCT=", " and ", list, sizeof list);
+            REFUSE("%s applies to %s, not to PRODUCT=%s", own[i], list, p->name);
+        }
+    }
+    if (o->env_map[0] && o->sky[0])
+        REFUSE("give ENV_MAP or SKY, not both: both are the light of the sky (SKY=%s "
+               "excludes ENV_MAP=%s)", o->sky, o->env_map);
+    if (envlight && !o->env_map[0] && !o->sky[0])
+        REFUSE("PRODUCT=%s needs a light: ENV_MAP=<an OpenEXR map> or "
+               "SKY=uniform|overcast|clear|cie:N", p->name);
+    if (o->env_map[0] && envlight && (tsd_options_given(o, "SUN_AZIMUTH") ||
+                                      tsd_options_given(o, "SUN_ELEVATION") ||
+                                      o->datetime[0]))
+        REFUSE("PRODUCT=%s with ENV_MAP is lit by the map alone: SUN_AZIMUTH, "
+               "SUN_ELEVATION and DATETIME place the sun of a SKY", p->name);
+    if (o->env_rotation != 0 && !o->env_map[0])
+        REFUSE("ENV_ROTATION turns ENV_MAP; a SKY turns with its sun (SUN_AZIMUTH or "
+               "DATETIME)");
+    if (!envlight && (o->env_map[0] || o->sky[0]) && !(o->sky_weight > 0))
+        REFUSE("%s sets the sky term of PRODUCT=%s, which SKY_WEIGHT=0 leaves out: give "
+               "SKY_WEIGHT > 0", o->env_map[0] ? "ENV_MAP" : "SKY", p->name);
+    if (o->env_normal_steps == 1)
+        REFUSE("ENV_NORMAL_STEPS must be 0 (exact) or at least 2, got 1");
+    if (o->exposure[0] && !tsd_options_output_byte(o))
+        REFUSE("EXPOSURE applies to OUTPUT_TYPE=Byte (the display image); Float32 "
+               "keeps the light's own values");
+    return 0;
+}
+
+int tsd_options_check(const tsd_options *o, char *msg, size_t n)
+{
+    const tsd_product_def *p = tsd_product_of(o);
+    const char *pn = p->name;
+    const int o_method = tsd_option_find("METHOD"), o_datetime = tsd_option_find("DATETIME"),
+              o_date = tsd_option_find("DATE");
+    const int from_time = tsd_options_sun_from_time(o);
+    char list[256];
+    if (p->byte == TSD_BYTE_ALWAYS && o->output_type == TSD_OUT_FLOAT32)
+        REFUSE("PRODUCT=%s is binary: its bands are Byte (0 lit, 1 in far "
+                    "shadow, 255 nodata); OUTPUT_TYPE=Float32 does not apply", pn);
+    if (o->output_type == TSD_OUT_BYTE && p->byte == TSD_BYTE_NEVER) {
+        byte_products(list, sizeof list);
+        REFUSE("OUTPUT_TYPE=Byte is only for the products with values in "
+               "0..1 (%s); PRODUCT=%s is in %s", list, pn, p->values);
+    }
+    if (o->method == TSD_METHOD_SHM && !tsd_product_takes(p, o_method)) {
+        tsd_products_taking(o_method, "PRODUCT=", " and ", list, sizeof list);
+        REFUSE("METHOD=shm applies to %s only, not to PRODUCT=%s", list, pn);
+    }
+    if (o->datetime[0] && !tsd_product_takes(p, o_datetime)) {
+        tsd_products_taking(o_datetime, "", " and ", list, sizeof list);
+        REFUSE("DATETIME applies to PRODUCT=%s, not to PRODUCT=%s", list, pn);
+    }
+    if (o->date[0] && !tsd_product_takes(p, o_date)) {
+        tsd_products_taking(o_date, "", ", ", list, sizeof list);
+        REFUSE("DATE applies to the day products (%s), not to PRODUCT=%s%s", list, pn,
+               tsd_product_takes(p, o_datetime) ? "; give the sun's instant as DATETIME"
+                                                : "");
+    }
+    if (o->date[0] && o->datetime[0])
+        REFUSE("give DATE (with TIMEZONE) or DATETIME, not both: both name the day");
+    if (p->daily && !o->date[0] && !o->datetime[0])
+        REFUSE("PRODUCT=%s needs a day: DATE=YYYY-MM-DD with TIMEZONE (e.g. "
+                    "+02:00), or DATETIME with an offset", pn);
+    if (o->date[0] && !o->timezone[0])
+        REFUSE("DATE=%s needs TIMEZONE, the offset from UTC of its local day (e.g. "
+                    "TIMEZONE=+02:00, or Z for UTC): without it the day's start is "
+                    "unknown", o->date);
+    if (o->timezone[0] && !o->date[0] && !(o->datetime[0] && p->daily))
+        REFUSE("TIMEZONE applies with DATE (or DATETIME) to the day products only");
+    if (from_time && (tsd_options_given(o, "SUN_AZIMUTH") ||
+                      tsd_options_given(o, "SUN_ELEVATION")))
+        REFUSE("%s places the sun: do not give %s with it",
+                    o->datetime[0] ? "DATETIME" : "DATE",
+                    tsd_options_given(o, "SUN_AZIMUTH") ? "SUN_AZIMUTH" : "SUN_ELEVATION");
+    if (p->daily && o->sun_position == TSD_SUN_PER_CELL &&
+        !tsd_product_takes(p, tsd_option_find("SUN_POSITION")))
+        REFUSE("PRODUCT=%s computes the sun at the DEM's centre only "
+                    "(SUN_POSITION=center)", pn);
+    /* the reason is farshadow's, the one product without MAX_DISTANCE */
+    if (o->max_distance > 0 && !tsd_product_takes(p, tsd_option_find("MAX_DISTANCE")))
+        REFUSE("MAX_DISTANCE does not apply to PRODUCT=%s (its far shadows "
+                    "start at FAR_THRESHOLD cells and have no end)", pn);
+    if (o->sun_position == TSD_SUN_PER_CELL && !from_time)
+        REFUSE("SUN_POSITION=per_cell needs the sun from DATETIME or DATE");
+    return check_environment(o, msg, n);
+}

@@ -1,0 +1,91 @@
+/*
+ * tsd_overview.cpp - the overview levels of a TERRASHADE:<dem> dataset.
+ *
+ * Level k (1, 2, ...) is the product computed from the DEM read at
+ * ceil(W / 2^k) x ceil(H / 2^k) cells through GDAL's RasterIO with average
+ * resampling (tsd_dem_load_resampled), with the geotransform scaled as
+ * gdal_translate -outsize scales it and everything else (cell sizes, per-row
+ * sizes of a geographic DEM, the sun, the memory check) set up as for a DEM
+ * of that size: a level is the product of a coarser DEM, not an average of
+ * the full-resolution product. Each level is a TSDataset of its own, made on
+ * first use and computed lazily on its first block read, then cached like
+ * the full level.
+ */
+#include <algorithm>
+#include <cstring>
+
+#include "tsd_dataset.h"
+#include "tsd_gdal.h"
+
+namespace tsd
+{
+
+int TSDataset::OverviewCount(const tsd_product_def *psProduct, int W, int H)
+{
+    /* farshadow: its FAR_THRESHOLD is in cells of the full-resolution DEM
+     * and its maps exist to be written as an atlas at that resolution,
+     * whose near shadows are recomputed from the same DEM; a coarser map
+     * would be neither. */
+    if (psProduct->byte == TSD_BYTE_ALWAYS)
+        return 0;
+    int n = 0;
+    for (int w = W, h = H; std::max(w, h) > OVERVIEW_MIN_SIDE && std::min(w, h) > 1;)
+    {
+        w = (w + 1) / 2;
+        h = (h + 1) / 2;
+        n++;
+    }
+    return n;
+}
+
+/* The dataset of level nLevel (>= 1), set up as the product of the DEM
+ * resampled to that level; nullptr with the error reported. */
+TSDataset *TSDataset::MakeOverview(int nLevel)
+{
+    const int nFactor = 1 << nLevel;
+    const int W = (nRasterXSize + nFactor - 1) / nFactor;
+    const int H = (nRasterYSize + nFactor - 1) / nFactor;
+    auto poOvr = std::unique_ptr<TSDataset>(new TSDataset());
+    poOvr->m_nLevel = nLevel;
+    poOvr->m_osDEM = m_osDEM;
+    poOvr->m_sOpts = m_sOpts;
+    poOvr->m_psProduct = m_psProduct;
+    poOvr->m_bHasGT = m_bHasGT;
+    poOvr->m_oSRS = m_oSRS;
+    memcpy(poOvr->m_adfGT, m_adfGT, sizeof m_adfGT);
+    // as gdal_translate -outsize W H scales it, so that the cells match
+    poOvr->m_adfGT[1] *= static_cast<double>(nRasterXSize) / W;
+    poOvr->m_adfGT[2] *= static_cast<double>(nRasterYSize) / H;
+    poOvr->m_adfGT[4] *= static_cast<double>(nRasterXSize) / W;
+    poOvr->m_adfGT[5] *= static_cast<double>(nRasterYSize) / H;
+    CPLDebug(DRIVER, "overview level %d of %s: %d x %d", nLevel, m_osDEM.c_str(), W, H);
+    if (!poOvr->Setup(CPLSPrintf("%s (overview level %d)", GetDescription(), nLevel), W, H))
+        return nullptr;
+    return poOvr.release();
+}
+
+/* Overview i (level i + 1), made on first use. */
+TSDataset *TSDataset::Overview(int i)
+{
+    if (i < 0 || i >= m_nOverviews)
+        return nullptr;
+    std::lock_guard<std::mutex> oLock(m_oOvrMutex);
+    if (m_apoOverviews.empty())
+        m_apoOverviews.resize(m_nOverviews);
+    if (!m_apoOverviews[i])
+        m_apoOverviews[i].reset(MakeOverview(i + 1));
+    return m_apoOverviews[i].get();
+}
+
+int TSRasterBand::GetOverviewCount()
+{
+    return static_cast<TSDataset *>(poDS)->m_nOverviews;
+}
+
+GDALRasterBand *TSRasterBand::GetOverview(int i)
+{
+    TSDataset *poOvr = static_cast<TSDataset *>(poDS)->Overview(i);
+    return poOvr ? poOvr->GetRasterBand(nBand) : nullptr;
+}
+
+} // namespace tsd

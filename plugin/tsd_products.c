@@ -1,0 +1,276 @@
+/* The product table and what is derived from it; see tsd_products.h. */
+#include "tsd_products.h"
+
+#include "tsd_text.h"
+
+#include <stdio.h>
+#include <string.h>
+#include <strings.h>
+
+static int one_band(const tsd_options *o)
+{
+    (void)o;
+    return 1;
+}
+
+static int per_direction(const tsd_options *o)
+{
+    return o->directions;
+}
+
+static int per_step(const tsd_options *o)
+{
+    return ts_day_step_count(86400.0, o->step_minutes * 60.0);
+}
+
+static int per_atlas_step(const tsd_options *o)
+{
+    return o->atlas_steps;
+}
+
+static const char *const INSOLATION_BANDS[] = {"global", "beam", "diffuse"};
+#define N_INSOLATION_BANDS ((int)(sizeof INSOLATION_BANDS / sizeof INSOLATION_BANDS[0]))
+
+static int insolation_bands(const tsd_options *o)
+{
+    (void)o;
+    return N_INSOLATION_BANDS;
+}
+
+/* a single band: named after the product */
+static void band_named(const tsd_product_def *p, const tsd_options *o, int k,
+                       tsd_band_info *info)
+{
+    (void)o;
+    (void)k;
+    snprintf(info->description, sizeof info->description, "%s", p->name);
+}
+
+/* one band per azimuth: "azimuth 22.5", AZIMUTH=22.5 */
+static void band_azimuth(const tsd_product_def *p, const tsd_options *o, int k,
+                         tsd_band_info *info)
+{
+    (void)p;
+    ts_horizon_opts h;
+    ts_horizon_opts_default(&h);
+    h.directions = o->directions;
+    h.start_azimuth = o->start_azimuth;
+    snprintf(info->value, sizeof info->value, "%.10g", ts_horizon_azimuth(&h, k));
+    snprintf(info->description, sizeof info->description, "azimuth %s", info->value);
+    info->key = "AZIMUTH";
+}
+
+static void band_insolation(const tsd_product_def *p, const tsd_options *o, int k,
+                            tsd_band_info *info)
+{
+    (void)o;
+    snprintf(info->description, sizeof info->description, "%s %s", p->name,
+             k >= 0 && k < N_INSOLATION_BANDS ? INSOLATION_BANDS[k] : "?");
+}
+
+static const char *const COLOUR_BANDS[] = {"Red", "Green", "Blue"};
+
+static int colour_bands(const tsd_options *o)
+{
+    (void)o;
+    return 3;
+}
+
+/* "envlight red", colour interpretation Red */
+static void band_colour(const tsd_product_def *p, const tsd_options *o, int k,
+                        tsd_band_info *info)
+{
+    (void)o;
+    info->color = k >= 0 && k < 3 ? COLOUR_BANDS[k] : NULL;
+    snprintf(info->description, sizeof info->description, "%s %s", p->name,
+             k == 0 ? "red" : k == 1 ? "green" : k == 2 ? "blue" : "?");
+}
+
+static int backend_always(const tsd_options *o, const tsd_sun *sun)
+{
+    (void)o;
+    (void)sun;
+    return 1;
+}
+
+/* shadow: not with the exact method and a per-cell sun (the core's
+ * ts_sun_visibility, C only) */
+static int shadow_uses_backend(const tsd_options *o, const tsd_sun *sun)
+{
+    int lattice = sun && sun->sites.nx * sun->sites.ny > 1;
+    return !(lattice && o->method == TSD_METHOD_EXACT);
+}
+
+/* Option groups of the rows below. */
+#define SUN_TIME "DATETIME PRESSURE TEMPERATURE DELTA_T "
+#define SUN_OPTS "SUN_AZIMUTH SUN_ELEVATION METHOD PENUMBRA_DEPTH " SUN_TIME "SUN_POSITION "
+#define SWEEP "DIRECTIONS START_AZIMUTH MAX_DISTANCE "
+#define DAY "DATE TIMEZONE " SUN_TIME
+#define ENV "ENV_MAP ENV_ROTATION SKY ENV_HORIZON_STEPS ENV_NORMAL_STEPS "
+
+static const tsd_product_def PRODUCTS[] = {
+    {"shade", "sun-lit relief with cast shadows", "", "0..1", one_band, NULL, band_named,
+     TSD_BYTE_AUTO, 0, 0, TSD_STEPS_NONE,
+     /* normals, a horizon plane or the SHM visibility; the sky accumulator
+      * and its horizon plane; the per-cell sun */
+     4, 2, 7, backend_always, SUN_OPTS SWEEP ENV "SKY_WEIGHT OUTPUT_TYPE BACKEND", NULL, NULL,
+     tsd_compute_shade},
+    {"shadow", "visible fraction of the sun's disk, 0..1", "", "0..1", one_band, NULL,
+     band_named, TSD_BYTE_ALLOWED, 0, 0, TSD_STEPS_NONE, 0, 0, 7, shadow_uses_backend,
+     SUN_OPTS "MAX_DISTANCE OUTPUT_TYPE BACKEND", NULL, NULL, tsd_compute_shadow},
+    {"horizon", "one band per azimuth, horizon elevation angle in degrees", "degree",
+     "degrees", per_direction, "DIRECTIONS", band_azimuth, TSD_BYTE_NEVER, 0, 0,
+     TSD_STEPS_NONE, 0, 0, 0, backend_always, SWEEP "BACKEND", NULL, NULL,
+     tsd_compute_horizon},
+    /* the sky products: normals and one horizon plane */
+    {"svf", "sky-view factor 0..1", "", "0..1", one_band, NULL, band_named,
+     TSD_BYTE_ALLOWED, 0, 0, TSD_STEPS_NONE, 4, 0, 0, backend_always,
+     SWEEP "OUTPUT_TYPE BACKEND", NULL, NULL, tsd_compute_svf},
+    {"openness", "positive openness, degrees", "degree", "degrees", one_band, NULL,
+     band_named, TSD_BYTE_NEVER, 0, 0, TSD_STEPS_NONE, 4, 0, 0, backend_always,
+     SWEEP "BACKEND", NULL, NULL, tsd_compute_openness},
+    {"sky", "uniform-sky irradiance 0..1", "", "0..1", one_band, NULL, band_named,
+     TSD_BYTE_ALLOWED, 0, 0, TSD_STEPS_NONE, 4, 0, 0, backend_always,
+     SWEEP "OUTPUT_TYPE BACKEND", NULL, NULL, tsd_compute_sky},
+    /* Earth horizon, horizon plane, visibility, double accumulator */
+    {"sunhours", "hours of direct sun on DATE", "hour", "hours", one_band, NULL, band_named,
+     TSD_BYTE_NEVER, 0, 1, TSD_STEPS_NONE, 5, 0, 3, NULL,
+     "MAX_DISTANCE " DAY "STEP_MINUTES SUN_POSITION SUNHOURS_RULE", NULL, NULL,
+     tsd_compute_sunhours},
+    /* normals, sky, visibility, pressure factor, two double accumulators,
+     * Earth horizon, horizon plane */
+    {"insolation", "clear-sky irradiation on DATE, Wh/m2: total, beam, diffuse", "Wh/m2",
+     "Wh/m2", insolation_bands, NULL, band_insolation, TSD_BYTE_NEVER, 0, 1,
+     TSD_STEPS_NONE, 12, 0, 5, NULL,
+     SWEEP DAY "STEP_MINUTES SUN_POSITION LINKE_TURBIDITY", "CLEAR_SKY_MODEL",
+     "ESRA (Rigollier et al. 2000): beam on the tilted surface x visible "
+     "fraction of the sun + diffuse horizontal x sky-view factor (sky term)",
+     tsd_compute_insolation},
+    {"daycycle", "visible fraction of the sun, one band per STEP_MINUTES", "", "0..1",
+     per_step, "STEP_MINUTES", NULL, TSD_BYTE_ALLOWED, 0, 1, TSD_STEPS_UNIFORM, 2, 0, 3,
+     NULL, "MAX_DISTANCE OUTPUT_TYPE " DAY "STEP_MINUTES SUN_POSITION", NULL, NULL,
+     tsd_compute_daycycle},
+    /* the far-field slopes */
+    {"farshadow", "binary far-shadow maps of ATLAS_STEPS sun positions", "", "0, 1",
+     per_atlas_step, "ATLAS_STEPS", NULL, TSD_BYTE_ALWAYS, 255, 1, TSD_STEPS_ATLAS, 1, 0, 0,
+     NULL, DAY "FAR_THRESHOLD ATLAS_STEPS", NULL, NULL, tsd_compute_farshadow},
+    /* normals and one horizon plane (docs/envlight.md) */
+    {"envlight", "light of an HDR environment map (ENV_MAP) or a standard sky (SKY) on a "
+     "white Lambertian surface, E/pi per colour: red, green, blue", "", "E/pi", colour_bands,
+     NULL, band_colour, TSD_BYTE_ALLOWED, 0, 0, TSD_STEPS_NONE, 4, 0, 0, backend_always,
+     SWEEP ENV "EXPOSURE OUTPUT_TYPE BACKEND SUN_AZIMUTH SUN_ELEVATION " SUN_TIME, NULL, NULL,
+     tsd_compute_envlight},
+};
+
+#define N_PRODUCTS ((int)(sizeof PRODUCTS / sizeof PRODUCTS[0]))
+
+int tsd_product_count(void)
+{
+    return N_PRODUCTS;
+}
+
+const tsd_product_def *tsd_product_at(int i)
+{
+    return i >= 0 && i < N_PRODUCTS ? &PRODUCTS[i] : NULL;
+}
+
+int tsd_product_find(const char *name)
+{
+    for (int i = 0; i < N_PRODUCTS; i++)
+        if (strcasecmp(name, PRODUCTS[i].name) == 0)
+            return i;
+    return -1;
+}
+
+const tsd_product_def *tsd_product_of(const tsd_options *o)
+{
+    const tsd_product_def *p = tsd_product_at(o->product);
+    return p ? p : &PRODUCTS[0];
+}
+
+/* 1 if the space-separated list holds the word. */
+static int list_has(const char *list, const char *word)
+{
+    size_t n = strlen(word);
+    for (const char *p = list; p && *p;) {
+        p += strspn(p, " ");
+        size_t len = strcspn(p, " ");
+        if (len == n && strncmp(p, word, n) == 0)
+            return 1;
+        p += len;
+    }
+    return 0;
+}
+
+int tsd_product_takes(const tsd_product_def *p, int option)
+{
+    if (!(tsd_option_scope(option) & TSD_SCOPE_PRODUCT))
+        return 0;
+    switch (tsd_option_applies(option)) {
+    case TSD_APPLIES_ALL: return 1;
+    case TSD_APPLIES_LISTED: return list_has(p->options, tsd_option_name(option));
+    default: return 0;
+    }
+}
+
+void tsd_products_taking(int option, const char *prefix, const char *last, char *buf,
+                         size_t n)
+{
+    int total = 0, k = 0;
+    size_t used = 0;
+    buf[0] = '\0';
+    for (int i = 0; i < N_PRODUCTS; i++)
+        total += tsd_product_takes(&PRODUCTS[i], option);
+    for (int i = 0; i < N_PRODUCTS && used < n; i++) {
+        if (!tsd_product_takes(&PRODUCTS[i], option))
+            continue;
+        const char *sep = k == 0 ? "" : k == total - 1 ? last : ", ";
+        used += (size_t)snprintf(buf + used, n - used, "%s%s%s", sep, prefix,
+                                 PRODUCTS[i].name);
+        k++;
+    }
+}
+
+double tsd_product_peak_bytes(const tsd_options *o, int width, int height, double *steady)
+{
+    const tsd_product_def *p = tsd_product_of(o);
+    double plane = (double)width * (double)height * sizeof(float);
+    double bands = tsd_options_band_count(o);
+    /* bytes are a quarter of a float plane per band */
+    double kept = p->byte == TSD_BYTE_ALWAYS ? bands / 4 : bands;
+    /* shade's sky term from SKY or ENV_MAP: two more colour accumulators */
+    int env_sky = o->sky_weight > 0 && p->sky_planes > 0 && (o->sky[0] || o->env_map[0]);
+    int extra = p->planes + (o->sky_weight > 0 ? p->sky_planes : 0) + 2 * env_sky +
+                (o->sun_position == TSD_SUN_PER_CELL ? p->per_cell_planes : 0);
+    if (steady)
+        *steady = kept * plane;
+    return (1 + kept + extra) * plane;
+}
+
+char *tsd_products_xml(void)
+{
+    static const char *const byte_names[] = {"never", "allowed", "auto", "always"};
+    tsd_options defaults;
+    tsd_strbuf b = {0};
+    tsd_options_defaults(&defaults);
+    tsd_strbuf_add(&b, "<Products>");
+    for (int i = 0; i < N_PRODUCTS; i++) {
+        const tsd_product_def *p = &PRODUCTS[i];
+        defaults.product = i;
+        tsd_strbuf_add(&b, "<Product name='%s' description='", p->name);
+        tsd_strbuf_add_xml(&b, p->description);
+        tsd_strbuf_add(&b, "' unit='");
+        tsd_strbuf_add_xml(&b, p->unit);
+        tsd_strbuf_add(&b, "' bands='%d'", p->band_count(&defaults));
+        if (p->bands_option)
+            tsd_strbuf_add(&b, " bands_option='%s'", p->bands_option);
+        tsd_strbuf_add(&b, " daily='%s' byte='%s' options='", p->daily ? "yes" : "no",
+                       byte_names[p->byte]);
+        for (int k = 0, listed = 0; k < tsd_options_count(); k++)
+            if (tsd_product_takes(p, k))
+                tsd_strbuf_add(&b, "%s%s", listed++ ? "," : "", tsd_option_name(k));
+        tsd_strbuf_add(&b, "'/>");
+    }
+    tsd_strbuf_add(&b, "</Products>");
+    return tsd_strbuf_finish(&b);
+}

@@ -1,0 +1,71 @@
+/* Failing with a sentence, and a growing string; see tsd_text.h. */
+#include "tsd_text.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+ts_status tsd_fail(char *msg, size_t n, ts_status code, const char *fmt, ...)
+{
+    if (msg && n) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(msg, n, fmt, ap);
+        va_end(ap);
+    }
+    return code == TS_OK ? TS_ERR_INTERNAL : code;
+}
+
+ts_status tsd_fail_core(char *msg, size_t n, const char *what, const ts_error *err)
+{
+    const char *text = err->message[0] ? err->message : ts_status_name(err->code);
+    if (what)
+        return tsd_fail(msg, n, err->code, "%s: %s", what, text);
+    return tsd_fail(msg, n, err->code, "%s", text);
+}
+
+void tsd_strbuf_add(tsd_strbuf *b, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int need = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    if (b->failed || need < 0) {
+        b->failed = 1;
+        return;
+    }
+    if (b->len + (size_t)need + 1 > b->cap) {
+        size_t cap = (b->cap ? b->cap * 2 : 4096) + (size_t)need;
+        char *s = realloc(b->s, cap);
+        if (!s) {
+            b->failed = 1;
+            return;
+        }
+        b->s = s;
+        b->cap = cap;
+    }
+    va_start(ap, fmt);
+    vsnprintf(b->s + b->len, b->cap - b->len, fmt, ap);
+    va_end(ap);
+    b->len += (size_t)need;
+}
+
+void tsd_strbuf_add_xml(tsd_strbuf *b, const char *text)
+{
+    for (const char *c = text; *c && !b->failed; c++)
+        switch (*c) {
+        case '\'': tsd_strbuf_add(b, "&apos;"); break;
+        case '&': tsd_strbuf_add(b, "&amp;"); break;
+        case '<': tsd_strbuf_add(b, "&lt;"); break;
+        default: tsd_strbuf_add(b, "%c", *c); break;
+        }
+}
+
+char *tsd_strbuf_finish(tsd_strbuf *b)
+{
+    if (b->failed) {
+        free(b->s);
+        b->s = NULL;
+    }
+    return b->s;
+}

@@ -1,0 +1,328 @@
+"""Run a TERRASHADE product over a DEM as window tasks on dask.distributed.
+
+    python3 -m terrashade.distributed [--scheduler ADDRESS | --workers N]
+        [--tile-size N] [-oo KEY=VALUE ...] SOURCE DEST
+
+SOURCE is a TERRASHADE connection string (TERRASHADE:PRODUCT=svf:dem.tif),
+DEST a tiled GeoTIFF or a COG. The client opens SOURCE once for the
+product's size, bands, types, nodata, georeferencing and metadata, creates
+DEST.partial, submits one task per --tile-size window (each task reads its
+window through the driver on a worker) and writes the windows as they
+complete, through one dataset, then renames DEST.partial to DEST. Any
+failure removes what was written and exits non-zero. See docs/distributed.md.
+"""
+import argparse
+import contextlib
+import logging
+import os
+import re
+import sys
+import threading
+import time
+
+from osgeo import gdal
+
+from terrashade import windows as W
+
+gdal.UseExceptions()
+
+PROG = "terrashade.distributed"
+TILE_MIN, TILE_MAX = 16, 65536
+INLINE = re.compile(r"^([A-Za-z_]\w*=[^,:]*(?:,[A-Za-z_]\w*=[^,:]*)*):")
+
+
+class Failure(Exception):
+    """A run that cannot go on: a sentence for the user and an exit code."""
+
+    def __init__(self, message, code=1):
+        super().__init__(message)
+        self.code = code
+
+
+def tile_size(text):
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError("must be a whole number, got %r" % text)
+    if n < TILE_MIN or n > TILE_MAX or n % 16:
+        raise argparse.ArgumentTypeError(
+            "must be a multiple of 16 between %d and %d (GeoTIFF tiles are "
+            "multiples of 16), got %d" % (TILE_MIN, TILE_MAX, n))
+    return n
+
+
+def positive(text):
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise argparse.ArgumentTypeError("must be a whole number >= 1, got %r" % text)
+    return n
+
+
+def parse_args(argv):
+    p = argparse.ArgumentParser(
+        prog=PROG, description="Compute a TERRASHADE product window by window "
+        "on dask.distributed and write it as a tiled GeoTIFF or COG.")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", metavar="ADDRESS",
+                       help="an existing Dask scheduler (tcp://host:8786); every "
+                       "worker must read the DEM by the same path and find the plugin")
+    where.add_argument("--workers", type=positive, metavar="N",
+                       help="worker processes of the local cluster (default: one per core)")
+    p.add_argument("--threads-per-worker", type=positive, default=1, metavar="N",
+                   help="threads of each local worker (default 1)")
+    p.add_argument("--tile-size", type=tile_size, default=1024, metavar="N",
+                   help="window size in cells, a multiple of 16 (default 1024)")
+    p.add_argument("-oo", dest="open_options", action="append", default=[],
+                   metavar="KEY=VALUE", help="an open option of the driver (repeatable)")
+    p.add_argument("--format", choices=["GTiff", "COG"],
+                   help="output format (default: COG for *.cog.tif, else GTiff)")
+    p.add_argument("-co", dest="creation_options", action="append", default=[],
+                   metavar="NAME=VALUE", help="a creation option of the output driver")
+    p.add_argument("--timeout", type=positive, default=10, metavar="SECONDS",
+                   help="how long to try to reach --scheduler (default 10)")
+    p.add_argument("-q", "--quiet", action="store_true",
+                   help="no progress bar and no summary line")
+    p.add_argument("source", metavar="SOURCE", help="TERRASHADE:[KEY=VALUE,...:]dem.tif")
+    p.add_argument("dest", metavar="DEST", help="output .tif (GeoTIFF) or .cog.tif (COG)")
+    args = p.parse_args(argv)
+    for oo in args.open_options:
+        if not re.match(r"^[A-Za-z_]\w*=", oo):
+            p.error("-oo takes KEY=VALUE, got %r" % oo)
+    return args
+
+
+def given_keys(source, open_options):
+    """Upper-case names of the options given inline in SOURCE or by -oo."""
+    keys = {oo.split("=", 1)[0].upper() for oo in open_options}
+    m = INLINE.match(source[len("TERRASHADE:"):])
+    if m:
+        keys |= {item.split("=", 1)[0].upper() for item in m.group(1).split(",")}
+    return keys
+
+
+def open_source(source, open_options):
+    if not source.upper().startswith("TERRASHADE:"):
+        raise Failure("SOURCE must be a TERRASHADE connection string "
+                      "(TERRASHADE:[KEY=VALUE,...:]dem.tif), got %r" % source)
+    if gdal.GetDriverByName("TERRASHADE") is None:
+        raise Failure("GDAL cannot find the TERRASHADE driver: set GDAL_DRIVER_PATH "
+                      "to the directory of gdal_TERRASHADE.so, or make install")
+    try:
+        return gdal.OpenEx(source, gdal.OF_RASTER | gdal.OF_READONLY,
+                           open_options=open_options)
+    except RuntimeError as e:
+        raise Failure("cannot open %s: %s" % (source, e))
+
+
+def output_format(args):
+    if args.format:
+        return args.format
+    low = args.dest.lower()
+    if low.endswith((".cog.tif", ".cog.tiff")):
+        return "COG"
+    if low.endswith((".tif", ".tiff")):
+        return "GTiff"
+    raise Failure("cannot tell the format of %s from its name: end it in .tif "
+                  "(GeoTIFF) or .cog.tif (COG), or give --format GTiff|COG" % args.dest)
+
+
+def block_size(tile):
+    """The output's internal tile size: the window size up to 512, else the
+    largest power of two up to 512 that divides it, so that every window
+    covers whole internal tiles."""
+    if tile <= 512:
+        return tile
+    b = 512
+    while tile % b:
+        b //= 2
+    return b
+
+
+def create_like(src, path, block, creation_options):
+    """A tiled GeoTIFF at path with src's size, bands, types, nodata,
+    georeferencing and metadata (what gdal_translate would copy)."""
+    opts = ["TILED=YES", "BLOCKXSIZE=%d" % block, "BLOCKYSIZE=%d" % block,
+            "BIGTIFF=IF_SAFER"] + list(creation_options)
+    b1 = src.GetRasterBand(1)
+    try:
+        out = gdal.GetDriverByName("GTiff").Create(
+            path, src.RasterXSize, src.RasterYSize, src.RasterCount, b1.DataType, opts)
+    except RuntimeError as e:
+        raise Failure("cannot write %s: %s" % (path, e))
+    out.SetGeoTransform(src.GetGeoTransform())
+    if src.GetProjection():
+        out.SetProjection(src.GetProjection())
+    out.SetMetadata(src.GetMetadata())
+    for i in range(1, src.RasterCount + 1):
+        s, d = src.GetRasterBand(i), out.GetRasterBand(i)
+        d.SetDescription(s.GetDescription())
+        d.SetColorInterpretation(s.GetColorInterpretation())
+        d.SetMetadata(s.GetMetadata())
+        if s.GetNoDataValue() is not None:
+            d.SetNoDataValue(s.GetNoDataValue())
+        if s.GetUnitType():
+            d.SetUnitType(s.GetUnitType())
+        if s.GetOffset() not in (None, 0.0):
+            d.SetOffset(s.GetOffset())
+        if s.GetScale() not in (None, 1.0):
+            d.SetScale(s.GetScale())
+    return out
+
+
+def start_cluster(args):
+    """(client, cluster or None, task options to add)."""
+    from dask.distributed import Client, LocalCluster
+    if args.scheduler:
+        try:
+            client = Client(args.scheduler, timeout="%ds" % args.timeout)
+        except (OSError, TimeoutError, ValueError) as e:
+            raise Failure("cannot reach the Dask scheduler at %s within %d s: %s"
+                          % (args.scheduler, args.timeout, e), code=2)
+        # A worker has one task slot per thread, by default one per core.
+        return client, None, 1
+    workers = args.workers or os.cpu_count() or 1
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=args.threads_per_worker,
+                           processes=True, dashboard_address=None,
+                           silence_logs=logging.ERROR)
+    slots = workers * args.threads_per_worker
+    return Client(cluster), cluster, max(1, (os.cpu_count() or 1) // slots)
+
+
+def check_workers(client):
+    try:
+        found = client.run(W.probe)
+    except Exception as e:
+        raise Failure("the Dask workers cannot run terrashade's tasks (%s): install "
+                      "the terrashade package on them (make install) or put it on "
+                      "their PYTHONPATH" % e)
+    if not found:
+        raise Failure("the Dask cluster has no workers")
+    missing = [w for w, r in found.items() if not r["driver"]]
+    if missing:
+        raise Failure("GDAL on worker(s) %s cannot find the TERRASHADE driver: set "
+                      "GDAL_DRIVER_PATH there (now %r) or install the plugin"
+                      % (", ".join(missing), found[missing[0]]["GDAL_DRIVER_PATH"]))
+    return len(found)
+
+
+def _progress_bar(futures):
+    from dask.distributed import progress
+    # dask's console bar writes to stdout; the program's stdout stays clean.
+    with contextlib.redirect_stdout(sys.stderr):
+        progress(futures, multi=False)
+
+
+def compute(client, out, source, task_options, tile, quiet):
+    from dask.distributed import as_completed
+    wins = W.windows(out.RasterXSize, out.RasterYSize, tile)
+    futures = [client.submit(W.read_window, source, task_options, w, pure=False)
+               for w in wins]
+    window_of = dict(zip((f.key for f in futures), wins))
+    bar = None
+    if not quiet:
+        bar = threading.Thread(target=_progress_bar, args=(futures,), daemon=True)
+        bar.start()
+    try:
+        for fut in as_completed(futures):
+            try:
+                (xoff, yoff, _, _), a = fut.result()
+            except Exception as e:
+                raise Failure("the window (xoff, yoff, xsize, ysize) = %r of %s "
+                              "failed: %s: %s" % (window_of[fut.key], source,
+                                                  type(e).__name__, e))
+            for i in range(out.RasterCount):
+                out.GetRasterBand(i + 1).WriteArray(a[i], xoff, yoff)
+            fut.release()
+    except BaseException:
+        client.cancel(futures)
+        raise
+    if bar is not None:
+        bar.join(timeout=5)
+    return len(wins)
+
+
+def finish(partial, fmt, dest, block, creation_options):
+    """partial (closed GeoTIFF) -> dest, in fmt, by rename."""
+    final = partial
+    if fmt == "COG":
+        final = dest + ".partial"
+        try:
+            gdal.Translate(final, partial, format="COG",
+                           creationOptions=["BLOCKSIZE=%d" % block] + list(creation_options))
+        except RuntimeError as e:
+            raise Failure("cannot write %s: %s" % (final, e))
+        remove(partial)
+    os.replace(final, dest)
+    if os.path.exists(final + ".aux.xml"):
+        os.replace(final + ".aux.xml", dest + ".aux.xml")
+
+
+def remove(path):
+    for p in (path, path + ".aux.xml"):
+        with contextlib.suppress(FileNotFoundError):
+            os.remove(p)
+
+
+def run(args):
+    src = open_source(args.source, args.open_options)
+    fmt = output_format(args)
+    block = block_size(args.tile_size)
+    partial = args.dest + (".tiles.partial" if fmt == "COG" else ".partial")
+    out = create_like(src, partial, block, [] if fmt == "COG" else args.creation_options)
+    size = (src.RasterXSize, src.RasterYSize, src.RasterCount)
+    src = None
+    client = cluster = None
+    t0 = time.time()
+    try:
+        client, cluster, threads = start_cluster(args)
+        nworkers = check_workers(client)
+        keys = given_keys(args.source, args.open_options)
+        task_options = list(args.open_options)
+        if "THREADS" not in keys:
+            task_options.append("THREADS=%d" % threads)
+        if "PROGRESS" not in keys:
+            task_options.append("PROGRESS=no")  # the Dask bar says it
+        n = compute(client, out, args.source, task_options, args.tile_size, args.quiet)
+        out.FlushCache()
+        out = None
+        finish(partial, fmt, args.dest, block, args.creation_options)
+    except BaseException:
+        out = None
+        remove(partial)
+        remove(args.dest + ".partial")
+        raise
+    finally:
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    if not args.quiet:
+        print("%s: wrote %s (%d x %d, %d bands, %s) from %d windows of %d on %d "
+              "worker%s in %.1f s" % (PROG, args.dest, size[0], size[1], size[2], fmt, n,
+                                       args.tile_size, nworkers, "s"[:nworkers > 1],
+                                       time.time() - t0),
+              file=sys.stderr)
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    try:
+        run(args)
+    except Failure as e:
+        print("%s: error: %s" % (PROG, e), file=sys.stderr)
+        return e.code
+    except Exception as e:  # GDAL or Dask, unforeseen: a sentence, not a traceback
+        print("%s: error: %s: %s (nothing written to %s)"
+              % (PROG, type(e).__name__, e, args.dest), file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("%s: interrupted; nothing written to %s" % (PROG, args.dest), file=sys.stderr)
+        return 130
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

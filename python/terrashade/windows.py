@@ -1,0 +1,73 @@
+"""Windows of a product and the task that reads one through the driver.
+
+This module runs on the Dask workers: it needs osgeo.gdal and the
+TERRASHADE plugin there (GDAL_DRIVER_PATH or the installed plugin), not
+dask. Functions are sent to workers by reference, so the workers import
+terrashade (installed by `make install`, or on PYTHONPATH).
+"""
+import os
+import threading
+
+from osgeo import gdal
+
+gdal.UseExceptions()
+
+# One open dataset per worker thread: GDAL datasets are not thread-safe, and
+# keeping the dataset open lets a worker's later windows reuse what the
+# driver has cached (today the whole product, later its chunks and its
+# far-field grid) instead of recomputing it for every window.
+_open = threading.local()
+
+# Test hook (tests/driver/test_distributed.py): the path of a flag file. The
+# first task that manages to create it kills its own worker process, so the
+# run loses a worker mid-way exactly once and Dask must retry the window.
+CRASH_ONCE_ENV = "TERRASHADE_DISTRIBUTED_CRASH_ONCE"
+
+
+def windows(width, height, tile):
+    """(xoff, yoff, xsize, ysize) of every tile x tile window, row by row;
+    the last column and row are cut to the raster's size."""
+    return [(x, y, min(tile, width - x), min(tile, height - y))
+            for y in range(0, height, tile) for x in range(0, width, tile)]
+
+
+def _dataset(source, open_options):
+    key = (source, tuple(open_options))
+    if getattr(_open, "key", None) != key:
+        _open.ds = None  # close the previous one first: bounded memory
+        _open.ds = gdal.OpenEx(source, gdal.OF_RASTER | gdal.OF_READONLY,
+                               open_options=list(open_options))
+        _open.key = key
+    return _open.ds
+
+
+def _maybe_crash():
+    flag = os.environ.get(CRASH_ONCE_ENV)
+    if not flag:
+        return
+    try:
+        fd = os.open(flag, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+    except FileExistsError:
+        return
+    os.close(fd)
+    os._exit(17)
+
+
+def read_window(source, open_options, window):
+    """The product's pixels in window (xoff, yoff, xsize, ysize) as an array
+    of shape (bands, ysize, xsize), read through the driver."""
+    _maybe_crash()
+    ds = _dataset(source, open_options)
+    xoff, yoff, xsize, ysize = window
+    a = ds.ReadAsArray(xoff, yoff, xsize, ysize)
+    if a is None:
+        raise RuntimeError("reading window %r of %s failed: %s"
+                           % (window, source, gdal.GetLastErrorMsg()))
+    return window, a.reshape((ds.RasterCount, ysize, xsize))
+
+
+def probe():
+    """On a worker: whether GDAL there finds the TERRASHADE driver."""
+    drv = gdal.GetDriverByName("TERRASHADE")
+    return {"driver": drv is not None, "gdal": gdal.__version__,
+            "GDAL_DRIVER_PATH": os.environ.get("GDAL_DRIVER_PATH", "")}

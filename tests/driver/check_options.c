@@ -1,0 +1,176 @@
+/*
+ * check_options - the driver's option table against the struct it fills:
+ * every declared default (the text that gdalinfo --format TERRASHADE shows)
+ * equals the default in tsd_options, whichever way it is read; and the
+ * refraction default is the core's.
+ *
+ * - the value of each option in tsd_options_defaults, written back as text,
+ *   is its declared default (OUTPUT_TYPE=AUTO: the field is TSD_OUT_AUTO);
+ * - giving each declared default explicitly (the parser users go through)
+ *   leaves the defaults struct unchanged;
+ * - the open-option XML declares the same default for every option;
+ * - REFRACTION's default is TSD_REFRACTION_DEFAULT and the core's
+ *   ts_horizon_opts_default; the sun defaults are gdaldem's 315 / 45;
+ * - sentences that scripts and tests read, made from the tables, are the
+ *   ones written before the tables made them.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "terrashade.h"
+#include "tsd_options.h"
+#include "tsd_products.h"
+
+static int failures = 0;
+
+#define EXPECT(cond, ...)                                                                \
+    do {                                                                                 \
+        if (!(cond)) {                                                                   \
+            failures++;                                                                  \
+            printf("FAIL %s:%d: ", __FILE__, __LINE__);                                  \
+            printf(__VA_ARGS__);                                                         \
+            printf("\n");                                                                \
+        }                                                                                \
+    } while (0)
+
+/* tsd_options without the given-bits (which say what was given, not values) */
+static int same_values(tsd_options a, tsd_options b)
+{
+    a.given = b.given = 0;
+    return memcmp(&a, &b, sizeof a) == 0;
+}
+
+static void check_round_trip(const tsd_options *d)
+{
+    for (int i = 0; i < tsd_options_count(); i++) {
+        char value[TSD_PATH_MAX];
+        const char *name = tsd_options_value(d, i, value, sizeof value);
+        const char *declared = tsd_option_default(i);
+        if (strcmp(name, "OUTPUT_TYPE") == 0) {
+            /* the value written is the effective type; the field is AUTO */
+            EXPECT(strcmp(declared, "AUTO") == 0 && d->output_type == TSD_OUT_AUTO,
+                   "OUTPUT_TYPE: declared %s, field %d", declared, d->output_type);
+            continue;
+        }
+        printf("%-16s declared '%s', struct '%s'\n", name, declared, value);
+        EXPECT(strcmp(value, declared) == 0, "%s: declared default '%s', struct has '%s'",
+               name, declared, value);
+    }
+}
+
+static void check_given_explicitly(const tsd_options *d)
+{
+    for (int i = 0; i < tsd_options_count(); i++) {
+        const char *declared = tsd_option_default(i);
+        if (!declared[0])
+            continue; /* a text option: off until given */
+        char item[256], msg[512] = "";
+        snprintf(item, sizeof item, "%s=%s", tsd_option_name(i), declared);
+        const char *kv[] = {item, NULL};
+        tsd_options o = *d;
+        int rc = tsd_option_scope(i) & TSD_SCOPE_PRODUCT
+                     ? tsd_options_apply(&o, kv, msg, sizeof msg)
+                     : tsd_options_apply_atlas(&o, kv, msg, sizeof msg);
+        EXPECT(rc == 0, "%s: %s", item, msg);
+        EXPECT(same_values(o, *d), "%s given explicitly changes the defaults", item);
+        EXPECT(tsd_options_given(&o, tsd_option_name(i)), "%s not marked as given", item);
+    }
+}
+
+static void check_xml(void)
+{
+    char *xml = tsd_options_xml();
+    EXPECT(xml != NULL, "no open-option XML");
+    for (int i = 0; xml && i < tsd_options_count(); i++) {
+        char key[64];
+        snprintf(key, sizeof key, "<Option name='%s' ", tsd_option_name(i));
+        const char *at = strstr(xml, key);
+        EXPECT(at != NULL, "%s missing from the open-option XML", tsd_option_name(i));
+        if (!at)
+            continue;
+        const char *end = strchr(at, '>');
+        const char *def = strstr(at, " default='");
+        const char *declared = tsd_option_default(i);
+        if (!def || def > end) {
+            EXPECT(!declared[0], "%s: no default in the XML, declared '%s'",
+                   tsd_option_name(i), declared);
+            continue;
+        }
+        def += strlen(" default='");
+        EXPECT(strncmp(def, declared, strlen(declared)) == 0 &&
+                   def[strlen(declared)] == '\'',
+               "%s: XML default differs from the declared '%s'", tsd_option_name(i),
+               declared);
+    }
+    free(xml);
+}
+
+/* Applying `item` fails with exactly `sentence`. */
+static void expect_sentence(int atlas, const char *item, const char *sentence)
+{
+    tsd_options o;
+    char msg[1024] = "";
+    const char *kv[] = {item, NULL};
+    tsd_options_defaults(&o);
+    int rc = atlas ? tsd_options_apply_atlas(&o, kv, msg, sizeof msg)
+                   : tsd_options_apply(&o, kv, msg, sizeof msg);
+    printf("%s -> %s\n", item, msg);
+    EXPECT(rc != 0 && strcmp(msg, sentence) == 0, "%s: got '%s', expected '%s'", item, msg,
+           sentence);
+}
+
+static void check_sentences(void)
+{
+    expect_sentence(1, "PRODUCT=shade",
+                    "an atlas takes the open options SHADOWS, DEM and THREADS, not 'PRODUCT'");
+    expect_sentence(1, "SHADOWS=near", "SHADOWS must be one of far, all, got 'near'");
+    expect_sentence(0, "SHADOWS=all",
+                    "SHADOWS is an open option of far-shadow atlas files (.tsa), not of "
+                    "TERRASHADE:<dem>");
+    expect_sentence(0, "PRODUCT=x",
+                    "PRODUCT must be one of shade, shadow, horizon, svf, openness, sky, "
+                    "sunhours, insolation, daycycle, farshadow, envlight, got 'x'");
+    expect_sentence(0, "SUN_AZIMUT=1",
+                    "unknown option 'SUN_AZIMUT'; the options are PRODUCT, SUN_AZIMUTH, "
+                    "SUN_ELEVATION, DIRECTIONS, START_AZIMUTH, METHOD, PENUMBRA_DEPTH, "
+                    "Z_FACTOR, MAX_DISTANCE, CURVATURE, REFRACTION, SKY_WEIGHT, BAND, "
+                    "THREADS, OUTPUT_TYPE, MAX_MEMORY, DATETIME, DATE, TIMEZONE, "
+                    "STEP_MINUTES, PRESSURE, TEMPERATURE, DELTA_T, SUN_POSITION, "
+                    "LINKE_TURBIDITY, FAR_THRESHOLD, ATLAS_STEPS, BACKEND, SUNHOURS_RULE, "
+                    "PROGRESS, ENV_MAP, ENV_ROTATION, SKY, ENV_HORIZON_STEPS, "
+                    "ENV_NORMAL_STEPS, EXPOSURE (see gdalinfo --format TERRASHADE)");
+    expect_sentence(0, "Z_FACTOR=0", "Z_FACTOR must be greater than 0 and at most 1e+06, got 0");
+    expect_sentence(0, "Z_FACTOR=feet", "Z_FACTOR must be AUTO or a number, got 'feet'");
+    expect_sentence(0, "SUN_POSITION=per_cell",
+                    "SUN_POSITION=per_cell needs the sun from DATETIME or DATE");
+}
+
+int main(void)
+{
+    tsd_options d;
+    ts_horizon_opts h;
+    tsd_options_defaults(&d);
+    ts_horizon_opts_default(&h);
+    EXPECT(d.given == 0, "defaults marked as given");
+    check_round_trip(&d);
+    check_given_explicitly(&d);
+    check_xml();
+    check_sentences();
+    EXPECT(d.refraction == TSD_REFRACTION_DEFAULT, "REFRACTION default %g", d.refraction);
+    EXPECT(h.refraction == TSD_REFRACTION_DEFAULT,
+           "the core's refraction default %g differs from the driver's %g", h.refraction,
+           TSD_REFRACTION_DEFAULT);
+    EXPECT(d.sun_azimuth == 315 && d.sun_elevation == 45, "sun default %g / %g",
+           d.sun_azimuth, d.sun_elevation);
+    EXPECT(strcmp(tsd_product_of(&d)->name, "shade") == 0, "PRODUCT default %s",
+           tsd_product_of(&d)->name);
+    /* Z_FACTOR=AUTO: NAN until the DEM's vertical unit decides it */
+    EXPECT(d.curvature == 1 && isnan(d.z_factor) && d.band == 1 && d.directions == 16,
+           "curvature %d, z %g, band %d, directions %d", d.curvature, d.z_factor, d.band,
+           d.directions);
+    printf("%s: %d option(s), %d failure(s)\n", failures ? "FAIL" : "PASS",
+           tsd_options_count(), failures);
+    return failures ? 1 : 0;
+}

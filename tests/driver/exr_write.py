@@ -1,0 +1,51 @@
+"""A minimal OpenEXR writer for the tests (numpy only): one part, scanlines,
+no compression, float R, G, B, and the `envmap` attribute (lat-long or cube)
+when asked. Enough for maps OpenEXR's own tools read (exrheader, exrenvmap)
+and the driver decodes; see the OpenEXR file layout (openexr.com,
+"OpenEXR File Layout")."""
+import struct
+
+import numpy as np
+
+ENVMAP = {"latlong": 0, "cube": 1}
+
+
+def _attr(name, kind, payload):
+    return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(payload)) \
+        + payload
+
+
+def write_exr(path, rgb, envmap=None):
+    """rgb: height x width x 3 floats, row 0 at the top (a lat-long map's
+    zenith). envmap: None, "latlong" or "cube"."""
+    rgb = np.ascontiguousarray(rgb, dtype="<f4")
+    h, w = rgb.shape[:2]
+    chans = b""
+    for c in "BGR":  # channels are listed (and stored) in name order
+        chans += c.encode() + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1)  # FLOAT
+    chans += b"\0"
+    box = struct.pack("<iiii", 0, 0, w - 1, h - 1)
+    header = b"".join([
+        _attr("channels", "chlist", chans),
+        _attr("compression", "compression", b"\0"),  # NO_COMPRESSION
+        _attr("dataWindow", "box2i", box),
+        _attr("displayWindow", "box2i", box),
+        _attr("lineOrder", "lineOrder", b"\0"),  # INCREASING_Y
+        _attr("pixelAspectRatio", "float", struct.pack("<f", 1.0)),
+        _attr("screenWindowCenter", "v2f", struct.pack("<ff", 0.0, 0.0)),
+        _attr("screenWindowWidth", "float", struct.pack("<f", 1.0)),
+    ])
+    if envmap is not None:
+        header += _attr("envmap", "envmap", bytes([ENVMAP[envmap]]))
+    head = struct.pack("<ii", 20000630, 2) + header + b"\0"
+    line_bytes = w * 3 * 4
+    first = len(head) + 8 * h
+    offsets = [first + y * (8 + line_bytes) for y in range(h)]
+    with open(path, "wb") as f:
+        f.write(head)
+        f.write(struct.pack("<%dQ" % h, *offsets))
+        for y in range(h):
+            f.write(struct.pack("<ii", y, line_bytes))
+            for c in (2, 1, 0):  # B, G, R
+                f.write(rgb[y, :, c].tobytes())
+    return path

@@ -1,0 +1,199 @@
+"""terrashade.distributed: a product computed as window tasks on
+dask.distributed equals gdal_translate of the same source, bit for bit.
+
+- a LocalCluster of 2 worker processes (--workers 2), small windows (12 of
+  them, the last column and row cut), for shade (Byte) and horizon (4 bands
+  of Float32): every band's bits, the georeferencing, nodata, band
+  descriptions and metadata equal gdal_translate's;
+- an existing cluster (--scheduler) writing a COG: the same pixels, COG layout;
+- a worker process that dies on its first task (a test hook in
+  terrashade/windows.py, once per run) is replaced, Dask retries the window,
+  and the result is still identical;
+- a window that fails (no retries allowed) fails the run: exit 1, the
+  older DEST untouched, no DEST.partial;
+- bad input (an unreachable scheduler, an unwritable destination, a SOURCE
+  the driver refuses, bad tile sizes): a clear message, a non-zero exit and
+  neither DEST nor DEST.partial left behind.
+"""
+import os
+import re
+import socket
+import sys
+import unittest
+
+import tsdriver as T
+from tsdriver import gdal, np
+
+UTM_GT = (600000.0, 30.0, 0.0, 4000000.0, 0.0, -30.0)
+PYTHONPATH = os.path.join(T.SRCDIR, "python")
+sys.path.insert(0, PYTHONPATH)
+HORIZON = {"PRODUCT": "horizon", "DIRECTIONS": 4}
+SHADE = {"PRODUCT": "shade", "SUN_AZIMUTH": 300, "SUN_ELEVATION": 20}
+
+
+def distributed(args, ok=True, **env):
+    return T.run(["/usr/bin/python3", "-m", "terrashade.distributed"] + list(args),
+                 ok=ok, PYTHONPATH=PYTHONPATH, **env)
+
+
+def bits(a):
+    """The array's raw bits, so that NaN payloads and -0 compare too."""
+    return a.view(np.uint8)
+
+
+class Distributed(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = T.TempDir()
+        cls.dir = cls.tmp.__enter__()
+        z = T.fractal_dem(200, seed=5)[:150]  # 200 x 150: windows of 64 are cut
+        z[40:48, 100:130] = np.nan  # nodata in, nodata out
+        cls.dem = T.write_tif(os.path.join(cls.dir, "dem.tif"), np.nan_to_num(z, nan=-9999),
+                              UTM_GT, 32617, nodata=-9999)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.__exit__(None, None, None)
+
+    def path(self, name):
+        return os.path.join(self.dir, name)
+
+    def reference(self, options, name):
+        return T.translate(self.dem, self.path(name), options)
+
+    def assert_identical(self, got, want):
+        a, b = gdal.Open(got), gdal.Open(want)
+        self.assertEqual((a.RasterXSize, a.RasterYSize, a.RasterCount),
+                         (b.RasterXSize, b.RasterYSize, b.RasterCount))
+        self.assertEqual(a.GetGeoTransform(), b.GetGeoTransform())
+        self.assertEqual(a.GetProjection(), b.GetProjection())
+        self.assertEqual(a.GetMetadata(), b.GetMetadata())
+        for i in range(1, a.RasterCount + 1):
+            ba, bb = a.GetRasterBand(i), b.GetRasterBand(i)
+            self.assertEqual(ba.DataType, bb.DataType)
+            self.assertEqual(str(ba.GetNoDataValue()), str(bb.GetNoDataValue()))
+            self.assertEqual(ba.GetDescription(), bb.GetDescription())
+            self.assertEqual(ba.GetMetadata(), bb.GetMetadata())
+            self.assertEqual(ba.GetUnitType(), bb.GetUnitType())
+            xa, xb = ba.ReadAsArray(), bb.ReadAsArray()
+            self.assertTrue(np.array_equal(bits(xa), bits(xb)),
+                            "band %d differs in %d cells" % (i, np.sum(xa != xb)))
+        print("%s: %d bands of %s, identical to gdal_translate" % (
+            os.path.basename(got), a.RasterCount,
+            gdal.GetDataTypeName(a.GetRasterBand(1).DataType)))
+
+    def assert_nothing_left(self, dest):
+        for p in (dest, dest + ".partial", dest + ".tiles.partial"):
+            self.assertFalse(os.path.exists(p), "%s was left behind" % p)
+
+    def test_windows_and_internal_tiles(self):
+        from terrashade import distributed as D, windows as W
+        for width, height, tile in ((200, 150, 64), (1024, 1024, 1024), (1, 1, 16),
+                                    (5000, 33, 1040)):
+            cover = np.zeros((height, width), np.int32)
+            for x, y, w, h in W.windows(width, height, tile):
+                self.assertTrue(0 < w <= tile and 0 < h <= tile)
+                cover[y:y + h, x:x + w] += 1
+            self.assertTrue((cover == 1).all(), "windows of %d miss or overlap" % tile)
+        # the output's tiles divide the window: a window covers whole tiles
+        self.assertEqual([D.block_size(t) for t in (16, 64, 496, 512, 1024, 1040, 3072)],
+                         [16, 64, 496, 512, 512, 16, 512])
+
+    def test_local_cluster_shade_and_horizon(self):
+        for name, options in (("shade", SHADE), ("horizon", HORIZON)):
+            with self.subTest(product=name):
+                dest = self.path("local_%s.tif" % name)
+                p = distributed(["--workers", 2, "--tile-size", 64] + T.oo_args(options)
+                                + [T.conn(self.dem), dest])
+                self.assertIn("from 12 windows of 64 on 2 workers", p.stderr)
+                self.assertIn("Completed", p.stderr)  # the Dask progress bar
+                self.assertEqual(p.stdout, "")
+                self.assertFalse(os.path.exists(dest + ".partial"))
+                self.assertEqual(gdal.Open(dest).GetRasterBand(1).GetBlockSize(), [64, 64])
+                self.assert_identical(dest, self.reference(options, "ref_%s.tif" % name))
+
+    def test_existing_cluster_writes_cog(self):
+        from dask.distributed import LocalCluster
+        cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                               dashboard_address=None, scheduler_port=0)
+        try:
+            dest = self.path("cluster.cog.tif")
+            # inline options, as a caller that cannot pass -oo would give them
+            src = "TERRASHADE:PRODUCT=horizon,DIRECTIONS=4:" + self.dem
+            distributed(["--scheduler", cluster.scheduler_address, "--tile-size", 64,
+                         src, dest])
+        finally:
+            cluster.close()
+        self.assertEqual(gdal.Open(dest).GetMetadata("IMAGE_STRUCTURE").get("LAYOUT"), "COG")
+        self.assert_identical(dest, self.reference(HORIZON, "ref_cog.tif"))
+
+    def test_killed_worker_is_retried(self):
+        flag = self.path("crashed")
+        dest = self.path("retried.tif")
+        distributed(["--workers", 2, "--tile-size", 64] + T.oo_args(HORIZON)
+                    + [T.conn(self.dem), dest], TERRASHADE_DISTRIBUTED_CRASH_ONCE=flag)
+        self.assertTrue(os.path.exists(flag), "no worker was killed")
+        self.assert_identical(dest, self.reference(HORIZON, "ref_retried.tif"))
+
+    def test_failed_window_leaves_nothing(self):
+        # no retries allowed: the killed worker's window fails the run
+        dest = self.path("failed.tif")
+        with open(dest, "w") as f:
+            f.write("an older result")
+        p = distributed(["--workers", 2, "--tile-size", 64] + T.oo_args(HORIZON)
+                        + [T.conn(self.dem), dest], ok=False,
+                        TERRASHADE_DISTRIBUTED_CRASH_ONCE=self.path("crashed_once"),
+                        DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES=0)
+        self.assertEqual(p.returncode, 1, p.stderr)
+        self.assertRegex(p.stderr, r"terrashade.distributed: error: the window "
+                         r"\(xoff, yoff, xsize, ysize\) = \(\d+, \d+, \d+, \d+\) of "
+                         + re.escape(T.conn(self.dem)) + " failed: KilledWorker")
+        with open(dest) as f:
+            self.assertEqual(f.read(), "an older result")  # DEST untouched
+        os.remove(dest)
+        self.assert_nothing_left(dest)
+
+    def test_unreachable_scheduler(self):
+        with socket.socket() as s:  # a port nobody listens on
+            s.bind(("127.0.0.1", 0))
+            port = s.getsockname()[1]
+        dest = self.path("unreachable.tif")
+        p = distributed(["--scheduler", "tcp://127.0.0.1:%d" % port, "--timeout", 2,
+                         T.conn(self.dem), dest], ok=False)
+        self.assertEqual(p.returncode, 2, p.stderr)
+        self.assertIn("cannot reach the Dask scheduler at tcp://127.0.0.1:%d within 2 s"
+                      % port, p.stderr)
+        self.assert_nothing_left(dest)
+
+    def test_bad_input(self):
+        missing_dir = self.path("no/such/dir/out.tif")
+        cases = [
+            ("unwritable destination", [T.conn(self.dem)],
+             "cannot write %s.partial" % missing_dir, missing_dir),
+            ("driver refuses SOURCE", ["-oo", "PRODUCT=hillshade", T.conn(self.dem)],
+             "PRODUCT must be one of", None),
+            ("missing DEM", [T.conn(self.path("nodem.tif"))],
+             "cannot open the DEM", None),
+            ("not a TERRASHADE source", [self.dem],
+             "SOURCE must be a TERRASHADE connection string", None),
+            ("tile size not a multiple of 16", ["--tile-size", 100, T.conn(self.dem)],
+             "must be a multiple of 16 between 16 and 65536 (GeoTIFF tiles are "
+             "multiples of 16), got 100", None),
+            ("tile size 0", ["--tile-size", 0, T.conn(self.dem)],
+             "must be a multiple of 16", None),
+            ("tile size not a number", ["--tile-size", "big", T.conn(self.dem)],
+             "must be a whole number, got 'big'", None),
+            ("unknown format", [T.conn(self.dem)], "cannot tell the format", "out.png"),
+        ]
+        for what, args, message, dest in cases:
+            with self.subTest(what):
+                if not (dest and os.path.isabs(dest)):
+                    dest = self.path(dest or "bad.tif")
+                p = distributed(["--workers", 1] + args + [dest], ok=False)
+                self.assertIn(message, p.stderr)
+                self.assertNotIn("Traceback", p.stderr)
+                self.assert_nothing_left(dest)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

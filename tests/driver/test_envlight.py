@@ -1,0 +1,281 @@
+"""PRODUCT=envlight and the environment sky term of shade, through the driver.
+
+- a constant environment of radiance 1 (an EXR written here, its cube copy
+  made by OpenEXR's exrenvmap, and SKY=uniform) gives the sky product;
+- a black map with one small bright patch shades like the sun there (the
+  orientation of maps on the terrain);
+- the lat-long and cube versions of tests/data/envmaps/sunset.exr give the
+  same light; ENV_ROTATION=90 equals the map with its columns rolled by a
+  quarter (and not rolled the other way);
+- a /vsimem/ map, Byte output (exposure and the sRGB curve), colour
+  interpretation and metadata;
+- shade's sky term from SKY, and the sun with a CIE clear sky from DATETIME;
+- bad input: a clear sentence and a non-zero exit of gdal_translate.
+"""
+import os
+import shutil
+import subprocess
+import unittest
+
+import tsdriver as T
+from tsdriver import gdal, np
+from exr_write import write_exr
+
+SUNSET = os.path.join(T.DATA, "envmaps", "sunset.exr")
+SUNSET_CUBE = os.path.join(T.DATA, "envmaps", "sunset_cube128.exr")
+
+
+def envlight(dem, **options):
+    """The envlight bands (3 x H x W floats) of dem with these options."""
+    return T.read(T.conn(dem), options=dict(options, PRODUCT="envlight", PROGRESS="no"))
+
+
+def luminance(rgb):
+    return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
+
+
+def latlong_direction(w, h, i, j):
+    """Terrain azimuth and elevation (degrees) of lat-long pixel (i, j)
+    (docs/envlight.md: column i at azimuth 360 i / (w - 1) - 180, row j at
+    elevation 90 - 180 j / (h - 1))."""
+    return 360.0 * i / (w - 1) - 180.0, 90.0 - 180.0 * j / (h - 1)
+
+
+def srgb(x):
+    x = np.clip(x, 0, 1)
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)
+
+
+class EnvLight(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmpdir = T.TempDir()
+        cls.tmp = cls.tmpdir.__enter__()
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmpdir.__exit__(None, None, None)
+
+    def path(self, name):
+        return os.path.join(self.tmp, name)
+
+    def test_constant_environment_is_the_sky_product(self):
+        # a texel row cut by the horizon counts wholly on one side: maps of
+        # 0.18 degree rows and faces (1024 x 512: 1.4e-3; 128 x 64: 1 %)
+        const = write_exr(self.path("const.exr"), np.ones((1024, 2048, 3)))
+        cube = self.path("const_cube.exr")
+        T.run(["exrenvmap", "-c", "-w", "512", const, cube])
+        self.assertIn("cube", T.run(["exrheader", cube]).stdout)
+        for dirs in (8, 16):
+            sky = T.read(T.conn(T.JACKSBORO), band=1,
+                         options=dict(PRODUCT="sky", DIRECTIONS=dirs, PROGRESS="no"))
+            for name, opts in (("map", dict(ENV_MAP=const)), ("cube", dict(ENV_MAP=cube)),
+                               ("SKY=uniform", dict(SKY="uniform"))):
+                rgb = envlight(T.JACKSBORO, DIRECTIONS=dirs, **opts)
+                for c in range(3):
+                    d = np.nanmax(np.abs(rgb[c] - sky))
+                    print("DIRECTIONS=%d %s band %d: max |envlight - sky| %.3g"
+                          % (dirs, name, c + 1, d))
+                    self.assertLessEqual(d, 1e-3)
+                    self.assertTrue(np.array_equal(np.isnan(rgb[c]), np.isnan(sky)))
+
+    def test_bright_patch_shades_like_the_sun_there(self):
+        w, h = 1024, 512
+        i, j = 895, 170  # a pixel centre near azimuth 135, elevation 30
+        az, el = latlong_direction(w, h, i, j)
+        img = np.zeros((h, w, 3))
+        img[j - 1:j + 2, i - 1:i + 2] = 5000.0
+        patch = write_exr(self.path("patch.exr"), img)
+        rgb = envlight(T.JACKSBORO, ENV_MAP=patch, DIRECTIONS=16)
+        sun = T.read(T.conn(T.JACKSBORO), band=1, options=dict(
+            PRODUCT="shade", OUTPUT_TYPE="Float32", SKY_WEIGHT=0, SUN_AZIMUTH=az,
+            SUN_ELEVATION=el, PROGRESS="no"))
+        ok = ~np.isnan(sun) & ~np.isnan(rgb[0])
+        r = np.corrcoef(rgb[0][ok], sun[ok])[0, 1]
+        # the same patch seen from the opposite side of the sky: no match
+        opposite = T.read(T.conn(T.JACKSBORO), band=1, options=dict(
+            PRODUCT="shade", OUTPUT_TYPE="Float32", SKY_WEIGHT=0,
+            SUN_AZIMUTH=(az + 180) % 360, SUN_ELEVATION=el, PROGRESS="no"))
+        r_opp = np.corrcoef(rgb[0][ok], opposite[ok])[0, 1]
+        print("patch at azimuth %.3f, elevation %.3f: correlation with shade's direct "
+              "term %.5f (sun opposite: %.3f)" % (az, el, r, r_opp))
+        self.assertGreaterEqual(r, 0.99)
+        self.assertLess(r_opp, 0.5)
+        # colour: grey patch, equal bands
+        self.assertTrue(np.allclose(rgb[0][ok], rgb[2][ok], rtol=1e-5, atol=1e-7))
+
+    def test_latlong_and_cube_maps_agree(self):
+        a = envlight(T.JACKSBORO, ENV_MAP=SUNSET)
+        b = envlight(T.JACKSBORO, ENV_MAP=SUNSET_CUBE)
+        for c in range(3):
+            rel = np.abs(a[c] - b[c]) / a[c]
+            med = np.nanmedian(rel)
+            print("band %d: median relative difference lat-long vs cube %.5f, max %.4f"
+                  % (c + 1, med, np.nanmax(rel)))
+            self.assertLessEqual(med, 0.01)
+
+    def test_rotation_is_a_roll_of_the_columns(self):
+        # 129 columns: pixel centres every 360/128 degrees, the last column
+        # on the first's meridian, so that a quarter turn is 32 columns
+        rng = np.random.default_rng(3)
+        w, h = 129, 65
+        img = rng.uniform(0.2, 1.0, size=(h, w, 3))
+        img[20:24, 40:44] = 40.0  # a bright spot, to make the direction plain
+        img[:, 128] = img[:, 0]
+        rolled = img.copy()
+        rolled[:, :128] = np.roll(img[:, :128], 32, axis=1)
+        rolled[:, 128] = rolled[:, 0]
+        back = img.copy()
+        back[:, :128] = np.roll(img[:, :128], -32, axis=1)
+        back[:, 128] = back[:, 0]
+        orig = write_exr(self.path("rot.exr"), img, envmap="latlong")
+        roll = write_exr(self.path("rot_rolled.exr"), rolled, envmap="latlong")
+        wrong = write_exr(self.path("rot_back.exr"), back, envmap="latlong")
+        turned = envlight(T.JACKSBORO, ENV_MAP=orig, ENV_ROTATION=90, DIRECTIONS=12)
+        want = envlight(T.JACKSBORO, ENV_MAP=roll, DIRECTIONS=12)
+        other = envlight(T.JACKSBORO, ENV_MAP=wrong, DIRECTIONS=12)
+        rel = np.nanmax(np.abs(turned - want) / want)
+        rel_other = np.nanmax(np.abs(turned - other) / other)
+        print("ENV_ROTATION=90 vs columns rolled a quarter: max relative difference %.3g "
+              "(rolled the other way: %.3g)" % (rel, rel_other))
+        self.assertLessEqual(rel, 1e-4)
+        self.assertGreater(rel_other, 0.05)
+
+    def test_vsimem_map(self):
+        with open(SUNSET, "rb") as f:
+            gdal.FileFromMemBuffer("/vsimem/envlight/sunset.exr", f.read())
+        try:
+            mem = envlight(T.JACKSBORO, ENV_MAP="/vsimem/envlight/sunset.exr")
+        finally:
+            gdal.Unlink("/vsimem/envlight/sunset.exr")
+        disk = envlight(T.JACKSBORO, ENV_MAP=SUNSET)
+        self.assertTrue(np.array_equal(mem, disk, equal_nan=True))
+
+    def flat_dem(self):
+        path = self.path("flat.tif")
+        if not os.path.exists(path):
+            T.write_tif(path, np.full((24, 32), 250.0, np.float32),
+                        (500000, 30, 0, 4000000, 0, -30), 32617)
+        return path
+
+    def test_byte_is_exposed_and_srgb_encoded(self):
+        flat = self.flat_dem()
+        f = envlight(flat, SKY="uniform")
+        self.assertTrue(np.allclose(f, 1.0, atol=1e-4), f.min())
+        ds = gdal.OpenEx(T.conn(flat), open_options=[
+            "PRODUCT=envlight", "SKY=uniform", "OUTPUT_TYPE=Byte", "EXPOSURE=-1",
+            "PROGRESS=no"])
+        b = ds.ReadAsArray()
+        md = ds.GetMetadata()
+        self.assertEqual(ds.GetRasterBand(1).DataType, gdal.GDT_Byte)
+        ds = None
+        # 1 x 2^-1 = 0.5, sRGB 0.7354, 1 + 254 x 0.7354 = 187.8
+        print("flat ground, SKY=uniform, EXPOSURE=-1: bytes", np.unique(b))
+        self.assertTrue((b == 188).all())
+        self.assertEqual(md["EXPOSURE"], "-1")
+        self.assertIn("sRGB", md["TRANSFER"])
+        # automatic: the brightest unshadowed surface is the flat one here
+        auto = T.read(T.conn(flat), options=dict(PRODUCT="envlight", SKY="uniform",
+                                                 OUTPUT_TYPE="Byte", PROGRESS="no"))
+        self.assertTrue((auto == 255).all(), np.unique(auto))
+        # a relief: the bytes follow the Float32 values through the curve
+        fl = envlight(T.JACKSBORO, ENV_MAP=SUNSET)
+        by = T.read(T.conn(T.JACKSBORO), options=dict(
+            ENV_MAP=SUNSET, EXPOSURE=0.5, PRODUCT="envlight", OUTPUT_TYPE="Byte",
+            PROGRESS="no"))
+        want = np.floor(1 + 254 * srgb(fl * 2 ** 0.5) + 0.5)
+        self.assertLessEqual(np.nanmax(np.abs(by - want)), 1)
+
+    def test_bands_and_metadata(self):
+        ds = gdal.OpenEx(T.conn(T.JACKSBORO), open_options=[
+            "PRODUCT=envlight", "ENV_MAP=" + SUNSET_CUBE, "ENV_ROTATION=30"])
+        self.assertEqual(ds.RasterCount, 3)
+        self.assertEqual([ds.GetRasterBand(k).GetColorInterpretation() for k in (1, 2, 3)],
+                         [gdal.GCI_RedBand, gdal.GCI_GreenBand, gdal.GCI_BlueBand])
+        self.assertEqual(ds.GetRasterBand(1).DataType, gdal.GDT_Float32)
+        md = ds.GetMetadata()
+        ds = None
+        self.assertEqual(md["ENV_MAP"], SUNSET_CUBE)
+        self.assertEqual(md["ENV_MAP_LAYOUT"], "cube")
+        self.assertEqual(md["ENV_MAP_SIZE"], "128 x 768")
+        self.assertEqual(md["ENV_ROTATION"], "30")
+        ds = gdal.OpenEx(T.conn(T.JACKSBORO), open_options=[
+            "PRODUCT=envlight", "SKY=cie:7", "SUN_AZIMUTH=100", "SUN_ELEVATION=20"])
+        self.assertEqual(ds.GetMetadataItem("SKY"), "cie:7")
+        ds = None
+
+    def test_shade_sky_term_from_a_sky(self):
+        base = dict(PRODUCT="shade", OUTPUT_TYPE="Float32", SKY_WEIGHT=0.4, DIRECTIONS=8,
+                    PROGRESS="no")
+        uniform = T.read(T.conn(T.JACKSBORO), band=1, options=base)
+        env = T.read(T.conn(T.JACKSBORO), band=1, options=dict(base, SKY="uniform"))
+        d = np.nanmax(np.abs(uniform - env))
+        print("shade: SKY=uniform vs the built-in uniform sky term: max |diff| %.3g" % d)
+        self.assertLessEqual(d, 1e-3)
+        # the sun and a CIE clear sky at 8 am on the solstice: one command
+        t = T.translate(T.JACKSBORO, self.path("clear.tif"), options=dict(
+            PRODUCT="shade", SKY="clear", SKY_WEIGHT=0.5, OUTPUT_TYPE="Float32",
+            DATETIME="2026-06-21T08:00:00-05:00", PROGRESS="no"))
+        clear = T.read(t, band=1)
+        overcast = T.read(T.conn(T.JACKSBORO), band=1, options=dict(
+            base, SKY="overcast", DATETIME="2026-06-21T08:00:00-05:00"))
+        self.assertTrue(np.isfinite(clear).any() and np.nanmax(clear) <= 1.5)
+        self.assertGreater(np.nanmax(np.abs(clear - overcast)), 0.01)
+        # the map's sky term is normalised: 1 on open flat ground
+        flat = self.flat_dem()
+        s = T.read(T.conn(flat), band=1, options=dict(
+            PRODUCT="shade", OUTPUT_TYPE="Float32", SKY_WEIGHT=1, SUN_ELEVATION=-10,
+            ENV_MAP=SUNSET, PROGRESS="no"))
+        self.assertTrue(np.allclose(s, 1.0, atol=1e-4), (np.nanmin(s), np.nanmax(s)))
+
+    def test_bad_input(self):
+        truncated = self.path("truncated.exr")
+        with open(SUNSET, "rb") as f:
+            data = f.read()
+        with open(truncated, "wb") as f:
+            f.write(data[:len(data) // 2])
+        text = self.path("text.exr")
+        with open(text, "w") as f:
+            f.write("this is not an OpenEXR file\n")
+        nan = np.ones((16, 32, 3))
+        nan[3, 5, 1] = np.nan
+        nan = write_exr(self.path("nan.exr"), nan)
+        wide = write_exr(self.path("wide.exr"), np.ones((10, 30, 3)))
+        cases = [
+            ("missing map", dict(ENV_MAP=self.path("nowhere.exr")), "no such file"),
+            ("truncated map", dict(ENV_MAP=truncated), "damaged or truncated"),
+            ("text named .exr", dict(ENV_MAP=text), "not a readable OpenEXR file"),
+            ("a NaN pixel", dict(ENV_MAP=nan), "NaN"),
+            ("3:1 without envmap", dict(ENV_MAP=wide), "neither 2:1 (lat-long) nor 1:6"),
+            ("ENV_MAP with SKY", dict(ENV_MAP=SUNSET, SKY="clear"),
+             "SKY=clear excludes ENV_MAP"),
+            ("cie:16", dict(SKY="cie:16"), "SKY"),
+            ("bad EXPOSURE", dict(SKY="uniform", OUTPUT_TYPE="Byte", EXPOSURE="bright"),
+             "EXPOSURE must be AUTO or a number of stops"),
+            ("EXPOSURE with Float32", dict(SKY="uniform", EXPOSURE="1"),
+             "EXPOSURE applies to OUTPUT_TYPE=Byte"),
+            ("no light", {}, "needs a light"),
+            ("rotation of a sky", dict(SKY="overcast", ENV_ROTATION=10),
+             "ENV_ROTATION turns ENV_MAP"),
+            ("normal steps 1", dict(SKY="uniform", ENV_NORMAL_STEPS=1),
+             "ENV_NORMAL_STEPS must be 0"),
+        ]
+        for name, opts, words in cases:
+            with self.subTest(name):
+                p = T.run(["gdal_translate", "-q"] + T.oo_args(dict(opts, PRODUCT="envlight"))
+                          + [T.conn(T.JACKSBORO), self.path("bad.tif")], ok=False)
+                print("%s: %s" % (name, p.stderr.strip()))
+                self.assertIn(words, p.stderr)
+                self.assertIn("TERRASHADE", p.stderr)
+        # ENV_MAP for a product that cannot use it
+        p = T.run(["gdal_translate", "-q", "-oo", "PRODUCT=svf", "-oo", "ENV_MAP=" + SUNSET,
+                   T.conn(T.JACKSBORO), self.path("bad.tif")], ok=False)
+        self.assertIn("ENV_MAP applies to PRODUCT=shade and PRODUCT=envlight, not to "
+                      "PRODUCT=svf", p.stderr)
+        p = T.run(["gdal_translate", "-q", "-oo", "SKY=clear",
+                   T.conn(T.JACKSBORO), self.path("bad.tif")], ok=False)
+        self.assertIn("SKY_WEIGHT > 0", p.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

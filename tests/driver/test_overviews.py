@@ -1,0 +1,290 @@
+"""Overviews: a TERRASHADE product offers levels 2x, 4x, ... down to about
+256 cells; level k is the product computed from the DEM resampled to that
+level by GDAL's average (bit for bit what TERRASHADE gives on the DEM
+written by gdal_translate -r average -outsize), computed lazily and once;
+gdal_translate -of COG writes the full resolution unchanged and sensible
+overviews; a coarse level is far faster and smaller than the full one."""
+import os
+import resource
+import subprocess
+import sys
+import time
+import unittest
+
+import tsdriver as T
+from tsdriver import gdal, np
+
+GT = (600000, 20, 0, 4000000, 0, -20)
+
+
+def open_ds(dem, **options):
+    return gdal.OpenEx(T.conn(dem), gdal.OF_RASTER,
+                       open_options=["%s=%s" % kv for kv in options.items()])
+
+
+def expected_sizes(w, h):
+    """2x, 4x, ... while the previous level's longer side exceeds 256."""
+    sizes = []
+    while max(w, h) > 256 and min(w, h) > 1:
+        w, h = -(-w // 2), -(-h // 2)
+        sizes.append((w, h))
+    return sizes
+
+
+def read_all(ds):
+    return np.array([ds.GetRasterBand(b).ReadAsArray()
+                     for b in range(1, ds.RasterCount + 1)])
+
+
+def read_overview(ds, i):
+    return np.array([ds.GetRasterBand(b).GetOverview(i).ReadAsArray()
+                     for b in range(1, ds.RasterCount + 1)])
+
+
+def downsampled(dem, w, h, out):
+    """The DEM resampled as the driver documents it: gdal_translate -r
+    average -outsize, Float32, same georeferencing."""
+    T.run(["gdal_translate", "-q", "-ot", "Float32", "-r", "average",
+           "-outsize", w, h, dem, out])
+    return out
+
+
+class Overviews(unittest.TestCase):
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = T.TempDir().__enter__()
+        z = T.fractal_dem(600, seed=3, relief=800)[:517]
+        z[100:140, 300:380] = -9999  # a nodata hole
+        cls.dem = T.write_tif(os.path.join(cls.tmp, "frac.tif"), z, GT, 32632,
+                              nodata=-9999)
+
+    @classmethod
+    def tearDownClass(cls):
+        T.shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def test_count_and_sizes(self):
+        for w, h in [(600, 517), (256, 256), (257, 10), (4096, 4096),
+                     (5000, 300), (300, 1)]:
+            dem = os.path.join(self.tmp, "empty_%dx%d.tif" % (w, h))
+            gdal.GetDriverByName("GTiff").Create(dem, w, h, 1, gdal.GDT_Float32)
+            ds = open_ds(dem, PRODUCT="horizon", DIRECTIONS=3)
+            want = expected_sizes(w, h)
+            for b in range(1, 4):
+                rb = ds.GetRasterBand(b)
+                got = [(rb.GetOverview(i).XSize, rb.GetOverview(i).YSize)
+                       for i in range(rb.GetOverviewCount())]
+                self.assertEqual(got, want, "%dx%d band %d" % (w, h, b))
+                for i in range(rb.GetOverviewCount()):
+                    self.assertEqual(rb.GetOverview(i).DataType, rb.DataType)
+            self.assertIsNone(ds.GetRasterBand(1).GetOverview(len(want)))
+            ds = None
+        self.assertEqual(expected_sizes(4096, 4096)[-1], (256, 256))
+        self.assertEqual(len(expected_sizes(600, 517)), 2)
+
+    def test_farshadow_has_none(self):
+        ds = open_ds(self.dem, PRODUCT="farshadow", DATE="2026-06-21",
+                     TIMEZONE="+02:00", ATLAS_STEPS=4)
+        self.assertEqual(ds.GetRasterBand(1).GetOverviewCount(), 0)
+
+    def check_levels_equal_downsampled(self, dem, name, **options):
+        ds = open_ds(dem, **options)
+        rb = ds.GetRasterBand(1)
+        self.assertGreater(rb.GetOverviewCount(), 0, name)
+        for i in range(rb.GetOverviewCount()):
+            ov = rb.GetOverview(i)
+            small = downsampled(dem, ov.XSize, ov.YSize,
+                                os.path.join(self.tmp, "%s_l%d.tif" % (name, i + 1)))
+            ref = open_ds(small, **options)
+            self.assertEqual(ref.RasterCount, ds.RasterCount)
+            a, b = read_overview(ds, i), read_all(ref)
+            self.assertTrue(np.array_equal(a, b, equal_nan=True),
+                            "%s level %d: %s" % (name, i + 1, T.describe(
+                                name, a.astype(float), b.astype(float))))
+            # reading the dataset at the level's size reads the level
+            c = ds.ReadAsArray(buf_xsize=ov.XSize, buf_ysize=ov.YSize)
+            self.assertTrue(np.array_equal(c.reshape(a.shape), a, equal_nan=True))
+            print("%s level %d (%d x %d): equal to the product of the "
+                  "downsampled DEM" % (name, i + 1, ov.XSize, ov.YSize))
+
+    def test_instant_products_equal_downsampled(self):
+        for name, opts in [("shade", {}),
+                           ("shade_sky", dict(SKY_WEIGHT=0.3, DIRECTIONS=4)),
+                           ("shadow", dict(PRODUCT="shadow",
+                                           DATETIME="2026-06-21T07:30:00+02:00")),
+                           ("horizon", dict(PRODUCT="horizon", DIRECTIONS=4)),
+                           ("svf", dict(PRODUCT="svf", DIRECTIONS=8)),
+                           ("openness", dict(PRODUCT="openness", DIRECTIONS=4)),
+                           ("sky", dict(PRODUCT="sky", DIRECTIONS=4,
+                                        MAX_DISTANCE=3000))]:
+            self.check_levels_equal_downsampled(self.dem, name, BACKEND="c", **opts)
+
+    def test_day_products_equal_downsampled(self):
+        day = dict(DATE="2026-06-21", TIMEZONE="+02:00", STEP_MINUTES=120,
+                   BACKEND="c")
+        for name, opts in [("sunhours", dict(PRODUCT="sunhours")),
+                           ("insolation", dict(PRODUCT="insolation", DIRECTIONS=4)),
+                           ("daycycle", dict(PRODUCT="daycycle")),
+                           ("daycycle_per_cell", dict(PRODUCT="daycycle",
+                                                      SUN_POSITION="per_cell"))]:
+            self.check_levels_equal_downsampled(self.dem, name, **dict(day, **opts))
+
+    def test_geographic_dem(self):
+        # jacksboro: degrees, Int16; per-row east-west cell sizes per level
+        self.check_levels_equal_downsampled(T.JACKSBORO, "jacksboro_shade")
+        self.check_levels_equal_downsampled(
+            T.JACKSBORO, "jacksboro_sunhours", PRODUCT="sunhours",
+            DATE="2026-12-21", TIMEZONE="-05:00", STEP_MINUTES=60)
+        ds = open_ds(T.JACKSBORO, PRODUCT="svf")
+        ov = ds.GetRasterBand(1).GetOverview(0).GetDataset()
+        md = ov.GetMetadata()
+        self.assertAlmostEqual(float(md["CELL_SIZE_Y"]),
+                               2 * float(ds.GetMetadataItem("CELL_SIZE_Y")),
+                               delta=0.01 * float(md["CELL_SIZE_Y"]))
+        self.assertNotEqual(md["CELL_SIZE_X_NORTH"], md["CELL_SIZE_X_SOUTH"])
+
+    def test_lazy_and_cached(self):
+        msgs = []
+
+        def handler(cls, no, msg):
+            if cls == gdal.CE_Debug and msg.startswith("TERRASHADE: computing"):
+                msgs.append(msg)
+        gdal.SetConfigOption("CPL_DEBUG", "TERRASHADE")
+        gdal.PushErrorHandler(handler)
+        try:
+            ds = open_ds(self.dem, PRODUCT="svf", DIRECTIONS=4, BACKEND="c")
+            rb = ds.GetRasterBand(1)
+            ov = rb.GetOverview(1)
+            sizes = [(rb.GetOverview(i).XSize, rb.GetOverview(i).YSize)
+                     for i in range(rb.GetOverviewCount())]
+            self.assertEqual(msgs, [])  # opening and listing compute nothing
+            self.assertEqual(sizes, expected_sizes(600, 517))
+            a = ov.ReadAsArray()
+            b = ov.ReadAsArray(10, 20, 50, 40)
+            ov.FlushCache()
+            c = ov.ReadAsArray()
+        finally:
+            gdal.PopErrorHandler()
+            gdal.SetConfigOption("CPL_DEBUG", None)
+        self.assertEqual(len(msgs), 1, msgs)
+        self.assertIn("level 2", msgs[0])
+        self.assertTrue(np.array_equal(a[20:60, 10:60], b, equal_nan=True))
+        self.assertTrue(np.array_equal(a, c, equal_nan=True))
+
+    def test_cog(self):
+        src = T.conn(self.dem)
+        oo = ["-oo", "PRODUCT=svf", "-oo", "DIRECTIONS=8", "-oo", "BACKEND=c"]
+        gtiff = os.path.join(self.tmp, "svf.tif")
+        cog = os.path.join(self.tmp, "svf_cog.tif")
+        own = os.path.join(self.tmp, "svf_cog_own.tif")
+        T.run(["gdal_translate", "-q", "-of", "GTiff"] + oo + [src, gtiff])
+        T.run(["gdal_translate", "-q", "-of", "COG"] + oo + [src, cog])
+        T.run(["gdal_translate", "-q", "-of", "COG", "-co",
+               "OVERVIEWS=IGNORE_EXISTING"] + oo + [src, own])
+        full = gdal.Open(gtiff).ReadAsArray()
+        ds = open_ds(self.dem, PRODUCT="svf", DIRECTIONS=8, BACKEND="c")
+        rb = ds.GetRasterBand(1)
+        lo, hi = np.nanmin(full), np.nanmax(full)
+        for path, what in [(cog, "default"), (own, "IGNORE_EXISTING")]:
+            c = gdal.Open(path)
+            self.assertTrue(np.array_equal(c.ReadAsArray(), full, equal_nan=True),
+                            what + ": full resolution differs from GTiff")
+            cb = c.GetRasterBand(1)
+            self.assertGreater(cb.GetOverviewCount(), 0, what)
+            for i in range(cb.GetOverviewCount()):
+                o = cb.GetOverview(i).ReadAsArray()
+                # COG sizes its own levels (W / 2^k rounded down): the
+                # driver's level read at that size
+                drv = rb.ReadAsArray(buf_xsize=o.shape[1], buf_ysize=o.shape[0])
+                ok = ~np.isnan(o) & ~np.isnan(drv)
+                self.assertGreater(ok.mean(), 0.9, what)
+                r = np.corrcoef(o[ok], drv[ok])[0, 1]
+                print("COG %s overview %d: %d x %d, range %.4f..%.4f "
+                      "(full %.4f..%.4f), r = %.4f with the driver's, max |diff| "
+                      "%.4f" % (what, i + 1, o.shape[1], o.shape[0], np.nanmin(o),
+                                np.nanmax(o), lo, hi, r, np.nanmax(abs(o - drv))))
+                if what == "default":
+                    # COG's OVERVIEWS=AUTO copies the source's own overviews
+                    self.assertTrue(np.array_equal(o, drv, equal_nan=True))
+                else:
+                    # computed by COG from the full resolution (its default
+                    # resampling, cubic, may overshoot a little)
+                    self.assertGreaterEqual(np.nanmin(o), lo - 0.05)
+                    self.assertLessEqual(np.nanmax(o), hi + 0.05)
+                    # the same terrain: correlated with the driver's level,
+                    # but shadows and horizons of a coarser DEM differ (svf
+                    # of a smoother DEM is higher)
+                    self.assertGreater(r, 0.7, what)
+                    if i == 0:
+                        # its first level is the full-resolution product
+                        # resampled (cubic, COG's default), bit for bit
+                        h, w = o.shape
+                        cub = os.path.join(self.tmp, "svf_cubic.tif")
+                        T.run(["gdal_translate", "-q", "-r", "cubic", "-outsize",
+                               w, h, gtiff, cub])
+                        self.assertTrue(np.array_equal(
+                            gdal.Open(cub).ReadAsArray(), o, equal_nan=True))
+                    self.assertFalse(np.array_equal(o, drv, equal_nan=True))
+
+
+class Cost(unittest.TestCase):
+    """A coarse level costs a fraction of the full level: time and memory."""
+
+    N = int(os.environ.get("TS_OVERVIEW_TEST_N", "4096"))
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = T.TempDir().__enter__()
+        cls.dem = T.write_tif(os.path.join(cls.tmp, "big.tif"),
+                              T.fractal_dem(cls.N, seed=5, relief=1500),
+                              (600000, 10, 0, 4000000, 0, -10), 32632)
+
+    @classmethod
+    def tearDownClass(cls):
+        T.shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def test_level3_10x_faster(self):
+        def timed(read):
+            ds = open_ds(self.dem, PRODUCT="shade", BACKEND="c")
+            t = time.perf_counter()
+            a = read(ds.GetRasterBand(1))
+            return time.perf_counter() - t, a
+        t3, a3 = timed(lambda b: b.GetOverview(2).ReadAsArray())
+        t0, a0 = timed(lambda b: b.ReadAsArray())
+        self.assertEqual(a3.shape, (self.N // 8, self.N // 8))
+        self.assertEqual(a0.shape, (self.N, self.N))
+        print("%d^2 shade: full resolution %.2f s, level 3 (%d^2) %.3f s: %.1fx "
+              "faster" % (self.N, t0, self.N // 8, t3, t0 / t3))
+        self.assertGreaterEqual(t0 / t3, 10)
+
+    def test_memory_per_level(self):
+        # peak RSS growth of a fresh process (GDAL's block cache kept small)
+        # reading one block of level 3, then of the full level: a level
+        # allocates its own size; it never holds the DEM at full resolution
+        code = ("import sys; sys.path.insert(0, %r); import tsdriver as T\n"
+                "from tsdriver import gdal\n"
+                "def kib(key):\n"
+                "    return int([l for l in open('/proc/self/status')\n"
+                "                if l.startswith(key)][0].split()[1])\n"
+                "ds = gdal.OpenEx(T.conn(%r), open_options=['PRODUCT=shade',"
+                " 'BACKEND=c'])\n"
+                "open('/proc/self/clear_refs', 'w').write('5')  # reset VmHWM\n"
+                "r0 = kib('VmRSS')\n"
+                "b = ds.GetRasterBand(1)\n"
+                "b = b.GetOverview(2) if sys.argv[1] == '3' else b\n"
+                "b.ReadAsArray(0, 0, 64, 64)\n"
+                "print(kib('VmHWM') - r0)\n"
+                % (os.path.dirname(os.path.abspath(__file__)), self.dem))
+        grow = {}
+        for level in ("3", "0"):
+            p = T.run([sys.executable, "-c", code, level], GDAL_CACHEMAX=8)
+            grow[level] = int(p.stdout.split()[-1]) / 1024.0
+        dem_mib = self.N * self.N * 4 / 1048576.0
+        print("peak RSS growth reading one block: level 3 %.1f MiB, full %.1f MiB "
+              "(the DEM alone: %.0f MiB)" % (grow["3"], grow["0"], dem_mib))
+        self.assertLess(grow["3"], dem_mib)
+        self.assertGreater(grow["0"], 2 * dem_mib)
+        self.assertLess(grow["3"], grow["0"] / 5)
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

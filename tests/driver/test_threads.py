@@ -1,0 +1,90 @@
+"""Threads: what docs/driver.md promises (Blocks, memory, threads).
+
+Supported: one dataset per thread. Two threads, each with its own dataset
+of the same DEM (product or atlas), read at the same moment, get exactly
+the pixels a single thread gets. One dataset shared by two threads is not
+supported (GDAL 3.6's block cache of a dataset is not thread-safe), so it
+is not tested here.
+"""
+import os
+import threading
+import unittest
+
+import tsdriver as T
+from tsdriver import gdal, np
+
+UTM_GT = (600000.0, 30.0, 0.0, 4000000.0, 0.0, -30.0)
+TRIALS = 3
+
+
+def read_all(name, options):
+    ds = gdal.OpenEx(name, gdal.OF_RASTER, open_options=options)
+    out = np.stack([ds.GetRasterBand(b).ReadAsArray()
+                    for b in range(1, ds.RasterCount + 1)])
+    ds = None
+    return out
+
+
+def in_two_threads(name, options):
+    """Both threads open their own dataset, then read it at once."""
+    start = threading.Barrier(2)
+    results, errors = [None, None], []
+
+    def work(i):
+        try:
+            ds = gdal.OpenEx(name, gdal.OF_RASTER, open_options=options)
+            start.wait(timeout=60)
+            results[i] = np.stack([ds.GetRasterBand(b).ReadAsArray()
+                                   for b in range(1, ds.RasterCount + 1)])
+            ds = None
+        except Exception as e:  # reported by the main thread
+            errors.append(e)
+            start.abort()
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=300)
+    if errors:
+        raise errors[0]
+    return results
+
+
+class Threads(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = T.TempDir()
+        cls.dir = cls.tmp.__enter__()
+        cls.dem = T.write_tif(os.path.join(cls.dir, "dem.tif"), T.fractal_dem(96, seed=5),
+                              UTM_GT, 32617)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.__exit__(None, None, None)
+
+    def same_in_threads(self, name, options):
+        single = read_all(name, options)
+        for trial in range(TRIALS):
+            for i, got in enumerate(in_two_threads(name, options)):
+                with self.subTest(trial=trial, thread=i):
+                    np.testing.assert_array_equal(got, single)
+
+    def test_products_one_dataset_per_thread(self):
+        for options in (["PRODUCT=shade", "SUN_ELEVATION=10", "THREADS=2"],
+                        ["PRODUCT=svf", "DIRECTIONS=8", "OUTPUT_TYPE=Float32"],
+                        ["PRODUCT=sunhours", "DATE=2026-06-21", "TIMEZONE=-04:00",
+                         "STEP_MINUTES=60"]):
+            with self.subTest(options=options):
+                self.same_in_threads(T.conn(self.dem), options + ["PROGRESS=no"])
+
+    def test_atlas_one_dataset_per_thread(self):
+        atlas = os.path.join(self.dir, "day.tsa")
+        T.run(["gdal_translate", "-q", "-of", "TERRASHADE", "-oo", "PRODUCT=farshadow",
+               "-oo", "DATE=2026-06-21", "-oo", "TIMEZONE=-04:00", "-oo", "ATLAS_STEPS=4",
+               "-oo", "FAR_THRESHOLD=8", "-oo", "PROGRESS=no", T.conn(self.dem), atlas])
+        self.same_in_threads(atlas, ["SHADOWS=all"])
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

@@ -1,0 +1,100 @@
+"""Z_FACTOR=AUTO (the default): heights in the DEM's vertical unit become
+metres, from the vertical CRS or the band's unit type; a number overrides;
+the metadata says which factor was used and why (docs/driver.md)."""
+import os
+import unittest
+
+import tsdriver as T
+from tsdriver import gdal, np
+
+# NAD83 / North Carolina (ftUS): cells in US survey feet
+NC_GT = (2000000.0, 100.0, 0.0, 600000.0, 0.0, -100.0)
+FT_US = 1200.0 / 3937.0
+OPTIONS = {"PRODUCT": "shadow", "SUN_ELEVATION": "6", "SUN_AZIMUTH": "120",
+           "PROGRESS": "no"}
+
+
+def opened(dem, **options):
+    oo = ["%s=%s" % kv for kv in dict(OPTIONS, **options).items()]
+    return gdal.OpenEx(T.conn(dem), gdal.OF_RASTER, open_options=oo)
+
+
+class VerticalUnits(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = T.TempDir()
+        d = cls.dir = cls.tmp.__enter__()
+        cls.z = T.fractal_dem(64, seed=11, relief=2000.0)  # the numbers in the file
+        # heights in US survey feet, said by a compound CRS (NAVD88 height (ftUS))
+        cls.ftus = T.write_tif(os.path.join(d, "ftus.tif"), cls.z, NC_GT, "EPSG:2264+6360")
+        # heights in feet, said by the band's unit only
+        cls.ft = T.write_tif(os.path.join(d, "ft.tif"), cls.z, NC_GT, 2264)
+        ds = gdal.Open(cls.ft, gdal.GA_Update)
+        ds.GetRasterBand(1).SetUnitType("ft")
+        ds = None
+        # nothing says the unit: metres
+        cls.plain = T.write_tif(os.path.join(d, "plain.tif"), cls.z, NC_GT, 2264)
+        # the same terrain converted to metres beforehand
+        cls.m_ftus = T.write_tif(os.path.join(d, "m_ftus.tif"),
+                                 (cls.z.astype(np.float64) * FT_US).astype(np.float32),
+                                 NC_GT, 2264)
+        cls.m_ft = T.write_tif(os.path.join(d, "m_ft.tif"),
+                               (cls.z.astype(np.float64) * 0.3048).astype(np.float32),
+                               NC_GT, 2264)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.__exit__(None, None, None)
+
+    def check(self, dem, factor, source, same_as, **options):
+        ds = opened(dem, **options)
+        md = ds.GetMetadata()
+        print(os.path.basename(dem), options, "->", md["Z_FACTOR"], "(%s)" % md["Z_FACTOR_SOURCE"])
+        self.assertEqual(md["Z_FACTOR"], "%.10g" % factor)
+        self.assertEqual(md["Z_FACTOR_SOURCE"], source)
+        got = ds.GetRasterBand(1).ReadAsArray()
+        ds = None
+        want = T.read(T.conn(same_as), band=1, options=OPTIONS)
+        np.testing.assert_array_equal(got, want)
+        return got
+
+    def test_compound_crs_in_us_survey_feet(self):
+        got = self.check(self.ftus, FT_US, "vertical unit US survey foot, from the CRS",
+                         self.m_ftus)
+        # as metres the terrain would be 3.28 times too steep: other shadows
+        self.assertFalse(np.array_equal(got, T.read(T.conn(self.plain), band=1,
+                                                    options=OPTIONS)))
+
+    def test_band_unit_feet(self):
+        self.check(self.ft, 0.3048, "band unit ft", self.m_ft)
+
+    def test_no_unit_is_metres(self):
+        self.check(self.plain, 1.0,
+                   "no vertical unit in the CRS or the band: heights taken as metres",
+                   self.plain)
+
+    def test_number_overrides(self):
+        self.check(self.ftus, 1.0, "given as Z_FACTOR", self.plain, Z_FACTOR="1")
+        self.check(self.ft, FT_US, "given as Z_FACTOR", self.m_ftus, Z_FACTOR=repr(FT_US))
+        # AUTO given explicitly is the default
+        self.check(self.ftus, FT_US, "vertical unit US survey foot, from the CRS",
+                   self.m_ftus, Z_FACTOR="auto")
+
+    def test_sample_dems_stay_in_metres(self):
+        """jacksboro and lux_elev say no vertical unit: factor 1, as before."""
+        for dem in (T.JACKSBORO, T.LUX):
+            ds = opened(dem)
+            self.assertEqual(ds.GetMetadataItem("Z_FACTOR"), "1")
+            self.assertEqual(ds.GetMetadataItem("Z_FACTOR_SOURCE"),
+                             "no vertical unit in the CRS or the band: heights taken as metres")
+            ds = None
+
+    def test_not_a_number(self):
+        with self.assertRaises(RuntimeError) as e:
+            opened(self.plain, Z_FACTOR="feet")
+        self.assertEqual(str(e.exception),
+                         "TERRASHADE: Z_FACTOR must be AUTO or a number, got 'feet'")
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
