@@ -428,12 +428,8 @@ static ts_status sweep_setup(const ts_grid *grid, double azimuth,
     C->near_skip = (TS_NEAR_STEPS + 0.5) * geom->step_m;
     /* A distance no two samples of a line (nor a ray on the grid) are
      * apart is no distance: the unbounded sweep, bit for bit. */
-    double longest = geom->step_m, shortest = geom->step_m;
-    if (geom->step_row)
-        for (int y = 0; y < grid->height; y++) {
-            longest = geom->step_row[y] > longest ? geom->step_row[y] : longest;
-            shortest = geom->step_row[y] < shortest ? geom->step_row[y] : shortest;
-        }
+    double longest, shortest;
+    ts_line_geom_step_range(geom, grid->height, &shortest, &longest);
     C->cap = opts->max_distance > longest * geom->U ? 0.0 : opts->max_distance;
     /* Within the near field of every row, the near field is all there is. */
     C->near_only = C->cap > 0 && C->cap <= TS_NEAR_STEPS * shortest;
