@@ -9,7 +9,11 @@
  * pixel-directions per second), the shadow height map for 8 sun azimuths
  * (million pixels per second, per azimuth), normals and direct sun
  * (million pixels per second) and sky terms from D horizon planes (million
- * pixel-directions per second). The OpenCL device is the one
+ * pixel-directions per second), and the environment light (envlight)
+ * under a CIE sky from D horizon planes, plane by plane as the driver runs
+ * it (million pixel-directions per second; the OpenCL side includes its
+ * session: table and normals uploaded once, the sums read back per plane).
+ * The OpenCL device is the one
  * TERRASHADE_OPENCL_DEVICE selects; its first use (context and kernel
  * build) is timed separately. Also prints the largest difference between
  * the backends' results.
@@ -22,6 +26,7 @@
 
 #include "terrashade.h"
 #include "terrashade_cl.h"
+#include "terrashade_env.h"
 #include "test_dem.h"
 
 static double now(void)
@@ -53,13 +58,35 @@ typedef struct {
     size_t n;
     float *hz, *nx, *ny, *nz, *out, *out2, *out3;
     int threads;
+    ts_env_table table; /* envlight: a CIE sky's */
 } ctx;
 
-enum { P_HORIZON, P_SHM, P_NORMALS, P_DIRECT, P_SKY, P_COUNT };
+enum { P_HORIZON, P_SHM, P_NORMALS, P_DIRECT, P_SKY, P_ENV, P_COUNT };
 static const char *NAMES[P_COUNT] = {"horizons", "shadow height map", "normals", "direct sun",
-                                     "sky terms (svf, sky, openness)"};
+                                     "sky terms (svf, sky, openness)",
+                                     "envlight (CIE sky 7, RGB)"};
 
 static const double SHM_AZ[8] = {15, 60, 105, 150, 195, 240, 285, 330};
+
+/* The environment light of every plane of c->hz into out, out2, out3. */
+static ts_status run_env(ctx *c, int cl, ts_error *e)
+{
+    ts_status st = TS_OK;
+    ts_cl_env_light *s = NULL;
+    for (int i = 0; i < 3; i++)
+        memset(i == 0 ? c->out : i == 1 ? c->out2 : c->out3, 0, c->n * sizeof(float));
+    if (cl)
+        st = ts_cl_env_light_open(&c->g, &c->table, c->nx, c->ny, c->nz, &s, e);
+    for (int k = 0; k < c->o.directions && st == TS_OK; k++) {
+        const float *plane = c->hz + c->n * k;
+        st = cl ? ts_cl_env_light_add(s, &c->g, &c->table, k, c->nx, c->ny, c->nz, plane, c->out,
+                                      c->out2, c->out3, e)
+                : ts_env_light_accumulate(&c->g, &c->table, k, c->nx, c->ny, c->nz, plane,
+                                          c->out, c->out2, c->out3, e);
+    }
+    ts_cl_env_light_close(s);
+    return st;
+}
 
 /* Run product p on backend cl (0 = C); results into c->out (horizons into
  * `hout`). */
@@ -90,6 +117,9 @@ static void run(ctx *c, int p, int cl, float *hout)
                                   c->out3, &e)
                 : ts_sky_terms(&c->g, c->nx, c->ny, c->nz, c->hz, &c->o, c->out, c->out2,
                                c->out3, &e);
+        break;
+    case P_ENV:
+        st = run_env(c, cl, &e);
         break;
     }
     if (st != TS_OK)
@@ -154,6 +184,14 @@ int main(int argc, char **argv)
     }
     if (ts_normals(&c.g, c.nx, c.ny, c.nz, &e) != TS_OK)
         die("normals", &e);
+    ts_env sky;
+    ts_env_table_opts to;
+    ts_env_table_opts_default(&to);
+    to.directions = dirs;
+    if (ts_env_sky(&sky, TS_SKY_CIE, 7, 120.0, 25.0, 0, 0, &e) != TS_OK ||
+        ts_env_table_build(&sky, &to, &c.table, &e) != TS_OK)
+        die("light table", &e);
+    ts_env_free(&sky);
 
     printf("\n%d x %d DEM, %d directions; best of %d\n", size, size, dirs, repeat);
     printf("%-32s %10s %10s %10s %7s %10s\n", "product", "unit", "C", "OpenCL", "CL/C",
@@ -174,16 +212,18 @@ int main(int argc, char **argv)
                     diff = p == P_HORIZON ? maxdiff(c.hz, hz_cl, c.n * dirs)
                                           : maxdiff(ref, c.out, c.n);
             }
-        double work = p == P_HORIZON || p == P_SKY ? (double)c.n * dirs
+        const int per_dir = p == P_HORIZON || p == P_SKY || p == P_ENV;
+        double work = per_dir ? (double)c.n * dirs
                       : p == P_SHM                   ? c.n * 8.0
                                                      : (double)c.n;
-        const char *unit = p == P_HORIZON || p == P_SKY ? "Mpx-dir/s" : "Mpx/s";
+        const char *unit = per_dir ? "Mpx-dir/s" : "Mpx/s";
         printf("%-32s %10s %10.1f %10.1f %6.2fx %10.3g   (%.3f s vs %.3f s)\n", NAMES[p], unit,
                work / best[0] / 1e6, work / best[1] / 1e6, best[0] / best[1], diff, best[0],
                best[1]);
     }
     free(hz_cl), free(c.hz), free(c.nx), free(c.ny), free(c.nz);
     free(c.out), free(c.out2), free(c.out3), free(ref);
+    ts_env_table_free(&c.table);
     ts_grid_free(&c.g);
     return 0;
 }

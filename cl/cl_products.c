@@ -252,11 +252,23 @@ ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
                           const float *horizons, const ts_horizon_opts *opts, float *svf,
                           float *sky, float *openness, ts_error *err)
 {
+    return ts_cl_sky_terms_model(grid, nx, ny, nz, horizons, opts, TS_SVF_RADIATIVE, svf, sky,
+                                 openness, err);
+}
+
+ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
+                                const float *nz, const float *horizons,
+                                const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
+                                float *sky, float *openness, ts_error *err)
+{
     ts_status st = ts_check_sky_terms_args(grid, nx, ny, nz, horizons, opts, err);
+    if (st == TS_OK)
+        st = ts_check_svf_model(svf_model, err);
     if (st != TS_OK)
         return st;
     const int n = opts->directions;
-    const cl_int want = (svf ? 1 : 0) | (sky ? 2 : 0) | (openness ? 4 : 0);
+    const cl_int want = (svf ? 1 : 0) | (sky ? 2 : 0) | (openness ? 4 : 0) |
+                        (svf && svf_model == TS_SVF_SOLID_ANGLE ? 8 : 0);
     if (!want)
         return ts_ok(err);
     const size_t cells = (size_t)grid->width * grid->height, bytes = cells * sizeof(float);

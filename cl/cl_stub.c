@@ -79,3 +79,55 @@ ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
     (void)svf, (void)sky, (void)openness;
     return NOT_BUILT(err);
 }
+
+ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
+                                const float *nz, const float *horizons,
+                                const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
+                                float *sky, float *openness, ts_error *err)
+{
+    (void)svf_model;
+    return ts_cl_sky_terms(grid, nx, ny, nz, horizons, opts, svf, sky, openness, err);
+}
+
+ts_status ts_cl_env_light_accumulate(const ts_grid *grid, const ts_env_table *table, int k,
+                                     const float *nx, const float *ny, const float *nz,
+                                     const float *plane, float *r, float *g, float *b,
+                                     ts_error *err)
+{
+    (void)grid, (void)table, (void)k, (void)nx, (void)ny, (void)nz, (void)plane;
+    (void)r, (void)g, (void)b;
+    return NOT_BUILT(err);
+}
+
+ts_status ts_cl_env_light_open(const ts_grid *grid, const ts_env_table *table, const float *nx,
+                               const float *ny, const float *nz, ts_cl_env_light **session,
+                               ts_error *err)
+{
+    (void)grid, (void)table, (void)nx, (void)ny, (void)nz;
+    if (session)
+        *session = NULL;
+    return NOT_BUILT(err);
+}
+
+int ts_cl_env_light_matches(const ts_cl_env_light *session, const ts_grid *grid,
+                            const ts_env_table *table, const float *nx, const float *ny,
+                            const float *nz)
+{
+    (void)session, (void)grid, (void)table, (void)nx, (void)ny, (void)nz;
+    return 0;
+}
+
+ts_status ts_cl_env_light_add(ts_cl_env_light *session, const ts_grid *grid,
+                              const ts_env_table *table, int k, const float *nx,
+                              const float *ny, const float *nz, const float *plane, float *r,
+                              float *g, float *b, ts_error *err)
+{
+    (void)session, (void)grid, (void)table, (void)k, (void)nx, (void)ny, (void)nz;
+    (void)plane, (void)r, (void)g, (void)b;
+    return NOT_BUILT(err);
+}
+
+void ts_cl_env_light_close(ts_cl_env_light *session)
+{
+    (void)session;
+}

@@ -40,8 +40,9 @@ __kernel void ts_direct(__global const float *nx, __global const float *ny,
 /*
  * Sky terms: accumulate nplanes horizon planes (directions with sines and
  * cosines sa[k], ca[k]) onto the accumulators, then, when `finish`, clamp
- * and average as ts_sky_finish. want: bit 0 svf, 1 sky, 2 openness; w1,
- * w2: 1/n and sin(pi/n)/pi.
+ * and average as ts_sky_finish. want: bit 0 svf, 1 sky, 2 openness, 3 the
+ * svf is the solid-angle one (TS_SVF_SOLID_ANGLE); w1, w2: 1/n and
+ * sin(pi/n)/pi.
  */
 __kernel void ts_sky(__global const float *nx, __global const float *ny,
                      __global const float *nz, __global const float *planes,
@@ -59,7 +60,8 @@ __kernel void ts_sky(__global const float *nx, __global const float *ny,
     const float nzi = nz[i], nxi = nx[i], nyi = ny[i];
     for (int k = 0; k < nplanes; k++) {
         const float h = planes[k * cells + i];
-        as += cm_sky_term(nxi, nyi, nzi, h, sa[k], ca[k], w1, w2, 0);
+        as += (want & 8) ? cm_svf_solid_term(h, w1) + (nzi - nzi)
+                         : cm_sky_term(nxi, nyi, nzi, h, sa[k], ca[k], w1, w2, 0);
         ak += cm_sky_term(nxi, nyi, nzi, h, sa[k], ca[k], w1, w2, 1);
         ao += cm_openness_term(h, nzi);
     }

@@ -26,6 +26,7 @@
 #define TERRASHADE_BACKEND_H
 
 #include "terrashade.h"
+#include "terrashade_env.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -94,6 +95,35 @@ ts_status ts_backend_sky_terms(ts_backend backend, const ts_grid *grid,
                                const float *horizons, const ts_horizon_opts *opts,
                                float *svf, float *sky, float *openness,
                                ts_backend_report *report, ts_error *err);
+
+/**
+ * What a product's environment light keeps between its per-plane calls of
+ * ts_backend_env_light_accumulate: the OpenCL session (light table and
+ * normals on the device, uploaded once), or, after an OpenCL failure, why
+ * the later planes run C. Zero it before the first plane; release it with
+ * ts_backend_env_light_release after the last.
+ */
+typedef struct {
+    struct ts_cl_env_light *cl; /**< the OpenCL session, or NULL */
+    int failed;                 /**< OpenCL failed: the later planes go to C */
+    char reason[256];           /**< the failure */
+} ts_backend_env_light;
+
+/**
+ * ts_env_light_accumulate (terrashade_env.h) on a backend: add sector k's
+ * light to r, g, b. `state` (may be NULL: every call then uploads the table)
+ * carries the device state from plane to plane; the C fallback carries on
+ * from the sums so far, which r, g, b hold after every call.
+ */
+ts_status ts_backend_env_light_accumulate(ts_backend backend, ts_backend_env_light *state,
+                                          const ts_grid *grid, const ts_env_table *table,
+                                          int k, const float *nx, const float *ny,
+                                          const float *nz, const float *plane, float *r,
+                                          float *g, float *b, ts_backend_report *report,
+                                          ts_error *err);
+
+/** Release the device state of `state` (NULL-safe) and zero it. */
+void ts_backend_env_light_release(ts_backend_env_light *state);
 
 #ifdef __cplusplus
 }

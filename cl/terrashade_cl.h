@@ -38,6 +38,7 @@
 #define TERRASHADE_CL_H
 
 #include "terrashade.h"
+#include "terrashade_env.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -114,6 +115,48 @@ ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
                           const float *nz, const float *horizons,
                           const ts_horizon_opts *opts, float *svf, float *sky,
                           float *openness, ts_error *err);
+/** ts_sky_terms_model on the device. */
+ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
+                                const float *nz, const float *horizons,
+                                const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
+                                float *sky, float *openness, ts_error *err);
+
+/** ts_env_light_accumulate on the device, in one call (uploads the light
+ * table and the normals for this one plane; a product uses a session). */
+ts_status ts_cl_env_light_accumulate(const ts_grid *grid, const ts_env_table *table, int k,
+                                     const float *nx, const float *ny, const float *nz,
+                                     const float *plane, float *r, float *g, float *b,
+                                     ts_error *err);
+
+/**
+ * A product's environment light on the device, one horizon plane at a time:
+ * ts_cl_env_light_open uploads the light table and the normals once (the
+ * arrays must stay as they are until ts_cl_env_light_close);
+ * ts_cl_env_light_add is ts_env_light_accumulate for sector k with the
+ * same grid, table and normals (else TS_ERR_ARG): it uploads the plane,
+ * launches, and reads the sums back into r, g, b, so that they hold the
+ * light so far after every call. The device keeps its own copy of the
+ * sums: between two calls with the same r, g, b the caller must not change
+ * them (new arrays are uploaded). After a failure every later call fails.
+ */
+typedef struct ts_cl_env_light ts_cl_env_light;
+
+ts_status ts_cl_env_light_open(const ts_grid *grid, const ts_env_table *table, const float *nx,
+                               const float *ny, const float *nz, ts_cl_env_light **session,
+                               ts_error *err);
+
+/** 1 if the session was opened for this grid's size, table and normals. */
+int ts_cl_env_light_matches(const ts_cl_env_light *session, const ts_grid *grid,
+                            const ts_env_table *table, const float *nx, const float *ny,
+                            const float *nz);
+
+ts_status ts_cl_env_light_add(ts_cl_env_light *session, const ts_grid *grid,
+                              const ts_env_table *table, int k, const float *nx,
+                              const float *ny, const float *nz, const float *plane, float *r,
+                              float *g, float *b, ts_error *err);
+
+/** Release the session's device buffers (NULL-safe). */
+void ts_cl_env_light_close(ts_cl_env_light *session);
 
 #ifdef __cplusplus
 }

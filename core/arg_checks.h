@@ -4,6 +4,7 @@
 #define TS_ARG_CHECKS_H
 
 #include "terrashade.h"
+#include "terrashade_env.h"
 
 /* Checks of ts_shm_compute's arguments; *azimuth is reduced to [0, 360). */
 ts_status ts_check_shm_args(const ts_grid *grid, double *azimuth, double elevation,
@@ -41,5 +42,17 @@ ts_status ts_direct_setup(const ts_grid *grid, const float *nx, const float *ny,
                           const ts_horizon_opts *opts, double sun_azimuth,
                           double sun_elevation, const float *out, int *k0, int *k1,
                           double *w, float light[3], ts_error *err);
+
+/* Checks of ts_env_light_accumulate's arguments (outputs only for NULL). */
+ts_status ts_check_env_light_args(const ts_grid *grid, const ts_env_table *table, int k,
+                                  const float *nx, const float *ny, const float *nz,
+                                  const float *plane, const float *r, const float *g,
+                                  const float *b, ts_error *err);
+
+/* Floats of one sector of a light table (lp + k * this is sector k). */
+size_t ts_env_table_sector_floats(const ts_env_table *table);
+
+/* Sine and cosine (as floats) of sector k's azimuth, as the C loop uses them. */
+void ts_env_sector_sincos(const ts_env_table *table, int k, float *sa, float *ca);
 
 #endif

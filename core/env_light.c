@@ -7,6 +7,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "arg_checks.h"
 #include "cellmath/env_light.h"
 #include "parallel.h"
 #include "status_internal.h"
@@ -78,10 +79,10 @@ static ts_status check_table(const ts_env_table *t, ts_error *err)
     return TS_OK;
 }
 
-ts_status ts_env_light_accumulate(const ts_grid *grid, const ts_env_table *table, int k,
+ts_status ts_check_env_light_args(const ts_grid *grid, const ts_env_table *table, int k,
                                   const float *nx, const float *ny, const float *nz,
-                                  const float *plane, float *r, float *g, float *b,
-                                  ts_error *err)
+                                  const float *plane, const float *r, const float *g,
+                                  const float *b, ts_error *err)
 {
     ts_status st = check_outputs(grid, r, g, b, err);
     if (st == TS_OK)
@@ -93,12 +94,34 @@ ts_status ts_env_light_accumulate(const ts_grid *grid, const ts_env_table *table
     if (k < 0 || k >= table->directions)
         return ts_fail(err, TS_ERR_ARG, "sector %d is outside the light table's %d directions",
                        k, table->directions);
-    double az = ts_env_table_azimuth(table, k) * DEG2RAD;
+    return TS_OK;
+}
+
+size_t ts_env_table_sector_floats(const ts_env_table *table)
+{
     size_t rows = table->normal_steps ? (size_t)table->normal_steps : 1;
-    size_t per_sector = rows * table->horizon_steps * 8;
-    light_ctx C = {grid, nx, ny, nz, plane, table->lp + per_sector * k,
-                   (float)sin(az), (float)cos(az), table->normal_steps, table->horizon_steps,
-                   r, g, b};
+    return rows * table->horizon_steps * 8;
+}
+
+void ts_env_sector_sincos(const ts_env_table *table, int k, float *sa, float *ca)
+{
+    double az = ts_env_table_azimuth(table, k) * DEG2RAD;
+    *sa = (float)sin(az);
+    *ca = (float)cos(az);
+}
+
+ts_status ts_env_light_accumulate(const ts_grid *grid, const ts_env_table *table, int k,
+                                  const float *nx, const float *ny, const float *nz,
+                                  const float *plane, float *r, float *g, float *b,
+                                  ts_error *err)
+{
+    ts_status st = ts_check_env_light_args(grid, table, k, nx, ny, nz, plane, r, g, b, err);
+    if (st != TS_OK)
+        return st;
+    float sa, ca;
+    ts_env_sector_sincos(table, k, &sa, &ca);
+    light_ctx C = {grid, nx, ny, nz, plane, table->lp + ts_env_table_sector_floats(table) * k,
+                   sa, ca, table->normal_steps, table->horizon_steps, r, g, b};
     return ts_parallel_for(ts_thread_count(0, grid->height), grid->height, light_rows, &C, err);
 }
 

@@ -1,9 +1,10 @@
 /*
  * Sky terms from horizons: sky-view factor with the surface normal and
- * uniform-sky light (Timonen & Westerholm 2010, eq. 4-5 with c = 1), and
- * positive openness. Each azimuth k is a swath of 360/n degrees; inside it
- * the sky is visible from zenith down to theta_k = min(horizon zenith
- * angle, the zenith angle where the tangent plane cuts azimuth k).
+ * uniform-sky light (Timonen & Westerholm 2010, eq. 4-5 with c = 1), the
+ * solid-angle sky-view factor (Zaksek et al. 2011), and openness. Each
+ * azimuth k is a swath of 360/n degrees; inside it the sky is visible from
+ * zenith down to theta_k = min(horizon zenith angle, the zenith angle where
+ * the tangent plane cuts azimuth k).
  */
 #include <math.h>
 #include <string.h>
@@ -20,6 +21,7 @@ typedef struct {
     const float *nx, *ny, *nz, *plane;
     float sa, ca;       /* sin, cos of the azimuth */
     float w1, w2;       /* 1/n and sin(pi/n)/pi */
+    ts_svf_model svf_model;
     float *svf, *sky, *open;
 } sky_ctx;
 
@@ -34,6 +36,12 @@ static void sky_rows(void *ctx, int worker, long y0, long y1)
     const float *restrict plane = C->plane;
     const float sa = C->sa, ca = C->ca, w1 = C->w1, w2 = C->w2;
     float *restrict acc[2] = {C->svf, C->sky};
+    if (C->svf && C->svf_model == TS_SVF_SOLID_ANGLE) {
+        float *restrict svf = C->svf;
+        for (size_t i = i0; i < i1; i++)
+            svf[i] += cm_svf_solid_term(plane[i], w1) + (nz[i] - nz[i]);
+        acc[0] = NULL;
+    }
     for (int term = 0; term < 2; term++) {
         float *restrict out = acc[term];
         if (!out)
@@ -53,7 +61,28 @@ ts_status ts_sky_accumulate(const ts_grid *grid, const float *nx, const float *n
                             int directions, float *svf_acc, float *sky_acc,
                             float *openness_acc, ts_error *err)
 {
-    ts_status st = ts_check_sky_args(grid, nx, ny, nz, directions, err);
+    return ts_sky_accumulate_model(grid, nx, ny, nz, plane, azimuth, directions,
+                                   TS_SVF_RADIATIVE, svf_acc, sky_acc, openness_acc, err);
+}
+
+ts_status ts_check_svf_model(ts_svf_model model, ts_error *err)
+{
+    if (model != TS_SVF_RADIATIVE && model != TS_SVF_SOLID_ANGLE)
+        return ts_fail(err, TS_ERR_ARG,
+                       "svf model must be TS_SVF_RADIATIVE or TS_SVF_SOLID_ANGLE, got %d",
+                       (int)model);
+    return ts_ok(err);
+}
+
+ts_status ts_sky_accumulate_model(const ts_grid *grid, const float *nx, const float *ny,
+                                  const float *nz, const float *plane, double azimuth,
+                                  int directions, ts_svf_model svf_model, float *svf_acc,
+                                  float *sky_acc, float *openness_acc, ts_error *err)
+{
+    ts_status st = ts_check_svf_model(svf_model, err);
+    if (st != TS_OK)
+        return st;
+    st = ts_check_sky_args(grid, nx, ny, nz, directions, err);
     if (st != TS_OK)
         return st;
     if (!plane)
@@ -64,7 +93,7 @@ ts_status ts_sky_accumulate(const ts_grid *grid, const float *nx, const float *n
     sky_ctx C = {grid, nx, ny, nz, plane,
                  (float)sin(azimuth * DEG2RAD), (float)cos(azimuth * DEG2RAD),
                  (float)(1.0 / directions), (float)(sin(M_PI / directions) / M_PI),
-                 svf_acc, sky_acc, openness_acc};
+                 svf_model, svf_acc, sky_acc, openness_acc};
     return ts_parallel_for(ts_thread_count(0, grid->height), grid->height, sky_rows, &C, err);
 }
 
@@ -93,7 +122,18 @@ ts_status ts_sky_terms(const ts_grid *grid, const float *nx, const float *ny, co
                        const float *horizons, const ts_horizon_opts *opts, float *svf,
                        float *sky, float *openness, ts_error *err)
 {
+    return ts_sky_terms_model(grid, nx, ny, nz, horizons, opts, TS_SVF_RADIATIVE, svf, sky,
+                              openness, err);
+}
+
+ts_status ts_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
+                             const float *nz, const float *horizons,
+                             const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
+                             float *sky, float *openness, ts_error *err)
+{
     ts_status st = ts_check_sky_terms_args(grid, nx, ny, nz, horizons, opts, err);
+    if (st == TS_OK)
+        st = ts_check_svf_model(svf_model, err);
     if (st != TS_OK)
         return st;
     size_t n = (size_t)grid->width * grid->height;
@@ -102,8 +142,9 @@ ts_status ts_sky_terms(const ts_grid *grid, const float *nx, const float *ny, co
         if (acc[j])
             memset(acc[j], 0, n * sizeof(float));
     for (int k = 0; k < opts->directions; k++) {
-        st = ts_sky_accumulate(grid, nx, ny, nz, horizons + n * k, ts_horizon_azimuth(opts, k),
-                               opts->directions, svf, sky, openness, err);
+        st = ts_sky_accumulate_model(grid, nx, ny, nz, horizons + n * k,
+                                     ts_horizon_azimuth(opts, k), opts->directions, svf_model,
+                                     svf, sky, openness, err);
         if (st != TS_OK)
             return st;
     }

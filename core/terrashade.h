@@ -229,7 +229,9 @@ ts_status ts_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
  *  - sky: irradiance from a uniform sky of unit radiance, the same integral
  *    with the horizon raised to at least 0 deg (the sky ends at the
  *    horizontal);
- *  - openness: positive openness, the mean of 90 - horizon angle, degrees.
+ *  - openness: positive openness (Yokoyama et al. 2002), the mean of
+ *    90 - horizon angle, degrees; negative openness is the same on the
+ *    negated DEM's horizons.
  */
 ts_status ts_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
                        const float *nz, const float *horizons,
@@ -250,6 +252,34 @@ ts_status ts_sky_accumulate(const ts_grid *grid, const float *nx,
                             float *openness_acc, ts_error *err);
 ts_status ts_sky_finish(const ts_grid *grid, int directions, float *svf_acc,
                         float *sky_acc, float *openness_acc, ts_error *err);
+
+/** Which sky-view factor the svf output of the sky terms holds. */
+typedef enum {
+    /** Timonen eq. 5 with the cell's normal: the cosine-weighted visible
+     * fraction of the hemisphere around the normal (what ts_sky_terms
+     * computes). */
+    TS_SVF_RADIATIVE = 0,
+    /** Zaksek et al. (2011), as RVT_py, SAGA and GRASS r.skyview: 1 - the
+     * mean over directions of sin(max(horizon, 0)), relative to the
+     * horizontal; no normal. */
+    TS_SVF_SOLID_ANGLE = 1
+} ts_svf_model;
+
+/** TS_OK if `model` is a ts_svf_model, else TS_ERR_ARG with a sentence. */
+ts_status ts_check_svf_model(ts_svf_model model, ts_error *err);
+
+/** ts_sky_terms with the svf output of model `svf_model`. */
+ts_status ts_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
+                             const float *nz, const float *horizons,
+                             const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
+                             float *sky, float *openness, ts_error *err);
+
+/** ts_sky_accumulate with the svf accumulator of model `svf_model` (finish
+ * it with ts_sky_finish as well). */
+ts_status ts_sky_accumulate_model(const ts_grid *grid, const float *nx, const float *ny,
+                                  const float *nz, const float *plane, double azimuth,
+                                  int directions, ts_svf_model svf_model, float *svf_acc,
+                                  float *sky_acc, float *openness_acc, ts_error *err);
 
 /**
  * Combined shade = clamp(direct + sky_weight * sky, 0, 1); NaN stays NaN.

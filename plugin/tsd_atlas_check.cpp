@@ -13,7 +13,6 @@
 
 #include "shadow_atlas.h"
 #include "tsd_atlas_check.h"
-#include "tsd_products.h"
 
 namespace tsd
 {
@@ -22,19 +21,12 @@ namespace tsd
  * dataset's options do; the others that matter are checked here. */
 std::string CheckAtlasMetadata(const CPLStringList &aosMeta, int nMaps, tsd_options *psOpts)
 {
-    /* The driver writes every option into a product's metadata, those of
-     * other products at their defaults (ENV_ROTATION=0): such an item says
-     * nothing, and given to farshadow it would be refused as not its own. */
-    const tsd_product_def *psFar = tsd_product_at(tsd_product_find("farshadow"));
     CPLStringList aosOpts;
     for (int i = 0; i < aosMeta.size(); i++)
     {
         char *pszKey = nullptr;
-        const char *pszValue = CPLParseNameValue(aosMeta[i], &pszKey);
-        const int iOpt = pszKey ? tsd_option_find(pszKey) : -1;
-        const bool bForeignDefault = iOpt >= 0 && !tsd_product_takes(psFar, iOpt) &&
-                                     pszValue && EQUAL(pszValue, tsd_option_default(iOpt));
-        if (iOpt >= 0 && !EQUAL(pszKey, "BACKEND") && !bForeignDefault)
+        CPLParseNameValue(aosMeta[i], &pszKey);
+        if (pszKey && tsd_option_find(pszKey) >= 0 && !EQUAL(pszKey, "BACKEND"))
             aosOpts.AddString(aosMeta[i]);
         CPLFree(pszKey);
     }

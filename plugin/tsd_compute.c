@@ -134,6 +134,7 @@ ts_status tsd_compute_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_pla
 typedef struct {
     const tsd_normals *nm;
     int directions;
+    ts_svf_model model;
     float *svf, *sky, *open;
 } sky_acc;
 
@@ -142,19 +143,32 @@ static ts_status sky_add(void *user, const ts_grid *g, int k, double azimuth,
 {
     (void)k;
     const sky_acc *a = user;
-    return ts_sky_accumulate(g, a->nm->nx, a->nm->ny, a->nm->nz, plane, azimuth,
-                             a->directions, a->svf, a->sky, a->open, err);
+    return ts_sky_accumulate_model(g, a->nm->nx, a->nm->ny, a->nm->nz, plane, azimuth,
+                                   a->directions, a->model, a->svf, a->sky, a->open, err);
 }
 
 /* Stream the DIRECTIONS horizon planes into one sky accumulator; `which`:
- * 0 = svf, 1 = sky, 2 = openness. acc must be zeroed. */
+ * 0 = svf (of SVF_MODEL), 1 = sky, 2 = openness (the horizons of g: pass
+ * the negated DEM for negative openness). acc must be zeroed. */
 static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const tsd_normals *nm,
                             int which, float *acc)
 {
     ts_error err;
     ts_status st;
-    sky_acc a = {nm, c->opts->directions, which == 0 ? acc : NULL, which == 1 ? acc : NULL,
-                 which == 2 ? acc : NULL};
+    sky_acc a = {nm, c->opts->directions,
+                 which == 0 ? (ts_svf_model)c->opts->svf_model : TS_SVF_RADIATIVE,
+                 which == 0 ? acc : NULL, which == 1 ? acc : NULL, which == 2 ? acc : NULL};
+    /* Curvature lowers far terrain; on the negated DEM it would raise it,
+     * so the sweep over the negated DEM (negative openness) runs without. */
+    tsd_options flat;
+    tsd_compute_ctx cflat;
+    if (which == 2 && c->opts->openness_negative) {
+        flat = *c->opts;
+        flat.curvature = 0;
+        cflat = *c;
+        cflat.opts = &flat;
+        c = &cflat;
+    }
     if ((st = tsd_compute_stream(c, g, sky_add, &a)) != TS_OK)
         return st;
     if (ts_sky_finish(g, a.directions, a.svf, a.sky, a.open, &err) != TS_OK)
@@ -314,14 +328,36 @@ TSD_COMPUTE_FN(tsd_compute_horizon)
     return TS_OK;
 }
 
+/* A copy of `dem` with its heights negated (NaN stays NaN), the surface
+ * whose openness is the negative openness (Yokoyama et al. 2002, as RVT_py
+ * computes it); free its z. */
+static ts_status negated_dem(const tsd_compute_ctx *c, const ts_grid *dem, ts_grid *neg)
+{
+    *neg = *dem;
+    neg->stride = dem->width;
+    neg->owns_memory = 0;
+    neg->z = malloc((size_t)dem->width * dem->height * sizeof(float));
+    if (!neg->z)
+        return oom(c, "the negated DEM of negative openness");
+    for (int y = 0; y < dem->height; y++)
+        for (int x = 0; x < dem->width; x++)
+            neg->z[(size_t)y * dem->width + x] = -dem->z[(ptrdiff_t)y * dem->stride + x];
+    return TS_OK;
+}
+
 static ts_status sky_product(const tsd_compute_ctx *c, const tsd_region *r, int which,
                              float *out)
 {
     tsd_normals nm = {0};
+    ts_grid neg = {0};
     ts_status st;
+    const int negative = which == 2 && c->opts->openness_negative;
     memset(out, 0, (size_t)r->width * r->height * sizeof(float));
-    if ((st = tsd_normals_make(c, r->dem, &nm)) == TS_OK)
-        st = sky_stream(c, r->dem, &nm, which, out);
+    if ((st = tsd_normals_make(c, r->dem, &nm)) == TS_OK && negative)
+        st = negated_dem(c, r->dem, &neg);
+    if (st == TS_OK)
+        st = sky_stream(c, negative ? &neg : r->dem, &nm, which, out);
+    free(neg.z);
     tsd_normals_free(&nm);
     return st;
 }

@@ -1,6 +1,7 @@
 /* Environment light in the driver; see tsd_compute_env.h. */
 #include "tsd_compute_env.h"
 
+#include "tsd_backend.h"
 #include "tsd_products.h"
 #include "tsd_text.h"
 
@@ -153,10 +154,13 @@ ts_status tsd_environment_setup(const tsd_options *o, const tsd_run *run, const 
     return TS_OK;
 }
 
-/* The environment light of sector k added to three accumulators. */
+/* The environment light of sector k added to three accumulators, on the
+ * backend (the device state carried from plane to plane in `state`). */
 typedef struct {
+    const tsd_compute_ctx *c;
     const tsd_environment *e;
     const tsd_normals *nm;
+    ts_backend_env_light state;
     float *r, *g, *b;
 } env_acc;
 
@@ -164,9 +168,14 @@ static ts_status env_add(void *user, const ts_grid *g, int k, double azimuth,
                          const float *plane, ts_error *err)
 {
     (void)azimuth; /* the table's sector k is the sweep's azimuth k */
-    const env_acc *a = user;
-    return ts_env_light_accumulate(g, &a->e->table, k, a->nm->nx, a->nm->ny, a->nm->nz, plane,
-                                   a->r, a->g, a->b, err);
+    env_acc *a = user;
+    ts_backend_report rep = {0};
+    ts_status st = ts_backend_env_light_accumulate(
+        tsd_backend_to_ts(a->c->opts->backend), &a->state, g, &a->e->table, k, a->nm->nx,
+        a->nm->ny, a->nm->nz, plane, a->r, a->g, a->b, &rep, err);
+    if (a->c->backend && rep.backend[0])
+        tsd_backend_summary_add(a->c->backend, &rep);
+    return st;
 }
 
 /* E/pi per colour into the zeroed planes r, g, b. */
@@ -174,9 +183,10 @@ static ts_status env_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
                            float *r, float *gr, float *b)
 {
     ts_error err;
-    ts_status st;
-    env_acc a = {c->run->env, nm, r, gr, b};
-    if ((st = tsd_compute_stream(c, g, env_add, &a)) != TS_OK)
+    env_acc a = {c, c->run->env, nm, {0}, r, gr, b};
+    ts_status st = tsd_compute_stream(c, g, env_add, &a);
+    ts_backend_env_light_release(&a.state);
+    if (st != TS_OK)
         return st;
     if (ts_env_light_finish(g, r, gr, b, &err) != TS_OK)
         return tsd_fail_core(c->msg, c->msg_size, NULL, &err);

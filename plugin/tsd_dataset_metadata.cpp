@@ -87,7 +87,11 @@ void TSDataset::SetupMetadata()
     for (int i = 0; i < tsd_options_count(); i++)
     {
         const char *pszName = tsd_options_value(&m_sOpts, i, szValue, sizeof szValue);
-        if (!(tsd_option_scope(i) & TSD_SCOPE_PRODUCT) || EQUAL(pszName, "THREADS") || EQUAL(pszName, "MAX_MEMORY") ||
+        // only the options of this product: an atlas copied from it is
+        // validated against them (tsd_atlas_check.cpp)
+        const bool bApplies = tsd_option_applies(i) == TSD_APPLIES_SELECTOR ||
+                              tsd_product_takes(m_psProduct, i);
+        if (!bApplies || EQUAL(pszName, "THREADS") || EQUAL(pszName, "MAX_MEMORY") ||
             EQUAL(pszName, "BACKEND") || !szValue[0])
             continue; // BACKEND: what ran (SetupBackendMetadata)
         GDALDataset::SetMetadataItem(pszName, szValue);

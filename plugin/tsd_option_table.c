@@ -172,6 +172,19 @@ const opt_def TSD_OPTION_ROWS[] = {
      "envlight with OUTPUT_TYPE=Byte: stops by which the light is scaled (x "
      "2^EXPOSURE) before the sRGB curve; empty or AUTO: the brightest "
      "unshadowed surface of any slope and aspect maps to 255"},
+
+    {"SVF_MODEL", K_SELECT, FIELD(svf_model), "radiative", 0, 0, 0, 0,
+     "radiative|solid_angle", 1, P, LISTED, NULL,
+     "svf: radiative (Timonen eq. 5 with the cell's normal: the "
+     "cosine-weighted visible sky, the light a tilted surface gets from a "
+     "uniform sky) or solid_angle (Zaksek et al. 2011, as RVT_py, SAGA and "
+     "GRASS r.skyview: 1 - mean sin(max(horizon, 0)), relative to the "
+     "horizontal)"},
+    {"OPENNESS", K_SELECT, FIELD(openness_negative), "positive", 0, 0, 0, 0,
+     "positive|negative", 1, P, LISTED, NULL,
+     "openness: positive (Yokoyama et al. 2002: mean over directions of 90 - "
+     "the horizon elevation angle) or negative (the same on the negated DEM, "
+     "as RVT_py: high in valleys and pits)"},
     /* options of atlas files (*.tsa) only */
     {"SHADOWS", K_SELECT, FIELD(shadows_all), "far", 0, 0, 0, 0, "far|all", 0, A, LISTED,
      NULL,

@@ -83,6 +83,9 @@ typedef struct {
     int env_horizon_steps;       /* ENV_HORIZON_STEPS: the L_p table's horizon axis */
     int env_normal_steps;        /* ENV_NORMAL_STEPS: its normal axis, 0 = exact */
     char exposure[TSD_TEXT_MAX]; /* EXPOSURE: stops (Byte), "" or AUTO = automatic */
+
+    int svf_model;           /* SVF_MODEL: a ts_svf_model (0 radiative, 1 solid_angle) */
+    int openness_negative;   /* OPENNESS: 0 = positive, 1 = negative */
     /* options of far-shadow atlas files (*.tsa) */
     int shadows_all;         /* SHADOWS: 0 = far, 1 = all */
     char dem[TSD_PATH_MAX];  /* DEM: "" = the atlas's SOURCE_DEM */

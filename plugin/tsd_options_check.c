@@ -107,6 +107,11 @@ int tsd_options_check(const tsd_options *o, char *msg, size_t n)
         tsd_products_taking(o_method, "PRODUCT=", " and ", list, sizeof list);
         REFUSE("METHOD=shm applies to %s only, not to PRODUCT=%s", list, pn);
     }
+    /* a model chosen for another product is a mistake, not a no-op */
+    if (o->svf_model != 0 && !tsd_product_takes(p, tsd_option_find("SVF_MODEL")))
+        REFUSE("SVF_MODEL=solid_angle applies to PRODUCT=svf only, not to PRODUCT=%s", pn);
+    if (o->openness_negative && !tsd_product_takes(p, tsd_option_find("OPENNESS")))
+        REFUSE("OPENNESS=negative applies to PRODUCT=openness only, not to PRODUCT=%s", pn);
     if (o->datetime[0] && !tsd_product_takes(p, o_datetime)) {
         tsd_products_taking(o_datetime, "", " and ", list, sizeof list);
         REFUSE("DATETIME applies to PRODUCT=%s, not to PRODUCT=%s", list, pn);

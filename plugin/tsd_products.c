@@ -125,10 +125,11 @@ static const tsd_product_def PRODUCTS[] = {
     /* the sky products: normals and one horizon plane */
     {"svf", "sky-view factor 0..1", "", "0..1", one_band, NULL, band_named,
      TSD_BYTE_ALLOWED, 0, 0, TSD_STEPS_NONE, 4, 0, 0, backend_always,
-     SWEEP "OUTPUT_TYPE BACKEND", NULL, NULL, tsd_compute_svf},
-    {"openness", "positive openness, degrees", "degree", "degrees", one_band, NULL,
-     band_named, TSD_BYTE_NEVER, 0, 0, TSD_STEPS_NONE, 4, 0, 0, backend_always,
-     SWEEP "BACKEND", NULL, NULL, tsd_compute_openness},
+     SWEEP "SVF_MODEL OUTPUT_TYPE BACKEND", NULL, NULL, tsd_compute_svf},
+    /* and, for OPENNESS=negative, the negated DEM */
+    {"openness", "positive or negative openness, degrees", "degree", "degrees", one_band,
+     NULL, band_named, TSD_BYTE_NEVER, 0, 0, TSD_STEPS_NONE, 5, 0, 0, backend_always,
+     SWEEP "OPENNESS BACKEND", NULL, NULL, tsd_compute_openness},
     {"sky", "uniform-sky irradiance 0..1", "", "0..1", one_band, NULL, band_named,
      TSD_BYTE_ALLOWED, 0, 0, TSD_STEPS_NONE, 4, 0, 0, backend_always,
      SWEEP "OUTPUT_TYPE BACKEND", NULL, NULL, tsd_compute_sky},

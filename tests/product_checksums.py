@@ -55,6 +55,8 @@ VARIANTS = {
     "insolation": dict(DAY, LINKE_TURBIDITY="4"),
     "daycycle": dict(DAY, STEP_MINUTES="120"),
     "farshadow": dict(DAY, ATLAS_STEPS="6", FAR_THRESHOLD="32"),
+    "svf_solid": {"DIRECTIONS": "16", "SVF_MODEL": "solid_angle"},
+    "openness_negative": {"DIRECTIONS": "16", "OPENNESS": "negative"},
 }
 
 # Environment light (docs/envlight.md): printed after all the above, so that

@@ -47,6 +47,17 @@ CM_FN float cm_sky_term(float nx, float ny, float nz, float h, float sa, float c
     return cm_sky_swath(nz, a, th, w1, w2) + (h - h) + (nz - nz);
 }
 
+/* The term a direction adds to the solid-angle sky-view factor (Zaksek et
+ * al. 2011, as RVT_py, SAGA and GRASS r.skyview): w1 * (1 - sin(max(h,
+ * 0))), the horizon h in degrees relative to the horizontal, w1 = 1/n. */
+CM_FN float cm_svf_solid_term(float h, float w1)
+{
+    float hp = h > 0.0f ? h : 0.0f, s, c;
+    /* sin(hp) = cos of the zenith angle, which lies in [0, pi/2] */
+    ts_sincos_0_pi(TS_PI_2_F - hp * TS_DEG2RAD_F, &s, &c);
+    return w1 * (1.0f - c) + (h - h);
+}
+
 /* The term a direction adds to the openness sum (degrees). */
 CM_FN float cm_openness_term(float h, float nz)
 {

@@ -1,0 +1,200 @@
+/* The sky-view factor models (radiative, solid angle) and openness of the
+ * sky terms, against their closed forms. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "terrashade.h"
+#include "test_grid.h"
+#include "test_run.h"
+
+static const double DEG = 3.14159265358979323846 / 180.0;
+
+/* Per-direction horizons of the cells, one row per cell: a mix of negative,
+ * zero and positive angles (the solid-angle model clamps at 0). */
+#define NDIR 8
+#define NCELL 4
+static const float HOR[NCELL][NDIR] = {
+    {-5, -5, -5, -5, -5, -5, -5, -5},
+    {0, 10, 20, 30, 40, 30, 20, 10},
+    {-20, 35, -1, 60, 2, 0, 15, -80},
+    {89, 89, 89, 89, 89, 89, 89, 89},
+};
+
+typedef struct {
+    ts_grid g;
+    float *nx, *ny, *nz, *hor;
+    ts_horizon_opts o;
+} sky_case;
+
+/* NCELL x 1 grid, flat normals, the horizons above (plane k = direction k). */
+static void case_make(sky_case *c)
+{
+    ts_error e;
+    ck_assert(ts_grid_create(&c->g, NCELL, 1, 10, 10, &e) == TS_OK);
+    c->nx = tdem_floats(NCELL), c->ny = tdem_floats(NCELL), c->nz = tdem_floats(NCELL);
+    c->hor = tdem_floats((size_t)NCELL * NDIR);
+    for (int i = 0; i < NCELL; i++) {
+        c->nx[i] = c->ny[i] = 0, c->nz[i] = 1;
+        for (int k = 0; k < NDIR; k++)
+            c->hor[k * NCELL + i] = HOR[i][k];
+    }
+    ts_horizon_opts_default(&c->o);
+    c->o.directions = NDIR;
+}
+
+static void case_free(sky_case *c)
+{
+    free(c->nx), free(c->ny), free(c->nz), free(c->hor);
+    ts_grid_free(&c->g);
+}
+
+START_TEST(test_solid_angle_closed_form)
+{
+    sky_case c;
+    case_make(&c);
+    float svf[NCELL], open[NCELL];
+    ts_error e;
+    ck_assert_msg(ts_sky_terms_model(&c.g, c.nx, c.ny, c.nz, c.hor, &c.o, TS_SVF_SOLID_ANGLE,
+                                     svf, NULL, open, &e) == TS_OK, "%s", e.message);
+    for (int i = 0; i < NCELL; i++) {
+        double s = 0, o = 0;
+        for (int k = 0; k < NDIR; k++) {
+            s += sin(fmax(HOR[i][k], 0) * DEG);
+            o += 90.0 - HOR[i][k];
+        }
+        double want = 1.0 - s / NDIR;
+        ck_assert_msg(fabs(svf[i] - want) < 2e-6, "cell %d: svf %.7f, 1 - mean sin %.7f", i,
+                      svf[i], want);
+        ck_assert_msg(fabs(open[i] - o / NDIR) < 1e-4, "cell %d: openness %.5f, want %.5f", i,
+                      open[i], o / NDIR);
+    }
+    /* an open plane (all horizons below 0) sees the whole sky in both models */
+    ck_assert_float_eq(svf[0], 1.0f);
+    case_free(&c);
+}
+END_TEST
+
+START_TEST(test_radiative_is_the_default)
+{
+    sky_case c;
+    case_make(&c);
+    float a[NCELL], b[NCELL];
+    ts_error e;
+    ck_assert(ts_sky_terms(&c.g, c.nx, c.ny, c.nz, c.hor, &c.o, a, NULL, NULL, &e) == TS_OK);
+    ck_assert(ts_sky_terms_model(&c.g, c.nx, c.ny, c.nz, c.hor, &c.o, TS_SVF_RADIATIVE, b,
+                                 NULL, NULL, &e) == TS_OK);
+    ck_assert(memcmp(a, b, sizeof a) == 0);
+    /* the radiative svf weighs the sky by cos(zenith): on a flat cell it
+     * is 1 - mean sin^2(max(h, 0)) instead of 1 - mean sin(max(h, 0)) */
+    for (int i = 0; i < NCELL; i++) {
+        double s2 = 0;
+        for (int k = 0; k < NDIR; k++)
+            s2 += pow(sin(fmax(HOR[i][k], 0) * DEG), 2);
+        ck_assert_msg(fabs(a[i] - (1.0 - s2 / NDIR)) < 1e-5, "cell %d: radiative %.6f vs %.6f",
+                      i, a[i], 1.0 - s2 / NDIR);
+    }
+    case_free(&c);
+}
+END_TEST
+
+START_TEST(test_accumulating_form_and_nodata)
+{
+    sky_case c;
+    case_make(&c);
+    c.hor[3 * NCELL + 2] = NAN; /* cell 2, direction 3: nodata */
+    float whole[NCELL], acc[NCELL] = {0};
+    ts_error e;
+    ck_assert(ts_sky_terms_model(&c.g, c.nx, c.ny, c.nz, c.hor, &c.o, TS_SVF_SOLID_ANGLE, whole,
+                                 NULL, NULL, &e) == TS_OK);
+    for (int k = 0; k < NDIR; k++)
+        ck_assert(ts_sky_accumulate_model(&c.g, c.nx, c.ny, c.nz, c.hor + k * NCELL,
+                                          ts_horizon_azimuth(&c.o, k), NDIR,
+                                          TS_SVF_SOLID_ANGLE, acc, NULL, NULL, &e) == TS_OK);
+    ck_assert(ts_sky_finish(&c.g, NDIR, acc, NULL, NULL, &e) == TS_OK);
+    for (int i = 0; i < NCELL; i++)
+        ck_assert_msg(memcmp(&acc[i], &whole[i], sizeof(float)) == 0, "cell %d: %g vs %g", i,
+                      acc[i], whole[i]);
+    ck_assert(isnan(whole[2]));
+    ck_assert(!isnan(whole[1]));
+    case_free(&c);
+}
+END_TEST
+
+START_TEST(test_bad_model)
+{
+    sky_case c;
+    case_make(&c);
+    float out[NCELL];
+    ts_error e;
+    ck_assert_int_eq(ts_sky_terms_model(&c.g, c.nx, c.ny, c.nz, c.hor, &c.o, (ts_svf_model)7,
+                                        out, NULL, NULL, &e),
+                     TS_ERR_ARG);
+    ck_assert_msg(strstr(e.message, "svf model") != NULL, "%s", e.message);
+    ck_assert_int_eq(ts_sky_accumulate_model(&c.g, c.nx, c.ny, c.nz, c.hor, 0, NDIR,
+                                             (ts_svf_model)-1, out, NULL, NULL, &e),
+                     TS_ERR_ARG);
+    case_free(&c);
+}
+END_TEST
+
+/* At the bottom of a conical pit of slope s the horizon is s all around:
+ * solid-angle svf 1 - sin s, openness 90 - s; on the negated DEM (a cone
+ * peak) the top's horizon is -s: openness 90 + s (negative openness of the
+ * pit's negation, as RVT computes it). Four directions, along the grid's
+ * axes, where the sweep's lines run through the cells: on other azimuths it
+ * interpolates between cells across the kink at the cone's tip. */
+START_TEST(test_cone)
+{
+    const int n = 101, mid = 50;
+    const double s = 25.0, cell = 10.0;
+    ts_grid g;
+    tdem_create(&g, n, n, cell, cell);
+    for (int y = 0; y < n; y++)
+        for (int x = 0; x < n; x++)
+            g.z[(size_t)y * g.stride + x] = (float)(hypot(x - mid, y - mid) * cell * tan(s * DEG));
+    ts_horizon_opts o;
+    ts_horizon_opts_default(&o);
+    o.directions = 4;
+    o.curvature = 0;
+    o.max_distance = 40 * cell;
+    size_t N = (size_t)n * n;
+    float *nx = tdem_floats(N), *ny = tdem_floats(N), *nz = tdem_floats(N);
+    float *hor = tdem_floats(N * o.directions), *svf = tdem_floats(N), *op = tdem_floats(N);
+    ts_error e;
+    for (int sign = 1; sign >= -1; sign -= 2) {
+        if (sign < 0)
+            for (size_t i = 0; i < N; i++)
+                g.z[i] = -g.z[i];
+        ck_assert(ts_normals(&g, nx, ny, nz, &e) == TS_OK);
+        ck_assert(ts_horizon_compute(&g, &o, hor, &e) == TS_OK);
+        ck_assert(ts_sky_terms_model(&g, nx, ny, nz, hor, &o, TS_SVF_SOLID_ANGLE, svf, NULL, op,
+                                     &e) == TS_OK);
+        size_t c = (size_t)mid * n + mid;
+        double want_svf = sign > 0 ? 1.0 - sin(s * DEG) : 1.0;
+        double want_op = 90.0 - sign * s;
+        printf("cone %s: svf %.4f (want %.4f), openness %.3f (want %.3f)\n",
+               sign > 0 ? "pit" : "peak", svf[c], want_svf, op[c], want_op);
+        ck_assert_msg(fabs(svf[c] - want_svf) < 1e-4, "svf %g, want %g", svf[c], want_svf);
+        ck_assert_msg(fabs(op[c] - want_op) < 1e-3, "openness %g, want %g", op[c], want_op);
+    }
+    free(nx), free(ny), free(nz), free(hor), free(svf), free(op);
+    ts_grid_free(&g);
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("sky_models");
+    TCase *tc = tcase_create("sky_models");
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, test_solid_angle_closed_form);
+    tcase_add_test(tc, test_radiative_is_the_default);
+    tcase_add_test(tc, test_accumulating_form_and_nodata);
+    tcase_add_test(tc, test_bad_model);
+    tcase_add_test(tc, test_cone);
+    suite_add_tcase(s, tc);
+    return test_run_suite(s);
+}
