@@ -1,12 +1,15 @@
 /*
  * ts_bench: throughput and memory of the core algorithms.
  *
- *   ts_bench [--size N] [--threads T] [--cell M] [--dirs 16,64] [--repeat R]
+ *   ts_bench [--size N] [--threads T] [--cell M] [--relief Z] [--dirs 16,64]
+ *            [--max-distance 0,100] [--repeat R]
  *
- * Generates an N x N fractal DEM (fBm value noise, Hurst 0.8, 1500 m relief,
- * M metre cells), then times the horizon sweep for each direction count
- * (million pixel-directions per second) and the shadow height map for 8
- * sun azimuths (million pixels per second), and reports peak memory.
+ * Generates an N x N fractal DEM (fBm value noise, Hurst 0.8, Z metres of
+ * relief, default 1500, M metre cells), then times the horizon sweep for
+ * each direction count and each maximum distance (metres, 0 = unbounded;
+ * million pixel-directions per second, and the time relative to the
+ * unbounded sweep) and the shadow height map for 8 sun azimuths (million
+ * pixels per second), and reports peak memory.
  */
 #include <math.h>
 #include <stdio.h>
@@ -61,8 +64,8 @@ static void die(const char *what, const ts_error *e)
 int main(int argc, char **argv)
 {
     int size = 4096, threads = 0, repeat = 3;
-    double cell = 10.0;
-    char dirs_arg[256] = "16,64";
+    double cell = 10.0, relief = 1500.0;
+    char dirs_arg[256] = "16,64", dist_arg[256] = "0";
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--size") && i + 1 < argc)
             size = atoi(argv[++i]);
@@ -72,17 +75,34 @@ int main(int argc, char **argv)
             cell = atof(argv[++i]);
         else if (!strcmp(argv[i], "--repeat") && i + 1 < argc)
             repeat = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--relief") && i + 1 < argc)
+            relief = atof(argv[++i]);
         else if (!strcmp(argv[i], "--dirs") && i + 1 < argc)
             snprintf(dirs_arg, sizeof dirs_arg, "%s", argv[++i]);
+        else if (!strcmp(argv[i], "--max-distance") && i + 1 < argc)
+            snprintf(dist_arg, sizeof dist_arg, "%s", argv[++i]);
         else {
-            fprintf(stderr, "usage: %s [--size N] [--threads T] [--cell M] [--dirs 16,64] [--repeat R]\n",
-                    argv[0]);
+            fprintf(stderr, "usage: %s [--size N] [--threads T] [--cell M] [--relief Z] "
+                    "[--dirs 16,64] [--max-distance 0,100] [--repeat R]\n", argv[0]);
             return 2;
         }
     }
-    if (size < 2 || repeat < 1) {
-        fprintf(stderr, "ts_bench: --size must be >= 2 and --repeat >= 1\n");
+    if (size < 2 || repeat < 1 || !(cell > 0) || !(relief > 0)) {
+        fprintf(stderr, "ts_bench: --size must be >= 2, --repeat >= 1, --cell and --relief > 0\n");
         return 2;
+    }
+    double dists[16];
+    int ndist = 0;
+    char *dsave = NULL;
+    for (char *tok = strtok_r(dist_arg, ",", &dsave); tok; tok = strtok_r(NULL, ",", &dsave)) {
+        char *end;
+        double v = strtod(tok, &end);
+        if (end == tok || *end || !(v >= 0) || ndist == 16) {
+            fprintf(stderr, "ts_bench: --max-distance takes up to 16 distances >= 0 in metres, "
+                    "got '%s'\n", tok);
+            return 2;
+        }
+        dists[ndist++] = v;
     }
     char cpu[256];
     cpu_name(cpu, sizeof cpu);
@@ -99,9 +119,9 @@ int main(int argc, char **argv)
     if (ts_grid_create(&g, size, size, cell, cell, &e))
         die("grid", &e);
     double t0 = now();
-    tdem_fbm(&g, 1234, 0.8, 1500.0);
-    printf("DEM: %d x %d fractal (fBm value noise, Hurst 0.8, 1500 m relief), %g m cells, "
-           "generated in %.2f s\n", size, size, cell, now() - t0);
+    tdem_fbm(&g, 1234, 0.8, relief);
+    printf("DEM: %d x %d fractal (fBm value noise, Hurst 0.8, %g m relief), %g m cells, "
+           "generated in %.2f s\n", size, size, relief, cell, now() - t0);
     double cells = (double)size * size;
     double dem_mib = cells * 4 / 1048576.0;
     double base_mib = peak_mib();
@@ -119,19 +139,35 @@ int main(int argc, char **argv)
             fprintf(stderr, "ts_bench: cannot allocate %d horizon planes\n", o.directions);
             return 1;
         }
-        double best = INFINITY;
-        for (int r = 0; r < repeat; r++) {
-            t0 = now();
-            if (ts_horizon_compute(&g, &o, out, &e))
-                die("horizon", &e);
-            double dt = now() - t0;
-            best = dt < best ? dt : best;
+        /* Distances interleaved within each repeat, so that all see the
+         * same load on a shared machine. */
+        double best[16];
+        for (int m = 0; m < ndist; m++)
+            best[m] = INFINITY;
+        for (int r = 0; r < repeat; r++)
+            for (int m = 0; m < ndist; m++) {
+                o.max_distance = dists[m];
+                t0 = now();
+                if (ts_horizon_compute(&g, &o, out, &e))
+                    die("horizon", &e);
+                double dt = now() - t0;
+                best[m] = dt < best[m] ? dt : best[m];
+            }
+        double unbounded = 0.0;
+        for (int m = 0; m < ndist; m++)
+            if (dists[m] == 0)
+                unbounded = best[m];
+        for (int m = 0; m < ndist; m++) {
+            double out_mib = cells * o.directions * 4 / 1048576.0;
+            printf("horizon %3d directions, max distance %8g m: %.3f s best of %d, "
+                   "%8.1f M pixel-directions/s", o.directions, dists[m], best[m], repeat,
+                   cells * o.directions / best[m] / 1e6);
+            if (unbounded > 0 && dists[m] > 0)
+                printf(", %.2fx the unbounded sweep", best[m] / unbounded);
+            printf("; peak RSS %.0f MiB = DEM %.0f + outputs %.0f + %.0f other\n", peak_mib(),
+                   dem_mib, out_mib, peak_mib() - dem_mib - out_mib);
         }
-        double out_mib = cells * o.directions * 4 / 1048576.0;
-        printf("horizon %3d directions: %.3f s best of %d, %8.1f M pixel-directions/s; "
-               "peak RSS %.0f MiB = DEM %.0f + outputs %.0f + %.0f other\n",
-               o.directions, best, repeat, cells * o.directions / best / 1e6, peak_mib(), dem_mib,
-               out_mib, peak_mib() - dem_mib - out_mib);
+        fflush(stdout);
         free(out);
     }
 

@@ -274,15 +274,44 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
     return st;
 }
 
+/* The options the kernels run with: TS_ERR_ARG when the maximum distance
+ * caps a line toward one of the azimuths (the C sweep's own test, so that
+ * the C backend takes exactly the capped sweeps), else a copy without the
+ * distance, which then caps nothing. */
+static ts_status uncapped_opts(const ts_grid *grid, const ts_horizon_opts *opts,
+                               const double *az, int n, ts_horizon_opts *run, ts_error *err)
+{
+    *run = *opts;
+    if (!(opts->max_distance > 0))
+        return TS_OK;
+    for (int a = 0; a < n; a++) {
+        ts_line_geom G;
+        ts_status st = ts_line_geom_init(&G, grid, az[a], err);
+        if (st != TS_OK)
+            return st;
+        double shortest, longest;
+        ts_line_geom_step_range(&G, grid->height, &shortest, &longest);
+        int caps = !(opts->max_distance > longest * G.U);
+        ts_line_geom_free(&G);
+        if (caps)
+            return ts_fail(err, TS_ERR_ARG, "%s", TS_CL_CAPPED_SWEEP_REASON);
+    }
+    run->max_distance = 0.0;
+    return TS_OK;
+}
+
 ts_status ts_cl_horizon_sweep(const ts_grid *grid, double azimuth, const ts_horizon_opts *opts,
                               float *out, ts_error *err)
 {
     if (!out)
         return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
     ts_status st = ts_check_sweep_args(grid, &azimuth, opts, err);
+    ts_horizon_opts run;
+    if (st == TS_OK)
+        st = uncapped_opts(grid, opts, &azimuth, 1, &run, err);
     if (st != TS_OK)
         return st;
-    return horizon_run(grid, opts, &azimuth, 1, out, err);
+    return horizon_run(grid, &run, &azimuth, 1, out, err);
 }
 
 ts_status ts_cl_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts, float *out,
@@ -296,7 +325,10 @@ ts_status ts_cl_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the azimuth list");
     for (int k = 0; k < opts->directions; k++)
         az[k] = ts_horizon_azimuth(opts, k); /* in [0, 360) */
-    st = horizon_run(grid, opts, az, opts->directions, out, err);
+    ts_horizon_opts run;
+    st = uncapped_opts(grid, opts, az, opts->directions, &run, err);
+    if (st == TS_OK)
+        st = horizon_run(grid, &run, az, opts->directions, out, err);
     free(az);
     return st;
 }

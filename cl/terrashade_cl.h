@@ -76,6 +76,16 @@ ts_status ts_cl_available(ts_cl_info *info, ts_error *err);
  */
 ts_status ts_cl_devices(ts_cl_info *list, int max, int *count, ts_error *err);
 
+/**
+ * The error message of ts_cl_horizon_sweep and ts_cl_horizon_compute for a
+ * maximum distance that caps a sweep line (TS_ERR_ARG): the C sweep keeps a
+ * sliding-window hull per line there, which the kernel has not. A distance
+ * beyond every line's length caps nothing and runs as the unbounded sweep.
+ */
+#define TS_CL_CAPPED_SWEEP_REASON                                                          \
+    "a MAX_DISTANCE sweep runs on the C backend (the OpenCL kernel has no sliding-window " \
+    "hull yet)"
+
 /** ts_horizon_sweep on the device: one azimuth, width*height degrees. */
 ts_status ts_cl_horizon_sweep(const ts_grid *grid, double azimuth,
                               const ts_horizon_opts *opts, float *out,

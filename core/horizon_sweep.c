@@ -15,6 +15,12 @@
  *  - the far field: the weighted mean (weights = 1 - distance to the line)
  *    of the slopes from the cell's own height to the hull points of the two
  *    neighbouring lines that lie beyond the near field.
+ *
+ * With a maximum distance, each line keeps the hull of a sliding window of
+ * its samples instead (window_hull.h): those beyond the near field and
+ * within the distance, in amortised O(1) per sample like the unbounded
+ * hull; the near field is cut at the distance, and the last part of a step
+ * before it is solved exactly on each cell's ray.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -25,11 +31,9 @@
 #include "near_field.h"
 #include "parallel.h"
 #include "status_internal.h"
+#include "window_hull.h"
 
-typedef struct {
-    double d, g;
-    int k;              /* step index of the sample on its line */
-} hull_pt;
+typedef ts_hull_pt hull_pt;
 
 /* The far-field occluder a hull query found: its step index on the line and
  * its distance from the query point; k < 0 when there is none. */
@@ -52,14 +56,18 @@ typedef struct {
     int *alloc_failed;  /* set by a worker that cannot get its workspace */
     ts_near_plan near;
     double near_skip;   /* hull points closer than this are near field */
+    int near_only;      /* the distance ends inside the near field: no lines */
     cm_ray_grid ray;    /* the grid as the geometry sees it, for cm_ray_slope */
 } sweep_ctx;
 
 typedef struct {
     hull_pt *stack;
     int n;
-    hull_pt *raw;       /* every pushed sample: the capped line slopes of the visitor */
+    hull_pt *raw;       /* with a maximum distance: the line's valid samples */
     int raw_n;
+    ts_window_hull win; /* with a maximum distance: the far-field window */
+    ts_window_hull vwin; /* and the visitor's (all samples within the distance) */
+    int finger[3][2];   /* where the window queries of each kind last ended */
     ts_line_pair lo;    /* occluders of the far side (occluder entries) */
     /* visitor buffers */
     float *vx, *vy, *vh, *vs;
@@ -69,14 +77,19 @@ typedef struct {
 /* The far-field occluder of a point at distance d, height h, among the
  * hull points 0..far (those beyond the near field): walk to farther points
  * while the slope grows (the slopes to an upper convex hull from a point
- * beyond it are unimodal). */
-static occluder hull_query(const sweep_ctx *C, const sweep_ws *w, int far, double d, float h)
+ * beyond it are unimodal). With a maximum distance, the window's. */
+static occluder hull_query(const sweep_ctx *C, sweep_ws *w, int far, double d, float h,
+                           int finger[2])
 {
     occluder none = {-1, 0.0f};
+    double g = h - C->c * d * d;
+    if (C->cap > 0) {
+        const hull_pt *p = ts_window_hull_query(&w->win, d, g, finger);
+        return p ? (occluder){p->k, (float)(d - p->d)} : none;
+    }
     if (far < 0)
         return none;
     const hull_pt *S = w->stack;
-    double g = h - C->c * d * d;
     int j = far;
     while (j > 0 && (S[j - 1].g - g) * (d - S[j].d) >= (S[j].g - g) * (d - S[j - 1].d))
         j--;
@@ -106,13 +119,11 @@ static float far_field(const sweep_ctx *C, int k, int i, float h, occluder lo, o
                        double step)
 {
     float best = -INFINITY;
-    int beyond_cap = 0;
     const occluder cand[2] = {lo, hi};
     for (int c = 0; c < 2; c++) {
         if (cand[c].k < 0 || (c == 1 && cand[1].k == cand[0].k))
             continue;
         int dk = k - cand[c].k;
-        beyond_cap |= C->cap > 0 && cand[c].dd > C->cap;
         for (int e = -FAR_SPREAD; e <= FAR_SPREAD; e++) {
             if (dk + e <= TS_NEAR_STEPS)
                 continue;
@@ -120,14 +131,7 @@ static float far_field(const sweep_ctx *C, int k, int i, float h, occluder lo, o
             best = s > best ? s : best;
         }
     }
-    if (!beyond_cap)
-        return best;
-    /* An occluder lies past the maximum distance: march the cell's ray over
-     * the far part of the radius instead, and never rise above the
-     * unbounded horizon (a smaller radius cannot raise it). */
-    const ts_line_geom *G = C->geom;
-    float win = ts_ray_exact(G, C->grid->z, k, i, h, TS_NEAR_EXACT, C->cap / step, step, C->c);
-    return win;
+    return best;
 }
 
 #ifndef PREFETCH_AHEAD
@@ -146,6 +150,8 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
     occluder *cur_lo = w->lo.cur;
     w->n = 0;
     w->raw_n = 0;
+    ts_window_hull_reset(&w->win);
+    ts_window_hull_reset(&w->vwin);
     const double c = C->c;
     double d = 0.0;
     int nv = 0;
@@ -168,23 +174,28 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
 
         int pushed = 0;
         float slope = -INFINITY;
-        if (!isnan(hs)) {
+        if (C->cap > 0) {
+            if (!isnan(hs)) {
+                double gs = hs - c * d * d;
+                if (w->vs) {
+                    ts_window_hull_slide(&w->vwin, w->raw, w->raw_n, d, 0.0, C->cap);
+                    const hull_pt *p = ts_window_hull_query(&w->vwin, d, gs, w->finger[2]);
+                    if (p)
+                        slope = (float)((p->g - gs) / (d - p->d) - 2.0 * c * d);
+                }
+                w->raw[w->raw_n++] = (hull_pt){d, gs, k};
+            }
+            ts_window_hull_slide(&w->win, w->raw, w->raw_n, d, C->near_skip, C->cap);
+            pushed = 1;
+        } else if (!isnan(hs)) {
             double gs = hs - c * d * d;
             hull_pt *S = w->stack;
             int n = w->n;
             while (n >= 2 &&
                    (S[n - 2].g - gs) * (d - S[n - 1].d) >= (S[n - 1].g - gs) * (d - S[n - 2].d))
                 n--;
-            if (w->vs && n > 0) {
-                double s = -INFINITY;
-                if (C->cap > 0 && d - S[n - 1].d > C->cap) {
-                    for (int j = w->raw_n - 1; j >= 0 && d - w->raw[j].d <= C->cap; j--)
-                        s = fmax(s, (w->raw[j].g - gs) / (d - w->raw[j].d));
-                } else {
-                    s = (S[n - 1].g - gs) / (d - S[n - 1].d);
-                }
-                slope = (float)(s - 2.0 * c * d);
-            }
+            if (w->vs && n > 0)
+                slope = (float)((S[n - 1].g - gs) / (d - S[n - 1].d) - 2.0 * c * d);
             /* Hull points 0..far lie beyond the near field; pops only take
              * from the top, and d only grows, so far moves in O(1) amortised. */
             if (far > n - 1)
@@ -195,8 +206,6 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
             S[n].g = gs;
             S[n].k = k;
             w->n = n + 1;
-            if (w->raw)
-                w->raw[w->raw_n++] = S[n];
             pushed = 1;
         }
         if (!pushed)
@@ -206,7 +215,7 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
         if (write) {
             float s_out = NAN;
             if (!isnan(hc)) {
-                occluder hi = inside ? hull_query(C, w, far, d, hc) : none;
+                occluder hi = inside ? hull_query(C, w, far, d, hc, w->finger[0]) : none;
                 occluder lo = (F > 0.0f && k >= pk0 && k <= pk1) ? prev_lo[k] : none;
                 int row = G->x_major ? i : G->u_start + k * G->u_step;
                 double step = G->step_row ? G->step_row[row] : G->step_m;
@@ -214,7 +223,7 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
             }
             C->out[C->o_origin + (ptrdiff_t)k * C->o_u_stride + (ptrdiff_t)i * C->o_v_stride] = s_out;
         }
-        cur_lo[k] = (has_next && !isnan(hn)) ? hull_query(C, w, far, d, hn) : none;
+        cur_lo[k] = (has_next && !isnan(hn)) ? hull_query(C, w, far, d, hn, w->finger[1]) : none;
         if (w->vs) {
             w->vx[nv] = G->x_major ? (float)(G->u_start + k * G->u_step) : (float)i + F;
             w->vy[nv] = G->x_major ? (float)i + F : (float)(G->u_start + k * G->u_step);
@@ -232,6 +241,8 @@ static void ws_free(sweep_ws *w)
 {
     free(w->stack);
     free(w->raw);
+    ts_window_hull_free(&w->win);
+    ts_window_hull_free(&w->vwin);
     free(w->lo.prev);
     free(w->lo.cur);
     free(w->vx);
@@ -241,16 +252,20 @@ static void ws_free(sweep_ws *w)
     free(w->vd);
 }
 
-static int ws_init(sweep_ws *w, int U, int need_raw, int need_visit)
+static int ws_init(sweep_ws *w, int U, int capped, int need_visit)
 {
     *w = (sweep_ws){0};
+    int ok = 1;
+    if (capped) {
+        w->raw = malloc((size_t)(U + 1) * sizeof *w->raw);
+        ok = w->raw && ts_window_hull_alloc(&w->win, U) &&
+             (!need_visit || ts_window_hull_alloc(&w->vwin, U));
+    }
     w->stack = malloc((size_t)(U + 1) * sizeof *w->stack);
     w->lo.prev = malloc((size_t)U * sizeof(occluder));
     w->lo.cur = malloc((size_t)U * sizeof(occluder));
     w->lo.prev_k0 = 1;
     w->lo.prev_k1 = 0;
-    if (need_raw)
-        w->raw = malloc((size_t)(U + 1) * sizeof *w->raw);
     if (need_visit) {
         w->vx = malloc((size_t)U * sizeof(float));
         w->vy = malloc((size_t)U * sizeof(float));
@@ -258,7 +273,7 @@ static int ws_init(sweep_ws *w, int U, int need_raw, int need_visit)
         w->vs = malloc((size_t)U * sizeof(float));
         w->vd = malloc((size_t)U * sizeof(double));
     }
-    return w->stack && w->lo.prev && w->lo.cur && (!need_raw || w->raw) &&
+    return ok && w->stack && w->lo.prev && w->lo.cur &&
            (!need_visit || (w->vx && w->vy && w->vh && w->vs && w->vd));
 }
 
@@ -268,7 +283,7 @@ static void sweep_range(void *ctx, int worker, long begin, long end)
     (void)worker;
     const sweep_ctx *C = ctx;
     sweep_ws w;
-    if (!ws_init(&w, C->geom->U, C->cap > 0 && C->visit, C->visit != NULL)) {
+    if (!ws_init(&w, C->geom->U, C->cap > 0, C->visit != NULL)) {
         ws_free(&w);
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
         return;
@@ -278,6 +293,70 @@ static void sweep_range(void *ctx, int worker, long begin, long end)
     for (long b = C->b0 + begin; b < C->b0 + end; b++)
         process_line(C, &w, b, 1);
     ws_free(&w);
+}
+
+/* An upper bound of the slope from cell (k, i) at height h to its ray
+ * between whole steps j and j + 1: the highest corner of the patches it
+ * crosses there; INFINITY if one is nodata or off the grid (then solve). */
+static float between_steps_bound(const ts_line_geom *G, const float *z, int k, int i, float h,
+                                 int j, double step, double c)
+{
+    double va = i - G->t * j, vb = i - G->t * (j + 1);
+    double lo = va < vb ? va : vb, hi = va < vb ? vb : va;
+    int r0 = (int)floor(lo), r1 = (int)ceil(hi), k0 = k - j - 1;
+    if (k0 < 0 || r0 < 0 || r1 > G->V - 1)
+        return INFINITY;
+    float hmax = -INFINITY;
+    const float *p = z + G->origin + (ptrdiff_t)k0 * G->u_stride + (ptrdiff_t)r0 * G->v_stride;
+    for (int r = r0; r <= r1; r++, p += G->v_stride) {
+        float a = p[0], b = p[G->u_stride];
+        if (a != a || b != b)
+            return INFINITY;
+        hmax = a > hmax ? a : hmax;
+        hmax = b > hmax ? b : hmax;
+    }
+    double dh = (double)hmax - h;
+    return (float)(dh / ((dh > 0 ? j : j + 1) * step) - c * j * step);
+}
+
+/*
+ * What the near field and the lines leave out within a maximum distance,
+ * solved exactly on each cell's own ray: a capped horizon is often near,
+ * often at the distance itself.
+ *  - Between the near field's whole steps (TS_NEAR_EXACT..TS_NEAR_STEPS)
+ *    the bilinear surface can rise above both steps (not along an axis,
+ *    where it is linear there); a step is solved where a bound says it may
+ *    raise the horizon.
+ *  - The part of a step before the distance ends, where the same bound
+ *    says it may.
+ */
+static void cap_tail(const sweep_ctx *C, int y, const float *zrow, float *orow, double step)
+{
+    const ts_line_geom *G = C->geom;
+    const float *z = C->grid->z;
+    double smax = C->cap / step, s0 = floor(smax);
+    double send = smax < TS_NEAR_STEPS ? smax : TS_NEAR_STEPS;
+    int axis = fabs(G->t) <= 1e-12;
+    s0 = s0 > TS_NEAR_EXACT ? s0 : TS_NEAR_EXACT;
+    int tail = s0 < smax && (axis || smax > TS_NEAR_STEPS);
+    for (int x = 0; x < C->grid->width; x++) {
+        if (isnan(zrow[x]))
+            continue;
+        int u = G->x_major ? x : y, i = G->x_major ? y : x;
+        int k = (u - G->u_start) * G->u_step;
+        float h = zrow[x], best = orow[x];
+        for (int j = TS_NEAR_EXACT; !axis && j < send; j++) {
+            if (between_steps_bound(G, z, k, i, h, j, step, C->c) < best)
+                continue;
+            float e = ts_ray_exact(G, z, k, i, h, j, j + 1 < send ? j + 1 : send, step, C->c);
+            best = e > best ? e : best;
+        }
+        if (tail && between_steps_bound(G, z, k, i, h, (int)s0, step, C->c) >= best) {
+            float e = ts_ray_exact(G, z, k, i, h, s0, smax, step, C->c);
+            best = e > best ? e : best;
+        }
+        orow[x] = best;
+    }
 }
 
 /* Rows [y0, y1): add each cell's near field to the far-field slope the
@@ -294,8 +373,13 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
         const float *zrow = grid->z + y * grid->stride;
         float *orow = C->out + y * W;
         double step = G->step_row ? G->step_row[y] : G->step_m;
-        /* The vectorised pass has no distance cap. */
-        int interior = scratch && C->cap == 0 && y >= m && y < H - m && W > 2 * m;
+        if (C->near_only) /* no lines wrote the far field */
+            for (int x = 0; x < W; x++)
+                orow[x] = isnan(zrow[x]) ? NAN : -INFINITY;
+        /* The vectorised pass has no distance cap: it serves a distance
+         * that ends beyond the near field, where the cap changes nothing. */
+        int uncut = C->cap == 0 || C->cap / step >= TS_NEAR_STEPS;
+        int interior = scratch && uncut && y >= m && y < H - m && W > 2 * m;
         int xa = interior ? m : W, xb = interior ? W - m : W;
         if (interior)
             ts_near_row(&C->near, G, grid->z, zrow, (int)y, xa, xb, step, C->c, orow, scratch);
@@ -312,6 +396,8 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
                                      zrow[x], step, C->c, C->cap, &left);
             orow[x] = left ? nf : fmaxf(nf, orow[x]);
         }
+        if (C->cap > 0)
+            cap_tail(C, (int)y, zrow, orow, step);
         for (int x = 0; x < W; x++)
             orow[x] = ts_atan_deg(orow[x]);
     }
@@ -336,11 +422,17 @@ static ts_status sweep_setup(const ts_grid *grid, double azimuth,
     C->ray = (cm_ray_grid){grid->z, geom->V, geom->t, geom->origin, geom->u_stride,
                            geom->v_stride};
     C->c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
-    C->cap = opts->max_distance;
     ts_line_out_strides(geom, grid->width, &C->o_origin, &C->o_u_stride, &C->o_v_stride);
     C->b0 = geom->b_lo;
     ts_near_plan_init(&C->near, geom);
     C->near_skip = (TS_NEAR_STEPS + 0.5) * geom->step_m;
+    /* A distance no two samples of a line (nor a ray on the grid) are
+     * apart is no distance: the unbounded sweep, bit for bit. */
+    double longest, shortest;
+    ts_line_geom_step_range(geom, grid->height, &shortest, &longest);
+    C->cap = opts->max_distance > longest * geom->U ? 0.0 : opts->max_distance;
+    /* Within the near field of every row, the near field is all there is. */
+    C->near_only = C->cap > 0 && C->cap <= TS_NEAR_STEPS * shortest;
     return TS_OK;
 }
 
@@ -360,7 +452,8 @@ ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
     long lines = geom.b_hi - geom.b_lo + 1;
     /* One chunk per thread: each chunk re-primes one line. */
     int threads = ts_thread_count(opts->threads, lines);
-    st = ts_parallel_for(threads, lines, sweep_range, &C, err);
+    if (!C.near_only)
+        st = ts_parallel_for(threads, lines, sweep_range, &C, err);
     if (st == TS_OK && !failed)
         st = ts_parallel_for(ts_thread_count(opts->threads, grid->height), grid->height,
                              finish_rows, &C, err);

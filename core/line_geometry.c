@@ -93,6 +93,17 @@ void ts_line_geom_free(ts_line_geom *g)
     memset(g, 0, sizeof *g);
 }
 
+void ts_line_geom_step_range(const ts_line_geom *g, int height, double *shortest,
+                             double *longest)
+{
+    *shortest = *longest = g->step_m;
+    if (g->step_row)
+        for (int y = 0; y < height; y++) {
+            *longest = g->step_row[y] > *longest ? g->step_row[y] : *longest;
+            *shortest = g->step_row[y] < *shortest ? g->step_row[y] : *shortest;
+        }
+}
+
 int ts_line_k_range(const ts_line_geom *g, long b, int *k0, int *k1)
 {
     return cm_line_k_range(g->fl, g->U, g->V, g->t >= 0, b, k0, k1);

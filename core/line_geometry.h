@@ -39,6 +39,12 @@ ts_status ts_line_geom_init(ts_line_geom *g, const ts_grid *grid, double azimuth
                             ts_error *err);
 void ts_line_geom_free(ts_line_geom *g);
 
+/* The shortest and longest metres per step over the grid's `height` rows.
+ * No two samples of a line (nor a ray on the grid) are farther apart than
+ * longest * U: a maximum distance beyond that caps nothing. */
+void ts_line_geom_step_range(const ts_line_geom *g, int height, double *shortest,
+                             double *longest);
+
 /* First and last k (inclusive) at which line b's lower row b + fl[k] lies in
  * [0, V-1]; returns 0 if the line misses the grid. */
 int ts_line_k_range(const ts_line_geom *g, long b, int *k0, int *k1);

@@ -87,6 +87,65 @@ START_TEST(test_max_distance)
 }
 END_TEST
 
+START_TEST(test_max_distance_short)
+{
+    /* 45 m ends inside the near field (no lines at all); 125 m ends half a
+     * cell past it, with a far-field window of about one cell; 1234 m
+     * slides a window over every line */
+    ts_grid g;
+    tdem_create(&g, 200, 150, 10.0, 10.0);
+    tdem_fractal(&g, 7, 300.0);
+    const double dist[] = {45.0, 125.0, 1234.0};
+    for (int k = 0; k < 3; k++) {
+        char label[64];
+        snprintf(label, sizeof label, "fractal, max_distance %g m", dist[k]);
+        ts_horizon_opts o = opts_with(1, dist[k]);
+        sweep_vs_oracle(label, &g, &o, 1);
+    }
+    ts_grid_free(&g);
+}
+END_TEST
+
+/* jacksboro, a geographic grid: per-row east-west spacing, curvature on
+ * (k = 0.13), every 3rd cell against the oracle. */
+static void jacksboro_vs_oracle(const char *label, double max_distance)
+{
+    ts_grid g;
+    tdem_load(&g, "jacksboro");
+    ts_horizon_opts o = opts_with(1, max_distance);
+    sweep_vs_oracle(label, &g, &o, 3);
+    ts_grid_free(&g);
+}
+
+START_TEST(test_max_distance_geographic)
+{
+    /* windows in metres, not in steps */
+    jacksboro_vs_oracle("jacksboro, max_distance 2500 m", 2500.0);
+}
+END_TEST
+
+START_TEST(test_max_distance_beyond_grid)
+{
+    /* a distance longer than any line is no distance: bit for bit */
+    ts_grid g;
+    tdem_create(&g, 120, 90, 10.0, 10.0);
+    tdem_fractal(&g, 3, 200.0);
+    size_t n = (size_t)g.width * g.height;
+    float *capped = tdem_floats(n), *unbounded = tdem_floats(n);
+    ts_horizon_opts o = opts_with(1, 1e6), u = opts_with(1, 0);
+    for (int k = 0; k < N_AZ; k++) {
+        ts_error err;
+        ck_assert(ts_horizon_sweep(&g, AZ[k], &o, capped, &err) == TS_OK);
+        ck_assert(ts_horizon_sweep(&g, AZ[k], &u, unbounded, &err) == TS_OK);
+        ck_assert_msg(memcmp(capped, unbounded, n * sizeof *capped) == 0,
+                      "az %g: max_distance 1e6 m differs from the unbounded sweep", AZ[k]);
+    }
+    free(capped);
+    free(unbounded);
+    ts_grid_free(&g);
+}
+END_TEST
+
 START_TEST(test_max_distance_lowers)
 {
     /* a shorter search can only lower the horizon, never raise it */
@@ -143,12 +202,7 @@ END_TEST
 
 START_TEST(test_jacksboro)
 {
-    /* geographic grid: per-row east-west spacing, curvature on (k = 0.13) */
-    ts_grid g;
-    tdem_load(&g, "jacksboro");
-    ts_horizon_opts o = opts_with(1, 0);
-    sweep_vs_oracle("jacksboro (every 3rd cell)", &g, &o, 3);
-    ts_grid_free(&g);
+    jacksboro_vs_oracle("jacksboro (every 3rd cell)", 0.0);
 }
 END_TEST
 
@@ -256,6 +310,9 @@ int main(void)
     tcase_add_test(tc, test_sines_curved);
     tcase_add_test(tc, test_hills_anisotropic);
     tcase_add_test(tc, test_max_distance);
+    tcase_add_test(tc, test_max_distance_short);
+    tcase_add_test(tc, test_max_distance_geographic);
+    tcase_add_test(tc, test_max_distance_beyond_grid);
     tcase_add_test(tc, test_max_distance_lowers);
     tcase_add_test(tc, test_jacksboro);
     tcase_add_test(tc, test_lux_compute);

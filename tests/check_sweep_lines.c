@@ -187,6 +187,8 @@ START_TEST(test_sharp_max_distance)
     tdem_create(&g, 120, 90, 10.0, 10.0);
     tdem_sharp(&g, 3);
     check_lines("sharp, max_distance 303.7 m", &g, 0, 0.13, 303.7);
+    /* a window of two or three samples: it empties and refills all along */
+    check_lines("sharp, max_distance 25.3 m", &g, 0, 0.13, 25.3);
     ts_grid_free(&g);
     tdem_create(&g, 120, 90, 100.0, 100.0);
     tdem_sharp(&g, 4);

@@ -100,6 +100,10 @@ double oracle_horizon_ex(const ts_grid *g, int x, int y, double azimuth,
         double tx = ux > 0 ? (floor(px) + 1 - px) / ux : ux < 0 ? (ceil(px) - 1 - px) / ux : INFINITY;
         double ty = uy > 0 ? (floor(py) + 1 - py) / uy : uy < 0 ? (ceil(py) - 1 - py) / uy : INFINITY;
         double step = fmin(s, fmin(tx, ty));
+        /* and on max_distance itself, where a capped horizon often lies */
+        double to_cap = opts->max_distance > 0 ? opts->max_distance - d : INFINITY;
+        if (to_cap > 0 && to_cap < step)
+            step = to_cap;
         px = step == tx ? rint(px + step * ux) : px + step * ux;
         py = step == ty ? rint(py + step * uy) : py + step * uy;
         d += step;
