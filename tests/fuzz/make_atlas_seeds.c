@@ -3,8 +3,8 @@
  * through the real writer (core/shadow_atlas.c). Run by hand when the format
  * changes (see docs/testing.md):
  *
- *   cc -std=c11 -Icore tests/fuzz/make_atlas_seeds.c core/shadow_atlas.c \
- *      core/status.c -llzma -lm -o /tmp/mas && /tmp/mas tests/fuzz/corpus/fuzz_atlas
+ *   cc -std=c11 -D_GNU_SOURCE -Icore tests/fuzz/make_atlas_seeds.c core/shadow_atlas*.c \
+ *      core/status.c core/datetime.c -llzma -lm -o /tmp/mas && /tmp/mas tests/fuzz/corpus/fuzz_atlas
  */
 #include <stdio.h>
 #include <stdlib.h>
