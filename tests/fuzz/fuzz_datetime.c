@@ -17,6 +17,7 @@
 #include "fuzz_util.h"
 #include "day_cycle.h"
 #include "terrashade_sun.h"
+#include "tsd_datetime.h"
 #include "tsd_options.h"
 
 static void check_iso(const char *s)

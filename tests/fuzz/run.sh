@@ -20,10 +20,20 @@ SECONDS_PER_TARGET=${1:-${FUZZ_TIME:-60}}
 BUILD=${FUZZ_BUILD:-$SRC/tests/fuzz/build}
 ARTIFACTS=${FUZZ_ARTIFACTS:-$SRC/tests/fuzz/artifacts}
 
-built=$("$SRC/tests/fuzz/build.sh" "$BUILD" | sed -n 's/^built: //p') || {
+# The build's own exit status decides (a pipeline would report sed's), and
+# no target built is a failure too: a run that fuzzes nothing must not pass.
+blog=$(mktemp)
+if ! "$SRC/tests/fuzz/build.sh" "$BUILD" >"$blog"; then
+    rm -f "$blog"
     echo "fuzz: build failed"
     exit 1
-}
+fi
+built=$(sed -n 's/^built: //p' "$blog")
+rm -f "$blog"
+if [ -z "$built" ]; then
+    echo "fuzz: no target was built"
+    exit 1
+fi
 targets=${*:-$built}
 mkdir -p "$ARTIFACTS"
 scratch=$(mktemp -d)
