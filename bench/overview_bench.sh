@@ -39,27 +39,7 @@ trap 'rm -rf "$WORK"' EXIT INT TERM
 DEM="$WORK/fractal_${SIZE}.tif"
 
 echo "== DEM: $SIZE x $SIZE cells of 10 m, EPSG:32617, Float32 (fractal, seed 42)"
-"$PYTHON" - "$SIZE" "$DEM" <<'EOF'
-import sys
-import numpy as np
-from osgeo import gdal, osr
-n, path = int(sys.argv[1]), sys.argv[2]
-rng = np.random.default_rng(42)
-f = np.hypot(np.fft.fftfreq(n)[None, :], np.fft.fftfreq(n)[:, None])
-f[0, 0] = 1
-spec = (rng.standard_normal((n, n)) + 1j * rng.standard_normal((n, n))) / f ** 1.1
-spec[0, 0] = 0
-z = np.fft.ifft2(spec).real
-z = (100 + 1400 * (z - z.min()) / (z.max() - z.min())).astype(np.float32)
-ds = gdal.GetDriverByName("GTiff").Create(path, n, n, 1, gdal.GDT_Float32,
-                                          ["TILED=YES"])
-ds.SetGeoTransform((500000.0, 10.0, 0.0, 4000000.0, 0.0, -10.0))
-srs = osr.SpatialReference()
-srs.ImportFromEPSG(32617)
-ds.SetProjection(srs.ExportToWkt())
-ds.GetRasterBand(1).WriteArray(z)
-ds = None
-EOF
+"$PYTHON" "$(dirname "$0")/fractal_tif.py" "$SIZE" "$DEM"
 
 echo "== machine: $(nproc 2>/dev/null || echo '?') CPU(s), load $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null);" \
      "GDAL $(gdal-config --version 2>/dev/null || gdalinfo --version)"

@@ -1,0 +1,23 @@
+"""The benchmarks' DEM: an N x N spectral fractal GeoTIFF (bench/*.sh).
+
+Usage: fractal_tif.py N PATH   (10 m cells, EPSG:32617, Float32, seed 42)
+"""
+import sys
+import numpy as np
+from osgeo import gdal, osr
+n, path = int(sys.argv[1]), sys.argv[2]
+rng = np.random.default_rng(42)
+f = np.hypot(np.fft.fftfreq(n)[None, :], np.fft.fftfreq(n)[:, None])
+f[0, 0] = 1
+spec = (rng.standard_normal((n, n)) + 1j * rng.standard_normal((n, n))) / f ** 1.1
+spec[0, 0] = 0
+z = np.fft.ifft2(spec).real
+z = (100 + 1400 * (z - z.min()) / (z.max() - z.min())).astype(np.float32)
+ds = gdal.GetDriverByName("GTiff").Create(path, n, n, 1, gdal.GDT_Float32,
+                                          ["TILED=YES"])
+ds.SetGeoTransform((500000.0, 10.0, 0.0, 4000000.0, 0.0, -10.0))
+srs = osr.SpatialReference()
+srs.ImportFromEPSG(32617)
+ds.SetProjection(srs.ExportToWkt())
+ds.GetRasterBand(1).WriteArray(z)
+ds = None
