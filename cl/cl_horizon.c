@@ -8,6 +8,11 @@
  * planes as fit the device (per azimuth the output plane and two planes of
  * far-field occluders, the one handed from each line to the next), and the
  * lines of a batch in launches of as many hull stacks as fit.
+ *
+ * The kernels see each azimuth's grid u-major (cl/horizon.cl): azimuths
+ * along x read a transposed copy of the heights, made once per call on the
+ * device, and their horizon planes are transposed back on the device
+ * (into the then unused occluder buffer) before they are read.
  */
 #ifdef HAVE_CONFIG_H
 #include <config.h>
@@ -29,6 +34,23 @@
 #define CPU_STACK_BUDGET (256ull << 20)
 /* Azimuths per batch, at most. */
 #define MAX_BATCH 32
+
+/* Transpose the R x C matrix of 32-bit values at element soff of src into
+ * dst at element doff (ts_transpose); wg: the work-group size, >= 32. */
+static void transpose(ts_cl_job *J, cl_kernel k, size_t wg, cl_mem src, cl_long soff, int R,
+                      int C, cl_mem dst, cl_long doff)
+{
+    const cl_int cR = R, cC = C;
+    ts_cl_job_arg(J, k, 0, sizeof src, &src);
+    ts_cl_job_arg(J, k, 1, sizeof soff, &soff);
+    ts_cl_job_arg(J, k, 2, sizeof cR, &cR);
+    ts_cl_job_arg(J, k, 3, sizeof cC, &cC);
+    ts_cl_job_arg(J, k, 4, sizeof dst, &dst);
+    ts_cl_job_arg(J, k, 5, sizeof doff, &doff);
+    size_t local[2] = {32, wg / 32};
+    size_t global[2] = {ts_cl_round_up((size_t)C, 32), ((size_t)R + 31) / 32 * local[1]};
+    ts_cl_job_run(J, k, 2, global, local, "ts_transpose");
+}
 
 /* Fill the table rows of azimuth `a` of a batch; returns 0 on NOMEM. */
 static int fill_azimuth(const ts_grid *pg, double azimuth, int a, int line0, int floff,
@@ -123,8 +145,9 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
     if (A < 1)
         A = 1; /* the buffers below then fail with a clean error */
 
-    /* Lines per batch, for the hull stacks. */
-    int max_items = 0;
+    /* Lines per batch, for the hull stacks; whether an azimuth runs along x
+     * (and needs the transposed heights). */
+    int max_items = 0, any_xm = 0;
     {
         ts_line_geom G;
         int items = 0;
@@ -136,6 +159,7 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
                 break;
             }
             items += (int)(G.b_hi - G.b_lo + 1);
+            any_xm |= G.x_major;
             ts_line_geom_free(&G);
             if (items > max_items)
                 max_items = items;
@@ -166,7 +190,11 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
         ts_cl_job_fail(&J, TS_ERR_NOMEM, "cannot allocate the horizon sweep tables");
 
     cl_mem zb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, plane_bytes, zsrc, "heights");
-    cl_mem ob = ts_cl_job_buffer(&J, CL_MEM_WRITE_ONLY, A * plane_bytes, NULL, "horizon planes");
+    /* The heights u-major for azimuths along x (else unused: zb stands in). */
+    cl_mem ztb = any_xm ? ts_cl_job_buffer(&J, CL_MEM_READ_WRITE, plane_bytes, NULL,
+                                           "transposed heights")
+                        : zb;
+    cl_mem ob = ts_cl_job_buffer(&J, CL_MEM_READ_WRITE, A * plane_bytes, NULL, "horizon planes");
     cl_mem hib = ts_cl_job_buffer(&J, CL_MEM_READ_WRITE, A * occ_bytes, NULL,
                                   "far-field occluders");
     cl_mem lob = ts_cl_job_buffer(&J, CL_MEM_READ_WRITE, A * occ_bytes, NULL,
@@ -183,8 +211,17 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
     cl_mem srb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, sr ? A * H * rs : 16, NULL, "step table");
     cl_kernel k1 = ts_cl_job_kernel(&J, "ts_sweep_lines");
     cl_kernel k2 = ts_cl_job_kernel(&J, "ts_sweep_finish");
+    cl_kernel k3 = ts_cl_job_kernel(&J, "ts_transpose");
     size_t wg1 = ts_cl_job_wg(&J, k1, 64);
     size_t wg2 = ts_cl_job_wg(&J, k2, D->is_cpu ? 256 : 128);
+    size_t wg3 = ts_cl_job_wg(&J, k3, 256);
+    if (J.st == TS_OK && wg3 < 32)
+        ts_cl_job_fail(&J, TS_ERR_INTERNAL,
+                       "OpenCL device %.60s runs work-groups of %zu work-items, fewer than "
+                       "the 32 the horizon kernels need",
+                       D->info.device, wg3);
+    if (any_xm)
+        transpose(&J, k3, wg3, zb, 0, H, W, ztb, 0);
     const cl_int cW = W, cH = H, cslots = (cl_int)nslots;
     const cl_long cplane = (cl_long)cells;
 
@@ -219,7 +256,7 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
         const cl_int cnaz = nb, citems = items;
         /* pass 1: lines */
         ts_cl_job_arg(&J, k1, 0, sizeof zb, &zb);
-        ts_cl_job_arg(&J, k1, 1, sizeof cW, &cW);
+        ts_cl_job_arg(&J, k1, 1, sizeof ztb, &ztb);
         ts_cl_job_arg(&J, k1, 2, sizeof cnaz, &cnaz);
         ts_cl_job_arg(&J, k1, 3, sizeof ipb, &ipb);
         ts_cl_job_arg(&J, k1, 4, sizeof dpb, &dpb);
@@ -243,22 +280,37 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
         }
         /* pass 2: cells */
         ts_cl_job_arg(&J, k2, 0, sizeof zb, &zb);
-        ts_cl_job_arg(&J, k2, 1, sizeof cW, &cW);
-        ts_cl_job_arg(&J, k2, 2, sizeof cH, &cH);
-        ts_cl_job_arg(&J, k2, 3, sizeof ipb, &ipb);
-        ts_cl_job_arg(&J, k2, 4, sizeof dpb, &dpb);
-        ts_cl_job_arg(&J, k2, 5, sizeof frb, &frb);
-        ts_cl_job_arg(&J, k2, 6, sizeof srb, &srb);
-        ts_cl_job_arg_real(&J, k2, 7, c);
-        ts_cl_job_arg_real(&J, k2, 8, cap);
-        ts_cl_job_arg(&J, k2, 9, sizeof ob, &ob);
-        ts_cl_job_arg(&J, k2, 10, sizeof hib, &hib);
-        ts_cl_job_arg(&J, k2, 11, sizeof lob, &lob);
-        ts_cl_job_arg(&J, k2, 12, sizeof cplane, &cplane);
+        ts_cl_job_arg(&J, k2, 1, sizeof ztb, &ztb);
+        ts_cl_job_arg(&J, k2, 2, sizeof cW, &cW);
+        ts_cl_job_arg(&J, k2, 3, sizeof cH, &cH);
+        ts_cl_job_arg(&J, k2, 4, sizeof ipb, &ipb);
+        ts_cl_job_arg(&J, k2, 5, sizeof dpb, &dpb);
+        ts_cl_job_arg(&J, k2, 6, sizeof frb, &frb);
+        ts_cl_job_arg(&J, k2, 7, sizeof srb, &srb);
+        ts_cl_job_arg_real(&J, k2, 8, c);
+        ts_cl_job_arg_real(&J, k2, 9, cap);
+        ts_cl_job_arg(&J, k2, 10, sizeof ob, &ob);
+        ts_cl_job_arg(&J, k2, 11, sizeof hib, &hib);
+        ts_cl_job_arg(&J, k2, 12, sizeof lob, &lob);
+        ts_cl_job_arg(&J, k2, 13, sizeof cplane, &cplane);
         size_t global2[2] = {ts_cl_round_up(cells, wg2), (size_t)nb}, local2[2] = {wg2, 1};
         ts_cl_job_run(&J, k2, 2, global2, local2, "ts_sweep_finish");
-        ts_cl_job_read(&J, ob, 0, (size_t)nb * plane_bytes, out + (size_t)first * cells,
-                       "horizon planes");
+        /* Planes along x back into rows, into the occluder buffer (free
+         * now, and twice a plane's size); then read each run of planes
+         * that lie in one buffer at once. */
+        for (int a = 0; a < nb; a++)
+            if (ip[(size_t)a * TS_CLI_N + TS_CLI_XMAJOR])
+                transpose(&J, k3, wg3, ob, (cl_long)(a * cells), W, H, hib,
+                          (cl_long)(a * cells));
+        for (int a = 0; a < nb;) {
+            const int xm = ip[(size_t)a * TS_CLI_N + TS_CLI_XMAJOR];
+            int e = a + 1;
+            while (e < nb && ip[(size_t)e * TS_CLI_N + TS_CLI_XMAJOR] == xm)
+                e++;
+            ts_cl_job_read(&J, xm ? hib : ob, a * plane_bytes, (size_t)(e - a) * plane_bytes,
+                           out + ((size_t)first + a) * cells, "horizon planes");
+            a = e;
+        }
     }
     ts_status st = ts_cl_job_end(&J);
     if (st == TS_OK)

@@ -3,6 +3,15 @@
  * core/near_field.c, one work-item per line or cell; the per-cell formulas
  * are core/cellmath/cm_near_field.h.
  *
+ * Memory layout: both passes index the grid "u-major", element (u, v) of
+ * an azimuth at u * V + v, so that neighbouring lines (pass 1) and
+ * neighbouring cells (pass 2) touch neighbouring addresses, which a GPU
+ * coalesces into one transaction. For azimuths along y (u = y, v = x) that
+ * is the DEM's own row-major layout; for azimuths along x (u = x, v = y)
+ * the kernels read a transposed copy of the heights (zt, made by
+ * ts_transpose), keep their occluder planes transposed and write the
+ * horizon plane transposed, which ts_transpose turns back into rows.
+ *
  * Pass 1 (ts_sweep_lines): one work-item per sweep line, lines of several
  * azimuths in one launch. Each keeps its convex hull in a stack of (d, g)
  * points (and their step indices k) in global memory, interleaved across
@@ -53,7 +62,7 @@ int2 ts_hull_query(__global const real2 *S, __global const int *SK, long ns, int
  * stack / stack_k hold nslots interleaved stacks of (longest line + 1)
  * entries.
  */
-__kernel void ts_sweep_lines(__global const float *z, const int W, const int naz,
+__kernel void ts_sweep_lines(__global const float *zr, __global const float *zt, const int naz,
                              __global const int *ip, __global const real *dp,
                              __global const int *fl_all, __global const float *fr_all,
                              __global const real *sr_all, const int item0, const int nitems,
@@ -72,8 +81,8 @@ __kernel void ts_sweep_lines(__global const float *z, const int W, const int naz
     __global const real *Q = dp + a * TS_CLD_N;
     const int xm = P[TS_CLI_XMAJOR], U = P[TS_CLI_U], V = P[TS_CLI_V];
     const int u_start = P[TS_CLI_USTART], u_step = P[TS_CLI_USTEP];
-    const long su = xm ? 1 : W;
-    const long u_stride = su * u_step, v_stride = xm ? W : 1, origin = su * u_start;
+    __global const float *z = xm ? zt : zr; /* u-major heights */
+    const long u_stride = (long)V * u_step, v_stride = 1, origin = (long)V * u_start;
     __global const int *fl = fl_all + P[TS_CLI_FLOFF];
     __global const float *fr = fr_all + P[TS_CLI_FLOFF];
     const int sroff = P[TS_CLI_SROFF];
@@ -218,8 +227,10 @@ float ts_near_fast(__global const float *zc, __global const int *P, __global con
     return best;
 }
 
-/* Pass 2: global size (cells rounded up, azimuths in the batch). */
-__kernel void ts_sweep_finish(__global const float *z, const int W, const int H,
+/* Pass 2: global size (cells rounded up, azimuths in the batch); work-item
+ * `cell` is the cell u * V + v of its azimuth's u-major layout. */
+__kernel void ts_sweep_finish(__global const float *zr, __global const float *zt, const int W,
+                              const int H,
                               __global const int *ip, __global const real *dp,
                               __global const float *fr_all, __global const real *sr_all,
                               const real c, const real cap, __global float *out,
@@ -232,17 +243,17 @@ __kernel void ts_sweep_finish(__global const float *z, const int W, const int H,
     __global const int *P = ip + a * TS_CLI_N;
     __global const real *Q = dp + a * TS_CLD_N;
     const long po = P[TS_CLI_PLANE] * plane + cell;
+    const int xm = P[TS_CLI_XMAJOR], V = P[TS_CLI_V];
+    __global const float *z = xm ? zt : zr; /* u-major heights */
     const float hc = z[cell];
     if (isnan(hc)) {
         out[po] = NAN;
         return;
     }
-    const int y = (int)(cell / W), x = (int)(cell - (long)y * W);
-    const int xm = P[TS_CLI_XMAJOR], V = P[TS_CLI_V];
+    const int u = (int)(cell / V), v = (int)(cell - (long)u * V);
+    const int x = xm ? u : v, y = xm ? v : u;
     const int u_start = P[TS_CLI_USTART], u_step = P[TS_CLI_USTEP];
-    const long su = xm ? 1 : W;
-    const long u_stride = su * u_step, v_stride = xm ? W : 1, origin = su * u_start;
-    const int u = xm ? x : y, v = xm ? y : x;
+    const long u_stride = (long)V * u_step, v_stride = 1, origin = (long)V * u_start;
     const int k = (u - u_start) * u_step;
     const float F = fr_all[P[TS_CLI_FLOFF] + k];
     const int2 none = (int2)(-1, 0);
@@ -270,4 +281,33 @@ __kernel void ts_sweep_finish(__global const float *z, const int W, const int H,
         res = left ? nf : fmax(nf, farf);
     }
     out[po] = ts_atan_deg(res);
+}
+
+/* ------------------------------------------------------------- transpose */
+
+#define TS_TR_TILE 32
+
+/* dst[c * R + r] = src[r * C + c] for the R x C matrix at src + soff, into
+ * dst + doff, as bits (a NaN's payload is kept). One work-group of 32 x n
+ * work-items (n = 1 .. 32) per 32 x 32 tile, global size (C rounded up to
+ * 32) x (tiles along R times n): the tile goes through local memory so that
+ * both the reads and the writes run along rows. */
+__kernel void ts_transpose(__global const uint *src, const long soff, const int R, const int C,
+                           __global uint *dst, const long doff)
+{
+    __local uint tile[TS_TR_TILE][TS_TR_TILE + 1]; /* +1: no bank conflicts */
+    const int lx = (int)get_local_id(0), ly0 = (int)get_local_id(1);
+    const int ny = (int)get_local_size(1);
+    const int c0 = (int)get_group_id(0) * TS_TR_TILE, r0 = (int)get_group_id(1) * TS_TR_TILE;
+    for (int ly = ly0; ly < TS_TR_TILE; ly += ny) {
+        const int r = r0 + ly, c = c0 + lx;
+        if (r < R && c < C)
+            tile[ly][lx] = src[soff + (long)r * C + c];
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+    for (int ly = ly0; ly < TS_TR_TILE; ly += ny) {
+        const int c = c0 + ly, r = r0 + lx;
+        if (r < R && c < C)
+            dst[doff + (long)c * R + r] = tile[lx][ly];
+    }
 }
