@@ -2,6 +2,7 @@
  * cl_bench: the C and the OpenCL backend side by side, product by product.
  *
  *   cl_bench [--size N] [--dirs D] [--repeat R] [--threads T]
+ *   cl_bench --list
  *
  * Generates an N x N fractal DEM (default 1024, fBm value noise, Hurst 0.8,
  * 1500 m relief, 10 m cells), then times, best of R runs, each product on
@@ -15,9 +16,18 @@
  * session: table and normals uploaded once, the sums read back per plane).
  * The OpenCL device is the one
  * TERRASHADE_OPENCL_DEVICE selects; its first use (context and kernel
- * build) is timed separately. Also prints the largest difference between
- * the backends' results.
+ * build) is timed separately; --list prints the devices and their
+ * TERRASHADE_OPENCL_DEVICE values. Also prints the largest difference
+ * between the backends' results (every output: the three normal
+ * components, svf, sky light and openness, the three colours), and, for the
+ * horizons, the time the device takes to copy the planes to host memory
+ * (the same bytes in the same buffer sizes, timed alone), so that the
+ * kernels' own rate can be told from the bus's.
  */
+#ifdef HAVE_CONFIG_H
+#include <config.h>
+#endif
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,6 +38,9 @@
 #include "terrashade_cl.h"
 #include "terrashade_env.h"
 #include "test_dem.h"
+#ifdef HAVE_OPENCL
+#include "cl_internal.h"
+#endif
 
 static double now(void)
 {
@@ -49,6 +62,67 @@ static double maxdiff(const float *a, const float *b, size_t n)
         if (!isnan(a[i]) && !isnan(b[i]) && fabs((double)a[i] - b[i]) > m)
             m = fabs((double)a[i] - b[i]);
     return m;
+}
+
+/* The largest difference over the n-cell planes of a and b. */
+static double maxdiff3(float *const a[3], float *const b[3], int planes, size_t n)
+{
+    double m = 0;
+    for (int i = 0; i < planes; i++) {
+        double d = maxdiff(a[i], b[i], n);
+        m = d > m ? d : m;
+    }
+    return m;
+}
+
+/* Seconds the selected device takes to copy `bytes` of a buffer into host
+ * memory dst, in reads of at most one horizon batch (32 planes of
+ * `plane` bytes) and the device's largest buffer, as ts_cl_horizon_compute
+ * reads its planes; best of `repeat`. -1 when it cannot be measured. */
+static double readback_seconds(void *dst, size_t bytes, size_t plane, int repeat)
+{
+#ifdef HAVE_OPENCL
+    ts_error e;
+    ts_cl_job J;
+    if (ts_cl_job_begin(&J, &e) != TS_OK)
+        return -1;
+    size_t chunk = 32 * plane < bytes ? 32 * plane : bytes;
+    while (chunk > J.max_alloc && chunk > plane)
+        chunk -= plane;
+    cl_mem m = ts_cl_job_buffer(&J, CL_MEM_READ_WRITE, chunk, NULL, "read-back test");
+    ts_cl_job_fill0(&J, m, chunk, "read-back test");
+    if (J.st == TS_OK)
+        clFinish(J.d->queue);
+    double best = 1e30;
+    for (int r = 0; r < repeat && J.st == TS_OK; r++) {
+        double t = now();
+        for (size_t off = 0; off < bytes; off += chunk)
+            ts_cl_job_read(&J, m, 0, bytes - off < chunk ? bytes - off : chunk,
+                           (char *)dst + off, "read-back test");
+        t = now() - t;
+        best = t < best ? t : best;
+    }
+    return ts_cl_job_end(&J) == TS_OK ? best : -1;
+#else
+    (void)dst, (void)bytes, (void)plane, (void)repeat;
+    return -1;
+#endif
+}
+
+/* --list: every OpenCL device with its TERRASHADE_OPENCL_DEVICE value. */
+static int list_devices(void)
+{
+    ts_cl_info d[32];
+    int n = 0;
+    ts_error e;
+    if (ts_cl_devices(d, 32, &n, &e) != TS_OK) {
+        fprintf(stderr, "cl_bench: %s\n", e.message);
+        return 1;
+    }
+    for (int i = 0; i < n && i < 32; i++)
+        printf("%d\t%d:%d\t%s\t%s\t%s\t%s\n", d[i].index, d[i].platform_index,
+               d[i].device_index, d[i].type, d[i].platform, d[i].device, d[i].version);
+    return 0;
 }
 
 /* Everything a product needs, so that one function can run either backend. */
@@ -130,6 +204,8 @@ int main(int argc, char **argv)
 {
     int size = 1024, dirs = 16, repeat = 3, threads = 0;
     for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--list"))
+            return list_devices();
         if (!strcmp(argv[i], "--size") && i + 1 < argc)
             size = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--dirs") && i + 1 < argc)
@@ -139,7 +215,8 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc)
             threads = atoi(argv[++i]);
         else {
-            fprintf(stderr, "usage: %s [--size N] [--dirs D] [--repeat R] [--threads T]\n",
+            fprintf(stderr,
+                    "usage: %s [--size N] [--dirs D] [--repeat R] [--threads T] | --list\n",
                     argv[0]);
             return 2;
         }
@@ -154,8 +231,10 @@ int main(int argc, char **argv)
     if (ts_cl_available(&info, &e) != TS_OK)
         die("OpenCL", &e);
     double t_init = now() - t0;
-    printf("OpenCL device: %s (%s), %s, %d compute units, fp64 %s\n", info.device, info.platform,
-           info.type, info.compute_units, info.fp64 ? "yes" : "no");
+    printf("OpenCL device %d: %s (%s), %s, %d compute units, %.1f GiB, fp64 %s\n", info.index,
+           info.device, info.platform, info.type, info.compute_units,
+           info.global_mem / 1073741824.0, info.fp64 ? "yes" : "no");
+    printf("OpenCL version: %s\n", info.version);
     printf("first use (context, program build): %.2f s\n", t_init);
     printf("C backend: %d threads\n", threads ? threads : ts_cpu_count());
 
@@ -177,8 +256,10 @@ int main(int argc, char **argv)
     c.out = malloc(c.n * sizeof(float));
     c.out2 = malloc(c.n * sizeof(float));
     c.out3 = malloc(c.n * sizeof(float));
-    float *ref = malloc(c.n * sizeof(float));
-    if (!hz_cl || !c.hz || !c.nx || !c.ny || !c.nz || !c.out || !c.out2 || !c.out3 || !ref) {
+    float *ref = malloc(c.n * sizeof(float)), *ref2 = malloc(c.n * sizeof(float)),
+          *ref3 = malloc(c.n * sizeof(float));
+    if (!hz_cl || !c.hz || !c.nx || !c.ny || !c.nz || !c.out || !c.out2 || !c.out3 || !ref ||
+        !ref2 || !ref3) {
         fprintf(stderr, "cl_bench: out of memory\n");
         return 1;
     }
@@ -196,7 +277,10 @@ int main(int argc, char **argv)
     printf("\n%d x %d DEM, %d directions; best of %d\n", size, size, dirs, repeat);
     printf("%-32s %10s %10s %10s %7s %10s\n", "product", "unit", "C", "OpenCL", "CL/C",
            "max diff");
+    float *const refs[3] = {ref, ref2, ref3}, *const outs[3] = {c.out, c.out2, c.out3};
+    double t_horizon_cl = 0;
     for (int p = 0; p < P_COUNT; p++) {
+        const int planes = p == P_NORMALS || p == P_SKY || p == P_ENV ? 3 : 1;
         double best[2] = {1e30, 1e30};
         double diff = 0;
         for (int b = 0; b < 2; b++)
@@ -207,11 +291,14 @@ int main(int argc, char **argv)
                 if (t < best[b])
                     best[b] = t;
                 if (r == 0 && b == 0 && p != P_HORIZON)
-                    memcpy(ref, c.out, c.n * sizeof(float));
+                    for (int i = 0; i < planes; i++)
+                        memcpy(refs[i], outs[i], c.n * sizeof(float));
                 if (r == 0 && b == 1)
                     diff = p == P_HORIZON ? maxdiff(c.hz, hz_cl, c.n * dirs)
-                                          : maxdiff(ref, c.out, c.n);
+                                          : maxdiff3(refs, outs, planes, c.n);
             }
+        if (p == P_HORIZON)
+            t_horizon_cl = best[1];
         const int per_dir = p == P_HORIZON || p == P_SKY || p == P_ENV;
         double work = per_dir ? (double)c.n * dirs
                       : p == P_SHM                   ? c.n * 8.0
@@ -221,6 +308,19 @@ int main(int argc, char **argv)
                work / best[0] / 1e6, work / best[1] / 1e6, best[0] / best[1], diff, best[0],
                best[1]);
     }
+    /* The horizon planes go to host memory: on a GPU that copy can take
+     * longer than the kernels. */
+    double rb = readback_seconds(hz_cl, c.n * dirs * sizeof(float), c.n * sizeof(float), repeat);
+    if (rb >= 0) {
+        double bytes = (double)c.n * dirs * sizeof(float);
+        printf("\nhorizons, OpenCL: %.3f s in all; copying the %d planes (%.0f MiB) to the host "
+               "alone: %.3f s (%.1f GB/s)\n",
+               t_horizon_cl, dirs, bytes / 1048576.0, rb, bytes / rb / 1e9);
+        if (t_horizon_cl > rb)
+            printf("horizons, OpenCL without the copy (difference): %.3f s = %.1f Mpx-dir/s\n",
+                   t_horizon_cl - rb, (double)c.n * dirs / (t_horizon_cl - rb) / 1e6);
+    }
+    free(ref2), free(ref3);
     free(hz_cl), free(c.hz), free(c.nx), free(c.ny), free(c.nz);
     free(c.out), free(c.out2), free(c.out3), free(ref);
     ts_env_table_free(&c.table);
