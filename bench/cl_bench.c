@@ -225,6 +225,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "cl_bench: size, dirs and repeat must be >= 1, threads >= 0\n");
         return 2;
     }
+    if (dirs % 8) {
+        fprintf(stderr, "cl_bench: --dirs must be a multiple of 8 (the direct sun comes from "
+                        "135 degrees, which must be one of the horizons' azimuths), got %d\n",
+                dirs);
+        return 2;
+    }
     ts_error e;
     ts_cl_info info;
     double t0 = now();
