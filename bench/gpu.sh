@@ -15,7 +15,9 @@
 #              (PoCL on a CPU), to test the script itself
 # Environment: CC (default cc), JOBS (parallel compiles, default nproc),
 # BUILD_DIR (default ${TMPDIR:-/tmp}/terrashade-gpu-bench), CL_INCLUDE (a
-# directory holding CL/cl.h), OPENCL_LIB (the ICD loader, libOpenCL.so.1).
+# directory holding CL/cl.h), OPENCL_LIB (the ICD loader, libOpenCL.so.1),
+# NVIDIA_OPENCL_LIB (NVIDIA's OpenCL driver library, libnvidia-opencl.so.1:
+# use it through a private ICD file whatever /etc/OpenCL/vendors holds).
 # Needs: a C11 compiler, the OpenCL headers (opencl-headers, or the CUDA
 # toolkit's), an ICD loader (ocl-icd-libopencl1, or the CUDA toolkit's).
 set -eu
@@ -101,28 +103,33 @@ case $cl_lib in /*) cl_link="$cl_lib -Wl,-rpath,$(dirname "$cl_lib")" ;; esac
 # The NVIDIA OpenCL driver: the ICD file the loader reads, or one of ours
 # pointing at libnvidia-opencl.so.1 (containers often have the library and
 # no /etc/OpenCL/vendors/nvidia.icd).
-nv_icd=
-for d in ${OCL_ICD_VENDORS:-} /etc/OpenCL/vendors /usr/local/etc/OpenCL/vendors; do
-    for f in "$d"/*.icd; do
-        [ -f "$f" ] && grep -qi nvidia "$f" && { nv_icd=$f; break 2; }
+nv_icd='' nv_lib=''
+if [ -n "${NVIDIA_OPENCL_LIB:-}" ]; then
+    [ -f "$NVIDIA_OPENCL_LIB" ] || fail "NVIDIA_OPENCL_LIB=$NVIDIA_OPENCL_LIB: no such file"
+    nv_lib=$NVIDIA_OPENCL_LIB
+else
+    for d in ${OCL_ICD_VENDORS:-} /etc/OpenCL/vendors /usr/local/etc/OpenCL/vendors; do
+        for f in "$d"/*.icd; do
+            [ -f "$f" ] && grep -qi nvidia "$f" && { nv_icd=$f; break 2; }
+        done
     done
-done
+fi
 if [ -n "$nv_icd" ]; then
     say "NVIDIA ICD file: $nv_icd ($(cat "$nv_icd"))"
 else
-    nv_lib=
-    for f in $(ldconfig -p 2>/dev/null | awk '/libnvidia-opencl\.so\.1 / {print $NF}') \
-        /usr/lib/x86_64-linux-gnu/libnvidia-opencl.so.1 /usr/lib64/libnvidia-opencl.so.1 \
-        /usr/lib/aarch64-linux-gnu/libnvidia-opencl.so.1 \
-        /usr/local/nvidia/lib64/libnvidia-opencl.so.1 /usr/lib/libnvidia-opencl.so.1; do
-        [ -f "$f" ] && { nv_lib=$f; break; }
-    done
+    [ -n "$nv_lib" ] ||
+        for f in $(ldconfig -p 2>/dev/null | awk '/libnvidia-opencl\.so\.1 / {print $NF}') \
+            /usr/lib/x86_64-linux-gnu/libnvidia-opencl.so.1 /usr/lib64/libnvidia-opencl.so.1 \
+            /usr/lib/aarch64-linux-gnu/libnvidia-opencl.so.1 \
+            /usr/local/nvidia/lib64/libnvidia-opencl.so.1 /usr/lib/libnvidia-opencl.so.1; do
+            [ -f "$f" ] && { nv_lib=$f; break; }
+        done
     if [ -n "$nv_lib" ]; then
         mkdir -p "$BUILD_DIR/icd"
         printf '%s\n' "$nv_lib" >"$BUILD_DIR/icd/nvidia.icd"
         # ocl-icd reads OCL_ICD_VENDORS, the Khronos loader OCL_ICD_FILENAMES
         export OCL_ICD_VENDORS="$BUILD_DIR/icd" OCL_ICD_FILENAMES="$nv_lib"
-        say "NVIDIA ICD file: none installed; wrote $BUILD_DIR/icd/nvidia.icd -> $nv_lib"
+        say "NVIDIA ICD file: wrote a private one, $BUILD_DIR/icd/nvidia.icd -> $nv_lib"
     else
         say "NVIDIA OpenCL driver: none found (no nvidia .icd file, no libnvidia-opencl.so.1)"
     fi
