@@ -108,10 +108,11 @@ static void run(ctx *c, int p, int cl, float *hout)
         st = cl ? ts_cl_normals(&c->g, c->out, c->out2, c->out3, &e)
                 : ts_normals(&c->g, c->out, c->out2, c->out3, &e);
         break;
-    case P_DIRECT:
-        st = cl ? ts_cl_shade_direct(&c->g, c->nx, c->ny, c->nz, c->hz, &c->o, 135, 30, c->out, &e)
-                : ts_shade_direct(&c->g, c->nx, c->ny, c->nz, c->hz, &c->o, 135, 30, c->out, &e);
+    case P_DIRECT: {
+        const ts_direct_request req = {&c->g, c->nx, c->ny, c->nz, c->hz, &c->o, 135, 30, c->out};
+        st = (cl ? ts_cl_shade_direct : ts_shade_direct)(&req, &e);
         break;
+    }
     case P_SKY:
         st = cl ? ts_cl_sky_terms(&c->g, c->nx, c->ny, c->nz, c->hz, &c->o, c->out, c->out2,
                                   c->out3, &e)

@@ -185,16 +185,10 @@ ts_status ts_backend_normals(ts_backend backend, const ts_grid *grid, float *nx,
     DISPATCH(ts_cl_normals(grid, nx, ny, nz, cl_err), ts_normals(grid, nx, ny, nz, err));
 }
 
-ts_status ts_backend_shade_direct(ts_backend backend, const ts_grid *grid, const float *nx,
-                                  const float *ny, const float *nz, const float *horizons,
-                                  const ts_horizon_opts *opts, double sun_azimuth,
-                                  double sun_elevation, float *out, ts_backend_report *report,
-                                  ts_error *err)
+ts_status ts_backend_shade_direct(ts_backend backend, const ts_direct_request *req,
+                                  ts_backend_report *report, ts_error *err)
 {
-    DISPATCH(ts_cl_shade_direct(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
-                                out, cl_err),
-             ts_shade_direct(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation, out,
-                             err));
+    DISPATCH(ts_cl_shade_direct(req, cl_err), ts_shade_direct(req, err));
 }
 
 ts_status ts_backend_sky_terms(ts_backend backend, const ts_grid *grid, const float *nx,

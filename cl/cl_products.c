@@ -199,29 +199,26 @@ ts_status ts_cl_normals(const ts_grid *grid, float *nx, float *ny, float *nz, ts
 
 /* --------------------------------------------------------------- direct */
 
-ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
-                             const float *nz, const float *horizons, const ts_horizon_opts *opts,
-                             double sun_azimuth, double sun_elevation, float *out, ts_error *err)
+ts_status ts_cl_shade_direct(const ts_direct_request *req, ts_error *err)
 {
-    int k0, k1;
-    double w;
-    cl_float light[3];
-    ts_status st = ts_direct_setup(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
-                                   out, &k0, &k1, &w, light, err);
+    ts_direct_plan p;
+    ts_status st = ts_direct_setup(req, &p, err);
     if (st != TS_OK)
         return st;
-    const size_t cells = (size_t)grid->width * grid->height, bytes = cells * sizeof(float);
+    const float *horizons = req->horizons;
+    const size_t cells = (size_t)req->grid->width * req->grid->height;
+    const size_t bytes = cells * sizeof(float);
     ts_cl_job J;
     if (ts_cl_job_begin(&J, err) != TS_OK)
         return J.st;
-    cl_mem xb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, nx, "normals");
-    cl_mem yb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, ny, "normals");
-    cl_mem zb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, nz, "normals");
-    cl_mem h0 = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, horizons + cells * k0,
+    cl_mem xb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, req->nx, "normals");
+    cl_mem yb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, req->ny, "normals");
+    cl_mem zb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, req->nz, "normals");
+    cl_mem h0 = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, horizons + cells * p.k0,
                                  "horizon plane");
-    cl_mem h1 = k1 == k0 ? h0
-                         : ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, horizons + cells * k1,
-                                            "horizon plane");
+    cl_mem h1 = p.k1 == p.k0 ? h0
+                             : ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes,
+                                                horizons + cells * p.k1, "horizon plane");
     cl_mem ob = ts_cl_job_buffer(&J, CL_MEM_WRITE_ONLY, bytes, NULL, "direct light");
     cl_kernel k = ts_cl_job_kernel(&J, "ts_direct");
     const cl_long ccells = (cl_long)cells;
@@ -231,18 +228,18 @@ ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *
     ts_cl_job_arg(&J, k, 3, sizeof h0, &h0);
     ts_cl_job_arg(&J, k, 4, sizeof h1, &h1);
     ts_cl_job_arg(&J, k, 5, sizeof ccells, &ccells);
-    const cl_float fw = (float)w;
+    const cl_float fw = (float)p.w;
     ts_cl_job_arg(&J, k, 6, sizeof fw, &fw);
     for (int j = 0; j < 3; j++)
-        ts_cl_job_arg(&J, k, 7 + j, sizeof light[j], &light[j]);
+        ts_cl_job_arg(&J, k, 7 + j, sizeof p.light[j], &p.light[j]);
     /* as core/shading.c */
-    const cl_float el_deg = (float)sun_elevation, inv_r = (float)(1.0 / TS_SUN_RADIUS_DEG);
+    const cl_float el_deg = (float)req->sun_elevation, inv_r = (float)(1.0 / TS_SUN_RADIUS_DEG);
     ts_cl_job_arg(&J, k, 10, sizeof el_deg, &el_deg);
     ts_cl_job_arg(&J, k, 11, sizeof inv_r, &inv_r);
     ts_cl_job_arg(&J, k, 12, sizeof ob, &ob);
     size_t L = ts_cl_job_wg(&J, k, 256), global = ts_cl_round_up(cells, L);
     ts_cl_job_run(&J, k, 1, &global, &L, "ts_direct");
-    ts_cl_job_read(&J, ob, 0, bytes, out, "direct light");
+    ts_cl_job_read(&J, ob, 0, bytes, req->out, "direct light");
     return ts_cl_job_end(&J);
 }
 

@@ -62,12 +62,9 @@ ts_status ts_cl_normals(const ts_grid *grid, float *nx, float *ny, float *nz, ts
     return NOT_BUILT(err);
 }
 
-ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
-                             const float *nz, const float *horizons, const ts_horizon_opts *opts,
-                             double sun_azimuth, double sun_elevation, float *out, ts_error *err)
+ts_status ts_cl_shade_direct(const ts_direct_request *req, ts_error *err)
 {
-    (void)grid, (void)nx, (void)ny, (void)nz, (void)horizons, (void)opts;
-    (void)sun_azimuth, (void)sun_elevation, (void)out;
+    (void)req;
     return NOT_BUILT(err);
 }
 

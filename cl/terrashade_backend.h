@@ -83,11 +83,7 @@ ts_status ts_backend_normals(ts_backend backend, const ts_grid *grid, float *nx,
                              float *ny, float *nz, ts_backend_report *report,
                              ts_error *err);
 
-ts_status ts_backend_shade_direct(ts_backend backend, const ts_grid *grid,
-                                  const float *nx, const float *ny,
-                                  const float *nz, const float *horizons,
-                                  const ts_horizon_opts *opts, double sun_azimuth,
-                                  double sun_elevation, float *out,
+ts_status ts_backend_shade_direct(ts_backend backend, const ts_direct_request *req,
                                   ts_backend_report *report, ts_error *err);
 
 ts_status ts_backend_sky_terms(ts_backend backend, const ts_grid *grid,

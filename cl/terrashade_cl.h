@@ -104,11 +104,8 @@ ts_status ts_cl_shm_compute(const ts_grid *grid, double azimuth, double elevatio
 ts_status ts_cl_normals(const ts_grid *grid, float *nx, float *ny, float *nz,
                         ts_error *err);
 
-/** ts_shade_direct on the device. */
-ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
-                             const float *nz, const float *horizons,
-                             const ts_horizon_opts *opts, double sun_azimuth,
-                             double sun_elevation, float *out, ts_error *err);
+/** The direct sun on the device (ts_shade_direct_fn). */
+ts_shade_direct_fn ts_cl_shade_direct;
 
 /** ts_sky_terms on the device (any of svf, sky, openness may be NULL). */
 ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,

@@ -34,14 +34,17 @@ ts_status ts_check_sky_terms_args(const ts_grid *grid, const float *nx, const fl
 ts_status ts_check_horizon_compute_args(const ts_grid *grid, const ts_horizon_opts *opts,
                                         const float *out, ts_error *err);
 
-/* Checks of ts_shade_direct's arguments, the two computed azimuths the
- * sun's lies between (planes k0 and k1, weight w of k1) and the unit vector
- * toward the sun (east, north, up) in light[]. */
-ts_status ts_direct_setup(const ts_grid *grid, const float *nx, const float *ny,
-                          const float *nz, const float *horizons,
-                          const ts_horizon_opts *opts, double sun_azimuth,
-                          double sun_elevation, const float *out, int *k0, int *k1,
-                          double *w, float light[3], ts_error *err);
+/* What both backends' direct sun derive from a ts_direct_request: the two
+ * computed azimuths the sun's lies between (planes k0 and k1, weight w of
+ * k1) and the unit vector toward the sun (east, north, up). */
+typedef struct {
+    int k0, k1;
+    double w;
+    float light[3];
+} ts_direct_plan;
+
+/* Checks of a ts_direct_request, then its plan. */
+ts_status ts_direct_setup(const ts_direct_request *req, ts_direct_plan *plan, ts_error *err);
 
 /* Checks of ts_env_light_accumulate's arguments (outputs only for NULL). */
 ts_status ts_check_env_light_args(const ts_grid *grid, const ts_env_table *table, int k,

@@ -208,17 +208,27 @@ ts_status ts_normals(const ts_grid *grid, float *nx, float *ny, float *nz,
  */
 double ts_sun_disk_fraction(double sun_elevation, double horizon);
 
+/** What the direct sun is computed from and into (ts_shade_direct_fn). */
+typedef struct {
+    const ts_grid *grid;
+    const float *nx, *ny, *nz;   /**< unit normals from ts_normals */
+    const float *horizons;       /**< opts->directions planes, layout of ts_horizon_compute */
+    const ts_horizon_opts *opts; /**< the options the horizons were computed with */
+    double sun_azimuth;          /**< degrees from north, finite */
+    double sun_elevation;        /**< degrees, in [-90, 90] */
+    float *out;                  /**< width*height: the direct light, NaN for nodata */
+} ts_direct_request;
+
 /**
  * Direct sun: max(0, N.L) times the visible fraction of the sun's disk above
  * the horizon at the sun's azimuth, interpolated between the two nearest of
- * the `opts->directions` computed azimuths in `horizons` (layout of
- * ts_horizon_compute). Normals from ts_normals. `out` width*height, NaN for
- * nodata.
+ * the `opts->directions` computed azimuths. Every pointer of the request
+ * must be set. The type of every backend's direct sun (terrashade_cl.h).
  */
-ts_status ts_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
-                          const float *nz, const float *horizons,
-                          const ts_horizon_opts *opts, double sun_azimuth,
-                          double sun_elevation, float *out, ts_error *err);
+typedef ts_status ts_shade_direct_fn(const ts_direct_request *req, ts_error *err);
+
+/** The direct sun on the C backend. */
+ts_shade_direct_fn ts_shade_direct;
 
 /**
  * Sky terms from horizons (layout of ts_horizon_compute), any output may be

@@ -183,16 +183,21 @@ START_TEST(test_shading_args)
     EXPECT_ARG(ts_normals(NULL, nx, ny, nz, err), err);
     EXPECT_ARG(ts_normals(&G, NULL, ny, nz, err), err);
     EXPECT_ARG(ts_normals(&G, nx, ny, NULL, err), err);
-    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, NULL, &o, 0, 30, out, err), err);
-    EXPECT_ARG(ts_shade_direct(&G, NULL, ny, nz, hor, &o, 0, 30, out, err), err);
-    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, NULL, 0, 30, out, err), err);
-    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, &o, 0, 30, NULL, err), err);
-    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, &o, NAN, 30, out, err), err);
-    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, &o, 0, 95, out, err), err);
-    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, &o, 0, NAN, out, err), err);
+    const ts_direct_request d0 = {&G, nx, ny, nz, hor, &o, 0, 30, out};
+    ts_direct_request d;
+    ck_assert(ts_shade_direct(&d0, err) == TS_OK);
+    EXPECT_ARG(ts_shade_direct(NULL, err), err);
+    EXPECT_ARG_FIELD(ts_shade_direct, d, d0, grid, NULL, err);
+    EXPECT_ARG_FIELD(ts_shade_direct, d, d0, horizons, NULL, err);
+    EXPECT_ARG_FIELD(ts_shade_direct, d, d0, nx, NULL, err);
+    EXPECT_ARG_FIELD(ts_shade_direct, d, d0, opts, NULL, err);
+    EXPECT_ARG_FIELD(ts_shade_direct, d, d0, out, NULL, err);
+    EXPECT_ARG_FIELD(ts_shade_direct, d, d0, sun_azimuth, NAN, err);
+    EXPECT_ARG_FIELD(ts_shade_direct, d, d0, sun_elevation, 95, err);
+    EXPECT_ARG_FIELD(ts_shade_direct, d, d0, sun_elevation, NAN, err);
     ts_horizon_opts o0 = o;
     o0.directions = 0;
-    EXPECT_ARG(ts_shade_direct(&G, nx, ny, nz, hor, &o0, 0, 30, out, err), err);
+    EXPECT_ARG_FIELD(ts_shade_direct, d, d0, opts, &o0, err);
     EXPECT_ARG(ts_sky_terms(NULL, nx, ny, nz, hor, &o, out, NULL, NULL, err), err);
     EXPECT_ARG(ts_sky_terms(&G, nx, ny, nz, NULL, &o, out, NULL, NULL, err), err);
     EXPECT_ARG(ts_sky_terms(&G, NULL, ny, nz, hor, &o, out, NULL, NULL, err), err);
@@ -247,7 +252,8 @@ START_TEST(test_no_writes_outside)
     ck_assert(ts_horizon_compute(&g, &o, h, &e) == TS_OK);
     ck_assert(ts_shm_compute(&g, 33, 20, 2, 2, v, s, &e) == TS_OK);
     ck_assert(ts_normals(&g, a, b, c, &e) == TS_OK);
-    ck_assert(ts_shade_direct(&g, a, b, c, h, &o, 100, 30, d, &e) == TS_OK);
+    const ts_direct_request dq = {&g, a, b, c, h, &o, 100, 30, d};
+    ck_assert(ts_shade_direct(&dq, &e) == TS_OK);
     ck_assert(ts_sky_terms(&g, a, b, c, h, &o, v, s, d, &e) == TS_OK);
     for (int y = 0; y < 10; y++)
         for (int x = 20; x < 27; x++)

@@ -159,8 +159,8 @@ static void light_free(lit *L)
 static void direct(const ts_grid *g, const lit *L, double az, double el, float *out)
 {
     ts_error err;
-    ck_assert_msg(ts_shade_direct(g, L->nx, L->ny, L->nz, L->hor, &L->o, az, el, out,
-                                  &err) == TS_OK, "%s", err.message);
+    const ts_direct_request req = {g, L->nx, L->ny, L->nz, L->hor, &L->o, az, el, out};
+    ck_assert_msg(ts_shade_direct(&req, &err) == TS_OK, "%s", err.message);
 }
 
 START_TEST(test_direct_flat)

@@ -436,6 +436,12 @@ static void scene_free(scene *sc, const dem_spec *s)
     free_dem(&sc->g, s);
 }
 
+/* The scene's direct sun at azimuth az, elevation el into out. */
+static ts_direct_request scene_direct(const scene *sc, double az, double el, float *out)
+{
+    return (ts_direct_request){&sc->g, sc->nx, sc->ny, sc->nz, sc->h, &sc->o, az, el, out};
+}
+
 START_TEST(test_direct)
 {
     require_opencl();
@@ -447,12 +453,10 @@ START_TEST(test_direct)
         float *c = tdem_floats(sc.n), *l = tdem_floats(sc.n);
         ts_error e;
         for (size_t k = 0; k < sizeof sun / sizeof *sun; k++) {
-            ck_assert_int_eq(ts_shade_direct(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, sun[k][0],
-                                             sun[k][1], c, &e),
-                             TS_OK);
-            ck_assert_msg(ts_cl_shade_direct(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, sun[k][0],
-                                             sun[k][1], l, &e) == TS_OK,
-                          "%s", e.message);
+            const ts_direct_request qc = scene_direct(&sc, sun[k][0], sun[k][1], c);
+            const ts_direct_request ql = scene_direct(&sc, sun[k][0], sun[k][1], l);
+            ck_assert_int_eq(ts_shade_direct(&qc, &e), TS_OK);
+            ck_assert_msg(ts_cl_shade_direct(&ql, &e) == TS_OK, "%s", e.message);
             char name[192], sh[64];
             snprintf(name, sizeof name, "direct %s, sun %g/%g", shape_name(s, sh, sizeof sh),
                      sun[k][0], sun[k][1]);
@@ -460,10 +464,9 @@ START_TEST(test_direct)
         }
         /* one direction, the sun on it */
         sc.o.directions = 1;
-        ck_assert_int_eq(ts_shade_direct(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, 5.0, 20, c, &e),
-                         TS_OK);
-        ck_assert_int_eq(
-            ts_cl_shade_direct(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, 5.0, 20, l, &e), TS_OK);
+        const ts_direct_request qc = scene_direct(&sc, 5.0, 20, c), ql = scene_direct(&sc, 5.0, 20, l);
+        ck_assert_int_eq(ts_shade_direct(&qc, &e), TS_OK);
+        ck_assert_int_eq(ts_cl_shade_direct(&ql, &e), TS_OK);
         expect_close("direct, one direction", c, l, sc.n, TOL);
         sc.o.directions = 8;
         free(c), free(l);
@@ -545,7 +548,8 @@ START_TEST(test_arguments)
     ck_assert_int_eq(ts_cl_normals(&g, a, b, NULL, &e), TS_ERR_ARG);
     ck_assert_int_eq(ts_cl_normals(NULL, a, b, c, &e), TS_ERR_ARG);
     o.directions = 1;
-    ck_assert_int_eq(ts_cl_shade_direct(&g, a, b, c, a, &o, 100, 20, b, &e), TS_ERR_ARG);
+    const ts_direct_request dq = {&g, a, b, c, a, &o, 100, 20, b};
+    ck_assert_int_eq(ts_cl_shade_direct(&dq, &e), TS_ERR_ARG);
     ck_assert_ptr_nonnull(strstr(e.message, "computed for azimuth 0 only"));
     ck_assert_int_eq(ts_cl_sky_terms(&g, a, b, c, NULL, &o, a, NULL, NULL, &e), TS_ERR_ARG);
     free(a), free(b), free(c);
@@ -910,11 +914,9 @@ START_TEST(test_dispatch_products)
     ck_assert_int_eq(r.used, TS_BACKEND_OPENCL);
     expect_close("dispatch shm visibility", c, a, sc.n, TOL);
     expect_close("dispatch shm height", b, a + sc.n, sc.n, TOL);
-    ck_assert_int_eq(ts_shade_direct(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, 150, 30, c, &e),
-                     TS_OK);
-    ck_assert_int_eq(ts_backend_shade_direct(TS_BACKEND_OPENCL, &sc.g, sc.nx, sc.ny, sc.nz, sc.h,
-                                             &sc.o, 150, 30, a, &r, &e),
-                     TS_OK);
+    const ts_direct_request dc = scene_direct(&sc, 150, 30, c), dl = scene_direct(&sc, 150, 30, a);
+    ck_assert_int_eq(ts_shade_direct(&dc, &e), TS_OK);
+    ck_assert_int_eq(ts_backend_shade_direct(TS_BACKEND_OPENCL, &dl, &r, &e), TS_OK);
     ck_assert_int_eq(r.used, TS_BACKEND_OPENCL);
     expect_close("dispatch direct", c, a, sc.n, TOL);
     ck_assert_int_eq(ts_sky_terms(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, c, NULL, NULL, &e),

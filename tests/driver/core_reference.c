@@ -174,8 +174,8 @@ int main(int argc, char **argv)
             one.start_azimuth = p.sun_az;
             if (ts_horizon_sweep(&g, p.sun_az, &one, hz, &err) != TS_OK)
                 die("ts_horizon_sweep", &err);
-            if (ts_shade_direct(&g, nx, ny, nz, hz, &one, p.sun_az, p.sun_el, out,
-                                &err) != TS_OK)
+            const ts_direct_request req = {&g, nx, ny, nz, hz, &one, p.sun_az, p.sun_el, out};
+            if (ts_shade_direct(&req, &err) != TS_OK)
                 die("ts_shade_direct", &err);
         }
         if (p.sky_weight > 0) {
