@@ -113,12 +113,12 @@ static void run(ctx *c, int p, int cl, float *hout)
         st = (cl ? ts_cl_shade_direct : ts_shade_direct)(&req, &e);
         break;
     }
-    case P_SKY:
-        st = cl ? ts_cl_sky_terms(&c->g, c->nx, c->ny, c->nz, c->hz, &c->o, c->out, c->out2,
-                                  c->out3, &e)
-                : ts_sky_terms(&c->g, c->nx, c->ny, c->nz, c->hz, &c->o, c->out, c->out2,
-                               c->out3, &e);
+    case P_SKY: {
+        const ts_sky_request req = {&c->g, c->nx, c->ny, c->nz, c->hz, &c->o, TS_SVF_RADIATIVE,
+                                    c->out, c->out2, c->out3};
+        st = (cl ? ts_cl_sky_terms : ts_sky_terms)(&req, &e);
         break;
+    }
     case P_ENV:
         st = run_env(c, cl, &e);
         break;

@@ -191,13 +191,10 @@ ts_status ts_backend_shade_direct(ts_backend backend, const ts_direct_request *r
     DISPATCH(ts_cl_shade_direct(req, cl_err), ts_shade_direct(req, err));
 }
 
-ts_status ts_backend_sky_terms(ts_backend backend, const ts_grid *grid, const float *nx,
-                               const float *ny, const float *nz, const float *horizons,
-                               const ts_horizon_opts *opts, float *svf, float *sky,
-                               float *openness, ts_backend_report *report, ts_error *err)
+ts_status ts_backend_sky_terms(ts_backend backend, const ts_sky_request *req,
+                               ts_backend_report *report, ts_error *err)
 {
-    DISPATCH(ts_cl_sky_terms(grid, nx, ny, nz, horizons, opts, svf, sky, openness, cl_err),
-             ts_sky_terms(grid, nx, ny, nz, horizons, opts, svf, sky, openness, err));
+    DISPATCH(ts_cl_sky_terms(req, cl_err), ts_sky_terms(req, err));
 }
 
 /* One plane on OpenCL, through the session of `state` (opened on the first

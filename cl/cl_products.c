@@ -245,30 +245,20 @@ ts_status ts_cl_shade_direct(const ts_direct_request *req, ts_error *err)
 
 /* ------------------------------------------------------------------ sky */
 
-ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny, const float *nz,
-                          const float *horizons, const ts_horizon_opts *opts, float *svf,
-                          float *sky, float *openness, ts_error *err)
+ts_status ts_cl_sky_terms(const ts_sky_request *req, ts_error *err)
 {
-    return ts_cl_sky_terms_model(grid, nx, ny, nz, horizons, opts, TS_SVF_RADIATIVE, svf, sky,
-                                 openness, err);
-}
-
-ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
-                                const float *nz, const float *horizons,
-                                const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
-                                float *sky, float *openness, ts_error *err)
-{
-    ts_status st = ts_check_sky_terms_args(grid, nx, ny, nz, horizons, opts, err);
-    if (st == TS_OK)
-        st = ts_check_svf_model(svf_model, err);
+    ts_status st = ts_check_sky_request(req, err);
     if (st != TS_OK)
         return st;
+    const ts_horizon_opts *opts = req->opts;
     const int n = opts->directions;
-    const cl_int want = (svf ? 1 : 0) | (sky ? 2 : 0) | (openness ? 4 : 0) |
-                        (svf && svf_model == TS_SVF_SOLID_ANGLE ? 8 : 0);
+    float *outs[3] = {req->svf, req->sky, req->openness};
+    const cl_int want = (outs[0] ? 1 : 0) | (outs[1] ? 2 : 0) | (outs[2] ? 4 : 0) |
+                        (outs[0] && req->svf_model == TS_SVF_SOLID_ANGLE ? 8 : 0);
     if (!want)
         return ts_ok(err);
-    const size_t cells = (size_t)grid->width * grid->height, bytes = cells * sizeof(float);
+    const size_t cells = (size_t)req->grid->width * req->grid->height;
+    const size_t bytes = cells * sizeof(float);
     ts_cl_job J;
     if (ts_cl_job_begin(&J, err) != TS_OK)
         return J.st;
@@ -289,9 +279,9 @@ ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const floa
             sa[k] = (float)sin(a * DEG2RAD);
             ca[k] = (float)cos(a * DEG2RAD);
         }
-    cl_mem xb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, nx, "normals");
-    cl_mem yb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, ny, "normals");
-    cl_mem zb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, nz, "normals");
+    cl_mem xb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, req->nx, "normals");
+    cl_mem yb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, req->ny, "normals");
+    cl_mem zb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, req->nz, "normals");
     cl_mem pb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, A * bytes, NULL, "horizon planes");
     cl_mem sab = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, (size_t)n * sizeof *sa, sa, "azimuths");
     cl_mem cab = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, (size_t)n * sizeof *ca, ca, "azimuths");
@@ -320,7 +310,7 @@ ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const floa
     for (int first = 0; first < n && J.st == TS_OK; first += (int)A) {
         const cl_int nb = n - first < (int)A ? n - first : (int)A;
         const cl_int finish = first + nb >= n;
-        ts_cl_job_write(&J, pb, 0, (size_t)nb * bytes, horizons + cells * first,
+        ts_cl_job_write(&J, pb, 0, (size_t)nb * bytes, req->horizons + cells * first,
                         "horizon planes");
         /* sa/ca of this batch: sub-buffers would need alignment; offset
          * copies are simpler. */
@@ -332,7 +322,6 @@ ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const floa
         ts_cl_job_arg(&J, k, 11, sizeof finish, &finish);
         ts_cl_job_run(&J, k, 1, &global, &L, "ts_sky");
     }
-    float *outs[3] = {svf, sky, openness};
     for (int i = 0; i < 3; i++)
         if (outs[i])
             ts_cl_job_read(&J, acc[i], 0, bytes, outs[i], "sky terms");

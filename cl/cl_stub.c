@@ -68,22 +68,10 @@ ts_status ts_cl_shade_direct(const ts_direct_request *req, ts_error *err)
     return NOT_BUILT(err);
 }
 
-ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny, const float *nz,
-                          const float *horizons, const ts_horizon_opts *opts, float *svf,
-                          float *sky, float *openness, ts_error *err)
+ts_status ts_cl_sky_terms(const ts_sky_request *req, ts_error *err)
 {
-    (void)grid, (void)nx, (void)ny, (void)nz, (void)horizons, (void)opts;
-    (void)svf, (void)sky, (void)openness;
+    (void)req;
     return NOT_BUILT(err);
-}
-
-ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
-                                const float *nz, const float *horizons,
-                                const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
-                                float *sky, float *openness, ts_error *err)
-{
-    (void)svf_model;
-    return ts_cl_sky_terms(grid, nx, ny, nz, horizons, opts, svf, sky, openness, err);
 }
 
 ts_status ts_cl_env_light_accumulate(const ts_grid *grid, const ts_env_table *table, int k,

@@ -86,10 +86,7 @@ ts_status ts_backend_normals(ts_backend backend, const ts_grid *grid, float *nx,
 ts_status ts_backend_shade_direct(ts_backend backend, const ts_direct_request *req,
                                   ts_backend_report *report, ts_error *err);
 
-ts_status ts_backend_sky_terms(ts_backend backend, const ts_grid *grid,
-                               const float *nx, const float *ny, const float *nz,
-                               const float *horizons, const ts_horizon_opts *opts,
-                               float *svf, float *sky, float *openness,
+ts_status ts_backend_sky_terms(ts_backend backend, const ts_sky_request *req,
                                ts_backend_report *report, ts_error *err);
 
 /**

@@ -107,16 +107,8 @@ ts_status ts_cl_normals(const ts_grid *grid, float *nx, float *ny, float *nz,
 /** The direct sun on the device (ts_shade_direct_fn). */
 ts_shade_direct_fn ts_cl_shade_direct;
 
-/** ts_sky_terms on the device (any of svf, sky, openness may be NULL). */
-ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
-                          const float *nz, const float *horizons,
-                          const ts_horizon_opts *opts, float *svf, float *sky,
-                          float *openness, ts_error *err);
-/** ts_sky_terms_model on the device. */
-ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
-                                const float *nz, const float *horizons,
-                                const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
-                                float *sky, float *openness, ts_error *err);
+/** The sky terms on the device (ts_sky_terms_fn). */
+ts_sky_terms_fn ts_cl_sky_terms;
 
 /** ts_env_light_accumulate on the device, in one call (uploads the light
  * table and the normals for this one plane; a product uses a session). */

@@ -83,18 +83,19 @@ ts_status ts_check_sky_args(const ts_grid *grid, const float *nx, const float *n
     return TS_OK;
 }
 
-ts_status ts_check_sky_terms_args(const ts_grid *grid, const float *nx, const float *ny,
-                                  const float *nz, const float *horizons,
-                                  const ts_horizon_opts *opts, ts_error *err)
+ts_status ts_check_sky_request(const ts_sky_request *req, ts_error *err)
 {
-    ts_status st = ts_horizon_opts_validate(opts, err);
+    if (!req)
+        return ts_fail(err, TS_ERR_ARG, "the sky terms request must not be NULL");
+    ts_status st = ts_horizon_opts_validate(req->opts, err);
     if (st != TS_OK)
         return st;
-    if ((st = ts_check_sky_args(grid, nx, ny, nz, opts->directions, err)) != TS_OK)
+    st = ts_check_sky_args(req->grid, req->nx, req->ny, req->nz, req->opts->directions, err);
+    if (st != TS_OK)
         return st;
-    if (!horizons)
+    if (!req->horizons)
         return ts_fail(err, TS_ERR_ARG, "horizons must not be NULL");
-    return TS_OK;
+    return ts_check_svf_model(req->svf_model, err);
 }
 
 ts_status ts_direct_setup(const ts_direct_request *req, ts_direct_plan *plan, ts_error *err)

@@ -24,10 +24,8 @@ ts_status ts_check_normals_args(const ts_grid *grid, const float *nx, const floa
 ts_status ts_check_sky_args(const ts_grid *grid, const float *nx, const float *ny,
                             const float *nz, int directions, ts_error *err);
 
-/* Checks of ts_sky_terms' arguments but its outputs. */
-ts_status ts_check_sky_terms_args(const ts_grid *grid, const float *nx, const float *ny,
-                                  const float *nz, const float *horizons,
-                                  const ts_horizon_opts *opts, ts_error *err);
+/* Checks of a ts_sky_request (its outputs may be NULL). */
+ts_status ts_check_sky_request(const ts_sky_request *req, ts_error *err);
 
 /* Checks of ts_horizon_compute's arguments, including that the
  * directions x width x height output floats can be addressed. */

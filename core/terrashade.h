@@ -230,23 +230,50 @@ typedef ts_status ts_shade_direct_fn(const ts_direct_request *req, ts_error *err
 /** The direct sun on the C backend. */
 ts_shade_direct_fn ts_shade_direct;
 
+/** Which sky-view factor the svf output of the sky terms holds. */
+typedef enum {
+    /** Timonen eq. 5 with the cell's normal: the cosine-weighted visible
+     * fraction of the hemisphere around the normal (the default). */
+    TS_SVF_RADIATIVE = 0,
+    /** Zaksek et al. (2011), as RVT_py, SAGA and GRASS r.skyview: 1 - the
+     * mean over directions of sin(max(horizon, 0)), relative to the
+     * horizontal; no normal. */
+    TS_SVF_SOLID_ANGLE = 1
+} ts_svf_model;
+
+/** TS_OK if `model` is a ts_svf_model, else TS_ERR_ARG with a sentence. */
+ts_status ts_check_svf_model(ts_svf_model model, ts_error *err);
+
+/** What the sky terms are computed from and into (ts_sky_terms_fn). */
+typedef struct {
+    const ts_grid *grid;
+    const float *nx, *ny, *nz;   /**< unit normals from ts_normals */
+    const float *horizons;       /**< opts->directions planes, layout of ts_horizon_compute */
+    const ts_horizon_opts *opts; /**< the options the horizons were computed with */
+    ts_svf_model svf_model;      /**< which sky-view factor `svf` holds */
+    float *svf;                  /**< width*height or NULL: the sky-view factor */
+    float *sky;                  /**< width*height or NULL: uniform-sky light */
+    float *openness;             /**< width*height or NULL: positive openness, degrees */
+} ts_sky_request;
+
 /**
- * Sky terms from horizons (layout of ts_horizon_compute), any output may be
- * NULL:
- *  - svf: sky-view factor with the surface normal, Timonen eq. 5 with c = 1
- *    (cosine-weighted visible fraction of the hemisphere around the normal;
- *    1 on an open plane, cos(slope) at the bottom of a V-valley);
+ * Sky terms from horizons, each output only where the request has one:
+ *  - svf: sky-view factor of model svf_model; TS_SVF_RADIATIVE is Timonen
+ *    eq. 5 with c = 1 (cosine-weighted visible fraction of the hemisphere
+ *    around the normal; 1 on an open plane, cos(slope) at the bottom of a
+ *    V-valley);
  *  - sky: irradiance from a uniform sky of unit radiance, the same integral
  *    with the horizon raised to at least 0 deg (the sky ends at the
  *    horizontal);
  *  - openness: positive openness (Yokoyama et al. 2002), the mean of
  *    90 - horizon angle, degrees; negative openness is the same on the
  *    negated DEM's horizons.
+ * The type of every backend's sky terms (terrashade_cl.h).
  */
-ts_status ts_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
-                       const float *nz, const float *horizons,
-                       const ts_horizon_opts *opts, float *svf, float *sky,
-                       float *openness, ts_error *err);
+typedef ts_status ts_sky_terms_fn(const ts_sky_request *req, ts_error *err);
+
+/** The sky terms on the C backend. */
+ts_sky_terms_fn ts_sky_terms;
 
 /**
  * Accumulating form of ts_sky_terms for one direction at a time, so that a
@@ -262,27 +289,6 @@ ts_status ts_sky_accumulate(const ts_grid *grid, const float *nx,
                             float *openness_acc, ts_error *err);
 ts_status ts_sky_finish(const ts_grid *grid, int directions, float *svf_acc,
                         float *sky_acc, float *openness_acc, ts_error *err);
-
-/** Which sky-view factor the svf output of the sky terms holds. */
-typedef enum {
-    /** Timonen eq. 5 with the cell's normal: the cosine-weighted visible
-     * fraction of the hemisphere around the normal (what ts_sky_terms
-     * computes). */
-    TS_SVF_RADIATIVE = 0,
-    /** Zaksek et al. (2011), as RVT_py, SAGA and GRASS r.skyview: 1 - the
-     * mean over directions of sin(max(horizon, 0)), relative to the
-     * horizontal; no normal. */
-    TS_SVF_SOLID_ANGLE = 1
-} ts_svf_model;
-
-/** TS_OK if `model` is a ts_svf_model, else TS_ERR_ARG with a sentence. */
-ts_status ts_check_svf_model(ts_svf_model model, ts_error *err);
-
-/** ts_sky_terms with the svf output of model `svf_model`. */
-ts_status ts_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
-                             const float *nz, const float *horizons,
-                             const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
-                             float *sky, float *openness, ts_error *err);
 
 /** ts_sky_accumulate with the svf accumulator of model `svf_model` (finish
  * it with ts_sky_finish as well). */

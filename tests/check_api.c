@@ -198,11 +198,16 @@ START_TEST(test_shading_args)
     ts_horizon_opts o0 = o;
     o0.directions = 0;
     EXPECT_ARG_FIELD(ts_shade_direct, d, d0, opts, &o0, err);
-    EXPECT_ARG(ts_sky_terms(NULL, nx, ny, nz, hor, &o, out, NULL, NULL, err), err);
-    EXPECT_ARG(ts_sky_terms(&G, nx, ny, nz, NULL, &o, out, NULL, NULL, err), err);
-    EXPECT_ARG(ts_sky_terms(&G, NULL, ny, nz, hor, &o, out, NULL, NULL, err), err);
-    EXPECT_ARG(ts_sky_terms(&G, nx, ny, nz, hor, NULL, out, NULL, NULL, err), err);
-    EXPECT_ARG(ts_sky_terms(&G, nx, ny, nz, hor, &o0, out, NULL, NULL, err), err);
+    const ts_sky_request s0 = {&G, nx, ny, nz, hor, &o, TS_SVF_RADIATIVE, out, NULL, NULL};
+    ts_sky_request s;
+    ck_assert(ts_sky_terms(&s0, err) == TS_OK);
+    EXPECT_ARG(ts_sky_terms(NULL, err), err);
+    EXPECT_ARG_FIELD(ts_sky_terms, s, s0, grid, NULL, err);
+    EXPECT_ARG_FIELD(ts_sky_terms, s, s0, horizons, NULL, err);
+    EXPECT_ARG_FIELD(ts_sky_terms, s, s0, nx, NULL, err);
+    EXPECT_ARG_FIELD(ts_sky_terms, s, s0, opts, NULL, err);
+    EXPECT_ARG_FIELD(ts_sky_terms, s, s0, opts, &o0, err);
+    EXPECT_ARG_FIELD(ts_sky_terms, s, s0, svf_model, (ts_svf_model)2, err);
     EXPECT_ARG(ts_sky_accumulate(&G, nx, ny, nz, hor, 0, 0, out, NULL, NULL, err), err);
     EXPECT_ARG(ts_sky_accumulate(&G, nx, ny, nz, hor, NAN, 16, out, NULL, NULL, err), err);
     EXPECT_ARG(ts_sky_accumulate(&G, nx, ny, nz, NULL, 0, 16, out, NULL, NULL, err), err);
@@ -254,7 +259,8 @@ START_TEST(test_no_writes_outside)
     ck_assert(ts_normals(&g, a, b, c, &e) == TS_OK);
     const ts_direct_request dq = {&g, a, b, c, h, &o, 100, 30, d};
     ck_assert(ts_shade_direct(&dq, &e) == TS_OK);
-    ck_assert(ts_sky_terms(&g, a, b, c, h, &o, v, s, d, &e) == TS_OK);
+    const ts_sky_request sq = {&g, a, b, c, h, &o, TS_SVF_RADIATIVE, v, s, d};
+    ck_assert(ts_sky_terms(&sq, &e) == TS_OK);
     for (int y = 0; y < 10; y++)
         for (int x = 20; x < 27; x++)
             ck_assert_msg(z[y * 27 + x] == -777.0f, "grid padding was written");

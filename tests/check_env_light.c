@@ -122,7 +122,9 @@ START_TEST(test_constant_env_is_sky_term)
     float *sky = tdem_floats(s.n), *svf = tdem_floats(s.n);
     float *r = tdem_floats(s.n), *g = tdem_floats(s.n), *b = tdem_floats(s.n);
     ts_error err;
-    ck_assert(ts_sky_terms(&s.g, s.nx, s.ny, s.nz, s.hor, &s.o, svf, sky, NULL, &err) == TS_OK);
+    const ts_sky_request sq = {&s.g, s.nx, s.ny, s.nz, s.hor, &s.o, TS_SVF_RADIATIVE, svf, sky,
+                               NULL};
+    ck_assert(ts_sky_terms(&sq, &err) == TS_OK);
     /* 360 rows put texel edges on the table's 1-degree horizon nodes; 512
      * rows do not (a row cut by a node counts wholly on one side). */
     const int rows[2] = {360, 512};

@@ -442,6 +442,13 @@ static ts_direct_request scene_direct(const scene *sc, double az, double el, flo
     return (ts_direct_request){&sc->g, sc->nx, sc->ny, sc->nz, sc->h, &sc->o, az, el, out};
 }
 
+/* The scene's sky terms of model m into svf, sky, open (each may be NULL). */
+static ts_sky_request scene_sky(const scene *sc, ts_svf_model m, float *svf, float *sky,
+                                float *open)
+{
+    return (ts_sky_request){&sc->g, sc->nx, sc->ny, sc->nz, sc->h, &sc->o, m, svf, sky, open};
+}
+
 START_TEST(test_direct)
 {
     require_opencl();
@@ -486,11 +493,11 @@ START_TEST(test_sky)
         for (int k = 0; k < 3; k++)
             c[k] = tdem_floats(sc.n), l[k] = tdem_floats(sc.n);
         ts_error e;
-        ck_assert_int_eq(
-            ts_sky_terms(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, c[0], c[1], c[2], &e), TS_OK);
-        ck_assert_msg(
-            ts_cl_sky_terms(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, l[0], l[1], l[2], &e) == TS_OK,
-            "%s", e.message);
+        const ts_svf_model rad = TS_SVF_RADIATIVE, solid = TS_SVF_SOLID_ANGLE;
+        ts_sky_request qc = scene_sky(&sc, rad, c[0], c[1], c[2]);
+        ts_sky_request ql = scene_sky(&sc, rad, l[0], l[1], l[2]);
+        ck_assert_int_eq(ts_sky_terms(&qc, &e), TS_OK);
+        ck_assert_msg(ts_cl_sky_terms(&ql, &e) == TS_OK, "%s", e.message);
         static const char *what[3] = {"svf", "sky", "openness (deg)"};
         for (int k = 0; k < 3; k++) {
             char name[192], sh[64];
@@ -498,27 +505,23 @@ START_TEST(test_sky)
             expect_close(name, c[k], l[k], sc.n, TOL);
         }
         /* outputs one at a time */
-        ck_assert_int_eq(
-            ts_cl_sky_terms(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, NULL, l[1], NULL, &e), TS_OK);
+        ql = scene_sky(&sc, rad, NULL, l[1], NULL);
+        ck_assert_int_eq(ts_cl_sky_terms(&ql, &e), TS_OK);
         expect_close("sky alone", c[1], l[1], sc.n, TOL);
         /* the solid-angle svf (Zaksek et al. 2011), with and without the others */
-        ck_assert_int_eq(ts_sky_terms_model(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o,
-                                            TS_SVF_SOLID_ANGLE, c[0], NULL, NULL, &e),
-                         TS_OK);
-        ck_assert_msg(ts_cl_sky_terms_model(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o,
-                                            TS_SVF_SOLID_ANGLE, l[0], l[1], l[2], &e) == TS_OK,
-                      "%s", e.message);
+        qc = scene_sky(&sc, solid, c[0], NULL, NULL);
+        ck_assert_int_eq(ts_sky_terms(&qc, &e), TS_OK);
+        ql = scene_sky(&sc, solid, l[0], l[1], l[2]);
+        ck_assert_msg(ts_cl_sky_terms(&ql, &e) == TS_OK, "%s", e.message);
         char name[192], sh[64];
         snprintf(name, sizeof name, "svf solid_angle %s", shape_name(s, sh, sizeof sh));
         expect_close(name, c[0], l[0], sc.n, TOL);
         expect_close("sky beside svf solid_angle", c[1], l[1], sc.n, TOL);
-        ck_assert_int_eq(ts_cl_sky_terms_model(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o,
-                                               TS_SVF_SOLID_ANGLE, l[0], NULL, NULL, &e),
-                         TS_OK);
+        ql = scene_sky(&sc, solid, l[0], NULL, NULL);
+        ck_assert_int_eq(ts_cl_sky_terms(&ql, &e), TS_OK);
         expect_close("svf solid_angle alone", c[0], l[0], sc.n, TOL);
-        ck_assert_int_eq(ts_cl_sky_terms_model(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o,
-                                               (ts_svf_model)5, l[0], NULL, NULL, &e),
-                         TS_ERR_ARG);
+        ql = scene_sky(&sc, (ts_svf_model)5, l[0], NULL, NULL);
+        ck_assert_int_eq(ts_cl_sky_terms(&ql, &e), TS_ERR_ARG);
         for (int k = 0; k < 3; k++)
             free(c[k]), free(l[k]);
         scene_free(&sc, s);
@@ -551,7 +554,10 @@ START_TEST(test_arguments)
     const ts_direct_request dq = {&g, a, b, c, a, &o, 100, 20, b};
     ck_assert_int_eq(ts_cl_shade_direct(&dq, &e), TS_ERR_ARG);
     ck_assert_ptr_nonnull(strstr(e.message, "computed for azimuth 0 only"));
-    ck_assert_int_eq(ts_cl_sky_terms(&g, a, b, c, NULL, &o, a, NULL, NULL, &e), TS_ERR_ARG);
+    const ts_sky_request sq = {&g, a, b, c, NULL, &o, TS_SVF_RADIATIVE, a, NULL, NULL};
+    ck_assert_int_eq(ts_cl_sky_terms(&sq, &e), TS_ERR_ARG);
+    ck_assert_int_eq(ts_cl_sky_terms(NULL, &e), TS_ERR_ARG);
+    ck_assert_int_eq(ts_cl_shade_direct(NULL, &e), TS_ERR_ARG);
     free(a), free(b), free(c);
     free_dem(&g, s);
 }
@@ -919,11 +925,10 @@ START_TEST(test_dispatch_products)
     ck_assert_int_eq(ts_backend_shade_direct(TS_BACKEND_OPENCL, &dl, &r, &e), TS_OK);
     ck_assert_int_eq(r.used, TS_BACKEND_OPENCL);
     expect_close("dispatch direct", c, a, sc.n, TOL);
-    ck_assert_int_eq(ts_sky_terms(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, c, NULL, NULL, &e),
-                     TS_OK);
-    ck_assert_int_eq(ts_backend_sky_terms(TS_BACKEND_OPENCL, &sc.g, sc.nx, sc.ny, sc.nz, sc.h,
-                                          &sc.o, a, NULL, NULL, &r, &e),
-                     TS_OK);
+    const ts_sky_request sc_ = scene_sky(&sc, TS_SVF_RADIATIVE, c, NULL, NULL);
+    const ts_sky_request sl = scene_sky(&sc, TS_SVF_RADIATIVE, a, NULL, NULL);
+    ck_assert_int_eq(ts_sky_terms(&sc_, &e), TS_OK);
+    ck_assert_int_eq(ts_backend_sky_terms(TS_BACKEND_OPENCL, &sl, &r, &e), TS_OK);
     ck_assert_int_eq(r.used, TS_BACKEND_OPENCL);
     expect_close("dispatch svf", c, a, sc.n, TOL);
     /* an argument error is the C backend's error */
