@@ -75,14 +75,13 @@ static ts_status run_env(ctx *c, int cl, ts_error *e)
     ts_cl_env_light *s = NULL;
     for (int i = 0; i < 3; i++)
         memset(i == 0 ? c->out : i == 1 ? c->out2 : c->out3, 0, c->n * sizeof(float));
+    ts_env_light_request req = {&c->g,  &c->table, 0,      c->nx,  c->ny,
+                                c->nz,  c->hz,     c->out, c->out2, c->out3};
     if (cl)
-        st = ts_cl_env_light_open(&c->g, &c->table, c->nx, c->ny, c->nz, &s, e);
-    for (int k = 0; k < c->o.directions && st == TS_OK; k++) {
-        const float *plane = c->hz + c->n * k;
-        st = cl ? ts_cl_env_light_add(s, &c->g, &c->table, k, c->nx, c->ny, c->nz, plane, c->out,
-                                      c->out2, c->out3, e)
-                : ts_env_light_accumulate(&c->g, &c->table, k, c->nx, c->ny, c->nz, plane,
-                                          c->out, c->out2, c->out3, e);
+        st = ts_cl_env_light_open(&req, &s, e);
+    for (req.k = 0; req.k < c->o.directions && st == TS_OK; req.k++) {
+        req.plane = c->hz + c->n * req.k;
+        st = cl ? ts_cl_env_light_add(s, &req, e) : ts_env_light_accumulate(&req, e);
     }
     ts_cl_env_light_close(s);
     return st;

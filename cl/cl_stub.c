@@ -74,41 +74,31 @@ ts_status ts_cl_sky_terms(const ts_sky_request *req, ts_error *err)
     return NOT_BUILT(err);
 }
 
-ts_status ts_cl_env_light_accumulate(const ts_grid *grid, const ts_env_table *table, int k,
-                                     const float *nx, const float *ny, const float *nz,
-                                     const float *plane, float *r, float *g, float *b,
-                                     ts_error *err)
+ts_status ts_cl_env_light_accumulate(const ts_env_light_request *req, ts_error *err)
 {
-    (void)grid, (void)table, (void)k, (void)nx, (void)ny, (void)nz, (void)plane;
-    (void)r, (void)g, (void)b;
+    (void)req;
     return NOT_BUILT(err);
 }
 
-ts_status ts_cl_env_light_open(const ts_grid *grid, const ts_env_table *table, const float *nx,
-                               const float *ny, const float *nz, ts_cl_env_light **session,
+ts_status ts_cl_env_light_open(const ts_env_light_request *req, ts_cl_env_light **session,
                                ts_error *err)
 {
-    (void)grid, (void)table, (void)nx, (void)ny, (void)nz;
+    (void)req;
     if (session)
         *session = NULL;
     return NOT_BUILT(err);
 }
 
-int ts_cl_env_light_matches(const ts_cl_env_light *session, const ts_grid *grid,
-                            const ts_env_table *table, const float *nx, const float *ny,
-                            const float *nz)
+int ts_cl_env_light_matches(const ts_cl_env_light *session, const ts_env_light_request *req)
 {
-    (void)session, (void)grid, (void)table, (void)nx, (void)ny, (void)nz;
+    (void)session, (void)req;
     return 0;
 }
 
-ts_status ts_cl_env_light_add(ts_cl_env_light *session, const ts_grid *grid,
-                              const ts_env_table *table, int k, const float *nx,
-                              const float *ny, const float *nz, const float *plane, float *r,
-                              float *g, float *b, ts_error *err)
+ts_status ts_cl_env_light_add(ts_cl_env_light *session, const ts_env_light_request *req,
+                              ts_error *err)
 {
-    (void)session, (void)grid, (void)table, (void)k, (void)nx, (void)ny, (void)nz;
-    (void)plane, (void)r, (void)g, (void)b;
+    (void)session, (void)req;
     return NOT_BUILT(err);
 }
 

@@ -110,39 +110,39 @@ ts_shade_direct_fn ts_cl_shade_direct;
 /** The sky terms on the device (ts_sky_terms_fn). */
 ts_sky_terms_fn ts_cl_sky_terms;
 
-/** ts_env_light_accumulate on the device, in one call (uploads the light
- * table and the normals for this one plane; a product uses a session). */
-ts_status ts_cl_env_light_accumulate(const ts_grid *grid, const ts_env_table *table, int k,
-                                     const float *nx, const float *ny, const float *nz,
-                                     const float *plane, float *r, float *g, float *b,
-                                     ts_error *err);
+/** The environment light on the device, in one call
+ * (ts_env_light_accumulate_fn; uploads the light table and the normals for
+ * this one plane: a product uses a session). */
+ts_env_light_accumulate_fn ts_cl_env_light_accumulate;
 
 /**
- * A product's environment light on the device, one horizon plane at a time:
- * ts_cl_env_light_open uploads the light table and the normals once (the
- * arrays must stay as they are until ts_cl_env_light_close);
- * ts_cl_env_light_add is ts_env_light_accumulate for sector k with the
- * same grid, table and normals (else TS_ERR_ARG): it uploads the plane,
- * launches, and reads the sums back into r, g, b, so that they hold the
- * light so far after every call. The device keeps its own copy of the
- * sums: between two calls with the same r, g, b the caller must not change
- * them (new arrays are uploaded). After a failure every later call fails.
+ * A product's environment light on the device, one horizon plane at a time.
+ * The device keeps its own copy of the sums: between two calls with the
+ * same r, g, b the caller must not change them (new arrays are uploaded).
+ * After a failure every later call fails.
  */
 typedef struct ts_cl_env_light ts_cl_env_light;
 
-ts_status ts_cl_env_light_open(const ts_grid *grid, const ts_env_table *table, const float *nx,
-                               const float *ny, const float *nz, ts_cl_env_light **session,
+/**
+ * Open a session for the request's grid size, light table and normals
+ * (the request is checked as ts_env_light_accumulate checks it): uploads
+ * the table and the normals once; those arrays must stay as they are until
+ * ts_cl_env_light_close.
+ */
+ts_status ts_cl_env_light_open(const ts_env_light_request *req, ts_cl_env_light **session,
                                ts_error *err);
 
-/** 1 if the session was opened for this grid's size, table and normals. */
-int ts_cl_env_light_matches(const ts_cl_env_light *session, const ts_grid *grid,
-                            const ts_env_table *table, const float *nx, const float *ny,
-                            const float *nz);
+/** 1 if the session was opened for this request's grid size, table and normals. */
+int ts_cl_env_light_matches(const ts_cl_env_light *session, const ts_env_light_request *req);
 
-ts_status ts_cl_env_light_add(ts_cl_env_light *session, const ts_grid *grid,
-                              const ts_env_table *table, int k, const float *nx,
-                              const float *ny, const float *nz, const float *plane, float *r,
-                              float *g, float *b, ts_error *err);
+/**
+ * ts_env_light_accumulate in the session, for a request with its grid size,
+ * table and normals (else TS_ERR_ARG): uploads the plane, launches, and
+ * reads the sums back into r, g, b, so that they hold the light so far
+ * after every call.
+ */
+ts_status ts_cl_env_light_add(ts_cl_env_light *session, const ts_env_light_request *req,
+                              ts_error *err);
 
 /** Release the session's device buffers (NULL-safe). */
 void ts_cl_env_light_close(ts_cl_env_light *session);

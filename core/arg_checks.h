@@ -44,11 +44,8 @@ typedef struct {
 /* Checks of a ts_direct_request, then its plan. */
 ts_status ts_direct_setup(const ts_direct_request *req, ts_direct_plan *plan, ts_error *err);
 
-/* Checks of ts_env_light_accumulate's arguments (outputs only for NULL). */
-ts_status ts_check_env_light_args(const ts_grid *grid, const ts_env_table *table, int k,
-                                  const float *nx, const float *ny, const float *nz,
-                                  const float *plane, const float *r, const float *g,
-                                  const float *b, ts_error *err);
+/* Checks of a ts_env_light_request (its outputs only for NULL). */
+ts_status ts_check_env_light_request(const ts_env_light_request *req, ts_error *err);
 
 /* Floats of one sector of a light table (lp + k * this is sector k). */
 size_t ts_env_table_sector_floats(const ts_env_table *table);

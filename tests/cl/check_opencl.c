@@ -449,6 +449,14 @@ static ts_sky_request scene_sky(const scene *sc, ts_svf_model m, float *svf, flo
     return (ts_sky_request){&sc->g, sc->nx, sc->ny, sc->nz, sc->h, &sc->o, m, svf, sky, open};
 }
 
+/* The scene's environment light of table t's sector k (its horizon plane k)
+ * into rgb: three planes of sc->n floats. */
+static ts_env_light_request scene_env(const scene *sc, const ts_env_table *t, int k, float *rgb)
+{
+    return (ts_env_light_request){&sc->g, t,   k, sc->nx, sc->ny, sc->nz, sc->h + sc->n * k,
+                                  rgb,    rgb + sc->n, rgb + 2 * sc->n};
+}
+
 START_TEST(test_direct)
 {
     require_opencl();
@@ -619,15 +627,12 @@ static double env_compare(const scene *sc, const ts_env_table *t, float *c, floa
     memset(c, 0, 3 * n * sizeof *c);
     memset(l, 0, 3 * n * sizeof *l);
     ts_cl_env_light *s;
-    ck_assert_msg(ts_cl_env_light_open(&sc->g, t, sc->nx, sc->ny, sc->nz, &s, &e) == TS_OK, "%s",
-                  e.message);
+    const ts_env_light_request first = scene_env(sc, t, 0, l);
+    ck_assert_msg(ts_cl_env_light_open(&first, &s, &e) == TS_OK, "%s", e.message);
     for (int k = 0; k < t->directions; k++) {
-        ck_assert_int_eq(ts_env_light_accumulate(&sc->g, t, k, sc->nx, sc->ny, sc->nz,
-                                                 sc->h + n * k, c, c + n, c + 2 * n, &e),
-                         TS_OK);
-        ck_assert_msg(ts_cl_env_light_add(s, &sc->g, t, k, sc->nx, sc->ny, sc->nz, sc->h + n * k,
-                                          l, l + n, l + 2 * n, &e) == TS_OK,
-                      "%s", e.message);
+        const ts_env_light_request qc = scene_env(sc, t, k, c), ql = scene_env(sc, t, k, l);
+        ck_assert_int_eq(ts_env_light_accumulate(&qc, &e), TS_OK);
+        ck_assert_msg(ts_cl_env_light_add(s, &ql, &e) == TS_OK, "%s", e.message);
     }
     ts_cl_env_light_close(s);
     ck_assert_int_eq(ts_env_light_finish(&sc->g, c, c + n, c + 2 * n, &e), TS_OK);
@@ -692,10 +697,10 @@ START_TEST(test_env_light_dispatch)
     ts_error e;
     ts_backend_report r;
     memset(c, 0, 3 * n * sizeof *c);
-    for (int k = 0; k < 8; k++)
-        ck_assert_int_eq(ts_env_light_accumulate(&sc.g, &t, k, sc.nx, sc.ny, sc.nz, sc.h + n * k,
-                                                 c, c + n, c + 2 * n, &e),
-                         TS_OK);
+    for (int k = 0; k < 8; k++) {
+        const ts_env_light_request qc = scene_env(&sc, &t, k, c);
+        ck_assert_int_eq(ts_env_light_accumulate(&qc, &e), TS_OK);
+    }
     for (int pass = 0; pass < 3; pass++) {
         /* 0: a state, 1: no state, 2: a state with the allocations capped */
         if (pass == 2)
@@ -703,9 +708,9 @@ START_TEST(test_env_light_dispatch)
         ts_backend_env_light st = {0};
         memset(l, 0, 3 * n * sizeof *l);
         for (int k = 0; k < 8; k++) {
-            ck_assert_msg(ts_backend_env_light_accumulate(
-                              TS_BACKEND_OPENCL, pass == 1 ? NULL : &st, &sc.g, &t, k, sc.nx,
-                              sc.ny, sc.nz, sc.h + n * k, l, l + n, l + 2 * n, &r, &e) == TS_OK,
+            const ts_env_light_request ql = scene_env(&sc, &t, k, l);
+            ck_assert_msg(ts_backend_env_light_accumulate(TS_BACKEND_OPENCL, pass == 1 ? NULL : &st,
+                                                          &ql, &r, &e) == TS_OK,
                           "%s", e.message);
             ck_assert_int_eq(r.used, pass == 2 ? TS_BACKEND_C : TS_BACKEND_OPENCL);
             ck_assert_int_eq(r.fell_back, pass == 2);
@@ -738,11 +743,10 @@ START_TEST(test_env_light_dispatch)
     for (int k = 0; k < 8; k++) {
         if (k == 4)
             setenv("TERRASHADE_OPENCL_MAX_ALLOC", "4k", 1);
-        const float *x = k < 4 ? sc.nx : nc, *y = k < 4 ? sc.ny : nc + n;
-        const float *z = k < 4 ? sc.nz : nc + 2 * n;
-        ck_assert_int_eq(ts_backend_env_light_accumulate(TS_BACKEND_OPENCL, &st, &sc.g, &t, k, x,
-                                                         y, z, sc.h + n * k, l, l + n, l + 2 * n,
-                                                         &r, &e),
+        ts_env_light_request ql = scene_env(&sc, &t, k, l);
+        if (k >= 4)
+            ql.nx = nc, ql.ny = nc + n, ql.nz = nc + 2 * n;
+        ck_assert_int_eq(ts_backend_env_light_accumulate(TS_BACKEND_OPENCL, &st, &ql, &r, &e),
                          TS_OK);
         ck_assert_int_eq(r.used, k < 4 ? TS_BACKEND_OPENCL : TS_BACKEND_C);
         ck_assert_int_eq(r.fell_back, k >= 4);
@@ -755,20 +759,20 @@ START_TEST(test_env_light_dispatch)
     free(nc);
     clear_env();
     /* argument errors: the C function's */
-    ck_assert_int_eq(ts_backend_env_light_accumulate(TS_BACKEND_OPENCL, NULL, &sc.g, &t, 8, sc.nx,
-                                                     sc.ny, sc.nz, sc.h, l, l + n, l + 2 * n, &r,
-                                                     &e),
+    const ts_env_light_request q0 = scene_env(&sc, &t, 0, l);
+    ts_env_light_request bad = q0;
+    bad.k = 8;
+    ck_assert_int_eq(ts_backend_env_light_accumulate(TS_BACKEND_OPENCL, NULL, &bad, &r, &e),
                      TS_ERR_ARG);
     ck_assert_ptr_nonnull(strstr(e.message, "outside the light table's 8 directions"));
-    ck_assert_int_eq(ts_cl_env_light_accumulate(&sc.g, &t, 0, sc.nx, NULL, sc.nz, sc.h, l, l + n,
-                                                l + 2 * n, &e),
-                     TS_ERR_ARG);
+    bad = q0, bad.ny = NULL;
+    ck_assert_int_eq(ts_cl_env_light_accumulate(&bad, &e), TS_ERR_ARG);
+    ck_assert_int_eq(ts_cl_env_light_accumulate(NULL, &e), TS_ERR_ARG);
     /* a session is for the arrays it was opened with */
     ts_cl_env_light *ss;
-    ck_assert_int_eq(ts_cl_env_light_open(&sc.g, &t, sc.nx, sc.ny, sc.nz, &ss, &e), TS_OK);
-    ck_assert_int_eq(ts_cl_env_light_add(ss, &sc.g, &t, 0, sc.ny, sc.ny, sc.nz, sc.h, l, l + n,
-                                         l + 2 * n, &e),
-                     TS_ERR_ARG);
+    ck_assert_int_eq(ts_cl_env_light_open(&q0, &ss, &e), TS_OK);
+    bad = q0, bad.nx = sc.ny;
+    ck_assert_int_eq(ts_cl_env_light_add(ss, &bad, &e), TS_ERR_ARG);
     ck_assert_ptr_nonnull(strstr(e.message, "opened for another"));
     ts_cl_env_light_close(ss);
     ts_env_table_free(&t);
