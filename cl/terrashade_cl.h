@@ -2,8 +2,10 @@
  * terrashade_cl.h - the OpenCL backend of libterrashade.
  *
  * The same products as the C core (terrashade.h), computed by OpenCL
- * kernels, with the same results: every function mirrors the C function of
- * the same name without the "cl_" and checks its arguments the same way.
+ * kernels, with the same results: every ts_cl_X is declared with the
+ * function type of the C function ts_X (ts_X_fn) and checks its arguments
+ * with the same shared checks (core/arg_checks.h), so that both backends
+ * accept and refuse the same calls with the same messages.
  * Measured differences to the C backend are in docs/opencl.md.
  *
  * Device: the environment variable TERRASHADE_OPENCL_DEVICE picks it, as a
@@ -86,23 +88,18 @@ ts_status ts_cl_devices(ts_cl_info *list, int max, int *count, ts_error *err);
     "a MAX_DISTANCE sweep runs on the C backend (the OpenCL kernel has no sliding-window " \
     "hull yet)"
 
-/** ts_horizon_sweep on the device: one azimuth, width*height degrees. */
-ts_status ts_cl_horizon_sweep(const ts_grid *grid, double azimuth,
-                              const ts_horizon_opts *opts, float *out,
-                              ts_error *err);
+/** The horizon sweep on the device (ts_horizon_sweep_fn): one azimuth. */
+ts_horizon_sweep_fn ts_cl_horizon_sweep;
 
-/** ts_horizon_compute on the device: opts->directions planes. */
-ts_status ts_cl_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts,
-                                float *out, ts_error *err);
+/** The horizons on the device (ts_horizon_compute_fn): opts->directions planes. */
+ts_horizon_compute_fn ts_cl_horizon_compute;
 
-/** ts_shm_compute on the device (`threads` is checked, then unused). */
-ts_status ts_cl_shm_compute(const ts_grid *grid, double azimuth, double elevation,
-                            double penumbra_depth, int threads, float *visibility,
-                            float *shadow_height, ts_error *err);
+/** The shadow height map on the device (ts_shm_compute_fn; `threads` is
+ * checked, then unused). */
+ts_shm_compute_fn ts_cl_shm_compute;
 
-/** ts_normals on the device. */
-ts_status ts_cl_normals(const ts_grid *grid, float *nx, float *ny, float *nz,
-                        ts_error *err);
+/** The normals on the device (ts_normals_fn). */
+ts_normals_fn ts_cl_normals;
 
 /** The direct sun on the device (ts_shade_direct_fn). */
 ts_shade_direct_fn ts_cl_shade_direct;

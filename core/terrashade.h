@@ -139,18 +139,24 @@ double ts_horizon_azimuth(const ts_horizon_opts *opts, int k);
  * `out` receives width*height signed elevation angles in degrees (row stride
  * = width); NaN where the DEM is nodata, -90 where nothing lies beyond the
  * cell in that direction. O(cells). opts->directions and start_azimuth are
- * ignored.
+ * ignored. The type of every backend's sweep (terrashade_cl.h).
  */
-ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
-                           const ts_horizon_opts *opts, float *out,
-                           ts_error *err);
+typedef ts_status ts_horizon_sweep_fn(const ts_grid *grid, double azimuth,
+                                      const ts_horizon_opts *opts, float *out, ts_error *err);
+
+/** The horizon sweep on the C backend. */
+ts_horizon_sweep_fn ts_horizon_sweep;
 
 /**
  * Horizons for opts->directions azimuths (ts_horizon_azimuth): `out` holds
- * directions planes of width*height floats, plane k for azimuth k.
+ * directions planes of width*height floats, plane k for azimuth k. The type
+ * of every backend's horizons.
  */
-ts_status ts_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts,
-                             float *out, ts_error *err);
+typedef ts_status ts_horizon_compute_fn(const ts_grid *grid, const ts_horizon_opts *opts,
+                                        float *out, ts_error *err);
+
+/** The horizons on the C backend. */
+ts_horizon_compute_fn ts_horizon_compute;
 
 /**
  * Horizon sweep along the sample lines only, for tests: the horizon slope
@@ -176,11 +182,15 @@ ts_status ts_horizon_sweep_lines(const ts_grid *grid, double azimuth,
  * `visibility` (width*height, may be NULL) receives the lit fraction:
  * 1 - clamp((S - h) / penumbra_depth, 0, 1), or the binary test S <= h when
  * penumbra_depth is 0; NaN for nodata. `shadow_height` (may be NULL)
- * receives S itself. Both have row stride = width.
+ * receives S itself. Both have row stride = width. The type of every
+ * backend's shadow height map.
  */
-ts_status ts_shm_compute(const ts_grid *grid, double azimuth, double elevation,
-                         double penumbra_depth, int threads, float *visibility,
-                         float *shadow_height, ts_error *err);
+typedef ts_status ts_shm_compute_fn(const ts_grid *grid, double azimuth, double elevation,
+                                    double penumbra_depth, int threads, float *visibility,
+                                    float *shadow_height, ts_error *err);
+
+/** The shadow height map on the C backend. */
+ts_shm_compute_fn ts_shm_compute;
 
 /* --------------------------------------------------------------- shading */
 
@@ -197,10 +207,13 @@ ts_status ts_shm_compute(const ts_grid *grid, double azimuth, double elevation,
  * Unit surface normals by Horn's method (as gdaldem hillshade), components
  * x = east, y = north, z = up; each array width*height (may not be NULL).
  * On edges and next to nodata the missing neighbours are replaced by the
- * centre cell; a nodata cell gets NaN.
+ * centre cell; a nodata cell gets NaN. The type of every backend's normals.
  */
-ts_status ts_normals(const ts_grid *grid, float *nx, float *ny, float *nz,
-                     ts_error *err);
+typedef ts_status ts_normals_fn(const ts_grid *grid, float *nx, float *ny, float *nz,
+                                ts_error *err);
+
+/** The normals on the C backend. */
+ts_normals_fn ts_normals;
 
 /**
  * Fraction (0..1) of the sun's disk, centre at `sun_elevation`, radius
