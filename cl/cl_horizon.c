@@ -219,13 +219,8 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
         const cl_int cnaz = nb, citems = items;
         /* pass 1: lines */
         ts_cl_job_arg(&J, k1, 0, sizeof zb, &zb);
-        ts_cl_job_arg(&J, k1, 1, sizeof cW, &cW);
-        ts_cl_job_arg(&J, k1, 2, sizeof cnaz, &cnaz);
-        ts_cl_job_arg(&J, k1, 3, sizeof ipb, &ipb);
-        ts_cl_job_arg(&J, k1, 4, sizeof dpb, &dpb);
-        ts_cl_job_arg(&J, k1, 5, sizeof flb, &flb);
-        ts_cl_job_arg(&J, k1, 6, sizeof frb, &frb);
-        ts_cl_job_arg(&J, k1, 7, sizeof srb, &srb);
+        ts_cl_job_ints(&J, k1, 1, 2, (const cl_int[]){cW, cnaz});
+        ts_cl_job_mems(&J, k1, 3, 5, (const cl_mem[]){ipb, dpb, flb, frb, srb});
         ts_cl_job_arg(&J, k1, 9, sizeof citems, &citems);
         ts_cl_job_arg_real(&J, k1, 10, c);
         ts_cl_job_arg(&J, k1, 11, sizeof hib, &hib);
@@ -243,12 +238,8 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
         }
         /* pass 2: cells */
         ts_cl_job_arg(&J, k2, 0, sizeof zb, &zb);
-        ts_cl_job_arg(&J, k2, 1, sizeof cW, &cW);
-        ts_cl_job_arg(&J, k2, 2, sizeof cH, &cH);
-        ts_cl_job_arg(&J, k2, 3, sizeof ipb, &ipb);
-        ts_cl_job_arg(&J, k2, 4, sizeof dpb, &dpb);
-        ts_cl_job_arg(&J, k2, 5, sizeof frb, &frb);
-        ts_cl_job_arg(&J, k2, 6, sizeof srb, &srb);
+        ts_cl_job_ints(&J, k2, 1, 2, (const cl_int[]){cW, cH});
+        ts_cl_job_mems(&J, k2, 3, 4, (const cl_mem[]){ipb, dpb, frb, srb});
         ts_cl_job_arg_real(&J, k2, 7, c);
         ts_cl_job_arg_real(&J, k2, 8, cap);
         ts_cl_job_arg(&J, k2, 9, sizeof ob, &ob);

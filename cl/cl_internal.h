@@ -71,6 +71,10 @@ cl_kernel ts_cl_job_kernel(ts_cl_job *j, const char *name);
 
 void ts_cl_job_arg(ts_cl_job *j, cl_kernel k, cl_uint index, size_t size, const void *value);
 
+/* Kernel arguments first .. first + n - 1: n buffers, or n ints. */
+void ts_cl_job_mems(ts_cl_job *j, cl_kernel k, cl_uint first, int n, const cl_mem *mems);
+void ts_cl_job_ints(ts_cl_job *j, cl_kernel k, cl_uint first, int n, const cl_int *ints);
+
 /* Work-group size for kernel k: at most `want`, a power of two, within the
  * kernel's and the device's limits. */
 size_t ts_cl_job_wg(ts_cl_job *j, cl_kernel k, size_t want);

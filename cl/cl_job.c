@@ -155,6 +155,18 @@ void ts_cl_job_arg(ts_cl_job *j, cl_kernel k, cl_uint index, size_t size, const 
         job_cl_fail(j, e, "clSetKernelArg (argument %u)", index);
 }
 
+void ts_cl_job_mems(ts_cl_job *j, cl_kernel k, cl_uint first, int n, const cl_mem *mems)
+{
+    for (int i = 0; i < n; i++)
+        ts_cl_job_arg(j, k, first + (cl_uint)i, sizeof mems[i], &mems[i]);
+}
+
+void ts_cl_job_ints(ts_cl_job *j, cl_kernel k, cl_uint first, int n, const cl_int *ints)
+{
+    for (int i = 0; i < n; i++)
+        ts_cl_job_arg(j, k, first + (cl_uint)i, sizeof ints[i], &ints[i]);
+}
+
 void ts_cl_job_arg_real(ts_cl_job *j, cl_kernel k, cl_uint index, double value)
 {
     if (j->st != TS_OK)

@@ -104,15 +104,10 @@ ts_status ts_cl_shm_compute(const ts_grid *grid, double azimuth, double elevatio
     cl_mem hb = ts_cl_job_buffer(&J, CL_MEM_WRITE_ONLY,
                                  shadow_height ? cells * sizeof(float) : 16, NULL,
                                  "shadow heights");
-    const cl_int cW = W, xm = G.x_major, V = G.V, us = G.u_start, ustep = G.u_step;
     const cl_int want_vis = vis != NULL, want_sh = shadow_height != NULL;
     const cl_float depth = (cl_float)penumbra_depth;
     ts_cl_job_arg(&J, k, 0, sizeof zb, &zb);
-    ts_cl_job_arg(&J, k, 1, sizeof cW, &cW);
-    ts_cl_job_arg(&J, k, 2, sizeof xm, &xm);
-    ts_cl_job_arg(&J, k, 3, sizeof V, &V);
-    ts_cl_job_arg(&J, k, 4, sizeof us, &us);
-    ts_cl_job_arg(&J, k, 5, sizeof ustep, &ustep);
+    ts_cl_job_ints(&J, k, 1, 5, (const cl_int[]){W, G.x_major, G.V, G.u_start, G.u_step});
     ts_cl_job_arg(&J, k, 6, sizeof off, &off);
     ts_cl_job_arg(&J, k, 7, sizeof F, &F);
     ts_cl_job_arg(&J, k, 8, sizeof db, &db);
@@ -175,17 +170,14 @@ ts_status ts_cl_normals(const ts_grid *grid, float *nx, float *ny, float *nz, ts
     cl_mem yb = ts_cl_job_buffer(&J, CL_MEM_WRITE_ONLY, bytes, NULL, "normals");
     cl_mem zzb = ts_cl_job_buffer(&J, CL_MEM_WRITE_ONLY, bytes, NULL, "normals");
     cl_kernel k = ts_cl_job_kernel(&J, "ts_normals");
-    const cl_int cW = W, cH = H, has = cxr != NULL;
+    const cl_int has = cxr != NULL;
     ts_cl_job_arg(&J, k, 0, sizeof zb, &zb);
-    ts_cl_job_arg(&J, k, 1, sizeof cW, &cW);
-    ts_cl_job_arg(&J, k, 2, sizeof cH, &cH);
+    ts_cl_job_ints(&J, k, 1, 2, (const cl_int[]){W, H});
     ts_cl_job_arg(&J, k, 3, sizeof cb, &cb);
     ts_cl_job_arg(&J, k, 4, sizeof has, &has);
     ts_cl_job_arg_real(&J, k, 5, grid->cell_x);
     ts_cl_job_arg_real(&J, k, 6, grid->cell_y);
-    ts_cl_job_arg(&J, k, 7, sizeof xb, &xb);
-    ts_cl_job_arg(&J, k, 8, sizeof yb, &yb);
-    ts_cl_job_arg(&J, k, 9, sizeof zzb, &zzb);
+    ts_cl_job_mems(&J, k, 7, 3, (const cl_mem[]){xb, yb, zzb});
     size_t L = ts_cl_job_wg(&J, k, 256), global = ts_cl_round_up(cells, L);
     ts_cl_job_run(&J, k, 1, &global, &L, "ts_normals");
     ts_cl_job_read(&J, xb, 0, bytes, nx, "normals");
@@ -222,11 +214,7 @@ ts_status ts_cl_shade_direct(const ts_direct_request *req, ts_error *err)
     cl_mem ob = ts_cl_job_buffer(&J, CL_MEM_WRITE_ONLY, bytes, NULL, "direct light");
     cl_kernel k = ts_cl_job_kernel(&J, "ts_direct");
     const cl_long ccells = (cl_long)cells;
-    ts_cl_job_arg(&J, k, 0, sizeof xb, &xb);
-    ts_cl_job_arg(&J, k, 1, sizeof yb, &yb);
-    ts_cl_job_arg(&J, k, 2, sizeof zb, &zb);
-    ts_cl_job_arg(&J, k, 3, sizeof h0, &h0);
-    ts_cl_job_arg(&J, k, 4, sizeof h1, &h1);
+    ts_cl_job_mems(&J, k, 0, 5, (const cl_mem[]){xb, yb, zb, h0, h1});
     ts_cl_job_arg(&J, k, 5, sizeof ccells, &ccells);
     const cl_float fw = (float)p.w;
     ts_cl_job_arg(&J, k, 6, sizeof fw, &fw);
@@ -294,18 +282,13 @@ ts_status ts_cl_sky_terms(const ts_sky_request *req, ts_error *err)
     cl_kernel k = ts_cl_job_kernel(&J, "ts_sky");
     const cl_long ccells = (cl_long)cells;
     const cl_float w1 = (float)(1.0 / n), w2 = (float)(sin(M_PI / n) / M_PI), fn = (float)n;
-    ts_cl_job_arg(&J, k, 0, sizeof xb, &xb);
-    ts_cl_job_arg(&J, k, 1, sizeof yb, &yb);
-    ts_cl_job_arg(&J, k, 2, sizeof zb, &zb);
-    ts_cl_job_arg(&J, k, 3, sizeof pb, &pb);
+    ts_cl_job_mems(&J, k, 0, 4, (const cl_mem[]){xb, yb, zb, pb});
     ts_cl_job_arg(&J, k, 5, sizeof ccells, &ccells);
     ts_cl_job_arg(&J, k, 8, sizeof w1, &w1);
     ts_cl_job_arg(&J, k, 9, sizeof w2, &w2);
     ts_cl_job_arg(&J, k, 10, sizeof want, &want);
     ts_cl_job_arg(&J, k, 12, sizeof fn, &fn);
-    ts_cl_job_arg(&J, k, 13, sizeof acc[0], &acc[0]);
-    ts_cl_job_arg(&J, k, 14, sizeof acc[1], &acc[1]);
-    ts_cl_job_arg(&J, k, 15, sizeof acc[2], &acc[2]);
+    ts_cl_job_mems(&J, k, 13, 3, acc);
     size_t L = ts_cl_job_wg(&J, k, 256), global = ts_cl_round_up(cells, L);
     for (int first = 0; first < n && J.st == TS_OK; first += (int)A) {
         const cl_int nb = n - first < (int)A ? n - first : (int)A;
