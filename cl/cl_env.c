@@ -63,16 +63,12 @@ ts_status ts_cl_env_light_open(const ts_env_light_request *req, ts_cl_env_light 
     s->k = ts_cl_job_kernel(J, "ts_env_light");
     const cl_long ccells = (cl_long)s->cells;
     const cl_int nn = table->normal_steps, nh = table->horizon_steps;
-    ts_cl_job_arg(J, s->k, 0, sizeof xb, &xb);
-    ts_cl_job_arg(J, s->k, 1, sizeof yb, &yb);
-    ts_cl_job_arg(J, s->k, 2, sizeof zb, &zb);
-    ts_cl_job_arg(J, s->k, 3, sizeof s->plane, &s->plane);
-    ts_cl_job_arg(J, s->k, 4, sizeof ccells, &ccells);
-    ts_cl_job_arg(J, s->k, 5, sizeof lpb, &lpb);
-    ts_cl_job_arg(J, s->k, 7, sizeof nn, &nn);
-    ts_cl_job_arg(J, s->k, 8, sizeof nh, &nh);
-    for (int c = 0; c < 3; c++)
-        ts_cl_job_arg(J, s->k, 11 + c, sizeof s->acc[c], &s->acc[c]);
+    ts_cl_job_args(J, s->k, 0,
+                   TS_CL_ARGS(TS_CL_ARG(xb), TS_CL_ARG(yb), TS_CL_ARG(zb), TS_CL_ARG(s->plane),
+                              TS_CL_ARG(ccells), TS_CL_ARG(lpb)));
+    ts_cl_job_args(J, s->k, 7, TS_CL_ARGS(TS_CL_ARG(nn), TS_CL_ARG(nh)));
+    ts_cl_job_args(J, s->k, 11,
+                   TS_CL_ARGS(TS_CL_ARG(s->acc[0]), TS_CL_ARG(s->acc[1]), TS_CL_ARG(s->acc[2])));
     s->L = ts_cl_job_wg(J, s->k, 256);
     s->global = ts_cl_round_up(s->cells, s->L);
     if (J->st != TS_OK) {
@@ -115,8 +111,7 @@ ts_status ts_cl_env_light_add(ts_cl_env_light *s, const ts_env_light_request *re
     const cl_long off = (cl_long)(ts_env_table_sector_floats(req->table) * (size_t)req->k);
     ts_cl_job_write(J, s->plane, 0, bytes, req->plane, "horizon plane");
     ts_cl_job_arg(J, s->k, 6, sizeof off, &off);
-    ts_cl_job_arg(J, s->k, 9, sizeof sa, &sa);
-    ts_cl_job_arg(J, s->k, 10, sizeof ca, &ca);
+    ts_cl_job_args(J, s->k, 9, TS_CL_ARGS(TS_CL_ARG(sa), TS_CL_ARG(ca)));
     ts_cl_job_run(J, s->k, 1, &s->global, &s->L, "ts_env_light");
     for (int c = 0; c < 3; c++)
         ts_cl_job_read(J, s->acc[c], 0, bytes, host[c], "light accumulators");

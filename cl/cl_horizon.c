@@ -218,17 +218,15 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
         }
         const cl_int cnaz = nb, citems = items;
         /* pass 1: lines */
-        ts_cl_job_arg(&J, k1, 0, sizeof zb, &zb);
-        ts_cl_job_ints(&J, k1, 1, 2, (const cl_int[]){cW, cnaz});
-        ts_cl_job_mems(&J, k1, 3, 5, (const cl_mem[]){ipb, dpb, flb, frb, srb});
+        ts_cl_job_args(&J, k1, 0,
+                       TS_CL_ARGS(TS_CL_ARG(zb), TS_CL_ARG(cW), TS_CL_ARG(cnaz), TS_CL_ARG(ipb),
+                                  TS_CL_ARG(dpb), TS_CL_ARG(flb), TS_CL_ARG(frb),
+                                  TS_CL_ARG(srb)));
         ts_cl_job_arg(&J, k1, 9, sizeof citems, &citems);
         ts_cl_job_arg_real(&J, k1, 10, c);
-        ts_cl_job_arg(&J, k1, 11, sizeof hib, &hib);
-        ts_cl_job_arg(&J, k1, 12, sizeof lob, &lob);
-        ts_cl_job_arg(&J, k1, 13, sizeof cplane, &cplane);
-        ts_cl_job_arg(&J, k1, 14, sizeof sb, &sb);
-        ts_cl_job_arg(&J, k1, 15, sizeof skb, &skb);
-        ts_cl_job_arg(&J, k1, 16, sizeof cslots, &cslots);
+        ts_cl_job_args(&J, k1, 11,
+                       TS_CL_ARGS(TS_CL_ARG(hib), TS_CL_ARG(lob), TS_CL_ARG(cplane),
+                                  TS_CL_ARG(sb), TS_CL_ARG(skb), TS_CL_ARG(cslots)));
         for (int item0 = 0; item0 < items && J.st == TS_OK; item0 += (int)nslots) {
             const cl_int citem0 = item0;
             size_t active = (size_t)(items - item0) < nslots ? (size_t)(items - item0) : nslots;
@@ -237,15 +235,14 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
             ts_cl_job_run(&J, k1, 1, &global, &wg1, "ts_sweep_lines");
         }
         /* pass 2: cells */
-        ts_cl_job_arg(&J, k2, 0, sizeof zb, &zb);
-        ts_cl_job_ints(&J, k2, 1, 2, (const cl_int[]){cW, cH});
-        ts_cl_job_mems(&J, k2, 3, 4, (const cl_mem[]){ipb, dpb, frb, srb});
+        ts_cl_job_args(&J, k2, 0,
+                       TS_CL_ARGS(TS_CL_ARG(zb), TS_CL_ARG(cW), TS_CL_ARG(cH), TS_CL_ARG(ipb),
+                                  TS_CL_ARG(dpb), TS_CL_ARG(frb), TS_CL_ARG(srb)));
         ts_cl_job_arg_real(&J, k2, 7, c);
         ts_cl_job_arg_real(&J, k2, 8, cap);
-        ts_cl_job_arg(&J, k2, 9, sizeof ob, &ob);
-        ts_cl_job_arg(&J, k2, 10, sizeof hib, &hib);
-        ts_cl_job_arg(&J, k2, 11, sizeof lob, &lob);
-        ts_cl_job_arg(&J, k2, 12, sizeof cplane, &cplane);
+        ts_cl_job_args(&J, k2, 9,
+                       TS_CL_ARGS(TS_CL_ARG(ob), TS_CL_ARG(hib), TS_CL_ARG(lob),
+                                  TS_CL_ARG(cplane)));
         size_t global2[2] = {ts_cl_round_up(cells, wg2), (size_t)nb}, local2[2] = {wg2, 1};
         ts_cl_job_run(&J, k2, 2, global2, local2, "ts_sweep_finish");
         ts_cl_job_read(&J, ob, 0, (size_t)nb * plane_bytes, out + (size_t)first * cells,

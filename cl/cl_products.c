@@ -104,28 +104,23 @@ ts_status ts_cl_shm_compute(const ts_grid *grid, double azimuth, double elevatio
     cl_mem hb = ts_cl_job_buffer(&J, CL_MEM_WRITE_ONLY,
                                  shadow_height ? cells * sizeof(float) : 16, NULL,
                                  "shadow heights");
+    const cl_int cW = W, xm = G.x_major, V = G.V, us = G.u_start, ustep = G.u_step;
     const cl_int want_vis = vis != NULL, want_sh = shadow_height != NULL;
     const cl_float depth = (cl_float)penumbra_depth;
-    ts_cl_job_arg(&J, k, 0, sizeof zb, &zb);
-    ts_cl_job_ints(&J, k, 1, 5, (const cl_int[]){W, G.x_major, G.V, G.u_start, G.u_step});
-    ts_cl_job_arg(&J, k, 6, sizeof off, &off);
-    ts_cl_job_arg(&J, k, 7, sizeof F, &F);
-    ts_cl_job_arg(&J, k, 8, sizeof db, &db);
-    ts_cl_job_arg(&J, k, 9, sizeof depth, &depth);
-    ts_cl_job_arg(&J, k, 12, sizeof hlo, &hlo);
-    ts_cl_job_arg(&J, k, 13, sizeof hhi, &hhi);
-    ts_cl_job_arg(&J, k, 16, sizeof vb, &vb);
-    ts_cl_job_arg(&J, k, 17, sizeof hb, &hb);
-    ts_cl_job_arg(&J, k, 18, sizeof want_vis, &want_vis);
-    ts_cl_job_arg(&J, k, 19, sizeof want_sh, &want_sh);
+    ts_cl_job_args(&J, k, 0,
+                   TS_CL_ARGS(TS_CL_ARG(zb), TS_CL_ARG(cW), TS_CL_ARG(xm), TS_CL_ARG(V),
+                              TS_CL_ARG(us), TS_CL_ARG(ustep), TS_CL_ARG(off), TS_CL_ARG(F),
+                              TS_CL_ARG(db), TS_CL_ARG(depth)));
+    ts_cl_job_args(&J, k, 12, TS_CL_ARGS(TS_CL_ARG(hlo), TS_CL_ARG(hhi)));
+    ts_cl_job_args(&J, k, 16,
+                   TS_CL_ARGS(TS_CL_ARG(vb), TS_CL_ARG(hb), TS_CL_ARG(want_vis),
+                              TS_CL_ARG(want_sh)));
     ts_cl_job_arg(&J, k, 20, 2 * E * sizeof(float), NULL);
     cl_mem in = s0, outm = s1;
     for (int k0 = 0; k0 < G.U && J.st == TS_OK; k0 += (int)K) {
         const cl_int ck0 = k0, nrows = G.U - k0 < (int)K ? G.U - k0 : (int)K;
-        ts_cl_job_arg(&J, k, 10, sizeof ck0, &ck0);
-        ts_cl_job_arg(&J, k, 11, sizeof nrows, &nrows);
-        ts_cl_job_arg(&J, k, 14, sizeof in, &in);
-        ts_cl_job_arg(&J, k, 15, sizeof outm, &outm);
+        ts_cl_job_args(&J, k, 10, TS_CL_ARGS(TS_CL_ARG(ck0), TS_CL_ARG(nrows)));
+        ts_cl_job_args(&J, k, 14, TS_CL_ARGS(TS_CL_ARG(in), TS_CL_ARG(outm)));
         size_t global = groups * L;
         ts_cl_job_run(&J, k, 1, &global, &L, "ts_shm_rows");
         cl_mem t = in;
@@ -170,14 +165,13 @@ ts_status ts_cl_normals(const ts_grid *grid, float *nx, float *ny, float *nz, ts
     cl_mem yb = ts_cl_job_buffer(&J, CL_MEM_WRITE_ONLY, bytes, NULL, "normals");
     cl_mem zzb = ts_cl_job_buffer(&J, CL_MEM_WRITE_ONLY, bytes, NULL, "normals");
     cl_kernel k = ts_cl_job_kernel(&J, "ts_normals");
-    const cl_int has = cxr != NULL;
-    ts_cl_job_arg(&J, k, 0, sizeof zb, &zb);
-    ts_cl_job_ints(&J, k, 1, 2, (const cl_int[]){W, H});
-    ts_cl_job_arg(&J, k, 3, sizeof cb, &cb);
-    ts_cl_job_arg(&J, k, 4, sizeof has, &has);
+    const cl_int cW = W, cH = H, has = cxr != NULL;
+    ts_cl_job_args(&J, k, 0,
+                   TS_CL_ARGS(TS_CL_ARG(zb), TS_CL_ARG(cW), TS_CL_ARG(cH), TS_CL_ARG(cb),
+                              TS_CL_ARG(has)));
     ts_cl_job_arg_real(&J, k, 5, grid->cell_x);
     ts_cl_job_arg_real(&J, k, 6, grid->cell_y);
-    ts_cl_job_mems(&J, k, 7, 3, (const cl_mem[]){xb, yb, zzb});
+    ts_cl_job_args(&J, k, 7, TS_CL_ARGS(TS_CL_ARG(xb), TS_CL_ARG(yb), TS_CL_ARG(zzb)));
     size_t L = ts_cl_job_wg(&J, k, 256), global = ts_cl_round_up(cells, L);
     ts_cl_job_run(&J, k, 1, &global, &L, "ts_normals");
     ts_cl_job_read(&J, xb, 0, bytes, nx, "normals");
@@ -214,17 +208,15 @@ ts_status ts_cl_shade_direct(const ts_direct_request *req, ts_error *err)
     cl_mem ob = ts_cl_job_buffer(&J, CL_MEM_WRITE_ONLY, bytes, NULL, "direct light");
     cl_kernel k = ts_cl_job_kernel(&J, "ts_direct");
     const cl_long ccells = (cl_long)cells;
-    ts_cl_job_mems(&J, k, 0, 5, (const cl_mem[]){xb, yb, zb, h0, h1});
-    ts_cl_job_arg(&J, k, 5, sizeof ccells, &ccells);
     const cl_float fw = (float)p.w;
-    ts_cl_job_arg(&J, k, 6, sizeof fw, &fw);
-    for (int j = 0; j < 3; j++)
-        ts_cl_job_arg(&J, k, 7 + j, sizeof p.light[j], &p.light[j]);
     /* as core/shading.c */
     const cl_float el_deg = (float)req->sun_elevation, inv_r = (float)(1.0 / TS_SUN_RADIUS_DEG);
-    ts_cl_job_arg(&J, k, 10, sizeof el_deg, &el_deg);
-    ts_cl_job_arg(&J, k, 11, sizeof inv_r, &inv_r);
-    ts_cl_job_arg(&J, k, 12, sizeof ob, &ob);
+    ts_cl_job_args(&J, k, 0,
+                   TS_CL_ARGS(TS_CL_ARG(xb), TS_CL_ARG(yb), TS_CL_ARG(zb), TS_CL_ARG(h0),
+                              TS_CL_ARG(h1), TS_CL_ARG(ccells), TS_CL_ARG(fw),
+                              TS_CL_ARG(p.light[0]), TS_CL_ARG(p.light[1]),
+                              TS_CL_ARG(p.light[2]), TS_CL_ARG(el_deg), TS_CL_ARG(inv_r),
+                              TS_CL_ARG(ob)));
     size_t L = ts_cl_job_wg(&J, k, 256), global = ts_cl_round_up(cells, L);
     ts_cl_job_run(&J, k, 1, &global, &L, "ts_direct");
     ts_cl_job_read(&J, ob, 0, bytes, req->out, "direct light");
@@ -282,13 +274,13 @@ ts_status ts_cl_sky_terms(const ts_sky_request *req, ts_error *err)
     cl_kernel k = ts_cl_job_kernel(&J, "ts_sky");
     const cl_long ccells = (cl_long)cells;
     const cl_float w1 = (float)(1.0 / n), w2 = (float)(sin(M_PI / n) / M_PI), fn = (float)n;
-    ts_cl_job_mems(&J, k, 0, 4, (const cl_mem[]){xb, yb, zb, pb});
+    ts_cl_job_args(&J, k, 0,
+                   TS_CL_ARGS(TS_CL_ARG(xb), TS_CL_ARG(yb), TS_CL_ARG(zb), TS_CL_ARG(pb)));
     ts_cl_job_arg(&J, k, 5, sizeof ccells, &ccells);
-    ts_cl_job_arg(&J, k, 8, sizeof w1, &w1);
-    ts_cl_job_arg(&J, k, 9, sizeof w2, &w2);
-    ts_cl_job_arg(&J, k, 10, sizeof want, &want);
-    ts_cl_job_arg(&J, k, 12, sizeof fn, &fn);
-    ts_cl_job_mems(&J, k, 13, 3, acc);
+    ts_cl_job_args(&J, k, 8, TS_CL_ARGS(TS_CL_ARG(w1), TS_CL_ARG(w2), TS_CL_ARG(want)));
+    ts_cl_job_args(&J, k, 12,
+                   TS_CL_ARGS(TS_CL_ARG(fn), TS_CL_ARG(acc[0]), TS_CL_ARG(acc[1]),
+                              TS_CL_ARG(acc[2])));
     size_t L = ts_cl_job_wg(&J, k, 256), global = ts_cl_round_up(cells, L);
     for (int first = 0; first < n && J.st == TS_OK; first += (int)A) {
         const cl_int nb = n - first < (int)A ? n - first : (int)A;
@@ -300,8 +292,7 @@ ts_status ts_cl_sky_terms(const ts_sky_request *req, ts_error *err)
         ts_cl_job_write(&J, sab, 0, (size_t)nb * sizeof *sa, sa + first, "azimuths");
         ts_cl_job_write(&J, cab, 0, (size_t)nb * sizeof *ca, ca + first, "azimuths");
         ts_cl_job_arg(&J, k, 4, sizeof nb, &nb);
-        ts_cl_job_arg(&J, k, 6, sizeof sab, &sab);
-        ts_cl_job_arg(&J, k, 7, sizeof cab, &cab);
+        ts_cl_job_args(&J, k, 6, TS_CL_ARGS(TS_CL_ARG(sab), TS_CL_ARG(cab)));
         ts_cl_job_arg(&J, k, 11, sizeof finish, &finish);
         ts_cl_job_run(&J, k, 1, &global, &L, "ts_sky");
     }
