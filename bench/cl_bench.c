@@ -149,14 +149,13 @@ static ts_status run_env(ctx *c, int cl, ts_error *e)
     ts_cl_env_light *s = NULL;
     for (int i = 0; i < 3; i++)
         memset(i == 0 ? c->out : i == 1 ? c->out2 : c->out3, 0, c->n * sizeof(float));
+    ts_env_light_request req = {&c->g,  &c->table, 0,      c->nx,  c->ny,
+                                c->nz,  c->hz,     c->out, c->out2, c->out3};
     if (cl)
-        st = ts_cl_env_light_open(&c->g, &c->table, c->nx, c->ny, c->nz, &s, e);
-    for (int k = 0; k < c->o.directions && st == TS_OK; k++) {
-        const float *plane = c->hz + c->n * k;
-        st = cl ? ts_cl_env_light_add(s, &c->g, &c->table, k, c->nx, c->ny, c->nz, plane, c->out,
-                                      c->out2, c->out3, e)
-                : ts_env_light_accumulate(&c->g, &c->table, k, c->nx, c->ny, c->nz, plane,
-                                          c->out, c->out2, c->out3, e);
+        st = ts_cl_env_light_open(&req, &s, e);
+    for (req.k = 0; req.k < c->o.directions && st == TS_OK; req.k++) {
+        req.plane = c->hz + c->n * req.k;
+        st = cl ? ts_cl_env_light_add(s, &req, e) : ts_env_light_accumulate(&req, e);
     }
     ts_cl_env_light_close(s);
     return st;
@@ -182,16 +181,17 @@ static void run(ctx *c, int p, int cl, float *hout)
         st = cl ? ts_cl_normals(&c->g, c->out, c->out2, c->out3, &e)
                 : ts_normals(&c->g, c->out, c->out2, c->out3, &e);
         break;
-    case P_DIRECT:
-        st = cl ? ts_cl_shade_direct(&c->g, c->nx, c->ny, c->nz, c->hz, &c->o, 135, 30, c->out, &e)
-                : ts_shade_direct(&c->g, c->nx, c->ny, c->nz, c->hz, &c->o, 135, 30, c->out, &e);
+    case P_DIRECT: {
+        const ts_direct_request req = {&c->g, c->nx, c->ny, c->nz, c->hz, &c->o, 135, 30, c->out};
+        st = (cl ? ts_cl_shade_direct : ts_shade_direct)(&req, &e);
         break;
-    case P_SKY:
-        st = cl ? ts_cl_sky_terms(&c->g, c->nx, c->ny, c->nz, c->hz, &c->o, c->out, c->out2,
-                                  c->out3, &e)
-                : ts_sky_terms(&c->g, c->nx, c->ny, c->nz, c->hz, &c->o, c->out, c->out2,
-                               c->out3, &e);
+    }
+    case P_SKY: {
+        const ts_sky_request req = {&c->g, c->nx, c->ny, c->nz, c->hz, &c->o, TS_SVF_RADIATIVE,
+                                    c->out, c->out2, c->out3};
+        st = (cl ? ts_cl_sky_terms : ts_sky_terms)(&req, &e);
         break;
+    }
     case P_ENV:
         st = run_env(c, cl, &e);
         break;

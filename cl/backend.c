@@ -185,45 +185,34 @@ ts_status ts_backend_normals(ts_backend backend, const ts_grid *grid, float *nx,
     DISPATCH(ts_cl_normals(grid, nx, ny, nz, cl_err), ts_normals(grid, nx, ny, nz, err));
 }
 
-ts_status ts_backend_shade_direct(ts_backend backend, const ts_grid *grid, const float *nx,
-                                  const float *ny, const float *nz, const float *horizons,
-                                  const ts_horizon_opts *opts, double sun_azimuth,
-                                  double sun_elevation, float *out, ts_backend_report *report,
-                                  ts_error *err)
+ts_status ts_backend_shade_direct(ts_backend backend, const ts_direct_request *req,
+                                  ts_backend_report *report, ts_error *err)
 {
-    DISPATCH(ts_cl_shade_direct(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
-                                out, cl_err),
-             ts_shade_direct(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation, out,
-                             err));
+    DISPATCH(ts_cl_shade_direct(req, cl_err), ts_shade_direct(req, err));
 }
 
-ts_status ts_backend_sky_terms(ts_backend backend, const ts_grid *grid, const float *nx,
-                               const float *ny, const float *nz, const float *horizons,
-                               const ts_horizon_opts *opts, float *svf, float *sky,
-                               float *openness, ts_backend_report *report, ts_error *err)
+ts_status ts_backend_sky_terms(ts_backend backend, const ts_sky_request *req,
+                               ts_backend_report *report, ts_error *err)
 {
-    DISPATCH(ts_cl_sky_terms(grid, nx, ny, nz, horizons, opts, svf, sky, openness, cl_err),
-             ts_sky_terms(grid, nx, ny, nz, horizons, opts, svf, sky, openness, err));
+    DISPATCH(ts_cl_sky_terms(req, cl_err), ts_sky_terms(req, err));
 }
 
 /* One plane on OpenCL, through the session of `state` (opened on the first
  * plane, reopened for other arrays) or, without a state, in one call. */
-static ts_status env_light_cl(ts_backend_env_light *state, const ts_grid *grid,
-                              const ts_env_table *table, int k, const float *nx,
-                              const float *ny, const float *nz, const float *plane, float *r,
-                              float *g, float *b, ts_error *err)
+static ts_status env_light_cl(ts_backend_env_light *state, const ts_env_light_request *req,
+                              ts_error *err)
 {
     if (!state)
-        return ts_cl_env_light_accumulate(grid, table, k, nx, ny, nz, plane, r, g, b, err);
+        return ts_cl_env_light_accumulate(req, err);
     if (state->failed) /* not again for every plane */
         return ts_fail(err, TS_ERR_INTERNAL, "%s", state->reason);
-    if (state->cl && !ts_cl_env_light_matches(state->cl, grid, table, nx, ny, nz))
+    if (state->cl && !ts_cl_env_light_matches(state->cl, req))
         ts_backend_env_light_release(state);
     ts_status st = TS_OK;
     if (!state->cl)
-        st = ts_cl_env_light_open(grid, table, nx, ny, nz, &state->cl, err);
+        st = ts_cl_env_light_open(req, &state->cl, err);
     if (st == TS_OK)
-        st = ts_cl_env_light_add(state->cl, grid, table, k, nx, ny, nz, plane, r, g, b, err);
+        st = ts_cl_env_light_add(state->cl, req, err);
     if (st != TS_OK && st != TS_ERR_ARG) {
         ts_cl_env_light_close(state->cl);
         state->cl = NULL;
@@ -233,16 +222,11 @@ static ts_status env_light_cl(ts_backend_env_light *state, const ts_grid *grid,
     return st;
 }
 
-/* red, green, blue: DISPATCH names the report r */
 ts_status ts_backend_env_light_accumulate(ts_backend backend, ts_backend_env_light *state,
-                                          const ts_grid *grid, const ts_env_table *table,
-                                          int k, const float *nx, const float *ny,
-                                          const float *nz, const float *plane, float *red,
-                                          float *green, float *blue, ts_backend_report *report,
-                                          ts_error *err)
+                                          const ts_env_light_request *req,
+                                          ts_backend_report *report, ts_error *err)
 {
-    DISPATCH(env_light_cl(state, grid, table, k, nx, ny, nz, plane, red, green, blue, cl_err),
-             ts_env_light_accumulate(grid, table, k, nx, ny, nz, plane, red, green, blue, err));
+    DISPATCH(env_light_cl(state, req, cl_err), ts_env_light_accumulate(req, err));
 }
 
 void ts_backend_env_light_release(ts_backend_env_light *state)

@@ -29,17 +29,17 @@ struct ts_cl_env_light {
     size_t L, global;
 };
 
-ts_status ts_cl_env_light_open(const ts_grid *grid, const ts_env_table *table, const float *nx,
-                               const float *ny, const float *nz, ts_cl_env_light **out,
+ts_status ts_cl_env_light_open(const ts_env_light_request *req, ts_cl_env_light **out,
                                ts_error *err)
 {
     if (!out)
         return ts_fail(err, TS_ERR_ARG, "the session pointer must not be NULL");
     *out = NULL;
-    /* the plane and the outputs come with each plane: checked there */
-    ts_status st = ts_check_env_light_args(grid, table, 0, nx, ny, nz, nz, nx, ny, nz, err);
+    ts_status st = ts_check_env_light_request(req, err);
     if (st != TS_OK)
         return st;
+    const ts_grid *grid = req->grid;
+    const ts_env_table *table = req->table;
     ts_cl_env_light *s = calloc(1, sizeof *s);
     if (!s)
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the OpenCL environment light");
@@ -50,29 +50,25 @@ ts_status ts_cl_env_light_open(const ts_grid *grid, const ts_env_table *table, c
     }
     s->W = grid->width, s->H = grid->height;
     s->cells = (size_t)grid->width * grid->height;
-    s->table = table, s->lp = table->lp, s->nx = nx, s->ny = ny, s->nz = nz;
+    s->table = table, s->lp = table->lp, s->nx = req->nx, s->ny = req->ny, s->nz = req->nz;
     const size_t bytes = s->cells * sizeof(float);
     const size_t lp_bytes = ts_env_table_sector_floats(table) * table->directions * sizeof(float);
     cl_mem lpb = ts_cl_job_buffer(J, CL_MEM_READ_ONLY, lp_bytes, table->lp, "light table");
-    cl_mem xb = ts_cl_job_buffer(J, CL_MEM_READ_ONLY, bytes, nx, "normals");
-    cl_mem yb = ts_cl_job_buffer(J, CL_MEM_READ_ONLY, bytes, ny, "normals");
-    cl_mem zb = ts_cl_job_buffer(J, CL_MEM_READ_ONLY, bytes, nz, "normals");
+    cl_mem xb = ts_cl_job_buffer(J, CL_MEM_READ_ONLY, bytes, req->nx, "normals");
+    cl_mem yb = ts_cl_job_buffer(J, CL_MEM_READ_ONLY, bytes, req->ny, "normals");
+    cl_mem zb = ts_cl_job_buffer(J, CL_MEM_READ_ONLY, bytes, req->nz, "normals");
     s->plane = ts_cl_job_buffer(J, CL_MEM_READ_ONLY, bytes, NULL, "horizon plane");
     for (int c = 0; c < 3; c++)
         s->acc[c] = ts_cl_job_buffer(J, CL_MEM_READ_WRITE, bytes, NULL, "light accumulators");
     s->k = ts_cl_job_kernel(J, "ts_env_light");
     const cl_long ccells = (cl_long)s->cells;
     const cl_int nn = table->normal_steps, nh = table->horizon_steps;
-    ts_cl_job_arg(J, s->k, 0, sizeof xb, &xb);
-    ts_cl_job_arg(J, s->k, 1, sizeof yb, &yb);
-    ts_cl_job_arg(J, s->k, 2, sizeof zb, &zb);
-    ts_cl_job_arg(J, s->k, 3, sizeof s->plane, &s->plane);
-    ts_cl_job_arg(J, s->k, 4, sizeof ccells, &ccells);
-    ts_cl_job_arg(J, s->k, 5, sizeof lpb, &lpb);
-    ts_cl_job_arg(J, s->k, 7, sizeof nn, &nn);
-    ts_cl_job_arg(J, s->k, 8, sizeof nh, &nh);
-    for (int c = 0; c < 3; c++)
-        ts_cl_job_arg(J, s->k, 11 + c, sizeof s->acc[c], &s->acc[c]);
+    ts_cl_job_args(J, s->k, 0,
+                   TS_CL_ARGS(TS_CL_ARG(xb), TS_CL_ARG(yb), TS_CL_ARG(zb), TS_CL_ARG(s->plane),
+                              TS_CL_ARG(ccells), TS_CL_ARG(lpb)));
+    ts_cl_job_args(J, s->k, 7, TS_CL_ARGS(TS_CL_ARG(nn), TS_CL_ARG(nh)));
+    ts_cl_job_args(J, s->k, 11,
+                   TS_CL_ARGS(TS_CL_ARG(s->acc[0]), TS_CL_ARG(s->acc[1]), TS_CL_ARG(s->acc[2])));
     s->L = ts_cl_job_wg(J, s->k, 256);
     s->global = ts_cl_round_up(s->cells, s->L);
     if (J->st != TS_OK) {
@@ -84,23 +80,19 @@ ts_status ts_cl_env_light_open(const ts_grid *grid, const ts_env_table *table, c
     return ts_ok(err);
 }
 
-int ts_cl_env_light_matches(const ts_cl_env_light *s, const ts_grid *grid,
-                            const ts_env_table *table, const float *nx, const float *ny,
-                            const float *nz)
+int ts_cl_env_light_matches(const ts_cl_env_light *s, const ts_env_light_request *req)
 {
-    return s && grid && table && s->W == grid->width && s->H == grid->height &&
-           s->table == table && s->lp == table->lp && s->nx == nx && s->ny == ny &&
-           s->nz == nz;
+    return s && req && req->grid && req->table && s->W == req->grid->width &&
+           s->H == req->grid->height && s->table == req->table && s->lp == req->table->lp &&
+           s->nx == req->nx && s->ny == req->ny && s->nz == req->nz;
 }
 
-ts_status ts_cl_env_light_add(ts_cl_env_light *s, const ts_grid *grid, const ts_env_table *table,
-                              int k, const float *nx, const float *ny, const float *nz,
-                              const float *plane, float *r, float *g, float *b, ts_error *err)
+ts_status ts_cl_env_light_add(ts_cl_env_light *s, const ts_env_light_request *req, ts_error *err)
 {
-    ts_status st = ts_check_env_light_args(grid, table, k, nx, ny, nz, plane, r, g, b, err);
+    ts_status st = ts_check_env_light_request(req, err);
     if (st != TS_OK)
         return st;
-    if (!s || !ts_cl_env_light_matches(s, grid, table, nx, ny, nz))
+    if (!s || !ts_cl_env_light_matches(s, req))
         return ts_fail(err, TS_ERR_ARG, "the OpenCL environment light was opened for another "
                                         "grid, light table or normals");
     ts_cl_job *J = &s->J;
@@ -108,19 +100,18 @@ ts_status ts_cl_env_light_add(ts_cl_env_light *s, const ts_grid *grid, const ts_
         return ts_fail(err, J->st, "the OpenCL environment light failed before");
     J->err = err;
     const size_t bytes = s->cells * sizeof(float);
-    float *host[3] = {r, g, b};
+    float *host[3] = {req->r, req->g, req->b};
     for (int c = 0; c < 3; c++)
         if (s->acc_host[c] != host[c]) { /* new accumulators: start from their sums */
             ts_cl_job_write(J, s->acc[c], 0, bytes, host[c], "light accumulators");
             s->acc_host[c] = host[c];
         }
     float sa, ca;
-    ts_env_sector_sincos(table, k, &sa, &ca);
-    const cl_long off = (cl_long)(ts_env_table_sector_floats(table) * (size_t)k);
-    ts_cl_job_write(J, s->plane, 0, bytes, plane, "horizon plane");
+    ts_env_sector_sincos(req->table, req->k, &sa, &ca);
+    const cl_long off = (cl_long)(ts_env_table_sector_floats(req->table) * (size_t)req->k);
+    ts_cl_job_write(J, s->plane, 0, bytes, req->plane, "horizon plane");
     ts_cl_job_arg(J, s->k, 6, sizeof off, &off);
-    ts_cl_job_arg(J, s->k, 9, sizeof sa, &sa);
-    ts_cl_job_arg(J, s->k, 10, sizeof ca, &ca);
+    ts_cl_job_args(J, s->k, 9, TS_CL_ARGS(TS_CL_ARG(sa), TS_CL_ARG(ca)));
     ts_cl_job_run(J, s->k, 1, &s->global, &s->L, "ts_env_light");
     for (int c = 0; c < 3; c++)
         ts_cl_job_read(J, s->acc[c], 0, bytes, host[c], "light accumulators");
@@ -142,18 +133,14 @@ void ts_cl_env_light_close(ts_cl_env_light *s)
     free(s);
 }
 
-ts_status ts_cl_env_light_accumulate(const ts_grid *grid, const ts_env_table *table, int k,
-                                     const float *nx, const float *ny, const float *nz,
-                                     const float *plane, float *r, float *g, float *b,
-                                     ts_error *err)
+/* One plane: a session for it alone (open checks the request). */
+ts_status ts_cl_env_light_accumulate(const ts_env_light_request *req, ts_error *err)
 {
-    ts_status st = ts_check_env_light_args(grid, table, k, nx, ny, nz, plane, r, g, b, err);
+    ts_cl_env_light *s;
+    ts_status st = ts_cl_env_light_open(req, &s, err);
     if (st != TS_OK)
         return st;
-    ts_cl_env_light *s;
-    if ((st = ts_cl_env_light_open(grid, table, nx, ny, nz, &s, err)) != TS_OK)
-        return st;
-    st = ts_cl_env_light_add(s, grid, table, k, nx, ny, nz, plane, r, g, b, err);
+    st = ts_cl_env_light_add(s, req, err);
     ts_cl_env_light_close(s);
     return st;
 }

@@ -41,12 +41,9 @@ static void transpose(ts_cl_job *J, cl_kernel k, size_t wg, cl_mem src, cl_long 
                       int C, cl_mem dst, cl_long doff)
 {
     const cl_int cR = R, cC = C;
-    ts_cl_job_arg(J, k, 0, sizeof src, &src);
-    ts_cl_job_arg(J, k, 1, sizeof soff, &soff);
-    ts_cl_job_arg(J, k, 2, sizeof cR, &cR);
-    ts_cl_job_arg(J, k, 3, sizeof cC, &cC);
-    ts_cl_job_arg(J, k, 4, sizeof dst, &dst);
-    ts_cl_job_arg(J, k, 5, sizeof doff, &doff);
+    ts_cl_job_args(J, k, 0,
+                   TS_CL_ARGS(TS_CL_ARG(src), TS_CL_ARG(soff), TS_CL_ARG(cR), TS_CL_ARG(cC),
+                              TS_CL_ARG(dst), TS_CL_ARG(doff)));
     size_t local[2] = {32, wg / 32};
     size_t global[2] = {ts_cl_round_up((size_t)C, 32), ((size_t)R + 31) / 32 * local[1]};
     ts_cl_job_run(J, k, 2, global, local, "ts_transpose");
@@ -255,22 +252,15 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
         }
         const cl_int cnaz = nb, citems = items;
         /* pass 1: lines */
-        ts_cl_job_arg(&J, k1, 0, sizeof zb, &zb);
-        ts_cl_job_arg(&J, k1, 1, sizeof ztb, &ztb);
-        ts_cl_job_arg(&J, k1, 2, sizeof cnaz, &cnaz);
-        ts_cl_job_arg(&J, k1, 3, sizeof ipb, &ipb);
-        ts_cl_job_arg(&J, k1, 4, sizeof dpb, &dpb);
-        ts_cl_job_arg(&J, k1, 5, sizeof flb, &flb);
-        ts_cl_job_arg(&J, k1, 6, sizeof frb, &frb);
-        ts_cl_job_arg(&J, k1, 7, sizeof srb, &srb);
+        ts_cl_job_args(&J, k1, 0,
+                       TS_CL_ARGS(TS_CL_ARG(zb), TS_CL_ARG(ztb), TS_CL_ARG(cnaz), TS_CL_ARG(ipb),
+                                  TS_CL_ARG(dpb), TS_CL_ARG(flb), TS_CL_ARG(frb),
+                                  TS_CL_ARG(srb)));
         ts_cl_job_arg(&J, k1, 9, sizeof citems, &citems);
         ts_cl_job_arg_real(&J, k1, 10, c);
-        ts_cl_job_arg(&J, k1, 11, sizeof hib, &hib);
-        ts_cl_job_arg(&J, k1, 12, sizeof lob, &lob);
-        ts_cl_job_arg(&J, k1, 13, sizeof cplane, &cplane);
-        ts_cl_job_arg(&J, k1, 14, sizeof sb, &sb);
-        ts_cl_job_arg(&J, k1, 15, sizeof skb, &skb);
-        ts_cl_job_arg(&J, k1, 16, sizeof cslots, &cslots);
+        ts_cl_job_args(&J, k1, 11,
+                       TS_CL_ARGS(TS_CL_ARG(hib), TS_CL_ARG(lob), TS_CL_ARG(cplane),
+                                  TS_CL_ARG(sb), TS_CL_ARG(skb), TS_CL_ARG(cslots)));
         for (int item0 = 0; item0 < items && J.st == TS_OK; item0 += (int)nslots) {
             const cl_int citem0 = item0;
             size_t active = (size_t)(items - item0) < nslots ? (size_t)(items - item0) : nslots;
@@ -279,20 +269,15 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
             ts_cl_job_run(&J, k1, 1, &global, &wg1, "ts_sweep_lines");
         }
         /* pass 2: cells */
-        ts_cl_job_arg(&J, k2, 0, sizeof zb, &zb);
-        ts_cl_job_arg(&J, k2, 1, sizeof ztb, &ztb);
-        ts_cl_job_arg(&J, k2, 2, sizeof cW, &cW);
-        ts_cl_job_arg(&J, k2, 3, sizeof cH, &cH);
-        ts_cl_job_arg(&J, k2, 4, sizeof ipb, &ipb);
-        ts_cl_job_arg(&J, k2, 5, sizeof dpb, &dpb);
-        ts_cl_job_arg(&J, k2, 6, sizeof frb, &frb);
-        ts_cl_job_arg(&J, k2, 7, sizeof srb, &srb);
+        ts_cl_job_args(&J, k2, 0,
+                       TS_CL_ARGS(TS_CL_ARG(zb), TS_CL_ARG(ztb), TS_CL_ARG(cW), TS_CL_ARG(cH),
+                                  TS_CL_ARG(ipb), TS_CL_ARG(dpb), TS_CL_ARG(frb),
+                                  TS_CL_ARG(srb)));
         ts_cl_job_arg_real(&J, k2, 8, c);
         ts_cl_job_arg_real(&J, k2, 9, cap);
-        ts_cl_job_arg(&J, k2, 10, sizeof ob, &ob);
-        ts_cl_job_arg(&J, k2, 11, sizeof hib, &hib);
-        ts_cl_job_arg(&J, k2, 12, sizeof lob, &lob);
-        ts_cl_job_arg(&J, k2, 13, sizeof cplane, &cplane);
+        ts_cl_job_args(&J, k2, 10,
+                       TS_CL_ARGS(TS_CL_ARG(ob), TS_CL_ARG(hib), TS_CL_ARG(lob),
+                                  TS_CL_ARG(cplane)));
         size_t global2[2] = {ts_cl_round_up(cells, wg2), (size_t)nb}, local2[2] = {wg2, 1};
         ts_cl_job_run(&J, k2, 2, global2, local2, "ts_sweep_finish");
         /* Planes along x back into rows, into the occluder buffer (free

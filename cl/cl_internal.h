@@ -71,6 +71,23 @@ cl_kernel ts_cl_job_kernel(ts_cl_job *j, const char *name);
 
 void ts_cl_job_arg(ts_cl_job *j, cl_kernel k, cl_uint index, size_t size, const void *value);
 
+/* One kernel argument: its size and where its value is. */
+typedef struct {
+    size_t size;
+    const void *value;
+} ts_cl_arg;
+
+/* The kernel argument held by the lvalue x (a cl_mem, cl_int, cl_float...). */
+#define TS_CL_ARG(x) ((ts_cl_arg){sizeof(x), &(x)})
+
+/* The count and the array of ts_cl_job_args from a list of TS_CL_ARGs. */
+#define TS_CL_ARGS(...)                                                                        \
+    (int)(sizeof((ts_cl_arg[]){__VA_ARGS__}) / sizeof(ts_cl_arg)), (const ts_cl_arg[]){__VA_ARGS__}
+
+/* Kernel arguments first .. first + n - 1 in one call:
+ * ts_cl_job_args(j, k, first, TS_CL_ARGS(TS_CL_ARG(a), TS_CL_ARG(b))). */
+void ts_cl_job_args(ts_cl_job *j, cl_kernel k, cl_uint first, int n, const ts_cl_arg *args);
+
 /* Work-group size for kernel k: at most `want`, a power of two, within the
  * kernel's and the device's limits. */
 size_t ts_cl_job_wg(ts_cl_job *j, cl_kernel k, size_t want);

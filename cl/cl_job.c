@@ -155,6 +155,12 @@ void ts_cl_job_arg(ts_cl_job *j, cl_kernel k, cl_uint index, size_t size, const 
         job_cl_fail(j, e, "clSetKernelArg (argument %u)", index);
 }
 
+void ts_cl_job_args(ts_cl_job *j, cl_kernel k, cl_uint first, int n, const ts_cl_arg *args)
+{
+    for (int i = 0; i < n; i++)
+        ts_cl_job_arg(j, k, first + (cl_uint)i, args[i].size, args[i].value);
+}
+
 void ts_cl_job_arg_real(ts_cl_job *j, cl_kernel k, cl_uint index, double value)
 {
     if (j->st != TS_OK)

@@ -107,30 +107,20 @@ ts_status ts_cl_shm_compute(const ts_grid *grid, double azimuth, double elevatio
     const cl_int cW = W, xm = G.x_major, V = G.V, us = G.u_start, ustep = G.u_step;
     const cl_int want_vis = vis != NULL, want_sh = shadow_height != NULL;
     const cl_float depth = (cl_float)penumbra_depth;
-    ts_cl_job_arg(&J, k, 0, sizeof zb, &zb);
-    ts_cl_job_arg(&J, k, 1, sizeof cW, &cW);
-    ts_cl_job_arg(&J, k, 2, sizeof xm, &xm);
-    ts_cl_job_arg(&J, k, 3, sizeof V, &V);
-    ts_cl_job_arg(&J, k, 4, sizeof us, &us);
-    ts_cl_job_arg(&J, k, 5, sizeof ustep, &ustep);
-    ts_cl_job_arg(&J, k, 6, sizeof off, &off);
-    ts_cl_job_arg(&J, k, 7, sizeof F, &F);
-    ts_cl_job_arg(&J, k, 8, sizeof db, &db);
-    ts_cl_job_arg(&J, k, 9, sizeof depth, &depth);
-    ts_cl_job_arg(&J, k, 12, sizeof hlo, &hlo);
-    ts_cl_job_arg(&J, k, 13, sizeof hhi, &hhi);
-    ts_cl_job_arg(&J, k, 16, sizeof vb, &vb);
-    ts_cl_job_arg(&J, k, 17, sizeof hb, &hb);
-    ts_cl_job_arg(&J, k, 18, sizeof want_vis, &want_vis);
-    ts_cl_job_arg(&J, k, 19, sizeof want_sh, &want_sh);
+    ts_cl_job_args(&J, k, 0,
+                   TS_CL_ARGS(TS_CL_ARG(zb), TS_CL_ARG(cW), TS_CL_ARG(xm), TS_CL_ARG(V),
+                              TS_CL_ARG(us), TS_CL_ARG(ustep), TS_CL_ARG(off), TS_CL_ARG(F),
+                              TS_CL_ARG(db), TS_CL_ARG(depth)));
+    ts_cl_job_args(&J, k, 12, TS_CL_ARGS(TS_CL_ARG(hlo), TS_CL_ARG(hhi)));
+    ts_cl_job_args(&J, k, 16,
+                   TS_CL_ARGS(TS_CL_ARG(vb), TS_CL_ARG(hb), TS_CL_ARG(want_vis),
+                              TS_CL_ARG(want_sh)));
     ts_cl_job_arg(&J, k, 20, 2 * E * sizeof(float), NULL);
     cl_mem in = s0, outm = s1;
     for (int k0 = 0; k0 < G.U && J.st == TS_OK; k0 += (int)K) {
         const cl_int ck0 = k0, nrows = G.U - k0 < (int)K ? G.U - k0 : (int)K;
-        ts_cl_job_arg(&J, k, 10, sizeof ck0, &ck0);
-        ts_cl_job_arg(&J, k, 11, sizeof nrows, &nrows);
-        ts_cl_job_arg(&J, k, 14, sizeof in, &in);
-        ts_cl_job_arg(&J, k, 15, sizeof outm, &outm);
+        ts_cl_job_args(&J, k, 10, TS_CL_ARGS(TS_CL_ARG(ck0), TS_CL_ARG(nrows)));
+        ts_cl_job_args(&J, k, 14, TS_CL_ARGS(TS_CL_ARG(in), TS_CL_ARG(outm)));
         size_t global = groups * L;
         ts_cl_job_run(&J, k, 1, &global, &L, "ts_shm_rows");
         cl_mem t = in;
@@ -176,16 +166,12 @@ ts_status ts_cl_normals(const ts_grid *grid, float *nx, float *ny, float *nz, ts
     cl_mem zzb = ts_cl_job_buffer(&J, CL_MEM_WRITE_ONLY, bytes, NULL, "normals");
     cl_kernel k = ts_cl_job_kernel(&J, "ts_normals");
     const cl_int cW = W, cH = H, has = cxr != NULL;
-    ts_cl_job_arg(&J, k, 0, sizeof zb, &zb);
-    ts_cl_job_arg(&J, k, 1, sizeof cW, &cW);
-    ts_cl_job_arg(&J, k, 2, sizeof cH, &cH);
-    ts_cl_job_arg(&J, k, 3, sizeof cb, &cb);
-    ts_cl_job_arg(&J, k, 4, sizeof has, &has);
+    ts_cl_job_args(&J, k, 0,
+                   TS_CL_ARGS(TS_CL_ARG(zb), TS_CL_ARG(cW), TS_CL_ARG(cH), TS_CL_ARG(cb),
+                              TS_CL_ARG(has)));
     ts_cl_job_arg_real(&J, k, 5, grid->cell_x);
     ts_cl_job_arg_real(&J, k, 6, grid->cell_y);
-    ts_cl_job_arg(&J, k, 7, sizeof xb, &xb);
-    ts_cl_job_arg(&J, k, 8, sizeof yb, &yb);
-    ts_cl_job_arg(&J, k, 9, sizeof zzb, &zzb);
+    ts_cl_job_args(&J, k, 7, TS_CL_ARGS(TS_CL_ARG(xb), TS_CL_ARG(yb), TS_CL_ARG(zzb)));
     size_t L = ts_cl_job_wg(&J, k, 256), global = ts_cl_round_up(cells, L);
     ts_cl_job_run(&J, k, 1, &global, &L, "ts_normals");
     ts_cl_job_read(&J, xb, 0, bytes, nx, "normals");
@@ -199,79 +185,60 @@ ts_status ts_cl_normals(const ts_grid *grid, float *nx, float *ny, float *nz, ts
 
 /* --------------------------------------------------------------- direct */
 
-ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
-                             const float *nz, const float *horizons, const ts_horizon_opts *opts,
-                             double sun_azimuth, double sun_elevation, float *out, ts_error *err)
+ts_status ts_cl_shade_direct(const ts_direct_request *req, ts_error *err)
 {
-    int k0, k1;
-    double w;
-    cl_float light[3];
-    ts_status st = ts_direct_setup(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
-                                   out, &k0, &k1, &w, light, err);
+    ts_direct_plan p;
+    ts_status st = ts_direct_setup(req, &p, err);
     if (st != TS_OK)
         return st;
-    const size_t cells = (size_t)grid->width * grid->height, bytes = cells * sizeof(float);
+    const float *horizons = req->horizons;
+    const size_t cells = (size_t)req->grid->width * req->grid->height;
+    const size_t bytes = cells * sizeof(float);
     ts_cl_job J;
     if (ts_cl_job_begin(&J, err) != TS_OK)
         return J.st;
-    cl_mem xb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, nx, "normals");
-    cl_mem yb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, ny, "normals");
-    cl_mem zb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, nz, "normals");
-    cl_mem h0 = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, horizons + cells * k0,
+    cl_mem xb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, req->nx, "normals");
+    cl_mem yb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, req->ny, "normals");
+    cl_mem zb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, req->nz, "normals");
+    cl_mem h0 = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, horizons + cells * p.k0,
                                  "horizon plane");
-    cl_mem h1 = k1 == k0 ? h0
-                         : ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, horizons + cells * k1,
-                                            "horizon plane");
+    cl_mem h1 = p.k1 == p.k0 ? h0
+                             : ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes,
+                                                horizons + cells * p.k1, "horizon plane");
     cl_mem ob = ts_cl_job_buffer(&J, CL_MEM_WRITE_ONLY, bytes, NULL, "direct light");
     cl_kernel k = ts_cl_job_kernel(&J, "ts_direct");
     const cl_long ccells = (cl_long)cells;
-    ts_cl_job_arg(&J, k, 0, sizeof xb, &xb);
-    ts_cl_job_arg(&J, k, 1, sizeof yb, &yb);
-    ts_cl_job_arg(&J, k, 2, sizeof zb, &zb);
-    ts_cl_job_arg(&J, k, 3, sizeof h0, &h0);
-    ts_cl_job_arg(&J, k, 4, sizeof h1, &h1);
-    ts_cl_job_arg(&J, k, 5, sizeof ccells, &ccells);
-    const cl_float fw = (float)w;
-    ts_cl_job_arg(&J, k, 6, sizeof fw, &fw);
-    for (int j = 0; j < 3; j++)
-        ts_cl_job_arg(&J, k, 7 + j, sizeof light[j], &light[j]);
+    const cl_float fw = (float)p.w;
     /* as core/shading.c */
-    const cl_float el_deg = (float)sun_elevation, inv_r = (float)(1.0 / TS_SUN_RADIUS_DEG);
-    ts_cl_job_arg(&J, k, 10, sizeof el_deg, &el_deg);
-    ts_cl_job_arg(&J, k, 11, sizeof inv_r, &inv_r);
-    ts_cl_job_arg(&J, k, 12, sizeof ob, &ob);
+    const cl_float el_deg = (float)req->sun_elevation, inv_r = (float)(1.0 / TS_SUN_RADIUS_DEG);
+    ts_cl_job_args(&J, k, 0,
+                   TS_CL_ARGS(TS_CL_ARG(xb), TS_CL_ARG(yb), TS_CL_ARG(zb), TS_CL_ARG(h0),
+                              TS_CL_ARG(h1), TS_CL_ARG(ccells), TS_CL_ARG(fw),
+                              TS_CL_ARG(p.light[0]), TS_CL_ARG(p.light[1]),
+                              TS_CL_ARG(p.light[2]), TS_CL_ARG(el_deg), TS_CL_ARG(inv_r),
+                              TS_CL_ARG(ob)));
     size_t L = ts_cl_job_wg(&J, k, 256), global = ts_cl_round_up(cells, L);
     ts_cl_job_run(&J, k, 1, &global, &L, "ts_direct");
-    ts_cl_job_read(&J, ob, 0, bytes, out, "direct light");
+    ts_cl_job_read(&J, ob, 0, bytes, req->out, "direct light");
     return ts_cl_job_end(&J);
 }
 
 /* ------------------------------------------------------------------ sky */
 
-ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny, const float *nz,
-                          const float *horizons, const ts_horizon_opts *opts, float *svf,
-                          float *sky, float *openness, ts_error *err)
+ts_status ts_cl_sky_terms(const ts_sky_request *req, ts_error *err)
 {
-    return ts_cl_sky_terms_model(grid, nx, ny, nz, horizons, opts, TS_SVF_RADIATIVE, svf, sky,
-                                 openness, err);
-}
-
-ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
-                                const float *nz, const float *horizons,
-                                const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
-                                float *sky, float *openness, ts_error *err)
-{
-    ts_status st = ts_check_sky_terms_args(grid, nx, ny, nz, horizons, opts, err);
-    if (st == TS_OK)
-        st = ts_check_svf_model(svf_model, err);
+    ts_status st = ts_check_sky_request(req, err);
     if (st != TS_OK)
         return st;
+    const ts_horizon_opts *opts = req->opts;
     const int n = opts->directions;
-    const cl_int want = (svf ? 1 : 0) | (sky ? 2 : 0) | (openness ? 4 : 0) |
-                        (svf && svf_model == TS_SVF_SOLID_ANGLE ? 8 : 0);
+    float *outs[3] = {req->svf, req->sky, req->openness};
+    const cl_int want = (outs[0] ? 1 : 0) | (outs[1] ? 2 : 0) | (outs[2] ? 4 : 0) |
+                        (outs[0] && req->svf_model == TS_SVF_SOLID_ANGLE ? 8 : 0);
     if (!want)
         return ts_ok(err);
-    const size_t cells = (size_t)grid->width * grid->height, bytes = cells * sizeof(float);
+    const size_t cells = (size_t)req->grid->width * req->grid->height;
+    const size_t bytes = cells * sizeof(float);
     ts_cl_job J;
     if (ts_cl_job_begin(&J, err) != TS_OK)
         return J.st;
@@ -292,9 +259,9 @@ ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const floa
             sa[k] = (float)sin(a * DEG2RAD);
             ca[k] = (float)cos(a * DEG2RAD);
         }
-    cl_mem xb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, nx, "normals");
-    cl_mem yb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, ny, "normals");
-    cl_mem zb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, nz, "normals");
+    cl_mem xb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, req->nx, "normals");
+    cl_mem yb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, req->ny, "normals");
+    cl_mem zb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, bytes, req->nz, "normals");
     cl_mem pb = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, A * bytes, NULL, "horizon planes");
     cl_mem sab = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, (size_t)n * sizeof *sa, sa, "azimuths");
     cl_mem cab = ts_cl_job_buffer(&J, CL_MEM_READ_ONLY, (size_t)n * sizeof *ca, ca, "azimuths");
@@ -307,35 +274,28 @@ ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const floa
     cl_kernel k = ts_cl_job_kernel(&J, "ts_sky");
     const cl_long ccells = (cl_long)cells;
     const cl_float w1 = (float)(1.0 / n), w2 = (float)(sin(M_PI / n) / M_PI), fn = (float)n;
-    ts_cl_job_arg(&J, k, 0, sizeof xb, &xb);
-    ts_cl_job_arg(&J, k, 1, sizeof yb, &yb);
-    ts_cl_job_arg(&J, k, 2, sizeof zb, &zb);
-    ts_cl_job_arg(&J, k, 3, sizeof pb, &pb);
+    ts_cl_job_args(&J, k, 0,
+                   TS_CL_ARGS(TS_CL_ARG(xb), TS_CL_ARG(yb), TS_CL_ARG(zb), TS_CL_ARG(pb)));
     ts_cl_job_arg(&J, k, 5, sizeof ccells, &ccells);
-    ts_cl_job_arg(&J, k, 8, sizeof w1, &w1);
-    ts_cl_job_arg(&J, k, 9, sizeof w2, &w2);
-    ts_cl_job_arg(&J, k, 10, sizeof want, &want);
-    ts_cl_job_arg(&J, k, 12, sizeof fn, &fn);
-    ts_cl_job_arg(&J, k, 13, sizeof acc[0], &acc[0]);
-    ts_cl_job_arg(&J, k, 14, sizeof acc[1], &acc[1]);
-    ts_cl_job_arg(&J, k, 15, sizeof acc[2], &acc[2]);
+    ts_cl_job_args(&J, k, 8, TS_CL_ARGS(TS_CL_ARG(w1), TS_CL_ARG(w2), TS_CL_ARG(want)));
+    ts_cl_job_args(&J, k, 12,
+                   TS_CL_ARGS(TS_CL_ARG(fn), TS_CL_ARG(acc[0]), TS_CL_ARG(acc[1]),
+                              TS_CL_ARG(acc[2])));
     size_t L = ts_cl_job_wg(&J, k, 256), global = ts_cl_round_up(cells, L);
     for (int first = 0; first < n && J.st == TS_OK; first += (int)A) {
         const cl_int nb = n - first < (int)A ? n - first : (int)A;
         const cl_int finish = first + nb >= n;
-        ts_cl_job_write(&J, pb, 0, (size_t)nb * bytes, horizons + cells * first,
+        ts_cl_job_write(&J, pb, 0, (size_t)nb * bytes, req->horizons + cells * first,
                         "horizon planes");
         /* sa/ca of this batch: sub-buffers would need alignment; offset
          * copies are simpler. */
         ts_cl_job_write(&J, sab, 0, (size_t)nb * sizeof *sa, sa + first, "azimuths");
         ts_cl_job_write(&J, cab, 0, (size_t)nb * sizeof *ca, ca + first, "azimuths");
         ts_cl_job_arg(&J, k, 4, sizeof nb, &nb);
-        ts_cl_job_arg(&J, k, 6, sizeof sab, &sab);
-        ts_cl_job_arg(&J, k, 7, sizeof cab, &cab);
+        ts_cl_job_args(&J, k, 6, TS_CL_ARGS(TS_CL_ARG(sab), TS_CL_ARG(cab)));
         ts_cl_job_arg(&J, k, 11, sizeof finish, &finish);
         ts_cl_job_run(&J, k, 1, &global, &L, "ts_sky");
     }
-    float *outs[3] = {svf, sky, openness};
     for (int i = 0; i < 3; i++)
         if (outs[i])
             ts_cl_job_read(&J, acc[i], 0, bytes, outs[i], "sky terms");

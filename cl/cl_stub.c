@@ -62,68 +62,43 @@ ts_status ts_cl_normals(const ts_grid *grid, float *nx, float *ny, float *nz, ts
     return NOT_BUILT(err);
 }
 
-ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
-                             const float *nz, const float *horizons, const ts_horizon_opts *opts,
-                             double sun_azimuth, double sun_elevation, float *out, ts_error *err)
+ts_status ts_cl_shade_direct(const ts_direct_request *req, ts_error *err)
 {
-    (void)grid, (void)nx, (void)ny, (void)nz, (void)horizons, (void)opts;
-    (void)sun_azimuth, (void)sun_elevation, (void)out;
+    (void)req;
     return NOT_BUILT(err);
 }
 
-ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny, const float *nz,
-                          const float *horizons, const ts_horizon_opts *opts, float *svf,
-                          float *sky, float *openness, ts_error *err)
+ts_status ts_cl_sky_terms(const ts_sky_request *req, ts_error *err)
 {
-    (void)grid, (void)nx, (void)ny, (void)nz, (void)horizons, (void)opts;
-    (void)svf, (void)sky, (void)openness;
+    (void)req;
     return NOT_BUILT(err);
 }
 
-ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
-                                const float *nz, const float *horizons,
-                                const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
-                                float *sky, float *openness, ts_error *err)
+ts_status ts_cl_env_light_accumulate(const ts_env_light_request *req, ts_error *err)
 {
-    (void)svf_model;
-    return ts_cl_sky_terms(grid, nx, ny, nz, horizons, opts, svf, sky, openness, err);
-}
-
-ts_status ts_cl_env_light_accumulate(const ts_grid *grid, const ts_env_table *table, int k,
-                                     const float *nx, const float *ny, const float *nz,
-                                     const float *plane, float *r, float *g, float *b,
-                                     ts_error *err)
-{
-    (void)grid, (void)table, (void)k, (void)nx, (void)ny, (void)nz, (void)plane;
-    (void)r, (void)g, (void)b;
+    (void)req;
     return NOT_BUILT(err);
 }
 
-ts_status ts_cl_env_light_open(const ts_grid *grid, const ts_env_table *table, const float *nx,
-                               const float *ny, const float *nz, ts_cl_env_light **session,
+ts_status ts_cl_env_light_open(const ts_env_light_request *req, ts_cl_env_light **session,
                                ts_error *err)
 {
-    (void)grid, (void)table, (void)nx, (void)ny, (void)nz;
+    (void)req;
     if (session)
         *session = NULL;
     return NOT_BUILT(err);
 }
 
-int ts_cl_env_light_matches(const ts_cl_env_light *session, const ts_grid *grid,
-                            const ts_env_table *table, const float *nx, const float *ny,
-                            const float *nz)
+int ts_cl_env_light_matches(const ts_cl_env_light *session, const ts_env_light_request *req)
 {
-    (void)session, (void)grid, (void)table, (void)nx, (void)ny, (void)nz;
+    (void)session, (void)req;
     return 0;
 }
 
-ts_status ts_cl_env_light_add(ts_cl_env_light *session, const ts_grid *grid,
-                              const ts_env_table *table, int k, const float *nx,
-                              const float *ny, const float *nz, const float *plane, float *r,
-                              float *g, float *b, ts_error *err)
+ts_status ts_cl_env_light_add(ts_cl_env_light *session, const ts_env_light_request *req,
+                              ts_error *err)
 {
-    (void)session, (void)grid, (void)table, (void)k, (void)nx, (void)ny, (void)nz;
-    (void)plane, (void)r, (void)g, (void)b;
+    (void)session, (void)req;
     return NOT_BUILT(err);
 }
 

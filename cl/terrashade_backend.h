@@ -83,17 +83,10 @@ ts_status ts_backend_normals(ts_backend backend, const ts_grid *grid, float *nx,
                              float *ny, float *nz, ts_backend_report *report,
                              ts_error *err);
 
-ts_status ts_backend_shade_direct(ts_backend backend, const ts_grid *grid,
-                                  const float *nx, const float *ny,
-                                  const float *nz, const float *horizons,
-                                  const ts_horizon_opts *opts, double sun_azimuth,
-                                  double sun_elevation, float *out,
+ts_status ts_backend_shade_direct(ts_backend backend, const ts_direct_request *req,
                                   ts_backend_report *report, ts_error *err);
 
-ts_status ts_backend_sky_terms(ts_backend backend, const ts_grid *grid,
-                               const float *nx, const float *ny, const float *nz,
-                               const float *horizons, const ts_horizon_opts *opts,
-                               float *svf, float *sky, float *openness,
+ts_status ts_backend_sky_terms(ts_backend backend, const ts_sky_request *req,
                                ts_backend_report *report, ts_error *err);
 
 /**
@@ -110,17 +103,15 @@ typedef struct {
 } ts_backend_env_light;
 
 /**
- * ts_env_light_accumulate (terrashade_env.h) on a backend: add sector k's
- * light to r, g, b. `state` (may be NULL: every call then uploads the table)
- * carries the device state from plane to plane; the C fallback carries on
- * from the sums so far, which r, g, b hold after every call.
+ * ts_env_light_accumulate (terrashade_env.h) on a backend: add the
+ * request's sector light to its r, g, b. `state` (may be NULL: every call
+ * then uploads the table) carries the device state from plane to plane; the
+ * C fallback carries on from the sums so far, which r, g, b hold after
+ * every call.
  */
 ts_status ts_backend_env_light_accumulate(ts_backend backend, ts_backend_env_light *state,
-                                          const ts_grid *grid, const ts_env_table *table,
-                                          int k, const float *nx, const float *ny,
-                                          const float *nz, const float *plane, float *r,
-                                          float *g, float *b, ts_backend_report *report,
-                                          ts_error *err);
+                                          const ts_env_light_request *req,
+                                          ts_backend_report *report, ts_error *err);
 
 /** Release the device state of `state` (NULL-safe) and zero it. */
 void ts_backend_env_light_release(ts_backend_env_light *state);

@@ -2,8 +2,10 @@
  * terrashade_cl.h - the OpenCL backend of libterrashade.
  *
  * The same products as the C core (terrashade.h), computed by OpenCL
- * kernels, with the same results: every function mirrors the C function of
- * the same name without the "cl_" and checks its arguments the same way.
+ * kernels, with the same results: every ts_cl_X is declared with the
+ * function type of the C function ts_X (ts_X_fn) and checks its arguments
+ * with the same shared checks (core/arg_checks.h), so that both backends
+ * accept and refuse the same calls with the same messages.
  * Measured differences to the C backend are in docs/opencl.md.
  *
  * Device: the environment variable TERRASHADE_OPENCL_DEVICE picks it, as a
@@ -86,74 +88,58 @@ ts_status ts_cl_devices(ts_cl_info *list, int max, int *count, ts_error *err);
     "a MAX_DISTANCE sweep runs on the C backend (the OpenCL kernel has no sliding-window " \
     "hull yet)"
 
-/** ts_horizon_sweep on the device: one azimuth, width*height degrees. */
-ts_status ts_cl_horizon_sweep(const ts_grid *grid, double azimuth,
-                              const ts_horizon_opts *opts, float *out,
-                              ts_error *err);
+/** The horizon sweep on the device (ts_horizon_sweep_fn): one azimuth. */
+ts_horizon_sweep_fn ts_cl_horizon_sweep;
 
-/** ts_horizon_compute on the device: opts->directions planes. */
-ts_status ts_cl_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts,
-                                float *out, ts_error *err);
+/** The horizons on the device (ts_horizon_compute_fn): opts->directions planes. */
+ts_horizon_compute_fn ts_cl_horizon_compute;
 
-/** ts_shm_compute on the device (`threads` is checked, then unused). */
-ts_status ts_cl_shm_compute(const ts_grid *grid, double azimuth, double elevation,
-                            double penumbra_depth, int threads, float *visibility,
-                            float *shadow_height, ts_error *err);
+/** The shadow height map on the device (ts_shm_compute_fn; `threads` is
+ * checked, then unused). */
+ts_shm_compute_fn ts_cl_shm_compute;
 
-/** ts_normals on the device. */
-ts_status ts_cl_normals(const ts_grid *grid, float *nx, float *ny, float *nz,
-                        ts_error *err);
+/** The normals on the device (ts_normals_fn). */
+ts_normals_fn ts_cl_normals;
 
-/** ts_shade_direct on the device. */
-ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
-                             const float *nz, const float *horizons,
-                             const ts_horizon_opts *opts, double sun_azimuth,
-                             double sun_elevation, float *out, ts_error *err);
+/** The direct sun on the device (ts_shade_direct_fn). */
+ts_shade_direct_fn ts_cl_shade_direct;
 
-/** ts_sky_terms on the device (any of svf, sky, openness may be NULL). */
-ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
-                          const float *nz, const float *horizons,
-                          const ts_horizon_opts *opts, float *svf, float *sky,
-                          float *openness, ts_error *err);
-/** ts_sky_terms_model on the device. */
-ts_status ts_cl_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
-                                const float *nz, const float *horizons,
-                                const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
-                                float *sky, float *openness, ts_error *err);
+/** The sky terms on the device (ts_sky_terms_fn). */
+ts_sky_terms_fn ts_cl_sky_terms;
 
-/** ts_env_light_accumulate on the device, in one call (uploads the light
- * table and the normals for this one plane; a product uses a session). */
-ts_status ts_cl_env_light_accumulate(const ts_grid *grid, const ts_env_table *table, int k,
-                                     const float *nx, const float *ny, const float *nz,
-                                     const float *plane, float *r, float *g, float *b,
-                                     ts_error *err);
+/** The environment light on the device, in one call
+ * (ts_env_light_accumulate_fn; uploads the light table and the normals for
+ * this one plane: a product uses a session). */
+ts_env_light_accumulate_fn ts_cl_env_light_accumulate;
 
 /**
- * A product's environment light on the device, one horizon plane at a time:
- * ts_cl_env_light_open uploads the light table and the normals once (the
- * arrays must stay as they are until ts_cl_env_light_close);
- * ts_cl_env_light_add is ts_env_light_accumulate for sector k with the
- * same grid, table and normals (else TS_ERR_ARG): it uploads the plane,
- * launches, and reads the sums back into r, g, b, so that they hold the
- * light so far after every call. The device keeps its own copy of the
- * sums: between two calls with the same r, g, b the caller must not change
- * them (new arrays are uploaded). After a failure every later call fails.
+ * A product's environment light on the device, one horizon plane at a time.
+ * The device keeps its own copy of the sums: between two calls with the
+ * same r, g, b the caller must not change them (new arrays are uploaded).
+ * After a failure every later call fails.
  */
 typedef struct ts_cl_env_light ts_cl_env_light;
 
-ts_status ts_cl_env_light_open(const ts_grid *grid, const ts_env_table *table, const float *nx,
-                               const float *ny, const float *nz, ts_cl_env_light **session,
+/**
+ * Open a session for the request's grid size, light table and normals
+ * (the request is checked as ts_env_light_accumulate checks it): uploads
+ * the table and the normals once; those arrays must stay as they are until
+ * ts_cl_env_light_close.
+ */
+ts_status ts_cl_env_light_open(const ts_env_light_request *req, ts_cl_env_light **session,
                                ts_error *err);
 
-/** 1 if the session was opened for this grid's size, table and normals. */
-int ts_cl_env_light_matches(const ts_cl_env_light *session, const ts_grid *grid,
-                            const ts_env_table *table, const float *nx, const float *ny,
-                            const float *nz);
+/** 1 if the session was opened for this request's grid size, table and normals. */
+int ts_cl_env_light_matches(const ts_cl_env_light *session, const ts_env_light_request *req);
 
-ts_status ts_cl_env_light_add(ts_cl_env_light *session, const ts_grid *grid,
-                              const ts_env_table *table, int k, const float *nx,
-                              const float *ny, const float *nz, const float *plane, float *r,
-                              float *g, float *b, ts_error *err);
+/**
+ * ts_env_light_accumulate in the session, for a request with its grid size,
+ * table and normals (else TS_ERR_ARG): uploads the plane, launches, and
+ * reads the sums back into r, g, b, so that they hold the light so far
+ * after every call.
+ */
+ts_status ts_cl_env_light_add(ts_cl_env_light *session, const ts_env_light_request *req,
+                              ts_error *err);
 
 /** Release the session's device buffers (NULL-safe). */
 void ts_cl_env_light_close(ts_cl_env_light *session);

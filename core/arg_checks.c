@@ -83,33 +83,34 @@ ts_status ts_check_sky_args(const ts_grid *grid, const float *nx, const float *n
     return TS_OK;
 }
 
-ts_status ts_check_sky_terms_args(const ts_grid *grid, const float *nx, const float *ny,
-                                  const float *nz, const float *horizons,
-                                  const ts_horizon_opts *opts, ts_error *err)
+ts_status ts_check_sky_request(const ts_sky_request *req, ts_error *err)
 {
-    ts_status st = ts_horizon_opts_validate(opts, err);
+    if (!req)
+        return ts_fail(err, TS_ERR_ARG, "the sky terms request must not be NULL");
+    ts_status st = ts_horizon_opts_validate(req->opts, err);
     if (st != TS_OK)
         return st;
-    if ((st = ts_check_sky_args(grid, nx, ny, nz, opts->directions, err)) != TS_OK)
+    st = ts_check_sky_args(req->grid, req->nx, req->ny, req->nz, req->opts->directions, err);
+    if (st != TS_OK)
         return st;
-    if (!horizons)
+    if (!req->horizons)
         return ts_fail(err, TS_ERR_ARG, "horizons must not be NULL");
-    return TS_OK;
+    return ts_check_svf_model(req->svf_model, err);
 }
 
-ts_status ts_direct_setup(const ts_grid *grid, const float *nx, const float *ny,
-                          const float *nz, const float *horizons,
-                          const ts_horizon_opts *opts, double sun_azimuth,
-                          double sun_elevation, const float *out, int *k0, int *k1,
-                          double *w, float light[3], ts_error *err)
+ts_status ts_direct_setup(const ts_direct_request *req, ts_direct_plan *plan, ts_error *err)
 {
-    ts_status st = ts_grid_validate(grid, err);
+    if (!req)
+        return ts_fail(err, TS_ERR_ARG, "the direct sun request must not be NULL");
+    ts_status st = ts_grid_validate(req->grid, err);
     if (st != TS_OK)
         return st;
+    const ts_horizon_opts *opts = req->opts;
     if ((st = ts_horizon_opts_validate(opts, err)) != TS_OK)
         return st;
-    if (!nx || !ny || !nz || !horizons || !out)
+    if (!req->nx || !req->ny || !req->nz || !req->horizons || !req->out)
         return ts_fail(err, TS_ERR_ARG, "normals, horizons and output must not be NULL");
+    const double sun_azimuth = req->sun_azimuth, sun_elevation = req->sun_elevation;
     if (!isfinite(sun_azimuth))
         return ts_fail(err, TS_ERR_ARG, "sun azimuth must be a finite number of degrees, got %g",
                        sun_azimuth);
@@ -122,23 +123,23 @@ ts_status ts_direct_setup(const ts_grid *grid, const float *nx, const float *ny,
     if (p < 0)
         p += 360.0;
     p /= step;
-    *k0 = (int)floor(p);
-    *w = p - *k0;
-    if (*k0 >= n) {
-        *k0 = 0;
-        *w = 0;
+    plan->k0 = (int)floor(p);
+    plan->w = p - plan->k0;
+    if (plan->k0 >= n) {
+        plan->k0 = 0;
+        plan->w = 0;
     }
-    *k1 = (*k0 + 1) % n;
-    if (n == 1 && *w * step > 1e-9 && (1 - *w) * step > 1e-9)
+    plan->k1 = (plan->k0 + 1) % n;
+    if (n == 1 && plan->w * step > 1e-9 && (1 - plan->w) * step > 1e-9)
         return ts_fail(err, TS_ERR_ARG,
                        "the horizons were computed for azimuth %g only, not for the sun's azimuth %g",
                        opts->start_azimuth, sun_azimuth);
     if (n == 1)
-        *w = 0;
+        plan->w = 0;
     double az = sun_azimuth * DEG2RAD, el = sun_elevation * DEG2RAD;
-    light[0] = (float)(sin(az) * cos(el));
-    light[1] = (float)(cos(az) * cos(el));
-    light[2] = (float)sin(el);
+    plan->light[0] = (float)(sin(az) * cos(el));
+    plan->light[1] = (float)(cos(az) * cos(el));
+    plan->light[2] = (float)sin(el);
     return TS_OK;
 }
 

@@ -24,30 +24,28 @@ ts_status ts_check_normals_args(const ts_grid *grid, const float *nx, const floa
 ts_status ts_check_sky_args(const ts_grid *grid, const float *nx, const float *ny,
                             const float *nz, int directions, ts_error *err);
 
-/* Checks of ts_sky_terms' arguments but its outputs. */
-ts_status ts_check_sky_terms_args(const ts_grid *grid, const float *nx, const float *ny,
-                                  const float *nz, const float *horizons,
-                                  const ts_horizon_opts *opts, ts_error *err);
+/* Checks of a ts_sky_request (its outputs may be NULL). */
+ts_status ts_check_sky_request(const ts_sky_request *req, ts_error *err);
 
 /* Checks of ts_horizon_compute's arguments, including that the
  * directions x width x height output floats can be addressed. */
 ts_status ts_check_horizon_compute_args(const ts_grid *grid, const ts_horizon_opts *opts,
                                         const float *out, ts_error *err);
 
-/* Checks of ts_shade_direct's arguments, the two computed azimuths the
- * sun's lies between (planes k0 and k1, weight w of k1) and the unit vector
- * toward the sun (east, north, up) in light[]. */
-ts_status ts_direct_setup(const ts_grid *grid, const float *nx, const float *ny,
-                          const float *nz, const float *horizons,
-                          const ts_horizon_opts *opts, double sun_azimuth,
-                          double sun_elevation, const float *out, int *k0, int *k1,
-                          double *w, float light[3], ts_error *err);
+/* What both backends' direct sun derive from a ts_direct_request: the two
+ * computed azimuths the sun's lies between (planes k0 and k1, weight w of
+ * k1) and the unit vector toward the sun (east, north, up). */
+typedef struct {
+    int k0, k1;
+    double w;
+    float light[3];
+} ts_direct_plan;
 
-/* Checks of ts_env_light_accumulate's arguments (outputs only for NULL). */
-ts_status ts_check_env_light_args(const ts_grid *grid, const ts_env_table *table, int k,
-                                  const float *nx, const float *ny, const float *nz,
-                                  const float *plane, const float *r, const float *g,
-                                  const float *b, ts_error *err);
+/* Checks of a ts_direct_request, then its plan. */
+ts_status ts_direct_setup(const ts_direct_request *req, ts_direct_plan *plan, ts_error *err);
+
+/* Checks of a ts_env_light_request (its outputs only for NULL). */
+ts_status ts_check_env_light_request(const ts_env_light_request *req, ts_error *err);
 
 /* Floats of one sector of a light table (lp + k * this is sector k). */
 size_t ts_env_table_sector_floats(const ts_env_table *table);

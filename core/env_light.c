@@ -79,21 +79,20 @@ static ts_status check_table(const ts_env_table *t, ts_error *err)
     return TS_OK;
 }
 
-ts_status ts_check_env_light_args(const ts_grid *grid, const ts_env_table *table, int k,
-                                  const float *nx, const float *ny, const float *nz,
-                                  const float *plane, const float *r, const float *g,
-                                  const float *b, ts_error *err)
+ts_status ts_check_env_light_request(const ts_env_light_request *req, ts_error *err)
 {
-    ts_status st = check_outputs(grid, r, g, b, err);
+    if (!req)
+        return ts_fail(err, TS_ERR_ARG, "the environment light request must not be NULL");
+    ts_status st = check_outputs(req->grid, req->r, req->g, req->b, err);
     if (st == TS_OK)
-        st = check_table(table, err);
+        st = check_table(req->table, err);
     if (st != TS_OK)
         return st;
-    if (!nx || !ny || !nz || !plane)
+    if (!req->nx || !req->ny || !req->nz || !req->plane)
         return ts_fail(err, TS_ERR_ARG, "normals and the horizon plane must not be NULL");
-    if (k < 0 || k >= table->directions)
+    if (req->k < 0 || req->k >= req->table->directions)
         return ts_fail(err, TS_ERR_ARG, "sector %d is outside the light table's %d directions",
-                       k, table->directions);
+                       req->k, req->table->directions);
     return TS_OK;
 }
 
@@ -110,19 +109,19 @@ void ts_env_sector_sincos(const ts_env_table *table, int k, float *sa, float *ca
     *ca = (float)cos(az);
 }
 
-ts_status ts_env_light_accumulate(const ts_grid *grid, const ts_env_table *table, int k,
-                                  const float *nx, const float *ny, const float *nz,
-                                  const float *plane, float *r, float *g, float *b,
-                                  ts_error *err)
+ts_status ts_env_light_accumulate(const ts_env_light_request *req, ts_error *err)
 {
-    ts_status st = ts_check_env_light_args(grid, table, k, nx, ny, nz, plane, r, g, b, err);
+    ts_status st = ts_check_env_light_request(req, err);
     if (st != TS_OK)
         return st;
+    const ts_env_table *table = req->table;
     float sa, ca;
-    ts_env_sector_sincos(table, k, &sa, &ca);
-    light_ctx C = {grid, nx, ny, nz, plane, table->lp + ts_env_table_sector_floats(table) * k,
-                   sa, ca, table->normal_steps, table->horizon_steps, r, g, b};
-    return ts_parallel_for(ts_thread_count(0, grid->height), grid->height, light_rows, &C, err);
+    ts_env_sector_sincos(table, req->k, &sa, &ca);
+    light_ctx C = {req->grid, req->nx, req->ny, req->nz, req->plane,
+                   table->lp + ts_env_table_sector_floats(table) * req->k, sa, ca,
+                   table->normal_steps, table->horizon_steps, req->r, req->g, req->b};
+    const int rows = req->grid->height;
+    return ts_parallel_for(ts_thread_count(0, rows), rows, light_rows, &C, err);
 }
 
 ts_status ts_env_light_finish(const ts_grid *grid, float *r, float *g, float *b, ts_error *err)
@@ -163,9 +162,10 @@ ts_status ts_env_light(const ts_grid *grid, const ts_env_table *table, const flo
     memset(r, 0, n * sizeof *r);
     memset(g, 0, n * sizeof *g);
     memset(b, 0, n * sizeof *b);
-    for (int k = 0; k < table->directions; k++) {
-        st = ts_env_light_accumulate(grid, table, k, nx, ny, nz, horizons + n * k, r, g, b, err);
-        if (st != TS_OK)
+    ts_env_light_request req = {grid, table, 0, nx, ny, nz, NULL, r, g, b};
+    for (req.k = 0; req.k < table->directions; req.k++) {
+        req.plane = horizons + n * req.k;
+        if ((st = ts_env_light_accumulate(&req, err)) != TS_OK)
             return st;
     }
     return ts_env_light_finish(grid, r, g, b, err);

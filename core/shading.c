@@ -40,21 +40,16 @@ static void direct_range(void *ctx, int worker, long begin, long end)
         out[i] = cm_direct_sun(nx[i], ny[i], nz[i], h0[i], h1[i], w, lx, ly, lz, el, inv_r);
 }
 
-ts_status ts_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
-                          const float *nz, const float *horizons,
-                          const ts_horizon_opts *opts, double sun_azimuth,
-                          double sun_elevation, float *out, ts_error *err)
+ts_status ts_shade_direct(const ts_direct_request *req, ts_error *err)
 {
-    int k0, k1;
-    double w;
-    float light[3];
-    ts_status st = ts_direct_setup(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
-                                   out, &k0, &k1, &w, light, err);
+    ts_direct_plan p;
+    ts_status st = ts_direct_setup(req, &p, err);
     if (st != TS_OK)
         return st;
-    size_t plane = (size_t)grid->width * grid->height;
-    direct_ctx C = {nx, ny, nz, horizons + plane * k0, horizons + plane * k1, (float)w,
-                    light[0], light[1], light[2], sun_elevation, out};
+    size_t plane = (size_t)req->grid->width * req->grid->height;
+    direct_ctx C = {req->nx, req->ny, req->nz, req->horizons + plane * p.k0,
+                    req->horizons + plane * p.k1, (float)p.w, p.light[0], p.light[1],
+                    p.light[2], req->sun_elevation, req->out};
     return ts_parallel_for(ts_thread_count(0, (long)(plane >> 16) + 1), (long)plane,
                            direct_range, &C, err);
 }

@@ -118,35 +118,24 @@ ts_status ts_sky_finish(const ts_grid *grid, int directions, float *svf_acc, flo
     return ts_ok(err);
 }
 
-ts_status ts_sky_terms(const ts_grid *grid, const float *nx, const float *ny, const float *nz,
-                       const float *horizons, const ts_horizon_opts *opts, float *svf,
-                       float *sky, float *openness, ts_error *err)
+ts_status ts_sky_terms(const ts_sky_request *req, ts_error *err)
 {
-    return ts_sky_terms_model(grid, nx, ny, nz, horizons, opts, TS_SVF_RADIATIVE, svf, sky,
-                              openness, err);
-}
-
-ts_status ts_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
-                             const float *nz, const float *horizons,
-                             const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
-                             float *sky, float *openness, ts_error *err)
-{
-    ts_status st = ts_check_sky_terms_args(grid, nx, ny, nz, horizons, opts, err);
-    if (st == TS_OK)
-        st = ts_check_svf_model(svf_model, err);
+    ts_status st = ts_check_sky_request(req, err);
     if (st != TS_OK)
         return st;
-    size_t n = (size_t)grid->width * grid->height;
-    float *acc[3] = {svf, sky, openness};
+    const ts_grid *grid = req->grid;
+    const int n = req->opts->directions;
+    size_t cells = (size_t)grid->width * grid->height;
+    float *acc[3] = {req->svf, req->sky, req->openness};
     for (int j = 0; j < 3; j++)
         if (acc[j])
-            memset(acc[j], 0, n * sizeof(float));
-    for (int k = 0; k < opts->directions; k++) {
-        st = ts_sky_accumulate_model(grid, nx, ny, nz, horizons + n * k,
-                                     ts_horizon_azimuth(opts, k), opts->directions, svf_model,
-                                     svf, sky, openness, err);
+            memset(acc[j], 0, cells * sizeof(float));
+    for (int k = 0; k < n; k++) {
+        st = ts_sky_accumulate_model(grid, req->nx, req->ny, req->nz, req->horizons + cells * k,
+                                     ts_horizon_azimuth(req->opts, k), n, req->svf_model,
+                                     acc[0], acc[1], acc[2], err);
         if (st != TS_OK)
             return st;
     }
-    return ts_sky_finish(grid, opts->directions, svf, sky, openness, err);
+    return ts_sky_finish(grid, n, acc[0], acc[1], acc[2], err);
 }

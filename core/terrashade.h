@@ -139,18 +139,24 @@ double ts_horizon_azimuth(const ts_horizon_opts *opts, int k);
  * `out` receives width*height signed elevation angles in degrees (row stride
  * = width); NaN where the DEM is nodata, -90 where nothing lies beyond the
  * cell in that direction. O(cells). opts->directions and start_azimuth are
- * ignored.
+ * ignored. The type of every backend's sweep (terrashade_cl.h).
  */
-ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
-                           const ts_horizon_opts *opts, float *out,
-                           ts_error *err);
+typedef ts_status ts_horizon_sweep_fn(const ts_grid *grid, double azimuth,
+                                      const ts_horizon_opts *opts, float *out, ts_error *err);
+
+/** The horizon sweep on the C backend. */
+ts_horizon_sweep_fn ts_horizon_sweep;
 
 /**
  * Horizons for opts->directions azimuths (ts_horizon_azimuth): `out` holds
- * directions planes of width*height floats, plane k for azimuth k.
+ * directions planes of width*height floats, plane k for azimuth k. The type
+ * of every backend's horizons.
  */
-ts_status ts_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts,
-                             float *out, ts_error *err);
+typedef ts_status ts_horizon_compute_fn(const ts_grid *grid, const ts_horizon_opts *opts,
+                                        float *out, ts_error *err);
+
+/** The horizons on the C backend. */
+ts_horizon_compute_fn ts_horizon_compute;
 
 /**
  * Horizon sweep along the sample lines only, for tests: the horizon slope
@@ -176,11 +182,15 @@ ts_status ts_horizon_sweep_lines(const ts_grid *grid, double azimuth,
  * `visibility` (width*height, may be NULL) receives the lit fraction:
  * 1 - clamp((S - h) / penumbra_depth, 0, 1), or the binary test S <= h when
  * penumbra_depth is 0; NaN for nodata. `shadow_height` (may be NULL)
- * receives S itself. Both have row stride = width.
+ * receives S itself. Both have row stride = width. The type of every
+ * backend's shadow height map.
  */
-ts_status ts_shm_compute(const ts_grid *grid, double azimuth, double elevation,
-                         double penumbra_depth, int threads, float *visibility,
-                         float *shadow_height, ts_error *err);
+typedef ts_status ts_shm_compute_fn(const ts_grid *grid, double azimuth, double elevation,
+                                    double penumbra_depth, int threads, float *visibility,
+                                    float *shadow_height, ts_error *err);
+
+/** The shadow height map on the C backend. */
+ts_shm_compute_fn ts_shm_compute;
 
 /* --------------------------------------------------------------- shading */
 
@@ -197,10 +207,13 @@ ts_status ts_shm_compute(const ts_grid *grid, double azimuth, double elevation,
  * Unit surface normals by Horn's method (as gdaldem hillshade), components
  * x = east, y = north, z = up; each array width*height (may not be NULL).
  * On edges and next to nodata the missing neighbours are replaced by the
- * centre cell; a nodata cell gets NaN.
+ * centre cell; a nodata cell gets NaN. The type of every backend's normals.
  */
-ts_status ts_normals(const ts_grid *grid, float *nx, float *ny, float *nz,
-                     ts_error *err);
+typedef ts_status ts_normals_fn(const ts_grid *grid, float *nx, float *ny, float *nz,
+                                ts_error *err);
+
+/** The normals on the C backend. */
+ts_normals_fn ts_normals;
 
 /**
  * Fraction (0..1) of the sun's disk, centre at `sun_elevation`, radius
@@ -208,35 +221,72 @@ ts_status ts_normals(const ts_grid *grid, float *nx, float *ny, float *nz,
  */
 double ts_sun_disk_fraction(double sun_elevation, double horizon);
 
+/** What the direct sun is computed from and into (ts_shade_direct_fn). */
+typedef struct {
+    const ts_grid *grid;
+    const float *nx, *ny, *nz;   /**< unit normals from ts_normals */
+    const float *horizons;       /**< opts->directions planes, layout of ts_horizon_compute */
+    const ts_horizon_opts *opts; /**< the options the horizons were computed with */
+    double sun_azimuth;          /**< degrees from north, finite */
+    double sun_elevation;        /**< degrees, in [-90, 90] */
+    float *out;                  /**< width*height: the direct light, NaN for nodata */
+} ts_direct_request;
+
 /**
  * Direct sun: max(0, N.L) times the visible fraction of the sun's disk above
  * the horizon at the sun's azimuth, interpolated between the two nearest of
- * the `opts->directions` computed azimuths in `horizons` (layout of
- * ts_horizon_compute). Normals from ts_normals. `out` width*height, NaN for
- * nodata.
+ * the `opts->directions` computed azimuths. Every pointer of the request
+ * must be set. The type of every backend's direct sun (terrashade_cl.h).
  */
-ts_status ts_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
-                          const float *nz, const float *horizons,
-                          const ts_horizon_opts *opts, double sun_azimuth,
-                          double sun_elevation, float *out, ts_error *err);
+typedef ts_status ts_shade_direct_fn(const ts_direct_request *req, ts_error *err);
+
+/** The direct sun on the C backend. */
+ts_shade_direct_fn ts_shade_direct;
+
+/** Which sky-view factor the svf output of the sky terms holds. */
+typedef enum {
+    /** Timonen eq. 5 with the cell's normal: the cosine-weighted visible
+     * fraction of the hemisphere around the normal (the default). */
+    TS_SVF_RADIATIVE = 0,
+    /** Zaksek et al. (2011), as RVT_py, SAGA and GRASS r.skyview: 1 - the
+     * mean over directions of sin(max(horizon, 0)), relative to the
+     * horizontal; no normal. */
+    TS_SVF_SOLID_ANGLE = 1
+} ts_svf_model;
+
+/** TS_OK if `model` is a ts_svf_model, else TS_ERR_ARG with a sentence. */
+ts_status ts_check_svf_model(ts_svf_model model, ts_error *err);
+
+/** What the sky terms are computed from and into (ts_sky_terms_fn). */
+typedef struct {
+    const ts_grid *grid;
+    const float *nx, *ny, *nz;   /**< unit normals from ts_normals */
+    const float *horizons;       /**< opts->directions planes, layout of ts_horizon_compute */
+    const ts_horizon_opts *opts; /**< the options the horizons were computed with */
+    ts_svf_model svf_model;      /**< which sky-view factor `svf` holds */
+    float *svf;                  /**< width*height or NULL: the sky-view factor */
+    float *sky;                  /**< width*height or NULL: uniform-sky light */
+    float *openness;             /**< width*height or NULL: positive openness, degrees */
+} ts_sky_request;
 
 /**
- * Sky terms from horizons (layout of ts_horizon_compute), any output may be
- * NULL:
- *  - svf: sky-view factor with the surface normal, Timonen eq. 5 with c = 1
- *    (cosine-weighted visible fraction of the hemisphere around the normal;
- *    1 on an open plane, cos(slope) at the bottom of a V-valley);
+ * Sky terms from horizons, each output only where the request has one:
+ *  - svf: sky-view factor of model svf_model; TS_SVF_RADIATIVE is Timonen
+ *    eq. 5 with c = 1 (cosine-weighted visible fraction of the hemisphere
+ *    around the normal; 1 on an open plane, cos(slope) at the bottom of a
+ *    V-valley);
  *  - sky: irradiance from a uniform sky of unit radiance, the same integral
  *    with the horizon raised to at least 0 deg (the sky ends at the
  *    horizontal);
  *  - openness: positive openness (Yokoyama et al. 2002), the mean of
  *    90 - horizon angle, degrees; negative openness is the same on the
  *    negated DEM's horizons.
+ * The type of every backend's sky terms (terrashade_cl.h).
  */
-ts_status ts_sky_terms(const ts_grid *grid, const float *nx, const float *ny,
-                       const float *nz, const float *horizons,
-                       const ts_horizon_opts *opts, float *svf, float *sky,
-                       float *openness, ts_error *err);
+typedef ts_status ts_sky_terms_fn(const ts_sky_request *req, ts_error *err);
+
+/** The sky terms on the C backend. */
+ts_sky_terms_fn ts_sky_terms;
 
 /**
  * Accumulating form of ts_sky_terms for one direction at a time, so that a
@@ -252,27 +302,6 @@ ts_status ts_sky_accumulate(const ts_grid *grid, const float *nx,
                             float *openness_acc, ts_error *err);
 ts_status ts_sky_finish(const ts_grid *grid, int directions, float *svf_acc,
                         float *sky_acc, float *openness_acc, ts_error *err);
-
-/** Which sky-view factor the svf output of the sky terms holds. */
-typedef enum {
-    /** Timonen eq. 5 with the cell's normal: the cosine-weighted visible
-     * fraction of the hemisphere around the normal (what ts_sky_terms
-     * computes). */
-    TS_SVF_RADIATIVE = 0,
-    /** Zaksek et al. (2011), as RVT_py, SAGA and GRASS r.skyview: 1 - the
-     * mean over directions of sin(max(horizon, 0)), relative to the
-     * horizontal; no normal. */
-    TS_SVF_SOLID_ANGLE = 1
-} ts_svf_model;
-
-/** TS_OK if `model` is a ts_svf_model, else TS_ERR_ARG with a sentence. */
-ts_status ts_check_svf_model(ts_svf_model model, ts_error *err);
-
-/** ts_sky_terms with the svf output of model `svf_model`. */
-ts_status ts_sky_terms_model(const ts_grid *grid, const float *nx, const float *ny,
-                             const float *nz, const float *horizons,
-                             const ts_horizon_opts *opts, ts_svf_model svf_model, float *svf,
-                             float *sky, float *openness, ts_error *err);
 
 /** ts_sky_accumulate with the svf accumulator of model `svf_model` (finish
  * it with ts_sky_finish as well). */

@@ -281,19 +281,30 @@ void ts_env_table_free(ts_env_table *table);
 /** Azimuth of the table's sector k, degrees in [0, 360). */
 double ts_env_table_azimuth(const ts_env_table *table, int k);
 
+/** What one sector's environment light is computed from and added to
+ *  (ts_env_light_accumulate_fn). Every pointer must be set. */
+typedef struct {
+    const ts_grid *grid;
+    const ts_env_table *table;
+    int k;                     /**< the sector, 0 <= k < table->directions */
+    const float *nx, *ny, *nz; /**< unit normals from ts_normals (nz > 0) */
+    const float *plane;        /**< sector k's horizon plane (ts_horizon_sweep at
+                                    ts_env_table_azimuth(table, k)) */
+    float *r, *g, *b;          /**< width*height accumulators, zeroed before sector 0 */
+} ts_env_light_request;
+
 /**
  * Environment light, one horizon plane at a time (Timonen eq. 6): add
  * |N_p| L_p(k, theta_n, h) = nz A + (N . u_k) B per colour, A and B bilinear
  * in both table axes (or, with normal_steps 0, linear at the cell's own cut),
- * to the accumulators r, g, b (width*height floats, zeroed before sector 0) for
- * sector k, whose horizon plane (ts_horizon_sweep at ts_env_table_azimuth(k))
- * is `plane`. Normals from ts_normals (nz > 0). Nodata (NaN normal or
- * horizon) gives NaN. Then ts_env_light_finish.
+ * to the request's accumulators for its sector k. Nodata (NaN normal or
+ * horizon) gives NaN. Then ts_env_light_finish. The type of every backend's
+ * environment light (terrashade_cl.h).
  */
-ts_status ts_env_light_accumulate(const ts_grid *grid, const ts_env_table *table, int k,
-                                  const float *nx, const float *ny, const float *nz,
-                                  const float *plane, float *r, float *g, float *b,
-                                  ts_error *err);
+typedef ts_status ts_env_light_accumulate_fn(const ts_env_light_request *req, ts_error *err);
+
+/** The environment light on the C backend. */
+ts_env_light_accumulate_fn ts_env_light_accumulate;
 
 /**
  * Finish the accumulated light: E/pi per colour, the light reflected by a

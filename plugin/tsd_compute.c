@@ -254,10 +254,9 @@ static ts_status shade_direct(const tsd_compute_ctx *c, const ts_grid *g, const 
         ts_error err;
         if ((st = sun_horizon(c, g, &h, work)) != TS_OK)
             return st;
-        if (NOTE(c, ts_backend_shade_direct(BK(c), g, nm->nx, nm->ny, nm->nz, work, &h,
-                                            c->run->sun_azimuth, c->run->sun_elevation, out,
-                                            &rep, &err),
-                 rep) != TS_OK)
+        const ts_direct_request req = {g, nm->nx, nm->ny, nm->nz, work, &h,
+                                       c->run->sun_azimuth, c->run->sun_elevation, out};
+        if (NOTE(c, ts_backend_shade_direct(BK(c), &req, &rep, &err), rep) != TS_OK)
             return core_fail(c, &err);
         return TS_OK;
     }

@@ -77,8 +77,9 @@ static ts_status sample_surfaces(tsd_environment *e, ts_error *err)
             nz[i] = (float)cos(t);
             plane[i] = -90.0f; /* nothing above the tangent plane */
         }
-    for (int k = 0; st == TS_OK && k < e->table.directions; k++)
-        st = ts_env_light_accumulate(&g, &e->table, k, nx, ny, nz, plane, r, gr, b, err);
+    ts_env_light_request req = {&g, &e->table, 0, nx, ny, nz, plane, r, gr, b};
+    for (req.k = 0; st == TS_OK && req.k < e->table.directions; req.k++)
+        st = ts_env_light_accumulate(&req, err);
     if (st == TS_OK)
         st = ts_env_light_finish(&g, r, gr, b, err);
     if (st == TS_OK) {
@@ -170,9 +171,10 @@ static ts_status env_add(void *user, const ts_grid *g, int k, double azimuth,
     (void)azimuth; /* the table's sector k is the sweep's azimuth k */
     env_acc *a = user;
     ts_backend_report rep = {0};
-    ts_status st = ts_backend_env_light_accumulate(
-        tsd_backend_to_ts(a->c->opts->backend), &a->state, g, &a->e->table, k, a->nm->nx,
-        a->nm->ny, a->nm->nz, plane, a->r, a->g, a->b, &rep, err);
+    const ts_env_light_request req = {g, &a->e->table, k, a->nm->nx, a->nm->ny, a->nm->nz,
+                                      plane, a->r, a->g, a->b};
+    ts_status st = ts_backend_env_light_accumulate(tsd_backend_to_ts(a->c->opts->backend),
+                                                   &a->state, &req, &rep, err);
     if (a->c->backend && rep.backend[0])
         tsd_backend_summary_add(a->c->backend, &rep);
     return st;

@@ -167,8 +167,9 @@ static valley valley_make(void)
     v.svf = tdem_floats(v.n), v.sky = tdem_floats(v.n), v.open = tdem_floats(v.n);
     ts_error err;
     ck_assert_msg(ts_normals(&v.g, v.nx, v.ny, v.nz, &err) == TS_OK, "%s", err.message);
-    ck_assert_msg(ts_sky_terms(&v.g, v.nx, v.ny, v.nz, v.hor, &v.o, v.svf, v.sky, v.open,
-                               &err) == TS_OK, "%s", err.message);
+    const ts_sky_request sq = {&v.g, v.nx, v.ny, v.nz, v.hor, &v.o, TS_SVF_RADIATIVE,
+                               v.svf, v.sky, v.open};
+    ck_assert_msg(ts_sky_terms(&sq, &err) == TS_OK, "%s", err.message);
     return v;
 }
 
@@ -259,7 +260,8 @@ START_TEST(test_cone_apex)
     float *svf = tdem_floats(n), *open = tdem_floats(n);
     ts_error err;
     ck_assert(ts_normals(&g, nx, ny, nz, &err) == TS_OK);
-    ck_assert(ts_sky_terms(&g, nx, ny, nz, hor, &o, svf, NULL, open, &err) == TS_OK);
+    const ts_sky_request sq = {&g, nx, ny, nz, hor, &o, TS_SVF_RADIATIVE, svf, NULL, open};
+    ck_assert(ts_sky_terms(&sq, &err) == TS_OK);
     printf("cone apex: horizon %.4f (want %.4f), svf %.6f, openness %.4f (want %.4f)\n",
            hor[apex], want, svf[apex], open[apex], 90 - want);
     ck_assert_msg(fabs(svf[apex] - 1.0) <= 1e-4, "apex svf %g", svf[apex]);
@@ -399,12 +401,12 @@ static void tiny_grid(int w, int h)
     float *vis = tdem_floats(n), *sh = tdem_floats(n), *dir = tdem_floats(n);
     ts_error err;
     ck_assert_msg(ts_normals(&g, nx, ny, nz, &err) == TS_OK, "%dx%d: %s", w, h, err.message);
-    ck_assert_msg(ts_sky_terms(&g, nx, ny, nz, hor, &o, svf, sky, open, &err) == TS_OK,
-                  "%dx%d: %s", w, h, err.message);
+    const ts_sky_request sq = {&g, nx, ny, nz, hor, &o, TS_SVF_RADIATIVE, svf, sky, open};
+    ck_assert_msg(ts_sky_terms(&sq, &err) == TS_OK, "%dx%d: %s", w, h, err.message);
     ck_assert_msg(ts_shm_compute(&g, 123.0, 20.0, 2.0, 0, vis, sh, &err) == TS_OK,
                   "%dx%d: %s", w, h, err.message);
-    ck_assert_msg(ts_shade_direct(&g, nx, ny, nz, hor, &o, 200.0, 35.0, dir, &err) == TS_OK,
-                  "%dx%d: %s", w, h, err.message);
+    const ts_direct_request dq = {&g, nx, ny, nz, hor, &o, 200.0, 35.0, dir};
+    ck_assert_msg(ts_shade_direct(&dq, &err) == TS_OK, "%dx%d: %s", w, h, err.message);
     for (size_t i = 0; i < n; i++) {
         for (int k = 0; k < 8; k++) {
             float v = hor[k * n + i];

@@ -10,6 +10,7 @@
 
 #include "terrashade_env.h"
 #include "test_dem.h"
+#include "test_expect.h"
 #include "test_grid.h"
 #include "test_run.h"
 
@@ -60,10 +61,11 @@ static void env_light(const scene *s, const ts_env *env, int dirs, int nn, int n
     int stride = s->o.directions / dirs;
     ck_assert(stride * dirs == s->o.directions);
     memset(r, 0, s->n * sizeof *r), memset(g, 0, s->n * sizeof *g), memset(b, 0, s->n * sizeof *b);
-    for (int k = 0; k < dirs; k++)
-        ck_assert_msg(ts_env_light_accumulate(&s->g, &t, k, s->nx, s->ny, s->nz,
-                                              s->hor + s->n * (size_t)(k * stride), r, g, b,
-                                              &err) == TS_OK, "%s", err.message);
+    ts_env_light_request req = {&s->g, &t, 0, s->nx, s->ny, s->nz, NULL, r, g, b};
+    for (req.k = 0; req.k < dirs; req.k++) {
+        req.plane = s->hor + s->n * (size_t)(req.k * stride);
+        ck_assert_msg(ts_env_light_accumulate(&req, &err) == TS_OK, "%s", err.message);
+    }
     ck_assert(ts_env_light_finish(&s->g, r, g, b, &err) == TS_OK);
     ts_env_table_free(&t);
 }
@@ -122,7 +124,9 @@ START_TEST(test_constant_env_is_sky_term)
     float *sky = tdem_floats(s.n), *svf = tdem_floats(s.n);
     float *r = tdem_floats(s.n), *g = tdem_floats(s.n), *b = tdem_floats(s.n);
     ts_error err;
-    ck_assert(ts_sky_terms(&s.g, s.nx, s.ny, s.nz, s.hor, &s.o, svf, sky, NULL, &err) == TS_OK);
+    const ts_sky_request sq = {&s.g, s.nx, s.ny, s.nz, s.hor, &s.o, TS_SVF_RADIATIVE, svf, sky,
+                               NULL};
+    ck_assert(ts_sky_terms(&sq, &err) == TS_OK);
     /* 360 rows put texel edges on the table's 1-degree horizon nodes; 512
      * rows do not (a row cut by a node counts wholly on one side). */
     const int rows[2] = {360, 512};
@@ -185,8 +189,8 @@ static double patch_vs_sun(const scene *s, double az, double el)
     float *sun = tdem_floats(s->n);
     env_light(s, &env, s->o.directions, TS_ENV_DEFAULT_NORMAL_STEPS,
               TS_ENV_DEFAULT_HORIZON_STEPS, 0, r, g, b);
-    ck_assert(ts_shade_direct(&s->g, s->nx, s->ny, s->nz, s->hor, &s->o, az, el, sun, &err) ==
-              TS_OK);
+    const ts_direct_request dq = {&s->g, s->nx, s->ny, s->nz, s->hor, &s->o, az, el, sun};
+    ck_assert(ts_shade_direct(&dq, &err) == TS_OK);
     long shadowed = 0;
     for (size_t i = 0; i < s->n; i++)
         shadowed += sun[i] == 0;
@@ -397,17 +401,18 @@ START_TEST(test_nodata_and_streaming)
     s.o.directions = 4;
     ck_assert(ts_env_light(&s.g, &t, s.nx, s.ny, s.nz, s.hor, &s.o, r, g, b, &err) ==
               TS_ERR_ARG);
-    ck_assert(ts_env_light_accumulate(&s.g, &t, 8, s.nx, s.ny, s.nz, s.hor, r, g, b, &err) ==
-              TS_ERR_ARG);
-    ck_assert(ts_env_light_accumulate(&s.g, &t, -1, s.nx, s.ny, s.nz, s.hor, r, g, b, &err) ==
-              TS_ERR_ARG);
-    ck_assert(ts_env_light_accumulate(&s.g, &t, 0, s.nx, s.ny, s.nz, NULL, r, g, b, &err) ==
-              TS_ERR_ARG);
-    ck_assert(ts_env_light_accumulate(&s.g, &t, 0, s.nx, s.ny, s.nz, s.hor, r, NULL, b, &err) ==
-              TS_ERR_ARG);
+    const ts_env_light_request q0 = {&s.g, &t, 0, s.nx, s.ny, s.nz, s.hor, r, g, b};
+    ts_env_light_request q;
+    ck_assert(ts_env_light_accumulate(&q0, &err) == TS_OK);
+    EXPECT_ARG(ts_env_light_accumulate(NULL, &err), &err);
+    EXPECT_ARG_FIELD(ts_env_light_accumulate, q, q0, k, 8, &err);
+    EXPECT_ARG_FIELD(ts_env_light_accumulate, q, q0, k, -1, &err);
+    EXPECT_ARG_FIELD(ts_env_light_accumulate, q, q0, plane, NULL, &err);
+    EXPECT_ARG_FIELD(ts_env_light_accumulate, q, q0, g, NULL, &err);
+    EXPECT_ARG_FIELD(ts_env_light_accumulate, q, q0, grid, NULL, &err);
+    EXPECT_ARG_FIELD(ts_env_light_accumulate, q, q0, table, NULL, &err);
     ts_env_table_free(&t);
-    ck_assert(ts_env_light_accumulate(&s.g, &t, 0, s.nx, s.ny, s.nz, s.hor, r, g, b, &err) ==
-              TS_ERR_ARG);
+    EXPECT_ARG(ts_env_light_accumulate(&q0, &err), &err);
     ts_env_table_free(NULL);
     free(r), free(g), free(b), free(r2), free(g2), free(b2);
     ts_env_free(&env);

@@ -159,8 +159,17 @@ static void light_free(lit *L)
 static void direct(const ts_grid *g, const lit *L, double az, double el, float *out)
 {
     ts_error err;
-    ck_assert_msg(ts_shade_direct(g, L->nx, L->ny, L->nz, L->hor, &L->o, az, el, out,
-                                  &err) == TS_OK, "%s", err.message);
+    const ts_direct_request req = {g, L->nx, L->ny, L->nz, L->hor, &L->o, az, el, out};
+    ck_assert_msg(ts_shade_direct(&req, &err) == TS_OK, "%s", err.message);
+}
+
+/* The radiative sky terms of the lit grid. */
+static void sky_terms(const ts_grid *g, const lit *L, float *svf, float *sky, float *op)
+{
+    ts_error err;
+    const ts_sky_request req = {g, L->nx, L->ny, L->nz, L->hor, &L->o, TS_SVF_RADIATIVE,
+                                svf, sky, op};
+    ck_assert_msg(ts_sky_terms(&req, &err) == TS_OK, "%s", err.message);
 }
 
 START_TEST(test_direct_flat)
@@ -281,8 +290,7 @@ START_TEST(test_sky_flat_and_tilted)
                 g.z[y * g.stride + x] = (float)(tan(gam * DEG) * y * 10.0 + 50.0);
         lit L = light_setup_dirs(&g, 64);
         float *svf = tdem_floats(L.n), *sky = tdem_floats(L.n), *op = tdem_floats(L.n);
-        ts_error err;
-        ck_assert(ts_sky_terms(&g, L.nx, L.ny, L.nz, L.hor, &L.o, svf, sky, op, &err) == TS_OK);
+        sky_terms(&g, &L, svf, sky, op);
         double want_sky = (1 + cos(gam * DEG)) / 2;
         for (int y = 1; y < 29; y++)
             for (int x = 1; x < 39; x++) {
@@ -321,7 +329,7 @@ START_TEST(test_sky_rough)
     float *as = calloc(n, 4), *ak = calloc(n, 4), *ao = calloc(n, 4);
     ck_assert(as && ak && ao);
     ts_error err;
-    ck_assert(ts_sky_terms(&g, L.nx, L.ny, L.nz, L.hor, &L.o, svf, sky, op, &err) == TS_OK);
+    sky_terms(&g, &L, svf, sky, op);
     for (int k = 0; k < 16; k++)
         ck_assert_msg(ts_sky_accumulate(&g, L.nx, L.ny, L.nz, L.hor + k * n,
                                         ts_horizon_azimuth(&L.o, k), 16, as, ak, ao,

@@ -45,6 +45,15 @@ static void case_make(sky_case *c)
     c->o.directions = NDIR;
 }
 
+/* The case's sky terms of model `model` into svf and open (may be NULL). */
+static ts_status case_sky(const sky_case *c, ts_svf_model model, float *svf, float *open,
+                          ts_error *e)
+{
+    const ts_sky_request req = {&c->g, c->nx, c->ny, c->nz, c->hor, &c->o, model,
+                                svf, NULL, open};
+    return ts_sky_terms(&req, e);
+}
+
 static void case_free(sky_case *c)
 {
     free(c->nx), free(c->ny), free(c->nz), free(c->hor);
@@ -57,8 +66,7 @@ START_TEST(test_solid_angle_closed_form)
     case_make(&c);
     float svf[NCELL], open[NCELL];
     ts_error e;
-    ck_assert_msg(ts_sky_terms_model(&c.g, c.nx, c.ny, c.nz, c.hor, &c.o, TS_SVF_SOLID_ANGLE,
-                                     svf, NULL, open, &e) == TS_OK, "%s", e.message);
+    ck_assert_msg(case_sky(&c, TS_SVF_SOLID_ANGLE, svf, open, &e) == TS_OK, "%s", e.message);
     for (int i = 0; i < NCELL; i++) {
         double s = 0, o = 0;
         for (int k = 0; k < NDIR; k++) {
@@ -83,9 +91,11 @@ START_TEST(test_radiative_is_the_default)
     case_make(&c);
     float a[NCELL], b[NCELL];
     ts_error e;
-    ck_assert(ts_sky_terms(&c.g, c.nx, c.ny, c.nz, c.hor, &c.o, a, NULL, NULL, &e) == TS_OK);
-    ck_assert(ts_sky_terms_model(&c.g, c.nx, c.ny, c.nz, c.hor, &c.o, TS_SVF_RADIATIVE, b,
-                                 NULL, NULL, &e) == TS_OK);
+    /* a request that leaves the model out asks for the radiative svf */
+    const ts_sky_request req = {.grid = &c.g, .nx = c.nx, .ny = c.ny, .nz = c.nz,
+                                .horizons = c.hor, .opts = &c.o, .svf = a};
+    ck_assert(ts_sky_terms(&req, &e) == TS_OK);
+    ck_assert(case_sky(&c, TS_SVF_RADIATIVE, b, NULL, &e) == TS_OK);
     ck_assert(memcmp(a, b, sizeof a) == 0);
     /* the radiative svf weighs the sky by cos(zenith): on a flat cell it
      * is 1 - mean sin^2(max(h, 0)) instead of 1 - mean sin(max(h, 0)) */
@@ -107,8 +117,7 @@ START_TEST(test_accumulating_form_and_nodata)
     c.hor[3 * NCELL + 2] = NAN; /* cell 2, direction 3: nodata */
     float whole[NCELL], acc[NCELL] = {0};
     ts_error e;
-    ck_assert(ts_sky_terms_model(&c.g, c.nx, c.ny, c.nz, c.hor, &c.o, TS_SVF_SOLID_ANGLE, whole,
-                                 NULL, NULL, &e) == TS_OK);
+    ck_assert(case_sky(&c, TS_SVF_SOLID_ANGLE, whole, NULL, &e) == TS_OK);
     for (int k = 0; k < NDIR; k++)
         ck_assert(ts_sky_accumulate_model(&c.g, c.nx, c.ny, c.nz, c.hor + k * NCELL,
                                           ts_horizon_azimuth(&c.o, k), NDIR,
@@ -129,9 +138,7 @@ START_TEST(test_bad_model)
     case_make(&c);
     float out[NCELL];
     ts_error e;
-    ck_assert_int_eq(ts_sky_terms_model(&c.g, c.nx, c.ny, c.nz, c.hor, &c.o, (ts_svf_model)7,
-                                        out, NULL, NULL, &e),
-                     TS_ERR_ARG);
+    ck_assert_int_eq(case_sky(&c, (ts_svf_model)7, out, NULL, &e), TS_ERR_ARG);
     ck_assert_msg(strstr(e.message, "svf model") != NULL, "%s", e.message);
     ck_assert_int_eq(ts_sky_accumulate_model(&c.g, c.nx, c.ny, c.nz, c.hor, 0, NDIR,
                                              (ts_svf_model)-1, out, NULL, NULL, &e),
@@ -170,8 +177,8 @@ START_TEST(test_cone)
                 g.z[i] = -g.z[i];
         ck_assert(ts_normals(&g, nx, ny, nz, &e) == TS_OK);
         ck_assert(ts_horizon_compute(&g, &o, hor, &e) == TS_OK);
-        ck_assert(ts_sky_terms_model(&g, nx, ny, nz, hor, &o, TS_SVF_SOLID_ANGLE, svf, NULL, op,
-                                     &e) == TS_OK);
+        const ts_sky_request req = {&g, nx, ny, nz, hor, &o, TS_SVF_SOLID_ANGLE, svf, NULL, op};
+        ck_assert(ts_sky_terms(&req, &e) == TS_OK);
         size_t c = (size_t)mid * n + mid;
         double want_svf = sign > 0 ? 1.0 - sin(s * DEG) : 1.0;
         double want_op = 90.0 - sign * s;

@@ -436,6 +436,27 @@ static void scene_free(scene *sc, const dem_spec *s)
     free_dem(&sc->g, s);
 }
 
+/* The scene's direct sun at azimuth az, elevation el into out. */
+static ts_direct_request scene_direct(const scene *sc, double az, double el, float *out)
+{
+    return (ts_direct_request){&sc->g, sc->nx, sc->ny, sc->nz, sc->h, &sc->o, az, el, out};
+}
+
+/* The scene's sky terms of model m into svf, sky, open (each may be NULL). */
+static ts_sky_request scene_sky(const scene *sc, ts_svf_model m, float *svf, float *sky,
+                                float *open)
+{
+    return (ts_sky_request){&sc->g, sc->nx, sc->ny, sc->nz, sc->h, &sc->o, m, svf, sky, open};
+}
+
+/* The scene's environment light of table t's sector k (its horizon plane k)
+ * into rgb: three planes of sc->n floats. */
+static ts_env_light_request scene_env(const scene *sc, const ts_env_table *t, int k, float *rgb)
+{
+    return (ts_env_light_request){&sc->g, t,   k, sc->nx, sc->ny, sc->nz, sc->h + sc->n * k,
+                                  rgb,    rgb + sc->n, rgb + 2 * sc->n};
+}
+
 START_TEST(test_direct)
 {
     require_opencl();
@@ -447,12 +468,10 @@ START_TEST(test_direct)
         float *c = tdem_floats(sc.n), *l = tdem_floats(sc.n);
         ts_error e;
         for (size_t k = 0; k < sizeof sun / sizeof *sun; k++) {
-            ck_assert_int_eq(ts_shade_direct(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, sun[k][0],
-                                             sun[k][1], c, &e),
-                             TS_OK);
-            ck_assert_msg(ts_cl_shade_direct(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, sun[k][0],
-                                             sun[k][1], l, &e) == TS_OK,
-                          "%s", e.message);
+            const ts_direct_request qc = scene_direct(&sc, sun[k][0], sun[k][1], c);
+            const ts_direct_request ql = scene_direct(&sc, sun[k][0], sun[k][1], l);
+            ck_assert_int_eq(ts_shade_direct(&qc, &e), TS_OK);
+            ck_assert_msg(ts_cl_shade_direct(&ql, &e) == TS_OK, "%s", e.message);
             char name[192], sh[64];
             snprintf(name, sizeof name, "direct %s, sun %g/%g", shape_name(s, sh, sizeof sh),
                      sun[k][0], sun[k][1]);
@@ -460,10 +479,9 @@ START_TEST(test_direct)
         }
         /* one direction, the sun on it */
         sc.o.directions = 1;
-        ck_assert_int_eq(ts_shade_direct(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, 5.0, 20, c, &e),
-                         TS_OK);
-        ck_assert_int_eq(
-            ts_cl_shade_direct(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, 5.0, 20, l, &e), TS_OK);
+        const ts_direct_request qc = scene_direct(&sc, 5.0, 20, c), ql = scene_direct(&sc, 5.0, 20, l);
+        ck_assert_int_eq(ts_shade_direct(&qc, &e), TS_OK);
+        ck_assert_int_eq(ts_cl_shade_direct(&ql, &e), TS_OK);
         expect_close("direct, one direction", c, l, sc.n, TOL);
         sc.o.directions = 8;
         free(c), free(l);
@@ -483,11 +501,11 @@ START_TEST(test_sky)
         for (int k = 0; k < 3; k++)
             c[k] = tdem_floats(sc.n), l[k] = tdem_floats(sc.n);
         ts_error e;
-        ck_assert_int_eq(
-            ts_sky_terms(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, c[0], c[1], c[2], &e), TS_OK);
-        ck_assert_msg(
-            ts_cl_sky_terms(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, l[0], l[1], l[2], &e) == TS_OK,
-            "%s", e.message);
+        const ts_svf_model rad = TS_SVF_RADIATIVE, solid = TS_SVF_SOLID_ANGLE;
+        ts_sky_request qc = scene_sky(&sc, rad, c[0], c[1], c[2]);
+        ts_sky_request ql = scene_sky(&sc, rad, l[0], l[1], l[2]);
+        ck_assert_int_eq(ts_sky_terms(&qc, &e), TS_OK);
+        ck_assert_msg(ts_cl_sky_terms(&ql, &e) == TS_OK, "%s", e.message);
         static const char *what[3] = {"svf", "sky", "openness (deg)"};
         for (int k = 0; k < 3; k++) {
             char name[192], sh[64];
@@ -495,27 +513,23 @@ START_TEST(test_sky)
             expect_close(name, c[k], l[k], sc.n, TOL);
         }
         /* outputs one at a time */
-        ck_assert_int_eq(
-            ts_cl_sky_terms(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, NULL, l[1], NULL, &e), TS_OK);
+        ql = scene_sky(&sc, rad, NULL, l[1], NULL);
+        ck_assert_int_eq(ts_cl_sky_terms(&ql, &e), TS_OK);
         expect_close("sky alone", c[1], l[1], sc.n, TOL);
         /* the solid-angle svf (Zaksek et al. 2011), with and without the others */
-        ck_assert_int_eq(ts_sky_terms_model(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o,
-                                            TS_SVF_SOLID_ANGLE, c[0], NULL, NULL, &e),
-                         TS_OK);
-        ck_assert_msg(ts_cl_sky_terms_model(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o,
-                                            TS_SVF_SOLID_ANGLE, l[0], l[1], l[2], &e) == TS_OK,
-                      "%s", e.message);
+        qc = scene_sky(&sc, solid, c[0], NULL, NULL);
+        ck_assert_int_eq(ts_sky_terms(&qc, &e), TS_OK);
+        ql = scene_sky(&sc, solid, l[0], l[1], l[2]);
+        ck_assert_msg(ts_cl_sky_terms(&ql, &e) == TS_OK, "%s", e.message);
         char name[192], sh[64];
         snprintf(name, sizeof name, "svf solid_angle %s", shape_name(s, sh, sizeof sh));
         expect_close(name, c[0], l[0], sc.n, TOL);
         expect_close("sky beside svf solid_angle", c[1], l[1], sc.n, TOL);
-        ck_assert_int_eq(ts_cl_sky_terms_model(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o,
-                                               TS_SVF_SOLID_ANGLE, l[0], NULL, NULL, &e),
-                         TS_OK);
+        ql = scene_sky(&sc, solid, l[0], NULL, NULL);
+        ck_assert_int_eq(ts_cl_sky_terms(&ql, &e), TS_OK);
         expect_close("svf solid_angle alone", c[0], l[0], sc.n, TOL);
-        ck_assert_int_eq(ts_cl_sky_terms_model(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o,
-                                               (ts_svf_model)5, l[0], NULL, NULL, &e),
-                         TS_ERR_ARG);
+        ql = scene_sky(&sc, (ts_svf_model)5, l[0], NULL, NULL);
+        ck_assert_int_eq(ts_cl_sky_terms(&ql, &e), TS_ERR_ARG);
         for (int k = 0; k < 3; k++)
             free(c[k]), free(l[k]);
         scene_free(&sc, s);
@@ -545,9 +559,13 @@ START_TEST(test_arguments)
     ck_assert_int_eq(ts_cl_normals(&g, a, b, NULL, &e), TS_ERR_ARG);
     ck_assert_int_eq(ts_cl_normals(NULL, a, b, c, &e), TS_ERR_ARG);
     o.directions = 1;
-    ck_assert_int_eq(ts_cl_shade_direct(&g, a, b, c, a, &o, 100, 20, b, &e), TS_ERR_ARG);
+    const ts_direct_request dq = {&g, a, b, c, a, &o, 100, 20, b};
+    ck_assert_int_eq(ts_cl_shade_direct(&dq, &e), TS_ERR_ARG);
     ck_assert_ptr_nonnull(strstr(e.message, "computed for azimuth 0 only"));
-    ck_assert_int_eq(ts_cl_sky_terms(&g, a, b, c, NULL, &o, a, NULL, NULL, &e), TS_ERR_ARG);
+    const ts_sky_request sq = {&g, a, b, c, NULL, &o, TS_SVF_RADIATIVE, a, NULL, NULL};
+    ck_assert_int_eq(ts_cl_sky_terms(&sq, &e), TS_ERR_ARG);
+    ck_assert_int_eq(ts_cl_sky_terms(NULL, &e), TS_ERR_ARG);
+    ck_assert_int_eq(ts_cl_shade_direct(NULL, &e), TS_ERR_ARG);
     free(a), free(b), free(c);
     free_dem(&g, s);
 }
@@ -609,15 +627,12 @@ static double env_compare(const scene *sc, const ts_env_table *t, float *c, floa
     memset(c, 0, 3 * n * sizeof *c);
     memset(l, 0, 3 * n * sizeof *l);
     ts_cl_env_light *s;
-    ck_assert_msg(ts_cl_env_light_open(&sc->g, t, sc->nx, sc->ny, sc->nz, &s, &e) == TS_OK, "%s",
-                  e.message);
+    const ts_env_light_request first = scene_env(sc, t, 0, l);
+    ck_assert_msg(ts_cl_env_light_open(&first, &s, &e) == TS_OK, "%s", e.message);
     for (int k = 0; k < t->directions; k++) {
-        ck_assert_int_eq(ts_env_light_accumulate(&sc->g, t, k, sc->nx, sc->ny, sc->nz,
-                                                 sc->h + n * k, c, c + n, c + 2 * n, &e),
-                         TS_OK);
-        ck_assert_msg(ts_cl_env_light_add(s, &sc->g, t, k, sc->nx, sc->ny, sc->nz, sc->h + n * k,
-                                          l, l + n, l + 2 * n, &e) == TS_OK,
-                      "%s", e.message);
+        const ts_env_light_request qc = scene_env(sc, t, k, c), ql = scene_env(sc, t, k, l);
+        ck_assert_int_eq(ts_env_light_accumulate(&qc, &e), TS_OK);
+        ck_assert_msg(ts_cl_env_light_add(s, &ql, &e) == TS_OK, "%s", e.message);
     }
     ts_cl_env_light_close(s);
     ck_assert_int_eq(ts_env_light_finish(&sc->g, c, c + n, c + 2 * n, &e), TS_OK);
@@ -682,10 +697,10 @@ START_TEST(test_env_light_dispatch)
     ts_error e;
     ts_backend_report r;
     memset(c, 0, 3 * n * sizeof *c);
-    for (int k = 0; k < 8; k++)
-        ck_assert_int_eq(ts_env_light_accumulate(&sc.g, &t, k, sc.nx, sc.ny, sc.nz, sc.h + n * k,
-                                                 c, c + n, c + 2 * n, &e),
-                         TS_OK);
+    for (int k = 0; k < 8; k++) {
+        const ts_env_light_request qc = scene_env(&sc, &t, k, c);
+        ck_assert_int_eq(ts_env_light_accumulate(&qc, &e), TS_OK);
+    }
     for (int pass = 0; pass < 3; pass++) {
         /* 0: a state, 1: no state, 2: a state with the allocations capped */
         if (pass == 2)
@@ -693,9 +708,9 @@ START_TEST(test_env_light_dispatch)
         ts_backend_env_light st = {0};
         memset(l, 0, 3 * n * sizeof *l);
         for (int k = 0; k < 8; k++) {
-            ck_assert_msg(ts_backend_env_light_accumulate(
-                              TS_BACKEND_OPENCL, pass == 1 ? NULL : &st, &sc.g, &t, k, sc.nx,
-                              sc.ny, sc.nz, sc.h + n * k, l, l + n, l + 2 * n, &r, &e) == TS_OK,
+            const ts_env_light_request ql = scene_env(&sc, &t, k, l);
+            ck_assert_msg(ts_backend_env_light_accumulate(TS_BACKEND_OPENCL, pass == 1 ? NULL : &st,
+                                                          &ql, &r, &e) == TS_OK,
                           "%s", e.message);
             ck_assert_int_eq(r.used, pass == 2 ? TS_BACKEND_C : TS_BACKEND_OPENCL);
             ck_assert_int_eq(r.fell_back, pass == 2);
@@ -728,11 +743,10 @@ START_TEST(test_env_light_dispatch)
     for (int k = 0; k < 8; k++) {
         if (k == 4)
             setenv("TERRASHADE_OPENCL_MAX_ALLOC", "4k", 1);
-        const float *x = k < 4 ? sc.nx : nc, *y = k < 4 ? sc.ny : nc + n;
-        const float *z = k < 4 ? sc.nz : nc + 2 * n;
-        ck_assert_int_eq(ts_backend_env_light_accumulate(TS_BACKEND_OPENCL, &st, &sc.g, &t, k, x,
-                                                         y, z, sc.h + n * k, l, l + n, l + 2 * n,
-                                                         &r, &e),
+        ts_env_light_request ql = scene_env(&sc, &t, k, l);
+        if (k >= 4)
+            ql.nx = nc, ql.ny = nc + n, ql.nz = nc + 2 * n;
+        ck_assert_int_eq(ts_backend_env_light_accumulate(TS_BACKEND_OPENCL, &st, &ql, &r, &e),
                          TS_OK);
         ck_assert_int_eq(r.used, k < 4 ? TS_BACKEND_OPENCL : TS_BACKEND_C);
         ck_assert_int_eq(r.fell_back, k >= 4);
@@ -745,20 +759,20 @@ START_TEST(test_env_light_dispatch)
     free(nc);
     clear_env();
     /* argument errors: the C function's */
-    ck_assert_int_eq(ts_backend_env_light_accumulate(TS_BACKEND_OPENCL, NULL, &sc.g, &t, 8, sc.nx,
-                                                     sc.ny, sc.nz, sc.h, l, l + n, l + 2 * n, &r,
-                                                     &e),
+    const ts_env_light_request q0 = scene_env(&sc, &t, 0, l);
+    ts_env_light_request bad = q0;
+    bad.k = 8;
+    ck_assert_int_eq(ts_backend_env_light_accumulate(TS_BACKEND_OPENCL, NULL, &bad, &r, &e),
                      TS_ERR_ARG);
     ck_assert_ptr_nonnull(strstr(e.message, "outside the light table's 8 directions"));
-    ck_assert_int_eq(ts_cl_env_light_accumulate(&sc.g, &t, 0, sc.nx, NULL, sc.nz, sc.h, l, l + n,
-                                                l + 2 * n, &e),
-                     TS_ERR_ARG);
+    bad = q0, bad.ny = NULL;
+    ck_assert_int_eq(ts_cl_env_light_accumulate(&bad, &e), TS_ERR_ARG);
+    ck_assert_int_eq(ts_cl_env_light_accumulate(NULL, &e), TS_ERR_ARG);
     /* a session is for the arrays it was opened with */
     ts_cl_env_light *ss;
-    ck_assert_int_eq(ts_cl_env_light_open(&sc.g, &t, sc.nx, sc.ny, sc.nz, &ss, &e), TS_OK);
-    ck_assert_int_eq(ts_cl_env_light_add(ss, &sc.g, &t, 0, sc.ny, sc.ny, sc.nz, sc.h, l, l + n,
-                                         l + 2 * n, &e),
-                     TS_ERR_ARG);
+    ck_assert_int_eq(ts_cl_env_light_open(&q0, &ss, &e), TS_OK);
+    bad = q0, bad.nx = sc.ny;
+    ck_assert_int_eq(ts_cl_env_light_add(ss, &bad, &e), TS_ERR_ARG);
     ck_assert_ptr_nonnull(strstr(e.message, "opened for another"));
     ts_cl_env_light_close(ss);
     ts_env_table_free(&t);
@@ -910,18 +924,15 @@ START_TEST(test_dispatch_products)
     ck_assert_int_eq(r.used, TS_BACKEND_OPENCL);
     expect_close("dispatch shm visibility", c, a, sc.n, TOL);
     expect_close("dispatch shm height", b, a + sc.n, sc.n, TOL);
-    ck_assert_int_eq(ts_shade_direct(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, 150, 30, c, &e),
-                     TS_OK);
-    ck_assert_int_eq(ts_backend_shade_direct(TS_BACKEND_OPENCL, &sc.g, sc.nx, sc.ny, sc.nz, sc.h,
-                                             &sc.o, 150, 30, a, &r, &e),
-                     TS_OK);
+    const ts_direct_request dc = scene_direct(&sc, 150, 30, c), dl = scene_direct(&sc, 150, 30, a);
+    ck_assert_int_eq(ts_shade_direct(&dc, &e), TS_OK);
+    ck_assert_int_eq(ts_backend_shade_direct(TS_BACKEND_OPENCL, &dl, &r, &e), TS_OK);
     ck_assert_int_eq(r.used, TS_BACKEND_OPENCL);
     expect_close("dispatch direct", c, a, sc.n, TOL);
-    ck_assert_int_eq(ts_sky_terms(&sc.g, sc.nx, sc.ny, sc.nz, sc.h, &sc.o, c, NULL, NULL, &e),
-                     TS_OK);
-    ck_assert_int_eq(ts_backend_sky_terms(TS_BACKEND_OPENCL, &sc.g, sc.nx, sc.ny, sc.nz, sc.h,
-                                          &sc.o, a, NULL, NULL, &r, &e),
-                     TS_OK);
+    const ts_sky_request sc_ = scene_sky(&sc, TS_SVF_RADIATIVE, c, NULL, NULL);
+    const ts_sky_request sl = scene_sky(&sc, TS_SVF_RADIATIVE, a, NULL, NULL);
+    ck_assert_int_eq(ts_sky_terms(&sc_, &e), TS_OK);
+    ck_assert_int_eq(ts_backend_sky_terms(TS_BACKEND_OPENCL, &sl, &r, &e), TS_OK);
     ck_assert_int_eq(r.used, TS_BACKEND_OPENCL);
     expect_close("dispatch svf", c, a, sc.n, TOL);
     /* an argument error is the C backend's error */

@@ -87,7 +87,8 @@ static void sky_terms(const ts_grid *g, const float *nx, const float *ny,
     float *hz = xalloc(cells * p->h.directions * sizeof(float));
     if (ts_horizon_compute(g, &p->h, hz, &err) != TS_OK)
         die("ts_horizon_compute", &err);
-    if (ts_sky_terms(g, nx, ny, nz, hz, &p->h, svf, sky, open, &err) != TS_OK)
+    const ts_sky_request req = {g, nx, ny, nz, hz, &p->h, TS_SVF_RADIATIVE, svf, sky, open};
+    if (ts_sky_terms(&req, &err) != TS_OK)
         die("ts_sky_terms", &err);
     free(hz);
 }
@@ -174,8 +175,8 @@ int main(int argc, char **argv)
             one.start_azimuth = p.sun_az;
             if (ts_horizon_sweep(&g, p.sun_az, &one, hz, &err) != TS_OK)
                 die("ts_horizon_sweep", &err);
-            if (ts_shade_direct(&g, nx, ny, nz, hz, &one, p.sun_az, p.sun_el, out,
-                                &err) != TS_OK)
+            const ts_direct_request req = {&g, nx, ny, nz, hz, &one, p.sun_az, p.sun_el, out};
+            if (ts_shade_direct(&req, &err) != TS_OK)
                 die("ts_shade_direct", &err);
         }
         if (p.sky_weight > 0) {
