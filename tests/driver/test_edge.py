@@ -194,6 +194,13 @@ class Edge(unittest.TestCase):
                  if "EDGE" in p.get("options").split(",")}
         self.assertEqual(takes, {"shade", "shadow", "horizon", "svf", "openness", "sky",
                                  "sunhours", "insolation", "daycycle", "envlight"})
+        ds = gdal.OpenEx(T.conn(self.flat), open_options=["PRODUCT=svf", "EDGE=nodata"])
+        self.assertEqual(ds.GetMetadataItem("EDGE"), "nodata")
+        ds = gdal.OpenEx(T.conn(self.flat), open_options=["PRODUCT=horizon"])
+        self.assertEqual(ds.GetMetadataItem("EDGE"), "horizon")
+        ds = gdal.OpenEx(T.conn(self.flat), open_options=[
+            "PRODUCT=farshadow", "DATE=2026-06-21", "TIMEZONE=Z"])
+        self.assertIsNone(ds.GetMetadataItem("EDGE"))
 
 
 if __name__ == "__main__":
