@@ -179,9 +179,7 @@ class Edge(unittest.TestCase):
 
     def test_bad_values(self):
         p = T.run(["gdalinfo", T.conn(self.flat, PRODUCT="svf", EDGE="foo")], ok=False)
-        self.assertIn("EDGE", p.stderr)
-        self.assertIn("foo", p.stderr)
-        self.assertIn("horizon", p.stderr)
+        self.assertIn("EDGE must be one of horizon, open, nodata, got 'foo'", p.stderr)
         p = T.run(["gdalinfo", T.conn(self.flat, PRODUCT="farshadow", DATE="2026-06-21",
                                       TIMEZONE="Z", EDGE="nodata")], ok=False)
         self.assertIn("EDGE applies to", p.stderr)
