@@ -10,16 +10,10 @@
 #define DEG2RAD (M_PI / 180.0)
 #define RAD2DEG (180.0 / M_PI)
 
-double ts_edge_horizon(double height_m, double edge_m, const ts_horizon_opts *opts)
+/* The tangent of the elevation of the highest sea-level point over s in
+ * [s0, s1] seen from height h, for a drop c s^2 (c = 0: no curvature). */
+static inline double edge_tangent(double h, double s0, double s1, double c)
 {
-    double h = height_m, s0 = edge_m;
-    double s1 = opts->max_distance > 0 ? opts->max_distance : INFINITY;
-    if (isnan(h))
-        return NAN;
-    if (s0 > s1)
-        return -90.0; /* the ray ends on the grid */
-    /* drop of the sea level below the cell's tangent plane: c s^2 */
-    double c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
     /* f(s) = (-h - c s^2) / s has f' = (h - c s^2) / s^2: it rises up to
      * s* = sqrt(h / c) (for h > 0), falls after; for h <= 0 it only falls. */
     double s;
@@ -29,50 +23,97 @@ double ts_edge_horizon(double height_m, double edge_m, const ts_horizon_opts *op
         s = fmin(fmax(sqrt(h / c), s0), s1);
     else
         s = s1; /* flat: -h / s rises toward the horizontal */
-    if (isinf(s))
-        return 0.0; /* the limit, from below */
-    return atan((-h - c * s * s) / s) * RAD2DEG;
+    return isinf(s) ? 0.0 : (-h - c * s * s) / s; /* 0: the limit, from below */
 }
 
-double ts_edge_distance(const ts_grid *grid, int x, int y, double azimuth)
+double ts_edge_horizon(double height_m, double edge_m, const ts_horizon_opts *opts)
 {
-    /* the direction of ts_line_geom_init, in cells per metre */
+    double s1 = opts->max_distance > 0 ? opts->max_distance : INFINITY;
+    if (isnan(height_m))
+        return NAN;
+    if (edge_m > s1)
+        return -90.0; /* the ray ends on the grid */
+    double c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
+    return atan(edge_tangent(height_m, edge_m, s1, c)) * RAD2DEG;
+}
+
+/* The ray toward an azimuth in cells per metre (the direction of
+ * ts_line_geom_init: the central row's cell size), as the metres per cell
+ * it advances along x and y (infinite along an axis it does not cross). */
+typedef struct {
+    double mx, my; /* metres per cell along x, y; INFINITY = parallel */
+    int east, south; /* 1: toward +x, +y */
+} edge_ray;
+
+static edge_ray edge_ray_of(const ts_grid *grid, double azimuth)
+{
     double a = azimuth * DEG2RAD;
     double sa = sin(a), ca = cos(a);
     if (fabs(sa) < 1e-12) sa = 0;
     if (fabs(ca) < 1e-12) ca = 0;
     double gx = sa / ts_grid_cell_x(grid, grid->height / 2), gy = -ca / grid->cell_y;
-    double px = x + 0.5, py = y + 0.5; /* the cell's centre; the grid is [0, W] x [0, H] */
-    double sx = gx > 0 ? (grid->width - px) / gx : gx < 0 ? px / -gx : INFINITY;
-    double sy = gy > 0 ? (grid->height - py) / gy : gy < 0 ? py / -gy : INFINITY;
-    return fmin(sx, sy);
+    edge_ray r = {gx != 0 ? 1.0 / fabs(gx) : INFINITY, gy != 0 ? 1.0 / fabs(gy) : INFINITY,
+                  gx > 0, gy > 0};
+    return r;
+}
+
+/* Metres from the centre of cell (x, y) to the grid's outer boundary. */
+static inline double edge_ray_distance(const edge_ray *r, const ts_grid *grid, int x, int y)
+{
+    double px = x + 0.5, py = y + 0.5; /* the grid is [0, W] x [0, H] */
+    double sx = (r->east ? grid->width - px : px) * r->mx;
+    double sy = (r->south ? grid->height - py : py) * r->my;
+    return sx < sy ? sx : sy;
+}
+
+double ts_edge_distance(const ts_grid *grid, int x, int y, double azimuth)
+{
+    edge_ray r = edge_ray_of(grid, azimuth);
+    return edge_ray_distance(&r, grid, x, y);
 }
 
 typedef struct {
     const ts_grid *grid;
     const ts_horizon_opts *opts;
-    double azimuth;
+    edge_ray ray;
     float *plane;
 } edge_job;
+
+/* An upper bound of atan(t) in degrees, cheap: atan(t) <= t for t >= 0,
+ * atan(t) <= t / (1 + t^2) for t < 0; a horizon at or above it needs no
+ * atan. */
+static inline double atan_deg_above(double t)
+{
+    return (t >= 0 ? t : t / (1.0 + t * t)) * RAD2DEG;
+}
 
 static void edge_rows(void *ctx, int worker, long begin, long end)
 {
     (void)worker;
     const edge_job *j = ctx;
     const ts_grid *g = j->grid;
-    const double reach = j->opts->max_distance > 0 ? j->opts->max_distance : INFINITY;
+    const ts_horizon_opts *o = j->opts;
+    const double reach = o->max_distance > 0 ? o->max_distance : INFINITY;
+    const double c = o->curvature ? (1.0 - o->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
     for (long y = begin; y < end; y++) {
         float *row = j->plane + (size_t)y * g->width;
         for (int x = 0; x < g->width; x++) {
             if (isnan(row[x]))
                 continue; /* nodata stays nodata */
-            double s = ts_edge_distance(g, x, (int)y, j->azimuth);
-            if (j->opts->edge == TS_EDGE_NODATA) {
+            double s = edge_ray_distance(&j->ray, g, x, (int)y);
+            if (o->edge == TS_EDGE_NODATA) {
                 if (s <= reach)
                     row[x] = NAN;
                 continue;
             }
-            float e = (float)ts_edge_horizon(ts_grid_at(g, x, (int)y), s, j->opts);
+            if (s > reach)
+                continue;
+            /* ts_edge_horizon's tangent; its atan only where it may win
+             * (float rounding is monotonic: row >= bound >= atan keeps row) */
+            double t = edge_tangent(ts_grid_at(g, x, (int)y), s, reach, c);
+            if (row[x] >= atan_deg_above(t))
+                continue;
+            float e = (float)(atan(t) * RAD2DEG);
             if (e > row[x])
                 row[x] = e;
         }
@@ -101,7 +142,7 @@ ts_status ts_horizon_edge_apply(const ts_grid *grid, double azimuth,
                        azimuth);
     if (opts->edge == TS_EDGE_OPEN)
         return ts_ok(err);
-    edge_job j = {grid, opts, azimuth, plane};
+    edge_job j = {grid, opts, edge_ray_of(grid, azimuth), plane};
     return ts_parallel_for(ts_thread_count(opts->threads, grid->height), grid->height,
                            edge_rows, &j, err);
 }
