@@ -76,8 +76,21 @@ typedef struct {
     const ts_grid *grid;
     const ts_horizon_opts *opts;
     edge_ray ray;
-    float *plane;
+    double reach;         /* max_distance, or INFINITY */
+    double c;             /* drop per square metre: (1 - k) / 2R, or 0 */
+    float *plane;         /* the horizons, or the sun's visibility */
+    double sun_elevation; /* ts_horizon_edge_sun */
 } edge_job;
+
+static edge_job edge_job_of(const ts_grid *grid, double azimuth, const ts_horizon_opts *o,
+                            float *plane, double sun_elevation)
+{
+    edge_job j = {grid, o, edge_ray_of(grid, azimuth),
+                  o->max_distance > 0 ? o->max_distance : INFINITY,
+                  o->curvature ? (1.0 - o->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0, plane,
+                  sun_elevation};
+    return j;
+}
 
 /* An upper bound of atan(t) in degrees, cheap: atan(t) <= t for t >= 0,
  * atan(t) <= t / (1 + t^2) for t < 0; a horizon at or above it needs no
@@ -87,35 +100,55 @@ static inline double atan_deg_above(double t)
     return (t >= 0 ? t : t / (1.0 + t * t)) * RAD2DEG;
 }
 
+/* Horizon v of valid cell (x, y) with the world beyond the edge. */
+static inline float edge_raise(const edge_job *j, int x, int y, float v)
+{
+    double s = edge_ray_distance(&j->ray, j->grid, x, y);
+    if (j->opts->edge == TS_EDGE_NODATA)
+        return s <= j->reach ? NAN : v;
+    if (s > j->reach)
+        return v;
+    /* ts_edge_horizon's tangent; its atan only where it may win (float
+     * rounding is monotonic: v >= bound >= atan keeps v) */
+    double t = edge_tangent(ts_grid_at(j->grid, x, y), s, j->reach, j->c);
+    if (v >= atan_deg_above(t))
+        return v;
+    float e = (float)(atan(t) * RAD2DEG);
+    return e > v ? e : v;
+}
+
 static void edge_rows(void *ctx, int worker, long begin, long end)
 {
     (void)worker;
     const edge_job *j = ctx;
-    const ts_grid *g = j->grid;
-    const ts_horizon_opts *o = j->opts;
-    const double reach = o->max_distance > 0 ? o->max_distance : INFINITY;
-    const double c = o->curvature ? (1.0 - o->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
     for (long y = begin; y < end; y++) {
-        float *row = j->plane + (size_t)y * g->width;
-        for (int x = 0; x < g->width; x++) {
-            if (isnan(row[x]))
-                continue; /* nodata stays nodata */
-            double s = edge_ray_distance(&j->ray, g, x, (int)y);
-            if (o->edge == TS_EDGE_NODATA) {
-                if (s <= reach)
-                    row[x] = NAN;
+        float *row = j->plane + (size_t)y * j->grid->width;
+        for (int x = 0; x < j->grid->width; x++)
+            if (!isnan(row[x])) /* nodata stays nodata */
+                row[x] = edge_raise(j, x, (int)y, row[x]);
+    }
+}
+
+/* The Earth's horizon as a floor of horizon v at height h (TS_EDGE_HORIZON). */
+static inline float earth_floor(const ts_horizon_opts *o, float h, float v)
+{
+    float f = (float)ts_earth_horizon(h, o);
+    return f > v ? f : v; /* NaN stays NaN */
+}
+
+static void sun_rows(void *ctx, int worker, long begin, long end)
+{
+    (void)worker;
+    const edge_job *j = ctx;
+    for (long y = begin; y < end; y++) {
+        float *vis = j->plane + (size_t)y * j->grid->width;
+        for (int x = 0; x < j->grid->width; x++) {
+            if (isnan(vis[x]))
                 continue;
-            }
-            if (s > reach)
-                continue;
-            /* ts_edge_horizon's tangent; its atan only where it may win
-             * (float rounding is monotonic: row >= bound >= atan keeps row) */
-            double t = edge_tangent(ts_grid_at(g, x, (int)y), s, reach, c);
-            if (row[x] >= atan_deg_above(t))
-                continue;
-            float e = (float)(atan(t) * RAD2DEG);
-            if (e > row[x])
-                row[x] = e;
+            float h = edge_raise(j, x, (int)y, -90.0f);
+            if (j->opts->edge == TS_EDGE_HORIZON)
+                h = earth_floor(j->opts, ts_grid_at(j->grid, x, (int)y), h);
+            vis[x] = isnan(h) ? NAN : vis[x] * (float)ts_sun_disk_fraction(j->sun_elevation, h);
         }
     }
 }
@@ -142,9 +175,25 @@ ts_status ts_horizon_edge_apply(const ts_grid *grid, double azimuth,
                        azimuth);
     if (opts->edge == TS_EDGE_OPEN)
         return ts_ok(err);
-    edge_job j = {grid, opts, edge_ray_of(grid, azimuth), plane};
+    edge_job j = edge_job_of(grid, azimuth, opts, plane, 0.0);
     return ts_parallel_for(ts_thread_count(opts->threads, grid->height), grid->height,
                            edge_rows, &j, err);
+}
+
+ts_status ts_horizon_edge_sun(const ts_grid *grid, double azimuth, double elevation,
+                              const ts_horizon_opts *opts, float *vis, ts_error *err)
+{
+    ts_status st = check_plane_args(grid, opts, vis, err);
+    if (st != TS_OK)
+        return st;
+    if (!isfinite(azimuth) || !(elevation >= -90.0 && elevation <= 90.0))
+        return ts_fail(err, TS_ERR_ARG, "the sun must be at a finite azimuth and an elevation "
+                       "within -90..90 degrees, got %g and %g", azimuth, elevation);
+    if (opts->edge == TS_EDGE_OPEN)
+        return ts_ok(err);
+    edge_job j = edge_job_of(grid, azimuth, opts, vis, elevation);
+    return ts_parallel_for(ts_thread_count(opts->threads, grid->height), grid->height,
+                           sun_rows, &j, err);
 }
 
 ts_status ts_horizon_earth_floor(const ts_grid *grid, const ts_horizon_opts *opts,
@@ -156,9 +205,7 @@ ts_status ts_horizon_earth_floor(const ts_grid *grid, const ts_horizon_opts *opt
     for (int y = 0; y < grid->height; y++)
         for (int x = 0; x < grid->width; x++) {
             float *v = plane + (size_t)y * grid->width + x;
-            float f = (float)ts_earth_horizon(ts_grid_at(grid, x, y), opts);
-            if (f > *v) /* NaN (nodata) stays NaN */
-                *v = f;
+            *v = earth_floor(opts, ts_grid_at(grid, x, y), *v);
         }
     return ts_ok(err);
 }

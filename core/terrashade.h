@@ -202,6 +202,17 @@ ts_status ts_horizon_earth_floor(const ts_grid *grid, const ts_horizon_opts *opt
                                  float *plane, ts_error *err);
 
 /**
+ * The direct sun of a method that sees no edge (the shadow height map):
+ * multiply each visibility in `vis` (width*height; NaN stays NaN) by the
+ * fraction of the sun's disk at (azimuth, elevation) above the horizon that
+ * the world beyond the edge (opts->edge) and, with TS_EDGE_HORIZON, the
+ * Earth (as ts_horizon_earth_floor) put before the cell alone; NaN where
+ * TS_EDGE_NODATA blanks the cell. TS_EDGE_OPEN changes nothing.
+ */
+ts_status ts_horizon_edge_sun(const ts_grid *grid, double azimuth, double elevation,
+                              const ts_horizon_opts *opts, float *vis, ts_error *err);
+
+/**
  * Horizons for opts->directions azimuths (ts_horizon_azimuth): `out` holds
  * directions planes of width*height floats, plane k for azimuth k.
  */

@@ -177,21 +177,6 @@ static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const ts
     return TS_OK;
 }
 
-/* The horizon that the world beyond the edge (EDGE) and the Earth put
- * before the sun, on its own: -90 raised by both (or NaN), into plane. */
-static ts_status sun_edge_plane(const tsd_compute_ctx *c, const ts_grid *g, float *plane)
-{
-    ts_horizon_opts h;
-    ts_error err;
-    tsd_compute_horizon_opts(c, &h);
-    for (size_t i = 0, n = (size_t)g->width * g->height; i < n; i++)
-        plane[i] = -90.0f;
-    if (ts_horizon_edge_apply(g, c->run->sun_azimuth, &h, plane, &err) != TS_OK ||
-        ts_horizon_earth_floor(g, &h, plane, &err) != TS_OK)
-        return core_fail(c, &err);
-    return TS_OK;
-}
-
 /* Shadow height map visibility of the sun into vis, times the fraction of
  * the sun's disk above the edge's horizon (EDGE=horizon or nodata: the
  * shadow height map sees nothing beyond the grid). */
@@ -204,16 +189,12 @@ static ts_status shm_visibility(const tsd_compute_ctx *c, const ts_grid *g, floa
                                        &rep, &err),
              rep) != TS_OK)
         return core_fail(c, &err);
-    if (tsd_options_edge(c->opts) == TS_EDGE_OPEN)
-        return TS_OK;
-    size_t cells = (size_t)g->width * g->height;
-    float *edge = malloc(cells * sizeof(float));
-    ts_status st = edge ? sun_edge_plane(c, g, edge) : oom(c, "the horizon of the DEM's edge");
-    for (size_t i = 0; st == TS_OK && i < cells; i++)
-        vis[i] *= isnan(edge[i]) ? NAN
-                                 : (float)ts_sun_disk_fraction(c->run->sun_elevation, edge[i]);
-    free(edge);
-    return st;
+    ts_horizon_opts h;
+    tsd_compute_horizon_opts(c, &h);
+    if (ts_horizon_edge_sun(g, c->run->sun_azimuth, c->run->sun_elevation, &h, vis, &err) !=
+        TS_OK)
+        return core_fail(c, &err);
+    return TS_OK;
 }
 
 /* Exact horizon at the sun's azimuth into plane; *h describes it. */

@@ -191,6 +191,50 @@ START_TEST(test_earth_floor)
 }
 END_TEST
 
+/* The sun of the shadow height map: its visibility times the disk above
+ * the edge's and the Earth's horizon, as a plane of -90 raised by both. */
+START_TEST(test_edge_sun)
+{
+    ts_grid g;
+    ts_error e;
+    tdem_create(&g, 30, 20, 30.0, 30.0);
+    tdem_fractal(&g, 9, 300.0);
+    g.z[45] = NAN;
+    const size_t n = 30 * 20;
+    float *vis = tdem_floats(n), *plane = tdem_floats(n);
+    const ts_edge_mode modes[] = {TS_EDGE_OPEN, TS_EDGE_HORIZON, TS_EDGE_NODATA};
+    for (int m = 0; m < 3; m++) {
+        ts_horizon_opts o = opts_edge(modes[m], 1, m == 2 ? 100.0 : 0.0);
+        for (size_t i = 0; i < n; i++) {
+            vis[i] = isnan(g.z[i]) ? NAN : 0.75f;
+            plane[i] = isnan(g.z[i]) ? NAN : -90.0f;
+        }
+        ck_assert_int_eq(ts_horizon_edge_sun(&g, 250.0, -0.2, &o, vis, &e), TS_OK);
+        ck_assert_int_eq(ts_horizon_edge_apply(&g, 250.0, &o, plane, &e), TS_OK);
+        ck_assert_int_eq(ts_horizon_earth_floor(&g, &o, plane, &e), TS_OK);
+        int lit = 0;
+        for (size_t i = 0; i < n; i++) {
+            if (isnan(plane[i])) {
+                ck_assert(isnan(vis[i]));
+                continue;
+            }
+            float want = modes[m] == TS_EDGE_OPEN
+                             ? 0.75f
+                             : 0.75f * (float)ts_sun_disk_fraction(-0.2, plane[i]);
+            ck_assert_float_eq(vis[i], want);
+            lit += vis[i] > 0;
+        }
+        /* a sun at -0.2 deg: above the dip of cells 100..400 m high */
+        ck_assert_int_gt(lit, 0);
+    }
+    ts_horizon_opts o = opts_edge(TS_EDGE_HORIZON, 1, 0);
+    ck_assert_int_eq(ts_horizon_edge_sun(&g, 250.0, 91.0, &o, vis, &e), TS_ERR_ARG);
+    free(vis);
+    free(plane);
+    ts_grid_free(&g);
+}
+END_TEST
+
 START_TEST(test_bad_mode)
 {
     ts_grid g;
@@ -217,6 +261,7 @@ int main(void)
     tcase_add_test(t, test_edge_distance);
     tcase_add_test(t, test_sweep_modes);
     tcase_add_test(t, test_earth_floor);
+    tcase_add_test(t, test_edge_sun);
     tcase_add_test(t, test_bad_mode);
     suite_add_tcase(s, t);
     return test_run_suite_mode(s, CK_VERBOSE);
