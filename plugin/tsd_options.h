@@ -92,7 +92,7 @@ typedef struct {
 
     int svf_model;           /* SVF_MODEL: a ts_svf_model (0 radiative, 1 solid_angle) */
     int openness_negative;   /* OPENNESS: 0 = positive, 1 = negative */
-    int edge;                /* EDGE: 0 = horizon, 1 = open, 2 = nodata (tsd_edge_to_ts) */
+    int edge;                /* EDGE: 0 = horizon, 1 = open, 2 = nodata (tsd_options_edge) */
     /* options of far-shadow atlas files (*.tsa) */
     int shadows_all;         /* SHADOWS: 0 = far, 1 = all */
     char dem[TSD_PATH_MAX];  /* DEM: "" = the atlas's SOURCE_DEM */
