@@ -337,6 +337,18 @@ static ts_status uncapped_opts(const ts_grid *grid, const ts_horizon_opts *opts,
     return TS_OK;
 }
 
+/* The world beyond the edge (opts->edge) on the n planes read back, by the
+ * core's own function: both backends clamp alike before any sum or test. */
+static ts_status edge_apply(const ts_grid *grid, const ts_horizon_opts *opts, const double *az,
+                            int n, float *out, ts_error *err)
+{
+    size_t cells = (size_t)grid->width * grid->height;
+    ts_status st = TS_OK;
+    for (int a = 0; st == TS_OK && a < n; a++)
+        st = ts_horizon_edge_apply(grid, az[a], opts, out + (size_t)a * cells, err);
+    return st;
+}
+
 ts_status ts_cl_horizon_sweep(const ts_grid *grid, double azimuth, const ts_horizon_opts *opts,
                               float *out, ts_error *err)
 {
@@ -346,9 +358,9 @@ ts_status ts_cl_horizon_sweep(const ts_grid *grid, double azimuth, const ts_hori
     ts_horizon_opts run;
     if (st == TS_OK)
         st = uncapped_opts(grid, opts, &azimuth, 1, &run, err);
-    if (st != TS_OK)
-        return st;
-    return horizon_run(grid, &run, &azimuth, 1, out, err);
+    if (st == TS_OK)
+        st = horizon_run(grid, &run, &azimuth, 1, out, err);
+    return st == TS_OK ? edge_apply(grid, opts, &azimuth, 1, out, err) : st;
 }
 
 ts_status ts_cl_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts, float *out,
@@ -366,6 +378,8 @@ ts_status ts_cl_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts
     st = uncapped_opts(grid, opts, az, opts->directions, &run, err);
     if (st == TS_OK)
         st = horizon_run(grid, &run, az, opts->directions, out, err);
+    if (st == TS_OK)
+        st = edge_apply(grid, opts, az, opts->directions, out, err);
     free(az);
     return st;
 }

@@ -321,7 +321,7 @@ ts_status ts_sun_hours(const ts_grid *grid, const ts_sun_sites *sites,
                 acc[i] += vis[i] * hrs;
         else
             for (size_t i = 0; i < c.cells; i++)
-                acc[i] += vis[i] > 0.0f ? hrs : 0.0;
+                acc[i] += vis[i] > 0.0f ? hrs : vis[i] == vis[i] ? 0.0 : NAN;
     }
     if ((st = ts_progress(&o->horizon, 1.0, err)) != TS_OK)
         goto done;
@@ -415,6 +415,8 @@ ts_status ts_insolation(const ts_grid *grid, const ts_sun_sites *sites,
                 if (isnan(pc[i]))
                     continue;
                 accd[i] += dh * sky[i];
+                if (!dark && isnan(vis[i])) /* EDGE=nodata */
+                    accb[i] = NAN;
                 if (dark || !(vis[i] > 0))
                     continue;
                 double cosi = nx[i] * lx + ny[i] * ly + nz[i] * lz;
@@ -430,6 +432,8 @@ ts_status ts_insolation(const ts_grid *grid, const ts_sun_sites *sites,
                     continue;
                 double sh = sin(e * DEG2RAD);
                 accd[i] += g0 * ts_esra_diffuse_factor(tl, sh) * hrs * sky[i];
+                if (!dark && isnan(vis[i])) /* EDGE=nodata */
+                    accb[i] = NAN;
                 if (dark || !(vis[i] > 0))
                     continue;
                 double a = caz[i] * DEG2RAD, ce = cos(e * DEG2RAD);
@@ -444,7 +448,7 @@ ts_status ts_insolation(const ts_grid *grid, const ts_sun_sites *sites,
     if ((st = ts_progress(&o->horizon, 1.0, err)) != TS_OK)
         goto done;
     for (size_t i = 0; i < cells; i++) {
-        int nd = isnan(pc[i]);
+        int nd = isnan(pc[i]) || isnan(accb[i] + accd[i]); /* EDGE=nodata: all bands */
         total[i] = nd ? NAN : (float)(accb[i] + accd[i]);
         if (beam)
             beam[i] = nd ? NAN : (float)accb[i];

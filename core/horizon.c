@@ -17,6 +17,7 @@ void ts_horizon_opts_default(ts_horizon_opts *opts)
     opts->threads = 0;
     opts->progress = NULL;
     opts->progress_user = NULL;
+    opts->edge = TS_EDGE_OPEN;
 }
 
 ts_status ts_horizon_opts_validate(const ts_horizon_opts *opts, ts_error *err)
@@ -36,6 +37,10 @@ ts_status ts_horizon_opts_validate(const ts_horizon_opts *opts, ts_error *err)
     if (!(opts->refraction >= 0 && opts->refraction <= 1))
         return ts_fail(err, TS_ERR_ARG, "refraction coefficient must be between 0 and 1, got %g",
                        opts->refraction);
+    if (opts->edge != TS_EDGE_OPEN && opts->edge != TS_EDGE_HORIZON &&
+        opts->edge != TS_EDGE_NODATA)
+        return ts_fail(err, TS_ERR_ARG, "the edge mode must be open, horizon or nodata, got %d",
+                       (int)opts->edge);
     if (opts->threads < 0)
         return ts_fail(err, TS_ERR_ARG, "threads must be 0 (all cores) or more, got %d",
                        opts->threads);

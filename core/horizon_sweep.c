@@ -462,7 +462,8 @@ ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
         return st;
     if (failed)
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate sweep workspace");
-    return ts_ok(err);
+    /* the world beyond the edge, before anyone reads the horizons */
+    return ts_horizon_edge_apply(grid, azimuth, opts, out, err);
 }
 
 ts_status ts_horizon_sweep_lines(const ts_grid *grid, double azimuth,

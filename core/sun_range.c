@@ -90,6 +90,7 @@ typedef struct {
     float *floor;        /* Earth horizon per cell, or NULL */
     double floor_min;
     float *tables;       /* beam transmittances, TS_RANGE_TABLE per position */
+    unsigned char *blank; /* TS_EDGE_NODATA: 1 where a swept plane was nodata */
 } range_ctx;
 
 static void range_free(range_ctx *c)
@@ -98,6 +99,7 @@ static void range_free(range_ctx *c)
     free(c->first);
     free(c->floor);
     free(c->tables);
+    free(c->blank);
 }
 
 static ts_status range_init(range_ctx *c, const ts_grid *g, const ts_sun_sites *sites,
@@ -127,6 +129,8 @@ static ts_status range_init(range_ctx *c, const ts_grid *g, const ts_sun_sites *
             return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the Earth-horizon plane");
         c->floor_min = ts_day_earth_floor(g, &o->horizon, c->floor);
     }
+    if (o->horizon.edge == TS_EDGE_NODATA && !(c->blank = calloc(c->cells, 1)))
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the nodata mask of the edge");
     return TS_OK;
 }
 
@@ -247,6 +251,8 @@ static ts_status sweep_plane(const range_ctx *c, const ts_horizon_opts *h, int k
     ts_status st = ts_progress(&c->o->horizon, done, err);
     if (st == TS_OK)
         st = ts_horizon_sweep(c->g, a, h, out, err);
+    for (size_t i = 0; st == TS_OK && c->blank && i < c->cells; i++)
+        c->blank[i] |= isnan(out[i]); /* EDGE=nodata: the ray leaves the grid */
     if (st == TS_OK && on_plane)
         st = on_plane(user, k, a, out, err);
     return st;
@@ -350,7 +356,8 @@ ts_status ts_sun_hours_range(const ts_grid *grid, const ts_sun_sites *sites,
     for (int y = 0; y < grid->height; y++)
         for (int x = 0; x < grid->width; x++) {
             size_t i = (size_t)y * grid->width + x;
-            hours[i] = isnan(ts_grid_at(grid, x, y)) ? NAN : (float)acc[i];
+            int nd = isnan(ts_grid_at(grid, x, y)) || (c.blank && c.blank[i]);
+            hours[i] = nd ? NAN : (float)acc[i];
         }
     st = ts_ok(err);
 done:
@@ -469,7 +476,7 @@ ts_status ts_insolation_range(const ts_grid *grid, const ts_sun_sites *sites,
         dsum += c.sun[i].g0_hours *
                 ts_esra_diffuse_factor(o->linke_turbidity, sin(c.sun[i].el * DEG2RAD));
     for (size_t i = 0; i < cells; i++) {
-        int nd = isnan(pc[i]);
+        int nd = isnan(pc[i]) || (c.blank && c.blank[i]);
         double d = dsum * sky[i];
         total[i] = nd ? NAN : (float)(acc[i] + d);
         if (beam)

@@ -113,6 +113,22 @@ static inline double ts_grid_cell_x(const ts_grid *g, int y)
  */
 typedef int (*ts_progress_fn)(double done, void *user);
 
+/**
+ * What lies beyond the DEM's edge (docs/algorithms.md, "The world beyond the
+ * DEM edge"), for a ray from a cell that leaves the grid:
+ */
+typedef enum {
+    /** nothing: an open sky down to -90 deg (the raw sweep) */
+    TS_EDGE_OPEN = 0,
+    /** the sea-level surface of the Earth, with curvature and refraction
+     * as `curvature` and `refraction` say: the horizon is at least the
+     * highest sea-level point beyond the edge (within max_distance) */
+    TS_EDGE_HORIZON = 1,
+    /** unknown: the cell is nodata (NaN) when its ray leaves the grid
+     * within max_distance (at all, when max_distance is 0) */
+    TS_EDGE_NODATA = 2
+} ts_edge_mode;
+
 /** Options of the horizon sweep. Fill with ts_horizon_opts_default. */
 typedef struct {
     int directions;       /**< number of azimuths, >= 1 */
@@ -123,9 +139,11 @@ typedef struct {
     int threads;          /**< worker threads; 0 = number of cores */
     ts_progress_fn progress; /**< NULL = no progress reports */
     void *progress_user;  /**< passed to progress */
+    ts_edge_mode edge;    /**< the world beyond the grid's edge */
 } ts_horizon_opts;
 
-/** Defaults: 16 directions from 0 deg, unbounded, curvature on, k = 0.13. */
+/** Defaults: 16 directions from 0 deg, unbounded, curvature on, k = 0.13,
+ * TS_EDGE_OPEN (the raw sweep; the driver's default is TS_EDGE_HORIZON). */
 void ts_horizon_opts_default(ts_horizon_opts *opts);
 
 /** Check horizon options; the message names the offending field. */
@@ -146,6 +164,55 @@ typedef ts_status ts_horizon_sweep_fn(const ts_grid *grid, double azimuth,
 
 /** The horizon sweep on the C backend. */
 ts_horizon_sweep_fn ts_horizon_sweep;
+
+/**
+ * The world beyond the edge (opts->edge) applied to a horizon plane of the
+ * sweep toward `azimuth`, in place: TS_EDGE_HORIZON raises each cell's angle
+ * to ts_edge_horizon of its height and distance to the edge along the
+ * azimuth, TS_EDGE_NODATA sets NaN where that distance is within
+ * max_distance (every cell when it is 0), TS_EDGE_OPEN changes nothing.
+ * ts_horizon_sweep ends with it; a backend that sweeps otherwise calls it.
+ */
+ts_status ts_horizon_edge_apply(const ts_grid *grid, double azimuth,
+                                const ts_horizon_opts *opts, float *plane,
+                                ts_error *err);
+
+/**
+ * Elevation angle (degrees) of the highest point of the sea-level surface
+ * beyond the edge seen from `height_m` metres, `edge_m` metres from the edge
+ * along the ray: the maximum over s in [edge_m, max_distance] (no upper
+ * bound when max_distance is 0) of atan((-h - c s^2) / s), c = (1 - k) / 2R
+ * with curvature, 0 without. -90 when edge_m > max_distance > 0 (the ray
+ * stays on the grid), NaN for a NaN height.
+ */
+double ts_edge_horizon(double height_m, double edge_m, const ts_horizon_opts *opts);
+
+/**
+ * Distance in metres from the centre of cell (x, y) to the grid's outer edge
+ * along `azimuth` (the sweep lines' direction: cells of the central row's
+ * size).
+ */
+double ts_edge_distance(const ts_grid *grid, int x, int y, double azimuth);
+
+/**
+ * The Earth's horizon as a floor of the direct sun: raise each cell of a
+ * horizon plane to the dip of the sea-level horizon seen from its height
+ * (ts_earth_horizon), when opts->edge is TS_EDGE_HORIZON; otherwise nothing.
+ * So a sun below the Earth's horizon lights no cell, whatever max_distance.
+ */
+ts_status ts_horizon_earth_floor(const ts_grid *grid, const ts_horizon_opts *opts,
+                                 float *plane, ts_error *err);
+
+/**
+ * The direct sun of a method that sees no edge (the shadow height map):
+ * multiply each visibility in `vis` (width*height; NaN stays NaN) by the
+ * fraction of the sun's disk at (azimuth, elevation) above the horizon that
+ * the world beyond the edge (opts->edge) and, with TS_EDGE_HORIZON, the
+ * Earth (as ts_horizon_earth_floor) put before the cell alone; NaN where
+ * TS_EDGE_NODATA blanks the cell. TS_EDGE_OPEN changes nothing.
+ */
+ts_status ts_horizon_edge_sun(const ts_grid *grid, double azimuth, double elevation,
+                              const ts_horizon_opts *opts, float *vis, ts_error *err);
 
 /**
  * Horizons for opts->directions azimuths (ts_horizon_azimuth): `out` holds

@@ -52,6 +52,7 @@ void tsd_compute_horizon_opts(const tsd_compute_ctx *c, ts_horizon_opts *h)
     h->max_distance = o->max_distance;
     h->curvature = o->curvature;
     h->refraction = o->refraction;
+    h->edge = tsd_options_edge(o);
     h->threads = o->threads;
     h->progress = c->run->progress;
     h->progress_user = c->run->progress_user;
@@ -176,7 +177,9 @@ static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const ts
     return TS_OK;
 }
 
-/* Shadow height map visibility of the sun into vis. */
+/* Shadow height map visibility of the sun into vis, times the fraction of
+ * the sun's disk above the edge's horizon (EDGE=horizon or nodata: the
+ * shadow height map sees nothing beyond the grid). */
 static ts_status shm_visibility(const tsd_compute_ctx *c, const ts_grid *g, float *vis)
 {
     ts_error err;
@@ -185,6 +188,11 @@ static ts_status shm_visibility(const tsd_compute_ctx *c, const ts_grid *g, floa
                                        c->opts->penumbra_depth, c->opts->threads, vis, NULL,
                                        &rep, &err),
              rep) != TS_OK)
+        return core_fail(c, &err);
+    ts_horizon_opts h;
+    tsd_compute_horizon_opts(c, &h);
+    if (ts_horizon_edge_sun(g, c->run->sun_azimuth, c->run->sun_elevation, &h, vis, &err) !=
+        TS_OK)
         return core_fail(c, &err);
     return TS_OK;
 }
@@ -200,7 +208,8 @@ static ts_status sun_horizon(const tsd_compute_ctx *c, const ts_grid *g, ts_hori
     h->start_azimuth = c->run->sun_azimuth;
     h->progress = NULL; /* one sweep */
     if (NOTE(c, ts_backend_horizon_sweep(BK(c), g, c->run->sun_azimuth, h, plane, &rep, &err),
-             rep) != TS_OK)
+             rep) != TS_OK ||
+        ts_horizon_earth_floor(g, h, plane, &err) != TS_OK) /* EDGE=horizon */
         return core_fail(c, &err);
     return TS_OK;
 }
@@ -213,15 +222,15 @@ static int sun_lattice(const tsd_compute_ctx *c)
 }
 
 /* Per-cell sun (SUN_POSITION=per_cell): visibility of the disk, and the
- * sun's grid azimuth and elevation per cell; terrain only, as the
- * classic shade and shadow. */
+ * sun's grid azimuth and elevation per cell; the Earth's horizon only with
+ * EDGE=horizon, as the exact method's sun_horizon. */
 static ts_status sun_per_cell(const tsd_compute_ctx *c, const ts_grid *g, float *vis,
                               float *az, float *el)
 {
     ts_error err;
     const tsd_sun *sun = c->run->sun;
     ts_day_opts d = sun->day;
-    d.earth_horizon = 0;
+    d.earth_horizon = tsd_options_edge(c->opts) == TS_EDGE_HORIZON;
     if (ts_sun_visibility(g, &sun->sites, &d, sun->instant, vis, az, el, NULL, &err) !=
         TS_OK)
         return core_fail(c, &err);

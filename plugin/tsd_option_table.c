@@ -205,6 +205,13 @@ const opt_def TSD_OPTION_ROWS[] = {
      "openness: positive (Yokoyama et al. 2002: mean over directions of 90 - "
      "the horizon elevation angle) or negative (the same on the negated DEM, "
      "as RVT_py: high in valleys and pits)"},
+    {"EDGE", K_SELECT, FIELD(edge), "horizon", 0, 0, 0, 0, "horizon|open|nodata", 1, P,
+     LISTED, NULL,
+     "What lies beyond the DEM's edge for a ray that leaves it (within "
+     "MAX_DISTANCE): horizon (the sea-level surface of the Earth, with "
+     "CURVATURE and REFRACTION: nothing below the Earth's horizon lights a "
+     "cell), open (an open sky down to -90 degrees) or nodata (such cells are "
+     "nodata)"},
     /* options of atlas files (*.tsa) only */
     {"SHADOWS", K_SELECT, FIELD(shadows_all), "far", 0, 0, 0, 0, "far|all", 0, A, LISTED,
      NULL,

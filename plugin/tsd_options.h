@@ -92,6 +92,7 @@ typedef struct {
 
     int svf_model;           /* SVF_MODEL: a ts_svf_model (0 radiative, 1 solid_angle) */
     int openness_negative;   /* OPENNESS: 0 = positive, 1 = negative */
+    int edge;                /* EDGE: 0 = horizon, 1 = open, 2 = nodata (tsd_options_edge) */
     /* options of far-shadow atlas files (*.tsa) */
     int shadows_all;         /* SHADOWS: 0 = far, 1 = all */
     char dem[TSD_PATH_MAX];  /* DEM: "" = the atlas's SOURCE_DEM */
@@ -150,6 +151,9 @@ int tsd_options_given(const tsd_options *o, const char *name);
 
 /** 1 if the product is written as Byte. */
 int tsd_options_output_byte(const tsd_options *o);
+
+/** The core's edge mode of EDGE; TS_EDGE_OPEN for a product without EDGE. */
+ts_edge_mode tsd_options_edge(const tsd_options *o);
 
 /** Number of output bands. */
 int tsd_options_band_count(const tsd_options *o);

@@ -27,6 +27,15 @@ int tsd_options_output_byte(const tsd_options *o)
     }
 }
 
+ts_edge_mode tsd_options_edge(const tsd_options *o)
+{
+    static const ts_edge_mode modes[] = {TS_EDGE_HORIZON, TS_EDGE_OPEN, TS_EDGE_NODATA};
+    if (!tsd_product_takes(tsd_product_of(o), tsd_option_find("EDGE")) || o->edge < 0 ||
+        o->edge > 2)
+        return TS_EDGE_OPEN;
+    return modes[o->edge];
+}
+
 int tsd_options_sun_from_time(const tsd_options *o)
 {
     const tsd_product_def *p = tsd_product_of(o);
@@ -159,6 +168,11 @@ int tsd_options_check(const tsd_options *o, char *msg, size_t n)
     /* a model chosen for another product is a mistake, not a no-op */
     if (o->svf_model != 0 && !tsd_product_takes(p, tsd_option_find("SVF_MODEL")))
         REFUSE("SVF_MODEL=solid_angle applies to PRODUCT=svf only, not to PRODUCT=%s", pn);
+    if (o->edge != 0 && !tsd_product_takes(p, tsd_option_find("EDGE"))) {
+        tsd_products_taking(tsd_option_find("EDGE"), "", ", ", list, sizeof list);
+        REFUSE("EDGE applies to the products that see past the DEM's edge (%s), not to "
+               "PRODUCT=%s", list, pn);
+    }
     if (o->openness_negative && !tsd_product_takes(p, tsd_option_find("OPENNESS")))
         REFUSE("OPENNESS=negative applies to PRODUCT=openness only, not to PRODUCT=%s", pn);
     if (o->datetime[0] && !tsd_product_takes(p, o_datetime)) {

@@ -104,7 +104,7 @@ static int shadow_uses_backend(const tsd_options *o, const tsd_sun *sun)
 /* Option groups of the rows below. */
 #define SUN_TIME "DATETIME PRESSURE TEMPERATURE DELTA_T "
 #define SUN_OPTS "SUN_AZIMUTH SUN_ELEVATION METHOD PENUMBRA_DEPTH " SUN_TIME "SUN_POSITION "
-#define SWEEP "DIRECTIONS START_AZIMUTH MAX_DISTANCE "
+#define SWEEP "DIRECTIONS START_AZIMUTH MAX_DISTANCE EDGE "
 #define DAY "DATE TIMEZONE " SUN_TIME
 #define RANGE "START_DATE END_DATE DAY_INTERVAL HORIZON_DIRECTIONS"
 #define ENV "ENV_MAP ENV_ROTATION SKY ENV_HORIZON_STEPS ENV_NORMAL_STEPS "
@@ -118,7 +118,7 @@ static const tsd_product_def PRODUCTS[] = {
      tsd_compute_shade},
     {"shadow", "visible fraction of the sun's disk, 0..1", "", "0..1", one_band, NULL,
      band_named, TSD_BYTE_ALLOWED, 0, 0, TSD_STEPS_NONE, 0, 0, 7, shadow_uses_backend,
-     SUN_OPTS "MAX_DISTANCE OUTPUT_TYPE BACKEND", NULL, NULL, tsd_compute_shadow},
+     SUN_OPTS "MAX_DISTANCE EDGE OUTPUT_TYPE BACKEND", NULL, NULL, tsd_compute_shadow},
     {"horizon", "one band per azimuth, horizon elevation angle in degrees", "degree",
      "degrees", per_direction, "DIRECTIONS", band_azimuth, TSD_BYTE_NEVER, 0, 0,
      TSD_STEPS_NONE, 0, 0, 0, backend_always, SWEEP "BACKEND", NULL, NULL,
@@ -138,7 +138,7 @@ static const tsd_product_def PRODUCTS[] = {
      * date range Earth horizon, three horizon planes, double accumulator */
     {"sunhours", "hours of direct sun on DATE, or in total from START_DATE to END_DATE",
      "hour", "hours", one_band, NULL, band_named, TSD_BYTE_NEVER, 0, 1, TSD_STEPS_NONE, 6, 0,
-     3, NULL, "MAX_DISTANCE " DAY "STEP_MINUTES SUN_POSITION SUNHOURS_RULE " RANGE, NULL,
+     3, NULL, "MAX_DISTANCE EDGE " DAY "STEP_MINUTES SUN_POSITION SUNHOURS_RULE " RANGE, NULL,
      NULL, tsd_compute_sunhours},
     /* normals, sky, visibility, pressure factor, two double accumulators,
      * Earth horizon, horizon plane (a date range: three horizon planes,
@@ -153,7 +153,7 @@ static const tsd_product_def PRODUCTS[] = {
      tsd_compute_insolation},
     {"daycycle", "visible fraction of the sun, one band per STEP_MINUTES", "", "0..1",
      per_step, "STEP_MINUTES", NULL, TSD_BYTE_ALLOWED, 0, 1, TSD_STEPS_UNIFORM, 2, 0, 3,
-     NULL, "MAX_DISTANCE OUTPUT_TYPE " DAY "STEP_MINUTES SUN_POSITION", NULL, NULL,
+     NULL, "MAX_DISTANCE EDGE OUTPUT_TYPE " DAY "STEP_MINUTES SUN_POSITION", NULL, NULL,
      tsd_compute_daycycle},
     /* the far-field slopes */
     {"farshadow", "binary far-shadow maps of ATLAS_STEPS sun positions", "", "0, 1",

@@ -103,6 +103,7 @@ ts_status tsd_sun_setup(const tsd_options *o, tsd_sites *sites, double min_cell_
     s->day.horizon.max_distance = o->max_distance;
     s->day.horizon.curvature = o->curvature;
     s->day.horizon.refraction = o->refraction;
+    s->day.horizon.edge = tsd_options_edge(o);
     s->day.horizon.threads = o->threads;
     s->day.sun.pressure = o->pressure;
     s->day.sun.temperature = o->temperature;

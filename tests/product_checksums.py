@@ -59,6 +59,35 @@ VARIANTS = {
     "openness_negative": {"DIRECTIONS": "16", "OPENNESS": "negative"},
 }
 
+# The world beyond the DEM edge (EDGE, docs/algorithms.md): the default,
+# EDGE=horizon, since it became the default; the variants above run with
+# EDGE=open (the behaviour before EDGE) wherever the product takes EDGE, so
+# that their lines stay as they were. Printed last.
+EDGE_VARIANTS = {
+    "shade_edge": {"SUN_AZIMUTH": "135", "SUN_ELEVATION": "2", "OUTPUT_TYPE": "Float32"},
+    "shade_edgeshm": {"METHOD": "shm", "SUN_ELEVATION": "1", "OUTPUT_TYPE": "Float32"},
+    "shadow_edge": {"SUN_AZIMUTH": "135", "SUN_ELEVATION": "-0.5"},
+    "shadow_edgenodata": {"SUN_ELEVATION": "5", "MAX_DISTANCE": "2000", "EDGE": "nodata"},
+    "horizon_edge": {"DIRECTIONS": "8", "START_AZIMUTH": "10"},
+    "svf_edge": {"DIRECTIONS": "16"},
+    "openness_edge": {"DIRECTIONS": "16"},
+    "openness_edgenodata": {"DIRECTIONS": "16", "MAX_DISTANCE": "3000", "EDGE": "nodata"},
+    "sky_edge": {"DIRECTIONS": "16", "CURVATURE": "NO"},
+    "sunhours_edge": dict(DAY),
+    "insolation_edge": dict(DAY, LINKE_TURBIDITY="4"),
+    "envlight_edge": {"SKY": "cie:7", "SUN_AZIMUTH": "120", "SUN_ELEVATION": "25",
+                      "DIRECTIONS": "8"},
+}
+
+
+def takes_edge():
+    """The products whose options list EDGE (the driver's product table)."""
+    import xml.etree.ElementTree as ET
+    xml = gdal.GetDriverByName("TERRASHADE").GetMetadataItem("TERRASHADE_PRODUCTS")
+    return {p.get("name") for p in ET.fromstring(xml)
+            if "EDGE" in p.get("options").split(",")}
+
+
 # Environment light (docs/envlight.md): printed after all the above, so that
 # the earlier lines keep their places.
 ENVMAPS = os.path.join(T.DATA, "envmaps")
@@ -161,7 +190,8 @@ def main():
     fractal = os.path.join(tmp, "fractal.tif")
     fractal_dem(fractal)
     dems = {"jacksboro": T.JACKSBORO, "lux": T.LUX, "fractal": fractal}
-    variants = dict(VARIANTS, **ENV_VARIANTS, **YEAR_VARIANTS)
+    variants = dict(VARIANTS, **ENV_VARIANTS, **YEAR_VARIANTS, **EDGE_VARIANTS)
+    edge_products = takes_edge()
     names = args.only.split(",") if args.only else list(variants)
     if args.save:
         os.makedirs(args.save, exist_ok=True)
@@ -169,13 +199,16 @@ def main():
     crossed = []
     # the variants of the first group come first in the record, each group
     # DEM by DEM, so that added groups append lines to it
-    for group in (VARIANTS, ENV_VARIANTS, YEAR_VARIANTS):
+    for group in (VARIANTS, ENV_VARIANTS, YEAR_VARIANTS, EDGE_VARIANTS):
         for dem_name, dem in dems.items():
             kept = {}
             for backend in args.backends.split(","):
                 for name in [n for n in names if n in group]:
-                    oo = dict(variants[name], PRODUCT=name.split("_")[0], BACKEND=backend,
+                    product = name.split("_")[0]
+                    oo = dict(variants[name], PRODUCT=product, BACKEND=backend,
                               PROGRESS="no")
+                    if group is not EDGE_VARIANTS and product in edge_products:
+                        oo["EDGE"] = "open"  # the record from before EDGE
                     ds = gdal.OpenEx("TERRASHADE:" + dem,
                                      open_options=["%s=%s" % kv for kv in oo.items()])
                     a = read_all(ds)

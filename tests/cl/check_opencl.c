@@ -280,6 +280,42 @@ START_TEST(test_horizon_small_buffers)
 }
 END_TEST
 
+/* EDGE: every mode gives the same planes in both backends (the clamp runs
+ * on the planes read back, before any sum or test), with and without a
+ * search radius that the kernel runs (one longer than every line). */
+START_TEST(test_horizon_edge)
+{
+    require_opencl();
+    static const ts_edge_mode modes[] = {TS_EDGE_OPEN, TS_EDGE_HORIZON, TS_EDGE_NODATA};
+    const int shapes[] = {4, 6, 7}; /* holes, geographic, 500 m cells */
+    for (int m = 0; m < 3; m++)
+        for (int i = 0; i < 3; i++)
+            for (int capped = 0; capped < 2; capped++) {
+                const dem_spec *s = &SHAPES[shapes[i]];
+                ts_grid g;
+                ts_error e;
+                char name[96], sh[64];
+                make_dem(&g, s);
+                ts_horizon_opts o;
+                ts_horizon_opts_default(&o);
+                o.directions = 7;
+                o.start_azimuth = 5.0;
+                o.edge = modes[m];
+                o.max_distance = capped ? 1e7 : 0.0;
+                size_t n = (size_t)s->w * s->h * o.directions;
+                float *c = tdem_floats(n), *cl = tdem_floats(n);
+                ck_assert_int_eq(ts_horizon_compute(&g, &o, c, &e), TS_OK);
+                ck_assert_msg(ts_cl_horizon_compute(&g, &o, cl, &e) == TS_OK, "%s", e.message);
+                snprintf(name, sizeof name, "horizon %s, edge mode %d%s",
+                         shape_name(s, sh, sizeof sh), (int)modes[m], capped ? ", 1e7 m" : "");
+                expect_close(name, c, cl, n, TOL_HORIZON);
+                free(c);
+                free(cl);
+                free_dem(&g, s);
+            }
+}
+END_TEST
+
 START_TEST(test_horizon_sweep)
 {
     require_opencl();
@@ -1243,6 +1279,7 @@ static Suite *opencl_suite(void)
     tcase_add_test(t, test_horizon);
     tcase_add_test(t, test_horizon_small_buffers);
     tcase_add_test(t, test_horizon_sweep);
+    tcase_add_test(t, test_horizon_edge);
     tcase_add_test(t, test_shm);
     tcase_add_test(t, test_shm_wide);
     tcase_add_test(t, test_normals);

@@ -13,7 +13,8 @@
  *   out.f32: the product, float planes (DIRECTIONS planes for horizon)
  *   keys: SUN_AZIMUTH SUN_ELEVATION DIRECTIONS START_AZIMUTH METHOD
  *         (exact|shm) PENUMBRA_DEPTH MAX_DISTANCE CURVATURE (YES|NO)
- *         REFRACTION SKY_WEIGHT THREADS ROWS (file of HEIGHT native doubles:
+ *         REFRACTION SKY_WEIGHT THREADS EDGE (horizon|open|nodata, default
+ *         horizon as the driver's) ROWS (file of HEIGHT native doubles:
  *         east-west cell size of each row)
  */
 #include <math.h>
@@ -72,6 +73,10 @@ static void parse_key(params *p, const char *kv)
     else if (KEY("REFRACTION")) p->h.refraction = atof(v);
     else if (KEY("SKY_WEIGHT")) p->sky_weight = atof(v);
     else if (KEY("THREADS")) p->h.threads = atoi(v);
+    else if (KEY("EDGE"))
+        p->h.edge = strcmp(v, "open") == 0     ? TS_EDGE_OPEN
+                    : strcmp(v, "nodata") == 0 ? TS_EDGE_NODATA
+                                               : TS_EDGE_HORIZON;
     else if (KEY("ROWS")) p->rows = v;
     else die(kv, NULL);
 #undef KEY
@@ -103,13 +108,23 @@ static void sun_visibility(const ts_grid *g, const params *p, float *vis,
         if (ts_shm_compute(g, p->sun_az, p->sun_el, p->penumbra, p->h.threads,
                            vis, NULL, &err) != TS_OK)
             die("ts_shm_compute", &err);
-        return;
-    }
-    if (ts_horizon_sweep(g, p->sun_az, &p->h, horizon, &err) != TS_OK)
+        if (p->h.edge == TS_EDGE_OPEN)
+            return;
+        /* the shadow height map sees no edge: times the disk above the
+         * edge's and the Earth's horizon alone */
+        for (size_t i = 0; i < cells; i++)
+            horizon[i] = -90.0f;
+        if (ts_horizon_edge_apply(g, p->sun_az, &p->h, horizon, &err) != TS_OK)
+            die("ts_horizon_edge_apply", &err);
+    } else if (ts_horizon_sweep(g, p->sun_az, &p->h, horizon, &err) != TS_OK) {
         die("ts_horizon_sweep", &err);
-    for (size_t i = 0; i < cells; i++)
-        vis[i] = isnan(horizon[i]) ? NAN
-                                   : (float)ts_sun_disk_fraction(p->sun_el, horizon[i]);
+    }
+    if (ts_horizon_earth_floor(g, &p->h, horizon, &err) != TS_OK)
+        die("ts_horizon_earth_floor", &err);
+    for (size_t i = 0; i < cells; i++) {
+        float f = isnan(horizon[i]) ? NAN : (float)ts_sun_disk_fraction(p->sun_el, horizon[i]);
+        vis[i] = p->shm ? vis[i] * f : f;
+    }
 }
 
 int main(int argc, char **argv)
@@ -121,6 +136,7 @@ int main(int argc, char **argv)
     }
     params p = {315, 45, 0, 0, 0, {0}, NULL};
     ts_horizon_opts_default(&p.h);
+    p.h.edge = TS_EDGE_HORIZON; /* the driver's default */
     for (int i = 8; i < argc; i++)
         parse_key(&p, argv[i]);
     const char *product = argv[1];
@@ -173,7 +189,8 @@ int main(int argc, char **argv)
             ts_horizon_opts one = p.h;
             one.directions = 1;
             one.start_azimuth = p.sun_az;
-            if (ts_horizon_sweep(&g, p.sun_az, &one, hz, &err) != TS_OK)
+            if (ts_horizon_sweep(&g, p.sun_az, &one, hz, &err) != TS_OK ||
+                ts_horizon_earth_floor(&g, &one, hz, &err) != TS_OK)
                 die("ts_horizon_sweep", &err);
             const ts_direct_request req = {&g, nx, ny, nz, hz, &one, p.sun_az, p.sun_el, out};
             if (ts_shade_direct(&req, &err) != TS_OK)

@@ -37,6 +37,11 @@ PRODUCTS = [
     ("svf", {"PRODUCT": "svf", "DIRECTIONS": 16}, 1e-4),
     ("sky", {"PRODUCT": "sky", "DIRECTIONS": 8}, 1e-4),
     ("openness", {"PRODUCT": "openness", "DIRECTIONS": 8}, 1e-3),
+    # EDGE: horizon (the default) above; open and nodata (a search radius
+    # that the shadow height map, which has none, runs on either backend)
+    ("svf edge open", {"PRODUCT": "svf", "DIRECTIONS": 8, "EDGE": "open"}, 1e-4),
+    ("shadow shm edge nodata", {"PRODUCT": "shadow", "METHOD": "shm", "SUN_ELEVATION": 12,
+                                "EDGE": "nodata", "MAX_DISTANCE": 300}, 1e-4),
 ]
 
 

@@ -31,6 +31,13 @@ CASES = [
     ("svf", {"DIRECTIONS": 12}),
     ("sky", {"DIRECTIONS": 12}),
     ("openness", {"DIRECTIONS": 12, "MAX_DISTANCE": 3000}),
+    # EDGE (the cases above run with the default, horizon)
+    ("shadow", {"SUN_ELEVATION": -0.5, "SUN_AZIMUTH": 200}),
+    ("shade", {"METHOD": "shm", "SUN_ELEVATION": 1}),
+    ("openness", {"DIRECTIONS": 8, "EDGE": "open"}),
+    ("svf", {"DIRECTIONS": 8, "EDGE": "nodata", "MAX_DISTANCE": 2000}),
+    ("shadow", {"SUN_ELEVATION": 8, "METHOD": "shm", "EDGE": "nodata",
+                "MAX_DISTANCE": 2000}),
 ]
 
 

@@ -67,14 +67,20 @@ class Options(unittest.TestCase):
             product(self.dem, PRODUCT="shadow", SUN_ELEVATION=10, SUN_AZIMUTH=360))
         lower = product(self.dem, PRODUCT="shadow", SUN_ELEVATION=3)
         self.assertLess(np.nanmean(lower), np.nanmean(base))
-        # sun below the horizontal: only cells whose horizon is lower still
-        # (overlooking a valley, or the DEM's edge) see it
+        # sun below the horizontal, with an open sky beyond the edge
+        # (EDGE=open): only cells whose horizon is lower still (overlooking
+        # a valley, or the DEM's edge) see it
         night = product(self.dem, PRODUCT="shade", SUN_ELEVATION=-10,
-                        OUTPUT_TYPE="Float32")[0]
+                        OUTPUT_TYPE="Float32", EDGE="open")[0]
         hz = product(self.dem, PRODUCT="horizon", DIRECTIONS=1,
-                     START_AZIMUTH=315)[0]
+                     START_AZIMUTH=315, EDGE="open")[0]
         self.assertTrue(np.all(hz[night > 0] < -10 + 0.2667))
         self.assertLess(np.mean(night > 0), 0.2)
+        self.assertTrue(np.any(night > 0))
+        # with the Earth beyond the edge (the default) it lights nothing
+        night = product(self.dem, PRODUCT="shade", SUN_ELEVATION=-10,
+                        OUTPUT_TYPE="Float32")[0]
+        self.assertFalse(np.any(night > 0))
 
     def test_directions_and_start_azimuth(self):
         hz = product(self.dem, PRODUCT="horizon", DIRECTIONS=4)

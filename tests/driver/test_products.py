@@ -143,7 +143,9 @@ class Products(unittest.TestCase):
 
     def test_sky_products_on_a_plane(self):
         """A horizontal plane: svf 1 and sky 1 everywhere; in the interior
-        openness 90 and horizon 0; at the edges nothing lies beyond (-90)."""
+        openness 90 and horizon 0; at the edges, looking out, the sea-level
+        plane beyond (EDGE=horizon, CURVATURE=NO: the horizontal), or
+        nothing (EDGE=open: -90)."""
         with T.TempDir() as tmp:
             flat = T.write_tif(os.path.join(tmp, "flat.tif"),
                                np.full((40, 50), 100, np.float32),
@@ -159,8 +161,11 @@ class Products(unittest.TestCase):
             np.testing.assert_allclose(opn[1:-1, 1:-1], 90, atol=1e-3)
             inner = hz[:, 1:-1, 1:-1]
             np.testing.assert_allclose(inner, 0, atol=1e-3)
-            # nothing beyond the edge: -90 on the edge facing outwards
-            np.testing.assert_array_equal(hz[0, 0, :], -90)   # north, row 0
+            # the sea-level plane beyond the edge facing outwards: 0
+            np.testing.assert_array_equal(hz[0, 0, :], 0)   # north, row 0
+            hz = T.read(T.conn(flat, PRODUCT="horizon", DIRECTIONS=4,
+                               CURVATURE="NO", EDGE="open"))
+            np.testing.assert_array_equal(hz[0, 0, :], -90)  # nothing beyond
 
 
 if __name__ == "__main__":

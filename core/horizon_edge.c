@@ -1,0 +1,211 @@
+/* The world beyond the DEM edge (ts_edge_mode): the sea-level surface of
+ * the Earth, an open sky, or nodata; docs/algorithms.md derives the first. */
+#include <math.h>
+#include <stdint.h>
+
+#include "day_cycle.h"
+#include "parallel.h"
+#include "status_internal.h"
+
+#define DEG2RAD (M_PI / 180.0)
+#define RAD2DEG (180.0 / M_PI)
+
+/* The tangent of the elevation of the highest sea-level point over s in
+ * [s0, s1] seen from height h, for a drop c s^2 (c = 0: no curvature). */
+static inline double edge_tangent(double h, double s0, double s1, double c)
+{
+    /* f(s) = (-h - c s^2) / s has f' = (h - c s^2) / s^2: it rises up to
+     * s* = sqrt(h / c) (for h > 0), falls after; for h <= 0 it only falls. */
+    double s;
+    if (h <= 0)
+        s = s0;
+    else if (c > 0)
+        s = fmin(fmax(sqrt(h / c), s0), s1);
+    else
+        s = s1; /* flat: -h / s rises toward the horizontal */
+    return isinf(s) ? 0.0 : (-h - c * s * s) / s; /* 0: the limit, from below */
+}
+
+double ts_edge_horizon(double height_m, double edge_m, const ts_horizon_opts *opts)
+{
+    double s1 = opts->max_distance > 0 ? opts->max_distance : INFINITY;
+    if (isnan(height_m))
+        return NAN;
+    if (edge_m > s1)
+        return -90.0; /* the ray ends on the grid */
+    double c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
+    return atan(edge_tangent(height_m, edge_m, s1, c)) * RAD2DEG;
+}
+
+/* The ray toward an azimuth in cells per metre (the direction of
+ * ts_line_geom_init: the central row's cell size), as the metres per cell
+ * it advances along x and y (infinite along an axis it does not cross). */
+typedef struct {
+    double mx, my; /* metres per cell along x, y; INFINITY = parallel */
+    int east, south; /* 1: toward +x, +y */
+} edge_ray;
+
+static edge_ray edge_ray_of(const ts_grid *grid, double azimuth)
+{
+    double a = azimuth * DEG2RAD;
+    double sa = sin(a), ca = cos(a);
+    if (fabs(sa) < 1e-12) sa = 0;
+    if (fabs(ca) < 1e-12) ca = 0;
+    double gx = sa / ts_grid_cell_x(grid, grid->height / 2), gy = -ca / grid->cell_y;
+    edge_ray r = {gx != 0 ? 1.0 / fabs(gx) : INFINITY, gy != 0 ? 1.0 / fabs(gy) : INFINITY,
+                  gx > 0, gy > 0};
+    return r;
+}
+
+/* Metres from the centre of cell (x, y) to the grid's outer boundary. */
+static inline double edge_ray_distance(const edge_ray *r, const ts_grid *grid, int x, int y)
+{
+    double px = x + 0.5, py = y + 0.5; /* the grid is [0, W] x [0, H] */
+    double sx = (r->east ? grid->width - px : px) * r->mx;
+    double sy = (r->south ? grid->height - py : py) * r->my;
+    return sx < sy ? sx : sy;
+}
+
+double ts_edge_distance(const ts_grid *grid, int x, int y, double azimuth)
+{
+    edge_ray r = edge_ray_of(grid, azimuth);
+    return edge_ray_distance(&r, grid, x, y);
+}
+
+typedef struct {
+    const ts_grid *grid;
+    const ts_horizon_opts *opts;
+    edge_ray ray;
+    double reach;         /* max_distance, or INFINITY */
+    double c;             /* drop per square metre: (1 - k) / 2R, or 0 */
+    float *plane;         /* the horizons, or the sun's visibility */
+    double sun_elevation; /* ts_horizon_edge_sun */
+} edge_job;
+
+static edge_job edge_job_of(const ts_grid *grid, double azimuth, const ts_horizon_opts *o,
+                            float *plane, double sun_elevation)
+{
+    edge_job j = {grid, o, edge_ray_of(grid, azimuth),
+                  o->max_distance > 0 ? o->max_distance : INFINITY,
+                  o->curvature ? (1.0 - o->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0, plane,
+                  sun_elevation};
+    return j;
+}
+
+/* An upper bound of atan(t) in degrees, cheap: atan(t) <= t for t >= 0,
+ * atan(t) <= t / (1 + t^2) for t < 0; a horizon at or above it needs no
+ * atan. */
+static inline double atan_deg_above(double t)
+{
+    return (t >= 0 ? t : t / (1.0 + t * t)) * RAD2DEG;
+}
+
+/* Horizon v of valid cell (x, y) with the world beyond the edge. */
+static inline float edge_raise(const edge_job *j, int x, int y, float v)
+{
+    double s = edge_ray_distance(&j->ray, j->grid, x, y);
+    if (j->opts->edge == TS_EDGE_NODATA)
+        return s <= j->reach ? NAN : v;
+    if (s > j->reach)
+        return v;
+    /* ts_edge_horizon's tangent; its atan only where it may win (float
+     * rounding is monotonic: v >= bound >= atan keeps v) */
+    double t = edge_tangent(ts_grid_at(j->grid, x, y), s, j->reach, j->c);
+    if (v >= atan_deg_above(t))
+        return v;
+    float e = (float)(atan(t) * RAD2DEG);
+    return e > v ? e : v;
+}
+
+static void edge_rows(void *ctx, int worker, long begin, long end)
+{
+    (void)worker;
+    const edge_job *j = ctx;
+    for (long y = begin; y < end; y++) {
+        float *row = j->plane + (size_t)y * j->grid->width;
+        for (int x = 0; x < j->grid->width; x++)
+            if (!isnan(row[x])) /* nodata stays nodata */
+                row[x] = edge_raise(j, x, (int)y, row[x]);
+    }
+}
+
+/* The Earth's horizon as a floor of horizon v at height h (TS_EDGE_HORIZON). */
+static inline float earth_floor(const ts_horizon_opts *o, float h, float v)
+{
+    float f = (float)ts_earth_horizon(h, o);
+    return f > v ? f : v; /* NaN stays NaN */
+}
+
+static void sun_rows(void *ctx, int worker, long begin, long end)
+{
+    (void)worker;
+    const edge_job *j = ctx;
+    for (long y = begin; y < end; y++) {
+        float *vis = j->plane + (size_t)y * j->grid->width;
+        for (int x = 0; x < j->grid->width; x++) {
+            if (isnan(vis[x]))
+                continue;
+            float h = edge_raise(j, x, (int)y, -90.0f);
+            if (j->opts->edge == TS_EDGE_HORIZON)
+                h = earth_floor(j->opts, ts_grid_at(j->grid, x, (int)y), h);
+            vis[x] = isnan(h) ? NAN : vis[x] * (float)ts_sun_disk_fraction(j->sun_elevation, h);
+        }
+    }
+}
+
+static ts_status check_plane_args(const ts_grid *grid, const ts_horizon_opts *opts,
+                                  const float *plane, ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if (!plane)
+        return ts_fail(err, TS_ERR_ARG, "the horizon plane is NULL");
+    return ts_horizon_opts_validate(opts, err);
+}
+
+ts_status ts_horizon_edge_apply(const ts_grid *grid, double azimuth,
+                                const ts_horizon_opts *opts, float *plane, ts_error *err)
+{
+    ts_status st = check_plane_args(grid, opts, plane, err);
+    if (st != TS_OK)
+        return st;
+    if (!isfinite(azimuth))
+        return ts_fail(err, TS_ERR_ARG, "azimuth must be a finite number of degrees, got %g",
+                       azimuth);
+    if (opts->edge == TS_EDGE_OPEN)
+        return ts_ok(err);
+    edge_job j = edge_job_of(grid, azimuth, opts, plane, 0.0);
+    return ts_parallel_for(ts_thread_count(opts->threads, grid->height), grid->height,
+                           edge_rows, &j, err);
+}
+
+ts_status ts_horizon_edge_sun(const ts_grid *grid, double azimuth, double elevation,
+                              const ts_horizon_opts *opts, float *vis, ts_error *err)
+{
+    ts_status st = check_plane_args(grid, opts, vis, err);
+    if (st != TS_OK)
+        return st;
+    if (!isfinite(azimuth) || !(elevation >= -90.0 && elevation <= 90.0))
+        return ts_fail(err, TS_ERR_ARG, "the sun must be at a finite azimuth and an elevation "
+                       "within -90..90 degrees, got %g and %g", azimuth, elevation);
+    if (opts->edge == TS_EDGE_OPEN)
+        return ts_ok(err);
+    edge_job j = edge_job_of(grid, azimuth, opts, vis, elevation);
+    return ts_parallel_for(ts_thread_count(opts->threads, grid->height), grid->height,
+                           sun_rows, &j, err);
+}
+
+ts_status ts_horizon_earth_floor(const ts_grid *grid, const ts_horizon_opts *opts,
+                                 float *plane, ts_error *err)
+{
+    ts_status st = check_plane_args(grid, opts, plane, err);
+    if (st != TS_OK || opts->edge != TS_EDGE_HORIZON)
+        return st;
+    for (int y = 0; y < grid->height; y++)
+        for (int x = 0; x < grid->width; x++) {
+            float *v = plane + (size_t)y * grid->width + x;
+            *v = earth_floor(opts, ts_grid_at(grid, x, y), *v);
+        }
+    return ts_ok(err);
+}

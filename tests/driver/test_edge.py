@@ -1,0 +1,205 @@
+"""EDGE=horizon|open|nodata: what lies beyond the DEM's edge (docs/algorithms.md).
+
+- a 40 x 40 DEM under a sun at -21 deg (night): lit cells with EDGE=open (the
+  behaviour before EDGE), none with EDGE=horizon (the default), for shade and
+  shadow, exact and shm; SUN_ELEVATION=-90 lights nothing;
+- a flat DEM at 1000 m: openness 90 deg within the dip with horizon, up to
+  about 152 at the edges with open, nodata on the edge band with nodata;
+  the horizon of an edge cell looking out is the analytic dip, and 0 without
+  curvature;
+- the day products: nodata at the edges with EDGE=nodata, no sun below the
+  Earth's horizon with horizon;
+- C and OpenCL agree in every mode; EDGE=foo and EDGE for farshadow are
+  refused with a sentence.
+"""
+import math
+import os
+import unittest
+
+import tsdriver as T
+from tsdriver import gdal, np
+
+GT = (600000, 30, 0, 4000000, 0, -30)
+EARTH_RADIUS = 6371008.8
+REFRACTION = 0.13
+
+
+def dip(height, k=REFRACTION):
+    """The sea-level horizon seen from `height` metres, degrees."""
+    c = (1 - k) / (2 * EARTH_RADIUS)
+    return -math.degrees(math.atan(2 * math.sqrt(height * c)))
+
+
+class Edge(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = T.TempDir()
+        d = cls.tmp.__enter__()
+        cls.rough = T.write_tif(os.path.join(d, "rough.tif"),
+                                T.fractal_dem(40, seed=3, relief=300.0), GT, 32617)
+        cls.flat = T.write_tif(os.path.join(d, "flat.tif"),
+                               np.full((40, 40), 1000, np.float32), GT, 32617)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.__exit__(None, None, None)
+
+    def lit(self, dem, **options):
+        a = T.read(T.conn(dem), 1, dict(options, OUTPUT_TYPE="Float32"))
+        self.assertFalse(np.isnan(a).any())
+        return int((a > 0).sum())
+
+    def test_night(self):
+        for product in ("shade", "shadow"):
+            for method in ("exact", "shm"):
+                with self.subTest(product=product, method=method):
+                    sun = dict(PRODUCT=product, METHOD=method, SUN_AZIMUTH=315)
+                    before = self.lit(self.rough, SUN_ELEVATION=-21, EDGE="open", **sun)
+                    print("  %s %s, sun at -21 deg: %d of 1600 lit with EDGE=open"
+                          % (product, method, before))
+                    self.assertGreater(before, 0)
+                    self.assertEqual(self.lit(self.rough, SUN_ELEVATION=-21, **sun), 0)
+                    self.assertEqual(self.lit(self.rough, SUN_ELEVATION=-21, EDGE="horizon",
+                                              **sun), 0)
+                    self.assertEqual(self.lit(self.rough, SUN_ELEVATION=-90, **sun), 0)
+        # half the sun's disk above an open sky at the outward edge
+        self.assertGreater(self.lit(self.rough, PRODUCT="shadow", SUN_ELEVATION=-90,
+                                    EDGE="open"), 0)
+        # the sun placed by date and time, per cell: midnight at 36 N
+        for product in ("shade", "shadow"):
+            night = dict(PRODUCT=product, DATETIME="2026-06-21T05:00:00Z",
+                         SUN_POSITION="per_cell")
+            before = self.lit(self.rough, EDGE="open", **night)
+            print("  %s per cell at midnight: %d lit with EDGE=open" % (product, before))
+            self.assertGreater(before, 0)
+            self.assertEqual(self.lit(self.rough, **night), 0)
+
+    def test_sun_just_below_the_earths_horizon(self):
+        """On the flat DEM at 1000 m the dip is -0.947 deg: a sun's disk
+        entirely below it lights nothing, a sun at -0.1 deg every cell. A
+        short MAX_DISTANCE does not let peaks see a sun below the Earth's
+        horizon either."""
+        for method in ("exact", "shm"):
+            with self.subTest(method=method):
+                o = dict(PRODUCT="shadow", SUN_AZIMUTH=200, METHOD=method)
+                self.assertEqual(self.lit(self.flat, SUN_ELEVATION=dip(1000) - 0.3, **o), 0)
+                if method == "exact":
+                    self.assertEqual(self.lit(self.flat, SUN_ELEVATION=-0.1, **o), 1600)
+                o = dict(o, SUN_ELEVATION=-2, MAX_DISTANCE=60)
+                before = self.lit(self.rough, EDGE="open", **o)
+                print("  %s, sun at -2 deg, MAX_DISTANCE=60: %d lit with EDGE=open"
+                      % (method, before))
+                self.assertGreater(before, 0)
+                self.assertEqual(self.lit(self.rough, **o), 0)
+
+    def test_flat_openness(self):
+        o = dict(PRODUCT="openness", DIRECTIONS=16)
+        horizon = T.read(T.conn(self.flat), 1, o)
+        open_ = T.read(T.conn(self.flat), 1, dict(o, EDGE="open"))
+        nodata = T.read(T.conn(self.flat), 1, dict(o, EDGE="nodata", MAX_DISTANCE=100))
+        print("  flat 1000 m: openness %.4f..%.4f (horizon), %.4f..%.4f (open)"
+              % (horizon.min(), horizon.max(), open_.min(), open_.max()))
+        self.assertGreaterEqual(horizon.min(), 90.0 - 1e-4)
+        self.assertLessEqual(horizon.max(), 90.0 - dip(1000) + 1e-4)
+        self.assertGreater(horizon.max(), 90.5)  # a corner looks out half the time
+        self.assertGreater(open_.max(), 150.0)
+        # cells within 100 m of the edge (3 rows of 30 m cells) are nodata
+        band = np.ones((40, 40), bool)
+        band[3:-3, 3:-3] = False
+        np.testing.assert_array_equal(np.isnan(nodata), band)
+        np.testing.assert_allclose(nodata[~band], 90.0, atol=1e-3)
+
+    def test_dip_of_an_edge_cell(self):
+        o = dict(PRODUCT="horizon", DIRECTIONS=4)
+        h = T.read(T.conn(self.flat), None, o)  # bands: north, east, south, west
+        print("  horizon of the west edge looking west: %.6f deg, analytic %.6f"
+              % (h[3][20, 0], dip(1000)))
+        self.assertAlmostEqual(h[3][20, 0], dip(1000), delta=1e-5)
+        self.assertAlmostEqual(h[0][0, 17], dip(1000), delta=1e-5)
+        h = T.read(T.conn(self.flat), None, dict(o, REFRACTION=0))
+        self.assertAlmostEqual(h[1][5, 39], dip(1000, 0.0), delta=1e-5)
+        h = T.read(T.conn(self.flat), None, dict(o, CURVATURE="NO"))
+        self.assertEqual(h[2][39, 4], 0.0)  # the sea-level plane: the horizontal
+        h = T.read(T.conn(self.flat), None, dict(o, EDGE="open"))
+        self.assertEqual(h[3][20, 0], -90.0)
+
+    def test_day_products(self):
+        """EDGE=nodata: nodata where a ray toward the sun (or the sky term's
+        directions) leaves the DEM within MAX_DISTANCE: within 60 m of the
+        edge (two cells), the southern and eastern ones among them (the sun
+        of a June day at 36 N), and nowhere else; elsewhere the values of
+        EDGE=open."""
+        day = dict(DATE="2026-06-21", TIMEZONE="+00:00", STEP_MINUTES=60)
+        year = dict(START_DATE="2026-06-01", END_DATE="2026-06-30", TIMEZONE="+00:00")
+        band = np.ones((40, 40), bool)
+        band[2:-2, 2:-2] = False
+        cases = [("sunhours", day, 1), ("insolation", day, 1), ("daycycle", day, 13),
+                 ("sunhours", year, 1), ("insolation", year, 2)]
+        for product, when, b in cases:
+            with self.subTest(product=product, range="START_DATE" in when):
+                o = dict(when, PRODUCT=product, MAX_DISTANCE=60)
+                nodata = T.read(T.conn(self.rough), b, dict(o, EDGE="nodata"))
+                open_ = T.read(T.conn(self.rough), b, dict(o, EDGE="open"))
+                blank = np.isnan(nodata)
+                print("  %s%s: %d nodata cells" % (product, " (range)" if "START_DATE" in when
+                                                   else "", blank.sum()))
+                self.assertFalse((blank & ~band).any())
+                self.assertTrue(blank[:, 38:].all())  # the morning sun, to the east
+                if product != "daycycle":  # 07:00 local: the sun is not south yet
+                    self.assertTrue(blank[38:, :].all())
+                np.testing.assert_array_equal(nodata[~blank], open_[~blank])
+        # the flat DEM at 1000 m: the sun counts from when it clears the dip,
+        # as the day products always did (EDGE=open keeps that floor)
+        o = dict(day, PRODUCT="sunhours", STEP_MINUTES=5)
+        horizon = T.read(T.conn(self.flat), 1, o)
+        open_ = T.read(T.conn(self.flat), 1, dict(o, EDGE="open"))
+        np.testing.assert_array_equal(horizon, open_)
+
+    def test_backends_agree(self):
+        cases = [
+            dict(PRODUCT="shade", SUN_ELEVATION=3, OUTPUT_TYPE="Float32"),
+            dict(PRODUCT="shade", METHOD="shm", SUN_ELEVATION=3, OUTPUT_TYPE="Float32"),
+            dict(PRODUCT="shadow", SUN_ELEVATION=-0.5, SUN_AZIMUTH=100),
+            dict(PRODUCT="horizon", DIRECTIONS=8, START_AZIMUTH=5),
+            dict(PRODUCT="svf", DIRECTIONS=8),
+            dict(PRODUCT="sky", DIRECTIONS=8),
+            dict(PRODUCT="openness", DIRECTIONS=8),
+            dict(PRODUCT="openness", OPENNESS="negative", DIRECTIONS=8),
+            dict(PRODUCT="envlight", SKY="overcast", DIRECTIONS=8),
+        ]
+        for edge in ("horizon", "open", "nodata"):
+            for case in cases:
+                with self.subTest(edge=edge, **case):
+                    o = dict(case, EDGE=edge)
+                    c = T.read(T.conn(self.rough), None, dict(o, BACKEND="c"))
+                    cl = T.read(T.conn(self.rough), None, dict(o, BACKEND="opencl"))
+                    np.testing.assert_array_equal(np.isnan(c), np.isnan(cl))
+                    if not np.isnan(c).all():
+                        self.assertLessEqual(np.nanmax(np.abs(c - cl)), 1e-3)
+
+    def test_bad_values(self):
+        p = T.run(["gdalinfo", T.conn(self.flat, PRODUCT="svf", EDGE="foo")], ok=False)
+        self.assertIn("EDGE must be one of horizon, open, nodata, got 'foo'", p.stderr)
+        p = T.run(["gdalinfo", T.conn(self.flat, PRODUCT="farshadow", DATE="2026-06-21",
+                                      TIMEZONE="Z", EDGE="nodata")], ok=False)
+        self.assertIn("EDGE applies to", p.stderr)
+        self.assertIn("not to PRODUCT=farshadow", p.stderr)
+
+    def test_metadata_lists_edge_where_it_applies(self):
+        import xml.etree.ElementTree as ET
+        xml = gdal.GetDriverByName("TERRASHADE").GetMetadataItem("TERRASHADE_PRODUCTS")
+        takes = {p.get("name") for p in ET.fromstring(xml)
+                 if "EDGE" in p.get("options").split(",")}
+        self.assertEqual(takes, {"shade", "shadow", "horizon", "svf", "openness", "sky",
+                                 "sunhours", "insolation", "daycycle", "envlight"})
+        ds = gdal.OpenEx(T.conn(self.flat), open_options=["PRODUCT=svf", "EDGE=nodata"])
+        self.assertEqual(ds.GetMetadataItem("EDGE"), "nodata")
+        ds = gdal.OpenEx(T.conn(self.flat), open_options=["PRODUCT=horizon"])
+        self.assertEqual(ds.GetMetadataItem("EDGE"), "horizon")
+        ds = gdal.OpenEx(T.conn(self.flat), open_options=[
+            "PRODUCT=farshadow", "DATE=2026-06-21", "TIMEZONE=Z"])
+        self.assertIsNone(ds.GetMetadataItem("EDGE"))
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
