@@ -27,12 +27,18 @@ int tsd_options_check_pyramid(const tsd_options *o, char *msg, size_t n)
                    ? ", whose shadows METHOD chooses (exact or shm)"
                    : "");
     }
+    /* as SVF_MODEL: a value that would do nothing is a mistake; the
+     * default given explicitly is not */
     if (o->horizon_method != TSD_HORIZON_PYRAMID) {
-        for (size_t i = 1; i < sizeof own / sizeof own[0]; i++)
-            if (tsd_options_given(o, own[i]))
-                REFUSE("%s applies with HORIZON_METHOD=pyramid; HORIZON_METHOD=exact (the "
-                       "sweep) has no pyramid",
-                       own[i]);
+        double k0 = atof(tsd_option_default(tsd_option_find("PYRAMID_LEVEL_STEP")));
+        double o0 = atof(tsd_option_default(tsd_option_find("PYRAMID_OFFSET")));
+        const char *which = o->pyramid_offset != o0         ? "PYRAMID_OFFSET"
+                            : o->pyramid_level_step != k0 ? "PYRAMID_LEVEL_STEP"
+                                                          : NULL;
+        if (which)
+            REFUSE("%s applies with HORIZON_METHOD=pyramid; HORIZON_METHOD=exact (the "
+                   "sweep) has no pyramid",
+                   which);
         return 0;
     }
     if (tsd_product_takes(p, tsd_option_find("SKY_WEIGHT")) && !(o->sky_weight > 0))
