@@ -158,6 +158,165 @@ START_TEST(test_valley_converges)
 }
 END_TEST
 
+/* svf of the real DEMs, pyramid against exact: the errors stated in
+ * docs/methods.md (16 directions, curvature on, k = 4), bounded with room. */
+static void real_svf(const char *name, double offset, double want_median, double want_p99)
+{
+    ts_grid g;
+    tdem_load(&g, name);
+    ts_horizon_opts o = hopts(16, 1);
+    o.start_azimuth = 0;
+    size_t n = (size_t)g.width * g.height;
+    float *nx = tdem_floats(n), *ny = tdem_floats(n), *nz = tdem_floats(n);
+    float *se = tdem_floats(n), *sp = tdem_floats(n);
+    ts_error err;
+    ck_assert(ts_normals(&g, nx, ny, nz, &err) == TS_OK);
+    float *ex = exact_planes(&g, &o);
+    ts_pyramid_opts p = popts(4, offset, TS_PYRAMID_BSPLINE);
+    float *py = pyramid_planes(&g, &p, &o);
+    err_stats h = diff_stats(ex, py, n * o.directions);
+    ck_assert(ts_sky_terms(&g, nx, ny, nz, ex, &o, se, NULL, NULL, &err) == TS_OK);
+    ck_assert(ts_sky_terms(&g, nx, ny, nz, py, &o, sp, NULL, NULL, &err) == TS_OK);
+    err_stats s = diff_stats(se, sp, n);
+    printf("%s o=%g: horizon |pyramid - exact| median %.3f p99 %.3f deg; svf median %.4f "
+           "p99 %.4f max %.4f\n", name, offset, h.median, h.p99, s.median, s.p99, s.max);
+    ck_assert_msg(s.median <= want_median && s.p99 <= want_p99,
+                  "%s o=%g: svf error median %g p99 %g (want <= %g, %g)", name, offset,
+                  s.median, s.p99, want_median, want_p99);
+    free(nx), free(ny), free(nz), free(se), free(sp), free(ex), free(py);
+    ts_grid_free(&g);
+}
+
+START_TEST(test_jacksboro_svf)
+{
+    real_svf("jacksboro", 0, 0.010, 0.060);
+    real_svf("jacksboro", 2, 0.005, 0.025);
+}
+END_TEST
+
+START_TEST(test_lux_svf)
+{
+    /* nodata outside Luxembourg: the NaN cells must agree (diff_stats) */
+    real_svf("lux_elev", 0, 0.001, 0.005);
+}
+END_TEST
+
+/* The B-spline's maximum never exceeds its largest sample: below the
+ * maximum over levels, which sees the same samples (both end where the
+ * ray leaves the DEM). */
+START_TEST(test_bspline_below_level_max)
+{
+    ts_grid g;
+    tdem_load(&g, "jacksboro");
+    ts_horizon_opts o = hopts(8, 1);
+    size_t n = (size_t)g.width * g.height * o.directions;
+    ts_pyramid_opts pb = popts(4, 0, TS_PYRAMID_BSPLINE), pm = popts(4, 0, TS_PYRAMID_LEVEL_MAX);
+    float *b = pyramid_planes(&g, &pb, &o), *m = pyramid_planes(&g, &pm, &o);
+    long above = 0;
+    for (size_t i = 0; i < n; i++)
+        above += b[i] > m[i] + 1e-3f;
+    err_stats d = diff_stats(b, m, n);
+    printf("jacksboro level max - B-spline: median %.3f p99 %.3f deg\n", d.median, d.p99);
+    ck_assert_msg(above == 0, "%ld cells with the spline above the level maximum", above);
+    free(b), free(m);
+    ts_grid_free(&g);
+}
+END_TEST
+
+/* A flat plane: 0 wherever something lies beyond the cell, -90 on the
+ * edge cells that look out of the grid, as the exact sweep. */
+START_TEST(test_flat_plane)
+{
+    ts_grid g;
+    tdem_create(&g, 50, 40, 10.0, 10.0);
+    tdem_fill(&g, 100.0f);
+    ts_horizon_opts o = hopts(16, 0);
+    size_t n = 50 * 40 * 16;
+    float *ex = exact_planes(&g, &o);
+    ts_pyramid_opts p = popts(4, 0, TS_PYRAMID_BSPLINE);
+    float *py = pyramid_planes(&g, &p, &o);
+    for (size_t i = 0; i < n; i++) {
+        ck_assert_msg((ex[i] == -90.0f) == (py[i] == -90.0f), "cell %zu: exact %g pyramid %g",
+                      i, ex[i], py[i]);
+        ck_assert_msg(py[i] == -90.0f || fabsf(py[i]) < 1e-4f, "cell %zu: %g", i, py[i]);
+    }
+    free(ex), free(py);
+    ts_grid_free(&g);
+}
+END_TEST
+
+/* Any thread count gives the same planes, bit for bit. */
+START_TEST(test_threads_identical)
+{
+    ts_grid g;
+    tdem_load(&g, "lux_elev");
+    ts_horizon_opts o = hopts(8, 1);
+    size_t n = (size_t)g.width * g.height * o.directions;
+    ts_pyramid_opts p = popts(3, 0.5, TS_PYRAMID_BSPLINE);
+    o.threads = 1;
+    float *a = pyramid_planes(&g, &p, &o);
+    o.threads = 3;
+    float *b = pyramid_planes(&g, &p, &o);
+    ck_assert(memcmp(a, b, n * sizeof *a) == 0);
+    free(a), free(b);
+    ts_grid_free(&g);
+}
+END_TEST
+
+START_TEST(test_bad_input)
+{
+    ts_pyramid_opts p;
+    ts_error err;
+    ts_pyramid_opts_default(&p);
+    ck_assert(p.level_step == 4 && p.offset == 0 && p.reconstruction == TS_PYRAMID_BSPLINE);
+    ck_assert(ts_pyramid_opts_validate(&p, &err) == TS_OK);
+    const double bad_k[] = {0.999, 0, -1, 16.5, NAN, INFINITY};
+    for (size_t i = 0; i < sizeof bad_k / sizeof bad_k[0]; i++) {
+        ts_pyramid_opts q = p;
+        q.level_step = bad_k[i];
+        ck_assert(ts_pyramid_opts_validate(&q, &err) == TS_ERR_ARG);
+        ck_assert_msg(strstr(err.message, "level step k must be between 1"), "%s",
+                      err.message);
+    }
+    const double bad_o[] = {-0.1, 64.5, NAN};
+    for (size_t i = 0; i < sizeof bad_o / sizeof bad_o[0]; i++) {
+        ts_pyramid_opts q = p;
+        q.offset = bad_o[i];
+        ck_assert(ts_pyramid_opts_validate(&q, &err) == TS_ERR_ARG);
+        ck_assert_msg(strstr(err.message, "level offset o must be between 0 and 64"), "%s",
+                      err.message);
+    }
+    ts_pyramid_opts q = p;
+    q.reconstruction = (ts_pyramid_reconstruction)7;
+    ck_assert(ts_pyramid_opts_validate(&q, &err) == TS_ERR_ARG);
+    ck_assert(ts_pyramid_opts_validate(NULL, &err) == TS_ERR_ARG);
+    printf("bad level step: %s\n", err.message);
+    ts_grid g;
+    tdem_create(&g, 8, 8, 1.0, 1.0);
+    ts_pyramid *pyr = (ts_pyramid *)1;
+    ck_assert(ts_pyramid_build(&g, &p, 0, NULL, &err) == TS_ERR_ARG);
+    ck_assert(ts_pyramid_build(NULL, &p, 0, &pyr, &err) == TS_ERR_ARG && pyr == NULL);
+    ck_assert(ts_pyramid_build(&g, &p, -1, &pyr, &err) == TS_ERR_ARG);
+    q.reconstruction = TS_PYRAMID_BSPLINE;
+    q.level_step = 0.5;
+    ck_assert(ts_pyramid_build(&g, &q, 0, &pyr, &err) == TS_ERR_ARG);
+    ck_assert(ts_pyramid_build(&g, &p, 0, &pyr, &err) == TS_OK);
+    ts_horizon_opts o = hopts(1, 0);
+    float out[64];
+    ck_assert(ts_pyramid_horizon(NULL, 0, &o, out, &err) == TS_ERR_ARG);
+    ck_assert(ts_pyramid_horizon(pyr, 0, &o, NULL, &err) == TS_ERR_ARG);
+    ck_assert(ts_pyramid_horizon(pyr, NAN, &o, out, &err) == TS_ERR_ARG);
+    ck_assert(ts_pyramid_horizon(pyr, 0, NULL, out, &err) == TS_ERR_ARG);
+    ck_assert(ts_pyramid_horizon(pyr, 370, &o, out, &err) == TS_OK);
+    ts_pyramid_free(pyr);
+    ts_pyramid_free(NULL);
+    ck_assert_int_eq(ts_pyramid_level_count(4096, 100, 4), 49);
+    ck_assert_int_eq(ts_pyramid_level_count(1, 1, 4), 1);
+    ck_assert_int_eq(ts_pyramid_level_count(10, 10, 0.5), 0);
+    ts_grid_free(&g);
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("pyramid");
@@ -165,6 +324,12 @@ static Suite *suite(void)
     tcase_set_timeout(tc, 600);
     tcase_add_test(tc, test_cone_converges);
     tcase_add_test(tc, test_valley_converges);
+    tcase_add_test(tc, test_jacksboro_svf);
+    tcase_add_test(tc, test_lux_svf);
+    tcase_add_test(tc, test_bspline_below_level_max);
+    tcase_add_test(tc, test_flat_plane);
+    tcase_add_test(tc, test_threads_identical);
+    tcase_add_test(tc, test_bad_input);
     suite_add_tcase(s, tc);
     return s;
 }
