@@ -8,9 +8,10 @@
  * For each DEM (the real ones of tests/data, and an N x N fractal: fBm
  * value noise, Hurst 0.8, 1500 m relief, 10 m cells, as ts_bench) it
  * computes the D horizon planes with the exact sweep and with the pyramid
- * (HORIZON_METHOD=pyramid, level step K, offset O), one direction at a
- * time, and prints: the median and p99 of |pyramid - exact| horizon angle
- * over every cell and direction, the same of the sky-view factor (radiative,
+ * (level step K, offset O) read both ways (the B-spline in log distance,
+ * and the maximum over levels), one direction at a time, and prints for
+ * each pyramid: the median and p99 of |pyramid - exact| horizon angle over
+ * every cell and direction, the same of the sky-view factor (radiative,
  * SVF_MODEL's default), the time of each svf (horizons plus accumulation;
  * the pyramid's build included) on the C backend, and the memory each
  * keeps besides the DEM and the output.
@@ -81,13 +82,37 @@ typedef struct {
     ts_pyramid_opts pyr;
 } setup;
 
+/* One method's errors against exact and time. */
 typedef struct {
     hist hor, svf;
-    double t_exact, t_pyramid, t_build;
+    double t, t_build;
+    float *plane, *svf_acc;
+    ts_pyramid *pyr;
+} method;
+
+typedef struct {
+    method m[3]; /* exact, pyramid B-spline, pyramid max over levels */
     double bytes_pyramid;
 } result;
 
-/* Both methods over every direction of g; errors and times into r. */
+static const char *const NAMES[3] = {"exact", "pyramid (B-spline)", "pyramid (level max)"};
+
+/* One direction of method i into its plane and svf accumulator. */
+static void run_method(int i, method *m, const ts_grid *g, const float *nx, const float *ny,
+                       const float *nz, double az, const ts_horizon_opts *o, int dirs)
+{
+    ts_error err;
+    double t0 = now();
+    ts_status st = i == 0 ? ts_horizon_sweep(g, az, o, m->plane, &err)
+                          : ts_pyramid_horizon(m->pyr, az, o, m->plane, &err);
+    if (st != TS_OK ||
+        ts_sky_accumulate(g, nx, ny, nz, m->plane, az, dirs, m->svf_acc, NULL, NULL, &err) !=
+            TS_OK)
+        die(NAMES[i], &err);
+    m->t += now() - t0;
+}
+
+/* Every method over every direction of g; errors and times into r. */
 static void compare(const ts_grid *g, const setup *su, result *r)
 {
     size_t n = (size_t)g->width * g->height;
@@ -97,71 +122,87 @@ static void compare(const ts_grid *g, const setup *su, result *r)
     o.threads = su->threads;
     ts_error err;
     float *nx = malloc(n * sizeof *nx), *ny = malloc(n * sizeof *ny), *nz = malloc(n * sizeof *nz);
-    float *pe = malloc(n * sizeof *pe), *pp = malloc(n * sizeof *pp);
-    float *se = calloc(n, sizeof *se), *sp = calloc(n, sizeof *sp);
-    if (!nx || !ny || !nz || !pe || !pp || !se || !sp) {
+    if (!nx || !ny || !nz) {
         fprintf(stderr, "methods_bench: out of memory\n");
         exit(1);
     }
     if (ts_normals(g, nx, ny, nz, &err) != TS_OK)
         die("normals", &err);
-    hist_init(&r->hor, 1e-4);
-    hist_init(&r->svf, 1e-6);
-    double t0 = now();
-    ts_pyramid *pyr;
-    if (ts_pyramid_build(g, &su->pyr, su->threads, &pyr, &err) != TS_OK)
-        die("pyramid", &err);
-    r->t_build = now() - t0;
-    r->t_pyramid = r->t_build;
-    r->t_exact = 0;
+    for (int i = 0; i < 3; i++) {
+        method *m = &r->m[i];
+        memset(m, 0, sizeof *m);
+        hist_init(&m->hor, 1e-4);
+        hist_init(&m->svf, 1e-6);
+        m->plane = malloc(n * sizeof(float));
+        m->svf_acc = calloc(n, sizeof(float));
+        if (!m->plane || !m->svf_acc) {
+            fprintf(stderr, "methods_bench: out of memory\n");
+            exit(1);
+        }
+        if (i == 0)
+            continue;
+        ts_pyramid_opts po = su->pyr;
+        po.reconstruction = i == 1 ? TS_PYRAMID_BSPLINE : TS_PYRAMID_LEVEL_MAX;
+        double t0 = now();
+        if (ts_pyramid_build(g, &po, su->threads, &m->pyr, &err) != TS_OK)
+            die("pyramid", &err);
+        m->t = m->t_build = now() - t0;
+    }
     r->bytes_pyramid = ts_pyramid_bytes(g->width, g->height, su->pyr.level_step);
     for (int k = 0; k < su->dirs; k++) {
         double az = ts_horizon_azimuth(&o, k);
-        t0 = now();
-        if (ts_horizon_sweep(g, az, &o, pe, &err) != TS_OK ||
-            ts_sky_accumulate(g, nx, ny, nz, pe, az, su->dirs, se, NULL, NULL, &err) != TS_OK)
-            die("exact", &err);
-        double t1 = now();
-        if (ts_pyramid_horizon(pyr, az, &o, pp, &err) != TS_OK ||
-            ts_sky_accumulate(g, nx, ny, nz, pp, az, su->dirs, sp, NULL, NULL, &err) != TS_OK)
-            die("pyramid", &err);
-        double t2 = now();
-        r->t_exact += t1 - t0;
-        r->t_pyramid += t2 - t1;
-        for (size_t i = 0; i < n; i++)
-            if (pe[i] == pe[i] && pp[i] == pp[i])
-                hist_add(&r->hor, fabs((double)pe[i] - pp[i]));
+        for (int i = 0; i < 3; i++)
+            run_method(i, &r->m[i], g, nx, ny, nz, az, &o, su->dirs);
+        const float *pe = r->m[0].plane;
+        for (int i = 1; i < 3; i++)
+            for (size_t c = 0; c < n; c++)
+                if (pe[c] == pe[c] && r->m[i].plane[c] == r->m[i].plane[c])
+                    hist_add(&r->m[i].hor, fabs((double)pe[c] - r->m[i].plane[c]));
     }
-    t0 = now();
-    if (ts_sky_finish(g, su->dirs, se, NULL, NULL, &err) != TS_OK)
-        die("exact svf", &err);
-    r->t_exact += now() - t0;
-    t0 = now();
-    if (ts_sky_finish(g, su->dirs, sp, NULL, NULL, &err) != TS_OK)
-        die("pyramid svf", &err);
-    r->t_pyramid += now() - t0;
-    for (size_t i = 0; i < n; i++)
-        if (se[i] == se[i] && sp[i] == sp[i])
-            hist_add(&r->svf, fabs((double)se[i] - sp[i]));
-    ts_pyramid_free(pyr);
-    free(nx), free(ny), free(nz), free(pe), free(pp), free(se), free(sp);
+    for (int i = 0; i < 3; i++) {
+        double t0 = now();
+        if (ts_sky_finish(g, su->dirs, r->m[i].svf_acc, NULL, NULL, &err) != TS_OK)
+            die(NAMES[i], &err);
+        r->m[i].t += now() - t0;
+    }
+    const float *se = r->m[0].svf_acc;
+    for (int i = 1; i < 3; i++)
+        for (size_t c = 0; c < n; c++)
+            if (se[c] == se[c] && r->m[i].svf_acc[c] == r->m[i].svf_acc[c])
+                hist_add(&r->m[i].svf, fabs((double)se[c] - r->m[i].svf_acc[c]));
+    free(nx), free(ny), free(nz);
+}
+
+static void result_free(result *r)
+{
+    for (int i = 0; i < 3; i++) {
+        free(r->m[i].hor.count);
+        free(r->m[i].svf.count);
+        free(r->m[i].plane);
+        free(r->m[i].svf_acc);
+        ts_pyramid_free(r->m[i].pyr);
+    }
 }
 
 static void report(const char *name, const ts_grid *g, const setup *su, const result *r)
 {
     double dem_mib = (double)g->width * g->height * 4 / 1048576.0;
-    printf("%s %d x %d, %d directions, k=%g o=%g:\n", name, g->width, g->height, su->dirs,
-           su->pyr.level_step, su->pyr.offset);
-    printf("  horizon |pyramid - exact|: median %.3f p99 %.3f max %.2f deg\n",
-           hist_quantile(&r->hor, 0.5), hist_quantile(&r->hor, 0.99), r->hor.max);
-    printf("  svf     |pyramid - exact|: median %.4f p99 %.4f max %.3f\n",
-           hist_quantile(&r->svf, 0.5), hist_quantile(&r->svf, 0.99), r->svf.max);
-    printf("  svf time (C): exact %.3f s, pyramid %.3f s (build %.3f s) = %.2f x exact\n",
-           r->t_exact, r->t_pyramid, r->t_build, r->t_pyramid / r->t_exact);
-    printf("  memory besides DEM and output: exact 1 plane (%.1f MiB), pyramid %d levels "
-           "%.1f MiB (%.1f x DEM) + 1 plane\n",
-           dem_mib, ts_pyramid_level_count(g->width, g->height, su->pyr.level_step),
-           r->bytes_pyramid / 1048576.0, r->bytes_pyramid / 1048576.0 / dem_mib);
+    printf("%s %d x %d, %d directions, k=%g o=%g, %d levels:\n", name, g->width, g->height,
+           su->dirs, su->pyr.level_step, su->pyr.offset,
+           ts_pyramid_level_count(g->width, g->height, su->pyr.level_step));
+    printf("  %-20s svf time (C) %8.3f s\n", NAMES[0], r->m[0].t);
+    for (int i = 1; i < 3; i++) {
+        const method *m = &r->m[i];
+        printf("  %-20s svf time (C) %8.3f s (build %.3f s) = %.2f x exact; |horizon - exact| "
+               "median %.3f p99 %.3f max %.2f deg; |svf - exact| median %.4f p99 %.4f max "
+               "%.3f\n",
+               NAMES[i], m->t, m->t_build, m->t / r->m[0].t, hist_quantile(&m->hor, 0.5),
+               hist_quantile(&m->hor, 0.99), m->hor.max, hist_quantile(&m->svf, 0.5),
+               hist_quantile(&m->svf, 0.99), m->svf.max);
+    }
+    printf("  memory besides DEM, normals and output: exact one plane (%.1f MiB), pyramid "
+           "%.1f MiB (%.1f x DEM) + one plane\n",
+           dem_mib, r->bytes_pyramid / 1048576.0, r->bytes_pyramid / 1048576.0 / dem_mib);
     fflush(stdout);
 }
 
@@ -209,8 +250,7 @@ int main(int argc, char **argv)
         result r;
         compare(&g, &su, &r);
         report(name, &g, &su, &r);
-        free(r.hor.count);
-        free(r.svf.count);
+        result_free(&r);
         ts_grid_free(&g);
     }
     return 0;

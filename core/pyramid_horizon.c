@@ -29,6 +29,9 @@
 #include "status_internal.h"
 
 #define DEG2RAD (M_PI / 180.0)
+#ifndef CHUNK
+#define CHUNK 256 /* columns: 8 rows of every level fit in a core's L2 */
+#endif
 
 typedef struct {
     const ts_pyramid *P;
@@ -45,7 +48,7 @@ typedef struct {
 /* Per-thread rows of state, one entry per cell of the grid row. */
 typedef struct {
     float *s0, *s1, *s2; /* the last three samples (degrees, or tangents) */
-    float *m, *raw;      /* spline maximum so far; largest sample */
+    float *m;            /* spline maximum (or largest tangent) so far */
     float *T, *R;        /* the level row at the samples; at the cells */
     float *A;            /* the samples being pushed */
 } row_ws;
@@ -101,7 +104,7 @@ static int level_taps(const ts_pyramid *P, int lev, double row, int idx[4], doub
 /* Sample a (c >= 2) of cell x: the spline's midpoint before the last
  * sample and its last knot join the maximum. */
 static inline void spline_step(float *restrict s0, float *restrict s1, float *restrict s2,
-                               float *restrict m, float *restrict raw, int x, float a)
+                               float *restrict m, int x, float a)
 {
     float p0 = s0[x], p1 = s1[x], p2 = s2[x];
     a = a == a ? a : p2; /* nodata: the sample before */
@@ -111,7 +114,6 @@ static inline void spline_step(float *restrict s0, float *restrict s1, float *re
     mm = mid > mm ? mid : mm;
     mm = knot > mm ? knot : mm;
     m[x] = mm;
-    raw[x] = a > raw[x] ? a : raw[x];
     s0[x] = p1;
     s1[x] = p2;
     s2[x] = a;
@@ -123,7 +125,7 @@ TS_PYR_CLONES
 static void push_run(row_ws *w, int bspline, int c, int x0, int x1, const float *restrict a_in)
 {
     float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
-    float *restrict m = w->m, *restrict raw = w->raw;
+    float *restrict m = w->m;
     if (!bspline) {
 #pragma GCC ivdep
         for (int x = x0; x <= x1; x++)
@@ -132,10 +134,8 @@ static void push_run(row_ws *w, int bspline, int c, int x0, int x1, const float 
     }
     if (c == 0) {
 #pragma GCC ivdep
-        for (int x = x0; x <= x1; x++) {
+        for (int x = x0; x <= x1; x++)
             s2[x] = a_in[x];
-            raw[x] = a_in[x] > raw[x] ? a_in[x] : raw[x];
-        }
         return;
     }
     if (c == 1) {
@@ -146,13 +146,12 @@ static void push_run(row_ws *w, int bspline, int c, int x0, int x1, const float 
             s1[x] = s2[x];
             s2[x] = a;
             m[x] = s1[x] > m[x] ? s1[x] : m[x];
-            raw[x] = a > raw[x] ? a : raw[x];
         }
         return;
     }
 #pragma GCC ivdep
     for (int x = x0; x <= x1; x++)
-        spline_step(s0, s1, s2, m, raw, x, a_in[x]);
+        spline_step(s0, s1, s2, m, x, a_in[x]);
 }
 
 /* One level's samples for the cells of [x0, x1]: the level row T at x + ix
@@ -168,7 +167,7 @@ static int level_run(row_ws *w, const float *restrict T, int ix, float fx,
     const float *restrict r0 = r[0], *restrict r1 = r[1], *restrict r2 = r[2], *restrict r3 = r[3];
     const float w0 = wr[0], w1 = wr[1], w2 = wr[2], w3 = wr[3];
     float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
-    float *restrict m = w->m, *restrict raw = w->raw, *restrict A = w->A;
+    float *restrict m = w->m, *restrict A = w->A;
     const float gx = 1.0f - fx;
     const float *restrict Ta = T + ix; /* T[x + ix] defeats the vectoriser */
     if (bspline && c >= 2) {
@@ -176,7 +175,7 @@ static int level_run(row_ws *w, const float *restrict T, int ix, float fx,
         for (int x = x0; x <= x1; x++) {
             float h = gx * Ta[x] + fx * Ta[x + 1];
             float R = w0 * r0[x] + w1 * r1[x] + w2 * r2[x] + w3 * r3[x];
-            spline_step(s0, s1, s2, m, raw, x, ts_atan_deg((h - R) * inv_d - cd));
+            spline_step(s0, s1, s2, m, x, ts_atan_deg((h - R) * inv_d - cd));
         }
         return 1;
     }
@@ -237,7 +236,7 @@ static void sample_run(const hz_ctx *C, row_ws *w, int y, int lev, double dist, 
 TS_PYR_CLONES
 static void finish_run(row_ws *w, int bspline, int count, int x0, int x1, float *restrict out)
 {
-    float *restrict s1 = w->s1, *restrict s2 = w->s2, *restrict m = w->m, *restrict raw = w->raw;
+    float *restrict s1 = w->s1, *restrict s2 = w->s2, *restrict m = w->m;
     if (!bspline) {
 #pragma GCC ivdep
         for (int x = x0; x <= x1; x++)
@@ -255,9 +254,10 @@ static void finish_run(row_ws *w, int bspline, int count, int x0, int x1, float 
             m[x] = s2[x] > m[x] ? s2[x] : m[x];
     }
 #pragma GCC ivdep
+    /* no spline value where nodata left fewer than three samples: the last */
     for (int x = x0; x <= x1; x++) {
-        float r = m[x] > -INFINITY ? m[x] : raw[x];
-        out[x] = r > -INFINITY ? r : -90.0f;
+        float r = m[x] > -INFINITY ? m[x] : s2[x];
+        out[x] = r == r && r > -INFINITY ? r : -90.0f;
     }
 }
 
@@ -300,19 +300,20 @@ static void drop_run(const hz_ctx *C, row_ws *w, int y, int a, int b, double t_r
     finish_run(w, C->bspline, j + 1, a, b, out);
 }
 
-static void horizon_row(const hz_ctx *C, row_ws *w, int y)
+/* The cells [c0, c1) of row y. */
+static void horizon_row(const hz_ctx *C, row_ws *w, int y, int c0, int c1)
 {
     const ts_pyramid *P = C->P;
     const ts_grid *g = P->grid;
     const int W = g->width, H = g->height;
     float *out = C->out + (size_t)y * W;
-    for (int x = 0; x < W; x++)
-        w->m[x] = w->raw[x] = -INFINITY;
+    for (int x = c0; x < c1; x++)
+        w->m[x] = -INFINITY;
     /* where every ray of the row leaves the grid (top or bottom) or ends */
     double t_row = C->vy > 0 ? (H - 1 - y) / C->vy : C->vy < 0 ? y / -C->vy : INFINITY;
     if (C->cap > 0 && C->cap / C->step[y] < t_row)
         t_row = C->cap / C->step[y];
-    int pa = 0, pb = W - 1, j = 0;
+    int pa = c0, pb = c1 - 1, j = 0;
     for (; j < P->levels && pa <= pb; j++) {
         double s = P->level[j].spacing, ox = s * C->vx;
         int xa = C->vx < 0 ? (int)ceil(-ox) : 0;
@@ -347,7 +348,7 @@ static void horizon_row(const hz_ctx *C, row_ws *w, int y)
     if (pa <= pb) /* not reached: the coarsest spacing spans the grid */
         drop_run(C, w, y, pa, pb, t_row, j, out);
     const float *z = g->z + (ptrdiff_t)y * g->stride;
-    for (int x = 0; x < W; x++)
+    for (int x = c0; x < c1; x++)
         if (z[x] != z[x])
             out[x] = NAN;
 }
@@ -357,16 +358,19 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
     (void)worker;
     const hz_ctx *C = ctx;
     const int W = C->P->grid->width;
-    /* s0, s1, s2, m, raw, R: W each; T and the samples: W + 1 each */
-    float *buf = malloc((size_t)(8 * W + 2) * sizeof *buf);
+    /* s0, s1, s2, m, R: W each; T and the samples: W + 1 each */
+    float *buf = malloc((size_t)(7 * W + 2) * sizeof *buf);
     if (!buf) {
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
         return;
     }
-    row_ws w = {buf,         buf + W,     buf + 2 * W,        buf + 3 * W,
-                buf + 4 * W, buf + 6 * W, buf + 5 * W, buf + 7 * W + 1};
-    for (long y = y0; y < y1; y++)
-        horizon_row(C, &w, (int)y);
+    row_ws w = {buf, buf + W, buf + 2 * W, buf + 3 * W, buf + 5 * W, buf + 4 * W,
+                buf + 6 * W + 1};
+    /* a chunk of columns down the rows, then the next: the level rows that
+     * the cells of a chunk read stay in the cache from row to row */
+    for (int c0 = 0; c0 < W; c0 += CHUNK)
+        for (long y = y0; y < y1; y++)
+            horizon_row(C, &w, (int)y, c0, c0 + CHUNK < W ? c0 + CHUNK : W);
     free(buf);
 }
 

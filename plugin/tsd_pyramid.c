@@ -76,8 +76,9 @@ static ts_status note_backend(const tsd_compute_ctx *c)
     return TS_OK;
 }
 
-ts_status tsd_pyramid_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_plane_fn add,
-                             void *user)
+/* The planes of the pyramid read with `rec`, one at a time, to `add`. */
+static ts_status pyramid_run(const tsd_compute_ctx *c, const ts_grid *g,
+                             ts_pyramid_reconstruction rec, tsd_plane_fn add, void *user)
 {
     const tsd_options *o = c->opts;
     ts_horizon_opts h;
@@ -89,7 +90,7 @@ ts_status tsd_pyramid_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_pla
     ts_pyramid_opts_default(&po);
     po.level_step = o->pyramid_level_step;
     po.offset = o->pyramid_offset;
-    po.reconstruction = c->run->env ? TS_PYRAMID_LEVEL_MAX : TS_PYRAMID_BSPLINE;
+    po.reconstruction = rec;
     if ((st = note_backend(c)) != TS_OK)
         return st;
     ts_pyramid *pyr = NULL;
@@ -125,7 +126,13 @@ static ts_status copy_plane(void *user, const ts_grid *g, int k, double azimuth,
     return TS_OK;
 }
 
+ts_status tsd_pyramid_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_plane_fn add,
+                             void *user)
+{
+    return pyramid_run(c, g, TS_PYRAMID_LEVEL_MAX, add, user);
+}
+
 ts_status tsd_pyramid_planes(const tsd_compute_ctx *c, const ts_grid *g, float *out)
 {
-    return tsd_pyramid_stream(c, g, copy_plane, out);
+    return pyramid_run(c, g, TS_PYRAMID_BSPLINE, copy_plane, out);
 }

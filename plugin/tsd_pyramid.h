@@ -24,12 +24,15 @@ int tsd_options_check_pyramid(const tsd_options *o, char *msg, size_t msg_size);
 double tsd_pyramid_bytes(const tsd_options *o, int width, int height);
 
 /** tsd_compute_stream with pyramid horizons: the DIRECTIONS planes, one
- * at a time, to `add`. Environment light (ENV_MAP, SKY) takes the maximum
- * over the levels (S&N section 6), the other products the B-spline. */
+ * at a time, to `add`, for the products that integrate the sky over the
+ * directions (svf, sky, openness, envlight, shade's sky term): read as the
+ * maximum over the levels (S&N section 6, their environment light), as
+ * accurate there as the B-spline and twice as fast (docs/methods.md). */
 ts_status tsd_pyramid_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_plane_fn add,
                              void *user);
 
-/** The DIRECTIONS planes of PRODUCT=horizon into out. */
+/** The DIRECTIONS planes of PRODUCT=horizon into out: the B-spline in log
+ * distance and its maximum (S&N eq. 4-5). */
 ts_status tsd_pyramid_planes(const tsd_compute_ctx *c, const ts_grid *g, float *out);
 
 #ifdef __cplusplus
