@@ -131,7 +131,7 @@ static void compare(const ts_grid *g, const setup *su, result *r)
     for (int i = 0; i < 3; i++) {
         method *m = &r->m[i];
         memset(m, 0, sizeof *m);
-        hist_init(&m->hor, 1e-4);
+        hist_init(&m->hor, 1e-3);
         hist_init(&m->svf, 1e-6);
         m->plane = malloc(n * sizeof(float));
         m->svf_acc = calloc(n, sizeof(float));
