@@ -49,7 +49,7 @@ typedef struct {
 typedef struct {
     float *s0, *s1, *s2; /* the last three samples (degrees, or tangents) */
     float *m;            /* spline maximum (or largest tangent) so far */
-    float *T, *R;        /* the level row at the samples; at the cells */
+    float *T;            /* the level row at the samples */
     float *A;            /* the samples being pushed */
 } row_ws;
 
@@ -358,14 +358,13 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
     (void)worker;
     const hz_ctx *C = ctx;
     const int W = C->P->grid->width;
-    /* s0, s1, s2, m, R: W each; T and the samples: W + 1 each */
-    float *buf = malloc((size_t)(7 * W + 2) * sizeof *buf);
+    /* s0, s1, s2, m: W each; T and the samples: W + 1 each */
+    float *buf = malloc((size_t)(6 * W + 2) * sizeof *buf);
     if (!buf) {
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
         return;
     }
-    row_ws w = {buf, buf + W, buf + 2 * W, buf + 3 * W, buf + 5 * W, buf + 4 * W,
-                buf + 6 * W + 1};
+    row_ws w = {buf, buf + W, buf + 2 * W, buf + 3 * W, buf + 4 * W, buf + 5 * W + 1};
     /* a chunk of columns down the rows, then the next: the level rows that
      * the cells of a chunk read stay in the cache from row to row */
     for (int c0 = 0; c0 < W; c0 += CHUNK)

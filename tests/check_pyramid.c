@@ -263,6 +263,34 @@ START_TEST(test_threads_identical)
 }
 END_TEST
 
+/* MAX_DISTANCE: the rays end at the distance, where their last sample
+ * is; on jacksboro (curvature on) the capped pyramid stays as close to
+ * the capped sweep as the unbounded ones are to each other. */
+START_TEST(test_max_distance)
+{
+    ts_grid g;
+    tdem_load(&g, "jacksboro");
+    ts_horizon_opts o = hopts(8, 1);
+    o.max_distance = 1500;
+    size_t n = (size_t)g.width * g.height * o.directions;
+    ts_pyramid_opts p = popts(4, 0, TS_PYRAMID_BSPLINE);
+    float *ex = exact_planes(&g, &o), *py = pyramid_planes(&g, &p, &o);
+    err_stats d = diff_stats(ex, py, n);
+    o.max_distance = 0;
+    float *free_py = pyramid_planes(&g, &p, &o);
+    long changed = 0;
+    for (size_t i = 0; i < n; i++)
+        changed += fabsf(free_py[i] - py[i]) > 0.01f;
+    printf("jacksboro MAX_DISTANCE=1500 m: |pyramid - exact| median %.3f p99 %.3f deg; %ld "
+           "of %zu cell-directions differ from the unbounded pyramid\n",
+           d.median, d.p99, changed, n);
+    ck_assert_msg(d.median <= 2.0 && d.p99 <= 12.0, "median %g p99 %g", d.median, d.p99);
+    ck_assert_msg(changed > (long)(n / 20), "the distance changed only %ld values", changed);
+    free(ex), free(py), free(free_py);
+    ts_grid_free(&g);
+}
+END_TEST
+
 START_TEST(test_bad_input)
 {
     ts_pyramid_opts p;
@@ -329,6 +357,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_bspline_below_level_max);
     tcase_add_test(tc, test_flat_plane);
     tcase_add_test(tc, test_threads_identical);
+    tcase_add_test(tc, test_max_distance);
     tcase_add_test(tc, test_bad_input);
     suite_add_tcase(s, tc);
     return s;
