@@ -385,6 +385,89 @@ ts_status ts_shade_combine(const ts_grid *grid, const float *direct,
                            const float *sky, double sky_weight, float *out,
                            ts_error *err);
 
+/* ------------------------------------------------------ pyramid horizons */
+
+/*
+ * Approximate horizons from a multi-resolution pyramid (Snyder &
+ * Nowrouzezahrai 2008, sections 3-4; docs/methods.md). Level j has a
+ * spacing of s_j = b^j DEM cells, b = 2^(1/k) for a level step k, and is
+ * made from level j - 1 by bilinear decimation; level 0 is the DEM. Levels
+ * from 1 up are read through a bicubic B-spline (reconstructed once at
+ * every DEM column, then bilinear between columns, as the paper's section
+ * 6), level 0 bilinearly. For a cell and an azimuth, level j gives the
+ * multi-scale directional derivative at distance d_j = s_j steps of the
+ * ray: tan w_j = (f(x + d_j) - f(x) - c d_j^2) / d_j, both heights read on
+ * the same level, in metres (per-row geographic cell sizes, curvature c as
+ * the sweep). The horizon is the maximum of the cubic B-spline through the
+ * w_j in log distance, sampled at its knots and midpoints (eq. 4-5); or,
+ * cheaper, the maximum over the levels (section 6, for environment light).
+ * The last sample is where the ray leaves the DEM (or reaches
+ * max_distance), read on the DEM itself. Cost: O(levels) per cell and
+ * azimuth, wherever the occluder is. Signed degrees, NaN for nodata, -90
+ * where nothing lies beyond the cell, as ts_horizon_sweep.
+ */
+
+/** How the blocking angles of the levels become one horizon angle. */
+typedef enum {
+    /** Cubic B-spline in log distance, its maximum at knots and midpoints. */
+    TS_PYRAMID_BSPLINE = 0,
+    /** The maximum over the levels (no spline, one arctangent). */
+    TS_PYRAMID_LEVEL_MAX = 1
+} ts_pyramid_reconstruction;
+
+/** Options of the pyramid. Fill with ts_pyramid_opts_default. */
+typedef struct {
+    double level_step; /**< k in [1, 16]: levels per halving of resolution */
+    double offset;     /**< o in [0, 64]: sample j reads level
+                            max(0, floor(j - k o)) (finer, sharper), at the
+                            same distance */
+    ts_pyramid_reconstruction reconstruction;
+} ts_pyramid_opts;
+
+/** Defaults: k = 4, o = 0, B-spline. */
+void ts_pyramid_opts_default(ts_pyramid_opts *opts);
+
+/** Check pyramid options; the message names the offending field. */
+ts_status ts_pyramid_opts_validate(const ts_pyramid_opts *opts, ts_error *err);
+
+/** Number of levels of a width x height pyramid of level step k:
+ * ceil(k log2(max(width, height))) + 1, so that the coarsest level's
+ * spacing spans the grid. 0 if the arguments are invalid. */
+int ts_pyramid_level_count(int width, int height, double level_step);
+
+/** Bytes a width x height pyramid of level step k keeps (about
+ * 1 / (1 - 2^(-1/k)) times the DEM: 6.3 for k = 4). */
+double ts_pyramid_bytes(int width, int height, double level_step);
+
+/** A built pyramid (opaque). */
+typedef struct ts_pyramid ts_pyramid;
+
+/**
+ * Build the pyramid of `grid` (threads: 0 = all cores). The pyramid reads
+ * grid's heights and cell sizes later: keep the grid alive and unchanged
+ * until ts_pyramid_free.
+ */
+ts_status ts_pyramid_build(const ts_grid *grid, const ts_pyramid_opts *opts, int threads,
+                           ts_pyramid **out, ts_error *err);
+
+/** Free a pyramid (NULL is fine). */
+void ts_pyramid_free(ts_pyramid *pyr);
+
+/**
+ * Pyramid horizon for one azimuth into `out` (width*height, row stride =
+ * width), as ts_horizon_sweep: opts->curvature, refraction, max_distance
+ * and threads are used (and opts->edge, through ts_horizon_edge_apply, as
+ * the sweep), directions and start_azimuth ignored.
+ */
+ts_status ts_pyramid_horizon(const ts_pyramid *pyr, double azimuth,
+                             const ts_horizon_opts *opts, float *out, ts_error *err);
+
+/** Build a pyramid and compute opts->directions planes, as
+ * ts_horizon_compute (with its progress reports). */
+ts_status ts_pyramid_horizon_compute(const ts_grid *grid, const ts_pyramid_opts *popts,
+                                     const ts_horizon_opts *opts, float *out,
+                                     ts_error *err);
+
 /* ----------------------------------------------------------------- misc */
 
 /** Number of online CPU cores (>= 1). */

@@ -4,6 +4,7 @@
 
 #include "tsd_compute_env.h"
 #include "tsd_products.h"
+#include "tsd_pyramid.h"
 #include "tsd_text.h"
 
 #include <math.h>
@@ -108,6 +109,8 @@ ts_status tsd_compute_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_pla
     ts_error err;
     ts_status st;
     tsd_compute_horizon_opts(c, &h);
+    if (c->opts->horizon_method == TSD_HORIZON_PYRAMID)
+        return tsd_pyramid_stream(c, g, add, user);
     float *plane = malloc(cells * sizeof(float));
     if (!plane)
         return oom(c, "a horizon plane");
@@ -330,6 +333,8 @@ TSD_COMPUTE_FN(tsd_compute_horizon)
     ts_horizon_opts h;
     ts_error err;
     ts_backend_report rep = {0};
+    if (c->opts->horizon_method == TSD_HORIZON_PYRAMID)
+        return tsd_pyramid_planes(c, r->dem, out);
     tsd_compute_horizon_opts(c, &h);
     if (NOTE(c, ts_backend_horizon_compute(BK(c), r->dem, &h, out, &rep, &err), rep) != TS_OK)
         return core_fail(c, &err);

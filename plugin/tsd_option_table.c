@@ -212,6 +212,23 @@ const opt_def TSD_OPTION_ROWS[] = {
      "CURVATURE and REFRACTION: nothing below the Earth's horizon lights a "
      "cell), open (an open sky down to -90 degrees) or nodata (such cells are "
      "nodata)"},
+    /* pyramid horizons (tsd_pyramid.c, docs/methods.md) */
+    {"HORIZON_METHOD", K_SELECT, FIELD(horizon_method), "exact", 0, 0, 0, 0, "exact|pyramid",
+     1, P, LISTED, NULL,
+     "How the horizons of horizon, svf, openness, sky, envlight and the sky term "
+     "of shade are found: exact (the sweep) or pyramid (Snyder & Nowrouzezahrai "
+     "2008: a multi-resolution pyramid, approximate, smoother with distance; "
+     "PYRAMID_LEVEL_STEP, PYRAMID_OFFSET; runs on the C backend)"},
+    {"PYRAMID_LEVEL_STEP", K_FLOAT, FIELD(pyramid_level_step), "4", 1, 16, 0, 1, NULL, 1, P,
+     LISTED, NULL,
+     "HORIZON_METHOD=pyramid: level step k, the pyramid's levels per halving of "
+     "resolution (b = 2^(1/k)), 1 (power of 2) to 16; more levels are smoother "
+     "and slower"},
+    {"PYRAMID_OFFSET", K_FLOAT, FIELD(pyramid_offset), "0", 0, 64, 0, 1, NULL, 1, P, LISTED,
+     NULL,
+     "HORIZON_METHOD=pyramid: level offset o, 0 to 64: each distance reads the "
+     "level k*o finer, so horizons are sharper and closer to exact (docs/methods.md "
+     "gives the error per offset)"},
     /* options of atlas files (*.tsa) only */
     {"SHADOWS", K_SELECT, FIELD(shadows_all), "far", 0, 0, 0, 0, "far|all", 0, A, LISTED,
      NULL,
@@ -232,6 +249,7 @@ _Static_assert(sizeof TSD_OPTION_ROWS / sizeof TSD_OPTION_ROWS[0] <= 64, "too ma
 _Static_assert(sizeof(tsd_method) == sizeof(int) && sizeof(tsd_output_type) == sizeof(int) &&
                    sizeof(tsd_sun_position) == sizeof(int) &&
                    sizeof(tsd_backend) == sizeof(int) &&
+                   sizeof(tsd_horizon_method) == sizeof(int) &&
                    sizeof(tsd_progress_mode) == sizeof(int),
                "enum options are int-sized");
 

@@ -30,6 +30,8 @@ extern "C" {
 typedef enum { TSD_SUN_CENTER = 0, TSD_SUN_PER_CELL } tsd_sun_position;
 typedef enum { TSD_PROGRESS_AUTO = 0, TSD_PROGRESS_YES, TSD_PROGRESS_NO } tsd_progress_mode;
 typedef enum { TSD_METHOD_EXACT = 0, TSD_METHOD_SHM } tsd_method;
+/* HORIZON_METHOD: the exact sweep or pyramid horizons (tsd_pyramid.h). */
+typedef enum { TSD_HORIZON_EXACT = 0, TSD_HORIZON_PYRAMID } tsd_horizon_method;
 typedef enum { TSD_OUT_AUTO = 0, TSD_OUT_BYTE, TSD_OUT_FLOAT32 } tsd_output_type;
 /* BACKEND: where the heavy core calls run (cl/terrashade_backend.h). */
 typedef enum { TSD_BACKEND_AUTO = 0, TSD_BACKEND_OPENCL, TSD_BACKEND_C } tsd_backend;
@@ -93,6 +95,9 @@ typedef struct {
     int svf_model;           /* SVF_MODEL: a ts_svf_model (0 radiative, 1 solid_angle) */
     int openness_negative;   /* OPENNESS: 0 = positive, 1 = negative */
     int edge;                /* EDGE: 0 = horizon, 1 = open, 2 = nodata (tsd_options_edge) */
+    tsd_horizon_method horizon_method; /* HORIZON_METHOD: exact or pyramid */
+    double pyramid_level_step; /* PYRAMID_LEVEL_STEP: k, b = 2^(1/k) */
+    double pyramid_offset;     /* PYRAMID_OFFSET: level offset o */
     /* options of far-shadow atlas files (*.tsa) */
     int shadows_all;         /* SHADOWS: 0 = far, 1 = all */
     char dem[TSD_PATH_MAX];  /* DEM: "" = the atlas's SOURCE_DEM */

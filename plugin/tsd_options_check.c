@@ -3,6 +3,7 @@
 
 #include "day_cycle.h"
 #include "tsd_products.h"
+#include "tsd_pyramid.h"
 #include "tsd_sun.h"
 #include "tsd_text.h"
 
@@ -216,5 +217,7 @@ int tsd_options_check(const tsd_options *o, char *msg, size_t n)
                     "start at FAR_THRESHOLD cells and have no end)", pn);
     if (o->sun_position == TSD_SUN_PER_CELL && !from_time)
         REFUSE("SUN_POSITION=per_cell needs the sun from DATETIME or DATE");
+    if (tsd_options_check_pyramid(o, msg, n) != 0)
+        return -1;
     return check_environment(o, msg, n);
 }

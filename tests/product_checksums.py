@@ -113,6 +113,16 @@ YEAR_VARIANTS = {
                          "HORIZON_DIRECTIONS": "32"},
 }
 
+# Pyramid horizons (HORIZON_METHOD=pyramid, docs/methods.md): printed after
+# the above.
+PYRAMID_VARIANTS = {
+    "horizon_pyramid": {"DIRECTIONS": "8", "START_AZIMUTH": "10", "HORIZON_METHOD": "pyramid",
+                        "PYRAMID_OFFSET": "1"},
+    "svf_pyramid": {"DIRECTIONS": "16", "HORIZON_METHOD": "pyramid"},
+    "envlight_pyramid": {"SKY": "uniform", "DIRECTIONS": "8", "HORIZON_METHOD": "pyramid",
+                         "PYRAMID_LEVEL_STEP": "2"},
+}
+
 
 def fractal_dem(path, n=512, seed=7):
     """Spectral-synthesis fractal (beta 2.2), 30 m cells, UTM 33N."""
@@ -190,7 +200,8 @@ def main():
     fractal = os.path.join(tmp, "fractal.tif")
     fractal_dem(fractal)
     dems = {"jacksboro": T.JACKSBORO, "lux": T.LUX, "fractal": fractal}
-    variants = dict(VARIANTS, **ENV_VARIANTS, **YEAR_VARIANTS, **EDGE_VARIANTS)
+    variants = dict(VARIANTS, **ENV_VARIANTS, **YEAR_VARIANTS, **EDGE_VARIANTS,
+                    **PYRAMID_VARIANTS)
     edge_products = takes_edge()
     names = args.only.split(",") if args.only else list(variants)
     if args.save:
@@ -199,7 +210,7 @@ def main():
     crossed = []
     # the variants of the first group come first in the record, each group
     # DEM by DEM, so that added groups append lines to it
-    for group in (VARIANTS, ENV_VARIANTS, YEAR_VARIANTS, EDGE_VARIANTS):
+    for group in (VARIANTS, ENV_VARIANTS, YEAR_VARIANTS, EDGE_VARIANTS, PYRAMID_VARIANTS):
         for dem_name, dem in dems.items():
             kept = {}
             for backend in args.backends.split(","):

@@ -140,8 +140,8 @@ static void check_sentences(void)
                     "TIMEZONE, STEP_MINUTES, DAY_INTERVAL, HORIZON_DIRECTIONS, PRESSURE, TEMPERATURE, DELTA_T, SUN_POSITION, "
                     "LINKE_TURBIDITY, FAR_THRESHOLD, ATLAS_STEPS, BACKEND, SUNHOURS_RULE, "
                     "PROGRESS, ENV_MAP, ENV_ROTATION, SKY, ENV_HORIZON_STEPS, "
-                    "ENV_NORMAL_STEPS, EXPOSURE, SVF_MODEL, OPENNESS, EDGE (see gdalinfo "
-                    "--format TERRASHADE)");
+                    "ENV_NORMAL_STEPS, EXPOSURE, SVF_MODEL, OPENNESS, EDGE, HORIZON_METHOD, "
+                    "PYRAMID_LEVEL_STEP, PYRAMID_OFFSET (see gdalinfo --format TERRASHADE)");
     expect_sentence(0, "EDGE=foo", "EDGE must be one of horizon, open, nodata, got 'foo'");
     expect_sentence(0, "Z_FACTOR=0", "Z_FACTOR must be greater than 0 and at most 1e+06, got 0");
     expect_sentence(0, "Z_FACTOR=feet", "Z_FACTOR must be AUTO or a number, got 'feet'");

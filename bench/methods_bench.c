@@ -1,0 +1,257 @@
+/*
+ * methods_bench: the approximate horizon methods against the exact sweep,
+ * error and time side by side (docs/methods.md).
+ *
+ *   methods_bench [--size N] [--dirs D] [--threads T] [--level-step K]
+ *                 [--offset O] [--dems jacksboro,lux_elev,fractal]
+ *
+ * For each DEM (the real ones of tests/data, and an N x N fractal: fBm
+ * value noise, Hurst 0.8, 1500 m relief, 10 m cells, as ts_bench) it
+ * computes the D horizon planes with the exact sweep and with the pyramid
+ * (level step K, offset O) read both ways (the B-spline in log distance,
+ * and the maximum over levels), one direction at a time, and prints for
+ * each pyramid: the median and p99 of |pyramid - exact| horizon angle over
+ * every cell and direction, the same of the sky-view factor (radiative,
+ * SVF_MODEL's default), the time of each svf (horizons plus accumulation;
+ * the pyramid's build included) on the C backend, and the memory each
+ * keeps besides the DEM and the output.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "terrashade.h"
+#include "test_dem.h"
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static void die(const char *what, const ts_error *e)
+{
+    fprintf(stderr, "methods_bench: %s: %s\n", what, e->message);
+    exit(1);
+}
+
+/* |error| histogram: median and p99 without keeping every value. */
+#define BINS 200000
+typedef struct {
+    double width; /* bin width */
+    long *count;
+    long n;
+    double max;
+} hist;
+
+static void hist_init(hist *h, double width)
+{
+    h->width = width;
+    h->count = calloc(BINS, sizeof *h->count);
+    h->n = 0;
+    h->max = 0;
+    if (!h->count) {
+        fprintf(stderr, "methods_bench: out of memory\n");
+        exit(1);
+    }
+}
+
+static void hist_add(hist *h, double e)
+{
+    long b = (long)(e / h->width);
+    h->count[b < BINS - 1 ? b : BINS - 1]++;
+    h->n++;
+    h->max = e > h->max ? e : h->max;
+}
+
+/* The upper edge of the bin holding quantile q. */
+static double hist_quantile(const hist *h, double q)
+{
+    long want = (long)ceil(q * h->n), seen = 0;
+    for (long b = 0; b < BINS; b++)
+        if ((seen += h->count[b]) >= want && want > 0)
+            return (b + 1) * h->width;
+    return h->max;
+}
+
+typedef struct {
+    int dirs, threads;
+    ts_pyramid_opts pyr;
+} setup;
+
+/* One method's errors against exact and time. */
+typedef struct {
+    hist hor, svf;
+    double t, t_build;
+    float *plane, *svf_acc;
+    ts_pyramid *pyr;
+} method;
+
+typedef struct {
+    method m[3]; /* exact, pyramid B-spline, pyramid max over levels */
+    double bytes_pyramid;
+} result;
+
+static const char *const NAMES[3] = {"exact", "pyramid (B-spline)", "pyramid (level max)"};
+
+/* One direction of method i into its plane and svf accumulator. */
+static void run_method(int i, method *m, const ts_grid *g, const float *nx, const float *ny,
+                       const float *nz, double az, const ts_horizon_opts *o, int dirs)
+{
+    ts_error err;
+    double t0 = now();
+    ts_status st = i == 0 ? ts_horizon_sweep(g, az, o, m->plane, &err)
+                          : ts_pyramid_horizon(m->pyr, az, o, m->plane, &err);
+    if (st != TS_OK ||
+        ts_sky_accumulate(g, nx, ny, nz, m->plane, az, dirs, m->svf_acc, NULL, NULL, &err) !=
+            TS_OK)
+        die(NAMES[i], &err);
+    m->t += now() - t0;
+}
+
+/* Every method over every direction of g; errors and times into r. */
+static void compare(const ts_grid *g, const setup *su, result *r)
+{
+    size_t n = (size_t)g->width * g->height;
+    ts_horizon_opts o;
+    ts_horizon_opts_default(&o);
+    o.directions = su->dirs;
+    o.threads = su->threads;
+    ts_error err;
+    float *nx = malloc(n * sizeof *nx), *ny = malloc(n * sizeof *ny), *nz = malloc(n * sizeof *nz);
+    if (!nx || !ny || !nz) {
+        fprintf(stderr, "methods_bench: out of memory\n");
+        exit(1);
+    }
+    if (ts_normals(g, nx, ny, nz, &err) != TS_OK)
+        die("normals", &err);
+    for (int i = 0; i < 3; i++) {
+        method *m = &r->m[i];
+        memset(m, 0, sizeof *m);
+        hist_init(&m->hor, 1e-3);
+        hist_init(&m->svf, 1e-6);
+        m->plane = malloc(n * sizeof(float));
+        m->svf_acc = calloc(n, sizeof(float));
+        if (!m->plane || !m->svf_acc) {
+            fprintf(stderr, "methods_bench: out of memory\n");
+            exit(1);
+        }
+        if (i == 0)
+            continue;
+        ts_pyramid_opts po = su->pyr;
+        po.reconstruction = i == 1 ? TS_PYRAMID_BSPLINE : TS_PYRAMID_LEVEL_MAX;
+        double t0 = now();
+        if (ts_pyramid_build(g, &po, su->threads, &m->pyr, &err) != TS_OK)
+            die("pyramid", &err);
+        m->t = m->t_build = now() - t0;
+    }
+    r->bytes_pyramid = ts_pyramid_bytes(g->width, g->height, su->pyr.level_step);
+    for (int k = 0; k < su->dirs; k++) {
+        double az = ts_horizon_azimuth(&o, k);
+        for (int i = 0; i < 3; i++)
+            run_method(i, &r->m[i], g, nx, ny, nz, az, &o, su->dirs);
+        const float *pe = r->m[0].plane;
+        for (int i = 1; i < 3; i++)
+            for (size_t c = 0; c < n; c++)
+                if (pe[c] == pe[c] && r->m[i].plane[c] == r->m[i].plane[c])
+                    hist_add(&r->m[i].hor, fabs((double)pe[c] - r->m[i].plane[c]));
+    }
+    for (int i = 0; i < 3; i++) {
+        double t0 = now();
+        if (ts_sky_finish(g, su->dirs, r->m[i].svf_acc, NULL, NULL, &err) != TS_OK)
+            die(NAMES[i], &err);
+        r->m[i].t += now() - t0;
+    }
+    const float *se = r->m[0].svf_acc;
+    for (int i = 1; i < 3; i++)
+        for (size_t c = 0; c < n; c++)
+            if (se[c] == se[c] && r->m[i].svf_acc[c] == r->m[i].svf_acc[c])
+                hist_add(&r->m[i].svf, fabs((double)se[c] - r->m[i].svf_acc[c]));
+    free(nx), free(ny), free(nz);
+}
+
+static void result_free(result *r)
+{
+    for (int i = 0; i < 3; i++) {
+        free(r->m[i].hor.count);
+        free(r->m[i].svf.count);
+        free(r->m[i].plane);
+        free(r->m[i].svf_acc);
+        ts_pyramid_free(r->m[i].pyr);
+    }
+}
+
+static void report(const char *name, const ts_grid *g, const setup *su, const result *r)
+{
+    double dem_mib = (double)g->width * g->height * 4 / 1048576.0;
+    printf("%s %d x %d, %d directions, k=%g o=%g, %d levels:\n", name, g->width, g->height,
+           su->dirs, su->pyr.level_step, su->pyr.offset,
+           ts_pyramid_level_count(g->width, g->height, su->pyr.level_step));
+    printf("  %-20s svf time (C) %8.3f s\n", NAMES[0], r->m[0].t);
+    for (int i = 1; i < 3; i++) {
+        const method *m = &r->m[i];
+        printf("  %-20s svf time (C) %8.3f s (build %.3f s) = %.2f x exact; |horizon - exact| "
+               "median %.3f p99 %.3f max %.2f deg; |svf - exact| median %.4f p99 %.4f max "
+               "%.3f\n",
+               NAMES[i], m->t, m->t_build, m->t / r->m[0].t, hist_quantile(&m->hor, 0.5),
+               hist_quantile(&m->hor, 0.99), m->hor.max, hist_quantile(&m->svf, 0.5),
+               hist_quantile(&m->svf, 0.99), m->svf.max);
+    }
+    printf("  memory besides DEM, normals and output: exact one plane (%.1f MiB), pyramid "
+           "%.1f MiB (%.1f x DEM) + one plane\n",
+           dem_mib, r->bytes_pyramid / 1048576.0, r->bytes_pyramid / 1048576.0 / dem_mib);
+    fflush(stdout);
+}
+
+int main(int argc, char **argv)
+{
+    int size = 4096;
+    char dems[256] = "jacksboro,lux_elev,fractal";
+    setup su;
+    su.dirs = 64;
+    su.threads = 0;
+    ts_pyramid_opts_default(&su.pyr);
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--size") && i + 1 < argc)
+            size = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--dirs") && i + 1 < argc)
+            su.dirs = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--threads") && i + 1 < argc)
+            su.threads = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--level-step") && i + 1 < argc)
+            su.pyr.level_step = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--offset") && i + 1 < argc)
+            su.pyr.offset = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--dems") && i + 1 < argc)
+            snprintf(dems, sizeof dems, "%s", argv[++i]);
+        else {
+            fprintf(stderr, "usage: methods_bench [--size N] [--dirs D] [--threads T] "
+                            "[--level-step K] [--offset O] [--dems a,b,fractal]\n");
+            return 2;
+        }
+    }
+    ts_error err;
+    if (ts_pyramid_opts_validate(&su.pyr, &err) != TS_OK)
+        die("options", &err);
+    for (char *name = strtok(dems, ","); name; name = strtok(NULL, ",")) {
+        ts_grid g;
+        char msg[256];
+        if (!strcmp(name, "fractal")) {
+            if (ts_grid_create(&g, size, size, 10.0, 10.0, &err) != TS_OK)
+                die("grid", &err);
+            tdem_fbm(&g, 1234, 0.8, 1500.0);
+        } else if (tdem_read(&g, name, NULL, NULL, msg, sizeof msg) != 0) {
+            fprintf(stderr, "methods_bench: %s\n", msg);
+            return 1;
+        }
+        result r;
+        compare(&g, &su, &r);
+        report(name, &g, &su, &r);
+        result_free(&r);
+        ts_grid_free(&g);
+    }
+    return 0;
+}

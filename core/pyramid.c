@@ -1,0 +1,248 @@
+/*
+ * The multi-resolution pyramid of Snyder & Nowrouzezahrai (2008), built for
+ * pyramid horizons (pyramid_horizon.c): levels of spacing b^j cells,
+ * b = 2^(1/k), each decimated bilinearly from the one before, then
+ * reconstructed along x at every DEM column with the cubic B-spline
+ * (pyramid_internal.h says how the levels are laid out).
+ *
+ * Nodata: a decimated sample is the weighted mean of the valid samples
+ * under its bilinear footprint, and nodata when less than half of that
+ * footprint (carried down as a coverage fraction) is valid, so that holes
+ * neither grow nor fill in as the levels coarsen. The B-spline
+ * reconstruction renormalises the same way.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "parallel.h"
+#include "pyramid_internal.h"
+#include "status_internal.h"
+
+#define MAX_LEVEL_STEP 16.0
+#define MAX_OFFSET 64.0
+
+void ts_pyramid_opts_default(ts_pyramid_opts *opts)
+{
+    if (!opts)
+        return;
+    opts->level_step = 4.0;
+    opts->offset = 0.0;
+    opts->reconstruction = TS_PYRAMID_BSPLINE;
+}
+
+ts_status ts_pyramid_opts_validate(const ts_pyramid_opts *opts, ts_error *err)
+{
+    if (!opts)
+        return ts_fail(err, TS_ERR_ARG, "pyramid options are NULL");
+    if (!(opts->level_step >= 1 && opts->level_step <= MAX_LEVEL_STEP))
+        return ts_fail(err, TS_ERR_ARG,
+                       "pyramid level step k must be between 1 (a power-of-2 pyramid) and "
+                       "%g (b = 2^(1/k) levels per halving), got %g",
+                       MAX_LEVEL_STEP, opts->level_step);
+    if (!(opts->offset >= 0 && opts->offset <= MAX_OFFSET))
+        return ts_fail(err, TS_ERR_ARG,
+                       "pyramid level offset o must be between 0 and %g (levels of k o finer), "
+                       "got %g",
+                       MAX_OFFSET, opts->offset);
+    if (opts->reconstruction != TS_PYRAMID_BSPLINE &&
+        opts->reconstruction != TS_PYRAMID_LEVEL_MAX)
+        return ts_fail(err, TS_ERR_ARG,
+                       "pyramid reconstruction must be TS_PYRAMID_BSPLINE or "
+                       "TS_PYRAMID_LEVEL_MAX, got %d",
+                       (int)opts->reconstruction);
+    return ts_ok(err);
+}
+
+int ts_pyramid_level_count(int width, int height, double level_step)
+{
+    if (width < 1 || height < 1 || !(level_step >= 1 && level_step <= MAX_LEVEL_STEP))
+        return 0;
+    int n = width > height ? width : height;
+    return (int)ceil(level_step * log2((double)n) - 1e-9) + 1;
+}
+
+/* Samples of a level of spacing s along an axis of n DEM cells: enough
+ * that the last sample centre reaches the last cell. */
+static int level_size(int n, double s)
+{
+    int m = (int)ceil((n - 0.5) / s + 0.5 - 1e-9);
+    return m < 1 ? 1 : m;
+}
+
+static double spacing(double level_step, int j)
+{
+    return exp2(j / level_step);
+}
+
+double ts_pyramid_bytes(int width, int height, double level_step)
+{
+    int levels = ts_pyramid_level_count(width, height, level_step);
+    double rows = 0;
+    for (int j = 1; j < levels; j++)
+        rows += level_size(height, spacing(level_step, j));
+    return rows * width * sizeof(float);
+}
+
+/* A level before reconstruction: its samples and their valid fraction. */
+typedef struct {
+    int w, h;
+    double s;
+    float *z, *cov;
+} coarse;
+
+typedef struct {
+    const coarse *src;
+    coarse *dst;
+} decimate_ctx;
+
+/* Rows [r0, r1) of dst from src by bilinear decimation. */
+static void decimate_rows(void *ctx, int worker, long r0, long r1)
+{
+    (void)worker;
+    const decimate_ctx *C = ctx;
+    const coarse *S = C->src;
+    coarse *D = C->dst;
+    const double ratio = D->s / S->s;
+    for (long r = r0; r < r1; r++) {
+        int ry[4], rx[4];
+        double wy[4], wx[4];
+        int ny = ts_pyr_taps((r + 0.5) * ratio - 0.5, S->h, 1, ry, wy);
+        for (int i = 0; i < D->w; i++) {
+            int nx = ts_pyr_taps((i + 0.5) * ratio - 0.5, S->w, 1, rx, wx);
+            double sum = 0, wsum = 0, cov = 0;
+            for (int a = 0; a < ny; a++)
+                for (int b = 0; b < nx; b++) {
+                    double w = wy[a] * wx[b];
+                    size_t k = (size_t)ry[a] * S->w + rx[b];
+                    float z = S->z[k];
+                    if (z != z)
+                        continue;
+                    sum += w * z;
+                    wsum += w;
+                    cov += w * (S->cov ? S->cov[k] : 1.0);
+                }
+            size_t o = (size_t)r * D->w + i;
+            D->cov[o] = (float)cov;
+            D->z[o] = cov >= 0.5 && wsum > 0 ? (float)(sum / wsum) : NAN;
+        }
+    }
+}
+
+typedef struct {
+    const coarse *lv;
+    float *hu;
+    int width;
+    const int *idx;       /* width x 4 column taps */
+    const double *w;      /* width x 4 weights */
+} recon_ctx;
+
+/* Rows [r0, r1) of a level reconstructed at every DEM column. */
+static void reconstruct_rows(void *ctx, int worker, long r0, long r1)
+{
+    (void)worker;
+    const recon_ctx *C = ctx;
+    for (long r = r0; r < r1; r++) {
+        const float *src = C->lv->z + (size_t)r * C->lv->w;
+        float *dst = C->hu + (size_t)r * C->width;
+        for (int x = 0; x < C->width; x++) {
+            const int *ix = C->idx + 4 * (size_t)x;
+            const double *w = C->w + 4 * (size_t)x;
+            double sum = 0, wsum = 0;
+            for (int t = 0; t < 4; t++) {
+                float z = src[ix[t]];
+                if (z == z)
+                    sum += w[t] * z, wsum += w[t];
+            }
+            dst[x] = wsum >= 0.5 ? (float)(sum / wsum) : NAN;
+        }
+    }
+}
+
+void ts_pyramid_free(ts_pyramid *pyr)
+{
+    if (!pyr)
+        return;
+    for (int j = 0; pyr->level && j < pyr->levels; j++)
+        free(pyr->level[j].hu);
+    free(pyr->level);
+    free(pyr);
+}
+
+/* Level j's reconstruction from its samples; 0 when out of memory. */
+static int reconstruct(ts_pyramid *P, const coarse *lv, int j, int threads, ts_error *err)
+{
+    const int W = P->grid->width;
+    int *idx = malloc((size_t)W * 4 * sizeof *idx);
+    double *w = malloc((size_t)W * 4 * sizeof *w);
+    P->level[j].hu = malloc((size_t)lv->h * W * sizeof(float));
+    if (!idx || !w || !P->level[j].hu) {
+        free(idx);
+        free(w);
+        return 0;
+    }
+    for (int x = 0; x < W; x++)
+        ts_pyr_taps((x + 0.5) / lv->s - 0.5, lv->w, 0, idx + 4 * (size_t)x, w + 4 * (size_t)x);
+    recon_ctx rc = {lv, P->level[j].hu, W, idx, w};
+    ts_parallel_for(ts_thread_count(threads, lv->h), lv->h, reconstruct_rows, &rc, err);
+    free(idx);
+    free(w);
+    return 1;
+}
+
+ts_status ts_pyramid_build(const ts_grid *grid, const ts_pyramid_opts *opts, int threads,
+                           ts_pyramid **out, ts_error *err)
+{
+    if (!out)
+        return ts_fail(err, TS_ERR_ARG, "pyramid output pointer is NULL");
+    *out = NULL;
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK || (st = ts_pyramid_opts_validate(opts, err)) != TS_OK)
+        return st;
+    if (threads < 0)
+        return ts_fail(err, TS_ERR_ARG, "threads must be 0 (all cores) or more, got %d",
+                       threads);
+    ts_pyramid *P = calloc(1, sizeof *P);
+    if (!P)
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the pyramid");
+    P->grid = grid;
+    P->opts = *opts;
+    P->levels = ts_pyramid_level_count(grid->width, grid->height, opts->level_step);
+    P->level = calloc((size_t)P->levels, sizeof *P->level);
+    if (!P->level) {
+        ts_pyramid_free(P);
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the pyramid");
+    }
+    /* level 0 is the DEM: a dense copy to decimate from */
+    const int W = grid->width, H = grid->height;
+    coarse prev = {W, H, 1.0, malloc((size_t)W * H * sizeof(float)), NULL};
+    P->level[0] = (ts_pyr_level){1.0, H, NULL};
+    int ok = prev.z != NULL;
+    for (int y = 0; ok && y < H; y++)
+        memcpy(prev.z + (size_t)y * W, grid->z + (ptrdiff_t)y * grid->stride,
+               (size_t)W * sizeof(float));
+    for (int j = 1; ok && j < P->levels; j++) {
+        double s = spacing(opts->level_step, j);
+        coarse cur = {level_size(W, s), level_size(H, s), s, NULL, NULL};
+        cur.z = malloc((size_t)cur.w * cur.h * sizeof(float));
+        cur.cov = malloc((size_t)cur.w * cur.h * sizeof(float));
+        if ((ok = cur.z && cur.cov)) {
+            decimate_ctx dc = {&prev, &cur};
+            ts_parallel_for(ts_thread_count(threads, cur.h), cur.h, decimate_rows, &dc, err);
+            P->level[j] = (ts_pyr_level){s, cur.h, NULL};
+            ok = reconstruct(P, &cur, j, threads, err);
+        }
+        free(prev.z);
+        free(prev.cov);
+        prev = cur;
+    }
+    free(prev.z);
+    free(prev.cov);
+    if (!ok) {
+        ts_pyramid_free(P);
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the pyramid's levels (%.0f MiB)",
+                       ts_pyramid_bytes(W, H, opts->level_step) / 1048576.0);
+    }
+    *out = P;
+    return ts_ok(err);
+}

@@ -1,0 +1,436 @@
+/*
+ * Pyramid horizons (Snyder & Nowrouzezahrai 2008, sections 4 and 6) from a
+ * pyramid of ts_pyramid_build; terrashade.h states the method.
+ *
+ * For one azimuth every cell's ray has the same direction, so sample j of
+ * every cell lies at the same offset (s_j vx, s_j vy) cells from it: along
+ * a grid row the samples are a contiguous run of a level row at constant
+ * weights, and the blocking angles of a whole row come from a few loops
+ * the compiler vectorises. Level j's samples exist for the cells whose ray
+ * has not yet left the DEM at distance s_j; these runs shrink from level
+ * to level, and a cell that drops out gets its last sample where its ray
+ * leaves the DEM (or reaches the maximum distance), read on the DEM, then
+ * its horizon.
+ *
+ * The B-spline of the samples w_0..w_{M-1} in log distance is evaluated at
+ * its knots (weights 1/6, 2/3, 1/6) and midpoints (1/48, 23/48, 23/48,
+ * 1/48), with linear extrapolation beyond the ends (w_{-1} = 2 w_0 - w_1),
+ * so that the end knots are w_0 and w_{M-1} themselves and no value
+ * exceeds the largest sample. A sample that touches nodata is no
+ * occluder: it repeats the sample before it.
+ */
+#include <math.h>
+#include <stdlib.h>
+
+#include "arg_checks.h"
+#include "cellmath/cm_fastmath.h"
+#include "parallel.h"
+#include "pyramid_internal.h"
+#include "status_internal.h"
+
+#define DEG2RAD (M_PI / 180.0)
+#ifndef CHUNK
+#define CHUNK 256 /* columns: 8 rows of every level fit in a core's L2 */
+#endif
+
+typedef struct {
+    const ts_pyramid *P;
+    double vx, vy;      /* ray direction, DEM cells per step (major component +-1) */
+    double *step;       /* metres per step, by row */
+    double c;           /* curvature coefficient (1 - k) / 2R, 0 when off */
+    double cap;         /* maximum distance in metres, 0 = none */
+    double ko;          /* level offset k o */
+    int bspline;        /* 1: B-spline in log distance; 0: max over levels */
+    float *out;
+    int *alloc_failed;
+} hz_ctx;
+
+/* Per-thread rows of state, one entry per cell of the grid row. */
+typedef struct {
+    float *s0, *s1, *s2; /* the last three samples (degrees, or tangents) */
+    float *m;            /* spline maximum (or largest tangent) so far */
+    float *T;            /* the level row at the samples */
+    float *A;            /* the samples being pushed */
+} row_ws;
+
+static double step_at(const hz_ctx *C, double row)
+{
+    int H = C->P->grid->height;
+    int r = (int)lround(row);
+    return C->step[r < 0 ? 0 : r > H - 1 ? H - 1 : r];
+}
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define TS_PYR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define TS_PYR_CLONES
+#endif
+
+/* dst[x] = sum of weights[t] * level row idx[t] at x, for x in [x0, x1]. */
+TS_PYR_CLONES
+static void combine_rows(const ts_pyramid *P, int lev, const int *idx, const double *w, int taps,
+                         int x0, int x1, float *restrict dst)
+{
+    const float *r0 = ts_pyr_row(P, lev, idx[0]);
+    const float w0 = (float)w[0];
+    if (taps == 1) {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++)
+            dst[x] = r0[x];
+        return;
+    }
+    const float *r1 = ts_pyr_row(P, lev, idx[1]);
+    const float w1 = (float)w[1];
+    if (taps == 2) {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++)
+            dst[x] = w0 * r0[x] + w1 * r1[x];
+        return;
+    }
+    const float *r2 = ts_pyr_row(P, lev, idx[2]), *r3 = ts_pyr_row(P, lev, idx[3]);
+    const float w2 = (float)w[2], w3 = (float)w[3];
+#pragma GCC ivdep
+    for (int x = x0; x <= x1; x++)
+        dst[x] = w0 * r0[x] + w1 * r1[x] + w2 * r2[x] + w3 * r3[x];
+}
+
+/* The taps of row position `row` (DEM coordinates) on level lev. */
+static int level_taps(const ts_pyramid *P, int lev, double row, int idx[4], double w[4])
+{
+    const ts_pyr_level *L = &P->level[lev];
+    return ts_pyr_taps((row + 0.5) / L->spacing - 0.5, L->rows, lev == 0, idx, w);
+}
+
+/* Sample a (c >= 2) of cell x: the spline's midpoint before the last
+ * sample and its last knot join the maximum. */
+static inline void spline_step(float *restrict s0, float *restrict s1, float *restrict s2,
+                               float *restrict m, int x, float a)
+{
+    float p0 = s0[x], p1 = s1[x], p2 = s2[x];
+    a = a == a ? a : p2; /* nodata: the sample before */
+    float mid = (p0 + 23.0f * p1 + 23.0f * p2 + a) * (1.0f / 48.0f);
+    float knot = (p1 + 4.0f * p2 + a) * (1.0f / 6.0f);
+    float mm = m[x];
+    mm = mid > mm ? mid : mm;
+    mm = knot > mm ? knot : mm;
+    m[x] = mm;
+    s0[x] = p1;
+    s1[x] = p2;
+    s2[x] = a;
+}
+
+/* Add sample number c (value a_in[x] for the cells of [x0, x1]) to the
+ * spline (or the maximum), as the file's comment says. */
+TS_PYR_CLONES
+static void push_run(row_ws *w, int bspline, int c, int x0, int x1, const float *restrict a_in)
+{
+    float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
+    float *restrict m = w->m;
+    if (!bspline) {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++)
+            m[x] = a_in[x] > m[x] ? a_in[x] : m[x];
+        return;
+    }
+    if (c == 0) {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++)
+            s2[x] = a_in[x];
+        return;
+    }
+    if (c == 1) {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++) {
+            float a = a_in[x] == a_in[x] ? a_in[x] : s2[x];
+            s0[x] = 2.0f * s2[x] - a; /* w_{-1}: knot 0 is w_0 */
+            s1[x] = s2[x];
+            s2[x] = a;
+            m[x] = s1[x] > m[x] ? s1[x] : m[x];
+        }
+        return;
+    }
+#pragma GCC ivdep
+    for (int x = x0; x <= x1; x++)
+        spline_step(s0, s1, s2, m, x, a_in[x]);
+}
+
+/* One level's samples for the cells of [x0, x1]: the level row T at x + ix
+ * and x + ix + 1 (weight fx) against the cells' own heights on the level
+ * (rows r, weights wr), at d metres (1 / d = inv_d, curvature drop over d
+ * = cd). Pushed as sample c in the same pass where the spline allows,
+ * else left in w->A for push_run (returns 0 then). */
+TS_PYR_CLONES
+static int level_run(row_ws *w, const float *restrict T, int ix, float fx,
+                     const float *const r[4], const float wr[4], float inv_d, float cd,
+                     int bspline, int c, int x0, int x1)
+{
+    const float *restrict r0 = r[0], *restrict r1 = r[1], *restrict r2 = r[2], *restrict r3 = r[3];
+    const float w0 = wr[0], w1 = wr[1], w2 = wr[2], w3 = wr[3];
+    float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
+    float *restrict m = w->m, *restrict A = w->A;
+    const float gx = 1.0f - fx;
+    const float *restrict Ta = T + ix; /* T[x + ix] defeats the vectoriser */
+    if (bspline && c >= 2) {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++) {
+            float h = gx * Ta[x] + fx * Ta[x + 1];
+            float R = w0 * r0[x] + w1 * r1[x] + w2 * r2[x] + w3 * r3[x];
+            spline_step(s0, s1, s2, m, x, ts_atan_deg((h - R) * inv_d - cd));
+        }
+        return 1;
+    }
+    if (!bspline) { /* the maximum of the tangents; one arctangent at the end */
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++) {
+            float h = gx * Ta[x] + fx * Ta[x + 1];
+            float R = w0 * r0[x] + w1 * r1[x] + w2 * r2[x] + w3 * r3[x];
+            float t = (h - R) * inv_d - cd;
+            m[x] = t > m[x] ? t : m[x];
+        }
+        return 1;
+    }
+#pragma GCC ivdep
+    for (int x = x0; x <= x1; x++) {
+        float h = gx * Ta[x] + fx * Ta[x + 1];
+        float R = w0 * r0[x] + w1 * r1[x] + w2 * r2[x] + w3 * r3[x];
+        A[x] = ts_atan_deg((h - R) * inv_d - cd);
+    }
+    return 0;
+}
+
+/* The samples of the cells [x0, x1] of row y at `dist` steps on level lev,
+ * pushed as sample c. */
+static void sample_run(const hz_ctx *C, row_ws *w, int y, int lev, double dist, int c, int x0,
+                       int x1)
+{
+    const ts_pyramid *P = C->P;
+    const int W = P->grid->width;
+    double ox = dist * C->vx, oy = dist * C->vy;
+    double fl = floor(ox);
+    int ix = (int)fl;
+    float fx = (float)(ox - fl);
+    int t0 = x0 + ix, t1 = x1 + ix + (fx > 0.0f);
+    t1 = t1 > W - 1 ? W - 1 : t1;
+    if (t0 < 0 || t1 < t0)
+        return; /* not reached: the runs keep the samples on the grid */
+    int idx[4];
+    double wd[4];
+    int taps = level_taps(P, lev, y + oy, idx, wd);
+    combine_rows(P, lev, idx, wd, taps, t0, t1, w->T);
+    w->T[t1 + 1] = w->T[t1]; /* a weight of fx = 0 there: no NaN from beyond */
+    /* the cells' own heights on the level: the DEM row itself on level 0 */
+    taps = level_taps(P, lev, y, idx, wd);
+    const float *r[4];
+    float wr[4];
+    for (int t = 0; t < 4; t++) {
+        r[t] = ts_pyr_row(P, lev, idx[t < taps ? t : 0]);
+        wr[t] = t < taps ? (float)wd[t] : 0.0f;
+    }
+    double d = dist * step_at(C, y + oy / 2);
+    if (!level_run(w, w->T, ix, fx, r, wr, (float)(1.0 / d), (float)(C->c * d), C->bspline, c,
+                   x0, x1))
+        push_run(w, C->bspline, c, x0, x1, w->A);
+}
+
+/* The horizons of cells [x0, x1] after `count` >= 1 samples, into out. */
+TS_PYR_CLONES
+static void finish_run(row_ws *w, int bspline, int count, int x0, int x1, float *restrict out)
+{
+    float *restrict s1 = w->s1, *restrict s2 = w->s2, *restrict m = w->m;
+    if (!bspline) {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++)
+            out[x] = m[x] > -INFINITY ? ts_atan_deg(m[x]) : -90.0f;
+        return;
+    }
+    if (count >= 2) { /* w_M = 2 w_{M-1} - w_{M-2}: knot M-1 is w_{M-1} */
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++)
+            w->A[x] = 2.0f * s2[x] - s1[x];
+        push_run(w, 1, count, x0, x1, w->A);
+    } else {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++)
+            m[x] = s2[x] > m[x] ? s2[x] : m[x];
+    }
+#pragma GCC ivdep
+    /* no spline value where nodata left fewer than three samples: the last */
+    for (int x = x0; x <= x1; x++) {
+        float r = m[x] > -INFINITY ? m[x] : s2[x];
+        out[x] = r == r && r > -INFINITY ? r : -90.0f;
+    }
+}
+
+/* The cells of [a, b] whose rays end before level j's sample (through a
+ * side of the grid, or at t_row steps): the last sample of each where its
+ * ray ends, read bilinearly on the DEM, then their horizons. */
+TS_PYR_CLONES
+static void drop_run(const hz_ctx *C, row_ws *w, int y, int a, int b, double t_row, int j,
+                     float *restrict out)
+{
+    if (a > b)
+        return;
+    const ts_grid *g = C->P->grid;
+    const int W = g->width, H = g->height;
+    const float *z = g->z, *zrow = g->z + (ptrdiff_t)y * g->stride;
+    const ptrdiff_t stride = g->stride;
+    const double vx = C->vx, vy = C->vy, c = C->c, lim = W - 1;
+    float *restrict A = w->A;
+    for (int x = a; x <= b; x++) {
+        double t = vx > 0 ? (lim - x) / vx : vx < 0 ? x / -vx : INFINITY;
+        t = t < t_row ? t : t_row;
+        double px = x + t * vx, py = y + t * vy;
+        px = px < 0 ? 0 : px > W - 1 ? W - 1 : px;
+        py = py < 0 ? 0 : py > H - 1 ? H - 1 : py;
+        int i = (int)px, k = (int)py;
+        float fx = (float)(px - i), fy = (float)(py - k);
+        int i1 = i + 1 < W ? i + 1 : i, k1 = k + 1 < H ? k + 1 : k;
+        float z00 = z[k * stride + i], z01 = z[k * stride + i1];
+        float z10 = z[k1 * stride + i], z11 = z[k1 * stride + i1];
+        /* a corner of weight 0 is not read: no NaN from it */
+        float top = fx > 0 ? z00 + fx * (z01 - z00) : z00;
+        float bot = fx > 0 ? z10 + fx * (z11 - z10) : z10;
+        float h = fy > 0 ? top + fy * (bot - top) : top;
+        int row = (int)(y + t * vy / 2 + 0.5);
+        double d = t * C->step[row < 0 ? 0 : row > H - 1 ? H - 1 : row];
+        float tan_w = (float)((h - zrow[x]) / d - c * d);
+        A[x] = t > 1e-9 ? (C->bspline ? ts_atan_deg(tan_w) : tan_w) : NAN;
+    }
+    push_run(w, C->bspline, j, a, b, A);
+    finish_run(w, C->bspline, j + 1, a, b, out);
+}
+
+/* The cells [c0, c1) of row y. */
+static void horizon_row(const hz_ctx *C, row_ws *w, int y, int c0, int c1)
+{
+    const ts_pyramid *P = C->P;
+    const ts_grid *g = P->grid;
+    const int W = g->width, H = g->height;
+    float *out = C->out + (size_t)y * W;
+    for (int x = c0; x < c1; x++)
+        w->m[x] = -INFINITY;
+    /* where every ray of the row leaves the grid (top or bottom) or ends */
+    double t_row = C->vy > 0 ? (H - 1 - y) / C->vy : C->vy < 0 ? y / -C->vy : INFINITY;
+    if (C->cap > 0 && C->cap / C->step[y] < t_row)
+        t_row = C->cap / C->step[y];
+    int pa = c0, pb = c1 - 1, j = 0;
+    for (; j < P->levels && pa <= pb; j++) {
+        double s = P->level[j].spacing, ox = s * C->vx;
+        int xa = C->vx < 0 ? (int)ceil(-ox) : 0;
+        int xb = C->vx > 0 ? (int)floor(W - 1 - ox) : W - 1;
+        xa = xa > pa ? xa : pa;
+        xb = xb < pb ? xb : pb;
+        if (xa > xb) {
+            drop_run(C, w, y, pa, pb, t_row, j, out);
+            pa = 1, pb = 0;
+            break;
+        }
+        drop_run(C, w, y, pa, xa - 1, t_row, j, out);
+        drop_run(C, w, y, xb + 1, pb, t_row, j, out);
+        pa = xa, pb = xb;
+        if (s <= t_row) {
+            double lf = floor(j - C->ko + 1e-9);
+            int lev = lf < 0 ? 0 : (int)lf;
+            sample_run(C, w, y, lev, s, j, pa, pb);
+        } else { /* the row's rays end here: one last sample on the DEM */
+            if (t_row > 1e-9) {
+                sample_run(C, w, y, 0, t_row, j, pa, pb);
+                finish_run(w, C->bspline, j + 1, pa, pb, out);
+            } else if (j == 0) {
+                for (int x = pa; x <= pb; x++)
+                    out[x] = -90.0f; /* nothing beyond these cells */
+            } else {
+                finish_run(w, C->bspline, j, pa, pb, out);
+            }
+            pa = 1, pb = 0;
+        }
+    }
+    if (pa <= pb) /* not reached: the coarsest spacing spans the grid */
+        drop_run(C, w, y, pa, pb, t_row, j, out);
+    const float *z = g->z + (ptrdiff_t)y * g->stride;
+    for (int x = c0; x < c1; x++)
+        if (z[x] != z[x])
+            out[x] = NAN;
+}
+
+static void rows_range(void *ctx, int worker, long y0, long y1)
+{
+    (void)worker;
+    const hz_ctx *C = ctx;
+    const int W = C->P->grid->width;
+    /* s0, s1, s2, m: W each; T and the samples: W + 1 each */
+    float *buf = malloc((size_t)(6 * W + 2) * sizeof *buf);
+    if (!buf) {
+        __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
+        return;
+    }
+    row_ws w = {buf, buf + W, buf + 2 * W, buf + 3 * W, buf + 4 * W, buf + 5 * W + 1};
+    /* a chunk of columns down the rows, then the next: the level rows that
+     * the cells of a chunk read stay in the cache from row to row */
+    for (int c0 = 0; c0 < W; c0 += CHUNK)
+        for (long y = y0; y < y1; y++)
+            horizon_row(C, &w, (int)y, c0, c0 + CHUNK < W ? c0 + CHUNK : W);
+    free(buf);
+}
+
+ts_status ts_pyramid_horizon(const ts_pyramid *pyr, double azimuth, const ts_horizon_opts *opts,
+                             float *out, ts_error *err)
+{
+    if (!pyr)
+        return ts_fail(err, TS_ERR_ARG, "pyramid is NULL");
+    if (!out)
+        return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
+    const ts_grid *g = pyr->grid;
+    ts_status st = ts_check_sweep_args(g, &azimuth, opts, err);
+    if (st != TS_OK)
+        return st;
+    const int H = g->height;
+    double a = azimuth * DEG2RAD, sa = sin(a), ca = cos(a);
+    /* as the sweep: exact axis directions, the direction in cells taken at
+     * the central row of a geographic grid */
+    if (fabs(sa) < 1e-12) sa = 0;
+    if (fabs(ca) < 1e-12) ca = 0;
+    double gx = sa / ts_grid_cell_x(g, H / 2), gy = -ca / g->cell_y;
+    double major = fabs(gx) > fabs(gy) ? fabs(gx) : fabs(gy);
+    hz_ctx C = {pyr, gx / major, gy / major, NULL, 0, 0, 0, 0, NULL, NULL};
+    C.step = malloc((size_t)H * sizeof *C.step);
+    if (!C.step)
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the pyramid's step table");
+    for (int y = 0; y < H; y++)
+        C.step[y] = hypot(ts_grid_cell_x(g, y) * C.vx, g->cell_y * C.vy);
+    C.c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
+    C.cap = opts->max_distance;
+    C.ko = pyr->opts.level_step * pyr->opts.offset;
+    C.bspline = pyr->opts.reconstruction == TS_PYRAMID_BSPLINE;
+    C.out = out;
+    int failed = 0;
+    C.alloc_failed = &failed;
+    st = ts_parallel_for(ts_thread_count(opts->threads, H), H, rows_range, &C, err);
+    free(C.step);
+    if (st != TS_OK)
+        return st;
+    if (failed)
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the pyramid's row workspace");
+    /* what lies beyond the DEM's edge, as after the exact sweep */
+    return ts_horizon_edge_apply(g, azimuth, opts, out, err);
+}
+
+ts_status ts_pyramid_horizon_compute(const ts_grid *grid, const ts_pyramid_opts *popts,
+                                     const ts_horizon_opts *opts, float *out, ts_error *err)
+{
+    ts_status st = ts_check_horizon_compute_args(grid, opts, out, err);
+    if (st != TS_OK)
+        return st;
+    ts_pyramid *pyr;
+    if ((st = ts_pyramid_build(grid, popts, opts->threads, &pyr, err)) != TS_OK)
+        return st;
+    size_t plane = (size_t)grid->width * (size_t)grid->height;
+    for (int k = 0; st == TS_OK && k < opts->directions; k++) {
+        if ((st = ts_progress(opts, (double)k / opts->directions, err)) == TS_OK)
+            st = ts_pyramid_horizon(pyr, ts_horizon_azimuth(opts, k), opts, out + plane * k, err);
+    }
+    ts_pyramid_free(pyr);
+    if (st == TS_OK)
+        st = ts_progress(opts, 1.0, err);
+    return st == TS_OK ? ts_ok(err) : st;
+}

@@ -1,0 +1,138 @@
+/* HORIZON_METHOD=pyramid in the driver; see tsd_pyramid.h. */
+#include "tsd_pyramid.h"
+
+#include "tsd_products.h"
+#include "tsd_text.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define REFUSE(...) return (tsd_fail(msg, n, TS_ERR_ARG, __VA_ARGS__), -1)
+
+int tsd_options_check_pyramid(const tsd_options *o, char *msg, size_t n)
+{
+    static const char *const own[] = {"HORIZON_METHOD", "PYRAMID_LEVEL_STEP", "PYRAMID_OFFSET"};
+    const tsd_product_def *p = tsd_product_of(o);
+    char list[256];
+    for (size_t i = 0; i < sizeof own / sizeof own[0]; i++) {
+        int id = tsd_option_find(own[i]);
+        if (!tsd_options_given(o, own[i]) || tsd_product_takes(p, id))
+            continue;
+        tsd_products_taking(id, "PRODUCT=", " and ", list, sizeof list);
+        REFUSE("%s applies to the products that use horizons (%s; shade: its sky term), "
+               "not to PRODUCT=%s%s",
+               own[i], list, p->name,
+               tsd_product_takes(p, tsd_option_find("METHOD"))
+                   ? ", whose shadows METHOD chooses (exact or shm)"
+                   : "");
+    }
+    /* as SVF_MODEL: a value that would do nothing is a mistake; the
+     * default given explicitly is not */
+    if (o->horizon_method != TSD_HORIZON_PYRAMID) {
+        double k0 = atof(tsd_option_default(tsd_option_find("PYRAMID_LEVEL_STEP")));
+        double o0 = atof(tsd_option_default(tsd_option_find("PYRAMID_OFFSET")));
+        const char *which = o->pyramid_offset != o0         ? "PYRAMID_OFFSET"
+                            : o->pyramid_level_step != k0 ? "PYRAMID_LEVEL_STEP"
+                                                          : NULL;
+        if (which)
+            REFUSE("%s applies with HORIZON_METHOD=pyramid; HORIZON_METHOD=exact (the "
+                   "sweep) has no pyramid",
+                   which);
+        return 0;
+    }
+    if (tsd_product_takes(p, tsd_option_find("SKY_WEIGHT")) && !(o->sky_weight > 0))
+        REFUSE("HORIZON_METHOD=pyramid applies to the sky term of PRODUCT=%s, which "
+               "SKY_WEIGHT=0 leaves out: give SKY_WEIGHT > 0 (the direct sun follows METHOD)",
+               p->name);
+    return 0;
+}
+
+double tsd_pyramid_bytes(const tsd_options *o, int width, int height)
+{
+    if (o->horizon_method != TSD_HORIZON_PYRAMID)
+        return 0;
+    return ts_pyramid_bytes(width, height, o->pyramid_level_step);
+}
+
+/* The backend report of the pyramid: C, and why not OpenCL when OpenCL
+ * was wanted and usable. */
+static ts_status note_backend(const tsd_compute_ctx *c)
+{
+    ts_backend_report r;
+    ts_error err;
+    if (ts_backend_choose(tsd_backend_to_ts(c->opts->backend), &r, &err) != TS_OK)
+        return tsd_fail_core(c->msg, c->msg_size, NULL, &err);
+    if (r.used == TS_BACKEND_OPENCL) {
+        r.used = TS_BACKEND_C;
+        r.fell_back = 1;
+        snprintf(r.backend, sizeof r.backend, "c");
+        snprintf(r.device, sizeof r.device, "CPU, %d cores", ts_cpu_count());
+        snprintf(r.reason, sizeof r.reason,
+                 "HORIZON_METHOD=pyramid runs on the C backend (there is no OpenCL pyramid)");
+    }
+    if (c->backend)
+        tsd_backend_summary_add(c->backend, &r);
+    return TS_OK;
+}
+
+/* The planes of the pyramid read with `rec`, one at a time, to `add`. */
+static ts_status pyramid_run(const tsd_compute_ctx *c, const ts_grid *g,
+                             ts_pyramid_reconstruction rec, tsd_plane_fn add, void *user)
+{
+    const tsd_options *o = c->opts;
+    ts_horizon_opts h;
+    ts_pyramid_opts po;
+    ts_error err;
+    ts_status st;
+    tsd_compute_horizon_opts(c, &h);
+    h.progress = NULL; /* reported here, per azimuth */
+    ts_pyramid_opts_default(&po);
+    po.level_step = o->pyramid_level_step;
+    po.offset = o->pyramid_offset;
+    po.reconstruction = rec;
+    if ((st = note_backend(c)) != TS_OK)
+        return st;
+    ts_pyramid *pyr = NULL;
+    float *plane = malloc((size_t)g->width * g->height * sizeof(float));
+    if (!plane)
+        return tsd_fail(c->msg, c->msg_size, TS_ERR_NOMEM, "out of memory for a horizon plane");
+    if (ts_pyramid_build(g, &po, o->threads, &pyr, &err) != TS_OK) {
+        free(plane);
+        return tsd_fail_core(c->msg, c->msg_size, NULL, &err);
+    }
+    for (int k = 0; k < h.directions; k++) {
+        double az = ts_horizon_azimuth(&h, k);
+        if ((st = tsd_compute_report(c, (double)k / h.directions)) != TS_OK)
+            break;
+        if (ts_pyramid_horizon(pyr, az, &h, plane, &err) != TS_OK ||
+            add(user, g, k, az, plane, &err) != TS_OK) {
+            st = tsd_fail_core(c->msg, c->msg_size, NULL, &err);
+            break;
+        }
+    }
+    ts_pyramid_free(pyr);
+    free(plane);
+    return st;
+}
+
+static ts_status copy_plane(void *user, const ts_grid *g, int k, double azimuth,
+                            const float *plane, ts_error *err)
+{
+    (void)azimuth;
+    (void)err;
+    size_t cells = (size_t)g->width * g->height;
+    memcpy((float *)user + cells * k, plane, cells * sizeof(float));
+    return TS_OK;
+}
+
+ts_status tsd_pyramid_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_plane_fn add,
+                             void *user)
+{
+    return pyramid_run(c, g, TS_PYRAMID_LEVEL_MAX, add, user);
+}
+
+ts_status tsd_pyramid_planes(const tsd_compute_ctx *c, const ts_grid *g, float *out)
+{
+    return pyramid_run(c, g, TS_PYRAMID_BSPLINE, copy_plane, out);
+}
