@@ -31,6 +31,7 @@
 #include "near_field.h"
 #include "parallel.h"
 #include "status_internal.h"
+#include "sweep_cap_tail.h"
 #include "window_hull.h"
 
 typedef ts_hull_pt hull_pt;
@@ -72,7 +73,61 @@ typedef struct {
     /* visitor buffers */
     float *vx, *vy, *vh, *vs;
     double *vd;
+    /* unbounded sweep: the lines of a block, swept in lockstep */
+    struct lane *lanes;
+    hull_pt *lane_stacks;
+    occluder *carry, *carry_next; /* far-side occluders from the line before */
 } sweep_ws;
+
+/* One line of a lockstep block (unbounded sweep): its hull and position. */
+typedef struct lane {
+    hull_pt *stack;
+    int n, far;         /* hull size; top-most point beyond the near field */
+    int k0, k1, live;   /* the line's steps on the grid */
+    double d;           /* distance of the current sample from sample k0 */
+} lane;
+
+/* The far-field occluder of a point at distance d and hull height g among
+ * the points 0..far of an unbounded line's hull S: walk to nearer points
+ * while the slope grows (the slopes to an upper convex hull from a point
+ * beyond it are unimodal). */
+static inline occluder stack_query(const hull_pt *S, int far, double d, double g)
+{
+    if (far < 0)
+        return (occluder){-1, 0.0f};
+    int j = far;
+    while (j > 0 && (S[j - 1].g - g) * (d - S[j].d) >= (S[j].g - g) * (d - S[j - 1].d))
+        j--;
+    return (occluder){S[j].k, (float)(d - S[j].d)};
+}
+
+/* Move far (the top-most hull point at least near_skip behind d) up: d
+ * only grows, so it moves in O(1) amortised. */
+static inline int far_advance(const hull_pt *S, int n, int far, double d, double near_skip)
+{
+    while (far + 1 < n && d - S[far + 1].d >= near_skip)
+        far++;
+    return far;
+}
+
+/* Push (d, gs, k) onto the unbounded hull S of *n points, popping the points
+ * it hides, and keep *far; returns the hull's size before the push (its top
+ * is the sample's own occluder on the line). */
+static inline int hull_push(hull_pt *S, int *n, int *far, double d, double gs, int k,
+                            double near_skip)
+{
+    int m = *n;
+    while (m >= 2 && (S[m - 2].g - gs) * (d - S[m - 1].d) >= (S[m - 1].g - gs) * (d - S[m - 2].d))
+        m--;
+    /* Pops only take from the top, so far is at most the new top. */
+    int f = *far > m - 1 ? m - 1 : *far;
+    *far = far_advance(S, m, f, d, near_skip);
+    S[m].d = d;
+    S[m].g = gs;
+    S[m].k = k;
+    *n = m + 1;
+    return m;
+}
 
 /* The far-field occluder of a point at distance d, height h, among the
  * hull points 0..far (those beyond the near field): walk to farther points
@@ -87,13 +142,7 @@ static occluder hull_query(const sweep_ctx *C, sweep_ws *w, int far, double d, f
         const hull_pt *p = ts_window_hull_query(&w->win, d, g, finger);
         return p ? (occluder){p->k, (float)(d - p->d)} : none;
     }
-    if (far < 0)
-        return none;
-    const hull_pt *S = w->stack;
-    int j = far;
-    while (j > 0 && (S[j - 1].g - g) * (d - S[j].d) >= (S[j].g - g) * (d - S[j - 1].d))
-        j--;
-    return (occluder){S[j].k, (float)(d - S[j].d)};
+    return stack_query(w->stack, far, d, g);
 }
 
 /* Slope from cell (k, i) at height h to its own ray, dk steps back (at
@@ -101,7 +150,10 @@ static occluder hull_query(const sweep_ctx *C, sweep_ws *w, int far, double d, f
  * the grid there or touches nodata. */
 static inline float ray_slope(const sweep_ctx *C, int k, int i, float h, int dk, float dd)
 {
-    return cm_ray_slope(&C->ray, k, i, h, dk, dd, (float)C->c);
+    if (dk <= 0 || dk > k)
+        return -INFINITY;
+    return cm_ray_slope_at(&C->ray, k, i, h, dk, C->geom->ray_o[dk], C->geom->ray_f[dk], dd,
+                           (float)C->c);
 }
 
 /* Steps on either side of a line's occluder at which the cell's ray is
@@ -127,7 +179,9 @@ static float far_field(const sweep_ctx *C, int k, int i, float h, occluder lo, o
         for (int e = -FAR_SPREAD; e <= FAR_SPREAD; e++) {
             if (dk + e <= TS_NEAR_STEPS)
                 continue;
-            float s = ray_slope(C, k, i, h, dk + e, cand[c].dd + (float)(e * step));
+            /* e = 0 adds exactly +0 to the distance: skip the conversion. */
+            float dd = e ? cand[c].dd + (float)(e * step) : cand[c].dd;
+            float s = ray_slope(C, k, i, h, dk + e, dd);
             best = s > best ? s : best;
         }
     }
@@ -189,28 +243,14 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
             pushed = 1;
         } else if (!isnan(hs)) {
             double gs = hs - c * d * d;
-            hull_pt *S = w->stack;
-            int n = w->n;
-            while (n >= 2 &&
-                   (S[n - 2].g - gs) * (d - S[n - 1].d) >= (S[n - 1].g - gs) * (d - S[n - 2].d))
-                n--;
+            const hull_pt *S = w->stack;
+            int n = hull_push(w->stack, &w->n, &far, d, gs, k, C->near_skip);
             if (w->vs && n > 0)
                 slope = (float)((S[n - 1].g - gs) / (d - S[n - 1].d) - 2.0 * c * d);
-            /* Hull points 0..far lie beyond the near field; pops only take
-             * from the top, and d only grows, so far moves in O(1) amortised. */
-            if (far > n - 1)
-                far = n - 1;
-            while (far + 1 < n && d - S[far + 1].d >= C->near_skip)
-                far++;
-            S[n].d = d;
-            S[n].g = gs;
-            S[n].k = k;
-            w->n = n + 1;
             pushed = 1;
         }
         if (!pushed)
-            while (far + 1 < w->n && d - w->stack[far + 1].d >= C->near_skip)
-                far++;
+            far = far_advance(w->stack, w->n, far, d, C->near_skip);
         occluder none = {-1, 0.0f};
         if (write) {
             float s_out = NAN;
@@ -237,6 +277,83 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
         C->visit(C->user, nv, w->vx, w->vy, w->vh, w->vd, w->vs);
 }
 
+/* Lines swept together in one block: at each step they read and write
+ * neighbouring cells of one grid row (or column), so memory streams. */
+#ifndef LOCKSTEP_LINES
+#define LOCKSTEP_LINES 64
+#endif
+
+/* Step k of lane L (line b) of an unbounded sweep: the same work, in the
+ * same order for the line, as process_line. lo_in is the far-side
+ * occluder the line before found at this step; returns this line's. */
+static inline occluder lane_step(const sweep_ctx *C, lane *L, long b, int k, occluder lo_in,
+                                 int write)
+{
+    const ts_line_geom *G = C->geom;
+    ts_line_sample ls;
+    ts_line_sample_at(G, C->grid->z, b, k, L->k0, 0.0f, &L->d, &ls);
+    const double d = L->d;
+    if (!isnan(ls.hs))
+        hull_push(L->stack, &L->n, &L->far, d, ls.hs - C->c * d * d, k, C->near_skip);
+    else
+        L->far = far_advance(L->stack, L->n, L->far, d, C->near_skip);
+    const occluder none = {-1, 0.0f};
+    if (write) {
+        float s_out = NAN;
+        if (!isnan(ls.hc)) {
+            occluder hi = ls.inside ? stack_query(L->stack, L->far, d, ls.hc - C->c * d * d) : none;
+            occluder lo = ls.F > 0.0f ? lo_in : none;
+            int row = G->x_major ? ls.i : G->u_start + k * G->u_step;
+            double step = G->step_row ? G->step_row[row] : G->step_m;
+            s_out = far_field(C, k, ls.i, ls.hc, lo, hi, step);
+        }
+        C->out[C->o_origin + (ptrdiff_t)k * C->o_u_stride + (ptrdiff_t)ls.i * C->o_v_stride] = s_out;
+    }
+    return (ls.has_next && !isnan(ls.hn)) ? stack_query(L->stack, L->far, d, ls.hn - C->c * d * d)
+                                          : none;
+}
+
+/* Lines bs .. bs + nl - 1 of an unbounded sweep, step by step; the first is
+ * only primed (not written) when `prime`. w->carry holds what the line
+ * before the block found; on return it holds the block's last line's. */
+static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int prime)
+{
+    const ts_line_geom *G = C->geom;
+    const occluder none = {-1, 0.0f};
+    int kmin = G->U, kmax = -1;
+    for (int j = 0; j < nl; j++) {
+        lane *L = &w->lanes[j];
+        L->live = ts_line_k_range(G, bs + j, &L->k0, &L->k1);
+        if (!L->live) {
+            L->k0 = 1;
+            L->k1 = 0;
+            continue;
+        }
+        L->n = 0;
+        L->far = -1;
+        L->d = 0.0;
+        kmin = L->k0 < kmin ? L->k0 : kmin;
+        kmax = L->k1 > kmax ? L->k1 : kmax;
+    }
+    occluder *next = w->carry_next;
+    for (int k = 0; k < G->U; k++)
+        next[k] = none;
+    for (int k = kmin; k <= kmax; k++) {
+        occluder lo = w->carry[k];
+        for (int j = 0; j < nl; j++) {
+            lane *L = &w->lanes[j];
+            if (k < L->k0 || k > L->k1) {
+                lo = none;
+                continue;
+            }
+            lo = lane_step(C, L, bs + j, k, lo, !(prime && j == 0));
+        }
+        next[k] = lo;
+    }
+    w->carry_next = w->carry;
+    w->carry = next;
+}
+
 static void ws_free(sweep_ws *w)
 {
     free(w->stack);
@@ -250,6 +367,10 @@ static void ws_free(sweep_ws *w)
     free(w->vh);
     free(w->vs);
     free(w->vd);
+    free(w->lanes);
+    free(w->lane_stacks);
+    free(w->carry);
+    free(w->carry_next);
 }
 
 static int ws_init(sweep_ws *w, int U, int capped, int need_visit)
@@ -273,6 +394,18 @@ static int ws_init(sweep_ws *w, int U, int capped, int need_visit)
         w->vs = malloc((size_t)U * sizeof(float));
         w->vd = malloc((size_t)U * sizeof(double));
     }
+    if (!capped && !need_visit) {
+        const occluder none = {-1, 0.0f};
+        w->lanes = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lanes);
+        w->lane_stacks = malloc((size_t)(LOCKSTEP_LINES + 1) * (U + 1) * sizeof *w->lane_stacks);
+        w->carry = malloc((size_t)U * sizeof *w->carry);
+        w->carry_next = malloc((size_t)U * sizeof *w->carry_next);
+        ok = w->lanes && w->lane_stacks && w->carry && w->carry_next;
+        for (int j = 0; ok && j <= LOCKSTEP_LINES; j++)
+            w->lanes[j].stack = w->lane_stacks + (size_t)j * (U + 1);
+        for (int k = 0; ok && k < U; k++)
+            w->carry[k] = none;
+    }
     return ok && w->stack && w->lo.prev && w->lo.cur &&
            (!need_visit || (w->vx && w->vy && w->vh && w->vs && w->vd));
 }
@@ -288,75 +421,21 @@ static void sweep_range(void *ctx, int worker, long begin, long end)
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
         return;
     }
+    if (w.lanes) {
+        long b = C->b0 + begin, bend = C->b0 + end;
+        for (int prime = begin > 0; b < bend; prime = 0) {
+            int nl = bend - b < LOCKSTEP_LINES ? (int)(bend - b) : LOCKSTEP_LINES;
+            sweep_block(C, &w, b - prime, nl + prime, prime);
+            b += nl;
+        }
+        ws_free(&w);
+        return;
+    }
     if (begin > 0)
         process_line(C, &w, C->b0 + begin - 1, 0);
     for (long b = C->b0 + begin; b < C->b0 + end; b++)
         process_line(C, &w, b, 1);
     ws_free(&w);
-}
-
-/* An upper bound of the slope from cell (k, i) at height h to its ray
- * between whole steps j and j + 1: the highest corner of the patches it
- * crosses there; INFINITY if one is nodata or off the grid (then solve). */
-static float between_steps_bound(const ts_line_geom *G, const float *z, int k, int i, float h,
-                                 int j, double step, double c)
-{
-    double va = i - G->t * j, vb = i - G->t * (j + 1);
-    double lo = va < vb ? va : vb, hi = va < vb ? vb : va;
-    int r0 = (int)floor(lo), r1 = (int)ceil(hi), k0 = k - j - 1;
-    if (k0 < 0 || r0 < 0 || r1 > G->V - 1)
-        return INFINITY;
-    float hmax = -INFINITY;
-    const float *p = z + G->origin + (ptrdiff_t)k0 * G->u_stride + (ptrdiff_t)r0 * G->v_stride;
-    for (int r = r0; r <= r1; r++, p += G->v_stride) {
-        float a = p[0], b = p[G->u_stride];
-        if (a != a || b != b)
-            return INFINITY;
-        hmax = a > hmax ? a : hmax;
-        hmax = b > hmax ? b : hmax;
-    }
-    double dh = (double)hmax - h;
-    return (float)(dh / ((dh > 0 ? j : j + 1) * step) - c * j * step);
-}
-
-/*
- * What the near field and the lines leave out within a maximum distance,
- * solved exactly on each cell's own ray: a capped horizon is often near,
- * often at the distance itself.
- *  - Between the near field's whole steps (TS_NEAR_EXACT..TS_NEAR_STEPS)
- *    the bilinear surface can rise above both steps (not along an axis,
- *    where it is linear there); a step is solved where a bound says it may
- *    raise the horizon.
- *  - The part of a step before the distance ends, where the same bound
- *    says it may.
- */
-static void cap_tail(const sweep_ctx *C, int y, const float *zrow, float *orow, double step)
-{
-    const ts_line_geom *G = C->geom;
-    const float *z = C->grid->z;
-    double smax = C->cap / step, s0 = floor(smax);
-    double send = smax < TS_NEAR_STEPS ? smax : TS_NEAR_STEPS;
-    int axis = fabs(G->t) <= 1e-12;
-    s0 = s0 > TS_NEAR_EXACT ? s0 : TS_NEAR_EXACT;
-    int tail = s0 < smax && (axis || smax > TS_NEAR_STEPS);
-    for (int x = 0; x < C->grid->width; x++) {
-        if (isnan(zrow[x]))
-            continue;
-        int u = G->x_major ? x : y, i = G->x_major ? y : x;
-        int k = (u - G->u_start) * G->u_step;
-        float h = zrow[x], best = orow[x];
-        for (int j = TS_NEAR_EXACT; !axis && j < send; j++) {
-            if (between_steps_bound(G, z, k, i, h, j, step, C->c) < best)
-                continue;
-            float e = ts_ray_exact(G, z, k, i, h, j, j + 1 < send ? j + 1 : send, step, C->c);
-            best = e > best ? e : best;
-        }
-        if (tail && between_steps_bound(G, z, k, i, h, (int)s0, step, C->c) >= best) {
-            float e = ts_ray_exact(G, z, k, i, h, s0, smax, step, C->c);
-            best = e > best ? e : best;
-        }
-        orow[x] = best;
-    }
 }
 
 /* Rows [y0, y1): add each cell's near field to the far-field slope the
@@ -397,7 +476,7 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
             orow[x] = left ? nf : fmaxf(nf, orow[x]);
         }
         if (C->cap > 0)
-            cap_tail(C, (int)y, zrow, orow, step);
+            ts_cap_tail(C->geom, grid, C->cap, C->c, (int)y, zrow, orow, step);
         for (int x = 0; x < W; x++)
             orow[x] = ts_atan_deg(orow[x]);
     }

@@ -45,7 +45,9 @@ ts_status ts_line_geom_init(ts_line_geom *g, const ts_grid *grid, double azimuth
 
     g->fl = malloc((size_t)g->U * sizeof *g->fl);
     g->fr = malloc((size_t)g->U * sizeof *g->fr);
-    if (!g->fl || !g->fr) {
+    g->ray_o = malloc((size_t)g->U * sizeof *g->ray_o);
+    g->ray_f = malloc((size_t)g->U * sizeof *g->ray_f);
+    if (!g->fl || !g->fr || !g->ray_o || !g->ray_f) {
         ts_line_geom_free(g);
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate sweep line tables");
     }
@@ -60,6 +62,10 @@ ts_status ts_line_geom_init(ts_line_geom *g, const ts_grid *grid, double azimuth
         }
         g->fl[k] = (int)f;
         g->fr[k] = fr;
+        /* The far field's ray: the same doubles as cm_ray_slope, no folding. */
+        double pv = -g->t * k, o = floor(pv);
+        g->ray_o[k] = (int)o;
+        g->ray_f[k] = (float)(pv - o);
     }
     int flmin = g->fl[0] < g->fl[g->U - 1] ? g->fl[0] : g->fl[g->U - 1];
     int flmax = g->fl[0] < g->fl[g->U - 1] ? g->fl[g->U - 1] : g->fl[0];
@@ -89,6 +95,8 @@ void ts_line_geom_free(ts_line_geom *g)
 {
     free(g->fl);
     free(g->fr);
+    free(g->ray_o);
+    free(g->ray_f);
     free(g->step_row);
     memset(g, 0, sizeof *g);
 }

@@ -29,6 +29,8 @@ typedef struct {
     long b_lo, b_hi;        /* intercepts of the lines that touch the grid */
     int *fl;                /* U entries: floor(t * k) */
     float *fr;              /* U entries: t * k - floor(t * k), in [0, 1) */
+    int *ray_o;             /* U entries: floor(-t * dk), the v offset of a ray */
+    float *ray_f;           /* dk steps back, and its fraction, as cm_ray_slope */
     double step_m;          /* metres per step when cell_x is constant */
     double *step_row;       /* metres per step by grid row, or NULL */
 } ts_line_geom;

@@ -236,16 +236,15 @@ CM_FN float cm_ray_exact(const cm_ray_grid *r, int k, int i, float h, cm_real s_
 
 /* Far field: the slope from cell (k, i) at height h to its own ray dk
  * steps back, at distance dd metres, interpolated between the two cells
- * around it; cf: the curvature coefficient; -inf off the grid or on
- * nodata. */
-CM_FN float cm_ray_slope(const cm_ray_grid *r, int k, int i, float h, int dk, float dd, float cf)
+ * around it (rows i + o and i + o + 1, fraction f); cf: the curvature
+ * coefficient; -inf off the grid or on nodata. */
+CM_FN float cm_ray_slope_at(const cm_ray_grid *r, int k, int i, float h, int dk, int o, float f,
+                            float dd, float cf)
 {
     int kk = k - dk;
     if (dk <= 0 || kk < 0 || dd <= 0.0f)
         return -INFINITY;
-    cm_real pv = -r->t * dk, o = floor(pv);
-    int r0 = i + (int)o;
-    float f = (float)(pv - o);
+    int r0 = i + o;
     if (r0 < 0 || r0 > r->V - 1 || (f > 0.0f && r0 + 1 > r->V - 1))
         return -INFINITY;
     const CM_GLOBAL float *zz = r->z + r->origin + (long)kk * r->u_stride + (long)r0 * r->v_stride;
@@ -254,6 +253,14 @@ CM_FN float cm_ray_slope(const cm_ray_grid *r, int k, int i, float h, int dk, fl
     if (isnan(hz))
         return -INFINITY;
     return (hz - h) / dd - cf * dd;
+}
+
+/* cm_ray_slope_at with the ray's offset dk steps back computed here:
+ * o = floor(-t dk) whole cells along v and the fraction f beyond. */
+CM_FN float cm_ray_slope(const cm_ray_grid *r, int k, int i, float h, int dk, float dd, float cf)
+{
+    cm_real pv = -r->t * dk, o = floor(pv);
+    return cm_ray_slope_at(r, k, i, h, dk, (int)o, (float)(pv - o), dd, cf);
 }
 
 /*

@@ -1,0 +1,71 @@
+/* The exact stretches of a capped (MAX_DISTANCE) sweep that the near field
+ * and the lines leave out; see sweep_cap_tail.h. Moved out of
+ * horizon_sweep.c unchanged. */
+#include <math.h>
+
+#include "near_field.h"
+#include "sweep_cap_tail.h"
+
+/* An upper bound of the slope from cell (k, i) at height h to its ray
+ * between whole steps j and j + 1: the highest corner of the patches it
+ * crosses there; INFINITY if one is nodata or off the grid (then solve). */
+static float between_steps_bound(const ts_line_geom *G, const float *z, int k, int i, float h,
+                                 int j, double step, double c)
+{
+    double va = i - G->t * j, vb = i - G->t * (j + 1);
+    double lo = va < vb ? va : vb, hi = va < vb ? vb : va;
+    int r0 = (int)floor(lo), r1 = (int)ceil(hi), k0 = k - j - 1;
+    if (k0 < 0 || r0 < 0 || r1 > G->V - 1)
+        return INFINITY;
+    float hmax = -INFINITY;
+    const float *p = z + G->origin + (ptrdiff_t)k0 * G->u_stride + (ptrdiff_t)r0 * G->v_stride;
+    for (int r = r0; r <= r1; r++, p += G->v_stride) {
+        float a = p[0], b = p[G->u_stride];
+        if (a != a || b != b)
+            return INFINITY;
+        hmax = a > hmax ? a : hmax;
+        hmax = b > hmax ? b : hmax;
+    }
+    double dh = (double)hmax - h;
+    return (float)(dh / ((dh > 0 ? j : j + 1) * step) - c * j * step);
+}
+
+/*
+ * What the near field and the lines leave out within a maximum distance,
+ * solved exactly on each cell's own ray: a capped horizon is often near,
+ * often at the distance itself.
+ *  - Between the near field's whole steps (TS_NEAR_EXACT..TS_NEAR_STEPS)
+ *    the bilinear surface can rise above both steps (not along an axis,
+ *    where it is linear there); a step is solved where a bound says it may
+ *    raise the horizon.
+ *  - The part of a step before the distance ends, where the same bound
+ *    says it may.
+ */
+void ts_cap_tail(const ts_line_geom *G, const ts_grid *grid, double cap, double c, int y,
+                 const float *zrow, float *orow, double step)
+{
+    const float *z = grid->z;
+    double smax = cap / step, s0 = floor(smax);
+    double send = smax < TS_NEAR_STEPS ? smax : TS_NEAR_STEPS;
+    int axis = fabs(G->t) <= 1e-12;
+    s0 = s0 > TS_NEAR_EXACT ? s0 : TS_NEAR_EXACT;
+    int tail = s0 < smax && (axis || smax > TS_NEAR_STEPS);
+    for (int x = 0; x < grid->width; x++) {
+        if (isnan(zrow[x]))
+            continue;
+        int u = G->x_major ? x : y, i = G->x_major ? y : x;
+        int k = (u - G->u_start) * G->u_step;
+        float h = zrow[x], best = orow[x];
+        for (int j = TS_NEAR_EXACT; !axis && j < send; j++) {
+            if (between_steps_bound(G, z, k, i, h, j, step, c) < best)
+                continue;
+            float e = ts_ray_exact(G, z, k, i, h, j, j + 1 < send ? j + 1 : send, step, c);
+            best = e > best ? e : best;
+        }
+        if (tail && between_steps_bound(G, z, k, i, h, (int)s0, step, c) >= best) {
+            float e = ts_ray_exact(G, z, k, i, h, s0, smax, step, c);
+            best = e > best ? e : best;
+        }
+        orow[x] = best;
+    }
+}
