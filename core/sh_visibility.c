@@ -1,0 +1,263 @@
+/*
+ * SH visibility from horizons (Snyder & Nowrouzezahrai 2008, section 5,
+ * eq. 6-8): between consecutive sampled azimuths the horizon is linear in
+ * azimuth; each such wedge's visibility is read from a table precomputed in
+ * canonical position (256 x 256 horizon pairs, bilinear), turned to its
+ * azimuth about z and summed; a partial swath adds a boundary wedge at each
+ * end (a 1D table) whose horizon rises to fully blocked at the swath's edge.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "parallel.h"
+#include "sh_internal.h"
+#include "status_internal.h"
+
+#define DEG2RAD (M_PI / 180.0)
+#define NQ 12            /* Gauss nodes per axis and piece */
+#define PIECE_DEG 90.0   /* the azimuth axis is cut in pieces at most this wide */
+#define N_STEPS TS_SH_WEDGE_STEPS
+
+static double clamp_omega(double w)
+{
+    return w < 0 ? 0 : w > 90 ? 90 : w;
+}
+
+void ts_sh_wedge_project(double extent_deg, double omega_a, double omega_b,
+                         double out[TS_SH_COEFFS])
+{
+    double gx[NQ], gw[NQ];
+    ts_sh_gauss(NQ, gx, gw);
+    memset(out, 0, sizeof(double) * TS_SH_COEFFS);
+    const double wa = clamp_omega(omega_a) * DEG2RAD, wb = clamp_omega(omega_b) * DEG2RAD;
+    const double ext = extent_deg * DEG2RAD;
+    const int pieces = (int)ceil(extent_deg / PIECE_DEG);
+    const double plen = ext / pieces;
+    for (int p = 0; p < pieces; p++)
+        for (int i = 0; i < NQ; i++) {
+            double phi = plen * (p + (gx[i] + 1) / 2), wphi = gw[i] * plen / 2;
+            double omega = wa + (wb - wa) * phi / ext;
+            double half = (M_PI / 2 - omega) / 2; /* theta from omega to pi/2 */
+            double cp = cos(phi), sp = sin(phi);
+            for (int j = 0; j < NQ; j++) {
+                double theta = omega + half * (gx[j] + 1), ct = cos(theta);
+                double d[3] = {cp * ct, sp * ct, sin(theta)}, y[TS_SH_COEFFS];
+                ts_sh_eval(d, y);
+                double w = wphi * gw[j] * half * ct; /* d(solid angle) = cos theta */
+                for (int k = 0; k < TS_SH_COEFFS; k++)
+                    out[k] += w * y[k];
+            }
+        }
+}
+
+static double node_omega(int a)
+{
+    return 90.0 * a / (N_STEPS - 1);
+}
+
+typedef struct {
+    const ts_sh_swath *s;
+    ts_sh_wedges *w;
+} build_ctx;
+
+static void build_rows(void *ctx, int worker, long a0, long a1)
+{
+    (void)worker;
+    const build_ctx *C = ctx;
+    double v[TS_SH_COEFFS];
+    for (long a = a0; a < a1; a++) {
+        for (int b = 0; b < N_STEPS; b++) {
+            ts_sh_wedge_project(C->s->step, node_omega((int)a), node_omega(b), v);
+            for (int k = 0; k < TS_SH_COEFFS; k++)
+                C->w->interior[((size_t)a * N_STEPS + b) * TS_SH_COEFFS + k] = (float)v[k];
+        }
+        if (!C->w->rise)
+            continue;
+        ts_sh_wedge_project(C->s->step / 2, node_omega((int)a), 90, v);
+        for (int k = 0; k < TS_SH_COEFFS; k++)
+            C->w->rise[a * TS_SH_COEFFS + k] = (float)v[k];
+        ts_sh_wedge_project(C->s->step / 2, 90, node_omega((int)a), v);
+        for (int k = 0; k < TS_SH_COEFFS; k++)
+            C->w->fall[a * TS_SH_COEFFS + k] = (float)v[k];
+    }
+}
+
+ts_status ts_sh_wedges_build(const ts_sh_swath *s, int threads, ts_sh_wedges *w,
+                             ts_error *err)
+{
+    if (!w)
+        return ts_fail(err, TS_ERR_ARG, "the wedge tables must not be NULL");
+    memset(w, 0, sizeof *w);
+    if (!s || s->n < 1 || !(s->step > 0) || !(s->span <= 360))
+        return ts_fail(err, TS_ERR_ARG, "the swath must have at least one azimuth and an "
+                       "extent of at most 360 degrees");
+    w->swath = *s;
+    w->interior = malloc(sizeof(float) * N_STEPS * N_STEPS * TS_SH_COEFFS);
+    if (!s->complete) {
+        w->rise = malloc(sizeof(float) * N_STEPS * TS_SH_COEFFS);
+        w->fall = malloc(sizeof(float) * N_STEPS * TS_SH_COEFFS);
+    }
+    if (!w->interior || (!s->complete && (!w->rise || !w->fall))) {
+        ts_sh_wedges_free(w);
+        return ts_fail(err, TS_ERR_NOMEM, "out of memory for the SH wedge tables");
+    }
+    build_ctx C = {s, w};
+    ts_status st = ts_parallel_for(ts_thread_count(threads, N_STEPS), N_STEPS, build_rows, &C,
+                                   err);
+    if (st != TS_OK)
+        ts_sh_wedges_free(w);
+    return st;
+}
+
+void ts_sh_wedges_free(ts_sh_wedges *w)
+{
+    if (!w)
+        return;
+    free(w->interior);
+    free(w->rise);
+    free(w->fall);
+    w->interior = w->rise = w->fall = NULL;
+}
+
+/* One wedge added to every cell: horizons from plane a (NULL = 90 deg) to
+ * plane b (NULL = 90), canonical start turned by `angle`. */
+typedef struct {
+    const ts_sh_visibility *v;
+    const float *a, *b;
+    const float *table; /* interior, rise (b NULL) or fall (a NULL) */
+    double cs[3], sn[3];
+} wedge_ctx;
+
+/* Node index and fraction of a horizon angle on the table's axis. */
+static int place(float omega, double *frac)
+{
+    double t = clamp_omega(omega) * (N_STEPS - 1) / 90.0;
+    int i = (int)t;
+    if (i >= N_STEPS - 1)
+        i = N_STEPS - 2;
+    *frac = t - i;
+    return i;
+}
+
+static void wedge_rows(void *ctx, int worker, long y0, long y1)
+{
+    (void)worker;
+    const wedge_ctx *C = ctx;
+    const size_t W = (size_t)C->v->grid->width, cells = W * C->v->grid->height;
+    float *vis = C->v->vis;
+    for (size_t c = (size_t)y0 * W; c < (size_t)y1 * W; c++) {
+        float wa = C->a ? C->a[c] : 90.0f, wb = C->b ? C->b[c] : 90.0f;
+        if (wa != wa || wb != wb) {
+            for (int k = 0; k < TS_SH_COEFFS; k++)
+                vis[k * cells + c] = NAN;
+            continue;
+        }
+        float v[TS_SH_COEFFS];
+        double acc[TS_SH_COEFFS] = {0}, fa, fb;
+        if (C->a && C->b) {
+            int ia = place(wa, &fa), ib = place(wb, &fb);
+            const float *t00 = C->table + ((size_t)ia * N_STEPS + ib) * TS_SH_COEFFS;
+            const float *t10 = t00 + N_STEPS * TS_SH_COEFFS;
+            for (int k = 0; k < TS_SH_COEFFS; k++)
+                v[k] = (float)((1 - fa) * ((1 - fb) * t00[k] + fb * t00[k + TS_SH_COEFFS]) +
+                               fa * ((1 - fb) * t10[k] + fb * t10[k + TS_SH_COEFFS]));
+        } else {
+            int i = place(C->a ? wa : wb, &fa);
+            const float *t0 = C->table + (size_t)i * TS_SH_COEFFS;
+            for (int k = 0; k < TS_SH_COEFFS; k++)
+                v[k] = (float)((1 - fa) * t0[k] + fa * t0[k + TS_SH_COEFFS]);
+        }
+        ts_sh_add_rotated(v, C->cs, C->sn, acc);
+        for (int k = 0; k < TS_SH_COEFFS; k++)
+            vis[k * cells + c] += (float)acc[k];
+    }
+}
+
+/* Add the wedge whose canonical start lies at azimuth `az_start` (its
+ * phi = 90 - az_start), horizons a (at the start) and b. */
+static ts_status add_wedge(const ts_sh_visibility *v, const float *table, double az_start,
+                           const float *a, const float *b, ts_error *err)
+{
+    wedge_ctx C = {v, a, b, table, {0}, {0}};
+    double angle = (90.0 - az_start) * DEG2RAD;
+    for (int m = 1; m <= 3; m++) {
+        C.cs[m - 1] = cos(m * angle);
+        C.sn[m - 1] = sin(m * angle);
+    }
+    return ts_parallel_for(ts_thread_count(0, v->grid->height), v->grid->height, wedge_rows,
+                           &C, err);
+}
+
+ts_status ts_sh_visibility_init(ts_sh_visibility *v, const ts_grid *grid,
+                                const ts_sh_wedges *w, ts_error *err)
+{
+    if (!v)
+        return ts_fail(err, TS_ERR_ARG, "the visibility must not be NULL");
+    memset(v, 0, sizeof *v);
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if (!w || !w->interior)
+        return ts_fail(err, TS_ERR_ARG, "the wedge tables were not built");
+    size_t cells = (size_t)grid->width * grid->height;
+    v->w = w;
+    v->grid = grid;
+    v->vis = calloc(cells * TS_SH_COEFFS, sizeof(float));
+    v->first = malloc(cells * sizeof(float));
+    v->prev = malloc(cells * sizeof(float));
+    if (!v->vis || !v->first || !v->prev) {
+        ts_sh_visibility_free(v);
+        return ts_fail(err, TS_ERR_NOMEM, "out of memory for the SH visibility (%zu floats "
+                       "a cell)", (size_t)TS_SH_COEFFS + 2);
+    }
+    return ts_ok(err);
+}
+
+ts_status ts_sh_visibility_add(ts_sh_visibility *v, int k, const float *plane, ts_error *err)
+{
+    if (!v || !v->vis || !plane)
+        return ts_fail(err, TS_ERR_ARG, "the visibility and the horizon plane must not be NULL");
+    const ts_sh_swath *s = &v->w->swath;
+    if (k != v->next || k >= s->n)
+        return ts_fail(err, TS_ERR_ARG, "horizon plane %d given, plane %d of %d expected", k,
+                       v->next, s->n);
+    size_t cells = (size_t)v->grid->width * v->grid->height;
+    ts_status st = TS_OK;
+    double az = ts_sh_swath_azimuth(s, k);
+    if (k > 0) /* from sample k - 1 clockwise to k: canonical start at k */
+        st = add_wedge(v, v->w->interior, az, plane, v->prev, err);
+    else if (!s->complete) /* the swath's edge, blocked, to sample 0 */
+        st = add_wedge(v, v->w->rise, az, plane, NULL, err);
+    if (k == 0 && s->complete)
+        memcpy(v->first, plane, cells * sizeof(float));
+    memcpy(v->prev, plane, cells * sizeof(float));
+    v->next = k + 1;
+    return st == TS_OK ? ts_ok(err) : st;
+}
+
+ts_status ts_sh_visibility_finish(ts_sh_visibility *v, ts_error *err)
+{
+    if (!v || !v->vis)
+        return ts_fail(err, TS_ERR_ARG, "the visibility must not be NULL");
+    const ts_sh_swath *s = &v->w->swath;
+    if (v->next != s->n)
+        return ts_fail(err, TS_ERR_ARG, "%d of the swath's %d horizon planes were added",
+                       v->next, s->n);
+    if (s->complete) /* the last sample clockwise to the first */
+        return add_wedge(v, v->w->interior, ts_sh_swath_azimuth(s, 0), v->first, v->prev,
+                         err);
+    /* the last sample to the swath's edge, blocked */
+    double edge = ts_sh_swath_azimuth(s, s->n - 1) + s->step / 2;
+    return add_wedge(v, v->w->fall, edge, NULL, v->prev, err);
+}
+
+void ts_sh_visibility_free(ts_sh_visibility *v)
+{
+    if (!v)
+        return;
+    free(v->vis);
+    free(v->first);
+    free(v->prev);
+    v->vis = v->first = v->prev = NULL;
+}
