@@ -138,8 +138,9 @@ double ts_sh_swath_azimuth(const ts_sh_swath *s, int k);
  * Wedge tables of a swath (eq. 8 of the paper): the SH projection of the
  * visibility of one wedge in canonical position (phi from 0 to its extent,
  * the horizon linear from omega_a at 0 to omega_b at the end; visible above
- * it, 0 below and outside the wedge), by Gauss quadrature (12 x 12 nodes,
- * error < 1e-9 of a wedge's coefficients). interior[(a * 256 + b) * 16 + i]
+ * it, 0 below and outside the wedge), by Gauss quadrature in azimuth of a
+ * tabulated integral over elevation (core/sh_visibility.c; within 3e-5 of a
+ * sum over a 0.09-degree grid of the sphere, tests/check_sh.c). interior[(a * 256 + b) * 16 + i]
  * at omega_a = 90 a / 255, omega_b = 90 b / 255 degrees, extent s->step;
  * for a partial swath rise[a * 16 + i] = the wedge of extent step / 2 from
  * omega_a to 90 degrees and fall[b * 16 + i] from 90 degrees to omega_b.
