@@ -132,12 +132,13 @@ void ts_sh_key_reference(const ts_sh_wedges *w, const double l[TS_SH_COEFFS],
                          double *share_ref)
 {
     double v[TS_SH_COEFFS], h[TS_SH_COEFFS], m[TS_SH_COEFFS][TS_SH_COEFFS];
-    double a = azimuth * DEG2RAD, e = elevation * DEG2RAD;
-    double d[3] = {sin(a) * cos(e), cos(a) * cos(e), sin(e)};
+    (void)azimuth; /* the swath and the light hold it */
+    double e = elevation * DEG2RAD, up[3] = {0, 0, 1};
     ts_sh_swath_visibility_flat(&w->swath, 0, v);
-    ts_sh_clamped_cosine(d, h);
+    ts_sh_clamped_cosine(up, h);
     ts_sh_product_matrix(l, m);
-    *shade_ref = ts_sh_triple(m, v, h);
+    /* open flat ground's SH value over its exact max(0, N . L) = sin e */
+    *shade_ref = sin(e) > 0 ? ts_sh_triple(m, v, h) / sin(e) : 0;
     double s = 0;
     for (int i = 0; i < TS_SH_COEFFS; i++)
         s += l[i] * v[i];

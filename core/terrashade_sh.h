@@ -212,13 +212,15 @@ ts_status ts_sh_visible_share(const ts_grid *grid, const double l[TS_SH_COEFFS],
 /* ---------------------------------------------------------- key light */
 
 /**
- * A key light's normalisers: of its swath with every horizon at 0 (open
- * flat ground), `shade_ref` = the triple product for a surface facing the
- * light and `share_ref` = the double product; shade divides by shade_ref so
- * that an unshadowed surface facing the light gets 1 (as the exact method's
- * max(0, N . L)), the visible share by share_ref so that open flat ground
- * sees all of it. Both are multiplied by ts_sh_disk_above (0 for a sun
- * below the horizontal).
+ * A key light's normalisers, from its swath with every horizon at 0 (open
+ * flat ground): `shade_ref` = the triple product with the upward clamped
+ * cosine divided by sin(elevation) (0 for a sun at or below the horizontal),
+ * so that shade divided by it gives open flat ground exactly the exact
+ * method's max(0, N . L) = sin e (of the normalisations tried, the one
+ * closest to the exact shade on jacksboro: mean |difference| 0.024 against
+ * 0.082 for "a surface facing the light gets 1", sun at 315/45 degrees);
+ * `share_ref` = the double product (light . visibility), so that open flat
+ * ground sees all of the light. Multiply both results by ts_sh_disk_above.
  */
 void ts_sh_key_reference(const ts_sh_wedges *w, const double l[TS_SH_COEFFS],
                          double azimuth, double elevation, double *shade_ref,

@@ -106,7 +106,7 @@ ts_status tsd_sh_key_direct(const tsd_compute_ctx *c, const ts_grid *g, const ts
     size_t cells = (size_t)g->width * g->height;
     for (size_t i = 0; st == TS_OK && i < cells; i++)
         if (out[i] > 1)
-            out[i] = 1; /* ringing above the facing surface's 1 */
+            out[i] = 1; /* as the exact max(0, N . L) */
     key_free(&k);
     return st;
 }

@@ -17,9 +17,9 @@ extern "C" {
 /** shade's direct term with METHOD=sh: the triple product of the key light
  *  (a disk of LIGHT_RADIUS at the run's sun), the visibility of its
  *  partial swath (SWATH_DIRECTIONS sweeps) and the clamped cosine around
- *  the normal, normalised so that an unshadowed surface facing the light on
- *  open ground gets 1, times the share of the disk above the horizontal;
- *  clamped to 0..1. */
+ *  the normal, normalised so that open flat ground gets the exact method's
+ *  sin(elevation) (ts_sh_key_reference), times the share of the disk above
+ *  the horizontal; clamped to 0..1. */
 ts_status tsd_sh_key_direct(const tsd_compute_ctx *c, const ts_grid *g, const tsd_normals *nm,
                             float *out);
 
