@@ -56,7 +56,7 @@ static void shade_rows(void *ctx, int worker, long y0, long y1)
 {
     (void)worker;
     const shade_ctx *C = ctx;
-    const size_t W = (size_t)C->g->width, cells = W * C->g->height;
+    const size_t W = (size_t)C->g->width;
     for (size_t c = (size_t)y0 * W; c < (size_t)y1 * W; c++) {
         double d[3] = {C->nx[c], C->ny[c], C->nz[c]}, y[TS_SH_COEFFS], s = 0;
         ts_sh_eval(d, y);
@@ -64,7 +64,7 @@ static void shade_rows(void *ctx, int worker, long y0, long y1)
             double t = 0;
             for (int k = 0; k < TS_SH_COEFFS; k++)
                 t += C->mh[j][k] * y[k];
-            s += C->vis[j * cells + c] * t;
+            s += C->vis[c * TS_SH_COEFFS + j] * t;
         }
         s *= C->scale;
         C->out[c] = s == s ? (float)(s > 0 ? s : 0) : NAN;
@@ -105,11 +105,11 @@ static void share_rows(void *ctx, int worker, long y0, long y1)
 {
     (void)worker;
     const shade_ctx *C = ctx;
-    const size_t W = (size_t)C->g->width, cells = W * C->g->height;
+    const size_t W = (size_t)C->g->width;
     for (size_t c = (size_t)y0 * W; c < (size_t)y1 * W; c++) {
         double s = 0;
         for (int i = 0; i < TS_SH_COEFFS; i++)
-            s += C->l[i] * C->vis[i * cells + c];
+            s += C->l[i] * C->vis[c * TS_SH_COEFFS + i];
         s *= C->scale;
         C->out[c] = s == s ? (float)(s < 0 ? 0 : s > 1 ? 1 : s) : NAN;
     }

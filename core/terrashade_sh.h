@@ -172,15 +172,15 @@ void ts_sh_wedge_project(double extent_deg, double omega_a, double omega_b,
  * planes arrive in order k = 0 .. n - 1 (ts_sh_visibility_add), then
  * finished (ts_sh_visibility_finish adds the wedges that need the last
  * plane: the closing one of a complete swath, the end boundary of a
- * partial one). vis: 16 planes of width * height floats (coefficient i of
- * cell c at vis[i * cells + c]); it keeps copies of the first and the last
+ * partial one). vis: 16 floats a cell, width * height cells (coefficient i of
+ * cell c at vis[c * 16 + i]); it keeps copies of the first and the last
  * plane. NaN horizons (nodata) give NaN.
  */
 typedef struct {
     const ts_sh_wedges *w;
     const ts_grid *grid;
     int next;        /**< the plane expected next */
-    float *vis;      /**< 16 planes, zeroed by init */
+    float *vis;      /**< 16 floats a cell, zeroed by init */
     float *first;    /**< plane 0 (complete swath) */
     float *prev;     /**< the last plane */
 } ts_sh_visibility;
