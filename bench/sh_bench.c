@@ -149,27 +149,28 @@ static void bench_key(const ts_grid *g, int swath, const float *nx, const float 
     t = now();
     ts_sh_swath s;
     ts_sh_wedges w;
-    ts_sh_visibility v;
-    double l[TS_SH_COEFFS], m[TS_SH_COEFFS][TS_SH_COEFFS], shade_ref, share_ref;
+    double l[TS_SH_COEFFS], shade_ref, share_ref;
     ts_sh_swath_key(&s, swath, az, el, radius);
     ts_sh_key_light(az, el, radius, l);
     check(ts_sh_wedges_build(&s, 0, &w, &e), "wedges", &e);
     stamp tables = now();
     tables.wall -= t.wall, tables.cpu -= t.cpu;
-    check(ts_sh_visibility_init(&v, g, &w, &e), "visibility", &e);
     ts_sh_key_reference(&w, l, az, el, &shade_ref, &share_ref);
+    float **planes = malloc(sizeof *planes * (size_t)s.n);
     for (int k = 0; k < s.n; k++) {
-        check(ts_horizon_sweep(g, ts_sh_swath_azimuth(&s, k), &o, plane, &e), "sweep", &e);
-        check(ts_sh_visibility_add(&v, k, plane, &e), "visibility", &e);
+        planes[k] = floats(n);
+        check(ts_horizon_sweep(g, ts_sh_swath_azimuth(&s, k), &o, planes[k], &e), "sweep", &e);
     }
-    check(ts_sh_visibility_finish(&v, &e), "visibility", &e);
-    ts_sh_product_matrix(l, m);
-    check(ts_sh_shade(g, m, nx, ny, nz, v.vis, 1 / shade_ref, out, &e), "shade", &e);
+    check(ts_sh_swath_light(g, &w, (const float *const *)planes, l, nx, ny, nz, 1 / shade_ref,
+                            out, 0, NULL, &e),
+          "shade", &e);
     add_since(t, &sh);
     printf("key light 315/45, direct term: exact %.2f s (CPU %.2f), sh with %d sweeps %.2f s "
            "(CPU %.2f; of which wedge tables %.2f s); sh / exact %.2f\n",
            exact.wall, exact.cpu, swath, sh.wall, sh.cpu, tables.wall, sh.wall / exact.wall);
-    ts_sh_visibility_free(&v);
+    for (int k = 0; k < s.n; k++)
+        free(planes[k]);
+    free(planes);
     ts_sh_wedges_free(&w);
     free(plane), free(out);
 }

@@ -47,6 +47,19 @@ void ts_sh_rotate_z(const double in[TS_SH_COEFFS], double angle, double out[TS_S
     }
 }
 
+void ts_sh_rotation_set(ts_sh_rotation *r, double az_start)
+{
+    double angle = (90.0 - az_start) * M_PI / 180;
+    for (int l = 0; l <= 3; l++)
+        for (int m = -l; m <= l; m++) {
+            /* c' = c cos - s sin, s' = c sin + s cos (ts_sh_rotate_z) */
+            int k = l * (l + 1) + m, am = m < 0 ? -m : m;
+            r->p[k] = (float)cos(am * angle);
+            r->perm[k] = l * (l + 1) - m;
+            r->q[k] = (float)(m > 0 ? -sin(am * angle) : m < 0 ? sin(am * angle) : 0);
+        }
+}
+
 /* A zonal function with coefficients zh[l] (of y_l0) rotated to unit
  * direction d: sqrt(4 pi / (2l + 1)) zh[l] y_lm(d). */
 static void zonal_to(const double zh[4], const double d[3], double out[TS_SH_COEFFS])

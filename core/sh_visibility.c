@@ -227,58 +227,20 @@ typedef struct {
     const ts_sh_visibility *v;
     const float *a, *b;
     const float *table; /* interior, rise (b NULL) or fall (a NULL) */
-    /* the rotation about z as out[k] = in[k] p[k] + in[perm[k]] q[k] */
-    float p[TS_SH_COEFFS], q[TS_SH_COEFFS];
-    int perm[TS_SH_COEFFS];
+    ts_sh_rotation rot;
 } wedge_ctx;
 
-/* Node index and fraction of a horizon angle on the table's axis. */
-static inline int place(float omega, float *frac)
-{
-    float t = (omega < 0 ? 0 : omega > 90 ? 90 : omega) * ((N_STEPS - 1) / 90.0f);
-    int i = (int)t;
-    i = i > N_STEPS - 2 ? N_STEPS - 2 : i;
-    *frac = t - (float)i;
-    return i;
-}
-
-/* Cells c0..c1 of one wedge: plain float loops of 16 the compiler
- * vectorises (cloned for wider vectors where the CPU has them). */
+/* Cells c0..c1 of one wedge (cloned for wider vectors where the CPU has
+ * them). */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 __attribute__((target_clones("avx512f", "avx2", "default")))
 #endif
 static void wedge_cells(const wedge_ctx *C, size_t c0, size_t c1)
 {
-    const float *restrict table = C->table;
-    for (size_t c = c0; c < c1; c++) {
-        float *restrict acc = C->v->vis + c * TS_SH_COEFFS; /* this cell's coefficients */
-        float wa = C->a ? C->a[c] : 90.0f, wb = C->b ? C->b[c] : 90.0f;
-        if (wa != wa || wb != wb) {
-            for (int k = 0; k < TS_SH_COEFFS; k++)
-                acc[k] = NAN;
-            continue;
-        }
-        float v[TS_SH_COEFFS], vp[TS_SH_COEFFS], fa, fb;
-        if (C->a && C->b) {
-            int ia = place(wa, &fa), ib = place(wb, &fb);
-            const float *t00 = table + ((size_t)ia * N_STEPS + ib) * TS_SH_COEFFS;
-            const float *t01 = t00 + TS_SH_COEFFS, *t10 = t00 + N_STEPS * TS_SH_COEFFS;
-            const float *t11 = t10 + TS_SH_COEFFS;
-            const float w00 = (1 - fa) * (1 - fb), w01 = (1 - fa) * fb, w10 = fa * (1 - fb),
-                        w11 = fa * fb;
-            for (int k = 0; k < TS_SH_COEFFS; k++)
-                v[k] = w00 * t00[k] + w01 * t01[k] + w10 * t10[k] + w11 * t11[k];
-        } else {
-            int i = place(C->a ? wa : wb, &fa);
-            const float *t0 = table + (size_t)i * TS_SH_COEFFS;
-            for (int k = 0; k < TS_SH_COEFFS; k++)
-                v[k] = (1 - fa) * t0[k] + fa * t0[k + TS_SH_COEFFS];
-        }
-        for (int k = 0; k < TS_SH_COEFFS; k++)
-            vp[k] = v[C->perm[k]];
-        for (int k = 0; k < TS_SH_COEFFS; k++)
-            acc[k] += v[k] * C->p[k] + vp[k] * C->q[k];
-    }
+    const int kind = C->a && C->b ? 2 : C->a ? 0 : 1;
+    for (size_t c = c0; c < c1; c++)
+        ts_sh_cell_wedge(C->table, kind, C->a ? C->a[c] : 90.0f, C->b ? C->b[c] : 90.0f,
+                         &C->rot, C->v->vis + c * TS_SH_COEFFS);
 }
 
 static void wedge_rows(void *ctx, int worker, long y0, long y1)
@@ -294,16 +256,8 @@ static void wedge_rows(void *ctx, int worker, long y0, long y1)
 static ts_status add_wedge(const ts_sh_visibility *v, const float *table, double az_start,
                            const float *a, const float *b, ts_error *err)
 {
-    wedge_ctx C = {v, a, b, table, {0}, {0}, {0}};
-    double angle = (90.0 - az_start) * DEG2RAD;
-    for (int l = 0; l <= 3; l++)
-        for (int m = -l; m <= l; m++) {
-            /* ts_sh_rotate_z: c' = c cos - s sin, s' = c sin + s cos */
-            int k = l * (l + 1) + m, am = m < 0 ? -m : m;
-            C.p[k] = (float)cos(am * angle);
-            C.perm[k] = l * (l + 1) - m;
-            C.q[k] = (float)(m > 0 ? -sin(am * angle) : m < 0 ? sin(am * angle) : 0);
-        }
+    wedge_ctx C = {v, a, b, table, {{0}, {0}, {0}}};
+    ts_sh_rotation_set(&C.rot, az_start);
     return ts_parallel_for(ts_thread_count(0, v->grid->height), v->grid->height, wedge_rows,
                            &C, err);
 }

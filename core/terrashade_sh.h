@@ -209,6 +209,21 @@ ts_status ts_sh_shade(const ts_grid *grid, const double m[TS_SH_COEFFS][TS_SH_CO
 ts_status ts_sh_visible_share(const ts_grid *grid, const double l[TS_SH_COEFFS],
                               const float *vis, double scale, float *out, ts_error *err);
 
+/**
+ * A swath's light in one pass over the cells from all its horizon planes at
+ * once (planes[k] at ts_sh_swath_azimuth(k), n of them), without storing the
+ * visibility (the cheaper form when the swath has few samples, as a key
+ * light's): each cell's visibility summed from the same wedges as
+ * ts_sh_visibility, then, where the output is not NULL,
+ * shade = max(0, scale_shade * triple(l, V, clamped cosine of N)) and
+ * share = clamp(scale_share * l . V, 0, 1); NaN stays NaN.
+ */
+ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
+                            const float *const *planes, const double l[TS_SH_COEFFS],
+                            const float *nx, const float *ny, const float *nz,
+                            double scale_shade, float *shade, double scale_share, float *share,
+                            ts_error *err);
+
 /* ---------------------------------------------------------- key light */
 
 /**

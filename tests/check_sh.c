@@ -268,17 +268,33 @@ START_TEST(visibility_planes)
         for (size_t c = 0; c < cells; c++) {
             double ref[N];
             if (c == 7) {
-                ck_assert(isnan(v.vis[c]));
+                ck_assert(isnan(v.vis[c * N]));
                 continue;
             }
             /* the tables' nodes are every 90/255 deg; 5c - 3 needs interpolation */
             ts_sh_swath_visibility_flat(&swaths[s], c * 5.0 - 3, ref);
             for (int i = 0; i < N; i++)
-                worst = fmax(worst, fabs(v.vis[i * cells + c] - ref[i]));
+                worst = fmax(worst, fabs(v.vis[c * N + i] - ref[i]));
         }
         printf("%s swath: visibility from the tables within %.2e of the direct sum\n",
                s ? "partial" : "complete", worst);
         ck_assert(worst < (s ? 2e-5 : 2e-4));
+        /* the one-pass form gives the same visible share as the stored visibility */
+        double l[N] = {0.5, 0.1, 0.3, -0.2, 0.05, 0.1, 0.2, -0.1, 0.1, 0.02, 0.03, 0.04, 0.05,
+                       -0.02, 0.01, 0.03};
+        float *share = tdem_floats(cells), *stored = tdem_floats(cells);
+        const float *planes[8];
+        for (int k = 0; k < swaths[s].n; k++)
+            planes[k] = plane;
+        ck_assert_msg(ts_sh_swath_light(&g, &w, planes, l, NULL, NULL, NULL, 0, NULL, 0.5,
+                                        share, &err) == TS_OK, "%s", err.message);
+        ck_assert(ts_sh_visible_share(&g, l, v.vis, 0.5, stored, &err) == TS_OK);
+        for (size_t c = 0; c < cells; c++)
+            ck_assert(c == 7 ? isnan(share[c]) && isnan(stored[c])
+                             : fabsf(share[c] - stored[c]) < 1e-6f);
+        EXPECT_ARG(ts_sh_swath_light(&g, &w, planes, l, NULL, NULL, NULL, 1, share, 0, NULL,
+                                     &err), &err);
+        free(share), free(stored);
         /* a plane out of order is refused */
         EXPECT_ARG(ts_sh_visibility_add(&v, 0, plane, &err), &err);
         ts_sh_visibility_free(&v);
