@@ -46,18 +46,18 @@ const opt_def TSD_OPTION_ROWS[] = {
      "from the sun's disk), shm (shadow height map, faster, approximate) or "
      "sh (order-4 spherical harmonics, Snyder & Nowrouzezahrai 2008: a soft "
      "key light of LIGHT_RADIUS from SWATH_DIRECTIONS horizon sweeps)"},
-    {"LIGHT_RADIUS", K_FLOAT, FIELD(light_radius), "0.2666", 0, 45, 1, 1, NULL, 1, P,
-     LISTED, NULL,
-     "Angular radius of the light's disk in degrees, 0 < r < 45 (default the "
-     "sun's 0.2666); used by METHOD=sh"},
-    {"SWATH_DIRECTIONS", K_INT, FIELD(swath_directions), "3", 1, 3600, 0, 1, NULL, 1, P,
-     LISTED, NULL,
-     "METHOD=sh: horizon sweeps across the azimuths the light's disk covers "
-     "(its partial swath)"},
     {"PENUMBRA_DEPTH", K_FLOAT, FIELD(penumbra_depth), "0", 0, 1e6, 0, 1, NULL, 1, P,
      LISTED, NULL,
      "METHOD=shm: metres below the shadow height over which light fades; "
      "0 = hard shadows"},
+    {"LIGHT_RADIUS", K_FLOAT, FIELD(light_radius), "0.2666", 0, 45, 1, 1, NULL, 1, P,
+     LISTED, NULL,
+     "Angular radius of the light's disk in degrees, greater than 0 and less "
+     "than 45; 0.2666 = the sun. A wider disk casts softer shadows"},
+    {"SWATH_DIRECTIONS", K_INT, FIELD(swath_directions), "3", 1, 3600, 0, 1, NULL, 1, P,
+     LISTED, NULL,
+     "METHOD=sh: horizon sweeps across the azimuths the light's disk covers "
+     "(its partial swath)"},
     {"Z_FACTOR", K_FLOAT_AUTO, FIELD(z_factor), "AUTO", 0, 1e6, 1, 1, "AUTO", 1, P, ALL,
      NULL,
      "Multiplies the heights: AUTO (from the vertical unit of the DEM's CRS, "

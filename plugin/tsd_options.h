@@ -52,6 +52,7 @@ typedef struct {
     double start_azimuth;    /* first of those azimuths */
     tsd_method method;       /* exact horizon or shadow height map */
     double penumbra_depth;   /* metres, METHOD=shm only */
+    double light_radius;     /* degrees: the light's disk (LIGHT_RADIUS) */
     double z_factor;         /* multiplies the DEM's heights; NAN = AUTO, decided
                                 from the DEM (tsd_dem_z_factor) */
     double max_distance;     /* metres, 0 = unbounded */
@@ -93,7 +94,6 @@ typedef struct {
     char exposure[TSD_TEXT_MAX]; /* EXPOSURE: stops (Byte), "" or AUTO = automatic */
     tsd_env_method env_method;   /* ENV_METHOD: table or sh (envlight) */
     /* the key light of METHOD=sh (tsd_compute_sh.c) */
-    double light_radius;         /* LIGHT_RADIUS: degrees, 0 < r < 45 */
     int swath_directions;        /* SWATH_DIRECTIONS: azimuths of its partial swath */
 
     int svf_model;           /* SVF_MODEL: a ts_svf_model (0 radiative, 1 solid_angle) */
