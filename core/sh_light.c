@@ -47,26 +47,27 @@ void ts_sh_swath_visibility_flat(const ts_sh_swath *s, double omega_deg,
 /* m with the clamped cosine's zonal factors, so that the triple product
  * with a normal n is sum_jk v_j mh[j][k] y_k(n). */
 static void fold_cosine(const double m[TS_SH_COEFFS][TS_SH_COEFFS],
-                        double mh[TS_SH_COEFFS][TS_SH_COEFFS])
+                        float mh[TS_SH_COEFFS][TS_SH_COEFFS])
 {
     for (int k = 0; k < TS_SH_COEFFS; k++) {
         int l = k < 1 ? 0 : k < 4 ? 1 : k < 9 ? 2 : 3;
         double f = sqrt(4 * M_PI / (2 * l + 1)) * TS_SH_CLAMPED_COS_ZH[l];
         for (int j = 0; j < TS_SH_COEFFS; j++)
-            mh[j][k] = m[j][k] * f;
+            mh[j][k] = (float)(m[j][k] * f);
     }
 }
 
-/* The triple product of visibility v (16 floats) with the folded matrix and
- * the normal (x, y, z): w = v^T mh as 16 independent sums (a loop the
- * compiler vectorises, not one chain of dependent additions), then w . y(n). */
-static inline double cell_triple(const double mh[TS_SH_COEFFS][TS_SH_COEFFS], const float *v, float x,
-                          float y, float z)
+/* The triple product of visibility v (16 floats) with the folded matrix (as
+ * floats) and the normal (x, y, z): w = v^T mh as 16 independent sums in a
+ * loop the compiler vectorises, then w . y(n). */
+static inline double cell_triple(const float mh[TS_SH_COEFFS][TS_SH_COEFFS], const float *v,
+                                 float x, float y, float z)
 {
-    double d[3] = {x, y, z}, yn[TS_SH_COEFFS], w[TS_SH_COEFFS] = {0}, s = 0;
+    double d[3] = {x, y, z}, yn[TS_SH_COEFFS], s = 0;
+    float w[TS_SH_COEFFS] = {0};
     ts_sh_eval(d, yn);
     for (int j = 0; j < TS_SH_COEFFS; j++) {
-        const double vj = v[j];
+        const float vj = v[j];
         for (int k = 0; k < TS_SH_COEFFS; k++)
             w[k] += vj * mh[j][k];
     }
@@ -77,7 +78,7 @@ static inline double cell_triple(const double mh[TS_SH_COEFFS][TS_SH_COEFFS], co
 
 typedef struct {
     const ts_grid *g;
-    double mh[TS_SH_COEFFS][TS_SH_COEFFS]; /* m with the clamped cosine's zonal factors */
+    float mh[TS_SH_COEFFS][TS_SH_COEFFS]; /* m with the clamped cosine's zonal factors */
     const float *nx, *ny, *nz, *vis;
     const double *l;
     double scale;
@@ -172,7 +173,7 @@ typedef struct {
     const float *const *planes;
     const ts_sh_rotation *rot; /* n + 1: wedge k ends at sample k; [0] rise or closing;
                                   [n] fall */
-    double mh[TS_SH_COEFFS][TS_SH_COEFFS];
+    float mh[TS_SH_COEFFS][TS_SH_COEFFS];
     const double *l;
     const float *nx, *ny, *nz;
     double scale_shade, scale_share;
