@@ -7,6 +7,7 @@
 #include "tsd_text.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 
 const char *tsd_options_product_name(const tsd_options *o)
 {
@@ -153,9 +154,11 @@ static int check_sh(const tsd_options *o, char *msg, size_t n)
     if (!(o->light_radius < 45))
         REFUSE("LIGHT_RADIUS must be greater than 0 and less than 45 degrees, got %g",
                o->light_radius);
-    if (tsd_options_given(o, "SWATH_DIRECTIONS") && o->method != TSD_METHOD_SH)
-        REFUSE("SWATH_DIRECTIONS sets the horizon sweeps of METHOD=sh's key light; "
-               "give METHOD=sh with it");
+    /* as ENV_ROTATION: a value other than the default that would do nothing */
+    const int o_swath = tsd_option_find("SWATH_DIRECTIONS");
+    if (o->swath_directions != atoi(tsd_option_default(o_swath)) && o->method != TSD_METHOD_SH)
+        REFUSE("SWATH_DIRECTIONS=%d sets the horizon sweeps of METHOD=sh's key light; "
+               "give METHOD=sh with it", o->swath_directions);
     if (o->method == TSD_METHOD_SH && o->sun_position == TSD_SUN_PER_CELL)
         REFUSE("METHOD=sh lights with one key light, the sun at the DEM's centre: "
                "SUN_POSITION=per_cell needs METHOD=exact");
