@@ -3,6 +3,7 @@
 #include "tsd_compute.h"
 
 #include "tsd_compute_env.h"
+#include "tsd_compute_sh.h"
 #include "tsd_products.h"
 #include "tsd_pyramid.h"
 #include "tsd_text.h"
@@ -260,6 +261,8 @@ static ts_status shade_direct(const tsd_compute_ctx *c, const ts_grid *g, const 
         free(el);
         return st;
     }
+    if (c->opts->method == TSD_METHOD_SH)
+        return tsd_sh_key_direct(c, g, nm, out);
     if (c->opts->method == TSD_METHOD_EXACT) {
         ts_horizon_opts h;
         ts_backend_report rep = {0};
@@ -318,6 +321,8 @@ TSD_COMPUTE_FN(tsd_compute_shadow)
         return sun_per_cell(c, g, out, NULL, NULL);
     if (c->opts->method == TSD_METHOD_SHM)
         return shm_visibility(c, g, out);
+    if (c->opts->method == TSD_METHOD_SH)
+        return tsd_sh_key_shadow(c, g, out);
     ts_horizon_opts h;
     if ((st = sun_horizon(c, g, &h, out)) != TS_OK)
         return st;

@@ -2,6 +2,7 @@
 #include "tsd_compute_env.h"
 
 #include "tsd_backend.h"
+#include "tsd_compute_sh.h"
 #include "tsd_products.h"
 #include "tsd_text.h"
 
@@ -214,7 +215,9 @@ TSD_COMPUTE_FN(tsd_compute_envlight)
                         "PRODUCT=envlight has no environment (ENV_MAP or SKY)");
     memset(out, 0, 3 * cells * sizeof(float));
     if ((st = tsd_normals_make(c, g, &nm)) == TS_OK)
-        st = env_light(c, g, &nm, out, out + cells, out + 2 * cells);
+        st = c->opts->env_method == TSD_ENV_SH
+                 ? tsd_sh_env_light(c, g, &nm, out, out + cells, out + 2 * cells)
+                 : env_light(c, g, &nm, out, out + cells, out + 2 * cells);
     tsd_normals_free(&nm);
     if (st != TS_OK || !tsd_options_output_byte(c->opts))
         return st;

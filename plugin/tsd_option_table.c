@@ -40,14 +40,24 @@ const opt_def TSD_OPTION_ROWS[] = {
      NULL,
      "First of the DIRECTIONS azimuths, degrees from north; the others "
      "follow every 360/DIRECTIONS degrees"},
-    {"METHOD", K_SELECT, FIELD(method), "exact", 0, 0, 0, 0, "exact|shm", 1, P, LISTED,
+    {"METHOD", K_SELECT, FIELD(method), "exact", 0, 0, 0, 0, "exact|shm|sh", 1, P, LISTED,
      NULL,
      "Shadow method of shade and shadow: exact (horizon sweep, penumbra "
-     "from the sun's disk) or shm (shadow height map, faster, approximate)"},
+     "from the sun's disk), shm (shadow height map, faster, approximate) or "
+     "sh (order-4 spherical harmonics, Snyder & Nowrouzezahrai 2008: a soft "
+     "key light of LIGHT_RADIUS from SWATH_DIRECTIONS horizon sweeps)"},
     {"PENUMBRA_DEPTH", K_FLOAT, FIELD(penumbra_depth), "0", 0, 1e6, 0, 1, NULL, 1, P,
      LISTED, NULL,
      "METHOD=shm: metres below the shadow height over which light fades; "
      "0 = hard shadows"},
+    {"LIGHT_RADIUS", K_FLOAT, FIELD(light_radius), "0.2666", 0, 45, 1, 1, NULL, 1, P,
+     LISTED, NULL,
+     "Angular radius of the light's disk in degrees, greater than 0 and less "
+     "than 45; 0.2666 = the sun. A wider disk casts softer shadows"},
+    {"SWATH_DIRECTIONS", K_INT, FIELD(swath_directions), "3", 1, 3600, 0, 1, NULL, 1, P,
+     LISTED, NULL,
+     "METHOD=sh: horizon sweeps across the azimuths the light's disk covers "
+     "(its partial swath)"},
     {"Z_FACTOR", K_FLOAT_AUTO, FIELD(z_factor), "AUTO", 0, 1e6, 1, 1, "AUTO", 1, P, ALL,
      NULL,
      "Multiplies the heights: AUTO (from the vertical unit of the DEM's CRS, "
@@ -193,6 +203,12 @@ const opt_def TSD_OPTION_ROWS[] = {
      "2^EXPOSURE) before the sRGB curve; empty or AUTO: the brightest "
      "unshadowed surface of any slope and aspect maps to 255"},
 
+    {"ENV_METHOD", K_SELECT, FIELD(env_method), "table", 0, 0, 0, 0, "table|sh", 1, P,
+     LISTED, NULL,
+     "envlight: table (Timonen's L_p per azimuth from the exact horizons) or "
+     "sh (order-4 spherical harmonics, Snyder & Nowrouzezahrai 2008: light, "
+     "visibility wedges and clamped cosine as 16 coefficients, approximate)"},
+
     {"SVF_MODEL", K_SELECT, FIELD(svf_model), "radiative", 0, 0, 0, 0,
      "radiative|solid_angle", 1, P, LISTED, NULL,
      "svf: radiative (Timonen eq. 5 with the cell's normal: the "
@@ -250,7 +266,8 @@ _Static_assert(sizeof(tsd_method) == sizeof(int) && sizeof(tsd_output_type) == s
                    sizeof(tsd_sun_position) == sizeof(int) &&
                    sizeof(tsd_backend) == sizeof(int) &&
                    sizeof(tsd_horizon_method) == sizeof(int) &&
-                   sizeof(tsd_progress_mode) == sizeof(int),
+                   sizeof(tsd_progress_mode) == sizeof(int) &&
+                   sizeof(tsd_env_method) == sizeof(int),
                "enum options are int-sized");
 
 static int check_datetime(const char *v, char *msg, size_t n)

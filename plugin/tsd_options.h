@@ -29,9 +29,11 @@ extern "C" {
 
 typedef enum { TSD_SUN_CENTER = 0, TSD_SUN_PER_CELL } tsd_sun_position;
 typedef enum { TSD_PROGRESS_AUTO = 0, TSD_PROGRESS_YES, TSD_PROGRESS_NO } tsd_progress_mode;
-typedef enum { TSD_METHOD_EXACT = 0, TSD_METHOD_SHM } tsd_method;
+typedef enum { TSD_METHOD_EXACT = 0, TSD_METHOD_SHM, TSD_METHOD_SH } tsd_method;
 /* HORIZON_METHOD: the exact sweep or pyramid horizons (tsd_pyramid.h). */
 typedef enum { TSD_HORIZON_EXACT = 0, TSD_HORIZON_PYRAMID } tsd_horizon_method;
+/* ENV_METHOD of envlight: Timonen's L_p table or order-4 SH. */
+typedef enum { TSD_ENV_TABLE = 0, TSD_ENV_SH } tsd_env_method;
 typedef enum { TSD_OUT_AUTO = 0, TSD_OUT_BYTE, TSD_OUT_FLOAT32 } tsd_output_type;
 /* BACKEND: where the heavy core calls run (cl/terrashade_backend.h). */
 typedef enum { TSD_BACKEND_AUTO = 0, TSD_BACKEND_OPENCL, TSD_BACKEND_C } tsd_backend;
@@ -52,6 +54,7 @@ typedef struct {
     double start_azimuth;    /* first of those azimuths */
     tsd_method method;       /* exact horizon or shadow height map */
     double penumbra_depth;   /* metres, METHOD=shm only */
+    double light_radius;     /* degrees: the light's disk (LIGHT_RADIUS) */
     double z_factor;         /* multiplies the DEM's heights; NAN = AUTO, decided
                                 from the DEM (tsd_dem_z_factor) */
     double max_distance;     /* metres, 0 = unbounded */
@@ -91,6 +94,9 @@ typedef struct {
     int env_horizon_steps;       /* ENV_HORIZON_STEPS: the L_p table's horizon axis */
     int env_normal_steps;        /* ENV_NORMAL_STEPS: its normal axis, 0 = exact */
     char exposure[TSD_TEXT_MAX]; /* EXPOSURE: stops (Byte), "" or AUTO = automatic */
+    tsd_env_method env_method;   /* ENV_METHOD: table or sh (envlight) */
+    /* the key light of METHOD=sh (tsd_compute_sh.c) */
+    int swath_directions;        /* SWATH_DIRECTIONS: azimuths of its partial swath */
 
     int svf_model;           /* SVF_MODEL: a ts_svf_model (0 radiative, 1 solid_angle) */
     int openness_negative;   /* OPENNESS: 0 = positive, 1 = negative */

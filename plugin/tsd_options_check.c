@@ -8,6 +8,7 @@
 #include "tsd_text.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 
 const char *tsd_options_product_name(const tsd_options *o)
 {
@@ -146,6 +147,34 @@ static int check_environment(const tsd_options *o, char *msg, size_t n)
     return 0;
 }
 
+/* The SH options: ENV_METHOD, METHOD=sh's key light. */
+static int check_sh(const tsd_options *o, char *msg, size_t n)
+{
+    const tsd_product_def *p = tsd_product_of(o);
+    const int o_env_method = tsd_option_find("ENV_METHOD");
+    char list[256];
+    if (o->env_method != TSD_ENV_TABLE && !tsd_product_takes(p, o_env_method)) {
+        tsd_products_taking(o_env_method, "PRODUCT=", " and ", list, sizeof list);
+        REFUSE("ENV_METHOD=sh applies to %s only, not to PRODUCT=%s%s", list, p->name,
+               tsd_product_takes(p, tsd_option_find("METHOD"))
+                   ? ": its soft SH key light is METHOD=sh"
+                   : "");
+    }
+    /* the option table's range is 0 < r <= 45; 45 itself is refused here */
+    if (!(o->light_radius < 45))
+        REFUSE("LIGHT_RADIUS must be greater than 0 and less than 45 degrees, got %g",
+               o->light_radius);
+    /* as ENV_ROTATION: a value other than the default that would do nothing */
+    const int o_swath = tsd_option_find("SWATH_DIRECTIONS");
+    if (o->swath_directions != atoi(tsd_option_default(o_swath)) && o->method != TSD_METHOD_SH)
+        REFUSE("SWATH_DIRECTIONS=%d sets the horizon sweeps of METHOD=sh's key light; "
+               "give METHOD=sh with it", o->swath_directions);
+    if (o->method == TSD_METHOD_SH && o->sun_position == TSD_SUN_PER_CELL)
+        REFUSE("METHOD=sh lights with one key light, the sun at the DEM's centre: "
+               "SUN_POSITION=per_cell needs METHOD=exact");
+    return 0;
+}
+
 int tsd_options_check(const tsd_options *o, char *msg, size_t n)
 {
     const tsd_product_def *p = tsd_product_of(o);
@@ -162,9 +191,10 @@ int tsd_options_check(const tsd_options *o, char *msg, size_t n)
         REFUSE("OUTPUT_TYPE=Byte is only for the products with values in "
                "0..1 (%s); PRODUCT=%s is in %s", list, pn, p->values);
     }
-    if (o->method == TSD_METHOD_SHM && !tsd_product_takes(p, o_method)) {
+    if (o->method != TSD_METHOD_EXACT && !tsd_product_takes(p, o_method)) {
         tsd_products_taking(o_method, "PRODUCT=", " and ", list, sizeof list);
-        REFUSE("METHOD=shm applies to %s only, not to PRODUCT=%s", list, pn);
+        REFUSE("METHOD=%s applies to %s only, not to PRODUCT=%s",
+               o->method == TSD_METHOD_SH ? "sh" : "shm", list, pn);
     }
     /* a model chosen for another product is a mistake, not a no-op */
     if (o->svf_model != 0 && !tsd_product_takes(p, tsd_option_find("SVF_MODEL")))
@@ -217,7 +247,7 @@ int tsd_options_check(const tsd_options *o, char *msg, size_t n)
                     "start at FAR_THRESHOLD cells and have no end)", pn);
     if (o->sun_position == TSD_SUN_PER_CELL && !from_time)
         REFUSE("SUN_POSITION=per_cell needs the sun from DATETIME or DATE");
-    if (tsd_options_check_pyramid(o, msg, n) != 0)
+    if (tsd_options_check_pyramid(o, msg, n) != 0 || check_sh(o, msg, n) != 0)
         return -1;
     return check_environment(o, msg, n);
 }

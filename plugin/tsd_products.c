@@ -104,7 +104,8 @@ static int shadow_uses_backend(const tsd_options *o, const tsd_sun *sun)
 
 /* Option groups of the rows below. */
 #define SUN_TIME "DATETIME PRESSURE TEMPERATURE DELTA_T "
-#define SUN_OPTS "SUN_AZIMUTH SUN_ELEVATION METHOD PENUMBRA_DEPTH " SUN_TIME "SUN_POSITION "
+#define SUN_OPTS "SUN_AZIMUTH SUN_ELEVATION METHOD PENUMBRA_DEPTH " SUN_TIME "SUN_POSITION " \
+    "LIGHT_RADIUS SWATH_DIRECTIONS "
 #define SWEEP "DIRECTIONS START_AZIMUTH MAX_DISTANCE EDGE "
 #define DAY "DATE TIMEZONE " SUN_TIME
 #define RANGE "START_DATE END_DATE DAY_INTERVAL HORIZON_DIRECTIONS"
@@ -165,7 +166,8 @@ static const tsd_product_def PRODUCTS[] = {
     {"envlight", "light of an HDR environment map (ENV_MAP) or a standard sky (SKY) on a "
      "white Lambertian surface, E/pi per colour: red, green, blue", "", "E/pi", colour_bands,
      NULL, band_colour, TSD_BYTE_ALLOWED, 0, 0, TSD_STEPS_NONE, 4, 0, 0, backend_always,
-     SWEEP ENV PYRAMID "EXPOSURE OUTPUT_TYPE BACKEND SUN_AZIMUTH SUN_ELEVATION " SUN_TIME, NULL, NULL,
+     SWEEP ENV PYRAMID "ENV_METHOD EXPOSURE OUTPUT_TYPE BACKEND SUN_AZIMUTH SUN_ELEVATION "
+     SUN_TIME, NULL, NULL,
      tsd_compute_envlight},
 };
 
@@ -247,7 +249,12 @@ double tsd_product_peak_bytes(const tsd_options *o, int width, int height, doubl
     double kept = p->byte == TSD_BYTE_ALWAYS ? bands / 4 : bands;
     /* shade's sky term from SKY or ENV_MAP: two more colour accumulators */
     int env_sky = o->sky_weight > 0 && p->sky_planes > 0 && (o->sky[0] || o->env_map[0]);
-    int extra = p->planes + (o->sky_weight > 0 ? p->sky_planes : 0) + 2 * env_sky +
+    /* SH: METHOD=sh keeps its SWATH_DIRECTIONS horizon planes; ENV_METHOD=sh
+     * 16 visibility floats a cell and the first and last horizon planes */
+    int sh = o->method == TSD_METHOD_SH && tsd_product_takes(p, tsd_option_find("METHOD"))
+                 ? o->swath_directions
+                 : o->env_method == TSD_ENV_SH ? 18 : 0;
+    int extra = p->planes + (o->sky_weight > 0 ? p->sky_planes : 0) + 2 * env_sky + sh +
                 (o->sun_position == TSD_SUN_PER_CELL ? p->per_cell_planes : 0);
     if (steady)
         *steady = kept * plane;

@@ -175,8 +175,13 @@ static void real_svf(const char *name, double offset, double want_median, double
     ts_pyramid_opts p = popts(4, offset, TS_PYRAMID_BSPLINE);
     float *py = pyramid_planes(&g, &p, &o);
     err_stats h = diff_stats(ex, py, n * o.directions);
-    ck_assert(ts_sky_terms(&g, nx, ny, nz, ex, &o, se, NULL, NULL, &err) == TS_OK);
-    ck_assert(ts_sky_terms(&g, nx, ny, nz, py, &o, sp, NULL, NULL, &err) == TS_OK);
+    const ts_sky_request re = {.grid = &g, .nx = nx, .ny = ny, .nz = nz, .horizons = ex,
+                               .opts = &o, .svf = se};
+    ts_sky_request rp = re;
+    rp.horizons = py;
+    rp.svf = sp;
+    ck_assert(ts_sky_terms(&re, &err) == TS_OK);
+    ck_assert(ts_sky_terms(&rp, &err) == TS_OK);
     err_stats s = diff_stats(se, sp, n);
     printf("%s o=%g: horizon |pyramid - exact| median %.3f p99 %.3f deg; svf median %.4f "
            "p99 %.4f max %.4f\n", name, offset, h.median, h.p99, s.median, s.p99, s.max);

@@ -135,13 +135,15 @@ static void check_sentences(void)
     expect_sentence(0, "SUN_AZIMUT=1",
                     "unknown option 'SUN_AZIMUT'; the options are PRODUCT, SUN_AZIMUTH, "
                     "SUN_ELEVATION, DIRECTIONS, START_AZIMUTH, METHOD, PENUMBRA_DEPTH, "
+                    "LIGHT_RADIUS, SWATH_DIRECTIONS, "
                     "Z_FACTOR, MAX_DISTANCE, CURVATURE, REFRACTION, SKY_WEIGHT, BAND, "
                     "THREADS, OUTPUT_TYPE, MAX_MEMORY, DATETIME, DATE, START_DATE, END_DATE, "
                     "TIMEZONE, STEP_MINUTES, DAY_INTERVAL, HORIZON_DIRECTIONS, PRESSURE, TEMPERATURE, DELTA_T, SUN_POSITION, "
                     "LINKE_TURBIDITY, FAR_THRESHOLD, ATLAS_STEPS, BACKEND, SUNHOURS_RULE, "
                     "PROGRESS, ENV_MAP, ENV_ROTATION, SKY, ENV_HORIZON_STEPS, "
-                    "ENV_NORMAL_STEPS, EXPOSURE, SVF_MODEL, OPENNESS, EDGE, HORIZON_METHOD, "
-                    "PYRAMID_LEVEL_STEP, PYRAMID_OFFSET (see gdalinfo --format TERRASHADE)");
+                    "ENV_NORMAL_STEPS, EXPOSURE, ENV_METHOD, SVF_MODEL, OPENNESS, EDGE, "
+                    "HORIZON_METHOD, PYRAMID_LEVEL_STEP, PYRAMID_OFFSET (see gdalinfo --format "
+                    "TERRASHADE)");
     expect_sentence(0, "EDGE=foo", "EDGE must be one of horizon, open, nodata, got 'foo'");
     expect_sentence(0, "Z_FACTOR=0", "Z_FACTOR must be greater than 0 and at most 1e+06, got 0");
     expect_sentence(0, "Z_FACTOR=feet", "Z_FACTOR must be AUTO or a number, got 'feet'");

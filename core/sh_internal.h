@@ -1,0 +1,70 @@
+/* sh_internal.h - what the SH files share (core/sh_*.c); not installed. */
+#ifndef TS_SH_INTERNAL_H
+#define TS_SH_INTERNAL_H
+
+#include <math.h>
+#include <stddef.h>
+
+#include "terrashade_sh.h"
+
+/** Zonal coefficients (of y_l0) of the clamped cosine max(0, z)
+ *  (Ramamoorthi & Hanrahan 2001): sqrt(pi)/2, sqrt(pi/3), sqrt(5 pi)/8, 0. */
+static const double TS_SH_CLAMPED_COS_ZH[4] = {0.886226925452758014, 1.023326707946488488,
+                                               0.495415912200751666, 0.0};
+
+/** Gauss-Legendre nodes and weights of n points (n <= 32) on [-1, 1]. */
+void ts_sh_gauss(int n, double *x, double *w);
+
+/** A rotation about z in the form out[k] = in[k] p[k] + in[perm[k]] q[k]. */
+typedef struct {
+    float p[TS_SH_COEFFS], q[TS_SH_COEFFS];
+    int perm[TS_SH_COEFFS];
+} ts_sh_rotation;
+
+/** The rotation that takes a canonical wedge to its start at azimuth
+ *  `az_start` degrees (phi = 90 - az_start; ts_sh_rotate_z's formulas). */
+void ts_sh_rotation_set(ts_sh_rotation *r, double az_start);
+
+/**
+ * Add one wedge of one cell to acc (16 floats): kind 2 reads the interior
+ * table bilinearly at (wa, wb), kind 0 the 1D rise table at wa, kind 1 the
+ * fall table at wb (ts_sh_wedges); then turns it by r. A NaN horizon makes
+ * acc NaN. Plain float loops of 16 that the compiler vectorises.
+ */
+static inline void ts_sh_cell_wedge(const float *restrict table, int kind, float wa, float wb,
+                                    const ts_sh_rotation *r, float *restrict acc)
+{
+    const int N = TS_SH_WEDGE_STEPS;
+    const float scale = (N - 1) / 90.0f;
+    if (wa != wa || wb != wb) {
+        for (int k = 0; k < TS_SH_COEFFS; k++)
+            acc[k] = NAN;
+        return;
+    }
+    float v[TS_SH_COEFFS], vp[TS_SH_COEFFS];
+    float ta = (wa < 0 ? 0 : wa > 90 ? 90 : wa) * scale, tb = (wb < 0 ? 0 : wb > 90 ? 90 : wb) * scale;
+    int ia = (int)ta, ib = (int)tb;
+    ia = ia > N - 2 ? N - 2 : ia;
+    ib = ib > N - 2 ? N - 2 : ib;
+    const float fa = ta - (float)ia, fb = tb - (float)ib;
+    if (kind == 2) {
+        const float *t00 = table + ((size_t)ia * N + ib) * TS_SH_COEFFS;
+        const float *t01 = t00 + TS_SH_COEFFS, *t10 = t00 + N * TS_SH_COEFFS;
+        const float *t11 = t10 + TS_SH_COEFFS;
+        const float w00 = (1 - fa) * (1 - fb), w01 = (1 - fa) * fb, w10 = fa * (1 - fb),
+                    w11 = fa * fb;
+        for (int k = 0; k < TS_SH_COEFFS; k++)
+            v[k] = w00 * t00[k] + w01 * t01[k] + w10 * t10[k] + w11 * t11[k];
+    } else {
+        const int i = kind == 0 ? ia : ib;
+        const float f = kind == 0 ? fa : fb, *t0 = table + (size_t)i * TS_SH_COEFFS;
+        for (int k = 0; k < TS_SH_COEFFS; k++)
+            v[k] = (1 - f) * t0[k] + f * t0[k + TS_SH_COEFFS];
+    }
+    for (int k = 0; k < TS_SH_COEFFS; k++)
+        vp[k] = v[r->perm[k]];
+    for (int k = 0; k < TS_SH_COEFFS; k++)
+        acc[k] += v[k] * r->p[k] + vp[k] * r->q[k];
+}
+
+#endif

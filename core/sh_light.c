@@ -1,0 +1,253 @@
+/*
+ * Shading from SH visibility (Snyder & Nowrouzezahrai 2008, section 5): the
+ * triple product of the light, the cell's visibility vector and the clamped
+ * cosine around its normal (the light's product matrix folded with the
+ * clamped cosine's zonal coefficients once, so a cell costs the 16 basis
+ * values of its normal and 272 multiply-adds); the double product of light
+ * and visibility for a key light's visible share; a key light's
+ * normalisers.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "parallel.h"
+#include "sh_internal.h"
+#include "status_internal.h"
+
+#define DEG2RAD (M_PI / 180.0)
+
+void ts_sh_swath_visibility_flat(const ts_sh_swath *s, double omega_deg,
+                                 double out[TS_SH_COEFFS])
+{
+    double v[TS_SH_COEFFS];
+    memset(out, 0, sizeof(double) * TS_SH_COEFFS);
+    /* canonical starts (terrashade_sh.h, core/sh_visibility.c): each wedge at
+     * the later of its two azimuths, clockwise */
+    for (int k = 0; k < s->n; k++) {
+        if (k == 0 && !s->complete)
+            continue;
+        ts_sh_wedge_project(s->step, omega_deg, omega_deg, v);
+        ts_sh_rotate_z(v, (90.0 - ts_sh_swath_azimuth(s, k)) * DEG2RAD, v);
+        for (int i = 0; i < TS_SH_COEFFS; i++)
+            out[i] += v[i];
+    }
+    if (s->complete)
+        return;
+    ts_sh_wedge_project(s->step / 2, omega_deg, 90, v);
+    ts_sh_rotate_z(v, (90.0 - ts_sh_swath_azimuth(s, 0)) * DEG2RAD, v);
+    for (int i = 0; i < TS_SH_COEFFS; i++)
+        out[i] += v[i];
+    ts_sh_wedge_project(s->step / 2, 90, omega_deg, v);
+    ts_sh_rotate_z(v, (90.0 - ts_sh_swath_azimuth(s, s->n - 1) - s->step / 2) * DEG2RAD, v);
+    for (int i = 0; i < TS_SH_COEFFS; i++)
+        out[i] += v[i];
+}
+
+/* m with the clamped cosine's zonal factors, so that the triple product
+ * with a normal n is sum_jk v_j mh[j][k] y_k(n). */
+static void fold_cosine(const double m[TS_SH_COEFFS][TS_SH_COEFFS],
+                        float mh[TS_SH_COEFFS][TS_SH_COEFFS])
+{
+    for (int k = 0; k < TS_SH_COEFFS; k++) {
+        int l = k < 1 ? 0 : k < 4 ? 1 : k < 9 ? 2 : 3;
+        double f = sqrt(4 * M_PI / (2 * l + 1)) * TS_SH_CLAMPED_COS_ZH[l];
+        for (int j = 0; j < TS_SH_COEFFS; j++)
+            mh[j][k] = (float)(m[j][k] * f);
+    }
+}
+
+/* The triple product of visibility v (16 floats) with the folded matrix (as
+ * floats) and the normal (x, y, z): w = v^T mh as 16 independent sums in a
+ * loop the compiler vectorises, then w . y(n). */
+static inline double cell_triple(const float mh[TS_SH_COEFFS][TS_SH_COEFFS], const float *v,
+                                 float x, float y, float z)
+{
+    double d[3] = {x, y, z}, yn[TS_SH_COEFFS], s = 0;
+    float w[TS_SH_COEFFS] = {0};
+    ts_sh_eval(d, yn);
+    for (int j = 0; j < TS_SH_COEFFS; j++) {
+        const float vj = v[j];
+        for (int k = 0; k < TS_SH_COEFFS; k++)
+            w[k] += vj * mh[j][k];
+    }
+    for (int k = 0; k < TS_SH_COEFFS; k++)
+        s += w[k] * yn[k];
+    return s;
+}
+
+typedef struct {
+    const ts_grid *g;
+    float mh[TS_SH_COEFFS][TS_SH_COEFFS]; /* m with the clamped cosine's zonal factors */
+    const float *nx, *ny, *nz, *vis;
+    const double *l;
+    double scale;
+    float *out;
+} shade_ctx;
+
+static void shade_rows(void *ctx, int worker, long y0, long y1)
+{
+    (void)worker;
+    const shade_ctx *C = ctx;
+    const size_t W = (size_t)C->g->width;
+    for (size_t c = (size_t)y0 * W; c < (size_t)y1 * W; c++) {
+        double s = C->scale * cell_triple(C->mh, C->vis + c * TS_SH_COEFFS, C->nx[c],
+                                          C->ny[c], C->nz[c]);
+        C->out[c] = s == s ? (float)(s > 0 ? s : 0) : NAN;
+    }
+}
+
+static ts_status check_planes(const ts_grid *grid, const float *vis, const float *out,
+                              ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if (!vis || !out)
+        return ts_fail(err, TS_ERR_ARG, "the visibility and the output must not be NULL");
+    return TS_OK;
+}
+
+ts_status ts_sh_shade(const ts_grid *grid, const double m[TS_SH_COEFFS][TS_SH_COEFFS],
+                      const float *nx, const float *ny, const float *nz, const float *vis,
+                      double scale, float *out, ts_error *err)
+{
+    ts_status st = check_planes(grid, vis, out, err);
+    if (st != TS_OK)
+        return st;
+    if (!m || !nx || !ny || !nz)
+        return ts_fail(err, TS_ERR_ARG, "the light and the normals must not be NULL");
+    shade_ctx C = {grid, {{0}}, nx, ny, nz, vis, NULL, scale, out};
+    fold_cosine(m, C.mh);
+    return ts_parallel_for(ts_thread_count(0, grid->height), grid->height, shade_rows, &C, err);
+}
+
+static void share_rows(void *ctx, int worker, long y0, long y1)
+{
+    (void)worker;
+    const shade_ctx *C = ctx;
+    const size_t W = (size_t)C->g->width;
+    for (size_t c = (size_t)y0 * W; c < (size_t)y1 * W; c++) {
+        double s = 0;
+        for (int i = 0; i < TS_SH_COEFFS; i++)
+            s += C->l[i] * C->vis[c * TS_SH_COEFFS + i];
+        s *= C->scale;
+        C->out[c] = s == s ? (float)(s < 0 ? 0 : s > 1 ? 1 : s) : NAN;
+    }
+}
+
+ts_status ts_sh_visible_share(const ts_grid *grid, const double l[TS_SH_COEFFS],
+                              const float *vis, double scale, float *out, ts_error *err)
+{
+    ts_status st = check_planes(grid, vis, out, err);
+    if (st != TS_OK)
+        return st;
+    if (!l)
+        return ts_fail(err, TS_ERR_ARG, "the light must not be NULL");
+    shade_ctx C = {grid, {{0}}, NULL, NULL, NULL, vis, l, scale, out};
+    return ts_parallel_for(ts_thread_count(0, grid->height), grid->height, share_rows, &C, err);
+}
+
+void ts_sh_key_reference(const ts_sh_wedges *w, const double l[TS_SH_COEFFS],
+                         double azimuth, double elevation, double *shade_ref,
+                         double *share_ref)
+{
+    double v[TS_SH_COEFFS], h[TS_SH_COEFFS], m[TS_SH_COEFFS][TS_SH_COEFFS];
+    (void)azimuth; /* the swath and the light hold it */
+    double e = elevation * DEG2RAD, up[3] = {0, 0, 1};
+    ts_sh_swath_visibility_flat(&w->swath, 0, v);
+    ts_sh_clamped_cosine(up, h);
+    ts_sh_product_matrix(l, m);
+    /* open flat ground's SH value over its exact max(0, N . L) = sin e */
+    *shade_ref = sin(e) > 0 ? ts_sh_triple(m, v, h) / sin(e) : 0;
+    double s = 0;
+    for (int i = 0; i < TS_SH_COEFFS; i++)
+        s += l[i] * v[i];
+    *share_ref = s;
+}
+
+/* ts_sh_swath_light's state: the wedges' rotations in swath order. */
+typedef struct {
+    const ts_grid *g;
+    const ts_sh_wedges *w;
+    const float *const *planes;
+    const ts_sh_rotation *rot; /* n + 1: wedge k ends at sample k; [0] rise or closing;
+                                  [n] fall */
+    float mh[TS_SH_COEFFS][TS_SH_COEFFS];
+    const double *l;
+    const float *nx, *ny, *nz;
+    double scale_shade, scale_share;
+    float *shade, *share;
+} swath_ctx;
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+static void swath_rows(void *ctx, int worker, long y0, long y1)
+{
+    (void)worker;
+    const swath_ctx *C = ctx;
+    const ts_sh_swath *s = &C->w->swath;
+    const float *const *P = C->planes;
+    const int n = s->n;
+    const size_t W = (size_t)C->g->width;
+    for (size_t c = (size_t)y0 * W; c < (size_t)y1 * W; c++) {
+        float v[TS_SH_COEFFS] = {0};
+        for (int k = 1; k < n; k++)
+            ts_sh_cell_wedge(C->w->interior, 2, P[k][c], P[k - 1][c], &C->rot[k], v);
+        if (s->complete) {
+            ts_sh_cell_wedge(C->w->interior, 2, P[0][c], P[n - 1][c], &C->rot[0], v);
+        } else {
+            ts_sh_cell_wedge(C->w->rise, 0, P[0][c], 90.0f, &C->rot[0], v);
+            ts_sh_cell_wedge(C->w->fall, 1, 90.0f, P[n - 1][c], &C->rot[n], v);
+        }
+        if (C->share) {
+            double t = 0;
+            for (int i = 0; i < TS_SH_COEFFS; i++)
+                t += C->l[i] * v[i];
+            t *= C->scale_share;
+            C->share[c] = t == t ? (float)(t < 0 ? 0 : t > 1 ? 1 : t) : NAN;
+        }
+        if (C->shade) {
+            double t = C->scale_shade * cell_triple(C->mh, v, C->nx[c], C->ny[c], C->nz[c]);
+            C->shade[c] = t == t ? (float)(t < 0 ? 0 : t) : NAN;
+        }
+    }
+}
+
+ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
+                            const float *const *planes, const double l[TS_SH_COEFFS],
+                            const float *nx, const float *ny, const float *nz,
+                            double scale_shade, float *shade, double scale_share, float *share,
+                            ts_error *err)
+{
+    ts_status st = ts_grid_validate(grid, err);
+    if (st != TS_OK)
+        return st;
+    if (!w || !w->interior || !planes || !l || (!shade && !share) ||
+        (shade && (!nx || !ny || !nz)))
+        return ts_fail(err, TS_ERR_ARG, "the wedge tables, the horizon planes, the light, an "
+                       "output and, for shade, the normals must not be NULL");
+    const ts_sh_swath *s = &w->swath;
+    for (int k = 0; k < s->n; k++)
+        if (!planes[k])
+            return ts_fail(err, TS_ERR_ARG, "horizon plane %d is NULL", k);
+    ts_sh_rotation *rot = malloc(sizeof *rot * (size_t)(s->n + 1));
+    if (!rot)
+        return ts_fail(err, TS_ERR_NOMEM, "out of memory for the swath's rotations");
+    /* canonical starts (core/sh_visibility.c): wedge k at sample k, the rise
+     * at sample 0, the closing wedge at sample 0, the fall at the far edge */
+    for (int k = 0; k < s->n; k++)
+        ts_sh_rotation_set(&rot[k], ts_sh_swath_azimuth(s, k));
+    ts_sh_rotation_set(&rot[s->n], ts_sh_swath_azimuth(s, s->n - 1) + s->step / 2);
+    swath_ctx C = {grid, w, planes, rot, {{0}}, l, nx, ny, nz, scale_shade, scale_share,
+                   shade, share};
+    if (shade) {
+        double m[TS_SH_COEFFS][TS_SH_COEFFS];
+        ts_sh_product_matrix(l, m);
+        fold_cosine(m, C.mh);
+    }
+    st = ts_parallel_for(ts_thread_count(0, grid->height), grid->height, swath_rows, &C, err);
+    free(rot);
+    return st;
+}

@@ -1,0 +1,148 @@
+/* The products' SH methods; see tsd_compute_sh.h. */
+#include "tsd_compute_sh.h"
+
+#include "terrashade_sh.h"
+#include "tsd_compute_env.h"
+#include "tsd_text.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static ts_status core_fail(const tsd_compute_ctx *c, const ts_error *err)
+{
+    return tsd_fail_core(c->msg, c->msg_size, NULL, err);
+}
+
+/* The SH part runs in C: say so in the backend summary when the sweeps'
+ * backend was not chosen as C (as the other C-only steps do). */
+static void note_c_part(const tsd_compute_ctx *c, const char *what)
+{
+    ts_backend_report r;
+    ts_error err;
+    if (!c->backend || !c->backend->calls || c->backend->requested == TS_BACKEND_C ||
+        ts_backend_choose(TS_BACKEND_C, &r, &err) != TS_OK)
+        return;
+    r.requested = c->backend->requested;
+    snprintf(r.reason, sizeof r.reason,
+             "%s: the SH visibility and lighting have no OpenCL kernel and run in C", what);
+    tsd_backend_summary_add(c->backend, &r);
+}
+
+/* The key light of METHOD=sh: its swath's SWATH_DIRECTIONS sweeps on the
+ * backend, all kept, then one pass of ts_sh_swath_light into shade (with the
+ * normals nm) or share. */
+static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd_normals *nm,
+                           float *shade, float *share)
+{
+    const tsd_options *o = c->opts;
+    const double az = c->run->sun_azimuth, el = c->run->sun_elevation, r = o->light_radius;
+    const size_t cells = (size_t)g->width * g->height;
+    ts_sh_swath s;
+    ts_sh_wedges w;
+    ts_horizon_opts h;
+    ts_error err;
+    ts_status st;
+    double l[TS_SH_COEFFS], shade_ref, share_ref, above = ts_sh_disk_above(el, r);
+    ts_sh_swath_key(&s, o->swath_directions, az, el, r);
+    ts_sh_key_light(az, el, r, l);
+    if ((st = ts_sh_wedges_build(&s, o->threads, &w, &err)) != TS_OK)
+        return core_fail(c, &err);
+    ts_sh_key_reference(&w, l, az, el, &shade_ref, &share_ref);
+    float **planes = calloc((size_t)s.n, sizeof *planes);
+    for (int i = 0; planes && i < s.n; i++)
+        if (!(planes[i] = malloc(cells * sizeof(float)))) {
+            for (int j = 0; j < i; j++)
+                free(planes[j]);
+            free(planes);
+            planes = NULL;
+        }
+    if (!planes) {
+        ts_sh_wedges_free(&w);
+        return tsd_fail(c->msg, c->msg_size, TS_ERR_NOMEM,
+                        "out of memory for the %d horizon planes of SWATH_DIRECTIONS", s.n);
+    }
+    tsd_compute_horizon_opts(c, &h);
+    h.progress = NULL; /* reported here, per sweep */
+    for (int i = 0; st == TS_OK && i < s.n; i++) {
+        ts_backend_report rep = {0};
+        if ((st = tsd_compute_report(c, (double)i / s.n)) != TS_OK)
+            break;
+        st = ts_backend_horizon_sweep(tsd_backend_to_ts(o->backend), g,
+                                      ts_sh_swath_azimuth(&s, i), &h, planes[i], &rep, &err);
+        if (c->backend && rep.backend[0])
+            tsd_backend_summary_add(c->backend, &rep);
+        if (st != TS_OK)
+            st = core_fail(c, &err);
+    }
+    if (st == TS_OK &&
+        (st = ts_sh_swath_light(g, &w, (const float *const *)planes, l, nm ? nm->nx : NULL,
+                                nm ? nm->ny : NULL, nm ? nm->nz : NULL,
+                                above > 0 && shade_ref > 0 ? above / shade_ref : 0, shade,
+                                above > 0 && share_ref > 0 ? above / share_ref : 0, share,
+                                &err)) != TS_OK)
+        st = core_fail(c, &err);
+    note_c_part(c, "METHOD=sh");
+    for (int i = 0; i < s.n; i++)
+        free(planes[i]);
+    free(planes);
+    ts_sh_wedges_free(&w);
+    return st;
+}
+
+ts_status tsd_sh_key_direct(const tsd_compute_ctx *c, const ts_grid *g, const tsd_normals *nm,
+                            float *out)
+{
+    ts_status st = key_light(c, g, nm, out, NULL);
+    size_t cells = (size_t)g->width * g->height;
+    for (size_t i = 0; st == TS_OK && i < cells; i++)
+        if (out[i] > 1)
+            out[i] = 1; /* as the exact max(0, N . L) */
+    return st;
+}
+
+ts_status tsd_sh_key_shadow(const tsd_compute_ctx *c, const ts_grid *g, float *out)
+{
+    return key_light(c, g, NULL, NULL, out);
+}
+
+static ts_status env_add(void *user, const ts_grid *g, int k, double azimuth,
+                         const float *plane, ts_error *err)
+{
+    (void)g;
+    (void)azimuth; /* the swath's sample k is the sweep's azimuth k */
+    return ts_sh_visibility_add(user, k, plane, err);
+}
+
+ts_status tsd_sh_env_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd_normals *nm,
+                           float *r, float *gr, float *b)
+{
+    const tsd_options *o = c->opts;
+    ts_sh_swath s;
+    ts_sh_wedges w;
+    ts_sh_visibility v = {0};
+    ts_error err;
+    ts_status st;
+    double light[3][TS_SH_COEFFS], m[TS_SH_COEFFS][TS_SH_COEFFS];
+    float *out[3] = {r, gr, b};
+    ts_sh_swath_complete(&s, o->directions, o->start_azimuth);
+    if ((st = ts_sh_project_env(&c->run->env->env, light, &err)) != TS_OK ||
+        (st = ts_sh_wedges_build(&s, o->threads, &w, &err)) != TS_OK)
+        return core_fail(c, &err);
+    if ((st = ts_sh_visibility_init(&v, g, &w, &err)) != TS_OK)
+        st = core_fail(c, &err);
+    else if ((st = tsd_compute_stream(c, g, env_add, &v)) == TS_OK &&
+             (st = ts_sh_visibility_finish(&v, &err)) != TS_OK)
+        st = core_fail(c, &err);
+    for (int k = 0; st == TS_OK && k < 3; k++) {
+        ts_sh_product_matrix(light[k], m);
+        if ((st = ts_sh_shade(g, m, nm->nx, nm->ny, nm->nz, v.vis, 1 / M_PI, out[k], &err)) !=
+            TS_OK)
+            st = core_fail(c, &err);
+    }
+    note_c_part(c, "ENV_METHOD=sh");
+    ts_sh_visibility_free(&v);
+    ts_sh_wedges_free(&w);
+    return st;
+}
