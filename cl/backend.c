@@ -197,6 +197,27 @@ ts_status ts_backend_shade_direct(ts_backend backend, const ts_grid *grid, const
                              err));
 }
 
+ts_status ts_backend_shade_direct_disk(ts_backend backend, const ts_grid *grid, const float *nx,
+                                       const float *ny, const float *nz, const float *horizons,
+                                       const ts_horizon_opts *opts, double sun_azimuth,
+                                       double sun_elevation, double light_radius, float *out,
+                                       ts_backend_report *report, ts_error *err)
+{
+    DISPATCH(ts_cl_shade_direct_disk(grid, nx, ny, nz, horizons, opts, sun_azimuth,
+                                     sun_elevation, light_radius, out, cl_err),
+             ts_shade_direct_disk(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
+                                  light_radius, out, err));
+}
+
+ts_status ts_backend_shadowmap_compute(ts_backend backend, const ts_grid *grid, double azimuth,
+                                       double elevation, const ts_shadowmap_opts *opts,
+                                       float *visibility, ts_backend_report *report,
+                                       ts_error *err)
+{
+    DISPATCH(ts_cl_shadowmap_compute(grid, azimuth, elevation, opts, visibility, cl_err),
+             ts_shadowmap_compute(grid, azimuth, elevation, opts, visibility, err));
+}
+
 ts_status ts_backend_sky_terms(ts_backend backend, const ts_grid *grid, const float *nx,
                                const float *ny, const float *nz, const float *horizons,
                                const ts_horizon_opts *opts, float *svf, float *sky,

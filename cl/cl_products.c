@@ -203,10 +203,23 @@ ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *
                              const float *nz, const float *horizons, const ts_horizon_opts *opts,
                              double sun_azimuth, double sun_elevation, float *out, ts_error *err)
 {
+    return ts_cl_shade_direct_disk(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
+                                   TS_SUN_RADIUS_DEG, out, err);
+}
+
+ts_status ts_cl_shade_direct_disk(const ts_grid *grid, const float *nx, const float *ny,
+                                  const float *nz, const float *horizons,
+                                  const ts_horizon_opts *opts, double sun_azimuth,
+                                  double sun_elevation, double light_radius, float *out,
+                                  ts_error *err)
+{
     int k0, k1;
     double w;
     cl_float light[3];
-    ts_status st = ts_direct_setup(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
+    ts_status st = ts_check_light_radius(light_radius, err);
+    if (st != TS_OK)
+        return st;
+    st = ts_direct_setup(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
                                    out, &k0, &k1, &w, light, err);
     if (st != TS_OK)
         return st;
@@ -236,7 +249,7 @@ ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *
     for (int j = 0; j < 3; j++)
         ts_cl_job_arg(&J, k, 7 + j, sizeof light[j], &light[j]);
     /* as core/shading.c */
-    const cl_float el_deg = (float)sun_elevation, inv_r = (float)(1.0 / TS_SUN_RADIUS_DEG);
+    const cl_float el_deg = (float)sun_elevation, inv_r = (float)(1.0 / light_radius);
     ts_cl_job_arg(&J, k, 10, sizeof el_deg, &el_deg);
     ts_cl_job_arg(&J, k, 11, sizeof inv_r, &inv_r);
     ts_cl_job_arg(&J, k, 12, sizeof ob, &ob);

@@ -71,6 +71,25 @@ ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *
     return NOT_BUILT(err);
 }
 
+ts_status ts_cl_shade_direct_disk(const ts_grid *grid, const float *nx, const float *ny,
+                                  const float *nz, const float *horizons,
+                                  const ts_horizon_opts *opts, double sun_azimuth,
+                                  double sun_elevation, double light_radius, float *out,
+                                  ts_error *err)
+{
+    (void)grid, (void)nx, (void)ny, (void)nz, (void)horizons, (void)opts;
+    (void)sun_azimuth, (void)sun_elevation, (void)light_radius, (void)out;
+    return NOT_BUILT(err);
+}
+
+ts_status ts_cl_shadowmap_compute(const ts_grid *grid, double azimuth, double elevation,
+                                  const ts_shadowmap_opts *opts, float *visibility,
+                                  ts_error *err)
+{
+    (void)grid, (void)azimuth, (void)elevation, (void)opts, (void)visibility;
+    return NOT_BUILT(err);
+}
+
 ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny, const float *nz,
                           const float *horizons, const ts_horizon_opts *opts, float *svf,
                           float *sky, float *openness, ts_error *err)

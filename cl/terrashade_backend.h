@@ -26,6 +26,7 @@
 #define TERRASHADE_BACKEND_H
 
 #include "terrashade.h"
+#include "terrashade_shadowmap.h"
 #include "terrashade_env.h"
 
 #ifdef __cplusplus
@@ -89,6 +90,21 @@ ts_status ts_backend_shade_direct(ts_backend backend, const ts_grid *grid,
                                   const ts_horizon_opts *opts, double sun_azimuth,
                                   double sun_elevation, float *out,
                                   ts_backend_report *report, ts_error *err);
+
+/** ts_shade_direct_disk: a light of angular radius light_radius degrees. */
+ts_status ts_backend_shade_direct_disk(ts_backend backend, const ts_grid *grid,
+                                       const float *nx, const float *ny,
+                                       const float *nz, const float *horizons,
+                                       const ts_horizon_opts *opts, double sun_azimuth,
+                                       double sun_elevation, double light_radius,
+                                       float *out, ts_backend_report *report,
+                                       ts_error *err);
+
+/** ts_shadowmap_compute (terrashade_shadowmap.h). */
+ts_status ts_backend_shadowmap_compute(ts_backend backend, const ts_grid *grid,
+                                       double azimuth, double elevation,
+                                       const ts_shadowmap_opts *opts, float *visibility,
+                                       ts_backend_report *report, ts_error *err);
 
 ts_status ts_backend_sky_terms(ts_backend backend, const ts_grid *grid,
                                const float *nx, const float *ny, const float *nz,

@@ -38,6 +38,7 @@
 #define TERRASHADE_CL_H
 
 #include "terrashade.h"
+#include "terrashade_shadowmap.h"
 #include "terrashade_env.h"
 
 #ifdef __cplusplus
@@ -109,6 +110,19 @@ ts_status ts_cl_shade_direct(const ts_grid *grid, const float *nx, const float *
                              const float *nz, const float *horizons,
                              const ts_horizon_opts *opts, double sun_azimuth,
                              double sun_elevation, float *out, ts_error *err);
+
+/** ts_shade_direct_disk on the device. */
+ts_status ts_cl_shade_direct_disk(const ts_grid *grid, const float *nx, const float *ny,
+                                  const float *nz, const float *horizons,
+                                  const ts_horizon_opts *opts, double sun_azimuth,
+                                  double sun_elevation, double light_radius, float *out,
+                                  ts_error *err);
+
+/** ts_shadowmap_compute on the device (cl/cl_shadowmap.c): the same map,
+ * rendered with atomic_max, and the same filter. */
+ts_status ts_cl_shadowmap_compute(const ts_grid *grid, double azimuth, double elevation,
+                                  const ts_shadowmap_opts *opts, float *visibility,
+                                  ts_error *err);
 
 /** ts_sky_terms on the device (any of svf, sky, openness may be NULL). */
 ts_status ts_cl_sky_terms(const ts_grid *grid, const float *nx, const float *ny,

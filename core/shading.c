@@ -8,9 +8,14 @@
 
 double ts_sun_disk_fraction(double sun_elevation, double horizon)
 {
-    if (isnan(sun_elevation) || isnan(horizon))
+    return ts_disk_fraction(sun_elevation, horizon, TS_SUN_RADIUS_DEG);
+}
+
+double ts_disk_fraction(double light_elevation, double horizon, double radius)
+{
+    if (isnan(light_elevation) || isnan(horizon) || !(radius > 0))
         return NAN;
-    double u = (sun_elevation - horizon) / TS_SUN_RADIUS_DEG;
+    double u = (light_elevation - horizon) / radius;
     if (u >= 1.0)
         return 1.0;
     if (u <= -1.0)
@@ -22,7 +27,7 @@ double ts_sun_disk_fraction(double sun_elevation, double horizon)
 typedef struct {
     const float *nx, *ny, *nz, *h0, *h1;
     float w, lx, ly, lz;
-    double sun_el;
+    double sun_el, radius;
     float *out;
 } direct_ctx;
 
@@ -35,7 +40,7 @@ static void direct_range(void *ctx, int worker, long begin, long end)
     const float *restrict h0 = C->h0, *restrict h1 = C->h1;
     float *restrict out = C->out;
     const float w = C->w, lx = C->lx, ly = C->ly, lz = C->lz;
-    const float el = (float)C->sun_el, inv_r = (float)(1.0 / TS_SUN_RADIUS_DEG);
+    const float el = (float)C->sun_el, inv_r = (float)(1.0 / C->radius);
     for (long i = begin; i < end; i++)
         out[i] = cm_direct_sun(nx[i], ny[i], nz[i], h0[i], h1[i], w, lx, ly, lz, el, inv_r);
 }
@@ -45,16 +50,37 @@ ts_status ts_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
                           const ts_horizon_opts *opts, double sun_azimuth,
                           double sun_elevation, float *out, ts_error *err)
 {
+    return ts_shade_direct_disk(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
+                                TS_SUN_RADIUS_DEG, out, err);
+}
+
+ts_status ts_check_light_radius(double radius, ts_error *err)
+{
+    if (!(radius > 0 && radius < TS_LIGHT_RADIUS_MAX))
+        return ts_fail(err, TS_ERR_ARG,
+                       "the light's angular radius must be > 0 and < %g degrees, got %g",
+                       TS_LIGHT_RADIUS_MAX, radius);
+    return ts_ok(err);
+}
+
+ts_status ts_shade_direct_disk(const ts_grid *grid, const float *nx, const float *ny,
+                               const float *nz, const float *horizons,
+                               const ts_horizon_opts *opts, double sun_azimuth,
+                               double sun_elevation, double light_radius, float *out,
+                               ts_error *err)
+{
     int k0, k1;
     double w;
     float light[3];
-    ts_status st = ts_direct_setup(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation,
-                                   out, &k0, &k1, &w, light, err);
+    ts_status st = ts_check_light_radius(light_radius, err);
+    if (st == TS_OK)
+        st = ts_direct_setup(grid, nx, ny, nz, horizons, opts, sun_azimuth, sun_elevation, out,
+                             &k0, &k1, &w, light, err);
     if (st != TS_OK)
         return st;
     size_t plane = (size_t)grid->width * grid->height;
     direct_ctx C = {nx, ny, nz, horizons + plane * k0, horizons + plane * k1, (float)w,
-                    light[0], light[1], light[2], sun_elevation, out};
+                    light[0], light[1], light[2], sun_elevation, light_radius, out};
     return ts_parallel_for(ts_thread_count(0, (long)(plane >> 16) + 1), (long)plane,
                            direct_range, &C, err);
 }

@@ -208,6 +208,21 @@ ts_status ts_normals(const ts_grid *grid, float *nx, float *ny, float *nz,
  */
 double ts_sun_disk_fraction(double sun_elevation, double horizon);
 
+/** Largest angular radius of a light's disk, degrees (exclusive). */
+#define TS_LIGHT_RADIUS_MAX 45.0
+
+/**
+ * Fraction (0..1) of a light's disk of angular radius `radius` degrees
+ * (> 0), centre at `light_elevation`, that lies above a horizon at
+ * `horizon` degrees; NaN if an argument is NaN or radius <= 0.
+ * ts_sun_disk_fraction is this with radius TS_SUN_RADIUS_DEG.
+ */
+double ts_disk_fraction(double light_elevation, double horizon, double radius);
+
+/** TS_OK if 0 < radius < TS_LIGHT_RADIUS_MAX degrees, else TS_ERR_ARG with
+ * a sentence. */
+ts_status ts_check_light_radius(double radius, ts_error *err);
+
 /**
  * Direct sun: max(0, N.L) times the visible fraction of the sun's disk above
  * the horizon at the sun's azimuth, interpolated between the two nearest of
@@ -219,6 +234,19 @@ ts_status ts_shade_direct(const ts_grid *grid, const float *nx, const float *ny,
                           const float *nz, const float *horizons,
                           const ts_horizon_opts *opts, double sun_azimuth,
                           double sun_elevation, float *out, ts_error *err);
+
+/**
+ * ts_shade_direct for a light of angular radius `light_radius` degrees
+ * (0 < r < TS_LIGHT_RADIUS_MAX) instead of the sun's: the visible fraction
+ * is that of the larger disk, so a wide light casts soft shadows (the
+ * exact reference of the approximate soft-shadow methods). With
+ * TS_SUN_RADIUS_DEG it is ts_shade_direct, bit for bit.
+ */
+ts_status ts_shade_direct_disk(const ts_grid *grid, const float *nx, const float *ny,
+                               const float *nz, const float *horizons,
+                               const ts_horizon_opts *opts, double sun_azimuth,
+                               double sun_elevation, double light_radius, float *out,
+                               ts_error *err);
 
 /**
  * Sky terms from horizons (layout of ts_horizon_compute), any output may be

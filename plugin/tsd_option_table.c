@@ -40,14 +40,30 @@ const opt_def TSD_OPTION_ROWS[] = {
      NULL,
      "First of the DIRECTIONS azimuths, degrees from north; the others "
      "follow every 360/DIRECTIONS degrees"},
-    {"METHOD", K_SELECT, FIELD(method), "exact", 0, 0, 0, 0, "exact|shm", 1, P, LISTED,
-     NULL,
+    {"METHOD", K_SELECT, FIELD(method), "exact", 0, 0, 0, 0, "exact|shm|shadowmap", 1, P,
+     LISTED, NULL,
      "Shadow method of shade and shadow: exact (horizon sweep, penumbra "
-     "from the sun's disk) or shm (shadow height map, faster, approximate)"},
+     "from the light's disk), shm (shadow height map, faster, approximate) "
+     "or shadowmap (orthographic depth map from the light with "
+     "percentage-closer filtering, approximate)"},
     {"PENUMBRA_DEPTH", K_FLOAT, FIELD(penumbra_depth), "0", 0, 1e6, 0, 1, NULL, 1, P,
      LISTED, NULL,
      "METHOD=shm: metres below the shadow height over which light fades; "
      "0 = hard shadows"},
+    {"LIGHT_RADIUS", K_FLOAT, FIELD(light_radius), "0.2666", 0, 45, 1, 1, NULL, 1, P,
+     LISTED, NULL,
+     "Angular radius of the light's disk in degrees, greater than 0 and less "
+     "than 45; 0.2666 = the sun. A wider disk casts softer shadows"},
+    {"SHADOWMAP_SCALE", K_FLOAT, FIELD(shadowmap_scale), "2", 0.25, 8, 0, 1, NULL, 1, P,
+     LISTED, NULL,
+     "METHOD=shadowmap: depth-map texels per DEM cell along each axis "
+     "(0.25 to 8); 2 samples the terrain twice as finely as the DEM"},
+    {"PCF_KERNEL", K_FLOAT_AUTO, FIELD(pcf_kernel), "auto", 0, 64, 1, 1, "auto", 1, P,
+     LISTED, NULL,
+     "METHOD=shadowmap: width of the percentage-closer filter in DEM cells "
+     "(greater than 0, at most 64), or auto: the width of the penumbra of "
+     "the LIGHT_RADIUS disk at the occluder's distance read from the depth "
+     "map, so shadows soften away from their caster"},
     {"Z_FACTOR", K_FLOAT_AUTO, FIELD(z_factor), "AUTO", 0, 1e6, 1, 1, "AUTO", 1, P, ALL,
      NULL,
      "Multiplies the heights: AUTO (from the vertical unit of the DEM's CRS, "

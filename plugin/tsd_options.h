@@ -29,7 +29,7 @@ extern "C" {
 
 typedef enum { TSD_SUN_CENTER = 0, TSD_SUN_PER_CELL } tsd_sun_position;
 typedef enum { TSD_PROGRESS_AUTO = 0, TSD_PROGRESS_YES, TSD_PROGRESS_NO } tsd_progress_mode;
-typedef enum { TSD_METHOD_EXACT = 0, TSD_METHOD_SHM } tsd_method;
+typedef enum { TSD_METHOD_EXACT = 0, TSD_METHOD_SHM, TSD_METHOD_SHADOWMAP } tsd_method;
 typedef enum { TSD_OUT_AUTO = 0, TSD_OUT_BYTE, TSD_OUT_FLOAT32 } tsd_output_type;
 /* BACKEND: where the heavy core calls run (cl/terrashade_backend.h). */
 typedef enum { TSD_BACKEND_AUTO = 0, TSD_BACKEND_OPENCL, TSD_BACKEND_C } tsd_backend;
@@ -50,6 +50,9 @@ typedef struct {
     double start_azimuth;    /* first of those azimuths */
     tsd_method method;       /* exact horizon or shadow height map */
     double penumbra_depth;   /* metres, METHOD=shm only */
+    double light_radius;     /* degrees: the light's disk (LIGHT_RADIUS) */
+    double shadowmap_scale;  /* METHOD=shadowmap: texels per DEM cell */
+    double pcf_kernel;       /* METHOD=shadowmap: PCF width in cells, NAN = auto */
     double z_factor;         /* multiplies the DEM's heights; NAN = AUTO, decided
                                 from the DEM (tsd_dem_z_factor) */
     double max_distance;     /* metres, 0 = unbounded */

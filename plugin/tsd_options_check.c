@@ -2,6 +2,7 @@
 #include "tsd_options.h"
 
 #include "day_cycle.h"
+#include "tsd_options_light.h"
 #include "tsd_products.h"
 #include "tsd_sun.h"
 #include "tsd_text.h"
@@ -152,10 +153,13 @@ int tsd_options_check(const tsd_options *o, char *msg, size_t n)
         REFUSE("OUTPUT_TYPE=Byte is only for the products with values in "
                "0..1 (%s); PRODUCT=%s is in %s", list, pn, p->values);
     }
-    if (o->method == TSD_METHOD_SHM && !tsd_product_takes(p, o_method)) {
+    if (o->method != TSD_METHOD_EXACT && !tsd_product_takes(p, o_method)) {
         tsd_products_taking(o_method, "PRODUCT=", " and ", list, sizeof list);
-        REFUSE("METHOD=shm applies to %s only, not to PRODUCT=%s", list, pn);
+        REFUSE("METHOD=%s applies to %s only, not to PRODUCT=%s",
+               o->method == TSD_METHOD_SHM ? "shm" : "shadowmap", list, pn);
     }
+    if (tsd_options_check_light(o, msg, n) != 0)
+        return -1;
     /* a model chosen for another product is a mistake, not a no-op */
     if (o->svf_model != 0 && !tsd_product_takes(p, tsd_option_find("SVF_MODEL")))
         REFUSE("SVF_MODEL=solid_angle applies to PRODUCT=svf only, not to PRODUCT=%s", pn);
