@@ -274,10 +274,10 @@ CM_FN float ts_sm_pcf_auto(CM_GLOBAL const float *P, CM_GLOBAL const int *map, i
             }
         }
     }
-    if (blockers == 0)
-        return 1.0f;
+    if (blockers == 0) /* a hard shadow's edge at most */
+        return ts_sm_tap(map, mw, mh, u, v, depth, gu, gv, u, v);
     float rad = sum * tr; /* the disk's radius there, metres */
-    return ts_sm_pcf_disk(map, mw, mh, u, v, depth, gu, gv, rad * P[TS_SMP_INV_DS],
+    return ts_sm_pcf_disk(map, mw, mh, u, v, depth, 0.0f, 0.0f, rad * P[TS_SMP_INV_DS],
                           rad * P[TS_SMP_INV_DT]);
 }
 
