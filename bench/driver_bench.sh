@@ -69,7 +69,11 @@ echo "   TERRASHADE shade (cast shadows): ${T_TS} s"
 echo "\$ gdal_translate -q -oo METHOD=shm TERRASHADE:$DEM $WORK/out.tif"
 T_SHM=$(best_time gdal_translate -q -oo METHOD=shm "TERRASHADE:$DEM" "$WORK/out.tif")
 echo "   TERRASHADE shade, METHOD=shm:    ${T_SHM} s  (for reference)"
+echo "\$ gdal_translate -q -oo METHOD=shadowmap TERRASHADE:$DEM $WORK/out.tif"
+T_SM=$(best_time gdal_translate -q -oo METHOD=shadowmap "TERRASHADE:$DEM" "$WORK/out.tif")
+echo "   TERRASHADE shade, METHOD=shadowmap: ${T_SM} s  (docs/methods.md)"
 awk -v a="$T_TS" -v b="$T_DEM" -v c="$T_SHM" 'BEGIN {
     printf "== ratio TERRASHADE / gdaldem = %.2f (goal <= 1.5)\n", a / b
     printf "   (METHOD=shm: %.2f)\n", c / b }'
+awk -v a="$T_SM" -v b="$T_DEM" 'BEGIN { printf "   (METHOD=shadowmap: %.2f)\n", a / b }'
 echo "   (CPL_DEBUG=TERRASHADE gdal_translate ... shows the driver's own timings)"

@@ -18,7 +18,7 @@ ts_status ts_cl_shadowmap_compute(const ts_grid *grid, double azimuth, double el
         return st;
     const int W = grid->width, H = grid->height;
     const size_t cells = (size_t)W * H, bytes = cells * sizeof(float);
-    const size_t texels = (size_t)f.width * f.height;
+    const size_t texels = ts_shadowmap_keys(&f); /* and the tiles' */
     const size_t zbytes = ((size_t)grid->stride * (H - 1) + W) * sizeof(float);
     float *cxr = malloc((size_t)H * sizeof(float));
     if (!cxr)

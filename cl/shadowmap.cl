@@ -22,6 +22,7 @@ __kernel void ts_shadowmap_project(__global const float *z, const long stride, c
     pd[i] = d;
 }
 
+/* The map and its tiles: empty. */
 __kernel void ts_shadowmap_clear(__global int *map, const long n)
 {
     const long i = get_global_id(0);
@@ -29,8 +30,9 @@ __kernel void ts_shadowmap_clear(__global int *map, const long n)
         map[i] = TS_SM_EMPTY;
 }
 
-/* One work-item per quad of the DEM; texels keep the largest key by
- * atomic_max, so the order of the work-items does not matter. */
+/* One work-item per quad of the DEM; texels and their tiles keep the
+ * largest key by atomic_max, so the order of the work-items does not
+ * matter. */
 __kernel void ts_shadowmap_render(__global const float *P, __global int *map, const int mw,
                                   const int mh, __global const float *pu,
                                   __global const float *pv, __global const float *pd,
@@ -40,7 +42,7 @@ __kernel void ts_shadowmap_render(__global const float *P, __global int *map, co
     if (q >= (long)(W - 1) * (H - 1))
         return;
     const int y = (int)(q / (W - 1)), x = (int)(q - (long)y * (W - 1));
-    ts_sm_quad(P, map, mw, 0, mh, pu, pv, pd, W, x, y);
+    ts_sm_quad(P, map, mw, mh, 0, mh, pu, pv, pd, W, x, y);
 }
 
 __kernel void ts_shadowmap_filter(__global const float *P, __global const int *map,

@@ -1,8 +1,8 @@
 /*
  * Shadow map with percentage-closer filtering, C backend: project the DEM's
  * vertices into light space, render its triangles into the depth map (each
- * thread a band of the map's rows, so no two threads write one texel), then
- * filter every cell against the map. The formulas are those of the OpenCL
+ * thread a band of the map's rows, so no two threads write one texel), take
+ * each tile's largest depth, then filter every cell against the map. The formulas are those of the OpenCL
  * kernels (core/cellmath/cm_shadowmap.h), so both render the same map.
  */
 #include <math.h>
@@ -51,9 +51,21 @@ static void render_band(void *ctx, int worker, long begin, long end)
             float lo = fminf(fminf(a, b), fminf(c, d)), hi = fmaxf(fmaxf(a, b), fmaxf(c, d));
             if (hi < (float)begin - 1.0f || lo > (float)end) /* NaN: in, then skipped */
                 continue;
-            ts_sm_quad(J->f->params, J->map, mw, (int)begin, (int)end, J->pu, J->pv, J->pd, W,
-                       x, y);
+            ts_sm_quad(J->f->params, J->map, mw, J->f->height, (int)begin, (int)end, J->pu,
+                       J->pv, J->pd, W, x, y);
         }
+}
+
+/* The tiles' largest keys, after the map: tile rows [begin, end). */
+static void tile_rows(void *ctx, int worker, long begin, long end)
+{
+    (void)worker;
+    const sm_job *J = ctx;
+    const int mw = J->f->width, mh = J->f->height, tw = (mw + TS_SM_TILE - 1) / TS_SM_TILE;
+    int *tiles = J->map + (long)mw * mh;
+    for (long ty = begin; ty < end; ty++)
+        for (int tx = 0; tx < tw; tx++)
+            tiles[ty * tw + tx] = ts_sm_tile_max(J->map, mw, mh, tx, (int)ty);
 }
 
 static void filter_rows(void *ctx, int worker, long begin, long end)
@@ -77,7 +89,7 @@ ts_status ts_shadowmap_compute(const ts_grid *grid, double azimuth, double eleva
     const size_t cells = (size_t)grid->width * grid->height;
     sm_job J = {grid, &f, malloc(cells * sizeof(float)), malloc(cells * sizeof(float)),
                 malloc(cells * sizeof(float)),
-                malloc((size_t)f.width * f.height * sizeof(int)), visibility};
+                malloc(ts_shadowmap_keys(&f) * sizeof(int)), visibility};
     if (!J.pu || !J.pv || !J.pd || !J.map)
         st = ts_fail(err, TS_ERR_NOMEM, "out of memory for a %d x %d shadow map", f.width,
                      f.height);
@@ -88,6 +100,9 @@ ts_status ts_shadowmap_compute(const ts_grid *grid, double azimuth, double eleva
     if (st == TS_OK)
         st = ts_parallel_for(ts_thread_count(threads, f.height), f.height, render_band, &J,
                              err);
+    const long th = (f.height + TS_SM_TILE - 1) / TS_SM_TILE;
+    if (st == TS_OK)
+        st = ts_parallel_for(ts_thread_count(threads, th), th, tile_rows, &J, err);
     if (st == TS_OK)
         st = ts_parallel_for(ts_thread_count(threads, grid->height), grid->height,
                              filter_rows, &J, err);

@@ -112,7 +112,7 @@ ts_status ts_shadowmap_frame_make(const ts_grid *grid, double azimuth, double el
     if ((tmax - tmin) / dt > rows_max)
         dt = (tmax - tmin) / rows_max;
     const double w = ceil((smax - smin) / ds) + 3, h = ceil((tmax - tmin) / dt) + 3;
-    if (w * h > MAX_TEXELS)
+    if (w * h * (1.0 + 1.0 / (TS_SM_TILE * TS_SM_TILE)) > MAX_TEXELS)
         return ts_fail(err, TS_ERR_NOMEM,
                        "the shadow map would have %.0f x %.0f texels; lower SHADOWMAP_SCALE "
                        "(now %g)",
@@ -132,7 +132,7 @@ ts_status ts_shadowmap_frame_make(const ts_grid *grid, double azimuth, double el
     P[TS_SMP_KERNEL_V] = (float)(opts->kernel * cell * sin(el) / dt);
     P[TS_SMP_TAN_R] = (float)tan(opts->light_radius * DEG2RAD);
     P[TS_SMP_DEPTH_MAX] = dmax;
-    P[TS_SMP_SEARCH_CAP] = (float)(16.0 * opts->scale);
+    P[TS_SMP_SEARCH_CAP] = (float)TS_SM_TILE;
     P[TS_SMP_INV_R] = (float)(1.0 / opts->light_radius);
     return ts_ok(err);
 }
@@ -144,4 +144,11 @@ ts_status ts_shadowmap_prepare(const ts_grid *grid, double azimuth, double eleva
     if (!visibility)
         return ts_fail(err, TS_ERR_ARG, "the visibility output must not be NULL");
     return ts_shadowmap_frame_make(grid, azimuth, elevation, opts, frame, err);
+}
+
+size_t ts_shadowmap_keys(const ts_shadowmap_frame *frame)
+{
+    size_t tw = ((size_t)frame->width + TS_SM_TILE - 1) / TS_SM_TILE;
+    size_t th = ((size_t)frame->height + TS_SM_TILE - 1) / TS_SM_TILE;
+    return (size_t)frame->width * frame->height + tw * th;
 }

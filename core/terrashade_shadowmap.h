@@ -58,6 +58,10 @@ typedef struct {
     float params[TS_SHADOWMAP_PARAMS];
 } ts_shadowmap_frame;
 
+/** Number of int keys of the frame's map: its texels, then the largest key
+ * of each 16 x 16 tile (TS_SM_TILE of cm_shadowmap.h). */
+size_t ts_shadowmap_keys(const ts_shadowmap_frame *frame);
+
 /**
  * The frame for a light at `azimuth` (degrees from north) and `elevation`
  * (degrees, 0 < e <= 90: a shadow map needs the light above the horizon).

@@ -43,7 +43,8 @@
 #define TS_SMP_KERNEL_V 14 /* and along v */
 #define TS_SMP_TAN_R 15    /* tan(light radius): auto's penumbra per metre */
 #define TS_SMP_DEPTH_MAX 16 /* largest depth of the map, metres */
-#define TS_SMP_SEARCH_CAP 17 /* largest blocker-search half-width, texels */
+#define TS_SMP_SEARCH_CAP 17 /* largest blocker-search half-width, texels
+                                (at most TS_SM_TILE: the tiles around) */
 #define TS_SMP_INV_R 18    /* 1 / the light's radius in degrees */
 #define TS_SMP_COUNT 19
 
@@ -54,9 +55,21 @@
 /* An empty texel: below every depth, so nothing there shadows. */
 #define TS_SM_EMPTY (-2147483647 - 1)
 
+/* The map is followed by the largest key of each TS_SM_TILE x TS_SM_TILE
+ * tile of it (row-major, ceil(mw / TILE) per row): where the blocker search
+ * of PCF_KERNEL=auto may stop looking. OpenCL keeps them while rendering;
+ * C computes them after (ts_sm_tile_max), its threads owning map rows. */
+#define TS_SM_TILE 16
+
 #ifdef __OPENCL_C_VERSION__
 #define TS_SM_KEEP_MAX(p, k) atomic_max((p), (k))
+#define TS_SM_KEEP_TILE(map, mw, mh, a, b, k)                                                  \
+    atomic_max(&(map)[(long)(mw) * (mh) + (long)((b) / TS_SM_TILE) *                          \
+                                            (((mw) + TS_SM_TILE - 1) / TS_SM_TILE) +          \
+                      (a) / TS_SM_TILE],                                                       \
+               (k))
 #else
+#define TS_SM_KEEP_TILE(map, mw, mh, a, b, k) ((void)(mh))
 #define TS_SM_KEEP_MAX(p, k)                                                                   \
     do {                                                                                       \
         if (*(p) < (k))                                                                        \
@@ -114,8 +127,8 @@ CM_FN float ts_sm_clampf(float x, float lo, float hi)
  * slope-scaled offset bias + min(max |depth slope|, cap). Triangles with a
  * NaN corner (nodata) or no area (seen edge-on) are skipped.
  */
-CM_FN void ts_sm_triangle(CM_GLOBAL const float *P, CM_GLOBAL int *map, int mw, int vlo,
-                          int vhi, float u0, float v0, float d0, float u1, float v1, float d1,
+CM_FN void ts_sm_triangle(CM_GLOBAL const float *P, CM_GLOBAL int *map, int mw, int mh,
+                          int vlo, int vhi, float u0, float v0, float d0, float u1, float v1, float d1,
                           float u2, float v2, float d2)
 {
     float area = (u1 - u0) * (v2 - v0) - (u2 - u0) * (v1 - v0);
@@ -148,10 +161,23 @@ CM_FN void ts_sm_triangle(CM_GLOBAL const float *P, CM_GLOBAL int *map, int mw, 
             float e2 = ((u0 - u2) * (fb - v2) - (v0 - v2) * (fa - u2)) * sg;
             if (e0 < 0.0f || e1 < 0.0f || e2 < 0.0f)
                 continue;
-            float d = d0 + gu * (fa - u0) + gv * (fb - v0) - off;
-            TS_SM_KEEP_MAX(&map[(long)b * mw + a], ts_sm_key(d));
+            int key = ts_sm_key(d0 + gu * (fa - u0) + gv * (fb - v0) - off);
+            TS_SM_KEEP_MAX(&map[(long)b * mw + a], key);
+            TS_SM_KEEP_TILE(map, mw, mh, a, b, key);
         }
     }
+}
+
+/* The largest key of tile (tx, ty) of the map (C: after rendering). */
+CM_FN int ts_sm_tile_max(CM_GLOBAL const int *map, int mw, int mh, int tx, int ty)
+{
+    int top = TS_SM_EMPTY;
+    for (int b = ty * TS_SM_TILE; b < (ty + 1) * TS_SM_TILE && b < mh; b++)
+        for (int a = tx * TS_SM_TILE; a < (tx + 1) * TS_SM_TILE && a < mw; a++) {
+            int k = map[(long)b * mw + a];
+            top = k > top ? k : top;
+        }
+    return top;
 }
 
 /* The map's depth at texel (a, b) as a key; off the map: empty (lit). */
@@ -244,7 +270,19 @@ CM_FN float ts_sm_pcf_auto(CM_GLOBAL const float *P, CM_GLOBAL const int *map, i
 {
     float tr = P[TS_SMP_TAN_R], cap = P[TS_SMP_SEARCH_CAP];
     float ds = 1.0f / P[TS_SMP_INV_DS], dt = 1.0f / P[TS_SMP_INV_DT];
-    float reach = (P[TS_SMP_DEPTH_MAX] - depth) * tr; /* metres */
+    /* the nearest the light anything within the search's reach can be */
+    int tw = (mw + TS_SM_TILE - 1) / TS_SM_TILE, th = (mh + TS_SM_TILE - 1) / TS_SM_TILE;
+    int tx = (int)floor(u + 0.5f) / TS_SM_TILE, ty = (int)floor(v + 0.5f) / TS_SM_TILE;
+    int top = TS_SM_EMPTY;
+    for (int j = ty - 1; j <= ty + 1; j++)
+        for (int i = tx - 1; i <= tx + 1; i++)
+            if (i >= 0 && j >= 0 && i < tw && j < th) {
+                int k = map[(long)mw * mh + (long)j * tw + i];
+                top = k > top ? k : top;
+            }
+    if (top <= ts_sm_key(depth)) /* nothing near is nearer the light */
+        return ts_sm_tap(map, mw, mh, u, v, depth, gu, gv, u, v);
+    float reach = (ts_sm_unkey(top) - depth) * tr; /* metres */
     float hu = ts_sm_clampf(reach * P[TS_SMP_INV_DS], 0.0f, cap);
     float hv = ts_sm_clampf(reach * P[TS_SMP_INV_DT], 0.0f, cap);
     int nu = 2 * (int)ceil(hu) + 1, nv = 2 * (int)ceil(hv) + 1;
@@ -316,15 +354,16 @@ CM_FN float ts_sm_cell(CM_GLOBAL const float *P, CM_GLOBAL const int *map, int m
 /* Render the two triangles of the quad whose north-west corner is vertex
  * (x, y) (x < W - 1, y < H - 1) of the projected vertices pu, pv, pd
  * (W per row). */
-CM_FN void ts_sm_quad(CM_GLOBAL const float *P, CM_GLOBAL int *map, int mw, int vlo, int vhi,
+CM_FN void ts_sm_quad(CM_GLOBAL const float *P, CM_GLOBAL int *map, int mw, int mh, int vlo,
+                      int vhi,
                       CM_GLOBAL const float *pu, CM_GLOBAL const float *pv,
                       CM_GLOBAL const float *pd, int W, int x, int y)
 {
     long i00 = (long)y * W + x, i10 = i00 + 1, i01 = i00 + W, i11 = i01 + 1;
-    ts_sm_triangle(P, map, mw, vlo, vhi, pu[i00], pv[i00], pd[i00], pu[i10], pv[i10], pd[i10],
-                   pu[i11], pv[i11], pd[i11]);
-    ts_sm_triangle(P, map, mw, vlo, vhi, pu[i00], pv[i00], pd[i00], pu[i11], pv[i11], pd[i11],
-                   pu[i01], pv[i01], pd[i01]);
+    ts_sm_triangle(P, map, mw, mh, vlo, vhi, pu[i00], pv[i00], pd[i00], pu[i10], pv[i10],
+                   pd[i10], pu[i11], pv[i11], pd[i11]);
+    ts_sm_triangle(P, map, mw, mh, vlo, vhi, pu[i00], pv[i00], pd[i00], pu[i11], pv[i11],
+                   pd[i11], pu[i01], pv[i01], pd[i01]);
 }
 
 /* Index of the neighbour (x, y), or i itself off the grid or at nodata. */
