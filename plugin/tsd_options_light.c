@@ -3,6 +3,8 @@
  * the combinations where they make no sense. */
 #include "tsd_options_light.h"
 
+#include <math.h>
+
 #include "tsd_products.h"
 #include "tsd_text.h"
 
@@ -11,7 +13,10 @@
 int tsd_options_check_light(const tsd_options *o, char *msg, size_t n)
 {
     const tsd_product_def *p = tsd_product_of(o);
-    const int radius_given = tsd_options_given(o, "LIGHT_RADIUS");
+    /* an option given with its declared default is no mistake */
+    tsd_options d;
+    tsd_options_defaults(&d);
+    const int radius_given = o->light_radius != d.light_radius;
     const int shadowmap = o->method == TSD_METHOD_SHADOWMAP;
     /* the table's upper bounds are inclusive; the disk must stay below 45 */
     if (!(o->light_radius < TS_LIGHT_RADIUS_MAX))
@@ -26,9 +31,9 @@ int tsd_options_check_light(const tsd_options *o, char *msg, size_t n)
     if (radius_given && o->sun_position == TSD_SUN_PER_CELL)
         REFUSE("LIGHT_RADIUS applies with SUN_POSITION=center: the per-cell sun is the sun's "
                "own disk");
-    if (!shadowmap && tsd_options_given(o, "SHADOWMAP_SCALE"))
+    if (!shadowmap && o->shadowmap_scale != d.shadowmap_scale)
         REFUSE("SHADOWMAP_SCALE applies to METHOD=shadowmap only");
-    if (!shadowmap && tsd_options_given(o, "PCF_KERNEL"))
+    if (!shadowmap && !isnan(o->pcf_kernel))
         REFUSE("PCF_KERNEL applies to METHOD=shadowmap only");
     if (shadowmap && o->sun_position == TSD_SUN_PER_CELL)
         REFUSE("METHOD=shadowmap renders one depth map for one light direction: it needs "
