@@ -418,12 +418,14 @@ CM_FN float ts_sm_cell_at(CM_GLOBAL const float *P, CM_GLOBAL const int *map, in
     const int rx[8] = {0, 1, 1, 1, 0, -1, -1, -1}, ry[8] = {-1, -1, 0, 1, 1, 1, 0, -1};
     for (int k = 0; k < 8; k++)
         ring[k] = ts_sm_neighbour(pd, W, H, i, x + rx[k], y + ry[k]);
+    if (isnan(pd[i]))
+        return pd[i];
+    float near = ts_sm_near(P, pu, pv, pd, i, ring);
+    if (!(near > 0.0f)) /* in its own shadow: the map cannot add light */
+        return 0.0f;
     float lit = ts_sm_cell(P, map, mw, mh, pu[i], pv[i], pd[i], pu[ring[6]], pv[ring[6]],
                            pd[ring[6]], pu[ring[2]], pv[ring[2]], pd[ring[2]], pu[ring[0]],
                            pv[ring[0]], pd[ring[0]], pu[ring[4]], pv[ring[4]], pd[ring[4]]);
-    if (isnan(lit))
-        return lit;
-    float near = ts_sm_near(P, pu, pv, pd, i, ring);
     return near < lit ? near : lit;
 }
 
