@@ -182,7 +182,8 @@ static void run(ctx *c, int p, int cl, float *hout)
                 : ts_normals(&c->g, c->out, c->out2, c->out3, &e);
         break;
     case P_DIRECT: {
-        const ts_direct_request req = {&c->g, c->nx, c->ny, c->nz, c->hz, &c->o, 135, 30, c->out};
+        const ts_direct_request req = {&c->g, c->nx, c->ny, c->nz, c->hz,
+                                       &c->o, 135,   30,    c->out, TS_SUN_RADIUS_DEG};
         st = (cl ? ts_cl_shade_direct : ts_shade_direct)(&req, &e);
         break;
     }

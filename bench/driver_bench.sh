@@ -74,7 +74,11 @@ echo "\$ gdal_translate -q -oo METHOD=sh -oo SWATH_DIRECTIONS=3 TERRASHADE:$DEM 
 T_SH=$(best_time gdal_translate -q -oo METHOD=sh -oo SWATH_DIRECTIONS=3 "TERRASHADE:$DEM" \
     "$WORK/out.tif")
 echo "   TERRASHADE shade, METHOD=sh:     ${T_SH} s  (SH soft key light, 3 sweeps)"
-awk -v a="$T_TS" -v b="$T_DEM" -v c="$T_SHM" -v d="$T_SH" 'BEGIN {
+echo "\$ gdal_translate -q -oo METHOD=shadowmap TERRASHADE:$DEM $WORK/out.tif"
+T_SM=$(best_time gdal_translate -q -oo METHOD=shadowmap "TERRASHADE:$DEM" "$WORK/out.tif")
+echo "   TERRASHADE shade, METHOD=shadowmap: ${T_SM} s  (docs/methods.md)"
+awk -v a="$T_TS" -v b="$T_DEM" -v c="$T_SHM" -v d="$T_SH" -v e="$T_SM" 'BEGIN {
     printf "== ratio TERRASHADE / gdaldem = %.2f (goal <= 1.5)\n", a / b
-    printf "   (METHOD=shm: %.2f; METHOD=sh: %.2f, goal <= 2)\n", c / b, d / b }'
+    printf "   (METHOD=shm: %.2f; METHOD=sh: %.2f, goal <= 2; METHOD=shadowmap: %.2f)\n",
+           c / b, d / b, e / b }'
 echo "   (CPL_DEBUG=TERRASHADE gdal_translate ... shows the driver's own timings)"

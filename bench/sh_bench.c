@@ -143,7 +143,7 @@ static void bench_key(const ts_grid *g, int swath, const float *nx, const float 
     o.start_azimuth = az;
     stamp exact = {0, 0}, sh = {0, 0}, t = now();
     check(ts_horizon_sweep(g, az, &o, plane, &e), "sweep", &e);
-    const ts_direct_request rq = {g, nx, ny, nz, plane, &o, az, el, out};
+    const ts_direct_request rq = {g, nx, ny, nz, plane, &o, az, el, out, TS_SUN_RADIUS_DEG};
     check(ts_shade_direct(&rq, &e), "direct", &e);
     add_since(t, &exact);
     t = now();

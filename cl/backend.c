@@ -191,6 +191,15 @@ ts_status ts_backend_shade_direct(ts_backend backend, const ts_direct_request *r
     DISPATCH(ts_cl_shade_direct(req, cl_err), ts_shade_direct(req, err));
 }
 
+ts_status ts_backend_shadowmap_compute(ts_backend backend, const ts_grid *grid, double azimuth,
+                                       double elevation, const ts_shadowmap_opts *opts,
+                                       float *visibility, ts_backend_report *report,
+                                       ts_error *err)
+{
+    DISPATCH(ts_cl_shadowmap_compute(grid, azimuth, elevation, opts, visibility, cl_err),
+             ts_shadowmap_compute(grid, azimuth, elevation, opts, visibility, err));
+}
+
 ts_status ts_backend_sky_terms(ts_backend backend, const ts_sky_request *req,
                                ts_backend_report *report, ts_error *err)
 {

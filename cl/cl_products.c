@@ -210,7 +210,7 @@ ts_status ts_cl_shade_direct(const ts_direct_request *req, ts_error *err)
     const cl_long ccells = (cl_long)cells;
     const cl_float fw = (float)p.w;
     /* as core/shading.c */
-    const cl_float el_deg = (float)req->sun_elevation, inv_r = (float)(1.0 / TS_SUN_RADIUS_DEG);
+    const cl_float el_deg = (float)req->sun_elevation, inv_r = (float)(1.0 / p.radius);
     ts_cl_job_args(&J, k, 0,
                    TS_CL_ARGS(TS_CL_ARG(xb), TS_CL_ARG(yb), TS_CL_ARG(zb), TS_CL_ARG(h0),
                               TS_CL_ARG(h1), TS_CL_ARG(ccells), TS_CL_ARG(fw),

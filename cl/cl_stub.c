@@ -68,6 +68,14 @@ ts_status ts_cl_shade_direct(const ts_direct_request *req, ts_error *err)
     return NOT_BUILT(err);
 }
 
+ts_status ts_cl_shadowmap_compute(const ts_grid *grid, double azimuth, double elevation,
+                                  const ts_shadowmap_opts *opts, float *visibility,
+                                  ts_error *err)
+{
+    (void)grid, (void)azimuth, (void)elevation, (void)opts, (void)visibility;
+    return NOT_BUILT(err);
+}
+
 ts_status ts_cl_sky_terms(const ts_sky_request *req, ts_error *err)
 {
     (void)req;

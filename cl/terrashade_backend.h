@@ -26,6 +26,7 @@
 #define TERRASHADE_BACKEND_H
 
 #include "terrashade.h"
+#include "terrashade_shadowmap.h"
 #include "terrashade_env.h"
 
 #ifdef __cplusplus
@@ -85,6 +86,12 @@ ts_status ts_backend_normals(ts_backend backend, const ts_grid *grid, float *nx,
 
 ts_status ts_backend_shade_direct(ts_backend backend, const ts_direct_request *req,
                                   ts_backend_report *report, ts_error *err);
+
+/** ts_shadowmap_compute (terrashade_shadowmap.h). */
+ts_status ts_backend_shadowmap_compute(ts_backend backend, const ts_grid *grid,
+                                       double azimuth, double elevation,
+                                       const ts_shadowmap_opts *opts, float *visibility,
+                                       ts_backend_report *report, ts_error *err);
 
 ts_status ts_backend_sky_terms(ts_backend backend, const ts_sky_request *req,
                                ts_backend_report *report, ts_error *err);

@@ -40,6 +40,7 @@
 #define TERRASHADE_CL_H
 
 #include "terrashade.h"
+#include "terrashade_shadowmap.h"
 #include "terrashade_env.h"
 
 #ifdef __cplusplus
@@ -103,6 +104,10 @@ ts_normals_fn ts_cl_normals;
 
 /** The direct sun on the device (ts_shade_direct_fn). */
 ts_shade_direct_fn ts_cl_shade_direct;
+
+/** ts_shadowmap_compute on the device (cl/cl_shadowmap.c): the same map,
+ * rendered with atomic_max, and the same filter. */
+ts_shadowmap_compute_fn ts_cl_shadowmap_compute;
 
 /** The sky terms on the device (ts_sky_terms_fn). */
 ts_sky_terms_fn ts_cl_sky_terms;

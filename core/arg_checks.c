@@ -117,6 +117,9 @@ ts_status ts_direct_setup(const ts_direct_request *req, ts_direct_plan *plan, ts
     if (!(sun_elevation >= -90 && sun_elevation <= 90))
         return ts_fail(err, TS_ERR_ARG, "sun elevation must be between -90 and 90, got %g",
                        sun_elevation);
+    plan->radius = req->light_radius == 0 ? TS_SUN_RADIUS_DEG : req->light_radius;
+    if ((st = ts_check_light_radius(plan->radius, err)) != TS_OK)
+        return st;
     int n = opts->directions;
     double step = 360.0 / n;
     double p = fmod(sun_azimuth - opts->start_azimuth, 360.0);

@@ -34,11 +34,13 @@ ts_status ts_check_horizon_compute_args(const ts_grid *grid, const ts_horizon_op
 
 /* What both backends' direct sun derive from a ts_direct_request: the two
  * computed azimuths the sun's lies between (planes k0 and k1, weight w of
- * k1) and the unit vector toward the sun (east, north, up). */
+ * k1), the unit vector toward the sun (east, north, up) and the radius of
+ * its disk. */
 typedef struct {
     int k0, k1;
     double w;
     float light[3];
+    double radius; /* the light's angular radius, degrees */
 } ts_direct_plan;
 
 /* Checks of a ts_direct_request, then its plan. */

@@ -8,9 +8,14 @@
 
 double ts_sun_disk_fraction(double sun_elevation, double horizon)
 {
-    if (isnan(sun_elevation) || isnan(horizon))
+    return ts_disk_fraction(sun_elevation, horizon, TS_SUN_RADIUS_DEG);
+}
+
+double ts_disk_fraction(double light_elevation, double horizon, double radius)
+{
+    if (isnan(light_elevation) || isnan(horizon) || !(radius > 0))
         return NAN;
-    double u = (sun_elevation - horizon) / TS_SUN_RADIUS_DEG;
+    double u = (light_elevation - horizon) / radius;
     if (u >= 1.0)
         return 1.0;
     if (u <= -1.0)
@@ -19,10 +24,19 @@ double ts_sun_disk_fraction(double sun_elevation, double horizon)
     return 0.5 + (u * sqrt(1.0 - u * u) + asin(u)) / M_PI;
 }
 
+ts_status ts_check_light_radius(double radius, ts_error *err)
+{
+    if (!(radius > 0 && radius < TS_LIGHT_RADIUS_MAX))
+        return ts_fail(err, TS_ERR_ARG,
+                       "the light's angular radius must be > 0 and < %g degrees, got %g",
+                       TS_LIGHT_RADIUS_MAX, radius);
+    return ts_ok(err);
+}
+
 typedef struct {
     const float *nx, *ny, *nz, *h0, *h1;
     float w, lx, ly, lz;
-    double sun_el;
+    double sun_el, radius;
     float *out;
 } direct_ctx;
 
@@ -35,7 +49,7 @@ static void direct_range(void *ctx, int worker, long begin, long end)
     const float *restrict h0 = C->h0, *restrict h1 = C->h1;
     float *restrict out = C->out;
     const float w = C->w, lx = C->lx, ly = C->ly, lz = C->lz;
-    const float el = (float)C->sun_el, inv_r = (float)(1.0 / TS_SUN_RADIUS_DEG);
+    const float el = (float)C->sun_el, inv_r = (float)(1.0 / C->radius);
     for (long i = begin; i < end; i++)
         out[i] = cm_direct_sun(nx[i], ny[i], nz[i], h0[i], h1[i], w, lx, ly, lz, el, inv_r);
 }
@@ -49,7 +63,7 @@ ts_status ts_shade_direct(const ts_direct_request *req, ts_error *err)
     size_t plane = (size_t)req->grid->width * req->grid->height;
     direct_ctx C = {req->nx, req->ny, req->nz, req->horizons + plane * p.k0,
                     req->horizons + plane * p.k1, (float)p.w, p.light[0], p.light[1],
-                    p.light[2], req->sun_elevation, req->out};
+                    p.light[2], req->sun_elevation, p.radius, req->out};
     return ts_parallel_for(ts_thread_count(0, (long)(plane >> 16) + 1), (long)plane,
                            direct_range, &C, err);
 }

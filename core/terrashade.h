@@ -288,6 +288,21 @@ ts_normals_fn ts_normals;
  */
 double ts_sun_disk_fraction(double sun_elevation, double horizon);
 
+/** Largest angular radius of a light's disk, degrees (exclusive). */
+#define TS_LIGHT_RADIUS_MAX 45.0
+
+/**
+ * Fraction (0..1) of a light's disk of angular radius `radius` degrees
+ * (> 0), centre at `light_elevation`, that lies above a horizon at
+ * `horizon` degrees; NaN if an argument is NaN or radius <= 0.
+ * ts_sun_disk_fraction is this with radius TS_SUN_RADIUS_DEG.
+ */
+double ts_disk_fraction(double light_elevation, double horizon, double radius);
+
+/** TS_OK if 0 < radius < TS_LIGHT_RADIUS_MAX degrees, else TS_ERR_ARG with
+ * a sentence. */
+ts_status ts_check_light_radius(double radius, ts_error *err);
+
 /** What the direct sun is computed from and into (ts_shade_direct_fn). */
 typedef struct {
     const ts_grid *grid;
@@ -297,6 +312,11 @@ typedef struct {
     double sun_azimuth;          /**< degrees from north, finite */
     double sun_elevation;        /**< degrees, in [-90, 90] */
     float *out;                  /**< width*height: the direct light, NaN for nodata */
+    double light_radius;         /**< the light's angular radius, degrees, in
+                                      (0, TS_LIGHT_RADIUS_MAX); 0 (unset): the
+                                      sun's, TS_SUN_RADIUS_DEG. A wider disk
+                                      casts soft shadows: the exact reference
+                                      of the approximate soft-shadow methods */
 } ts_direct_request;
 
 /**
@@ -337,6 +357,7 @@ typedef struct {
 } ts_sky_request;
 
 /**
+
  * Sky terms from horizons, each output only where the request has one:
  *  - svf: sky-view factor of model svf_model; TS_SVF_RADIATIVE is Timonen
  *    eq. 5 with c = 1 (cosine-weighted visible fraction of the hemisphere

@@ -181,9 +181,7 @@ static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const ts
     return TS_OK;
 }
 
-/* Shadow height map visibility of the sun into vis, times the fraction of
- * the sun's disk above the edge's horizon (EDGE=horizon or nodata: the
- * shadow height map sees nothing beyond the grid). */
+/* Shadow height map visibility of the sun into vis. */
 static ts_status shm_visibility(const tsd_compute_ctx *c, const ts_grid *g, float *vis)
 {
     ts_error err;
@@ -193,6 +191,38 @@ static ts_status shm_visibility(const tsd_compute_ctx *c, const ts_grid *g, floa
                                        &rep, &err),
              rep) != TS_OK)
         return core_fail(c, &err);
+    return TS_OK;
+}
+
+/* METHOD=shadowmap: the lit fraction by the shadow map into vis. */
+static ts_status shadowmap_visibility(const tsd_compute_ctx *c, const ts_grid *g, float *vis)
+{
+    ts_error err;
+    ts_backend_report rep = {0};
+    ts_shadowmap_opts so;
+    ts_shadowmap_opts_default(&so);
+    so.scale = c->opts->shadowmap_scale;
+    so.kernel = isnan(c->opts->pcf_kernel) ? TS_SHADOWMAP_AUTO : c->opts->pcf_kernel;
+    so.light_radius = c->opts->light_radius;
+    so.threads = c->opts->threads;
+    if (NOTE(c, ts_backend_shadowmap_compute(BK(c), g, c->run->sun_azimuth,
+                                             c->run->sun_elevation, &so, vis, &rep, &err),
+             rep) != TS_OK)
+        return core_fail(c, &err);
+    return TS_OK;
+}
+
+/* The visibility of a map method (METHOD=shm or shadowmap), times the
+ * fraction of the sun's disk above the edge's horizon (EDGE=horizon or
+ * nodata: neither map sees beyond the grid). */
+static ts_status approx_visibility(const tsd_compute_ctx *c, const ts_grid *g, float *vis)
+{
+    ts_status st = c->opts->method == TSD_METHOD_SHADOWMAP ? shadowmap_visibility(c, g, vis)
+                                                           : shm_visibility(c, g, vis);
+    if (st != TS_OK)
+        return st;
+    /* neither sees beyond the DEM's edge: EDGE's part of the disk */
+    ts_error err;
     ts_horizon_opts h;
     tsd_compute_horizon_opts(c, &h);
     if (ts_horizon_edge_sun(g, c->run->sun_azimuth, c->run->sun_elevation, &h, vis, &err) !=
@@ -270,12 +300,13 @@ static ts_status shade_direct(const tsd_compute_ctx *c, const ts_grid *g, const 
         if ((st = sun_horizon(c, g, &h, work)) != TS_OK)
             return st;
         const ts_direct_request req = {g, nm->nx, nm->ny, nm->nz, work, &h,
-                                       c->run->sun_azimuth, c->run->sun_elevation, out};
+                                       c->run->sun_azimuth, c->run->sun_elevation, out,
+                                       c->opts->light_radius};
         if (NOTE(c, ts_backend_shade_direct(BK(c), &req, &rep, &err), rep) != TS_OK)
             return core_fail(c, &err);
         return TS_OK;
     }
-    if ((st = shm_visibility(c, g, work)) != TS_OK)
+    if ((st = approx_visibility(c, g, work)) != TS_OK)
         return st;
     double az0 = c->run->sun_azimuth * M_PI / 180, el0 = c->run->sun_elevation * M_PI / 180;
     double lx = sin(az0) * cos(el0), ly = cos(az0) * cos(el0), lz = sin(el0);
@@ -319,16 +350,17 @@ TSD_COMPUTE_FN(tsd_compute_shadow)
     ts_status st;
     if (sun_lattice(c) && c->opts->method == TSD_METHOD_EXACT)
         return sun_per_cell(c, g, out, NULL, NULL);
-    if (c->opts->method == TSD_METHOD_SHM)
-        return shm_visibility(c, g, out);
     if (c->opts->method == TSD_METHOD_SH)
         return tsd_sh_key_shadow(c, g, out);
+    if (c->opts->method != TSD_METHOD_EXACT)
+        return approx_visibility(c, g, out);
     ts_horizon_opts h;
     if ((st = sun_horizon(c, g, &h, out)) != TS_OK)
         return st;
     for (size_t i = 0; i < cells; i++)
         if (out[i] == out[i])
-            out[i] = (float)ts_sun_disk_fraction(c->run->sun_elevation, out[i]);
+            out[i] = (float)ts_disk_fraction(c->run->sun_elevation, out[i],
+                                             c->opts->light_radius);
     return TS_OK;
 }
 

@@ -40,12 +40,14 @@ const opt_def TSD_OPTION_ROWS[] = {
      NULL,
      "First of the DIRECTIONS azimuths, degrees from north; the others "
      "follow every 360/DIRECTIONS degrees"},
-    {"METHOD", K_SELECT, FIELD(method), "exact", 0, 0, 0, 0, "exact|shm|sh", 1, P, LISTED,
-     NULL,
+    {"METHOD", K_SELECT, FIELD(method), "exact", 0, 0, 0, 0, "exact|shm|shadowmap|sh", 1, P,
+     LISTED, NULL,
      "Shadow method of shade and shadow: exact (horizon sweep, penumbra "
-     "from the sun's disk), shm (shadow height map, faster, approximate) or "
-     "sh (order-4 spherical harmonics, Snyder & Nowrouzezahrai 2008: a soft "
-     "key light of LIGHT_RADIUS from SWATH_DIRECTIONS horizon sweeps)"},
+     "from the light's disk), shm (shadow height map, faster, approximate), "
+     "shadowmap (orthographic depth map from the light with "
+     "percentage-closer filtering, approximate) or sh (order-4 spherical "
+     "harmonics, Snyder & Nowrouzezahrai 2008: a soft key light of "
+     "LIGHT_RADIUS from SWATH_DIRECTIONS horizon sweeps)"},
     {"PENUMBRA_DEPTH", K_FLOAT, FIELD(penumbra_depth), "0", 0, 1e6, 0, 1, NULL, 1, P,
      LISTED, NULL,
      "METHOD=shm: metres below the shadow height over which light fades; "
@@ -58,6 +60,16 @@ const opt_def TSD_OPTION_ROWS[] = {
      LISTED, NULL,
      "METHOD=sh: horizon sweeps across the azimuths the light's disk covers "
      "(its partial swath)"},
+    {"SHADOWMAP_SCALE", K_FLOAT, FIELD(shadowmap_scale), "2", 0.25, 8, 0, 1, NULL, 1, P,
+     LISTED, NULL,
+     "METHOD=shadowmap: depth-map texels per DEM cell along each axis "
+     "(0.25 to 8); 2 samples the terrain twice as finely as the DEM"},
+    {"PCF_KERNEL", K_FLOAT_AUTO, FIELD(pcf_kernel), "auto", 0, 64, 1, 1, "auto", 1, P,
+     LISTED, NULL,
+     "METHOD=shadowmap: width of the percentage-closer filter in DEM cells "
+     "(greater than 0, at most 64), or auto: the width of the penumbra of "
+     "the LIGHT_RADIUS disk at the occluder's distance read from the depth "
+     "map, so shadows soften away from their caster"},
     {"Z_FACTOR", K_FLOAT_AUTO, FIELD(z_factor), "AUTO", 0, 1e6, 1, 1, "AUTO", 1, P, ALL,
      NULL,
      "Multiplies the heights: AUTO (from the vertical unit of the DEM's CRS, "

@@ -29,7 +29,12 @@ extern "C" {
 
 typedef enum { TSD_SUN_CENTER = 0, TSD_SUN_PER_CELL } tsd_sun_position;
 typedef enum { TSD_PROGRESS_AUTO = 0, TSD_PROGRESS_YES, TSD_PROGRESS_NO } tsd_progress_mode;
-typedef enum { TSD_METHOD_EXACT = 0, TSD_METHOD_SHM, TSD_METHOD_SH } tsd_method;
+typedef enum {
+    TSD_METHOD_EXACT = 0,
+    TSD_METHOD_SHM,
+    TSD_METHOD_SHADOWMAP,
+    TSD_METHOD_SH
+} tsd_method;
 /* HORIZON_METHOD: the exact sweep or pyramid horizons (tsd_pyramid.h). */
 typedef enum { TSD_HORIZON_EXACT = 0, TSD_HORIZON_PYRAMID } tsd_horizon_method;
 /* ENV_METHOD of envlight: Timonen's L_p table or order-4 SH. */
@@ -55,6 +60,8 @@ typedef struct {
     tsd_method method;       /* exact horizon or shadow height map */
     double penumbra_depth;   /* metres, METHOD=shm only */
     double light_radius;     /* degrees: the light's disk (LIGHT_RADIUS) */
+    double shadowmap_scale;  /* METHOD=shadowmap: texels per DEM cell */
+    double pcf_kernel;       /* METHOD=shadowmap: PCF width in cells, NAN = auto */
     double z_factor;         /* multiplies the DEM's heights; NAN = AUTO, decided
                                 from the DEM (tsd_dem_z_factor) */
     double max_distance;     /* metres, 0 = unbounded */

@@ -2,6 +2,7 @@
 #include "tsd_options.h"
 
 #include "day_cycle.h"
+#include "tsd_options_light.h"
 #include "tsd_products.h"
 #include "tsd_pyramid.h"
 #include "tsd_sun.h"
@@ -160,10 +161,6 @@ static int check_sh(const tsd_options *o, char *msg, size_t n)
                    ? ": its soft SH key light is METHOD=sh"
                    : "");
     }
-    /* the option table's range is 0 < r <= 45; 45 itself is refused here */
-    if (!(o->light_radius < 45))
-        REFUSE("LIGHT_RADIUS must be greater than 0 and less than 45 degrees, got %g",
-               o->light_radius);
     /* as ENV_ROTATION: a value other than the default that would do nothing */
     const int o_swath = tsd_option_find("SWATH_DIRECTIONS");
     if (o->swath_directions != atoi(tsd_option_default(o_swath)) && o->method != TSD_METHOD_SH)
@@ -194,8 +191,13 @@ int tsd_options_check(const tsd_options *o, char *msg, size_t n)
     if (o->method != TSD_METHOD_EXACT && !tsd_product_takes(p, o_method)) {
         tsd_products_taking(o_method, "PRODUCT=", " and ", list, sizeof list);
         REFUSE("METHOD=%s applies to %s only, not to PRODUCT=%s",
-               o->method == TSD_METHOD_SH ? "sh" : "shm", list, pn);
+               o->method == TSD_METHOD_SH    ? "sh"
+               : o->method == TSD_METHOD_SHM ? "shm"
+                                             : "shadowmap",
+               list, pn);
     }
+    if (tsd_options_check_light(o, msg, n) != 0)
+        return -1;
     /* a model chosen for another product is a mistake, not a no-op */
     if (o->svf_model != 0 && !tsd_product_takes(p, tsd_option_find("SVF_MODEL")))
         REFUSE("SVF_MODEL=solid_angle applies to PRODUCT=svf only, not to PRODUCT=%s", pn);

@@ -104,8 +104,9 @@ static int shadow_uses_backend(const tsd_options *o, const tsd_sun *sun)
 
 /* Option groups of the rows below. */
 #define SUN_TIME "DATETIME PRESSURE TEMPERATURE DELTA_T "
-#define SUN_OPTS "SUN_AZIMUTH SUN_ELEVATION METHOD PENUMBRA_DEPTH " SUN_TIME "SUN_POSITION " \
-    "LIGHT_RADIUS SWATH_DIRECTIONS "
+#define SUN_OPTS                                                                           \
+    "SUN_AZIMUTH SUN_ELEVATION METHOD PENUMBRA_DEPTH LIGHT_RADIUS SWATH_DIRECTIONS "       \
+    "SHADOWMAP_SCALE PCF_KERNEL " SUN_TIME "SUN_POSITION "
 #define SWEEP "DIRECTIONS START_AZIMUTH MAX_DISTANCE EDGE "
 #define DAY "DATE TIMEZONE " SUN_TIME
 #define RANGE "START_DATE END_DATE DAY_INTERVAL HORIZON_DIRECTIONS"

@@ -405,7 +405,7 @@ static void tiny_grid(int w, int h)
     ck_assert_msg(ts_sky_terms(&sq, &err) == TS_OK, "%dx%d: %s", w, h, err.message);
     ck_assert_msg(ts_shm_compute(&g, 123.0, 20.0, 2.0, 0, vis, sh, &err) == TS_OK,
                   "%dx%d: %s", w, h, err.message);
-    const ts_direct_request dq = {&g, nx, ny, nz, hor, &o, 200.0, 35.0, dir};
+    const ts_direct_request dq = {&g, nx, ny, nz, hor, &o, 200.0, 35.0, dir, TS_SUN_RADIUS_DEG};
     ck_assert_msg(ts_shade_direct(&dq, &err) == TS_OK, "%dx%d: %s", w, h, err.message);
     for (size_t i = 0; i < n; i++) {
         for (int k = 0; k < 8; k++) {

@@ -138,14 +138,14 @@ START_TEST(test_horizon_args)
     EXPECT_ARG(ts_horizon_sweep_lines(NULL, 0, &o, noop_visit, NULL, err), err);
 
     const struct { const char *field; ts_horizon_opts o; } bad[] = {
-        {"direction", {0, 0, 0, 1, 0.13, 0, NULL, NULL}},
-        {"direction", {-5, 0, 0, 1, 0.13, 0, NULL, NULL}},
-        {"refraction", {16, 0, 0, 1, -0.01, 0, NULL, NULL}},
-        {"refraction", {16, 0, 0, 1, 1.01, 0, NULL, NULL}},
-        {"refraction", {16, 0, 0, 1, NAN, 0, NULL, NULL}},
-        {"azimuth", {16, NAN, 0, 1, 0.13, 0, NULL, NULL}},
-        {"distance", {16, 0, -1, 1, 0.13, 0, NULL, NULL}},
-        {"distance", {16, 0, NAN, 1, 0.13, 0, NULL, NULL}},
+        {"direction", {0, 0, 0, 1, 0.13, 0, NULL, NULL, TS_EDGE_OPEN}},
+        {"direction", {-5, 0, 0, 1, 0.13, 0, NULL, NULL, TS_EDGE_OPEN}},
+        {"refraction", {16, 0, 0, 1, -0.01, 0, NULL, NULL, TS_EDGE_OPEN}},
+        {"refraction", {16, 0, 0, 1, 1.01, 0, NULL, NULL, TS_EDGE_OPEN}},
+        {"refraction", {16, 0, 0, 1, NAN, 0, NULL, NULL, TS_EDGE_OPEN}},
+        {"azimuth", {16, NAN, 0, 1, 0.13, 0, NULL, NULL, TS_EDGE_OPEN}},
+        {"distance", {16, 0, -1, 1, 0.13, 0, NULL, NULL, TS_EDGE_OPEN}},
+        {"distance", {16, 0, NAN, 1, 0.13, 0, NULL, NULL, TS_EDGE_OPEN}},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         const ts_horizon_opts *b = &bad[i].o;
@@ -183,7 +183,7 @@ START_TEST(test_shading_args)
     EXPECT_ARG(ts_normals(NULL, nx, ny, nz, err), err);
     EXPECT_ARG(ts_normals(&G, NULL, ny, nz, err), err);
     EXPECT_ARG(ts_normals(&G, nx, ny, NULL, err), err);
-    const ts_direct_request d0 = {&G, nx, ny, nz, hor, &o, 0, 30, out};
+    const ts_direct_request d0 = {&G, nx, ny, nz, hor, &o, 0, 30, out, TS_SUN_RADIUS_DEG};
     ts_direct_request d;
     ck_assert(ts_shade_direct(&d0, err) == TS_OK);
     EXPECT_ARG(ts_shade_direct(NULL, err), err);
@@ -257,7 +257,7 @@ START_TEST(test_no_writes_outside)
     ck_assert(ts_horizon_compute(&g, &o, h, &e) == TS_OK);
     ck_assert(ts_shm_compute(&g, 33, 20, 2, 2, v, s, &e) == TS_OK);
     ck_assert(ts_normals(&g, a, b, c, &e) == TS_OK);
-    const ts_direct_request dq = {&g, a, b, c, h, &o, 100, 30, d};
+    const ts_direct_request dq = {&g, a, b, c, h, &o, 100, 30, d, TS_SUN_RADIUS_DEG};
     ck_assert(ts_shade_direct(&dq, &e) == TS_OK);
     const ts_sky_request sq = {&g, a, b, c, h, &o, TS_SVF_RADIATIVE, v, s, d};
     ck_assert(ts_sky_terms(&sq, &e) == TS_OK);

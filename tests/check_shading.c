@@ -159,7 +159,8 @@ static void light_free(lit *L)
 static void direct(const ts_grid *g, const lit *L, double az, double el, float *out)
 {
     ts_error err;
-    const ts_direct_request req = {g, L->nx, L->ny, L->nz, L->hor, &L->o, az, el, out};
+    const ts_direct_request req = {g,  L->nx, L->ny, L->nz, L->hor, &L->o,
+                                   az, el,    out,   TS_SUN_RADIUS_DEG};
     ck_assert_msg(ts_shade_direct(&req, &err) == TS_OK, "%s", err.message);
 }
 

@@ -140,7 +140,10 @@ const char *tenv_tmp(const char *name)
     static char paths[8][256];
     static int next;
     char *p = paths[next++ % 8];
-    snprintf(p, 256, "%s/%s", tmp_dir, name);
+    if (snprintf(p, 256, "%s/%s", tmp_dir, name) >= 256) {
+        fprintf(stderr, "tenv_tmp: name too long: %s\n", name);
+        abort();
+    }
     return p;
 }
 

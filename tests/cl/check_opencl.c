@@ -475,7 +475,8 @@ static void scene_free(scene *sc, const dem_spec *s)
 /* The scene's direct sun at azimuth az, elevation el into out. */
 static ts_direct_request scene_direct(const scene *sc, double az, double el, float *out)
 {
-    return (ts_direct_request){&sc->g, sc->nx, sc->ny, sc->nz, sc->h, &sc->o, az, el, out};
+    return (ts_direct_request){&sc->g, sc->nx, sc->ny, sc->nz, sc->h,
+                               &sc->o, az,     el,     out,    TS_SUN_RADIUS_DEG};
 }
 
 /* The scene's sky terms of model m into svf, sky, open (each may be NULL). */
@@ -595,7 +596,7 @@ START_TEST(test_arguments)
     ck_assert_int_eq(ts_cl_normals(&g, a, b, NULL, &e), TS_ERR_ARG);
     ck_assert_int_eq(ts_cl_normals(NULL, a, b, c, &e), TS_ERR_ARG);
     o.directions = 1;
-    const ts_direct_request dq = {&g, a, b, c, a, &o, 100, 20, b};
+    const ts_direct_request dq = {&g, a, b, c, a, &o, 100, 20, b, TS_SUN_RADIUS_DEG};
     ck_assert_int_eq(ts_cl_shade_direct(&dq, &e), TS_ERR_ARG);
     ck_assert_ptr_nonnull(strstr(e.message, "computed for azimuth 0 only"));
     const ts_sky_request sq = {&g, a, b, c, NULL, &o, TS_SVF_RADIATIVE, a, NULL, NULL};

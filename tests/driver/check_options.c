@@ -135,7 +135,7 @@ static void check_sentences(void)
     expect_sentence(0, "SUN_AZIMUT=1",
                     "unknown option 'SUN_AZIMUT'; the options are PRODUCT, SUN_AZIMUTH, "
                     "SUN_ELEVATION, DIRECTIONS, START_AZIMUTH, METHOD, PENUMBRA_DEPTH, "
-                    "LIGHT_RADIUS, SWATH_DIRECTIONS, "
+                    "LIGHT_RADIUS, SWATH_DIRECTIONS, SHADOWMAP_SCALE, PCF_KERNEL, "
                     "Z_FACTOR, MAX_DISTANCE, CURVATURE, REFRACTION, SKY_WEIGHT, BAND, "
                     "THREADS, OUTPUT_TYPE, MAX_MEMORY, DATETIME, DATE, START_DATE, END_DATE, "
                     "TIMEZONE, STEP_MINUTES, DAY_INTERVAL, HORIZON_DIRECTIONS, PRESSURE, TEMPERATURE, DELTA_T, SUN_POSITION, "

@@ -1,0 +1,432 @@
+/*
+ * cm_shadowmap.h - the per-vertex, per-triangle and per-cell formulas of the
+ * shadow map (METHOD=shadowmap; core/shadowmap.c, cl/shadowmap.cl).
+ *
+ * Light space: s runs across the light's azimuth, t up the light's view,
+ * depth towards the light (larger = nearer the light). A DEM vertex at
+ * metres (X east, Y north, Z up) from the DEM's centre projects to
+ *   along = X sin(az) + Y cos(az)          (horizontal, towards the light)
+ *   s = X cos(az) - Y sin(az)
+ *   t = Z cos(el) - along sin(el)
+ *   depth = along cos(el) + Z sin(el)
+ * and to texel coordinates u = (s - s0) / ds, v = (t - t0) / dt; texel
+ * (a, b) is centred at u = a, v = b. The depth map keeps, per texel, the
+ * largest depth of the terrain's triangles over its centre, as an int key
+ * that orders like the float (so that OpenCL can keep it with atomic_max),
+ * less a slope-scaled offset (glPolygonOffset's factor and units). A cell
+ * is lit where its own depth is not below the map's.
+ *
+ * The frame's parameters travel as one float array, indexed by TS_SMP_*.
+ */
+#ifndef TS_CM_SHADOWMAP_H
+#define TS_CM_SHADOWMAP_H
+
+#include "cm_prelude.h"
+#include "cm_fastmath.h"
+#include "cm_sun.h"
+
+/* Indices into the frame's parameter array. */
+#define TS_SMP_CA 0        /* cos(azimuth) */
+#define TS_SMP_SA 1        /* sin(azimuth) */
+#define TS_SMP_CE 2        /* cos(elevation) */
+#define TS_SMP_SE 3        /* sin(elevation) */
+#define TS_SMP_S0 4        /* s of texel column 0, metres */
+#define TS_SMP_T0 5        /* t of texel row 0, metres */
+#define TS_SMP_INV_DS 6    /* texels per metre along s */
+#define TS_SMP_INV_DT 7    /* texels per metre along t */
+#define TS_SMP_CX0 8       /* column of the DEM's centre */
+#define TS_SMP_CY0 9       /* row of the DEM's centre */
+#define TS_SMP_CELL_Y 10   /* north-south cell size, metres */
+#define TS_SMP_BIAS 11     /* constant depth offset, metres */
+#define TS_SMP_SLOPE_CAP 12 /* largest depth slope used, metres per texel */
+#define TS_SMP_KERNEL_U 13 /* fixed PCF width in texels along u; 0 = auto */
+#define TS_SMP_KERNEL_V 14 /* and along v */
+#define TS_SMP_TAN_R 15    /* tan(light radius): auto's penumbra per metre */
+#define TS_SMP_DEPTH_MAX 16 /* largest depth of the map, metres */
+#define TS_SMP_SEARCH_CAP 17 /* largest blocker-search half-width, texels
+                                (at most TS_SM_TILE: the tiles around) */
+#define TS_SMP_INV_R 18    /* 1 / the light's radius in degrees */
+#define TS_SMP_COUNT 19
+
+/* Most PCF taps along one axis: wider kernels spread them out. */
+#define TS_SM_MAX_TAPS 9
+/* Taps of the blocker search of PCF_KERNEL=auto along one axis, at most. */
+#define TS_SM_SEARCH_TAPS 7
+/* An empty texel: below every depth, so nothing there shadows. */
+#define TS_SM_EMPTY (-2147483647 - 1)
+
+/* The map is followed by the largest key of each TS_SM_TILE x TS_SM_TILE
+ * tile of it (row-major, ceil(mw / TILE) per row): where the blocker search
+ * of PCF_KERNEL=auto may stop looking. OpenCL keeps them while rendering;
+ * C computes them after (ts_sm_tile_max), its threads owning map rows. */
+#define TS_SM_TILE 16
+
+#ifdef __OPENCL_C_VERSION__
+#define TS_SM_KEEP_MAX(p, k) atomic_max((p), (k))
+#define TS_SM_KEEP_TILE(map, mw, mh, a, b, k)                                                  \
+    atomic_max(&(map)[(long)(mw) * (mh) + (long)((b) / TS_SM_TILE) *                          \
+                                            (((mw) + TS_SM_TILE - 1) / TS_SM_TILE) +          \
+                      (a) / TS_SM_TILE],                                                       \
+               (k))
+#else
+#define TS_SM_KEEP_TILE(map, mw, mh, a, b, k) ((void)(mh))
+#define TS_SM_KEEP_MAX(p, k)                                                                   \
+    do {                                                                                       \
+        if (*(p) < (k))                                                                        \
+            *(p) = (k);                                                                        \
+    } while (0)
+#endif
+
+/* An int that orders as the float f does (f not NaN). */
+CM_FN int ts_sm_key(float f)
+{
+    union {
+        float f;
+        int i;
+    } x;
+    x.f = f;
+    return x.i < 0 ? x.i ^ 0x7fffffff : x.i;
+}
+
+/* The float of a key (not TS_SM_EMPTY). */
+CM_FN float ts_sm_unkey(int k)
+{
+    union {
+        float f;
+        int i;
+    } x;
+    x.i = k < 0 ? k ^ 0x7fffffff : k;
+    return x.f;
+}
+
+/* Texel coordinates (u, v) and depth of the vertex at column col of a row
+ * with east-west cell size cell_x, height z (NaN stays NaN). */
+CM_FN void ts_sm_project(CM_GLOBAL const float *P, int col, int row, float cell_x, float z,
+                         float *u, float *v, float *depth)
+{
+    float X = ((float)col - P[TS_SMP_CX0]) * cell_x;
+    float Y = (P[TS_SMP_CY0] - (float)row) * P[TS_SMP_CELL_Y];
+    float along = X * P[TS_SMP_SA] + Y * P[TS_SMP_CA];
+    float s = X * P[TS_SMP_CA] - Y * P[TS_SMP_SA];
+    float t = z * P[TS_SMP_CE] - along * P[TS_SMP_SE];
+    *u = (s - P[TS_SMP_S0]) * P[TS_SMP_INV_DS];
+    *v = (t - P[TS_SMP_T0]) * P[TS_SMP_INV_DT];
+    *depth = along * P[TS_SMP_CE] + z * P[TS_SMP_SE];
+}
+
+CM_FN float ts_sm_clampf(float x, float lo, float hi)
+{
+    return x < lo ? lo : x > hi ? hi : x;
+}
+
+/*
+ * Render one triangle (texel coordinates and depths of its corners) into
+ * the map of mw x mh texels, rows [vlo, vhi) only (the C backend's band).
+ * A texel whose centre lies inside the triangle or on its edge keeps the
+ * larger of its key and that of the triangle's depth there less the
+ * slope-scaled offset bias + min(max |depth slope|, cap). Triangles with a
+ * NaN corner (nodata) or no area (seen edge-on) are skipped.
+ */
+CM_FN void ts_sm_triangle(CM_GLOBAL const float *P, CM_GLOBAL int *map, int mw, int mh,
+                          int vlo, int vhi, float u0, float v0, float d0, float u1, float v1, float d1,
+                          float u2, float v2, float d2)
+{
+    float area = (u1 - u0) * (v2 - v0) - (u2 - u0) * (v1 - v0);
+    if (!(area > 1e-12f || area < -1e-12f)) /* also NaN */
+        return;
+    if (isnan(d0 + d1 + d2))
+        return;
+    float gu = ((d1 - d0) * (v2 - v0) - (d2 - d0) * (v1 - v0)) / area;
+    float gv = ((d2 - d0) * (u1 - u0) - (d1 - d0) * (u2 - u0)) / area;
+    float slope = CM_FABSF(gu) > CM_FABSF(gv) ? CM_FABSF(gu) : CM_FABSF(gv);
+    float cap = P[TS_SMP_SLOPE_CAP];
+    float off = P[TS_SMP_BIAS] + 0.75f * (slope < cap ? slope : cap);
+    float umin = u0 < u1 ? (u0 < u2 ? u0 : u2) : (u1 < u2 ? u1 : u2);
+    float umax = u0 > u1 ? (u0 > u2 ? u0 : u2) : (u1 > u2 ? u1 : u2);
+    float vmin = v0 < v1 ? (v0 < v2 ? v0 : v2) : (v1 < v2 ? v1 : v2);
+    float vmax = v0 > v1 ? (v0 > v2 ? v0 : v2) : (v1 > v2 ? v1 : v2);
+    int a0 = (int)ceil(umin), a1 = (int)floor(umax);
+    int b0 = (int)ceil(vmin), b1 = (int)floor(vmax);
+    a0 = a0 < 0 ? 0 : a0;
+    a1 = a1 > mw - 1 ? mw - 1 : a1;
+    b0 = b0 < vlo ? vlo : b0;
+    b1 = b1 > vhi - 1 ? vhi - 1 : b1;
+    float sg = area > 0.0f ? 1.0f : -1.0f;
+    for (int b = b0; b <= b1; b++) {
+        float fb = (float)b;
+        for (int a = a0; a <= a1; a++) {
+            float fa = (float)a;
+            float e0 = ((u1 - u0) * (fb - v0) - (v1 - v0) * (fa - u0)) * sg;
+            float e1 = ((u2 - u1) * (fb - v1) - (v2 - v1) * (fa - u1)) * sg;
+            float e2 = ((u0 - u2) * (fb - v2) - (v0 - v2) * (fa - u2)) * sg;
+            if (e0 < 0.0f || e1 < 0.0f || e2 < 0.0f)
+                continue;
+            int key = ts_sm_key(d0 + gu * (fa - u0) + gv * (fb - v0) - off);
+            TS_SM_KEEP_MAX(&map[(long)b * mw + a], key);
+            TS_SM_KEEP_TILE(map, mw, mh, a, b, key);
+        }
+    }
+}
+
+/* The largest key of tile (tx, ty) of the map (C: after rendering). */
+CM_FN int ts_sm_tile_max(CM_GLOBAL const int *map, int mw, int mh, int tx, int ty)
+{
+    int top = TS_SM_EMPTY;
+    for (int b = ty * TS_SM_TILE; b < (ty + 1) * TS_SM_TILE && b < mh; b++)
+        for (int a = tx * TS_SM_TILE; a < (tx + 1) * TS_SM_TILE && a < mw; a++) {
+            int k = map[(long)b * mw + a];
+            top = k > top ? k : top;
+        }
+    return top;
+}
+
+/* The map's depth at texel (a, b) as a key; off the map: empty (lit). */
+CM_FN int ts_sm_fetch(CM_GLOBAL const int *map, int mw, int mh, int a, int b)
+{
+    return a < 0 || b < 0 || a >= mw || b >= mh ? TS_SM_EMPTY : map[(long)b * mw + a];
+}
+
+/* Lit share of one tap at (tu, tv): the comparisons at the four texels
+ * around it, weighted bilinearly (the hardware filtering of shadow
+ * textures), each against the receiver's plane at that texel. */
+CM_FN float ts_sm_tap(CM_GLOBAL const int *map, int mw, int mh, float u, float v, float depth,
+                      float gu, float gv, float tu, float tv)
+{
+    float fa = floor(tu), fb = floor(tv);
+    float wu = tu - fa, wv = tv - fb;
+    int a = (int)fa, b = (int)fb;
+    float dark = 0.0f; /* so that all lit is exactly 1 */
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            float d = depth + gu * ((float)(a + i) - u) + gv * ((float)(b + j) - v);
+            float w = (i ? wu : 1.0f - wu) * (j ? wv : 1.0f - wv);
+            dark += ts_sm_fetch(map, mw, mh, a + i, b + j) > ts_sm_key(d) ? w : 0.0f;
+        }
+    return 1.0f - dark;
+}
+
+/*
+ * Lit fraction of a receiver at (u, v, depth) whose surface's depth slopes
+ * by gu, gv metres per texel (receiver-plane bias: each tap compares the
+ * map with the receiver's plane at that texel, so a wide kernel does not
+ * shadow a slope by itself): the mean over nu x nv taps spread over a
+ * ku x kv texel box around it.
+ */
+CM_FN float ts_sm_pcf(CM_GLOBAL const int *map, int mw, int mh, float u, float v, float depth,
+                      float gu, float gv, float ku, float kv)
+{
+    int nu = (int)ceil(ku - 1e-3f), nv = (int)ceil(kv - 1e-3f);
+    nu = nu < 1 ? 1 : nu > TS_SM_MAX_TAPS ? TS_SM_MAX_TAPS : nu;
+    nv = nv < 1 ? 1 : nv > TS_SM_MAX_TAPS ? TS_SM_MAX_TAPS : nv;
+    float lit = 0.0f;
+    for (int j = 0; j < nv; j++) {
+        float tv = v + (((float)j + 0.5f) / (float)nv - 0.5f) * (nv > 1 ? kv : 0.0f);
+        for (int i = 0; i < nu; i++) {
+            float tu = u + (((float)i + 0.5f) / (float)nu - 0.5f) * (nu > 1 ? ku : 0.0f);
+            lit += ts_sm_tap(map, mw, mh, u, v, depth, gu, gv, tu, tv);
+        }
+    }
+    return lit / (float)(nu * nv);
+}
+
+/*
+ * PCF over the light's disk as it falls on the map, an ellipse of radii
+ * ru x rv texels: rows of taps across it, each row weighted by its chord
+ * (so that a straight edge across the light's view darkens the receiver
+ * by the disk's area above it, as the exact method's disk does).
+ */
+CM_FN float ts_sm_pcf_disk(CM_GLOBAL const int *map, int mw, int mh, float u, float v,
+                           float depth, float gu, float gv, float ru, float rv)
+{
+    int nv = (int)ceil(2.0f * rv - 1e-3f);
+    nv = nv < 1 ? 1 : nv > TS_SM_MAX_TAPS ? TS_SM_MAX_TAPS : nv;
+    float lit = 0.0f, weight = 0.0f;
+    for (int j = 0; j < nv; j++) {
+        float y = nv > 1 ? ((float)j + 0.5f) / (float)nv * 2.0f - 1.0f : 0.0f;
+        float chord = CM_SQRTF(1.0f - y * y);
+        int nu = (int)ceil(2.0f * chord * ru - 1e-3f);
+        nu = nu < 1 ? 1 : nu > TS_SM_MAX_TAPS ? TS_SM_MAX_TAPS : nu;
+        float row = 0.0f;
+        for (int i = 0; i < nu; i++) {
+            float x = nu > 1 ? (((float)i + 0.5f) / (float)nu * 2.0f - 1.0f) * chord : 0.0f;
+            row += ts_sm_tap(map, mw, mh, u, v, depth, gu, gv, u + x * ru, v + y * rv);
+        }
+        lit += chord * row / (float)nu;
+        weight += chord;
+    }
+    return lit / weight;
+}
+
+/*
+ * PCF_KERNEL=auto (percentage-closer soft shadows): search the map around
+ * the receiver, over the width of the penumbra the farthest occluder could
+ * cast, for blockers: texels nearer the light than the receiver's plane by
+ * D, no farther than D tan(r) across (so that they hide part of the
+ * light's disk). Their mean D sets the kernel to the penumbra of the disk
+ * there, a disk of radius D tan(r) in light space. No blocker: fully lit.
+ */
+CM_FN float ts_sm_pcf_auto(CM_GLOBAL const float *P, CM_GLOBAL const int *map, int mw, int mh,
+                           float u, float v, float depth, float gu, float gv)
+{
+    float tr = P[TS_SMP_TAN_R], cap = P[TS_SMP_SEARCH_CAP];
+    float ds = 1.0f / P[TS_SMP_INV_DS], dt = 1.0f / P[TS_SMP_INV_DT];
+    /* the nearest the light anything within the search's reach can be */
+    int tw = (mw + TS_SM_TILE - 1) / TS_SM_TILE, th = (mh + TS_SM_TILE - 1) / TS_SM_TILE;
+    int tx = (int)floor(u + 0.5f) / TS_SM_TILE, ty = (int)floor(v + 0.5f) / TS_SM_TILE;
+    int top = TS_SM_EMPTY;
+    for (int j = ty - 1; j <= ty + 1; j++)
+        for (int i = tx - 1; i <= tx + 1; i++)
+            if (i >= 0 && j >= 0 && i < tw && j < th) {
+                int k = map[(long)mw * mh + (long)j * tw + i];
+                top = k > top ? k : top;
+            }
+    if (top <= ts_sm_key(depth)) /* nothing near is nearer the light */
+        return ts_sm_tap(map, mw, mh, u, v, depth, gu, gv, u, v);
+    float reach = (ts_sm_unkey(top) - depth) * tr; /* metres */
+    float hu = ts_sm_clampf(reach * P[TS_SMP_INV_DS], 0.0f, cap);
+    float hv = ts_sm_clampf(reach * P[TS_SMP_INV_DT], 0.0f, cap);
+    int nu = 2 * (int)ceil(hu) + 1, nv = 2 * (int)ceil(hv) + 1;
+    nu = nu > TS_SM_SEARCH_TAPS ? TS_SM_SEARCH_TAPS : nu;
+    nv = nv > TS_SM_SEARCH_TAPS ? TS_SM_SEARCH_TAPS : nv;
+    float sum = 0.0f;
+    int blockers = 0;
+    for (int j = 0; j < nv; j++) {
+        float tv = v + (nv > 1 ? ((float)j / (float)(nv - 1) * 2.0f - 1.0f) * hv : 0.0f);
+        int b = (int)floor(tv + 0.5f);
+        for (int i = 0; i < nu; i++) {
+            float tu = u + (nu > 1 ? ((float)i / (float)(nu - 1) * 2.0f - 1.0f) * hu : 0.0f);
+            int a = (int)floor(tu + 0.5f);
+            float d = depth + gu * ((float)a - u) + gv * ((float)b - v);
+            int k = ts_sm_fetch(map, mw, mh, a, b);
+            if (!(k > ts_sm_key(d)))
+                continue;
+            /* a blocker only where it can hide part of the disk: within
+             * its height above the receiver times tan(r) */
+            float D = ts_sm_unkey(k) - d;
+            float du = CM_FABSF((float)a - u) - 0.5f, dv = CM_FABSF((float)b - v) - 0.5f;
+            du = du > 0.0f ? du * ds : 0.0f; /* from the texel's nearest point */
+            dv = dv > 0.0f ? dv * dt : 0.0f;
+            if (du * du + dv * dv <= D * D * tr * tr) {
+                sum = blockers == 0 || D < sum ? D : sum;
+                blockers++;
+            }
+        }
+    }
+    if (blockers == 0) /* a hard shadow's edge at most */
+        return ts_sm_tap(map, mw, mh, u, v, depth, gu, gv, u, v);
+    float rad = sum * tr; /* the disk's radius there, metres */
+    return ts_sm_pcf_disk(map, mw, mh, u, v, depth, 0.0f, 0.0f, rad * P[TS_SMP_INV_DS],
+                          rad * P[TS_SMP_INV_DT]);
+}
+
+/*
+ * Lit fraction of the cell whose projected centre is (u, v, depth), with
+ * the projected centres of its neighbours west/east (uw..de) and
+ * north/south (un..ds) (the cell itself where one is missing): they give
+ * the receiver's depth slope. NaN for nodata.
+ */
+CM_FN float ts_sm_cell(CM_GLOBAL const float *P, CM_GLOBAL const int *map, int mw, int mh,
+                       float u, float v, float depth, float uw, float vw, float dw, float ue,
+                       float ve, float de, float un, float vn, float dn, float us, float vs,
+                       float ds)
+{
+    if (isnan(depth))
+        return depth;
+    /* the plane through the two central differences, in (u, v, depth) */
+    float au = ue - uw, av = ve - vw, ad = de - dw;
+    float bu = us - un, bv = vs - vn, bd = ds - dn;
+    float nu = av * bd - ad * bv, nv = ad * bu - au * bd, nd = au * bv - av * bu;
+    float cap = P[TS_SMP_SLOPE_CAP], gu = 0.0f, gv = 0.0f;
+    /* nd > 0: the surface faces the light (flat ground under a light above
+     * the horizon gives nd > 0; nd changes sign only edge-on). A surface
+     * facing away is compared at its own depth: its plane's steep slope
+     * would lift it past its occluder. */
+    if (nd > 1e-12f) {
+        gu = ts_sm_clampf(-nu / nd, -cap, cap);
+        gv = ts_sm_clampf(-nv / nd, -cap, cap);
+    }
+    float ku = P[TS_SMP_KERNEL_U];
+    if (ku > 0.0f)
+        return ts_sm_pcf(map, mw, mh, u, v, depth, gu, gv, ku, P[TS_SMP_KERNEL_V]);
+    return ts_sm_pcf_auto(P, map, mw, mh, u, v, depth, gu, gv);
+}
+
+/* Render the two triangles of the quad whose north-west corner is vertex
+ * (x, y) (x < W - 1, y < H - 1) of the projected vertices pu, pv, pd
+ * (W per row). */
+CM_FN void ts_sm_quad(CM_GLOBAL const float *P, CM_GLOBAL int *map, int mw, int mh, int vlo,
+                      int vhi,
+                      CM_GLOBAL const float *pu, CM_GLOBAL const float *pv,
+                      CM_GLOBAL const float *pd, int W, int x, int y)
+{
+    long i00 = (long)y * W + x, i10 = i00 + 1, i01 = i00 + W, i11 = i01 + 1;
+    ts_sm_triangle(P, map, mw, mh, vlo, vhi, pu[i00], pv[i00], pd[i00], pu[i10], pv[i10],
+                   pd[i10], pu[i11], pv[i11], pd[i11]);
+    ts_sm_triangle(P, map, mw, mh, vlo, vhi, pu[i00], pv[i00], pd[i00], pu[i11], pv[i11],
+                   pd[i11], pu[i01], pv[i01], pd[i01]);
+}
+
+/* Index of the neighbour (x, y), or i itself off the grid or at nodata. */
+CM_FN long ts_sm_neighbour(CM_GLOBAL const float *pd, int W, int H, long i, int x, int y)
+{
+    if (x < 0 || y < 0 || x >= W || y >= H)
+        return i;
+    long j = (long)y * W + x;
+    return isnan(pd[j]) ? i : j;
+}
+
+/*
+ * The receiver's own slope towards the light (the self-shadow that a depth
+ * map cannot resolve below one texel, and the DEM's edge, beyond which the
+ * map holds no face): on the ring of the 8 neighbours (ring[k]: their
+ * indices, clockwise, the cell itself where one is missing), the point F
+ * with the receiver's u lies on the light's side; the terrain there rises
+ * h - e above the light's direction, tan(h - e) = dt (v_F - v) / (d_F - d)
+ * (light space turns elevation angles by e), and hides the part of the
+ * disk below it, as the exact method's first sample does.
+ */
+CM_FN float ts_sm_near(CM_GLOBAL const float *P, CM_GLOBAL const float *pu,
+                       CM_GLOBAL const float *pv, CM_GLOBAL const float *pd, long i,
+                       const long *ring)
+{
+    const float dt = 1.0f / P[TS_SMP_INV_DT], u = pu[i], v = pv[i], d = pd[i];
+    float lit = 1.0f;
+    for (int k = 0; k < 8; k++) {
+        long a = ring[k], b = ring[(k + 1) & 7];
+        float ea = pu[a] - u, eb = pu[b] - u;
+        if (a == i || b == i || !(ea * eb <= 0.0f) || ea == eb)
+            continue;
+        float l = ea / (ea - eb);
+        float dv = (pv[a] + l * (pv[b] - pv[a]) - v) * dt;
+        float dd = pd[a] + l * (pd[b] - pd[a]) - d;
+        if (!(dd * P[TS_SMP_CE] - dv * P[TS_SMP_SE] > 0.0f) || !(dd > 0.0f))
+            continue; /* the side away from the light, or a drop beyond 90 - e */
+        float rise = ts_atanf(dv / dd) * 57.2957795f; /* h - e, degrees */
+        float f = ts_disk_fraction_u(-rise * P[TS_SMP_INV_R]);
+        lit = f < lit ? f : lit;
+    }
+    return lit;
+}
+
+/* ts_sm_cell for cell (x, y) of the projected vertices pu, pv, pd. */
+CM_FN float ts_sm_cell_at(CM_GLOBAL const float *P, CM_GLOBAL const int *map, int mw, int mh,
+                          CM_GLOBAL const float *pu, CM_GLOBAL const float *pv,
+                          CM_GLOBAL const float *pd, int W, int H, int x, int y)
+{
+    long i = (long)y * W + x;
+    long ring[8];
+    const int rx[8] = {0, 1, 1, 1, 0, -1, -1, -1}, ry[8] = {-1, -1, 0, 1, 1, 1, 0, -1};
+    for (int k = 0; k < 8; k++)
+        ring[k] = ts_sm_neighbour(pd, W, H, i, x + rx[k], y + ry[k]);
+    if (isnan(pd[i]))
+        return pd[i];
+    float near = ts_sm_near(P, pu, pv, pd, i, ring);
+    if (!(near > 0.0f)) /* in its own shadow: the map cannot add light */
+        return 0.0f;
+    float lit = ts_sm_cell(P, map, mw, mh, pu[i], pv[i], pd[i], pu[ring[6]], pv[ring[6]],
+                           pd[ring[6]], pu[ring[2]], pv[ring[2]], pd[ring[2]], pu[ring[0]],
+                           pv[ring[0]], pd[ring[0]], pu[ring[4]], pv[ring[4]], pd[ring[4]]);
+    return near < lit ? near : lit;
+}
+
+#endif

@@ -1,0 +1,45 @@
+/* The light's options: LIGHT_RADIUS (the disk of the exact method, and of
+ * METHOD=shadowmap's auto filter) and METHOD=shadowmap's own options, and
+ * the combinations where they make no sense. */
+#include "tsd_options_light.h"
+
+#include <math.h>
+
+#include "tsd_products.h"
+#include "tsd_text.h"
+
+#define REFUSE(...) return (tsd_fail(msg, n, TS_ERR_ARG, __VA_ARGS__), -1)
+
+int tsd_options_check_light(const tsd_options *o, char *msg, size_t n)
+{
+    const tsd_product_def *p = tsd_product_of(o);
+    /* an option given with its declared default is no mistake */
+    tsd_options d;
+    tsd_options_defaults(&d);
+    const int radius_given = o->light_radius != d.light_radius;
+    const int shadowmap = o->method == TSD_METHOD_SHADOWMAP;
+    /* the table's upper bounds are inclusive; the disk must stay below 45 */
+    if (!(o->light_radius < TS_LIGHT_RADIUS_MAX))
+        REFUSE("LIGHT_RADIUS must be greater than 0 and less than %g degrees, got %g",
+               TS_LIGHT_RADIUS_MAX, o->light_radius);
+    if (radius_given && !tsd_product_takes(p, tsd_option_find("LIGHT_RADIUS")))
+        REFUSE("LIGHT_RADIUS applies to PRODUCT=shade and PRODUCT=shadow, not to "
+               "PRODUCT=%s", p->name);
+    if (radius_given && o->method == TSD_METHOD_SHM)
+        REFUSE("LIGHT_RADIUS does not apply to METHOD=shm, whose soft edges are set by "
+               "PENUMBRA_DEPTH; use METHOD=exact, METHOD=shadowmap or METHOD=sh");
+    if (radius_given && o->sun_position == TSD_SUN_PER_CELL)
+        REFUSE("LIGHT_RADIUS applies with SUN_POSITION=center: the per-cell sun is the sun's "
+               "own disk");
+    if (!shadowmap && o->shadowmap_scale != d.shadowmap_scale)
+        REFUSE("SHADOWMAP_SCALE applies to METHOD=shadowmap only");
+    if (!shadowmap && !isnan(o->pcf_kernel))
+        REFUSE("PCF_KERNEL applies to METHOD=shadowmap only");
+    if (shadowmap && o->sun_position == TSD_SUN_PER_CELL)
+        REFUSE("METHOD=shadowmap renders one depth map for one light direction: it needs "
+               "SUN_POSITION=center");
+    if (shadowmap && o->max_distance > 0)
+        REFUSE("MAX_DISTANCE does not apply to METHOD=shadowmap (its depth map holds the "
+               "whole DEM); use METHOD=exact");
+    return 0;
+}

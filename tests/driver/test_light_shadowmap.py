@@ -1,0 +1,150 @@
+"""LIGHT_RADIUS and METHOD=shadowmap through the driver, on both backends.
+
+- a pillar's penumbra on flat ground spans h/tan(e+r) .. h/tan(e-r) for the
+  disk of LIGHT_RADIUS r (PRODUCT=shadow, METHOD=exact), BACKEND=c and
+  BACKEND=opencl alike;
+- METHOD=shadowmap on jacksboro agrees with the exact shadow on >= 97 % of
+  the cells at 135/10 and 315/30, C and OpenCL within 1e-4; shade with it;
+- bad values and combinations: a clear sentence, never a crash.
+"""
+import math
+import os
+import unittest
+
+import tsdriver as T
+from tsdriver import gdal, np
+
+for _k in ("TERRASHADE_BACKEND", "TERRASHADE_OPENCL_DEVICE"):
+    os.environ.pop(_k, None)
+
+PILLAR_X, HEIGHT, WIDTH = 20, 50.0, 640
+
+
+def array(dem, **options):
+    oo = ["%s=%s" % kv for kv in options.items()]
+    ds = gdal.OpenEx(T.conn(dem), gdal.OF_RASTER, open_options=oo)
+    return ds.GetRasterBand(1).ReadAsArray().astype(np.float64), ds.GetMetadataItem("BACKEND")
+
+
+class LightRadius(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = T.TempDir()
+        d = cls.tmp.__enter__()
+        z = np.zeros((5, WIDTH), np.float32)
+        z[2, PILLAR_X] = HEIGHT
+        cls.dem = os.path.join(d, "pillar.tif")
+        T.write_tif(cls.dem, z, (500000, 1, 0, 4000000, 0, -1), 32617)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.__exit__(None, None, None)
+
+    def test_pillar_penumbra(self):
+        for backend in ("c", "opencl"):
+            for el, r in ((20, 0.2666), (20, 2), (10, 5), (35, 1)):
+                a, ran = array(self.dem, PRODUCT="shadow", SUN_AZIMUTH=270, SUN_ELEVATION=el,
+                               LIGHT_RADIUS=r, CURVATURE="NO", OUTPUT_TYPE="Float32",
+                               BACKEND=backend)
+                self.assertEqual(ran, backend)
+                row = a[2, PILLAR_X + 1:]
+                start = 1 + int(np.argmax(row > 0))
+                end = 1 + int(np.argmax(row >= 1))
+                want0 = HEIGHT / math.tan(math.radians(el + r))
+                want1 = HEIGHT / math.tan(math.radians(el - r))
+                print("%s e=%g r=%g: penumbra %d..%d m, geometry %.2f..%.2f m"
+                      % (backend, el, r, start, end, want0, want1))
+                self.assertEqual(start, math.floor(want0) + 1)
+                self.assertEqual(end, math.ceil(want1))
+
+    def test_default_is_the_sun(self):
+        a, _ = array(self.dem, PRODUCT="shadow", SUN_AZIMUTH=270, SUN_ELEVATION=20,
+                     OUTPUT_TYPE="Float32")
+        b, _ = array(self.dem, PRODUCT="shadow", SUN_AZIMUTH=270, SUN_ELEVATION=20,
+                     OUTPUT_TYPE="Float32", LIGHT_RADIUS=0.2666)
+        self.assertTrue(np.array_equal(a, b))
+
+
+class Shadowmap(unittest.TestCase):
+    def test_jacksboro(self):
+        for az, el in ((135, 10), (315, 30)):
+            ex, _ = array(T.JACKSBORO, PRODUCT="shadow", SUN_AZIMUTH=az, SUN_ELEVATION=el,
+                          OUTPUT_TYPE="Float32", BACKEND="c")
+            runs = {}
+            for backend in ("c", "opencl"):
+                sm, ran = array(T.JACKSBORO, PRODUCT="shadow", METHOD="shadowmap",
+                                SUN_AZIMUTH=az, SUN_ELEVATION=el, OUTPUT_TYPE="Float32",
+                                BACKEND=backend)
+                self.assertEqual(ran, backend)
+                runs[backend] = sm
+            ok = ~np.isnan(ex)
+            self.assertTrue(np.array_equal(ok, ~np.isnan(runs["c"])))
+            agree = np.mean((ex[ok] >= 0.5) == (runs["c"][ok] >= 0.5))
+            diff = np.nanmax(np.abs(runs["c"] - runs["opencl"]))
+            print("jacksboro %g/%g: shadowmap agrees with exact on %.2f %%; |C - OpenCL| %.3g"
+                  % (az, el, 100 * agree, diff))
+            self.assertGreaterEqual(agree, 0.97)
+            self.assertLessEqual(diff, 1e-4)
+
+    def test_shade_and_kernels(self):
+        shade, _ = array(T.JACKSBORO, METHOD="shadowmap", SUN_AZIMUTH=200, SUN_ELEVATION=25)
+        exact, _ = array(T.JACKSBORO, SUN_AZIMUTH=200, SUN_ELEVATION=25)
+        self.assertGreater(np.mean(np.abs(shade - exact) <= 1), 0.97)
+        hard, _ = array(T.JACKSBORO, PRODUCT="shadow", METHOD="shadowmap", PCF_KERNEL=0.5,
+                        SUN_AZIMUTH=135, SUN_ELEVATION=10, OUTPUT_TYPE="Float32")
+        soft, _ = array(T.JACKSBORO, PRODUCT="shadow", METHOD="shadowmap", PCF_KERNEL=4,
+                        SHADOWMAP_SCALE=1, SUN_AZIMUTH=135, SUN_ELEVATION=10,
+                        OUTPUT_TYPE="Float32")
+        partial = lambda a: np.mean((a > 0) & (a < 1))  # noqa: E731
+        self.assertGreater(partial(soft), 2 * partial(hard))
+
+
+# (open options, text the message must hold)
+BAD = [
+    (["PCF_KERNEL=0", "METHOD=shadowmap", "PRODUCT=shadow"],
+     "PCF_KERNEL must be greater than 0 and at most 64, got 0"),
+    (["PCF_KERNEL=1000", "METHOD=shadowmap"], "PCF_KERNEL must be greater than 0 and at most 64"),
+    (["PCF_KERNEL=-3", "METHOD=shadowmap"], "PCF_KERNEL must be greater than 0"),
+    (["PCF_KERNEL=huge", "METHOD=shadowmap"], "PCF_KERNEL must be auto or a number, got 'huge'"),
+    (["SHADOWMAP_SCALE=0.1", "METHOD=shadowmap"],
+     "SHADOWMAP_SCALE must be between 0.25 and 8, got 0.1"),
+    (["SHADOWMAP_SCALE=9", "METHOD=shadowmap"], "SHADOWMAP_SCALE must be between 0.25 and 8"),
+    (["METHOD=shadowmap", "PRODUCT=svf"],
+     "METHOD=shadowmap applies to PRODUCT=shade and PRODUCT=shadow only, not to PRODUCT=svf"),
+    (["PCF_KERNEL=3"], "PCF_KERNEL applies to METHOD=shadowmap only"),
+    (["SHADOWMAP_SCALE=4", "METHOD=shm"], "SHADOWMAP_SCALE applies to METHOD=shadowmap only"),
+    (["METHOD=shadowmap", "MAX_DISTANCE=1000"],
+     "MAX_DISTANCE does not apply to METHOD=shadowmap"),
+    (["LIGHT_RADIUS=0"], "LIGHT_RADIUS must be greater than 0"),
+    (["LIGHT_RADIUS=45"], "LIGHT_RADIUS must be greater than 0 and less than 45 degrees, got 45"),
+    (["LIGHT_RADIUS=90"], "LIGHT_RADIUS must be greater than 0 and at most 45, got 90"),
+    (["LIGHT_RADIUS=2", "METHOD=shm"], "LIGHT_RADIUS does not apply to METHOD=shm"),
+    (["LIGHT_RADIUS=2", "PRODUCT=svf"],
+     "LIGHT_RADIUS applies to PRODUCT=shade and PRODUCT=shadow, not to PRODUCT=svf"),
+]
+
+
+class BadInput(unittest.TestCase):
+    def test_open(self):
+        for oo, text in BAD:
+            with self.assertRaises(RuntimeError, msg=str(oo)) as cm:
+                gdal.OpenEx(T.conn(T.LUX), gdal.OF_RASTER, open_options=oo)
+            print("%-50s -> %s" % (" ".join(oo), cm.exception))
+            self.assertIn(text, str(cm.exception))
+
+    def test_low_light(self):
+        """The light below the horizon: the core's sentence on reading, and
+        gdal_translate exits non-zero."""
+        ds = gdal.OpenEx(T.conn(T.LUX), gdal.OF_RASTER,
+                         open_options=["METHOD=shadowmap", "SUN_ELEVATION=-5"])
+        with self.assertRaises(RuntimeError) as cm:
+            ds.GetRasterBand(1).ReadAsArray()
+        self.assertIn("a shadow map needs the light above the horizon", str(cm.exception))
+        with T.TempDir() as d:
+            p = T.run(["gdal_translate", "-q", "-oo", "METHOD=shadowmap", "-oo",
+                       "SUN_ELEVATION=0", T.conn(T.LUX), os.path.join(d, "o.tif")], ok=False)
+            self.assertIn("elevation must be greater than 0", p.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
