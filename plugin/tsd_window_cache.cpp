@@ -6,6 +6,7 @@
  * that GDAL's row-by-row reads compute each chunk once.
  */
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -291,8 +292,12 @@ const WindowChunk *TSDataset::Chunk(int cx, int cy)
     while (static_cast<int>(s.lru.size()) >= std::max(4, s.plan.cache_chunks))
         s.lru.pop_back();
     WindowChunk c;
+    const auto tStart = std::chrono::steady_clock::now();
     if (!ComputeChunk(cx, cy, c))
         return nullptr;
+    const std::chrono::duration<double> dfSec = std::chrono::steady_clock::now() - tStart;
+    CPLDebug(DRIVER, "computed chunk (%d, %d) of %d x %d cells in %.3f s", cx, cy, c.w, c.h,
+             dfSec.count());
     s.lru.push_front(std::move(c));
     return &s.lru.front();
 }
