@@ -11,7 +11,8 @@
 # then, timed with /usr/bin/time (wall seconds, peak resident MiB):
 #   window  gdal_translate -srcwin 0 0 256 256 OPTIONS [-oo TILE_SIZE=T] TERRASHADE:dem out
 #   whole   gdal_translate OPTIONS [-oo TILE_SIZE=T] TERRASHADE:dem out   (Mcells/s)
-# for T = 0 (the whole DEM at once) and the default (2048). TILE_SIZE=0 on a
+# for T = 0 (the whole DEM at once) and the default (2048), and the window
+# with TILE_SIZE=512. TILE_SIZE=0 on a
 # DEM larger than the memory limit is refused, and printed so.
 #
 # The plugin is taken from $BUILDDIR/plugin/.libs (BUILDDIR defaults to the
@@ -85,6 +86,9 @@ echo "window_bench: $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg), optio
 for n in $SIZES; do
     dem_of "$n"
     dem=$(ls "$WORK"/dem_"$n".* | head -n1)
+    timed "$n^2 window 256^2, TILE_SIZE=512" 65536 \
+        gdal_translate -q -srcwin 0 0 256 256 "$@" -oo TILE_SIZE=512 \
+        "TERRASHADE:$dem" "$WORK/w.tif"
     for t in 0 2048; do
         timed "$n^2 window 256^2, TILE_SIZE=$t" 65536 \
             gdal_translate -q -srcwin 0 0 256 256 "$@" -oo TILE_SIZE=$t \
