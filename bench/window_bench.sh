@@ -11,7 +11,7 @@
 # then, timed with /usr/bin/time (wall seconds, peak resident MiB):
 #   window  gdal_translate -srcwin 0 0 256 256 OPTIONS [-oo TILE_SIZE=T] TERRASHADE:dem out
 #   whole   gdal_translate OPTIONS [-oo TILE_SIZE=T] TERRASHADE:dem out   (Mcells/s)
-# for T = 0 (the whole DEM at once) and the default (2048), and the window
+# for T = 0 (the whole DEM at once) and 2048, and the window
 # with TILE_SIZE=512. TILE_SIZE=0 on a
 # DEM larger than the memory limit is refused, and printed so.
 #

@@ -82,7 +82,7 @@ const opt_def TSD_OPTION_ROWS[] = {
      NULL,
      "Refuse to compute a product needing more than this many MiB; 0 = "
      "three quarters of the physical memory"},
-    {"TILE_SIZE", K_INT, FIELD(tile_size), "2048", 0, 1 << 20, 0, 1, NULL, 0, P, LISTED,
+    {"TILE_SIZE", K_INT, FIELD(tile_size), "4096", 0, 1 << 20, 0, 1, NULL, 0, P, LISTED,
      check_tile_size,
      "Compute the product in chunks of this many cells square, each from the DEM "
      "around it (NEAR_DISTANCE) and one coarse grid of the whole DEM, so that "

@@ -155,7 +155,7 @@ bool TSDataset::SetupWindow(int W, int H)
     }
     if (!poState->plan.windowed)
     {
-        CPLDebug(DRIVER, "computing the whole DEM at once: %s", poState->plan.why_whole);
+        CPLDebug(DRIVER, "whole-DEM path (no chunks): %s", poState->plan.why_whole);
         return true;
     }
     const tsd_window_plan &p = poState->plan;
