@@ -137,7 +137,7 @@ class LargeDEM(unittest.TestCase):
         dem = self.big(16384, 8)
         out = os.path.join(self.tmp, "all.tif")
         p, sec = self.limited(["gdal_translate", "-co", "COMPRESS=DEFLATE", "-co", "TILED=YES"]
-                              + T.oo_args(dict(SHADE, TILE_SIZE=2048, NEAR_DISTANCE=1000))
+                              + T.oo_args(dict(SHADE, TILE_SIZE=2048, NEAR_DISTANCE=300))
                               + [T.conn(dem), out])
         print("gdal_translate of shade on a 16384^2 DEM (1 GiB of heights): %.1f s" % sec)
         self.assertIn("100 - done", p.stdout)
