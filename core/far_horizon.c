@@ -24,6 +24,7 @@ typedef struct {
     const ts_line_geom *geom;
     double c;   /* curvature coefficient (1-k)/(2R), 0 when off */
     double T;   /* threshold, metres */
+    double dz;  /* observers stand this high above the cells */
     float *out; /* slopes, then degrees; row stride = width */
     ptrdiff_t o_origin, o_u_stride, o_v_stride;
     long b0;
@@ -69,7 +70,7 @@ static inline float far_query(const far_ctx *C, const far_ws *w, double d, float
 {
     if (w->n == 0)
         return -INFINITY;
-    double g = h - C->c * d * d;
+    double g = h + C->dz - C->c * d * d;
     return (float)(hull_tangent(w, d, g) - 2.0 * C->c * d);
 }
 
@@ -164,7 +165,7 @@ static void to_degrees(void *ctx, int worker, long y0, long y1)
 /* The far-field sweep: slopes (tangents) into out, or, with `degrees`,
  * elevation angles. */
 static ts_status far_sweep(const ts_grid *grid, double azimuth, double threshold_m,
-                           const ts_horizon_opts *opts, int degrees, float *out,
+                           double dz, const ts_horizon_opts *opts, int degrees, float *out,
                            ts_error *err)
 {
     ts_status st = ts_grid_validate(grid, err);
@@ -192,6 +193,7 @@ static ts_status far_sweep(const ts_grid *grid, double azimuth, double threshold
     C.geom = &geom;
     C.c = o.curvature ? (1.0 - o.refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
     C.T = threshold_m;
+    C.dz = dz;
     C.out = out;
     ts_line_out_strides(&geom, grid->width, &C.o_origin, &C.o_u_stride, &C.o_v_stride);
     C.b0 = geom.b_lo;
@@ -212,7 +214,17 @@ static ts_status far_sweep(const ts_grid *grid, double azimuth, double threshold
 ts_status ts_far_horizon(const ts_grid *grid, double azimuth, double threshold_m,
                          const ts_horizon_opts *opts, float *out, ts_error *err)
 {
-    return far_sweep(grid, azimuth, threshold_m, opts, 1, out, err);
+    return far_sweep(grid, azimuth, threshold_m, 0.0, opts, 1, out, err);
+}
+
+ts_status ts_far_slope_raised(const ts_grid *grid, double azimuth, double threshold_m,
+                              double dz, const ts_horizon_opts *opts, float *out,
+                              ts_error *err)
+{
+    if (!isfinite(dz))
+        return ts_fail(err, TS_ERR_ARG, "the observers' height above the cells must be "
+                       "finite, got %g", dz);
+    return far_sweep(grid, azimuth, threshold_m, dz, opts, 0, out, err);
 }
 
 ts_status ts_far_shadow(const ts_grid *grid, double azimuth, double elevation,
@@ -231,7 +243,7 @@ ts_status ts_far_shadow(const ts_grid *grid, double azimuth, double elevation,
     float *s = malloc(cells * sizeof *s);
     if (!s)
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate a far-horizon plane");
-    st = far_sweep(grid, azimuth, threshold_m, opts, 0, s, err);
+    st = far_sweep(grid, azimuth, threshold_m, 0.0, opts, 0, s, err);
     if (st == TS_OK) {
         /* slope > tan(elevation) <=> horizon angle > elevation */
         double t = elevation >= 90.0 ? INFINITY : tan(elevation * (M_PI / 180.0));

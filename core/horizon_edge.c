@@ -38,7 +38,8 @@ double ts_edge_horizon(double height_m, double edge_m, const ts_horizon_opts *op
 }
 
 /* The ray toward an azimuth in cells per metre (the direction of
- * ts_line_geom_init: the central row's cell size), as the metres per cell
+ * ts_line_geom_init: the central row's cell size, the larger DEM's for a
+ * window), as the metres per cell
  * it advances along x and y (infinite along an axis it does not cross). */
 typedef struct {
     double mx, my; /* metres per cell along x, y; INFINITY = parallel */
@@ -51,18 +52,28 @@ static edge_ray edge_ray_of(const ts_grid *grid, double azimuth)
     double sa = sin(a), ca = cos(a);
     if (fabs(sa) < 1e-12) sa = 0;
     if (fabs(ca) < 1e-12) ca = 0;
-    double gx = sa / ts_grid_cell_x(grid, grid->height / 2), gy = -ca / grid->cell_y;
+    double cx = grid->origin ? grid->origin->ref_cell_x : ts_grid_cell_x(grid, grid->height / 2);
+    double gx = sa / cx, gy = -ca / grid->cell_y;
     edge_ray r = {gx != 0 ? 1.0 / fabs(gx) : INFINITY, gy != 0 ? 1.0 / fabs(gy) : INFINITY,
                   gx > 0, gy > 0};
     return r;
 }
 
-/* Metres from the centre of cell (x, y) to the grid's outer boundary. */
+/* Metres from the centre of cell (x, y) to the grid's outer boundary: the
+ * larger DEM's for a window, whose own edges are not the world's. */
 static inline double edge_ray_distance(const edge_ray *r, const ts_grid *grid, int x, int y)
 {
+    const ts_grid_origin *o = grid->origin;
     double px = x + 0.5, py = y + 0.5; /* the grid is [0, W] x [0, H] */
-    double sx = (r->east ? grid->width - px : px) * r->mx;
-    double sy = (r->south ? grid->height - py : py) * r->my;
+    double W = grid->width, H = grid->height;
+    if (o) {
+        px += o->x0;
+        py += o->y0;
+        W = o->full_width;
+        H = o->full_height;
+    }
+    double sx = (r->east ? W - px : px) * r->mx;
+    double sy = (r->south ? H - py : py) * r->my;
     return sx < sy ? sx : sy;
 }
 

@@ -22,7 +22,8 @@ ts_status ts_line_geom_init(ts_line_geom *g, const ts_grid *grid, double azimuth
     int W = grid->width, H = grid->height;
     /* Direction toward the azimuth in cells (x east, y south); the line
      * direction is taken at the central row for geographic grids. */
-    double cx = ts_grid_cell_x(grid, H / 2), cy = grid->cell_y;
+    const ts_grid_origin *o = grid->origin;
+    double cx = o ? o->ref_cell_x : ts_grid_cell_x(grid, H / 2), cy = grid->cell_y;
     double a = azimuth * DEG2RAD;
     double s = sin(a), c = cos(a);
     /* Snap tiny components so that 0, 90, 180, 270 give exact axis lines. */
@@ -51,8 +52,19 @@ ts_status ts_line_geom_init(ts_line_geom *g, const ts_grid *grid, double azimuth
         ts_line_geom_free(g);
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate sweep line tables");
     }
+    /* A window's lines are the whole DEM's: its sample k is the whole
+     * DEM's step q = k + k_anchor (q = u * u_step in the DEM's u), at v
+     * t * q there; fl[k] counts from floor(t * k_anchor), an integer shift
+     * of the window's line intercepts. */
+    double f0 = 0;
+    if (o) {
+        long ou = g->x_major ? o->x0 : o->y0;
+        g->anchored = 1;
+        g->k_anchor = (ou + g->u_start) * (long)g->u_step;
+        f0 = floor(g->t * (double)g->k_anchor);
+    }
     for (int k = 0; k < g->U; k++) {
-        double p = g->t * k;
+        double p = g->t * (double)(k + g->k_anchor);
         double f = floor(p);
         float fr = (float)(p - f);
         /* Rounding can land a hair below 1: fold it onto the next cell. */
@@ -60,7 +72,7 @@ ts_status ts_line_geom_init(ts_line_geom *g, const ts_grid *grid, double azimuth
             f += 1;
             fr = 0.0f;
         }
-        g->fl[k] = (int)f;
+        g->fl[k] = (int)(f - f0);
         g->fr[k] = fr;
         /* The far field's ray: the same doubles as cm_ray_slope, no folding. */
         double pv = -g->t * k, o = floor(pv);
@@ -86,7 +98,9 @@ ts_status ts_line_geom_init(ts_line_geom *g, const ts_grid *grid, double azimuth
             double cxy = grid->cell_x_row[y];
             g->step_row[y] = g->x_major ? hypot(cxy, tv * cy) : hypot(tv * cxy, cy);
         }
-        g->step_m = g->step_row[H / 2];
+        /* a window's near-field reach is the whole DEM's */
+        double cxm = o ? o->ref_cell_x : grid->cell_x_row[H / 2];
+        g->step_m = g->x_major ? hypot(cxm, tv * cy) : hypot(tv * cxm, cy);
     }
     return ts_ok(err);
 }

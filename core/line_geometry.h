@@ -33,6 +33,8 @@ typedef struct {
     float *ray_f;           /* dk steps back, and its fraction, as cm_ray_slope */
     double step_m;          /* metres per step when cell_x is constant */
     double *step_row;       /* metres per step by grid row, or NULL */
+    int anchored;           /* the grid is a window (ts_grid_origin): */
+    long k_anchor;          /* sample k is step k + k_anchor of the whole DEM's lines */
 } ts_line_geom;
 
 /* Set up the lines for the horizon toward `azimuth` (degrees, any finite
@@ -112,6 +114,8 @@ static inline void ts_line_sample_at(const ts_line_geom *G, const float *z, long
             int row = G->x_major ? s->i : G->u_start + k * G->u_step;
             *d += G->step_row[row];
         }
+    } else if (G->anchored) {
+        *d = (double)(k + G->k_anchor) * G->step_m; /* as on the whole DEM */
     } else {
         *d = (double)(k - k0) * G->step_m;
     }

@@ -52,6 +52,18 @@ ts_status ts_far_horizon(const ts_grid *grid, double azimuth, double threshold_m
                          const ts_horizon_opts *opts, float *out, ts_error *err);
 
 /**
+ * The far field of ts_far_horizon as slopes (tangents of the angles, with
+ * the curvature term; -inf where no far terrain exists, NaN for nodata)
+ * seen by observers standing `dz` metres above each cell (dz < 0: below).
+ * Two heights give a cell's far field as a function of the observer's
+ * height: the windowed driver places its full-resolution cells on a
+ * coarse grid's far field so (plugin/tsd_window_far.c).
+ */
+ts_status ts_far_slope_raised(const ts_grid *grid, double azimuth, double threshold_m,
+                              double dz, const ts_horizon_opts *opts, float *out,
+                              ts_error *err);
+
+/**
  * Binary far-shadow map of a point sun at (azimuth, elevation): 1 where
  * ts_far_horizon is above `elevation`, 0 where not, TS_ATLAS_NODATA for
  * nodata. `out` width*height bytes.

@@ -55,6 +55,20 @@ const char *ts_status_name(ts_status code);
  * size shrinks with latitude: set `cell_x_row` to `height` per-row values
  * (row 0 first); NULL means every row has `cell_x`.
  */
+/**
+ * Where a grid lies in a larger DEM when it is a window of it (ts_grid's
+ * `origin`): horizon sweeps then place their lines and measure distances
+ * as they would on the whole DEM, so that a cell's horizon depends on the
+ * terrain around it and not on where the window starts.
+ */
+typedef struct {
+    int x0, y0;        /**< the grid's first cell in the larger DEM */
+    double ref_cell_x; /**< east-west cell size the larger DEM's sweeps take
+                            their direction from (its central row's) */
+    int full_width, full_height; /**< the larger DEM's size, cells: where its
+                                      edge lies (ts_horizon_edge_apply) */
+} ts_grid_origin;
+
 typedef struct {
     int width;
     int height;
@@ -64,6 +78,7 @@ typedef struct {
     double cell_y;
     double *cell_x_row;
     int owns_memory; /* set by ts_grid_create; ts_grid_free frees only then */
+    const ts_grid_origin *origin; /* a window of a larger DEM, or NULL */
 } ts_grid;
 
 /**

@@ -52,9 +52,17 @@ void tsd_compute_horizon_opts(const tsd_compute_ctx *c, ts_horizon_opts *h)
     h->directions = o->directions;
     h->start_azimuth = o->start_azimuth;
     h->max_distance = o->max_distance;
+    /* a window: the near field within its margin (tsd_window.h) */
+    if (c->run->near_distance > 0 &&
+        (h->max_distance == 0 || h->max_distance > c->run->near_distance))
+        h->max_distance = c->run->near_distance;
     h->curvature = o->curvature;
     h->refraction = o->refraction;
     h->edge = tsd_options_edge(o);
+    /* a window's sweep reaches its near field only: the world beyond the
+     * DEM's edge joins after the far field (tsd_compute_far) */
+    if (h->max_distance != o->max_distance)
+        h->edge = TS_EDGE_OPEN;
     h->threads = o->threads;
     h->progress = c->run->progress;
     h->progress_user = c->run->progress_user;
@@ -125,8 +133,15 @@ ts_status tsd_compute_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_pla
         }
         /* the sweep on the backend; the accumulation is C only */
         if (NOTE(c, ts_backend_horizon_sweep(BK(c), g, az, &h, plane, &rep, &err), rep) !=
-                TS_OK ||
-            add(user, g, k, az, plane, &err) != TS_OK) {
+            TS_OK) {
+            free(plane);
+            return core_fail(c, &err);
+        }
+        if ((st = tsd_compute_far(c, g, az, 0, plane)) != TS_OK) {
+            free(plane);
+            return st;
+        }
+        if (add(user, g, k, az, plane, &err) != TS_OK) {
             free(plane);
             return core_fail(c, &err);
         }
@@ -245,7 +260,7 @@ static ts_status sun_horizon(const tsd_compute_ctx *c, const ts_grid *g, ts_hori
              rep) != TS_OK ||
         ts_horizon_earth_floor(g, h, plane, &err) != TS_OK) /* EDGE=horizon */
         return core_fail(c, &err);
-    return TS_OK;
+    return tsd_compute_far(c, g, c->run->sun_azimuth, 1, plane);
 }
 
 /* 1 if the sun is computed per cell (SUN_POSITION=per_cell: a lattice). */
@@ -375,7 +390,11 @@ TSD_COMPUTE_FN(tsd_compute_horizon)
     tsd_compute_horizon_opts(c, &h);
     if (NOTE(c, ts_backend_horizon_compute(BK(c), r->dem, &h, out, &rep, &err), rep) != TS_OK)
         return core_fail(c, &err);
-    return TS_OK;
+    size_t cells = (size_t)r->dem->width * r->dem->height;
+    ts_status st = TS_OK;
+    for (int k = 0; st == TS_OK && k < h.directions; k++)
+        st = tsd_compute_far(c, r->dem, ts_horizon_azimuth(&h, k), 0, out + k * cells);
+    return st;
 }
 
 /* A copy of `dem` with its heights negated (NaN stays NaN), the surface

@@ -55,6 +55,11 @@ typedef struct {
     const tsd_environment *env; /* ENV_MAP or SKY (tsd_environment_setup), or NULL */
     ts_progress_fn progress; /* NULL = no reports */
     void *progress_user;
+    /* a window of a larger DEM (tsd_window.h): horizons are swept within
+     * near_distance metres and raised to the far field beyond; 0 / NULL
+     * for the whole DEM */
+    double near_distance;
+    struct tsd_far_field *far;
 } tsd_run;
 
 /** The run state of options `o`, with `sun` (may be NULL) placing the sun
@@ -128,6 +133,12 @@ typedef ts_status (*tsd_plane_fn)(void *user, const ts_grid *g, int k, double az
  * progress per azimuth) and hand each to `add`. */
 ts_status tsd_compute_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_plane_fn add,
                              void *user);
+
+/* A horizon plane of g toward `azimuth` (degrees), just swept: raised to
+ * the far field of a window (c->run->far; nothing without one). `sun`:
+ * the sun's own sweep, which the sun's elevation may spare the far field. */
+ts_status tsd_compute_far(const tsd_compute_ctx *c, const ts_grid *g, double azimuth, int sun,
+                          float *plane);
 
 #ifdef __cplusplus
 }

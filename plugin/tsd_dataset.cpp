@@ -29,6 +29,7 @@
 #include "tsd_dem.h"
 #include "tsd_gdal.h"
 #include "tsd_progress.h"
+#include "tsd_window.h"
 
 namespace tsd
 {
@@ -62,6 +63,8 @@ const char *TSRasterBand::GetUnitType()
 CPLErr TSRasterBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
 {
     TSDataset *ds = static_cast<TSDataset *>(poDS);
+    if (ds->m_poWindow) // chunk by chunk (tsd_window_cache.cpp)
+        return WindowReadBlock(nBlockXOff, nBlockYOff, pImage);
     if (ds->EnsureComputed() != CE_None)
         return CE_Failure;
     const int W = nRasterXSize, H = nRasterYSize;
@@ -114,6 +117,7 @@ CPLErr TSRasterBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
 TSDataset::~TSDataset()
 {
     TSDataset::FlushCache(true);
+    FreeWindow(m_poWindow);
     if (m_poDEM)
         GDALClose(m_poDEM);
     tsd_cells_free(&m_sCells);
@@ -239,10 +243,12 @@ CPLErr TSDataset::EnsureComputed()
 }
 
 /* Refuse products that cannot fit, with a sentence saying what to do. */
-static bool CheckMemory(const tsd_options &sOpts, int W, int H)
+static bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *psPlan)
 {
     double dfSteady = 0;
-    const double dfPeak = tsd_product_peak_bytes(&sOpts, W, H, &dfSteady);
+    // windowed: the chunk with its margin, the cache and the far field
+    const double dfPeak = psPlan ? tsd_window_peak_bytes(&sOpts, psPlan, &dfSteady)
+                                 : tsd_product_peak_bytes(&sOpts, W, H, &dfSteady);
     double dfLimit = 0;
     const char *pszWhy = "MAX_MEMORY";
     if (sOpts.max_memory_mb > 0)
@@ -388,7 +394,8 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
         return false;
     if (m_sCells.warning[0] && m_nLevel == 0) // said once, for the DEM itself
         CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", m_sCells.warning);
-    if (!CheckMemory(sOpts, W, H))
+    if (!SetupWindow(W, H) ||
+        !CheckMemory(sOpts, W, H, WindowPlan(m_poWindow)))
         return false;
     /* a bad TERRASHADE_BACKEND is an error here (without probing OpenCL) */
     m_bUsesBackend = m_psProduct->uses_backend && m_psProduct->uses_backend(&sOpts, psSun);

@@ -21,11 +21,17 @@
 #include "tsd_options.h"
 #include "tsd_products.h"
 #include "tsd_sun.h"
+#include "tsd_window.h"
 
 namespace tsd
 {
 
 class TSRasterBand;
+struct WindowState; // tsd_window_cache.cpp
+struct WindowChunk;
+void FreeWindow(WindowState *p);
+/* The chunks' plan, or null when the whole DEM is computed at once. */
+const tsd_window_plan *WindowPlan(const WindowState *p);
 
 /** A TERRASHADE:<dem> dataset: one product of a DEM. */
 class TSDataset final : public GDALPamDataset
@@ -60,8 +66,14 @@ class TSDataset final : public GDALPamDataset
     bool m_bBackendKnown = false;     // m_sBackend filled (predicted or ran)
     tsd_backend_summary m_sBackend{}; // predicted, then what ran
     tsd_environment m_sEnv{};         // ENV_MAP or SKY (tsd_dataset_env.cpp)
+    WindowState *m_poWindow = nullptr; // computed chunk by chunk (tsd_window_cache.cpp), or null
 
     CPLErr EnsureComputed();
+    bool SetupWindow(int W, int H);
+    bool EnsureFarField();
+    bool ComputeChunk(int cx, int cy, WindowChunk &c);
+    const WindowChunk *Chunk(int cx, int cy);
+    CPLErr WindowBlock(int iPlane, int x0, int y0, int nBW, int nBH, bool bByte, void *pImage);
     bool Setup(const char *pszConnection, int W, int H);
     TSDataset *Overview(int i);
     TSDataset *MakeOverview(int nLevel);
@@ -96,6 +108,7 @@ class TSRasterBand final : public GDALPamRasterBand
 {
     int m_nPlane;
     GDALColorInterp m_eColor = GCI_GrayIndex;
+    CPLErr WindowReadBlock(int nBlockXOff, int nBlockYOff, void *pImage); // tsd_window_cache.cpp
 
   public:
     TSRasterBand(TSDataset *poDSIn, int nBandIn, GDALDataType eType);

@@ -94,29 +94,95 @@ ts_status tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_fa
                                   GDALGetRasterBandYSize(band), grid, msg, n);
 }
 
-ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
-                                 double z_factor, int w, int h, ts_grid *grid, char *msg,
-                                 size_t n)
+/* The band's scale and offset in metres (times z_factor, NAN = AUTO). */
+static void metres_of(GDALRasterBandH band, double z_factor, double *scale, double *offset)
+{
+    int has_scale = 0, has_offset = 0;
+    *scale = GDALGetRasterScale(band, &has_scale);
+    *offset = GDALGetRasterOffset(band, &has_offset);
+    if (!has_scale)
+        *scale = 1;
+    if (!has_offset)
+        *offset = 0;
+    if (isnan(z_factor))
+        z_factor = tsd_dem_z_factor(band, z_factor, NULL, 0);
+    *scale *= z_factor;
+    *offset *= z_factor;
+}
+
+/* Heights in metres, NaN where the mask row says invalid or not finite. */
+static void to_metres(float *r, const unsigned char *mr, int w, double scale, double offset)
+{
+    for (int x = 0; x < w; x++) {
+        double v = r[x] * scale + offset;
+        r[x] = (mr && !mr[x]) || !isfinite(v) ? NAN : (float)v;
+    }
+}
+
+static ts_status read_failed(ts_grid *grid, unsigned char *m, char *msg, size_t n)
+{
+    const char *last = CPLGetLastErrorMsg();
+    free(m);
+    ts_grid_free(grid);
+    return tsd_fail(msg, n, TS_ERR_INTERNAL, "cannot read the DEM%s%s",
+                    last && *last ? ": " : "", last ? last : "");
+}
+
+/* A w x h grid of the cells' sizes, row spacing from row `row0` on. */
+static ts_status grid_of(const tsd_cells *cells, int w, int h, int row0, ts_grid *grid,
+                         char *msg, size_t n)
 {
     ts_error err;
     if (ts_grid_create(grid, w, h, cells->cell_x, cells->cell_y, &err) != TS_OK)
         return tsd_fail_core(msg, n, NULL, &err);
     if (cells->cell_x_row &&
-        ts_grid_set_row_spacing(grid, cells->cell_x_row, &err) != TS_OK) {
+        ts_grid_set_row_spacing(grid, cells->cell_x_row + row0, &err) != TS_OK) {
         ts_grid_free(grid);
         return tsd_fail_core(msg, n, NULL, &err);
     }
-    int has_scale = 0, has_offset = 0;
-    double scale = GDALGetRasterScale(band, &has_scale);
-    double offset = GDALGetRasterOffset(band, &has_offset);
-    if (!has_scale)
-        scale = 1;
-    if (!has_offset)
-        offset = 0;
-    if (isnan(z_factor))
-        z_factor = tsd_dem_z_factor(band, z_factor, NULL, 0);
-    scale *= z_factor;
-    offset *= z_factor;
+    return TS_OK;
+}
+
+ts_status tsd_dem_load_window(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
+                              int x0, int y0, int w, int h, ts_grid *grid, char *msg,
+                              size_t n)
+{
+    const int W = GDALGetRasterBandXSize(band), H = GDALGetRasterBandYSize(band);
+    ts_status st = grid_of(cells, w, h, y0, grid, msg, n);
+    if (st != TS_OK)
+        return st;
+    double scale, offset;
+    metres_of(band, z_factor, &scale, &offset);
+    /* the grid's window in the band's own orientation */
+    const int rx = cells->flip_x ? W - x0 - w : x0, ry = cells->flip_y ? H - y0 - h : y0;
+    GDALRasterBandH mask =
+        GDALGetMaskFlags(band) == GMF_ALL_VALID ? NULL : GDALGetMaskBand(band);
+    unsigned char *m = mask ? malloc((size_t)w * h) : NULL;
+    if (mask && !m) {
+        ts_grid_free(grid);
+        return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory reading the DEM's mask");
+    }
+    if (GDALRasterIO(band, GF_Read, rx, ry, w, h, grid->z, w, h, GDT_Float32, 0,
+                     (int)(grid->stride * sizeof(float))) != CE_None ||
+        (mask && GDALRasterIO(mask, GF_Read, rx, ry, w, h, m, w, h, GDT_Byte, 0, w) != CE_None))
+        return read_failed(grid, m, msg, n);
+    for (int y = 0; y < h; y++)
+        to_metres(grid->z + (ptrdiff_t)y * grid->stride, m ? m + (size_t)y * w : NULL, w,
+                  scale, offset);
+    free(m);
+    flip(grid, cells->flip_x, cells->flip_y);
+    return TS_OK;
+}
+
+ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
+                                 double z_factor, int w, int h, ts_grid *grid, char *msg,
+                                 size_t n)
+{
+    ts_status st = grid_of(cells, w, h, 0, grid, msg, n);
+    if (st != TS_OK)
+        return st;
+    double scale, offset;
+    metres_of(band, z_factor, &scale, &offset);
 
     int all_valid = GDALGetMaskFlags(band) == GMF_ALL_VALID || nodata_in_values(band, w, h);
     GDALRasterBandH mask = all_valid ? NULL : GDALGetMaskBand(band);
@@ -134,21 +200,11 @@ ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
         int rows = h - y0 < strip ? h - y0 : strip;
         float *z = grid->z + (ptrdiff_t)y0 * grid->stride;
         if (read_rows(band, y0, rows, w, h, z, grid->stride, GDT_Float32) != CE_None ||
-            (mask && read_rows(mask, y0, rows, w, h, m, w, GDT_Byte) != CE_None)) {
-            const char *last = CPLGetLastErrorMsg();
-            free(m);
-            ts_grid_free(grid);
-            return tsd_fail(msg, n, TS_ERR_INTERNAL, "cannot read the DEM%s%s",
-                            last && *last ? ": " : "", last ? last : "");
-        }
-        for (int y = 0; y < rows; y++) {
-            float *r = z + (ptrdiff_t)y * grid->stride;
-            const unsigned char *mr = m ? m + (size_t)y * w : NULL;
-            for (int x = 0; x < w; x++) {
-                double v = r[x] * scale + offset;
-                r[x] = (mr && !mr[x]) || !isfinite(v) ? NAN : (float)v;
-            }
-        }
+            (mask && read_rows(mask, y0, rows, w, h, m, w, GDT_Byte) != CE_None))
+            return read_failed(grid, m, msg, n);
+        for (int y = 0; y < rows; y++)
+            to_metres(z + (ptrdiff_t)y * grid->stride, m ? m + (size_t)y * w : NULL, w, scale,
+                      offset);
     }
     free(m);
     flip(grid, cells->flip_x, cells->flip_y);

@@ -32,6 +32,13 @@ ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
                                  double z_factor, int w, int h, ts_grid *grid, char *msg,
                                  size_t msg_size);
 
+/** The window of w x h cells at (x0, y0) of the grid (row 0 north, after
+ * the flips of `cells`, whose per-row sizes are the whole DEM's), at full
+ * resolution, as tsd_dem_load reads the whole. */
+ts_status tsd_dem_load_window(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
+                              int x0, int y0, int w, int h, ts_grid *grid, char *msg,
+                              size_t msg_size);
+
 /**
  * The Z_FACTOR that turns `band`'s heights (after its scale and offset)
  * into metres. A finite `requested` is the user's number and is kept; NAN

@@ -6,6 +6,7 @@
 #include "tsd_compute_env.h"
 #include "tsd_datetime.h"
 #include "tsd_text.h"
+#include "tsd_window.h"
 
 #define FIELD(f) offsetof(tsd_options, f), sizeof(((tsd_options *)0)->f)
 #define P TSD_SCOPE_PRODUCT
@@ -20,6 +21,7 @@ static int check_end_date(const char *v, char *msg, size_t n);
 static int check_timezone(const char *v, char *msg, size_t n);
 static int check_sky(const char *v, char *msg, size_t n);
 static int check_exposure(const char *v, char *msg, size_t n);
+static int check_tile_size(const char *v, char *msg, size_t n);
 
 const opt_def TSD_OPTION_ROWS[] = {
     {"PRODUCT", K_PRODUCT, FIELD(product), "shade", 0, 0, 0, 0, NULL, 1, P,
@@ -102,6 +104,18 @@ const opt_def TSD_OPTION_ROWS[] = {
      NULL,
      "Refuse to compute a product needing more than this many MiB; 0 = "
      "three quarters of the physical memory"},
+    {"TILE_SIZE", K_INT, FIELD(tile_size), "4096", 0, 1 << 20, 0, 1, NULL, 0, P, LISTED,
+     check_tile_size,
+     "Compute the product in chunks of this many cells square, each from the DEM "
+     "around it (NEAR_DISTANCE) and one coarse grid of the whole DEM, so that "
+     "memory does not grow with the DEM (docs/windows.md); 0 = the whole DEM "
+     "at once, as does a DEM within one chunk. At least 64"},
+    {"NEAR_DISTANCE", K_FLOAT, FIELD(near_distance), "0", 0, 1e6, 0, 1, NULL, 1, P, LISTED,
+     NULL,
+     "Chunks (TILE_SIZE): metres within which occluders come from the "
+     "full-resolution DEM, exactly; farther ones from a coarser grid "
+     "(the DEM's overviews or a decimated read). 0 = 128 cells, or 32 cells of "
+     "the far grid where that is longer (a DEM of more than 2048 x 2048 far cells)"},
     {"DATETIME", K_TEXT, FIELD(datetime), "", 0, 0, 0, 0, NULL, 1, P, LISTED,
      check_datetime,
      "Place the sun by date and time (SPA) instead of SUN_AZIMUTH and "
@@ -345,5 +359,19 @@ static int check_exposure(const char *v, char *msg, size_t n)
                          "EXPOSURE must be AUTO or a number of stops between %g and %g, "
                          "got '%s'", -TSD_EXPOSURE_MAX, TSD_EXPOSURE_MAX, v),
                 -1);
+    return 0;
+}
+
+/* TILE_SIZE: 0, or a chunk no smaller than TSD_TILE_MIN (its margin would
+ * cost more than the chunk). */
+static int check_tile_size(const char *v, char *msg, size_t n)
+{
+    char *end;
+    long t = strtol(v, &end, 10);
+    if (*end == '\0' && t > 0 && t < TSD_TILE_MIN) {
+        tsd_fail(msg, n, TS_ERR_ARG, "TILE_SIZE must be 0 (the whole DEM) or at least %d "
+                 "cells, got %s", TSD_TILE_MIN, v);
+        return -1;
+    }
     return 0;
 }

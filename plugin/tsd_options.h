@@ -72,6 +72,8 @@ typedef struct {
     int threads;             /* 0 = all cores */
     tsd_output_type output_type; /* as asked; see tsd_options_output_byte */
     int max_memory_mb;       /* 0 = automatic */
+    int tile_size;           /* cells of a chunk (tsd_window.h); 0 = the whole DEM */
+    double near_distance;    /* metres of the exact near field; 0 = automatic */
     /* the sun from a date and time (see tsd_sun.h) */
     char datetime[TSD_TEXT_MAX]; /* ISO 8601 with an offset, "" = not given */
     char date[TSD_TEXT_MAX];     /* YYYY-MM-DD, "" = not given */

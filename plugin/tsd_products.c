@@ -108,6 +108,7 @@ static int shadow_uses_backend(const tsd_options *o, const tsd_sun *sun)
     "SUN_AZIMUTH SUN_ELEVATION METHOD PENUMBRA_DEPTH LIGHT_RADIUS SWATH_DIRECTIONS "       \
     "SHADOWMAP_SCALE PCF_KERNEL " SUN_TIME "SUN_POSITION "
 #define SWEEP "DIRECTIONS START_AZIMUTH MAX_DISTANCE EDGE "
+#define WINDOW "TILE_SIZE NEAR_DISTANCE "
 #define DAY "DATE TIMEZONE " SUN_TIME
 #define RANGE "START_DATE END_DATE DAY_INTERVAL HORIZON_DIRECTIONS"
 #define ENV "ENV_MAP ENV_ROTATION SKY ENV_HORIZON_STEPS ENV_NORMAL_STEPS "
@@ -118,26 +119,28 @@ static const tsd_product_def PRODUCTS[] = {
      TSD_BYTE_AUTO, 0, 0, TSD_STEPS_NONE,
      /* normals, a horizon plane or the SHM visibility; the sky accumulator
       * and its horizon plane; the per-cell sun */
-     4, 2, 7, backend_always, SUN_OPTS SWEEP ENV PYRAMID "SKY_WEIGHT OUTPUT_TYPE BACKEND", NULL, NULL,
+     4, 2, 7, backend_always,
+     SUN_OPTS SWEEP WINDOW ENV PYRAMID "SKY_WEIGHT OUTPUT_TYPE BACKEND", NULL,
+     NULL,
      tsd_compute_shade},
     {"shadow", "visible fraction of the sun's disk, 0..1", "", "0..1", one_band, NULL,
      band_named, TSD_BYTE_ALLOWED, 0, 0, TSD_STEPS_NONE, 0, 0, 7, shadow_uses_backend,
-     SUN_OPTS "MAX_DISTANCE EDGE OUTPUT_TYPE BACKEND", NULL, NULL, tsd_compute_shadow},
+     SUN_OPTS "MAX_DISTANCE EDGE " WINDOW "OUTPUT_TYPE BACKEND", NULL, NULL, tsd_compute_shadow},
     {"horizon", "one band per azimuth, horizon elevation angle in degrees", "degree",
      "degrees", per_direction, "DIRECTIONS", band_azimuth, TSD_BYTE_NEVER, 0, 0,
-     TSD_STEPS_NONE, 0, 0, 0, backend_always, SWEEP PYRAMID "BACKEND", NULL, NULL,
+     TSD_STEPS_NONE, 0, 0, 0, backend_always, SWEEP WINDOW PYRAMID "BACKEND", NULL, NULL,
      tsd_compute_horizon},
     /* the sky products: normals and one horizon plane */
     {"svf", "sky-view factor 0..1", "", "0..1", one_band, NULL, band_named,
      TSD_BYTE_ALLOWED, 0, 0, TSD_STEPS_NONE, 4, 0, 0, backend_always,
-     SWEEP PYRAMID "SVF_MODEL OUTPUT_TYPE BACKEND", NULL, NULL, tsd_compute_svf},
+     SWEEP WINDOW PYRAMID "SVF_MODEL OUTPUT_TYPE BACKEND", NULL, NULL, tsd_compute_svf},
     /* and, for OPENNESS=negative, the negated DEM */
     {"openness", "positive or negative openness, degrees", "degree", "degrees", one_band,
      NULL, band_named, TSD_BYTE_NEVER, 0, 0, TSD_STEPS_NONE, 5, 0, 0, backend_always,
-     SWEEP PYRAMID "OPENNESS BACKEND", NULL, NULL, tsd_compute_openness},
+     SWEEP WINDOW PYRAMID "OPENNESS BACKEND", NULL, NULL, tsd_compute_openness},
     {"sky", "uniform-sky irradiance 0..1", "", "0..1", one_band, NULL, band_named,
      TSD_BYTE_ALLOWED, 0, 0, TSD_STEPS_NONE, 4, 0, 0, backend_always,
-     SWEEP PYRAMID "OUTPUT_TYPE BACKEND", NULL, NULL, tsd_compute_sky},
+     SWEEP WINDOW PYRAMID "OUTPUT_TYPE BACKEND", NULL, NULL, tsd_compute_sky},
     /* Earth horizon, horizon plane, visibility, double accumulator; over a
      * date range Earth horizon, three horizon planes, double accumulator */
     {"sunhours", "hours of direct sun on DATE, or in total from START_DATE to END_DATE",
@@ -167,7 +170,7 @@ static const tsd_product_def PRODUCTS[] = {
     {"envlight", "light of an HDR environment map (ENV_MAP) or a standard sky (SKY) on a "
      "white Lambertian surface, E/pi per colour: red, green, blue", "", "E/pi", colour_bands,
      NULL, band_colour, TSD_BYTE_ALLOWED, 0, 0, TSD_STEPS_NONE, 4, 0, 0, backend_always,
-     SWEEP ENV PYRAMID "ENV_METHOD EXPOSURE OUTPUT_TYPE BACKEND SUN_AZIMUTH SUN_ELEVATION "
+     SWEEP WINDOW ENV PYRAMID "ENV_METHOD EXPOSURE OUTPUT_TYPE BACKEND SUN_AZIMUTH SUN_ELEVATION "
      SUN_TIME, NULL, NULL,
      tsd_compute_envlight},
 };

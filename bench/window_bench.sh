@@ -1,0 +1,101 @@
+#!/bin/sh
+# window_bench.sh - windowed computation (TILE_SIZE, docs/windows.md): the
+# latency and peak memory of one small window against the whole-DEM path,
+# and the throughput of whole products, one run each in a fresh process.
+#
+#   bench/window_bench.sh [SIZES] [PRODUCT_OPTIONS...]
+#       (defaults: "4096 16384", -oo PRODUCT=shade -oo BACKEND=c)
+#
+# For each SIZE: a SIZE x SIZE fractal DEM (bench/fractal_tif.py: 10 m cells,
+# EPSG:32617; 16384 and above as a VRT mosaic of the 4096 one, no disk cost),
+# then, timed with /usr/bin/time (wall seconds, peak resident MiB):
+#   window  gdal_translate -srcwin 0 0 256 256 OPTIONS [-oo TILE_SIZE=T] TERRASHADE:dem out
+#   whole   gdal_translate OPTIONS [-oo TILE_SIZE=T] TERRASHADE:dem out   (Mcells/s)
+# for T = 0 (the whole DEM at once) and 2048, and the window
+# with TILE_SIZE=512. TILE_SIZE=0 on a
+# DEM larger than the memory limit is refused, and printed so.
+#
+# The plugin is taken from $BUILDDIR/plugin/.libs (BUILDDIR defaults to the
+# current directory) or from wherever GDAL finds it. Needs /usr/bin/python3
+# with numpy and osgeo, and GNU time (/usr/bin/time).
+set -eu
+
+SIZES=${1:-"4096 16384"}
+[ $# -gt 0 ] && shift
+if [ $# -eq 0 ]; then
+    set -- -oo PRODUCT=shade -oo BACKEND=c
+fi
+PYTHON=${PYTHON:-/usr/bin/python3}
+BUILDDIR=${BUILDDIR:-$(pwd)}
+HERE=$(cd "$(dirname "$0")" && pwd)
+if [ -f "$BUILDDIR/plugin/.libs/gdal_TERRASHADE.so" ]; then
+    GDAL_DRIVER_PATH="$BUILDDIR/plugin/.libs"
+    export GDAL_DRIVER_PATH
+fi
+if ! gdalinfo --formats | grep -q TERRASHADE; then
+    echo "window_bench: GDAL cannot find the TERRASHADE driver; build it (make)" \
+         "and run from the build directory, or set GDAL_DRIVER_PATH" >&2
+    exit 1
+fi
+
+WORK=$(mktemp -d "${TMPDIR:-/tmp}/window_bench.XXXXXX")
+trap 'rm -rf "$WORK"' EXIT INT TERM
+"$PYTHON" "$HERE/fractal_tif.py" 4096 "$WORK/dem_4096.tif"
+
+dem_of() { # the DEM of size $1: the 4096 one, or a mosaic of it
+    if [ "$1" -le 4096 ]; then
+        [ "$1" -eq 4096 ] || gdal_translate -q -srcwin 0 0 "$1" "$1" \
+            "$WORK/dem_4096.tif" "$WORK/dem_$1.tif"
+    else
+        "$PYTHON" - "$1" "$WORK" <<'PY'
+import sys
+from osgeo import gdal
+n, work = int(sys.argv[1]), sys.argv[2]
+k = n // 4096
+src = gdal.Open(work + "/dem_4096.tif")
+parts = []
+for j in range(k):
+    for i in range(k):
+        parts.append('<SimpleSource><SourceFilename relativeToVRT="1" shared="1">dem_4096.tif'
+                     '</SourceFilename><SourceBand>1</SourceBand><SrcRect xOff="0" yOff="0" '
+                     'xSize="4096" ySize="4096"/><DstRect xOff="%d" yOff="%d" xSize="4096" '
+                     'ySize="4096"/></SimpleSource>' % (i * 4096, j * 4096))
+wkt = src.GetProjection().replace("&", "&amp;").replace("<", "&lt;").replace('"', "&quot;")
+gt = ", ".join(repr(v) for v in src.GetGeoTransform())
+open("%s/dem_%d.vrt" % (work, n), "w").write(
+    '<VRTDataset rasterXSize="%d" rasterYSize="%d"><SRS>%s</SRS><GeoTransform>%s'
+    '</GeoTransform><VRTRasterBand dataType="Float32" band="1">%s</VRTRasterBand>'
+    '</VRTDataset>' % (n, n, wkt, gt, "".join(parts)))
+PY
+    fi
+}
+
+timed() { # label cells command...: one line of seconds, MiB, Mcells/s
+    label=$1 cells=$2
+    shift 2
+    if /usr/bin/time -f "%e %M" -o "$WORK/time" "$@" >/dev/null 2>"$WORK/err"; then
+        read -r sec kb <"$WORK/time"
+        awk -v l="$label" -v s="$sec" -v k="$kb" -v c="$cells" 'BEGIN {
+            printf "%-40s %8.2f s %8.0f MiB %8.1f Mcells/s\n", l, s, k / 1024, c / s / 1e6 }'
+    else
+        printf "%-40s refused: %s\n" "$label" "$(grep -m1 ERROR "$WORK/err" | cut -c1-160)"
+    fi
+}
+
+echo "window_bench: $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg), options: $*"
+for n in $SIZES; do
+    dem_of "$n"
+    dem=$(ls "$WORK"/dem_"$n".* | head -n1)
+    timed "$n^2 window 256^2, TILE_SIZE=512" 65536 \
+        gdal_translate -q -srcwin 0 0 256 256 "$@" -oo TILE_SIZE=512 \
+        "TERRASHADE:$dem" "$WORK/w.tif"
+    for t in 0 2048; do
+        timed "$n^2 window 256^2, TILE_SIZE=$t" 65536 \
+            gdal_translate -q -srcwin 0 0 256 256 "$@" -oo TILE_SIZE=$t \
+            "TERRASHADE:$dem" "$WORK/w.tif"
+        timed "$n^2 whole product, TILE_SIZE=$t" $((n * n)) \
+            gdal_translate -q -co TILED=YES -co COMPRESS=DEFLATE "$@" -oo TILE_SIZE=$t \
+            "TERRASHADE:$dem" "$WORK/all.tif"
+        rm -f "$WORK/all.tif"
+    done
+done

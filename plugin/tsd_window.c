@@ -1,0 +1,271 @@
+/* Windowed computation, C side: the plan of a dataset's chunks and the far
+ * field every chunk shares (tsd_window.h, docs/windows.md). */
+#include "tsd_window.h"
+
+#include "shadow_atlas.h"
+#include "tsd_products.h"
+#include "tsd_text.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The two observers of a far plane stand this far below and above the
+ * coarse cell's height: the far field between them is close to linear in
+ * the height (the slope to one dominant occluder). */
+#define TSD_FAR_DZ 25.0
+
+/* 1 if d is product a or b */
+static int is(const tsd_product_def *d, const char *a, const char *b)
+{
+    return strcmp(d->name, a) == 0 || (b && strcmp(d->name, b) == 0);
+}
+
+static int ceil_cells(double metres, double cell)
+{
+    return (int)ceil(metres / cell - 1e-9);
+}
+
+int tsd_window_plan_make(const tsd_options *o, int per_cell_sun, int W, int H,
+                         double cells_min_x, double cell_y, tsd_window_plan *p, char *msg,
+                         size_t n)
+{
+    const tsd_product_def *d = tsd_product_of(o);
+    memset(p, 0, sizeof *p);
+    p->tile = o->tile_size;
+    if (o->tile_size == 0)
+        p->why_whole = "TILE_SIZE=0";
+    else if (W <= o->tile_size && H <= o->tile_size)
+        p->why_whole = "the DEM fits in one tile";
+    else if (d->daily)
+        p->why_whole = "a product of a day follows the sun over the whole DEM";
+    else if (o->method == TSD_METHOD_SHM && is(d, "shade", "shadow"))
+        p->why_whole = "METHOD=shm carries shadows across the whole DEM";
+    else if (o->method == TSD_METHOD_SHADOWMAP && is(d, "shade", "shadow"))
+        p->why_whole = "METHOD=shadowmap renders one depth map of the whole DEM";
+    else if (o->method == TSD_METHOD_SH && is(d, "shade", "shadow"))
+        p->why_whole = "METHOD=sh sweeps its key light's swath over the whole DEM";
+    else if (o->horizon_method == TSD_HORIZON_PYRAMID)
+        p->why_whole = "HORIZON_METHOD=pyramid reads one pyramid of the whole DEM";
+    else if (o->env_method == TSD_ENV_SH && is(d, "envlight", NULL))
+        p->why_whole = "ENV_METHOD=sh sweeps the whole DEM";
+    else if (per_cell_sun)
+        p->why_whole = "SUN_POSITION=per_cell places the sun on the whole DEM's lattice";
+    else if (o->openness_negative && is(d, "openness", NULL))
+        p->why_whole = "negative openness sweeps the negated DEM";
+    if (p->why_whole)
+        return 0;
+    double cell = cells_min_x < cell_y ? cells_min_x : cell_y;
+    /* the far grid's coarsening that keeps it within TSD_FAR_MAX_CELLS */
+    int f_mem = (int)ceil(sqrt((double)W * H / TSD_FAR_MAX_CELLS));
+    double near = o->near_distance;
+    if (near == 0) {
+        int cells = TSD_NEAR_AUTO_CELLS > TSD_FAR_CELLS_PER_NEAR * f_mem
+                        ? TSD_NEAR_AUTO_CELLS
+                        : TSD_FAR_CELLS_PER_NEAR * f_mem;
+        near = cells * cell;
+    }
+    /* MAX_DISTANCE: the near field is all there is, exact to it */
+    p->far = o->max_distance == 0;
+    p->near_m = p->far ? near : o->max_distance;
+    const int need = TSD_NEAR_MIN_CELLS;
+    if (p->far && near < need * cell) {
+        tsd_fail(msg, n, TS_ERR_ARG,
+                 "NEAR_DISTANCE=%g m is %.1f cells of this DEM; the near field needs at "
+                 "least %d cells (%.0f m): give a larger NEAR_DISTANCE, or 0 for %d cells",
+                 near, near / cell, need, need * cell,
+                 TSD_NEAR_AUTO_CELLS > TSD_FAR_CELLS_PER_NEAR * f_mem
+                     ? TSD_NEAR_AUTO_CELLS
+                     : TSD_FAR_CELLS_PER_NEAR * f_mem);
+        return -1;
+    }
+    /* the sweep samples a cell's neighbours too: two cells more */
+    double mx = ceil_cells(p->near_m, cells_min_x) + 2.0, my = ceil_cells(p->near_m, cell_y) + 2.0;
+    p->margin_x = mx < W ? (int)mx : W;
+    p->margin_y = my < H ? (int)my : H;
+    p->windowed = 1;
+    /* a cache that holds a row of chunks: GDAL reads blocks row by row */
+    p->cache_chunks = (W + p->tile - 1) / p->tile + 1;
+    if (p->far) {
+        int f = (int)floor(near / TSD_FAR_CELLS_PER_NEAR / cell);
+        f = f > f_mem ? f : f_mem;
+        f = f < 1 ? 1 : f;
+        p->far_w = (W + f - 1) / f;
+        p->far_h = (H + f - 1) / f;
+        /* the sweeps of a chunk: the sun's, DIRECTIONS, or both */
+        p->far_planes = is(d, "shadow", NULL) || (is(d, "shade", NULL) && o->sky_weight == 0)
+                            ? 1
+                            : o->directions + is(d, "shade", NULL);
+    }
+    return 0;
+}
+
+double tsd_window_peak_bytes(const tsd_options *o, const tsd_window_plan *p, double *steady)
+{
+    const int W = p->tile + 2 * p->margin_x, H = p->tile + 2 * p->margin_y;
+    double kept_one = 0;
+    double computing = tsd_product_peak_bytes(o, W, H, &kept_one);
+    /* the chunk cropped out of it, and the cache */
+    double chunk = (double)p->tile * p->tile * sizeof(float) * tsd_options_band_count(o);
+    double far = (double)p->far_w * p->far_h * sizeof(float) * (1 + 2.0 * p->far_planes + 2);
+    double kept = chunk * p->cache_chunks + far;
+    if (steady)
+        *steady = kept;
+    return computing + chunk + kept;
+}
+
+void tsd_far_field_init(tsd_far_field *f, ts_grid *coarse, int fine_w, int fine_h,
+                        double threshold, const tsd_options *o)
+{
+    memset(f, 0, sizeof *f);
+    f->coarse = *coarse;
+    memset(coarse, 0, sizeof *coarse);
+    f->fine_w = fine_w;
+    f->fine_h = fine_h;
+    f->threshold = threshold;
+    ts_horizon_opts_default(&f->hopts);
+    f->hopts.directions = 1;
+    f->hopts.curvature = o->curvature;
+    f->hopts.refraction = o->refraction;
+    f->hopts.threads = o->threads;
+    f->zmax = -INFINITY;
+    for (int y = 0; y < f->coarse.height; y++)
+        for (int x = 0; x < f->coarse.width; x++) {
+            float z = ts_grid_at(&f->coarse, x, y);
+            f->zmax = z > f->zmax ? z : f->zmax; /* NaN is never larger */
+        }
+}
+
+void tsd_far_field_free(tsd_far_field *f)
+{
+    for (int i = 0; i < f->n; i++) {
+        free(f->planes[i].base);
+        free(f->planes[i].per_m);
+    }
+    free(f->planes);
+    ts_grid_free(&f->coarse);
+    memset(f, 0, sizeof *f);
+}
+
+/* The far plane of `azimuth`, swept on first use; NULL with msg. */
+static const struct tsd_far_plane *far_plane(tsd_far_field *f, double azimuth,
+                                            const tsd_compute_ctx *c)
+{
+    for (int i = 0; i < f->n; i++)
+        if (f->planes[i].azimuth == azimuth)
+            return &f->planes[i];
+    if (f->n == f->cap) {
+        int cap = f->cap ? 2 * f->cap : 16;
+        struct tsd_far_plane *p = realloc(f->planes, (size_t)cap * sizeof *p);
+        if (!p)
+            return tsd_fail(c->msg, c->msg_size, TS_ERR_NOMEM, "out of memory for the far "
+                            "field"), NULL;
+        f->planes = p;
+        f->cap = cap;
+    }
+    size_t cells = (size_t)f->coarse.width * f->coarse.height;
+    float *lo = malloc(cells * sizeof *lo), *hi = malloc(cells * sizeof *hi);
+    ts_error err;
+    ts_status st = !lo || !hi ? TS_ERR_NOMEM : TS_OK;
+    if (st != TS_OK)
+        tsd_fail(c->msg, c->msg_size, st, "out of memory for the far field");
+    else if ((st = ts_far_slope_raised(&f->coarse, azimuth, f->threshold, -TSD_FAR_DZ,
+                                       &f->hopts, lo, &err)) != TS_OK ||
+             (st = ts_far_slope_raised(&f->coarse, azimuth, f->threshold, TSD_FAR_DZ,
+                                       &f->hopts, hi, &err)) != TS_OK)
+        tsd_fail_core(c->msg, c->msg_size, "the far field", &err);
+    if (st != TS_OK) {
+        free(lo);
+        free(hi);
+        return NULL;
+    }
+    for (size_t i = 0; i < cells; i++) /* -inf - -inf: no far terrain, slope 0 */
+        hi[i] = isinf(lo[i]) ? 0.0f : (float)((hi[i] - lo[i]) / (2 * TSD_FAR_DZ));
+    f->planes[f->n] = (struct tsd_far_plane){azimuth, lo, hi};
+    return &f->planes[f->n++];
+}
+
+/* 1 if no far horizon can reach the lower limb of the light (of angular
+ * radius `radius`) from any cell of g: the far field is the coarse grid's,
+ * no higher than its highest cell. */
+static int sun_clears_far(const tsd_far_field *f, const ts_grid *g, double elevation,
+                          double radius)
+{
+    double limb = elevation - radius;
+    if (!(limb > 0) || !isfinite(f->zmax))
+        return !isfinite(f->zmax); /* no far terrain at all */
+    float zmin = INFINITY;
+    for (int y = 0; y < g->height; y++)
+        for (int x = 0; x < g->width; x++) {
+            float z = ts_grid_at(g, x, y);
+            zmin = z < zmin ? z : zmin;
+        }
+    return !isfinite(zmin) ||
+           (double)f->zmax - zmin < f->threshold * tan(limb * (M_PI / 180.0));
+}
+
+static ts_status far_raise(const tsd_compute_ctx *c, const ts_grid *g, double azimuth,
+                           float *plane);
+static ts_status far_edge(const tsd_compute_ctx *c, const ts_grid *g, double azimuth, int sun,
+                          float *plane);
+
+ts_status tsd_compute_far(const tsd_compute_ctx *c, const ts_grid *g, double azimuth, int sun,
+                          float *plane)
+{
+    tsd_far_field *f = c->run->far;
+    if (!f || !g->origin)
+        return TS_OK;
+    if (!(sun && sun_clears_far(f, g, c->run->sun_elevation, c->opts->light_radius))) {
+        ts_status st = far_raise(c, g, azimuth, plane);
+        if (st != TS_OK)
+            return st;
+    }
+    return far_edge(c, g, azimuth, sun, plane);
+}
+
+/* The world beyond the DEM's edge over the whole reach (EDGE), and the
+ * Earth's horizon under the sun, which the near field's sweep left out
+ * (tsd_compute_horizon_opts): the DEM's edges, not the window's. */
+static ts_status far_edge(const tsd_compute_ctx *c, const ts_grid *g, double azimuth, int sun,
+                          float *plane)
+{
+    ts_horizon_opts h;
+    ts_error err;
+    tsd_compute_horizon_opts(c, &h);
+    h.max_distance = c->opts->max_distance;
+    h.edge = tsd_options_edge(c->opts);
+    if (ts_horizon_edge_apply(g, azimuth, &h, plane, &err) != TS_OK ||
+        (sun && ts_horizon_earth_floor(g, &h, plane, &err) != TS_OK))
+        return tsd_fail_core(c->msg, c->msg_size, NULL, &err);
+    return TS_OK;
+}
+
+/* The far field: each cell's horizon raised to the coarse grid's beyond the
+ * near field. */
+static ts_status far_raise(const tsd_compute_ctx *c, const ts_grid *g, double azimuth,
+                           float *plane)
+{
+    tsd_far_field *f = c->run->far;
+    const struct tsd_far_plane *p = far_plane(f, azimuth, c);
+    if (!p)
+        return TS_ERR_NOMEM;
+    const int cw = f->coarse.width, ch = f->coarse.height;
+    for (int y = 0; y < g->height; y++) {
+        long gy = g->origin->y0 + y;
+        int cy = (int)(gy * ch / f->fine_h);
+        const float *zc = f->coarse.z + (ptrdiff_t)cy * f->coarse.stride;
+        const float *base = p->base + (size_t)cy * cw, *per_m = p->per_m + (size_t)cy * cw;
+        float *row = plane + (size_t)y * g->width;
+        const float *zrow = g->z + (ptrdiff_t)y * g->stride;
+        for (int x = 0; x < g->width; x++) {
+            long gx = g->origin->x0 + x;
+            int cx = (int)(gx * cw / f->fine_w);
+            if (isnan(row[x]) || isnan(zc[cx]) || isnan(base[cx]) || isinf(base[cx]))
+                continue;
+            double s = base[cx] + ((double)zrow[x] - zc[cx] + TSD_FAR_DZ) * per_m[cx];
+            float deg = (float)(atan(s) * (180.0 / M_PI));
+            row[x] = deg > row[x] ? deg : row[x];
+        }
+    }
+    return TS_OK;
+}

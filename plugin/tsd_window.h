@@ -1,0 +1,99 @@
+/*
+ * tsd_window.h - windowed computation (docs/windows.md): a product is
+ * computed chunk by chunk, each chunk from the full-resolution DEM around
+ * it (a margin of NEAR_DISTANCE) for the near field, and from one coarse
+ * grid of the whole DEM for the far field (Chajdas et al. 2015). This is
+ * the C side: the chunk's geometry and the far field. The chunk cache and
+ * the GDAL reads are in tsd_window_cache.cpp. No GDAL here.
+ */
+#ifndef TSD_WINDOW_H
+#define TSD_WINDOW_H
+
+#include <stddef.h>
+
+#include "terrashade.h"
+#include "tsd_compute.h"
+#include "tsd_options.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Smallest TILE_SIZE (0 = the whole DEM at once). */
+#define TSD_TILE_MIN 64
+/** NEAR_DISTANCE=0 (automatic): this many cells of the DEM, or
+ * TSD_FAR_CELLS_PER_NEAR cells of the far grid if that is longer. */
+#define TSD_NEAR_AUTO_CELLS 128
+/** The near field must reach at least this many cells. */
+#define TSD_NEAR_MIN_CELLS 16
+/** The far grid's cells are at most NEAR_DISTANCE / TSD_FAR_CELLS_PER_NEAR
+ * (docs/windows.md: the far field's error grows with its cells)... */
+#define TSD_FAR_CELLS_PER_NEAR 32
+/** ...unless that grid would exceed this many cells: its planes are kept
+ * for the dataset's life, one pair per azimuth. */
+#define TSD_FAR_MAX_CELLS (2048.0 * 2048.0)
+
+/** How a dataset is computed window by window; see tsd_window_plan. */
+typedef struct {
+    int windowed;          /* 0: the whole DEM at once */
+    const char *why_whole; /* windowed == 0: why (for the debug log and docs) */
+    int tile;              /* chunk side, cells */
+    double near_m;         /* near field, metres (NEAR_DISTANCE or MAX_DISTANCE) */
+    int margin_x, margin_y; /* the near field in cells, with the sweep's own reach */
+    int far;               /* 1: a far field beyond near_m (MAX_DISTANCE=0) */
+    int far_w, far_h;      /* the far grid's size */
+    int far_planes;        /* far-field azimuths kept (the sweeps of a chunk) */
+    int cache_chunks;      /* chunks the LRU cache keeps */
+} tsd_window_plan;
+
+/**
+ * Plan the windowed computation of options o on a W x H DEM of cells
+ * `cells_min_x` (the smallest east-west cell size over its rows) by
+ * `cell_y` metres: windowed when TILE_SIZE > 0, the DEM is larger than one
+ * tile and the product is one whose value depends only on nearby terrain
+ * and horizons (not the day products, METHOD=shm, negative openness or a
+ * per-cell sun: `per_cell_sun`). 0, or -1 with a sentence in msg
+ * (NEAR_DISTANCE too short for this DEM).
+ */
+int tsd_window_plan_make(const tsd_options *o, int per_cell_sun, int W, int H,
+                         double cells_min_x, double cell_y, tsd_window_plan *plan, char *msg,
+                         size_t msg_size);
+
+/** Bytes a windowed computation keeps at most: one chunk with its margin
+ * while computing, the cache, and the far grid with its planes. */
+double tsd_window_peak_bytes(const tsd_options *o, const tsd_window_plan *plan,
+                             double *steady);
+
+/**
+ * The far field of a dataset: the coarse grid of the whole DEM (grid
+ * orientation, as tsd_dem reads it) and, per azimuth swept so far, the
+ * slopes of terrain at least near_m away from each coarse cell, as a
+ * linear function of the observer's height (ts_far_slope_raised at two
+ * heights): a full-resolution cell takes its coarse cell's function at its
+ * own height. Computed once per dataset, so that every chunk sees the same.
+ */
+typedef struct tsd_far_field {
+    ts_grid coarse;         /* owned */
+    int fine_w, fine_h;     /* the DEM's size */
+    double threshold;       /* metres: the near field's reach */
+    float zmax;             /* highest coarse height */
+    ts_horizon_opts hopts;  /* curvature and threads of the sweeps */
+    int n, cap;
+    struct tsd_far_plane {
+        double azimuth;
+        float *base;        /* slope seen from TSD_FAR_DZ below the coarse height */
+        float *per_m;       /* its change per metre of observer height */
+    } *planes;
+} tsd_far_field;
+
+/** Take `coarse` (the far grid, ownership passes) for a fine_w x fine_h
+ * DEM; the options give curvature and threads. */
+void tsd_far_field_init(tsd_far_field *f, ts_grid *coarse, int fine_w, int fine_h,
+                        double threshold, const tsd_options *o);
+void tsd_far_field_free(tsd_far_field *f);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

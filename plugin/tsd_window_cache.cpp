@@ -1,0 +1,384 @@
+/*
+ * tsd_window_cache.cpp - windowed computation, GDAL side (tsd_window.h,
+ * docs/windows.md): a block read computes the chunk of TILE_SIZE x
+ * TILE_SIZE cells around it from the DEM read with its margin and the
+ * dataset's one far-field grid, and keeps the most recent chunks (LRU) so
+ * that GDAL's row-by-row reads compute each chunk once.
+ */
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <list>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cpl_conv.h"
+#include "cpl_string.h"
+#include "gdal_priv.h"
+
+#include "tsd_dataset.h"
+#include "tsd_dem.h"
+#include "tsd_gdal.h"
+#include "tsd_window.h"
+
+namespace tsd
+{
+
+/* A computed chunk: all bands, w x h cells each, grid orientation. */
+struct WindowChunk
+{
+    int cx = 0, cy = 0, w = 0, h = 0;
+    std::vector<float> data{};
+};
+
+struct WindowState
+{
+    tsd_window_plan plan{};
+    double refCellX = 0; // the whole DEM's central row: the sweeps' direction
+    bool farTried = false;
+    std::string error{};  // the first failure, repeated to later reads
+    ts_status status = TS_OK;
+    tsd_far_field far{};
+    bool farReady = false;
+    std::list<WindowChunk> lru{}; // most recent first
+    ~WindowState()
+    {
+        if (farReady)
+            tsd_far_field_free(&far);
+    }
+};
+
+void FreeWindow(WindowState *p)
+{
+    delete p;
+}
+
+const tsd_window_plan *WindowPlan(const WindowState *p)
+{
+    return p ? &p->plan : nullptr;
+}
+
+/* The overview of `hBand` that GDAL would read for a W' = w grid (the
+ * smallest not smaller), compared over a sample with the average of the
+ * full-resolution cells under it. false with the error set. */
+static bool OverviewsAgree(GDALRasterBand *poBand, int w, const std::string &osDEM)
+{
+    GDALRasterBand *poOvr = nullptr;
+    for (int i = 0; i < poBand->GetOverviewCount(); i++)
+    {
+        GDALRasterBand *p = poBand->GetOverview(i);
+        if (p && p->GetXSize() >= w && (!poOvr || p->GetXSize() < poOvr->GetXSize()))
+            poOvr = p;
+    }
+    if (!poOvr)
+        return true;
+    const int W = poBand->GetXSize(), H = poBand->GetYSize();
+    const int ow = poOvr->GetXSize(), oh = poOvr->GetYSize();
+    const double rx = static_cast<double>(W) / ow, ry = static_cast<double>(H) / oh;
+    // a centred sample of at most 32 x 32 overview cells and 2048 x 2048 DEM cells
+    const int n = std::max(1, std::min({32, ow, oh, static_cast<int>(2048 / std::max(rx, ry))}));
+    const int ox = (ow - n) / 2, oy = (oh - n) / 2;
+    const int fx = static_cast<int>(ox * rx), fy = static_cast<int>(oy * ry);
+    const int fw = std::min(W - fx, static_cast<int>(std::ceil(n * rx)));
+    const int fh = std::min(H - fy, static_cast<int>(std::ceil(n * ry)));
+    std::vector<float> afOvr(static_cast<size_t>(n) * n), afFull(static_cast<size_t>(fw) * fh);
+    if (poOvr->RasterIO(GF_Read, ox, oy, n, n, afOvr.data(), n, n, GDT_Float32, 0, 0,
+                        nullptr) != CE_None ||
+        poBand->RasterIO(GF_Read, fx, fy, fw, fh, afFull.data(), fw, fh, GDT_Float32, 0, 0,
+                         nullptr) != CE_None)
+        return true; // unreadable here: the reads that follow will say
+    int bHasNoData = FALSE;
+    const double dfNoData = poBand->GetNoDataValue(&bHasNoData);
+    double dfSum = 0, dfMin = INFINITY, dfMax = -INFINITY;
+    int nCompared = 0;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++)
+        {
+            const float o = afOvr[static_cast<size_t>(j) * n + i];
+            double s = 0;
+            int c = 0;
+            const int x0 = static_cast<int>((ox + i) * rx) - fx, y0 = static_cast<int>((oy + j) * ry) - fy;
+            const int x1 = std::min(fw, static_cast<int>((ox + i + 1) * rx) - fx);
+            const int y1 = std::min(fh, static_cast<int>((oy + j + 1) * ry) - fy);
+            for (int y = y0; y < y1; y++)
+                for (int x = x0; x < x1; x++)
+                {
+                    const float v = afFull[static_cast<size_t>(y) * fw + x];
+                    if (std::isfinite(v) && !(bHasNoData && v == dfNoData))
+                        s += v, c++;
+                }
+            if (c == 0 || !std::isfinite(o) || (bHasNoData && o == dfNoData))
+                continue;
+            dfSum += std::fabs(o - s / c);
+            dfMin = std::min(dfMin, s / c);
+            dfMax = std::max(dfMax, s / c);
+            nCompared++;
+        }
+    if (nCompared == 0)
+        return true;
+    const double dfMean = dfSum / nCompared;
+    const double dfTol = std::max(0.5, 0.02 * (dfMax - dfMin));
+    if (dfMean <= dfTol)
+        return true;
+    Fail(TS_ERR_ARG,
+         CPLSPrintf("the DEM '%s' has overviews that disagree with it: its %d x %d overview "
+                    "differs from the average of the full-resolution cells under it by %.3g "
+                    "on average over a %d x %d sample (tolerance %.3g); the far field of "
+                    "TILE_SIZE would come from it. Rebuild the overviews (gdaladdo -r "
+                    "average) or remove them (gdaladdo -clean), or set TILE_SIZE=0",
+                    osDEM.c_str(), ow, oh, dfMean, n, n, dfTol));
+    return false;
+}
+
+/* Plan the chunks of a W x H product (level 0 only); false with the
+ * error reported. */
+bool TSDataset::SetupWindow(int W, int H)
+{
+    auto poState = std::unique_ptr<WindowState>(new WindowState());
+    double dfMinX = m_sCells.cell_x;
+    for (int y = 0; m_sCells.cell_x_row && y < H; y++)
+        dfMinX = std::min(dfMinX, m_sCells.cell_x_row[y]);
+    poState->refCellX = m_sCells.cell_x_row ? m_sCells.cell_x_row[H / 2] : m_sCells.cell_x;
+    const bool bPerCell = m_bHasSun && m_sSun.sites.nx * m_sSun.sites.ny > 1;
+    char szMsg[512];
+    if (tsd_window_plan_make(&m_sOpts, bPerCell, W, H, dfMinX, m_sCells.cell_y,
+                             &poState->plan, szMsg, sizeof szMsg) != 0)
+        return Fail(TS_ERR_ARG, szMsg), false;
+    if (m_nLevel > 0 && poState->plan.windowed)
+    {
+        // an overview level is the product of the DEM read at its size
+        poState->plan.windowed = 0;
+        poState->plan.why_whole = "an overview level";
+    }
+    if (!poState->plan.windowed)
+    {
+        CPLDebug(DRIVER, "whole-DEM path (no chunks): %s", poState->plan.why_whole);
+        return true;
+    }
+    const tsd_window_plan &p = poState->plan;
+    CPLDebug(DRIVER, "windowed: chunks of %d cells, near field %.0f m (margin %d x %d "
+             "cells), far grid %d x %d, cache of %d chunks",
+             p.tile, p.near_m, p.margin_x, p.margin_y, p.far_w, p.far_h, p.cache_chunks);
+    if (p.far && m_poDEM &&
+        !OverviewsAgree(m_poDEM->GetRasterBand(m_sOpts.band), p.far_w, m_osDEM))
+        return false;
+    m_poWindow = poState.release();
+    return true;
+}
+
+/* The far grid, read once: the DEM averaged to the plan's size (GDAL takes
+ * it from the DEM's overviews where they are fine enough). */
+bool TSDataset::EnsureFarField()
+{
+    WindowState &s = *m_poWindow;
+    if (!s.plan.far || s.farTried)
+        return s.error.empty();
+    s.farTried = true;
+    const int W = nRasterXSize, H = nRasterYSize, fw = s.plan.far_w, fh = s.plan.far_h;
+    double adfGT[6];
+    memcpy(adfGT, m_adfGT, sizeof adfGT);
+    // as gdal_translate -outsize fw fh scales it, so that the cells match
+    for (int i : {1, 4})
+        adfGT[i] *= static_cast<double>(W) / fw;
+    for (int i : {2, 5})
+        adfGT[i] *= static_cast<double>(H) / fh;
+    OGRSpatialReferenceH hSRS =
+        m_oSRS.IsEmpty() ? nullptr : OGRSpatialReference::ToHandle(&m_oSRS);
+    char szMsg[1024] = "";
+    tsd_cells sCells{};
+    ts_grid sCoarse{};
+    ts_status eSt = tsd_cells_compute(adfGT, fw, fh, hSRS, &sCells, szMsg, sizeof szMsg);
+    if (eSt == TS_OK)
+        eSt = tsd_dem_load_resampled(GDALRasterBand::ToHandle(m_poDEM->GetRasterBand(m_sOpts.band)),
+                                     &sCells, m_sOpts.z_factor, fw, fh, &sCoarse, szMsg,
+                                     sizeof szMsg);
+    tsd_cells_free(&sCells);
+    if (eSt != TS_OK)
+    {
+        s.status = eSt;
+        s.error = std::string("the far-field grid: ") + szMsg;
+        return false;
+    }
+    tsd_far_field_init(&s.far, &sCoarse, W, H, s.plan.near_m, &m_sOpts);
+    s.farReady = true;
+    return true;
+}
+
+/* Compute chunk (cx, cy) into c; false with s.error. */
+bool TSDataset::ComputeChunk(int cx, int cy, WindowChunk &c)
+{
+    WindowState &s = *m_poWindow;
+    const tsd_window_plan &p = s.plan;
+    const int W = nRasterXSize, H = nRasterYSize;
+    c.cx = cx;
+    c.cy = cy;
+    const int gx0 = cx * p.tile, gy0 = cy * p.tile;
+    c.w = std::min(p.tile, W - gx0);
+    c.h = std::min(p.tile, H - gy0);
+    const int ax0 = std::max(0, gx0 - p.margin_x), ay0 = std::max(0, gy0 - p.margin_y);
+    const int aw = std::min(W, gx0 + c.w + p.margin_x) - ax0;
+    const int ah = std::min(H, gy0 + c.h + p.margin_y) - ay0;
+    char szMsg[1024] = "";
+    ts_grid sGrid{};
+    ts_status eSt = tsd_dem_load_window(GDALRasterBand::ToHandle(m_poDEM->GetRasterBand(m_sOpts.band)),
+                                        &m_sCells, m_sOpts.z_factor, ax0, ay0, aw, ah, &sGrid,
+                                        szMsg, sizeof szMsg);
+    const ts_grid_origin sOrigin{ax0, ay0, s.refCellX, W, H};
+    sGrid.origin = &sOrigin;
+    const int nBands = tsd_options_band_count(&m_sOpts);
+    const size_t nCells = static_cast<size_t>(aw) * ah;
+    float *pafOut = nullptr;
+    if (eSt == TS_OK &&
+        !(pafOut = static_cast<float *>(VSI_MALLOC3_VERBOSE(nCells, nBands, sizeof(float)))))
+    {
+        eSt = TS_ERR_NOMEM;
+        snprintf(szMsg, sizeof szMsg, "out of memory for a chunk of %d x %d cells", aw, ah);
+    }
+    if (eSt == TS_OK)
+    {
+        tsd_run sRun = m_sRun;
+        sRun.near_distance = p.near_m;
+        sRun.far = p.far ? &s.far : nullptr;
+        tsd_backend_summary sRan{};
+        tsd_region sRegion;
+        tsd_region_whole(&sRegion, &sGrid);
+        const tsd_compute_ctx sCtx{&m_sOpts, &sRun, &sRan, szMsg, sizeof szMsg};
+        eSt = tsd_product_compute(&sCtx, &sRegion, pafOut, nullptr);
+        if (eSt == TS_OK && sRan.calls > 0 && !m_bBackendKnown)
+        {
+            m_sBackend = sRan;
+            m_bBackendKnown = true;
+            SetupBackendMetadata();
+            ReportBackend();
+        }
+    }
+    if (eSt == TS_OK)
+    {
+        // the chunk out of the chunk with its margin
+        c.data.resize(static_cast<size_t>(nBands) * c.w * c.h);
+        for (int b = 0; b < nBands; b++)
+            for (int y = 0; y < c.h; y++)
+                memcpy(&c.data[(static_cast<size_t>(b) * c.h + y) * c.w],
+                       pafOut + b * nCells + static_cast<size_t>(gy0 - ay0 + y) * aw +
+                           (gx0 - ax0),
+                       c.w * sizeof(float));
+    }
+    VSIFree(pafOut);
+    ts_grid_free(&sGrid);
+    if (eSt != TS_OK)
+    {
+        s.status = eSt;
+        s.error = szMsg;
+        return false;
+    }
+    return true;
+}
+
+/* Chunk (cx, cy), from the cache or computed; nullptr with s.error. */
+const WindowChunk *TSDataset::Chunk(int cx, int cy)
+{
+    WindowState &s = *m_poWindow;
+    for (auto it = s.lru.begin(); it != s.lru.end(); ++it)
+        if (it->cx == cx && it->cy == cy)
+        {
+            s.lru.splice(s.lru.begin(), s.lru, it);
+            return &s.lru.front();
+        }
+    if (!EnsureFarField())
+        return nullptr;
+    while (static_cast<int>(s.lru.size()) >= std::max(4, s.plan.cache_chunks))
+        s.lru.pop_back();
+    WindowChunk c;
+    const auto tStart = std::chrono::steady_clock::now();
+    if (!ComputeChunk(cx, cy, c))
+        return nullptr;
+    const std::chrono::duration<double> dfSec = std::chrono::steady_clock::now() - tStart;
+    CPLDebug(DRIVER, "computed chunk (%d, %d) of %d x %d cells in %.3f s", cx, cy, c.w, c.h,
+             dfSec.count());
+    s.lru.push_front(std::move(c));
+    return &s.lru.front();
+}
+
+/* Block (x0, y0) of nBW x nBH cells of band plane iPlane, assembled from
+ * the chunks it overlaps. */
+CPLErr TSDataset::WindowBlock(int iPlane, int x0, int y0, int nBW, int nBH, bool bByte,
+                              void *pImage)
+{
+    std::lock_guard<std::mutex> oLock(m_oMutex);
+    WindowState &s = *m_poWindow;
+    const int W = nRasterXSize, H = nRasterYSize, T = s.plan.tile;
+    const float fNaN = std::numeric_limits<float>::quiet_NaN();
+    for (int by = 0; by < nBH && s.error.empty(); by++)
+    {
+        const int y = y0 + by;
+        const int gy = m_sCells.flip_y ? H - 1 - y : y;
+        const WindowChunk *c = nullptr;
+        for (int bx = 0; bx < nBW; bx++)
+        {
+            const int x = x0 + bx;
+            const int gx = m_sCells.flip_x ? W - 1 - x : x;
+            float v = fNaN;
+            if (y < H && x < W)
+            {
+                if (!c || c->cx != gx / T)
+                    c = Chunk(gx / T, gy / T);
+                if (!c)
+                    break;
+                v = c->data[(static_cast<size_t>(iPlane) * c->h + (gy - c->cy * T)) * c->w +
+                            (gx - c->cx * T)];
+            }
+            const size_t i = static_cast<size_t>(by) * nBW + bx;
+            if (bByte)
+                static_cast<GByte *>(pImage)[i] = tsd_to_byte(v);
+            else
+                static_cast<float *>(pImage)[i] = v;
+        }
+    }
+    if (!s.error.empty())
+    {
+        Fail(s.status, s.error.c_str());
+        return CE_Failure;
+    }
+    return CE_None;
+}
+
+/* A block, and the same block of the other bands into GDAL's block cache:
+ * a chunk holds every band, and a reader that takes the bands one after
+ * the other over the whole raster would otherwise compute it again for
+ * each. */
+CPLErr TSRasterBand::WindowReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
+{
+    TSDataset *ds = static_cast<TSDataset *>(poDS);
+    const int x0 = nBlockXOff * nBlockXSize, y0 = nBlockYOff * nBlockYSize;
+    const bool bByte = eDataType == GDT_Byte;
+    if (ds->WindowBlock(m_nPlane, x0, y0, nBlockXSize, nBlockYSize, bByte, pImage) != CE_None)
+        return CE_Failure;
+    for (int i = 1; i <= ds->GetRasterCount(); i++)
+    {
+        if (i == nBand)
+            continue;
+        GDALRasterBand *poOther = ds->GetRasterBand(i);
+        GDALRasterBlock *poBlock = poOther->TryGetLockedBlockRef(nBlockXOff, nBlockYOff);
+        if (poBlock)
+        {
+            poBlock->DropLock();
+            continue;
+        }
+        poBlock = poOther->GetLockedBlockRef(nBlockXOff, nBlockYOff, TRUE);
+        if (!poBlock)
+            continue; // no room in the block cache: read again when asked
+        const CPLErr eErr = ds->WindowBlock(i - 1, x0, y0, nBlockXSize, nBlockYSize, bByte,
+                                            poBlock->GetDataRef());
+        if (eErr != CE_None)
+            poBlock->MarkClean();
+        poBlock->DropLock();
+        if (eErr != CE_None)
+            return CE_Failure;
+    }
+    return CE_None;
+}
+
+} // namespace tsd
