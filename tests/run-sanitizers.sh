@@ -1,6 +1,6 @@
 #!/bin/sh
 # Build the C check programs with AddressSanitizer and UBSan and run every
-# one of them (tests/check_*, tests/cl/check_opencl) under it, leaks
+# one of them (tests/check_*, tests/cl/check_opencl*) under it, leaks
 # included. Usage: tests/run-sanitizers.sh [BUILDDIR]
 #
 # The tree may be configured and built in place (as CI leaves it after the
