@@ -19,20 +19,8 @@ set -eu
 
 SIZE=${1:-4096}
 REPEATS=${2:-3}
-PYTHON=${PYTHON:-/usr/bin/python3}
-BUILDDIR=${BUILDDIR:-$(pwd)}
-if [ -f "$BUILDDIR/plugin/.libs/gdal_TERRASHADE.so" ]; then
-    GDAL_DRIVER_PATH="$BUILDDIR/plugin/.libs"
-    export GDAL_DRIVER_PATH
-fi
-if ! gdalinfo --formats | grep -q TERRASHADE; then
-    echo "driver_bench: GDAL cannot find the TERRASHADE driver; build it (make)" \
-         "and run from the build directory, or set GDAL_DRIVER_PATH" >&2
-    exit 1
-fi
-
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/driver_bench.XXXXXX")
-trap 'rm -rf "$WORK"' EXIT INT TERM
+. "$(dirname "$0")/bench_common.sh"
+bench_setup driver_bench
 DEM="$WORK/fractal_${SIZE}.tif"
 
 echo "== DEM: $SIZE x $SIZE cells of 10 m, EPSG:32617, Float32"

@@ -25,21 +25,9 @@ SIZES=${1:-"4096 16384"}
 if [ $# -eq 0 ]; then
     set -- -oo PRODUCT=shade -oo BACKEND=c
 fi
-PYTHON=${PYTHON:-/usr/bin/python3}
-BUILDDIR=${BUILDDIR:-$(pwd)}
 HERE=$(cd "$(dirname "$0")" && pwd)
-if [ -f "$BUILDDIR/plugin/.libs/gdal_TERRASHADE.so" ]; then
-    GDAL_DRIVER_PATH="$BUILDDIR/plugin/.libs"
-    export GDAL_DRIVER_PATH
-fi
-if ! gdalinfo --formats | grep -q TERRASHADE; then
-    echo "window_bench: GDAL cannot find the TERRASHADE driver; build it (make)" \
-         "and run from the build directory, or set GDAL_DRIVER_PATH" >&2
-    exit 1
-fi
-
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/window_bench.XXXXXX")
-trap 'rm -rf "$WORK"' EXIT INT TERM
+. "$(dirname "$0")/bench_common.sh"
+bench_setup window_bench
 "$PYTHON" "$HERE/fractal_tif.py" 4096 "$WORK/dem_4096.tif"
 
 dem_of() { # the DEM of size $1: the 4096 one, or a mosaic of it
