@@ -47,7 +47,8 @@ static float between_steps_bound(const ts_line_geom *G, const float *z, int k, i
  * The stencils of row y: between whole steps j, sb (at most TS_NEAR_STEPS -
  * TS_NEAR_EXACT of them), then the tail's; bounds[n * W + x] is stencil n's
  * bound at x, NaN where it has none (the cell falls back to the per-cell
- * path), and one more row of scratch. Returns how many. */
+ * path), and one more row: scratch, then the largest of the bounds at x.
+ * Returns how many. */
 enum { MAX_STENCILS = TS_NEAR_STEPS - TS_NEAR_EXACT + 1 };
 
 static int row_bounds(const ts_line_geom *G, const float *zrow, int W, int y, double send,
@@ -68,6 +69,15 @@ static int row_bounds(const ts_line_geom *G, const float *zrow, int W, int y, do
             b[x] = NAN;
         if (xa < xb)
             ts_cap_stencil_row(&st[m], zrow, xa, xb, b, bounds + (size_t)n * W);
+    }
+    /* the last row: the largest of them, NaN if any is */
+    float *top = bounds + (size_t)n * W;
+    for (int x = 0; x < W; x++)
+        top[x] = -INFINITY;
+    for (int m = 0; m < n; m++) {
+        const float *b = bounds + (size_t)m * W;
+        for (int x = 0; x < W; x++)
+            top[x] = b[x] != b[x] || top[x] != top[x] ? NAN : b[x] > top[x] ? b[x] : top[x];
     }
     return n;
 }
@@ -102,6 +112,8 @@ void ts_cap_tail(const ts_line_geom *G, const ts_grid *grid, double cap, double 
         int u = G->x_major ? x : y, i = G->x_major ? y : x;
         int k = (u - G->u_start) * G->u_step;
         float h = zrow[x], best = orow[x];
+        if (nst > 0 && bounds[(size_t)nst * W + x] < best)
+            continue; /* no stretch can raise it */
         int m = 0; /* the stencil of the stretch at hand */
         for (int j = TS_NEAR_EXACT; !axis && j < send; j++, m++) {
             if ((m < nst && bounds[(size_t)m * W + x] < best) ||
