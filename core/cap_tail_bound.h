@@ -5,12 +5,13 @@
  * Along a cell's ray a stretch [sa, sb] within one step crosses at most two
  * bilinear patches; on each the height is a quadratic in the distance, at
  * most its chord plus, where it is concave (gamma = X t < 0), -gamma
- * len^2 / 4; the slope to a chord is largest at one of its ends. The patches, the ends' weights and the
- * chord terms are the same for every cell of a row (they depend on the
- * direction and the stretch only), so the bound is a fixed stencil that a
- * loop over the row vectorises. It carries a margin far above the rounding
- * of ts_ray_exact, so a stretch whose bound is below the horizon found so
- * far cannot raise it: skipping it leaves the result bit for bit the same.
+ * len^2 / 4; the slope to a chord is largest at one of its ends. The
+ * patches, the ends' weights and the chord terms are the same for every
+ * cell of a row (they depend on the direction and the stretch only), so the
+ * bound is a fixed stencil that a loop over the row vectorises. It carries
+ * a margin far above the rounding of ts_ray_exact, so a stretch whose bound
+ * is below the horizon found so far cannot raise it: skipping it leaves the
+ * result bit for bit the same.
  */
 #ifndef TS_CAP_TAIL_BOUND_H
 #define TS_CAP_TAIL_BOUND_H

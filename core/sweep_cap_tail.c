@@ -31,17 +31,6 @@ static float between_steps_bound(const ts_line_geom *G, const float *z, int k, i
     return (float)(dh / ((dh > 0 ? j : j + 1) * step) - c * j * step);
 }
 
-/*
- * What the near field and the lines leave out within a maximum distance,
- * solved exactly on each cell's own ray: a capped horizon is often near,
- * often at the distance itself.
- *  - Between the near field's whole steps (TS_NEAR_EXACT..TS_NEAR_STEPS)
- *    the bilinear surface can rise above both steps (not along an axis,
- *    where it is linear there); a step is solved where a bound says it may
- *    raise the horizon.
- *  - The part of a step before the distance ends, where the same bound
- *    says it may.
- */
 /* Most stretches lie below the horizon found so far: a row-wide bound
  * (cap_tail_bound.h) rules them out before the per-cell bound and solve.
  * The stencils of row y: between whole steps j, sb (at most TS_NEAR_STEPS -
