@@ -1,0 +1,48 @@
+/*
+ * A cheap upper bound of a capped sweep's exact ray stretches
+ * (sweep_cap_tail.c), for a whole grid row at once.
+ *
+ * Along a cell's ray a stretch [sa, sb] within one step crosses at most two
+ * bilinear patches; on each the height is a quadratic in the distance, at
+ * most its chord plus, where it is concave (gamma = X t < 0), -gamma
+ * len^2 / 4; the slope to a chord is largest at one of its ends. The
+ * patches, the ends' weights and the chord terms are the same for every
+ * cell of a row (they depend on the direction and the stretch only), so the
+ * bound is a fixed stencil that a loop over the row vectorises. It carries
+ * a margin far above the rounding of ts_ray_exact, so a stretch whose bound
+ * is below the horizon found so far cannot raise it: skipping it leaves the
+ * result bit for bit the same.
+ */
+#ifndef TS_CAP_TAIL_BOUND_H
+#define TS_CAP_TAIL_BOUND_H
+
+#include "line_geometry.h"
+
+typedef struct {
+    int npieces;              /* 1 or 2; 0: no stencil (the stretch is empty) */
+    ptrdiff_t off[2][4];      /* corners 00, 10, 01, 11 of each piece's patch */
+    float w[2][2][4];         /* corner weights of each piece's two ends */
+    float bulge[2];           /* t len^2 / 4 of each piece */
+    float inv[2][2];          /* 1 / (distance in metres) of each piece's ends */
+    float drop;               /* c sa step: the curvature term at sa */
+    int jback;                /* steps back of the patches' farther column */
+    int vlo, vhi;             /* v offsets of the rows read, from the cell's */
+} ts_cap_stencil;
+
+/* The stencil of stretch [sa, sb] (1 <= sa < sb <= floor(sa) + 1) of the
+ * rays in direction G, at `step` metres per step, curvature coefficient c
+ * (>= 0); no pieces when the stretch is empty. */
+void ts_cap_stencil_init(ts_cap_stencil *s, const ts_line_geom *G, double sa, double sb,
+                         double step, double c);
+
+/* The cells x of grid row y whose stencil lies on the grid: [*xa, *xb). */
+void ts_cap_stencil_range(const ts_cap_stencil *s, const ts_line_geom *G, int width, int y,
+                          int *xa, int *xb);
+
+/* bound[x] for xa <= x < xb of the row whose heights start at zrow: an
+ * upper bound of the slope to the stretch (NaN where nodata is near);
+ * flag: scratch of the same extent. */
+void ts_cap_stencil_row(const ts_cap_stencil *s, const float *zrow, int xa, int xb,
+                        float *bound, float *flag);
+
+#endif
