@@ -162,18 +162,23 @@ class Windows(unittest.TestCase):
 
     def test_overviews_disagree(self):
         """A DEM whose overviews are of other heights would give a far field
-        of other terrain: refused, with what to do."""
+        of other terrain: refused, with what to do. The far grid is this DEM
+        itself where it fits its budget (no overview read): MAX_MEMORY=64
+        leaves it 16 MiB, which 16 directions fill at half resolution."""
         dem = os.path.join(self.tmp, "stale.tif")
         shutil.copy(self.dem, dem)
         T.run(["gdaladdo", "-q", "-r", "average", dem, "2", "4"])
-        ok = product(dem, PRODUCT="svf", DIRECTIONS=4, TILE_SIZE=128)
+        coarse = {"TILE_SIZE": 128, "PRODUCT": "svf", "DIRECTIONS": 16, "MAX_MEMORY": 64}
+        ok = product(dem, **coarse)
         self.assertTrue(np.isfinite(ok).all())
         ds = gdal.Open(dem, gdal.GA_Update)
         z = ds.GetRasterBand(1).ReadAsArray()
         ds.GetRasterBand(1).WriteArray(z + 500)  # the overviews stay as they were
         ds = None
-        self.refused({"TILE_SIZE": 128, "PRODUCT": "svf"},
-                     ["has overviews that disagree with it", "gdaladdo"], dem=dem)
+        self.refused(coarse, ["has overviews that disagree with it", "gdaladdo"], dem=dem)
+        # at full resolution the far grid reads no overview
+        self.assertTrue(np.isfinite(product(dem, TILE_SIZE=128, PRODUCT="svf",
+                                            DIRECTIONS=4)).all())
         # the whole-DEM path takes no far grid from them
         T.run(["gdal_translate", "-q", "-oo", "TILE_SIZE=0", T.conn(dem),
                os.path.join(self.tmp, "y.tif")])
