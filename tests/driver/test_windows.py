@@ -97,8 +97,11 @@ class Windows(unittest.TestCase):
         it part of the difference is the whole-DEM path's own error; against
         the exact sweep of the whole DEM (MAX_DISTANCE = its diagonal) the
         difference is the windowed far field's."""
-        self.check_near_whole(T.LUX, 64, 0.1, 0.1, "lux_elev")
-        self.check_near_whole(T.JACKSBORO, 128, 0.17, 0.21, "jacksboro")  # goal 0.1: not met
+        self.check_near_whole(T.LUX, 64, 0.01, 0.05, "lux_elev")
+        # against TILE_SIZE=0 the goal of 0.1 is out of reach while the
+        # whole-DEM sweep itself is 0.12 (p99) off the exact one here
+        # (docs/windows.md, Measured error)
+        self.check_near_whole(T.JACKSBORO, 128, 0.025, 0.15, "jacksboro")
 
     def test_shadow_agreement(self):
         """Shadow agreement (within 0.01 of the disk) with the exact sweep of
@@ -117,7 +120,7 @@ class Windows(unittest.TestCase):
                       "sweep, %.3f %% with TILE_SIZE=0" % (elev, os.path.basename(dem),
                                                           100 * a_exact, 100 * a_whole))
                 self.assertGreaterEqual(a_exact, 0.999)
-                self.assertGreaterEqual(a_whole, 0.99)
+                self.assertGreaterEqual(a_whole, 0.994)
 
     def test_edge_is_the_dems(self):
         """EDGE acts at the DEM's edges, not at a window's: with EDGE=nodata
