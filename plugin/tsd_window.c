@@ -26,6 +26,30 @@ static int ceil_cells(double metres, double cell)
     return (int)ceil(metres / cell - 1e-9);
 }
 
+/* Bytes the far field keeps per cell of its grid: the heights, two planes
+ * per azimuth, and two more while one is swept (tsd_window_peak_bytes). */
+static double far_bytes_per_cell(int planes)
+{
+    return sizeof(float) * (1 + 2.0 * planes + 2);
+}
+
+/* The far grid's cell in DEM cells: 1 (the DEM itself) where it fits
+ * TSD_FAR_MAX_CELLS (f_mem) and the budget, else as fine as they allow;
+ * never coarser than near_cells / TSD_FAR_CELLS_PER_NEAR for the budget's
+ * sake (the rule before the budget), nor finer than f_mem. */
+static int far_factor(const tsd_options *o, int W, int H, int f_mem, double near_cells,
+                      int planes)
+{
+    double budget = TSD_FAR_BUDGET_MB * 1048576.0;
+    if (o->max_memory_mb > 0 && o->max_memory_mb * 1048576.0 / 4 < budget)
+        budget = o->max_memory_mb * 1048576.0 / 4;
+    int f_budget = (int)ceil(sqrt((double)W * H * far_bytes_per_cell(planes) / budget));
+    int f_near = (int)floor(near_cells / TSD_FAR_CELLS_PER_NEAR);
+    int f = f_budget < f_near ? f_budget : f_near;
+    f = f > f_mem ? f : f_mem;
+    return f < 1 ? 1 : f;
+}
+
 int tsd_window_plan_make(const tsd_options *o, int per_cell_sun, int W, int H,
                          double cells_min_x, double cell_y, tsd_window_plan *p, char *msg,
                          size_t n)
@@ -87,15 +111,13 @@ int tsd_window_plan_make(const tsd_options *o, int per_cell_sun, int W, int H,
     /* a cache that holds a row of chunks: GDAL reads blocks row by row */
     p->cache_chunks = (W + p->tile - 1) / p->tile + 1;
     if (p->far) {
-        int f = (int)floor(near / TSD_FAR_CELLS_PER_NEAR / cell);
-        f = f > f_mem ? f : f_mem;
-        f = f < 1 ? 1 : f;
-        p->far_w = (W + f - 1) / f;
-        p->far_h = (H + f - 1) / f;
         /* the sweeps of a chunk: the sun's, DIRECTIONS, or both */
         p->far_planes = is(d, "shadow", NULL) || (is(d, "shade", NULL) && o->sky_weight == 0)
                             ? 1
                             : o->directions + is(d, "shade", NULL);
+        int f = far_factor(o, W, H, f_mem, near / cell, p->far_planes);
+        p->far_w = (W + f - 1) / f;
+        p->far_h = (H + f - 1) / f;
     }
     return 0;
 }
@@ -107,7 +129,7 @@ double tsd_window_peak_bytes(const tsd_options *o, const tsd_window_plan *p, dou
     double computing = tsd_product_peak_bytes(o, W, H, &kept_one);
     /* the chunk cropped out of it, and the cache */
     double chunk = (double)p->tile * p->tile * sizeof(float) * tsd_options_band_count(o);
-    double far = (double)p->far_w * p->far_h * sizeof(float) * (1 + 2.0 * p->far_planes + 2);
+    double far = (double)p->far_w * p->far_h * far_bytes_per_cell(p->far_planes);
     double kept = chunk * p->cache_chunks + far;
     if (steady)
         *steady = kept;
@@ -240,8 +262,41 @@ static ts_status far_edge(const tsd_compute_ctx *c, const ts_grid *g, double azi
     return TS_OK;
 }
 
+/* One coarse cell's far slope seen from a fine cell at height z: the
+ * plane's linear function of the observer's height; NAN where it has none
+ * (nodata, or no far terrain). */
+static inline double far_slope_at(const struct tsd_far_plane *p, size_t i, const float *zc,
+                                  double z)
+{
+    float b = p->base[i];
+    if (isnan(zc[0]) || isnan(b) || isinf(b))
+        return NAN;
+    return b + (z - zc[0] + TSD_FAR_DZ) * p->per_m[i];
+}
+
+/* Where fine cell g (global index, of n) lies between the centres of the
+ * coarse cells (of m): the lower one and the weight of the upper. */
+static inline int far_lerp_at(long g, int n, int m, float *w)
+{
+    double c = (g + 0.5) * m / n - 0.5;
+    int i = (int)floor(c);
+    if (i < 0) {
+        *w = 0.0f;
+        return 0;
+    }
+    if (i >= m - 1) {
+        *w = 0.0f;
+        return m - 1;
+    }
+    *w = (float)(c - i);
+    return i;
+}
+
 /* The far field: each cell's horizon raised to the coarse grid's beyond the
- * near field. */
+ * near field, interpolated bilinearly between the four coarse cells around
+ * it (each evaluated at the cell's own height): a coarse cell's far field
+ * is the one seen from its centre, which is up to half a coarse cell nearer
+ * or farther along the ray than the cell. */
 static ts_status far_raise(const tsd_compute_ctx *c, const ts_grid *g, double azimuth,
                            float *plane)
 {
@@ -251,19 +306,34 @@ static ts_status far_raise(const tsd_compute_ctx *c, const ts_grid *g, double az
         return TS_ERR_NOMEM;
     const int cw = f->coarse.width, ch = f->coarse.height;
     for (int y = 0; y < g->height; y++) {
-        long gy = g->origin->y0 + y;
-        int cy = (int)(gy * ch / f->fine_h);
-        const float *zc = f->coarse.z + (ptrdiff_t)cy * f->coarse.stride;
-        const float *base = p->base + (size_t)cy * cw, *per_m = p->per_m + (size_t)cy * cw;
+        float wy;
+        int cy = far_lerp_at(g->origin->y0 + y, f->fine_h, ch, &wy);
+        int cy1 = cy + 1 < ch ? cy + 1 : cy;
         float *row = plane + (size_t)y * g->width;
         const float *zrow = g->z + (ptrdiff_t)y * g->stride;
         for (int x = 0; x < g->width; x++) {
-            long gx = g->origin->x0 + x;
-            int cx = (int)(gx * cw / f->fine_w);
-            if (isnan(row[x]) || isnan(zc[cx]) || isnan(base[cx]) || isinf(base[cx]))
+            if (isnan(row[x]))
                 continue;
-            double s = base[cx] + ((double)zrow[x] - zc[cx] + TSD_FAR_DZ) * per_m[cx];
-            float deg = (float)(atan(s) * (180.0 / M_PI));
+            float wx;
+            int cx = far_lerp_at(g->origin->x0 + x, f->fine_w, cw, &wx);
+            int cx1 = cx + 1 < cw ? cx + 1 : cx;
+            const int xs[4] = {cx, cx1, cx, cx1}, ys[4] = {cy, cy, cy1, cy1};
+            const float ws[4] = {(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy};
+            double sum = 0, wsum = 0;
+            for (int k = 0; k < 4; k++) {
+                if (ws[k] <= 0)
+                    continue;
+                size_t i = (size_t)ys[k] * cw + xs[k];
+                double s = far_slope_at(
+                    p, i, f->coarse.z + (ptrdiff_t)ys[k] * f->coarse.stride + xs[k], zrow[x]);
+                if (isnan(s))
+                    continue;
+                sum += ws[k] * s;
+                wsum += ws[k];
+            }
+            if (!(wsum > 0))
+                continue;
+            float deg = (float)(atan(sum / wsum) * (180.0 / M_PI));
             row[x] = deg > row[x] ? deg : row[x];
         }
     }

@@ -26,12 +26,15 @@ extern "C" {
 #define TSD_NEAR_AUTO_CELLS 128
 /** The near field must reach at least this many cells. */
 #define TSD_NEAR_MIN_CELLS 16
-/** The far grid's cells are at most NEAR_DISTANCE / TSD_FAR_CELLS_PER_NEAR
- * (docs/windows.md: the far field's error grows with its cells)... */
-#define TSD_FAR_CELLS_PER_NEAR 32
-/** ...unless that grid would exceed this many cells: its planes are kept
- * for the dataset's life, one pair per azimuth. */
+/** The far grid is the DEM at full resolution where it fits (docs/windows.md:
+ * the far field's error is the averaging of its cells), else averaged to at
+ * most TSD_FAR_MAX_CELLS cells (its planes are kept for the dataset's life,
+ * one pair per azimuth) and to the grid, with its planes, within
+ * TSD_FAR_BUDGET_MB (or a quarter of MAX_MEMORY where that is less), but
+ * never to cells coarser than NEAR_DISTANCE / TSD_FAR_CELLS_PER_NEAR. */
 #define TSD_FAR_MAX_CELLS (2048.0 * 2048.0)
+#define TSD_FAR_BUDGET_MB 1024.0
+#define TSD_FAR_CELLS_PER_NEAR 32
 
 /** How a dataset is computed window by window; see tsd_window_plan. */
 typedef struct {

@@ -97,8 +97,11 @@ class Windows(unittest.TestCase):
         it part of the difference is the whole-DEM path's own error; against
         the exact sweep of the whole DEM (MAX_DISTANCE = its diagonal) the
         difference is the windowed far field's."""
-        self.check_near_whole(T.LUX, 64, 0.1, 0.1, "lux_elev")
-        self.check_near_whole(T.JACKSBORO, 128, 0.17, 0.21, "jacksboro")  # goal 0.1: not met
+        self.check_near_whole(T.LUX, 64, 0.01, 0.05, "lux_elev")
+        # against TILE_SIZE=0 the goal of 0.1 is out of reach while the
+        # whole-DEM sweep itself is 0.12 (p99) off the exact one here
+        # (docs/windows.md, Measured error)
+        self.check_near_whole(T.JACKSBORO, 128, 0.025, 0.15, "jacksboro")
 
     def test_shadow_agreement(self):
         """Shadow agreement (within 0.01 of the disk) with the exact sweep of
@@ -117,7 +120,7 @@ class Windows(unittest.TestCase):
                       "sweep, %.3f %% with TILE_SIZE=0" % (elev, os.path.basename(dem),
                                                           100 * a_exact, 100 * a_whole))
                 self.assertGreaterEqual(a_exact, 0.999)
-                self.assertGreaterEqual(a_whole, 0.99)
+                self.assertGreaterEqual(a_whole, 0.994)
 
     def test_edge_is_the_dems(self):
         """EDGE acts at the DEM's edges, not at a window's: with EDGE=nodata
@@ -162,18 +165,23 @@ class Windows(unittest.TestCase):
 
     def test_overviews_disagree(self):
         """A DEM whose overviews are of other heights would give a far field
-        of other terrain: refused, with what to do."""
+        of other terrain: refused, with what to do. The far grid is this DEM
+        itself where it fits its budget (no overview read): MAX_MEMORY=64
+        leaves it 16 MiB, which 16 directions fill at half resolution."""
         dem = os.path.join(self.tmp, "stale.tif")
         shutil.copy(self.dem, dem)
         T.run(["gdaladdo", "-q", "-r", "average", dem, "2", "4"])
-        ok = product(dem, PRODUCT="svf", DIRECTIONS=4, TILE_SIZE=128)
+        coarse = {"TILE_SIZE": 128, "PRODUCT": "svf", "DIRECTIONS": 16, "MAX_MEMORY": 64}
+        ok = product(dem, **coarse)
         self.assertTrue(np.isfinite(ok).all())
         ds = gdal.Open(dem, gdal.GA_Update)
         z = ds.GetRasterBand(1).ReadAsArray()
         ds.GetRasterBand(1).WriteArray(z + 500)  # the overviews stay as they were
         ds = None
-        self.refused({"TILE_SIZE": 128, "PRODUCT": "svf"},
-                     ["has overviews that disagree with it", "gdaladdo"], dem=dem)
+        self.refused(coarse, ["has overviews that disagree with it", "gdaladdo"], dem=dem)
+        # at full resolution the far grid reads no overview
+        self.assertTrue(np.isfinite(product(dem, TILE_SIZE=128, PRODUCT="svf",
+                                            DIRECTIONS=4)).all())
         # the whole-DEM path takes no far grid from them
         T.run(["gdal_translate", "-q", "-oo", "TILE_SIZE=0", T.conn(dem),
                os.path.join(self.tmp, "y.tif")])
