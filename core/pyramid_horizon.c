@@ -30,7 +30,7 @@
 
 #define DEG2RAD (M_PI / 180.0)
 #ifndef CHUNK
-#define CHUNK 256 /* columns: 8 rows of every level fit in a core's L2 */
+#define CHUNK 512 /* columns: the rows of every level a chunk reads stay in L2 */
 #endif
 #define ROW_BLOCK 32 /* rows whose per-level entries are filled at a time */
 
@@ -320,7 +320,12 @@ static void drop_run(const hz_ctx *C, row_ws *w, int y, int a, int b, double t_r
     const double vx = C->vx, vy = C->vy, c = C->c, lim = W - 1;
     float *restrict A = w->A;
     for (int x = a; x <= b; x++) {
-        double t = vx > 0 ? (lim - x) / vx : vx < 0 ? x / -vx : INFINITY;
+        /* vx = +-1 for an x-major azimuth: no division (the same value) */
+        double t = vx == 1.0    ? lim - x
+                   : vx == -1.0 ? (double)x
+                   : vx > 0     ? (lim - x) / vx
+                   : vx < 0     ? x / -vx
+                                : INFINITY;
         t = t < t_row ? t : t_row;
         double px = x + t * vx, py = y + t * vy;
         px = px < 0 ? 0 : px > W - 1 ? W - 1 : px;
