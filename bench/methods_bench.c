@@ -3,7 +3,7 @@
  * error and time side by side (docs/methods.md).
  *
  *   methods_bench [--size N] [--dirs D] [--threads T] [--level-step K]
- *                 [--offset O] [--dems jacksboro,lux_elev,fractal]
+ *                 [--offset O] [--dems jacksboro,lux_elev,fractal] [--cpu]
  *
  * For each DEM (the real ones of tests/data, and an N x N fractal: fBm
  * value noise, Hurst 0.8, 1500 m relief, 10 m cells, as ts_bench) it
@@ -14,7 +14,8 @@
  * every cell and direction, the same of the sky-view factor (radiative,
  * SVF_MODEL's default), the time of each svf (horizons plus accumulation;
  * the pyramid's build included) on the C backend, and the memory each
- * keeps besides the DEM and the output.
+ * keeps besides the DEM and the output. Times are wall-clock seconds, or
+ * with --cpu the process's CPU seconds.
  */
 #include <math.h>
 #include <stdio.h>
@@ -25,10 +26,14 @@
 #include "terrashade.h"
 #include "test_dem.h"
 
+/* --cpu: the process's CPU time instead of the wall clock, steadier
+ * than wall time on a shared machine (with --threads 1, one core's time) */
+static clockid_t timer = CLOCK_MONOTONIC;
+
 static double now(void)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(timer, &ts);
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
@@ -190,7 +195,8 @@ static void report(const char *name, const ts_grid *g, const setup *su, const re
     printf("%s %d x %d, %d directions, k=%g o=%g, %d levels:\n", name, g->width, g->height,
            su->dirs, su->pyr.level_step, su->pyr.offset,
            ts_pyramid_level_count(g->width, g->height, su->pyr.level_step));
-    printf("  %-20s svf time (C) %8.3f s\n", NAMES[0], r->m[0].t);
+    printf("  %-20s svf time (C) %8.3f s%s\n", NAMES[0], r->m[0].t,
+           timer == CLOCK_MONOTONIC ? "" : " (CPU time)");
     for (int i = 1; i < 3; i++) {
         const method *m = &r->m[i];
         printf("  %-20s svf time (C) %8.3f s (build %.3f s) = %.2f x exact; |horizon - exact| "
@@ -227,9 +233,11 @@ int main(int argc, char **argv)
             su.pyr.offset = atof(argv[++i]);
         else if (!strcmp(argv[i], "--dems") && i + 1 < argc)
             snprintf(dems, sizeof dems, "%s", argv[++i]);
+        else if (!strcmp(argv[i], "--cpu"))
+            timer = CLOCK_PROCESS_CPUTIME_ID;
         else {
             fprintf(stderr, "usage: methods_bench [--size N] [--dirs D] [--threads T] "
-                            "[--level-step K] [--offset O] [--dems a,b,fractal]\n");
+                            "[--level-step K] [--offset O] [--dems a,b,fractal] [--cpu]\n");
             return 2;
         }
     }

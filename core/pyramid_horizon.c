@@ -30,8 +30,33 @@
 
 #define DEG2RAD (M_PI / 180.0)
 #ifndef CHUNK
-#define CHUNK 256 /* columns: 8 rows of every level fit in a core's L2 */
+#define CHUNK 512 /* columns: the rows of every level a chunk reads stay in L2 */
 #endif
+#define ROW_BLOCK 32 /* rows whose per-level entries are filled at a time */
+
+/* What sample j of every cell shares for one azimuth: its offset in
+ * cells, split into a whole column ix and a fraction fx, the columns
+ * [xa, xb] whose sample is on the grid, and the level it reads. */
+typedef struct {
+    double s;   /* distance in steps: the level's spacing */
+    int ix;     /* floor of the column offset s vx */
+    float fx;   /* the fraction of it */
+    int xa, xb; /* cells whose sample lies within the grid's columns */
+    int lev;    /* level read: j - k o, at least 0 */
+} level_az;
+
+/* What sample j of the cells of one row shares: the level rows at the
+ * samples' row (the vertical taps), the cells' own row on the level, and
+ * the distance in metres. Filled once per row and azimuth, read by every
+ * chunk of the row. */
+typedef struct {
+    const float *t[4]; /* level rows at the samples' row */
+    float wt[4];
+    int taps;
+    const float *r[4]; /* level rows at the cells' own row (weight 0: unused) */
+    float wr[4];
+    float inv_d, cd; /* 1 / distance, curvature drop over it */
+} row_level;
 
 typedef struct {
     const ts_pyramid *P;
@@ -41,6 +66,7 @@ typedef struct {
     double cap;         /* maximum distance in metres, 0 = none */
     double ko;          /* level offset k o */
     int bspline;        /* 1: B-spline in log distance; 0: max over levels */
+    const level_az *lv; /* by sample number j */
     float *out;
     int *alloc_failed;
 } hz_ctx;
@@ -66,29 +92,29 @@ static double step_at(const hz_ctx *C, double row)
 #define TS_PYR_CLONES
 #endif
 
-/* dst[x] = sum of weights[t] * level row idx[t] at x, for x in [x0, x1]. */
+/* dst[x] = sum of weights w[t] * rows r[t] at x, for x in [x0, x1]. */
 TS_PYR_CLONES
-static void combine_rows(const ts_pyramid *P, int lev, const int *idx, const double *w, int taps,
-                         int x0, int x1, float *restrict dst)
+static void combine_rows(const float *const r[4], const float w[4], int taps, int x0, int x1,
+                         float *restrict dst)
 {
-    const float *r0 = ts_pyr_row(P, lev, idx[0]);
-    const float w0 = (float)w[0];
+    const float *r0 = r[0];
+    const float w0 = w[0];
     if (taps == 1) {
 #pragma GCC ivdep
         for (int x = x0; x <= x1; x++)
             dst[x] = r0[x];
         return;
     }
-    const float *r1 = ts_pyr_row(P, lev, idx[1]);
-    const float w1 = (float)w[1];
+    const float *r1 = r[1];
+    const float w1 = w[1];
     if (taps == 2) {
 #pragma GCC ivdep
         for (int x = x0; x <= x1; x++)
             dst[x] = w0 * r0[x] + w1 * r1[x];
         return;
     }
-    const float *r2 = ts_pyr_row(P, lev, idx[2]), *r3 = ts_pyr_row(P, lev, idx[3]);
-    const float w2 = (float)w[2], w3 = (float)w[3];
+    const float *r2 = r[2], *r3 = r[3];
+    const float w2 = w[2], w3 = w[3];
 #pragma GCC ivdep
     for (int x = x0; x <= x1; x++)
         dst[x] = w0 * r0[x] + w1 * r1[x] + w2 * r2[x] + w3 * r3[x];
@@ -198,38 +224,55 @@ static int level_run(row_ws *w, const float *restrict T, int ix, float fx,
     return 0;
 }
 
-/* The samples of the cells [x0, x1] of row y at `dist` steps on level lev,
- * pushed as sample c. */
-static void sample_run(const hz_ctx *C, row_ws *w, int y, int lev, double dist, int c, int x0,
-                       int x1)
+/* The row-level entry of row y for samples at `dist` steps on level lev. */
+static void row_level_fill(const hz_ctx *C, int y, int lev, double dist, row_level *e)
 {
     const ts_pyramid *P = C->P;
-    const int W = P->grid->width;
-    double ox = dist * C->vx, oy = dist * C->vy;
-    double fl = floor(ox);
-    int ix = (int)fl;
-    float fx = (float)(ox - fl);
+    double oy = dist * C->vy;
+    int idx[4];
+    double wd[4];
+    e->taps = level_taps(P, lev, y + oy, idx, wd);
+    for (int t = 0; t < 4; t++) {
+        e->t[t] = ts_pyr_row(P, lev, idx[t < e->taps ? t : 0]);
+        e->wt[t] = (float)wd[t < e->taps ? t : 0];
+    }
+    /* the cells' own heights on the level: the DEM row itself on level 0 */
+    int taps = level_taps(P, lev, y, idx, wd);
+    for (int t = 0; t < 4; t++) {
+        e->r[t] = ts_pyr_row(P, lev, idx[t < taps ? t : 0]);
+        e->wr[t] = t < taps ? (float)wd[t] : 0.0f;
+    }
+    double d = dist * step_at(C, y + oy / 2);
+    e->inv_d = (float)(1.0 / d);
+    e->cd = (float)(C->c * d);
+}
+
+/* The samples of the cells [x0, x1] described by e, at column offset
+ * ix + fx, pushed as sample c. */
+static void sample_level(const hz_ctx *C, row_ws *w, const row_level *e, int ix, float fx, int c,
+                         int x0, int x1)
+{
+    const int W = C->P->grid->width;
     int t0 = x0 + ix, t1 = x1 + ix + (fx > 0.0f);
     t1 = t1 > W - 1 ? W - 1 : t1;
     if (t0 < 0 || t1 < t0)
         return; /* not reached: the runs keep the samples on the grid */
-    int idx[4];
-    double wd[4];
-    int taps = level_taps(P, lev, y + oy, idx, wd);
-    combine_rows(P, lev, idx, wd, taps, t0, t1, w->T);
+    combine_rows(e->t, e->wt, e->taps, t0, t1, w->T);
     w->T[t1 + 1] = w->T[t1]; /* a weight of fx = 0 there: no NaN from beyond */
-    /* the cells' own heights on the level: the DEM row itself on level 0 */
-    taps = level_taps(P, lev, y, idx, wd);
-    const float *r[4];
-    float wr[4];
-    for (int t = 0; t < 4; t++) {
-        r[t] = ts_pyr_row(P, lev, idx[t < taps ? t : 0]);
-        wr[t] = t < taps ? (float)wd[t] : 0.0f;
-    }
-    double d = dist * step_at(C, y + oy / 2);
-    if (!level_run(w, w->T, ix, fx, r, wr, (float)(1.0 / d), (float)(C->c * d), C->bspline, c,
-                   x0, x1))
+    if (!level_run(w, w->T, ix, fx, e->r, e->wr, e->inv_d, e->cd, C->bspline, c, x0, x1))
         push_run(w, C->bspline, c, x0, x1, w->A);
+}
+
+/* The samples of the cells [x0, x1] of row y at `dist` steps on level lev,
+ * pushed as sample c (the last sample of a row whose rays end early). */
+static void sample_run(const hz_ctx *C, row_ws *w, int y, int lev, double dist, int c, int x0,
+                       int x1)
+{
+    double ox = dist * C->vx;
+    double fl = floor(ox);
+    row_level e;
+    row_level_fill(C, y, lev, dist, &e);
+    sample_level(C, w, &e, (int)fl, (float)(ox - fl), c, x0, x1);
 }
 
 /* The horizons of cells [x0, x1] after `count` >= 1 samples, into out. */
@@ -277,7 +320,12 @@ static void drop_run(const hz_ctx *C, row_ws *w, int y, int a, int b, double t_r
     const double vx = C->vx, vy = C->vy, c = C->c, lim = W - 1;
     float *restrict A = w->A;
     for (int x = a; x <= b; x++) {
-        double t = vx > 0 ? (lim - x) / vx : vx < 0 ? x / -vx : INFINITY;
+        /* vx = +-1 for an x-major azimuth: no division (the same value) */
+        double t = vx == 1.0    ? lim - x
+                   : vx == -1.0 ? (double)x
+                   : vx > 0     ? (lim - x) / vx
+                   : vx < 0     ? x / -vx
+                                : INFINITY;
         t = t < t_row ? t : t_row;
         double px = x + t * vx, py = y + t * vy;
         px = px < 0 ? 0 : px > W - 1 ? W - 1 : px;
@@ -300,8 +348,8 @@ static void drop_run(const hz_ctx *C, row_ws *w, int y, int a, int b, double t_r
     finish_run(w, C->bspline, j + 1, a, b, out);
 }
 
-/* The cells [c0, c1) of row y. */
-static void horizon_row(const hz_ctx *C, row_ws *w, int y, int c0, int c1)
+/* The cells [c0, c1) of row y; rl: the row's entry for every level. */
+static void horizon_row(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const row_level *rl)
 {
     const ts_pyramid *P = C->P;
     const ts_grid *g = P->grid;
@@ -315,11 +363,9 @@ static void horizon_row(const hz_ctx *C, row_ws *w, int y, int c0, int c1)
         t_row = C->cap / C->step[y];
     int pa = c0, pb = c1 - 1, j = 0;
     for (; j < P->levels && pa <= pb; j++) {
-        double s = P->level[j].spacing, ox = s * C->vx;
-        int xa = C->vx < 0 ? (int)ceil(-ox) : 0;
-        int xb = C->vx > 0 ? (int)floor(W - 1 - ox) : W - 1;
-        xa = xa > pa ? xa : pa;
-        xb = xb < pb ? xb : pb;
+        const level_az *L = &C->lv[j];
+        int xa = L->xa > pa ? L->xa : pa;
+        int xb = L->xb < pb ? L->xb : pb;
         if (xa > xb) {
             drop_run(C, w, y, pa, pb, t_row, j, out);
             pa = 1, pb = 0;
@@ -328,10 +374,8 @@ static void horizon_row(const hz_ctx *C, row_ws *w, int y, int c0, int c1)
         drop_run(C, w, y, pa, xa - 1, t_row, j, out);
         drop_run(C, w, y, xb + 1, pb, t_row, j, out);
         pa = xa, pb = xb;
-        if (s <= t_row) {
-            double lf = floor(j - C->ko + 1e-9);
-            int lev = lf < 0 ? 0 : (int)lf;
-            sample_run(C, w, y, lev, s, j, pa, pb);
+        if (L->s <= t_row) {
+            sample_level(C, w, &rl[j], L->ix, L->fx, j, pa, pb);
         } else { /* the row's rays end here: one last sample on the DEM */
             if (t_row > 1e-9) {
                 sample_run(C, w, y, 0, t_row, j, pa, pb);
@@ -357,20 +401,49 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
 {
     (void)worker;
     const hz_ctx *C = ctx;
-    const int W = C->P->grid->width;
+    const int W = C->P->grid->width, levels = C->P->levels;
     /* s0, s1, s2, m: W each; T and the samples: W + 1 each */
     float *buf = malloc((size_t)(6 * W + 2) * sizeof *buf);
-    if (!buf) {
+    row_level *rl = malloc((size_t)ROW_BLOCK * levels * sizeof *rl);
+    if (!buf || !rl) {
+        free(buf);
+        free(rl);
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
         return;
     }
     row_ws w = {buf, buf + W, buf + 2 * W, buf + 3 * W, buf + 4 * W, buf + 5 * W + 1};
-    /* a chunk of columns down the rows, then the next: the level rows that
-     * the cells of a chunk read stay in the cache from row to row */
-    for (int c0 = 0; c0 < W; c0 += CHUNK)
-        for (long y = y0; y < y1; y++)
-            horizon_row(C, &w, (int)y, c0, c0 + CHUNK < W ? c0 + CHUNK : W);
+    for (long yb = y0; yb < y1; yb += ROW_BLOCK) {
+        long ye = yb + ROW_BLOCK < y1 ? yb + ROW_BLOCK : y1;
+        for (long y = yb; y < ye; y++)
+            for (int j = 0; j < levels; j++)
+                row_level_fill(C, (int)y, C->lv[j].lev, C->lv[j].s,
+                               &rl[(size_t)(y - yb) * levels + j]);
+        /* a chunk of columns down the rows, then the next: the level rows
+         * that the cells of a chunk read stay in the cache from row to row */
+        for (int c0 = 0; c0 < W; c0 += CHUNK)
+            for (long y = yb; y < ye; y++)
+                horizon_row(C, &w, (int)y, c0, c0 + CHUNK < W ? c0 + CHUNK : W,
+                            &rl[(size_t)(y - yb) * levels]);
+    }
+    free(rl);
     free(buf);
+}
+
+/* Sample j's shares for the azimuth of C (vx, ko set). */
+static void level_az_fill(const hz_ctx *C, level_az *lv)
+{
+    const ts_pyramid *P = C->P;
+    const int W = P->grid->width;
+    for (int j = 0; j < P->levels; j++) {
+        double s = P->level[j].spacing, ox = s * C->vx;
+        double fl = floor(ox), lf = floor(j - C->ko + 1e-9);
+        lv[j] = (level_az){s,
+                           (int)fl,
+                           (float)(ox - fl),
+                           C->vx < 0 ? (int)ceil(-ox) : 0,
+                           C->vx > 0 ? (int)floor(W - 1 - ox) : W - 1,
+                           lf < 0 ? 0 : (int)lf};
+    }
 }
 
 ts_status ts_pyramid_horizon(const ts_pyramid *pyr, double azimuth, const ts_horizon_opts *opts,
@@ -392,21 +465,28 @@ ts_status ts_pyramid_horizon(const ts_pyramid *pyr, double azimuth, const ts_hor
     if (fabs(ca) < 1e-12) ca = 0;
     double gx = sa / ts_grid_cell_x(g, H / 2), gy = -ca / g->cell_y;
     double major = fabs(gx) > fabs(gy) ? fabs(gx) : fabs(gy);
-    hz_ctx C = {pyr, gx / major, gy / major, NULL, 0, 0, 0, 0, NULL, NULL};
+    hz_ctx C = {pyr, gx / major, gy / major, NULL, 0, 0, 0, 0, NULL, NULL, NULL};
     C.step = malloc((size_t)H * sizeof *C.step);
-    if (!C.step)
+    level_az *lv = malloc((size_t)pyr->levels * sizeof *lv);
+    if (!C.step || !lv) {
+        free(C.step);
+        free(lv);
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the pyramid's step table");
+    }
     for (int y = 0; y < H; y++)
         C.step[y] = hypot(ts_grid_cell_x(g, y) * C.vx, g->cell_y * C.vy);
     C.c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
     C.cap = opts->max_distance;
     C.ko = pyr->opts.level_step * pyr->opts.offset;
     C.bspline = pyr->opts.reconstruction == TS_PYRAMID_BSPLINE;
+    level_az_fill(&C, lv);
+    C.lv = lv;
     C.out = out;
     int failed = 0;
     C.alloc_failed = &failed;
     st = ts_parallel_for(ts_thread_count(opts->threads, H), H, rows_range, &C, err);
     free(C.step);
+    free(lv);
     if (st != TS_OK)
         return st;
     if (failed)
