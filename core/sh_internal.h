@@ -95,4 +95,38 @@ static inline void ts_sh_cell_wedge(const float *restrict table, int kind, float
         acc[k] += v[k] * r->p[k] + vp[k] * r->q[k];
 }
 
+/* Sum of 16 floats as a pairwise tree: vector halves, not a chain of 16
+ * dependent scalar additions. */
+static inline float ts_sh_sum16(const float p[TS_SH_COEFFS])
+{
+    float a[8], b[4];
+    for (int k = 0; k < 8; k++)
+        a[k] = p[k] + p[k + 8];
+    for (int k = 0; k < 4; k++)
+        b[k] = a[k] + a[k + 4];
+    return (b[0] + b[2]) + (b[1] + b[3]);
+}
+
+/* sum_jk v_j mh[j][k] yn_k (mh of ts_sh_fold_cosine, yn the basis at the
+ * normal: the triple product), the matrix-vector product in four independent
+ * accumulators (a chain of 16 dependent vector additions would be its
+ * latency). */
+static inline float ts_sh_triple_folded(const float mh[TS_SH_COEFFS][TS_SH_COEFFS],
+                                        const float v[TS_SH_COEFFS],
+                                        const float yn[TS_SH_COEFFS])
+{
+    float u0[TS_SH_COEFFS] = {0}, u1[TS_SH_COEFFS] = {0}, u2[TS_SH_COEFFS] = {0},
+          u3[TS_SH_COEFFS] = {0}, p[TS_SH_COEFFS];
+    for (int j = 0; j < TS_SH_COEFFS; j += 4)
+        for (int k = 0; k < TS_SH_COEFFS; k++) { /* one vector of k per line */
+            u0[k] += v[j] * mh[j][k];
+            u1[k] += v[j + 1] * mh[j + 1][k];
+            u2[k] += v[j + 2] * mh[j + 2][k];
+            u3[k] += v[j + 3] * mh[j + 3][k];
+        }
+    for (int k = 0; k < TS_SH_COEFFS; k++)
+        p[k] = ((u0[k] + u1[k]) + (u2[k] + u3[k])) * yn[k];
+    return ts_sh_sum16(p);
+}
+
 #endif

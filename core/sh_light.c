@@ -55,23 +55,14 @@ void ts_sh_fold_cosine(const double m[TS_SH_COEFFS][TS_SH_COEFFS],
     }
 }
 
-/* The triple product of visibility v (16 floats) with the folded matrix (as
- * floats) and the normal (x, y, z): w = v^T mh as 16 independent sums in a
- * loop the compiler vectorises, then w . y(n). */
+/* The triple product of visibility v (16 floats) with the folded matrix and
+ * the normal (x, y, z), in float (ts_sh_triple_folded). */
 static inline double cell_triple(const float mh[TS_SH_COEFFS][TS_SH_COEFFS], const float *v,
                                  float x, float y, float z)
 {
-    double d[3] = {x, y, z}, yn[TS_SH_COEFFS], s = 0;
-    float w[TS_SH_COEFFS] = {0};
-    ts_sh_eval(d, yn);
-    for (int j = 0; j < TS_SH_COEFFS; j++) {
-        const float vj = v[j];
-        for (int k = 0; k < TS_SH_COEFFS; k++)
-            w[k] += vj * mh[j][k];
-    }
-    for (int k = 0; k < TS_SH_COEFFS; k++)
-        s += w[k] * yn[k];
-    return s;
+    float yn[TS_SH_COEFFS];
+    TS_SH_BASIS(float, x, y, z, yn);
+    return ts_sh_triple_folded(mh, v, yn);
 }
 
 typedef struct {

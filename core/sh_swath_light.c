@@ -100,35 +100,6 @@ static inline void add_boundary(const float *restrict table, float w,
 }
 
 
-/* Sum of 16 floats as a pairwise tree: vector halves, not a chain of 16
- * dependent scalar additions. */
-static inline float sum16(const float p[N])
-{
-    float a[8], b[4];
-    for (int k = 0; k < 8; k++)
-        a[k] = p[k] + p[k + 8];
-    for (int k = 0; k < 4; k++)
-        b[k] = a[k] + a[k + 4];
-    return (b[0] + b[2]) + (b[1] + b[3]);
-}
-
-/* sum_jk v_j mh[j][k] yn_k, the matrix-vector product in four independent
- * accumulators (a chain of 16 dependent vector additions would be its
- * latency). */
-static inline float triple_folded(const float mh[N][N], const float v[N], const float yn[N])
-{
-    float u0[N] = {0}, u1[N] = {0}, u2[N] = {0}, u3[N] = {0}, p[N];
-    for (int j = 0; j < N; j += 4)
-        for (int k = 0; k < N; k++) { /* one vector of k per line */
-            u0[k] += v[j] * mh[j][k];
-            u1[k] += v[j + 1] * mh[j + 1][k];
-            u2[k] += v[j + 2] * mh[j + 2][k];
-            u3[k] += v[j + 3] * mh[j + 3][k];
-        }
-    for (int k = 0; k < N; k++)
-        p[k] = ((u0[k] + u1[k]) + (u2[k] + u3[k])) * yn[k];
-    return sum16(p);
-}
 
 /* Cells c0..c1 (cloned for wider vectors where the CPU has them). */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
@@ -165,13 +136,13 @@ static void swath_cells(const swath_ctx *C, size_t c0, size_t c1)
             float p[N];
             for (int k = 0; k < N; k++)
                 p[k] = C->l[k] * v[k];
-            float t = sum16(p) * C->scale_share;
+            float t = ts_sh_sum16(p) * C->scale_share;
             C->share[c] = t < 0 ? 0 : t > 1 ? 1 : t;
         }
         if (C->shade) {
             float yn[N];
             TS_SH_BASIS(float, C->nx[c], C->ny[c], C->nz[c], yn);
-            float t = triple_folded(C->mh, v, yn) * C->scale_shade;
+            float t = ts_sh_triple_folded(C->mh, v, yn) * C->scale_shade;
             C->shade[c] = t == t ? (t < 0 ? 0 : t) : NAN; /* NaN normal: NaN */
         }
     }
