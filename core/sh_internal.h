@@ -12,6 +12,34 @@
 static const double TS_SH_CLAMPED_COS_ZH[4] = {0.886226925452758014, 1.023326707946488488,
                                                0.495415912200751666, 0.0};
 
+/** m (a light's product matrix) with the clamped cosine's zonal factors,
+ *  so that the triple product with a normal n is sum_jk v_j mh[j][k] y_k(n). */
+void ts_sh_fold_cosine(const double m[TS_SH_COEFFS][TS_SH_COEFFS],
+                       float mh[TS_SH_COEFFS][TS_SH_COEFFS]);
+
+/** The 16 basis functions at unit direction (x, y, z) in type T (double for
+ *  ts_sh_eval, float in the per-cell loops): the one home of the formulas. */
+#define TS_SH_BASIS(T, x, y, z, out)                                                     \
+    do {                                                                                 \
+        const T x_ = (x), y_ = (y), z_ = (z), zz_ = z_ * z_;                             \
+        (out)[0] = (T)0.282094791773878143;                                              \
+        (out)[1] = (T)0.488602511902919921 * y_;                                         \
+        (out)[2] = (T)0.488602511902919921 * z_;                                         \
+        (out)[3] = (T)0.488602511902919921 * x_;                                         \
+        (out)[4] = (T)1.092548430592079070 * x_ * y_;                                    \
+        (out)[5] = (T)1.092548430592079070 * y_ * z_;                                    \
+        (out)[6] = (T)0.315391565252520002 * (3 * zz_ - 1);                              \
+        (out)[7] = (T)1.092548430592079070 * x_ * z_;                                    \
+        (out)[8] = (T)0.546274215296039535 * (x_ * x_ - y_ * y_);                        \
+        (out)[9] = (T)0.590043589926643510 * y_ * (3 * x_ * x_ - y_ * y_);              \
+        (out)[10] = (T)2.890611442640554055 * x_ * y_ * z_;                              \
+        (out)[11] = (T)0.457045799464465737 * y_ * (5 * zz_ - 1);                        \
+        (out)[12] = (T)0.373176332590115391 * z_ * (5 * zz_ - 3);                        \
+        (out)[13] = (T)0.457045799464465737 * x_ * (5 * zz_ - 1);                        \
+        (out)[14] = (T)1.445305721320277027 * z_ * (x_ * x_ - y_ * y_);                  \
+        (out)[15] = (T)0.590043589926643510 * x_ * (x_ * x_ - 3 * y_ * y_);             \
+    } while (0)
+
 /** Gauss-Legendre nodes and weights of n points (n <= 32) on [-1, 1]. */
 void ts_sh_gauss(int n, double *x, double *w);
 
@@ -65,6 +93,40 @@ static inline void ts_sh_cell_wedge(const float *restrict table, int kind, float
         vp[k] = v[r->perm[k]];
     for (int k = 0; k < TS_SH_COEFFS; k++)
         acc[k] += v[k] * r->p[k] + vp[k] * r->q[k];
+}
+
+/* Sum of 16 floats as a pairwise tree: vector halves, not a chain of 16
+ * dependent scalar additions. */
+static inline float ts_sh_sum16(const float p[TS_SH_COEFFS])
+{
+    float a[8], b[4];
+    for (int k = 0; k < 8; k++)
+        a[k] = p[k] + p[k + 8];
+    for (int k = 0; k < 4; k++)
+        b[k] = a[k] + a[k + 4];
+    return (b[0] + b[2]) + (b[1] + b[3]);
+}
+
+/* sum_jk v_j mh[j][k] yn_k (mh of ts_sh_fold_cosine, yn the basis at the
+ * normal: the triple product), the matrix-vector product in four independent
+ * accumulators (a chain of 16 dependent vector additions would be its
+ * latency). */
+static inline float ts_sh_triple_folded(const float mh[TS_SH_COEFFS][TS_SH_COEFFS],
+                                        const float v[TS_SH_COEFFS],
+                                        const float yn[TS_SH_COEFFS])
+{
+    float u0[TS_SH_COEFFS] = {0}, u1[TS_SH_COEFFS] = {0}, u2[TS_SH_COEFFS] = {0},
+          u3[TS_SH_COEFFS] = {0}, p[TS_SH_COEFFS];
+    for (int j = 0; j < TS_SH_COEFFS; j += 4)
+        for (int k = 0; k < TS_SH_COEFFS; k++) { /* one vector of k per line */
+            u0[k] += v[j] * mh[j][k];
+            u1[k] += v[j + 1] * mh[j + 1][k];
+            u2[k] += v[j + 2] * mh[j + 2][k];
+            u3[k] += v[j + 3] * mh[j + 3][k];
+        }
+    for (int k = 0; k < TS_SH_COEFFS; k++)
+        p[k] = ((u0[k] + u1[k]) + (u2[k] + u3[k])) * yn[k];
+    return ts_sh_sum16(p);
 }
 
 #endif

@@ -5,7 +5,7 @@
  * clamped cosine's zonal coefficients once, so a cell costs the 16 basis
  * values of its normal and 272 multiply-adds); the double product of light
  * and visibility for a key light's visible share; a key light's
- * normalisers.
+ * normalisers (a swath's light in one pass: core/sh_swath_light.c).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -44,9 +44,7 @@ void ts_sh_swath_visibility_flat(const ts_sh_swath *s, double omega_deg,
         out[i] += v[i];
 }
 
-/* m with the clamped cosine's zonal factors, so that the triple product
- * with a normal n is sum_jk v_j mh[j][k] y_k(n). */
-static void fold_cosine(const double m[TS_SH_COEFFS][TS_SH_COEFFS],
+void ts_sh_fold_cosine(const double m[TS_SH_COEFFS][TS_SH_COEFFS],
                         float mh[TS_SH_COEFFS][TS_SH_COEFFS])
 {
     for (int k = 0; k < TS_SH_COEFFS; k++) {
@@ -57,23 +55,14 @@ static void fold_cosine(const double m[TS_SH_COEFFS][TS_SH_COEFFS],
     }
 }
 
-/* The triple product of visibility v (16 floats) with the folded matrix (as
- * floats) and the normal (x, y, z): w = v^T mh as 16 independent sums in a
- * loop the compiler vectorises, then w . y(n). */
+/* The triple product of visibility v (16 floats) with the folded matrix and
+ * the normal (x, y, z), in float (ts_sh_triple_folded). */
 static inline double cell_triple(const float mh[TS_SH_COEFFS][TS_SH_COEFFS], const float *v,
                                  float x, float y, float z)
 {
-    double d[3] = {x, y, z}, yn[TS_SH_COEFFS], s = 0;
-    float w[TS_SH_COEFFS] = {0};
-    ts_sh_eval(d, yn);
-    for (int j = 0; j < TS_SH_COEFFS; j++) {
-        const float vj = v[j];
-        for (int k = 0; k < TS_SH_COEFFS; k++)
-            w[k] += vj * mh[j][k];
-    }
-    for (int k = 0; k < TS_SH_COEFFS; k++)
-        s += w[k] * yn[k];
-    return s;
+    float yn[TS_SH_COEFFS];
+    TS_SH_BASIS(float, x, y, z, yn);
+    return ts_sh_triple_folded(mh, v, yn);
 }
 
 typedef struct {
@@ -118,7 +107,7 @@ ts_status ts_sh_shade(const ts_grid *grid, const double m[TS_SH_COEFFS][TS_SH_CO
     if (!m || !nx || !ny || !nz)
         return ts_fail(err, TS_ERR_ARG, "the light and the normals must not be NULL");
     shade_ctx C = {grid, {{0}}, nx, ny, nz, vis, NULL, scale, out};
-    fold_cosine(m, C.mh);
+    ts_sh_fold_cosine(m, C.mh);
     return ts_parallel_for(ts_thread_count(0, grid->height), grid->height, shade_rows, &C, err);
 }
 
@@ -164,90 +153,4 @@ void ts_sh_key_reference(const ts_sh_wedges *w, const double l[TS_SH_COEFFS],
     for (int i = 0; i < TS_SH_COEFFS; i++)
         s += l[i] * v[i];
     *share_ref = s;
-}
-
-/* ts_sh_swath_light's state: the wedges' rotations in swath order. */
-typedef struct {
-    const ts_grid *g;
-    const ts_sh_wedges *w;
-    const float *const *planes;
-    const ts_sh_rotation *rot; /* n + 1: wedge k ends at sample k; [0] rise or closing;
-                                  [n] fall */
-    float mh[TS_SH_COEFFS][TS_SH_COEFFS];
-    const double *l;
-    const float *nx, *ny, *nz;
-    double scale_shade, scale_share;
-    float *shade, *share;
-} swath_ctx;
-
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
-static void swath_rows(void *ctx, int worker, long y0, long y1)
-{
-    (void)worker;
-    const swath_ctx *C = ctx;
-    const ts_sh_swath *s = &C->w->swath;
-    const float *const *P = C->planes;
-    const int n = s->n;
-    const size_t W = (size_t)C->g->width;
-    for (size_t c = (size_t)y0 * W; c < (size_t)y1 * W; c++) {
-        float v[TS_SH_COEFFS] = {0};
-        for (int k = 1; k < n; k++)
-            ts_sh_cell_wedge(C->w->interior, 2, P[k][c], P[k - 1][c], &C->rot[k], v);
-        if (s->complete) {
-            ts_sh_cell_wedge(C->w->interior, 2, P[0][c], P[n - 1][c], &C->rot[0], v);
-        } else {
-            ts_sh_cell_wedge(C->w->rise, 0, P[0][c], 90.0f, &C->rot[0], v);
-            ts_sh_cell_wedge(C->w->fall, 1, 90.0f, P[n - 1][c], &C->rot[n], v);
-        }
-        if (C->share) {
-            double t = 0;
-            for (int i = 0; i < TS_SH_COEFFS; i++)
-                t += C->l[i] * v[i];
-            t *= C->scale_share;
-            C->share[c] = t == t ? (float)(t < 0 ? 0 : t > 1 ? 1 : t) : NAN;
-        }
-        if (C->shade) {
-            double t = C->scale_shade * cell_triple(C->mh, v, C->nx[c], C->ny[c], C->nz[c]);
-            C->shade[c] = t == t ? (float)(t < 0 ? 0 : t) : NAN;
-        }
-    }
-}
-
-ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
-                            const float *const *planes, const double l[TS_SH_COEFFS],
-                            const float *nx, const float *ny, const float *nz,
-                            double scale_shade, float *shade, double scale_share, float *share,
-                            ts_error *err)
-{
-    ts_status st = ts_grid_validate(grid, err);
-    if (st != TS_OK)
-        return st;
-    if (!w || !w->interior || !planes || !l || (!shade && !share) ||
-        (shade && (!nx || !ny || !nz)))
-        return ts_fail(err, TS_ERR_ARG, "the wedge tables, the horizon planes, the light, an "
-                       "output and, for shade, the normals must not be NULL");
-    const ts_sh_swath *s = &w->swath;
-    for (int k = 0; k < s->n; k++)
-        if (!planes[k])
-            return ts_fail(err, TS_ERR_ARG, "horizon plane %d is NULL", k);
-    ts_sh_rotation *rot = malloc(sizeof *rot * (size_t)(s->n + 1));
-    if (!rot)
-        return ts_fail(err, TS_ERR_NOMEM, "out of memory for the swath's rotations");
-    /* canonical starts (core/sh_visibility.c): wedge k at sample k, the rise
-     * at sample 0, the closing wedge at sample 0, the fall at the far edge */
-    for (int k = 0; k < s->n; k++)
-        ts_sh_rotation_set(&rot[k], ts_sh_swath_azimuth(s, k));
-    ts_sh_rotation_set(&rot[s->n], ts_sh_swath_azimuth(s, s->n - 1) + s->step / 2);
-    swath_ctx C = {grid, w, planes, rot, {{0}}, l, nx, ny, nz, scale_shade, scale_share,
-                   shade, share};
-    if (shade) {
-        double m[TS_SH_COEFFS][TS_SH_COEFFS];
-        ts_sh_product_matrix(l, m);
-        fold_cosine(m, C.mh);
-    }
-    st = ts_parallel_for(ts_thread_count(0, grid->height), grid->height, swath_rows, &C, err);
-    free(rot);
-    return st;
 }

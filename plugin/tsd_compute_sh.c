@@ -3,6 +3,7 @@
 
 #include "terrashade_sh.h"
 #include "tsd_compute_env.h"
+#include "tsd_pyramid.h"
 #include "tsd_text.h"
 
 #include <math.h>
@@ -30,9 +31,24 @@ static void note_c_part(const tsd_compute_ctx *c, const char *what)
     tsd_backend_summary_add(c->backend, &r);
 }
 
-/* The key light of METHOD=sh: its swath's SWATH_DIRECTIONS sweeps on the
- * backend, all kept, then one pass of ts_sh_swath_light into shade (with the
- * normals nm) or share. */
+/* HORIZON_METHOD=pyramid: the swath's horizons from the pyramid (B-spline). */
+static ts_status pyramid_planes(const tsd_compute_ctx *c, const ts_grid *g,
+                                const ts_sh_swath *s, float **planes)
+{
+    double *az = malloc((size_t)s->n * sizeof *az);
+    if (!az)
+        return tsd_fail(c->msg, c->msg_size, TS_ERR_NOMEM, "out of memory for the swath");
+    for (int i = 0; i < s->n; i++)
+        az[i] = ts_sh_swath_azimuth(s, i);
+    ts_status st = tsd_pyramid_planes_at(c, g, s->n, az, planes);
+    free(az);
+    return st;
+}
+
+/* The key light of METHOD=sh: its swath's SWATH_DIRECTIONS horizons (sweeps
+ * on the backend, or the pyramid's with HORIZON_METHOD=pyramid), all kept,
+ * then one pass of ts_sh_swath_light into shade (with the normals nm) or
+ * share. */
 static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd_normals *nm,
                            float *shade, float *share)
 {
@@ -65,7 +81,9 @@ static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
     }
     tsd_compute_horizon_opts(c, &h);
     h.progress = NULL; /* reported here, per sweep */
-    for (int i = 0; st == TS_OK && i < s.n; i++) {
+    if (o->horizon_method == TSD_HORIZON_PYRAMID)
+        st = pyramid_planes(c, g, &s, planes);
+    for (int i = 0; o->horizon_method != TSD_HORIZON_PYRAMID && st == TS_OK && i < s.n; i++) {
         ts_backend_report rep = {0};
         if ((st = tsd_compute_report(c, (double)i / s.n)) != TS_OK)
             break;

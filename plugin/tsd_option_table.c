@@ -257,8 +257,8 @@ const opt_def TSD_OPTION_ROWS[] = {
     /* pyramid horizons (tsd_pyramid.c, docs/methods.md) */
     {"HORIZON_METHOD", K_SELECT, FIELD(horizon_method), "exact", 0, 0, 0, 0, "exact|pyramid",
      1, P, LISTED, NULL,
-     "How the horizons of horizon, svf, openness, sky, envlight and the sky term "
-     "of shade are found: exact (the sweep) or pyramid (Snyder & Nowrouzezahrai "
+     "How the horizons of horizon, svf, openness, sky, envlight, the sky term "
+     "of shade and METHOD=sh's key light are found: exact (the sweep) or pyramid (Snyder & Nowrouzezahrai "
      "2008: a multi-resolution pyramid, approximate, smoother with distance; "
      "PYRAMID_LEVEL_STEP, PYRAMID_OFFSET; runs on the C backend)"},
     {"PYRAMID_LEVEL_STEP", K_FLOAT, FIELD(pyramid_level_step), "4", 1, 16, 0, 1, NULL, 1, P,

@@ -17,14 +17,16 @@ int tsd_options_check_pyramid(const tsd_options *o, char *msg, size_t n)
     char list[256];
     for (size_t i = 0; i < sizeof own / sizeof own[0]; i++) {
         int id = tsd_option_find(own[i]);
-        if (!tsd_options_given(o, own[i]) || tsd_product_takes(p, id))
+        /* METHOD=sh's key light (shade, shadow) is built from horizons */
+        if (!tsd_options_given(o, own[i]) || tsd_product_takes(p, id) ||
+            o->method == TSD_METHOD_SH)
             continue;
         tsd_products_taking(id, "PRODUCT=", " and ", list, sizeof list);
         REFUSE("%s applies to the products that use horizons (%s; shade: its sky term), "
                "not to PRODUCT=%s%s",
                own[i], list, p->name,
                tsd_product_takes(p, tsd_option_find("METHOD"))
-                   ? ", whose shadows METHOD chooses (exact or shm)"
+                   ? ", whose shadows METHOD chooses (with METHOD=sh from horizons)"
                    : "");
     }
     /* as SVF_MODEL: a value that would do nothing is a mistake; the
@@ -41,9 +43,11 @@ int tsd_options_check_pyramid(const tsd_options *o, char *msg, size_t n)
                    which);
         return 0;
     }
-    if (tsd_product_takes(p, tsd_option_find("SKY_WEIGHT")) && !(o->sky_weight > 0))
+    if (tsd_product_takes(p, tsd_option_find("SKY_WEIGHT")) && !(o->sky_weight > 0) &&
+        o->method != TSD_METHOD_SH)
         REFUSE("HORIZON_METHOD=pyramid applies to the sky term of PRODUCT=%s, which "
-               "SKY_WEIGHT=0 leaves out: give SKY_WEIGHT > 0 (the direct sun follows METHOD)",
+               "SKY_WEIGHT=0 leaves out: give SKY_WEIGHT > 0 (the direct sun follows METHOD; "
+               "METHOD=sh takes its horizons from the pyramid too)",
                p->name);
     return 0;
 }
@@ -76,9 +80,11 @@ static ts_status note_backend(const tsd_compute_ctx *c)
     return TS_OK;
 }
 
-/* The planes of the pyramid read with `rec`, one at a time, to `add`. */
+/* The planes of the pyramid read with `rec`, one at a time, to `add`: at
+ * the `count` azimuths `az` (degrees), or at DIRECTIONS' when az is NULL. */
 static ts_status pyramid_run(const tsd_compute_ctx *c, const ts_grid *g,
-                             ts_pyramid_reconstruction rec, tsd_plane_fn add, void *user)
+                             ts_pyramid_reconstruction rec, int count, const double *azimuths,
+                             tsd_plane_fn add, void *user)
 {
     const tsd_options *o = c->opts;
     ts_horizon_opts h;
@@ -101,9 +107,11 @@ static ts_status pyramid_run(const tsd_compute_ctx *c, const ts_grid *g,
         free(plane);
         return tsd_fail_core(c->msg, c->msg_size, NULL, &err);
     }
-    for (int k = 0; k < h.directions; k++) {
-        double az = ts_horizon_azimuth(&h, k);
-        if ((st = tsd_compute_report(c, (double)k / h.directions)) != TS_OK)
+    if (!azimuths)
+        count = h.directions;
+    for (int k = 0; k < count; k++) {
+        double az = azimuths ? azimuths[k] : ts_horizon_azimuth(&h, k);
+        if ((st = tsd_compute_report(c, (double)k / count)) != TS_OK)
             break;
         if (ts_pyramid_horizon(pyr, az, &h, plane, &err) != TS_OK ||
             add(user, g, k, az, plane, &err) != TS_OK) {
@@ -129,10 +137,25 @@ static ts_status copy_plane(void *user, const ts_grid *g, int k, double azimuth,
 ts_status tsd_pyramid_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_plane_fn add,
                              void *user)
 {
-    return pyramid_run(c, g, TS_PYRAMID_LEVEL_MAX, add, user);
+    return pyramid_run(c, g, TS_PYRAMID_LEVEL_MAX, 0, NULL, add, user);
 }
 
 ts_status tsd_pyramid_planes(const tsd_compute_ctx *c, const ts_grid *g, float *out)
 {
-    return pyramid_run(c, g, TS_PYRAMID_BSPLINE, copy_plane, out);
+    return pyramid_run(c, g, TS_PYRAMID_BSPLINE, 0, NULL, copy_plane, out);
+}
+
+static ts_status copy_to_planes(void *user, const ts_grid *g, int k, double azimuth,
+                                const float *plane, ts_error *err)
+{
+    (void)azimuth;
+    (void)err;
+    memcpy(((float **)user)[k], plane, (size_t)g->width * g->height * sizeof(float));
+    return TS_OK;
+}
+
+ts_status tsd_pyramid_planes_at(const tsd_compute_ctx *c, const ts_grid *g, int count,
+                                const double *azimuths, float **planes)
+{
+    return pyramid_run(c, g, TS_PYRAMID_BSPLINE, count, azimuths, copy_to_planes, planes);
 }

@@ -35,6 +35,11 @@ ts_status tsd_pyramid_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_pla
  * distance and its maximum (S&N eq. 4-5). */
 ts_status tsd_pyramid_planes(const tsd_compute_ctx *c, const ts_grid *g, float *out);
 
+/** The B-spline horizons (as tsd_pyramid_planes) at `count` given azimuths
+ * (degrees), into planes[0 .. count - 1]: METHOD=sh's key light. */
+ts_status tsd_pyramid_planes_at(const tsd_compute_ctx *c, const ts_grid *g, int count,
+                                const double *azimuths, float **planes);
+
 #ifdef __cplusplus
 }
 #endif
