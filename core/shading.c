@@ -24,6 +24,20 @@ double ts_disk_fraction(double light_elevation, double horizon, double radius)
     return 0.5 + (u * sqrt(1.0 - u * u) + asin(u)) / M_PI;
 }
 
+int ts_light_clears_horizontal(double light_elevation, double radius)
+{
+    if (radius == 0)
+        radius = TS_SUN_RADIUS_DEG;
+    if (!(radius > 0) || !(light_elevation <= 90))
+        return 0;
+    /* the horizon 0 in ts_disk_fraction's u and in cm_direct_sun's: a
+     * lower horizon gives a u at least as large (monotonic rounding), and
+     * every u >= 1 the same fraction */
+    double u = (light_elevation - 0.0) / radius;
+    float uf = ((float)light_elevation - 0.0f) * (float)(1.0 / radius);
+    return u >= 1.0 && uf >= 1.0f;
+}
+
 ts_status ts_check_light_radius(double radius, ts_error *err)
 {
     if (!(radius > 0 && radius < TS_LIGHT_RADIUS_MAX))

@@ -256,6 +256,9 @@ static ts_status sun_horizon(const tsd_compute_ctx *c, const ts_grid *g, ts_hori
     h->directions = 1;
     h->start_azimuth = c->run->sun_azimuth;
     h->progress = NULL; /* one sweep */
+    /* read only through the sun's disk (the direct term, the shadow) */
+    h->nonpositive_moot = ts_light_clears_horizontal(c->run->sun_elevation,
+                                                     c->opts->light_radius);
     if (NOTE(c, ts_backend_horizon_sweep(BK(c), g, c->run->sun_azimuth, h, plane, &rep, &err),
              rep) != TS_OK ||
         ts_horizon_earth_floor(g, h, plane, &err) != TS_OK) /* EDGE=horizon */
