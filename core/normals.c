@@ -4,6 +4,7 @@
 
 #include "arg_checks.h"
 #include "cellmath/cm_normals.h"
+#include "horn_row.h"
 #include "parallel.h"
 #include "status_internal.h"
 
@@ -43,27 +44,29 @@ static void horn_interior(const float *restrict up, const float *restrict mid,
     }
 }
 
+void ts_horn_row(const ts_grid *g, int y, float *nx, float *ny, float *nz)
+{
+    const int W = g->width, H = g->height;
+    double ew = 8.0 * ts_grid_cell_x(g, y), ns = 8.0 * g->cell_y;
+    int inner = y > 0 && y < H - 1 && W > 2;
+    for (int x = 0; x < W; x++) {
+        if (inner && x == 1) {
+            const float *mid = g->z + (ptrdiff_t)y * g->stride;
+            horn_interior(mid - g->stride, mid, mid + g->stride, 1, W - 1, ew, ns, nx, ny, nz);
+            x = W - 2;
+            continue;
+        }
+        cm_horn_normal(g->z, g->stride, W, H, x, y, ew, ns, &nx[x], &ny[x], &nz[x]);
+    }
+}
+
 static void normals_rows(void *ctx, int worker, long y0, long y1)
 {
     (void)worker;
     const normals_ctx *C = ctx;
-    const ts_grid *g = C->g;
-    const int W = g->width, H = g->height;
     for (int y = (int)y0; y < (int)y1; y++) {
-        double ew = 8.0 * ts_grid_cell_x(g, y), ns = 8.0 * g->cell_y;
-        size_t o = (size_t)y * W;
-        int inner = y > 0 && y < H - 1 && W > 2;
-        for (int x = 0; x < W; x++) {
-            if (inner && x == 1) {
-                const float *mid = g->z + (ptrdiff_t)y * g->stride;
-                horn_interior(mid - g->stride, mid, mid + g->stride, 1, W - 1, ew, ns,
-                              C->nx + o, C->ny + o, C->nz + o);
-                x = W - 2;
-                continue;
-            }
-            cm_horn_normal(g->z, g->stride, W, H, x, y, ew, ns, &C->nx[o + x], &C->ny[o + x],
-                           &C->nz[o + x]);
-        }
+        size_t o = (size_t)y * C->g->width;
+        ts_horn_row(C->g, y, C->nx + o, C->ny + o, C->nz + o);
     }
 }
 

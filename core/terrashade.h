@@ -362,6 +362,14 @@ typedef ts_status ts_shade_direct_fn(const ts_direct_request *req, ts_error *err
 /** The direct sun on the C backend. */
 ts_shade_direct_fn ts_shade_direct;
 
+/**
+ * ts_shade_direct with the normals computed on the fly, row by row, from
+ * req->grid by Horn's method (as ts_normals): req->nx, ny, nz are not read
+ * and may be NULL. The same values as ts_normals then ts_shade_direct,
+ * without the three planes of normals.
+ */
+ts_shade_direct_fn ts_shade_direct_horn;
+
 /** Which sky-view factor the svf output of the sky terms holds. */
 typedef enum {
     /** Timonen eq. 5 with the cell's normal: the cosine-weighted visible
