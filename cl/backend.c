@@ -191,6 +191,32 @@ ts_status ts_backend_shade_direct(ts_backend backend, const ts_direct_request *r
     DISPATCH(ts_cl_shade_direct(req, cl_err), ts_shade_direct(req, err));
 }
 
+/* The normals on the device into planes, then the direct sun from them. */
+static ts_status cl_shade_direct_horn(const ts_direct_request *req, ts_error *err)
+{
+    if (!req || !req->grid)
+        return ts_fail(err, TS_ERR_ARG, "the direct sun request and its grid must be set");
+    size_t cells = (size_t)req->grid->width * req->grid->height;
+    float *n = malloc(3 * cells * sizeof *n);
+    if (!n)
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the planes of normals");
+    ts_direct_request r = *req;
+    r.nx = n;
+    r.ny = n + cells;
+    r.nz = n + 2 * cells;
+    ts_status st = ts_cl_normals(req->grid, n, n + cells, n + 2 * cells, err);
+    if (st == TS_OK)
+        st = ts_cl_shade_direct(&r, err);
+    free(n);
+    return st;
+}
+
+ts_status ts_backend_shade_direct_horn(ts_backend backend, const ts_direct_request *req,
+                                       ts_backend_report *report, ts_error *err)
+{
+    DISPATCH(cl_shade_direct_horn(req, cl_err), ts_shade_direct_horn(req, err));
+}
+
 ts_status ts_backend_shadowmap_compute(ts_backend backend, const ts_grid *grid, double azimuth,
                                        double elevation, const ts_shadowmap_opts *opts,
                                        float *visibility, ts_backend_report *report,

@@ -87,6 +87,12 @@ ts_status ts_backend_normals(ts_backend backend, const ts_grid *grid, float *nx,
 ts_status ts_backend_shade_direct(ts_backend backend, const ts_direct_request *req,
                                   ts_backend_report *report, ts_error *err);
 
+/* ts_backend_shade_direct with the normals of req->grid made on the way
+ * (req->nx, ny, nz unused): on C without planes of normals
+ * (ts_shade_direct_horn), on OpenCL from ts_cl_normals' planes. */
+ts_status ts_backend_shade_direct_horn(ts_backend backend, const ts_direct_request *req,
+                                       ts_backend_report *report, ts_error *err);
+
 /** ts_shadowmap_compute (terrashade_shadowmap.h). */
 ts_status ts_backend_shadowmap_compute(ts_backend backend, const ts_grid *grid,
                                        double azimuth, double elevation,

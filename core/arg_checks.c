@@ -100,6 +100,14 @@ ts_status ts_check_sky_request(const ts_sky_request *req, ts_error *err)
 
 ts_status ts_direct_setup(const ts_direct_request *req, ts_direct_plan *plan, ts_error *err)
 {
+    if (req && (!req->nx || !req->ny || !req->nz))
+        return ts_fail(err, TS_ERR_ARG, "normals, horizons and output must not be NULL");
+    return ts_direct_setup_horn(req, plan, err);
+}
+
+ts_status ts_direct_setup_horn(const ts_direct_request *req, ts_direct_plan *plan,
+                               ts_error *err)
+{
     if (!req)
         return ts_fail(err, TS_ERR_ARG, "the direct sun request must not be NULL");
     ts_status st = ts_grid_validate(req->grid, err);
@@ -108,8 +116,8 @@ ts_status ts_direct_setup(const ts_direct_request *req, ts_direct_plan *plan, ts
     const ts_horizon_opts *opts = req->opts;
     if ((st = ts_horizon_opts_validate(opts, err)) != TS_OK)
         return st;
-    if (!req->nx || !req->ny || !req->nz || !req->horizons || !req->out)
-        return ts_fail(err, TS_ERR_ARG, "normals, horizons and output must not be NULL");
+    if (!req->horizons || !req->out)
+        return ts_fail(err, TS_ERR_ARG, "horizons and output must not be NULL");
     const double sun_azimuth = req->sun_azimuth, sun_elevation = req->sun_elevation;
     if (!isfinite(sun_azimuth))
         return ts_fail(err, TS_ERR_ARG, "sun azimuth must be a finite number of degrees, got %g",

@@ -45,6 +45,9 @@ typedef struct {
 
 /* Checks of a ts_direct_request, then its plan. */
 ts_status ts_direct_setup(const ts_direct_request *req, ts_direct_plan *plan, ts_error *err);
+/* The same without the normals (ts_shade_direct_horn computes them). */
+ts_status ts_direct_setup_horn(const ts_direct_request *req, ts_direct_plan *plan,
+                               ts_error *err);
 
 /* Checks of a ts_env_light_request (its outputs only for NULL). */
 ts_status ts_check_env_light_request(const ts_env_light_request *req, ts_error *err);

@@ -18,6 +18,7 @@ void ts_horizon_opts_default(ts_horizon_opts *opts)
     opts->progress = NULL;
     opts->progress_user = NULL;
     opts->edge = TS_EDGE_OPEN;
+    opts->nonpositive_moot = 0;
 }
 
 ts_status ts_horizon_opts_validate(const ts_horizon_opts *opts, ts_error *err)

@@ -91,6 +91,7 @@ typedef struct {
     double c;             /* drop per square metre: (1 - k) / 2R, or 0 */
     float *plane;         /* the horizons, or the sun's visibility */
     double sun_elevation; /* ts_horizon_edge_sun */
+    int skip_nonneg;      /* nonpositive_moot: cells of height >= 0 left as they are */
 } edge_job;
 
 static edge_job edge_job_of(const ts_grid *grid, double azimuth, const ts_horizon_opts *o,
@@ -99,7 +100,10 @@ static edge_job edge_job_of(const ts_grid *grid, double azimuth, const ts_horizo
     edge_job j = {grid, o, edge_ray_of(grid, azimuth),
                   o->max_distance > 0 ? o->max_distance : INFINITY,
                   o->curvature ? (1.0 - o->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0, plane,
-                  sun_elevation};
+                  sun_elevation, 0};
+    /* from a height h >= 0 (with c >= 0) the edge's tangent (-h - c s^2) / s
+     * is <= 0: its raise stays at or below 0 deg, moot to the caller */
+    j.skip_nonneg = o->nonpositive_moot && o->edge == TS_EDGE_HORIZON && j.c >= 0;
     return j;
 }
 
@@ -134,8 +138,9 @@ static void edge_rows(void *ctx, int worker, long begin, long end)
     const edge_job *j = ctx;
     for (long y = begin; y < end; y++) {
         float *row = j->plane + (size_t)y * j->grid->width;
+        const float *z = j->grid->z + (ptrdiff_t)y * j->grid->stride;
         for (int x = 0; x < j->grid->width; x++)
-            if (!isnan(row[x])) /* nodata stays nodata */
+            if (!isnan(row[x]) && !(j->skip_nonneg && z[x] >= 0)) /* nodata stays nodata */
                 row[x] = edge_raise(j, x, (int)y, row[x]);
     }
 }
@@ -143,6 +148,8 @@ static void edge_rows(void *ctx, int worker, long begin, long end)
 /* The Earth's horizon as a floor of horizon v at height h (TS_EDGE_HORIZON). */
 static inline float earth_floor(const ts_horizon_opts *o, float h, float v)
 {
+    if (v >= 0)
+        return v; /* the dip is <= 0: no acos */
     float f = (float)ts_earth_horizon(h, o);
     return f > v ? f : v; /* NaN stays NaN */
 }
@@ -211,7 +218,8 @@ ts_status ts_horizon_earth_floor(const ts_grid *grid, const ts_horizon_opts *opt
                                  float *plane, ts_error *err)
 {
     ts_status st = check_plane_args(grid, opts, plane, err);
-    if (st != TS_OK || opts->edge != TS_EDGE_HORIZON)
+    /* the dip is <= 0 deg: moot where nonpositive_moot says so */
+    if (st != TS_OK || opts->edge != TS_EDGE_HORIZON || opts->nonpositive_moot)
         return st;
     for (int y = 0; y < grid->height; y++)
         for (int x = 0; x < grid->width; x++) {

@@ -4,6 +4,7 @@
 
 #include "arg_checks.h"
 #include "cellmath/cm_normals.h"
+#include "horn_row.h"
 #include "parallel.h"
 #include "status_internal.h"
 
@@ -12,18 +13,60 @@ typedef struct {
     float *nx, *ny, *nz;
 } normals_ctx;
 
+/* The neighbour as cm_neighbour has it inside the grid. */
+static inline float horn_nb(float v, float centre)
+{
+    return isnan(v) ? centre : v;
+}
+
+/* cm_horn_normal of cells x0..x1-1 of a row whose 3x3 neighbourhoods lie
+ * inside the grid (rows up, mid, dn): the same operations in the same order
+ * without the bounds checks, so it vectorises and gives the same bits. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+static void horn_interior(const float *restrict up, const float *restrict mid,
+                          const float *restrict dn, int x0, int x1, double ew, double ns,
+                          float *restrict nx, float *restrict ny, float *restrict nz)
+{
+    for (int x = x0; x < x1; x++) {
+        float e = mid[x];
+        double a = horn_nb(up[x - 1], e), b = horn_nb(up[x], e), c = horn_nb(up[x + 1], e);
+        double d = horn_nb(mid[x - 1], e), f = horn_nb(mid[x + 1], e);
+        double g = horn_nb(dn[x - 1], e), h = horn_nb(dn[x], e), i = horn_nb(dn[x + 1], e);
+        double dzdx = ((c + 2 * f + i) - (a + 2 * d + g)) / ew;
+        double dzdy = ((g + 2 * h + i) - (a + 2 * b + c)) / ns;
+        double inv = 1 / sqrt(1 + dzdx * dzdx + dzdy * dzdy);
+        int nodata = isnan(e);
+        nx[x] = nodata ? NAN : (float)(-dzdx * inv);
+        ny[x] = nodata ? NAN : (float)(dzdy * inv);
+        nz[x] = nodata ? NAN : (float)inv;
+    }
+}
+
+void ts_horn_row(const ts_grid *g, int y, float *nx, float *ny, float *nz)
+{
+    const int W = g->width, H = g->height;
+    double ew = 8.0 * ts_grid_cell_x(g, y), ns = 8.0 * g->cell_y;
+    int inner = y > 0 && y < H - 1 && W > 2;
+    for (int x = 0; x < W; x++) {
+        if (inner && x == 1) {
+            const float *mid = g->z + (ptrdiff_t)y * g->stride;
+            horn_interior(mid - g->stride, mid, mid + g->stride, 1, W - 1, ew, ns, nx, ny, nz);
+            x = W - 2;
+            continue;
+        }
+        cm_horn_normal(g->z, g->stride, W, H, x, y, ew, ns, &nx[x], &ny[x], &nz[x]);
+    }
+}
+
 static void normals_rows(void *ctx, int worker, long y0, long y1)
 {
     (void)worker;
     const normals_ctx *C = ctx;
-    const ts_grid *g = C->g;
     for (int y = (int)y0; y < (int)y1; y++) {
-        double ew = 8.0 * ts_grid_cell_x(g, y), ns = 8.0 * g->cell_y;
-        for (int x = 0; x < g->width; x++) {
-            size_t o = (size_t)y * g->width + x;
-            cm_horn_normal(g->z, g->stride, g->width, g->height, x, y, ew, ns, &C->nx[o],
-                           &C->ny[o], &C->nz[o]);
-        }
+        size_t o = (size_t)y * C->g->width;
+        ts_horn_row(C->g, y, C->nx + o, C->ny + o, C->nz + o);
     }
 }
 

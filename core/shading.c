@@ -1,8 +1,10 @@
 /* Direct sun with the visible fraction of the sun's disk, and the final mix. */
 #include <math.h>
+#include <stdlib.h>
 
 #include "arg_checks.h"
 #include "cellmath/cm_sun.h"
+#include "horn_row.h"
 #include "parallel.h"
 #include "status_internal.h"
 
@@ -22,6 +24,20 @@ double ts_disk_fraction(double light_elevation, double horizon, double radius)
         return 0.0;
     /* Area of the disk above a horizontal chord at height -u radii. */
     return 0.5 + (u * sqrt(1.0 - u * u) + asin(u)) / M_PI;
+}
+
+int ts_light_clears_horizontal(double light_elevation, double radius)
+{
+    if (radius == 0)
+        radius = TS_SUN_RADIUS_DEG;
+    if (!(radius > 0) || !(light_elevation <= 90))
+        return 0;
+    /* the horizon 0 in ts_disk_fraction's u and in cm_direct_sun's: a
+     * lower horizon gives a u at least as large (monotonic rounding), and
+     * every u >= 1 the same fraction */
+    double u = (light_elevation - 0.0) / radius;
+    float uf = ((float)light_elevation - 0.0f) * (float)(1.0 / radius);
+    return u >= 1.0 && uf >= 1.0f;
 }
 
 ts_status ts_check_light_radius(double radius, ts_error *err)
@@ -54,18 +70,76 @@ static void direct_range(void *ctx, int worker, long begin, long end)
         out[i] = cm_direct_sun(nx[i], ny[i], nz[i], h0[i], h1[i], w, lx, ly, lz, el, inv_r);
 }
 
-ts_status ts_shade_direct(const ts_direct_request *req, ts_error *err)
+/* The direct term's loop state of a checked request and its plan. */
+static direct_ctx direct_ctx_of(const ts_direct_request *req, const ts_direct_plan *p)
+{
+    size_t plane = (size_t)req->grid->width * req->grid->height;
+    direct_ctx C = {req->nx, req->ny, req->nz, req->horizons + plane * p->k0,
+                    req->horizons + plane * p->k1, (float)p->w, p->light[0], p->light[1],
+                    p->light[2], req->sun_elevation, p->radius, req->out};
+    return C;
+}
+
+typedef struct {
+    direct_ctx d;
+    const ts_grid *grid;
+    int *alloc_failed;
+} direct_horn_ctx;
+
+/* Rows begin..end-1: the Horn normals of a row into row buffers, then
+ * direct_range's term from them; the same bits as the two passes. */
+static void direct_horn_rows(void *ctx, int worker, long begin, long end)
+{
+    (void)worker;
+    const direct_horn_ctx *C = ctx;
+    const int W = C->grid->width;
+    float *n = malloc(3 * (size_t)W * sizeof *n);
+    if (!n) {
+        __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
+        return;
+    }
+    for (long y = begin; y < end; y++) {
+        size_t o = (size_t)y * W;
+        ts_horn_row(C->grid, (int)y, n, n + W, n + 2 * (size_t)W);
+        direct_ctx row = C->d; /* this row's cells from index 0 */
+        row.nx = n;
+        row.ny = n + W;
+        row.nz = n + 2 * (size_t)W;
+        row.h0 += o;
+        row.h1 += o;
+        row.out += o;
+        direct_range(&row, worker, 0, W);
+    }
+    free(n);
+}
+
+/* The direct sun from the request's normals, or (horn) from rows of Horn
+ * normals made on the way. */
+static ts_status shade_direct(const ts_direct_request *req, int horn, ts_error *err)
 {
     ts_direct_plan p;
-    ts_status st = ts_direct_setup(req, &p, err);
+    ts_status st = horn ? ts_direct_setup_horn(req, &p, err) : ts_direct_setup(req, &p, err);
     if (st != TS_OK)
         return st;
     size_t plane = (size_t)req->grid->width * req->grid->height;
-    direct_ctx C = {req->nx, req->ny, req->nz, req->horizons + plane * p.k0,
-                    req->horizons + plane * p.k1, (float)p.w, p.light[0], p.light[1],
-                    p.light[2], req->sun_elevation, p.radius, req->out};
-    return ts_parallel_for(ts_thread_count(0, (long)(plane >> 16) + 1), (long)plane,
-                           direct_range, &C, err);
+    int threads = ts_thread_count(0, (long)(plane >> 16) + 1), failed = 0;
+    direct_horn_ctx C = {direct_ctx_of(req, &p), req->grid, &failed};
+    if (!horn)
+        return ts_parallel_for(threads, (long)plane, direct_range, &C.d, err);
+    st = ts_parallel_for(threads, req->grid->height, direct_horn_rows, &C, err);
+    if (st == TS_OK && failed)
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the rows of normals");
+    return st;
+}
+
+ts_status ts_shade_direct(const ts_direct_request *req, ts_error *err)
+{
+    return shade_direct(req, 0, err);
+}
+
+ts_status ts_shade_direct_horn(const ts_direct_request *req, ts_error *err)
+{
+    return shade_direct(req, 1, err);
 }
 
 ts_status ts_shade_combine(const ts_grid *grid, const float *direct, const float *sky,

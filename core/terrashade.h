@@ -155,6 +155,13 @@ typedef struct {
     ts_progress_fn progress; /**< NULL = no progress reports */
     void *progress_user;  /**< passed to progress */
     ts_edge_mode edge;    /**< the world beyond the grid's edge */
+    /** 1: the caller reads the horizons only through a light whose disk is
+     * wholly above the horizontal (ts_light_clears_horizontal), to which
+     * every horizon at or below 0 deg is the same; the TS_EDGE_HORIZON
+     * raises that cannot lift a cell above 0 deg (the sea-level surface
+     * seen from a height >= 0, the Earth's horizon) are then skipped.
+     * 0 (the default): every horizon exact. */
+    int nonpositive_moot;
 } ts_horizon_opts;
 
 /** Defaults: 16 directions from 0 deg, unbounded, curvature on, k = 0.13,
@@ -314,6 +321,16 @@ double ts_sun_disk_fraction(double sun_elevation, double horizon);
  */
 double ts_disk_fraction(double light_elevation, double horizon, double radius);
 
+/**
+ * 1 if a light at `light_elevation` of angular radius `radius` degrees
+ * (0: TS_SUN_RADIUS_DEG) is wholly visible above every horizon at or below
+ * 0 deg, in ts_disk_fraction's double arithmetic and in the float one of the
+ * direct sun (cm_direct_sun, both backends): both are monotonic in the
+ * horizon, so a horizon raised from one value <= 0 to another changes no
+ * lit fraction (ts_horizon_opts.nonpositive_moot). 0 otherwise.
+ */
+int ts_light_clears_horizontal(double light_elevation, double radius);
+
 /** TS_OK if 0 < radius < TS_LIGHT_RADIUS_MAX degrees, else TS_ERR_ARG with
  * a sentence. */
 ts_status ts_check_light_radius(double radius, ts_error *err);
@@ -344,6 +361,14 @@ typedef ts_status ts_shade_direct_fn(const ts_direct_request *req, ts_error *err
 
 /** The direct sun on the C backend. */
 ts_shade_direct_fn ts_shade_direct;
+
+/**
+ * ts_shade_direct with the normals computed on the fly, row by row, from
+ * req->grid by Horn's method (as ts_normals): req->nx, ny, nz are not read
+ * and may be NULL. The same values as ts_normals then ts_shade_direct,
+ * without the three planes of normals.
+ */
+ts_shade_direct_fn ts_shade_direct_horn;
 
 /** Which sky-view factor the svf output of the sky terms holds. */
 typedef enum {

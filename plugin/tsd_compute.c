@@ -256,6 +256,9 @@ static ts_status sun_horizon(const tsd_compute_ctx *c, const ts_grid *g, ts_hori
     h->directions = 1;
     h->start_azimuth = c->run->sun_azimuth;
     h->progress = NULL; /* one sweep */
+    /* read only through the sun's disk (the direct term, the shadow) */
+    h->nonpositive_moot = ts_light_clears_horizontal(c->run->sun_elevation,
+                                                     c->opts->light_radius);
     if (NOTE(c, ts_backend_horizon_sweep(BK(c), g, c->run->sun_azimuth, h, plane, &rep, &err),
              rep) != TS_OK ||
         ts_horizon_earth_floor(g, h, plane, &err) != TS_OK) /* EDGE=horizon */
@@ -317,7 +320,10 @@ static ts_status shade_direct(const tsd_compute_ctx *c, const ts_grid *g, const 
         const ts_direct_request req = {g, nm->nx, nm->ny, nm->nz, work, &h,
                                        c->run->sun_azimuth, c->run->sun_elevation, out,
                                        c->opts->light_radius};
-        if (NOTE(c, ts_backend_shade_direct(BK(c), &req, &rep, &err), rep) != TS_OK)
+        /* without planes of normals (no sky term): made row by row */
+        st = nm->nx ? ts_backend_shade_direct(BK(c), &req, &rep, &err)
+                    : ts_backend_shade_direct_horn(BK(c), &req, &rep, &err);
+        if (NOTE(c, st, rep) != TS_OK)
             return core_fail(c, &err);
         return TS_OK;
     }
@@ -341,9 +347,12 @@ TSD_COMPUTE_FN(tsd_compute_shade)
     ts_error err;
     ts_status st;
     float *work = malloc(cells * sizeof(float));
+    /* the exact method's direct sun alone makes its normals row by row */
+    int planes = !(c->opts->method == TSD_METHOD_EXACT && !sun_lattice(c) &&
+                   !(c->opts->sky_weight > 0));
     if (!work)
         st = oom(c, "a horizon plane");
-    else if ((st = tsd_normals_make(c, g, &nm)) == TS_OK &&
+    else if ((st = planes ? tsd_normals_make(c, g, &nm) : TS_OK) == TS_OK &&
              (st = shade_direct(c, g, &nm, work, out)) == TS_OK && c->opts->sky_weight > 0) {
         memset(work, 0, cells * sizeof(float));
         /* the uniform sky, or that of SKY / ENV_MAP (tsd_compute_env.c) */

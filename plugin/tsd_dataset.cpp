@@ -90,26 +90,44 @@ CPLErr TSRasterBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
         return CE_None;
     }
     const float *plane = ds->m_pafProduct + static_cast<size_t>(m_nPlane) * W * H;
-    float *pafOut = static_cast<float *>(pImage);
-    const float fNaN = std::numeric_limits<float>::quiet_NaN();
+    const int n = x0 < W ? std::min(nBlockXSize, W - x0) : 0; // cells on the grid per row
     for (int by = 0; by < nBlockYSize; by++)
     {
         const int y = y0 + by;
         const int gy = ds->m_sCells.flip_y ? H - 1 - y : y;
         const float *row = y < H ? plane + static_cast<size_t>(gy) * W : nullptr;
-        for (int bx = 0; bx < nBlockXSize; bx++)
-        {
-            const int x = x0 + bx;
-            const int gx = ds->m_sCells.flip_x ? W - 1 - x : x;
-            const float v = row && x < W ? row[gx] : fNaN;
-            const size_t i = static_cast<size_t>(by) * nBlockXSize + bx;
-            if (bByte)
-                pabyOut[i] = tsd_to_byte(v);
-            else
-                pafOut[i] = v;
-        }
+        const size_t i0 = static_cast<size_t>(by) * nBlockXSize;
+        CopyRow(row ? n : 0, row, x0, W, ds->m_sCells.flip_x != 0, bByte, pabyOut + i0,
+                static_cast<float *>(pImage) + i0);
     }
     return CE_None;
+}
+
+/* Cells x0 .. x0+n-1 of a product row (mirrored when flip_x) into a block
+ * row, as bytes (tsd_to_byte) or floats; the rest of the block row is
+ * nodata. Split by case so that each loop is a plain one. */
+void TSRasterBand::CopyRow(int n, const float *row, int x0, int W, bool flip_x, bool bByte,
+                           GByte *pabyOut, float *pafOut) const
+{
+    if (bByte && !flip_x)
+        for (int bx = 0; bx < n; bx++)
+            pabyOut[bx] = tsd_to_byte(row[x0 + bx]);
+    else if (bByte)
+        for (int bx = 0; bx < n; bx++)
+            pabyOut[bx] = tsd_to_byte(row[W - 1 - (x0 + bx)]);
+    else if (!flip_x)
+        memcpy(pafOut, row + x0, static_cast<size_t>(n) * sizeof(float));
+    else
+        for (int bx = 0; bx < n; bx++)
+            pafOut[bx] = row[W - 1 - (x0 + bx)];
+    const float fNaN = std::numeric_limits<float>::quiet_NaN();
+    for (int bx = n; bx < nBlockXSize; bx++)
+    {
+        if (bByte)
+            pabyOut[bx] = tsd_to_byte(fNaN);
+        else
+            pafOut[bx] = fNaN;
+    }
 }
 
 /* ------------------------------------------------------------- dataset */

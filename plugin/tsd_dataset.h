@@ -109,6 +109,8 @@ class TSRasterBand final : public GDALPamRasterBand
     int m_nPlane;
     GDALColorInterp m_eColor = GCI_GrayIndex;
     CPLErr WindowReadBlock(int nBlockXOff, int nBlockYOff, void *pImage); // tsd_window_cache.cpp
+    void CopyRow(int n, const float *row, int x0, int W, bool flip_x, bool bByte, GByte *pabyOut,
+                 float *pafOut) const;
 
   public:
     TSRasterBand(TSDataset *poDSIn, int nBandIn, GDALDataType eType);

@@ -256,6 +256,9 @@ static ts_status far_edge(const tsd_compute_ctx *c, const ts_grid *g, double azi
     tsd_compute_horizon_opts(c, &h);
     h.max_distance = c->opts->max_distance;
     h.edge = tsd_options_edge(c->opts);
+    /* under the sun, read only through its disk (sun_horizon) */
+    h.nonpositive_moot = sun && ts_light_clears_horizontal(c->run->sun_elevation,
+                                                           c->opts->light_radius);
     if (ts_horizon_edge_apply(g, azimuth, &h, plane, &err) != TS_OK ||
         (sun && ts_horizon_earth_floor(g, &h, plane, &err) != TS_OK))
         return tsd_fail_core(c->msg, c->msg_size, NULL, &err);

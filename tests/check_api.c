@@ -138,14 +138,14 @@ START_TEST(test_horizon_args)
     EXPECT_ARG(ts_horizon_sweep_lines(NULL, 0, &o, noop_visit, NULL, err), err);
 
     const struct { const char *field; ts_horizon_opts o; } bad[] = {
-        {"direction", {0, 0, 0, 1, 0.13, 0, NULL, NULL, TS_EDGE_OPEN}},
-        {"direction", {-5, 0, 0, 1, 0.13, 0, NULL, NULL, TS_EDGE_OPEN}},
-        {"refraction", {16, 0, 0, 1, -0.01, 0, NULL, NULL, TS_EDGE_OPEN}},
-        {"refraction", {16, 0, 0, 1, 1.01, 0, NULL, NULL, TS_EDGE_OPEN}},
-        {"refraction", {16, 0, 0, 1, NAN, 0, NULL, NULL, TS_EDGE_OPEN}},
-        {"azimuth", {16, NAN, 0, 1, 0.13, 0, NULL, NULL, TS_EDGE_OPEN}},
-        {"distance", {16, 0, -1, 1, 0.13, 0, NULL, NULL, TS_EDGE_OPEN}},
-        {"distance", {16, 0, NAN, 1, 0.13, 0, NULL, NULL, TS_EDGE_OPEN}},
+        {"direction", {0, 0, 0, 1, 0.13, 0, NULL, NULL, TS_EDGE_OPEN, 0}},
+        {"direction", {-5, 0, 0, 1, 0.13, 0, NULL, NULL, TS_EDGE_OPEN, 0}},
+        {"refraction", {16, 0, 0, 1, -0.01, 0, NULL, NULL, TS_EDGE_OPEN, 0}},
+        {"refraction", {16, 0, 0, 1, 1.01, 0, NULL, NULL, TS_EDGE_OPEN, 0}},
+        {"refraction", {16, 0, 0, 1, NAN, 0, NULL, NULL, TS_EDGE_OPEN, 0}},
+        {"azimuth", {16, NAN, 0, 1, 0.13, 0, NULL, NULL, TS_EDGE_OPEN, 0}},
+        {"distance", {16, 0, -1, 1, 0.13, 0, NULL, NULL, TS_EDGE_OPEN, 0}},
+        {"distance", {16, 0, NAN, 1, 0.13, 0, NULL, NULL, TS_EDGE_OPEN, 0}},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         const ts_horizon_opts *b = &bad[i].o;

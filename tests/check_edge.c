@@ -235,6 +235,54 @@ START_TEST(test_edge_sun)
 }
 END_TEST
 
+/* nonpositive_moot: under a sun that clears the horizontal, the sweep's
+ * plane with its EDGE raises and Earth's floor skipped where they stay
+ * <= 0 deg lights every cell as the exact plane does; cells below sea
+ * level keep their exact horizons; a grazing sun does not clear. */
+START_TEST(test_nonpositive_moot)
+{
+    ts_grid g;
+    tdem_create(&g, 48, 40, 30.0, 30.0);
+    tdem_fractal(&g, 9, 400.0);
+    ck_assert(g.stride == g.width); /* cell i is z[i] */
+    size_t n = (size_t)g.width * g.height;
+    float lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        lo = g.z[i] < lo ? g.z[i] : lo;
+        hi = g.z[i] > hi ? g.z[i] : hi;
+    }
+    for (size_t i = 0; i < n; i++) /* 0 m at 30 % of the relief: some cells below */
+        g.z[i] -= lo + 0.3f * (hi - lo);
+    float *exact = tdem_floats(n), *moot = tdem_floats(n);
+    ts_horizon_opts o = opts_edge(TS_EDGE_HORIZON, 1, 0), m = o;
+    m.nonpositive_moot = 1;
+    const double az = 250.0, el = 5.0;
+    ck_assert(ts_light_clears_horizontal(el, 0) && ts_light_clears_horizontal(0.27, 0.2666));
+    ck_assert(!ts_light_clears_horizontal(0.2, 0) && !ts_light_clears_horizontal(-3, 0));
+    ts_error err;
+    ck_assert_msg(ts_horizon_sweep(&g, az, &o, exact, &err) == TS_OK, "%s", err.message);
+    ck_assert(ts_horizon_earth_floor(&g, &o, exact, &err) == TS_OK);
+    ck_assert_msg(ts_horizon_sweep(&g, az, &m, moot, &err) == TS_OK, "%s", err.message);
+    ck_assert(ts_horizon_earth_floor(&g, &m, moot, &err) == TS_OK);
+    int below = 0, skipped = 0;
+    for (size_t i = 0; i < n; i++) {
+        ck_assert(ts_sun_disk_fraction(el, exact[i]) == ts_sun_disk_fraction(el, moot[i]));
+        ck_assert(moot[i] <= exact[i] && (moot[i] == exact[i] || exact[i] <= 0));
+        skipped += moot[i] != exact[i];
+        if (g.z[i] < 0) {
+            below++;
+            ck_assert(moot[i] == exact[i] || exact[i] == 0); /* only the floor of 0 */
+        }
+    }
+    printf("  moot: %d of %zu cells below sea level, %d horizons left lower\n", below, n,
+           skipped);
+    ck_assert(below > 0 && skipped > 0);
+    free(exact);
+    free(moot);
+    ts_grid_free(&g);
+}
+END_TEST
+
 START_TEST(test_bad_mode)
 {
     ts_grid g;
@@ -262,6 +310,7 @@ int main(void)
     tcase_add_test(t, test_sweep_modes);
     tcase_add_test(t, test_earth_floor);
     tcase_add_test(t, test_edge_sun);
+    tcase_add_test(t, test_nonpositive_moot);
     tcase_add_test(t, test_bad_mode);
     suite_add_tcase(s, t);
     return test_run_suite_mode(s, CK_VERBOSE);

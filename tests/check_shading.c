@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "terrashade.h"
 #include "test_grid.h"
@@ -360,6 +361,35 @@ START_TEST(test_sky_rough)
 }
 END_TEST
 
+/* Normals made row by row on the way (ts_shade_direct_horn): the same bits
+ * as the planes of ts_normals then ts_shade_direct, nodata included. */
+START_TEST(test_direct_horn_same_bits)
+{
+    ts_grid g;
+    tdem_create(&g, 61, 47, 10.0, 12.0);
+    tdem_fractal(&g, 5, 300.0);
+    g.z[20 * g.stride + 30] = NAN;
+    g.z[0 * g.stride + 3] = NAN;
+    g.z[46 * g.stride + 60] = NAN;
+    lit L = light_setup(&g);
+    float *a = tdem_floats(L.n), *b = tdem_floats(L.n);
+    const double sun[][2] = {{100, 20}, {315, 45}, {22.5, 3}, {200, 0.1}, {90, -2}};
+    for (int k = 0; k < 5; k++) {
+        direct(&g, &L, sun[k][0], sun[k][1], a);
+        ts_error err;
+        const ts_direct_request req = {&g, NULL, NULL, NULL, L.hor, &L.o,
+                                       sun[k][0], sun[k][1], b, TS_SUN_RADIUS_DEG};
+        ck_assert_msg(ts_shade_direct_horn(&req, &err) == TS_OK, "%s", err.message);
+        ck_assert_msg(memcmp(a, b, L.n * sizeof *a) == 0, "sun %g/%g: other bits",
+                      sun[k][0], sun[k][1]);
+    }
+    free(a);
+    free(b);
+    light_free(&L);
+    ts_grid_free(&g);
+}
+END_TEST
+
 int main(void)
 {
     setvbuf(stdout, NULL, _IOLBF, 0); /* lines reach the log before a failure exits */
@@ -371,6 +401,7 @@ int main(void)
     tcase_add_test(tc, test_normals_signs);
     tcase_add_test(tc, test_direct_flat);
     tcase_add_test(tc, test_direct_tilted);
+    tcase_add_test(tc, test_direct_horn_same_bits);
     tcase_add_test(tc, test_direct_pillar_shadow);
     tcase_add_test(tc, test_combine);
     tcase_add_test(tc, test_sky_flat_and_tilted);
