@@ -77,8 +77,12 @@ void ts_env_free(ts_env *env);
 
 /** The most pixels a map may have (2^26, e.g. 8192 x 8192; a 16384 x 8192
  *  lat-long map is refused): reading takes 12 bytes a pixel, plus 28 a
- *  texel (see max_texels). */
+ *  texel (see max_texels). The fuzz build (tests/fuzz/build.sh) sets a
+ *  smaller limit, so that a few-byte file declaring a legal but huge,
+ *  highly compressible map cannot spend libFuzzer's per-input time on it. */
+#ifndef TS_ENV_MAX_PIXELS
 #define TS_ENV_MAX_PIXELS ((size_t)1 << 26)
+#endif
 
 /** An environment from a lat-long image in OpenEXR's convention (above):
  *  rgb holds width x height pixels, row 0 (the zenith) first, three floats

@@ -23,7 +23,9 @@ if ! command -v "$CC" >/dev/null 2>&1; then
 fi
 SAN="-fsanitize=address,undefined -fno-sanitize-recover=undefined"
 # Warnings are the gcc build's business for core/ and plugin/; the targets get them.
-CFLAGS="-std=c11 -D_GNU_SOURCE -g -O1 -fno-omit-frame-pointer -Werror=implicit-function-declaration $SAN"
+# environment maps of at most 2^20 pixels (terrashade_env.h): a legal 2^26-pixel
+# map takes longer than libFuzzer's per-input timeout under ASan
+CFLAGS="-std=c11 -D_GNU_SOURCE -DTS_ENV_MAX_PIXELS=((size_t)1<<20) -g -O1 -fno-omit-frame-pointer -Werror=implicit-function-declaration $SAN"
 WARN="-Wall -Wextra"
 INC="-I$SRC/core -I$SRC/plugin -I$SRC/cl"
 LIBS="-llzma -lm -lpthread"
