@@ -80,10 +80,6 @@ static int fill_azimuth(const ts_grid *pg, double azimuth, int a, int line0, int
         Dp[TS_CLD_PSA + n] = NP.piece_sa[n];
         Dp[TS_CLD_PSB + n] = NP.piece_sb[n];
     }
-    for (int j = 0; j <= TS_NEAR_STEPS; j++) {
-        I[TS_CLI_SDV + j] = NP.sample_dv[j];
-        Dp[TS_CLD_SFV + j] = NP.sample_fv[j];
-    }
     Dp[TS_CLD_T] = G.t;
     Dp[TS_CLD_STEPM] = G.step_m;
     Dp[TS_CLD_NEARSKIP] = (TS_NEAR_STEPS + 0.5) * G.step_m;

@@ -182,7 +182,7 @@ float ts_far_field(const cm_ray_grid *r, int k, int i, float h, int2 lo, int2 hi
     }
     if (!beyond_cap)
         return best;
-    return cm_ray_exact(r, k, i, h, TS_NEAR_EXACT, cap / step, step, c);
+    return cm_ray_exact(r, k, i, h, TS_NEAR_STEPS, cap / step, step, c);
 }
 
 /* ------------------------------------------------------------ near field */
@@ -191,13 +191,13 @@ float ts_far_field(const cm_ray_grid *r, int k, int i, float h, int2 lo, int2 hi
 cm_near_tables ts_near_tables(__global const int *P, __global const real *Q)
 {
     cm_near_tables q = {P[TS_CLI_NPIECES], P + TS_CLI_PDU, P + TS_CLI_PDV, Q + TS_CLD_PSA,
-                        Q + TS_CLD_PSB, P + TS_CLI_SDV, Q + TS_CLD_SFV};
+                        Q + TS_CLD_PSB};
     return q;
 }
 
 /* The float fast path of near_run (near_field.c) for one interior cell zc
- * at height h, piece by piece then sample by sample as there. *flag: a
- * NaN was met (the cell is then redone by cm_near_exact). */
+ * at height h, piece by piece as there. *flag: a NaN was met (the cell is
+ * then redone by cm_near_exact). */
 float ts_near_fast(__global const float *zc, __global const int *P, __global const real *Q,
                    long u_stride, long v_stride, float h, float L, float c, int *flag)
 {
@@ -214,14 +214,6 @@ float ts_near_fast(__global const float *zc, __global const int *P, __global con
                                       q0[u_stride + v_stride], h, L, c);
         best = m > best ? m : best;
         nans += (m != m) ? 1.0f : 0.0f;
-    }
-    for (int j = TS_NEAR_EXACT + 1; j <= TS_NEAR_STEPS; j++) {
-        __global const float *q0 = zc - (long)j * u_stride + (long)P[TS_CLI_SDV + j] * v_stride;
-        const float d = (float)j * L;
-        float s = cm_fast_sample_slope(q0[0], q0[v_stride], (float)Q[TS_CLD_SFV + j], h,
-                                       1.0f / d, c * d);
-        best = s > best ? s : best;
-        nans += (s != s) ? 1.0f : 0.0f;
     }
     *flag = nans != 0.0f;
     return best;

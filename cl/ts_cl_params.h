@@ -23,8 +23,7 @@
 #define TS_CLI_NPIECES 10 /* near field: exact pieces */
 #define TS_CLI_PDU 11     /* near field: piece corner offsets along u */
 #define TS_CLI_PDV (TS_CLI_PDU + TS_NEAR_MAX_PIECES)
-#define TS_CLI_SDV (TS_CLI_PDV + TS_NEAR_MAX_PIECES) /* whole steps: v offset */
-#define TS_CLI_N (TS_CLI_SDV + TS_NEAR_STEPS + 1)
+#define TS_CLI_N (TS_CLI_PDV + TS_NEAR_MAX_PIECES)
 
 /* real table */
 #define TS_CLD_T 0        /* v advance per step */
@@ -32,7 +31,6 @@
 #define TS_CLD_NEARSKIP 2 /* hull points closer than this are near field */
 #define TS_CLD_PSA 3      /* near field pieces: start and end, in steps */
 #define TS_CLD_PSB (TS_CLD_PSA + TS_NEAR_MAX_PIECES)
-#define TS_CLD_SFV (TS_CLD_PSB + TS_NEAR_MAX_PIECES) /* whole steps: v fraction */
-#define TS_CLD_N (TS_CLD_SFV + TS_NEAR_STEPS + 1)
+#define TS_CLD_N (TS_CLD_PSB + TS_NEAR_MAX_PIECES)
 
 #endif

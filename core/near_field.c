@@ -16,14 +16,14 @@ void ts_near_plan_init(ts_near_plan *p, const ts_line_geom *g)
 {
     p->t = g->t;
     /* Break points: whole steps (new column) and v crossing an integer. */
-    double br[4 * TS_NEAR_EXACT + 4];
+    double br[4 * TS_NEAR_STEPS + 4];
     int nb = 0;
     br[nb++] = 0.0;
-    for (int j = 1; j <= TS_NEAR_EXACT; j++)
+    for (int j = 1; j <= TS_NEAR_STEPS; j++)
         br[nb++] = j;
     double at = fabs(g->t);
     if (at > 1e-12)
-        for (int m = 1; m / at < TS_NEAR_EXACT - 1e-9 && nb < (int)(sizeof br / sizeof *br); m++)
+        for (int m = 1; m / at < TS_NEAR_STEPS - 1e-9 && nb < (int)(sizeof br / sizeof *br); m++)
             br[nb++] = m / at;
     qsort(br, nb, sizeof *br, cmp_double);
     p->npieces = 0;
@@ -44,18 +44,6 @@ void ts_near_plan_init(ts_near_plan *p, const ts_line_geom *g)
         p->piece_off[n][2] = o + g->v_stride;
         p->piece_off[n][3] = o + g->u_stride + g->v_stride;
     }
-    for (int j = 0; j <= TS_NEAR_STEPS; j++) {
-        double v = -g->t * j, f = floor(v);
-        float fv = (float)(v - f);
-        p->sample_dv[j] = (int)f;
-        if (fv >= 1.0f) {
-            p->sample_dv[j]++;
-            fv = 0.0f;
-        }
-        p->sample_fv[j] = fv;
-        p->sample_off[j][0] = -j * g->u_stride + p->sample_dv[j] * g->v_stride;
-        p->sample_off[j][1] = p->sample_off[j][0] + g->v_stride;
-    }
 }
 
 static cm_ray_grid ray_grid(const ts_line_geom *g, const float *z)
@@ -69,8 +57,7 @@ float ts_near_field(const ts_near_plan *p, const ts_line_geom *g, const float *z
 {
     cm_ray_grid r = ray_grid(g, z);
     r.t = p->t;
-    cm_near_tables q = {p->npieces, p->piece_du, p->piece_dv, p->piece_sa,
-                        p->piece_sb, p->sample_dv, p->sample_fv};
+    cm_near_tables q = {p->npieces, p->piece_du, p->piece_dv, p->piece_sa, p->piece_sb};
     return cm_near_exact(&r, &q, k, i, h, step, c, cap, left);
 }
 
@@ -109,32 +96,6 @@ static void near_run(const ts_near_plan *p, const float *restrict zrow, int x0, 
             best[x] = m > best[x] ? m : best[x];
             flag[x] += (m != m) ? 1.0f : 0.0f;
         }
-    }
-    /* The whole steps, all in one pass: a fixed count, so the step loop
-     * unrolls and the cell loop vectorises (with the offsets as pointers
-     * per step, gcc gave up on it: "evolution of base is not affine"). */
-    enum { NS = TS_NEAR_STEPS - TS_NEAR_EXACT };
-    ptrdiff_t oa[NS], ob[NS];
-    float fs[NS], invd[NS], cd[NS];
-    for (int s = 0; s < NS; s++) {
-        int j = TS_NEAR_EXACT + 1 + s;
-        const float d = (float)j * L;
-        oa[s] = p->sample_off[j][0];
-        ob[s] = p->sample_off[j][1];
-        fs[s] = (float)p->sample_fv[j];
-        invd[s] = 1.0f / d;
-        cd[s] = c * d;
-    }
-    for (int x = x0; x < x1; x++) {
-        float b = best[x], nan_count = flag[x];
-        for (int s = 0; s < NS; s++) {
-            float v = cm_fast_sample_slope(zrow[x + oa[s]], zrow[x + ob[s]], fs[s], zrow[x],
-                                           invd[s], cd[s]);
-            b = v > b ? v : b;
-            nan_count += (v != v) ? 1.0f : 0.0f;
-        }
-        best[x] = b;
-        flag[x] = nan_count;
     }
 }
 

@@ -15,23 +15,18 @@
 #include "line_geometry.h"
 
 /* Piece n of the ray, [piece_sa[n], piece_sb[n]] steps, lies in the patch
- * with corner (k + piece_du[n], i + piece_dv[n]); whole step j is
- * interpolated at v offset sample_dv[j] + sample_fv[j] (a float's value). */
+ * with corner (k + piece_du[n], i + piece_dv[n]). */
 typedef struct {
     double t;                              /* v per step, as the geometry */
     int npieces;
     int piece_du[TS_NEAR_MAX_PIECES], piece_dv[TS_NEAR_MAX_PIECES];
     double piece_sa[TS_NEAR_MAX_PIECES], piece_sb[TS_NEAR_MAX_PIECES];
-    int sample_dv[TS_NEAR_STEPS + 1];
-    double sample_fv[TS_NEAR_STEPS + 1];
     /* Element offsets from the cell, for the vectorised interior pass:
-     * corners 00, 10, 01, 11 of each piece, and the two cells of each whole
-     * step sample. */
+     * corners 00, 10, 01, 11 of each piece. */
     ptrdiff_t piece_off[TS_NEAR_MAX_PIECES][4];
-    ptrdiff_t sample_off[TS_NEAR_STEPS + 1][2];
 } ts_near_plan;
 
-/* Pieces and samples for the geometry's direction. */
+/* The pieces for the geometry's direction. */
 void ts_near_plan_init(ts_near_plan *p, const ts_line_geom *g);
 
 /* Largest horizon slope (with curvature term -c d) from cell (k, i) at

@@ -31,92 +31,42 @@ static float between_steps_bound(const ts_line_geom *G, const float *z, int k, i
     return (float)(dh / ((dh > 0 ? j : j + 1) * step) - c * j * step);
 }
 
-/* Most stretches lie below the horizon found so far: a row-wide bound
- * (cap_tail_bound.h) rules them out before the per-cell bound and solve.
- * The stencils of row y: between whole steps j, sb (at most TS_NEAR_STEPS -
- * TS_NEAR_EXACT of them), then the tail's; bounds[n * W + x] is stencil n's
- * bound at x, NaN where it has none (the cell falls back to the per-cell
- * path), and one more row: scratch, then the largest of the bounds at x.
- * Returns how many. */
-enum { MAX_STENCILS = TS_NEAR_STEPS - TS_NEAR_EXACT + 1 };
-
-static int row_bounds(const ts_line_geom *G, const float *zrow, int W, int y, double send,
-                      int between, double s0, double smax, int tail, double step, double c,
-                      float *bounds)
-{
-    int n = 0;
-    ts_cap_stencil st[MAX_STENCILS];
-    for (int j = TS_NEAR_EXACT; between && j < send; j++)
-        ts_cap_stencil_init(&st[n++], G, j, j + 1 < send ? j + 1 : send, step, c);
-    if (tail)
-        ts_cap_stencil_init(&st[n++], G, s0, smax, step, c);
-    for (int m = 0; m < n; m++) {
-        float *b = bounds + (size_t)m * W;
-        int xa, xb;
-        ts_cap_stencil_range(&st[m], G, W, y, &xa, &xb);
-        for (int x = 0; x < W; x++)
-            b[x] = NAN;
-        if (xa < xb)
-            ts_cap_stencil_row(&st[m], zrow, xa, xb, b, bounds + (size_t)n * W);
-    }
-    /* the last row: the largest of them, NaN if any is */
-    float *top = bounds + (size_t)n * W;
-    for (int x = 0; x < W; x++)
-        top[x] = -INFINITY;
-    for (int m = 0; m < n; m++) {
-        const float *b = bounds + (size_t)m * W;
-        for (int x = 0; x < W; x++)
-            top[x] = b[x] != b[x] || top[x] != top[x] ? NAN : b[x] > top[x] ? b[x] : top[x];
-    }
-    return n;
-}
-
 /*
- * What the near field and the lines leave out within a maximum distance,
- * solved exactly on each cell's own ray: a capped horizon is often near,
- * often at the distance itself.
- *  - Between the near field's whole steps (TS_NEAR_EXACT..TS_NEAR_STEPS)
- *    the bilinear surface can rise above both steps (not along an axis,
- *    where it is linear there); a step is solved where a bound says it may
- *    raise the horizon.
- *  - The part of a step before the distance ends, where the same bound
- *    says it may.
+ * The part of a capped ray's last step before the distance ends, solved
+ * exactly on each cell's own ray where a bound says it may raise the
+ * horizon (a capped horizon is often at the distance itself): the near
+ * field covers the first TS_NEAR_STEPS steps, the lines the whole steps
+ * beyond. Most cells are ruled out by a row-wide bound (cap_tail_bound.h)
+ * before the per-cell bound and the solve.
  */
 void ts_cap_tail(const ts_line_geom *G, const ts_grid *grid, double cap, double c, int y,
                  const float *zrow, float *orow, double step)
 {
-    const float *z = grid->z;
     const int W = grid->width;
     double smax = cap / step, s0 = floor(smax);
-    double send = smax < TS_NEAR_STEPS ? smax : TS_NEAR_STEPS;
-    int axis = fabs(G->t) <= 1e-12;
-    s0 = s0 > TS_NEAR_EXACT ? s0 : TS_NEAR_EXACT;
-    int tail = s0 < smax && (axis || smax > TS_NEAR_STEPS);
-    float *bounds = malloc((size_t)(MAX_STENCILS + 1) * W * sizeof *bounds);
-    int nst = bounds ? row_bounds(G, zrow, W, y, send, !axis, s0, smax, tail, step, c, bounds)
-                     : 0;
+    if (!(smax > TS_NEAR_STEPS && s0 < smax))
+        return; /* within the near field, or the cap ends on a whole step */
+    ts_cap_stencil st;
+    ts_cap_stencil_init(&st, G, s0, smax, step, c);
+    int xa = W, xb = W;
+    float *bound = malloc(2 * (size_t)W * sizeof *bound);
+    if (bound) {
+        ts_cap_stencil_range(&st, G, W, y, &xa, &xb);
+        for (int x = 0; x < W; x++)
+            bound[x] = NAN; /* no row bound: the per-cell path */
+        if (xa < xb)
+            ts_cap_stencil_row(&st, zrow, xa, xb, bound, bound + W);
+    }
     for (int x = 0; x < W; x++) {
-        if (isnan(zrow[x]))
+        if (isnan(zrow[x]) || (bound && bound[x] < orow[x]))
             continue;
         int u = G->x_major ? x : y, i = G->x_major ? y : x;
         int k = (u - G->u_start) * G->u_step;
-        float h = zrow[x], best = orow[x];
-        if (nst > 0 && bounds[(size_t)nst * W + x] < best)
-            continue; /* no stretch can raise it */
-        int m = 0; /* the stencil of the stretch at hand */
-        for (int j = TS_NEAR_EXACT; !axis && j < send; j++, m++) {
-            if ((m < nst && bounds[(size_t)m * W + x] < best) ||
-                between_steps_bound(G, z, k, i, h, j, step, c) < best)
-                continue;
-            float e = ts_ray_exact(G, z, k, i, h, j, j + 1 < send ? j + 1 : send, step, c);
-            best = e > best ? e : best;
-        }
-        if (tail && !(m < nst && bounds[(size_t)m * W + x] < best) &&
-            between_steps_bound(G, z, k, i, h, (int)s0, step, c) >= best) {
-            float e = ts_ray_exact(G, z, k, i, h, s0, smax, step, c);
-            best = e > best ? e : best;
-        }
-        orow[x] = best;
+        float h = zrow[x];
+        if (between_steps_bound(G, grid->z, k, i, h, (int)s0, step, c) < orow[x])
+            continue;
+        float e = ts_ray_exact(G, grid->z, k, i, h, s0, smax, step, c);
+        orow[x] = e > orow[x] ? e : orow[x];
     }
-    free(bounds);
+    free(bound);
 }

@@ -200,6 +200,38 @@ START_TEST(test_max_distance_lowers)
 }
 END_TEST
 
+START_TEST(test_unbounded_covers_near_field)
+{
+    /* The whole-DEM sweep sees every stretch a near-field-only cap sees:
+     * its horizon is never lower (up to the float fast path's rounding).
+     * It once looked at the whole steps only and missed the bilinear
+     * surface between steps 4 and 10 (16.6 deg against 35.3 on this DEM). */
+    ts_grid g;
+    tdem_create(&g, 256, 256, 10.0, 10.0);
+    tdem_fractal(&g, 11, 900.0);
+    ts_horizon_opts near = opts_with(0, 95.0), unbounded = opts_with(0, 0);
+    size_t n = (size_t)g.width * g.height;
+    float *capped = tdem_floats(n), *whole = tdem_floats(n);
+    const double az[] = {33.7, 135, 222.2, 300, 11.25};
+    for (int k = 0; k < 5; k++) {
+        ts_error err;
+        ck_assert(ts_horizon_sweep(&g, az[k], &near, capped, &err) == TS_OK);
+        ck_assert(ts_horizon_sweep(&g, az[k], &unbounded, whole, &err) == TS_OK);
+        long below = 0, worst = -1;
+        for (size_t i = 0; i < n; i++)
+            if (whole[i] < capped[i] - 1e-3f && below++ == 0)
+                worst = (long)i;
+        ck_assert_msg(below == 0,
+                      "az %g: %ld cells' unbounded horizon is below the 95 m one, first (%ld,%ld): "
+                      "%.3f < %.3f", az[k], below, worst % g.width, worst / g.width,
+                      worst >= 0 ? whole[worst] : 0.0f, worst >= 0 ? capped[worst] : 0.0f);
+    }
+    free(capped);
+    free(whole);
+    ts_grid_free(&g);
+}
+END_TEST
+
 START_TEST(test_jacksboro)
 {
     jacksboro_vs_oracle("jacksboro (every 3rd cell)", 0.0);
@@ -314,6 +346,7 @@ int main(void)
     tcase_add_test(tc, test_max_distance_geographic);
     tcase_add_test(tc, test_max_distance_beyond_grid);
     tcase_add_test(tc, test_max_distance_lowers);
+    tcase_add_test(tc, test_unbounded_covers_near_field);
     tcase_add_test(tc, test_jacksboro);
     tcase_add_test(tc, test_lux_compute);
     tcase_add_test(tc, test_compute_matches_sweep);

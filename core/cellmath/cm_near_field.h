@@ -11,11 +11,12 @@
 
 #include "cm_prelude.h"
 
-/* Cells of the ray solved exactly, then whole-step samples up to
- * TS_NEAR_STEPS; the sweep's hulls cover what lies beyond. */
-#define TS_NEAR_EXACT 4
+/* Steps of the ray solved exactly, patch by patch; the sweep's hulls cover
+ * what lies beyond. (Whole-step samples between the exact cells and here,
+ * as once, miss the surface rising between two steps: up to tens of
+ * degrees on rough terrain, and a ray's last stretch at the grid's edge.) */
 #define TS_NEAR_STEPS 10
-#define TS_NEAR_MAX_PIECES (2 * TS_NEAR_EXACT + 2)
+#define TS_NEAR_MAX_PIECES (2 * TS_NEAR_STEPS + 2)
 /* Cells at least this far from every edge have their whole near field on
  * the grid. */
 #define TS_NEAR_MARGIN (TS_NEAR_STEPS + 2)
@@ -31,13 +32,11 @@ typedef struct {
 
 /* One direction's near-field plan (ts_near_plan_init): piece n of the ray,
  * [sa[n], sb[n]] steps, lies in the patch with corner (k + du[n],
- * i + dv[n]); whole step j is interpolated at v offset sdv[j] + sfv[j]. */
+ * i + dv[n]). */
 typedef struct {
     int npieces;
     const CM_GLOBAL int *du, *dv;
     const CM_GLOBAL cm_real *sa, *sb;
-    const CM_GLOBAL int *sdv;
-    const CM_GLOBAL cm_real *sfv;
 } cm_near_tables;
 
 /* Bilinear height at (a, b) of a patch (corners 00, 10, 01, 11) from the
@@ -122,17 +121,9 @@ CM_FN cm_real cm_near_piece(float hc0, float hc1, float hc2, float hc3, cm_real 
     return cm_piece_max(alpha - h, beta, gamma, sa, sb, L, c);
 }
 
-/* Slope to a whole-step sample between heights va and vb (fraction f) at
- * d metres; NaN if either is nodata. */
-CM_FN cm_real cm_sample_slope(float va, float vb, float f, float h, cm_real d, cm_real c)
-{
-    float hj = va + f * (vb - va);
-    return (hj - h) / d - c * d;
-}
-
 /*
  * Exact near field of cell (k, i) at height h: the largest slope over its
- * pieces, then its whole-step samples, within cap metres (0 = none); step:
+ * pieces, within cap metres (0 = none); step:
  * metres per step; -inf if none. *left: the ray leaves the grid inside the
  * near field (what was found up to there is returned).
  */
@@ -163,19 +154,6 @@ CM_FN float cm_near_exact(const cm_ray_grid *r, const cm_near_tables *q, int k, 
         cm_real m = cm_near_piece(hc0, hc1, hc2, hc3, -q->du[n], flat_v ? 0 : -q->dv[n], t,
                                   q->sa[n], sb, h, step, c);
         best = m > best ? m : best;
-    }
-    /* Whole steps beyond the exact cells: linear along the column. */
-    for (int j = TS_NEAR_EXACT + 1; j <= TS_NEAR_STEPS && j <= smax; j++) {
-        int kk = k - j, r0 = i + q->sdv[j];
-        float f = (float)q->sfv[j];
-        if (kk < 0 || r0 < 0 || r0 > V - 1 || (f > 0.0f && r0 + 1 > V - 1)) {
-            *left = 1;
-            break;
-        }
-        const CM_GLOBAL float *zz = r->z + r->origin + (long)kk * r->u_stride +
-                                    (long)r0 * r->v_stride;
-        cm_real s = cm_sample_slope(zz[0], f > 0.0f ? zz[r->v_stride] : zz[0], f, h, j * step, c);
-        best = s > best ? s : best;
     }
     return (float)best;
 }
@@ -317,14 +295,6 @@ CM_FN float cm_fast_piece_slope(cm_fast_piece q, float t, float c00, float c10, 
     float fs = (P / sd + beta + gamma * ss) * q.invL - c * ss * L;
     int inner = q.has_sa & (P < 0.0f) & (g2 < 0.0f) & (ss > q.sa) & (ss < q.sb) & (fs > m);
     return inner ? fs : m;
-}
-
-/* Slope to whole-step sample between va and vb (fraction f), invd = 1 /
- * its distance d, cd = c d. */
-CM_FN float cm_fast_sample_slope(float va, float vb, float f, float h, float invd, float cd)
-{
-    float hj = va + f * (vb - va);
-    return (hj - h) * invd - cd;
 }
 
 #endif
