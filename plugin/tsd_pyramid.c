@@ -43,6 +43,13 @@ int tsd_options_check_pyramid(const tsd_options *o, char *msg, size_t n)
                    which);
         return 0;
     }
+    /* shadow's only horizons are METHOD=sh's key light */
+    if (!tsd_product_takes(p, tsd_option_find("SKY_WEIGHT")) &&
+        tsd_product_takes(p, tsd_option_find("METHOD")) && o->method != TSD_METHOD_SH)
+        REFUSE("HORIZON_METHOD=pyramid applies to PRODUCT=%s with METHOD=sh (its key light "
+               "from horizons); the other METHODs cast their shadows without horizons or with "
+               "the exact sweep",
+               p->name);
     if (tsd_product_takes(p, tsd_option_find("SKY_WEIGHT")) && !(o->sky_weight > 0) &&
         o->method != TSD_METHOD_SH)
         REFUSE("HORIZON_METHOD=pyramid applies to the sky term of PRODUCT=%s, which "

@@ -112,11 +112,14 @@ class Pyramid(unittest.TestCase):
             (dict(PYR, PYRAMID_OFFSET="-1"), "PYRAMID_OFFSET must be between 0 and 64, got -1"),
             (dict(PYR, PYRAMID_OFFSET="many"), "PYRAMID_OFFSET must be a number"),
             (dict(PYR, PRODUCT="shadow"),
-             "HORIZON_METHOD applies to the products that use horizons"),
+             "HORIZON_METHOD=pyramid applies to PRODUCT=shadow with METHOD=sh"),
+            (dict(PYR, PRODUCT="shadow", METHOD="shm"),
+             "HORIZON_METHOD=pyramid applies to PRODUCT=shadow with METHOD=sh"),
             ({"PRODUCT": "sunhours", "DATE": "2026-06-21", "TIMEZONE": "Z",
               "HORIZON_METHOD": "exact"},
              "HORIZON_METHOD applies to the products that use horizons"),
-            ({"PRODUCT": "shadow", "PYRAMID_OFFSET": "1"},
+            ({"PRODUCT": "daycycle", "DATE": "2026-06-21", "TIMEZONE": "Z",
+              "PYRAMID_OFFSET": "1"},
              "PYRAMID_OFFSET applies to the products that use horizons"),
             ({"PRODUCT": "svf", "PYRAMID_OFFSET": "1"},
              "PYRAMID_OFFSET applies with HORIZON_METHOD=pyramid"),
@@ -132,7 +135,8 @@ class Pyramid(unittest.TestCase):
         # and through a tool: a non-zero exit with the sentence
         p = T.run(["gdalinfo", "-oo", "HORIZON_METHOD=pyramid", "-oo", "PRODUCT=shadow",
                    T.conn(T.LUX)], ok=False)
-        self.assertIn("HORIZON_METHOD applies to the products that use horizons", p.stderr)
+        self.assertIn("HORIZON_METHOD=pyramid applies to PRODUCT=shadow with METHOD=sh",
+                      p.stderr)
 
     def test_option_list_and_products(self):
         drv = gdal.GetDriverByName("TERRASHADE")
@@ -140,8 +144,9 @@ class Pyramid(unittest.TestCase):
         for line in products.split("<Product ")[1:]:
             name = line.split("'")[1]
             takes = "HORIZON_METHOD" in line
-            self.assertEqual(takes, name in ("shade", "horizon", "svf", "openness", "sky",
-                                             "envlight"), name)
+            # shadow: METHOD=sh's key light
+            self.assertEqual(takes, name in ("shade", "shadow", "horizon", "svf", "openness",
+                                             "sky", "envlight"), name)
             self.assertEqual("PYRAMID_OFFSET" in line, takes, name)
         self.assertIn("PYRAMID_LEVEL_STEP", drv.GetMetadataItem(gdal.DMD_OPENOPTIONLIST))
 
