@@ -27,6 +27,7 @@
 
 #include "arg_checks.h"
 #include "cellmath/cm_fastmath.h"
+#include "lane_hull.h"
 #include "lane_passes.h"
 #include "line_geometry.h"
 #include "near_field.h"
@@ -75,8 +76,8 @@ typedef struct {
     float *vx, *vy, *vh, *vs;
     double *vd;
     /* unbounded sweep: the lines of a block, swept in lockstep */
-    struct lane *lanes;
-    hull_pt *lane_stacks;
+    hull_pt *lane_stacks; /* line j's hull at lane_stacks + j * (U + 1) */
+    int *lane_n, *lane_far; /* its size, its top-most point beyond the near field */
     occluder *carry, *carry_next; /* far-side occluders from the line before */
     /* the block's current step, by line (one entry more than lines) */
     float *lane_f;      /* holds: */
@@ -87,12 +88,6 @@ typedef struct {
     int *lane_k0;       /* each line's first step */
     double *lane_d;     /* and the distance of its current sample from it */
 } sweep_ws;
-
-/* One line of a lockstep block (unbounded sweep): its hull. */
-typedef struct lane {
-    hull_pt *stack;
-    int n, far;         /* hull size; top-most point beyond the near field */
-} lane;
 
 /* The far-field occluder of a point at distance d and hull height g among
  * the points 0..far of an unbounded line's hull S: walk to nearer points
@@ -313,6 +308,32 @@ static void lane_distances(const sweep_ctx *C, sweep_ws *w, int k, int i0, int j
     }
 }
 
+/* ts_lane_hull_step in scalar code, line by line. */
+static void lane_hulls_scalar(const ts_lane_hulls *h, const ts_lane_step *s,
+                              const ts_lane_occluders *occ)
+{
+    const occluder none = {-1, 0.0f};
+    const double c = s->c;
+    for (int j = s->j0; j <= s->j1; j++) {
+        hull_pt *S = h->pts + (size_t)j * h->stride;
+        const double d = s->d[j];
+        const float hs = s->hs[j], hc = s->hc[j], hn = s->hn[j];
+        if (!isnan(hs))
+            hull_push(S, &h->n[j], &h->far[j], d, hs - c * d * d, s->k, s->near_skip);
+        else
+            h->far[j] = far_advance(S, h->n[j], h->far[j], d, s->near_skip);
+        const int far = h->far[j];
+        occluder hi = !isnan(hc) && j >= s->hi_from && j <= s->hi_to
+                          ? stack_query(S, far, d, hc - c * d * d)
+                          : none;
+        occluder lo = !isnan(hn) ? stack_query(S, far, d, hn - c * d * d) : none;
+        occ->hi_k[j] = hi.k;
+        occ->hi_dd[j] = hi.dd;
+        occ->lo_k[j + 1] = lo.k;
+        occ->lo_dd[j + 1] = lo.dd;
+    }
+}
+
 /* Lines bs .. bs + nl - 1 of an unbounded sweep, step by step; the first is
  * only primed (not written) when `prime`. w->carry holds what the line
  * before the block found; on return it holds the block's last line's.
@@ -327,12 +348,11 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
     const occluder none = {-1, 0.0f};
     int kmin = G->U, kmax = -1;
     for (int j = 0; j < nl; j++) {
-        lane *L = &w->lanes[j];
         int k0, k1;
         if (!ts_line_k_range(G, bs + j, &k0, &k1))
             continue;
-        L->n = 0;
-        L->far = -1;
+        w->lane_n[j] = 0;
+        w->lane_far[j] = -1;
         w->lane_k0[j] = k0;
         w->lane_d[j] = 0.0;
         kmin = k0 < kmin ? k0 : kmin;
@@ -342,6 +362,7 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
     for (int k = 0; k < G->U; k++)
         next[k] = none;
     const ts_lane_occluders occ = {w->lo_k, w->hi_k, w->lo_dd, w->hi_dd};
+    const ts_lane_hulls hulls = {w->lane_stacks, G->U + 1, w->lane_n, w->lane_far};
     const double c = C->c;
     for (int k = kmin; k <= kmax; k++) {
         /* The lines on the grid at step k: rows i0 + j in [0, V - 1]. */
@@ -358,23 +379,10 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         w->lo_k[j0] = lo0.k;
         w->lo_dd[j0] = lo0.dd;
         const int last_inside = G->fr[k] == 0.0f ? j1 : G->V - 2 - (int)i0;
-        for (int j = j0; j <= j1; j++) {
-            lane *L = &w->lanes[j];
-            const double d = w->lane_d[j];
-            const float hs = w->hs[j], hc = w->hc[j], hn = w->hn[j];
-            if (!isnan(hs))
-                hull_push(L->stack, &L->n, &L->far, d, hs - c * d * d, k, C->near_skip);
-            else
-                L->far = far_advance(L->stack, L->n, L->far, d, C->near_skip);
-            occluder hi = !isnan(hc) && j <= last_inside && !(prime && j == 0)
-                              ? stack_query(L->stack, L->far, d, hc - c * d * d)
-                              : none;
-            occluder lo = !isnan(hn) ? stack_query(L->stack, L->far, d, hn - c * d * d) : none;
-            w->hi_k[j] = hi.k;
-            w->hi_dd[j] = hi.dd;
-            w->lo_k[j + 1] = lo.k;
-            w->lo_dd[j + 1] = lo.dd;
-        }
+        const ts_lane_step step = {k, j0, j1, prime, last_inside, w->lane_d, w->hs, w->hc,
+                                   w->hn, c, C->near_skip};
+        if (!ts_lane_hull_step(&hulls, &step, &occ))
+            lane_hulls_scalar(&hulls, &step, &occ);
         if (j1 == nl - 1)
             next[k] = (occluder){w->lo_k[nl], w->lo_dd[nl]};
         const int jw = prime && j0 == 0 ? 1 : j0;
@@ -401,8 +409,9 @@ static void ws_free(sweep_ws *w)
     free(w->vh);
     free(w->vs);
     free(w->vd);
-    free(w->lanes);
     free(w->lane_stacks);
+    free(w->lane_n);
+    free(w->lane_far);
     free(w->carry);
     free(w->carry_next);
     free(w->lane_f);
@@ -433,7 +442,8 @@ static int ws_init(sweep_ws *w, int U, int capped, int need_visit)
     }
     if (!capped && !need_visit) {
         const occluder none = {-1, 0.0f};
-        w->lanes = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lanes);
+        w->lane_n = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_n);
+        w->lane_far = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_far);
         w->lane_stacks = malloc((size_t)(LOCKSTEP_LINES + 1) * (U + 1) * sizeof *w->lane_stacks);
         w->carry = malloc((size_t)U * sizeof *w->carry);
         w->carry_next = malloc((size_t)U * sizeof *w->carry_next);
@@ -442,7 +452,7 @@ static int ws_init(sweep_ws *w, int U, int capped, int need_visit)
         w->lane_f = malloc(6 * row * sizeof *w->lane_f);
         w->lane_i = malloc(3 * row * sizeof *w->lane_i);
         w->lane_d = malloc(row * sizeof *w->lane_d);
-        ok = w->lanes && w->lane_stacks && w->carry && w->carry_next && w->lane_f &&
+        ok = w->lane_n && w->lane_far && w->lane_stacks && w->carry && w->carry_next && w->lane_f &&
              w->lane_i && w->lane_d;
         if (ok) {
             w->hc = w->lane_f;
@@ -455,8 +465,6 @@ static int ws_init(sweep_ws *w, int U, int capped, int need_visit)
             w->hi_k = w->lane_i + row;
             w->lane_k0 = w->lane_i + 2 * row;
         }
-        for (int j = 0; ok && j <= LOCKSTEP_LINES; j++)
-            w->lanes[j].stack = w->lane_stacks + (size_t)j * (U + 1);
         for (int k = 0; ok && k < U; k++)
             w->carry[k] = none;
     }
@@ -475,7 +483,7 @@ static void sweep_range(void *ctx, int worker, long begin, long end)
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
         return;
     }
-    if (w.lanes) {
+    if (w.lane_stacks) {
         long b = C->b0 + begin, bend = C->b0 + end;
         for (int prime = begin > 0; b < bend; prime = 0) {
             int nl = bend - b < LOCKSTEP_LINES ? (int)(bend - b) : LOCKSTEP_LINES;
