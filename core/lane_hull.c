@@ -62,8 +62,8 @@ AVX512 static inline void store8i(int *p, __mmask8 m, __m256i v)
  * queries of the same lines), so that their latencies overlap; Q is a
  * constant where they are inlined. */
 #define ALWAYS AVX512 static inline __attribute__((always_inline))
-/* vectors of eight lines a step takes at once (4: measured faster than 1
- * and 2), and at most twice as many walks (two queries per line) */
+/* vectors of eight lines a step takes at once (4: measured faster than 1,
+ * 2 and 8), and at most twice as many walks (two queries per line) */
 #define NG 4
 #define QMAX (2 * NG)
 
