@@ -27,6 +27,8 @@
 
 #include "arg_checks.h"
 #include "cellmath/cm_fastmath.h"
+#include "lane_hull.h"
+#include "lane_passes.h"
 #include "line_geometry.h"
 #include "near_field.h"
 #include "parallel.h"
@@ -74,18 +76,18 @@ typedef struct {
     float *vx, *vy, *vh, *vs;
     double *vd;
     /* unbounded sweep: the lines of a block, swept in lockstep */
-    struct lane *lanes;
-    hull_pt *lane_stacks;
+    hull_pt *lane_stacks; /* line j's hull at lane_stacks + j * (U + 1) */
+    int *lane_n, *lane_far; /* its size, its top-most point beyond the near field */
     occluder *carry, *carry_next; /* far-side occluders from the line before */
+    /* the block's current step, by line (one entry more than lines) */
+    float *lane_f;      /* holds: */
+    float *hc, *hn, *hs, *slope; /* samples (lane_passes.h), far-field slopes */
+    float *lo_dd, *hi_dd;
+    int *lane_i;        /* holds: */
+    int *lo_k, *hi_k;   /* far-field occluders; lo_k[j]: from line j - 1 */
+    int *lane_k0;       /* each line's first step */
+    double *lane_d;     /* and the distance of its current sample from it */
 } sweep_ws;
-
-/* One line of a lockstep block (unbounded sweep): its hull and position. */
-typedef struct lane {
-    hull_pt *stack;
-    int n, far;         /* hull size; top-most point beyond the near field */
-    int k0, k1, live;   /* the line's steps on the grid */
-    double d;           /* distance of the current sample from sample k0 */
-} lane;
 
 /* The far-field occluder of a point at distance d and hull height g among
  * the points 0..far of an unbounded line's hull S: walk to nearer points
@@ -283,72 +285,112 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
 #define LOCKSTEP_LINES 64
 #endif
 
-/* Step k of lane L (line b) of an unbounded sweep: the same work, in the
- * same order for the line, as process_line. lo_in is the far-side
- * occluder the line before found at this step; returns this line's. */
-static inline occluder lane_step(const sweep_ctx *C, lane *L, long b, int k, occluder lo_in,
-                                 int write)
+/* Step k of lines j0..j1 of a block (rows i0 + j): each line's distance
+ * from its first sample, as ts_line_sample_at advances it. */
+static void lane_distances(const sweep_ctx *C, sweep_ws *w, int k, int i0, int j0, int j1)
 {
     const ts_line_geom *G = C->geom;
-    ts_line_sample ls;
-    ts_line_sample_at(G, C->grid->z, b, k, L->k0, 0.0f, &L->d, &ls);
-    const double d = L->d;
-    if (!isnan(ls.hs))
-        hull_push(L->stack, &L->n, &L->far, d, ls.hs - C->c * d * d, k, C->near_skip);
-    else
-        L->far = far_advance(L->stack, L->n, L->far, d, C->near_skip);
-    const occluder none = {-1, 0.0f};
-    if (write) {
-        float s_out = NAN;
-        if (!isnan(ls.hc)) {
-            occluder hi = ls.inside ? stack_query(L->stack, L->far, d, ls.hc - C->c * d * d) : none;
-            occluder lo = ls.F > 0.0f ? lo_in : none;
-            int row = G->x_major ? ls.i : G->u_start + k * G->u_step;
-            double step = G->step_row ? G->step_row[row] : G->step_m;
-            s_out = far_field(C, k, ls.i, ls.hc, lo, hi, step);
+    double *restrict dist = w->lane_d;
+    const int *restrict k0 = w->lane_k0;
+    if (G->step_row) {
+        for (int j = j0; j <= j1; j++) {
+            int row = G->x_major ? i0 + j : G->u_start + k * G->u_step;
+            if (k > k0[j])
+                dist[j] += G->step_row[row];
         }
-        C->out[C->o_origin + (ptrdiff_t)k * C->o_u_stride + (ptrdiff_t)ls.i * C->o_v_stride] = s_out;
+    } else if (G->anchored) {
+        const double d = (double)(k + G->k_anchor) * G->step_m; /* as on the whole DEM */
+        for (int j = j0; j <= j1; j++)
+            dist[j] = d;
+    } else {
+        for (int j = j0; j <= j1; j++)
+            dist[j] = (double)(k - k0[j]) * G->step_m;
     }
-    return (ls.has_next && !isnan(ls.hn)) ? stack_query(L->stack, L->far, d, ls.hn - C->c * d * d)
-                                          : none;
+}
+
+/* ts_lane_hull_step in scalar code, line by line. */
+static void lane_hulls_scalar(const ts_lane_hulls *h, const ts_lane_step *s,
+                              const ts_lane_occluders *occ)
+{
+    const occluder none = {-1, 0.0f};
+    const double c = s->c;
+    for (int j = s->j0; j <= s->j1; j++) {
+        hull_pt *S = h->pts + (size_t)j * h->stride;
+        const double d = s->d[j];
+        const float hs = s->hs[j], hc = s->hc[j], hn = s->hn[j];
+        if (!isnan(hs))
+            hull_push(S, &h->n[j], &h->far[j], d, hs - c * d * d, s->k, s->near_skip);
+        else
+            h->far[j] = far_advance(S, h->n[j], h->far[j], d, s->near_skip);
+        const int far = h->far[j];
+        occluder hi = !isnan(hc) && j >= s->hi_from && j <= s->hi_to
+                          ? stack_query(S, far, d, hc - c * d * d)
+                          : none;
+        occluder lo = !isnan(hn) ? stack_query(S, far, d, hn - c * d * d) : none;
+        occ->hi_k[j] = hi.k;
+        occ->hi_dd[j] = hi.dd;
+        occ->lo_k[j + 1] = lo.k;
+        occ->lo_dd[j + 1] = lo.dd;
+    }
 }
 
 /* Lines bs .. bs + nl - 1 of an unbounded sweep, step by step; the first is
  * only primed (not written) when `prime`. w->carry holds what the line
- * before the block found; on return it holds the block's last line's. */
+ * before the block found; on return it holds the block's last line's.
+ * Each step samples the lines together (lane_passes.h), pushes and queries
+ * each line's hull in the same order as process_line, then evaluates the
+ * far field of the step's cells together: the cell between lines j - 1 and
+ * j takes its far-side occluder from line j - 1 and its own from line j. */
 static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int prime)
 {
+    _Static_assert(FAR_SPREAD == 0, "the lockstep far field samples at the occluders only");
     const ts_line_geom *G = C->geom;
     const occluder none = {-1, 0.0f};
     int kmin = G->U, kmax = -1;
     for (int j = 0; j < nl; j++) {
-        lane *L = &w->lanes[j];
-        L->live = ts_line_k_range(G, bs + j, &L->k0, &L->k1);
-        if (!L->live) {
-            L->k0 = 1;
-            L->k1 = 0;
+        int k0, k1;
+        if (!ts_line_k_range(G, bs + j, &k0, &k1))
             continue;
-        }
-        L->n = 0;
-        L->far = -1;
-        L->d = 0.0;
-        kmin = L->k0 < kmin ? L->k0 : kmin;
-        kmax = L->k1 > kmax ? L->k1 : kmax;
+        w->lane_n[j] = 0;
+        w->lane_far[j] = -1;
+        w->lane_k0[j] = k0;
+        w->lane_d[j] = 0.0;
+        kmin = k0 < kmin ? k0 : kmin;
+        kmax = k1 > kmax ? k1 : kmax;
     }
     occluder *next = w->carry_next;
     for (int k = 0; k < G->U; k++)
         next[k] = none;
+    const ts_lane_occluders occ = {w->lo_k, w->hi_k, w->lo_dd, w->hi_dd};
+    const ts_lane_hulls hulls = {w->lane_stacks, G->U + 1, w->lane_n, w->lane_far};
+    const double c = C->c;
     for (int k = kmin; k <= kmax; k++) {
-        occluder lo = w->carry[k];
-        for (int j = 0; j < nl; j++) {
-            lane *L = &w->lanes[j];
-            if (k < L->k0 || k > L->k1) {
-                lo = none;
-                continue;
-            }
-            lo = lane_step(C, L, bs + j, k, lo, !(prime && j == 0));
-        }
-        next[k] = lo;
+        /* The lines on the grid at step k: rows i0 + j in [0, V - 1]. */
+        const long i0 = bs + G->fl[k];
+        const int j0 = i0 < 0 ? (int)-i0 : 0;
+        const int j1 = G->V - 1 - i0 < nl - 1 ? (int)(G->V - 1 - i0) : nl - 1;
+        if (j0 > j1)
+            continue;
+        ts_lane_sample(G, C->grid->z, k, (int)i0, j0, j1, w->hc, w->hn, w->hs);
+        lane_distances(C, w, k, (int)i0, j0, j1);
+        /* lo_k[j]: the far-side occluder of line j's cell, found by the
+         * line before (none where that line is off the grid). */
+        const occluder lo0 = j0 == 0 ? w->carry[k] : none;
+        w->lo_k[j0] = lo0.k;
+        w->lo_dd[j0] = lo0.dd;
+        const int last_inside = G->fr[k] == 0.0f ? j1 : G->V - 2 - (int)i0;
+        const ts_lane_step step = {k, j0, j1, prime, last_inside, w->lane_d, w->hs, w->hc,
+                                   w->hn, c, C->near_skip};
+        if (!ts_lane_hull_step(&hulls, &step, &occ))
+            lane_hulls_scalar(&hulls, &step, &occ);
+        if (j1 == nl - 1)
+            next[k] = (occluder){w->lo_k[nl], w->lo_dd[nl]};
+        const int jw = prime && j0 == 0 ? 1 : j0;
+        ts_lane_far_field(G, C->grid->z, (float)c, k, (int)i0, jw, j1, w->hc, &occ, w->slope);
+        float *o = C->out + C->o_origin + (ptrdiff_t)k * C->o_u_stride;
+        const ptrdiff_t ovs = C->o_v_stride;
+        for (int j = jw; j <= j1; j++)
+            o[(i0 + j) * ovs] = w->slope[j];
     }
     w->carry_next = w->carry;
     w->carry = next;
@@ -367,10 +409,14 @@ static void ws_free(sweep_ws *w)
     free(w->vh);
     free(w->vs);
     free(w->vd);
-    free(w->lanes);
     free(w->lane_stacks);
+    free(w->lane_n);
+    free(w->lane_far);
     free(w->carry);
     free(w->carry_next);
+    free(w->lane_f);
+    free(w->lane_i);
+    free(w->lane_d);
 }
 
 static int ws_init(sweep_ws *w, int U, int capped, int need_visit)
@@ -396,13 +442,29 @@ static int ws_init(sweep_ws *w, int U, int capped, int need_visit)
     }
     if (!capped && !need_visit) {
         const occluder none = {-1, 0.0f};
-        w->lanes = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lanes);
+        w->lane_n = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_n);
+        w->lane_far = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_far);
         w->lane_stacks = malloc((size_t)(LOCKSTEP_LINES + 1) * (U + 1) * sizeof *w->lane_stacks);
         w->carry = malloc((size_t)U * sizeof *w->carry);
         w->carry_next = malloc((size_t)U * sizeof *w->carry_next);
-        ok = w->lanes && w->lane_stacks && w->carry && w->carry_next;
-        for (int j = 0; ok && j <= LOCKSTEP_LINES; j++)
-            w->lanes[j].stack = w->lane_stacks + (size_t)j * (U + 1);
+        /* a block has up to LOCKSTEP_LINES + 1 lines (with the primed one) */
+        const size_t row = LOCKSTEP_LINES + 2;
+        w->lane_f = malloc(6 * row * sizeof *w->lane_f);
+        w->lane_i = malloc(3 * row * sizeof *w->lane_i);
+        w->lane_d = malloc(row * sizeof *w->lane_d);
+        ok = w->lane_n && w->lane_far && w->lane_stacks && w->carry && w->carry_next && w->lane_f &&
+             w->lane_i && w->lane_d;
+        if (ok) {
+            w->hc = w->lane_f;
+            w->hn = w->lane_f + row;
+            w->hs = w->lane_f + 2 * row;
+            w->slope = w->lane_f + 3 * row;
+            w->lo_dd = w->lane_f + 4 * row;
+            w->hi_dd = w->lane_f + 5 * row;
+            w->lo_k = w->lane_i;
+            w->hi_k = w->lane_i + row;
+            w->lane_k0 = w->lane_i + 2 * row;
+        }
         for (int k = 0; ok && k < U; k++)
             w->carry[k] = none;
     }
@@ -421,7 +483,7 @@ static void sweep_range(void *ctx, int worker, long begin, long end)
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
         return;
     }
-    if (w.lanes) {
+    if (w.lane_stacks) {
         long b = C->b0 + begin, bend = C->b0 + end;
         for (int prime = begin > 0; b < bend; prime = 0) {
             int nl = bend - b < LOCKSTEP_LINES ? (int)(bend - b) : LOCKSTEP_LINES;

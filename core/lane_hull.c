@@ -1,0 +1,265 @@
+/* A lockstep block's hull step, eight lines per AVX-512 vector; see
+ * lane_hull.h. */
+#include <limits.h>
+#include <stddef.h>
+
+#include "lane_hull.h"
+
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+
+/* Gathers address a point's fields as doubles (d, g) and ints (k). */
+_Static_assert(sizeof(ts_hull_pt) == 3 * sizeof(double) && offsetof(ts_hull_pt, d) == 0 &&
+                   offsetof(ts_hull_pt, g) == sizeof(double) &&
+                   offsetof(ts_hull_pt, k) == 2 * sizeof(double),
+               "ts_hull_pt is laid out as the gathers read it");
+
+#define AVX512 __attribute__((target("avx512f")))
+
+typedef struct {
+    __m512d d;     /* the lines' distances */
+    __m256i first; /* index of each line's first point */
+    const double *pd;
+    const int *pk;
+} group;
+
+AVX512 static inline __mmask8 mask_of(__m256i v)
+{
+    return (__mmask8)_mm256_movemask_ps(_mm256_castsi256_ps(v));
+}
+
+AVX512 static inline __m256i ones_where(__mmask8 m)
+{
+    return _mm512_castsi512_si256(_mm512_maskz_set1_epi32((__mmask16)m, 1));
+}
+
+/* Field f (0: d, 1: g) of point p of each line, where m. */
+AVX512 static inline __m512d field(const group *G, __mmask8 m, __m256i p, int f)
+{
+    __m256i i = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_add_epi32(G->first, p),
+                                                    _mm256_set1_epi32(3)),
+                                 _mm256_set1_epi32(f));
+    return _mm512_mask_i32gather_pd(_mm512_setzero_pd(), m, i, G->pd, 8);
+}
+
+AVX512 static inline __m256 load8f(__mmask8 m, const float *p)
+{
+    return _mm512_castps512_ps256(_mm512_maskz_loadu_ps((__mmask16)m, p));
+}
+
+AVX512 static inline __m256i load8i(__mmask8 m, const int *p)
+{
+    return _mm512_castsi512_si256(_mm512_maskz_loadu_epi32((__mmask16)m, p));
+}
+
+AVX512 static inline void store8i(int *p, __mmask8 m, __m256i v)
+{
+    _mm512_mask_storeu_epi32(p, (__mmask16)m, _mm512_castsi256_si512(v));
+}
+
+/* The loops below walk several hulls' stacks at once: each pass of a
+ * loop issues the gathers of Q independent vectors (lines, or the two
+ * queries of the same lines), so that their latencies overlap; Q is a
+ * constant where they are inlined. */
+#define ALWAYS AVX512 static inline __attribute__((always_inline))
+/* vectors of eight lines a step takes at once (4: measured faster than 1,
+ * 2 and 8), and at most twice as many walks (two queries per line) */
+#define NG 4
+#define QMAX (2 * NG)
+
+ALWAYS __mmask8 any_of(int Q, const __mmask8 *active)
+{
+    __mmask8 any = 0;
+    for (int q = 0; q < Q; q++)
+        any |= active[q];
+    return any;
+}
+
+/* The walk of hull_push's pops and of stack_query, for Q vectors of lines
+ * (those of active[q], of group G[q]) at hull heights g[q]: j[q] moves
+ * down while point j - 1 hides point j (dj, gj: point j's fields) as seen
+ * from the lines' samples, and stays at 0 at most. */
+ALWAYS void walk_down(int Q, const group *const *G, const __m512d *g, __mmask8 *active,
+                      __m256i *j, __m512d *dj, __m512d *gj)
+{
+    const __m256i zero = _mm256_setzero_si256(), one = _mm256_set1_epi32(1);
+    while (any_of(Q, active))
+        for (int q = 0; q < Q; q++) {
+            const __m512d d = G[q]->d;
+            __m256i jm = _mm256_sub_epi32(j[q], one);
+            __m512d dm = field(G[q], active[q], jm, 0), gm = field(G[q], active[q], jm, 1);
+            __m512d lhs = _mm512_mul_pd(_mm512_sub_pd(gm, g[q]), _mm512_sub_pd(d, dj[q]));
+            __m512d rhs = _mm512_mul_pd(_mm512_sub_pd(gj[q], g[q]), _mm512_sub_pd(d, dm));
+            __mmask8 pop = _mm512_mask_cmp_pd_mask(active[q], lhs, rhs, _CMP_GE_OQ);
+            dj[q] = _mm512_mask_mov_pd(dj[q], pop, dm);
+            gj[q] = _mm512_mask_mov_pd(gj[q], pop, gm);
+            j[q] = _mm256_sub_epi32(j[q], ones_where(pop));
+            active[q] = pop & mask_of(_mm256_cmpgt_epi32(j[q], zero));
+        }
+}
+
+/* far_advance for Q groups: far[q] moves up while its next point (below
+ * n[q]) is near_skip behind. */
+ALWAYS void advance(int Q, const group *G, const __mmask8 *lanes, __m256i *far,
+                    const __m256i *n, __m512d near_skip)
+{
+    const __m256i one = _mm256_set1_epi32(1);
+    __mmask8 active[QMAX];
+    for (int q = 0; q < Q; q++)
+        active[q] = lanes[q] & mask_of(_mm256_cmpgt_epi32(n[q], _mm256_add_epi32(far[q], one)));
+    while (any_of(Q, active))
+        for (int q = 0; q < Q; q++) {
+            __m256i next = _mm256_add_epi32(far[q], one);
+            __m512d dn = field(&G[q], active[q], next, 0);
+            __mmask8 go = _mm512_mask_cmp_pd_mask(active[q], _mm512_sub_pd(G[q].d, dn),
+                                                  near_skip, _CMP_GE_OQ);
+            far[q] = _mm256_add_epi32(far[q], ones_where(go));
+            active[q] = go & mask_of(_mm256_cmpgt_epi32(n[q], _mm256_add_epi32(far[q], one)));
+        }
+}
+
+/* stack_query for Q vectors of lines (those of m[q], of group G[q]) at
+ * hull heights g[q]: walk down from far while the slope grows; the
+ * occluder's step (-1: none) and distance. */
+ALWAYS void query(int Q, const group *const *G, const __mmask8 *m, const __m256i *far,
+                  const __m512d *g, __m256i *k_out, __m256 *dd_out)
+{
+    const __m256i zero = _mm256_setzero_si256();
+    __mmask8 ok[QMAX], active[QMAX];
+    __m256i j[QMAX];
+    __m512d dj[QMAX], gj[QMAX];
+    for (int q = 0; q < Q; q++) {
+        ok[q] = m[q] & ~mask_of(_mm256_cmpgt_epi32(zero, far[q]));
+        j[q] = far[q];
+        dj[q] = field(G[q], ok[q], j[q], 0);
+        gj[q] = field(G[q], ok[q], j[q], 1);
+        active[q] = ok[q] & mask_of(_mm256_cmpgt_epi32(j[q], zero));
+    }
+    walk_down(Q, G, g, active, j, dj, gj);
+    for (int q = 0; q < Q; q++) {
+        __m256i ki = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_add_epi32(G[q]->first, j[q]),
+                                                         _mm256_set1_epi32(6)),
+                                      _mm256_set1_epi32(4));
+        __m512i k = _mm512_mask_i32gather_epi32(_mm512_set1_epi32(-1), (__mmask16)ok[q],
+                                                _mm512_castsi256_si512(ki), G[q]->pk, 4);
+        k_out[q] = _mm512_castsi512_si256(k);
+        dd_out[q] = _mm512_maskz_cvtpd_ps(ok[q], _mm512_sub_pd(G[q]->d, dj[q]));
+    }
+}
+
+/* Groups of eight lines from j on, NG of them at once, those of lanes[q]
+ * in group q (a group with none is left alone). */
+AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, int j,
+                               const __mmask8 *lanes, const ts_lane_occluders *occ)
+{
+    const __m512d c = _mm512_set1_pd(s->c), near_skip = _mm512_set1_pd(s->near_skip);
+    const __m256i one = _mm256_set1_epi32(1);
+    group G[NG];
+    const group *GP[NG];
+    __m256i idx[NG], m[NG], top[NG], far[NG];
+    __m512d cdd[NG], gs[NG], d1[NG], g1[NG];
+    __mmask8 push[NG], active[NG];
+    for (int q = 0; q < NG; q++) {
+        const int jq = j + 8 * q;
+        idx[q] = _mm256_add_epi32(_mm256_set1_epi32(jq), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+        G[q].d = _mm512_maskz_loadu_pd(lanes[q], s->d + jq);
+        G[q].first = _mm256_mullo_epi32(idx[q], _mm256_set1_epi32(H->stride));
+        G[q].pd = (const double *)H->pts;
+        G[q].pk = (const int *)H->pts;
+        cdd[q] = _mm512_mul_pd(_mm512_mul_pd(c, G[q].d), G[q].d);
+        /* hull_push: pop the points the sample hides */
+        const __m512d hs = _mm512_cvtps_pd(load8f(lanes[q], s->hs + jq));
+        push[q] = _mm512_mask_cmp_pd_mask(lanes[q], hs, hs, _CMP_ORD_Q);
+        gs[q] = _mm512_sub_pd(hs, cdd[q]);
+        m[q] = load8i(lanes[q], H->n + jq);
+        /* the top point is m - 1; the walk leaves the new top */
+        top[q] = _mm256_sub_epi32(m[q], one);
+        active[q] = push[q] & mask_of(_mm256_cmpgt_epi32(top[q], _mm256_setzero_si256()));
+        d1[q] = field(&G[q], active[q], top[q], 0);
+        g1[q] = field(&G[q], active[q], top[q], 1);
+        GP[q] = &G[q];
+    }
+    walk_down(NG, GP, gs, active, top, d1, g1);
+    /* Pops only take from the top, so far is at most the new top; lines
+     * with nothing to push keep m = n, where far already is. */
+    for (int q = 0; q < NG; q++) {
+        m[q] = _mm256_add_epi32(top[q], one);
+        far[q] = _mm256_min_epi32(load8i(lanes[q], H->far + j + 8 * q), top[q]);
+    }
+    advance(NG, G, lanes, far, m, near_skip);
+    const group *QG[2 * NG];
+    __mmask8 qm[2 * NG];
+    __m256i qfar[2 * NG], k[2 * NG];
+    __m512d qg[2 * NG];
+    __m256 dd[2 * NG];
+    for (int q = 0; q < NG; q++) {
+        const int jq = j + 8 * q;
+        /* the push itself */
+        const __m256i at = _mm256_mullo_epi32(_mm256_add_epi32(G[q].first, m[q]),
+                                              _mm256_set1_epi32(3));
+        _mm512_mask_i32scatter_pd((double *)H->pts, push[q], at, G[q].d, 8);
+        _mm512_mask_i32scatter_pd((double *)H->pts, push[q], _mm256_add_epi32(at, one), gs[q], 8);
+        const __m256i kat = _mm256_add_epi32(_mm256_add_epi32(at, at), _mm256_set1_epi32(4));
+        _mm512_mask_i32scatter_epi32((int *)H->pts, (__mmask16)push[q],
+                                     _mm512_castsi256_si512(kat), _mm512_set1_epi32(s->k), 4);
+        store8i(H->n + jq, lanes[q], _mm256_add_epi32(m[q], ones_where(push[q])));
+        store8i(H->far + jq, lanes[q], far[q]);
+        /* the occluders of the cells below (hi, when asked) and above (lo) */
+        const __m512d hc = _mm512_cvtps_pd(load8f(lanes[q], s->hc + jq));
+        const __m512d hn = _mm512_cvtps_pd(load8f(lanes[q], s->hn + jq));
+        const __mmask8 want_hi =
+            lanes[q] & ~mask_of(_mm256_cmpgt_epi32(_mm256_set1_epi32(s->hi_from), idx[q])) &
+            ~mask_of(_mm256_cmpgt_epi32(idx[q], _mm256_set1_epi32(s->hi_to)));
+        QG[2 * q] = QG[2 * q + 1] = &G[q];
+        qfar[2 * q] = qfar[2 * q + 1] = far[q];
+        qm[2 * q] = _mm512_mask_cmp_pd_mask(want_hi, hc, hc, _CMP_ORD_Q);
+        qg[2 * q] = _mm512_sub_pd(hc, cdd[q]);
+        qm[2 * q + 1] = _mm512_mask_cmp_pd_mask(lanes[q], hn, hn, _CMP_ORD_Q);
+        qg[2 * q + 1] = _mm512_sub_pd(hn, cdd[q]);
+    }
+    query(2 * NG, QG, qm, qfar, qg, k, dd);
+    for (int q = 0; q < NG; q++) {
+        const int jq = j + 8 * q;
+        store8i(occ->hi_k + jq, lanes[q], k[2 * q]);
+        _mm512_mask_storeu_ps(occ->hi_dd + jq, (__mmask16)lanes[q],
+                              _mm512_castps256_ps512(dd[2 * q]));
+        store8i(occ->lo_k + jq + 1, lanes[q], k[2 * q + 1]);
+        _mm512_mask_storeu_ps(occ->lo_dd + jq + 1, (__mmask16)lanes[q],
+                              _mm512_castps256_ps512(dd[2 * q + 1]));
+    }
+}
+
+int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ)
+{
+    static int known = -1; /* the CPU's answer, once asked */
+    int have = __atomic_load_n(&known, __ATOMIC_RELAXED);
+    if (have < 0) {
+        __builtin_cpu_init();
+        have = __builtin_cpu_supports("avx512f") != 0;
+        __atomic_store_n(&known, have, __ATOMIC_RELAXED);
+    }
+    /* 32-bit offsets: the last line's points, as ints */
+    if (!have || (long long)(s->j1 + 1) * h->stride * 6 > INT_MAX)
+        return 0;
+    for (int j = s->j0; j <= s->j1; j += 8 * NG) {
+        __mmask8 lanes[NG];
+        for (int q = 0; q < NG; q++) {
+            int left = s->j1 - (j + 8 * q) + 1;
+            lanes[q] = left >= 8 ? 0xFF : left <= 0 ? 0 : (__mmask8)((1u << left) - 1);
+        }
+        hull_groups(h, s, j, lanes, occ);
+    }
+    return 1;
+}
+
+#else
+
+int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ)
+{
+    (void)h;
+    (void)s;
+    (void)occ;
+    return 0;
+}
+
+#endif

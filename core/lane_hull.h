@@ -1,0 +1,45 @@
+/*
+ * One step of the hulls of a lockstep block of sweep lines (the unbounded
+ * sweep's sweep_block, core/horizon_sweep.c), eight lines per AVX-512
+ * vector, several vectors at once so that their gathers overlap: each line pushes its sample onto its upper convex hull, popping
+ * the points it hides (masked: a vector's pop loop runs while any of its
+ * lines still pops), moves its first point beyond the near field, and asks
+ * its hull for the far-field occluders of the cells below and above it.
+ * Per line the same double operations in the same order as the scalar
+ * hull_push, far_advance and stack_query, so the results are the same bit
+ * for bit.
+ */
+#ifndef TS_LANE_HULL_H
+#define TS_LANE_HULL_H
+
+#include "lane_passes.h"
+#include "window_hull.h"
+
+/* The block's hulls: line j's points at pts + j * stride, n[j] of them,
+ * far[j] the top-most one at least near_skip behind the line's sample
+ * (-1: none). */
+typedef struct {
+    ts_hull_pt *pts;
+    int stride;
+    int *n, *far;
+} ts_lane_hulls;
+
+/* Step k of lines j0..j1: each line's distance d[j] from its first sample,
+ * its height hs[j] (NaN: no sample to push), and the heights hc[j], hn[j]
+ * of the cells below and above it (NaN: no query). Line j asks for its own
+ * cell's occluder (hi) only when hi_from <= j <= hi_to; line j's answer
+ * for the cell above goes to lo entry j + 1. c: the curvature
+ * coefficient. */
+typedef struct {
+    int k, j0, j1, hi_from, hi_to;
+    const double *d;
+    const float *hs, *hc, *hn;
+    double c, near_skip;
+} ts_lane_step;
+
+/* The step, vectorised: returns 0, having done nothing, where the CPU (or
+ * the build) has no AVX-512 or the hulls are too large for 32-bit
+ * offsets; the caller then runs the scalar code. */
+int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ);
+
+#endif

@@ -1,0 +1,40 @@
+/*
+ * The passes of one step of a lockstep block of sweep lines (the unbounded
+ * sweep's sweep_block, core/horizon_sweep.c) that run over all the block's
+ * lines at once: at step k, line bs + j samples between rows (or columns)
+ * i0 + j and i0 + j + 1 (i0 = bs + fl[k]), all with the same fraction, so
+ * the lines read neighbouring cells; and each written cell's far field is
+ * its own ray sampled at the occluders the lines' hulls found, the ray
+ * samples being gathers. Only the hull itself stays scalar, line by line.
+ * Both passes compute, per line, exactly what the line-by-line code did.
+ */
+#ifndef TS_LANE_PASSES_H
+#define TS_LANE_PASSES_H
+
+#include <stddef.h>
+
+#include "line_geometry.h"
+
+/* Step k's samples of lines j0..j1 (rows i0 + j, all on the grid): the
+ * cell below (hc), the one after (hn, NaN where none) and the height on
+ * the line (hs, NaN off the grid or at nodata), as ts_line_sample_at. */
+void ts_lane_sample(const ts_line_geom *G, const float *z, int k, int i0, int j0, int j1,
+                    float *hc, float *hn, float *hs);
+
+/* Far-field occluders of a step's cells, per line j: their steps (< 0:
+ * none) and distances from the cell, from the line below (lo) and the
+ * cell's own line (hi). */
+typedef struct {
+    int *lo_k, *hi_k;
+    float *lo_dd, *hi_dd;
+} ts_lane_occluders;
+
+/* The far-field slope of cells (k, i0 + j), j0 <= j <= j1, at heights
+ * hc[j] into slope[j]: the larger of the cell's own ray sampled at the
+ * two occluders (the second skipped when it is the first's step; either
+ * skipped within the near field), -inf when none counts, NaN where hc is
+ * nodata; cf is the curvature coefficient. */
+void ts_lane_far_field(const ts_line_geom *G, const float *z, float cf, int k, int i0, int j0,
+                       int j1, const float *hc, const ts_lane_occluders *occ, float *slope);
+
+#endif
