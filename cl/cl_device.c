@@ -395,6 +395,22 @@ ts_status ts_cl_available(ts_cl_info *info, ts_error *err)
     return ts_ok(err);
 }
 
+ts_status ts_cl_peek(ts_cl_info *info, ts_error *err)
+{
+    ts_status st = list_ready(err);
+    int i = 0;
+    unsigned long long cap;
+    if (st != TS_OK || (st = select_device(&i, err)) != TS_OK ||
+        (st = ts_cl_env_max_alloc(&cap, err)) != TS_OK)
+        return st;
+    if (info) {
+        fill_info(&g_list.dev[i], i, info);
+        if (cap && cap < info->max_alloc)
+            info->max_alloc = cap;
+    }
+    return ts_ok(err);
+}
+
 ts_status ts_cl_devices(ts_cl_info *list, int max, int *count, ts_error *err)
 {
     if (!count || (max > 0 && !list))

@@ -24,6 +24,12 @@ ts_status ts_cl_available(ts_cl_info *info, ts_error *err)
     return NOT_BUILT(err);
 }
 
+ts_status ts_cl_peek(ts_cl_info *info, ts_error *err)
+{
+    (void)info;
+    return NOT_BUILT(err);
+}
+
 ts_status ts_cl_devices(ts_cl_info *list, int max, int *count, ts_error *err)
 {
     (void)list;

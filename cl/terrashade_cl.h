@@ -74,6 +74,14 @@ int ts_cl_built(void);
 ts_status ts_cl_available(ts_cl_info *info, ts_error *err);
 
 /**
+ * The device ts_cl_available would select, described in *info (may be NULL)
+ * without making its context, queue or program (no kernel is compiled), and
+ * the same errors for a bad TERRASHADE_OPENCL_DEVICE or
+ * TERRASHADE_OPENCL_MAX_ALLOC. TS_OK does not promise that making it works.
+ */
+ts_status ts_cl_peek(ts_cl_info *info, ts_error *err);
+
+/**
  * List every OpenCL device of every platform (nothing is built): up to
  * `max` entries into `list`, the number found into *count.
  */

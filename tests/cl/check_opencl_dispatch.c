@@ -45,6 +45,12 @@ START_TEST(test_dispatch)
     ts_error e;
     ck_assert_int_eq(ts_cl_available(&info, &e), TS_OK);
     ck_assert_ptr_nonnull(strstr(r.device, info.device));
+    /* the device auto would pick, described without building it */
+    ts_cl_info peek;
+    ck_assert_int_eq(ts_cl_peek(&peek, &e), TS_OK);
+    ck_assert_str_eq(peek.device, info.device);
+    ck_assert_str_eq(peek.type, info.type);
+    ck_assert_int_eq(peek.index, info.index);
 
     r = dispatch_normals(TS_BACKEND_C, s);
     ck_assert_int_eq(r.used, TS_BACKEND_C);
@@ -187,6 +193,8 @@ START_TEST(test_bogus_device)
         ck_assert_int_ne(st, TS_OK);
         ck_assert_ptr_nonnull(strstr(e.message, "TERRASHADE_OPENCL_DEVICE"));
         printf("  TERRASHADE_OPENCL_DEVICE=%s: %s\n", bad[i], e.message);
+        ck_assert_int_ne(ts_cl_peek(&info, &e), TS_OK);
+        ck_assert_ptr_nonnull(strstr(e.message, "TERRASHADE_OPENCL_DEVICE"));
         ts_backend_report r = dispatch_normals(TS_BACKEND_OPENCL, &SHAPES[5]);
         ck_assert_int_eq(r.used, TS_BACKEND_C);
         ck_assert_int_eq(r.fell_back, 1);
