@@ -110,8 +110,7 @@ void TSRasterBand::CopyRow(int n, const float *row, int x0, int W, bool flip_x, 
                            GByte *pabyOut, float *pafOut) const
 {
     if (bByte && !flip_x)
-        for (int bx = 0; bx < n; bx++)
-            pabyOut[bx] = tsd_to_byte(row[x0 + bx]);
+        tsd_row_to_byte(row + x0, n, pabyOut);
     else if (bByte)
         for (int bx = 0; bx < n; bx++)
             pabyOut[bx] = tsd_to_byte(row[W - 1 - (x0 + bx)]);

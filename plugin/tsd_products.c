@@ -4,6 +4,7 @@
 #include "tsd_pyramid.h"
 #include "tsd_text.h"
 
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 #include <strings.h>
@@ -292,4 +293,24 @@ char *tsd_products_xml(void)
     }
     tsd_strbuf_add(&b, "</Products>");
     return tsd_strbuf_finish(&b);
+}
+
+void tsd_row_to_byte(const float *restrict v, int n, unsigned char *restrict out)
+{
+    /* on the bits, without float compares (which would keep the loop from
+     * vectorising under trapping math): masks of 0 < v < 1, v NaN and
+     * 1 <= v <= inf; heights of the rest 0 before the conversion, so that
+     * it is defined; then tsd_to_byte's rounding or its constants */
+    for (int i = 0; i < n; i++) {
+        uint32_t u;
+        memcpy(&u, &v[i], sizeof u);
+        uint32_t in = -(uint32_t)(u - 1u < 0x3f7fffffu);
+        uint32_t uc = u & in;
+        float c;
+        memcpy(&c, &uc, sizeof c);
+        uint32_t b = (uint32_t)(int32_t)(1.0f + 254.0f * c + 0.5f);
+        uint32_t nan = -(uint32_t)((u & 0x7fffffffu) > 0x7f800000u);
+        uint32_t big = -(uint32_t)(u - 0x3f800000u <= 0x7f800000u - 0x3f800000u);
+        out[i] = (unsigned char)(((b & ~big) | (255u & big)) & ~nan);
+    }
 }

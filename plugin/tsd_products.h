@@ -128,6 +128,10 @@ static inline unsigned char tsd_to_byte(float v)
     return (unsigned char)(1.0f + 254.0f * v + 0.5f);
 }
 
+/** tsd_to_byte of v[0..n-1] into out, branch-free so that it vectorises
+ * (the driver's block copies of Byte products). */
+void tsd_row_to_byte(const float *v, int n, unsigned char *out);
+
 #ifdef __cplusplus
 }
 #endif

@@ -12,9 +12,13 @@
  * - REFRACTION's default is TSD_REFRACTION_DEFAULT and the core's
  *   ts_horizon_opts_default; the sun defaults are gdaldem's 315 / 45;
  * - sentences that scripts and tests read, made from the tables, are the
- *   ones written before the tables made them.
+ *   ones written before the tables made them;
+ * - the block copies' vectorised tsd_row_to_byte equals tsd_to_byte on
+ *   every float of a stride through all 2^32 bit patterns and on the
+ *   values where it changes (0, 1, NaN, inf and each rounding boundary).
  */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -152,6 +156,55 @@ static void check_sentences(void)
                     "SUN_POSITION=per_cell needs the sun from DATETIME or DATE");
 }
 
+/* tsd_row_to_byte against tsd_to_byte on n floats of bits u[] */
+static void expect_bytes(const uint32_t *u, int n)
+{
+    float v[256];
+    unsigned char b[256];
+    for (int i = 0; i < n; i++)
+        memcpy(&v[i], &u[i], sizeof v[i]);
+    tsd_row_to_byte(v, n, b);
+    for (int i = 0; i < n; i++)
+        EXPECT(b[i] == tsd_to_byte(v[i]), "tsd_row_to_byte(%a) = %d, tsd_to_byte %d", v[i],
+               b[i], tsd_to_byte(v[i]));
+}
+
+/* add the float of bits x to the batch u (n of them), checked when full */
+static void push_bits(uint32_t *u, int *n, uint32_t x)
+{
+    u[(*n)++] = x;
+    if (*n == 256)
+        expect_bytes(u, *n), *n = 0;
+}
+
+static void push_float(uint32_t *u, int *n, float f)
+{
+    uint32_t x;
+    memcpy(&x, &f, sizeof x);
+    push_bits(u, n, x);
+}
+
+static void check_row_to_byte(void)
+{
+    uint32_t u[256];
+    int n = 0;
+    for (uint64_t x = 0; x < (1ull << 32); x += 4093)
+        push_bits(u, &n, (uint32_t)x);
+    static const float special[] = {0.0f, -0.0f, 1.0f, -1.0f, INFINITY, -INFINITY, NAN, -NAN};
+    for (size_t i = 0; i < sizeof special / sizeof *special; i++) {
+        push_float(u, &n, nextafterf(special[i], -INFINITY));
+        push_float(u, &n, special[i]);
+        push_float(u, &n, nextafterf(special[i], INFINITY));
+    }
+    for (int k = 1; k <= 255; k++) { /* 1 + 254 v + 0.5 crosses k + 1 */
+        float f = (float)((k - 0.5) / 254.0);
+        push_float(u, &n, nextafterf(f, 0.0f));
+        push_float(u, &n, f);
+        push_float(u, &n, nextafterf(f, 1.0f));
+    }
+    expect_bytes(u, n);
+}
+
 int main(void)
 {
     tsd_options d;
@@ -163,6 +216,7 @@ int main(void)
     check_given_explicitly(&d);
     check_xml();
     check_sentences();
+    check_row_to_byte();
     EXPECT(d.refraction == TSD_REFRACTION_DEFAULT, "REFRACTION default %g", d.refraction);
     EXPECT(h.refraction == TSD_REFRACTION_DEFAULT,
            "the core's refraction default %g differs from the driver's %g", h.refraction,
