@@ -37,15 +37,14 @@ static float between_steps_bound(const ts_line_geom *G, const float *z, int k, i
  * TS_NEAR_EXACT of them), then the tail's; bounds[n * W + x] is stencil n's
  * bound at x, NaN where it has none (the cell falls back to the per-cell
  * path), and one more row: scratch, then the largest of the bounds at x.
- * Returns how many. */
+ * st receives the stencils. Returns how many. */
 enum { MAX_STENCILS = TS_NEAR_STEPS - TS_NEAR_EXACT + 1 };
 
 static int row_bounds(const ts_line_geom *G, const float *zrow, int W, int y, double send,
                       int between, double s0, double smax, int tail, double step, double c,
-                      float *bounds)
+                      ts_cap_stencil st[MAX_STENCILS], float *bounds)
 {
     int n = 0;
-    ts_cap_stencil st[MAX_STENCILS];
     for (int j = TS_NEAR_EXACT; between && j < send; j++)
         ts_cap_stencil_init(&st[n++], G, j, j + 1 < send ? j + 1 : send, step, c);
     if (tail)
@@ -71,6 +70,15 @@ static int row_bounds(const ts_line_geom *G, const float *zrow, int W, int y, do
     return n;
 }
 
+/* Whether stencil m solves cell x's stretch as ts_ray_exact would: its
+ * pieces are the ray's and its bound at x is a number (on the grid, no
+ * nodata). */
+static inline int fast_exact(const ts_cap_stencil *st, int nst, int m, const float *bound,
+                             int x)
+{
+    return m < nst && st[m].exact && bound[x] == bound[x];
+}
+
 /*
  * What the near field and the lines leave out within a maximum distance,
  * solved exactly on each cell's own ray: a capped horizon is often near,
@@ -93,7 +101,9 @@ void ts_cap_tail(const ts_line_geom *G, const ts_grid *grid, double cap, double 
     s0 = s0 > TS_NEAR_EXACT ? s0 : TS_NEAR_EXACT;
     int tail = s0 < smax && (axis || smax > TS_NEAR_STEPS);
     float *bounds = malloc((size_t)(MAX_STENCILS + 1) * W * sizeof *bounds);
-    int nst = bounds ? row_bounds(G, zrow, W, y, send, !axis, s0, smax, tail, step, c, bounds)
+    ts_cap_stencil st[MAX_STENCILS];
+    int nst = bounds ? row_bounds(G, zrow, W, y, send, !axis, s0, smax, tail, step, c, st,
+                                  bounds)
                      : 0;
     for (int x = 0; x < W; x++) {
         if (isnan(zrow[x]))
@@ -108,12 +118,16 @@ void ts_cap_tail(const ts_line_geom *G, const ts_grid *grid, double cap, double 
             if ((m < nst && bounds[(size_t)m * W + x] < best) ||
                 between_steps_bound(G, z, k, i, h, j, step, c) < best)
                 continue;
-            float e = ts_ray_exact(G, z, k, i, h, j, j + 1 < send ? j + 1 : send, step, c);
+            float e = fast_exact(st, nst, m, bounds + (size_t)m * W, x)
+                          ? ts_cap_stencil_exact(&st[m], zrow, x)
+                          : ts_ray_exact(G, z, k, i, h, j, j + 1 < send ? j + 1 : send, step, c);
             best = e > best ? e : best;
         }
         if (tail && !(m < nst && bounds[(size_t)m * W + x] < best) &&
             between_steps_bound(G, z, k, i, h, (int)s0, step, c) >= best) {
-            float e = ts_ray_exact(G, z, k, i, h, s0, smax, step, c);
+            float e = fast_exact(st, nst, m, bounds + (size_t)m * W, x)
+                          ? ts_cap_stencil_exact(&st[m], zrow, x)
+                          : ts_ray_exact(G, z, k, i, h, s0, smax, step, c);
             best = e > best ? e : best;
         }
         orow[x] = best;
