@@ -115,19 +115,30 @@ void ts_cap_tail(const ts_line_geom *G, const ts_grid *grid, double cap, double 
             continue; /* no stretch can raise it */
         int m = 0; /* the stencil of the stretch at hand */
         for (int j = TS_NEAR_EXACT; !axis && j < send; j++, m++) {
-            if ((m < nst && bounds[(size_t)m * W + x] < best) ||
-                between_steps_bound(G, z, k, i, h, j, step, c) < best)
+            if (m < nst && bounds[(size_t)m * W + x] < best)
                 continue;
-            float e = fast_exact(st, nst, m, bounds + (size_t)m * W, x)
-                          ? ts_cap_stencil_exact(&st[m], zrow, x)
-                          : ts_ray_exact(G, z, k, i, h, j, j + 1 < send ? j + 1 : send, step, c);
+            /* the corner bound decides only where the stretch would raise */
+            float e;
+            if (fast_exact(st, nst, m, bounds + (size_t)m * W, x)) {
+                e = ts_cap_stencil_exact(&st[m], zrow, x);
+                if (e > best && between_steps_bound(G, z, k, i, h, j, step, c) < best)
+                    continue;
+            } else {
+                if (between_steps_bound(G, z, k, i, h, j, step, c) < best)
+                    continue;
+                e = ts_ray_exact(G, z, k, i, h, j, j + 1 < send ? j + 1 : send, step, c);
+            }
             best = e > best ? e : best;
         }
-        if (tail && !(m < nst && bounds[(size_t)m * W + x] < best) &&
-            between_steps_bound(G, z, k, i, h, (int)s0, step, c) >= best) {
-            float e = fast_exact(st, nst, m, bounds + (size_t)m * W, x)
-                          ? ts_cap_stencil_exact(&st[m], zrow, x)
-                          : ts_ray_exact(G, z, k, i, h, s0, smax, step, c);
+        if (tail && !(m < nst && bounds[(size_t)m * W + x] < best)) {
+            float e = -INFINITY;
+            if (fast_exact(st, nst, m, bounds + (size_t)m * W, x)) {
+                e = ts_cap_stencil_exact(&st[m], zrow, x);
+                if (e > best && between_steps_bound(G, z, k, i, h, (int)s0, step, c) < best)
+                    e = -INFINITY;
+            } else if (between_steps_bound(G, z, k, i, h, (int)s0, step, c) >= best) {
+                e = ts_ray_exact(G, z, k, i, h, s0, smax, step, c);
+            }
             best = e > best ? e : best;
         }
         orow[x] = best;
