@@ -76,4 +76,14 @@ static inline float ts_cap_stencil_exact(const ts_cap_stencil *s, const float *z
     return (float)best;
 }
 
+/* Whether ts_ray_exact finds nothing on the stretch (-inf) for cell (k, i)
+ * of a stencil with s->exact set, because the ray leaves the grid in its
+ * first piece. */
+static inline int ts_cap_stencil_off_grid(const ts_cap_stencil *s, const ts_line_geom *G, int k,
+                                          int i)
+{
+    int r0 = i - (int)s->b0[0];
+    return s->exact && (k < s->jback || r0 < 0 || r0 + (s->t != 0) > G->V - 1);
+}
+
 #endif

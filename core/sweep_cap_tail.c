@@ -124,7 +124,8 @@ void ts_cap_tail(const ts_line_geom *G, const ts_grid *grid, double cap, double 
                 if (e > best && between_steps_bound(G, z, k, i, h, j, step, c) < best)
                     continue;
             } else {
-                if (between_steps_bound(G, z, k, i, h, j, step, c) < best)
+                if ((m < nst && ts_cap_stencil_off_grid(&st[m], G, k, i)) ||
+                    between_steps_bound(G, z, k, i, h, j, step, c) < best)
                     continue;
                 e = ts_ray_exact(G, z, k, i, h, j, j + 1 < send ? j + 1 : send, step, c);
             }
@@ -136,7 +137,8 @@ void ts_cap_tail(const ts_line_geom *G, const ts_grid *grid, double cap, double 
                 e = ts_cap_stencil_exact(&st[m], zrow, x);
                 if (e > best && between_steps_bound(G, z, k, i, h, (int)s0, step, c) < best)
                     e = -INFINITY;
-            } else if (between_steps_bound(G, z, k, i, h, (int)s0, step, c) >= best) {
+            } else if (!(m < nst && ts_cap_stencil_off_grid(&st[m], G, k, i)) &&
+                       between_steps_bound(G, z, k, i, h, (int)s0, step, c) >= best) {
                 e = ts_ray_exact(G, z, k, i, h, s0, smax, step, c);
             }
             best = e > best ? e : best;
