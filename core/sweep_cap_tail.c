@@ -64,8 +64,10 @@ static int row_bounds(const ts_line_geom *G, const float *zrow, int W, int y, do
         top[x] = -INFINITY;
     for (int m = 0; m < n; m++) {
         const float *b = bounds + (size_t)m * W;
-        for (int x = 0; x < W; x++)
-            top[x] = b[x] != b[x] || top[x] != top[x] ? NAN : b[x] > top[x] ? b[x] : top[x];
+        for (int x = 0; x < W; x++) { /* one select, so that it vectorises */
+            float v = b[x], t = top[x];
+            top[x] = v > t || v != v ? v : t;
+        }
     }
     return n;
 }
@@ -105,6 +107,9 @@ void ts_cap_tail(const ts_line_geom *G, const ts_grid *grid, double cap, double 
     int nst = bounds ? row_bounds(G, zrow, W, y, send, !axis, s0, smax, tail, step, c, st,
                                   bounds)
                      : 0;
+    int jend = TS_NEAR_EXACT; /* the between stretches are j < jend */
+    while (!axis && jend < send)
+        jend++;
     for (int x = 0; x < W; x++) {
         if (isnan(zrow[x]))
             continue;
@@ -114,7 +119,7 @@ void ts_cap_tail(const ts_line_geom *G, const ts_grid *grid, double cap, double 
         if (nst > 0 && bounds[(size_t)nst * W + x] < best)
             continue; /* no stretch can raise it */
         int m = 0; /* the stencil of the stretch at hand */
-        for (int j = TS_NEAR_EXACT; !axis && j < send; j++, m++) {
+        for (int j = TS_NEAR_EXACT; j < jend; j++, m++) {
             if (m < nst && bounds[(size_t)m * W + x] < best)
                 continue;
             /* the corner bound decides only where the stretch would raise */
