@@ -11,7 +11,10 @@
  * bound is a fixed stencil that a loop over the row vectorises. It carries
  * a margin far above the rounding of ts_ray_exact, so a stretch whose bound
  * is below the horizon found so far cannot raise it: skipping it leaves the
- * result bit for bit the same.
+ * result bit for bit the same. A stretch it lets through is solved from the
+ * same stencil (ts_cap_stencil_exact) where its pieces are provably those
+ * that ts_ray_exact finds for every cell of the row, with the same
+ * operations, so again with the same bits.
  */
 #ifndef TS_CAP_TAIL_BOUND_H
 #define TS_CAP_TAIL_BOUND_H
