@@ -15,6 +15,47 @@ static void corner_weights(double a, double b, float w[4])
     w[3] = (float)(a * b);
 }
 
+/* How far x is from the nearest integer. */
+static double off_integer(double x)
+{
+    return fabs(x - floor(x + 0.5));
+}
+
+/* ts_ray_exact's pieces of stretch [sa, sb] relative to the cell (its loop,
+ * with v = i - t s taken at i = 0), checked against the stencil's; sets
+ * s->exact only if they match and every floor and ceil of that loop is at
+ * least 5e-10 from a jump, so that the cell's own index (rounding of
+ * i - t s up to ~1e-10 for a row of 2^20 cells) cannot change them. */
+static void exact_pieces(ts_cap_stencil *s, double sa, double sb, const int rr[2])
+{
+    const double t = s->t, gap = 5e-10;
+    const int use_r1 = t != 0;
+    int np = 0, ok = 1;
+    double x = sa;
+    while (ok && x < sb - 1e-12) {
+        double nxt = floor(x + 1e-9) + 1;
+        if (use_r1) {
+            double v = -t * x;
+            double w = t > 0 ? v - 1e-9 : v + 1e-9;
+            ok &= off_integer(w) > gap;
+            double vb = t > 0 ? ceil(w) - 1 : floor(w) + 1;
+            double sv = -vb / t; /* (i - vb) / t, i - vb an integer */
+            if (sv > x + 1e-9 && sv < nxt)
+                nxt = sv;
+        }
+        double se = nxt < sb ? nxt : sb, mid = 0.5 * (x + se);
+        ok &= off_integer(mid) > gap && (!use_r1 || off_integer(-t * mid) > gap);
+        ok &= np < s->npieces && ceil(mid) == s->a0 && (!use_r1 || floor(-t * mid) == rr[np]);
+        if (ok) {
+            s->s[np][0] = x;
+            s->s[np][1] = se;
+            np++;
+        }
+        x = se;
+    }
+    s->exact = ok && np == s->npieces;
+}
+
 void ts_cap_stencil_init(ts_cap_stencil *s, const ts_line_geom *G, double sa, double sb,
                          double step, double c)
 {
@@ -39,6 +80,7 @@ void ts_cap_stencil_init(ts_cap_stencil *s, const ts_line_geom *G, double sa, do
         }
     }
     s->npieces = ncut - 1;
+    int rr[2] = {0, 0};
     s->vlo = 1 << 30;
     s->vhi = -(1 << 30);
     for (int p = 0; p < s->npieces; p++) {
@@ -55,6 +97,8 @@ void ts_cap_stencil_init(ts_cap_stencil *s, const ts_line_geom *G, double sa, do
             corner_weights(j + 1 - se, t != 0 ? -t * se - r : 0.0, s->w[p][e]);
         }
         s->bulge[p] = (float)(t * (pb - pa) * (pb - pa) * 0.25);
+        s->b0[p] = -r;
+        rr[p] = r;
         s->inv[p][0] = (float)(1.0 / (pa * step));
         s->inv[p][1] = (float)(1.0 / (pb * step));
         s->vlo = r < s->vlo ? r : s->vlo;
@@ -62,6 +106,11 @@ void ts_cap_stencil_init(ts_cap_stencil *s, const ts_line_geom *G, double sa, do
     }
     s->jback = j + 1;
     s->drop = (float)(c * sa * step);
+    s->a0 = j + 1;
+    s->t = t;
+    s->step = step;
+    s->c = c;
+    exact_pieces(s, sa, sb, rr);
 }
 
 void ts_cap_stencil_range(const ts_cap_stencil *s, const ts_line_geom *G, int width, int y,

@@ -11,11 +11,17 @@
  * bound is a fixed stencil that a loop over the row vectorises. It carries
  * a margin far above the rounding of ts_ray_exact, so a stretch whose bound
  * is below the horizon found so far cannot raise it: skipping it leaves the
- * result bit for bit the same.
+ * result bit for bit the same. A stretch it lets through is solved from the
+ * same stencil (ts_cap_stencil_exact) where its pieces are provably those
+ * that ts_ray_exact finds for every cell of the row, with the same
+ * operations, so again with the same bits.
  */
 #ifndef TS_CAP_TAIL_BOUND_H
 #define TS_CAP_TAIL_BOUND_H
 
+#include <math.h>
+
+#include "cellmath/cm_near_field.h"
 #include "line_geometry.h"
 
 typedef struct {
@@ -25,6 +31,12 @@ typedef struct {
     float bulge[2];           /* t len^2 / 4 of each piece */
     float inv[2][2];          /* 1 / (distance in metres) of each piece's ends */
     float drop;               /* c sa step: the curvature term at sa */
+    /* for ts_cap_stencil_exact: */
+    int exact;                /* the pieces are ts_ray_exact's for every cell */
+    double s[2][2];           /* each piece's ends, in steps */
+    double a0, b0[2];         /* the cell in each piece's patch */
+    double t, step, c;        /* v per step (0 along a grid line), metres per step,
+                                 curvature coefficient */
     int jback;                /* steps back of the patches' farther column */
     int vlo, vhi;             /* v offsets of the rows read, from the cell's */
 } ts_cap_stencil;
@@ -44,5 +56,37 @@ void ts_cap_stencil_range(const ts_cap_stencil *s, const ts_line_geom *G, int wi
  * flag: scratch of the same extent. */
 void ts_cap_stencil_row(const ts_cap_stencil *s, const float *zrow, int xa, int xb,
                         float *bound, float *flag);
+
+/* The stretch's slope from the cell at x of the row whose heights start at
+ * zrow, bit for bit what ts_ray_exact returns (same pieces, same
+ * operations), for a cell whose bound ts_cap_stencil_row found finite (on
+ * the grid, no nodata) of a stencil with s->exact set. */
+static inline float ts_cap_stencil_exact(const ts_cap_stencil *s, const float *zrow, int x)
+{
+    const double L = s->step, c = s->c, a0 = s->a0, t = s->t;
+    const double h = zrow[x];
+    double best = -INFINITY;
+    for (int p = 0; p < s->npieces; p++) {
+        const float *zz = zrow + x;
+        double h00 = zz[s->off[p][0]], h10 = zz[s->off[p][1]];
+        double h01 = zz[s->off[p][2]], h11 = zz[s->off[p][3]];
+        double alpha, beta, gamma;
+        cm_patch_poly(h00, h10 - h00, h01 - h00, h11 - h10 - h01 + h00, a0, s->b0[p], t, &alpha,
+                      &beta, &gamma);
+        double m = cm_piece_max(alpha - h, beta, gamma, s->s[p][0], s->s[p][1], L, c);
+        best = m > best ? m : best;
+    }
+    return (float)best;
+}
+
+/* Whether ts_ray_exact finds nothing on the stretch (-inf) for cell (k, i)
+ * of a stencil with s->exact set, because the ray leaves the grid in its
+ * first piece. */
+static inline int ts_cap_stencil_off_grid(const ts_cap_stencil *s, const ts_line_geom *G, int k,
+                                          int i)
+{
+    int r0 = i - (int)s->b0[0];
+    return s->exact && (k < s->jback || r0 < 0 || r0 + (s->t != 0) > G->V - 1);
+}
 
 #endif

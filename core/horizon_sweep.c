@@ -135,8 +135,8 @@ static inline int hull_push(hull_pt *S, int *n, int *far, double d, double gs, i
  * hull points 0..far (those beyond the near field): walk to farther points
  * while the slope grows (the slopes to an upper convex hull from a point
  * beyond it are unimodal). With a maximum distance, the window's. */
-static occluder hull_query(const sweep_ctx *C, sweep_ws *w, int far, double d, float h,
-                           int finger[2])
+static inline __attribute__((always_inline)) occluder
+hull_query(const sweep_ctx *C, sweep_ws *w, int far, double d, float h, int finger[2])
 {
     occluder none = {-1, 0.0f};
     double g = h - C->c * d * d;

@@ -62,11 +62,20 @@ void ts_cap_tail(const ts_line_geom *G, const ts_grid *grid, double cap, double 
             continue;
         int u = G->x_major ? x : y, i = G->x_major ? y : x;
         int k = (u - G->u_start) * G->u_step;
-        float h = zrow[x];
-        if (between_steps_bound(G, grid->z, k, i, h, (int)s0, step, c) < orow[x])
-            continue;
-        float e = ts_ray_exact(G, grid->z, k, i, h, s0, smax, step, c);
-        orow[x] = e > orow[x] ? e : orow[x];
+        float h = zrow[x], best = orow[x], e;
+        if (bound && st.exact && bound[x] == bound[x]) {
+            /* solved from the row's stencil, ts_ray_exact's bits; the
+             * corner bound decides only where it would raise */
+            e = ts_cap_stencil_exact(&st, zrow, x);
+            if (e > best && between_steps_bound(G, grid->z, k, i, h, (int)s0, step, c) < best)
+                continue;
+        } else {
+            if (ts_cap_stencil_off_grid(&st, G, k, i) ||
+                between_steps_bound(G, grid->z, k, i, h, (int)s0, step, c) < best)
+                continue; /* off the grid: ts_ray_exact's -inf */
+            e = ts_ray_exact(G, grid->z, k, i, h, s0, smax, step, c);
+        }
+        orow[x] = e > best ? e : best;
     }
     free(bound);
 }
