@@ -19,6 +19,7 @@
  * exceeds the largest sample. A sample that touches nodata is no
  * occluder: it repeats the sample before it.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 
@@ -77,6 +78,8 @@ typedef struct {
     float *m;            /* spline maximum (or largest tangent) so far */
     float *T;            /* the level row at the samples */
     float *A;            /* the samples being pushed */
+    double *tpp;         /* drop_cells: t, px, py of the cells (3 rows) */
+    int *jd;             /* the sample number at which each cell drops out */
 } row_ws;
 
 static double step_at(const hz_ctx *C, double row)
@@ -127,22 +130,32 @@ static int level_taps(const ts_pyramid *P, int lev, double row, int idx[4], doub
     return ts_pyr_taps((row + 0.5) / L->spacing - 0.5, L->rows, lev == 0, idx, w);
 }
 
-/* Sample a (c >= 2) of cell x: the spline's midpoint before the last
- * sample and its last knot join the maximum. */
+/* Sample a (c >= 2) after p0, p1, p2: the spline's midpoint before the
+ * last sample and its last knot join the maximum *m. */
+static inline void spline_push(float *p0, float *p1, float *p2, float *m, float a)
+{
+    a = a == a ? a : *p2; /* nodata: the sample before */
+    float mid = (*p0 + 23.0f * *p1 + 23.0f * *p2 + a) * (1.0f / 48.0f);
+    float knot = (*p1 + 4.0f * *p2 + a) * (1.0f / 6.0f);
+    float mm = *m;
+    mm = mid > mm ? mid : mm;
+    mm = knot > mm ? knot : mm;
+    *m = mm;
+    *p0 = *p1;
+    *p1 = *p2;
+    *p2 = a;
+}
+
+/* spline_push on the state of cell x. */
 static inline void spline_step(float *restrict s0, float *restrict s1, float *restrict s2,
                                float *restrict m, int x, float a)
 {
-    float p0 = s0[x], p1 = s1[x], p2 = s2[x];
-    a = a == a ? a : p2; /* nodata: the sample before */
-    float mid = (p0 + 23.0f * p1 + 23.0f * p2 + a) * (1.0f / 48.0f);
-    float knot = (p1 + 4.0f * p2 + a) * (1.0f / 6.0f);
-    float mm = m[x];
-    mm = mid > mm ? mid : mm;
-    mm = knot > mm ? knot : mm;
+    float p0 = s0[x], p1 = s1[x], p2 = s2[x], mm = m[x];
+    spline_push(&p0, &p1, &p2, &mm, a);
     m[x] = mm;
-    s0[x] = p1;
-    s1[x] = p2;
-    s2[x] = a;
+    s0[x] = p0;
+    s1[x] = p1;
+    s2[x] = p2;
 }
 
 /* Add sample number c (value a_in[x] for the cells of [x0, x1]) to the
@@ -304,48 +317,164 @@ static void finish_run(row_ws *w, int bspline, int count, int x0, int x1, float 
     }
 }
 
-/* The cells of [a, b] whose rays end before level j's sample (through a
- * side of the grid, or at t_row steps): the last sample of each where its
- * ray ends, read bilinearly on the DEM, then their horizons. */
-TS_PYR_CLONES
-static void drop_run(const hz_ctx *C, row_ws *w, int y, int a, int b, double t_row, int j,
-                     float *restrict out)
+/* Where the ray of cell x leaves the grid's columns, in steps: `side`
+ * says how (1, -1: vx = +-1, an x-major azimuth, no division; 2, -2: the
+ * sign of another vx; 0: vx = 0, never). */
+static inline __attribute__((always_inline)) double side_exit(int side, double lim, double vx,
+                                                              int x)
 {
-    if (a > b)
-        return;
-    const ts_grid *g = C->P->grid;
-    const int W = g->width, H = g->height;
-    const float *z = g->z, *zrow = g->z + (ptrdiff_t)y * g->stride;
-    const ptrdiff_t stride = g->stride;
-    const double vx = C->vx, vy = C->vy, c = C->c, lim = W - 1;
-    float *restrict A = w->A;
+    return side == 1    ? lim - x
+           : side == -1 ? (double)x
+           : side == 2  ? (lim - x) / vx
+           : side == -2 ? x / -vx
+                        : INFINITY;
+}
+
+/* Where the rays of the cells [a, b] end (drop_cells): t steps (at most
+ * t_row), at DEM column px and row py, into tpp's three rows. */
+static inline __attribute__((always_inline)) void drop_ends(const hz_ctx *C, int side, int y,
+                                                            int a, int b, double t_row,
+                                                            double *restrict tpp)
+{
+    const int W = C->P->grid->width;
+    const double vx = C->vx, vy = C->vy, lim = W - 1, bot_y = C->P->grid->height - 1;
     for (int x = a; x <= b; x++) {
-        /* vx = +-1 for an x-major azimuth: no division (the same value) */
-        double t = vx == 1.0    ? lim - x
-                   : vx == -1.0 ? (double)x
-                   : vx > 0     ? (lim - x) / vx
-                   : vx < 0     ? x / -vx
-                                : INFINITY;
+        double t = side_exit(side, lim, vx, x);
         t = t < t_row ? t : t_row;
         double px = x + t * vx, py = y + t * vy;
-        px = px < 0 ? 0 : px > W - 1 ? W - 1 : px;
-        py = py < 0 ? 0 : py > H - 1 ? H - 1 : py;
+        tpp[x] = t;
+        tpp[W + x] = px < 0 ? 0 : px > lim ? lim : px;
+        tpp[2 * W + x] = py < 0 ? 0 : py > bot_y ? bot_y : py;
+    }
+}
+
+/* The index of the DEM's sample at row k, column i; `narrow`: it fits an
+ * int (which the vectoriser gathers with). */
+static inline __attribute__((always_inline)) ptrdiff_t dem_index(int narrow, ptrdiff_t stride,
+                                                                 int k, int i)
+{
+    return narrow ? k * (int)stride + i : k * stride + i;
+}
+
+/* The last samples at the ends tpp of the rays of cells [a, b] (tangents,
+ * NaN where a ray ends at its cell), read bilinearly on the DEM, into A. */
+static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int narrow, int y,
+                                                            int a, int b,
+                                                            const double *restrict tpp,
+                                                            float *restrict A)
+{
+    const ts_grid *g = C->P->grid;
+    const int W = g->width, H = g->height;
+    const float *restrict z = g->z, *restrict zrow = g->z + (ptrdiff_t)y * g->stride;
+    const double *restrict step = C->step;
+    const ptrdiff_t stride = g->stride;
+    const double vy = C->vy, c = C->c;
+    for (int x = a; x <= b; x++) {
+        double t = tpp[x], px = tpp[W + x], py = tpp[2 * W + x];
         int i = (int)px, k = (int)py;
         float fx = (float)(px - i), fy = (float)(py - k);
         int i1 = i + 1 < W ? i + 1 : i, k1 = k + 1 < H ? k + 1 : k;
-        float z00 = z[k * stride + i], z01 = z[k * stride + i1];
-        float z10 = z[k1 * stride + i], z11 = z[k1 * stride + i1];
-        /* a corner of weight 0 is not read: no NaN from it */
+        float z00 = z[dem_index(narrow, stride, k, i)], z01 = z[dem_index(narrow, stride, k, i1)];
+        float z10 = z[dem_index(narrow, stride, k1, i)], z11 = z[dem_index(narrow, stride, k1, i1)];
+        /* a corner of weight 0 does not count: no NaN from it */
         float top = fx > 0 ? z00 + fx * (z01 - z00) : z00;
         float bot = fx > 0 ? z10 + fx * (z11 - z10) : z10;
         float h = fy > 0 ? top + fy * (bot - top) : top;
         int row = (int)(y + t * vy / 2 + 0.5);
-        double d = t * C->step[row < 0 ? 0 : row > H - 1 ? H - 1 : row];
+        row = row < 0 ? 0 : row;
+        row = row > H - 1 ? H - 1 : row;
+        double d = t * step[row];
         float tan_w = (float)((h - zrow[x]) / d - c * d);
-        A[x] = t > 1e-9 ? (C->bspline ? ts_atan_deg(tan_w) : tan_w) : NAN;
+        A[x] = t > 1e-9 ? tan_w : NAN;
     }
-    push_run(w, C->bspline, j, a, b, A);
-    finish_run(w, C->bspline, j + 1, a, b, out);
+}
+
+/* The last sample A[x] of each cell of [a, b], its sample number jd[x]
+ * (B-spline only), then its horizon into out: push_run and finish_run for
+ * one cell, with the sample number per cell (selects, not branches). */
+TS_PYR_CLONES
+static void finish_last(row_ws *w, int bspline, int a, int b, const float *restrict A,
+                        float *restrict out)
+{
+    const float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
+    const float *restrict m = w->m;
+    const int *restrict jd = w->jd;
+    if (!bspline) {
+#pragma GCC ivdep
+        for (int x = a; x <= b; x++) {
+            float mm = A[x] > m[x] ? A[x] : m[x];
+            out[x] = mm > -INFINITY ? ts_atan_deg(mm) : -90.0f;
+        }
+        return;
+    }
+#pragma GCC ivdep
+    for (int x = a; x <= b; x++) {
+        int c = jd[x];
+        float v = A[x], p2 = s2[x], mm = m[x];
+        /* c = 0: the one sample is the spline */
+        float m0 = v > mm ? v : mm;
+        /* c = 1: w_{-1} = 2 w_0 - w_1, knot 0 is w_0 */
+        float v1 = v == v ? v : p2;
+        float q0 = 2.0f * p2 - v1, q1 = p2, q2 = v1;
+        float m1 = q1 > mm ? q1 : mm;
+        /* c >= 2 */
+        float r0 = s0[x], r1 = s1[x], r2 = p2, m2 = mm;
+        spline_push(&r0, &r1, &r2, &m2, v);
+        /* then w_M = 2 w_{M-1} - w_{M-2}: knot M-1 is w_{M-1} */
+        float e0 = c == 1 ? q0 : r0, e1 = c == 1 ? q1 : r1, e2 = c == 1 ? q2 : r2;
+        float em = c == 1 ? m1 : m2;
+        spline_push(&e0, &e1, &e2, &em, 2.0f * e2 - e1);
+        float fm = c == 0 ? m0 : em, last = c == 0 ? v : e2;
+        /* no spline value where nodata left fewer than three samples: the last */
+        float r = fm > -INFINITY ? fm : last;
+        out[x] = r == r && r > -INFINITY ? r : -90.0f;
+    }
+}
+
+/* The cells of [a, b] whose rays ended before the samples of the levels
+ * (through a side of the grid, or at t_row steps), each after jd[x]
+ * samples: the last sample of each where its ray ends, read bilinearly on
+ * the DEM, then their horizons. A dropped cell's state is left as it was,
+ * so this runs once a row for all of them. */
+TS_PYR_CLONES
+static void drop_cells(const hz_ctx *C, row_ws *w, int y, int a, int b, double t_row,
+                       float *restrict out)
+{
+    if (a > b)
+        return;
+    const ts_grid *g = C->P->grid;
+    const double vx = C->vx;
+    float *restrict A = w->A;
+    double *restrict tpp = w->tpp;
+    /* constant arguments: one branch-free loop each, vectorised */
+    if (vx == 1.0)
+        drop_ends(C, 1, y, a, b, t_row, tpp);
+    else if (vx == -1.0)
+        drop_ends(C, -1, y, a, b, t_row, tpp);
+    else if (vx > 0)
+        drop_ends(C, 2, y, a, b, t_row, tpp);
+    else if (vx < 0)
+        drop_ends(C, -2, y, a, b, t_row, tpp);
+    else
+        drop_ends(C, 0, y, a, b, t_row, tpp);
+    if ((double)g->stride * g->height <= INT_MAX)
+        drop_read(C, 1, y, a, b, tpp, A);
+    else
+        drop_read(C, 0, y, a, b, tpp, A);
+    if (C->bspline) {
+#pragma GCC ivdep
+        for (int x = a; x <= b; x++)
+            A[x] = ts_atan_deg(A[x]); /* atan(NaN) is NaN */
+    }
+    finish_last(w, C->bspline, a, b, A, out);
+}
+
+/* Cells [a, b] drop out before sample j (B-spline: their sample number). */
+static void mark_drop(const hz_ctx *C, row_ws *w, int a, int b, int j)
+{
+    if (C->bspline)
+        for (int x = a; x <= b; x++)
+            w->jd[x] = j;
 }
 
 /* The cells [c0, c1) of row y; rl: the row's entry for every level. */
@@ -362,17 +491,18 @@ static void horizon_row(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const
     if (C->cap > 0 && C->cap / C->step[y] < t_row)
         t_row = C->cap / C->step[y];
     int pa = c0, pb = c1 - 1, j = 0;
+    int fa = c1, fb = c1 - 1; /* the cells whose rays end at t_row: the others drop */
     for (; j < P->levels && pa <= pb; j++) {
         const level_az *L = &C->lv[j];
         int xa = L->xa > pa ? L->xa : pa;
         int xb = L->xb < pb ? L->xb : pb;
         if (xa > xb) {
-            drop_run(C, w, y, pa, pb, t_row, j, out);
+            mark_drop(C, w, pa, pb, j);
             pa = 1, pb = 0;
             break;
         }
-        drop_run(C, w, y, pa, xa - 1, t_row, j, out);
-        drop_run(C, w, y, xb + 1, pb, t_row, j, out);
+        mark_drop(C, w, pa, xa - 1, j);
+        mark_drop(C, w, xb + 1, pb, j);
         pa = xa, pb = xb;
         if (L->s <= t_row) {
             sample_level(C, w, &rl[j], L->ix, L->fx, j, pa, pb);
@@ -386,11 +516,14 @@ static void horizon_row(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const
             } else {
                 finish_run(w, C->bspline, j, pa, pb, out);
             }
+            fa = pa, fb = pb;
             pa = 1, pb = 0;
         }
     }
     if (pa <= pb) /* not reached: the coarsest spacing spans the grid */
-        drop_run(C, w, y, pa, pb, t_row, j, out);
+        mark_drop(C, w, pa, pb, j);
+    drop_cells(C, w, y, c0, fa - 1, t_row, out);
+    drop_cells(C, w, y, fb + 1, c1 - 1, t_row, out);
     const float *z = g->z + (ptrdiff_t)y * g->stride;
     for (int x = c0; x < c1; x++)
         if (z[x] != z[x])
@@ -404,14 +537,18 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
     const int W = C->P->grid->width, levels = C->P->levels;
     /* s0, s1, s2, m: W each; T and the samples: W + 1 each */
     float *buf = malloc((size_t)(6 * W + 2) * sizeof *buf);
+    double *tpp = malloc((size_t)3 * W * sizeof *tpp);
+    int *jd = malloc((size_t)W * sizeof *jd);
     row_level *rl = malloc((size_t)ROW_BLOCK * levels * sizeof *rl);
-    if (!buf || !rl) {
+    if (!buf || !tpp || !jd || !rl) {
         free(buf);
+        free(tpp);
+        free(jd);
         free(rl);
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
         return;
     }
-    row_ws w = {buf, buf + W, buf + 2 * W, buf + 3 * W, buf + 4 * W, buf + 5 * W + 1};
+    row_ws w = {buf, buf + W, buf + 2 * W, buf + 3 * W, buf + 4 * W, buf + 5 * W + 1, tpp, jd};
     for (long yb = y0; yb < y1; yb += ROW_BLOCK) {
         long ye = yb + ROW_BLOCK < y1 ? yb + ROW_BLOCK : y1;
         for (long y = yb; y < ye; y++)
@@ -426,6 +563,8 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
                             &rl[(size_t)(y - yb) * levels]);
     }
     free(rl);
+    free(jd);
+    free(tpp);
     free(buf);
 }
 
