@@ -19,14 +19,13 @@
  * exceeds the largest sample. A sample that touches nodata is no
  * occluder: it repeats the sample before it.
  */
-#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 
 #include "arg_checks.h"
 #include "cellmath/cm_fastmath.h"
 #include "parallel.h"
-#include "pyramid_internal.h"
+#include "pyramid_hz.h"
 #include "status_internal.h"
 
 #define DEG2RAD (M_PI / 180.0)
@@ -34,17 +33,6 @@
 #define CHUNK 512 /* columns: the rows of every level a chunk reads stay in L2 */
 #endif
 #define ROW_BLOCK 32 /* rows whose per-level entries are filled at a time */
-
-/* What sample j of every cell shares for one azimuth: its offset in
- * cells, split into a whole column ix and a fraction fx, the columns
- * [xa, xb] whose sample is on the grid, and the level it reads. */
-typedef struct {
-    double s;   /* distance in steps: the level's spacing */
-    int ix;     /* floor of the column offset s vx */
-    float fx;   /* the fraction of it */
-    int xa, xb; /* cells whose sample lies within the grid's columns */
-    int lev;    /* level read: j - k o, at least 0 */
-} level_az;
 
 /* What sample j of the cells of one row shares: the level rows at the
  * samples' row (the vertical taps), the cells' own row on the level, and
@@ -59,41 +47,12 @@ typedef struct {
     float inv_d, cd; /* 1 / distance, curvature drop over it */
 } row_level;
 
-typedef struct {
-    const ts_pyramid *P;
-    double vx, vy;      /* ray direction, DEM cells per step (major component +-1) */
-    double *step;       /* metres per step, by row */
-    double c;           /* curvature coefficient (1 - k) / 2R, 0 when off */
-    double cap;         /* maximum distance in metres, 0 = none */
-    double ko;          /* level offset k o */
-    int bspline;        /* 1: B-spline in log distance; 0: max over levels */
-    const level_az *lv; /* by sample number j */
-    float *out;
-    int *alloc_failed;
-} hz_ctx;
-
-/* Per-thread rows of state, one entry per cell of the grid row. */
-typedef struct {
-    float *s0, *s1, *s2; /* the last three samples (degrees, or tangents) */
-    float *m;            /* spline maximum (or largest tangent) so far */
-    float *T;            /* the level row at the samples */
-    float *A;            /* the samples being pushed */
-    double *tpp;         /* drop_cells: t, px, py of the cells (3 rows) */
-    int *jd;             /* the sample number at which each cell drops out */
-} row_ws;
-
 static double step_at(const hz_ctx *C, double row)
 {
     int H = C->P->grid->height;
     int r = (int)lround(row);
     return C->step[r < 0 ? 0 : r > H - 1 ? H - 1 : r];
 }
-
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define TS_PYR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define TS_PYR_CLONES
-#endif
 
 /* dst[x] = sum of weights w[t] * rows r[t] at x, for x in [x0, x1]. */
 TS_PYR_CLONES
@@ -128,22 +87,6 @@ static int level_taps(const ts_pyramid *P, int lev, double row, int idx[4], doub
 {
     const ts_pyr_level *L = &P->level[lev];
     return ts_pyr_taps((row + 0.5) / L->spacing - 0.5, L->rows, lev == 0, idx, w);
-}
-
-/* Sample a (c >= 2) after p0, p1, p2: the spline's midpoint before the
- * last sample and its last knot join the maximum *m. */
-static inline void spline_push(float *p0, float *p1, float *p2, float *m, float a)
-{
-    a = a == a ? a : *p2; /* nodata: the sample before */
-    float mid = (*p0 + 23.0f * *p1 + 23.0f * *p2 + a) * (1.0f / 48.0f);
-    float knot = (*p1 + 4.0f * *p2 + a) * (1.0f / 6.0f);
-    float mm = *m;
-    mm = mid > mm ? mid : mm;
-    mm = knot > mm ? knot : mm;
-    *m = mm;
-    *p0 = *p1;
-    *p1 = *p2;
-    *p2 = a;
 }
 
 /* spline_push on the state of cell x. */
@@ -317,158 +260,6 @@ static void finish_run(row_ws *w, int bspline, int count, int x0, int x1, float 
     }
 }
 
-/* Where the ray of cell x leaves the grid's columns, in steps: `side`
- * says how (1, -1: vx = +-1, an x-major azimuth, no division; 2, -2: the
- * sign of another vx; 0: vx = 0, never). */
-static inline __attribute__((always_inline)) double side_exit(int side, double lim, double vx,
-                                                              int x)
-{
-    return side == 1    ? lim - x
-           : side == -1 ? (double)x
-           : side == 2  ? (lim - x) / vx
-           : side == -2 ? x / -vx
-                        : INFINITY;
-}
-
-/* Where the rays of the cells [a, b] end (drop_cells): t steps (at most
- * t_row), at DEM column px and row py, into tpp's three rows. */
-static inline __attribute__((always_inline)) void drop_ends(const hz_ctx *C, int side, int y,
-                                                            int a, int b, double t_row,
-                                                            double *restrict tpp)
-{
-    const int W = C->P->grid->width;
-    const double vx = C->vx, vy = C->vy, lim = W - 1, bot_y = C->P->grid->height - 1;
-    for (int x = a; x <= b; x++) {
-        double t = side_exit(side, lim, vx, x);
-        t = t < t_row ? t : t_row;
-        double px = x + t * vx, py = y + t * vy;
-        tpp[x] = t;
-        tpp[W + x] = px < 0 ? 0 : px > lim ? lim : px;
-        tpp[2 * W + x] = py < 0 ? 0 : py > bot_y ? bot_y : py;
-    }
-}
-
-/* The index of the DEM's sample at row k, column i; `narrow`: it fits an
- * int (which the vectoriser gathers with). */
-static inline __attribute__((always_inline)) ptrdiff_t dem_index(int narrow, ptrdiff_t stride,
-                                                                 int k, int i)
-{
-    return narrow ? k * (int)stride + i : k * stride + i;
-}
-
-/* The last samples at the ends tpp of the rays of cells [a, b] (tangents,
- * NaN where a ray ends at its cell), read bilinearly on the DEM, into A. */
-static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int narrow, int y,
-                                                            int a, int b,
-                                                            const double *restrict tpp,
-                                                            float *restrict A)
-{
-    const ts_grid *g = C->P->grid;
-    const int W = g->width, H = g->height;
-    const float *restrict z = g->z, *restrict zrow = g->z + (ptrdiff_t)y * g->stride;
-    const double *restrict step = C->step;
-    const ptrdiff_t stride = g->stride;
-    const double vy = C->vy, c = C->c;
-    for (int x = a; x <= b; x++) {
-        double t = tpp[x], px = tpp[W + x], py = tpp[2 * W + x];
-        int i = (int)px, k = (int)py;
-        float fx = (float)(px - i), fy = (float)(py - k);
-        int i1 = i + 1 < W ? i + 1 : i, k1 = k + 1 < H ? k + 1 : k;
-        float z00 = z[dem_index(narrow, stride, k, i)], z01 = z[dem_index(narrow, stride, k, i1)];
-        float z10 = z[dem_index(narrow, stride, k1, i)], z11 = z[dem_index(narrow, stride, k1, i1)];
-        /* a corner of weight 0 does not count: no NaN from it */
-        float top = fx > 0 ? z00 + fx * (z01 - z00) : z00;
-        float bot = fx > 0 ? z10 + fx * (z11 - z10) : z10;
-        float h = fy > 0 ? top + fy * (bot - top) : top;
-        int row = (int)(y + t * vy / 2 + 0.5);
-        row = row < 0 ? 0 : row;
-        row = row > H - 1 ? H - 1 : row;
-        double d = t * step[row];
-        float tan_w = (float)((h - zrow[x]) / d - c * d);
-        A[x] = t > 1e-9 ? tan_w : NAN;
-    }
-}
-
-/* The last sample A[x] of each cell of [a, b], its sample number jd[x]
- * (B-spline only), then its horizon into out: push_run and finish_run for
- * one cell, with the sample number per cell (selects, not branches). */
-TS_PYR_CLONES
-static void finish_last(row_ws *w, int bspline, int a, int b, const float *restrict A,
-                        float *restrict out)
-{
-    const float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
-    const float *restrict m = w->m;
-    const int *restrict jd = w->jd;
-    if (!bspline) {
-#pragma GCC ivdep
-        for (int x = a; x <= b; x++) {
-            float mm = A[x] > m[x] ? A[x] : m[x];
-            out[x] = mm > -INFINITY ? ts_atan_deg(mm) : -90.0f;
-        }
-        return;
-    }
-#pragma GCC ivdep
-    for (int x = a; x <= b; x++) {
-        int c = jd[x];
-        float v = A[x], p2 = s2[x], mm = m[x];
-        /* c = 0: the one sample is the spline */
-        float m0 = v > mm ? v : mm;
-        /* c = 1: w_{-1} = 2 w_0 - w_1, knot 0 is w_0 */
-        float v1 = v == v ? v : p2;
-        float q0 = 2.0f * p2 - v1, q1 = p2, q2 = v1;
-        float m1 = q1 > mm ? q1 : mm;
-        /* c >= 2 */
-        float r0 = s0[x], r1 = s1[x], r2 = p2, m2 = mm;
-        spline_push(&r0, &r1, &r2, &m2, v);
-        /* then w_M = 2 w_{M-1} - w_{M-2}: knot M-1 is w_{M-1} */
-        float e0 = c == 1 ? q0 : r0, e1 = c == 1 ? q1 : r1, e2 = c == 1 ? q2 : r2;
-        float em = c == 1 ? m1 : m2;
-        spline_push(&e0, &e1, &e2, &em, 2.0f * e2 - e1);
-        float fm = c == 0 ? m0 : em, last = c == 0 ? v : e2;
-        /* no spline value where nodata left fewer than three samples: the last */
-        float r = fm > -INFINITY ? fm : last;
-        out[x] = r == r && r > -INFINITY ? r : -90.0f;
-    }
-}
-
-/* The cells of [a, b] whose rays ended before the samples of the levels
- * (through a side of the grid, or at t_row steps), each after jd[x]
- * samples: the last sample of each where its ray ends, read bilinearly on
- * the DEM, then their horizons. A dropped cell's state is left as it was,
- * so this runs once a row for all of them. */
-TS_PYR_CLONES
-static void drop_cells(const hz_ctx *C, row_ws *w, int y, int a, int b, double t_row,
-                       float *restrict out)
-{
-    if (a > b)
-        return;
-    const ts_grid *g = C->P->grid;
-    const double vx = C->vx;
-    float *restrict A = w->A;
-    double *restrict tpp = w->tpp;
-    /* constant arguments: one branch-free loop each, vectorised */
-    if (vx == 1.0)
-        drop_ends(C, 1, y, a, b, t_row, tpp);
-    else if (vx == -1.0)
-        drop_ends(C, -1, y, a, b, t_row, tpp);
-    else if (vx > 0)
-        drop_ends(C, 2, y, a, b, t_row, tpp);
-    else if (vx < 0)
-        drop_ends(C, -2, y, a, b, t_row, tpp);
-    else
-        drop_ends(C, 0, y, a, b, t_row, tpp);
-    if ((double)g->stride * g->height <= INT_MAX)
-        drop_read(C, 1, y, a, b, tpp, A);
-    else
-        drop_read(C, 0, y, a, b, tpp, A);
-    if (C->bspline) {
-#pragma GCC ivdep
-        for (int x = a; x <= b; x++)
-            A[x] = ts_atan_deg(A[x]); /* atan(NaN) is NaN */
-    }
-    finish_last(w, C->bspline, a, b, A, out);
-}
-
 /* Cells [a, b] drop out before sample j (B-spline: their sample number). */
 static void mark_drop(const hz_ctx *C, row_ws *w, int a, int b, int j)
 {
@@ -522,8 +313,8 @@ static void horizon_row(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const
     }
     if (pa <= pb) /* not reached: the coarsest spacing spans the grid */
         mark_drop(C, w, pa, pb, j);
-    drop_cells(C, w, y, c0, fa - 1, t_row, out);
-    drop_cells(C, w, y, fb + 1, c1 - 1, t_row, out);
+    ts_pyr_drop_cells(C, w, y, c0, fa - 1, t_row, out);
+    ts_pyr_drop_cells(C, w, y, fb + 1, c1 - 1, t_row, out);
     const float *z = g->z + (ptrdiff_t)y * g->stride;
     for (int x = c0; x < c1; x++)
         if (z[x] != z[x])
