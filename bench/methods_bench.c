@@ -102,17 +102,29 @@ typedef struct {
 
 static const char *const NAMES[3] = {"exact", "pyramid (B-spline)", "pyramid (level max)"};
 
-/* One direction of method i into its plane and svf accumulator. */
+/* Directions az[0..count) of method i into its planes and svf
+ * accumulator: the sweep one at a time, the pyramid count at once (as the
+ * driver does). */
 static void run_method(int i, method *m, const ts_grid *g, const float *nx, const float *ny,
-                       const float *nz, double az, const ts_horizon_opts *o, int dirs)
+                       const float *nz, int count, const double *az, const ts_horizon_opts *o,
+                       int dirs)
 {
     ts_error err;
+    size_t cells = (size_t)g->width * g->height;
+    float *planes[TS_PYRAMID_BATCH];
+    for (int k = 0; k < count; k++)
+        planes[k] = m->plane + cells * k;
     double t0 = now();
-    ts_status st = i == 0 ? ts_horizon_sweep(g, az, o, m->plane, &err)
-                          : ts_pyramid_horizon(m->pyr, az, o, m->plane, &err);
-    if (st != TS_OK ||
-        ts_sky_accumulate(g, nx, ny, nz, m->plane, az, dirs, m->svf_acc, NULL, NULL, &err) !=
-            TS_OK)
+    ts_status st = TS_OK;
+    if (i == 0)
+        for (int k = 0; st == TS_OK && k < count; k++)
+            st = ts_horizon_sweep(g, az[k], o, planes[k], &err);
+    else
+        st = ts_pyramid_horizons(m->pyr, count, az, o, planes, &err);
+    for (int k = 0; st == TS_OK && k < count; k++)
+        st = ts_sky_accumulate(g, nx, ny, nz, planes[k], az[k], dirs, m->svf_acc, NULL, NULL,
+                               &err);
+    if (st != TS_OK)
         die(NAMES[i], &err);
     m->t += now() - t0;
 }
@@ -138,7 +150,7 @@ static void compare(const ts_grid *g, const setup *su, result *r)
         memset(m, 0, sizeof *m);
         hist_init(&m->hor, 1e-3);
         hist_init(&m->svf, 1e-6);
-        m->plane = malloc(n * sizeof(float));
+        m->plane = malloc(n * TS_PYRAMID_BATCH * sizeof(float));
         m->svf_acc = calloc(n, sizeof(float));
         if (!m->plane || !m->svf_acc) {
             fprintf(stderr, "methods_bench: out of memory\n");
@@ -154,13 +166,16 @@ static void compare(const ts_grid *g, const setup *su, result *r)
         m->t = m->t_build = now() - t0;
     }
     r->bytes_pyramid = ts_pyramid_bytes(g->width, g->height, su->pyr.level_step);
-    for (int k = 0; k < su->dirs; k++) {
-        double az = ts_horizon_azimuth(&o, k);
+    for (int k = 0; k < su->dirs; k += TS_PYRAMID_BATCH) {
+        int count = su->dirs - k < TS_PYRAMID_BATCH ? su->dirs - k : TS_PYRAMID_BATCH;
+        double az[TS_PYRAMID_BATCH];
+        for (int b = 0; b < count; b++)
+            az[b] = ts_horizon_azimuth(&o, k + b);
         for (int i = 0; i < 3; i++)
-            run_method(i, &r->m[i], g, nx, ny, nz, az, &o, su->dirs);
+            run_method(i, &r->m[i], g, nx, ny, nz, count, az, &o, su->dirs);
         const float *pe = r->m[0].plane;
         for (int i = 1; i < 3; i++)
-            for (size_t c = 0; c < n; c++)
+            for (size_t c = 0; c < n * count; c++)
                 if (pe[c] == pe[c] && r->m[i].plane[c] == r->m[i].plane[c])
                     hist_add(&r->m[i].hor, fabs((double)pe[c] - r->m[i].plane[c]));
     }
@@ -207,8 +222,9 @@ static void report(const char *name, const ts_grid *g, const setup *su, const re
                hist_quantile(&m->svf, 0.99), m->svf.max);
     }
     printf("  memory besides DEM, normals and output: exact one plane (%.1f MiB), pyramid "
-           "%.1f MiB (%.1f x DEM) + one plane\n",
-           dem_mib, r->bytes_pyramid / 1048576.0, r->bytes_pyramid / 1048576.0 / dem_mib);
+           "%.1f MiB (%.1f x DEM) + %d planes (as many azimuths at once)\n",
+           dem_mib, r->bytes_pyramid / 1048576.0, r->bytes_pyramid / 1048576.0 / dem_mib,
+           TS_PYRAMID_BATCH);
     fflush(stdout);
 }
 

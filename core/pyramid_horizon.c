@@ -25,7 +25,7 @@
 #include "arg_checks.h"
 #include "cellmath/cm_fastmath.h"
 #include "parallel.h"
-#include "pyramid_internal.h"
+#include "pyramid_hz.h"
 #include "status_internal.h"
 
 #define DEG2RAD (M_PI / 180.0)
@@ -33,17 +33,6 @@
 #define CHUNK 512 /* columns: the rows of every level a chunk reads stay in L2 */
 #endif
 #define ROW_BLOCK 32 /* rows whose per-level entries are filled at a time */
-
-/* What sample j of every cell shares for one azimuth: its offset in
- * cells, split into a whole column ix and a fraction fx, the columns
- * [xa, xb] whose sample is on the grid, and the level it reads. */
-typedef struct {
-    double s;   /* distance in steps: the level's spacing */
-    int ix;     /* floor of the column offset s vx */
-    float fx;   /* the fraction of it */
-    int xa, xb; /* cells whose sample lies within the grid's columns */
-    int lev;    /* level read: j - k o, at least 0 */
-} level_az;
 
 /* What sample j of the cells of one row shares: the level rows at the
  * samples' row (the vertical taps), the cells' own row on the level, and
@@ -58,39 +47,12 @@ typedef struct {
     float inv_d, cd; /* 1 / distance, curvature drop over it */
 } row_level;
 
-typedef struct {
-    const ts_pyramid *P;
-    double vx, vy;      /* ray direction, DEM cells per step (major component +-1) */
-    double *step;       /* metres per step, by row */
-    double c;           /* curvature coefficient (1 - k) / 2R, 0 when off */
-    double cap;         /* maximum distance in metres, 0 = none */
-    double ko;          /* level offset k o */
-    int bspline;        /* 1: B-spline in log distance; 0: max over levels */
-    const level_az *lv; /* by sample number j */
-    float *out;
-    int *alloc_failed;
-} hz_ctx;
-
-/* Per-thread rows of state, one entry per cell of the grid row. */
-typedef struct {
-    float *s0, *s1, *s2; /* the last three samples (degrees, or tangents) */
-    float *m;            /* spline maximum (or largest tangent) so far */
-    float *T;            /* the level row at the samples */
-    float *A;            /* the samples being pushed */
-} row_ws;
-
 static double step_at(const hz_ctx *C, double row)
 {
     int H = C->P->grid->height;
     int r = (int)lround(row);
     return C->step[r < 0 ? 0 : r > H - 1 ? H - 1 : r];
 }
-
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define TS_PYR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define TS_PYR_CLONES
-#endif
 
 /* dst[x] = sum of weights w[t] * rows r[t] at x, for x in [x0, x1]. */
 TS_PYR_CLONES
@@ -127,22 +89,16 @@ static int level_taps(const ts_pyramid *P, int lev, double row, int idx[4], doub
     return ts_pyr_taps((row + 0.5) / L->spacing - 0.5, L->rows, lev == 0, idx, w);
 }
 
-/* Sample a (c >= 2) of cell x: the spline's midpoint before the last
- * sample and its last knot join the maximum. */
+/* spline_push on the state of cell x. */
 static inline void spline_step(float *restrict s0, float *restrict s1, float *restrict s2,
                                float *restrict m, int x, float a)
 {
-    float p0 = s0[x], p1 = s1[x], p2 = s2[x];
-    a = a == a ? a : p2; /* nodata: the sample before */
-    float mid = (p0 + 23.0f * p1 + 23.0f * p2 + a) * (1.0f / 48.0f);
-    float knot = (p1 + 4.0f * p2 + a) * (1.0f / 6.0f);
-    float mm = m[x];
-    mm = mid > mm ? mid : mm;
-    mm = knot > mm ? knot : mm;
+    float p0 = s0[x], p1 = s1[x], p2 = s2[x], mm = m[x];
+    spline_push(&p0, &p1, &p2, &mm, a);
     m[x] = mm;
-    s0[x] = p1;
-    s1[x] = p2;
-    s2[x] = a;
+    s0[x] = p0;
+    s1[x] = p1;
+    s2[x] = p2;
 }
 
 /* Add sample number c (value a_in[x] for the cells of [x0, x1]) to the
@@ -182,16 +138,14 @@ static void push_run(row_ws *w, int bspline, int c, int x0, int x1, const float 
 
 /* One level's samples for the cells of [x0, x1]: the level row T at x + ix
  * and x + ix + 1 (weight fx) against the cells' own heights on the level
- * (rows r, weights wr), at d metres (1 / d = inv_d, curvature drop over d
+ * R, at d metres (1 / d = inv_d, curvature drop over d
  * = cd). Pushed as sample c in the same pass where the spline allows,
  * else left in w->A for push_run (returns 0 then). */
 TS_PYR_CLONES
 static int level_run(row_ws *w, const float *restrict T, int ix, float fx,
-                     const float *const r[4], const float wr[4], float inv_d, float cd,
-                     int bspline, int c, int x0, int x1)
+                     const float *restrict R, float inv_d, float cd, int bspline, int c, int x0,
+                     int x1)
 {
-    const float *restrict r0 = r[0], *restrict r1 = r[1], *restrict r2 = r[2], *restrict r3 = r[3];
-    const float w0 = wr[0], w1 = wr[1], w2 = wr[2], w3 = wr[3];
     float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
     float *restrict m = w->m, *restrict A = w->A;
     const float gx = 1.0f - fx;
@@ -200,8 +154,7 @@ static int level_run(row_ws *w, const float *restrict T, int ix, float fx,
 #pragma GCC ivdep
         for (int x = x0; x <= x1; x++) {
             float h = gx * Ta[x] + fx * Ta[x + 1];
-            float R = w0 * r0[x] + w1 * r1[x] + w2 * r2[x] + w3 * r3[x];
-            spline_step(s0, s1, s2, m, x, ts_atan_deg((h - R) * inv_d - cd));
+                spline_step(s0, s1, s2, m, x, ts_atan_deg((h - R[x]) * inv_d - cd));
         }
         return 1;
     }
@@ -209,8 +162,7 @@ static int level_run(row_ws *w, const float *restrict T, int ix, float fx,
 #pragma GCC ivdep
         for (int x = x0; x <= x1; x++) {
             float h = gx * Ta[x] + fx * Ta[x + 1];
-            float R = w0 * r0[x] + w1 * r1[x] + w2 * r2[x] + w3 * r3[x];
-            float t = (h - R) * inv_d - cd;
+                float t = (h - R[x]) * inv_d - cd;
             m[x] = t > m[x] ? t : m[x];
         }
         return 1;
@@ -218,8 +170,7 @@ static int level_run(row_ws *w, const float *restrict T, int ix, float fx,
 #pragma GCC ivdep
     for (int x = x0; x <= x1; x++) {
         float h = gx * Ta[x] + fx * Ta[x + 1];
-        float R = w0 * r0[x] + w1 * r1[x] + w2 * r2[x] + w3 * r3[x];
-        A[x] = ts_atan_deg((h - R) * inv_d - cd);
+        A[x] = ts_atan_deg((h - R[x]) * inv_d - cd);
     }
     return 0;
 }
@@ -248,9 +199,9 @@ static void row_level_fill(const hz_ctx *C, int y, int lev, double dist, row_lev
 }
 
 /* The samples of the cells [x0, x1] described by e, at column offset
- * ix + fx, pushed as sample c. */
-static void sample_level(const hz_ctx *C, row_ws *w, const row_level *e, int ix, float fx, int c,
-                         int x0, int x1)
+ * ix + fx, against their own heights R on the level, pushed as sample c. */
+static void sample_level(const hz_ctx *C, row_ws *w, const row_level *e, const float *R, int ix,
+                         float fx, int c, int x0, int x1)
 {
     const int W = C->P->grid->width;
     int t0 = x0 + ix, t1 = x1 + ix + (fx > 0.0f);
@@ -259,20 +210,32 @@ static void sample_level(const hz_ctx *C, row_ws *w, const row_level *e, int ix,
         return; /* not reached: the runs keep the samples on the grid */
     combine_rows(e->t, e->wt, e->taps, t0, t1, w->T);
     w->T[t1 + 1] = w->T[t1]; /* a weight of fx = 0 there: no NaN from beyond */
-    if (!level_run(w, w->T, ix, fx, e->r, e->wr, e->inv_d, e->cd, C->bspline, c, x0, x1))
+    if (!level_run(w, w->T, ix, fx, R, e->inv_d, e->cd, C->bspline, c, x0, x1))
         push_run(w, C->bspline, c, x0, x1, w->A);
 }
 
-/* The samples of the cells [x0, x1] of row y at `dist` steps on level lev,
- * pushed as sample c (the last sample of a row whose rays end early). */
-static void sample_run(const hz_ctx *C, row_ws *w, int y, int lev, double dist, int c, int x0,
-                       int x1)
+/* The samples of the cells [x0, x1] of row y at `dist` steps on the DEM
+ * (the cells' heights R), pushed as sample c (the last sample of a row
+ * whose rays end early). */
+static void sample_run(const hz_ctx *C, row_ws *w, int y, const float *R, double dist, int c,
+                       int x0, int x1)
 {
     double ox = dist * C->vx;
     double fl = floor(ox);
     row_level e;
-    row_level_fill(C, y, lev, dist, &e);
-    sample_level(C, w, &e, (int)fl, (float)(ox - fl), c, x0, x1);
+    row_level_fill(C, y, 0, dist, &e);
+    sample_level(C, w, &e, R, (int)fl, (float)(ox - fl), c, x0, x1);
+}
+
+/* Where every ray of row y leaves the grid (top or bottom) or ends, in
+ * steps. */
+static double row_reach(const hz_ctx *C, int y)
+{
+    const int H = C->P->grid->height;
+    double t_row = C->vy > 0 ? (H - 1 - y) / C->vy : C->vy < 0 ? y / -C->vy : INFINITY;
+    if (C->cap > 0 && C->cap / C->step[y] < t_row)
+        t_row = C->cap / C->step[y];
+    return t_row;
 }
 
 /* The horizons of cells [x0, x1] after `count` >= 1 samples, into out. */
@@ -304,128 +267,185 @@ static void finish_run(row_ws *w, int bspline, int count, int x0, int x1, float 
     }
 }
 
-/* The cells of [a, b] whose rays end before level j's sample (through a
- * side of the grid, or at t_row steps): the last sample of each where its
- * ray ends, read bilinearly on the DEM, then their horizons. */
-TS_PYR_CLONES
-static void drop_run(const hz_ctx *C, row_ws *w, int y, int a, int b, double t_row, int j,
-                     float *restrict out)
+/* Cells [a, b] drop out before sample j (B-spline: their sample number). */
+static void mark_drop(const hz_ctx *C, row_ws *w, int a, int b, int j)
 {
-    if (a > b)
-        return;
-    const ts_grid *g = C->P->grid;
-    const int W = g->width, H = g->height;
-    const float *z = g->z, *zrow = g->z + (ptrdiff_t)y * g->stride;
-    const ptrdiff_t stride = g->stride;
-    const double vx = C->vx, vy = C->vy, c = C->c, lim = W - 1;
-    float *restrict A = w->A;
-    for (int x = a; x <= b; x++) {
-        /* vx = +-1 for an x-major azimuth: no division (the same value) */
-        double t = vx == 1.0    ? lim - x
-                   : vx == -1.0 ? (double)x
-                   : vx > 0     ? (lim - x) / vx
-                   : vx < 0     ? x / -vx
-                                : INFINITY;
-        t = t < t_row ? t : t_row;
-        double px = x + t * vx, py = y + t * vy;
-        px = px < 0 ? 0 : px > W - 1 ? W - 1 : px;
-        py = py < 0 ? 0 : py > H - 1 ? H - 1 : py;
-        int i = (int)px, k = (int)py;
-        float fx = (float)(px - i), fy = (float)(py - k);
-        int i1 = i + 1 < W ? i + 1 : i, k1 = k + 1 < H ? k + 1 : k;
-        float z00 = z[k * stride + i], z01 = z[k * stride + i1];
-        float z10 = z[k1 * stride + i], z11 = z[k1 * stride + i1];
-        /* a corner of weight 0 is not read: no NaN from it */
-        float top = fx > 0 ? z00 + fx * (z01 - z00) : z00;
-        float bot = fx > 0 ? z10 + fx * (z11 - z10) : z10;
-        float h = fy > 0 ? top + fy * (bot - top) : top;
-        int row = (int)(y + t * vy / 2 + 0.5);
-        double d = t * C->step[row < 0 ? 0 : row > H - 1 ? H - 1 : row];
-        float tan_w = (float)((h - zrow[x]) / d - c * d);
-        A[x] = t > 1e-9 ? (C->bspline ? ts_atan_deg(tan_w) : tan_w) : NAN;
-    }
-    push_run(w, C->bspline, j, a, b, A);
-    finish_run(w, C->bspline, j + 1, a, b, out);
+    if (C->bspline)
+        for (int x = a; x <= b; x++)
+            w->jd[x] = j;
 }
 
-/* The cells [c0, c1) of row y; rl: the row's entry for every level. */
-static void horizon_row(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const row_level *rl)
+/* A row's cells [c0, c1) for one azimuth, level by level: the run [pa, pb]
+ * of those whose samples lie on the grid so far (empty once every ray has
+ * ended), and [fa, fb], those whose rays end at the row's reach t_row. */
+typedef struct {
+    int pa, pb, fa, fb;
+    double t_row;
+} row_run;
+
+static void row_start(const hz_ctx *C, row_ws *w, int y, int c0, int c1, row_run *r)
 {
-    const ts_pyramid *P = C->P;
-    const ts_grid *g = P->grid;
-    const int W = g->width, H = g->height;
-    float *out = C->out + (size_t)y * W;
     for (int x = c0; x < c1; x++)
         w->m[x] = -INFINITY;
-    /* where every ray of the row leaves the grid (top or bottom) or ends */
-    double t_row = C->vy > 0 ? (H - 1 - y) / C->vy : C->vy < 0 ? y / -C->vy : INFINITY;
-    if (C->cap > 0 && C->cap / C->step[y] < t_row)
-        t_row = C->cap / C->step[y];
-    int pa = c0, pb = c1 - 1, j = 0;
-    for (; j < P->levels && pa <= pb; j++) {
-        const level_az *L = &C->lv[j];
-        int xa = L->xa > pa ? L->xa : pa;
-        int xb = L->xb < pb ? L->xb : pb;
-        if (xa > xb) {
-            drop_run(C, w, y, pa, pb, t_row, j, out);
-            pa = 1, pb = 0;
-            break;
-        }
-        drop_run(C, w, y, pa, xa - 1, t_row, j, out);
-        drop_run(C, w, y, xb + 1, pb, t_row, j, out);
-        pa = xa, pb = xb;
-        if (L->s <= t_row) {
-            sample_level(C, w, &rl[j], L->ix, L->fx, j, pa, pb);
-        } else { /* the row's rays end here: one last sample on the DEM */
-            if (t_row > 1e-9) {
-                sample_run(C, w, y, 0, t_row, j, pa, pb);
-                finish_run(w, C->bspline, j + 1, pa, pb, out);
-            } else if (j == 0) {
-                for (int x = pa; x <= pb; x++)
-                    out[x] = -90.0f; /* nothing beyond these cells */
-            } else {
-                finish_run(w, C->bspline, j, pa, pb, out);
-            }
-            pa = 1, pb = 0;
-        }
+    *r = (row_run){c0, c1 - 1, c1, c1 - 1, row_reach(C, y)};
+}
+
+/* The range of the run that sample j keeps, [*xa, *xb] (empty: none), and
+ * whether the sample is read on level j (0: the rays end before it). */
+static int row_keeps(const hz_ctx *C, const row_run *r, int j, int *xa, int *xb)
+{
+    const level_az *L = &C->lv[j];
+    *xa = L->xa > r->pa ? L->xa : r->pa;
+    *xb = L->xb < r->pb ? L->xb : r->pb;
+    return L->s <= r->t_row;
+}
+
+/* Sample j of the run of row y (e: the row's entry; R and R0: the cells'
+ * heights on its level and on the DEM), or the last one where the rays
+ * end before it; the cells whose rays leave the grid drop out. */
+static void row_sample(const hz_ctx *C, row_ws *w, int y, int j, const row_level *e,
+                       const float *R, const float *R0, row_run *r)
+{
+    int pa = r->pa, pb = r->pb, xa, xb;
+    if (pa > pb)
+        return;
+    int on_level = row_keeps(C, r, j, &xa, &xb);
+    if (xa > xb) {
+        mark_drop(C, w, pa, pb, j);
+        r->pa = 1, r->pb = 0;
+        return;
     }
-    if (pa <= pb) /* not reached: the coarsest spacing spans the grid */
-        drop_run(C, w, y, pa, pb, t_row, j, out);
+    mark_drop(C, w, pa, xa - 1, j);
+    mark_drop(C, w, xb + 1, pb, j);
+    pa = r->pa = xa, pb = r->pb = xb;
+    if (on_level) {
+        sample_level(C, w, e, R, C->lv[j].ix, C->lv[j].fx, j, pa, pb);
+        return;
+    }
+    /* the row's rays end here: one last sample on the DEM */
+    float *out = C->out + (size_t)y * C->P->grid->width;
+    if (r->t_row > 1e-9) {
+        sample_run(C, w, y, R0, r->t_row, j, pa, pb);
+        finish_run(w, C->bspline, j + 1, pa, pb, out);
+    } else if (j == 0) {
+        for (int x = pa; x <= pb; x++)
+            out[x] = -90.0f; /* nothing beyond these cells */
+    } else {
+        finish_run(w, C->bspline, j, pa, pb, out);
+    }
+    r->fa = pa, r->fb = pb;
+    r->pa = 1, r->pb = 0;
+}
+
+/* The horizons of the cells of row y that dropped out, and nodata. */
+static void row_finish(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const row_run *r)
+{
+    const ts_grid *g = C->P->grid;
+    float *out = C->out + (size_t)y * g->width;
+    if (r->pa <= r->pb) /* not reached: the coarsest spacing spans the grid */
+        mark_drop(C, w, r->pa, r->pb, C->P->levels);
+    ts_pyr_drop_cells(C, w, y, c0, r->fa - 1, r->t_row, out);
+    ts_pyr_drop_cells(C, w, y, r->fb + 1, c1 - 1, r->t_row, out);
     const float *z = g->z + (ptrdiff_t)y * g->stride;
     for (int x = c0; x < c1; x++)
         if (z[x] != z[x])
             out[x] = NAN;
 }
 
+/* Azimuths computed together: the cells' own heights on each level are
+ * the same for all of them. */
+typedef struct {
+    int n;
+    const hz_ctx *az; /* n */
+} batch_ctx;
+
+/* The cells [c0, c1) of row y for every azimuth of B, level by level: the
+ * cells' own heights on a level (the same rows and weights for every
+ * azimuth, from azimuth 0's entries rl[n][j]) are computed once, over
+ * the runs that read them, into R (on the DEM: R0, kept for the rays
+ * that end early). */
+static void batch_row(const batch_ctx *B, row_ws *w, int y, int c0, int c1,
+                      const row_level *const *rl, float *R0, float *R)
+{
+    const int levels = B->az[0].P->levels;
+    row_run run[TS_PYRAMID_BATCH];
+    for (int a = 0; a < B->n; a++)
+        row_start(&B->az[a], &w[a], y, c0, c1, &run[a]);
+    /* 4 taps, weight 0 unused: as the one-azimuth sums */
+    combine_rows(rl[0][0].r, rl[0][0].wr, 4, c0, c1 - 1, R0);
+    for (int j = 0; j < levels; j++) {
+        int lo = c1, hi = c0 - 1, xa, xb;
+        for (int a = 0; a < B->n; a++)
+            if (run[a].pa <= run[a].pb && row_keeps(&B->az[a], &run[a], j, &xa, &xb)) {
+                lo = xa < lo ? xa : lo;
+                hi = xb > hi ? xb : hi;
+            }
+        const float *Rj = R0;
+        if (lo <= hi && B->az[0].lv[j].lev > 0) {
+            combine_rows(rl[0][j].r, rl[0][j].wr, 4, lo, hi, R);
+            Rj = R;
+        }
+        int active = 0;
+        for (int a = 0; a < B->n; a++) {
+            row_sample(&B->az[a], &w[a], y, j, &rl[a][j], Rj, R0, &run[a]);
+            active |= run[a].pa <= run[a].pb;
+        }
+        if (!active)
+            break;
+    }
+    for (int a = 0; a < B->n; a++)
+        row_finish(&B->az[a], &w[a], y, c0, c1, &run[a]);
+}
+
 static void rows_range(void *ctx, int worker, long y0, long y1)
 {
     (void)worker;
-    const hz_ctx *C = ctx;
-    const int W = C->P->grid->width, levels = C->P->levels;
-    /* s0, s1, s2, m: W each; T and the samples: W + 1 each */
-    float *buf = malloc((size_t)(6 * W + 2) * sizeof *buf);
-    row_level *rl = malloc((size_t)ROW_BLOCK * levels * sizeof *rl);
-    if (!buf || !rl) {
+    const batch_ctx *B = ctx;
+    const int n = B->n, W = B->az[0].P->grid->width, levels = B->az[0].P->levels;
+    /* per azimuth s0, s1, s2, m: W each; T and the samples: W + 1 each */
+    float *buf = malloc((size_t)n * (6 * W + 2) * sizeof *buf);
+    float *own = malloc((size_t)2 * W * sizeof *own);
+    double *tpp = malloc((size_t)3 * W * sizeof *tpp);
+    int *jd = malloc((size_t)n * W * sizeof *jd);
+    row_level *rl = malloc((size_t)n * ROW_BLOCK * levels * sizeof *rl);
+    row_ws w[TS_PYRAMID_BATCH];
+    if (!buf || !own || !tpp || !jd || !rl) {
         free(buf);
+        free(own);
+        free(tpp);
+        free(jd);
         free(rl);
-        __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
+        __atomic_store_n(B->az[0].alloc_failed, 1, __ATOMIC_RELAXED);
         return;
     }
-    row_ws w = {buf, buf + W, buf + 2 * W, buf + 3 * W, buf + 4 * W, buf + 5 * W + 1};
+    for (int a = 0; a < n; a++) {
+        float *f = buf + (size_t)a * (6 * W + 2);
+        w[a] = (row_ws){f, f + W, f + 2 * W, f + 3 * W, f + 4 * W, f + 5 * W + 1, tpp,
+                        jd + (size_t)a * W};
+    }
     for (long yb = y0; yb < y1; yb += ROW_BLOCK) {
         long ye = yb + ROW_BLOCK < y1 ? yb + ROW_BLOCK : y1;
-        for (long y = yb; y < ye; y++)
-            for (int j = 0; j < levels; j++)
-                row_level_fill(C, (int)y, C->lv[j].lev, C->lv[j].s,
-                               &rl[(size_t)(y - yb) * levels + j]);
+        for (int a = 0; a < n; a++)
+            for (long y = yb; y < ye; y++)
+                for (int j = 0; j < levels; j++)
+                    row_level_fill(&B->az[a], (int)y, B->az[a].lv[j].lev, B->az[a].lv[j].s,
+                                   &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels + j]);
         /* a chunk of columns down the rows, then the next: the level rows
          * that the cells of a chunk read stay in the cache from row to row */
-        for (int c0 = 0; c0 < W; c0 += CHUNK)
-            for (long y = yb; y < ye; y++)
-                horizon_row(C, &w, (int)y, c0, c0 + CHUNK < W ? c0 + CHUNK : W,
-                            &rl[(size_t)(y - yb) * levels]);
+        for (int c0 = 0; c0 < W; c0 += CHUNK) {
+            int c1 = c0 + CHUNK < W ? c0 + CHUNK : W;
+            for (long y = yb; y < ye; y++) {
+                const row_level *rly[TS_PYRAMID_BATCH];
+                for (int a = 0; a < n; a++)
+                    rly[a] = &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels];
+                batch_row(B, w, (int)y, c0, c1, rly, own, own + W);
+            }
+        }
     }
     free(rl);
+    free(jd);
+    free(tpp);
+    free(own);
     free(buf);
 }
 
@@ -446,17 +466,12 @@ static void level_az_fill(const hz_ctx *C, level_az *lv)
     }
 }
 
-ts_status ts_pyramid_horizon(const ts_pyramid *pyr, double azimuth, const ts_horizon_opts *opts,
-                             float *out, ts_error *err)
+/* The context of azimuth `azimuth` (checked) into C: its step table and
+ * level shares allocated; 0 when out of memory. */
+static int az_ctx_init(const ts_pyramid *pyr, double azimuth, const ts_horizon_opts *opts,
+                       float *out, int *failed, hz_ctx *C)
 {
-    if (!pyr)
-        return ts_fail(err, TS_ERR_ARG, "pyramid is NULL");
-    if (!out)
-        return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
     const ts_grid *g = pyr->grid;
-    ts_status st = ts_check_sweep_args(g, &azimuth, opts, err);
-    if (st != TS_OK)
-        return st;
     const int H = g->height;
     double a = azimuth * DEG2RAD, sa = sin(a), ca = cos(a);
     /* as the sweep: exact axis directions, the direction in cells taken at
@@ -465,34 +480,71 @@ ts_status ts_pyramid_horizon(const ts_pyramid *pyr, double azimuth, const ts_hor
     if (fabs(ca) < 1e-12) ca = 0;
     double gx = sa / ts_grid_cell_x(g, H / 2), gy = -ca / g->cell_y;
     double major = fabs(gx) > fabs(gy) ? fabs(gx) : fabs(gy);
-    hz_ctx C = {pyr, gx / major, gy / major, NULL, 0, 0, 0, 0, NULL, NULL, NULL};
-    C.step = malloc((size_t)H * sizeof *C.step);
+    *C = (hz_ctx){pyr, gx / major, gy / major, NULL, 0, 0, 0, 0, NULL, out, failed};
+    C->step = malloc((size_t)H * sizeof *C->step);
     level_az *lv = malloc((size_t)pyr->levels * sizeof *lv);
-    if (!C.step || !lv) {
-        free(C.step);
-        free(lv);
-        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the pyramid's step table");
-    }
+    C->lv = lv;
+    if (!C->step || !lv)
+        return 0;
     for (int y = 0; y < H; y++)
-        C.step[y] = hypot(ts_grid_cell_x(g, y) * C.vx, g->cell_y * C.vy);
-    C.c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
-    C.cap = opts->max_distance;
-    C.ko = pyr->opts.level_step * pyr->opts.offset;
-    C.bspline = pyr->opts.reconstruction == TS_PYRAMID_BSPLINE;
-    level_az_fill(&C, lv);
-    C.lv = lv;
-    C.out = out;
-    int failed = 0;
-    C.alloc_failed = &failed;
-    st = ts_parallel_for(ts_thread_count(opts->threads, H), H, rows_range, &C, err);
-    free(C.step);
-    free(lv);
+        C->step[y] = hypot(ts_grid_cell_x(g, y) * C->vx, g->cell_y * C->vy);
+    C->c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
+    C->cap = opts->max_distance;
+    C->ko = pyr->opts.level_step * pyr->opts.offset;
+    C->bspline = pyr->opts.reconstruction == TS_PYRAMID_BSPLINE;
+    level_az_fill(C, lv);
+    return 1;
+}
+
+ts_status ts_pyramid_horizons(const ts_pyramid *pyr, int count, const double *azimuths,
+                              const ts_horizon_opts *opts, float *const *out, ts_error *err)
+{
+    if (!pyr)
+        return ts_fail(err, TS_ERR_ARG, "pyramid is NULL");
+    if (count < 1 || count > TS_PYRAMID_BATCH)
+        return ts_fail(err, TS_ERR_ARG, "azimuths at once must be 1 to %d, got %d",
+                       TS_PYRAMID_BATCH, count);
+    if (!azimuths)
+        return ts_fail(err, TS_ERR_ARG, "azimuths are NULL");
+    const ts_grid *g = pyr->grid;
+    double az[TS_PYRAMID_BATCH];
+    ts_status st;
+    for (int k = 0; k < count; k++) {
+        if (!out || !out[k])
+            return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
+        az[k] = azimuths[k];
+        if ((st = ts_check_sweep_args(g, &az[k], opts, err)) != TS_OK)
+            return st;
+    }
+    hz_ctx C[TS_PYRAMID_BATCH];
+    int failed = 0, ok = 1, k = 0;
+    for (; ok && k < count; k++)
+        ok = az_ctx_init(pyr, az[k], opts, out[k], &failed, &C[k]);
+    if (ok) {
+        batch_ctx B = {count, C};
+        st = ts_parallel_for(ts_thread_count(opts->threads, g->height), g->height, rows_range,
+                             &B, err);
+    }
+    for (int i = 0; i < k; i++) {
+        free(C[i].step);
+        free((level_az *)C[i].lv);
+    }
+    if (!ok)
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the pyramid's step tables");
     if (st != TS_OK)
         return st;
     if (failed)
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the pyramid's row workspace");
     /* what lies beyond the DEM's edge, as after the exact sweep */
-    return ts_horizon_edge_apply(g, azimuth, opts, out, err);
+    for (int i = 0; i < count && st == TS_OK; i++)
+        st = ts_horizon_edge_apply(g, az[i], opts, out[i], err);
+    return st;
+}
+
+ts_status ts_pyramid_horizon(const ts_pyramid *pyr, double azimuth, const ts_horizon_opts *opts,
+                             float *out, ts_error *err)
+{
+    return ts_pyramid_horizons(pyr, 1, &azimuth, opts, &out, err);
 }
 
 ts_status ts_pyramid_horizon_compute(const ts_grid *grid, const ts_pyramid_opts *popts,
@@ -505,9 +557,16 @@ ts_status ts_pyramid_horizon_compute(const ts_grid *grid, const ts_pyramid_opts 
     if ((st = ts_pyramid_build(grid, popts, opts->threads, &pyr, err)) != TS_OK)
         return st;
     size_t plane = (size_t)grid->width * (size_t)grid->height;
-    for (int k = 0; st == TS_OK && k < opts->directions; k++) {
+    for (int k = 0; st == TS_OK && k < opts->directions; k += TS_PYRAMID_BATCH) {
+        int n = opts->directions - k < TS_PYRAMID_BATCH ? opts->directions - k : TS_PYRAMID_BATCH;
+        double az[TS_PYRAMID_BATCH];
+        float *planes[TS_PYRAMID_BATCH];
+        for (int i = 0; i < n; i++) {
+            az[i] = ts_horizon_azimuth(opts, k + i);
+            planes[i] = out + plane * (k + i);
+        }
         if ((st = ts_progress(opts, (double)k / opts->directions, err)) == TS_OK)
-            st = ts_pyramid_horizon(pyr, ts_horizon_azimuth(opts, k), opts, out + plane * k, err);
+            st = ts_pyramid_horizons(pyr, n, az, opts, planes, err);
     }
     ts_pyramid_free(pyr);
     if (st == TS_OK)

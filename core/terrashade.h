@@ -523,6 +523,18 @@ void ts_pyramid_free(ts_pyramid *pyr);
 ts_status ts_pyramid_horizon(const ts_pyramid *pyr, double azimuth,
                              const ts_horizon_opts *opts, float *out, ts_error *err);
 
+/** The most azimuths ts_pyramid_horizons computes at once. */
+#define TS_PYRAMID_BATCH 4
+
+/**
+ * Pyramid horizons for `count` azimuths (1 to TS_PYRAMID_BATCH) into
+ * out[k] (each width*height): bit for bit ts_pyramid_horizon of each, in
+ * less time than one at a time (the cells' own heights on each level,
+ * the same for every azimuth, are read once).
+ */
+ts_status ts_pyramid_horizons(const ts_pyramid *pyr, int count, const double *azimuths,
+                              const ts_horizon_opts *opts, float *const *out, ts_error *err);
+
 /** Build a pyramid and compute opts->directions planes, as
  * ts_horizon_compute (with its progress reports). */
 ts_status ts_pyramid_horizon_compute(const ts_grid *grid, const ts_pyramid_opts *popts,

@@ -87,8 +87,9 @@ static ts_status note_backend(const tsd_compute_ctx *c)
     return TS_OK;
 }
 
-/* The planes of the pyramid read with `rec`, one at a time, to `add`: at
- * the `count` azimuths `az` (degrees), or at DIRECTIONS' when az is NULL. */
+/* The planes of the pyramid read with `rec`, TS_PYRAMID_BATCH at a time
+ * (one at a time where memory is short), to `add` in order: at the
+ * `count` azimuths `az` (degrees), or at DIRECTIONS' when az is NULL. */
 static ts_status pyramid_run(const tsd_compute_ctx *c, const ts_grid *g,
                              ts_pyramid_reconstruction rec, int count, const double *azimuths,
                              tsd_plane_fn add, void *user)
@@ -97,37 +98,47 @@ static ts_status pyramid_run(const tsd_compute_ctx *c, const ts_grid *g,
     ts_horizon_opts h;
     ts_pyramid_opts po;
     ts_error err;
-    ts_status st;
+    ts_status st = TS_OK;
     tsd_compute_horizon_opts(c, &h);
-    h.progress = NULL; /* reported here, per azimuth */
+    h.progress = NULL; /* reported here, per batch of azimuths */
     ts_pyramid_opts_default(&po);
     po.level_step = o->pyramid_level_step;
     po.offset = o->pyramid_offset;
     po.reconstruction = rec;
     if ((st = note_backend(c)) != TS_OK)
         return st;
-    ts_pyramid *pyr = NULL;
-    float *plane = malloc((size_t)g->width * g->height * sizeof(float));
-    if (!plane)
-        return tsd_fail(c->msg, c->msg_size, TS_ERR_NOMEM, "out of memory for a horizon plane");
-    if (ts_pyramid_build(g, &po, o->threads, &pyr, &err) != TS_OK) {
-        free(plane);
-        return tsd_fail_core(c->msg, c->msg_size, NULL, &err);
-    }
     if (!azimuths)
         count = h.directions;
-    for (int k = 0; k < count; k++) {
-        double az = azimuths ? azimuths[k] : ts_horizon_azimuth(&h, k);
+    size_t cells = (size_t)g->width * g->height;
+    int batch = count < TS_PYRAMID_BATCH ? count : TS_PYRAMID_BATCH;
+    float *planes = malloc(cells * batch * sizeof(float));
+    if (!planes && batch > 1)
+        planes = malloc(cells * (batch = 1) * sizeof(float));
+    if (!planes)
+        return tsd_fail(c->msg, c->msg_size, TS_ERR_NOMEM, "out of memory for a horizon plane");
+    ts_pyramid *pyr = NULL;
+    if (ts_pyramid_build(g, &po, o->threads, &pyr, &err) != TS_OK) {
+        free(planes);
+        return tsd_fail_core(c->msg, c->msg_size, NULL, &err);
+    }
+    for (int k = 0; st == TS_OK && k < count; k += batch) {
+        int n = count - k < batch ? count - k : batch;
+        double az[TS_PYRAMID_BATCH];
+        float *out[TS_PYRAMID_BATCH];
+        for (int i = 0; i < n; i++) {
+            az[i] = azimuths ? azimuths[k + i] : ts_horizon_azimuth(&h, k + i);
+            out[i] = planes + cells * i;
+        }
         if ((st = tsd_compute_report(c, (double)k / count)) != TS_OK)
             break;
-        if (ts_pyramid_horizon(pyr, az, &h, plane, &err) != TS_OK ||
-            add(user, g, k, az, plane, &err) != TS_OK) {
+        if (ts_pyramid_horizons(pyr, n, az, &h, out, &err) != TS_OK)
             st = tsd_fail_core(c->msg, c->msg_size, NULL, &err);
-            break;
-        }
+        for (int i = 0; st == TS_OK && i < n; i++)
+            if (add(user, g, k + i, az[i], out[i], &err) != TS_OK)
+                st = tsd_fail_core(c->msg, c->msg_size, NULL, &err);
     }
     ts_pyramid_free(pyr);
-    free(plane);
+    free(planes);
     return st;
 }
 

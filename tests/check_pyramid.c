@@ -268,6 +268,44 @@ START_TEST(test_threads_identical)
 }
 END_TEST
 
+/* ts_pyramid_horizons: the azimuths computed together are bit for bit
+ * those computed one at a time, for both reconstructions, with a level
+ * offset, nodata (lux_elev) and a maximum distance. */
+START_TEST(test_batch_identical)
+{
+    ts_grid g;
+    tdem_load(&g, "lux_elev");
+    size_t cells = (size_t)g.width * g.height;
+    const double az[TS_PYRAMID_BATCH + 2] = {7.5, 100, 181.25, 271, 333.3, 45};
+    float *one = tdem_floats(cells), *many = tdem_floats(cells * TS_PYRAMID_BATCH);
+    ts_error err;
+    for (int v = 0; v < 4; v++) {
+        ts_pyramid_opts p = popts(4, v & 1 ? 0.5 : 0, v & 2 ? TS_PYRAMID_LEVEL_MAX
+                                                          : TS_PYRAMID_BSPLINE);
+        ts_horizon_opts o = hopts(1, 1);
+        o.max_distance = v == 3 ? 900 : 0;
+        ts_pyramid *pyr;
+        ck_assert_msg(ts_pyramid_build(&g, &p, 0, &pyr, &err) == TS_OK, "%s", err.message);
+        for (int count = 2; count <= TS_PYRAMID_BATCH; count++) {
+            float *planes[TS_PYRAMID_BATCH];
+            for (int k = 0; k < count; k++)
+                planes[k] = many + cells * k;
+            const double *a = az + (count + v) % 3;
+            ck_assert_msg(ts_pyramid_horizons(pyr, count, a, &o, planes, &err) == TS_OK, "%s",
+                          err.message);
+            for (int k = 0; k < count; k++) {
+                ck_assert(ts_pyramid_horizon(pyr, a[k], &o, one, &err) == TS_OK);
+                ck_assert_msg(memcmp(one, planes[k], cells * sizeof *one) == 0,
+                              "variant %d, %d at once: azimuth %g differs", v, count, a[k]);
+            }
+        }
+        ts_pyramid_free(pyr);
+    }
+    free(one), free(many);
+    ts_grid_free(&g);
+}
+END_TEST
+
 /* MAX_DISTANCE: the rays end at the distance, where their last sample
  * is; on jacksboro (curvature on) the capped pyramid stays as close to
  * the capped sweep as the unbounded ones are to each other. */
@@ -341,6 +379,15 @@ START_TEST(test_bad_input)
     ck_assert(ts_pyramid_horizon(pyr, NAN, &o, out, &err) == TS_ERR_ARG);
     ck_assert(ts_pyramid_horizon(pyr, 0, NULL, out, &err) == TS_ERR_ARG);
     ck_assert(ts_pyramid_horizon(pyr, 370, &o, out, &err) == TS_OK);
+    double az[TS_PYRAMID_BATCH + 1] = {0};
+    float *outs[TS_PYRAMID_BATCH + 1] = {out, out};
+    ck_assert(ts_pyramid_horizons(pyr, 0, az, &o, outs, &err) == TS_ERR_ARG);
+    ck_assert(ts_pyramid_horizons(pyr, TS_PYRAMID_BATCH + 1, az, &o, outs, &err) == TS_ERR_ARG);
+    printf("too many azimuths: %s\n", err.message);
+    ck_assert(ts_pyramid_horizons(pyr, 1, NULL, &o, outs, &err) == TS_ERR_ARG);
+    ck_assert(ts_pyramid_horizons(pyr, 1, az, &o, NULL, &err) == TS_ERR_ARG);
+    ck_assert(ts_pyramid_horizons(pyr, 3, az, &o, outs, &err) == TS_ERR_ARG); /* outs[2] NULL */
+    ck_assert(ts_pyramid_horizons(NULL, 1, az, &o, outs, &err) == TS_ERR_ARG);
     ts_pyramid_free(pyr);
     ts_pyramid_free(NULL);
     ck_assert_int_eq(ts_pyramid_level_count(4096, 100, 4), 49);
@@ -362,6 +409,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_bspline_below_level_max);
     tcase_add_test(tc, test_flat_plane);
     tcase_add_test(tc, test_threads_identical);
+    tcase_add_test(tc, test_batch_identical);
     tcase_add_test(tc, test_max_distance);
     tcase_add_test(tc, test_bad_input);
     suite_add_tcase(s, tc);

@@ -1,0 +1,73 @@
+/* What core/pyramid_horizon.c and core/pyramid_drop.c share: one
+ * azimuth's context and a thread's rows of state. */
+#ifndef TS_PYRAMID_HZ_H
+#define TS_PYRAMID_HZ_H
+
+#include "pyramid_internal.h"
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define TS_PYR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define TS_PYR_CLONES
+#endif
+
+/* What sample j of every cell shares for one azimuth: its offset in
+ * cells, split into a whole column ix and a fraction fx, the columns
+ * [xa, xb] whose sample is on the grid, and the level it reads. */
+typedef struct {
+    double s;   /* distance in steps: the level's spacing */
+    int ix;     /* floor of the column offset s vx */
+    float fx;   /* the fraction of it */
+    int xa, xb; /* cells whose sample lies within the grid's columns */
+    int lev;    /* level read: j - k o, at least 0 */
+} level_az;
+
+typedef struct {
+    const ts_pyramid *P;
+    double vx, vy;      /* ray direction, DEM cells per step (major component +-1) */
+    double *step;       /* metres per step, by row */
+    double c;           /* curvature coefficient (1 - k) / 2R, 0 when off */
+    double cap;         /* maximum distance in metres, 0 = none */
+    double ko;          /* level offset k o */
+    int bspline;        /* 1: B-spline in log distance; 0: max over levels */
+    const level_az *lv; /* by sample number j */
+    float *out;
+    int *alloc_failed;
+} hz_ctx;
+
+/* Per-thread rows of state, one entry per cell of the grid row. */
+typedef struct {
+    float *s0, *s1, *s2; /* the last three samples (degrees, or tangents) */
+    float *m;            /* spline maximum (or largest tangent) so far */
+    float *T;            /* the level row at the samples */
+    float *A;            /* the samples being pushed */
+    double *tpp;         /* drop_cells: t, px, py of the cells (3 rows) */
+    int *jd;             /* the sample number at which each cell drops out */
+} row_ws;
+
+/* Sample a (c >= 2) after p0, p1, p2: the spline's midpoint before the
+ * last sample and its last knot join the maximum *m. */
+static inline void spline_push(float *p0, float *p1, float *p2, float *m, float a)
+{
+    a = a == a ? a : *p2; /* nodata: the sample before */
+    float mid = (*p0 + 23.0f * *p1 + 23.0f * *p2 + a) * (1.0f / 48.0f);
+    float knot = (*p1 + 4.0f * *p2 + a) * (1.0f / 6.0f);
+    float mm = *m;
+    mm = mid > mm ? mid : mm;
+    mm = knot > mm ? knot : mm;
+    *m = mm;
+    *p0 = *p1;
+    *p1 = *p2;
+    *p2 = a;
+}
+
+/* The cells of [a, b] of row y whose rays ended before the samples of
+ * the levels (through a side of the grid, or at t_row steps), each after
+ * w->jd[x] samples (B-spline; the level maximum needs no count): the last
+ * sample of each where its ray ends, read bilinearly on the DEM, then
+ * their horizons into out. A dropped cell's state is left as it was, so
+ * this runs once a row for all of them (core/pyramid_drop.c). */
+void ts_pyr_drop_cells(const hz_ctx *C, row_ws *w, int y, int a, int b, double t_row,
+                       float *out);
+
+#endif
