@@ -63,7 +63,10 @@ double tsd_pyramid_bytes(const tsd_options *o, int width, int height)
 {
     if (o->horizon_method != TSD_HORIZON_PYRAMID)
         return 0;
-    return ts_pyramid_bytes(width, height, o->pyramid_level_step);
+    /* pyramid_run's batch holds TS_PYRAMID_BATCH planes where the sweep
+     * holds one (counted with the product's) */
+    double extra = (TS_PYRAMID_BATCH - 1) * (double)width * height * sizeof(float);
+    return ts_pyramid_bytes(width, height, o->pyramid_level_step) + extra;
 }
 
 /* The backend report of the pyramid: C, and why not OpenCL when OpenCL

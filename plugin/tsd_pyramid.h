@@ -19,7 +19,8 @@ extern "C" {
  * product and each other: 0, or -1 with a sentence in msg. */
 int tsd_options_check_pyramid(const tsd_options *o, char *msg, size_t msg_size);
 
-/** Bytes of the pyramid of a width x height DEM under options o (0 with
+/** Bytes of the pyramid of a width x height DEM under options o, and of the
+ * horizon planes its batches add to the product's one (0 with
  * HORIZON_METHOD=exact). */
 double tsd_pyramid_bytes(const tsd_options *o, int width, int height);
 
