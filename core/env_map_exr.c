@@ -155,11 +155,17 @@ static ts_status plan_layout(exr_context_t ctx, const exr_source *src, int64_t w
     return TS_OK;
 }
 
+/* Where the channels no product reads are decoded to, and thrown away. */
+typedef struct {
+    uint8_t *buf;
+    size_t size;
+} discard_buffer;
+
 /* Decode one chunk whose top-left pixel is (x0, y0) from the data window's
  * corner into the interleaved rgb image of width w. */
 static exr_result_t decode_chunk(exr_context_t ctx, const exr_chunk_info_t *ci, int x0, int y0,
                                  int w, float *rgb, const channel_plan *plan,
-                                 exr_decode_pipeline_t *dec, int *started)
+                                 exr_decode_pipeline_t *dec, int *started, discard_buffer *discard)
 {
     exr_result_t rv = *started ? exr_decoding_update(ctx, 0, ci, dec)
                                : exr_decoding_initialize(ctx, 0, ci, dec);
@@ -170,7 +176,24 @@ static exr_result_t decode_chunk(exr_context_t ctx, const exr_chunk_info_t *ci, 
         exr_coding_channel_info_t *ch = &dec->channels[c];
         int slot = slot_of(plan, ch->channel_name);
         if (slot < 0) {
-            ch->decode_to_ptr = NULL;
+            /* Every channel gets a destination: OpenEXRCore 3.1's unpackers
+             * can write through a NULL decode_to_ptr when only some channels
+             * are wanted (a fuzzed tiled file with B, G and Y crashed there).
+             * The unused ones go, in their own type, to a scratch buffer. */
+            size_t need = (size_t)(ch->width > 0 ? ch->width : 1) *
+                          (size_t)(ch->height > 0 ? ch->height : 1) * sizeof(float);
+            if (need > discard->size) {
+                uint8_t *b = realloc(discard->buf, need);
+                if (!b)
+                    return EXR_ERR_OUT_OF_MEMORY;
+                discard->buf = b;
+                discard->size = need;
+            }
+            ch->decode_to_ptr = discard->buf;
+            ch->user_pixel_stride = (int32_t)sizeof(float);
+            ch->user_line_stride = (int32_t)sizeof(float) * (ch->width > 0 ? ch->width : 1);
+            ch->user_data_type = ch->data_type;
+            ch->user_bytes_per_element = ch->bytes_per_element;
             continue;
         }
         ch->decode_to_ptr = (uint8_t *)(rgb + ((size_t)y0 * (size_t)w + (size_t)x0) * 3 + slot);
@@ -190,6 +213,7 @@ static exr_result_t decode_pixels(exr_context_t ctx, exr_storage_t storage, int 
                                   float *rgb, const channel_plan *plan)
 {
     exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
+    discard_buffer discard = {NULL, 0};
     int started = 0;
     exr_result_t rv = EXR_ERR_SUCCESS;
     exr_chunk_info_t ci;
@@ -202,7 +226,8 @@ static exr_result_t decode_pixels(exr_context_t ctx, exr_storage_t storage, int 
             for (int tx = 0; rv == EXR_ERR_SUCCESS && (int64_t)tx * tw < w; tx++) {
                 rv = exr_read_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &ci);
                 if (rv == EXR_ERR_SUCCESS)
-                    rv = decode_chunk(ctx, &ci, tx * tw, ty * th, w, rgb, plan, &dec, &started);
+                    rv = decode_chunk(ctx, &ci, tx * tw, ty * th, w, rgb, plan, &dec, &started,
+                                      &discard);
             }
     } else {
         exr_attr_box2i_t dw;
@@ -216,11 +241,12 @@ static exr_result_t decode_pixels(exr_context_t ctx, exr_storage_t storage, int 
             rv = exr_read_scanline_chunk_info(ctx, 0, dw.min.y + (int)y, &ci);
             if (rv == EXR_ERR_SUCCESS)
                 rv = decode_chunk(ctx, &ci, 0, ci.start_y - dw.min.y, w, rgb, plan, &dec,
-                                  &started);
+                                  &started, &discard);
         }
     }
     if (started)
         exr_decoding_destroy(ctx, &dec);
+    free(discard.buf);
     return rv;
 }
 
