@@ -378,37 +378,38 @@ int ts_cl_built(void)
     return 1;
 }
 
-ts_status ts_cl_available(ts_cl_info *info, ts_error *err)
+/* *info = *dev (if info is given), its max_alloc capped by
+ * TERRASHADE_OPENCL_MAX_ALLOC. */
+static ts_status report_info(const ts_cl_info *dev, ts_cl_info *info, ts_error *err)
 {
-    ts_cl_dev *d;
-    ts_status st = ts_cl_device(&d, err);
+    unsigned long long cap;
+    ts_status st = ts_cl_env_max_alloc(&cap, err);
     if (st != TS_OK)
         return st;
-    unsigned long long cap;
-    if ((st = ts_cl_env_max_alloc(&cap, err)) != TS_OK)
-        return st;
     if (info) {
-        *info = d->info;
+        *info = *dev;
         if (cap && cap < info->max_alloc)
             info->max_alloc = cap;
     }
     return ts_ok(err);
 }
 
+ts_status ts_cl_available(ts_cl_info *info, ts_error *err)
+{
+    ts_cl_dev *d;
+    ts_status st = ts_cl_device(&d, err);
+    return st != TS_OK ? st : report_info(&d->info, info, err);
+}
+
 ts_status ts_cl_peek(ts_cl_info *info, ts_error *err)
 {
     ts_status st = list_ready(err);
     int i = 0;
-    unsigned long long cap;
-    if (st != TS_OK || (st = select_device(&i, err)) != TS_OK ||
-        (st = ts_cl_env_max_alloc(&cap, err)) != TS_OK)
+    if (st != TS_OK || (st = select_device(&i, err)) != TS_OK)
         return st;
-    if (info) {
-        fill_info(&g_list.dev[i], i, info);
-        if (cap && cap < info->max_alloc)
-            info->max_alloc = cap;
-    }
-    return ts_ok(err);
+    ts_cl_info listed;
+    fill_info(&g_list.dev[i], i, &listed);
+    return report_info(&listed, info, err);
 }
 
 ts_status ts_cl_devices(ts_cl_info *list, int max, int *count, ts_error *err)
