@@ -53,14 +53,18 @@ ts_status ts_line_geom_init(ts_line_geom *g, const ts_grid *grid, double azimuth
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate sweep line tables");
     }
     /* A window's lines are the whole DEM's: its sample k is the whole
-     * DEM's step q = k + k_anchor (q = u * u_step in the DEM's u), at v
-     * t * q there; fl[k] counts from floor(t * k_anchor), an integer shift
-     * of the window's line intercepts. */
+     * DEM's step q = k + k_anchor (q counted, as there, from the DEM's
+     * first u in the sweep's direction: its last column or row when the
+     * sweep runs backwards), at v t * q there; fl[k] counts from
+     * floor(t * k_anchor), an integer shift of the window's line
+     * intercepts. */
     double f0 = 0;
     if (o) {
         long ou = g->x_major ? o->x0 : o->y0;
+        long full_u = g->x_major ? o->full_width : o->full_height;
+        long full_start = g->u_step > 0 ? 0 : full_u - 1;
         g->anchored = 1;
-        g->k_anchor = (ou + g->u_start) * (long)g->u_step;
+        g->k_anchor = (ou + g->u_start - full_start) * (long)g->u_step;
         f0 = floor(g->t * (double)g->k_anchor);
     }
     for (int k = 0; k < g->U; k++) {
