@@ -3,8 +3,10 @@
  * distance behind a cell counts (Chajdas et al. 2015). The sweep of
  * horizon_sweep.c, with two differences: a sample joins its line's hull
  * only once the line has moved the threshold past it (so the hull holds
- * exactly the far samples), and a cell's value mixes the two lines'
- * tangents linearly (there is no near field to solve exactly).
+ * exactly the far samples), and there is no near field to solve. As in
+ * the whole sweep, a cell between two lines takes its own ray's slope at
+ * the occluders the two lines' hulls find (the lines' own slopes, mixed,
+ * were up to a degree off on rough terrain at odd azimuths).
  * See shadow_atlas.h.
  */
 #include <math.h>
@@ -17,7 +19,16 @@
 
 typedef struct {
     double d, g;
+    int k; /* the sample's step */
 } fpt;
+
+/* A query's tangent vertex: its step (-1: none) and its distance from the
+ * query, measured along the line that holds it (each line counts its
+ * distances from its own first sample). */
+typedef struct {
+    double D;
+    int k;
+} fvertex;
 
 typedef struct {
     const ts_grid *grid;
@@ -34,7 +45,7 @@ typedef struct {
 typedef struct {
     fpt *hull, *raw;
     int n, raw_n, pending;
-    ts_line_pair lo;   /* far-side slopes (float entries) */
+    ts_line_pair lo;   /* far-side tangent vertices (fvertex entries) */
 } far_ws;
 
 /* Push onto the upper hull (points arrive by increasing d). */
@@ -49,10 +60,10 @@ static inline void hull_push(far_ws *w, fpt p)
     w->n = n + 1;
 }
 
-/* Largest slope (without the curvature term -2cd) from (d, g) to the hull,
- * which lies entirely behind d: the slopes to the vertices rise and then
- * fall, so a binary search finds the tangent vertex. */
-static inline double hull_tangent(const far_ws *w, double d, double g)
+/* The vertex of largest slope from (d, g) to the hull, which lies entirely
+ * behind d: the slopes to the vertices rise and then fall, so a binary
+ * search finds it. */
+static inline int hull_tangent(const far_ws *w, double d, double g)
 {
     const fpt *S = w->hull;
     int lo = 0, hi = w->n - 1; /* answer in [lo, hi] */
@@ -63,29 +74,50 @@ static inline double hull_tangent(const far_ws *w, double d, double g)
         else
             hi = j;
     }
-    return (S[lo].g - g) / (d - S[lo].d);
+    return lo;
 }
 
-static inline float far_query(const far_ctx *C, const far_ws *w, double d, float h)
+/* The tangent vertex of an observer at height h, d along the line. */
+static inline fvertex far_vertex(const far_ctx *C, const far_ws *w, double d, float h)
+{
+    if (w->n == 0)
+        return (fvertex){0.0, -1};
+    const fpt *v = &w->hull[hull_tangent(w, d, h + C->dz - C->c * d * d)];
+    return (fvertex){d - v->d, v->k};
+}
+
+/* Slope from an observer at height h, d along the line, to the line's own
+ * vertex: (h' - h) / D - c D with D = d - d'. */
+static inline float line_slope(const far_ctx *C, const far_ws *w, double d, float h)
 {
     if (w->n == 0)
         return -INFINITY;
     double g = h + C->dz - C->c * d * d;
-    return (float)(hull_tangent(w, d, g) - 2.0 * C->c * d);
+    const fpt *v = &w->hull[hull_tangent(w, d, g)];
+    return (float)((v->g - g) / (d - v->d) - 2.0 * C->c * d);
 }
 
-/* The core sweep's rule for mixing the two lines around a cell. */
-static inline float combine(float lo, float hi, float F)
+/* Slope from cell (k, i) at height h to its own ray at the step of vertex
+ * v (which lies between the two lines around the ray); -inf where there is
+ * none, the ray is off the grid there or touches nodata (cm_ray_slope_at). */
+static inline double ray_slope(const far_ctx *C, int k, int i, float h, fvertex v)
 {
-    if (F == 0.0f || isnan(lo))
-        return hi;
-    if (isnan(hi))
-        return lo;
-    if (lo == -INFINITY)
-        return hi;
-    if (hi == -INFINITY)
-        return lo;
-    return F * lo + (1.0f - F) * hi;
+    const ts_line_geom *G = C->geom;
+    int dk = k - v.k;
+    double D = v.D;
+    if (v.k < 0 || dk <= 0 || !(D > 0))
+        return -INFINITY;
+    int r0 = i + G->ray_o[dk];
+    float f = G->ray_f[dk];
+    if (r0 < 0 || r0 > G->V - 1 || (f > 0.0f && r0 + 1 > G->V - 1))
+        return -INFINITY;
+    const float *zz = C->grid->z + G->origin + (ptrdiff_t)v.k * G->u_stride +
+                      (ptrdiff_t)r0 * G->v_stride;
+    float a = zz[0], b = f > 0.0f ? zz[G->v_stride] : a;
+    float hz = a + f * (b - a);
+    if (isnan(hz))
+        return -INFINITY;
+    return (hz - (h + C->dz)) / D - C->c * D;
 }
 
 static void far_line(const far_ctx *C, far_ws *w, long b, int write)
@@ -95,8 +127,8 @@ static void far_line(const far_ctx *C, far_ws *w, long b, int write)
     int k0, k1;
     if (!ts_line_pair_next(&w->lo, G, b, &k0, &k1))
         return;
-    const float *prev_lo = w->lo.prev;
-    float *cur_lo = w->lo.cur;
+    const fvertex *prev_lo = w->lo.prev;
+    fvertex *cur_lo = w->lo.cur;
     w->n = w->raw_n = w->pending = 0;
     double d = 0.0;
     for (int k = k0; k <= k1; k++) {
@@ -111,17 +143,21 @@ static void far_line(const far_ctx *C, far_ws *w, long b, int write)
             float s_out;
             if (isnan(s.hc)) {
                 s_out = NAN;
+            } else if (s.F == 0.0f) { /* the cell is on the line */
+                s_out = line_slope(C, w, d, s.hc);
             } else {
-                float hi = s.inside ? far_query(C, w, d, s.hc) : NAN;
-                float lo = (s.F > 0.0f && k >= pk0 && k <= pk1) ? prev_lo[k] : NAN;
-                s_out = combine(lo, hi, s.F);
+                fvertex hi = s.inside ? far_vertex(C, w, d, s.hc) : (fvertex){0.0, -1};
+                fvertex lo = (k >= pk0 && k <= pk1) ? prev_lo[k] : (fvertex){0.0, -1};
+                double a = ray_slope(C, k, s.i, s.hc, lo);
+                double b = ray_slope(C, k, s.i, s.hc, hi);
+                s_out = (float)(a > b ? a : b);
             }
             C->out[C->o_origin + (ptrdiff_t)k * C->o_u_stride +
                    (ptrdiff_t)s.i * C->o_v_stride] = s_out;
         }
-        cur_lo[k] = (s.has_next && !isnan(s.hn)) ? far_query(C, w, d, s.hn) : NAN;
+        cur_lo[k] = (s.has_next && !isnan(s.hn)) ? far_vertex(C, w, d, s.hn) : (fvertex){0.0, -1};
         if (!isnan(s.hs))
-            w->raw[w->raw_n++] = (fpt){d, s.hs - C->c * d * d};
+            w->raw[w->raw_n++] = (fpt){d, s.hs - C->c * d * d, k};
     }
 }
 
@@ -133,8 +169,8 @@ static void far_range(void *ctx, int worker, long begin, long end)
     far_ws w = {0};
     w.hull = malloc((size_t)(U + 1) * sizeof *w.hull);
     w.raw = malloc((size_t)(U + 1) * sizeof *w.raw);
-    w.lo.prev = malloc((size_t)U * sizeof(float));
-    w.lo.cur = malloc((size_t)U * sizeof(float));
+    w.lo.prev = malloc((size_t)U * sizeof(fvertex));
+    w.lo.cur = malloc((size_t)U * sizeof(fvertex));
     w.lo.prev_k0 = 1;
     w.lo.prev_k1 = 0;
     if (w.hull && w.raw && w.lo.prev && w.lo.cur) {

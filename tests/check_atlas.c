@@ -121,8 +121,11 @@ START_TEST(test_far_horizon_against_full)
         printf("az %.1f, T = 20 cells: far above full by > 0.25 deg in %zu of %zu cells; "
                "where far dominates, %zu of %zu within 0.25 deg\n",
                azs[a], above, n, agree, dom);
-        ck_assert(above < n / 200);
-        ck_assert(agree >= dom * 95 / 100);
+        /* each cell's own ray at the lines' occluders, as the full sweep:
+         * 3-38 cells above, 99.7-99.99 % agreeing (the two lines' slopes
+         * mixed gave 137-480 and 97.4-99.7 %) */
+        ck_assert(above < n / 1000);
+        ck_assert(agree >= dom * 99 / 100);
     }
     free(far);
     free(full);
