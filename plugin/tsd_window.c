@@ -26,11 +26,23 @@ static int ceil_cells(double metres, double cell)
     return (int)ceil(metres / cell - 1e-9);
 }
 
-/* Bytes the far field keeps per cell of its grid: the heights, two planes
- * per azimuth, and two more while one is swept (tsd_window_peak_bytes). */
-static double far_bytes_per_cell(int planes)
+/* Bytes the far field keeps per cell of its grid: the heights, two float
+ * planes per azimuth, and two more while one is swept; where the grid is
+ * the DEM itself one 16-bit plane per azimuth, and one float plane while
+ * it is swept (tsd_window_peak_bytes). */
+static double far_bytes_per_cell(int planes, int own)
 {
+    if (own)
+        return sizeof(float) * 2 + sizeof(uint16_t) * (double)planes;
     return sizeof(float) * (1 + 2.0 * planes + 2);
+}
+
+static double far_budget(const tsd_options *o)
+{
+    double budget = TSD_FAR_BUDGET_MB * 1048576.0;
+    if (o->max_memory_mb > 0 && o->max_memory_mb * 1048576.0 / 4 < budget)
+        budget = o->max_memory_mb * 1048576.0 / 4;
+    return budget;
 }
 
 /* The far grid's cell in DEM cells: 1 (the DEM itself) where it fits
@@ -40,10 +52,11 @@ static double far_bytes_per_cell(int planes)
 static int far_factor(const tsd_options *o, int W, int H, int f_mem, double near_cells,
                       int planes)
 {
-    double budget = TSD_FAR_BUDGET_MB * 1048576.0;
-    if (o->max_memory_mb > 0 && o->max_memory_mb * 1048576.0 / 4 < budget)
-        budget = o->max_memory_mb * 1048576.0 / 4;
-    int f_budget = (int)ceil(sqrt((double)W * H * far_bytes_per_cell(planes) / budget));
+    double budget = far_budget(o);
+    if ((double)W * H <= TSD_FAR_OWN_MAX_CELLS &&
+        (double)W * H * far_bytes_per_cell(planes, 1) <= budget)
+        return 1;
+    int f_budget = (int)ceil(sqrt((double)W * H * far_bytes_per_cell(planes, 0) / budget));
     int f_near = (int)floor(near_cells / TSD_FAR_CELLS_PER_NEAR);
     int f = f_budget < f_near ? f_budget : f_near;
     f = f > f_mem ? f : f_mem;
@@ -118,6 +131,7 @@ int tsd_window_plan_make(const tsd_options *o, int per_cell_sun, int W, int H,
         int f = far_factor(o, W, H, f_mem, near / cell, p->far_planes);
         p->far_w = (W + f - 1) / f;
         p->far_h = (H + f - 1) / f;
+        p->far_own = f == 1;
     }
     return 0;
 }
@@ -129,7 +143,7 @@ double tsd_window_peak_bytes(const tsd_options *o, const tsd_window_plan *p, dou
     double computing = tsd_product_peak_bytes(o, W, H, &kept_one);
     /* the chunk cropped out of it, and the cache */
     double chunk = (double)p->tile * p->tile * sizeof(float) * tsd_options_band_count(o);
-    double far = (double)p->far_w * p->far_h * far_bytes_per_cell(p->far_planes);
+    double far = (double)p->far_w * p->far_h * far_bytes_per_cell(p->far_planes, p->far_own);
     double kept = chunk * p->cache_chunks + far;
     if (steady)
         *steady = kept;
@@ -144,6 +158,7 @@ void tsd_far_field_init(tsd_far_field *f, ts_grid *coarse, int fine_w, int fine_
     memset(coarse, 0, sizeof *coarse);
     f->fine_w = fine_w;
     f->fine_h = fine_h;
+    f->own = f->coarse.width == fine_w && f->coarse.height == fine_h;
     f->threshold = threshold;
     ts_horizon_opts_default(&f->hopts);
     f->hopts.directions = 1;
@@ -163,10 +178,41 @@ void tsd_far_field_free(tsd_far_field *f)
     for (int i = 0; i < f->n; i++) {
         free(f->planes[i].base);
         free(f->planes[i].per_m);
+        free(f->planes[i].angle);
     }
     free(f->planes);
     ts_grid_free(&f->coarse);
     memset(f, 0, sizeof *f);
+}
+
+/* The far plane of a grid that is the DEM itself: each cell's far horizon
+ * from its own height, in degrees, rounded to 1/TSD_FAR_STEPS_PER_DEGREE
+ * (0.0014 degrees at most) to keep a plane per azimuth in 16 bits. */
+static const struct tsd_far_plane *own_plane(tsd_far_field *f, double azimuth,
+                                             const tsd_compute_ctx *c)
+{
+    size_t cells = (size_t)f->coarse.width * f->coarse.height;
+    float *deg = malloc(cells * sizeof *deg);
+    uint16_t *q = malloc(cells * sizeof *q);
+    ts_error err;
+    ts_status st = !deg || !q ? TS_ERR_NOMEM : TS_OK;
+    if (st != TS_OK)
+        tsd_fail(c->msg, c->msg_size, st, "out of memory for the far field");
+    else if ((st = ts_far_horizon(&f->coarse, azimuth, f->threshold, &f->hopts, deg, &err)) !=
+             TS_OK)
+        tsd_fail_core(c->msg, c->msg_size, "the far field", &err);
+    if (st != TS_OK) {
+        free(deg);
+        free(q);
+        return NULL;
+    }
+    for (size_t i = 0; i < cells; i++) /* NaN, or -90: no far terrain */
+        q[i] = !(deg[i] > -90.0f)
+                   ? 0
+                   : (uint16_t)(1 + lrint((deg[i] + 90.0) * TSD_FAR_STEPS_PER_DEGREE));
+    free(deg);
+    f->planes[f->n] = (struct tsd_far_plane){azimuth, NULL, NULL, q};
+    return &f->planes[f->n++];
 }
 
 /* The far plane of `azimuth`, swept on first use; NULL with msg. */
@@ -185,6 +231,8 @@ static const struct tsd_far_plane *far_plane(tsd_far_field *f, double azimuth,
         f->planes = p;
         f->cap = cap;
     }
+    if (f->own)
+        return own_plane(f, azimuth, c);
     size_t cells = (size_t)f->coarse.width * f->coarse.height;
     float *lo = malloc(cells * sizeof *lo), *hi = malloc(cells * sizeof *hi);
     ts_error err;
@@ -203,7 +251,7 @@ static const struct tsd_far_plane *far_plane(tsd_far_field *f, double azimuth,
     }
     for (size_t i = 0; i < cells; i++) /* -inf - -inf: no far terrain, slope 0 */
         hi[i] = isinf(lo[i]) ? 0.0f : (float)((hi[i] - lo[i]) / (2 * TSD_FAR_DZ));
-    f->planes[f->n] = (struct tsd_far_plane){azimuth, lo, hi};
+    f->planes[f->n] = (struct tsd_far_plane){azimuth, lo, hi, NULL};
     return &f->planes[f->n++];
 }
 
@@ -308,6 +356,19 @@ static ts_status far_raise(const tsd_compute_ctx *c, const ts_grid *g, double az
     if (!p)
         return TS_ERR_NOMEM;
     const int cw = f->coarse.width, ch = f->coarse.height;
+    if (f->own) {
+        for (int y = 0; y < g->height; y++) {
+            float *row = plane + (size_t)y * g->width;
+            const uint16_t *q = p->angle + (size_t)(g->origin->y0 + y) * cw + g->origin->x0;
+            for (int x = 0; x < g->width; x++) {
+                if (q[x] == 0 || isnan(row[x]))
+                    continue;
+                float deg = (float)((q[x] - 1) * (1.0 / TSD_FAR_STEPS_PER_DEGREE) - 90.0);
+                row[x] = deg > row[x] ? deg : row[x];
+            }
+        }
+        return TS_OK;
+    }
     for (int y = 0; y < g->height; y++) {
         float wy;
         int cy = far_lerp_at(g->origin->y0 + y, f->fine_h, ch, &wy);

@@ -10,6 +10,7 @@
 #define TSD_WINDOW_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "terrashade.h"
 #include "tsd_compute.h"
@@ -27,11 +28,16 @@ extern "C" {
 /** The near field must reach at least this many cells. */
 #define TSD_NEAR_MIN_CELLS 16
 /** The far grid is the DEM at full resolution where it fits (docs/windows.md:
- * the far field's error is the averaging of its cells), else averaged to at
- * most TSD_FAR_MAX_CELLS cells (its planes are kept for the dataset's life,
- * one pair per azimuth) and to the grid, with its planes, within
- * TSD_FAR_BUDGET_MB (or a quarter of MAX_MEMORY where that is less), but
- * never to cells coarser than NEAR_DISTANCE / TSD_FAR_CELLS_PER_NEAR. */
+ * the far field's error is the averaging of its cells): a DEM of at most
+ * TSD_FAR_OWN_MAX_CELLS cells, with one plane of 16-bit angles per azimuth
+ * (TSD_FAR_STEPS_PER_DEGREE), within the budget below. Else the DEM
+ * averaged to at most TSD_FAR_MAX_CELLS cells (its planes are kept for the
+ * dataset's life, one pair of float slopes per azimuth) and to the grid,
+ * with its planes, within TSD_FAR_BUDGET_MB (or a quarter of MAX_MEMORY
+ * where that is less), but never to cells coarser than NEAR_DISTANCE /
+ * TSD_FAR_CELLS_PER_NEAR. */
+#define TSD_FAR_OWN_MAX_CELLS (4096.0 * 4096.0)
+#define TSD_FAR_STEPS_PER_DEGREE 360
 #define TSD_FAR_MAX_CELLS (2048.0 * 2048.0)
 #define TSD_FAR_BUDGET_MB 1024.0
 #define TSD_FAR_CELLS_PER_NEAR 32
@@ -45,6 +51,7 @@ typedef struct {
     int margin_x, margin_y; /* the near field in cells, with the sweep's own reach */
     int far;               /* 1: a far field beyond near_m (MAX_DISTANCE=0) */
     int far_w, far_h;      /* the far grid's size */
+    int far_own;           /* the far grid is the DEM itself (16-bit angle planes) */
     int far_planes;        /* far-field azimuths kept (the sweeps of a chunk) */
     int cache_chunks;      /* chunks the LRU cache keeps */
 } tsd_window_plan;
@@ -73,7 +80,9 @@ double tsd_window_peak_bytes(const tsd_options *o, const tsd_window_plan *plan,
  * slopes of terrain at least near_m away from each coarse cell, as a
  * linear function of the observer's height (ts_far_slope_raised at two
  * heights): a full-resolution cell takes its coarse cell's function at its
- * own height. Computed once per dataset, so that every chunk sees the same.
+ * own height. Where the coarse grid is the DEM itself (`own`), each cell's
+ * far horizon from its own height instead, as an angle in 16 bits.
+ * Computed once per dataset, so that every chunk sees the same.
  */
 typedef struct tsd_far_field {
     ts_grid coarse;         /* owned */
@@ -81,11 +90,13 @@ typedef struct tsd_far_field {
     double threshold;       /* metres: the near field's reach */
     float zmax;             /* highest coarse height */
     ts_horizon_opts hopts;  /* curvature and threads of the sweeps */
+    int own;                /* the coarse grid is the DEM: angles, not slopes */
     int n, cap;
     struct tsd_far_plane {
         double azimuth;
         float *base;        /* slope seen from TSD_FAR_DZ below the coarse height */
         float *per_m;       /* its change per metre of observer height */
+        uint16_t *angle;    /* own: 0 none, else 1 + (degrees + 90) * STEPS_PER_DEGREE */
     } *planes;
 } tsd_far_field;
 
