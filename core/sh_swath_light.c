@@ -419,10 +419,12 @@ ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
         ts_sh_product_matrix(l, m);
         ts_sh_fold_cosine(m, C.mh);
     }
-    /* a table per slot only pays on a large grid: its build costs some
-     * S^2 x 272 multiply-adds, against about 300 saved a cell */
+    /* the tables only pay on a large grid: an interior slot's costs some
+     * S^2 x 290 multiply-adds to build, against about 300 saved a cell */
+    const int interior_slots = s->complete ? s->n : s->n - 1;
     if (s->n <= FOLD_MAX_SAMPLES && (size_t)grid->width * grid->height >=
-                                        (size_t)TS_SH_WEDGE_STEPS * TS_SH_WEDGE_STEPS)
+                                        (size_t)interior_slots * TS_SH_WEDGE_STEPS *
+                                            TS_SH_WEDGE_STEPS)
         st = fold_tables(&C, az_start, err);
     if (st == TS_OK)
         st = ts_parallel_for(ts_thread_count(0, grid->height), grid->height, swath_rows, &C,

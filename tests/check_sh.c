@@ -311,7 +311,7 @@ END_TEST
  * 90, a NaN), normals varied (one NaN). */
 START_TEST(swath_light_folded)
 {
-    const int W = 300, H = 240; /* 72000 cells: past the folding's threshold */
+    const int W = 400, H = 340; /* 136000 cells: past the folding's threshold */
     const size_t cells = (size_t)W * H;
     ts_grid g;
     ts_error err;
@@ -323,13 +323,13 @@ START_TEST(swath_light_folded)
     }
     nz[11] = NAN;
     ts_sh_swath swaths[2];
-    ts_sh_swath_complete(&swaths[0], 5, 30);
+    ts_sh_swath_complete(&swaths[0], 2, 30); /* 2 interior slots, as the key's 3 */
     ts_sh_swath_key(&swaths[1], 3, 315, 35, 4);
     for (int s = 0; s < 2; s++) {
         const int n = swaths[s].n;
         ts_sh_wedges w;
         ts_sh_visibility v;
-        float *planes[5];
+        float *planes[3];
         ck_assert_msg(ts_sh_wedges_build(&swaths[s], 0, &w, &err) == TS_OK, "%s", err.message);
         ck_assert(ts_sh_visibility_init(&v, &g, &w, &err) == TS_OK);
         for (int k = 0; k < n; k++) {
