@@ -13,6 +13,13 @@
  * is folded with the clamped cosine's zonal factors once per run, and the
  * basis at the normal is evaluated in float. Same sums as
  * ts_sh_visibility + ts_sh_shade up to float rounding.
+ *
+ * A swath of few samples (a key light's; FOLD_MAX_SAMPLES) goes further:
+ * every slot's wedge table is folded once per run with its rotation and
+ * the light (l . R t for share; mh^T R t for shade, mh the folded product
+ * matrix), so that a cell reads its wedges from per-slot tables and needs
+ * only a dot product with the basis at its normal (no 16 x 16 product, no
+ * rotation): the same sums in another order, the folding in double.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -42,7 +49,14 @@ typedef struct {
     const float *nx, *ny, *nz;
     float scale_shade, scale_share;
     float *shade, *share;
+    /* folded per-slot tables (slot k as rot[k]); NULL: the general path */
+    float **fold_shade; /* 16 floats a node */
+    float **fold_share; /* 1 float a node */
 } swath_ctx;
+
+/* Swaths of at most this many samples use the folded tables (4 MiB for
+ * shade per interior slot: 32 MiB at most). */
+#define FOLD_MAX_SAMPLES 8
 
 static void slot_rotation_set(slot_rotation *s, double az_start)
 {
@@ -62,20 +76,38 @@ static inline float clamp_node(float w)
 
 /* a1 += v p, a2 += v q' for the wedge v read bilinearly from the interior
  * table at horizons (wa, wb). */
+/* The node index and fraction of horizon w on a table axis. */
+static inline int node_of(float w, float *frac)
+{
+    const float t = clamp_node(w);
+    int i = (int)t;
+    i = i > TS_SH_WEDGE_STEPS - 2 ? TS_SH_WEDGE_STEPS - 2 : i;
+    *frac = t - (float)i;
+    return i;
+}
+
+/* The bilinear read of an interior table at horizons (wa, wb): the node
+ * (ia, ib) (*at = ia * S + ib) and the weights of its four corners
+ * (ia, ib), (ia, ib + 1), (ia + 1, ib), (ia + 1, ib + 1). */
+static inline void bilinear_at(float wa, float wb, size_t *at, float wt[4])
+{
+    float fa, fb;
+    const int ia = node_of(wa, &fa), ib = node_of(wb, &fb);
+    *at = (size_t)ia * TS_SH_WEDGE_STEPS + ib;
+    wt[0] = (1 - fa) * (1 - fb), wt[1] = (1 - fa) * fb, wt[2] = fa * (1 - fb), wt[3] = fa * fb;
+}
+
 static inline void add_interior(const float *restrict table, float wa, float wb,
                                 const slot_rotation *restrict r, float *restrict a1,
                                 float *restrict a2)
 {
     const int S = TS_SH_WEDGE_STEPS;
-    const float ta = clamp_node(wa), tb = clamp_node(wb);
-    int ia = (int)ta, ib = (int)tb;
-    ia = ia > S - 2 ? S - 2 : ia;
-    ib = ib > S - 2 ? S - 2 : ib;
-    const float fa = ta - (float)ia, fb = tb - (float)ib;
-    const float *t00 = table + ((size_t)ia * S + ib) * N, *t01 = t00 + N;
+    size_t at;
+    float wt[4];
+    bilinear_at(wa, wb, &at, wt);
+    const float *t00 = table + at * N, *t01 = t00 + N;
     const float *t10 = t00 + (size_t)S * N, *t11 = t10 + N;
-    const float w00 = (1 - fa) * (1 - fb), w01 = (1 - fa) * fb, w10 = fa * (1 - fb),
-                w11 = fa * fb;
+    const float w00 = wt[0], w01 = wt[1], w10 = wt[2], w11 = wt[3];
     for (int k = 0; k < N; k++) {
         float v = w00 * t00[k] + w01 * t01[k] + w10 * t10[k] + w11 * t11[k];
         a1[k] += v * r->p[k];
@@ -88,10 +120,8 @@ static inline void add_boundary(const float *restrict table, float w,
                                 const slot_rotation *restrict r, float *restrict a1,
                                 float *restrict a2)
 {
-    const float t = clamp_node(w);
-    int i = (int)t;
-    i = i > TS_SH_WEDGE_STEPS - 2 ? TS_SH_WEDGE_STEPS - 2 : i;
-    const float f = t - (float)i, *t0 = table + (size_t)i * N;
+    float f;
+    const float *t0 = table + (size_t)node_of(w, &f) * N;
     for (int k = 0; k < N; k++) {
         float v = (1 - f) * t0[k] + f * t0[k + N];
         a1[k] += v * r->p[k];
@@ -99,7 +129,34 @@ static inline void add_boundary(const float *restrict table, float w,
     }
 }
 
+/* 1 if a horizon of cell c is NaN (nodata): its outputs are then NaN. */
+static inline int cell_nodata(const swath_ctx *C, size_t c)
+{
+    int nodata = 0;
+    for (int k = 0; k < C->w->swath.n; k++)
+        nodata |= C->planes[k][c] != C->planes[k][c];
+    if (nodata) {
+        if (C->share)
+            C->share[c] = NAN;
+        if (C->shade)
+            C->shade[c] = NAN;
+    }
+    return nodata;
+}
 
+/* The outputs of cell c from its share l . V and its shade before
+ * scaling (NaN normal: NaN). */
+static inline void store_share(const swath_ctx *C, size_t c, float share)
+{
+    float t = share * C->scale_share;
+    C->share[c] = t < 0 ? 0 : t > 1 ? 1 : t;
+}
+
+static inline void store_shade(const swath_ctx *C, size_t c, float shade)
+{
+    float t = shade * C->scale_shade;
+    C->shade[c] = t == t ? (t < 0 ? 0 : t) : NAN;
+}
 
 /* Cells c0..c1 (cloned for wider vectors where the CPU has them). */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
@@ -111,16 +168,8 @@ static void swath_cells(const swath_ctx *C, size_t c0, size_t c1)
     const float *const *P = C->planes;
     const int n = w->swath.n, complete = w->swath.complete;
     for (size_t c = c0; c < c1; c++) {
-        int nodata = 0;
-        for (int k = 0; k < n; k++)
-            nodata |= P[k][c] != P[k][c];
-        if (nodata) { /* a NaN horizon (nodata) makes the cell NaN */
-            if (C->share)
-                C->share[c] = NAN;
-            if (C->shade)
-                C->shade[c] = NAN;
+        if (cell_nodata(C, c))
             continue;
-        }
         float a1[N] = {0}, a2[N] = {0}, v[N];
         for (int k = 1; k < n; k++)
             add_interior(w->interior, P[k][c], P[k - 1][c], &C->rot[k], a1, a2);
@@ -136,14 +185,82 @@ static void swath_cells(const swath_ctx *C, size_t c0, size_t c1)
             float p[N];
             for (int k = 0; k < N; k++)
                 p[k] = C->l[k] * v[k];
-            float t = ts_sh_sum16(p) * C->scale_share;
-            C->share[c] = t < 0 ? 0 : t > 1 ? 1 : t;
+            store_share(C, c, ts_sh_sum16(p));
         }
         if (C->shade) {
             float yn[N];
             TS_SH_BASIS(float, C->nx[c], C->ny[c], C->nz[c], yn);
-            float t = ts_sh_triple_folded(C->mh, v, yn) * C->scale_shade;
-            C->shade[c] = t == t ? (t < 0 ? 0 : t) : NAN; /* NaN normal: NaN */
+            store_shade(C, c, ts_sh_triple_folded(C->mh, v, yn));
+        }
+    }
+}
+
+/* One slot's wedge from its folded tables, shade's 16 floats into acc and
+ * share's one into *share (where the tables are there): an interior slot
+ * bilinear at horizons (wa, wb), a boundary slot (rise or fall, 1D) linear
+ * at wa. */
+static inline void add_folded_interior(const swath_ctx *C, int slot, float wa, float wb,
+                                       float *restrict acc, float *restrict share)
+{
+    const size_t S = TS_SH_WEDGE_STEPS;
+    size_t at;
+    float wt[4];
+    bilinear_at(wa, wb, &at, wt);
+    if (C->fold_shade) {
+        const float *t00 = C->fold_shade[slot] + at * N, *t01 = t00 + N, *t10 = t00 + S * N,
+                    *t11 = t10 + N;
+        for (int k = 0; k < N; k++)
+            acc[k] += (wt[0] * t00[k] + wt[1] * t01[k]) + (wt[2] * t10[k] + wt[3] * t11[k]);
+    }
+    if (C->fold_share) {
+        const float *t = C->fold_share[slot] + at;
+        *share += (wt[0] * t[0] + wt[1] * t[1]) + (wt[2] * t[S] + wt[3] * t[S + 1]);
+    }
+}
+
+static inline void add_folded_boundary(const swath_ctx *C, int slot, float w,
+                                       float *restrict acc, float *restrict share)
+{
+    float f;
+    const size_t at = (size_t)node_of(w, &f);
+    if (C->fold_shade) {
+        const float *t0 = C->fold_shade[slot] + at * N, *t1 = t0 + N;
+        for (int k = 0; k < N; k++)
+            acc[k] += (1 - f) * t0[k] + f * t1[k];
+    }
+    if (C->fold_share) {
+        const float *t = C->fold_share[slot] + at;
+        *share += (1 - f) * t[0] + f * t[1];
+    }
+}
+
+/* Cells c0..c1 from the folded tables. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+static void folded_cells(const swath_ctx *C, size_t c0, size_t c1)
+{
+    const float *const *P = C->planes;
+    const int n = C->w->swath.n, complete = C->w->swath.complete;
+    for (size_t c = c0; c < c1; c++) {
+        if (cell_nodata(C, c))
+            continue;
+        float acc[N] = {0}, share = 0;
+        /* slot k: from sample k - 1 (the last, for the closing slot 0) to k */
+        for (int k = complete ? 0 : 1; k < n; k++)
+            add_folded_interior(C, k, P[k][c], P[k ? k - 1 : n - 1][c], acc, &share);
+        if (!complete) {
+            add_folded_boundary(C, 0, P[0][c], acc, &share);
+            add_folded_boundary(C, n, P[n - 1][c], acc, &share);
+        }
+        if (C->share)
+            store_share(C, c, share);
+        if (C->shade) {
+            float yn[N], p[N];
+            TS_SH_BASIS(float, C->nx[c], C->ny[c], C->nz[c], yn);
+            for (int k = 0; k < N; k++)
+                p[k] = acc[k] * yn[k];
+            store_shade(C, c, ts_sh_sum16(p));
         }
     }
 }
@@ -153,7 +270,113 @@ static void swath_rows(void *ctx, int worker, long y0, long y1)
     (void)worker;
     const swath_ctx *C = ctx;
     const size_t W = (size_t)C->g->width;
-    swath_cells(C, (size_t)y0 * W, (size_t)y1 * W);
+    if (C->fold_shade || C->fold_share)
+        folded_cells(C, (size_t)y0 * W, (size_t)y1 * W);
+    else
+        swath_cells(C, (size_t)y0 * W, (size_t)y1 * W);
+}
+
+/* The folded tables' slots: interior ones (1 .. n - 1, and 0 when complete)
+ * of S x S nodes, boundary ones (0 rise, n fall) of S. */
+static int slot_count(const ts_sh_swath *s)
+{
+    return s->complete ? s->n : s->n + 1;
+}
+
+static int slot_interior(const ts_sh_swath *s, int k)
+{
+    return s->complete || (k > 0 && k < s->n);
+}
+
+typedef struct {
+    swath_ctx *C;
+    double mh[N][N], l[N];
+    ts_sh_rotation *rot; /* of every slot */
+} fold_job;
+
+/* Items a: row a % S of slot a / S (a boundary slot's row is one node). */
+static void fold_rows(void *ctx, int worker, long a0, long a1)
+{
+    (void)worker;
+    const fold_job *J = ctx;
+    const swath_ctx *C = J->C;
+    const ts_sh_swath *s = &C->w->swath;
+    const long S = TS_SH_WEDGE_STEPS;
+    for (long a = a0; a < a1; a++) {
+        const int slot = (int)(a / S), interior = slot_interior(s, slot);
+        const ts_sh_rotation *r = &J->rot[slot];
+        const float *src = !interior ? (slot == 0 ? C->w->rise : C->w->fall)
+                                     : C->w->interior;
+        const size_t first = interior ? (size_t)(a % S) * S : (size_t)(a % S);
+        const size_t count = interior ? (size_t)S : 1;
+        for (size_t e = first; e < first + count; e++) {
+            const float *t = src + e * N;
+            double u[N], share = 0;
+            for (int k = 0; k < N; k++) { /* the rotation, as add_interior's */
+                u[k] = (double)t[k] * r->p[k] + (double)t[r->perm[k]] * r->q[k];
+                share += J->l[k] * u[k];
+            }
+            if (C->fold_share)
+                C->fold_share[slot][e] = (float)share;
+            for (int k = 0; C->fold_shade && k < N; k++) {
+                double f = 0;
+                for (int j = 0; j < N; j++)
+                    f += u[j] * J->mh[j][k];
+                C->fold_shade[slot][e * N + k] = (float)f;
+            }
+        }
+    }
+}
+
+static void fold_free(swath_ctx *C, int slots)
+{
+    for (int k = 0; k < slots; k++) {
+        if (C->fold_shade)
+            free(C->fold_shade[k]);
+        if (C->fold_share)
+            free(C->fold_share[k]);
+    }
+    free(C->fold_shade);
+    free(C->fold_share);
+    C->fold_shade = C->fold_share = NULL;
+}
+
+/* Fold the wedge tables of every slot with its rotation (whose canonical
+ * start is az_start[slot]) and the light; mh the folded product matrix.
+ * Out of memory leaves C on the general path. */
+static ts_status fold_tables(swath_ctx *C, const double *az_start, ts_error *err)
+{
+    const ts_sh_swath *s = &C->w->swath;
+    const int slots = slot_count(s), S = TS_SH_WEDGE_STEPS;
+    fold_job J = {C, {{0}}, {0}, malloc(sizeof(ts_sh_rotation) * (size_t)slots)};
+    int ok = J.rot != NULL;
+    if (C->shade && ok)
+        ok = (C->fold_shade = calloc((size_t)slots, sizeof *C->fold_shade)) != NULL;
+    if (C->share && ok)
+        ok = (C->fold_share = calloc((size_t)slots, sizeof *C->fold_share)) != NULL;
+    for (int k = 0; ok && k < slots; k++) {
+        size_t nodes = slot_interior(s, k) ? (size_t)S * S : (size_t)S;
+        if (C->fold_shade)
+            ok = (C->fold_shade[k] = malloc(nodes * N * sizeof(float))) != NULL;
+        if (ok && C->fold_share)
+            ok = (C->fold_share[k] = malloc(nodes * sizeof(float))) != NULL;
+        if (ok)
+            ts_sh_rotation_set(&J.rot[k], az_start[k]);
+    }
+    ts_status st = TS_OK;
+    if (ok) {
+        for (int j = 0; j < N; j++) {
+            J.l[j] = C->l[j];
+            for (int k = 0; k < N; k++)
+                J.mh[j][k] = C->mh[j][k];
+        }
+        st = ts_parallel_for(ts_thread_count(0, (long)slots * S), (long)slots * S, fold_rows,
+                             &J, err);
+    }
+    if (!ok || st != TS_OK)
+        fold_free(C, slots);
+    free(J.rot);
+    return st;
 }
 
 ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
@@ -174,15 +397,21 @@ ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
         if (!planes[k])
             return ts_fail(err, TS_ERR_ARG, "horizon plane %d is NULL", k);
     slot_rotation *rot = malloc(sizeof *rot * (size_t)(s->n + 1));
-    if (!rot)
+    double *az_start = malloc(sizeof *az_start * (size_t)(s->n + 1));
+    if (!rot || !az_start) {
+        free(rot);
+        free(az_start);
         return ts_fail(err, TS_ERR_NOMEM, "out of memory for the swath's rotations");
+    }
     /* canonical starts (core/sh_visibility.c): wedge k at sample k, the rise
      * at sample 0, the closing wedge at sample 0, the fall at the far edge */
     for (int k = 0; k < s->n; k++)
-        slot_rotation_set(&rot[k], ts_sh_swath_azimuth(s, k));
-    slot_rotation_set(&rot[s->n], ts_sh_swath_azimuth(s, s->n - 1) + s->step / 2);
+        az_start[k] = ts_sh_swath_azimuth(s, k);
+    az_start[s->n] = ts_sh_swath_azimuth(s, s->n - 1) + s->step / 2;
+    for (int k = 0; k <= s->n; k++)
+        slot_rotation_set(&rot[k], az_start[k]);
     swath_ctx C = {grid, w, planes, rot, {{0}}, {0}, nx, ny, nz, (float)scale_shade,
-                   (float)scale_share, shade, share};
+                   (float)scale_share, shade, share, NULL, NULL};
     for (int k = 0; k < N; k++)
         C.l[k] = (float)l[k];
     if (shade) {
@@ -190,7 +419,18 @@ ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
         ts_sh_product_matrix(l, m);
         ts_sh_fold_cosine(m, C.mh);
     }
-    st = ts_parallel_for(ts_thread_count(0, grid->height), grid->height, swath_rows, &C, err);
+    /* the tables only pay on a large grid: an interior slot's costs some
+     * S^2 x 290 multiply-adds to build, against about 300 saved a cell */
+    const int interior_slots = s->complete ? s->n : s->n - 1;
+    if (s->n <= FOLD_MAX_SAMPLES && (size_t)grid->width * grid->height >=
+                                        (size_t)interior_slots * TS_SH_WEDGE_STEPS *
+                                            TS_SH_WEDGE_STEPS)
+        st = fold_tables(&C, az_start, err);
+    if (st == TS_OK)
+        st = ts_parallel_for(ts_thread_count(0, grid->height), grid->height, swath_rows, &C,
+                             err);
+    fold_free(&C, slot_count(s));
     free(rot);
+    free(az_start);
     return st;
 }

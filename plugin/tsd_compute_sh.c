@@ -81,6 +81,10 @@ static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
     }
     tsd_compute_horizon_opts(c, &h);
     h.progress = NULL; /* reported here, per sweep */
+    /* the wedge tables clamp every horizon at 0 deg (the sky ends at the
+     * horizontal), so horizons at or below it are all the same here: the
+     * sweep may skip the edge's raises that stay there */
+    h.nonpositive_moot = 1;
     if (o->horizon_method == TSD_HORIZON_PYRAMID)
         st = pyramid_planes(c, g, &s, planes);
     for (int i = 0; o->horizon_method != TSD_HORIZON_PYRAMID && st == TS_OK && i < s.n; i++) {

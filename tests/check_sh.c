@@ -305,6 +305,74 @@ START_TEST(visibility_planes)
 }
 END_TEST
 
+/* The one-pass form on a grid large enough for its folded per-slot tables
+ * (core/sh_swath_light.c) against the stored visibility, ts_sh_shade and
+ * ts_sh_visible_share: horizons varied per cell and sample (below 0, above
+ * 90, a NaN), normals varied (one NaN). */
+START_TEST(swath_light_folded)
+{
+    const int W = 400, H = 340; /* 136000 cells: past the folding's threshold */
+    const size_t cells = (size_t)W * H;
+    ts_grid g;
+    ts_error err;
+    tdem_create(&g, W, H, 1, 1);
+    float *nx = tdem_floats(cells), *ny = tdem_floats(cells), *nz = tdem_floats(cells);
+    for (size_t c = 0; c < cells; c++) {
+        double a = 0.37 * (double)c, t = 0.6 * fabs(sin(0.011 * (double)c));
+        nx[c] = (float)(sin(t) * cos(a)), ny[c] = (float)(sin(t) * sin(a)), nz[c] = (float)cos(t);
+    }
+    nz[11] = NAN;
+    ts_sh_swath swaths[2];
+    ts_sh_swath_complete(&swaths[0], 2, 30); /* 2 interior slots, as the key's 3 */
+    ts_sh_swath_key(&swaths[1], 3, 315, 35, 4);
+    for (int s = 0; s < 2; s++) {
+        const int n = swaths[s].n;
+        ts_sh_wedges w;
+        ts_sh_visibility v;
+        float *planes[3];
+        ck_assert_msg(ts_sh_wedges_build(&swaths[s], 0, &w, &err) == TS_OK, "%s", err.message);
+        ck_assert(ts_sh_visibility_init(&v, &g, &w, &err) == TS_OK);
+        for (int k = 0; k < n; k++) {
+            planes[k] = tdem_floats(cells);
+            for (size_t c = 0; c < cells; c++) /* -10 .. 100 degrees */
+                planes[k][c] = (float)(45 + 55 * sin(0.013 * (double)c + 1.7 * k));
+            planes[k][5] = k == n - 1 ? NAN : planes[k][5];
+            ck_assert(ts_sh_visibility_add(&v, k, planes[k], &err) == TS_OK);
+        }
+        ck_assert(ts_sh_visibility_finish(&v, &err) == TS_OK);
+        double l[N], m[N][N];
+        ts_sh_key_light(315, 35, 4, l);
+        ts_sh_product_matrix(l, m);
+        float *shade = tdem_floats(cells), *share = tdem_floats(cells);
+        float *ref_shade = tdem_floats(cells), *ref_share = tdem_floats(cells);
+        ck_assert_msg(ts_sh_swath_light(&g, &w, (const float *const *)planes, l, nx, ny, nz, 2,
+                                        shade, 3, share, &err) == TS_OK, "%s", err.message);
+        ck_assert(ts_sh_shade(&g, m, nx, ny, nz, v.vis, 2, ref_shade, &err) == TS_OK);
+        ck_assert(ts_sh_visible_share(&g, l, v.vis, 3, ref_share, &err) == TS_OK);
+        double worst = 0;
+        for (size_t c = 0; c < cells; c++) {
+            ck_assert(isnan(shade[c]) == isnan(ref_shade[c]));
+            ck_assert(isnan(share[c]) == isnan(ref_share[c]));
+            if (!isnan(shade[c]))
+                worst = fmax(worst, fabs(shade[c] - ref_shade[c]));
+            if (!isnan(share[c]))
+                worst = fmax(worst, fabs(share[c] - ref_share[c]));
+        }
+        ck_assert(isnan(shade[5]) && isnan(share[5]) && isnan(shade[11]) && !isnan(share[11]));
+        printf("%s swath, folded tables: shade and share within %.2e of the stored "
+               "visibility's\n", s ? "partial" : "complete", worst);
+        ck_assert(worst < 2e-6);
+        for (int k = 0; k < n; k++)
+            free(planes[k]);
+        free(shade), free(share), free(ref_shade), free(ref_share);
+        ts_sh_visibility_free(&v);
+        ts_sh_wedges_free(&w);
+    }
+    free(nx), free(ny), free(nz);
+    ts_grid_free(&g);
+}
+END_TEST
+
 /* Open flat ground under a constant sky: E/pi = 1 exactly in the
  * continuous case; state what order 4 gives. */
 START_TEST(flat_ground_constant_sky)
@@ -366,6 +434,7 @@ static Suite *suite(void)
     tcase_add_test(tc, triple_product_brute_force);
     tcase_add_test(tc, wedges_brute_force);
     tcase_add_test(tc, visibility_planes);
+    tcase_add_test(tc, swath_light_folded);
     tcase_add_test(tc, flat_ground_constant_sky);
     tcase_add_test(tc, key_light_reference);
     tcase_add_test(tc, bad_input);
