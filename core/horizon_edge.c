@@ -136,12 +136,19 @@ static void edge_rows(void *ctx, int worker, long begin, long end)
 {
     (void)worker;
     const edge_job *j = ctx;
+    /* From a height h >= 0 (c >= 0) the edge's tangent is <= 0: a horizon
+     * at or above 0 deg stays, and needs neither the distance nor the
+     * tangent (most cells of rough terrain, toward most azimuths). */
+    const int above_stays = j->opts->edge == TS_EDGE_HORIZON && j->c >= 0;
     for (long y = begin; y < end; y++) {
         float *row = j->plane + (size_t)y * j->grid->width;
         const float *z = j->grid->z + (ptrdiff_t)y * j->grid->stride;
-        for (int x = 0; x < j->grid->width; x++)
-            if (!isnan(row[x]) && !(j->skip_nonneg && z[x] >= 0)) /* nodata stays nodata */
-                row[x] = edge_raise(j, x, (int)y, row[x]);
+        for (int x = 0; x < j->grid->width; x++) {
+            float v = row[x];
+            if (isnan(v) || (z[x] >= 0 && (j->skip_nonneg || (above_stays && v >= 0))))
+                continue; /* nodata stays nodata */
+            row[x] = edge_raise(j, x, (int)y, v);
+        }
     }
 }
 
