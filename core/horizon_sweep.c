@@ -20,9 +20,7 @@
  * its samples instead (window_hull.h): those beyond the near field and
  * within the distance, in amortised O(1) per sample like the unbounded
  * hull; the near field is cut at the distance, and the last part of a step
- * before it is solved exactly on each cell's ray. Both sweep their lines in
- * lockstep blocks (sweep_block); process_line, line by line, serves the
- * line visitor.
+ * before it is solved exactly on each cell's ray.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -37,7 +35,6 @@
 #include "status_internal.h"
 #include "sweep_cap_tail.h"
 #include "window_hull.h"
-#include "window_lanes.h"
 
 typedef ts_hull_pt hull_pt;
 
@@ -81,7 +78,6 @@ typedef struct {
     /* unbounded sweep: the lines of a block, swept in lockstep */
     hull_pt *lane_stacks; /* line j's hull at lane_stacks + j * (U + 1) */
     int *lane_n, *lane_far; /* its size, its top-most point beyond the near field */
-    ts_window_lanes wlanes; /* capped sweep: the lines' window hulls instead */
     occluder *carry, *carry_next; /* far-side occluders from the line before */
     /* the block's current step, by line (one entry more than lines) */
     float *lane_f;      /* holds: */
@@ -338,12 +334,11 @@ static void lane_hulls_scalar(const ts_lane_hulls *h, const ts_lane_step *s,
     }
 }
 
-/* Lines bs .. bs + nl - 1 of a sweep, step by step; the first is
+/* Lines bs .. bs + nl - 1 of an unbounded sweep, step by step; the first is
  * only primed (not written) when `prime`. w->carry holds what the line
  * before the block found; on return it holds the block's last line's.
  * Each step samples the lines together (lane_passes.h), pushes and queries
- * each line's hull (with a maximum distance, its window: window_lanes.h)
- * in the same order as process_line, then evaluates the
+ * each line's hull in the same order as process_line, then evaluates the
  * far field of the step's cells together: the cell between lines j - 1 and
  * j takes its far-side occluder from line j - 1 and its own from line j. */
 static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int prime)
@@ -356,12 +351,8 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         int k0, k1;
         if (!ts_line_k_range(G, bs + j, &k0, &k1))
             continue;
-        if (C->cap > 0) {
-            ts_window_lanes_reset(&w->wlanes, j);
-        } else {
-            w->lane_n[j] = 0;
-            w->lane_far[j] = -1;
-        }
+        w->lane_n[j] = 0;
+        w->lane_far[j] = -1;
         w->lane_k0[j] = k0;
         w->lane_d[j] = 0.0;
         kmin = k0 < kmin ? k0 : kmin;
@@ -390,9 +381,7 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         const int last_inside = G->fr[k] == 0.0f ? j1 : G->V - 2 - (int)i0;
         const ts_lane_step step = {k, j0, j1, prime, last_inside, w->lane_d, w->hs, w->hc,
                                    w->hn, c, C->near_skip};
-        if (C->cap > 0)
-            ts_window_lanes_step(&w->wlanes, &step, &occ);
-        else if (!ts_lane_hull_step(&hulls, &step, &occ))
+        if (!ts_lane_hull_step(&hulls, &step, &occ))
             lane_hulls_scalar(&hulls, &step, &occ);
         if (j1 == nl - 1)
             next[k] = (occluder){w->lo_k[nl], w->lo_dd[nl]};
@@ -421,7 +410,6 @@ static void ws_free(sweep_ws *w)
     free(w->vs);
     free(w->vd);
     free(w->lane_stacks);
-    ts_window_lanes_free(&w->wlanes);
     free(w->lane_n);
     free(w->lane_far);
     free(w->carry);
@@ -431,12 +419,11 @@ static void ws_free(sweep_ws *w)
     free(w->lane_d);
 }
 
-static int ws_init(sweep_ws *w, int U, double cap, int need_visit)
+static int ws_init(sweep_ws *w, int U, int capped, int need_visit)
 {
     *w = (sweep_ws){0};
-    const int capped = cap > 0;
     int ok = 1;
-    if (capped && need_visit) { /* process_line's */
+    if (capped) {
         w->raw = malloc((size_t)(U + 1) * sizeof *w->raw);
         ok = w->raw && ts_window_hull_alloc(&w->win, U) &&
              (!need_visit || ts_window_hull_alloc(&w->vwin, U));
@@ -453,17 +440,11 @@ static int ws_init(sweep_ws *w, int U, double cap, int need_visit)
         w->vs = malloc((size_t)U * sizeof(float));
         w->vd = malloc((size_t)U * sizeof(double));
     }
-    if (!need_visit) {
+    if (!capped && !need_visit) {
         const occluder none = {-1, 0.0f};
-        if (capped) {
-            ok = ts_window_lanes_alloc(&w->wlanes, LOCKSTEP_LINES + 1, U, cap);
-        } else {
-            w->lane_n = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_n);
-            w->lane_far = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_far);
-            w->lane_stacks =
-                malloc((size_t)(LOCKSTEP_LINES + 1) * (U + 1) * sizeof *w->lane_stacks);
-            ok = w->lane_n && w->lane_far && w->lane_stacks;
-        }
+        w->lane_n = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_n);
+        w->lane_far = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_far);
+        w->lane_stacks = malloc((size_t)(LOCKSTEP_LINES + 1) * (U + 1) * sizeof *w->lane_stacks);
         w->carry = malloc((size_t)U * sizeof *w->carry);
         w->carry_next = malloc((size_t)U * sizeof *w->carry_next);
         /* a block has up to LOCKSTEP_LINES + 1 lines (with the primed one) */
@@ -471,7 +452,8 @@ static int ws_init(sweep_ws *w, int U, double cap, int need_visit)
         w->lane_f = malloc(6 * row * sizeof *w->lane_f);
         w->lane_i = malloc(3 * row * sizeof *w->lane_i);
         w->lane_d = malloc(row * sizeof *w->lane_d);
-        ok = ok && w->carry && w->carry_next && w->lane_f && w->lane_i && w->lane_d;
+        ok = w->lane_n && w->lane_far && w->lane_stacks && w->carry && w->carry_next && w->lane_f &&
+             w->lane_i && w->lane_d;
         if (ok) {
             w->hc = w->lane_f;
             w->hn = w->lane_f + row;
@@ -496,12 +478,12 @@ static void sweep_range(void *ctx, int worker, long begin, long end)
     (void)worker;
     const sweep_ctx *C = ctx;
     sweep_ws w;
-    if (!ws_init(&w, C->geom->U, C->cap, C->visit != NULL)) {
+    if (!ws_init(&w, C->geom->U, C->cap > 0, C->visit != NULL)) {
         ws_free(&w);
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
         return;
     }
-    if (w.carry) { /* lockstep blocks */
+    if (w.lane_stacks) {
         long b = C->b0 + begin, bend = C->b0 + end;
         for (int prime = begin > 0; b < bend; prime = 0) {
             int nl = bend - b < LOCKSTEP_LINES ? (int)(bend - b) : LOCKSTEP_LINES;

@@ -229,7 +229,7 @@ AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, in
     }
 }
 
-int ts_lane_has_avx512f(void)
+int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ)
 {
     static int known = -1; /* the CPU's answer, once asked */
     int have = __atomic_load_n(&known, __ATOMIC_RELAXED);
@@ -238,13 +238,8 @@ int ts_lane_has_avx512f(void)
         have = __builtin_cpu_supports("avx512f") != 0;
         __atomic_store_n(&known, have, __ATOMIC_RELAXED);
     }
-    return have;
-}
-
-int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ)
-{
     /* 32-bit offsets: the last line's points, as ints */
-    if (!ts_lane_has_avx512f() || (long long)(s->j1 + 1) * h->stride * 6 > INT_MAX)
+    if (!have || (long long)(s->j1 + 1) * h->stride * 6 > INT_MAX)
         return 0;
     for (int j = s->j0; j <= s->j1; j += 8 * NG) {
         __mmask8 lanes[NG];
@@ -258,11 +253,6 @@ int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_la
 }
 
 #else
-
-int ts_lane_has_avx512f(void)
-{
-    return 0;
-}
 
 int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ)
 {

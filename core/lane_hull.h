@@ -37,9 +37,6 @@ typedef struct {
     double c, near_skip;
 } ts_lane_step;
 
-/* Whether the CPU (and the build) runs the AVX-512 lane code: 1 or 0. */
-int ts_lane_has_avx512f(void);
-
 /* The step, vectorised: returns 0, having done nothing, where the CPU (or
  * the build) has no AVX-512 or the hulls are too large for 32-bit
  * offsets; the caller then runs the scalar code. */
