@@ -75,6 +75,7 @@ class TSDataset final : public GDALPamDataset
     const WindowChunk *Chunk(int cx, int cy);
     CPLErr WindowBlock(int iPlane, int x0, int y0, int nBW, int nBH, bool bByte, void *pImage);
     bool Setup(const char *pszConnection, int W, int H);
+    static GDALDataset *OpenDEM(const char *pszDEM);
     TSDataset *Overview(int i);
     TSDataset *MakeOverview(int nLevel);
     void EnsureBackendMetadata();
