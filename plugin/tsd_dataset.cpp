@@ -133,6 +133,9 @@ void TSRasterBand::CopyRow(int n, const float *row, int x0, int W, bool flip_x, 
 
 TSDataset::~TSDataset()
 {
+    if (m_oReadAhead.joinable()) // before the DEM closes
+        m_oReadAhead.join();
+    ts_grid_free(&m_sReadGrid);
     TSDataset::FlushCache(true);
     FreeWindow(m_poWindow);
     if (m_poDEM)
@@ -167,6 +170,57 @@ GDALDataset *TSDataset::OpenDEM(const char *pszDEM)
     return GDALDataset::Open(pszDEM, GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR);
 }
 
+/* Start reading the DEM on a thread of its own, for ReadDEM, while this
+ * one probes the OpenCL device for the metadata (tens of ms with PoCL):
+ * the whole-DEM path only, which reads it once, and only before computing.
+ * Under m_oMutex. */
+void TSDataset::StartReadAhead()
+{
+    if (m_poWindow || !m_poDEM || m_bTried || m_oReadAhead.joinable())
+        return;
+    try
+    {
+        m_oReadAhead = std::thread(
+            [this]
+            {
+                char szMsg[1024] = "";
+                m_eReadStatus = tsd_dem_load_resampled(
+                    GDALGetRasterBand(m_poDEM, m_sOpts.band), &m_sCells, m_sOpts.z_factor,
+                    nRasterXSize, nRasterYSize, &m_sReadGrid, szMsg, sizeof szMsg);
+                m_osReadMsg = szMsg;
+            });
+    }
+    catch (const std::exception &)
+    {
+        // no thread: EnsureComputed reads the DEM itself
+    }
+}
+
+/* The DEM at the dataset's size into *psGrid: what StartReadAhead read, or
+ * read now (an overview level opens the DEM again). */
+ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
+{
+    if (m_oReadAhead.joinable())
+    {
+        m_oReadAhead.join();
+        *psGrid = m_sReadGrid;
+        m_sReadGrid = ts_grid{};
+        snprintf(pszMsg, nMsg, "%s", m_osReadMsg.c_str());
+        return m_eReadStatus;
+    }
+    if (!m_poDEM) // an overview level: the DEM again, read at its size
+        m_poDEM = OpenDEM(m_osDEM.c_str());
+    if (!m_poDEM)
+    {
+        snprintf(pszMsg, nMsg, "cannot open the DEM '%s' again for overview level %d",
+                 m_osDEM.c_str(), m_nLevel);
+        return TS_ERR_INTERNAL;
+    }
+    return tsd_dem_load_resampled(GDALGetRasterBand(m_poDEM, m_sOpts.band), &m_sCells,
+                                  m_sOpts.z_factor, nRasterXSize, nRasterYSize, psGrid,
+                                  pszMsg, nMsg);
+}
+
 /* Compute the product once; later calls return the same outcome. */
 CPLErr TSDataset::EnsureComputed()
 {
@@ -194,18 +248,8 @@ CPLErr TSDataset::EnsureComputed()
         sRun.progress = tsd_progress_report;
         sRun.progress_user = &sProgress;
         ts_grid sGrid;
-        if (!m_poDEM) // an overview level: the DEM again, read at its size
-            m_poDEM = OpenDEM(m_osDEM.c_str());
-        if (!m_poDEM)
-        {
-            eStatus = TS_ERR_INTERNAL;
-            snprintf(szMsg, sizeof szMsg, "cannot open the DEM '%s' again for overview "
-                     "level %d", m_osDEM.c_str(), m_nLevel);
-        }
-        else
-            eStatus = tsd_dem_load_resampled(
-                GDALGetRasterBand(m_poDEM, m_sOpts.band), &m_sCells, m_sOpts.z_factor, W, H,
-                &sGrid, szMsg, sizeof szMsg);
+        const bool bAhead = m_oReadAhead.joinable();
+        eStatus = ReadDEM(&sGrid, szMsg, sizeof szMsg);
         if (eStatus != TS_OK)
         {
             m_osError = szMsg;
@@ -214,7 +258,8 @@ CPLErr TSDataset::EnsureComputed()
         {
             const std::chrono::duration<double> dfRead =
                 std::chrono::steady_clock::now() - tStart;
-            CPLDebug(DRIVER, "read the DEM in %.3f s", dfRead.count());
+            CPLDebug(DRIVER, "read the DEM in %.3f s%s", dfRead.count(),
+                     bAhead ? " (waited for the read ahead)" : "");
             if (m_psProduct->byte == TSD_BYTE_ALWAYS)
                 m_pabyProduct = static_cast<GByte *>(VSI_MALLOC2_VERBOSE(nCells, nBands));
             else
