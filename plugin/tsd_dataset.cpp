@@ -133,6 +133,9 @@ void TSRasterBand::CopyRow(int n, const float *row, int x0, int W, bool flip_x, 
 
 TSDataset::~TSDataset()
 {
+    if (m_oReadAhead.joinable()) // before the DEM closes
+        m_oReadAhead.join();
+    ts_grid_free(&m_sReadGrid);
     TSDataset::FlushCache(true);
     FreeWindow(m_poWindow);
     if (m_poDEM)
@@ -155,6 +158,67 @@ CPLErr TSDataset::GetGeoTransform(double *padfGT)
 const OGRSpatialReference *TSDataset::GetSpatialRef() const
 {
     return m_oSRS.IsEmpty() ? nullptr : &m_oSRS;
+}
+
+/* The DEM opened for reading. An uncompressed GeoTIFF is read straight
+ * into the grid, not through the block cache (GTIFF_DIRECT_IO, which GDAL
+ * takes at open): one copy fewer and no cache the size of the DEM, the
+ * same values. The user's own setting wins. */
+GDALDataset *TSDataset::OpenDEM(const char *pszDEM)
+{
+    CPLConfigOptionSetter oDirect("GTIFF_DIRECT_IO", "YES", true);
+    return GDALDataset::Open(pszDEM, GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR);
+}
+
+/* Start reading the DEM on a thread of its own, for ReadDEM, while this
+ * one probes the OpenCL device for the metadata (tens of ms with PoCL):
+ * the whole-DEM path only, which reads it once, and only before computing.
+ * Under m_oMutex. */
+void TSDataset::StartReadAhead()
+{
+    if (m_poWindow || !m_poDEM || m_bTried || m_oReadAhead.joinable())
+        return;
+    try
+    {
+        m_oReadAhead = std::thread(
+            [this]
+            {
+                char szMsg[1024] = "";
+                m_eReadStatus = tsd_dem_load_resampled(
+                    GDALGetRasterBand(m_poDEM, m_sOpts.band), &m_sCells, m_sOpts.z_factor,
+                    nRasterXSize, nRasterYSize, &m_sReadGrid, szMsg, sizeof szMsg);
+                m_osReadMsg = szMsg;
+            });
+    }
+    catch (const std::exception &)
+    {
+        // no thread: EnsureComputed reads the DEM itself
+    }
+}
+
+/* The DEM at the dataset's size into *psGrid: what StartReadAhead read, or
+ * read now (an overview level opens the DEM again). */
+ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
+{
+    if (m_oReadAhead.joinable())
+    {
+        m_oReadAhead.join();
+        *psGrid = m_sReadGrid;
+        m_sReadGrid = ts_grid{};
+        snprintf(pszMsg, nMsg, "%s", m_osReadMsg.c_str());
+        return m_eReadStatus;
+    }
+    if (!m_poDEM) // an overview level: the DEM again, read at its size
+        m_poDEM = OpenDEM(m_osDEM.c_str());
+    if (!m_poDEM)
+    {
+        snprintf(pszMsg, nMsg, "cannot open the DEM '%s' again for overview level %d",
+                 m_osDEM.c_str(), m_nLevel);
+        return TS_ERR_INTERNAL;
+    }
+    return tsd_dem_load_resampled(GDALGetRasterBand(m_poDEM, m_sOpts.band), &m_sCells,
+                                  m_sOpts.z_factor, nRasterXSize, nRasterYSize, psGrid,
+                                  pszMsg, nMsg);
 }
 
 /* Compute the product once; later calls return the same outcome. */
@@ -184,18 +248,8 @@ CPLErr TSDataset::EnsureComputed()
         sRun.progress = tsd_progress_report;
         sRun.progress_user = &sProgress;
         ts_grid sGrid;
-        if (!m_poDEM) // an overview level: the DEM again, read at its size
-            m_poDEM = GDALDataset::Open(m_osDEM.c_str(), GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR);
-        if (!m_poDEM)
-        {
-            eStatus = TS_ERR_INTERNAL;
-            snprintf(szMsg, sizeof szMsg, "cannot open the DEM '%s' again for overview "
-                     "level %d", m_osDEM.c_str(), m_nLevel);
-        }
-        else
-            eStatus = tsd_dem_load_resampled(
-                GDALGetRasterBand(m_poDEM, m_sOpts.band), &m_sCells, m_sOpts.z_factor, W, H,
-                &sGrid, szMsg, sizeof szMsg);
+        const bool bAhead = m_oReadAhead.joinable();
+        eStatus = ReadDEM(&sGrid, szMsg, sizeof szMsg);
         if (eStatus != TS_OK)
         {
             m_osError = szMsg;
@@ -204,7 +258,8 @@ CPLErr TSDataset::EnsureComputed()
         {
             const std::chrono::duration<double> dfRead =
                 std::chrono::steady_clock::now() - tStart;
-            CPLDebug(DRIVER, "read the DEM in %.3f s", dfRead.count());
+            CPLDebug(DRIVER, "read the DEM in %.3f s%s", dfRead.count(),
+                     bAhead ? " (waited for the read ahead)" : "");
             if (m_psProduct->byte == TSD_BYTE_ALWAYS)
                 m_pabyProduct = static_cast<GByte *>(VSI_MALLOC2_VERBOSE(nCells, nBands));
             else
@@ -322,9 +377,7 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
         return FailOpen(TS_ERR_ARG, szMsg);
     poDS->m_psProduct = tsd_product_of(&sOpts);
 
-    GDALDataset *poDEM = GDALDataset::Open(
-        osDEM.c_str(), GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR, nullptr, nullptr,
-        nullptr);
+    GDALDataset *poDEM = OpenDEM(osDEM.c_str());
     if (!poDEM)
         return FailOpen(CPLE_OpenFailed,
                              CPLSPrintf("cannot open the DEM '%s' as a raster",

@@ -9,6 +9,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "gdal_pam.h"
@@ -67,6 +68,10 @@ class TSDataset final : public GDALPamDataset
     tsd_backend_summary m_sBackend{}; // predicted, then what ran
     tsd_environment m_sEnv{};         // ENV_MAP or SKY (tsd_dataset_env.cpp)
     WindowState *m_poWindow = nullptr; // computed chunk by chunk (tsd_window_cache.cpp), or null
+    std::thread m_oReadAhead{};  // the DEM read while OpenCL is probed (StartReadAhead)
+    ts_grid m_sReadGrid{};       // what it read, for ReadDEM
+    ts_status m_eReadStatus = TS_OK;
+    std::string m_osReadMsg{};
 
     CPLErr EnsureComputed();
     bool SetupWindow(int W, int H);
@@ -75,6 +80,9 @@ class TSDataset final : public GDALPamDataset
     const WindowChunk *Chunk(int cx, int cy);
     CPLErr WindowBlock(int iPlane, int x0, int y0, int nBW, int nBH, bool bByte, void *pImage);
     bool Setup(const char *pszConnection, int W, int H);
+    static GDALDataset *OpenDEM(const char *pszDEM);
+    void StartReadAhead();
+    ts_status ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg);
     TSDataset *Overview(int i);
     TSDataset *MakeOverview(int nLevel);
     void EnsureBackendMetadata();

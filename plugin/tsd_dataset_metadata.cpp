@@ -27,6 +27,7 @@ void TSDataset::EnsureBackendMetadata()
     if (!m_bUsesBackend || m_bBackendKnown || m_bTried)
         return;
     char szMsg[256];
+    StartReadAhead(); // the DEM is read meanwhile
     if (tsd_backend_predict(&m_sOpts, &m_sBackend, szMsg, sizeof szMsg) != 0)
         return; // TERRASHADE_BACKEND changed since open: computing will say
     m_bBackendKnown = true;
