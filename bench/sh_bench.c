@@ -113,7 +113,7 @@ static void bench_env(const ts_grid *g, int dirs, const float *nx, const float *
     check(ts_sh_visibility_finish(&v, &e), "visibility", &e);
     for (int c = 0; c < 3; c++) {
         ts_sh_product_matrix(light[c], m);
-        check(ts_sh_shade(g, m, nx, ny, nz, v.vis, 1 / M_PI, rgb + c * n, &e), "shade", &e);
+        check(ts_sh_shade(g, m, nx, ny, nz, v.vis, 1 / M_PI, 0, rgb + c * n, &e), "shade", &e);
     }
     add_since(t, &sh);
     printf("envlight, %d directions: sweeps %.2f s (CPU %.2f); lighting on top: table %.2f s "

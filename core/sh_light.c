@@ -99,7 +99,7 @@ static ts_status check_planes(const ts_grid *grid, const float *vis, const float
 
 ts_status ts_sh_shade(const ts_grid *grid, const double m[TS_SH_COEFFS][TS_SH_COEFFS],
                       const float *nx, const float *ny, const float *nz, const float *vis,
-                      double scale, float *out, ts_error *err)
+                      double scale, int threads, float *out, ts_error *err)
 {
     ts_status st = check_planes(grid, vis, out, err);
     if (st != TS_OK)
@@ -108,7 +108,8 @@ ts_status ts_sh_shade(const ts_grid *grid, const double m[TS_SH_COEFFS][TS_SH_CO
         return ts_fail(err, TS_ERR_ARG, "the light and the normals must not be NULL");
     shade_ctx C = {grid, {{0}}, nx, ny, nz, vis, NULL, scale, out};
     ts_sh_fold_cosine(m, C.mh);
-    return ts_parallel_for(ts_thread_count(0, grid->height), grid->height, shade_rows, &C, err);
+    return ts_parallel_for(ts_thread_count(threads, grid->height), grid->height, shade_rows, &C,
+                           err);
 }
 
 static void share_rows(void *ctx, int worker, long y0, long y1)
@@ -126,7 +127,8 @@ static void share_rows(void *ctx, int worker, long y0, long y1)
 }
 
 ts_status ts_sh_visible_share(const ts_grid *grid, const double l[TS_SH_COEFFS],
-                              const float *vis, double scale, float *out, ts_error *err)
+                              const float *vis, double scale, int threads, float *out,
+                              ts_error *err)
 {
     ts_status st = check_planes(grid, vis, out, err);
     if (st != TS_OK)
@@ -134,7 +136,8 @@ ts_status ts_sh_visible_share(const ts_grid *grid, const double l[TS_SH_COEFFS],
     if (!l)
         return ts_fail(err, TS_ERR_ARG, "the light must not be NULL");
     shade_ctx C = {grid, {{0}}, NULL, NULL, NULL, vis, l, scale, out};
-    return ts_parallel_for(ts_thread_count(0, grid->height), grid->height, share_rows, &C, err);
+    return ts_parallel_for(ts_thread_count(threads, grid->height), grid->height, share_rows, &C,
+                           err);
 }
 
 void ts_sh_key_reference(const ts_sh_wedges *w, const double l[TS_SH_COEFFS],

@@ -370,7 +370,8 @@ static ts_status fold_tables(swath_ctx *C, const double *az_start, ts_error *err
             for (int k = 0; k < N; k++)
                 J.mh[j][k] = C->mh[j][k];
         }
-        st = ts_parallel_for(ts_thread_count(0, (long)slots * S), (long)slots * S, fold_rows,
+        st = ts_parallel_for(ts_thread_count(C->w->threads, (long)slots * S), (long)slots * S,
+                             fold_rows,
                              &J, err);
     }
     if (!ok || st != TS_OK)
@@ -427,7 +428,7 @@ ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
                                             TS_SH_WEDGE_STEPS)
         st = fold_tables(&C, az_start, err);
     if (st == TS_OK)
-        st = ts_parallel_for(ts_thread_count(0, grid->height), grid->height, swath_rows, &C,
+        st = ts_parallel_for(ts_thread_count(w->threads, grid->height), grid->height, swath_rows, &C,
                              err);
     fold_free(&C, slot_count(s));
     free(rot);

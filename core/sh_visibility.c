@@ -194,6 +194,7 @@ ts_status ts_sh_wedges_build(const ts_sh_swath *s, int threads, ts_sh_wedges *w,
         return ts_fail(err, TS_ERR_ARG, "the swath must have at least one azimuth and an "
                        "extent of at most 360 degrees");
     w->swath = *s;
+    w->threads = threads;
     w->interior = malloc(sizeof(float) * N_STEPS * N_STEPS * TS_SH_COEFFS);
     if (!s->complete) {
         w->rise = malloc(sizeof(float) * N_STEPS * TS_SH_COEFFS);
@@ -258,7 +259,8 @@ static ts_status add_wedge(const ts_sh_visibility *v, const float *table, double
 {
     wedge_ctx C = {v, a, b, table, {{0}, {0}, {0}}};
     ts_sh_rotation_set(&C.rot, az_start);
-    return ts_parallel_for(ts_thread_count(0, v->grid->height), v->grid->height, wedge_rows,
+    return ts_parallel_for(ts_thread_count(v->w->threads, v->grid->height), v->grid->height,
+                           wedge_rows,
                            &C, err);
 }
 

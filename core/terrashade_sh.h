@@ -149,9 +149,12 @@ typedef struct {
     ts_sh_swath swath;
     float *interior;
     float *rise, *fall; /**< NULL for a complete swath */
+    int threads;        /**< what ts_sh_wedges_build was given: the passes
+                             that take these tables use as many */
 } ts_sh_wedges;
 
-/** Build the tables of swath s (threads: 0 = all cores). Free with
+/** Build the tables of swath s (threads: 0 = all cores; the visibility and
+ *  swath-light passes over these tables use the same count). Free with
  *  ts_sh_wedges_free. */
 ts_status ts_sh_wedges_build(const ts_sh_swath *s, int threads, ts_sh_wedges *w,
                              ts_error *err);
@@ -198,16 +201,18 @@ void ts_sh_visibility_free(ts_sh_visibility *v);
  * The SH triple product per cell: out[c] = scale * sum_jk vis_j m[j][k]
  * h_k(N), h the clamped cosine around the cell's normal (ts_normals), m the
  * light's product matrix; negative results (ringing) become 0; NaN normal or
- * visibility give NaN.
+ * visibility give NaN. threads: 0 = all cores.
  */
 ts_status ts_sh_shade(const ts_grid *grid, const double m[TS_SH_COEFFS][TS_SH_COEFFS],
                       const float *nx, const float *ny, const float *nz, const float *vis,
-                      double scale, float *out, ts_error *err);
+                      double scale, int threads, float *out, ts_error *err);
 
 /** out[c] = clamp(scale * sum_i l_i vis_i, 0, 1): the visible share of a
- *  light (ts_sh_shadow's double product); NaN stays NaN. */
+ *  light (ts_sh_shadow's double product); NaN stays NaN. threads: 0 = all
+ *  cores (as ts_sh_shade). */
 ts_status ts_sh_visible_share(const ts_grid *grid, const double l[TS_SH_COEFFS],
-                              const float *vis, double scale, float *out, ts_error *err);
+                              const float *vis, double scale, int threads, float *out,
+                              ts_error *err);
 
 /**
  * A swath's light in one pass over the cells from all its horizon planes at

@@ -159,8 +159,8 @@ ts_status tsd_sh_env_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
         st = core_fail(c, &err);
     for (int k = 0; st == TS_OK && k < 3; k++) {
         ts_sh_product_matrix(light[k], m);
-        if ((st = ts_sh_shade(g, m, nm->nx, nm->ny, nm->nz, v.vis, 1 / M_PI, out[k], &err)) !=
-            TS_OK)
+        if ((st = ts_sh_shade(g, m, nm->nx, nm->ny, nm->nz, v.vis, 1 / M_PI, o->threads, out[k],
+                              &err)) != TS_OK)
             st = core_fail(c, &err);
     }
     note_c_part(c, "ENV_METHOD=sh");

@@ -288,7 +288,7 @@ START_TEST(visibility_planes)
             planes[k] = plane;
         ck_assert_msg(ts_sh_swath_light(&g, &w, planes, l, NULL, NULL, NULL, 0, NULL, 0.5,
                                         share, &err) == TS_OK, "%s", err.message);
-        ck_assert(ts_sh_visible_share(&g, l, v.vis, 0.5, stored, &err) == TS_OK);
+        ck_assert(ts_sh_visible_share(&g, l, v.vis, 0.5, 0, stored, &err) == TS_OK);
         for (size_t c = 0; c < cells; c++)
             ck_assert(c == 7 ? isnan(share[c]) && isnan(stored[c])
                              : fabsf(share[c] - stored[c]) < 1e-6f);
@@ -347,8 +347,8 @@ START_TEST(swath_light_folded)
         float *ref_shade = tdem_floats(cells), *ref_share = tdem_floats(cells);
         ck_assert_msg(ts_sh_swath_light(&g, &w, (const float *const *)planes, l, nx, ny, nz, 2,
                                         shade, 3, share, &err) == TS_OK, "%s", err.message);
-        ck_assert(ts_sh_shade(&g, m, nx, ny, nz, v.vis, 2, ref_shade, &err) == TS_OK);
-        ck_assert(ts_sh_visible_share(&g, l, v.vis, 3, ref_share, &err) == TS_OK);
+        ck_assert(ts_sh_shade(&g, m, nx, ny, nz, v.vis, 2, 1, ref_shade, &err) == TS_OK);
+        ck_assert(ts_sh_visible_share(&g, l, v.vis, 3, 2, ref_share, &err) == TS_OK);
         double worst = 0;
         for (size_t c = 0; c < cells; c++) {
             ck_assert(isnan(shade[c]) == isnan(ref_shade[c]));
@@ -418,7 +418,7 @@ START_TEST(bad_input)
     tdem_create(&g, 4, 4, 1, 1);
     ts_sh_visibility v;
     EXPECT_ARG(ts_sh_visibility_init(&v, &g, NULL, &err), &err);
-    EXPECT_ARG(ts_sh_visible_share(&g, NULL, NULL, 1, NULL, &err), &err);
+    EXPECT_ARG(ts_sh_visible_share(&g, NULL, NULL, 1, 0, NULL, &err), &err);
     ts_grid_free(&g);
 }
 END_TEST
