@@ -70,17 +70,24 @@ static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int
         int i1 = i + 1 < W ? i + 1 : i, k1 = k + 1 < H ? k + 1 : k;
         float z00 = z[dem_index(narrow, stride, k, i)], z01 = z[dem_index(narrow, stride, k, i1)];
         float z10 = z[dem_index(narrow, stride, k1, i)], z11 = z[dem_index(narrow, stride, k1, i1)];
-        /* a corner of weight 0 does not count: no NaN from it */
-        float top = fx > 0 ? z00 + fx * (z01 - z00) : z00;
-        float bot = fx > 0 ? z10 + fx * (z11 - z10) : z10;
-        float h = fy > 0 ? top + fy * (bot - top) : top;
+        /* a corner of weight 0 does not count: no NaN from it (computed,
+         * then selected: a conditional float operation is control flow
+         * that keeps the loop scalar) */
+        float top_i = z00 + fx * (z01 - z00), bot_i = z10 + fx * (z11 - z10);
+        float top = fx > 0 ? top_i : z00;
+        float bot = fx > 0 ? bot_i : z10;
+        float h_i = top + fy * (bot - top);
+        float h = fy > 0 ? h_i : top;
         int row = (int)(y + t * vy / 2 + 0.5);
         row = row < 0 ? 0 : row;
         row = row > H - 1 ? H - 1 : row;
         double d = t * step[row];
         float tan_w = (float)((h - zrow[x]) / d - c * d);
-        A[x] = t > 1e-9 ? tan_w : NAN;
+        A[x] = tan_w;
     }
+    /* apart: a select in the loop above becomes a branch around tan_w */
+    for (int x = a; x <= b; x++)
+        A[x] = tpp[x] > 1e-9 ? A[x] : NAN;
 }
 
 /* The last sample A[x] of each cell of [a, b], its sample number jd[x]
