@@ -23,7 +23,6 @@
 #include <stdlib.h>
 
 #include "arg_checks.h"
-#include "cellmath/cm_fastmath.h"
 #include "parallel.h"
 #include "pyramid_hz.h"
 #include "status_internal.h"
@@ -54,125 +53,11 @@ static double step_at(const hz_ctx *C, double row)
     return C->step[r < 0 ? 0 : r > H - 1 ? H - 1 : r];
 }
 
-/* dst[x] = sum of weights w[t] * rows r[t] at x, for x in [x0, x1]. */
-TS_PYR_CLONES
-static void combine_rows(const float *const r[4], const float w[4], int taps, int x0, int x1,
-                         float *restrict dst)
-{
-    const float *r0 = r[0];
-    const float w0 = w[0];
-    if (taps == 1) {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++)
-            dst[x] = r0[x];
-        return;
-    }
-    const float *r1 = r[1];
-    const float w1 = w[1];
-    if (taps == 2) {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++)
-            dst[x] = w0 * r0[x] + w1 * r1[x];
-        return;
-    }
-    const float *r2 = r[2], *r3 = r[3];
-    const float w2 = w[2], w3 = w[3];
-#pragma GCC ivdep
-    for (int x = x0; x <= x1; x++)
-        dst[x] = w0 * r0[x] + w1 * r1[x] + w2 * r2[x] + w3 * r3[x];
-}
-
 /* The taps of row position `row` (DEM coordinates) on level lev. */
 static int level_taps(const ts_pyramid *P, int lev, double row, int idx[4], double w[4])
 {
     const ts_pyr_level *L = &P->level[lev];
     return ts_pyr_taps((row + 0.5) / L->spacing - 0.5, L->rows, lev == 0, idx, w);
-}
-
-/* spline_push on the state of cell x. */
-static inline void spline_step(float *restrict s0, float *restrict s1, float *restrict s2,
-                               float *restrict m, int x, float a)
-{
-    float p0 = s0[x], p1 = s1[x], p2 = s2[x], mm = m[x];
-    spline_push(&p0, &p1, &p2, &mm, a);
-    m[x] = mm;
-    s0[x] = p0;
-    s1[x] = p1;
-    s2[x] = p2;
-}
-
-/* Add sample number c (value a_in[x] for the cells of [x0, x1]) to the
- * spline (or the maximum), as the file's comment says. */
-TS_PYR_CLONES
-static void push_run(row_ws *w, int bspline, int c, int x0, int x1, const float *restrict a_in)
-{
-    float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
-    float *restrict m = w->m;
-    if (!bspline) {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++)
-            m[x] = a_in[x] > m[x] ? a_in[x] : m[x];
-        return;
-    }
-    if (c == 0) {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++)
-            s2[x] = a_in[x];
-        return;
-    }
-    if (c == 1) {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++) {
-            float a = a_in[x] == a_in[x] ? a_in[x] : s2[x];
-            s0[x] = 2.0f * s2[x] - a; /* w_{-1}: knot 0 is w_0 */
-            s1[x] = s2[x];
-            s2[x] = a;
-            m[x] = s1[x] > m[x] ? s1[x] : m[x];
-        }
-        return;
-    }
-#pragma GCC ivdep
-    for (int x = x0; x <= x1; x++)
-        spline_step(s0, s1, s2, m, x, a_in[x]);
-}
-
-/* One level's samples for the cells of [x0, x1]: the level row T at x + ix
- * and x + ix + 1 (weight fx) against the cells' own heights on the level
- * R, at d metres (1 / d = inv_d, curvature drop over d
- * = cd). Pushed as sample c in the same pass where the spline allows,
- * else left in w->A for push_run (returns 0 then). */
-TS_PYR_CLONES
-static int level_run(row_ws *w, const float *restrict T, int ix, float fx,
-                     const float *restrict R, float inv_d, float cd, int bspline, int c, int x0,
-                     int x1)
-{
-    float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
-    float *restrict m = w->m, *restrict A = w->A;
-    const float gx = 1.0f - fx;
-    const float *restrict Ta = T + ix; /* T[x + ix] defeats the vectoriser */
-    if (bspline && c >= 2) {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++) {
-            float h = gx * Ta[x] + fx * Ta[x + 1];
-                spline_step(s0, s1, s2, m, x, ts_atan_deg((h - R[x]) * inv_d - cd));
-        }
-        return 1;
-    }
-    if (!bspline) { /* the maximum of the tangents; one arctangent at the end */
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++) {
-            float h = gx * Ta[x] + fx * Ta[x + 1];
-                float t = (h - R[x]) * inv_d - cd;
-            m[x] = t > m[x] ? t : m[x];
-        }
-        return 1;
-    }
-#pragma GCC ivdep
-    for (int x = x0; x <= x1; x++) {
-        float h = gx * Ta[x] + fx * Ta[x + 1];
-        A[x] = ts_atan_deg((h - R[x]) * inv_d - cd);
-    }
-    return 0;
 }
 
 /* The row-level entry of row y for samples at `dist` steps on level lev. */
@@ -208,10 +93,10 @@ static void sample_level(const hz_ctx *C, row_ws *w, const row_level *e, const f
     t1 = t1 > W - 1 ? W - 1 : t1;
     if (t0 < 0 || t1 < t0)
         return; /* not reached: the runs keep the samples on the grid */
-    combine_rows(e->t, e->wt, e->taps, t0, t1, w->T);
+    ts_pyr_combine_rows(e->t, e->wt, e->taps, t0, t1, w->T);
     w->T[t1 + 1] = w->T[t1]; /* a weight of fx = 0 there: no NaN from beyond */
-    if (!level_run(w, w->T, ix, fx, R, e->inv_d, e->cd, C->bspline, c, x0, x1))
-        push_run(w, C->bspline, c, x0, x1, w->A);
+    if (!ts_pyr_level_run(w, w->T, ix, fx, R, e->inv_d, e->cd, C->bspline, c, x0, x1))
+        ts_pyr_push_run(w, C->bspline, c, x0, x1, w->A);
 }
 
 /* The samples of the cells [x0, x1] of row y at `dist` steps on the DEM
@@ -236,35 +121,6 @@ static double row_reach(const hz_ctx *C, int y)
     if (C->cap > 0 && C->cap / C->step[y] < t_row)
         t_row = C->cap / C->step[y];
     return t_row;
-}
-
-/* The horizons of cells [x0, x1] after `count` >= 1 samples, into out. */
-TS_PYR_CLONES
-static void finish_run(row_ws *w, int bspline, int count, int x0, int x1, float *restrict out)
-{
-    float *restrict s1 = w->s1, *restrict s2 = w->s2, *restrict m = w->m;
-    if (!bspline) {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++)
-            out[x] = m[x] > -INFINITY ? ts_atan_deg(m[x]) : -90.0f;
-        return;
-    }
-    if (count >= 2) { /* w_M = 2 w_{M-1} - w_{M-2}: knot M-1 is w_{M-1} */
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++)
-            w->A[x] = 2.0f * s2[x] - s1[x];
-        push_run(w, 1, count, x0, x1, w->A);
-    } else {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++)
-            m[x] = s2[x] > m[x] ? s2[x] : m[x];
-    }
-#pragma GCC ivdep
-    /* no spline value where nodata left fewer than three samples: the last */
-    for (int x = x0; x <= x1; x++) {
-        float r = m[x] > -INFINITY ? m[x] : s2[x];
-        out[x] = r == r && r > -INFINITY ? r : -90.0f;
-    }
 }
 
 /* Cells [a, b] drop out before sample j (B-spline: their sample number). */
@@ -326,12 +182,12 @@ static void row_sample(const hz_ctx *C, row_ws *w, int y, int j, const row_level
     float *out = C->out + (size_t)y * C->P->grid->width;
     if (r->t_row > 1e-9) {
         sample_run(C, w, y, R0, r->t_row, j, pa, pb);
-        finish_run(w, C->bspline, j + 1, pa, pb, out);
+        ts_pyr_finish_run(w, C->bspline, j + 1, pa, pb, out);
     } else if (j == 0) {
         for (int x = pa; x <= pb; x++)
             out[x] = -90.0f; /* nothing beyond these cells */
     } else {
-        finish_run(w, C->bspline, j, pa, pb, out);
+        ts_pyr_finish_run(w, C->bspline, j, pa, pb, out);
     }
     r->fa = pa, r->fb = pb;
     r->pa = 1, r->pb = 0;
@@ -372,7 +228,7 @@ static void batch_row(const batch_ctx *B, row_ws *w, int y, int c0, int c1,
     for (int a = 0; a < B->n; a++)
         row_start(&B->az[a], &w[a], y, c0, c1, &run[a]);
     /* 4 taps, weight 0 unused: as the one-azimuth sums */
-    combine_rows(rl[0][0].r, rl[0][0].wr, 4, c0, c1 - 1, R0);
+    ts_pyr_combine_rows(rl[0][0].r, rl[0][0].wr, 4, c0, c1 - 1, R0);
     for (int j = 0; j < levels; j++) {
         int lo = c1, hi = c0 - 1, xa, xb;
         for (int a = 0; a < B->n; a++)
@@ -382,7 +238,7 @@ static void batch_row(const batch_ctx *B, row_ws *w, int y, int c0, int c1,
             }
         const float *Rj = R0;
         if (lo <= hi && B->az[0].lv[j].lev > 0) {
-            combine_rows(rl[0][j].r, rl[0][j].wr, 4, lo, hi, R);
+            ts_pyr_combine_rows(rl[0][j].r, rl[0][j].wr, 4, lo, hi, R);
             Rj = R;
         }
         int active = 0;
