@@ -19,6 +19,7 @@
  * exceeds the largest sample. A sample that touches nodata is no
  * occluder: it repeats the sample before it.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 
@@ -83,19 +84,34 @@ static void row_level_fill(const hz_ctx *C, int y, int lev, double dist, row_lev
     e->cd = (float)(C->c * d);
 }
 
+/* The columns [*t0, *t1] of the level row that the samples at column
+ * offset ix + fx of the cells [x0, x1] read; 0 when none (not reached:
+ * the runs keep the samples on the grid). */
+static int sample_cols(int W, int ix, float fx, int x0, int x1, int *t0, int *t1)
+{
+    *t0 = x0 + ix;
+    *t1 = x1 + ix + (fx > 0.0f);
+    *t1 = *t1 > W - 1 ? W - 1 : *t1;
+    return *t0 >= 0 && *t1 >= *t0;
+}
+
 /* The samples of the cells [x0, x1] described by e, at column offset
- * ix + fx, against their own heights R on the level, pushed as sample c. */
+ * ix + fx, against their own heights R on the level, pushed as sample c
+ * (the level row at the samples' row: combined into w->T, or shared). */
 static void sample_level(const hz_ctx *C, row_ws *w, const row_level *e, const float *R, int ix,
                          float fx, int c, int x0, int x1)
 {
-    const int W = C->P->grid->width;
-    int t0 = x0 + ix, t1 = x1 + ix + (fx > 0.0f);
-    t1 = t1 > W - 1 ? W - 1 : t1;
-    if (t0 < 0 || t1 < t0)
-        return; /* not reached: the runs keep the samples on the grid */
-    ts_pyr_combine_rows(e->t, e->wt, e->taps, t0, t1, w->T);
-    w->T[t1 + 1] = w->T[t1]; /* a weight of fx = 0 there: no NaN from beyond */
-    if (!ts_pyr_level_run(w, w->T, ix, fx, R, e->inv_d, e->cd, C->bspline, c, x0, x1))
+    int t0, t1;
+    if (!sample_cols(C->P->grid->width, ix, fx, x0, x1, &t0, &t1))
+        return;
+    const float *T = w->Tsh;
+    if (t0 < w->t_lo || t1 > w->t_hi) {
+        ts_pyr_combine_rows(e->t, e->wt, e->taps, t0, t1, w->T);
+        w->T[t1 + 1] = w->T[t1]; /* a weight of fx = 0 there: no NaN from beyond */
+        T = w->T;
+    }
+    w->t_lo = 1, w->t_hi = 0;
+    if (!ts_pyr_level_run(w, T, ix, fx, R, e->inv_d, e->cd, C->bspline, c, x0, x1))
         ts_pyr_push_run(w, C->bspline, c, x0, x1, w->A);
 }
 
@@ -215,13 +231,57 @@ typedef struct {
     const hz_ctx *az; /* n */
 } batch_ctx;
 
+/* Whether two entries read the same level rows with the same weights. */
+static int same_rows(const row_level *a, const row_level *b)
+{
+    if (a->taps != b->taps)
+        return 0;
+    for (int t = 0; t < a->taps; t++)
+        if (a->t[t] != b->t[t] || a->wt[t] != b->wt[t])
+            return 0;
+    return 1;
+}
+
+/* Sample j's level row, combined once into Tsh for the azimuths that read
+ * the same rows with the same weights (the y-major azimuths of a batch all
+ * do: their vy is the same +-1) where the union of the columns they read
+ * is no wider than their sum. Only samples with a fraction fx > 0 share:
+ * they read no column past their own, so sample_level has no end to pad. */
+static void share_level_row(const batch_ctx *B, row_ws *w, const row_level *const *rl,
+                            const row_run *run, int j, float *Tsh)
+{
+    int t0[TS_PYRAMID_BATCH], t1[TS_PYRAMID_BATCH], in[TS_PYRAMID_BATCH];
+    int lo = INT_MAX, hi = INT_MIN, sum = 0, members = 0, xa, xb;
+    const row_level *e0 = NULL;
+    for (int a = 0; a < B->n; a++) {
+        const level_az *L = &B->az[a].lv[j];
+        in[a] = run[a].pa <= run[a].pb && row_keeps(&B->az[a], &run[a], j, &xa, &xb) &&
+                xa <= xb && L->fx > 0.0f &&
+                sample_cols(B->az[a].P->grid->width, L->ix, L->fx, xa, xb, &t0[a], &t1[a]) &&
+                (!e0 || same_rows(e0, &rl[a][j]));
+        if (!in[a])
+            continue;
+        e0 = e0 ? e0 : &rl[a][j];
+        lo = t0[a] < lo ? t0[a] : lo;
+        hi = t1[a] > hi ? t1[a] : hi;
+        sum += t1[a] - t0[a] + 1;
+        members++;
+    }
+    if (members < 2 || hi - lo + 1 > sum)
+        return;
+    ts_pyr_combine_rows(e0->t, e0->wt, e0->taps, lo, hi, Tsh);
+    for (int a = 0; a < B->n; a++)
+        if (in[a])
+            w[a].Tsh = Tsh, w[a].t_lo = lo, w[a].t_hi = hi;
+}
+
 /* The cells [c0, c1) of row y for every azimuth of B, level by level: the
  * cells' own heights on a level (the same rows and weights for every
  * azimuth, from azimuth 0's entries rl[n][j]) are computed once, over
  * the runs that read them, into R (on the DEM: R0, kept for the rays
  * that end early). */
 static void batch_row(const batch_ctx *B, row_ws *w, int y, int c0, int c1,
-                      const row_level *const *rl, float *R0, float *R)
+                      const row_level *const *rl, float *R0, float *R, float *Tsh)
 {
     const int levels = B->az[0].P->levels;
     row_run run[TS_PYRAMID_BATCH];
@@ -241,6 +301,7 @@ static void batch_row(const batch_ctx *B, row_ws *w, int y, int c0, int c1,
             ts_pyr_combine_rows(rl[0][j].r, rl[0][j].wr, 4, lo, hi, R);
             Rj = R;
         }
+        share_level_row(B, w, rl, run, j, Tsh);
         int active = 0;
         for (int a = 0; a < B->n; a++) {
             row_sample(&B->az[a], &w[a], y, j, &rl[a][j], Rj, R0, &run[a]);
@@ -260,7 +321,7 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
     const int n = B->n, W = B->az[0].P->grid->width, levels = B->az[0].P->levels;
     /* per azimuth s0, s1, s2, m: W each; T and the samples: W + 1 each */
     float *buf = malloc((size_t)n * (6 * W + 2) * sizeof *buf);
-    float *own = malloc((size_t)2 * W * sizeof *own);
+    float *own = malloc((size_t)3 * W * sizeof *own + sizeof *own);
     double *tpp = malloc((size_t)3 * W * sizeof *tpp);
     int *jd = malloc((size_t)n * W * sizeof *jd);
     row_level *rl = malloc((size_t)n * ROW_BLOCK * levels * sizeof *rl);
@@ -277,7 +338,7 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
     for (int a = 0; a < n; a++) {
         float *f = buf + (size_t)a * (6 * W + 2);
         w[a] = (row_ws){f, f + W, f + 2 * W, f + 3 * W, f + 4 * W, f + 5 * W + 1, tpp,
-                        jd + (size_t)a * W};
+                        jd + (size_t)a * W, NULL, 1, 0};
     }
     for (long yb = y0; yb < y1; yb += ROW_BLOCK) {
         long ye = yb + ROW_BLOCK < y1 ? yb + ROW_BLOCK : y1;
@@ -294,7 +355,7 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
                 const row_level *rly[TS_PYRAMID_BATCH];
                 for (int a = 0; a < n; a++)
                     rly[a] = &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels];
-                batch_row(B, w, (int)y, c0, c1, rly, own, own + W);
+                batch_row(B, w, (int)y, c0, c1, rly, own, own + W, own + 2 * W);
             }
         }
     }

@@ -43,6 +43,10 @@ typedef struct {
     float *A;            /* the samples being pushed */
     double *tpp;         /* drop_cells: t, px, py of the cells (3 rows) */
     int *jd;             /* the sample number at which each cell drops out */
+    /* the next sample's level row, columns [t_lo, t_hi] already combined in
+     * Tsh with the other azimuths that read the same rows (t_lo > t_hi: no) */
+    const float *Tsh;
+    int t_lo, t_hi;
 } row_ws;
 
 /* Sample a (c >= 2) after p0, p1, p2: the spline's midpoint before the
