@@ -61,8 +61,9 @@ static int level_taps(const ts_pyramid *P, int lev, double row, int idx[4], doub
     return ts_pyr_taps((row + 0.5) / L->spacing - 0.5, L->rows, lev == 0, idx, w);
 }
 
-/* The row-level entry of row y for samples at `dist` steps on level lev. */
-static void row_level_fill(const hz_ctx *C, int y, int lev, double dist, row_level *e)
+/* The row-level entry of row y for samples at `dist` steps on level lev;
+ * the cells' own rows only with `own` (batch_row reads azimuth 0's). */
+static void row_level_fill(const hz_ctx *C, int y, int lev, double dist, int own, row_level *e)
 {
     const ts_pyramid *P = C->P;
     double oy = dist * C->vy;
@@ -74,8 +75,8 @@ static void row_level_fill(const hz_ctx *C, int y, int lev, double dist, row_lev
         e->wt[t] = (float)wd[t < e->taps ? t : 0];
     }
     /* the cells' own heights on the level: the DEM row itself on level 0 */
-    int taps = level_taps(P, lev, y, idx, wd);
-    for (int t = 0; t < 4; t++) {
+    int taps = own ? level_taps(P, lev, y, idx, wd) : 0;
+    for (int t = 0; t < 4 && own; t++) {
         e->r[t] = ts_pyr_row(P, lev, idx[t < taps ? t : 0]);
         e->wr[t] = t < taps ? (float)wd[t] : 0.0f;
     }
@@ -124,7 +125,7 @@ static void sample_run(const hz_ctx *C, row_ws *w, int y, const float *R, double
     double ox = dist * C->vx;
     double fl = floor(ox);
     row_level e;
-    row_level_fill(C, y, 0, dist, &e);
+    row_level_fill(C, y, 0, dist, 0, &e);
     sample_level(C, w, &e, R, (int)fl, (float)(ox - fl), c, x0, x1);
 }
 
@@ -219,9 +220,10 @@ static void row_finish(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const 
     ts_pyr_drop_cells(C, w, y, c0, r->fa - 1, r->t_row, out);
     ts_pyr_drop_cells(C, w, y, r->fb + 1, c1 - 1, r->t_row, out);
     const float *z = g->z + (ptrdiff_t)y * g->stride;
-    for (int x = c0; x < c1; x++)
-        if (z[x] != z[x])
-            out[x] = NAN;
+    for (int x = c0; x < c1; x++) {
+        float o = out[x]; /* a select, not a branch: the loop vectorises */
+        out[x] = z[x] == z[x] ? o : NAN;
+    }
 }
 
 /* Azimuths computed together: the cells' own heights on each level are
@@ -346,7 +348,7 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
             for (long y = yb; y < ye; y++)
                 for (int j = 0; j < levels; j++)
                     row_level_fill(&B->az[a], (int)y, B->az[a].lv[j].lev, B->az[a].lv[j].s,
-                                   &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels + j]);
+                                   a == 0, &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels + j]);
         /* a chunk of columns down the rows, then the next: the level rows
          * that the cells of a chunk read stay in the cache from row to row */
         for (int c0 = 0; c0 < W; c0 += CHUNK) {
