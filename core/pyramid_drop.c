@@ -51,9 +51,11 @@ static inline __attribute__((always_inline)) ptrdiff_t dem_index(int narrow, ptr
 }
 
 /* The last samples at the ends tpp of the rays of cells [a, b] (tangents,
- * NaN where a ray ends at its cell), read bilinearly on the DEM, into A. */
-static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int narrow, int y,
-                                                            int a, int b,
+ * NaN where a ray ends at its cell), read bilinearly on the DEM, into A;
+ * `on_col`: every end lies on a column (a side, vx = +-1), whose
+ * neighbour has weight 0 and is not read. */
+static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int narrow,
+                                                            int on_col, int y, int a, int b,
                                                             const double *restrict tpp,
                                                             float *restrict A)
 {
@@ -68,19 +70,27 @@ static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int
         int i = (int)px, k = (int)py;
         float fx = (float)(px - i), fy = (float)(py - k);
         int i1 = i + 1 < W ? i + 1 : i, k1 = k + 1 < H ? k + 1 : k;
+        i1 = on_col ? i : i1;
         float z00 = z[dem_index(narrow, stride, k, i)], z01 = z[dem_index(narrow, stride, k, i1)];
         float z10 = z[dem_index(narrow, stride, k1, i)], z11 = z[dem_index(narrow, stride, k1, i1)];
-        /* a corner of weight 0 does not count: no NaN from it */
-        float top = fx > 0 ? z00 + fx * (z01 - z00) : z00;
-        float bot = fx > 0 ? z10 + fx * (z11 - z10) : z10;
-        float h = fy > 0 ? top + fy * (bot - top) : top;
+        /* a corner of weight 0 does not count: no NaN from it (computed,
+         * then selected: a conditional float operation is control flow
+         * that keeps the loop scalar) */
+        float top_i = z00 + fx * (z01 - z00), bot_i = z10 + fx * (z11 - z10);
+        float top = fx > 0 ? top_i : z00;
+        float bot = fx > 0 ? bot_i : z10;
+        float h_i = top + fy * (bot - top);
+        float h = fy > 0 ? h_i : top;
         int row = (int)(y + t * vy / 2 + 0.5);
         row = row < 0 ? 0 : row;
         row = row > H - 1 ? H - 1 : row;
         double d = t * step[row];
         float tan_w = (float)((h - zrow[x]) / d - c * d);
-        A[x] = t > 1e-9 ? tan_w : NAN;
+        A[x] = tan_w;
     }
+    /* apart: a select in the loop above becomes a branch around tan_w */
+    for (int x = a; x <= b; x++)
+        A[x] = tpp[x] > 1e-9 ? A[x] : NAN;
 }
 
 /* The last sample A[x] of each cell of [a, b], its sample number jd[x]
@@ -146,10 +156,18 @@ void ts_pyr_drop_cells(const hz_ctx *C, row_ws *w, int y, int a, int b, double t
         drop_ends(C, -2, y, a, b, t_row, tpp);
     else
         drop_ends(C, 0, y, a, b, t_row, tpp);
-    if ((double)g->stride * g->height <= INT_MAX)
-        drop_read(C, 1, y, a, b, tpp, A);
-    else
-        drop_read(C, 0, y, a, b, tpp, A);
+    /* x-major rays that all end on their side (not earlier, at t_row) end
+     * on a whole column: x + (lim - x) or x - x, exactly */
+    const double lim = g->width - 1;
+    int on_col = (vx == 1.0 && lim - a <= t_row) || (vx == -1.0 && b <= t_row);
+    if ((double)g->stride * g->height <= INT_MAX) {
+        if (on_col)
+            drop_read(C, 1, 1, y, a, b, tpp, A);
+        else
+            drop_read(C, 1, 0, y, a, b, tpp, A);
+    } else {
+        drop_read(C, 0, 0, y, a, b, tpp, A);
+    }
     if (C->bspline) {
 #pragma GCC ivdep
         for (int x = a; x <= b; x++)

@@ -19,11 +19,11 @@
  * exceeds the largest sample. A sample that touches nodata is no
  * occluder: it repeats the sample before it.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 
 #include "arg_checks.h"
-#include "cellmath/cm_fastmath.h"
 #include "parallel.h"
 #include "pyramid_hz.h"
 #include "status_internal.h"
@@ -54,34 +54,6 @@ static double step_at(const hz_ctx *C, double row)
     return C->step[r < 0 ? 0 : r > H - 1 ? H - 1 : r];
 }
 
-/* dst[x] = sum of weights w[t] * rows r[t] at x, for x in [x0, x1]. */
-TS_PYR_CLONES
-static void combine_rows(const float *const r[4], const float w[4], int taps, int x0, int x1,
-                         float *restrict dst)
-{
-    const float *r0 = r[0];
-    const float w0 = w[0];
-    if (taps == 1) {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++)
-            dst[x] = r0[x];
-        return;
-    }
-    const float *r1 = r[1];
-    const float w1 = w[1];
-    if (taps == 2) {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++)
-            dst[x] = w0 * r0[x] + w1 * r1[x];
-        return;
-    }
-    const float *r2 = r[2], *r3 = r[3];
-    const float w2 = w[2], w3 = w[3];
-#pragma GCC ivdep
-    for (int x = x0; x <= x1; x++)
-        dst[x] = w0 * r0[x] + w1 * r1[x] + w2 * r2[x] + w3 * r3[x];
-}
-
 /* The taps of row position `row` (DEM coordinates) on level lev. */
 static int level_taps(const ts_pyramid *P, int lev, double row, int idx[4], double w[4])
 {
@@ -89,94 +61,9 @@ static int level_taps(const ts_pyramid *P, int lev, double row, int idx[4], doub
     return ts_pyr_taps((row + 0.5) / L->spacing - 0.5, L->rows, lev == 0, idx, w);
 }
 
-/* spline_push on the state of cell x. */
-static inline void spline_step(float *restrict s0, float *restrict s1, float *restrict s2,
-                               float *restrict m, int x, float a)
-{
-    float p0 = s0[x], p1 = s1[x], p2 = s2[x], mm = m[x];
-    spline_push(&p0, &p1, &p2, &mm, a);
-    m[x] = mm;
-    s0[x] = p0;
-    s1[x] = p1;
-    s2[x] = p2;
-}
-
-/* Add sample number c (value a_in[x] for the cells of [x0, x1]) to the
- * spline (or the maximum), as the file's comment says. */
-TS_PYR_CLONES
-static void push_run(row_ws *w, int bspline, int c, int x0, int x1, const float *restrict a_in)
-{
-    float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
-    float *restrict m = w->m;
-    if (!bspline) {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++)
-            m[x] = a_in[x] > m[x] ? a_in[x] : m[x];
-        return;
-    }
-    if (c == 0) {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++)
-            s2[x] = a_in[x];
-        return;
-    }
-    if (c == 1) {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++) {
-            float a = a_in[x] == a_in[x] ? a_in[x] : s2[x];
-            s0[x] = 2.0f * s2[x] - a; /* w_{-1}: knot 0 is w_0 */
-            s1[x] = s2[x];
-            s2[x] = a;
-            m[x] = s1[x] > m[x] ? s1[x] : m[x];
-        }
-        return;
-    }
-#pragma GCC ivdep
-    for (int x = x0; x <= x1; x++)
-        spline_step(s0, s1, s2, m, x, a_in[x]);
-}
-
-/* One level's samples for the cells of [x0, x1]: the level row T at x + ix
- * and x + ix + 1 (weight fx) against the cells' own heights on the level
- * R, at d metres (1 / d = inv_d, curvature drop over d
- * = cd). Pushed as sample c in the same pass where the spline allows,
- * else left in w->A for push_run (returns 0 then). */
-TS_PYR_CLONES
-static int level_run(row_ws *w, const float *restrict T, int ix, float fx,
-                     const float *restrict R, float inv_d, float cd, int bspline, int c, int x0,
-                     int x1)
-{
-    float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
-    float *restrict m = w->m, *restrict A = w->A;
-    const float gx = 1.0f - fx;
-    const float *restrict Ta = T + ix; /* T[x + ix] defeats the vectoriser */
-    if (bspline && c >= 2) {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++) {
-            float h = gx * Ta[x] + fx * Ta[x + 1];
-                spline_step(s0, s1, s2, m, x, ts_atan_deg((h - R[x]) * inv_d - cd));
-        }
-        return 1;
-    }
-    if (!bspline) { /* the maximum of the tangents; one arctangent at the end */
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++) {
-            float h = gx * Ta[x] + fx * Ta[x + 1];
-                float t = (h - R[x]) * inv_d - cd;
-            m[x] = t > m[x] ? t : m[x];
-        }
-        return 1;
-    }
-#pragma GCC ivdep
-    for (int x = x0; x <= x1; x++) {
-        float h = gx * Ta[x] + fx * Ta[x + 1];
-        A[x] = ts_atan_deg((h - R[x]) * inv_d - cd);
-    }
-    return 0;
-}
-
-/* The row-level entry of row y for samples at `dist` steps on level lev. */
-static void row_level_fill(const hz_ctx *C, int y, int lev, double dist, row_level *e)
+/* The row-level entry of row y for samples at `dist` steps on level lev;
+ * the cells' own rows only with `own` (batch_row reads azimuth 0's). */
+static void row_level_fill(const hz_ctx *C, int y, int lev, double dist, int own, row_level *e)
 {
     const ts_pyramid *P = C->P;
     double oy = dist * C->vy;
@@ -188,8 +75,8 @@ static void row_level_fill(const hz_ctx *C, int y, int lev, double dist, row_lev
         e->wt[t] = (float)wd[t < e->taps ? t : 0];
     }
     /* the cells' own heights on the level: the DEM row itself on level 0 */
-    int taps = level_taps(P, lev, y, idx, wd);
-    for (int t = 0; t < 4; t++) {
+    int taps = own ? level_taps(P, lev, y, idx, wd) : 0;
+    for (int t = 0; t < 4 && own; t++) {
         e->r[t] = ts_pyr_row(P, lev, idx[t < taps ? t : 0]);
         e->wr[t] = t < taps ? (float)wd[t] : 0.0f;
     }
@@ -198,20 +85,35 @@ static void row_level_fill(const hz_ctx *C, int y, int lev, double dist, row_lev
     e->cd = (float)(C->c * d);
 }
 
+/* The columns [*t0, *t1] of the level row that the samples at column
+ * offset ix + fx of the cells [x0, x1] read; 0 when none (not reached:
+ * the runs keep the samples on the grid). */
+static int sample_cols(int W, int ix, float fx, int x0, int x1, int *t0, int *t1)
+{
+    *t0 = x0 + ix;
+    *t1 = x1 + ix + (fx > 0.0f);
+    *t1 = *t1 > W - 1 ? W - 1 : *t1;
+    return *t0 >= 0 && *t1 >= *t0;
+}
+
 /* The samples of the cells [x0, x1] described by e, at column offset
- * ix + fx, against their own heights R on the level, pushed as sample c. */
+ * ix + fx, against their own heights R on the level, pushed as sample c
+ * (the level row at the samples' row: combined into w->T, or shared). */
 static void sample_level(const hz_ctx *C, row_ws *w, const row_level *e, const float *R, int ix,
                          float fx, int c, int x0, int x1)
 {
-    const int W = C->P->grid->width;
-    int t0 = x0 + ix, t1 = x1 + ix + (fx > 0.0f);
-    t1 = t1 > W - 1 ? W - 1 : t1;
-    if (t0 < 0 || t1 < t0)
-        return; /* not reached: the runs keep the samples on the grid */
-    combine_rows(e->t, e->wt, e->taps, t0, t1, w->T);
-    w->T[t1 + 1] = w->T[t1]; /* a weight of fx = 0 there: no NaN from beyond */
-    if (!level_run(w, w->T, ix, fx, R, e->inv_d, e->cd, C->bspline, c, x0, x1))
-        push_run(w, C->bspline, c, x0, x1, w->A);
+    int t0, t1;
+    if (!sample_cols(C->P->grid->width, ix, fx, x0, x1, &t0, &t1))
+        return;
+    const float *T = w->Tsh;
+    if (t0 < w->t_lo || t1 > w->t_hi) {
+        ts_pyr_combine_rows(e->t, e->wt, e->taps, t0, t1, w->T);
+        w->T[t1 + 1] = w->T[t1]; /* a weight of fx = 0 there: no NaN from beyond */
+        T = w->T;
+    }
+    w->t_lo = 1, w->t_hi = 0;
+    if (!ts_pyr_level_run(w, T, ix, fx, R, e->inv_d, e->cd, C->bspline, c, x0, x1))
+        ts_pyr_push_run(w, C->bspline, c, x0, x1, w->A);
 }
 
 /* The samples of the cells [x0, x1] of row y at `dist` steps on the DEM
@@ -223,7 +125,7 @@ static void sample_run(const hz_ctx *C, row_ws *w, int y, const float *R, double
     double ox = dist * C->vx;
     double fl = floor(ox);
     row_level e;
-    row_level_fill(C, y, 0, dist, &e);
+    row_level_fill(C, y, 0, dist, 0, &e);
     sample_level(C, w, &e, R, (int)fl, (float)(ox - fl), c, x0, x1);
 }
 
@@ -236,35 +138,6 @@ static double row_reach(const hz_ctx *C, int y)
     if (C->cap > 0 && C->cap / C->step[y] < t_row)
         t_row = C->cap / C->step[y];
     return t_row;
-}
-
-/* The horizons of cells [x0, x1] after `count` >= 1 samples, into out. */
-TS_PYR_CLONES
-static void finish_run(row_ws *w, int bspline, int count, int x0, int x1, float *restrict out)
-{
-    float *restrict s1 = w->s1, *restrict s2 = w->s2, *restrict m = w->m;
-    if (!bspline) {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++)
-            out[x] = m[x] > -INFINITY ? ts_atan_deg(m[x]) : -90.0f;
-        return;
-    }
-    if (count >= 2) { /* w_M = 2 w_{M-1} - w_{M-2}: knot M-1 is w_{M-1} */
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++)
-            w->A[x] = 2.0f * s2[x] - s1[x];
-        push_run(w, 1, count, x0, x1, w->A);
-    } else {
-#pragma GCC ivdep
-        for (int x = x0; x <= x1; x++)
-            m[x] = s2[x] > m[x] ? s2[x] : m[x];
-    }
-#pragma GCC ivdep
-    /* no spline value where nodata left fewer than three samples: the last */
-    for (int x = x0; x <= x1; x++) {
-        float r = m[x] > -INFINITY ? m[x] : s2[x];
-        out[x] = r == r && r > -INFINITY ? r : -90.0f;
-    }
 }
 
 /* Cells [a, b] drop out before sample j (B-spline: their sample number). */
@@ -326,12 +199,12 @@ static void row_sample(const hz_ctx *C, row_ws *w, int y, int j, const row_level
     float *out = C->out + (size_t)y * C->P->grid->width;
     if (r->t_row > 1e-9) {
         sample_run(C, w, y, R0, r->t_row, j, pa, pb);
-        finish_run(w, C->bspline, j + 1, pa, pb, out);
+        ts_pyr_finish_run(w, C->bspline, j + 1, pa, pb, out);
     } else if (j == 0) {
         for (int x = pa; x <= pb; x++)
             out[x] = -90.0f; /* nothing beyond these cells */
     } else {
-        finish_run(w, C->bspline, j, pa, pb, out);
+        ts_pyr_finish_run(w, C->bspline, j, pa, pb, out);
     }
     r->fa = pa, r->fb = pb;
     r->pa = 1, r->pb = 0;
@@ -347,9 +220,10 @@ static void row_finish(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const 
     ts_pyr_drop_cells(C, w, y, c0, r->fa - 1, r->t_row, out);
     ts_pyr_drop_cells(C, w, y, r->fb + 1, c1 - 1, r->t_row, out);
     const float *z = g->z + (ptrdiff_t)y * g->stride;
-    for (int x = c0; x < c1; x++)
-        if (z[x] != z[x])
-            out[x] = NAN;
+    for (int x = c0; x < c1; x++) {
+        float o = out[x]; /* a select, not a branch: the loop vectorises */
+        out[x] = z[x] == z[x] ? o : NAN;
+    }
 }
 
 /* Azimuths computed together: the cells' own heights on each level are
@@ -359,20 +233,64 @@ typedef struct {
     const hz_ctx *az; /* n */
 } batch_ctx;
 
+/* Whether two entries read the same level rows with the same weights. */
+static int same_rows(const row_level *a, const row_level *b)
+{
+    if (a->taps != b->taps)
+        return 0;
+    for (int t = 0; t < a->taps; t++)
+        if (a->t[t] != b->t[t] || a->wt[t] != b->wt[t])
+            return 0;
+    return 1;
+}
+
+/* Sample j's level row, combined once into Tsh for the azimuths that read
+ * the same rows with the same weights (the y-major azimuths of a batch all
+ * do: their vy is the same +-1) where the union of the columns they read
+ * is no wider than their sum. Only samples with a fraction fx > 0 share:
+ * they read no column past their own, so sample_level has no end to pad. */
+static void share_level_row(const batch_ctx *B, row_ws *w, const row_level *const *rl,
+                            const row_run *run, int j, float *Tsh)
+{
+    int t0[TS_PYRAMID_BATCH], t1[TS_PYRAMID_BATCH], in[TS_PYRAMID_BATCH];
+    int lo = INT_MAX, hi = INT_MIN, sum = 0, members = 0, xa, xb;
+    const row_level *e0 = NULL;
+    for (int a = 0; a < B->n; a++) {
+        const level_az *L = &B->az[a].lv[j];
+        in[a] = run[a].pa <= run[a].pb && row_keeps(&B->az[a], &run[a], j, &xa, &xb) &&
+                xa <= xb && L->fx > 0.0f &&
+                sample_cols(B->az[a].P->grid->width, L->ix, L->fx, xa, xb, &t0[a], &t1[a]) &&
+                (!e0 || same_rows(e0, &rl[a][j]));
+        if (!in[a])
+            continue;
+        e0 = e0 ? e0 : &rl[a][j];
+        lo = t0[a] < lo ? t0[a] : lo;
+        hi = t1[a] > hi ? t1[a] : hi;
+        sum += t1[a] - t0[a] + 1;
+        members++;
+    }
+    if (members < 2 || hi - lo + 1 > sum)
+        return;
+    ts_pyr_combine_rows(e0->t, e0->wt, e0->taps, lo, hi, Tsh);
+    for (int a = 0; a < B->n; a++)
+        if (in[a])
+            w[a].Tsh = Tsh, w[a].t_lo = lo, w[a].t_hi = hi;
+}
+
 /* The cells [c0, c1) of row y for every azimuth of B, level by level: the
  * cells' own heights on a level (the same rows and weights for every
  * azimuth, from azimuth 0's entries rl[n][j]) are computed once, over
  * the runs that read them, into R (on the DEM: R0, kept for the rays
  * that end early). */
 static void batch_row(const batch_ctx *B, row_ws *w, int y, int c0, int c1,
-                      const row_level *const *rl, float *R0, float *R)
+                      const row_level *const *rl, float *R0, float *R, float *Tsh)
 {
     const int levels = B->az[0].P->levels;
     row_run run[TS_PYRAMID_BATCH];
     for (int a = 0; a < B->n; a++)
         row_start(&B->az[a], &w[a], y, c0, c1, &run[a]);
     /* 4 taps, weight 0 unused: as the one-azimuth sums */
-    combine_rows(rl[0][0].r, rl[0][0].wr, 4, c0, c1 - 1, R0);
+    ts_pyr_combine_rows(rl[0][0].r, rl[0][0].wr, 4, c0, c1 - 1, R0);
     for (int j = 0; j < levels; j++) {
         int lo = c1, hi = c0 - 1, xa, xb;
         for (int a = 0; a < B->n; a++)
@@ -382,9 +300,10 @@ static void batch_row(const batch_ctx *B, row_ws *w, int y, int c0, int c1,
             }
         const float *Rj = R0;
         if (lo <= hi && B->az[0].lv[j].lev > 0) {
-            combine_rows(rl[0][j].r, rl[0][j].wr, 4, lo, hi, R);
+            ts_pyr_combine_rows(rl[0][j].r, rl[0][j].wr, 4, lo, hi, R);
             Rj = R;
         }
+        share_level_row(B, w, rl, run, j, Tsh);
         int active = 0;
         for (int a = 0; a < B->n; a++) {
             row_sample(&B->az[a], &w[a], y, j, &rl[a][j], Rj, R0, &run[a]);
@@ -404,7 +323,7 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
     const int n = B->n, W = B->az[0].P->grid->width, levels = B->az[0].P->levels;
     /* per azimuth s0, s1, s2, m: W each; T and the samples: W + 1 each */
     float *buf = malloc((size_t)n * (6 * W + 2) * sizeof *buf);
-    float *own = malloc((size_t)2 * W * sizeof *own);
+    float *own = malloc((size_t)3 * W * sizeof *own + sizeof *own);
     double *tpp = malloc((size_t)3 * W * sizeof *tpp);
     int *jd = malloc((size_t)n * W * sizeof *jd);
     row_level *rl = malloc((size_t)n * ROW_BLOCK * levels * sizeof *rl);
@@ -421,7 +340,7 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
     for (int a = 0; a < n; a++) {
         float *f = buf + (size_t)a * (6 * W + 2);
         w[a] = (row_ws){f, f + W, f + 2 * W, f + 3 * W, f + 4 * W, f + 5 * W + 1, tpp,
-                        jd + (size_t)a * W};
+                        jd + (size_t)a * W, NULL, 1, 0};
     }
     for (long yb = y0; yb < y1; yb += ROW_BLOCK) {
         long ye = yb + ROW_BLOCK < y1 ? yb + ROW_BLOCK : y1;
@@ -429,7 +348,7 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
             for (long y = yb; y < ye; y++)
                 for (int j = 0; j < levels; j++)
                     row_level_fill(&B->az[a], (int)y, B->az[a].lv[j].lev, B->az[a].lv[j].s,
-                                   &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels + j]);
+                                   a == 0, &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels + j]);
         /* a chunk of columns down the rows, then the next: the level rows
          * that the cells of a chunk read stay in the cache from row to row */
         for (int c0 = 0; c0 < W; c0 += CHUNK) {
@@ -438,7 +357,7 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
                 const row_level *rly[TS_PYRAMID_BATCH];
                 for (int a = 0; a < n; a++)
                     rly[a] = &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels];
-                batch_row(B, w, (int)y, c0, c1, rly, own, own + W);
+                batch_row(B, w, (int)y, c0, c1, rly, own, own + W, own + 2 * W);
             }
         }
     }

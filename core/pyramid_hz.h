@@ -43,6 +43,10 @@ typedef struct {
     float *A;            /* the samples being pushed */
     double *tpp;         /* drop_cells: t, px, py of the cells (3 rows) */
     int *jd;             /* the sample number at which each cell drops out */
+    /* the next sample's level row, columns [t_lo, t_hi] already combined in
+     * Tsh with the other azimuths that read the same rows (t_lo > t_hi: no) */
+    const float *Tsh;
+    int t_lo, t_hi;
 } row_ws;
 
 /* Sample a (c >= 2) after p0, p1, p2: the spline's midpoint before the
@@ -60,6 +64,27 @@ static inline void spline_push(float *p0, float *p1, float *p2, float *m, float 
     *p1 = *p2;
     *p2 = a;
 }
+
+/* core/pyramid_runs.c: the loops over the cells [x0, x1] of a grid row. */
+
+/* dst[x] = sum of weights w[t] * rows r[t] at x, for x in [x0, x1]. */
+void ts_pyr_combine_rows(const float *const r[4], const float w[4], int taps, int x0, int x1,
+                         float *restrict dst);
+
+/* Add sample number c (value a_in[x]) to the spline (or the maximum). */
+void ts_pyr_push_run(row_ws *w, int bspline, int c, int x0, int x1, const float *restrict a_in);
+
+/* One level's samples: the level row T at x + ix and x + ix + 1 (weight
+ * fx) against the cells' own heights on the level R, at d metres (1 / d =
+ * inv_d, curvature drop over d = cd). Pushed as sample c in the same pass
+ * where the spline allows, else left in w->A for ts_pyr_push_run (returns
+ * 0 then). */
+int ts_pyr_level_run(row_ws *w, const float *restrict T, int ix, float fx,
+                     const float *restrict R, float inv_d, float cd, int bspline, int c, int x0,
+                     int x1);
+
+/* The horizons of the cells after `count` >= 1 samples, into out. */
+void ts_pyr_finish_run(row_ws *w, int bspline, int count, int x0, int x1, float *restrict out);
 
 /* The cells of [a, b] of row y whose rays ended before the samples of
  * the levels (through a side of the grid, or at t_row steps), each after

@@ -1,0 +1,153 @@
+/*
+ * The loops of pyramid horizons (core/pyramid_horizon.c) over a run of
+ * cells of one grid row: the level rows combined at the samples' row, the
+ * samples' blocking angles, the spline (or the maximum) they feed, and the
+ * horizons. Branch-free, vectorised, one clone per instruction set.
+ */
+#include <math.h>
+
+#include "cellmath/cm_fastmath.h"
+#include "pyramid_hz.h"
+
+/* dst[x] = sum of weights w[t] * rows r[t] at x, for x in [x0, x1]. */
+TS_PYR_CLONES
+void ts_pyr_combine_rows(const float *const r[4], const float w[4], int taps, int x0, int x1,
+                         float *restrict dst)
+{
+    const float *r0 = r[0];
+    const float w0 = w[0];
+    if (taps == 1) {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++)
+            dst[x] = r0[x];
+        return;
+    }
+    const float *r1 = r[1];
+    const float w1 = w[1];
+    if (taps == 2) {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++)
+            dst[x] = w0 * r0[x] + w1 * r1[x];
+        return;
+    }
+    const float *r2 = r[2], *r3 = r[3];
+    const float w2 = w[2], w3 = w[3];
+#pragma GCC ivdep
+    for (int x = x0; x <= x1; x++)
+        dst[x] = w0 * r0[x] + w1 * r1[x] + w2 * r2[x] + w3 * r3[x];
+}
+
+/* spline_push on the state of cell x. */
+static inline void spline_step(float *restrict s0, float *restrict s1, float *restrict s2,
+                               float *restrict m, int x, float a)
+{
+    float p0 = s0[x], p1 = s1[x], p2 = s2[x], mm = m[x];
+    spline_push(&p0, &p1, &p2, &mm, a);
+    m[x] = mm;
+    s0[x] = p0;
+    s1[x] = p1;
+    s2[x] = p2;
+}
+
+/* Add sample number c (value a_in[x] for the cells of [x0, x1]) to the
+ * spline (or the maximum), as core/pyramid_horizon.c says. */
+TS_PYR_CLONES
+void ts_pyr_push_run(row_ws *w, int bspline, int c, int x0, int x1, const float *restrict a_in)
+{
+    float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
+    float *restrict m = w->m;
+    if (!bspline) {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++)
+            m[x] = a_in[x] > m[x] ? a_in[x] : m[x];
+        return;
+    }
+    if (c == 0) {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++)
+            s2[x] = a_in[x];
+        return;
+    }
+    if (c == 1) {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++) {
+            float a = a_in[x] == a_in[x] ? a_in[x] : s2[x];
+            s0[x] = 2.0f * s2[x] - a; /* w_{-1}: knot 0 is w_0 */
+            s1[x] = s2[x];
+            s2[x] = a;
+            m[x] = s1[x] > m[x] ? s1[x] : m[x];
+        }
+        return;
+    }
+#pragma GCC ivdep
+    for (int x = x0; x <= x1; x++)
+        spline_step(s0, s1, s2, m, x, a_in[x]);
+}
+
+/* One level's samples for the cells of [x0, x1]: the level row T at x + ix
+ * and x + ix + 1 (weight fx) against the cells' own heights on the level
+ * R, at d metres (1 / d = inv_d, curvature drop over d
+ * = cd). Pushed as sample c in the same pass where the spline allows,
+ * else left in w->A for push_run (returns 0 then). */
+TS_PYR_CLONES
+int ts_pyr_level_run(row_ws *w, const float *restrict T, int ix, float fx,
+                     const float *restrict R, float inv_d, float cd, int bspline, int c, int x0,
+                     int x1)
+{
+    float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
+    float *restrict m = w->m, *restrict A = w->A;
+    const float gx = 1.0f - fx;
+    const float *restrict Ta = T + ix; /* T[x + ix] defeats the vectoriser */
+    if (bspline && c >= 2) {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++) {
+            float h = gx * Ta[x] + fx * Ta[x + 1];
+                spline_step(s0, s1, s2, m, x, ts_atan_deg((h - R[x]) * inv_d - cd));
+        }
+        return 1;
+    }
+    if (!bspline) { /* the maximum of the tangents; one arctangent at the end */
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++) {
+            float h = gx * Ta[x] + fx * Ta[x + 1];
+                float t = (h - R[x]) * inv_d - cd;
+            m[x] = t > m[x] ? t : m[x];
+        }
+        return 1;
+    }
+#pragma GCC ivdep
+    for (int x = x0; x <= x1; x++) {
+        float h = gx * Ta[x] + fx * Ta[x + 1];
+        A[x] = ts_atan_deg((h - R[x]) * inv_d - cd);
+    }
+    return 0;
+}
+
+/* The horizons of cells [x0, x1] after `count` >= 1 samples, into out. */
+TS_PYR_CLONES
+void ts_pyr_finish_run(row_ws *w, int bspline, int count, int x0, int x1, float *restrict out)
+{
+    float *restrict s1 = w->s1, *restrict s2 = w->s2, *restrict m = w->m;
+    if (!bspline) {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++)
+            out[x] = m[x] > -INFINITY ? ts_atan_deg(m[x]) : -90.0f;
+        return;
+    }
+    if (count >= 2) { /* w_M = 2 w_{M-1} - w_{M-2}: knot M-1 is w_{M-1} */
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++)
+            w->A[x] = 2.0f * s2[x] - s1[x];
+        ts_pyr_push_run(w, 1, count, x0, x1, w->A);
+    } else {
+#pragma GCC ivdep
+        for (int x = x0; x <= x1; x++)
+            m[x] = s2[x] > m[x] ? s2[x] : m[x];
+    }
+#pragma GCC ivdep
+    /* no spline value where nodata left fewer than three samples: the last */
+    for (int x = x0; x <= x1; x++) {
+        float r = m[x] > -INFINITY ? m[x] : s2[x];
+        out[x] = r == r && r > -INFINITY ? r : -90.0f;
+    }
+}
