@@ -150,7 +150,7 @@ static ts_status run_env(ctx *c, int cl, ts_error *e)
     for (int i = 0; i < 3; i++)
         memset(i == 0 ? c->out : i == 1 ? c->out2 : c->out3, 0, c->n * sizeof(float));
     ts_env_light_request req = {&c->g,  &c->table, 0,      c->nx,  c->ny,
-                                c->nz,  c->hz,     c->out, c->out2, c->out3};
+                                c->nz,  c->hz,     c->out, c->out2, c->out3, 0};
     if (cl)
         st = ts_cl_env_light_open(&req, &s, e);
     for (req.k = 0; req.k < c->o.directions && st == TS_OK; req.k++) {

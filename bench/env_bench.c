@@ -101,7 +101,7 @@ static void bench_size(int size, int dirs, int limit, const ts_env *env,
         if (ts_horizon_sweep(&g, ts_env_table_azimuth(&t, k), &o, plane, &e))
             fail("sweep", &e);
         double t1 = seconds(), c1 = cpu_seconds();
-        const ts_env_light_request req = {&g, &t, k, nx, ny, nz, plane, r, gr, b};
+        const ts_env_light_request req = {&g, &t, k, nx, ny, nz, plane, r, gr, b, 0};
         if (ts_env_light_accumulate(&req, &e))
             fail("lighting", &e);
         t_sweep += t1 - t0, c_sweep += c1 - c0;

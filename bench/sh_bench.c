@@ -99,7 +99,8 @@ static void bench_env(const ts_grid *g, int dirs, const float *nx, const float *
         check(ts_horizon_sweep(g, ts_env_table_azimuth(&tab, k), &o, plane, &e), "sweep", &e);
         add_since(t, &sweeps);
         t = now();
-        const ts_env_light_request rq = {g, &tab, k, nx, ny, nz, plane, rgb, rgb + n, rgb + 2 * n};
+        const ts_env_light_request rq = {g,   &tab,    k,           nx, ny, nz,
+                                         plane, rgb, rgb + n, rgb + 2 * n, 0};
         check(ts_env_light_accumulate(&rq, &e), "table lighting", &e);
         add_since(t, &table);
         t = now();

@@ -183,10 +183,11 @@ ts_status ts_backend_shm_compute(ts_backend backend, const ts_grid *grid, double
                             shadow_height, err));
 }
 
-ts_status ts_backend_normals(ts_backend backend, const ts_grid *grid, float *nx, float *ny,
-                             float *nz, ts_backend_report *report, ts_error *err)
+ts_status ts_backend_normals(ts_backend backend, const ts_grid *grid, int threads, float *nx,
+                             float *ny, float *nz, ts_backend_report *report, ts_error *err)
 {
-    DISPATCH(ts_cl_normals(grid, nx, ny, nz, cl_err), ts_normals(grid, nx, ny, nz, err));
+    DISPATCH(ts_cl_normals(grid, nx, ny, nz, cl_err),
+             ts_normals_threads(grid, threads, nx, ny, nz, err));
 }
 
 ts_status ts_backend_shade_direct(ts_backend backend, const ts_direct_request *req,

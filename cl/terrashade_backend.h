@@ -80,7 +80,7 @@ ts_status ts_backend_shm_compute(ts_backend backend, const ts_grid *grid,
                                  float *visibility, float *shadow_height,
                                  ts_backend_report *report, ts_error *err);
 
-ts_status ts_backend_normals(ts_backend backend, const ts_grid *grid, float *nx,
+ts_status ts_backend_normals(ts_backend backend, const ts_grid *grid, int threads, float *nx,
                              float *ny, float *nz, ts_backend_report *report,
                              ts_error *err);
 

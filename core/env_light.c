@@ -121,7 +121,7 @@ ts_status ts_env_light_accumulate(const ts_env_light_request *req, ts_error *err
                    table->lp + ts_env_table_sector_floats(table) * req->k, sa, ca,
                    table->normal_steps, table->horizon_steps, req->r, req->g, req->b};
     const int rows = req->grid->height;
-    return ts_parallel_for(ts_thread_count(0, rows), rows, light_rows, &C, err);
+    return ts_parallel_for(ts_thread_count(req->threads, rows), rows, light_rows, &C, err);
 }
 
 ts_status ts_env_light_finish(const ts_grid *grid, float *r, float *g, float *b, ts_error *err)
@@ -162,7 +162,7 @@ ts_status ts_env_light(const ts_grid *grid, const ts_env_table *table, const flo
     memset(r, 0, n * sizeof *r);
     memset(g, 0, n * sizeof *g);
     memset(b, 0, n * sizeof *b);
-    ts_env_light_request req = {grid, table, 0, nx, ny, nz, NULL, r, g, b};
+    ts_env_light_request req = {grid, table, 0, nx, ny, nz, NULL, r, g, b, 0};
     for (req.k = 0; req.k < table->directions; req.k++) {
         req.plane = horizons + n * req.k;
         if ((st = ts_env_light_accumulate(&req, err)) != TS_OK)

@@ -70,11 +70,18 @@ static void normals_rows(void *ctx, int worker, long y0, long y1)
     }
 }
 
-ts_status ts_normals(const ts_grid *grid, float *nx, float *ny, float *nz, ts_error *err)
+ts_status ts_normals_threads(const ts_grid *grid, int threads, float *nx, float *ny, float *nz,
+                             ts_error *err)
 {
     ts_status st = ts_check_normals_args(grid, nx, ny, nz, err);
     if (st != TS_OK)
         return st;
     normals_ctx C = {grid, nx, ny, nz};
-    return ts_parallel_for(ts_thread_count(0, grid->height), grid->height, normals_rows, &C, err);
+    return ts_parallel_for(ts_thread_count(threads, grid->height), grid->height, normals_rows,
+                           &C, err);
+}
+
+ts_status ts_normals(const ts_grid *grid, float *nx, float *ny, float *nz, ts_error *err)
+{
+    return ts_normals_threads(grid, 0, nx, ny, nz, err);
 }

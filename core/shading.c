@@ -122,7 +122,8 @@ static ts_status shade_direct(const ts_direct_request *req, int horn, ts_error *
     if (st != TS_OK)
         return st;
     size_t plane = (size_t)req->grid->width * req->grid->height;
-    int threads = ts_thread_count(0, (long)(plane >> 16) + 1), failed = 0;
+    int threads = ts_thread_count(req->opts ? req->opts->threads : 0, (long)(plane >> 16) + 1),
+        failed = 0;
     direct_horn_ctx C = {direct_ctx_of(req, &p), req->grid, &failed};
     if (!horn)
         return ts_parallel_for(threads, (long)plane, direct_range, &C.d, err);

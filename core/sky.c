@@ -62,7 +62,7 @@ ts_status ts_sky_accumulate(const ts_grid *grid, const float *nx, const float *n
                             float *openness_acc, ts_error *err)
 {
     return ts_sky_accumulate_model(grid, nx, ny, nz, plane, azimuth, directions,
-                                   TS_SVF_RADIATIVE, svf_acc, sky_acc, openness_acc, err);
+                                   TS_SVF_RADIATIVE, 0, svf_acc, sky_acc, openness_acc, err);
 }
 
 ts_status ts_check_svf_model(ts_svf_model model, ts_error *err)
@@ -76,8 +76,9 @@ ts_status ts_check_svf_model(ts_svf_model model, ts_error *err)
 
 ts_status ts_sky_accumulate_model(const ts_grid *grid, const float *nx, const float *ny,
                                   const float *nz, const float *plane, double azimuth,
-                                  int directions, ts_svf_model svf_model, float *svf_acc,
-                                  float *sky_acc, float *openness_acc, ts_error *err)
+                                  int directions, ts_svf_model svf_model, int threads,
+                                  float *svf_acc, float *sky_acc, float *openness_acc,
+                                  ts_error *err)
 {
     ts_status st = ts_check_svf_model(svf_model, err);
     if (st != TS_OK)
@@ -94,7 +95,8 @@ ts_status ts_sky_accumulate_model(const ts_grid *grid, const float *nx, const fl
                  (float)sin(azimuth * DEG2RAD), (float)cos(azimuth * DEG2RAD),
                  (float)(1.0 / directions), (float)(sin(M_PI / directions) / M_PI),
                  svf_model, svf_acc, sky_acc, openness_acc};
-    return ts_parallel_for(ts_thread_count(0, grid->height), grid->height, sky_rows, &C, err);
+    return ts_parallel_for(ts_thread_count(threads, grid->height), grid->height, sky_rows, &C,
+                           err);
 }
 
 ts_status ts_sky_finish(const ts_grid *grid, int directions, float *svf_acc, float *sky_acc,
@@ -133,7 +135,7 @@ ts_status ts_sky_terms(const ts_sky_request *req, ts_error *err)
     for (int k = 0; k < n; k++) {
         st = ts_sky_accumulate_model(grid, req->nx, req->ny, req->nz, req->horizons + cells * k,
                                      ts_horizon_azimuth(req->opts, k), n, req->svf_model,
-                                     acc[0], acc[1], acc[2], err);
+                                     req->opts->threads, acc[0], acc[1], acc[2], err);
         if (st != TS_OK)
             return st;
     }

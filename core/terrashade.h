@@ -301,8 +301,12 @@ ts_shm_compute_fn ts_shm_compute;
 typedef ts_status ts_normals_fn(const ts_grid *grid, float *nx, float *ny, float *nz,
                                 ts_error *err);
 
-/** The normals on the C backend. */
+/** The normals on the C backend (on every core). */
 ts_normals_fn ts_normals;
+
+/** ts_normals on `threads` threads (0 = every core). */
+ts_status ts_normals_threads(const ts_grid *grid, int threads, float *nx, float *ny, float *nz,
+                             ts_error *err);
 
 /**
  * Fraction (0..1) of the sun's disk, centre at `sun_elevation`, radius
@@ -432,11 +436,13 @@ ts_status ts_sky_finish(const ts_grid *grid, int directions, float *svf_acc,
                         float *sky_acc, float *openness_acc, ts_error *err);
 
 /** ts_sky_accumulate with the svf accumulator of model `svf_model` (finish
- * it with ts_sky_finish as well). */
+ * it with ts_sky_finish as well), on `threads` threads (0 = every core, as
+ * ts_sky_accumulate). */
 ts_status ts_sky_accumulate_model(const ts_grid *grid, const float *nx, const float *ny,
                                   const float *nz, const float *plane, double azimuth,
-                                  int directions, ts_svf_model svf_model, float *svf_acc,
-                                  float *sky_acc, float *openness_acc, ts_error *err);
+                                  int directions, ts_svf_model svf_model, int threads,
+                                  float *svf_acc, float *sky_acc, float *openness_acc,
+                                  ts_error *err);
 
 /**
  * Combined shade = clamp(direct + sky_weight * sky, 0, 1); NaN stays NaN.

@@ -295,6 +295,7 @@ typedef struct {
     const float *plane;        /**< sector k's horizon plane (ts_horizon_sweep at
                                     ts_env_table_azimuth(table, k)) */
     float *r, *g, *b;          /**< width*height accumulators, zeroed before sector 0 */
+    int threads;               /**< threads of the C backend, 0 (unset) = every core */
 } ts_env_light_request;
 
 /**

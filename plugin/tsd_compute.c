@@ -104,7 +104,9 @@ ts_status tsd_normals_make(const tsd_compute_ctx *c, const ts_grid *g, tsd_norma
     nm->nz = malloc(cells * sizeof(float));
     if (!nm->nx || !nm->ny || !nm->nz)
         return oom(c, "the surface normals");
-    if (NOTE(c, ts_backend_normals(BK(c), g, nm->nx, nm->ny, nm->nz, &rep, &err), rep) !=
+    if (NOTE(c, ts_backend_normals(BK(c), g, c->opts->threads, nm->nx, nm->ny, nm->nz, &rep,
+                                   &err),
+             rep) !=
         TS_OK)
         return core_fail(c, &err);
     return TS_OK;
@@ -155,6 +157,7 @@ typedef struct {
     const tsd_normals *nm;
     int directions;
     ts_svf_model model;
+    int threads;
     float *svf, *sky, *open;
 } sky_acc;
 
@@ -164,7 +167,8 @@ static ts_status sky_add(void *user, const ts_grid *g, int k, double azimuth,
     (void)k;
     const sky_acc *a = user;
     return ts_sky_accumulate_model(g, a->nm->nx, a->nm->ny, a->nm->nz, plane, azimuth,
-                                   a->directions, a->model, a->svf, a->sky, a->open, err);
+                                   a->directions, a->model, a->threads, a->svf, a->sky, a->open,
+                                   err);
 }
 
 /* Stream the DIRECTIONS horizon planes into one sky accumulator; `which`:
@@ -177,7 +181,7 @@ static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const ts
     ts_status st;
     sky_acc a = {nm, c->opts->directions,
                  which == 0 ? (ts_svf_model)c->opts->svf_model : TS_SVF_RADIATIVE,
-                 which == 0 ? acc : NULL, which == 1 ? acc : NULL, which == 2 ? acc : NULL};
+                 c->opts->threads, which == 0 ? acc : NULL, which == 1 ? acc : NULL, which == 2 ? acc : NULL};
     /* Curvature lowers far terrain; on the negated DEM it would raise it,
      * so the sweep over the negated DEM (negative openness) runs without. */
     tsd_options flat;

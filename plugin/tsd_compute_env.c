@@ -78,7 +78,7 @@ static ts_status sample_surfaces(tsd_environment *e, ts_error *err)
             nz[i] = (float)cos(t);
             plane[i] = -90.0f; /* nothing above the tangent plane */
         }
-    ts_env_light_request req = {&g, &e->table, 0, nx, ny, nz, plane, r, gr, b};
+    ts_env_light_request req = {&g, &e->table, 0, nx, ny, nz, plane, r, gr, b, 0};
     for (req.k = 0; st == TS_OK && req.k < e->table.directions; req.k++)
         st = ts_env_light_accumulate(&req, err);
     if (st == TS_OK)
@@ -173,7 +173,7 @@ static ts_status env_add(void *user, const ts_grid *g, int k, double azimuth,
     env_acc *a = user;
     ts_backend_report rep = {0};
     const ts_env_light_request req = {g, &a->e->table, k, a->nm->nx, a->nm->ny, a->nm->nz,
-                                      plane, a->r, a->g, a->b};
+                                      plane, a->r, a->g, a->b, a->c->opts->threads};
     ts_status st = ts_backend_env_light_accumulate(tsd_backend_to_ts(a->c->opts->backend),
                                                    &a->state, &req, &rep, err);
     if (a->c->backend && rep.backend[0])

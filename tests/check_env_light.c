@@ -61,7 +61,7 @@ static void env_light(const scene *s, const ts_env *env, int dirs, int nn, int n
     int stride = s->o.directions / dirs;
     ck_assert(stride * dirs == s->o.directions);
     memset(r, 0, s->n * sizeof *r), memset(g, 0, s->n * sizeof *g), memset(b, 0, s->n * sizeof *b);
-    ts_env_light_request req = {&s->g, &t, 0, s->nx, s->ny, s->nz, NULL, r, g, b};
+    ts_env_light_request req = {&s->g, &t, 0, s->nx, s->ny, s->nz, NULL, r, g, b, 0};
     for (req.k = 0; req.k < dirs; req.k++) {
         req.plane = s->hor + s->n * (size_t)(req.k * stride);
         ck_assert_msg(ts_env_light_accumulate(&req, &err) == TS_OK, "%s", err.message);
@@ -401,7 +401,7 @@ START_TEST(test_nodata_and_streaming)
     s.o.directions = 4;
     ck_assert(ts_env_light(&s.g, &t, s.nx, s.ny, s.nz, s.hor, &s.o, r, g, b, &err) ==
               TS_ERR_ARG);
-    const ts_env_light_request q0 = {&s.g, &t, 0, s.nx, s.ny, s.nz, s.hor, r, g, b};
+    const ts_env_light_request q0 = {&s.g, &t, 0, s.nx, s.ny, s.nz, s.hor, r, g, b, 1};
     ts_env_light_request q;
     ck_assert(ts_env_light_accumulate(&q0, &err) == TS_OK);
     EXPECT_ARG(ts_env_light_accumulate(NULL, &err), &err);

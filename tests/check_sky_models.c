@@ -121,7 +121,7 @@ START_TEST(test_accumulating_form_and_nodata)
     for (int k = 0; k < NDIR; k++)
         ck_assert(ts_sky_accumulate_model(&c.g, c.nx, c.ny, c.nz, c.hor + k * NCELL,
                                           ts_horizon_azimuth(&c.o, k), NDIR,
-                                          TS_SVF_SOLID_ANGLE, acc, NULL, NULL, &e) == TS_OK);
+                                          TS_SVF_SOLID_ANGLE, 1, acc, NULL, NULL, &e) == TS_OK);
     ck_assert(ts_sky_finish(&c.g, NDIR, acc, NULL, NULL, &e) == TS_OK);
     for (int i = 0; i < NCELL; i++)
         ck_assert_msg(memcmp(&acc[i], &whole[i], sizeof(float)) == 0, "cell %d: %g vs %g", i,
@@ -141,7 +141,7 @@ START_TEST(test_bad_model)
     ck_assert_int_eq(case_sky(&c, (ts_svf_model)7, out, NULL, &e), TS_ERR_ARG);
     ck_assert_msg(strstr(e.message, "svf model") != NULL, "%s", e.message);
     ck_assert_int_eq(ts_sky_accumulate_model(&c.g, c.nx, c.ny, c.nz, c.hor, 0, NDIR,
-                                             (ts_svf_model)-1, out, NULL, NULL, &e),
+                                             (ts_svf_model)-1, 0, out, NULL, NULL, &e),
                      TS_ERR_ARG);
     case_free(&c);
 }

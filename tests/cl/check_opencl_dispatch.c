@@ -87,7 +87,7 @@ START_TEST(test_dispatch)
     ts_grid g;
     make_dem(&g, s);
     float *a = tdem_floats(g.width * g.height * 3);
-    ck_assert_int_eq(ts_backend_normals(TS_BACKEND_AUTO, &g, a, a + g.width * g.height,
+    ck_assert_int_eq(ts_backend_normals(TS_BACKEND_AUTO, &g, 0, a, a + g.width * g.height,
                                         a + 2 * g.width * g.height, NULL, &e),
                      TS_ERR_ARG);
     ck_assert_ptr_nonnull(strstr(e.message, "TERRASHADE_BACKEND"));
@@ -254,7 +254,7 @@ static int child_no_platform(void)
         rc = 3;
     for (int k = 0; k < 2 && !rc; k++) {
         ts_backend want = k ? TS_BACKEND_AUTO : TS_BACKEND_OPENCL;
-        if (ts_backend_normals(want, &g, b, b + 143, b + 286, &r, &e) != TS_OK)
+        if (ts_backend_normals(want, &g, 0, b, b + 143, b + 286, &r, &e) != TS_OK)
             rc = 4;
         else if (r.used != TS_BACKEND_C || !r.fell_back || !strstr(r.reason, "no OpenCL platform"))
             rc = 5;

@@ -144,7 +144,7 @@ ts_sky_request scene_sky(const scene *sc, ts_svf_model m, float *svf, float *sky
 ts_env_light_request scene_env(const scene *sc, const ts_env_table *t, int k, float *rgb)
 {
     return (ts_env_light_request){&sc->g, t,   k, sc->nx, sc->ny, sc->nz, sc->h + sc->n * k,
-                                  rgb,    rgb + sc->n, rgb + 2 * sc->n};
+                                  rgb,    rgb + sc->n, rgb + 2 * sc->n, 0};
 }
 
 void clear_env(void)
@@ -166,7 +166,7 @@ ts_backend_report dispatch_normals(ts_backend b, const dem_spec *s)
     ts_backend_report r;
     memset(&r, 0xff, sizeof r);
     ck_assert_int_eq(ts_normals(&g, c[0], c[1], c[2], &e), TS_OK);
-    ts_status st = ts_backend_normals(b, &g, l[0], l[1], l[2], &r, &e);
+    ts_status st = ts_backend_normals(b, &g, 0, l[0], l[1], l[2], &r, &e);
     ck_assert_msg(st == TS_OK, "ts_backend_normals: %s", e.message);
     for (int k = 0; k < 3; k++) {
         diff d = compare(c[k], l[k], n);
