@@ -184,9 +184,7 @@ void TSDataset::StartReadAhead()
             [this]
             {
                 char szMsg[1024] = "";
-                m_eReadStatus = tsd_dem_load_resampled(
-                    GDALGetRasterBand(m_poDEM, m_sOpts.band), &m_sCells, m_sOpts.z_factor,
-                    nRasterXSize, nRasterYSize, &m_sReadGrid, szMsg, sizeof szMsg);
+                m_eReadStatus = LoadDEM(&m_sReadGrid, szMsg, sizeof szMsg);
                 m_osReadMsg = szMsg;
             });
     }
@@ -194,6 +192,14 @@ void TSDataset::StartReadAhead()
     {
         // no thread: EnsureComputed reads the DEM itself
     }
+}
+
+/* The open DEM's band, resampled to the dataset's size, into *psGrid. */
+ts_status TSDataset::LoadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
+{
+    return tsd_dem_load_resampled(GDALGetRasterBand(m_poDEM, m_sOpts.band), &m_sCells,
+                                  m_sOpts.z_factor, nRasterXSize, nRasterYSize, psGrid,
+                                  pszMsg, nMsg);
 }
 
 /* The DEM at the dataset's size into *psGrid: what StartReadAhead read, or
@@ -216,9 +222,7 @@ ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
                  m_osDEM.c_str(), m_nLevel);
         return TS_ERR_INTERNAL;
     }
-    return tsd_dem_load_resampled(GDALGetRasterBand(m_poDEM, m_sOpts.band), &m_sCells,
-                                  m_sOpts.z_factor, nRasterXSize, nRasterYSize, psGrid,
-                                  pszMsg, nMsg);
+    return LoadDEM(psGrid, pszMsg, nMsg);
 }
 
 /* Compute the product once; later calls return the same outcome. */

@@ -81,6 +81,7 @@ class TSDataset final : public GDALPamDataset
     CPLErr WindowBlock(int iPlane, int x0, int y0, int nBW, int nBH, bool bByte, void *pImage);
     bool Setup(const char *pszConnection, int W, int H);
     static GDALDataset *OpenDEM(const char *pszDEM);
+    ts_status LoadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg);
     void StartReadAhead();
     ts_status ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg);
     TSDataset *Overview(int i);
