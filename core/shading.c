@@ -1,6 +1,7 @@
 /* Direct sun with the visible fraction of the sun's disk, and the final mix. */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "arg_checks.h"
 #include "cellmath/cm_sun.h"
@@ -56,7 +57,11 @@ typedef struct {
     float *out;
 } direct_ctx;
 
-/* cm_direct_sun is branch-free, so that this loop vectorises. */
+/* cm_direct_sun is branch-free, so that this loop vectorises (AVX-512/AVX2
+ * clones: the same float operations, no contraction under -std=c11). */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
 static void direct_range(void *ctx, int worker, long begin, long end)
 {
     (void)worker;
@@ -87,13 +92,15 @@ typedef struct {
 } direct_horn_ctx;
 
 /* Rows begin..end-1: the Horn normals of a row into row buffers, then
- * direct_range's term from them; the same bits as the two passes. */
+ * direct_range's term from them; the same bits as the two passes. In place
+ * (the horizons in out), a row's horizons are copied first (restrict). */
 static void direct_horn_rows(void *ctx, int worker, long begin, long end)
 {
     (void)worker;
     const direct_horn_ctx *C = ctx;
     const int W = C->grid->width;
-    float *n = malloc(3 * (size_t)W * sizeof *n);
+    const int in_place = C->d.h0 == C->d.out; /* and h1 (shade_direct) */
+    float *n = malloc((in_place ? 4 : 3) * (size_t)W * sizeof *n);
     if (!n) {
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
         return;
@@ -108,6 +115,10 @@ static void direct_horn_rows(void *ctx, int worker, long begin, long end)
         row.h0 += o;
         row.h1 += o;
         row.out += o;
+        if (in_place) { /* one direction: h0 and h1 are the same plane */
+            memcpy(n + 3 * (size_t)W, row.h0, (size_t)W * sizeof *n);
+            row.h0 = row.h1 = n + 3 * (size_t)W;
+        }
         direct_range(&row, worker, 0, W);
     }
     free(n);
@@ -121,6 +132,9 @@ static ts_status shade_direct(const ts_direct_request *req, int horn, ts_error *
     ts_status st = horn ? ts_direct_setup_horn(req, &p, err) : ts_direct_setup(req, &p, err);
     if (st != TS_OK)
         return st;
+    if (req->out == req->horizons && !(horn && p.k0 == 0 && p.k1 == 0))
+        return ts_fail(err, TS_ERR_ARG,
+                       "the direct sun is computed in place only from one horizon plane");
     size_t plane = (size_t)req->grid->width * req->grid->height;
     int threads = ts_thread_count(req->opts ? req->opts->threads : 0, (long)(plane >> 16) + 1),
         failed = 0;

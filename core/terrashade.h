@@ -370,7 +370,8 @@ ts_shade_direct_fn ts_shade_direct;
  * ts_shade_direct with the normals computed on the fly, row by row, from
  * req->grid by Horn's method (as ts_normals): req->nx, ny, nz are not read
  * and may be NULL. The same values as ts_normals then ts_shade_direct,
- * without the three planes of normals.
+ * without the three planes of normals. With one direction, req->out may be
+ * req->horizons (in place: no plane besides the output).
  */
 ts_shade_direct_fn ts_shade_direct_horn;
 

@@ -350,10 +350,11 @@ TSD_COMPUTE_FN(tsd_compute_shade)
     tsd_normals nm = {0};
     ts_error err;
     ts_status st;
-    float *work = malloc(cells * sizeof(float));
-    /* the exact method's direct sun alone makes its normals row by row */
+    /* the exact method's direct sun alone makes its normals row by row,
+     * and takes the sun's horizons in out (a fresh plane costs page faults) */
     int planes = !(c->opts->method == TSD_METHOD_EXACT && !sun_lattice(c) &&
                    !(c->opts->sky_weight > 0));
+    float *work = planes ? malloc(cells * sizeof(float)) : out;
     if (!work)
         st = oom(c, "a horizon plane");
     else if ((st = planes ? tsd_normals_make(c, g, &nm) : TS_OK) == TS_OK &&
@@ -365,7 +366,8 @@ TSD_COMPUTE_FN(tsd_compute_shade)
             ts_shade_combine(g, out, work, c->opts->sky_weight, out, &err) != TS_OK)
             st = core_fail(c, &err);
     }
-    free(work);
+    if (work != out)
+        free(work);
     tsd_normals_free(&nm);
     return st;
 }

@@ -390,6 +390,43 @@ START_TEST(test_direct_horn_same_bits)
 }
 END_TEST
 
+/* The direct sun in place (req->out is the one horizon plane, as the
+ * driver's shade takes it): the same bits as into another plane; refused
+ * with several horizon planes. */
+START_TEST(test_direct_horn_in_place)
+{
+    ts_grid g;
+    tdem_create(&g, 53, 41, 10.0, 12.0);
+    tdem_fractal(&g, 7, 300.0);
+    g.z[17 * g.stride + 9] = NAN;
+    const size_t n = (size_t)g.width * g.height;
+    float *hz = tdem_floats(n), *a = tdem_floats(n);
+    const double sun[][2] = {{100, 20}, {315, 45}, {200, 0.1}, {90, -2}};
+    ts_error err;
+    for (int k = 0; k < 4; k++) {
+        ts_horizon_opts o;
+        ts_horizon_opts_default(&o);
+        o.directions = 1;
+        o.start_azimuth = sun[k][0];
+        ck_assert_msg(ts_horizon_compute(&g, &o, hz, &err) == TS_OK, "%s", err.message);
+        ts_direct_request req = {&g, NULL, NULL, NULL, hz, &o, sun[k][0], sun[k][1], a, 0.0};
+        ck_assert_msg(ts_shade_direct_horn(&req, &err) == TS_OK, "%s", err.message);
+        req.out = hz;
+        ck_assert_msg(ts_shade_direct_horn(&req, &err) == TS_OK, "%s", err.message);
+        ck_assert_msg(memcmp(a, hz, n * sizeof *a) == 0, "sun %g/%g: other bits in place",
+                      sun[k][0], sun[k][1]);
+    }
+    lit L = light_setup(&g);
+    const ts_direct_request req = {&g, NULL, NULL, NULL, L.hor, &L.o, 100, 20, L.hor, 0.0};
+    ck_assert(ts_shade_direct_horn(&req, &err) == TS_ERR_ARG);
+    ck_assert_msg(strstr(err.message, "in place") != NULL, "%s", err.message);
+    free(hz);
+    free(a);
+    light_free(&L);
+    ts_grid_free(&g);
+}
+END_TEST
+
 int main(void)
 {
     setvbuf(stdout, NULL, _IOLBF, 0); /* lines reach the log before a failure exits */
@@ -402,6 +439,7 @@ int main(void)
     tcase_add_test(tc, test_direct_flat);
     tcase_add_test(tc, test_direct_tilted);
     tcase_add_test(tc, test_direct_horn_same_bits);
+    tcase_add_test(tc, test_direct_horn_in_place);
     tcase_add_test(tc, test_direct_pillar_shadow);
     tcase_add_test(tc, test_combine);
     tcase_add_test(tc, test_sky_flat_and_tilted);
