@@ -500,6 +500,17 @@ static void sweep_range(void *ctx, int worker, long begin, long end)
     ws_free(&w);
 }
 
+/* Slopes to degrees over a row, in AVX-512/AVX2 clones (branch-free; the
+ * same float operations at any width). */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+static void degrees_row(float *restrict o, int n)
+{
+    for (int x = 0; x < n; x++)
+        o[x] = ts_atan_deg(o[x]);
+}
+
 /* Rows [y0, y1): add each cell's near field to the far-field slope the
  * lines left in out, then turn slopes into degrees. */
 static void finish_rows(void *ctx, int worker, long y0, long y1)
@@ -539,8 +550,7 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
         }
         if (C->cap > 0)
             ts_cap_tail(C->geom, grid, C->cap, C->c, (int)y, zrow, orow, step);
-        for (int x = 0; x < W; x++)
-            orow[x] = ts_atan_deg(orow[x]);
+        degrees_row(orow, W);
     }
     if (!scratch)
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);

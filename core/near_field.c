@@ -99,22 +99,40 @@ static void near_run(const ts_near_plan *p, const float *restrict zrow, int x0, 
     }
 }
 
+/* out[x] = max(best[x], out[x]) over the cells with a height and no flag,
+ * branch-free; returns whether any cell is flagged. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
+static int near_merge(const float *restrict zrow, const float *restrict best,
+                      const float *restrict flag, int x0, int x1, float *restrict out)
+{
+    int flagged = 0;
+    for (int x = x0; x < x1; x++) {
+        const float o = out[x], b = best[x];
+        const int take = (zrow[x] == zrow[x]) & (flag[x] == 0.0f) & (b > o);
+        out[x] = take ? b : o;
+        flagged |= flag[x] != 0.0f;
+    }
+    return flagged;
+}
+
 void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
                  const float *zrow, int y, int x0, int x1, double step, double c,
                  float *out, float *scratch)
 {
     float *best = scratch, *flag = scratch + x1;
     near_run(p, zrow, x0, x1, (float)step, (float)c, best, flag);
+    if (!near_merge(zrow, best, flag, x0, x1, out))
+        return;
+    /* cells whose near field touches nodata: the scalar near field */
     for (int x = x0; x < x1; x++) {
-        if (isnan(zrow[x]))
+        if (flag[x] == 0.0f || isnan(zrow[x]))
             continue;
-        float nf = best[x];
-        if (flag[x] != 0.0f) {
-            int u = g->x_major ? x : y, v = g->x_major ? y : x;
-            int left;
-            nf = ts_near_field(p, g, z, (u - g->u_start) * g->u_step, v, zrow[x], step, c, 0.0,
-                               &left);
-        }
+        int u = g->x_major ? x : y, v = g->x_major ? y : x;
+        int left;
+        float nf = ts_near_field(p, g, z, (u - g->u_start) * g->u_step, v, zrow[x], step, c,
+                                 0.0, &left);
         out[x] = nf > out[x] ? nf : out[x];
     }
 }
