@@ -295,6 +295,10 @@ char *tsd_products_xml(void)
     return tsd_strbuf_finish(&b);
 }
 
+/* AVX-512/AVX2 clones: CopyRow runs in the caller's one thread. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
 void tsd_row_to_byte(const float *restrict v, int n, unsigned char *restrict out)
 {
     /* on the bits, without float compares (which would keep the loop from
