@@ -32,12 +32,7 @@
 #ifndef CHUNK
 #define CHUNK 512 /* columns: the rows of every level a chunk reads stay in L2 */
 #endif
-/* Rows whose per-level entries are filled at a time, and that a chunk of
- * columns goes down before the next chunk: each chunk's start reloads the
- * level rows its cells read (at 4096², from memory), so long bands pay
- * (with 32 rows the 4096² horizons took 8-25 % longer). 256 rows of
- * entries are 5.4 MiB at 4 azimuths and 49 levels. */
-#define ROW_BLOCK 256
+#define ROW_BLOCK 32 /* rows whose per-level entries are filled at a time */
 
 /* What sample j of the cells of one row shares: the level rows at the
  * samples' row (the vertical taps), the cells' own row on the level, and
@@ -331,8 +326,7 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
     float *own = malloc((size_t)3 * W * sizeof *own + sizeof *own);
     double *tpp = malloc((size_t)3 * W * sizeof *tpp);
     int *jd = malloc((size_t)n * W * sizeof *jd);
-    const long block = y1 - y0 < ROW_BLOCK ? y1 - y0 : ROW_BLOCK;
-    row_level *rl = malloc((size_t)n * block * levels * sizeof *rl);
+    row_level *rl = malloc((size_t)n * ROW_BLOCK * levels * sizeof *rl);
     row_ws w[TS_PYRAMID_BATCH];
     if (!buf || !own || !tpp || !jd || !rl) {
         free(buf);
@@ -348,13 +342,13 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
         w[a] = (row_ws){f, f + W, f + 2 * W, f + 3 * W, f + 4 * W, f + 5 * W + 1, tpp,
                         jd + (size_t)a * W, NULL, 1, 0};
     }
-    for (long yb = y0; yb < y1; yb += block) {
-        long ye = yb + block < y1 ? yb + block : y1;
+    for (long yb = y0; yb < y1; yb += ROW_BLOCK) {
+        long ye = yb + ROW_BLOCK < y1 ? yb + ROW_BLOCK : y1;
         for (int a = 0; a < n; a++)
             for (long y = yb; y < ye; y++)
                 for (int j = 0; j < levels; j++)
                     row_level_fill(&B->az[a], (int)y, B->az[a].lv[j].lev, B->az[a].lv[j].s,
-                                   a == 0, &rl[((size_t)a * block + (y - yb)) * levels + j]);
+                                   a == 0, &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels + j]);
         /* a chunk of columns down the rows, then the next: the level rows
          * that the cells of a chunk read stay in the cache from row to row */
         for (int c0 = 0; c0 < W; c0 += CHUNK) {
@@ -362,7 +356,7 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
             for (long y = yb; y < ye; y++) {
                 const row_level *rly[TS_PYRAMID_BATCH];
                 for (int a = 0; a < n; a++)
-                    rly[a] = &rl[((size_t)a * block + (y - yb)) * levels];
+                    rly[a] = &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels];
                 batch_row(B, w, (int)y, c0, c1, rly, own, own + W, own + 2 * W);
             }
         }
