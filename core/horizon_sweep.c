@@ -20,9 +20,7 @@
  * its samples instead (window_hull.h): those beyond the near field and
  * within the distance, in amortised O(1) per sample like the unbounded
  * hull; the near field is cut at the distance, and the last part of a step
- * before it is solved exactly on each cell's ray. Long distances keep the
- * window lazily: the hull of all the samples answers wherever its tangent
- * lies within the distance, and the window catches up only elsewhere.
+ * before it is solved exactly on each cell's ray.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -39,11 +37,6 @@
 #include "window_hull.h"
 
 typedef ts_hull_pt hull_pt;
-
-/* Distances of at least this many steps use the lazy window. */
-#ifndef TS_LAZY_WINDOW_STEPS
-#define TS_LAZY_WINDOW_STEPS 64
-#endif
 
 /* The far-field occluder a hull query found: its step index on the line and
  * its distance from the query point; k < 0 when there is none. */
@@ -67,7 +60,6 @@ typedef struct {
     ts_near_plan near;
     double near_skip;   /* hull points closer than this are near field */
     int near_only;      /* the distance ends inside the near field: no lines */
-    int lazy;           /* the far-field window in lazy mode (window_hull.h) */
     cm_ray_grid ray;    /* the grid as the geometry sees it, for cm_ray_slope */
 } sweep_ctx;
 
@@ -78,7 +70,7 @@ typedef struct {
     int raw_n;
     ts_window_hull win; /* with a maximum distance: the far-field window */
     ts_window_hull vwin; /* and the visitor's (all samples within the distance) */
-    int finger[3][3];   /* where the window queries of each kind last ended */
+    int finger[3][2];   /* where the window queries of each kind last ended */
     ts_line_pair lo;    /* occluders of the far side (occluder entries) */
     /* visitor buffers */
     float *vx, *vy, *vh, *vs;
@@ -144,13 +136,12 @@ static inline int hull_push(hull_pt *S, int *n, int *far, double d, double gs, i
  * while the slope grows (the slopes to an upper convex hull from a point
  * beyond it are unimodal). With a maximum distance, the window's. */
 static inline __attribute__((always_inline)) occluder
-hull_query(const sweep_ctx *C, sweep_ws *w, int far, double d, float h, int finger[3])
+hull_query(const sweep_ctx *C, sweep_ws *w, int far, double d, float h, int finger[2])
 {
     occluder none = {-1, 0.0f};
     double g = h - C->c * d * d;
     if (C->cap > 0) {
-        const hull_pt *p = C->lazy ? ts_window_hull_query_lazy(&w->win, w->raw, d, g, finger)
-                                   : ts_window_hull_query(&w->win, d, g, finger);
+        const hull_pt *p = ts_window_hull_query(&w->win, d, g, finger);
         return p ? (occluder){p->k, (float)(d - p->d)} : none;
     }
     return stack_query(w->stack, far, d, g);
@@ -250,10 +241,7 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
                 }
                 w->raw[w->raw_n++] = (hull_pt){d, gs, k};
             }
-            if (C->lazy)
-                ts_window_hull_track(&w->win, w->raw, w->raw_n, d, C->near_skip, C->cap);
-            else
-                ts_window_hull_slide(&w->win, w->raw, w->raw_n, d, C->near_skip, C->cap);
+            ts_window_hull_slide(&w->win, w->raw, w->raw_n, d, C->near_skip, C->cap);
             pushed = 1;
         } else if (!isnan(hs)) {
             double gs = hs - c * d * d;
@@ -586,9 +574,6 @@ static ts_status sweep_setup(const ts_grid *grid, double azimuth,
     C->cap = opts->max_distance > longest * geom->U ? 0.0 : opts->max_distance;
     /* Within the near field of every row, the near field is all there is. */
     C->near_only = C->cap > 0 && C->cap <= TS_NEAR_STEPS * shortest;
-    /* The lazy window pays where it holds many samples (callgrind, 400^2:
-     * 3-8 % fewer instructions at 100-200 steps, 1-8 % more at 20-50). */
-    C->lazy = C->cap >= TS_LAZY_WINDOW_STEPS * geom->step_m;
     return TS_OK;
 }
 

@@ -11,8 +11,7 @@ int ts_window_hull_alloc(ts_window_hull *w, int n)
     w->front = calloc((size_t)n + 1, sizeof *w->front);
     w->undo_pt = calloc((size_t)n + 1, sizeof *w->undo_pt);
     w->undo_n = calloc((size_t)n + 1, sizeof *w->undo_n);
-    w->all = malloc(((size_t)n + 1) * sizeof *w->all);
-    return w->back && w->front && w->undo_pt && w->undo_n && w->all;
+    return w->back && w->front && w->undo_pt && w->undo_n;
 }
 
 void ts_window_hull_free(ts_window_hull *w)
@@ -21,15 +20,14 @@ void ts_window_hull_free(ts_window_hull *w)
     free(w->front);
     free(w->undo_pt);
     free(w->undo_n);
-    free(w->all);
     *w = (ts_window_hull){0};
 }
 
-void ts_window_hull_refill_range(ts_window_hull *w, const ts_hull_pt *pts, int lo, int hi)
+void ts_window_hull_refill(ts_window_hull *w, const ts_hull_pt *pts)
 {
     ts_hull_pt *F = w->front;
     w->nf = 0;
-    for (int i = hi - 1; i >= lo; i--) {
+    for (int i = w->in - 1; i >= w->out; i--) {
         const ts_hull_pt p = pts[i];
         /* mirror of the back's pop: seen forward from p, F[m - 1] is
          * hidden when F[m - 2] is at least as steep */
@@ -42,4 +40,6 @@ void ts_window_hull_refill_range(ts_window_hull *w, const ts_hull_pt *pts, int l
         F[m] = p;
         w->nf = m + 1;
     }
+    w->mid = w->in;
+    w->nb = 0;
 }

@@ -37,13 +37,6 @@ typedef struct {
     int nf;
     ts_hull_pt *undo_pt; /* by sample index: what its front push overwrote */
     int *undo_n;         /* by sample index: front size before its push */
-    /* Lazy mode (ts_window_hull_track): the hulls lag behind the indices */
-    ts_hull_pt *all;     /* hull of every sample that entered, [0, in) */
-    int nall;
-    int bin;             /* the back holds samples [mid, bin) */
-    int fmid;            /* the front was last refilled up to fmid */
-    int fout;            /* and its undos applied up to fout */
-    int rlo;             /* the latest refill takes samples [rlo, mid) */
 } ts_window_hull;
 
 /* Buffers for lines of up to n samples; 0 if out of memory (then
@@ -56,31 +49,10 @@ static inline void ts_window_hull_reset(ts_window_hull *w)
 {
     w->in = w->mid = w->out = 0;
     w->nb = w->nf = 0;
-    w->nall = w->bin = w->fmid = w->fout = w->rlo = 0;
 }
-
-/* Rebuild the front from samples [lo, hi), newest first, recording the
- * undo of each push. */
-void ts_window_hull_refill_range(ts_window_hull *w, const ts_hull_pt *pts, int lo, int hi);
 
 /* Rebuild the front from samples [out, in), newest first; the back empties. */
-static inline void ts_window_hull_refill(ts_window_hull *w, const ts_hull_pt *pts)
-{
-    ts_window_hull_refill_range(w, pts, w->out, w->in);
-    w->mid = w->in;
-    w->nb = 0;
-}
-
-/* Push p onto the upper hull S[0, m) (oldest first), popping the points it
- * hides; returns the new size. */
-static inline int ts_hull_push(ts_hull_pt *S, int m, ts_hull_pt p)
-{
-    while (m >= 2 && (S[m - 2].g - p.g) * (p.d - S[m - 1].d) >=
-                         (S[m - 1].g - p.g) * (p.d - S[m - 2].d))
-        m--;
-    S[m] = p;
-    return m + 1;
-}
+void ts_window_hull_refill(ts_window_hull *w, const ts_hull_pt *pts);
 
 /*
  * Slide the window to query distance d over the line's samples pts[0, n):
@@ -90,8 +62,16 @@ static inline int ts_hull_push(ts_hull_pt *S, int m, ts_hull_pt p)
 static inline void ts_window_hull_slide(ts_window_hull *w, const ts_hull_pt *pts, int n,
                                         double d, double near, double cap)
 {
-    while (w->in < n && d - pts[w->in].d >= near)
-        w->nb = ts_hull_push(w->back, w->nb, pts[w->in++]);
+    while (w->in < n && d - pts[w->in].d >= near) {
+        const ts_hull_pt p = pts[w->in++];
+        ts_hull_pt *S = w->back;
+        int m = w->nb;
+        while (m >= 2 && (S[m - 2].g - p.g) * (p.d - S[m - 1].d) >=
+                             (S[m - 1].g - p.g) * (p.d - S[m - 2].d))
+            m--;
+        S[m] = p;
+        w->nb = m + 1;
+    }
     while (w->out < w->in && d - pts[w->out].d > cap) {
         if (w->out == w->mid)
             ts_window_hull_refill(w, pts);
@@ -105,35 +85,15 @@ static inline void ts_window_hull_slide(ts_window_hull *w, const ts_hull_pt *pts
 
 /* The hull point of largest slope seen from (d, g) among P[0, n), n > 0,
  * found by climbing from P[j] (the slopes along a hull are unimodal, and a
- * query from the next sample's point has its tangent nearby). If tie is
- * not NULL, *tie says whether P[j - 1] is as steep as the answer (the climb
- * stops on a strictly less steep P[j + 1], so only P[j - 1] can tie). */
-static inline __attribute__((always_inline)) int ts_hull_climb_tie(const ts_hull_pt *P, int n,
-                                                                   int j, double d, double g,
-                                                                   int *tie)
+ * query from the next sample's point has its tangent nearby). */
+static inline int ts_hull_climb(const ts_hull_pt *P, int n, int j, double d, double g)
 {
     j = j < n ? j : n - 1;
     while (j + 1 < n && (P[j + 1].g - g) * (d - P[j].d) >= (P[j].g - g) * (d - P[j + 1].d))
         j++;
-    for (;;) {
-        if (j == 0) {
-            if (tie)
-                *tie = 0;
-            return 0;
-        }
-        double up = (P[j - 1].g - g) * (d - P[j].d), here = (P[j].g - g) * (d - P[j - 1].d);
-        if (!(up > here)) {
-            if (tie)
-                *tie = up == here;
-            return j;
-        }
+    while (j > 0 && (P[j - 1].g - g) * (d - P[j].d) > (P[j].g - g) * (d - P[j - 1].d))
         j--;
-    }
-}
-
-static inline int ts_hull_climb(const ts_hull_pt *P, int n, int j, double d, double g)
-{
-    return ts_hull_climb_tie(P, n, j, d, g, NULL);
+    return j;
 }
 
 /* The window's sample of largest slope (g_p - g) / (d - d_p) seen from the
@@ -155,66 +115,6 @@ static inline const ts_hull_pt *ts_window_hull_query(const ts_window_hull *w, do
             best = b;
     }
     return best;
-}
-
-/*
- * Lazy mode: ts_window_hull_track moves the window's bounds as
- * ts_window_hull_slide would, but only pushes the entering samples onto
- * `all`, the hull of every sample that entered (the unbounded hull, less
- * the near field). Where the tangent to `all` lies in the window, it is the
- * window's answer; only elsewhere do the two hulls catch up, replaying the
- * pushes, refill and undos that the slides would have done, in order.
- */
-static inline void ts_window_hull_track(ts_window_hull *w, const ts_hull_pt *pts, int n,
-                                        double d, double near, double cap)
-{
-    while (w->in < n && d - pts[w->in].d >= near)
-        w->nall = ts_hull_push(w->all, w->nall, pts[w->in++]);
-    while (w->out < w->in && d - pts[w->out].d > cap) {
-        if (w->out == w->mid) { /* ts_window_hull_slide refills here */
-            w->rlo = w->out;
-            w->mid = w->in;
-        }
-        w->out++;
-    }
-}
-
-/* Bring the two hulls to the state the slides would have left them in. */
-static inline void ts_window_hull_catch_up(ts_window_hull *w, const ts_hull_pt *pts)
-{
-    if (w->fmid != w->mid) { /* refilled since: only the latest refill counts */
-        ts_window_hull_refill_range(w, pts, w->rlo, w->mid);
-        w->fmid = w->mid;
-        w->fout = w->rlo;
-        w->nb = 0;
-        w->bin = w->mid;
-    }
-    for (; w->fout < w->out; w->fout++) {
-        w->front[w->nf - 1] = w->undo_pt[w->fout];
-        w->nf = w->undo_n[w->fout];
-    }
-    while (w->bin < w->in)
-        w->nb = ts_hull_push(w->back, w->nb, pts[w->bin++]);
-}
-
-/* ts_window_hull_query for a window moved by ts_window_hull_track. The
- * tangent to `all` answers when it lies in the window and no other point
- * of `all` is as steep (the climbs break ties their own way). finger[2]
- * is where the last such query ended on `all`. */
-static inline __attribute__((always_inline)) const ts_hull_pt *ts_window_hull_query_lazy(ts_window_hull *w,
-                                                          const ts_hull_pt *pts, double d,
-                                                          double g, int finger[3])
-{
-    const ts_hull_pt *S = w->all;
-    const int n = w->nall;
-    if (n > 0 && w->out < w->in) {
-        int tie;
-        int j = finger[2] = ts_hull_climb_tie(S, n, finger[2], d, g, &tie);
-        if (!tie && S[j].d >= pts[w->out].d)
-            return &S[j];
-    }
-    ts_window_hull_catch_up(w, pts);
-    return ts_window_hull_query(w, d, g, finger);
 }
 
 #endif
