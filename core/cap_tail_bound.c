@@ -3,6 +3,7 @@
 #include <math.h>
 
 #include "cap_tail_bound.h"
+#include "simd_clones.h"
 
 /* Corner weights of the point (a, b) of a patch, clamped into it. */
 static void corner_weights(double a, double b, float w[4])
@@ -145,9 +146,7 @@ void ts_cap_stencil_range(const ts_cap_stencil *s, const ts_line_geom *G, int wi
  * the nodata count into flag[]: plain float loops the compiler vectorises.
  * Along the chord, (h(s) - h) / s is monotonic, so its ends bound it; the
  * concave bulge and the rounding margin count at the nearer end. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
+TS_SIMD_CLONES
 static void piece_run(const float *restrict zrow, const ptrdiff_t off[4], const float wa[4],
                       const float wb[4], float tb, float inv_a, float inv_b, int xa, int xb,
                       float *restrict bound, float *restrict flag)

@@ -32,6 +32,7 @@
 #include "line_geometry.h"
 #include "near_field.h"
 #include "parallel.h"
+#include "simd_clones.h"
 #include "status_internal.h"
 #include "sweep_cap_tail.h"
 #include "window_hull.h"
@@ -502,9 +503,7 @@ static void sweep_range(void *ctx, int worker, long begin, long end)
 
 /* Slopes to degrees over a row, in AVX-512/AVX2 clones (branch-free; the
  * same float operations at any width). */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
+TS_SIMD_CLONES
 static void degrees_row(float *restrict o, int n)
 {
     for (int x = 0; x < n; x++)

@@ -4,12 +4,7 @@
 
 #include "cellmath/cm_near_field.h"
 #include "lane_passes.h"
-
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define LANE_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define LANE_CLONES
-#endif
+#include "simd_clones.h"
 
 /* ts_lane_sample with the lines' cells vs elements apart: a constant 1
  * where they are neighbours in memory, so that the loops vectorise. */
@@ -34,7 +29,7 @@ sample_run(const float *restrict zk, ptrdiff_t vs, float F, int j0, int j1, int 
         hn[j] = hs[j] = (float)NAN;
 }
 
-LANE_CLONES
+TS_SIMD_CLONES
 void ts_lane_sample(const ts_line_geom *G, const float *z, int k, int i0, int j0, int j1,
                     float *hc, float *hn, float *hs)
 {
@@ -113,13 +108,13 @@ ray_at(ray_view R, int wide, const int *restrict ray_o, const float *restrict ra
         const float *restrict hc, const int *restrict lo_k, const float *restrict lo_dd,       \
         const int *restrict hi_k, const float *restrict hi_dd, float *restrict slope
 
-LANE_CLONES
+TS_SIMD_CLONES
 static void far_run32(FAR_PARAMS)
 {
     FAR_LOOP(0)
 }
 
-LANE_CLONES
+TS_SIMD_CLONES
 static void far_run64(FAR_PARAMS)
 {
     FAR_LOOP(1)

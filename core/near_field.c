@@ -5,6 +5,7 @@
 #include <stdlib.h>
 
 #include "near_field.h"
+#include "simd_clones.h"
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -72,9 +73,7 @@ float ts_ray_exact(const ts_line_geom *g, const float *z, int k, int i, float h,
  * arithmetic in loops the compiler vectorises. NaN corners make the slope
  * NaN, which the comparison ignores; such cells are flagged and redone in
  * scalar code. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
+TS_SIMD_CLONES
 static void near_run(const ts_near_plan *p, const float *restrict zrow, int x0, int x1,
                      float L, float c, float *restrict best, float *restrict flag)
 {
@@ -101,9 +100,7 @@ static void near_run(const ts_near_plan *p, const float *restrict zrow, int x0, 
 
 /* out[x] = max(best[x], out[x]) over the cells with a height and no flag,
  * branch-free; returns whether any cell is flagged. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
+TS_SIMD_CLONES
 static int near_merge(const float *restrict zrow, const float *restrict best,
                       const float *restrict flag, int x0, int x1, float *restrict out)
 {

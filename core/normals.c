@@ -6,6 +6,7 @@
 #include "cellmath/cm_normals.h"
 #include "horn_row.h"
 #include "parallel.h"
+#include "simd_clones.h"
 #include "status_internal.h"
 
 typedef struct {
@@ -22,9 +23,7 @@ static inline float horn_nb(float v, float centre)
 /* cm_horn_normal of cells x0..x1-1 of a row whose 3x3 neighbourhoods lie
  * inside the grid (rows up, mid, dn): the same operations in the same order
  * without the bounds checks, so it vectorises and gives the same bits. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
+TS_SIMD_CLONES
 static void horn_interior(const float *restrict up, const float *restrict mid,
                           const float *restrict dn, int x0, int x1, double ew, double ns,
                           float *restrict nx, float *restrict ny, float *restrict nz)

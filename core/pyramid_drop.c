@@ -96,7 +96,7 @@ static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int
 /* The last sample A[x] of each cell of [a, b], its sample number jd[x]
  * (B-spline only), then its horizon into out: push_run and finish_run for
  * one cell, with the sample number per cell (selects, not branches). */
-TS_PYR_CLONES
+TS_SIMD_CLONES
 static void finish_last(row_ws *w, int bspline, int a, int b, const float *restrict A,
                         float *restrict out)
 {
@@ -135,7 +135,7 @@ static void finish_last(row_ws *w, int bspline, int a, int b, const float *restr
     }
 }
 
-TS_PYR_CLONES
+TS_SIMD_CLONES
 void ts_pyr_drop_cells(const hz_ctx *C, row_ws *w, int y, int a, int b, double t_row,
                        float *out)
 {

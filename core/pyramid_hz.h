@@ -4,12 +4,7 @@
 #define TS_PYRAMID_HZ_H
 
 #include "pyramid_internal.h"
-
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define TS_PYR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define TS_PYR_CLONES
-#endif
+#include "simd_clones.h"
 
 /* What sample j of every cell shares for one azimuth: its offset in
  * cells, split into a whole column ix and a fraction fx, the columns

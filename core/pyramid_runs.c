@@ -10,7 +10,7 @@
 #include "pyramid_hz.h"
 
 /* dst[x] = sum of weights w[t] * rows r[t] at x, for x in [x0, x1]. */
-TS_PYR_CLONES
+TS_SIMD_CLONES
 void ts_pyr_combine_rows(const float *const r[4], const float w[4], int taps, int x0, int x1,
                          float *restrict dst)
 {
@@ -51,7 +51,7 @@ static inline void spline_step(float *restrict s0, float *restrict s1, float *re
 
 /* Add sample number c (value a_in[x] for the cells of [x0, x1]) to the
  * spline (or the maximum), as core/pyramid_horizon.c says. */
-TS_PYR_CLONES
+TS_SIMD_CLONES
 void ts_pyr_push_run(row_ws *w, int bspline, int c, int x0, int x1, const float *restrict a_in)
 {
     float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
@@ -89,7 +89,7 @@ void ts_pyr_push_run(row_ws *w, int bspline, int c, int x0, int x1, const float 
  * R, at d metres (1 / d = inv_d, curvature drop over d
  * = cd). Pushed as sample c in the same pass where the spline allows,
  * else left in w->A for push_run (returns 0 then). */
-TS_PYR_CLONES
+TS_SIMD_CLONES
 int ts_pyr_level_run(row_ws *w, const float *restrict T, int ix, float fx,
                      const float *restrict R, float inv_d, float cd, int bspline, int c, int x0,
                      int x1)
@@ -124,7 +124,7 @@ int ts_pyr_level_run(row_ws *w, const float *restrict T, int ix, float fx,
 }
 
 /* The horizons of cells [x0, x1] after `count` >= 1 samples, into out. */
-TS_PYR_CLONES
+TS_SIMD_CLONES
 void ts_pyr_finish_run(row_ws *w, int bspline, int count, int x0, int x1, float *restrict out)
 {
     float *restrict s1 = w->s1, *restrict s2 = w->s2, *restrict m = w->m;

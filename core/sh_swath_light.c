@@ -26,6 +26,7 @@
 
 #include "parallel.h"
 #include "sh_internal.h"
+#include "simd_clones.h"
 #include "status_internal.h"
 
 #define N TS_SH_COEFFS
@@ -159,9 +160,7 @@ static inline void store_shade(const swath_ctx *C, size_t c, float shade)
 }
 
 /* Cells c0..c1 (cloned for wider vectors where the CPU has them). */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
+TS_SIMD_CLONES
 static void swath_cells(const swath_ctx *C, size_t c0, size_t c1)
 {
     const ts_sh_wedges *w = C->w;
@@ -235,9 +234,7 @@ static inline void add_folded_boundary(const swath_ctx *C, int slot, float w,
 }
 
 /* Cells c0..c1 from the folded tables. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
+TS_SIMD_CLONES
 static void folded_cells(const swath_ctx *C, size_t c0, size_t c1)
 {
     const float *const *P = C->planes;

@@ -12,6 +12,7 @@
 
 #include "parallel.h"
 #include "sh_internal.h"
+#include "simd_clones.h"
 #include "status_internal.h"
 
 #define DEG2RAD (M_PI / 180.0)
@@ -233,9 +234,7 @@ typedef struct {
 
 /* Cells c0..c1 of one wedge (cloned for wider vectors where the CPU has
  * them). */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
+TS_SIMD_CLONES
 static void wedge_cells(const wedge_ctx *C, size_t c0, size_t c1)
 {
     const int kind = C->a && C->b ? 2 : C->a ? 0 : 1;

@@ -7,6 +7,7 @@
 #include "cellmath/cm_sun.h"
 #include "horn_row.h"
 #include "parallel.h"
+#include "simd_clones.h"
 #include "status_internal.h"
 
 double ts_sun_disk_fraction(double sun_elevation, double horizon)
@@ -59,9 +60,7 @@ typedef struct {
 
 /* cm_direct_sun is branch-free, so that this loop vectorises (AVX-512/AVX2
  * clones: the same float operations, no contraction under -std=c11). */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
+TS_SIMD_CLONES
 static void direct_range(void *ctx, int worker, long begin, long end)
 {
     (void)worker;

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "cellmath/cm_sun.h"
+#include "simd_clones.h"
 #include "sun_range_internal.h"
 
 #define BLOCK 256
@@ -21,9 +22,7 @@ static inline float horizon_at(const float *h0, const float *dh, const float *fl
     return h > fl[j] ? h : fl[j];
 }
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
+TS_SIMD_CLONES
 static void eval_range(void *ctx, int worker, long begin, long end)
 {
     (void)worker;

@@ -1,6 +1,7 @@
 /* The product table and what is derived from it; see tsd_products.h. */
 #include "tsd_products.h"
 
+#include "simd_clones.h"
 #include "tsd_pyramid.h"
 #include "tsd_text.h"
 
@@ -296,9 +297,7 @@ char *tsd_products_xml(void)
 }
 
 /* AVX-512/AVX2 clones: CopyRow runs in the caller's one thread. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default")))
-#endif
+TS_SIMD_CLONES
 void tsd_row_to_byte(const float *restrict v, int n, unsigned char *restrict out)
 {
     /* on the bits, without float compares (which would keep the loop from

@@ -1,0 +1,15 @@
+/* TS_SIMD_CLONES: a function compiled for AVX-512, AVX2 and baseline x86-64,
+ * chosen at load time (GCC's target_clones), so that a loop written once
+ * runs at the widest vectors the CPU has. Elsewhere it is nothing. The
+ * clones do the same float operations (no contraction under -std=c11), so
+ * the results have the same bits at any width. */
+#ifndef TS_SIMD_CLONES_H
+#define TS_SIMD_CLONES_H
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define TS_SIMD_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define TS_SIMD_CLONES
+#endif
+
+#endif
