@@ -5,6 +5,7 @@
 
 #include "day_cycle.h"
 #include "parallel.h"
+#include "simd_clones.h"
 #include "status_internal.h"
 
 #define DEG2RAD (M_PI / 180.0)
@@ -132,23 +133,40 @@ static inline float edge_raise(const edge_job *j, int x, int y, float v)
     return e > v ? e : v;
 }
 
+/* Whether cell x of a row keeps its horizon v without edge_raise: nodata
+ * stays nodata; from a height h >= 0 (c >= 0) the edge's tangent is <= 0,
+ * so a horizon at or above 0 deg stays (most cells of rough terrain, toward
+ * most azimuths), and every one when skip_nonneg. */
+static inline int edge_stays(float v, float z, int skip_nonneg, int above_stays)
+{
+    return (v != v) | ((z >= 0) & (skip_nonneg | (above_stays & (v >= 0))));
+}
+
+/* Whether some cell of the row needs edge_raise: branch-free, so that the
+ * common row where none does is one vectorised pass, not a scalar loop. */
+TS_SIMD_CLONES
+static int row_needs_raise(const float *restrict row, const float *restrict z, int w,
+                           int skip_nonneg, int above_stays)
+{
+    int need = 0;
+    for (int x = 0; x < w; x++)
+        need |= !edge_stays(row[x], z[x], skip_nonneg, above_stays);
+    return need;
+}
+
 static void edge_rows(void *ctx, int worker, long begin, long end)
 {
     (void)worker;
     const edge_job *j = ctx;
-    /* From a height h >= 0 (c >= 0) the edge's tangent is <= 0: a horizon
-     * at or above 0 deg stays, and needs neither the distance nor the
-     * tangent (most cells of rough terrain, toward most azimuths). */
     const int above_stays = j->opts->edge == TS_EDGE_HORIZON && j->c >= 0;
     for (long y = begin; y < end; y++) {
         float *row = j->plane + (size_t)y * j->grid->width;
         const float *z = j->grid->z + (ptrdiff_t)y * j->grid->stride;
-        for (int x = 0; x < j->grid->width; x++) {
-            float v = row[x];
-            if (isnan(v) || (z[x] >= 0 && (j->skip_nonneg || (above_stays && v >= 0))))
-                continue; /* nodata stays nodata */
-            row[x] = edge_raise(j, x, (int)y, v);
-        }
+        if (!row_needs_raise(row, z, j->grid->width, j->skip_nonneg, above_stays))
+            continue;
+        for (int x = 0; x < j->grid->width; x++)
+            if (!edge_stays(row[x], z[x], j->skip_nonneg, above_stays))
+                row[x] = edge_raise(j, x, (int)y, row[x]);
     }
 }
 

@@ -103,11 +103,80 @@ CPLErr TSRasterBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
     return CE_None;
 }
 
+/* A read of the band's own type at full resolution, once the whole product
+ * is computed (not chunk by chunk), copied from the product straight into
+ * the caller's rows: gdal_translate's copy then skips GDAL's block cache
+ * (a fresh 256 x 256 block per block read, and one more pass over every
+ * cell, in gdal_translate's one thread). Same cells as IReadBlock gives.
+ * false: the generic path reads it. */
+bool TSRasterBand::DirectRead(int nXOff, int nYOff, int nXSize, int nYSize, void *pData,
+                              GSpacing nLineSpace, GDALRasterIOExtraArg *psExtraArg,
+                              CPLErr *peErr)
+{
+    TSDataset *ds = static_cast<TSDataset *>(poDS);
+    if (ds->m_poWindow || ds->m_psProduct->byte == TSD_BYTE_ALWAYS)
+        return false;
+    if ((*peErr = ds->EnsureComputed()) != CE_None)
+        return true;
+    const int W = nRasterXSize, H = nRasterYSize;
+    const bool bByte = eDataType == GDT_Byte;
+    const float *plane = ds->m_pafProduct + static_cast<size_t>(m_nPlane) * W * H;
+    GByte *pabyOut = static_cast<GByte *>(pData);
+    for (int i = 0; i < nYSize; i++)
+    {
+        const int y = nYOff + i;
+        const int gy = ds->m_sCells.flip_y ? H - 1 - y : y;
+        GByte *pabyRow = pabyOut + static_cast<GPtrDiff_t>(i) * nLineSpace;
+        CopyCells(nXSize, plane + static_cast<size_t>(gy) * W, nXOff, W,
+                  ds->m_sCells.flip_x != 0, bByte, pabyRow, reinterpret_cast<float *>(pabyRow));
+    }
+    if (psExtraArg && psExtraArg->pfnProgress &&
+        !psExtraArg->pfnProgress(1.0, "", psExtraArg->pProgressData))
+    {
+        CPLError(CE_Failure, CPLE_UserInterrupt, "User terminated");
+        *peErr = CE_Failure;
+    }
+    return true;
+}
+
+CPLErr TSRasterBand::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize,
+                               int nYSize, void *pData, int nBufXSize, int nBufYSize,
+                               GDALDataType eBufType, GSpacing nPixelSpace, GSpacing nLineSpace,
+                               GDALRasterIOExtraArg *psExtraArg)
+{
+    CPLErr eErr = CE_None;
+    if (eRWFlag == GF_Read && nBufXSize == nXSize && nBufYSize == nYSize &&
+        eBufType == eDataType && nPixelSpace == GDALGetDataTypeSizeBytes(eDataType) &&
+        nLineSpace % nPixelSpace == 0 &&
+        reinterpret_cast<uintptr_t>(pData) % static_cast<uintptr_t>(nPixelSpace) == 0 &&
+        DirectRead(nXOff, nYOff, nXSize, nYSize, pData, nLineSpace, psExtraArg, &eErr))
+        return eErr;
+    return GDALPamRasterBand::IRasterIO(eRWFlag, nXOff, nYOff, nXSize, nYSize, pData,
+                                        nBufXSize, nBufYSize, eBufType, nPixelSpace,
+                                        nLineSpace, psExtraArg);
+}
+
 /* Cells x0 .. x0+n-1 of a product row (mirrored when flip_x) into a block
  * row, as bytes (tsd_to_byte) or floats; the rest of the block row is
- * nodata. Split by case so that each loop is a plain one. */
+ * nodata. */
 void TSRasterBand::CopyRow(int n, const float *row, int x0, int W, bool flip_x, bool bByte,
                            GByte *pabyOut, float *pafOut) const
+{
+    CopyCells(n, row, x0, W, flip_x, bByte, pabyOut, pafOut);
+    const float fNaN = std::numeric_limits<float>::quiet_NaN();
+    for (int bx = n; bx < nBlockXSize; bx++)
+    {
+        if (bByte)
+            pabyOut[bx] = tsd_to_byte(fNaN);
+        else
+            pafOut[bx] = fNaN;
+    }
+}
+
+/* Cells x0 .. x0+n-1 of a product row (mirrored when flip_x) as bytes or
+ * floats. */
+void TSRasterBand::CopyCells(int n, const float *row, int x0, int W, bool flip_x, bool bByte,
+                             GByte *pabyOut, float *pafOut)
 {
     if (bByte && !flip_x)
         tsd_row_to_byte(row + x0, n, pabyOut);
@@ -119,14 +188,6 @@ void TSRasterBand::CopyRow(int n, const float *row, int x0, int W, bool flip_x, 
     else
         for (int bx = 0; bx < n; bx++)
             pafOut[bx] = row[W - 1 - (x0 + bx)];
-    const float fNaN = std::numeric_limits<float>::quiet_NaN();
-    for (int bx = n; bx < nBlockXSize; bx++)
-    {
-        if (bByte)
-            pabyOut[bx] = tsd_to_byte(fNaN);
-        else
-            pafOut[bx] = fNaN;
-    }
 }
 
 /* ------------------------------------------------------------- dataset */

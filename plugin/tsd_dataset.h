@@ -120,11 +120,19 @@ class TSRasterBand final : public GDALPamRasterBand
     CPLErr WindowReadBlock(int nBlockXOff, int nBlockYOff, void *pImage); // tsd_window_cache.cpp
     void CopyRow(int n, const float *row, int x0, int W, bool flip_x, bool bByte, GByte *pabyOut,
                  float *pafOut) const;
+    static void CopyCells(int n, const float *row, int x0, int W, bool flip_x, bool bByte,
+                          GByte *pabyOut, float *pafOut);
+    bool DirectRead(int nXOff, int nYOff, int nXSize, int nYSize, void *pData,
+                    GSpacing nLineSpace, GDALRasterIOExtraArg *psExtraArg, CPLErr *peErr);
 
   public:
     TSRasterBand(TSDataset *poDSIn, int nBandIn, GDALDataType eType);
 
     CPLErr IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage) override;
+    CPLErr IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize, int nYSize,
+                     void *pData, int nBufXSize, int nBufYSize, GDALDataType eBufType,
+                     GSpacing nPixelSpace, GSpacing nLineSpace,
+                     GDALRasterIOExtraArg *psExtraArg) override;
     double GetNoDataValue(int *pbSuccess = nullptr) override;
     GDALColorInterp GetColorInterpretation() override
     {

@@ -4,12 +4,15 @@
 #include "tsd_text.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 
 #include "cpl_error.h"
+
+#include "simd_clones.h"
 
 #define STRIP_ROWS 256
 
@@ -110,12 +113,26 @@ static void metres_of(GDALRasterBandH band, double z_factor, double *scale, doub
     *offset *= z_factor;
 }
 
-/* Heights in metres, NaN where the mask row says invalid or not finite. */
-static void to_metres(float *r, const unsigned char *mr, int w, double scale, double offset)
+/* Heights in metres, NaN where the mask row says invalid or not finite:
+ * r * scale + offset in double, as (float), selected on the bits (a float
+ * or double compare would keep gcc from vectorising under trapping math;
+ * the read ahead of the whole DEM waits on this loop). */
+TS_SIMD_CLONES
+static void to_metres(float *restrict r, const unsigned char *restrict mr, int w, double scale,
+                      double offset)
 {
+    const uint32_t nan_bits = 0x7fc00000u; /* NAN */
     for (int x = 0; x < w; x++) {
         double v = r[x] * scale + offset;
-        r[x] = (mr && !mr[x]) || !isfinite(v) ? NAN : (float)v;
+        float f = (float)v;
+        uint64_t vb;
+        uint32_t fb;
+        memcpy(&vb, &v, sizeof vb);
+        memcpy(&fb, &f, sizeof fb);
+        uint32_t finite = (uint32_t)((vb & 0x7ff0000000000000u) != 0x7ff0000000000000u);
+        uint32_t keep = -(finite & (uint32_t)(!mr || mr[x]));
+        fb = (fb & keep) | (nan_bits & ~keep);
+        memcpy(&r[x], &fb, sizeof fb);
     }
 }
 
