@@ -229,7 +229,7 @@ AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, in
     }
 }
 
-int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ)
+int ts_lane_have_avx512(void)
 {
     static int known = -1; /* the CPU's answer, once asked */
     int have = __atomic_load_n(&known, __ATOMIC_RELAXED);
@@ -238,8 +238,13 @@ int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_la
         have = __builtin_cpu_supports("avx512f") != 0;
         __atomic_store_n(&known, have, __ATOMIC_RELAXED);
     }
+    return have;
+}
+
+int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ)
+{
     /* 32-bit offsets: the last line's points, as ints */
-    if (!have || (long long)(s->j1 + 1) * h->stride * 6 > INT_MAX)
+    if (!ts_lane_have_avx512() || (long long)(s->j1 + 1) * h->stride * 6 > INT_MAX)
         return 0;
     for (int j = s->j0; j <= s->j1; j += 8 * NG) {
         __mmask8 lanes[NG];
@@ -253,6 +258,11 @@ int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_la
 }
 
 #else
+
+int ts_lane_have_avx512(void)
+{
+    return 0;
+}
 
 int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ)
 {

@@ -37,6 +37,9 @@ typedef struct {
     double c, near_skip;
 } ts_lane_step;
 
+/* 1 where the CPU and the build run AVX-512 (asked once). */
+int ts_lane_have_avx512(void);
+
 /* The step, vectorised: returns 0, having done nothing, where the CPU (or
  * the build) has no AVX-512 or the hulls are too large for 32-bit
  * offsets; the caller then runs the scalar code. */
