@@ -13,10 +13,7 @@
  * cross-multiplication (no division), eight lines at a time, no gathers.
  * Among equally steep samples the oldest (smallest step) wins, whatever
  * the block's first step, so a line's answers do not depend on where a
- * block or a tile begins. Long windows are scanned in chunks of steps from
- * the line's previous answer, which is usually the answer again: a chunk
- * whose highest sample, at the chunk's least distance, cannot be as steep
- * is skipped (the same answers as the full scan, in fewer operations).
+ * block or a tile begins.
  */
 #ifndef TS_CAPPED_LANES_H
 #define TS_CAPPED_LANES_H
@@ -34,31 +31,17 @@ typedef struct {
      * and the answers (steps, -1: none; distances) */
     double *qd, *qc, *qn, *ddc, *ddn;
     long long *kc, *kn;
-    /* long windows (chunked): the slots are taken in chunks of
-     * TS_CAP_CHUNK steps, each line's highest g per chunk kept in a ring of
-     * nch chunks; a query starts from the line's previous answer (pkc, pkn:
-     * steps, -1: none; bnc, bnn: its numerators) and skips the chunks whose
-     * bound cannot reach it */
-    int chunked, nch;
-    double shortest;
-    double *cmax, *bnc, *bnn;
-    long long *pkc, *pkn;
 } ts_cap_lanes;
-
-/* Steps per chunk of a long window. */
-#define TS_CAP_CHUNK 8
 
 /* The lags of a window from near to cap metres behind, on lines whose
  * steps are shortest..longest metres long. */
 void ts_cap_lanes_lags(double near, double cap, double shortest, double longest, int *lag_lo,
                        int *lag_hi);
 
-/* Rings for up to `lines` lines and lags up to lag_hi, on lines whose
- * steps are at least `shortest` metres; chunked: queries skip chunks by
- * their bounds (for long windows). 0 if out of memory (ts_cap_lanes_free
- * still applies). */
+/* Rings for up to `lines` lines and lags up to lag_hi; 0 if out of
+ * memory (ts_cap_lanes_free still applies). */
 int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, int lag_lo, int lag_hi, double near,
-                       double cap, double shortest, int chunked);
+                       double cap);
 void ts_cap_lanes_free(ts_cap_lanes *r);
 
 /* Forget every sample: a new block starts. */

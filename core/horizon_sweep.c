@@ -64,7 +64,6 @@ typedef struct {
     int near_only;      /* the distance ends inside the near field: no lines */
     cm_ray_grid ray;    /* the grid as the geometry sees it, for cm_ray_slope */
     int lag_lo, lag_hi; /* with a maximum distance: the steps back a window spans */
-    double shortest;    /* the shortest step, metres */
 } sweep_ctx;
 
 typedef struct {
@@ -294,11 +293,7 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
 /* Capped lines run in lockstep blocks where their windows span fewer
  * steps than this (brute force per query), one by one otherwise. */
 #ifndef CAP_LANES_MAX_LAGS
-#define CAP_LANES_MAX_LAGS 100000
-#endif
-/* and scan windows of this many steps and more in chunks */
-#ifndef CAP_LANES_CHUNKED
-#define CAP_LANES_CHUNKED 48
+#define CAP_LANES_MAX_LAGS 96
 #endif
 
 /* Step k of lines j0..j1 of a block (rows i0 + j): each line's distance
@@ -475,8 +470,7 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
         w->lane_stacks = malloc((size_t)(LOCKSTEP_LINES + 1) * hull_pts * sizeof *w->lane_stacks);
         if (capped)
             ok = ts_cap_lanes_alloc(&w->capl, LOCKSTEP_LINES + 1, C->lag_lo, C->lag_hi,
-                                    C->near_skip, C->cap, C->shortest,
-                                    C->lag_hi - C->lag_lo >= CAP_LANES_CHUNKED);
+                                    C->near_skip, C->cap);
         w->carry = malloc((size_t)U * sizeof *w->carry);
         w->carry_next = malloc((size_t)U * sizeof *w->carry_next);
         /* a block has up to LOCKSTEP_LINES + 1 lines (with the primed one) */
@@ -614,7 +608,6 @@ static ts_status sweep_setup(const ts_grid *grid, double azimuth,
     C->cap = opts->max_distance > longest * geom->U ? 0.0 : opts->max_distance;
     /* Within the near field of every row, the near field is all there is. */
     C->near_only = C->cap > 0 && C->cap <= TS_NEAR_STEPS * shortest;
-    C->shortest = shortest;
     if (C->cap > 0)
         ts_cap_lanes_lags(C->near_skip, C->cap, shortest, longest, &C->lag_lo, &C->lag_hi);
     return TS_OK;
