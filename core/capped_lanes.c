@@ -6,15 +6,19 @@
 
 #include "capped_lanes.h"
 
-void ts_cap_lanes_lags(double near, double cap, double shortest, double longest, int *lag_lo,
-                       int *lag_hi)
+void ts_cap_lanes_lags(double near, double cap, double shortest, double longest, int lags[4])
 {
     /* A lag of L steps spans between L * shortest and L * longest metres
      * (up to rounding far below these margins). */
-    double lo = ceil(near / longest * (1.0 - 1e-9));
-    double hi = floor(cap / shortest * (1.0 + 1e-9));
-    *lag_lo = lo < 1.0 ? 1 : (int)lo;
-    *lag_hi = hi < (double)*lag_lo ? *lag_lo : hi > 1e8 ? 100000000 : (int)hi;
+    const double lo = ceil(near / longest * (1.0 - 1e-9));
+    const double hi = floor(cap / shortest * (1.0 + 1e-9));
+    lags[0] = lo < 1.0 ? 1 : (int)lo;
+    lags[1] = hi < (double)lags[0] ? lags[0] : hi > 1e8 ? 100000000 : (int)hi;
+    /* the lags surely within: at least near, at most cap metres */
+    const double sure_lo = ceil(near / (shortest * (1.0 - 1e-9)));
+    const double sure_hi = floor(cap / (longest * (1.0 + 1e-9)));
+    lags[2] = sure_lo > 1e8 ? 100000000 : (int)sure_lo;
+    lags[3] = sure_hi > 1e8 ? 100000000 : (int)sure_hi;
 }
 
 static void *zalloc(size_t n)
@@ -25,14 +29,15 @@ static void *zalloc(size_t n)
     return p;
 }
 
-int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, int lag_lo, int lag_hi, double near,
-                       double cap)
+int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, const int lags[4], double near, double cap)
 {
     *r = (ts_cap_lanes){0};
     r->stride = (lines + 7) / 8 * 8;
-    r->slots = lag_hi + 1;
-    r->lag_lo = lag_lo;
-    r->lag_hi = lag_hi;
+    r->lag_lo = lags[0];
+    r->lag_hi = lags[1];
+    r->sure_lo = lags[2];
+    r->sure_hi = lags[3];
+    r->slots = r->lag_hi + 1;
     r->near = near;
     r->cap = cap;
     const size_t ring = (size_t)r->slots * r->stride * sizeof(double);
@@ -108,7 +113,7 @@ static void scan_scalar(const ts_cap_lanes *r, int k, int g0, int g1)
 #define AVX512 __attribute__((target("avx512f")))
 /* groups of eight lines scanned together: independent chains of compares
  * and selects, so that their latencies overlap */
-#define NG 4
+#define NG 3
 
 /* scan_scalar for up to NG groups from g (those below g1), eight lines
  * per AVX-512 vector: the same operations per line. */
@@ -134,12 +139,18 @@ AVX512 static void scan_avx512(const ts_cap_lanes *r, int k, int g, int g1)
         const double *pd = r->d + (size_t)slot * r->stride + g;
         const double *pg = r->g + (size_t)slot * r->stride + g;
         slot = slot + 1 == r->slots ? 0 : slot + 1;
+        /* within the sure lags, the distance needs no test (a slot without
+         * a sample has d NaN, which fails the slope's compare) */
+        const int sure = lag >= r->sure_lo && lag <= r->sure_hi;
         for (int q = 0; q < NG; q++) {
             if (q >= ng)
                 break;
             const __m512d dd = _mm512_sub_pd(d[q], _mm512_load_pd(pd + 8 * q));
-            __mmask8 in = _mm512_cmp_pd_mask(dd, near, _CMP_GE_OQ);
-            in = _mm512_mask_cmp_pd_mask(in, dd, cap, _CMP_LE_OQ);
+            __mmask8 in = 0xFF;
+            if (!sure) {
+                in = _mm512_cmp_pd_mask(dd, near, _CMP_GE_OQ);
+                in = _mm512_mask_cmp_pd_mask(in, dd, cap, _CMP_LE_OQ);
+            }
             const __m512d sg = _mm512_load_pd(pg + 8 * q);
             const __m512d nc = _mm512_sub_pd(sg, gc[q]), nn = _mm512_sub_pd(sg, gn[q]);
             const __mmask8 wc = _mm512_mask_cmp_pd_mask(in, _mm512_mul_pd(nc, bdc[q]),

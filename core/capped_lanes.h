@@ -26,6 +26,7 @@ typedef struct {
     int stride;         /* lines per slot, a multiple of 8 */
     int slots;          /* lag_hi + 1 */
     int lag_lo, lag_hi; /* the lags (steps back) a window sample may have */
+    int sure_lo, sure_hi; /* and those that are surely in the window */
     double near, cap;
     /* per line, padded to stride: the step's distance and query heights,
      * and the answers (steps, -1: none; distances) */
@@ -33,15 +34,16 @@ typedef struct {
     long long *kc, *kn;
 } ts_cap_lanes;
 
-/* The lags of a window from near to cap metres behind, on lines whose
- * steps are shortest..longest metres long. */
-void ts_cap_lanes_lags(double near, double cap, double shortest, double longest, int *lag_lo,
-                       int *lag_hi);
+/* The lags (steps back) of a window from near to cap metres behind, on
+ * lines whose steps are shortest..longest metres long: lags[0..1], those
+ * a sample of the window may have; lags[2..3], those that are surely in
+ * it (none where lags[2] > lags[3]). */
+void ts_cap_lanes_lags(double near, double cap, double shortest, double longest, int lags[4]);
 
-/* Rings for up to `lines` lines and lags up to lag_hi; 0 if out of
- * memory (ts_cap_lanes_free still applies). */
-int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, int lag_lo, int lag_hi, double near,
-                       double cap);
+/* Rings for up to `lines` lines and the window of lags (as
+ * ts_cap_lanes_lags gives them); 0 if out of memory (ts_cap_lanes_free
+ * still applies). */
+int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, const int lags[4], double near, double cap);
 void ts_cap_lanes_free(ts_cap_lanes *r);
 
 /* Forget every sample: a new block starts. */

@@ -63,7 +63,8 @@ typedef struct {
     double near_skip;   /* hull points closer than this are near field */
     int near_only;      /* the distance ends inside the near field: no lines */
     cm_ray_grid ray;    /* the grid as the geometry sees it, for cm_ray_slope */
-    int lag_lo, lag_hi; /* with a maximum distance: the steps back a window spans */
+    int lags[4];        /* with a maximum distance: the steps back a window spans
+                           (ts_cap_lanes_lags) */
 } sweep_ctx;
 
 typedef struct {
@@ -443,7 +444,7 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
     const int U = C->geom->U, capped = C->cap > 0, need_visit = C->visit != NULL;
     *w = (sweep_ws){0};
     int ok = 1;
-    w->lockstep = !need_visit && (!capped || C->lag_hi - C->lag_lo < CAP_LANES_MAX_LAGS);
+    w->lockstep = !need_visit && (!capped || C->lags[1] - C->lags[0] < CAP_LANES_MAX_LAGS);
     if (capped && !w->lockstep) {
         w->raw = malloc((size_t)(U + 1) * sizeof *w->raw);
         ok = w->raw && ts_window_hull_alloc(&w->win, U) &&
@@ -469,8 +470,7 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
         w->lane_far = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_far);
         w->lane_stacks = malloc((size_t)(LOCKSTEP_LINES + 1) * hull_pts * sizeof *w->lane_stacks);
         if (capped)
-            ok = ts_cap_lanes_alloc(&w->capl, LOCKSTEP_LINES + 1, C->lag_lo, C->lag_hi,
-                                    C->near_skip, C->cap);
+            ok = ts_cap_lanes_alloc(&w->capl, LOCKSTEP_LINES + 1, C->lags, C->near_skip, C->cap);
         w->carry = malloc((size_t)U * sizeof *w->carry);
         w->carry_next = malloc((size_t)U * sizeof *w->carry_next);
         /* a block has up to LOCKSTEP_LINES + 1 lines (with the primed one) */
@@ -609,7 +609,7 @@ static ts_status sweep_setup(const ts_grid *grid, double azimuth,
     /* Within the near field of every row, the near field is all there is. */
     C->near_only = C->cap > 0 && C->cap <= TS_NEAR_STEPS * shortest;
     if (C->cap > 0)
-        ts_cap_lanes_lags(C->near_skip, C->cap, shortest, longest, &C->lag_lo, &C->lag_hi);
+        ts_cap_lanes_lags(C->near_skip, C->cap, shortest, longest, C->lags);
     return TS_OK;
 }
 
