@@ -78,7 +78,7 @@ void ts_cap_lanes_clear(ts_cap_lanes *r)
 /* Lines [g0, g1) (multiples of 8) at step k: for each query height (NaN:
  * none), the window sample of largest slope (g_p - g) / (d - d_p), the
  * oldest on ties; compared by cross-multiplication (both denominators are
- * positive). Scalar: for CPUs without AVX-512 (and valgrind). */
+ * positive). Scalar: for CPUs without AVX2. */
 static void scan_scalar(const ts_cap_lanes *r, int k, int g0, int g1)
 {
     const int lag_hi = k < r->lag_hi ? k : r->lag_hi; /* no samples before step 0 */
@@ -174,16 +174,92 @@ AVX512 static void scan_avx512(const ts_cap_lanes *r, int k, int g, int g1)
     }
 }
 
+#define AVX2 __attribute__((target("avx2")))
+
+/* scan_avx512 for the eight lines from g, four per AVX2 vector (the
+ * compares give lane masks as vectors, the selects are blends): the same
+ * operations per line. */
+AVX2 static void scan_avx2(const ts_cap_lanes *r, int k, int g)
+{
+    const int lag_hi = k < r->lag_hi ? k : r->lag_hi;
+    const __m256d near = _mm256_set1_pd(r->near), cap = _mm256_set1_pd(r->cap);
+    __m256d d[2], gc[2], gn[2], bnc[2], bdc[2], bnn[2], bdn[2], bkc[2], bkn[2];
+    for (int q = 0; q < 2; q++) {
+        d[q] = _mm256_load_pd(r->qd + g + 4 * q);
+        gc[q] = _mm256_load_pd(r->qc + g + 4 * q);
+        gn[q] = _mm256_load_pd(r->qn + g + 4 * q);
+        bnc[q] = bnn[q] = _mm256_set1_pd(-INFINITY);
+        bdc[q] = bdn[q] = _mm256_set1_pd(1.0);
+        /* the steps, as 64-bit integers carried in double vectors */
+        bkc[q] = bkn[q] = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+    }
+    int slot = (k - lag_hi) % r->slots;
+    for (int lag = lag_hi; lag >= r->lag_lo; lag--) {
+        const __m256d ks = _mm256_castsi256_pd(_mm256_set1_epi64x(k - lag));
+        const double *pd = r->d + (size_t)slot * r->stride + g;
+        const double *pg = r->g + (size_t)slot * r->stride + g;
+        slot = slot + 1 == r->slots ? 0 : slot + 1;
+        const int sure = lag >= r->sure_lo && lag <= r->sure_hi;
+        for (int q = 0; q < 2; q++) {
+            const __m256d dd = _mm256_sub_pd(d[q], _mm256_load_pd(pd + 4 * q));
+            __m256d in = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+            if (!sure)
+                in = _mm256_and_pd(_mm256_cmp_pd(dd, near, _CMP_GE_OQ),
+                                   _mm256_cmp_pd(dd, cap, _CMP_LE_OQ));
+            const __m256d sg = _mm256_load_pd(pg + 4 * q);
+            const __m256d nc = _mm256_sub_pd(sg, gc[q]), nn = _mm256_sub_pd(sg, gn[q]);
+            const __m256d wc = _mm256_and_pd(in, _mm256_cmp_pd(_mm256_mul_pd(nc, bdc[q]),
+                                                               _mm256_mul_pd(bnc[q], dd),
+                                                               _CMP_GT_OQ));
+            const __m256d wn = _mm256_and_pd(in, _mm256_cmp_pd(_mm256_mul_pd(nn, bdn[q]),
+                                                               _mm256_mul_pd(bnn[q], dd),
+                                                               _CMP_GT_OQ));
+            bnc[q] = _mm256_blendv_pd(bnc[q], nc, wc);
+            bdc[q] = _mm256_blendv_pd(bdc[q], dd, wc);
+            bkc[q] = _mm256_blendv_pd(bkc[q], ks, wc);
+            bnn[q] = _mm256_blendv_pd(bnn[q], nn, wn);
+            bdn[q] = _mm256_blendv_pd(bdn[q], dd, wn);
+            bkn[q] = _mm256_blendv_pd(bkn[q], ks, wn);
+        }
+    }
+    for (int q = 0; q < 2; q++) {
+        const int o = g + 4 * q;
+        _mm256_store_si256((__m256i *)(r->kc + o), _mm256_castpd_si256(bkc[q]));
+        _mm256_store_pd(r->ddc + o, bdc[q]);
+        _mm256_store_si256((__m256i *)(r->kn + o), _mm256_castpd_si256(bkn[q]));
+        _mm256_store_pd(r->ddn + o, bdn[q]);
+    }
+}
+
+int ts_cap_lanes_pays(const int lags[4])
+{
+    /* measured (docs/performance.md, "Bounded sweep, session 9"): the
+     * brute force costs about the line-by-line window at ~96 steps with
+     * AVX-512, ~40 with AVX2 */
+    const int span = lags[1] - lags[0] + 1;
+    const int level = ts_lane_vector_level();
+    return level == 2 ? span <= 96 : level == 1 ? span <= 40 : 0;
+}
+
 static void scan_groups(const ts_cap_lanes *r, int k, int g0, int g1)
 {
-    if (!ts_lane_have_avx512()) {
+    const int level = ts_lane_vector_level();
+    if (level == 2)
+        for (int g = g0; g < g1; g += 8 * NG)
+            scan_avx512(r, k, g, g1);
+    else if (level == 1)
+        for (int g = g0; g < g1; g += 8)
+            scan_avx2(r, k, g);
+    else
         scan_scalar(r, k, g0, g1);
-        return;
-    }
-    for (int g = g0; g < g1; g += 8 * NG)
-        scan_avx512(r, k, g, g1);
 }
 #else
+int ts_cap_lanes_pays(const int lags[4])
+{
+    (void)lags;
+    return 0;
+}
+
 static void scan_groups(const ts_cap_lanes *r, int k, int g0, int g1)
 {
     scan_scalar(r, k, g0, g1);

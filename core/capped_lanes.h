@@ -40,6 +40,11 @@ typedef struct {
  * it (none where lags[2] > lags[3]). */
 void ts_cap_lanes_lags(double near, double cap, double shortest, double longest, int lags[4]);
 
+/* Whether the brute force is the cheaper way to answer windows of these
+ * lags on this CPU (else the line-by-line sliding window hull is). The
+ * answers differ only between exactly equally steep samples. */
+int ts_cap_lanes_pays(const int lags[4]);
+
 /* Rings for up to `lines` lines and the window of lags (as
  * ts_cap_lanes_lags gives them); 0 if out of memory (ts_cap_lanes_free
  * still applies). */

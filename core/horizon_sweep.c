@@ -291,12 +291,6 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
 #define LOCKSTEP_LINES 64
 #endif
 
-/* Capped lines run in lockstep blocks where their windows span fewer
- * steps than this (brute force per query), one by one otherwise. */
-#ifndef CAP_LANES_MAX_LAGS
-#define CAP_LANES_MAX_LAGS 96
-#endif
-
 /* Step k of lines j0..j1 of a block (rows i0 + j): each line's distance
  * from its first sample, as ts_line_sample_at advances it. */
 static void lane_distances(const sweep_ctx *C, sweep_ws *w, int k, int i0, int j0, int j1)
@@ -444,7 +438,9 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
     const int U = C->geom->U, capped = C->cap > 0, need_visit = C->visit != NULL;
     *w = (sweep_ws){0};
     int ok = 1;
-    w->lockstep = !need_visit && (!capped || C->lags[1] - C->lags[0] < CAP_LANES_MAX_LAGS);
+    /* capped lines too where their windows are short enough for the
+     * brute force (capped_lanes.h), one by one otherwise */
+    w->lockstep = !need_visit && (!capped || ts_cap_lanes_pays(C->lags));
     if (capped && !w->lockstep) {
         w->raw = malloc((size_t)(U + 1) * sizeof *w->raw);
         ok = w->raw && ts_window_hull_alloc(&w->win, U) &&
