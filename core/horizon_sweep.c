@@ -16,10 +16,13 @@
  *    of the slopes from the cell's own height to the hull points of the two
  *    neighbouring lines that lie beyond the near field.
  *
- * With a maximum distance, each line keeps the hull of a sliding window of
- * its samples instead (window_hull.h): those beyond the near field and
- * within the distance, in amortised O(1) per sample like the unbounded
- * hull; the near field is cut at the distance, and the last part of a step
+ * With a maximum distance, the occluder is the steepest of the line's
+ * samples beyond the near field and within the distance: for short windows
+ * (capped_lanes.h) the lines run in the same lockstep blocks and each
+ * query is a brute-force maximum over the window, vectorised across lines;
+ * for long ones each line keeps the hull of a sliding window of its
+ * samples (window_hull.h), in amortised O(1) per sample like the unbounded
+ * hull. The near field is cut at the distance, and the last part of a step
  * before it is solved exactly on each cell's ray.
  */
 #include <math.h>
