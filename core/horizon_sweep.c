@@ -16,16 +16,20 @@
  *    of the slopes from the cell's own height to the hull points of the two
  *    neighbouring lines that lie beyond the near field.
  *
- * With a maximum distance, each line keeps the hull of a sliding window of
- * its samples instead (window_hull.h): those beyond the near field and
- * within the distance, in amortised O(1) per sample like the unbounded
- * hull; the near field is cut at the distance, and the last part of a step
+ * With a maximum distance, the occluder is the steepest of the line's
+ * samples beyond the near field and within the distance: for short windows
+ * (capped_lanes.h) the lines run in the same lockstep blocks and each
+ * query is a brute-force maximum over the window, vectorised across lines;
+ * for long ones each line keeps the hull of a sliding window of its
+ * samples (window_hull.h), in amortised O(1) per sample like the unbounded
+ * hull. The near field is cut at the distance, and the last part of a step
  * before it is solved exactly on each cell's ray.
  */
 #include <math.h>
 #include <stdlib.h>
 
 #include "arg_checks.h"
+#include "capped_lanes.h"
 #include "cellmath/cm_fastmath.h"
 #include "lane_hull.h"
 #include "lane_passes.h"
@@ -62,6 +66,8 @@ typedef struct {
     double near_skip;   /* hull points closer than this are near field */
     int near_only;      /* the distance ends inside the near field: no lines */
     cm_ray_grid ray;    /* the grid as the geometry sees it, for cm_ray_slope */
+    int lags[4];        /* with a maximum distance: the steps back a window spans
+                           (ts_cap_lanes_lags) */
 } sweep_ctx;
 
 typedef struct {
@@ -88,6 +94,8 @@ typedef struct {
     int *lo_k, *hi_k;   /* far-field occluders; lo_k[j]: from line j - 1 */
     int *lane_k0;       /* each line's first step */
     double *lane_d;     /* and the distance of its current sample from it */
+    ts_cap_lanes capl;  /* capped lines in lockstep: their windows */
+    int lockstep;       /* lines in lockstep blocks (sweep_block), not one by one */
 } sweep_ws;
 
 /* The far-field occluder of a point at distance d and hull height g among
@@ -362,6 +370,8 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
     occluder *next = w->carry_next;
     for (int k = 0; k < G->U; k++)
         next[k] = none;
+    if (C->cap > 0)
+        ts_cap_lanes_clear(&w->capl);
     const ts_lane_occluders occ = {w->lo_k, w->hi_k, w->lo_dd, w->hi_dd};
     const ts_lane_hulls hulls = {w->lane_stacks, G->U + 1, w->lane_n, w->lane_far};
     const double c = C->c;
@@ -370,8 +380,11 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         const long i0 = bs + G->fl[k];
         const int j0 = i0 < 0 ? (int)-i0 : 0;
         const int j1 = G->V - 1 - i0 < nl - 1 ? (int)(G->V - 1 - i0) : nl - 1;
-        if (j0 > j1)
+        if (j0 > j1) {
+            if (C->cap > 0) /* no samples: the rings forget this step */
+                ts_cap_lanes_step(&w->capl, &(ts_lane_step){.k = k, .j0 = 1, .j1 = 0}, nl, NULL);
             continue;
+        }
         ts_lane_sample(G, C->grid->z, k, (int)i0, j0, j1, w->hc, w->hn, w->hs);
         lane_distances(C, w, k, (int)i0, j0, j1);
         /* lo_k[j]: the far-side occluder of line j's cell, found by the
@@ -382,7 +395,9 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         const int last_inside = G->fr[k] == 0.0f ? j1 : G->V - 2 - (int)i0;
         const ts_lane_step step = {k, j0, j1, prime, last_inside, w->lane_d, w->hs, w->hc,
                                    w->hn, c, C->near_skip};
-        if (!ts_lane_hull_step(&hulls, &step, &occ))
+        if (C->cap > 0)
+            ts_cap_lanes_step(&w->capl, &step, nl, &occ);
+        else if (!ts_lane_hull_step(&hulls, &step, &occ))
             lane_hulls_scalar(&hulls, &step, &occ);
         if (j1 == nl - 1)
             next[k] = (occluder){w->lo_k[nl], w->lo_dd[nl]};
@@ -418,13 +433,18 @@ static void ws_free(sweep_ws *w)
     free(w->lane_f);
     free(w->lane_i);
     free(w->lane_d);
+    ts_cap_lanes_free(&w->capl);
 }
 
-static int ws_init(sweep_ws *w, int U, int capped, int need_visit)
+static int ws_init(sweep_ws *w, const sweep_ctx *C)
 {
+    const int U = C->geom->U, capped = C->cap > 0, need_visit = C->visit != NULL;
     *w = (sweep_ws){0};
     int ok = 1;
-    if (capped) {
+    /* capped lines too where their windows are short enough for the
+     * brute force (capped_lanes.h), one by one otherwise */
+    w->lockstep = !need_visit && (!capped || ts_cap_lanes_pays(C->lags));
+    if (capped && !w->lockstep) {
         w->raw = malloc((size_t)(U + 1) * sizeof *w->raw);
         ok = w->raw && ts_window_hull_alloc(&w->win, U) &&
              (!need_visit || ts_window_hull_alloc(&w->vwin, U));
@@ -441,11 +461,15 @@ static int ws_init(sweep_ws *w, int U, int capped, int need_visit)
         w->vs = malloc((size_t)U * sizeof(float));
         w->vd = malloc((size_t)U * sizeof(double));
     }
-    if (!capped && !need_visit) {
+    if (w->lockstep) {
         const occluder none = {-1, 0.0f};
+        /* capped lines keep windows (rings) instead of hulls */
+        const int hull_pts = capped ? 1 : U + 1;
         w->lane_n = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_n);
         w->lane_far = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_far);
-        w->lane_stacks = malloc((size_t)(LOCKSTEP_LINES + 1) * (U + 1) * sizeof *w->lane_stacks);
+        w->lane_stacks = malloc((size_t)(LOCKSTEP_LINES + 1) * hull_pts * sizeof *w->lane_stacks);
+        if (capped)
+            ok = ts_cap_lanes_alloc(&w->capl, LOCKSTEP_LINES + 1, C->lags, C->near_skip, C->cap);
         w->carry = malloc((size_t)U * sizeof *w->carry);
         w->carry_next = malloc((size_t)U * sizeof *w->carry_next);
         /* a block has up to LOCKSTEP_LINES + 1 lines (with the primed one) */
@@ -453,8 +477,8 @@ static int ws_init(sweep_ws *w, int U, int capped, int need_visit)
         w->lane_f = malloc(6 * row * sizeof *w->lane_f);
         w->lane_i = malloc(3 * row * sizeof *w->lane_i);
         w->lane_d = malloc(row * sizeof *w->lane_d);
-        ok = w->lane_n && w->lane_far && w->lane_stacks && w->carry && w->carry_next && w->lane_f &&
-             w->lane_i && w->lane_d;
+        ok = ok && w->lane_n && w->lane_far && w->lane_stacks && w->carry && w->carry_next &&
+             w->lane_f && w->lane_i && w->lane_d;
         if (ok) {
             w->hc = w->lane_f;
             w->hn = w->lane_f + row;
@@ -479,12 +503,12 @@ static void sweep_range(void *ctx, int worker, long begin, long end)
     (void)worker;
     const sweep_ctx *C = ctx;
     sweep_ws w;
-    if (!ws_init(&w, C->geom->U, C->cap > 0, C->visit != NULL)) {
+    if (!ws_init(&w, C)) {
         ws_free(&w);
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
         return;
     }
-    if (w.lane_stacks) {
+    if (w.lockstep) {
         long b = C->b0 + begin, bend = C->b0 + end;
         for (int prime = begin > 0; b < bend; prime = 0) {
             int nl = bend - b < LOCKSTEP_LINES ? (int)(bend - b) : LOCKSTEP_LINES;
@@ -583,6 +607,8 @@ static ts_status sweep_setup(const ts_grid *grid, double azimuth,
     C->cap = opts->max_distance > longest * geom->U ? 0.0 : opts->max_distance;
     /* Within the near field of every row, the near field is all there is. */
     C->near_only = C->cap > 0 && C->cap <= TS_NEAR_STEPS * shortest;
+    if (C->cap > 0)
+        ts_cap_lanes_lags(C->near_skip, C->cap, shortest, longest, C->lags);
     return TS_OK;
 }
 

@@ -229,17 +229,27 @@ AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, in
     }
 }
 
-int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ)
+int ts_lane_vector_level(void)
 {
     static int known = -1; /* the CPU's answer, once asked */
-    int have = __atomic_load_n(&known, __ATOMIC_RELAXED);
-    if (have < 0) {
+    int level = __atomic_load_n(&known, __ATOMIC_RELAXED);
+    if (level < 0) {
         __builtin_cpu_init();
-        have = __builtin_cpu_supports("avx512f") != 0;
-        __atomic_store_n(&known, have, __ATOMIC_RELAXED);
+        level = __builtin_cpu_supports("avx512f") ? 2 : __builtin_cpu_supports("avx2") ? 1 : 0;
+        __atomic_store_n(&known, level, __ATOMIC_RELAXED);
     }
+    return level;
+}
+
+int ts_lane_have_avx512(void)
+{
+    return ts_lane_vector_level() == 2;
+}
+
+int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ)
+{
     /* 32-bit offsets: the last line's points, as ints */
-    if (!have || (long long)(s->j1 + 1) * h->stride * 6 > INT_MAX)
+    if (!ts_lane_have_avx512() || (long long)(s->j1 + 1) * h->stride * 6 > INT_MAX)
         return 0;
     for (int j = s->j0; j <= s->j1; j += 8 * NG) {
         __mmask8 lanes[NG];
@@ -253,6 +263,16 @@ int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_la
 }
 
 #else
+
+int ts_lane_vector_level(void)
+{
+    return 0;
+}
+
+int ts_lane_have_avx512(void)
+{
+    return 0;
+}
 
 int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ)
 {
