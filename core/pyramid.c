@@ -167,6 +167,8 @@ void ts_pyramid_free(ts_pyramid *pyr)
     for (int j = 0; pyr->level && j < pyr->levels; j++)
         free(pyr->level[j].hu);
     free(pyr->level);
+    free(pyr->side[0]);
+    free(pyr->side[1]);
     free(pyr);
 }
 
@@ -225,7 +227,13 @@ ts_status ts_pyramid_build(const ts_grid *grid, const ts_pyramid_opts *opts, int
                                 : 1;
     float *buf[2][2] = {{malloc(most * sizeof(float)), malloc(most * sizeof(float))},
                         {malloc(most * sizeof(float)), malloc(most * sizeof(float))}};
-    int ok = buf[0][0] && buf[0][1] && buf[1][0] && buf[1][1];
+    P->side[0] = malloc((size_t)H * sizeof(float));
+    P->side[1] = malloc((size_t)H * sizeof(float));
+    int ok = buf[0][0] && buf[0][1] && buf[1][0] && buf[1][1] && P->side[0] && P->side[1];
+    for (int y = 0; ok && y < H; y++) {
+        P->side[0][y] = grid->z[(ptrdiff_t)y * grid->stride];
+        P->side[1][y] = grid->z[(ptrdiff_t)y * grid->stride + W - 1];
+    }
     for (int j = 1; ok && j < P->levels; j++) {
         double s = spacing(opts->level_step, j);
         coarse cur = {level_size(W, s), level_size(H, s), s, buf[j % 2][0], buf[j % 2][1], 0};
