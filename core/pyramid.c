@@ -13,7 +13,6 @@
  */
 #include <math.h>
 #include <stdlib.h>
-#include <string.h>
 
 #include "parallel.h"
 #include "pyramid_internal.h"
@@ -84,11 +83,13 @@ double ts_pyramid_bytes(int width, int height, double level_step)
     return rows * width * sizeof(float);
 }
 
-/* A level before reconstruction: its samples and their valid fraction. */
+/* A level before reconstruction: its samples (rows `stride` floats apart)
+ * and their valid fraction (NULL: all valid, as the DEM's). */
 typedef struct {
     int w, h;
     double s;
     float *z, *cov;
+    ptrdiff_t stride;
 } coarse;
 
 typedef struct {
@@ -114,13 +115,13 @@ static void decimate_rows(void *ctx, int worker, long r0, long r1)
             for (int a = 0; a < ny; a++)
                 for (int b = 0; b < nx; b++) {
                     double w = wy[a] * wx[b];
-                    size_t k = (size_t)ry[a] * S->w + rx[b];
+                    size_t k = (size_t)ry[a] * S->stride + rx[b];
                     float z = S->z[k];
                     if (z != z)
                         continue;
                     sum += w * z;
                     wsum += w;
-                    cov += w * (S->cov ? S->cov[k] : 1.0);
+                    cov += w * (S->cov ? S->cov[(size_t)ry[a] * S->w + rx[b]] : 1.0);
                 }
             size_t o = (size_t)r * D->w + i;
             D->cov[o] = (float)cov;
@@ -166,6 +167,8 @@ void ts_pyramid_free(ts_pyramid *pyr)
     for (int j = 0; pyr->level && j < pyr->levels; j++)
         free(pyr->level[j].hu);
     free(pyr->level);
+    free(pyr->side[0]);
+    free(pyr->side[1]);
     free(pyr);
 }
 
@@ -213,31 +216,36 @@ ts_status ts_pyramid_build(const ts_grid *grid, const ts_pyramid_opts *opts, int
         ts_pyramid_free(P);
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the pyramid");
     }
-    /* level 0 is the DEM: a dense copy to decimate from */
+    /* level 0 is the DEM, decimated from where it lies; the coarse levels
+     * alternate between two buffers sized for level 1 (the largest), so
+     * that their pages are faulted in once, not once a level */
     const int W = grid->width, H = grid->height;
-    coarse prev = {W, H, 1.0, malloc((size_t)W * H * sizeof(float)), NULL};
+    coarse prev = {W, H, 1.0, grid->z, NULL, grid->stride};
     P->level[0] = (ts_pyr_level){1.0, H, NULL};
-    int ok = prev.z != NULL;
-    for (int y = 0; ok && y < H; y++)
-        memcpy(prev.z + (size_t)y * W, grid->z + (ptrdiff_t)y * grid->stride,
-               (size_t)W * sizeof(float));
+    size_t most = P->levels > 1 ? (size_t)level_size(W, spacing(opts->level_step, 1)) *
+                                      level_size(H, spacing(opts->level_step, 1))
+                                : 1;
+    float *buf[2][2] = {{malloc(most * sizeof(float)), malloc(most * sizeof(float))},
+                        {malloc(most * sizeof(float)), malloc(most * sizeof(float))}};
+    P->side[0] = malloc((size_t)H * sizeof(float));
+    P->side[1] = malloc((size_t)H * sizeof(float));
+    int ok = buf[0][0] && buf[0][1] && buf[1][0] && buf[1][1] && P->side[0] && P->side[1];
+    for (int y = 0; ok && y < H; y++) {
+        P->side[0][y] = grid->z[(ptrdiff_t)y * grid->stride];
+        P->side[1][y] = grid->z[(ptrdiff_t)y * grid->stride + W - 1];
+    }
     for (int j = 1; ok && j < P->levels; j++) {
         double s = spacing(opts->level_step, j);
-        coarse cur = {level_size(W, s), level_size(H, s), s, NULL, NULL};
-        cur.z = malloc((size_t)cur.w * cur.h * sizeof(float));
-        cur.cov = malloc((size_t)cur.w * cur.h * sizeof(float));
-        if ((ok = cur.z && cur.cov)) {
-            decimate_ctx dc = {&prev, &cur};
-            ts_parallel_for(ts_thread_count(threads, cur.h), cur.h, decimate_rows, &dc, err);
-            P->level[j] = (ts_pyr_level){s, cur.h, NULL};
-            ok = reconstruct(P, &cur, j, threads, err);
-        }
-        free(prev.z);
-        free(prev.cov);
+        coarse cur = {level_size(W, s), level_size(H, s), s, buf[j % 2][0], buf[j % 2][1], 0};
+        cur.stride = cur.w;
+        decimate_ctx dc = {&prev, &cur};
+        ts_parallel_for(ts_thread_count(threads, cur.h), cur.h, decimate_rows, &dc, err);
+        P->level[j] = (ts_pyr_level){s, cur.h, NULL};
+        ok = reconstruct(P, &cur, j, threads, err);
         prev = cur;
     }
-    free(prev.z);
-    free(prev.cov);
+    for (int i = 0; i < 4; i++)
+        free(buf[i / 2][i % 2]);
     if (!ok) {
         ts_pyramid_free(P);
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the pyramid's levels (%.0f MiB)",

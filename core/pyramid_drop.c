@@ -59,6 +59,8 @@ static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int
                                                             const double *restrict tpp,
                                                             float *restrict A)
 {
+    /* on a column: the pyramid's copy of that side of the DEM, read down */
+    const float *restrict col = C->P->side[C->vx > 0];
     const ts_grid *g = C->P->grid;
     const int W = g->width, H = g->height;
     const float *restrict z = g->z, *restrict zrow = g->z + (ptrdiff_t)y * g->stride;
@@ -70,9 +72,14 @@ static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int
         int i = (int)px, k = (int)py;
         float fx = (float)(px - i), fy = (float)(py - k);
         int i1 = i + 1 < W ? i + 1 : i, k1 = k + 1 < H ? k + 1 : k;
-        i1 = on_col ? i : i1;
-        float z00 = z[dem_index(narrow, stride, k, i)], z01 = z[dem_index(narrow, stride, k, i1)];
-        float z10 = z[dem_index(narrow, stride, k1, i)], z11 = z[dem_index(narrow, stride, k1, i1)];
+        float z00, z01, z10, z11;
+        if (on_col) {
+            z00 = z01 = col[k];
+            z10 = z11 = col[k1];
+        } else {
+            z00 = z[dem_index(narrow, stride, k, i)], z01 = z[dem_index(narrow, stride, k, i1)];
+            z10 = z[dem_index(narrow, stride, k1, i)], z11 = z[dem_index(narrow, stride, k1, i1)];
+        }
         /* a corner of weight 0 does not count: no NaN from it (computed,
          * then selected: a conditional float operation is control flow
          * that keeps the loop scalar) */

@@ -26,6 +26,10 @@ struct ts_pyramid {
     ts_pyramid_opts opts;
     int levels;
     ts_pyr_level *level;
+    /* the DEM's first and last columns, H floats each: the x-major rays
+     * that leave through a side end there (pyramid_drop.c), and a column
+     * read down the DEM's rows misses the cache (and the TLB) at every row */
+    float *side[2];
 };
 
 /* Row r of level j, `width` floats (a DEM row for level 0). */

@@ -12,6 +12,7 @@
 #include "arg_checks.h"
 #include "cellmath/cm_sky.h"
 #include "parallel.h"
+#include "simd_clones.h"
 #include "status_internal.h"
 
 #define DEG2RAD (M_PI / 180.0)
@@ -26,8 +27,8 @@ typedef struct {
 } sky_ctx;
 
 /* One loop per term, each vectorised (cm_sky.h carries NaN explicitly,
- * because the comparisons drop it). */
-static void sky_rows(void *ctx, int worker, long y0, long y1)
+ * because the comparisons drop it); AVX-512/AVX2 clones, the same bits. */
+TS_SIMD_CLONES static void sky_rows(void *ctx, int worker, long y0, long y1)
 {
     (void)worker;
     const sky_ctx *C = ctx;
