@@ -531,7 +531,7 @@ ts_status ts_pyramid_horizon(const ts_pyramid *pyr, double azimuth,
                              const ts_horizon_opts *opts, float *out, ts_error *err);
 
 /** The most azimuths ts_pyramid_horizons computes at once. */
-#define TS_PYRAMID_BATCH 4
+#define TS_PYRAMID_BATCH 8
 
 /**
  * Pyramid horizons for `count` azimuths (1 to TS_PYRAMID_BATCH) into
