@@ -241,15 +241,10 @@ int ts_lane_vector_level(void)
     return level;
 }
 
-int ts_lane_have_avx512(void)
-{
-    return ts_lane_vector_level() == 2;
-}
-
 int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ)
 {
     /* 32-bit offsets: the last line's points, as ints */
-    if (!ts_lane_have_avx512() || (long long)(s->j1 + 1) * h->stride * 6 > INT_MAX)
+    if (ts_lane_vector_level() != 2 || (long long)(s->j1 + 1) * h->stride * 6 > INT_MAX)
         return 0;
     for (int j = s->j0; j <= s->j1; j += 8 * NG) {
         __mmask8 lanes[NG];
@@ -265,11 +260,6 @@ int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_la
 #else
 
 int ts_lane_vector_level(void)
-{
-    return 0;
-}
-
-int ts_lane_have_avx512(void)
 {
     return 0;
 }

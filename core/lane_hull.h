@@ -38,9 +38,8 @@ typedef struct {
 } ts_lane_step;
 
 /* The widest vectors the CPU and the build run (asked once): 2 AVX-512,
- * 1 AVX2, 0 neither; and whether it is AVX-512. */
+ * 1 AVX2, 0 neither. */
 int ts_lane_vector_level(void);
-int ts_lane_have_avx512(void);
 
 /* The step, vectorised: returns 0, having done nothing, where the CPU (or
  * the build) has no AVX-512 or the hulls are too large for 32-bit
