@@ -360,8 +360,10 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         int k0, k1;
         if (!ts_line_k_range(G, bs + j, &k0, &k1))
             continue;
-        w->lane_n[j] = 0;
-        w->lane_far[j] = -1;
+        if (C->cap == 0) {
+            w->lane_n[j] = 0;
+            w->lane_far[j] = -1;
+        }
         w->lane_k0[j] = k0;
         w->lane_d[j] = 0.0;
         kmin = k0 < kmin ? k0 : kmin;
@@ -464,12 +466,15 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
     if (w->lockstep) {
         const occluder none = {-1, 0.0f};
         /* capped lines keep windows (rings) instead of hulls */
-        const int hull_pts = capped ? 1 : U + 1;
-        w->lane_n = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_n);
-        w->lane_far = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_far);
-        w->lane_stacks = malloc((size_t)(LOCKSTEP_LINES + 1) * hull_pts * sizeof *w->lane_stacks);
-        if (capped)
+        if (capped) {
             ok = ts_cap_lanes_alloc(&w->capl, LOCKSTEP_LINES + 1, C->lags, C->near_skip, C->cap);
+        } else {
+            w->lane_n = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_n);
+            w->lane_far = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_far);
+            w->lane_stacks =
+                malloc((size_t)(LOCKSTEP_LINES + 1) * (U + 1) * sizeof *w->lane_stacks);
+            ok = w->lane_n && w->lane_far && w->lane_stacks;
+        }
         w->carry = malloc((size_t)U * sizeof *w->carry);
         w->carry_next = malloc((size_t)U * sizeof *w->carry_next);
         /* a block has up to LOCKSTEP_LINES + 1 lines (with the primed one) */
@@ -477,8 +482,7 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
         w->lane_f = malloc(6 * row * sizeof *w->lane_f);
         w->lane_i = malloc(3 * row * sizeof *w->lane_i);
         w->lane_d = malloc(row * sizeof *w->lane_d);
-        ok = ok && w->lane_n && w->lane_far && w->lane_stacks && w->carry && w->carry_next &&
-             w->lane_f && w->lane_i && w->lane_d;
+        ok = ok && w->carry && w->carry_next && w->lane_f && w->lane_i && w->lane_d;
         if (ok) {
             w->hc = w->lane_f;
             w->hn = w->lane_f + row;
