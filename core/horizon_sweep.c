@@ -547,7 +547,7 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
     const ts_grid *grid = C->grid;
     const ts_line_geom *G = C->geom;
     const int W = grid->width, H = grid->height, m = TS_NEAR_MARGIN;
-    float *scratch = malloc(2 * (size_t)W * sizeof *scratch);
+    float *scratch = malloc(4 * (size_t)W * sizeof *scratch); /* ts_near_edges' */
     for (long y = y0; y < y1; y++) {
         const float *zrow = grid->z + y * grid->stride;
         float *orow = C->out + y * W;
@@ -562,19 +562,9 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
         int xa = interior ? m : W, xb = interior ? W - m : W;
         if (interior)
             ts_near_row(&C->near, G, grid->z, zrow, (int)y, xa, xb, step, C->c, orow, scratch);
-        for (int x = 0; x < W; x++) {
-            if (x == xa)
-                x = xb;
-            if (x >= W)
-                break;
-            if (isnan(zrow[x]))
-                continue;
-            int u = G->x_major ? x : (int)y, v = G->x_major ? (int)y : x;
-            int left;
-            float nf = ts_near_field(&C->near, G, grid->z, (u - G->u_start) * G->u_step, v,
-                                     zrow[x], step, C->c, C->cap, &left);
-            orow[x] = left ? nf : fmaxf(nf, orow[x]);
-        }
+        if (scratch)
+            ts_near_edges(&C->near, G, grid->z, zrow, (int)y, xa, xb, W, step, C->c, C->cap,
+                          orow, scratch);
         if (C->cap > 0)
             ts_cap_tail(C->geom, grid, C->cap, C->c, (int)y, zrow, orow, step);
         degrees_row(orow, W);
