@@ -31,6 +31,7 @@
 #include "arg_checks.h"
 #include "capped_lanes.h"
 #include "cellmath/cm_fastmath.h"
+#include "horizon_edge.h"
 #include "lane_hull.h"
 #include "lane_passes.h"
 #include "line_geometry.h"
@@ -68,6 +69,8 @@ typedef struct {
     cm_ray_grid ray;    /* the grid as the geometry sees it, for cm_ray_slope */
     int lags[4];        /* with a maximum distance: the steps back a window spans
                            (ts_cap_lanes_lags) */
+    ts_edge_job edge;   /* the world beyond the edge, raised row by row */
+    int edge_rows;      /* whether finish_rows raises (not TS_EDGE_OPEN) */
 } sweep_ctx;
 
 typedef struct {
@@ -568,6 +571,8 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
         if (C->cap > 0)
             ts_cap_tail(C->geom, grid, C->cap, C->c, (int)y, zrow, orow, step);
         degrees_row(orow, W);
+        if (C->edge_rows) /* while the row is at hand */
+            ts_edge_row(&C->edge, (int)y);
     }
     if (!scratch)
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
@@ -611,14 +616,18 @@ ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
 {
     if (!out)
         return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
+    /* the options as ts_horizon_edge_apply takes them (every direction) */
+    ts_status st = opts ? ts_horizon_opts_validate(opts, err) : TS_OK;
+    if (st != TS_OK)
+        return st;
     ts_line_geom geom;
     sweep_ctx C;
-    ts_status st = sweep_setup(grid, azimuth, opts, &geom, &C, err);
-    if (st != TS_OK)
+    if ((st = sweep_setup(grid, azimuth, opts, &geom, &C, err)) != TS_OK)
         return st;
     int failed = 0;
     C.out = out;
     C.alloc_failed = &failed;
+    C.edge_rows = ts_edge_rows_init(&C.edge, grid, azimuth, opts, out);
     long lines = geom.b_hi - geom.b_lo + 1;
     /* One chunk per thread: each chunk re-primes one line. */
     int threads = ts_thread_count(opts->threads, lines);
@@ -632,8 +641,9 @@ ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
         return st;
     if (failed)
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate sweep workspace");
-    /* the world beyond the edge, before anyone reads the horizons */
-    return ts_horizon_edge_apply(grid, azimuth, opts, out, err);
+    /* the world beyond the edge was raised row by row (finish_rows),
+     * before anyone reads the horizons */
+    return ts_ok(err);
 }
 
 ts_status ts_horizon_sweep_lines(const ts_grid *grid, double azimuth,
