@@ -207,8 +207,9 @@ AVX512 static inline __m512 ray16(const ray_view *R, const int *ray_o, const flo
                                 _mm512_set1_ps(-INFINITY), s);
 }
 
-/* far_run32 (FAR_LOOP's cells) sixteen at once. */
-AVX512 static void far_run32_avx512(FAR_PARAMS)
+/* far_run32 (FAR_LOOP's cells) sixteen at once, cell j's slope to
+ * slope[j * ostride] (straight into the output). */
+AVX512 static void far_run32_avx512(FAR_PARAMS, int ostride)
 {
     const __m512 cfv = _mm512_set1_ps(cf);
     const __m512i kv = _mm512_set1_epi32(k), step = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8,
@@ -230,7 +231,13 @@ AVX512 static void far_run32_avx512(FAR_PARAMS)
                              best);
         const __m512 out = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(h, h, _CMP_UNORD_Q), best,
                                                 _mm512_set1_ps((float)NAN));
-        _mm512_mask_storeu_ps(slope + j, lanes, out);
+        if (ostride == 1)
+            _mm512_mask_storeu_ps(slope + j, lanes, out);
+        else
+            _mm512_mask_i32scatter_ps(slope, lanes,
+                                      _mm512_mullo_epi32(_mm512_add_epi32(_mm512_set1_epi32(j), step),
+                                                         _mm512_set1_epi32(ostride)),
+                                      out, 4);
     }
 }
 #define HAVE_FAR_AVX512 1
@@ -239,17 +246,24 @@ AVX512 static void far_run32_avx512(FAR_PARAMS)
 #endif
 
 void ts_lane_far_field(const ts_line_geom *G, const float *z, float cf, int k, int i0, int j0,
-                       int j1, const float *hc, const ts_lane_occluders *occ, float *slope)
+                       int j1, const float *hc, const ts_lane_occluders *occ, float *slope,
+                       float *out, ptrdiff_t ostride)
 {
     const ray_view R = {G->origin, G->u_stride, G->v_stride, G->V};
     /* Every element the ray reads lies within U x V cells of the grid. */
     const ptrdiff_t span = (ptrdiff_t)(G->U - 1) * (G->u_stride < 0 ? -G->u_stride : G->u_stride) +
                            (ptrdiff_t)(G->V - 1) * G->v_stride + 1;
-    void (*run)(FAR_PARAMS) = span > INT_MAX ? far_run64 : far_run32;
 #if HAVE_FAR_AVX512
-    if (span <= INT_MAX && ts_lane_vector_level() == 2)
-        run = far_run32_avx512;
+    const ptrdiff_t omax = INT_MAX / (j1 + 16); /* the scatter's offsets in 32 bits */
+    if (span <= INT_MAX && ostride <= omax && ostride >= -omax && ts_lane_vector_level() == 2) {
+        far_run32_avx512(R, G->ray_o, G->ray_f, z, cf, k, i0, j0, j1, hc, occ->lo_k, occ->lo_dd,
+                         occ->hi_k, occ->hi_dd, out, (int)ostride);
+        return;
+    }
 #endif
-    run(R, G->ray_o, G->ray_f, z, cf, k, i0, j0, j1, hc, occ->lo_k, occ->lo_dd, occ->hi_k,
-        occ->hi_dd, slope);
+    (span > INT_MAX ? far_run64 : far_run32)(R, G->ray_o, G->ray_f, z, cf, k, i0, j0, j1, hc,
+                                             occ->lo_k, occ->lo_dd, occ->hi_k, occ->hi_dd,
+                                             slope);
+    for (int j = j0; j <= j1; j++)
+        out[j * ostride] = slope[j];
 }
