@@ -79,7 +79,6 @@ double ts_edge_distance(const ts_grid *grid, int x, int y, double azimuth)
     return edge_ray_distance(&r, grid, x, y);
 }
 
-
 static edge_job edge_job_of(const ts_grid *grid, double azimuth, const ts_horizon_opts *o,
                             float *plane, double sun_elevation)
 {

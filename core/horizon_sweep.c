@@ -407,7 +407,8 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         if (j1 == nl - 1)
             next[k] = (occluder){w->lo_k[nl], w->lo_dd[nl]};
         const int jw = prime && j0 == 0 ? 1 : j0;
-        float *o = C->out + C->o_origin + (ptrdiff_t)k * C->o_u_stride + i0 * C->o_v_stride;
+        float *o = C->out + C->o_origin + (ptrdiff_t)k * C->o_u_stride +
+                   (i0 + jw) * C->o_v_stride; /* cell (k, i0 + jw) */
         ts_lane_far_field(G, C->grid->z, (float)c, k, (int)i0, jw, j1, w->hc, &occ, w->slope, o,
                           C->o_v_stride);
     }

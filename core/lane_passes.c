@@ -208,7 +208,7 @@ AVX512 static inline __m512 ray16(const ray_view *R, const int *ray_o, const flo
 }
 
 /* far_run32 (FAR_LOOP's cells) sixteen at once, cell j's slope to
- * slope[j * ostride] (straight into the output). */
+ * slope[(j - j0) * ostride] (straight into the output). */
 AVX512 static void far_run32_avx512(FAR_PARAMS, int ostride)
 {
     const __m512 cfv = _mm512_set1_ps(cf);
@@ -232,12 +232,13 @@ AVX512 static void far_run32_avx512(FAR_PARAMS, int ostride)
         const __m512 out = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(h, h, _CMP_UNORD_Q), best,
                                                 _mm512_set1_ps((float)NAN));
         if (ostride == 1)
-            _mm512_mask_storeu_ps(slope + j, lanes, out);
+            _mm512_mask_storeu_ps(slope + (j - j0), lanes, out);
         else
-            _mm512_mask_i32scatter_ps(slope, lanes,
-                                      _mm512_mullo_epi32(_mm512_add_epi32(_mm512_set1_epi32(j), step),
-                                                         _mm512_set1_epi32(ostride)),
-                                      out, 4);
+            _mm512_mask_i32scatter_ps(
+                slope, lanes,
+                _mm512_mullo_epi32(_mm512_add_epi32(_mm512_set1_epi32(j - j0), step),
+                                   _mm512_set1_epi32(ostride)),
+                out, 4);
     }
 }
 #define HAVE_FAR_AVX512 1
@@ -265,5 +266,5 @@ void ts_lane_far_field(const ts_line_geom *G, const float *z, float cf, int k, i
                                              occ->lo_k, occ->lo_dd, occ->hi_k, occ->hi_dd,
                                              slope);
     for (int j = j0; j <= j1; j++)
-        out[j * ostride] = slope[j];
+        out[(j - j0) * ostride] = slope[j];
 }

@@ -30,7 +30,7 @@ typedef struct {
 } ts_lane_occluders;
 
 /* The far-field slope of cells (k, i0 + j), j0 <= j <= j1, at heights
- * hc[j] into out[j * ostride]: the larger of the cell's own ray sampled at
+ * hc[j] into out[(j - j0) * ostride]: the larger of the cell's own ray sampled at
  * the two occluders (the second skipped when it is the first's step;
  * either skipped within the near field), -inf when none counts, NaN where
  * hc is nodata; cf is the curvature coefficient; slope: scratch of j1 + 1
