@@ -4,12 +4,16 @@
 #include <stdint.h>
 
 #include "day_cycle.h"
+#include "horizon_edge.h"
 #include "parallel.h"
 #include "simd_clones.h"
 #include "status_internal.h"
 
 #define DEG2RAD (M_PI / 180.0)
 #define RAD2DEG (180.0 / M_PI)
+
+typedef ts_edge_ray edge_ray;
+typedef ts_edge_job edge_job;
 
 /* The tangent of the elevation of the highest sea-level point over s in
  * [s0, s1] seen from height h, for a drop c s^2 (c = 0: no curvature). */
@@ -37,15 +41,6 @@ double ts_edge_horizon(double height_m, double edge_m, const ts_horizon_opts *op
     double c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
     return atan(edge_tangent(height_m, edge_m, s1, c)) * RAD2DEG;
 }
-
-/* The ray toward an azimuth in cells per metre (the direction of
- * ts_line_geom_init: the central row's cell size, the larger DEM's for a
- * window), as the metres per cell
- * it advances along x and y (infinite along an axis it does not cross). */
-typedef struct {
-    double mx, my; /* metres per cell along x, y; INFINITY = parallel */
-    int east, south; /* 1: toward +x, +y */
-} edge_ray;
 
 static edge_ray edge_ray_of(const ts_grid *grid, double azimuth)
 {
@@ -83,17 +78,6 @@ double ts_edge_distance(const ts_grid *grid, int x, int y, double azimuth)
     edge_ray r = edge_ray_of(grid, azimuth);
     return edge_ray_distance(&r, grid, x, y);
 }
-
-typedef struct {
-    const ts_grid *grid;
-    const ts_horizon_opts *opts;
-    edge_ray ray;
-    double reach;         /* max_distance, or INFINITY */
-    double c;             /* drop per square metre: (1 - k) / 2R, or 0 */
-    float *plane;         /* the horizons, or the sun's visibility */
-    double sun_elevation; /* ts_horizon_edge_sun */
-    int skip_nonneg;      /* nonpositive_moot: cells of height >= 0 left as they are */
-} edge_job;
 
 static edge_job edge_job_of(const ts_grid *grid, double azimuth, const ts_horizon_opts *o,
                             float *plane, double sun_elevation)
@@ -154,20 +138,30 @@ static int row_needs_raise(const float *restrict row, const float *restrict z, i
     return need;
 }
 
+void ts_edge_row(const edge_job *j, int y)
+{
+    const int above_stays = j->opts->edge == TS_EDGE_HORIZON && j->c >= 0;
+    float *row = j->plane + (size_t)y * j->grid->width;
+    const float *z = j->grid->z + (ptrdiff_t)y * j->grid->stride;
+    if (!row_needs_raise(row, z, j->grid->width, j->skip_nonneg, above_stays))
+        return;
+    for (int x = 0; x < j->grid->width; x++)
+        if (!edge_stays(row[x], z[x], j->skip_nonneg, above_stays))
+            row[x] = edge_raise(j, x, y, row[x]);
+}
+
 static void edge_rows(void *ctx, int worker, long begin, long end)
 {
     (void)worker;
-    const edge_job *j = ctx;
-    const int above_stays = j->opts->edge == TS_EDGE_HORIZON && j->c >= 0;
-    for (long y = begin; y < end; y++) {
-        float *row = j->plane + (size_t)y * j->grid->width;
-        const float *z = j->grid->z + (ptrdiff_t)y * j->grid->stride;
-        if (!row_needs_raise(row, z, j->grid->width, j->skip_nonneg, above_stays))
-            continue;
-        for (int x = 0; x < j->grid->width; x++)
-            if (!edge_stays(row[x], z[x], j->skip_nonneg, above_stays))
-                row[x] = edge_raise(j, x, (int)y, row[x]);
-    }
+    for (long y = begin; y < end; y++)
+        ts_edge_row(ctx, (int)y);
+}
+
+int ts_edge_rows_init(edge_job *j, const ts_grid *grid, double azimuth,
+                      const ts_horizon_opts *opts, float *plane)
+{
+    *j = edge_job_of(grid, azimuth, opts, plane, 0.0);
+    return opts->edge != TS_EDGE_OPEN;
 }
 
 /* The Earth's horizon as a floor of horizon v at height h (TS_EDGE_HORIZON). */

@@ -31,6 +31,7 @@
 #include "arg_checks.h"
 #include "capped_lanes.h"
 #include "cellmath/cm_fastmath.h"
+#include "horizon_edge.h"
 #include "lane_hull.h"
 #include "lane_passes.h"
 #include "line_geometry.h"
@@ -68,6 +69,8 @@ typedef struct {
     cm_ray_grid ray;    /* the grid as the geometry sees it, for cm_ray_slope */
     int lags[4];        /* with a maximum distance: the steps back a window spans
                            (ts_cap_lanes_lags) */
+    ts_edge_job edge;   /* the world beyond the edge, raised row by row */
+    int edge_rows;      /* whether finish_rows raises (not TS_EDGE_OPEN) */
 } sweep_ctx;
 
 typedef struct {
@@ -404,11 +407,10 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         if (j1 == nl - 1)
             next[k] = (occluder){w->lo_k[nl], w->lo_dd[nl]};
         const int jw = prime && j0 == 0 ? 1 : j0;
-        ts_lane_far_field(G, C->grid->z, (float)c, k, (int)i0, jw, j1, w->hc, &occ, w->slope);
-        float *o = C->out + C->o_origin + (ptrdiff_t)k * C->o_u_stride;
-        const ptrdiff_t ovs = C->o_v_stride;
-        for (int j = jw; j <= j1; j++)
-            o[(i0 + j) * ovs] = w->slope[j];
+        float *o = C->out + C->o_origin + (ptrdiff_t)k * C->o_u_stride +
+                   (i0 + jw) * C->o_v_stride; /* cell (k, i0 + jw) */
+        ts_lane_far_field(G, C->grid->z, (float)c, k, (int)i0, jw, j1, w->hc, &occ, w->slope, o,
+                          C->o_v_stride);
     }
     w->carry_next = w->carry;
     w->carry = next;
@@ -547,7 +549,7 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
     const ts_grid *grid = C->grid;
     const ts_line_geom *G = C->geom;
     const int W = grid->width, H = grid->height, m = TS_NEAR_MARGIN;
-    float *scratch = malloc(2 * (size_t)W * sizeof *scratch);
+    float *scratch = malloc(4 * (size_t)W * sizeof *scratch); /* ts_near_edges' */
     for (long y = y0; y < y1; y++) {
         const float *zrow = grid->z + y * grid->stride;
         float *orow = C->out + y * W;
@@ -562,22 +564,14 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
         int xa = interior ? m : W, xb = interior ? W - m : W;
         if (interior)
             ts_near_row(&C->near, G, grid->z, zrow, (int)y, xa, xb, step, C->c, orow, scratch);
-        for (int x = 0; x < W; x++) {
-            if (x == xa)
-                x = xb;
-            if (x >= W)
-                break;
-            if (isnan(zrow[x]))
-                continue;
-            int u = G->x_major ? x : (int)y, v = G->x_major ? (int)y : x;
-            int left;
-            float nf = ts_near_field(&C->near, G, grid->z, (u - G->u_start) * G->u_step, v,
-                                     zrow[x], step, C->c, C->cap, &left);
-            orow[x] = left ? nf : fmaxf(nf, orow[x]);
-        }
+        if (scratch)
+            ts_near_edges(&C->near, G, grid->z, zrow, (int)y, xa, xb, W, step, C->c, C->cap,
+                          orow, scratch);
         if (C->cap > 0)
             ts_cap_tail(C->geom, grid, C->cap, C->c, (int)y, zrow, orow, step);
         degrees_row(orow, W);
+        if (C->edge_rows) /* while the row is at hand */
+            ts_edge_row(&C->edge, (int)y);
     }
     if (!scratch)
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
@@ -621,14 +615,18 @@ ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
 {
     if (!out)
         return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
+    /* the options as ts_horizon_edge_apply takes them (every direction) */
+    ts_status st = opts ? ts_horizon_opts_validate(opts, err) : TS_OK;
+    if (st != TS_OK)
+        return st;
     ts_line_geom geom;
     sweep_ctx C;
-    ts_status st = sweep_setup(grid, azimuth, opts, &geom, &C, err);
-    if (st != TS_OK)
+    if ((st = sweep_setup(grid, azimuth, opts, &geom, &C, err)) != TS_OK)
         return st;
     int failed = 0;
     C.out = out;
     C.alloc_failed = &failed;
+    C.edge_rows = ts_edge_rows_init(&C.edge, grid, azimuth, opts, out);
     long lines = geom.b_hi - geom.b_lo + 1;
     /* One chunk per thread: each chunk re-primes one line. */
     int threads = ts_thread_count(opts->threads, lines);
@@ -642,8 +640,9 @@ ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
         return st;
     if (failed)
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate sweep workspace");
-    /* the world beyond the edge, before anyone reads the horizons */
-    return ts_horizon_edge_apply(grid, azimuth, opts, out, err);
+    /* the world beyond the edge was raised row by row (finish_rows),
+     * before anyone reads the horizons */
+    return ts_ok(err);
 }
 
 ts_status ts_horizon_sweep_lines(const ts_grid *grid, double azimuth,

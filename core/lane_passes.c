@@ -3,6 +3,7 @@
 #include <math.h>
 
 #include "cellmath/cm_near_field.h"
+#include "lane_hull.h"
 #include "lane_passes.h"
 #include "simd_clones.h"
 
@@ -29,7 +30,56 @@ sample_run(const float *restrict zk, ptrdiff_t vs, float F, int j0, int j1, int 
         hn[j] = hs[j] = (float)NAN;
 }
 
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+
+#define AVX512 __attribute__((target("avx512f")))
+
+/* sample_run with the lines' cells vs apart, sixteen lines at a time with
+ * gathers (gcc's clones load the cells one by one); the same float
+ * operations. Offsets j vs in 32 bits. */
+AVX512 static void sample_strided_avx512(const float *zk, int vs, float F, int j0, int j1, int jn,
+                                         float *hc, float *hn, float *hs)
+{
+    const __m512i step = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    const __m512 nan = _mm512_set1_ps((float)NAN), f = _mm512_set1_ps(F);
+    for (int j = j0; j <= j1; j += 16) {
+        const __mmask16 lanes = j1 - j >= 15 ? 0xFFFF : (__mmask16)((1u << (j1 - j + 1)) - 1);
+        const __m512i at = _mm512_mullo_epi32(_mm512_add_epi32(_mm512_set1_epi32(j), step),
+                                              _mm512_set1_epi32(vs));
+        const __m512 c = _mm512_mask_i32gather_ps(nan, lanes, at, zk, 4);
+        _mm512_mask_storeu_ps(hc + j, lanes, c);
+        if (F == 0.0f) {
+            _mm512_mask_storeu_ps(hn + j, lanes, nan);
+            _mm512_mask_storeu_ps(hs + j, lanes, c);
+            continue;
+        }
+        const int left = jn - j + 1; /* lines with a next cell */
+        const __mmask16 next = lanes & (left >= 16  ? 0xFFFF
+                                        : left <= 0 ? 0
+                                                    : (__mmask16)((1u << left) - 1));
+        const __m512 n = _mm512_mask_i32gather_ps(nan, next, _mm512_add_epi32(at, _mm512_set1_epi32(vs)),
+                                                  zk, 4);
+        const __m512 h = _mm512_add_ps(c, _mm512_mul_ps(f, _mm512_sub_ps(n, c)));
+        _mm512_mask_storeu_ps(hn + j, lanes, n);
+        _mm512_mask_storeu_ps(hs + j, lanes, _mm512_mask_blend_ps(next, nan, h));
+    }
+}
+#define HAVE_SAMPLE_AVX512 1
+#else
+#define HAVE_SAMPLE_AVX512 0
+#endif
+
 TS_SIMD_CLONES
+static void sample_any(const float *zk, ptrdiff_t vs, float F, int j0, int j1, int jn, float *hc,
+                       float *hn, float *hs)
+{
+    if (vs == 1)
+        sample_run(zk, 1, F, j0, j1, jn, hc, hn, hs);
+    else
+        sample_run(zk, vs, F, j0, j1, jn, hc, hn, hs);
+}
+
 void ts_lane_sample(const ts_line_geom *G, const float *z, int k, int i0, int j0, int j1,
                     float *hc, float *hn, float *hs)
 {
@@ -38,10 +88,13 @@ void ts_lane_sample(const ts_line_geom *G, const float *z, int k, int i0, int j0
     const float *zk = z + G->origin + (ptrdiff_t)k * G->u_stride + (ptrdiff_t)i0 * vs;
     /* Every line has a next cell but one on the grid's last row. */
     int jn = G->V - 2 - i0 < j1 ? G->V - 2 - i0 : j1;
-    if (vs == 1)
-        sample_run(zk, 1, F, j0, j1, jn, hc, hn, hs);
-    else
-        sample_run(zk, vs, F, j0, j1, jn, hc, hn, hs);
+#if HAVE_SAMPLE_AVX512
+    if (vs != 1 && vs <= INT_MAX / (j1 + 2) && ts_lane_vector_level() == 2) {
+        sample_strided_avx512(zk, (int)vs, F, j0, j1, jn, hc, hn, hs);
+        return;
+    }
+#endif
+    sample_any(zk, vs, F, j0, j1, jn, hc, hn, hs);
 }
 
 /* The grid's layout as the direction sees it. */
@@ -120,14 +173,98 @@ static void far_run64(FAR_PARAMS)
     FAR_LOOP(1)
 }
 
+#if defined(__GNUC__) && defined(__x86_64__)
+/* ray_at (32-bit offsets) for 16 cells i at once, where lanes: the same
+ * float operations, the loads as gathers (gcc's far_run32 emulates them
+ * with scalar loads, three instructions an element). */
+AVX512 static inline __m512 ray16(const ray_view *R, const int *ray_o, const float *ray_f,
+                                  const float *z, __m512 cf, __m512i k, __m512i i, __m512 h,
+                                  __m512i kc, __m512 dd, __mmask16 lanes)
+{
+    const __m512i zero = _mm512_setzero_si512(), last = _mm512_set1_epi32(R->V - 1);
+    const __m512 fzero = _mm512_setzero_ps();
+    const __m512i dk = _mm512_sub_epi32(k, kc);
+    __mmask16 ok = lanes & _mm512_cmpge_epi32_mask(kc, zero) &
+                   _mm512_cmpgt_epi32_mask(dk, _mm512_set1_epi32(TS_NEAR_STEPS)) &
+                   _mm512_cmp_ps_mask(dd, fzero, _CMP_GT_OQ);
+    const __m512i dks = _mm512_maskz_mov_epi32(ok, dk); /* 0 where not ok: a valid entry */
+    const __m512i r0 = _mm512_add_epi32(i, _mm512_i32gather_epi32(dks, ray_o, 4));
+    const __m512 f = _mm512_i32gather_ps(dks, ray_f, 4);
+    ok &= _mm512_cmpge_epi32_mask(r0, zero) & _mm512_cmple_epi32_mask(r0, last) &
+          (_mm512_cmp_ps_mask(f, fzero, _CMP_LE_OQ) |
+           _mm512_cmple_epi32_mask(_mm512_add_epi32(r0, _mm512_set1_epi32(1)), last));
+    const __mmask16 two = ok & _mm512_cmp_ps_mask(f, fzero, _CMP_GT_OQ);
+    const __m512i vs = _mm512_set1_epi32((int)(unsigned)R->v_stride);
+    const __m512i ia = _mm512_add_epi32(
+        _mm512_add_epi32(_mm512_set1_epi32((int)(unsigned)R->origin),
+                         _mm512_mullo_epi32(kc, _mm512_set1_epi32((int)(unsigned)R->u_stride))),
+        _mm512_mullo_epi32(r0, vs));
+    const __m512 a = _mm512_mask_i32gather_ps(fzero, ok, ia, z, 4);
+    const __m512 b = _mm512_mask_i32gather_ps(a, two, _mm512_add_epi32(ia, vs), z, 4);
+    const __m512 hz = _mm512_add_ps(a, _mm512_mul_ps(f, _mm512_sub_ps(b, a)));
+    const __m512 s = _mm512_sub_ps(_mm512_div_ps(_mm512_sub_ps(hz, h), dd), _mm512_mul_ps(cf, dd));
+    return _mm512_mask_blend_ps(ok & _mm512_cmp_ps_mask(hz, hz, _CMP_ORD_Q),
+                                _mm512_set1_ps(-INFINITY), s);
+}
+
+/* far_run32 (FAR_LOOP's cells) sixteen at once, cell j's slope to
+ * slope[(j - j0) * ostride] (straight into the output). */
+AVX512 static void far_run32_avx512(FAR_PARAMS, int ostride)
+{
+    const __m512 cfv = _mm512_set1_ps(cf);
+    const __m512i kv = _mm512_set1_epi32(k), step = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8,
+                                                                     9, 10, 11, 12, 13, 14, 15);
+    for (int j = j0; j <= j1; j += 16) {
+        const __mmask16 lanes = j1 - j >= 15 ? 0xFFFF : (__mmask16)((1u << (j1 - j + 1)) - 1);
+        const __m512 h = _mm512_maskz_loadu_ps(lanes, hc + j);
+        const __m512i i = _mm512_add_epi32(_mm512_set1_epi32(i0 + j), step);
+        const __m512i kl = _mm512_maskz_loadu_epi32(lanes, lo_k + j);
+        const __m512i khi = _mm512_maskz_loadu_epi32(lanes, hi_k + j);
+        const __m512i kh = _mm512_mask_mov_epi32(khi, _mm512_cmpeq_epi32_mask(khi, kl),
+                                                 _mm512_set1_epi32(-1)); /* the same step */
+        __m512 best = _mm512_set1_ps(-INFINITY);
+        best = _mm512_max_ps(ray16(&R, ray_o, ray_f, z, cfv, kv, i, h, kl,
+                                   _mm512_maskz_loadu_ps(lanes, lo_dd + j), lanes),
+                             best);
+        best = _mm512_max_ps(ray16(&R, ray_o, ray_f, z, cfv, kv, i, h, kh,
+                                   _mm512_maskz_loadu_ps(lanes, hi_dd + j), lanes),
+                             best);
+        const __m512 out = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(h, h, _CMP_UNORD_Q), best,
+                                                _mm512_set1_ps((float)NAN));
+        if (ostride == 1)
+            _mm512_mask_storeu_ps(slope + (j - j0), lanes, out);
+        else
+            _mm512_mask_i32scatter_ps(
+                slope, lanes,
+                _mm512_mullo_epi32(_mm512_add_epi32(_mm512_set1_epi32(j - j0), step),
+                                   _mm512_set1_epi32(ostride)),
+                out, 4);
+    }
+}
+#define HAVE_FAR_AVX512 1
+#else
+#define HAVE_FAR_AVX512 0
+#endif
+
 void ts_lane_far_field(const ts_line_geom *G, const float *z, float cf, int k, int i0, int j0,
-                       int j1, const float *hc, const ts_lane_occluders *occ, float *slope)
+                       int j1, const float *hc, const ts_lane_occluders *occ, float *slope,
+                       float *out, ptrdiff_t ostride)
 {
     const ray_view R = {G->origin, G->u_stride, G->v_stride, G->V};
     /* Every element the ray reads lies within U x V cells of the grid. */
     const ptrdiff_t span = (ptrdiff_t)(G->U - 1) * (G->u_stride < 0 ? -G->u_stride : G->u_stride) +
                            (ptrdiff_t)(G->V - 1) * G->v_stride + 1;
+#if HAVE_FAR_AVX512
+    const ptrdiff_t omax = INT_MAX / (j1 + 16); /* the scatter's offsets in 32 bits */
+    if (span <= INT_MAX && ostride <= omax && ostride >= -omax && ts_lane_vector_level() == 2) {
+        far_run32_avx512(R, G->ray_o, G->ray_f, z, cf, k, i0, j0, j1, hc, occ->lo_k, occ->lo_dd,
+                         occ->hi_k, occ->hi_dd, out, (int)ostride);
+        return;
+    }
+#endif
     (span > INT_MAX ? far_run64 : far_run32)(R, G->ray_o, G->ray_f, z, cf, k, i0, j0, j1, hc,
                                              occ->lo_k, occ->lo_dd, occ->hi_k, occ->hi_dd,
                                              slope);
+    for (int j = j0; j <= j1; j++)
+        out[(j - j0) * ostride] = slope[j];
 }

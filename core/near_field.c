@@ -38,6 +38,13 @@ void ts_near_plan_init(ts_near_plan *p, const ts_line_geom *g)
         p->piece_du[n] = (int)floor(-mid);
         p->piece_dv[n] = at > 1e-12 ? (int)floor(-g->t * mid) : 0;
     }
+    p->du_min = p->dv_min = p->dv_max = 0;
+    for (int n = 0; n < p->npieces; n++) {
+        const int dv_top = p->piece_dv[n] + (at > 1e-12); /* the 01 and 11 corners */
+        p->du_min = p->piece_du[n] < p->du_min ? p->piece_du[n] : p->du_min;
+        p->dv_min = p->piece_dv[n] < p->dv_min ? p->piece_dv[n] : p->dv_min;
+        p->dv_max = dv_top > p->dv_max ? dv_top : p->dv_max;
+    }
     for (int n = 0; n < p->npieces; n++) {
         ptrdiff_t o = p->piece_du[n] * g->u_stride + p->piece_dv[n] * g->v_stride;
         p->piece_off[n][0] = o;
@@ -131,5 +138,95 @@ void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
         float nf = ts_near_field(p, g, z, (u - g->u_start) * g->u_step, v, zrow[x], step, c,
                                  0.0, &left);
         out[x] = nf > out[x] ? nf : out[x];
+    }
+}
+
+/* cm_near_exact over cells x0 <= x < x1 of a row whose every piece is on
+ * the grid: the pieces before smax steps (with sb cut there), each by
+ * cm_near_piece's arithmetic for corners without nodata, in loops the
+ * compiler vectorises; cells with a nodata corner (where cm_near_piece
+ * takes its other branch) are flagged. best: doubles. */
+TS_SIMD_CLONES
+static void exact_run(const ts_near_plan *p, const float *restrict zrow, int x0, int x1,
+                      double smax, double L, double c, double *restrict best,
+                      float *restrict flag)
+{
+    for (int x = x0; x < x1; x++) {
+        best[x] = -INFINITY;
+        flag[x] = 0.0f;
+    }
+    const int flat_v = fabs(p->t) <= 1e-12; /* along a grid line: 01, 11 weigh nothing */
+    const double t = flat_v ? 0 : p->t;
+    for (int n = 0; n < p->npieces && p->piece_sa[n] < smax; n++) {
+        const float *restrict c00 = zrow + p->piece_off[n][0];
+        const float *restrict c10 = zrow + p->piece_off[n][1];
+        const float *restrict c01 = flat_v ? c00 : zrow + p->piece_off[n][2];
+        const float *restrict c11 = flat_v ? c10 : zrow + p->piece_off[n][3];
+        const double a0 = -p->piece_du[n], b0 = flat_v ? 0 : -p->piece_dv[n];
+        const double sa = p->piece_sa[n], sb = p->piece_sb[n] < smax ? p->piece_sb[n] : smax;
+        for (int x = x0; x < x1; x++) {
+            const float h0 = c00[x], h1 = c10[x], h2 = c01[x], h3 = c11[x];
+            const float A = h1 - h0, B = h2 - h0, X = h3 - h1 - h2 + h0;
+            double alpha, beta, gamma;
+            cm_patch_poly(h0, A, B, X, a0, b0, t, &alpha, &beta, &gamma);
+            const double m = cm_piece_max(alpha - zrow[x], beta, gamma, sa, sb, L, c);
+            best[x] = m > best[x] ? m : best[x];
+            flag[x] += (h0 != h0) | (h1 != h1) | (h2 != h2) | (h3 != h3) ? 1.0f : 0.0f;
+        }
+    }
+}
+
+/* ts_near_field's answer for cell x of row y, and whether the ray left. */
+static float near_cell(const ts_near_plan *p, const ts_line_geom *g, const float *z,
+                       const float *zrow, int y, int x, double step, double c, double cap,
+                       int *left)
+{
+    int u = g->x_major ? x : y, v = g->x_major ? y : x;
+    return ts_near_field(p, g, z, (u - g->u_start) * g->u_step, v, zrow[x], step, c, cap, left);
+}
+
+/* Whether every piece of cell x of row y is on the grid. */
+static int near_on_grid(const ts_near_plan *p, const ts_line_geom *g, int y, int x)
+{
+    int u = g->x_major ? x : y, i = g->x_major ? y : x, k = (u - g->u_start) * g->u_step;
+    return k + p->du_min >= 0 && i + p->dv_min >= 0 && i + p->dv_max <= g->V - 1;
+}
+
+void ts_near_edges(const ts_near_plan *p, const ts_line_geom *g, const float *z,
+                   const float *zrow, int y, int xa, int xb, int W, double step, double c,
+                   double cap, float *out, float *scratch)
+{
+    double *best = (double *)scratch;
+    float *flag = scratch + 2 * (size_t)W;
+    const double smax = cap > 0 ? cap / step : INFINITY; /* as cm_near_exact */
+    for (int x = 0; x < W;) {
+        if (x == xa) {
+            x = xb;
+            continue;
+        }
+        /* the run of cells from x whose pieces are all on the grid, together */
+        const int end = x < xa ? xa : W;
+        int x1 = x;
+        while (x1 < end && near_on_grid(p, g, y, x1))
+            x1++;
+        if (x1 > x) {
+            exact_run(p, zrow, x, x1, smax, step, c, best, flag);
+            for (; x < x1; x++) {
+                if (isnan(zrow[x]))
+                    continue;
+                int left; /* 0 on the grid */
+                float nf = flag[x] == 0.0f
+                               ? (float)best[x]
+                               : near_cell(p, g, z, zrow, y, x, step, c, cap, &left);
+                out[x] = fmaxf(nf, out[x]);
+            }
+        } else { /* a piece off the grid: ts_near_field tells where the ray left */
+            if (!isnan(zrow[x])) {
+                int left;
+                float nf = near_cell(p, g, z, zrow, y, x, step, c, cap, &left);
+                out[x] = left ? nf : fmaxf(nf, out[x]);
+            }
+            x++;
+        }
     }
 }

@@ -24,6 +24,9 @@ typedef struct {
     /* Element offsets from the cell, for the vectorised interior pass:
      * corners 00, 10, 01, 11 of each piece. */
     ptrdiff_t piece_off[TS_NEAR_MAX_PIECES][4];
+    /* The pieces' extent from the cell: every piece's patch is on the
+     * grid where k + du_min >= 0 and dv_min <= -i, i + dv_max <= V - 1. */
+    int du_min, dv_min, dv_max;
 } ts_near_plan;
 
 /* The pieces for the geometry's direction. */
@@ -52,5 +55,17 @@ float ts_ray_exact(const ts_line_geom *g, const float *z, int k, int i, float h,
 void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
                  const float *zrow, int y, int x0, int x1, double step, double c,
                  float *out, float *scratch);
+
+/*
+ * Near field of the cells of row y outside [xa, xb) (the interior that
+ * ts_near_row does), cap as ts_near_field: out[x] = the near field where
+ * the ray leaves the grid inside it, else max(out[x], near field). Cells
+ * whose near field lies on the grid and touches no nodata take the
+ * vectorised form of ts_near_field's double arithmetic, the others
+ * ts_near_field itself; the same bits either way. scratch: 4 W floats.
+ */
+void ts_near_edges(const ts_near_plan *p, const ts_line_geom *g, const float *z,
+                   const float *zrow, int y, int xa, int xb, int W, double step, double c,
+                   double cap, float *out, float *scratch);
 
 #endif
