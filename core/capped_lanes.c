@@ -54,7 +54,9 @@ int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, const int lags[4], double nea
     r->slots = r->groups[0] * TS_CAP_G0;
     r->near = near;
     r->cap = cap;
-    r->prune = ts_lane_vector_level() == 2 && r->lag_hi - r->lag_lo + 1 >= PRUNE_FROM;
+    /* (the prune's margin holds for windows of up to 10^5 samples) */
+    r->prune = ts_lane_vector_level() == 2 && r->lag_hi - r->lag_lo + 1 >= PRUNE_FROM &&
+               r->lag_hi <= 100000;
     const size_t ring = (size_t)r->slots * r->stride * sizeof(double);
     const size_t line = (size_t)r->stride * sizeof(double);
     r->d = zalloc(ring);
