@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "capped_lanes.h"
+#include "capped_lanes512.h"
 
 void ts_cap_lanes_lags(double near, double cap, double shortest, double longest, int lags[4])
 {
@@ -29,6 +30,15 @@ static void *zalloc(size_t n)
     return p;
 }
 
+/* Windows of at least PRUNE_FROM lags take the pruned scan (with AVX-512),
+ * up to lags of PRUNE_TO (beyond, the line-by-line window hull is cheaper). */
+#ifndef PRUNE_TO
+#define PRUNE_TO 256
+#endif
+#ifndef PRUNE_FROM
+#define PRUNE_FROM 64
+#endif
+
 int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, const int lags[4], double near, double cap)
 {
     *r = (ts_cap_lanes){0};
@@ -37,9 +47,16 @@ int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, const int lags[4], double nea
     r->lag_hi = lags[1];
     r->sure_lo = lags[2];
     r->sure_hi = lags[3];
-    r->slots = r->lag_hi + 1;
+    /* a multiple of TS_CAP_G0, so that a level-0 group's slots lie together;
+     * more than lag_hi, so that a group is reset only once out of the window */
+    r->groups[0] = (r->lag_hi + TS_CAP_G0 - 1) / TS_CAP_G0 + 1;
+    r->groups[1] = (r->lag_hi + TS_CAP_G1 - 1) / TS_CAP_G1 + 1;
+    r->slots = r->groups[0] * TS_CAP_G0;
     r->near = near;
     r->cap = cap;
+    /* (the prune's margin holds for windows of up to 10^5 samples) */
+    r->prune = ts_lane_vector_level() == 2 && r->lag_hi - r->lag_lo + 1 >= PRUNE_FROM &&
+               r->lag_hi <= 100000;
     const size_t ring = (size_t)r->slots * r->stride * sizeof(double);
     const size_t line = (size_t)r->stride * sizeof(double);
     r->d = zalloc(ring);
@@ -51,7 +68,15 @@ int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, const int lags[4], double nea
     r->ddn = zalloc(line);
     r->kc = zalloc(line);
     r->kn = zalloc(line);
-    return r->d && r->g && r->qd && r->qc && r->qn && r->ddc && r->ddn && r->kc && r->kn;
+    int ok = r->d && r->g && r->qd && r->qc && r->qn && r->ddc && r->ddn && r->kc && r->kn;
+    for (int l = 0; l < 2 && r->prune; l++) {
+        const size_t n = (size_t)r->groups[l] * line;
+        r->gmax[l] = zalloc(n);
+        r->dlo[l] = zalloc(n);
+        r->dhi[l] = zalloc(n);
+        ok = ok && r->gmax[l] && r->dlo[l] && r->dhi[l];
+    }
+    return ok;
 }
 
 void ts_cap_lanes_free(ts_cap_lanes *r)
@@ -65,6 +90,11 @@ void ts_cap_lanes_free(ts_cap_lanes *r)
     free(r->ddn);
     free(r->kc);
     free(r->kn);
+    for (int l = 0; l < 2; l++) {
+        free(r->gmax[l]);
+        free(r->dlo[l]);
+        free(r->dhi[l]);
+    }
     *r = (ts_cap_lanes){0};
 }
 
@@ -73,6 +103,10 @@ void ts_cap_lanes_clear(ts_cap_lanes *r)
     const size_t n = (size_t)r->slots * r->stride;
     for (size_t i = 0; i < n; i++)
         r->d[i] = NAN;
+    for (int j = 0; j < r->stride; j++)
+        r->kc[j] = r->kn[j] = -1; /* no previous answers */
+    for (int l = 0; l < 2 && r->prune; l++)
+        ts_cap_groups_empty(r->gmax[l], r->dlo[l], r->dhi[l], (size_t)r->groups[l] * r->stride);
 }
 
 /* Lines [g0, g1) (multiples of 8) at step k: for each query height (NaN:
@@ -110,73 +144,9 @@ static void scan_scalar(const ts_cap_lanes *r, int k, int g0, int g1)
 #if defined(__GNUC__) && defined(__x86_64__)
 #include <immintrin.h>
 
-#define AVX512 __attribute__((target("avx512f")))
-/* groups of eight lines scanned together: independent chains of compares
- * and selects, so that their latencies overlap */
-#define NG 3
-
-/* scan_scalar for up to NG groups from g (those below g1), eight lines
- * per AVX-512 vector: the same operations per line. */
-AVX512 static void scan_avx512(const ts_cap_lanes *r, int k, int g, int g1)
-{
-    const int lag_hi = k < r->lag_hi ? k : r->lag_hi;
-    const int ng = (g1 - g) / 8 < NG ? (g1 - g) / 8 : NG;
-    const __m512d near = _mm512_set1_pd(r->near), cap = _mm512_set1_pd(r->cap);
-    __m512d d[NG], gc[NG], gn[NG], bnc[NG], bdc[NG], bnn[NG], bdn[NG];
-    __m512i bkc[NG], bkn[NG];
-    for (int q = 0; q < NG; q++) {
-        const int o = g + 8 * (q < ng ? q : 0);
-        d[q] = _mm512_load_pd(r->qd + o);
-        gc[q] = _mm512_load_pd(r->qc + o);
-        gn[q] = _mm512_load_pd(r->qn + o);
-        bnc[q] = bnn[q] = _mm512_set1_pd(-INFINITY);
-        bdc[q] = bdn[q] = _mm512_set1_pd(1.0);
-        bkc[q] = bkn[q] = _mm512_set1_epi64(-1);
-    }
-    int slot = (k - lag_hi) % r->slots;
-    for (int lag = lag_hi; lag >= r->lag_lo; lag--) {
-        const __m512i ks = _mm512_set1_epi64(k - lag);
-        const double *pd = r->d + (size_t)slot * r->stride + g;
-        const double *pg = r->g + (size_t)slot * r->stride + g;
-        slot = slot + 1 == r->slots ? 0 : slot + 1;
-        /* within the sure lags, the distance needs no test (a slot without
-         * a sample has d NaN, which fails the slope's compare) */
-        const int sure = lag >= r->sure_lo && lag <= r->sure_hi;
-        for (int q = 0; q < NG; q++) {
-            if (q >= ng)
-                break;
-            const __m512d dd = _mm512_sub_pd(d[q], _mm512_load_pd(pd + 8 * q));
-            __mmask8 in = 0xFF;
-            if (!sure) {
-                in = _mm512_cmp_pd_mask(dd, near, _CMP_GE_OQ);
-                in = _mm512_mask_cmp_pd_mask(in, dd, cap, _CMP_LE_OQ);
-            }
-            const __m512d sg = _mm512_load_pd(pg + 8 * q);
-            const __m512d nc = _mm512_sub_pd(sg, gc[q]), nn = _mm512_sub_pd(sg, gn[q]);
-            const __mmask8 wc = _mm512_mask_cmp_pd_mask(in, _mm512_mul_pd(nc, bdc[q]),
-                                                        _mm512_mul_pd(bnc[q], dd), _CMP_GT_OQ);
-            const __mmask8 wn = _mm512_mask_cmp_pd_mask(in, _mm512_mul_pd(nn, bdn[q]),
-                                                        _mm512_mul_pd(bnn[q], dd), _CMP_GT_OQ);
-            bnc[q] = _mm512_mask_mov_pd(bnc[q], wc, nc);
-            bdc[q] = _mm512_mask_mov_pd(bdc[q], wc, dd);
-            bkc[q] = _mm512_mask_mov_epi64(bkc[q], wc, ks);
-            bnn[q] = _mm512_mask_mov_pd(bnn[q], wn, nn);
-            bdn[q] = _mm512_mask_mov_pd(bdn[q], wn, dd);
-            bkn[q] = _mm512_mask_mov_epi64(bkn[q], wn, ks);
-        }
-    }
-    for (int q = 0; q < ng; q++) {
-        const int o = g + 8 * q;
-        _mm512_store_epi64(r->kc + o, bkc[q]);
-        _mm512_store_pd(r->ddc + o, bdc[q]);
-        _mm512_store_epi64(r->kn + o, bkn[q]);
-        _mm512_store_pd(r->ddn + o, bdn[q]);
-    }
-}
-
 #define AVX2 __attribute__((target("avx2")))
 
-/* scan_avx512 for the eight lines from g, four per AVX2 vector (the
+/* ts_cap_scan512 for the eight lines from g, four per AVX2 vector (the
  * compares give lane masks as vectors, the selects are blends): the same
  * operations per line. */
 AVX2 static void scan_avx2(const ts_cap_lanes *r, int k, int g)
@@ -233,20 +203,22 @@ AVX2 static void scan_avx2(const ts_cap_lanes *r, int k, int g)
 
 int ts_cap_lanes_pays(const int lags[4])
 {
-    /* measured (docs/performance.md, "Bounded sweep, session 9"): the
-     * brute force costs about the line-by-line window at ~96 steps with
-     * AVX-512, ~40 with AVX2 */
+    /* measured (docs/performance.md, "Bounded sweep", sessions 9 and 10):
+     * the brute force costs about the line-by-line window at ~96 steps
+     * with AVX-512, ~40 with AVX2; pruned, from PRUNE_FROM steps on, at
+     * ~200-300 (AVX-512 only) */
     const int span = lags[1] - lags[0] + 1;
     const int level = ts_lane_vector_level();
-    return level == 2 ? span <= 96 : level == 1 ? span <= 40 : 0;
+    return level == 2 ? span <= 96 || (span >= PRUNE_FROM && lags[1] <= PRUNE_TO)
+         : level == 1 ? span <= 40 : 0;
 }
 
 static void scan_groups(const ts_cap_lanes *r, int k, int g0, int g1)
 {
     const int level = ts_lane_vector_level();
     if (level == 2)
-        for (int g = g0; g < g1; g += 8 * NG)
-            scan_avx512(r, k, g, g1);
+        for (int g = g0; g < g1; g += 8 * TS_CAP_NG)
+            ts_cap_scan512(r, k, g, g1);
     else if (level == 1)
         for (int g = g0; g < g1; g += 8)
             scan_avx2(r, k, g);
@@ -275,29 +247,39 @@ void ts_cap_lanes_step(ts_cap_lanes *r, const ts_lane_step *s, int nl,
     double *rg = r->g + (size_t)(k % r->slots) * r->stride;
     for (int j = 0; j < nl; j++)
         rd[j] = NAN;
-    if (j0 > j1)
-        return;
-    const int g0 = j0 / 8 * 8, g1 = (j1 + 8) / 8 * 8;
-    for (int j = g0; j < g1; j++) {
-        const int on = j >= j0 && j <= j1;
-        const double d = on ? s->d[j] : 0.0;
-        const double cdd = c * d * d;
-        const int hi = on && j >= s->hi_from && j <= s->hi_to;
-        r->qd[j] = d;
-        /* as hull_query and ts_lane_hull_step: g = h - c d^2 */
-        r->qc[j] = hi ? (double)s->hc[j] - cdd : NAN;
-        r->qn[j] = on ? (double)s->hn[j] - cdd : NAN;
-    }
-    scan_groups(r, k, g0, g1);
-    for (int j = j0; j <= j1; j++) {
-        occ->hi_k[j] = (int)r->kc[j];
-        occ->hi_dd[j] = (float)r->ddc[j];
-        occ->lo_k[j + 1] = (int)r->kn[j];
-        occ->lo_dd[j + 1] = (float)r->ddn[j];
-        /* the step's own sample enters the ring after its queries (it is
-         * no occluder of its own step: lag 0 < lag_lo) */
-        const double hs = s->hs[j], d = s->d[j];
-        rd[j] = isnan(hs) ? NAN : d;
-        rg[j] = hs - c * d * d;
+    if (j0 <= j1) {
+        const int g0 = j0 / 8 * 8, g1 = (j1 + 8) / 8 * 8;
+#if defined(__GNUC__) && defined(__x86_64__)
+        if (ts_lane_vector_level() == 2) {
+            ts_cap_queries512(r, s, g0, g1);
+            scan_groups(r, k, g0, g1);
+            ts_cap_answers512(r, s, g0, g1, occ, rd, rg);
+            if (r->prune)
+                ts_cap_groups_add512(r, k, rd, rg);
+            return;
+        }
+#endif
+        for (int j = g0; j < g1; j++) {
+            const int on = j >= j0 && j <= j1;
+            const double d = on ? s->d[j] : 0.0;
+            const double cdd = c * d * d;
+            const int hi = on && j >= s->hi_from && j <= s->hi_to;
+            r->qd[j] = d;
+            /* as hull_query and ts_lane_hull_step: g = h - c d^2 */
+            r->qc[j] = hi ? (double)s->hc[j] - cdd : NAN;
+            r->qn[j] = on ? (double)s->hn[j] - cdd : NAN;
+        }
+        scan_groups(r, k, g0, g1);
+        for (int j = j0; j <= j1; j++) {
+            occ->hi_k[j] = (int)r->kc[j];
+            occ->hi_dd[j] = (float)r->ddc[j];
+            occ->lo_k[j + 1] = (int)r->kn[j];
+            occ->lo_dd[j + 1] = (float)r->ddn[j];
+            /* the step's own sample enters the ring after its queries (it
+             * is no occluder of its own step: lag 0 < lag_lo) */
+            const double hs = s->hs[j], d = s->d[j];
+            rd[j] = isnan(hs) ? NAN : d;
+            rg[j] = hs - c * d * d;
+        }
     }
 }

@@ -13,7 +13,9 @@
  * cross-multiplication (no division), eight lines at a time, no gathers.
  * Among equally steep samples the oldest (smallest step) wins, whatever
  * the block's first step, so a line's answers do not depend on where a
- * block or a tile begins.
+ * block or a tile begins. Long windows (with AVX-512) skip the groups of
+ * slots whose bounds show they cannot change the answer
+ * (capped_lanes512.c), with the same bits.
  */
 #ifndef TS_CAPPED_LANES_H
 #define TS_CAPPED_LANES_H
@@ -28,11 +30,27 @@ typedef struct {
     int lag_lo, lag_hi; /* the lags (steps back) a window sample may have */
     int sure_lo, sure_hi; /* and those that are surely in the window */
     double near, cap;
+    /* Pruning (AVX-512, long windows): per aligned group of TS_CAP_G0 steps
+     * (level 0, whose slots lie together in the ring) and of TS_CAP_G1 steps
+     * (level 1), per line, the largest g of its samples and the distances
+     * of its oldest and newest; -inf, 0, 0 when it has none. Group m of
+     * level l sits at [(m % groups[l]) * stride + j]. */
+    int prune;
+    int groups[2];
+    double *gmax[2], *dlo[2], *dhi[2];
     /* per line, padded to stride: the step's distance and query heights,
      * and the answers (steps, -1: none; distances) */
     double *qd, *qc, *qn, *ddc, *ddn;
     long long *kc, *kn;
 } ts_cap_lanes;
+
+/* Level 0 and level 1 groups of the pruned scan, in steps. */
+#ifndef TS_CAP_G0
+#define TS_CAP_G0 8
+#endif
+#ifndef TS_CAP_G1
+#define TS_CAP_G1 64
+#endif
 
 /* The lags (steps back) of a window from near to cap metres behind, on
  * lines whose steps are shortest..longest metres long: lags[0..1], those
@@ -40,9 +58,10 @@ typedef struct {
  * it (none where lags[2] > lags[3]). */
 void ts_cap_lanes_lags(double near, double cap, double shortest, double longest, int lags[4]);
 
-/* Whether the brute force is the cheaper way to answer windows of these
- * lags on this CPU (else the line-by-line sliding window hull is). The
- * answers differ only between exactly equally steep samples. */
+/* Whether the brute force (pruned for long windows) is the cheaper way to
+ * answer windows of these lags on this CPU (else the line-by-line sliding
+ * window hull is). The answers differ only between exactly equally steep
+ * samples. */
 int ts_cap_lanes_pays(const int lags[4]);
 
 /* Rings for up to `lines` lines and the window of lags (as

@@ -31,6 +31,21 @@ static float between_steps_bound(const ts_line_geom *G, const float *z, int k, i
     return (float)(dh / ((dh > 0 ? j : j + 1) * step) - c * j * step);
 }
 
+/* Whether ts_ray_exact from s0 stops in its first piece, so returns -inf:
+ * that piece's middle lies beyond s0, so behind step 0 where k < s0, and
+ * off the rows where v = i - t s (the same rounded operations, monotone
+ * in s) is already off at s0. */
+static int ray_off_from(const ts_line_geom *G, int k, int i, double s0)
+{
+    if (k < s0)
+        return 1;
+    const double t = G->t;
+    if (!(fabs(t) > 1e-12))
+        return 0;
+    const double v = i - t * s0;
+    return t > 0 ? v < 0 : v >= G->V - 1;
+}
+
 /*
  * The part of a capped ray's last step before the distance ends, solved
  * exactly on each cell's own ray where a bound says it may raise the
@@ -70,7 +85,7 @@ void ts_cap_tail(const ts_line_geom *G, const ts_grid *grid, double cap, double 
             if (e > best && between_steps_bound(G, grid->z, k, i, h, (int)s0, step, c) < best)
                 continue;
         } else {
-            if (ts_cap_stencil_off_grid(&st, G, k, i) ||
+            if (ts_cap_stencil_off_grid(&st, G, k, i) || ray_off_from(G, k, i, s0) ||
                 between_steps_bound(G, grid->z, k, i, h, (int)s0, step, c) < best)
                 continue; /* off the grid: ts_ray_exact's -inf */
             e = ts_ray_exact(G, grid->z, k, i, h, s0, smax, step, c);

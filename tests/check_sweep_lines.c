@@ -2,9 +2,11 @@
  * lines: same samples, so the slopes must agree to float precision. */
 #include <check.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "capped_lanes.h"
 #include "oracle.h"
 #include "terrashade.h"
 #include "test_grid.h"
@@ -233,6 +235,136 @@ START_TEST(test_jacksboro_rows)
 }
 END_TEST
 
+/* The capped lines' window scan (capped_lanes.h) on synthetic lines,
+ * against its definition: each query scans its window oldest first and
+ * takes a sample where its slope compares strictly greater
+ * (cross-multiplied). Long windows take the pruned scan (on AVX-512 CPUs),
+ * which must give the same steps and distances bit for bit as the unpruned
+ * one and as the definition: terraced heights with many exact ties, NaN
+ * holes, curvature, lines entering and leaving, steps without lines. */
+#define CL_LINES 65
+#define CL_STEPS 900
+
+static uint32_t cl_rand(uint32_t *s)
+{
+    *s ^= *s << 13;
+    *s ^= *s >> 17;
+    *s ^= *s << 5;
+    return *s;
+}
+
+/* line j is on the grid for steps 3j .. 300 + 7j, none for 500..507 */
+static int cl_on(int j, int k)
+{
+    return k >= 3 * j && k <= 300 + 7 * j && !(k >= 500 && k <= 507);
+}
+
+static void check_capped_scan(double near, double cap, double c, double jitter, uint32_t seed)
+{
+    static float hs[CL_STEPS][CL_LINES + 1], hc[CL_STEPS][CL_LINES + 1], hn[CL_STEPS][CL_LINES + 1];
+    static double d[CL_STEPS][CL_LINES + 1];
+    const double step = 10.0;
+    for (int k = 0; k < CL_STEPS; k++)
+        for (int j = 0; j < CL_LINES; j++) {
+            /* terraces of 2.5 m (exact ties), spikes, holes; steps of
+             * 10 m, or of 10 m +- jitter (per-row spacing) */
+            const double x = k - 3 * j;
+            float h = (float)(2.5 * floor((x * 0.37 + 40.0 * sin(x * 0.013 + j)) / 2.5));
+            if (cl_rand(&seed) % 61 == 0)
+                h += (float)(cl_rand(&seed) % 300);
+            if ((k / 37 + j) % 11 == 0)
+                h = NAN;
+            hs[k][j] = h;
+            hc[k][j] = cl_rand(&seed) % 17 == 0 ? NAN : h - (float)(cl_rand(&seed) % 5) * 2.5f;
+            hn[k][j] = h + (float)(cl_rand(&seed) % 3) * 2.5f;
+            d[k][j] = k == 3 * j ? 0.0 : (k > 0 ? d[k - 1][j] : 0.0) +
+                                         step * (1.0 + jitter * sin(k * 0.7));
+        }
+    int lags[4];
+    ts_cap_lanes_lags(near, cap, step * (1.0 - jitter), step * (1.0 + jitter), lags);
+    ts_cap_lanes pruned, full;
+    ck_assert(ts_cap_lanes_alloc(&pruned, CL_LINES, lags, near, cap));
+    ck_assert(ts_cap_lanes_alloc(&full, CL_LINES, lags, near, cap));
+    full.prune = 0;
+    ts_cap_lanes_clear(&pruned);
+    ts_cap_lanes_clear(&full);
+    int ok_k[2][CL_LINES + 1], hi_k[2][CL_LINES + 1];
+    float ok_dd[2][CL_LINES + 1], hi_dd[2][CL_LINES + 1];
+    long queries = 0, ties = 0, bad = 0;
+    for (int k = 0; k < CL_STEPS; k++) {
+        int j0 = CL_LINES, j1 = -1;
+        for (int j = 0; j < CL_LINES; j++)
+            if (cl_on(j, k)) {
+                j0 = j < j0 ? j : j0;
+                j1 = j;
+            }
+        double dk[CL_LINES + 1];
+        for (int j = 0; j <= CL_LINES; j++)
+            dk[j] = d[k][j];
+        const int hi_from = j0 + (k % 3 == 0), hi_to = j1 - (k % 5 == 0);
+        const ts_lane_step st = {k, j0 <= j1 ? j0 : 1, j0 <= j1 ? j1 : 0, hi_from, hi_to,
+                                 dk, hs[k], hc[k], hn[k], c, near};
+        for (int v = 0; v < 2; v++) {
+            const ts_lane_occluders occ = {ok_k[v], hi_k[v], ok_dd[v], hi_dd[v]};
+            ts_cap_lanes_step(v ? &full : &pruned, &st, CL_LINES, &occ);
+        }
+        for (int j = j0; j <= j1; j++)
+            for (int q = 0; q < 2; q++) {
+                if (q == 0 && (j < hi_from || j > hi_to))
+                    continue;
+                /* the definition */
+                const double gq = (double)(q ? hn[k][j] : hc[k][j]) - c * d[k][j] * d[k][j];
+                double bn = -INFINITY, bd = 1.0;
+                long bk = -1, nbest = 0;
+                for (int lag = (k < lags[1] ? k : lags[1]); lag >= lags[0]; lag--) {
+                    const int kp = k - lag;
+                    if (!cl_on(j, kp) || isnan(hs[kp][j]))
+                        continue;
+                    const double dd = d[k][j] - d[kp][j];
+                    if (!(dd >= near && dd <= cap))
+                        continue;
+                    const double n = (double)hs[kp][j] - c * d[kp][j] * d[kp][j] - gq;
+                    if (n * bd > bn * dd) {
+                        bn = n, bd = dd, bk = kp, nbest = 1;
+                    } else if (n * bd == bn * dd) {
+                        nbest++;
+                    }
+                }
+                if (isnan(gq))
+                    bk = -1, bd = 1.0;
+                queries++;
+                ties += nbest > 1;
+                const int jo = q ? j + 1 : j;
+                for (int v = 0; v < 2; v++) {
+                    const int gk = q ? ok_k[v][jo] : hi_k[v][jo];
+                    const float gdd = q ? ok_dd[v][jo] : hi_dd[v][jo];
+                    if (gk != bk || gdd != (float)bd) {
+                        if (bad++ == 0)
+                            printf("step %d line %d query %d (%s): step %d dd %.9g, want %ld %.9g\n",
+                                   k, j, q, v ? "unpruned" : "pruned", gk, gdd, bk, bd);
+                    }
+                }
+            }
+    }
+    printf("capped scan, lags %d..%d, %s, c %g, jitter %g: %ld queries, %ld with tied "
+           "steepest, %ld wrong\n", lags[0], lags[1], pruned.prune ? "pruned" : "not pruned",
+           c, jitter, queries, ties, bad);
+    ts_cap_lanes_free(&pruned);
+    ts_cap_lanes_free(&full);
+    ck_assert_msg(queries > 10000 && bad == 0, "%ld of %ld capped queries wrong", bad, queries);
+}
+
+START_TEST(test_capped_scan_pruned)
+{
+    const double curved = (1 - TS_DEFAULT_REFRACTION) / (2 * TS_EARTH_RADIUS);
+    check_capped_scan(25.0, 2000.0, 0.0, 0.0, 1);    /* 3..200 lags: pruned */
+    check_capped_scan(25.0, 2000.0, curved, 0.0, 2);
+    check_capped_scan(25.0, 2555.0, 0.0, 0.01, 3);   /* per-row steps, up to 258 lags */
+    check_capped_scan(80.0, 1200.0, curved, 0.01, 4);
+    check_capped_scan(25.0, 500.0, 0.0, 0.0, 5);     /* 50 lags: the whole window */
+}
+END_TEST
+
 int main(void)
 {
     setvbuf(stdout, NULL, _IOLBF, 0); /* lines reach the log before a failure exits */
@@ -244,6 +376,7 @@ int main(void)
     tcase_add_test(tc, test_sharp_max_distance);
     tcase_add_test(tc, test_nodata_skipped);
     tcase_add_test(tc, test_jacksboro_rows);
+    tcase_add_test(tc, test_capped_scan_pruned);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

@@ -1,0 +1,332 @@
+/* The AVX-512 work of a lockstep block of capped lines (capped_lanes.h):
+ * the window scan, pruned for long windows, and the step's queries and
+ * answers; see capped_lanes512.h. */
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#include <math.h>
+
+#include "capped_lanes512.h"
+
+#define AVX512 __attribute__((target("avx512f")))
+/* groups of eight lines scanned together: independent chains of compares
+ * and selects, so that their latencies overlap */
+#define NG TS_CAP_NG
+
+/* The accumulators of up to NG groups of eight lines: the queries' distance
+ * and heights, the best slope so far (numerator, denominator) and its step,
+ * for the cell below (c) and the one above (n). */
+typedef struct {
+    __m512d d[NG], gc[NG], gn[NG], bnc[NG], bdc[NG], bnn[NG], bdn[NG];
+    __m512i bkc[NG], bkn[NG];
+} scan512;
+
+/* One slot of the window (its distances pd, heights pg, step ks) for ng
+ * groups of eight lines: the operations of scan_scalar; the distance test
+ * only where `test`. */
+AVX512 static inline __attribute__((always_inline)) void
+scan512_slot(const ts_cap_lanes *r, int ng, const double *pd, const double *pg, __m512i ks,
+             int test, scan512 *a)
+{
+    const __m512d near = _mm512_set1_pd(r->near), cap = _mm512_set1_pd(r->cap);
+    for (int q = 0; q < NG; q++) {
+        if (q >= ng)
+            break;
+        const __m512d dd = _mm512_sub_pd(a->d[q], _mm512_load_pd(pd + 8 * q));
+        __mmask8 in = 0xFF;
+        if (test) {
+            in = _mm512_cmp_pd_mask(dd, near, _CMP_GE_OQ);
+            in = _mm512_mask_cmp_pd_mask(in, dd, cap, _CMP_LE_OQ);
+        }
+        const __m512d sg = _mm512_load_pd(pg + 8 * q);
+        const __m512d nc = _mm512_sub_pd(sg, a->gc[q]), nn = _mm512_sub_pd(sg, a->gn[q]);
+        const __mmask8 wc = _mm512_mask_cmp_pd_mask(in, _mm512_mul_pd(nc, a->bdc[q]),
+                                                    _mm512_mul_pd(a->bnc[q], dd), _CMP_GT_OQ);
+        const __mmask8 wn = _mm512_mask_cmp_pd_mask(in, _mm512_mul_pd(nn, a->bdn[q]),
+                                                    _mm512_mul_pd(a->bnn[q], dd), _CMP_GT_OQ);
+        a->bnc[q] = _mm512_mask_mov_pd(a->bnc[q], wc, nc);
+        a->bdc[q] = _mm512_mask_mov_pd(a->bdc[q], wc, dd);
+        a->bkc[q] = _mm512_mask_mov_epi64(a->bkc[q], wc, ks);
+        a->bnn[q] = _mm512_mask_mov_pd(a->bnn[q], wn, nn);
+        a->bdn[q] = _mm512_mask_mov_pd(a->bdn[q], wn, dd);
+        a->bkn[q] = _mm512_mask_mov_epi64(a->bkn[q], wn, ks);
+    }
+}
+
+/* The window's slots of lags lag_from down to lag_to (oldest first), for
+ * ng groups of eight lines from line g. */
+AVX512 static inline __attribute__((always_inline)) void
+scan512_lags(const ts_cap_lanes *r, int k, int g, int ng, int lag_from, int lag_to, scan512 *a)
+{
+    int slot = (k - lag_from) % r->slots;
+    for (int lag = lag_from; lag >= lag_to; lag--) {
+        const size_t at = (size_t)slot * r->stride + g;
+        slot = slot + 1 == r->slots ? 0 : slot + 1;
+        /* within the sure lags, the distance needs no test (a slot without
+         * a sample has d NaN, which fails the slope's compare) */
+        const int sure = lag >= r->sure_lo && lag <= r->sure_hi;
+        scan512_slot(r, ng, r->d + at, r->g + at, _mm512_set1_epi64(k - lag), !sure, a);
+    }
+}
+
+/* A whole level-0 group from step s0, all of whose lags are sure. */
+AVX512 static inline __attribute__((always_inline)) void
+scan512_group(const ts_cap_lanes *r, int g, int ng, int s0, scan512 *a)
+{
+    const size_t at = (size_t)(s0 % r->slots) * r->stride + g;
+#pragma GCC unroll 8
+    for (int i = 0; i < TS_CAP_G0; i++)
+        scan512_slot(r, ng, r->d + at + (size_t)i * r->stride, r->g + at + (size_t)i * r->stride,
+                     _mm512_set1_epi64(s0 + i), 0, a);
+}
+
+/*
+ * Pruning. A query (d, g) scans its window oldest first and takes a sample
+ * only where its slope compares strictly greater (cross-multiplied, so
+ * rounded): the answer is the chain of such takes. A group whose samples
+ * all have slopes below T, T well below the slope of a sample L of the
+ * window, can be left out without changing the answer: its samples could
+ * only be taken while the chain's slope is below theirs, and the chains
+ * with and without them can then differ only by samples within rounding
+ * of each other (a take of one not taken by the other is at most one
+ * rounding of the products above the other's slope), so by at most about
+ * 2^-52 of the slopes per sample, and L, above both by the margin, is taken
+ * by both and joins them again. The margin, PRUNE_MARGIN of |slope(L)|, is
+ * far above that drift for windows of up to 10^5 samples (the pruned scan
+ * takes windows of at most PRUNE_TO = 256 lags, capped_lanes.c).
+ * L is the steepest of a few samples of the window (prune_threshold).
+ *
+ * A group's samples p have g_p <= gmax and dlo <= d_p <= dhi, so for a
+ * query (d, g) with g >= gmin, (g_p - g) / (d - d_p) < T wherever
+ * gmax - gmin < T (d - dsel), dsel = dhi where T >= 0, dlo where T < 0;
+ * tested as gmax + T dsel < gmin + T d, each side with one rounding (a
+ * fused multiply-add), against a right side lowered by 1e-12 of its terms'
+ * size, far above those roundings. The scan's rounded (g_p - g) / (d - d_p)
+ * is then below T + 2^-51 |T|, far inside the margin.
+ */
+#define PRUNE_MARGIN 1e-9
+/* The newest lags are scanned without a test: their groups seldom prune. */
+#ifndef PRUNE_NEAR
+#define PRUNE_NEAR 8
+#endif
+
+/* For the eight lines from j: the prune threshold T (-inf: none known;
+ * +inf: no query), the lower of the two query heights (+inf: no query) and
+ * the lines without a query. T is the steepest (for the query of lower
+ * slope) of four samples of the window, each taken only where the scan's
+ * own tests put it in the window: the line's previous answers of both
+ * queries, and its newest and oldest slot. */
+AVX512 static inline __attribute__((always_inline)) void
+prune_threshold(const ts_cap_lanes *r, int k, int lag_hi, int j, const scan512 *a, int q,
+                __m512d *thr, __m512d *gmin, __mmask8 *idle)
+{
+    const __m512i zero = _mm512_setzero_si512();
+    const __m512d near = _mm512_set1_pd(r->near), cap = _mm512_set1_pd(r->cap);
+    const __m256i lane =
+        _mm256_add_epi32(_mm256_set1_epi32(j), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    __m512d cd[4], cg[4];
+    __mmask8 cok[4];
+    for (int i = 0; i < 2; i++) { /* the previous answers */
+        const __m512i kk = _mm512_load_epi64((i ? r->kn : r->kc) + j);
+        const __m512i lag = _mm512_sub_epi64(_mm512_set1_epi64(k), kk);
+        __mmask8 ok = _mm512_cmpge_epi64_mask(kk, zero);
+        ok = _mm512_mask_cmpge_epi64_mask(ok, lag, _mm512_set1_epi64(r->lag_lo));
+        ok = _mm512_mask_cmple_epi64_mask(ok, lag, _mm512_set1_epi64(lag_hi));
+        /* its slot: (k mod slots - lag) mod slots */
+        __m512i slot = _mm512_sub_epi64(_mm512_set1_epi64(k % r->slots), lag);
+        slot = _mm512_mask_add_epi64(slot, _mm512_cmplt_epi64_mask(slot, zero), slot,
+                                     _mm512_set1_epi64(r->slots));
+        const __m256i at = _mm256_add_epi32(
+            _mm256_mullo_epi32(_mm512_cvtepi64_epi32(slot), _mm256_set1_epi32(r->stride)), lane);
+        cd[i] = _mm512_mask_i32gather_pd(_mm512_set1_pd(NAN), ok, at, r->d, 8);
+        cg[i] = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), ok, at, r->g, 8);
+        cok[i] = ok;
+    }
+    for (int i = 2; i < 4; i++) { /* the oldest and the newest slot */
+        const size_t at = (size_t)((k - (i == 2 ? lag_hi : r->lag_lo)) % r->slots) * r->stride + j;
+        cd[i] = _mm512_load_pd(r->d + at);
+        cg[i] = _mm512_load_pd(r->g + at);
+        cok[i] = 0xFF;
+    }
+    const __m512d gq[2] = {a->gc[q], a->gn[q]};
+    __m512d t[2], gs[2];
+    __mmask8 has[2];
+    for (int i = 0; i < 2; i++) {
+        __m512d bn = _mm512_set1_pd(-INFINITY), bd = _mm512_set1_pd(1.0);
+        for (int c = 0; c < 4; c++) {
+            const __m512d dd = _mm512_sub_pd(a->d[q], cd[c]), n = _mm512_sub_pd(cg[c], gq[i]);
+            __mmask8 ok = _mm512_mask_cmp_pd_mask(cok[c], dd, near, _CMP_GE_OQ);
+            ok = _mm512_mask_cmp_pd_mask(ok, dd, cap, _CMP_LE_OQ);
+            ok = _mm512_mask_cmp_pd_mask(ok, _mm512_mul_pd(n, bd), _mm512_mul_pd(bn, dd),
+                                         _CMP_GT_OQ);
+            bn = _mm512_mask_mov_pd(bn, ok, n);
+            bd = _mm512_mask_mov_pd(bd, ok, dd);
+        }
+        const __m512d s = _mm512_div_pd(bn, bd); /* -inf where none */
+        /* s - margin |s| */
+        t[i] = _mm512_fnmadd_pd(_mm512_abs_pd(s), _mm512_set1_pd(PRUNE_MARGIN), s);
+        has[i] = _mm512_cmp_pd_mask(gq[i], gq[i], _CMP_ORD_Q);
+        t[i] = _mm512_mask_mov_pd(_mm512_set1_pd(INFINITY), has[i], t[i]);
+        gs[i] = _mm512_mask_mov_pd(_mm512_set1_pd(INFINITY), has[i], gq[i]);
+    }
+    *thr = _mm512_min_pd(t[0], t[1]);
+    *gmin = _mm512_min_pd(gs[0], gs[1]);
+    *idle = (__mmask8)~(has[0] | has[1]);
+}
+
+/* Whether group idx of level l may hold, for any of the ng groups of lines
+ * from g, a sample at least as steep as the threshold: unless
+ * gmax + T dsel < gmin + T d (above: rhs), dsel the group's newest
+ * distance where T >= 0, its oldest where T < 0 (neg). */
+AVX512 static inline __attribute__((always_inline)) int
+group_needed(const ts_cap_lanes *r, int l, int idx, int g, int ng, const __m512d *thr,
+             const __m512d *rhs, const __mmask8 *neg, const __mmask8 *idle)
+{
+    const size_t at = (size_t)idx * r->stride + g;
+    __mmask8 need = 0;
+    for (int q = 0; q < NG; q++) {
+        if (q >= ng)
+            break;
+        const __m512d dsel = _mm512_mask_load_pd(_mm512_load_pd(r->dhi[l] + at + 8 * q), neg[q],
+                                                 r->dlo[l] + at + 8 * q);
+        const __m512d lhs = _mm512_fmadd_pd(thr[q], dsel, _mm512_load_pd(r->gmax[l] + at + 8 * q));
+        need |= (__mmask8)~(_mm512_cmp_pd_mask(lhs, rhs[q], _CMP_LT_OQ) | idle[q]);
+    }
+    return need != 0;
+}
+
+/* scan_scalar for up to NG groups from g (those below g1), eight lines
+ * per AVX-512 vector: the same operations per line; with r->prune, only
+ * the groups of slots that may change the answer. */
+
+AVX512 void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1)
+{
+    const int lag_hi = k < r->lag_hi ? k : r->lag_hi;
+    const int ng = (g1 - g) / 8 < NG ? (g1 - g) / 8 : NG;
+    scan512 a;
+    for (int q = 0; q < NG; q++) {
+        const int o = g + 8 * (q < ng ? q : 0);
+        a.d[q] = _mm512_load_pd(r->qd + o);
+        a.gc[q] = _mm512_load_pd(r->qc + o);
+        a.gn[q] = _mm512_load_pd(r->qn + o);
+        a.bnc[q] = a.bnn[q] = _mm512_set1_pd(-INFINITY);
+        a.bdc[q] = a.bdn[q] = _mm512_set1_pd(1.0);
+        a.bkc[q] = a.bkn[q] = _mm512_set1_epi64(-1);
+    }
+    if (!r->prune || lag_hi < r->lag_lo) {
+        scan512_lags(r, k, g, ng, lag_hi, r->lag_lo, &a);
+    } else {
+        __m512d thr[NG], rhs[NG];
+        __mmask8 idle[NG], neg[NG];
+        for (int q = 0; q < ng; q++) {
+            __m512d gmin;
+            prune_threshold(r, k, lag_hi, g + 8 * q, &a, q, &thr[q], &gmin, &idle[q]);
+            neg[q] = _mm512_cmp_pd_mask(thr[q], _mm512_setzero_pd(), _CMP_LT_OQ);
+            const __m512d td = _mm512_mul_pd(thr[q], a.d[q]);
+            const __m512d size = _mm512_add_pd(_mm512_abs_pd(gmin), _mm512_abs_pd(td));
+            rhs[q] = _mm512_fnmadd_pd(size, _mm512_set1_pd(1e-12), _mm512_fmadd_pd(thr[q], a.d[q], gmin));
+        }
+        /* the window's steps, and those scanned without a test */
+        const int s_lo = k - lag_hi, s_hi = k - r->lag_lo, s_near = s_hi - PRUNE_NEAR + 1;
+        for (int m1 = s_lo / TS_CAP_G1; m1 <= s_hi / TS_CAP_G1; m1++) {
+            const int a1 = m1 * TS_CAP_G1 > s_lo ? m1 * TS_CAP_G1 : s_lo;
+            const int b1 = m1 * TS_CAP_G1 + TS_CAP_G1 - 1 < s_hi ? m1 * TS_CAP_G1 + TS_CAP_G1 - 1 : s_hi;
+            if (b1 < s_near &&
+                !group_needed(r, 1, m1 % r->groups[1], g, ng, thr, rhs, neg, idle))
+                continue;
+            /* which of its level-0 groups to scan, then those in order */
+            const int f0 = a1 / TS_CAP_G0, l0 = b1 / TS_CAP_G0;
+            unsigned scan = 0;
+            for (int m0 = f0; m0 <= l0; m0++) {
+                const int near_group = m0 * TS_CAP_G0 + TS_CAP_G0 - 1 >= s_near;
+                scan |= (unsigned)(near_group |
+                                   group_needed(r, 0, m0 % r->groups[0], g, ng, thr, rhs, neg, idle))
+                        << (m0 - f0);
+            }
+            while (scan) {
+                const int m0 = f0 + __builtin_ctz(scan);
+                scan &= scan - 1;
+                const int a0 = m0 * TS_CAP_G0 > a1 ? m0 * TS_CAP_G0 : a1;
+                const int b0 = m0 * TS_CAP_G0 + TS_CAP_G0 - 1 < b1 ? m0 * TS_CAP_G0 + TS_CAP_G0 - 1 : b1;
+                if (b0 - a0 == TS_CAP_G0 - 1 && k - b0 >= r->sure_lo && k - a0 <= r->sure_hi)
+                    scan512_group(r, g, ng, a0, &a);
+                else
+                    scan512_lags(r, k, g, ng, k - a0, k - b0, &a);
+            }
+        }
+    }
+    for (int q = 0; q < ng; q++) {
+        const int o = g + 8 * q;
+        _mm512_store_epi64(r->kc + o, a.bkc[q]);
+        _mm512_store_pd(r->ddc + o, a.bdc[q]);
+        _mm512_store_epi64(r->kn + o, a.bkn[q]);
+        _mm512_store_pd(r->ddn + o, a.bdn[q]);
+    }
+}
+
+/* Step k's samples (ring slots rd, rg; d NaN: none) into their groups; a
+ * group's first step empties it first. */
+AVX512 void ts_cap_groups_add512(ts_cap_lanes *r, int k, const double *rd, const double *rg)
+{
+    for (int l = 0; l < 2; l++) {
+        const int size = l ? TS_CAP_G1 : TS_CAP_G0;
+        const size_t at = (size_t)(k / size % r->groups[l]) * r->stride;
+        double *gm = r->gmax[l] + at, *lo = r->dlo[l] + at, *hi = r->dhi[l] + at;
+        if (k % size == 0)
+            ts_cap_groups_empty(gm, lo, hi, (size_t)r->stride);
+        for (int j = 0; j < r->stride; j += 8) {
+            const __m512d d = _mm512_load_pd(rd + j), g = _mm512_load_pd(rg + j);
+            const __m512d m = _mm512_load_pd(gm + j);
+            const __mmask8 has = _mm512_cmp_pd_mask(d, d, _CMP_ORD_Q);
+            /* lines' distances grow: a group's first sample is its oldest */
+            const __mmask8 first = _mm512_mask_cmp_pd_mask(has, m, _mm512_set1_pd(-INFINITY), _CMP_EQ_OQ);
+            _mm512_store_pd(lo + j, _mm512_mask_mov_pd(_mm512_load_pd(lo + j), first, d));
+            _mm512_store_pd(hi + j, _mm512_mask_mov_pd(_mm512_load_pd(hi + j), has, d));
+            _mm512_store_pd(gm + j, _mm512_mask_max_pd(m, has, m, g));
+        }
+    }
+}
+
+/* ts_cap_lanes_step's work before and after the scan, eight lines per
+ * vector (the same operations per line): the queries of lines [g0, g1),
+ * then the answers and the step's samples of lines j0..j1. */
+AVX512 void ts_cap_queries512(ts_cap_lanes *r, const ts_lane_step *s, int g0, int g1)
+{
+    const __m512d c = _mm512_set1_pd(s->c), nan = _mm512_set1_pd(NAN);
+    for (int j = g0; j < g1; j += 8) {
+        const __m512i idx = _mm512_add_epi64(_mm512_set1_epi64(j), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
+        __mmask8 on = _mm512_cmpge_epi64_mask(idx, _mm512_set1_epi64(s->j0));
+        on = _mm512_mask_cmple_epi64_mask(on, idx, _mm512_set1_epi64(s->j1));
+        __mmask8 hi = _mm512_mask_cmpge_epi64_mask(on, idx, _mm512_set1_epi64(s->hi_from));
+        hi = _mm512_mask_cmple_epi64_mask(hi, idx, _mm512_set1_epi64(s->hi_to));
+        const __m512d d = _mm512_maskz_loadu_pd(on, s->d + j);
+        const __m512d cdd = _mm512_mul_pd(_mm512_mul_pd(c, d), d);
+        const __m512d hc = _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_maskz_loadu_ps(hi, s->hc + j)));
+        const __m512d hn = _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_maskz_loadu_ps(on, s->hn + j)));
+        _mm512_store_pd(r->qd + j, d);
+        _mm512_store_pd(r->qc + j, _mm512_mask_sub_pd(nan, hi, hc, cdd));
+        _mm512_store_pd(r->qn + j, _mm512_mask_sub_pd(nan, on, hn, cdd));
+    }
+}
+
+AVX512 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0, int g1,
+                                       const ts_lane_occluders *occ, double *rd, double *rg)
+{
+    const __m512d c = _mm512_set1_pd(s->c), nan = _mm512_set1_pd(NAN);
+    for (int j = g0; j < g1; j += 8) {
+        const __m512i idx = _mm512_add_epi64(_mm512_set1_epi64(j), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
+        __mmask8 on = _mm512_cmpge_epi64_mask(idx, _mm512_set1_epi64(s->j0));
+        on = _mm512_mask_cmple_epi64_mask(on, idx, _mm512_set1_epi64(s->j1));
+        _mm512_mask_cvtepi64_storeu_epi32(occ->hi_k + j, on, _mm512_load_epi64(r->kc + j));
+        _mm512_mask_cvtepi64_storeu_epi32(occ->lo_k + j + 1, on, _mm512_load_epi64(r->kn + j));
+        _mm512_mask_storeu_ps(occ->hi_dd + j, on, _mm512_castps256_ps512(_mm512_cvtpd_ps(_mm512_load_pd(r->ddc + j))));
+        _mm512_mask_storeu_ps(occ->lo_dd + j + 1, on, _mm512_castps256_ps512(_mm512_cvtpd_ps(_mm512_load_pd(r->ddn + j))));
+        /* the step's own samples enter the ring after its queries */
+        const __m512d d = _mm512_maskz_loadu_pd(on, s->d + j);
+        const __m512d hs = _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_maskz_loadu_ps(on, s->hs + j)));
+        const __mmask8 has = _mm512_cmp_pd_mask(hs, hs, _CMP_ORD_Q);
+        _mm512_mask_store_pd(rd + j, on, _mm512_mask_mov_pd(nan, has, d));
+        _mm512_mask_store_pd(rg + j, on, _mm512_sub_pd(hs, _mm512_mul_pd(_mm512_mul_pd(c, d), d)));
+    }
+}
+
+#endif
