@@ -17,20 +17,18 @@
  *    neighbouring lines that lie beyond the near field.
  *
  * With a maximum distance, the occluder is the steepest of the line's
- * samples beyond the near field and within the distance. The lines run in
- * the same lockstep blocks: for short windows (capped_lanes.h) each query
- * is a brute-force maximum over the window, vectorised across lines; for
- * long ones (capped_hulls.h) each line keeps the hull of a sliding window
- * of its samples (window_hull.h), in amortised O(1) per sample like the
- * unbounded hull, as process_line does for a line alone (the line visitor,
- * and windows too long for the blocks' workspace). The near field is cut at the distance, and the last part of a step
+ * samples beyond the near field and within the distance: for short windows
+ * (capped_lanes.h) the lines run in the same lockstep blocks and each
+ * query is a brute-force maximum over the window, vectorised across lines;
+ * for long ones each line keeps the hull of a sliding window of its
+ * samples (window_hull.h), in amortised O(1) per sample like the unbounded
+ * hull. The near field is cut at the distance, and the last part of a step
  * before it is solved exactly on each cell's ray.
  */
 #include <math.h>
 #include <stdlib.h>
 
 #include "arg_checks.h"
-#include "capped_hulls.h"
 #include "capped_lanes.h"
 #include "cellmath/cm_fastmath.h"
 #include "horizon_edge.h"
@@ -78,8 +76,7 @@ typedef struct {
 typedef struct {
     hull_pt *stack;
     int n;
-    hull_pt *raw;       /* with a maximum distance: the line's valid samples (a
-                           ring, window_hull.h) */
+    hull_pt *raw;       /* with a maximum distance: the line's valid samples */
     int raw_n;
     ts_window_hull win; /* with a maximum distance: the far-field window */
     ts_window_hull vwin; /* and the visitor's (all samples within the distance) */
@@ -100,11 +97,7 @@ typedef struct {
     int *lo_k, *hi_k;   /* far-field occluders; lo_k[j]: from line j - 1 */
     int *lane_k0;       /* each line's first step */
     double *lane_d;     /* and the distance of its current sample from it */
-    double *step_d;     /* those distances, by step of a chunk */
-    int chunk;          /* steps a block takes together */
-    ts_cap_lanes capl;  /* capped lines in lockstep: their windows (short) */
-    ts_cap_hulls caph;  /* or their window hulls (long) */
-    int hulls;          /* whether caph, not capl */
+    ts_cap_lanes capl;  /* capped lines in lockstep: their windows */
     int lockstep;       /* lines in lockstep blocks (sweep_block), not one by one */
 } sweep_ws;
 
@@ -258,7 +251,7 @@ static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
                     if (p)
                         slope = (float)((p->g - gs) / (d - p->d) - 2.0 * c * d);
                 }
-                w->raw[w->raw_n++ & w->win.mask] = (hull_pt){d, gs, k};
+                w->raw[w->raw_n++] = (hull_pt){d, gs, k};
             }
             ts_window_hull_slide(&w->win, w->raw, w->raw_n, d, C->near_skip, C->cap);
             pushed = 1;
@@ -353,21 +346,13 @@ static void lane_hulls_scalar(const ts_lane_hulls *h, const ts_lane_step *s,
     }
 }
 
-/* Steps a capped block through window hulls takes together: the
- * block samples them, then each line runs its window over all of them
- * while it is in cache, then the block evaluates their far field. */
-#ifndef HULL_CHUNK
-#define HULL_CHUNK 16
-#endif
-
-/* Lines bs .. bs + nl - 1 of a sweep, step by step; the first is only
- * primed (not written) when `prime`. w->carry holds what the line before
- * the block found; on return it holds the block's last line's. Each step
- * samples the lines together (lane_passes.h), pushes and queries each
- * line's hull (or window) in the same order as process_line, then
- * evaluates the far field of the step's cells together: the cell between
- * lines j - 1 and j takes its far-side occluder from line j - 1 and its
- * own from line j. With window hulls, w->chunk steps at a time. */
+/* Lines bs .. bs + nl - 1 of an unbounded sweep, step by step; the first is
+ * only primed (not written) when `prime`. w->carry holds what the line
+ * before the block found; on return it holds the block's last line's.
+ * Each step samples the lines together (lane_passes.h), pushes and queries
+ * each line's hull in the same order as process_line, then evaluates the
+ * far field of the step's cells together: the cell between lines j - 1 and
+ * j takes its far-side occluder from line j - 1 and its own from line j. */
 static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int prime)
 {
     _Static_assert(FAR_SPREAD == 0, "the lockstep far field samples at the occluders only");
@@ -390,64 +375,42 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
     occluder *next = w->carry_next;
     for (int k = 0; k < G->U; k++)
         next[k] = none;
-    if (C->cap > 0 && w->hulls)
-        ts_cap_hulls_clear(&w->caph);
-    else if (C->cap > 0)
+    if (C->cap > 0)
         ts_cap_lanes_clear(&w->capl);
+    const ts_lane_occluders occ = {w->lo_k, w->hi_k, w->lo_dd, w->hi_dd};
     const ts_lane_hulls hulls = {w->lane_stacks, G->U + 1, w->lane_n, w->lane_far};
     const double c = C->c;
-    const size_t row = LOCKSTEP_LINES + 2;
-    ts_lane_step steps[HULL_CHUNK];
-    ts_lane_occluders occs[HULL_CHUNK];
-    for (int kc = kmin; kc <= kmax; kc += w->chunk) {
-        const int n = kmax - kc + 1 < w->chunk ? kmax - kc + 1 : w->chunk;
-        for (int t = 0; t < n; t++) {
-            const int k = kc + t;
-            /* The lines on the grid at step k: rows i0 + j in [0, V - 1]. */
-            const long i0 = bs + G->fl[k];
-            const int j0 = i0 < 0 ? (int)-i0 : 0;
-            const int j1 = G->V - 1 - i0 < nl - 1 ? (int)(G->V - 1 - i0) : nl - 1;
-            float *hc = w->hc + t * row, *hn = w->hn + t * row, *hs = w->hs + t * row;
-            double *d = w->step_d + t * row;
-            occs[t] = (ts_lane_occluders){w->lo_k + t * row, w->hi_k + t * row,
-                                          w->lo_dd + t * row, w->hi_dd + t * row};
-            steps[t] = (ts_lane_step){.k = k, .j0 = 1, .j1 = 0}; /* no samples */
-            if (j0 > j1)
-                continue;
-            ts_lane_sample(G, C->grid->z, k, (int)i0, j0, j1, hc, hn, hs);
-            lane_distances(C, w, k, (int)i0, j0, j1);
-            for (int j = j0; j <= j1; j++)
-                d[j] = w->lane_d[j];
-            /* lo_k[j]: the far-side occluder of line j's cell, found by the
-             * line before (none where that line is off the grid). */
-            const occluder lo0 = j0 == 0 ? w->carry[k] : none;
-            occs[t].lo_k[j0] = lo0.k;
-            occs[t].lo_dd[j0] = lo0.dd;
-            const int last_inside = G->fr[k] == 0.0f ? j1 : G->V - 2 - (int)i0;
-            steps[t] = (ts_lane_step){k, j0, j1, prime, last_inside, d, hs, hc, hn, c,
-                                      C->near_skip};
+    for (int k = kmin; k <= kmax; k++) {
+        /* The lines on the grid at step k: rows i0 + j in [0, V - 1]. */
+        const long i0 = bs + G->fl[k];
+        const int j0 = i0 < 0 ? (int)-i0 : 0;
+        const int j1 = G->V - 1 - i0 < nl - 1 ? (int)(G->V - 1 - i0) : nl - 1;
+        if (j0 > j1) {
+            if (C->cap > 0) /* no samples: the rings forget this step */
+                ts_cap_lanes_step(&w->capl, &(ts_lane_step){.k = k, .j0 = 1, .j1 = 0}, nl, NULL);
+            continue;
         }
-        if (C->cap > 0 && w->hulls)
-            ts_cap_hulls_run(&w->caph, steps, occs, n, nl);
-        for (int t = 0; t < n && !(C->cap > 0 && w->hulls); t++) {
-            if (C->cap > 0) /* (without samples, the rings forget the step) */
-                ts_cap_lanes_step(&w->capl, &steps[t], nl, &occs[t]);
-            else if (steps[t].j0 <= steps[t].j1 && !ts_lane_hull_step(&hulls, &steps[t], &occs[t]))
-                lane_hulls_scalar(&hulls, &steps[t], &occs[t]);
-        }
-        for (int t = 0; t < n; t++) {
-            const int k = kc + t, j0 = steps[t].j0, j1 = steps[t].j1;
-            if (j0 > j1)
-                continue;
-            const long i0 = bs + G->fl[k];
-            if (j1 == nl - 1)
-                next[k] = (occluder){occs[t].lo_k[nl], occs[t].lo_dd[nl]};
-            const int jw = prime && j0 == 0 ? 1 : j0;
-            float *o = C->out + C->o_origin + (ptrdiff_t)k * C->o_u_stride +
-                       (i0 + jw) * C->o_v_stride; /* cell (k, i0 + jw) */
-            ts_lane_far_field(G, C->grid->z, (float)c, k, (int)i0, jw, j1, steps[t].hc,
-                              &occs[t], w->slope, o, C->o_v_stride);
-        }
+        ts_lane_sample(G, C->grid->z, k, (int)i0, j0, j1, w->hc, w->hn, w->hs);
+        lane_distances(C, w, k, (int)i0, j0, j1);
+        /* lo_k[j]: the far-side occluder of line j's cell, found by the
+         * line before (none where that line is off the grid). */
+        const occluder lo0 = j0 == 0 ? w->carry[k] : none;
+        w->lo_k[j0] = lo0.k;
+        w->lo_dd[j0] = lo0.dd;
+        const int last_inside = G->fr[k] == 0.0f ? j1 : G->V - 2 - (int)i0;
+        const ts_lane_step step = {k, j0, j1, prime, last_inside, w->lane_d, w->hs, w->hc,
+                                   w->hn, c, C->near_skip};
+        if (C->cap > 0)
+            ts_cap_lanes_step(&w->capl, &step, nl, &occ);
+        else if (!ts_lane_hull_step(&hulls, &step, &occ))
+            lane_hulls_scalar(&hulls, &step, &occ);
+        if (j1 == nl - 1)
+            next[k] = (occluder){w->lo_k[nl], w->lo_dd[nl]};
+        const int jw = prime && j0 == 0 ? 1 : j0;
+        float *o = C->out + C->o_origin + (ptrdiff_t)k * C->o_u_stride +
+                   (i0 + jw) * C->o_v_stride; /* cell (k, i0 + jw) */
+        ts_lane_far_field(G, C->grid->z, (float)c, k, (int)i0, jw, j1, w->hc, &occ, w->slope, o,
+                          C->o_v_stride);
     }
     w->carry_next = w->carry;
     w->carry = next;
@@ -475,7 +438,6 @@ static void ws_free(sweep_ws *w)
     free(w->lane_i);
     free(w->lane_d);
     ts_cap_lanes_free(&w->capl);
-    ts_cap_hulls_free(&w->caph);
 }
 
 static int ws_init(sweep_ws *w, const sweep_ctx *C)
@@ -483,18 +445,13 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
     const int U = C->geom->U, capped = C->cap > 0, need_visit = C->visit != NULL;
     *w = (sweep_ws){0};
     int ok = 1;
-    /* capped lines too: by brute force where it pays (capped_lanes.h), else
-     * through window hulls (capped_hulls.h) where their workspace is small
-     * enough; one by one otherwise */
-    const int brute = capped && ts_cap_lanes_pays(C->lags);
-    w->hulls = capped && !brute && ts_cap_hulls_fit(C->lags, U);
-    w->lockstep = !need_visit && (!capped || brute || w->hulls);
-    w->chunk = w->hulls ? HULL_CHUNK : 1;
+    /* capped lines too where their windows are short enough for the
+     * brute force (capped_lanes.h), one by one otherwise */
+    w->lockstep = !need_visit && (!capped || ts_cap_lanes_pays(C->lags));
     if (capped && !w->lockstep) {
-        const int span = ts_cap_window_span(C->lags, U);
-        w->raw = malloc((size_t)ts_window_hull_ring(span) * sizeof *w->raw);
-        ok = w->raw && ts_window_hull_alloc(&w->win, span) &&
-             (!need_visit || ts_window_hull_alloc(&w->vwin, span));
+        w->raw = malloc((size_t)(U + 1) * sizeof *w->raw);
+        ok = w->raw && ts_window_hull_alloc(&w->win, U) &&
+             (!need_visit || ts_window_hull_alloc(&w->vwin, U));
     }
     w->stack = malloc((size_t)(U + 1) * sizeof *w->stack);
     w->lo.prev = malloc((size_t)U * sizeof(occluder));
@@ -511,9 +468,7 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
     if (w->lockstep) {
         const occluder none = {-1, 0.0f};
         /* capped lines keep windows (rings) instead of hulls */
-        if (w->hulls) {
-            ok = ts_cap_hulls_alloc(&w->caph, LOCKSTEP_LINES + 1, C->lags, U, C->cap);
-        } else if (capped) {
+        if (capped) {
             ok = ts_cap_lanes_alloc(&w->capl, LOCKSTEP_LINES + 1, C->lags, C->near_skip, C->cap);
         } else {
             w->lane_n = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_n);
@@ -524,24 +479,22 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
         }
         w->carry = malloc((size_t)U * sizeof *w->carry);
         w->carry_next = malloc((size_t)U * sizeof *w->carry_next);
-        /* a block has up to LOCKSTEP_LINES + 1 lines (with the primed one);
-         * the steps' buffers, one row per step of a chunk */
-        const size_t row = LOCKSTEP_LINES + 2, ch = (size_t)w->chunk * row;
-        w->lane_f = malloc((5 * ch + row) * sizeof *w->lane_f);
-        w->lane_i = malloc((2 * ch + row) * sizeof *w->lane_i);
-        w->lane_d = malloc((ch + row) * sizeof *w->lane_d);
+        /* a block has up to LOCKSTEP_LINES + 1 lines (with the primed one) */
+        const size_t row = LOCKSTEP_LINES + 2;
+        w->lane_f = malloc(6 * row * sizeof *w->lane_f);
+        w->lane_i = malloc(3 * row * sizeof *w->lane_i);
+        w->lane_d = malloc(row * sizeof *w->lane_d);
         ok = ok && w->carry && w->carry_next && w->lane_f && w->lane_i && w->lane_d;
         if (ok) {
             w->hc = w->lane_f;
-            w->hn = w->lane_f + ch;
-            w->hs = w->lane_f + 2 * ch;
-            w->lo_dd = w->lane_f + 3 * ch;
-            w->hi_dd = w->lane_f + 4 * ch;
-            w->slope = w->lane_f + 5 * ch;
+            w->hn = w->lane_f + row;
+            w->hs = w->lane_f + 2 * row;
+            w->slope = w->lane_f + 3 * row;
+            w->lo_dd = w->lane_f + 4 * row;
+            w->hi_dd = w->lane_f + 5 * row;
             w->lo_k = w->lane_i;
-            w->hi_k = w->lane_i + ch;
-            w->lane_k0 = w->lane_i + 2 * ch;
-            w->step_d = w->lane_d + row;
+            w->hi_k = w->lane_i + row;
+            w->lane_k0 = w->lane_i + 2 * row;
         }
         for (int k = 0; ok && k < U; k++)
             w->carry[k] = none;

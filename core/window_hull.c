@@ -3,25 +3,14 @@
 
 #include "window_hull.h"
 
-int ts_window_hull_ring(int span)
-{
-    int n = 1;
-    while (n < span)
-        n *= 2;
-    return n;
-}
-
-int ts_window_hull_alloc(ts_window_hull *w, int span)
+int ts_window_hull_alloc(ts_window_hull *w, int n)
 {
     *w = (ts_window_hull){0};
-    const size_t n = (size_t)ts_window_hull_ring(span);
-    w->mask = (int)n - 1;
-    /* zeroed: a push may save a slot above the hull that was never written;
-     * each hull holds at most the window's samples */
-    w->back = calloc(n + 1, sizeof *w->back);
-    w->front = calloc(n + 1, sizeof *w->front);
-    w->undo_pt = calloc(n, sizeof *w->undo_pt);
-    w->undo_n = calloc(n, sizeof *w->undo_n);
+    /* zeroed: a push may save a slot above the hull that was never written */
+    w->back = calloc((size_t)n + 1, sizeof *w->back);
+    w->front = calloc((size_t)n + 1, sizeof *w->front);
+    w->undo_pt = calloc((size_t)n + 1, sizeof *w->undo_pt);
+    w->undo_n = calloc((size_t)n + 1, sizeof *w->undo_n);
     return w->back && w->front && w->undo_pt && w->undo_n;
 }
 
@@ -39,15 +28,15 @@ void ts_window_hull_refill(ts_window_hull *w, const ts_hull_pt *pts)
     ts_hull_pt *F = w->front;
     w->nf = 0;
     for (int i = w->in - 1; i >= w->out; i--) {
-        const ts_hull_pt p = pts[i & w->mask];
+        const ts_hull_pt p = pts[i];
         /* mirror of the back's pop: seen forward from p, F[m - 1] is
          * hidden when F[m - 2] is at least as steep */
         int m = w->nf;
         while (m >= 2 && (F[m - 2].g - p.g) * (F[m - 1].d - p.d) >=
                              (F[m - 1].g - p.g) * (F[m - 2].d - p.d))
             m--;
-        w->undo_pt[i & w->mask] = F[m];
-        w->undo_n[i & w->mask] = w->nf;
+        w->undo_pt[i] = F[m];
+        w->undo_n[i] = w->nf;
         F[m] = p;
         w->nf = m + 1;
     }

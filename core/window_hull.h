@@ -20,10 +20,6 @@
  *
  * Heights are g = h - c d^2 as in the sweep (horizon_sweep.c), so the hull
  * stays exact with Earth curvature.
- *
- * A window only ever holds the samples of its last steps, so the line's
- * samples and the undo records are rings (sample i at i & mask, a power of
- * two of slots): the caller keeps its samples in a ring of the same size.
  */
 #ifndef TS_WINDOW_HULL_H
 #define TS_WINDOW_HULL_H
@@ -41,16 +37,11 @@ typedef struct {
     int nf;
     ts_hull_pt *undo_pt; /* by sample index: what its front push overwrote */
     int *undo_n;         /* by sample index: front size before its push */
-    int mask;            /* ring slots - 1 */
 } ts_window_hull;
 
-/* The ring slots for windows of up to `span` samples at once (counting the
- * newest, not yet entered ones): the power of two at least span. */
-int ts_window_hull_ring(int span);
-
-/* Buffers for windows of up to `span` samples; 0 if out of memory (then
+/* Buffers for lines of up to n samples; 0 if out of memory (then
  * ts_window_hull_free still applies). */
-int ts_window_hull_alloc(ts_window_hull *w, int span);
+int ts_window_hull_alloc(ts_window_hull *w, int n);
 void ts_window_hull_free(ts_window_hull *w);
 
 /* Empty the window for a new line. */
@@ -71,9 +62,8 @@ void ts_window_hull_refill(ts_window_hull *w, const ts_hull_pt *pts);
 static inline void ts_window_hull_slide(ts_window_hull *w, const ts_hull_pt *pts, int n,
                                         double d, double near, double cap)
 {
-    const int mask = w->mask;
-    while (w->in < n && d - pts[w->in & mask].d >= near) {
-        const ts_hull_pt p = pts[w->in++ & mask];
+    while (w->in < n && d - pts[w->in].d >= near) {
+        const ts_hull_pt p = pts[w->in++];
         ts_hull_pt *S = w->back;
         int m = w->nb;
         while (m >= 2 && (S[m - 2].g - p.g) * (p.d - S[m - 1].d) >=
@@ -82,11 +72,11 @@ static inline void ts_window_hull_slide(ts_window_hull *w, const ts_hull_pt *pts
         S[m] = p;
         w->nb = m + 1;
     }
-    while (w->out < w->in && d - pts[w->out & mask].d > cap) {
+    while (w->out < w->in && d - pts[w->out].d > cap) {
         if (w->out == w->mid)
             ts_window_hull_refill(w, pts);
         /* the oldest sample was the front's last push: undo it */
-        int o = w->out++ & mask;
+        int o = w->out++;
         int pos = w->nf - 1;
         w->front[pos] = w->undo_pt[o];
         w->nf = w->undo_n[o];
