@@ -218,10 +218,10 @@ int ts_cap_lanes_pays(const int lags[4])
 int ts_cap_lanes_hybrid_pays(const int lags[4])
 {
     /* measured (docs/performance.md, "Bounded sweep: unbounded hull first"):
-     * 0.80-0.88x the line-by-line window's CPU time at 300-1000 lags; the
-     * ring's pruned scan holds for windows of up to 10^5 lags */
-    /* and its hulls take the samples lags[0] steps back, which must be
-     * surely beyond the near field (lines of equal steps) */
+     * 0.80-0.89x the line-by-line window's CPU time at 300-2000 lags. The
+     * ring's pruned scan holds for windows of up to 10^5 lags; the hulls
+     * take the samples lags[0] steps back, which must be surely beyond the
+     * near field (lines of equal steps). */
     return ts_lane_vector_level() == 2 && lags[1] - lags[0] + 1 >= PRUNE_FROM &&
            lags[1] <= 100000 && lags[2] <= lags[0];
 }

@@ -24,8 +24,9 @@
  * of its samples beyond the near field, whose answer is the window's
  * wherever it lies in the window (capped_lanes.h, the hybrid); else each
  * line keeps the hull of a sliding window of its samples (window_hull.h),
- * in amortised O(1) per sample like the unbounded hull. The near field is cut at the distance, and the last part of a step
- * before it is solved exactly on each cell's ray.
+ * in amortised O(1) per sample like the unbounded hull. The near field is
+ * cut at the distance, and the last part of a step before it is solved
+ * exactly on each cell's ray.
  */
 #include <limits.h>
 #include <math.h>
@@ -404,11 +405,10 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         const int last_inside = G->fr[k] == 0.0f ? j1 : G->V - 2 - (int)i0;
         const ts_lane_step step = {k, j0, j1, prime, last_inside, w->lane_d, w->hs, w->hc,
                                    w->hn, c, C->near_skip, NULL, NULL, 0};
-        if (w->hybrid && ts_cap_lanes_hybrid_step(&w->capl, &hulls, &step, nl, &occ))
-            ;
-        else if (C->cap > 0)
+        const int hybrid = w->hybrid && ts_cap_lanes_hybrid_step(&w->capl, &hulls, &step, nl, &occ);
+        if (!hybrid && C->cap > 0)
             ts_cap_lanes_step(&w->capl, &step, nl, &occ);
-        else if (!ts_lane_hull_step(&hulls, &step, &occ))
+        else if (!hybrid && !ts_lane_hull_step(&hulls, &step, &occ))
             lane_hulls_scalar(&hulls, &step, &occ);
         if (j1 == nl - 1)
             next[k] = (occluder){w->lo_k[nl], w->lo_dd[nl]};
@@ -478,7 +478,8 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
     }
     if (w->lockstep) {
         const occluder none = {-1, 0.0f};
-        /* capped lines keep windows (rings) instead of hulls */
+        /* capped lines keep windows (rings) instead of hulls, the hybrid's
+         * both */
         if (capped)
             ok = ts_cap_lanes_alloc(&w->capl, LOCKSTEP_LINES + 1, C->lags, C->near_skip, C->cap);
         if (!capped || w->hybrid) {
