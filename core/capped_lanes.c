@@ -31,7 +31,8 @@ static void *zalloc(size_t n)
 }
 
 /* Windows of at least PRUNE_FROM lags take the pruned scan (with AVX-512),
- * up to lags of PRUNE_TO (beyond, the line-by-line window hull is cheaper). */
+ * up to lags of PRUNE_TO; beyond, the scan alone costs more than the
+ * line-by-line window hull, and the hybrid (capped_hybrid.c) less. */
 #ifndef PRUNE_TO
 #define PRUNE_TO 256
 #endif
@@ -105,6 +106,7 @@ void ts_cap_lanes_clear(ts_cap_lanes *r)
         r->d[i] = NAN;
     for (int j = 0; j < r->stride; j++)
         r->kc[j] = r->kn[j] = -1; /* no previous answers */
+    r->hull_lost = 0;
     for (int l = 0; l < 2 && r->prune; l++)
         ts_cap_groups_empty(r->gmax[l], r->dlo[l], r->dhi[l], (size_t)r->groups[l] * r->stride);
 }
@@ -213,6 +215,17 @@ int ts_cap_lanes_pays(const int lags[4])
          : level == 1 ? span <= 40 : 0;
 }
 
+int ts_cap_lanes_hybrid_pays(const int lags[4])
+{
+    /* measured (docs/performance.md, "Bounded sweep: unbounded hull first"):
+     * 0.80-0.89x the line-by-line window's CPU time at 300-2000 lags. The
+     * ring's pruned scan holds for windows of up to 10^5 lags; the hulls
+     * take the samples lags[0] steps back, which must be surely beyond the
+     * near field (lines of equal steps). */
+    return ts_lane_vector_level() == 2 && lags[1] - lags[0] + 1 >= PRUNE_FROM &&
+           lags[1] <= 100000 && lags[2] <= lags[0];
+}
+
 static void scan_groups(const ts_cap_lanes *r, int k, int g0, int g1)
 {
     const int level = ts_lane_vector_level();
@@ -227,6 +240,12 @@ static void scan_groups(const ts_cap_lanes *r, int k, int g0, int g1)
 }
 #else
 int ts_cap_lanes_pays(const int lags[4])
+{
+    (void)lags;
+    return 0;
+}
+
+int ts_cap_lanes_hybrid_pays(const int lags[4])
 {
     (void)lags;
     return 0;
@@ -247,6 +266,7 @@ void ts_cap_lanes_step(ts_cap_lanes *r, const ts_lane_step *s, int nl,
     double *rg = r->g + (size_t)(k % r->slots) * r->stride;
     for (int j = 0; j < nl; j++)
         rd[j] = NAN;
+    r->hull_lost = 1; /* (a step a hybrid's hulls did not take) */
     if (j0 <= j1) {
         const int g0 = j0 / 8 * 8, g1 = (j1 + 8) / 8 * 8;
 #if defined(__GNUC__) && defined(__x86_64__)

@@ -42,6 +42,9 @@ typedef struct {
      * and the answers (steps, -1: none; distances) */
     double *qd, *qc, *qn, *ddc, *ddn;
     long long *kc, *kn;
+    /* ts_cap_lanes_hybrid_step's hulls miss samples (a step without lines
+     * pushed none): the block's other steps take the scan alone */
+    int hull_lost;
 } ts_cap_lanes;
 
 /* Level 0 and level 1 groups of the pruned scan, in steps. */
@@ -79,5 +82,26 @@ void ts_cap_lanes_clear(ts_cap_lanes *r);
  * j + 1), as ts_lane_hull_step does for unbounded lines. */
 void ts_cap_lanes_step(ts_cap_lanes *r, const ts_lane_step *s, int nl,
                        const ts_lane_occluders *occ);
+
+/* Lines a block may have for ts_cap_lanes_hybrid_step. */
+#define TS_CAP_MAX_LINES 256
+
+/* Whether the hybrid (ts_cap_lanes_hybrid_step) is the cheaper way to
+ * answer windows of these lags on this CPU than the line-by-line window
+ * hull (only where ts_cap_lanes_pays is not). */
+int ts_cap_lanes_hybrid_pays(const int lags[4]);
+
+/* ts_cap_lanes_step for long windows (AVX-512), with each line's hull h
+ * (ts_lane_hull_step's, emptied with the block) of its samples beyond the
+ * near field: where the hull's steepest sample lies in the window, it is
+ * the window's; the ring's scan answers the rest, by group of eight lines
+ * (capped_hybrid.c). Only for windows whose lags[0] steps are surely beyond
+ * the near field (ts_cap_lanes_hybrid_pays). The answers differ from
+ * ts_cap_lanes_step's only between equally steep samples (up to rounding).
+ * Returns 0, having done nothing, where the CPU has no AVX-512, the block
+ * too many lines, or the hulls missed a step (hull_lost): the caller then
+ * runs ts_cap_lanes_step. */
+int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_lane_step *s,
+                             int nl, const ts_lane_occluders *occ);
 
 #endif

@@ -329,4 +329,48 @@ AVX512 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0, in
     }
 }
 
+/* The hull's answers (occ, from ts_lane_hull_step) to the queries of lines
+ * [g0, g1) into r->kc, ddc, kn, ddn, where they lie in the window as the
+ * scan tests it (lag <= lag_hi, d - d_p <= cap); lines without a query get
+ * none (-1, 1.0), those the hull cannot answer keep their last answers.
+ * need[(g - g0) / 8]: whether a query of group g is left to the scan. */
+AVX512 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
+                                   const ts_lane_occluders *occ, unsigned char *need)
+{
+    const __m512d cap = _mm512_set1_pd(r->cap);
+    const __m512i zero = _mm512_setzero_si512(), none = _mm512_set1_epi64(-1);
+    for (int j = g0; j < g1; j += 8) {
+        const __m256i lane =
+            _mm256_add_epi32(_mm256_set1_epi32(j), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+        const __m512d d = _mm512_load_pd(r->qd + j);
+        __mmask8 left = 0;
+        for (int q = 0; q < 2; q++) {
+            const int *kq = q ? occ->lo_k + j + 1 : occ->hi_k + j;
+            long long *ko = q ? r->kn : r->kc;
+            double *ddo = q ? r->ddn : r->ddc;
+            const __m512d gq = _mm512_load_pd((q ? r->qn : r->qc) + j);
+            const __mmask8 has = _mm512_cmp_pd_mask(gq, gq, _CMP_ORD_Q);
+            const __m512i kk = _mm512_cvtepi32_epi64(
+                _mm512_castsi512_si256(_mm512_maskz_loadu_epi32((__mmask16)has, kq)));
+            const __m512i lag = _mm512_sub_epi64(_mm512_set1_epi64(k), kk);
+            __mmask8 ok = _mm512_mask_cmpge_epi64_mask(has, kk, zero);
+            ok = _mm512_mask_cmple_epi64_mask(ok, lag, _mm512_set1_epi64(r->lag_hi));
+            /* its slot: (k mod slots - lag) mod slots */
+            __m512i slot = _mm512_sub_epi64(_mm512_set1_epi64(k % r->slots), lag);
+            slot = _mm512_mask_add_epi64(slot, _mm512_cmplt_epi64_mask(slot, zero), slot,
+                                         _mm512_set1_epi64(r->slots));
+            const __m256i at = _mm256_add_epi32(
+                _mm256_mullo_epi32(_mm512_cvtepi64_epi32(slot), _mm256_set1_epi32(r->stride)), lane);
+            const __m512d dd = _mm512_sub_pd(d, _mm512_mask_i32gather_pd(_mm512_set1_pd(NAN), ok, at, r->d, 8));
+            ok = _mm512_mask_cmp_pd_mask(ok, dd, cap, _CMP_LE_OQ);
+            const __m512i kb = _mm512_mask_mov_epi64(none, has, _mm512_load_epi64(ko + j));
+            const __m512d db = _mm512_mask_mov_pd(_mm512_set1_pd(1.0), has, _mm512_load_pd(ddo + j));
+            _mm512_store_epi64(ko + j, _mm512_mask_mov_epi64(kb, ok, kk));
+            _mm512_store_pd(ddo + j, _mm512_mask_mov_pd(db, ok, dd));
+            left |= has & ~ok;
+        }
+        need[(j - g0) / 8] = left != 0;
+    }
+}
+
 #endif

@@ -26,6 +26,12 @@ void ts_cap_queries512(ts_cap_lanes *r, const ts_lane_step *s, int g0, int g1);
 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0, int g1,
                        const ts_lane_occluders *occ, double *rd, double *rg);
 
+/* The hull's answers of the hybrid (capped_hybrid.c) where they lie in the
+ * window, for lines [g0, g1); need[(g - g0) / 8]: whether group g has a
+ * query left to the scan. */
+void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
+                            const ts_lane_occluders *occ, unsigned char *need);
+
 /* Step k's samples (ring slots rd, rg; d NaN: none) into their groups of
  * both levels, each emptied at its first step. */
 void ts_cap_groups_add512(ts_cap_lanes *r, int k, const double *rd, const double *rg);

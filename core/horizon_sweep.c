@@ -20,11 +20,15 @@
  * samples beyond the near field and within the distance: for short windows
  * (capped_lanes.h) the lines run in the same lockstep blocks and each
  * query is a brute-force maximum over the window, vectorised across lines;
- * for long ones each line keeps the hull of a sliding window of its
- * samples (window_hull.h), in amortised O(1) per sample like the unbounded
- * hull. The near field is cut at the distance, and the last part of a step
- * before it is solved exactly on each cell's ray.
+ * for long ones, with AVX-512, each line in the blocks also keeps the hull
+ * of its samples beyond the near field, whose answer is the window's
+ * wherever it lies in the window (capped_lanes.h, the hybrid); else each
+ * line keeps the hull of a sliding window of its samples (window_hull.h),
+ * in amortised O(1) per sample like the unbounded hull. The near field is
+ * cut at the distance, and the last part of a step before it is solved
+ * exactly on each cell's ray.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 
@@ -99,6 +103,7 @@ typedef struct {
     double *lane_d;     /* and the distance of its current sample from it */
     ts_cap_lanes capl;  /* capped lines in lockstep: their windows */
     int lockstep;       /* lines in lockstep blocks (sweep_block), not one by one */
+    int hybrid;         /* capped lines in lockstep keep unbounded hulls too */
 } sweep_ws;
 
 /* The far-field occluder of a point at distance d and hull height g among
@@ -363,7 +368,7 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         int k0, k1;
         if (!ts_line_k_range(G, bs + j, &k0, &k1))
             continue;
-        if (C->cap == 0) {
+        if (C->cap == 0 || w->hybrid) {
             w->lane_n[j] = 0;
             w->lane_far[j] = -1;
         }
@@ -399,10 +404,11 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         w->lo_dd[j0] = lo0.dd;
         const int last_inside = G->fr[k] == 0.0f ? j1 : G->V - 2 - (int)i0;
         const ts_lane_step step = {k, j0, j1, prime, last_inside, w->lane_d, w->hs, w->hc,
-                                   w->hn, c, C->near_skip};
-        if (C->cap > 0)
+                                   w->hn, c, C->near_skip, NULL, NULL, 0};
+        const int hybrid = w->hybrid && ts_cap_lanes_hybrid_step(&w->capl, &hulls, &step, nl, &occ);
+        if (!hybrid && C->cap > 0)
             ts_cap_lanes_step(&w->capl, &step, nl, &occ);
-        else if (!ts_lane_hull_step(&hulls, &step, &occ))
+        else if (!hybrid && !ts_lane_hull_step(&hulls, &step, &occ))
             lane_hulls_scalar(&hulls, &step, &occ);
         if (j1 == nl - 1)
             next[k] = (occluder){w->lo_k[nl], w->lo_dd[nl]};
@@ -448,6 +454,11 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
     /* capped lines too where their windows are short enough for the
      * brute force (capped_lanes.h), one by one otherwise */
     w->lockstep = !need_visit && (!capped || ts_cap_lanes_pays(C->lags));
+    /* long windows: in lockstep too where the hybrid pays (and its hulls'
+     * offsets fit the gathers' 32 bits, as ts_lane_hull_step asks) */
+    w->hybrid = !need_visit && capped && !w->lockstep && ts_cap_lanes_hybrid_pays(C->lags) &&
+                (long long)(LOCKSTEP_LINES + 1) * (U + 1) * 6 <= INT_MAX;
+    w->lockstep |= w->hybrid;
     if (capped && !w->lockstep) {
         w->raw = malloc((size_t)(U + 1) * sizeof *w->raw);
         ok = w->raw && ts_window_hull_alloc(&w->win, U) &&
@@ -467,15 +478,16 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
     }
     if (w->lockstep) {
         const occluder none = {-1, 0.0f};
-        /* capped lines keep windows (rings) instead of hulls */
-        if (capped) {
+        /* capped lines keep windows (rings) instead of hulls, the hybrid's
+         * both */
+        if (capped)
             ok = ts_cap_lanes_alloc(&w->capl, LOCKSTEP_LINES + 1, C->lags, C->near_skip, C->cap);
-        } else {
+        if (!capped || w->hybrid) {
             w->lane_n = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_n);
             w->lane_far = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_far);
             w->lane_stacks =
                 malloc((size_t)(LOCKSTEP_LINES + 1) * (U + 1) * sizeof *w->lane_stacks);
-            ok = w->lane_n && w->lane_far && w->lane_stacks;
+            ok = ok && w->lane_n && w->lane_far && w->lane_stacks;
         }
         w->carry = malloc((size_t)U * sizeof *w->carry);
         w->carry_next = malloc((size_t)U * sizeof *w->carry_next);

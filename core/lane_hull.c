@@ -154,7 +154,7 @@ AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, in
 {
     const __m512d c = _mm512_set1_pd(s->c), near_skip = _mm512_set1_pd(s->near_skip);
     const __m256i one = _mm256_set1_epi32(1);
-    group G[NG];
+    group G[NG], P[NG]; /* the lines at their queries' and their pushes' distances */
     const group *GP[NG];
     __m256i idx[NG], m[NG], top[NG], far[NG];
     __m512d cdd[NG], gs[NG], d1[NG], g1[NG];
@@ -168,16 +168,23 @@ AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, in
         G[q].pk = (const int *)H->pts;
         cdd[q] = _mm512_mul_pd(_mm512_mul_pd(c, G[q].d), G[q].d);
         /* hull_push: pop the points the sample hides */
-        const __m512d hs = _mm512_cvtps_pd(load8f(lanes[q], s->hs + jq));
-        push[q] = _mm512_mask_cmp_pd_mask(lanes[q], hs, hs, _CMP_ORD_Q);
-        gs[q] = _mm512_sub_pd(hs, cdd[q]);
+        P[q] = G[q];
+        if (s->push_d) {
+            P[q].d = _mm512_maskz_loadu_pd(lanes[q], s->push_d + jq);
+            push[q] = _mm512_mask_cmp_pd_mask(lanes[q], P[q].d, P[q].d, _CMP_ORD_Q);
+            gs[q] = _mm512_maskz_loadu_pd(push[q], s->push_g + jq);
+        } else {
+            const __m512d hs = _mm512_cvtps_pd(load8f(lanes[q], s->hs + jq));
+            push[q] = _mm512_mask_cmp_pd_mask(lanes[q], hs, hs, _CMP_ORD_Q);
+            gs[q] = _mm512_sub_pd(hs, cdd[q]);
+        }
         m[q] = load8i(lanes[q], H->n + jq);
         /* the top point is m - 1; the walk leaves the new top */
         top[q] = _mm256_sub_epi32(m[q], one);
         active[q] = push[q] & mask_of(_mm256_cmpgt_epi32(top[q], _mm256_setzero_si256()));
         d1[q] = field(&G[q], active[q], top[q], 0);
         g1[q] = field(&G[q], active[q], top[q], 1);
-        GP[q] = &G[q];
+        GP[q] = &P[q];
     }
     walk_down(NG, GP, gs, active, top, d1, g1);
     /* Pops only take from the top, so far is at most the new top; lines
@@ -186,7 +193,11 @@ AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, in
         m[q] = _mm256_add_epi32(top[q], one);
         far[q] = _mm256_min_epi32(load8i(lanes[q], H->far + j + 8 * q), top[q]);
     }
-    advance(NG, G, lanes, far, m, near_skip);
+    if (s->push_d) /* every point is beyond the near field, the new one too */
+        for (int q = 0; q < NG; q++)
+            far[q] = _mm256_add_epi32(top[q], ones_where(push[q]));
+    else
+        advance(NG, G, lanes, far, m, near_skip);
     const group *QG[2 * NG];
     __mmask8 qm[2 * NG];
     __m256i qfar[2 * NG], k[2 * NG];
@@ -197,11 +208,12 @@ AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, in
         /* the push itself */
         const __m256i at = _mm256_mullo_epi32(_mm256_add_epi32(G[q].first, m[q]),
                                               _mm256_set1_epi32(3));
-        _mm512_mask_i32scatter_pd((double *)H->pts, push[q], at, G[q].d, 8);
+        _mm512_mask_i32scatter_pd((double *)H->pts, push[q], at, P[q].d, 8);
         _mm512_mask_i32scatter_pd((double *)H->pts, push[q], _mm256_add_epi32(at, one), gs[q], 8);
         const __m256i kat = _mm256_add_epi32(_mm256_add_epi32(at, at), _mm256_set1_epi32(4));
         _mm512_mask_i32scatter_epi32((int *)H->pts, (__mmask16)push[q],
-                                     _mm512_castsi256_si512(kat), _mm512_set1_epi32(s->k), 4);
+                                     _mm512_castsi256_si512(kat),
+                                     _mm512_set1_epi32(s->push_d ? s->push_k : s->k), 4);
         store8i(H->n + jq, lanes[q], _mm256_add_epi32(m[q], ones_where(push[q])));
         store8i(H->far + jq, lanes[q], far[q]);
         /* the occluders of the cells below (hi, when asked) and above (lo) */

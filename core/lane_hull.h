@@ -35,6 +35,11 @@ typedef struct {
     const double *d;
     const float *hs, *hc, *hn;
     double c, near_skip;
+    /* where set (ts_lane_hull_step only): line j pushes the point of
+     * distance push_d[j] (NaN: none) and hull height push_g[j], of step
+     * push_k, instead of its sample */
+    const double *push_d, *push_g;
+    int push_k;
 } ts_lane_step;
 
 /* The widest vectors the CPU and the build run (asked once): 2 AVX-512,

@@ -288,9 +288,21 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
     full.prune = 0;
     ts_cap_lanes_clear(&pruned);
     ts_cap_lanes_clear(&full);
-    int ok_k[2][CL_LINES + 1], hi_k[2][CL_LINES + 1];
-    float ok_dd[2][CL_LINES + 1], hi_dd[2][CL_LINES + 1];
-    long queries = 0, ties = 0, bad = 0;
+    int ok_k[3][CL_LINES + 1], hi_k[3][CL_LINES + 1];
+    float ok_dd[3][CL_LINES + 1], hi_dd[3][CL_LINES + 1];
+    long queries = 0, ties = 0, bad = 0, hull_steps = 0, hyb_ties = 0;
+    /* long windows (AVX-512): the hybrid, unbounded hulls first */
+    const int hybrid = ts_cap_lanes_hybrid_pays(lags) && !ts_cap_lanes_pays(lags);
+    ts_cap_lanes hyb = {0};
+    static ts_hull_pt pts[CL_LINES * (CL_STEPS + 1)];
+    int hn_n[CL_LINES + 1] = {0}, hn_far[CL_LINES + 1];
+    const ts_lane_hulls hulls = {pts, CL_STEPS + 1, hn_n, hn_far};
+    for (int j = 0; j <= CL_LINES; j++)
+        hn_far[j] = -1;
+    if (hybrid) {
+        ck_assert(ts_cap_lanes_alloc(&hyb, CL_LINES, lags, near, cap));
+        ts_cap_lanes_clear(&hyb);
+    }
     for (int k = 0; k < CL_STEPS; k++) {
         int j0 = CL_LINES, j1 = -1;
         for (int j = 0; j < CL_LINES; j++)
@@ -303,10 +315,16 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
             dk[j] = d[k][j];
         const int hi_from = j0 + (k % 3 == 0), hi_to = j1 - (k % 5 == 0);
         const ts_lane_step st = {k, j0 <= j1 ? j0 : 1, j0 <= j1 ? j1 : 0, hi_from, hi_to,
-                                 dk, hs[k], hc[k], hn[k], c, near};
+                                 dk, hs[k], hc[k], hn[k], c, near, NULL, NULL, 0};
         for (int v = 0; v < 2; v++) {
             const ts_lane_occluders occ = {ok_k[v], hi_k[v], ok_dd[v], hi_dd[v]};
             ts_cap_lanes_step(v ? &full : &pruned, &st, CL_LINES, &occ);
+        }
+        if (hybrid) {
+            const ts_lane_occluders occ = {ok_k[2], hi_k[2], ok_dd[2], hi_dd[2]};
+            if (!ts_cap_lanes_hybrid_step(&hyb, &hulls, &st, CL_LINES, &occ))
+                ts_cap_lanes_step(&hyb, &st, CL_LINES, &occ);
+            hull_steps += !hyb.hull_lost;
         }
         for (int j = j0; j <= j1; j++)
             for (int q = 0; q < 2; q++) {
@@ -335,6 +353,22 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
                 queries++;
                 ties += nbest > 1;
                 const int jo = q ? j + 1 : j;
+                if (hybrid) {
+                    /* the steepest slope; another equally steep sample's
+                     * step (the hull's tie rule) counts as a tie */
+                    const int gk = q ? ok_k[2][jo] : hi_k[2][jo];
+                    const float gdd = q ? ok_dd[2][jo] : hi_dd[2][jo];
+                    int good = gk == bk && gdd == (float)bd;
+                    if (!good && gk >= 0 && bk >= 0 && cl_on(j, gk) && !isnan(hs[gk][j])) {
+                        const double dd = d[k][j] - d[gk][j];
+                        const double n = (double)hs[gk][j] - c * d[gk][j] * d[gk][j] - gq;
+                        good = dd >= near && dd <= cap && gdd == (float)dd && n * bd == bn * dd;
+                        hyb_ties += good;
+                    }
+                    if (!good && bad++ == 0)
+                        printf("step %d line %d query %d (hybrid): step %d dd %.9g, want %ld %.9g\n",
+                               k, j, q, gk, gdd, bk, bd);
+                }
                 for (int v = 0; v < 2; v++) {
                     const int gk = q ? ok_k[v][jo] : hi_k[v][jo];
                     const float gdd = q ? ok_dd[v][jo] : hi_dd[v][jo];
@@ -349,9 +383,14 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
     printf("capped scan, lags %d..%d, %s, c %g, jitter %g: %ld queries, %ld with tied "
            "steepest, %ld wrong\n", lags[0], lags[1], pruned.prune ? "pruned" : "not pruned",
            c, jitter, queries, ties, bad);
+    if (hybrid)
+        printf("  hybrid: hulls on %ld of %d steps, %ld answers another tied sample\n",
+               hull_steps, CL_STEPS, hyb_ties);
     ts_cap_lanes_free(&pruned);
     ts_cap_lanes_free(&full);
+    ts_cap_lanes_free(&hyb);
     ck_assert_msg(queries > 10000 && bad == 0, "%ld of %ld capped queries wrong", bad, queries);
+    ck_assert(!hybrid || hull_steps > 400);
 }
 
 START_TEST(test_capped_scan_pruned)
@@ -362,6 +401,10 @@ START_TEST(test_capped_scan_pruned)
     check_capped_scan(25.0, 2555.0, 0.0, 0.01, 3);   /* per-row steps, up to 258 lags */
     check_capped_scan(80.0, 1200.0, curved, 0.01, 4);
     check_capped_scan(25.0, 500.0, 0.0, 0.0, 5);     /* 50 lags: the whole window */
+    /* 3..500 and 9..3000 lags: the hybrid too (with AVX-512) */
+    check_capped_scan(25.0, 5000.0, 0.0, 0.0, 6);
+    check_capped_scan(25.0, 5000.0, curved, 0.0, 7);
+    check_capped_scan(85.0, 30000.0, curved, 0.0, 8);
 }
 END_TEST
 

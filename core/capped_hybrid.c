@@ -1,0 +1,85 @@
+/*
+ * Long capped windows in the lockstep blocks (AVX-512): an unbounded hull
+ * first, the window's ring only where the hull cannot answer; see
+ * capped_lanes.h (ts_cap_lanes_hybrid_step).
+ *
+ * Each line's hull takes its samples once they leave the near field (from
+ * the ring, lag_lo steps late: on lines of equal steps every sample that
+ * many steps back is beyond the near field), so it holds every sample
+ * beyond the near field, and its query finds the steepest of them. Where
+ * that one lies in the window (as the ring tests it: lag <= lag_hi,
+ * d - d_p <= cap), it is the window's steepest, the window being a subset
+ * of what the hull saw; else the ring's (pruned) scan answers, by group of
+ * eight lines. (Pushing samples at once, as the unbounded sweep does, lets
+ * a sample still in the near field hide older ones, ~100 steps of them on
+ * fractal terrain.)
+ */
+#include <math.h>
+
+#include "capped_lanes.h"
+#include "capped_lanes512.h"
+
+#if defined(__GNUC__) && defined(__x86_64__)
+
+int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_lane_step *s,
+                             int nl, const ts_lane_occluders *occ)
+{
+    const int k = s->k, j0 = s->j0, j1 = s->j1;
+    if (r->hull_lost || j0 > j1 || r->stride > TS_CAP_MAX_LINES) {
+        r->hull_lost = 1;
+        return 0;
+    }
+    /* the samples that leave the near field: those lag_lo steps back */
+    const int kp = k - r->lag_lo;
+    const size_t at = (size_t)((kp % r->slots + r->slots) % r->slots) * r->stride;
+    ts_lane_step hs = *s;
+    hs.push_d = r->d + at;
+    hs.push_g = r->g + at;
+    hs.push_k = kp;
+    hs.near_skip = 0.0; /* every point of the hull is beyond the near field */
+    if (!ts_lane_hull_step(h, &hs, occ)) {
+        r->hull_lost = 1;
+        return 0;
+    }
+    double *rd = r->d + (size_t)(k % r->slots) * r->stride;
+    double *rg = r->g + (size_t)(k % r->slots) * r->stride;
+    for (int j = 0; j < nl; j++)
+        rd[j] = NAN;
+    const int g0 = j0 / 8 * 8, g1 = (j1 + 8) / 8 * 8;
+    ts_cap_queries512(r, s, g0, g1);
+    /* the hull's answers, where they are the window's; the groups of eight
+     * lines where some are not */
+    unsigned char scan[TS_CAP_MAX_LINES / 8];
+    ts_cap_hull_answers512(r, k, g0, g1, occ, scan);
+    /* the ring's scan for the groups that need it, up to TS_CAP_NG at once */
+    for (int g = g0; g < g1;) {
+        if (!scan[(g - g0) / 8]) {
+            g += 8;
+            continue;
+        }
+        int e = g + 8;
+        while (e < g1 && e - g < 8 * TS_CAP_NG && scan[(e - g0) / 8])
+            e += 8;
+        ts_cap_scan512(r, k, g, e);
+        g = e;
+    }
+    ts_cap_answers512(r, s, g0, g1, occ, rd, rg);
+    if (r->prune)
+        ts_cap_groups_add512(r, k, rd, rg);
+    return 1;
+}
+
+#else
+
+int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_lane_step *s,
+                             int nl, const ts_lane_occluders *occ)
+{
+    (void)r;
+    (void)h;
+    (void)s;
+    (void)nl;
+    (void)occ;
+    return 0;
+}
+
+#endif
