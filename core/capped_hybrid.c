@@ -47,26 +47,22 @@ int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_l
         rd[j] = NAN;
     const int g0 = j0 / 8 * 8, g1 = (j1 + 8) / 8 * 8;
     ts_cap_queries512(r, s, g0, g1);
-    /* the hull's answers, where they are the window's; the queries where
-     * they are not (per group of eight lines, in bits) */
-    unsigned char open[TS_CAP_MAX_LINES / 4];
-    ts_cap_hull_answers512(r, k, g0, g1, occ, open);
-    /* the ring's scan for the groups that need it, up to TS_CAP_NG at once,
-     * for their open queries only (the others keep the hull's answers, so
-     * their lines' samples do not widen the scan) */
-#define OPEN(g) (open[((g) - g0) / 4] | open[((g) - g0) / 4 + 1])
+    /* the hull's answers, where they are the window's; the groups of eight
+     * lines where some are not */
+    unsigned char scan[TS_CAP_MAX_LINES / 8];
+    ts_cap_hull_answers512(r, k, g0, g1, occ, scan);
+    /* the ring's scan for the groups that need it, up to TS_CAP_NG at once */
     for (int g = g0; g < g1;) {
-        if (!OPEN(g)) {
+        if (!scan[(g - g0) / 8]) {
             g += 8;
             continue;
         }
         int e = g + 8;
-        while (e < g1 && e - g < 8 * TS_CAP_NG && OPEN(e))
+        while (e < g1 && e - g < 8 * TS_CAP_NG && scan[(e - g0) / 8])
             e += 8;
-        ts_cap_scan512(r, k, g, e, open + (g - g0) / 4);
+        ts_cap_scan512(r, k, g, e);
         g = e;
     }
-#undef OPEN
     ts_cap_answers512(r, s, g0, g1, occ, rd, rg);
     if (r->prune)
         ts_cap_groups_add512(r, k, rd, rg);

@@ -231,7 +231,7 @@ static void scan_groups(const ts_cap_lanes *r, int k, int g0, int g1)
     const int level = ts_lane_vector_level();
     if (level == 2)
         for (int g = g0; g < g1; g += 8 * TS_CAP_NG)
-            ts_cap_scan512(r, k, g, g1, NULL);
+            ts_cap_scan512(r, k, g, g1);
     else if (level == 1)
         for (int g = g0; g < g1; g += 8)
             scan_avx2(r, k, g);

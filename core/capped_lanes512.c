@@ -111,14 +111,13 @@ scan512_group(const ts_cap_lanes *r, int g, int ng, int s0, scan512 *a)
 
 /* For the eight lines from j: the prune threshold T (-inf: none known;
  * +inf: no query), the lower of the two query heights (+inf: no query) and
- * the lines without a query; only the queries of `open` (per query, lines
- * in bits) count. T is the steepest (for the query of lower
+ * the lines without a query. T is the steepest (for the query of lower
  * slope) of four samples of the window, each taken only where the scan's
  * own tests put it in the window: the line's previous answers of both
  * queries, and its newest and oldest slot. */
 AVX512 static inline __attribute__((always_inline)) void
 prune_threshold(const ts_cap_lanes *r, int k, int lag_hi, int j, const scan512 *a, int q,
-                const __mmask8 open[2], __m512d *thr, __m512d *gmin, __mmask8 *idle)
+                __m512d *thr, __m512d *gmin, __mmask8 *idle)
 {
     const __m512i zero = _mm512_setzero_si512();
     const __m512d near = _mm512_set1_pd(r->near), cap = _mm512_set1_pd(r->cap);
@@ -165,7 +164,7 @@ prune_threshold(const ts_cap_lanes *r, int k, int lag_hi, int j, const scan512 *
         const __m512d s = _mm512_div_pd(bn, bd); /* -inf where none */
         /* s - margin |s| */
         t[i] = _mm512_fnmadd_pd(_mm512_abs_pd(s), _mm512_set1_pd(PRUNE_MARGIN), s);
-        has[i] = _mm512_mask_cmp_pd_mask(open[i], gq[i], gq[i], _CMP_ORD_Q);
+        has[i] = _mm512_cmp_pd_mask(gq[i], gq[i], _CMP_ORD_Q);
         t[i] = _mm512_mask_mov_pd(_mm512_set1_pd(INFINITY), has[i], t[i]);
         gs[i] = _mm512_mask_mov_pd(_mm512_set1_pd(INFINITY), has[i], gq[i]);
     }
@@ -197,16 +196,12 @@ group_needed(const ts_cap_lanes *r, int l, int idx, int g, int ng, const __m512d
 
 /* scan_scalar for up to NG groups from g (those below g1), eight lines
  * per AVX-512 vector: the same operations per line; with r->prune, only
- * the groups of slots that may change the answer of the queries open. */
+ * the groups of slots that may change the answer. */
 
-AVX512 void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1, const unsigned char *open)
+AVX512 void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1)
 {
     const int lag_hi = k < r->lag_hi ? k : r->lag_hi;
     const int ng = (g1 - g) / 8 < NG ? (g1 - g) / 8 : NG;
-    __mmask8 op[NG][2];
-    for (int q = 0; q < NG; q++)
-        for (int i = 0; i < 2; i++)
-            op[q][i] = open && q < ng ? open[2 * q + i] : 0xFF;
     scan512 a;
     for (int q = 0; q < NG; q++) {
         const int o = g + 8 * (q < ng ? q : 0);
@@ -224,7 +219,7 @@ AVX512 void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1, const un
         __mmask8 idle[NG], neg[NG];
         for (int q = 0; q < ng; q++) {
             __m512d gmin;
-            prune_threshold(r, k, lag_hi, g + 8 * q, &a, q, op[q], &thr[q], &gmin, &idle[q]);
+            prune_threshold(r, k, lag_hi, g + 8 * q, &a, q, &thr[q], &gmin, &idle[q]);
             neg[q] = _mm512_cmp_pd_mask(thr[q], _mm512_setzero_pd(), _CMP_LT_OQ);
             const __m512d td = _mm512_mul_pd(thr[q], a.d[q]);
             const __m512d size = _mm512_add_pd(_mm512_abs_pd(gmin), _mm512_abs_pd(td));
@@ -261,10 +256,10 @@ AVX512 void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1, const un
     }
     for (int q = 0; q < ng; q++) {
         const int o = g + 8 * q;
-        _mm512_mask_store_epi64(r->kc + o, op[q][0], a.bkc[q]);
-        _mm512_mask_store_pd(r->ddc + o, op[q][0], a.bdc[q]);
-        _mm512_mask_store_epi64(r->kn + o, op[q][1], a.bkn[q]);
-        _mm512_mask_store_pd(r->ddn + o, op[q][1], a.bdn[q]);
+        _mm512_store_epi64(r->kc + o, a.bkc[q]);
+        _mm512_store_pd(r->ddc + o, a.bdc[q]);
+        _mm512_store_epi64(r->kn + o, a.bkn[q]);
+        _mm512_store_pd(r->ddn + o, a.bdn[q]);
     }
 }
 
@@ -338,10 +333,9 @@ AVX512 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0, in
  * [g0, g1) into r->kc, ddc, kn, ddn, where they lie in the window as the
  * scan tests it (lag <= lag_hi, d - d_p <= cap); lines without a query get
  * none (-1, 1.0), those the hull cannot answer keep their last answers.
- * open[2 * (g - g0) / 8 + q]: group g's lines whose query q (0: below, 1:
- * above) is left to the scan, in bits. */
+ * need[(g - g0) / 8]: whether a query of group g is left to the scan. */
 AVX512 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
-                                   const ts_lane_occluders *occ, unsigned char *open)
+                                   const ts_lane_occluders *occ, unsigned char *need)
 {
     const __m512d cap = _mm512_set1_pd(r->cap);
     const __m512i zero = _mm512_setzero_si512(), none = _mm512_set1_epi64(-1);
@@ -349,6 +343,7 @@ AVX512 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
         const __m256i lane =
             _mm256_add_epi32(_mm256_set1_epi32(j), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
         const __m512d d = _mm512_load_pd(r->qd + j);
+        __mmask8 left = 0;
         for (int q = 0; q < 2; q++) {
             const int *kq = q ? occ->lo_k + j + 1 : occ->hi_k + j;
             long long *ko = q ? r->kn : r->kc;
@@ -372,8 +367,9 @@ AVX512 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
             const __m512d db = _mm512_mask_mov_pd(_mm512_set1_pd(1.0), has, _mm512_load_pd(ddo + j));
             _mm512_store_epi64(ko + j, _mm512_mask_mov_epi64(kb, ok, kk));
             _mm512_store_pd(ddo + j, _mm512_mask_mov_pd(db, ok, dd));
-            open[(j - g0) / 8 * 2 + q] = has & ~ok;
+            left |= has & ~ok;
         }
+        need[(j - g0) / 8] = left != 0;
     }
 }
 

@@ -16,10 +16,8 @@
 
 /* The window scan of lines [g, g + 8 * TS_CAP_NG), those below g1, at
  * step k: answers into r->kc, ddc, kn, ddn; only the groups of slots that
- * may change an answer where r->prune. open (NULL: every query): per group
- * of eight lines from g, its lines whose query below (open[2 i]) and
- * above (open[2 i + 1]) are scanned, in bits; the others' answers stay. */
-void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1, const unsigned char *open);
+ * may change an answer where r->prune. */
+void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1);
 
 /* The queries of lines [g0, g1) of step s (r->qd, qc, qn), and after the
  * scan the answers of its lines j0..j1 into occ and their samples into the
@@ -29,10 +27,10 @@ void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0, int g1,
                        const ts_lane_occluders *occ, double *rd, double *rg);
 
 /* The hull's answers of the hybrid (capped_hybrid.c) where they lie in the
- * window, for lines [g0, g1); open[2 (g - g0) / 8 + q]: the lines of group
- * g whose query q (0: below, 1: above) is left to the scan, in bits. */
+ * window, for lines [g0, g1); need[(g - g0) / 8]: whether group g has a
+ * query left to the scan. */
 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
-                            const ts_lane_occluders *occ, unsigned char *open);
+                            const ts_lane_occluders *occ, unsigned char *need);
 
 /* Step k's samples (ring slots rd, rg; d NaN: none) into their groups of
  * both levels, each emptied at its first step. */
