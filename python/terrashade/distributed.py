@@ -208,11 +208,22 @@ def check_workers(client):
     return len(found)
 
 
-def _progress_bar(futures):
-    from dask.distributed import progress
-    # dask's console bar writes to stdout; the program's stdout stays clean.
-    with contextlib.redirect_stdout(sys.stderr):
-        progress(futures, multi=False)
+def _progress_bar(futures, ready):
+    """Dask's console progress bar over futures; sets ready once the
+    scheduler tracks them (its first draw), or when the bar gives up."""
+    from distributed.diagnostics.progressbar import TextProgressBar
+
+    class Bar(TextProgressBar):
+        def _draw_bar(self, **kwargs):
+            ready.set()
+            super()._draw_bar(**kwargs)
+
+    try:
+        # dask's console bar writes to stdout; the program's stdout stays clean.
+        with contextlib.redirect_stdout(sys.stderr):
+            Bar(futures, complete=True)
+    finally:
+        ready.set()
 
 
 def compute(client, out, source, task_options, tile, quiet):
@@ -222,9 +233,16 @@ def compute(client, out, source, task_options, tile, quiet):
                for w in wins]
     window_of = dict(zip((f.key for f in futures), wins))
     bar = None
-    if not quiet:
-        bar = threading.Thread(target=_progress_bar, args=(futures,), daemon=True)
+    ready = threading.Event()  # the bar tracks the futures (or there is none)
+    if quiet:
+        ready.set()
+    else:
+        bar = threading.Thread(target=_progress_bar, args=(futures, ready), daemon=True)
         bar.start()
+    # Written windows are released so that the workers drop them, but not
+    # before the bar's scheduler side has seen every key: it waits for all
+    # of them, and a key forgotten first would leave it waiting for ever.
+    held = []
     try:
         for fut in as_completed(futures):
             try:
@@ -235,12 +253,18 @@ def compute(client, out, source, task_options, tile, quiet):
                                                   type(e).__name__, e))
             for i in range(out.RasterCount):
                 out.GetRasterBand(i + 1).WriteArray(a[i], xoff, yoff)
-            fut.release()
+            held.append(fut)
+            if ready.is_set():
+                for f in held:
+                    f.release()
+                held.clear()
     except BaseException:
         client.cancel(futures)
         raise
     if bar is not None:
         bar.join(timeout=5)
+    for f in held:
+        f.release()
     return len(wins)
 
 
