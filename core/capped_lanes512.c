@@ -6,8 +6,8 @@
 #include <math.h>
 
 #include "capped_lanes512.h"
+#include "simd_clones.h"
 
-#define AVX512 __attribute__((target("avx512f")))
 /* groups of eight lines scanned together: independent chains of compares
  * and selects, so that their latencies overlap */
 #define NG TS_CAP_NG
@@ -23,7 +23,7 @@ typedef struct {
 /* One slot of the window (its distances pd, heights pg, step ks) for ng
  * groups of eight lines: the operations of scan_scalar; the distance test
  * only where `test`. */
-AVX512 static inline __attribute__((always_inline)) void
+TS_AVX512 static inline __attribute__((always_inline)) void
 scan512_slot(const ts_cap_lanes *r, int ng, const double *pd, const double *pg, __m512i ks,
              int test, scan512 *a)
 {
@@ -54,7 +54,7 @@ scan512_slot(const ts_cap_lanes *r, int ng, const double *pd, const double *pg, 
 
 /* The window's slots of lags lag_from down to lag_to (oldest first), for
  * ng groups of eight lines from line g. */
-AVX512 static inline __attribute__((always_inline)) void
+TS_AVX512 static inline __attribute__((always_inline)) void
 scan512_lags(const ts_cap_lanes *r, int k, int g, int ng, int lag_from, int lag_to, scan512 *a)
 {
     int slot = (k - lag_from) % r->slots;
@@ -69,7 +69,7 @@ scan512_lags(const ts_cap_lanes *r, int k, int g, int ng, int lag_from, int lag_
 }
 
 /* A whole level-0 group from step s0, all of whose lags are sure. */
-AVX512 static inline __attribute__((always_inline)) void
+TS_AVX512 static inline __attribute__((always_inline)) void
 scan512_group(const ts_cap_lanes *r, int g, int ng, int s0, scan512 *a)
 {
     const size_t at = (size_t)(s0 % r->slots) * r->stride + g;
@@ -115,7 +115,7 @@ scan512_group(const ts_cap_lanes *r, int g, int ng, int s0, scan512 *a)
  * slope) of four samples of the window, each taken only where the scan's
  * own tests put it in the window: the line's previous answers of both
  * queries, and its newest and oldest slot. */
-AVX512 static inline __attribute__((always_inline)) void
+TS_AVX512 static inline __attribute__((always_inline)) void
 prune_threshold(const ts_cap_lanes *r, int k, int lag_hi, int j, const scan512 *a, int q,
                 __m512d *thr, __m512d *gmin, __mmask8 *idle)
 {
@@ -177,7 +177,7 @@ prune_threshold(const ts_cap_lanes *r, int k, int lag_hi, int j, const scan512 *
  * from g, a sample at least as steep as the threshold: unless
  * gmax + T dsel < gmin + T d (above: rhs), dsel the group's newest
  * distance where T >= 0, its oldest where T < 0 (neg). */
-AVX512 static inline __attribute__((always_inline)) int
+TS_AVX512 static inline __attribute__((always_inline)) int
 group_needed(const ts_cap_lanes *r, int l, int idx, int g, int ng, const __m512d *thr,
              const __m512d *rhs, const __mmask8 *neg, const __mmask8 *idle)
 {
@@ -198,7 +198,7 @@ group_needed(const ts_cap_lanes *r, int l, int idx, int g, int ng, const __m512d
  * per AVX-512 vector: the same operations per line; with r->prune, only
  * the groups of slots that may change the answer. */
 
-AVX512 void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1)
+TS_AVX512 void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1)
 {
     const int lag_hi = k < r->lag_hi ? k : r->lag_hi;
     const int ng = (g1 - g) / 8 < NG ? (g1 - g) / 8 : NG;
@@ -265,7 +265,7 @@ AVX512 void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1)
 
 /* Step k's samples (ring slots rd, rg; d NaN: none) into their groups; a
  * group's first step empties it first. */
-AVX512 void ts_cap_groups_add512(ts_cap_lanes *r, int k, const double *rd, const double *rg)
+TS_AVX512 void ts_cap_groups_add512(ts_cap_lanes *r, int k, const double *rd, const double *rg)
 {
     for (int l = 0; l < 2; l++) {
         const int size = l ? TS_CAP_G1 : TS_CAP_G0;
@@ -289,7 +289,7 @@ AVX512 void ts_cap_groups_add512(ts_cap_lanes *r, int k, const double *rd, const
 /* ts_cap_lanes_step's work before and after the scan, eight lines per
  * vector (the same operations per line): the queries of lines [g0, g1),
  * then the answers and the step's samples of lines j0..j1. */
-AVX512 void ts_cap_queries512(ts_cap_lanes *r, const ts_lane_step *s, int g0, int g1)
+TS_AVX512 void ts_cap_queries512(ts_cap_lanes *r, const ts_lane_step *s, int g0, int g1)
 {
     const __m512d c = _mm512_set1_pd(s->c), nan = _mm512_set1_pd(NAN);
     for (int j = g0; j < g1; j += 8) {
@@ -308,8 +308,8 @@ AVX512 void ts_cap_queries512(ts_cap_lanes *r, const ts_lane_step *s, int g0, in
     }
 }
 
-AVX512 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0, int g1,
-                                       const ts_lane_occluders *occ, double *rd, double *rg)
+TS_AVX512 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0, int g1,
+                                 const ts_lane_occluders *occ, double *rd, double *rg)
 {
     const __m512d c = _mm512_set1_pd(s->c), nan = _mm512_set1_pd(NAN);
     for (int j = g0; j < g1; j += 8) {
@@ -334,8 +334,8 @@ AVX512 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0, in
  * scan tests it (lag <= lag_hi, d - d_p <= cap); lines without a query get
  * none (-1, 1.0), those the hull cannot answer keep their last answers.
  * need[(g - g0) / 8]: whether a query of group g is left to the scan. */
-AVX512 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
-                                   const ts_lane_occluders *occ, unsigned char *need)
+TS_AVX512 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
+                                      const ts_lane_occluders *occ, unsigned char *need)
 {
     const __m512d cap = _mm512_set1_pd(r->cap);
     const __m512i zero = _mm512_setzero_si512(), none = _mm512_set1_epi64(-1);

@@ -4,6 +4,7 @@
 #include <stddef.h>
 
 #include "lane_hull.h"
+#include "simd_clones.h"
 
 #if defined(__GNUC__) && defined(__x86_64__)
 #include <immintrin.h>
@@ -14,8 +15,6 @@ _Static_assert(sizeof(ts_hull_pt) == 3 * sizeof(double) && offsetof(ts_hull_pt, 
                    offsetof(ts_hull_pt, k) == 2 * sizeof(double),
                "ts_hull_pt is laid out as the gathers read it");
 
-#define AVX512 __attribute__((target("avx512f")))
-
 typedef struct {
     __m512d d;     /* the lines' distances */
     __m256i first; /* index of each line's first point */
@@ -23,18 +22,18 @@ typedef struct {
     const int *pk;
 } group;
 
-AVX512 static inline __mmask8 mask_of(__m256i v)
+TS_AVX512 static inline __mmask8 mask_of(__m256i v)
 {
     return (__mmask8)_mm256_movemask_ps(_mm256_castsi256_ps(v));
 }
 
-AVX512 static inline __m256i ones_where(__mmask8 m)
+TS_AVX512 static inline __m256i ones_where(__mmask8 m)
 {
     return _mm512_castsi512_si256(_mm512_maskz_set1_epi32((__mmask16)m, 1));
 }
 
 /* Field f (0: d, 1: g) of point p of each line, where m. */
-AVX512 static inline __m512d field(const group *G, __mmask8 m, __m256i p, int f)
+TS_AVX512 static inline __m512d field(const group *G, __mmask8 m, __m256i p, int f)
 {
     __m256i i = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_add_epi32(G->first, p),
                                                     _mm256_set1_epi32(3)),
@@ -42,17 +41,17 @@ AVX512 static inline __m512d field(const group *G, __mmask8 m, __m256i p, int f)
     return _mm512_mask_i32gather_pd(_mm512_setzero_pd(), m, i, G->pd, 8);
 }
 
-AVX512 static inline __m256 load8f(__mmask8 m, const float *p)
+TS_AVX512 static inline __m256 load8f(__mmask8 m, const float *p)
 {
     return _mm512_castps512_ps256(_mm512_maskz_loadu_ps((__mmask16)m, p));
 }
 
-AVX512 static inline __m256i load8i(__mmask8 m, const int *p)
+TS_AVX512 static inline __m256i load8i(__mmask8 m, const int *p)
 {
     return _mm512_castsi512_si256(_mm512_maskz_loadu_epi32((__mmask16)m, p));
 }
 
-AVX512 static inline void store8i(int *p, __mmask8 m, __m256i v)
+TS_AVX512 static inline void store8i(int *p, __mmask8 m, __m256i v)
 {
     _mm512_mask_storeu_epi32(p, (__mmask16)m, _mm512_castsi256_si512(v));
 }
@@ -61,7 +60,7 @@ AVX512 static inline void store8i(int *p, __mmask8 m, __m256i v)
  * loop issues the gathers of Q independent vectors (lines, or the two
  * queries of the same lines), so that their latencies overlap; Q is a
  * constant where they are inlined. */
-#define ALWAYS AVX512 static inline __attribute__((always_inline))
+#define ALWAYS TS_AVX512 static inline __attribute__((always_inline))
 /* vectors of eight lines a step takes at once (4: measured faster than 1,
  * 2 and 8), and at most twice as many walks (two queries per line) */
 #define NG 4
@@ -149,8 +148,8 @@ ALWAYS void query(int Q, const group *const *G, const __mmask8 *m, const __m256i
 
 /* Groups of eight lines from j on, NG of them at once, those of lanes[q]
  * in group q (a group with none is left alone). */
-AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, int j,
-                               const __mmask8 *lanes, const ts_lane_occluders *occ)
+TS_AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, int j,
+                                  const __mmask8 *lanes, const ts_lane_occluders *occ)
 {
     const __m512d c = _mm512_set1_pd(s->c), near_skip = _mm512_set1_pd(s->near_skip);
     const __m256i one = _mm256_set1_epi32(1);

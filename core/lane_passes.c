@@ -33,18 +33,22 @@ sample_run(const float *restrict zk, ptrdiff_t vs, float F, int j0, int j1, int 
 #if defined(__GNUC__) && defined(__x86_64__)
 #include <immintrin.h>
 
-#define AVX512 __attribute__((target("avx512f")))
+/* The first n of sixteen lanes: none for n <= 0, all for n >= 16. */
+static inline __mmask16 first_lanes16(int n)
+{
+    return n >= 16 ? 0xFFFF : n <= 0 ? 0 : (__mmask16)((1u << n) - 1);
+}
 
 /* sample_run with the lines' cells vs apart, sixteen lines at a time with
  * gathers (gcc's clones load the cells one by one); the same float
  * operations. Offsets j vs in 32 bits. */
-AVX512 static void sample_strided_avx512(const float *zk, int vs, float F, int j0, int j1, int jn,
-                                         float *hc, float *hn, float *hs)
+TS_AVX512 static void sample_strided_avx512(const float *zk, int vs, float F, int j0, int j1,
+                                            int jn, float *hc, float *hn, float *hs)
 {
     const __m512i step = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
     const __m512 nan = _mm512_set1_ps((float)NAN), f = _mm512_set1_ps(F);
     for (int j = j0; j <= j1; j += 16) {
-        const __mmask16 lanes = j1 - j >= 15 ? 0xFFFF : (__mmask16)((1u << (j1 - j + 1)) - 1);
+        const __mmask16 lanes = first_lanes16(j1 - j + 1);
         const __m512i at = _mm512_mullo_epi32(_mm512_add_epi32(_mm512_set1_epi32(j), step),
                                               _mm512_set1_epi32(vs));
         const __m512 c = _mm512_mask_i32gather_ps(nan, lanes, at, zk, 4);
@@ -54,10 +58,8 @@ AVX512 static void sample_strided_avx512(const float *zk, int vs, float F, int j
             _mm512_mask_storeu_ps(hs + j, lanes, c);
             continue;
         }
-        const int left = jn - j + 1; /* lines with a next cell */
-        const __mmask16 next = lanes & (left >= 16  ? 0xFFFF
-                                        : left <= 0 ? 0
-                                                    : (__mmask16)((1u << left) - 1));
+        /* the lines with a next cell */
+        const __mmask16 next = lanes & first_lanes16(jn - j + 1);
         const __m512 n = _mm512_mask_i32gather_ps(nan, next, _mm512_add_epi32(at, _mm512_set1_epi32(vs)),
                                                   zk, 4);
         const __m512 h = _mm512_add_ps(c, _mm512_mul_ps(f, _mm512_sub_ps(n, c)));
@@ -177,7 +179,7 @@ static void far_run64(FAR_PARAMS)
 /* ray_at (32-bit offsets) for 16 cells i at once, where lanes: the same
  * float operations, the loads as gathers (gcc's far_run32 emulates them
  * with scalar loads, three instructions an element). */
-AVX512 static inline __m512 ray16(const ray_view *R, const int *ray_o, const float *ray_f,
+TS_AVX512 static inline __m512 ray16(const ray_view *R, const int *ray_o, const float *ray_f,
                                   const float *z, __m512 cf, __m512i k, __m512i i, __m512 h,
                                   __m512i kc, __m512 dd, __mmask16 lanes)
 {
@@ -209,13 +211,13 @@ AVX512 static inline __m512 ray16(const ray_view *R, const int *ray_o, const flo
 
 /* far_run32 (FAR_LOOP's cells) sixteen at once, cell j's slope to
  * slope[(j - j0) * ostride] (straight into the output). */
-AVX512 static void far_run32_avx512(FAR_PARAMS, int ostride)
+TS_AVX512 static void far_run32_avx512(FAR_PARAMS, int ostride)
 {
     const __m512 cfv = _mm512_set1_ps(cf);
     const __m512i kv = _mm512_set1_epi32(k), step = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8,
                                                                      9, 10, 11, 12, 13, 14, 15);
     for (int j = j0; j <= j1; j += 16) {
-        const __mmask16 lanes = j1 - j >= 15 ? 0xFFFF : (__mmask16)((1u << (j1 - j + 1)) - 1);
+        const __mmask16 lanes = first_lanes16(j1 - j + 1);
         const __m512 h = _mm512_maskz_loadu_ps(lanes, hc + j);
         const __m512i i = _mm512_add_epi32(_mm512_set1_epi32(i0 + j), step);
         const __m512i kl = _mm512_maskz_loadu_epi32(lanes, lo_k + j);
