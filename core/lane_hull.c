@@ -165,9 +165,12 @@ AVX512VL static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, 
         G[q].pd = (const double *)H->pts;
         G[q].pk = (const int *)H->pts;
         cdd[q] = _mm512_mul_pd(_mm512_mul_pd(c, G[q].d), G[q].d);
-        /* hull_push: pop the points the sample hides */
-        P[q] = G[q];
+        /* hull_push: pop the points the sample hides (from its own
+         * distance where it pushes another point's) */
+        GP[q] = &G[q];
         if (s->push_d) {
+            P[q] = G[q];
+            GP[q] = &P[q];
             P[q].d = _mm512_maskz_loadu_pd(lanes[q], s->push_d + jq);
             push[q] = _mm512_mask_cmp_pd_mask(lanes[q], P[q].d, P[q].d, _CMP_ORD_Q);
             gs[q] = _mm512_maskz_loadu_pd(push[q], s->push_g + jq);
@@ -182,7 +185,6 @@ AVX512VL static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, 
         active[q] = _mm256_mask_cmpgt_epi32_mask(push[q], top[q], _mm256_setzero_si256());
         d1[q] = field(&G[q], active[q], top[q], 0);
         g1[q] = field(&G[q], active[q], top[q], 1);
-        GP[q] = &P[q];
     }
     walk_down(NG, GP, gs, active, top, d1, g1);
     /* Pops only take from the top, so far is at most the new top; lines
@@ -205,7 +207,7 @@ AVX512VL static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, 
         const int jq = j + 8 * q;
         /* the push itself */
         const __m256i at = times3(_mm256_add_epi32(G[q].first, m[q]));
-        _mm512_mask_i32scatter_pd((double *)H->pts, push[q], at, P[q].d, 8);
+        _mm512_mask_i32scatter_pd((double *)H->pts, push[q], at, GP[q]->d, 8);
         _mm512_mask_i32scatter_pd((double *)H->pts, push[q], _mm256_add_epi32(at, one), gs[q], 8);
         const __m256i kat = _mm256_add_epi32(_mm256_add_epi32(at, at), _mm256_set1_epi32(4));
         _mm512_mask_i32scatter_epi32((int *)H->pts, (__mmask16)push[q],
