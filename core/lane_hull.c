@@ -150,8 +150,9 @@ ALWAYS void query(int Q, const group *const *G, const __mmask8 *m, const __m256i
     }
     walk_down(Q, G, g, active, j, dj, gj);
     for (int q = 0; q < Q; q++) {
-        __m256i ki = _mm256_add_epi32(_mm256_slli_epi32(times3(_mm256_add_epi32(G[q]->first, j[q])), 1),
-                                      _mm256_set1_epi32(4));
+        /* the step k of point j: ints 6 (first + j) + 4 */
+        const __m256i j3 = times3(_mm256_add_epi32(G[q]->first, j[q]));
+        __m256i ki = _mm256_add_epi32(_mm256_slli_epi32(j3, 1), _mm256_set1_epi32(4));
         __m512i k = _mm512_mask_i32gather_epi32(_mm512_set1_epi32(-1), (__mmask16)ok[q],
                                                 _mm512_castsi256_si512(ki), G[q]->pk, 4);
         k_out[q] = _mm512_castsi512_si256(k);

@@ -63,10 +63,9 @@ TS_AVX512 static void sample_avx512(const float *zk, int vs, float F, int j0, in
         }
         /* the lines with a next cell */
         const __mmask16 next = lanes & first_lanes16(jn - j + 1);
-        const __m512 n =
-            vs == 1 ? _mm512_mask_loadu_ps(nan, next, zk + j + 1)
-                    : _mm512_mask_i32gather_ps(nan, next, _mm512_add_epi32(at, _mm512_set1_epi32(vs)),
-                                               zk, 4);
+        const __m512i at_n = _mm512_add_epi32(at, _mm512_set1_epi32(vs));
+        const __m512 n = vs == 1 ? _mm512_mask_loadu_ps(nan, next, zk + j + 1)
+                                 : _mm512_mask_i32gather_ps(nan, next, at_n, zk, 4);
         const __m512 h = _mm512_add_ps(c, _mm512_mul_ps(f, _mm512_sub_ps(n, c)));
         _mm512_mask_storeu_ps(hn + j, lanes, n);
         _mm512_mask_storeu_ps(hs + j, lanes, _mm512_mask_blend_ps(next, nan, h));

@@ -37,10 +37,11 @@ static inline __mmask16 first16(int n)
     return n >= 16 ? 0xFFFF : n <= 0 ? 0 : (__mmask16)((1u << n) - 1);
 }
 
-/* The peaks of one piece's queued cells (n of them: cells x[e], whose P,
- * beta, gamma are qP[x], qb[x], qg[x]), cm_fast_piece_slope's float operations: where the peak lies
- * inside the piece, best[x] = fs > best[x] ? fs : best[x]. Cells whose
- * peak is a zero get redo[x] = 1; returns whether there was one. */
+/* The peaks of one piece's queued cells (n of them: cells x = qx[e], whose
+ * P, beta, gamma are qP[x], qb[x], qg[x]) by cm_fast_piece_slope's float
+ * operations: where the peak lies inside the piece, best[x] = fs > best[x]
+ * ? fs : best[x] (the cells are distinct: a gather and a scatter). Cells
+ * whose peak is a zero get redo[x] = 1; returns whether there was one. */
 TS_AVX512 static int piece_peaks(const cm_fast_piece *q, float L, float c, const float *qP,
                                  const float *qb, const float *qg, const int *qx, int n,
                                  float *best, int *redo)

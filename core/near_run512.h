@@ -4,8 +4,8 @@
  * operations give the same bits; what differs is that a piece's inner peak
  * (two divisions and a square root per cell) is solved only for the cells
  * where it may lie inside the piece: a division-free test with a margin
- * picks them, they are queued (compressed) and solved sixteen at a time
- * after the piece's run. The peaks then join best[] after the ends of
+ * picks them, their indices are queued (compressed) and they are solved
+ * sixteen at a time after the piece's run. The peaks then join best[] after the ends of
  * their piece rather than in their place among the pieces, which gives
  * the same maximum; only a peak that is exactly zero could tie a zero of
  * the other sign differently, and its cell is folded again in the pieces'
