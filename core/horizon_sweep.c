@@ -561,7 +561,7 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
     const ts_grid *grid = C->grid;
     const ts_line_geom *G = C->geom;
     const int W = grid->width, H = grid->height, m = TS_NEAR_MARGIN;
-    float *scratch = malloc(4 * (size_t)W * sizeof *scratch); /* ts_near_edges' */
+    float *scratch = malloc(TS_NEAR_ROW_SCRATCH(W) * sizeof *scratch); /* and ts_near_edges' */
     for (long y = y0; y < y1; y++) {
         const float *zrow = grid->z + y * grid->stride;
         float *orow = C->out + y * W;

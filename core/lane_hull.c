@@ -22,36 +22,36 @@ typedef struct {
     const int *pk;
 } group;
 
-TS_AVX512 static inline __mmask8 mask_of(__m256i v)
-{
-    return (__mmask8)_mm256_movemask_ps(_mm256_castsi256_ps(v));
-}
+/* AVX-512 with its 256-bit forms (every AVX-512 CPU but the Xeon Phi has
+ * them; ts_lane_vector_level asks): mask compares and masked adds of the
+ * lines' indices, each one instruction on the walks' dependent chains. */
+#define AVX512VL __attribute__((target("avx512f,avx512vl")))
 
-TS_AVX512 static inline __m256i ones_where(__mmask8 m)
+/* 3 x: a shift and an add, where vpmulld takes 10 cycles (on the walks'
+ * chains: index, gather, compare, index). */
+AVX512VL static inline __m256i times3(__m256i x)
 {
-    return _mm512_castsi512_si256(_mm512_maskz_set1_epi32((__mmask16)m, 1));
+    return _mm256_add_epi32(_mm256_slli_epi32(x, 1), x);
 }
 
 /* Field f (0: d, 1: g) of point p of each line, where m. */
-TS_AVX512 static inline __m512d field(const group *G, __mmask8 m, __m256i p, int f)
+AVX512VL static inline __m512d field(const group *G, __mmask8 m, __m256i p, int f)
 {
-    __m256i i = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_add_epi32(G->first, p),
-                                                    _mm256_set1_epi32(3)),
-                                 _mm256_set1_epi32(f));
+    __m256i i = _mm256_add_epi32(times3(_mm256_add_epi32(G->first, p)), _mm256_set1_epi32(f));
     return _mm512_mask_i32gather_pd(_mm512_setzero_pd(), m, i, G->pd, 8);
 }
 
-TS_AVX512 static inline __m256 load8f(__mmask8 m, const float *p)
+AVX512VL static inline __m256 load8f(__mmask8 m, const float *p)
 {
     return _mm512_castps512_ps256(_mm512_maskz_loadu_ps((__mmask16)m, p));
 }
 
-TS_AVX512 static inline __m256i load8i(__mmask8 m, const int *p)
+AVX512VL static inline __m256i load8i(__mmask8 m, const int *p)
 {
     return _mm512_castsi512_si256(_mm512_maskz_loadu_epi32((__mmask16)m, p));
 }
 
-TS_AVX512 static inline void store8i(int *p, __mmask8 m, __m256i v)
+AVX512VL static inline void store8i(int *p, __mmask8 m, __m256i v)
 {
     _mm512_mask_storeu_epi32(p, (__mmask16)m, _mm512_castsi256_si512(v));
 }
@@ -60,7 +60,7 @@ TS_AVX512 static inline void store8i(int *p, __mmask8 m, __m256i v)
  * loop issues the gathers of Q independent vectors (lines, or the two
  * queries of the same lines), so that their latencies overlap; Q is a
  * constant where they are inlined. */
-#define ALWAYS TS_AVX512 static inline __attribute__((always_inline))
+#define ALWAYS AVX512VL static inline __attribute__((always_inline))
 /* vectors of eight lines a step takes at once (4: measured faster than 1,
  * 2 and 8), and at most twice as many walks (two queries per line) */
 #define NG 4
@@ -92,8 +92,8 @@ ALWAYS void walk_down(int Q, const group *const *G, const __m512d *g, __mmask8 *
             __mmask8 pop = _mm512_mask_cmp_pd_mask(active[q], lhs, rhs, _CMP_GE_OQ);
             dj[q] = _mm512_mask_mov_pd(dj[q], pop, dm);
             gj[q] = _mm512_mask_mov_pd(gj[q], pop, gm);
-            j[q] = _mm256_sub_epi32(j[q], ones_where(pop));
-            active[q] = pop & mask_of(_mm256_cmpgt_epi32(j[q], zero));
+            j[q] = _mm256_mask_sub_epi32(j[q], pop, j[q], one);
+            active[q] = _mm256_mask_cmpgt_epi32_mask(pop, j[q], zero);
         }
 }
 
@@ -105,40 +105,54 @@ ALWAYS void advance(int Q, const group *G, const __mmask8 *lanes, __m256i *far,
     const __m256i one = _mm256_set1_epi32(1);
     __mmask8 active[QMAX];
     for (int q = 0; q < Q; q++)
-        active[q] = lanes[q] & mask_of(_mm256_cmpgt_epi32(n[q], _mm256_add_epi32(far[q], one)));
+        active[q] = _mm256_mask_cmpgt_epi32_mask(lanes[q], n[q], _mm256_add_epi32(far[q], one));
     while (any_of(Q, active))
         for (int q = 0; q < Q; q++) {
             __m256i next = _mm256_add_epi32(far[q], one);
             __m512d dn = field(&G[q], active[q], next, 0);
             __mmask8 go = _mm512_mask_cmp_pd_mask(active[q], _mm512_sub_pd(G[q].d, dn),
                                                   near_skip, _CMP_GE_OQ);
-            far[q] = _mm256_add_epi32(far[q], ones_where(go));
-            active[q] = go & mask_of(_mm256_cmpgt_epi32(n[q], _mm256_add_epi32(far[q], one)));
+            far[q] = _mm256_mask_add_epi32(far[q], go, far[q], one);
+            active[q] = _mm256_mask_cmpgt_epi32_mask(go, n[q], _mm256_add_epi32(far[q], one));
         }
 }
 
 /* stack_query for Q vectors of lines (those of m[q], of group G[q]) at
  * hull heights g[q]: walk down from far while the slope grows; the
- * occluder's step (-1: none) and distance. */
+ * occluder's step (-1: none) and distance. Vectors 2p and 2p + 1 are the
+ * same lines (the same group and far): they share the gathers of far and
+ * of the point below it, which answer 99 % of the queries (walk_down's
+ * first pass, the same operations). */
 ALWAYS void query(int Q, const group *const *G, const __mmask8 *m, const __m256i *far,
                   const __m512d *g, __m256i *k_out, __m256 *dd_out)
 {
-    const __m256i zero = _mm256_setzero_si256();
+    const __m256i zero = _mm256_setzero_si256(), one = _mm256_set1_epi32(1);
     __mmask8 ok[QMAX], active[QMAX];
     __m256i j[QMAX];
     __m512d dj[QMAX], gj[QMAX];
-    for (int q = 0; q < Q; q++) {
-        ok[q] = m[q] & ~mask_of(_mm256_cmpgt_epi32(zero, far[q]));
-        j[q] = far[q];
-        dj[q] = field(G[q], ok[q], j[q], 0);
-        gj[q] = field(G[q], ok[q], j[q], 1);
-        active[q] = ok[q] & mask_of(_mm256_cmpgt_epi32(j[q], zero));
+    for (int q = 0; q < Q; q += 2) {
+        const __mmask8 both = _mm256_mask_cmpge_epi32_mask(m[q] | m[q + 1], far[q], zero);
+        const __mmask8 below = _mm256_mask_cmpgt_epi32_mask(both, far[q], zero);
+        const __m256i fm = _mm256_sub_epi32(far[q], one);
+        const __m512d df = field(G[q], both, far[q], 0), gf = field(G[q], both, far[q], 1);
+        const __m512d dm = field(G[q], below, fm, 0), gm = field(G[q], below, fm, 1);
+        const __m512d d = G[q]->d;
+        for (int r = q; r < q + 2; r++) {
+            ok[r] = _mm256_mask_cmpge_epi32_mask(m[r], far[r], zero);
+            const __m512d lhs = _mm512_mul_pd(_mm512_sub_pd(gm, g[r]), _mm512_sub_pd(d, df));
+            const __m512d rhs = _mm512_mul_pd(_mm512_sub_pd(gf, g[r]), _mm512_sub_pd(d, dm));
+            const __mmask8 pop = _mm512_mask_cmp_pd_mask(ok[r] & below, lhs, rhs, _CMP_GE_OQ);
+            dj[r] = _mm512_mask_mov_pd(df, pop, dm);
+            gj[r] = _mm512_mask_mov_pd(gf, pop, gm);
+            j[r] = _mm256_mask_sub_epi32(far[r], pop, far[r], one);
+            active[r] = _mm256_mask_cmpgt_epi32_mask(pop, j[r], zero);
+        }
     }
     walk_down(Q, G, g, active, j, dj, gj);
     for (int q = 0; q < Q; q++) {
-        __m256i ki = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_add_epi32(G[q]->first, j[q]),
-                                                         _mm256_set1_epi32(6)),
-                                      _mm256_set1_epi32(4));
+        /* the step k of point j: ints 6 (first + j) + 4 */
+        const __m256i j3 = times3(_mm256_add_epi32(G[q]->first, j[q]));
+        __m256i ki = _mm256_add_epi32(_mm256_slli_epi32(j3, 1), _mm256_set1_epi32(4));
         __m512i k = _mm512_mask_i32gather_epi32(_mm512_set1_epi32(-1), (__mmask16)ok[q],
                                                 _mm512_castsi256_si512(ki), G[q]->pk, 4);
         k_out[q] = _mm512_castsi512_si256(k);
@@ -148,7 +162,7 @@ ALWAYS void query(int Q, const group *const *G, const __mmask8 *m, const __m256i
 
 /* Groups of eight lines from j on, NG of them at once, those of lanes[q]
  * in group q (a group with none is left alone). */
-TS_AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, int j,
+AVX512VL static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, int j,
                                   const __mmask8 *lanes, const ts_lane_occluders *occ)
 {
     const __m512d c = _mm512_set1_pd(s->c), near_skip = _mm512_set1_pd(s->near_skip);
@@ -166,9 +180,12 @@ TS_AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s,
         G[q].pd = (const double *)H->pts;
         G[q].pk = (const int *)H->pts;
         cdd[q] = _mm512_mul_pd(_mm512_mul_pd(c, G[q].d), G[q].d);
-        /* hull_push: pop the points the sample hides */
-        P[q] = G[q];
+        /* hull_push: pop the points the sample hides (from its own
+         * distance where it pushes another point's) */
+        GP[q] = &G[q];
         if (s->push_d) {
+            P[q] = G[q];
+            GP[q] = &P[q];
             P[q].d = _mm512_maskz_loadu_pd(lanes[q], s->push_d + jq);
             push[q] = _mm512_mask_cmp_pd_mask(lanes[q], P[q].d, P[q].d, _CMP_ORD_Q);
             gs[q] = _mm512_maskz_loadu_pd(push[q], s->push_g + jq);
@@ -180,10 +197,9 @@ TS_AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s,
         m[q] = load8i(lanes[q], H->n + jq);
         /* the top point is m - 1; the walk leaves the new top */
         top[q] = _mm256_sub_epi32(m[q], one);
-        active[q] = push[q] & mask_of(_mm256_cmpgt_epi32(top[q], _mm256_setzero_si256()));
+        active[q] = _mm256_mask_cmpgt_epi32_mask(push[q], top[q], _mm256_setzero_si256());
         d1[q] = field(&G[q], active[q], top[q], 0);
         g1[q] = field(&G[q], active[q], top[q], 1);
-        GP[q] = &P[q];
     }
     walk_down(NG, GP, gs, active, top, d1, g1);
     /* Pops only take from the top, so far is at most the new top; lines
@@ -194,7 +210,7 @@ TS_AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s,
     }
     if (s->push_d) /* every point is beyond the near field, the new one too */
         for (int q = 0; q < NG; q++)
-            far[q] = _mm256_add_epi32(top[q], ones_where(push[q]));
+            far[q] = _mm256_mask_add_epi32(top[q], push[q], top[q], one);
     else
         advance(NG, G, lanes, far, m, near_skip);
     const group *QG[2 * NG];
@@ -205,22 +221,21 @@ TS_AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s,
     for (int q = 0; q < NG; q++) {
         const int jq = j + 8 * q;
         /* the push itself */
-        const __m256i at = _mm256_mullo_epi32(_mm256_add_epi32(G[q].first, m[q]),
-                                              _mm256_set1_epi32(3));
-        _mm512_mask_i32scatter_pd((double *)H->pts, push[q], at, P[q].d, 8);
+        const __m256i at = times3(_mm256_add_epi32(G[q].first, m[q]));
+        _mm512_mask_i32scatter_pd((double *)H->pts, push[q], at, GP[q]->d, 8);
         _mm512_mask_i32scatter_pd((double *)H->pts, push[q], _mm256_add_epi32(at, one), gs[q], 8);
         const __m256i kat = _mm256_add_epi32(_mm256_add_epi32(at, at), _mm256_set1_epi32(4));
         _mm512_mask_i32scatter_epi32((int *)H->pts, (__mmask16)push[q],
                                      _mm512_castsi256_si512(kat),
                                      _mm512_set1_epi32(s->push_d ? s->push_k : s->k), 4);
-        store8i(H->n + jq, lanes[q], _mm256_add_epi32(m[q], ones_where(push[q])));
+        store8i(H->n + jq, lanes[q], _mm256_mask_add_epi32(m[q], push[q], m[q], one));
         store8i(H->far + jq, lanes[q], far[q]);
         /* the occluders of the cells below (hi, when asked) and above (lo) */
         const __m512d hc = _mm512_cvtps_pd(load8f(lanes[q], s->hc + jq));
         const __m512d hn = _mm512_cvtps_pd(load8f(lanes[q], s->hn + jq));
-        const __mmask8 want_hi =
-            lanes[q] & ~mask_of(_mm256_cmpgt_epi32(_mm256_set1_epi32(s->hi_from), idx[q])) &
-            ~mask_of(_mm256_cmpgt_epi32(idx[q], _mm256_set1_epi32(s->hi_to)));
+        const __mmask8 want_hi = _mm256_mask_cmple_epi32_mask(
+            _mm256_mask_cmpge_epi32_mask(lanes[q], idx[q], _mm256_set1_epi32(s->hi_from)), idx[q],
+            _mm256_set1_epi32(s->hi_to));
         QG[2 * q] = QG[2 * q + 1] = &G[q];
         qfar[2 * q] = qfar[2 * q + 1] = far[q];
         qm[2 * q] = _mm512_mask_cmp_pd_mask(want_hi, hc, hc, _CMP_ORD_Q);
@@ -246,7 +261,9 @@ int ts_lane_vector_level(void)
     int level = __atomic_load_n(&known, __ATOMIC_RELAXED);
     if (level < 0) {
         __builtin_cpu_init();
-        level = __builtin_cpu_supports("avx512f") ? 2 : __builtin_cpu_supports("avx2") ? 1 : 0;
+        level = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") ? 2
+                : __builtin_cpu_supports("avx2")                                        ? 1
+                                                                                        : 0;
         __atomic_store_n(&known, level, __ATOMIC_RELAXED);
     }
     return level;

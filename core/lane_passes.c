@@ -40,9 +40,10 @@ static inline __mmask16 first_lanes16(int n)
 }
 
 /* sample_run with the lines' cells vs apart, sixteen lines at a time with
- * gathers (gcc's clones load the cells one by one); the same float
- * operations. Offsets j vs in 32 bits. */
-TS_AVX512 static void sample_strided_avx512(const float *zk, int vs, float F, int j0, int j1,
+ * gathers (gcc's clones load the cells one by one), or plain loads where
+ * vs = 1 (gcc's copy of the row's cells is a call to memmove); the same
+ * float operations. Offsets j vs in 32 bits. */
+TS_AVX512 static void sample_avx512(const float *zk, int vs, float F, int j0, int j1,
                                             int jn, float *hc, float *hn, float *hs)
 {
     const __m512i step = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
@@ -51,7 +52,9 @@ TS_AVX512 static void sample_strided_avx512(const float *zk, int vs, float F, in
         const __mmask16 lanes = first_lanes16(j1 - j + 1);
         const __m512i at = _mm512_mullo_epi32(_mm512_add_epi32(_mm512_set1_epi32(j), step),
                                               _mm512_set1_epi32(vs));
-        const __m512 c = _mm512_mask_i32gather_ps(nan, lanes, at, zk, 4);
+        /* along rows (vs = 1) the cells are contiguous: plain loads */
+        const __m512 c = vs == 1 ? _mm512_mask_loadu_ps(nan, lanes, zk + j)
+                                 : _mm512_mask_i32gather_ps(nan, lanes, at, zk, 4);
         _mm512_mask_storeu_ps(hc + j, lanes, c);
         if (F == 0.0f) {
             _mm512_mask_storeu_ps(hn + j, lanes, nan);
@@ -60,8 +63,9 @@ TS_AVX512 static void sample_strided_avx512(const float *zk, int vs, float F, in
         }
         /* the lines with a next cell */
         const __mmask16 next = lanes & first_lanes16(jn - j + 1);
-        const __m512 n = _mm512_mask_i32gather_ps(nan, next, _mm512_add_epi32(at, _mm512_set1_epi32(vs)),
-                                                  zk, 4);
+        const __m512i at_n = _mm512_add_epi32(at, _mm512_set1_epi32(vs));
+        const __m512 n = vs == 1 ? _mm512_mask_loadu_ps(nan, next, zk + j + 1)
+                                 : _mm512_mask_i32gather_ps(nan, next, at_n, zk, 4);
         const __m512 h = _mm512_add_ps(c, _mm512_mul_ps(f, _mm512_sub_ps(n, c)));
         _mm512_mask_storeu_ps(hn + j, lanes, n);
         _mm512_mask_storeu_ps(hs + j, lanes, _mm512_mask_blend_ps(next, nan, h));
@@ -91,8 +95,8 @@ void ts_lane_sample(const ts_line_geom *G, const float *z, int k, int i0, int j0
     /* Every line has a next cell but one on the grid's last row. */
     int jn = G->V - 2 - i0 < j1 ? G->V - 2 - i0 : j1;
 #if HAVE_SAMPLE_AVX512
-    if (vs != 1 && vs <= INT_MAX / (j1 + 2) && ts_lane_vector_level() == 2) {
-        sample_strided_avx512(zk, (int)vs, F, j0, j1, jn, hc, hn, hs);
+    if (vs <= INT_MAX / (j1 + 2) && ts_lane_vector_level() == 2) {
+        sample_avx512(zk, (int)vs, F, j0, j1, jn, hc, hn, hs);
         return;
     }
 #endif

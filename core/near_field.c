@@ -5,6 +5,7 @@
 #include <stdlib.h>
 
 #include "near_field.h"
+#include "near_run512.h"
 #include "simd_clones.h"
 
 static int cmp_double(const void *a, const void *b)
@@ -126,7 +127,8 @@ void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
                  float *out, float *scratch)
 {
     float *best = scratch, *flag = scratch + x1;
-    near_run(p, zrow, x0, x1, (float)step, (float)c, best, flag);
+    if (!ts_near_run_avx512(p, zrow, x0, x1, (float)step, (float)c, best, flag, scratch + 2 * x1))
+        near_run(p, zrow, x0, x1, (float)step, (float)c, best, flag);
     if (!near_merge(zrow, best, flag, x0, x1, out))
         return;
     /* cells whose near field touches nodata: the scalar near field */

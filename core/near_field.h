@@ -51,7 +51,9 @@ float ts_ray_exact(const ts_line_geom *g, const float *z, int k, int i, float h,
  * the same metres per step. zrow points at the row's first height;
  * out[x] receives max(out[x], near field) (the far field is already there).
  * Cells whose near field touches nodata are redone by ts_near_field.
+ * scratch: TS_NEAR_ROW_SCRATCH(x1) floats.
  */
+#define TS_NEAR_ROW_SCRATCH(x1) (7 * (size_t)(x1) + 80)
 void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
                  const float *zrow, int y, int x0, int x1, double step, double c,
                  float *out, float *scratch);
@@ -62,7 +64,8 @@ void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
  * the ray leaves the grid inside it, else max(out[x], near field). Cells
  * whose near field lies on the grid and touches no nodata take the
  * vectorised form of ts_near_field's double arithmetic, the others
- * ts_near_field itself; the same bits either way. scratch: 4 W floats.
+ * ts_near_field itself; the same bits either way. scratch: 4 W floats
+ * (TS_NEAR_ROW_SCRATCH(W) is more).
  */
 void ts_near_edges(const ts_near_plan *p, const ts_line_geom *g, const float *z,
                    const float *zrow, int y, int xa, int xb, int W, double step, double c,
