@@ -12,7 +12,9 @@
 #include "capped_lanes.h"
 
 /* Groups of eight lines that one scan takes together. */
+#ifndef TS_CAP_NG
 #define TS_CAP_NG 3
+#endif
 
 /* The window scan of lines [g, g + 8 * TS_CAP_NG), those below g1, at
  * step k: answers into r->kc, ddc, kn, ddn; only the groups of slots that
