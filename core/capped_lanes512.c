@@ -108,8 +108,8 @@ scan512_lags(const ts_cap_lanes *r, int k, int g, int ng, int lag_from, int lag_
 
 /* For the eight lines from j: the prune threshold T (-inf: none known;
  * +inf: no query), the lower of the two query heights (+inf: no query) and
- * the lines without a query. T is the steepest (for the query of lower
- * slope) of four samples of the window, each taken only where the scan's
+ * the lines without a query. T is the steepest (for the higher query
+ * point) of four samples of the window, each taken only where the scan's
  * own tests put it in the window: the line's previous answers of both
  * queries, and its newest and oldest slot. */
 TS_AVX512 static inline __attribute__((always_inline)) void
@@ -144,36 +144,37 @@ prune_threshold(const ts_cap_lanes *r, int k, int lag_hi, int j, const scan512 *
         cg[i] = _mm512_load_pd(r->g + at);
         cok[i] = 0xFF;
     }
-    const __m512d gq[2] = {a->gc[q], a->gn[q]};
-    __m512d t[2], gs[2];
-    __mmask8 has[2];
-    for (int i = 0; i < 2; i++) {
-        __m512d bn = _mm512_set1_pd(-INFINITY), bd = _mm512_set1_pd(1.0);
-        for (int c = 0; c < 4; c++) {
-            const __m512d dd = _mm512_sub_pd(a->d[q], cd[c]), n = _mm512_sub_pd(cg[c], gq[i]);
-            __mmask8 ok = _mm512_mask_cmp_pd_mask(cok[c], dd, near, _CMP_GE_OQ);
-            ok = _mm512_mask_cmp_pd_mask(ok, dd, cap, _CMP_LE_OQ);
-            ok = _mm512_mask_cmp_pd_mask(ok, _mm512_mul_pd(n, bd), _mm512_mul_pd(bn, dd),
-                                         _CMP_GT_OQ);
-            bn = _mm512_mask_mov_pd(bn, ok, n);
-            bd = _mm512_mask_mov_pd(bd, ok, dd);
-        }
-        /* s = bn / bd (-inf where none) without a division: 1 / bd to 14
-         * bits, then two Newton steps (to within ~2^-52 of 1 / bd: s lies
-         * within 1e-15 of bn / bd, far inside the margin below) */
-        __m512d y = _mm512_rcp14_pd(bd);
-        y = _mm512_mul_pd(y, _mm512_fnmadd_pd(bd, y, _mm512_set1_pd(2.0)));
-        y = _mm512_mul_pd(y, _mm512_fnmadd_pd(bd, y, _mm512_set1_pd(2.0)));
-        const __m512d s = _mm512_mul_pd(bn, y);
-        /* s - margin |s| */
-        t[i] = _mm512_fnmadd_pd(_mm512_abs_pd(s), _mm512_set1_pd(PRUNE_MARGIN), s);
-        has[i] = _mm512_cmp_pd_mask(gq[i], gq[i], _CMP_ORD_Q);
-        t[i] = _mm512_mask_mov_pd(_mm512_set1_pd(INFINITY), has[i], t[i]);
-        gs[i] = _mm512_mask_mov_pd(_mm512_set1_pd(INFINITY), has[i], gq[i]);
+    /* The threshold of the higher query point only: from it every
+     * sample's slope is at most its slope from the lower one, so the
+     * steepest candidate's is the lower of the two queries' (up to the
+     * compares' rounding: T is the slope of a window sample either way). */
+    const __mmask8 hc = _mm512_cmp_pd_mask(a->gc[q], a->gc[q], _CMP_ORD_Q);
+    const __mmask8 hn = _mm512_cmp_pd_mask(a->gn[q], a->gn[q], _CMP_ORD_Q);
+    const __m512d inf = _mm512_set1_pd(INFINITY);
+    const __m512d gc = _mm512_mask_mov_pd(_mm512_set1_pd(-INFINITY), hc, a->gc[q]);
+    const __m512d gn = _mm512_mask_mov_pd(_mm512_set1_pd(-INFINITY), hn, a->gn[q]);
+    const __m512d ghi = _mm512_max_pd(gc, gn);
+    __m512d bn = _mm512_set1_pd(-INFINITY), bd = _mm512_set1_pd(1.0);
+    for (int c = 0; c < 4; c++) {
+        const __m512d dd = _mm512_sub_pd(a->d[q], cd[c]), n = _mm512_sub_pd(cg[c], ghi);
+        __mmask8 ok = _mm512_mask_cmp_pd_mask(cok[c], dd, near, _CMP_GE_OQ);
+        ok = _mm512_mask_cmp_pd_mask(ok, dd, cap, _CMP_LE_OQ);
+        ok = _mm512_mask_cmp_pd_mask(ok, _mm512_mul_pd(n, bd), _mm512_mul_pd(bn, dd), _CMP_GT_OQ);
+        bn = _mm512_mask_mov_pd(bn, ok, n);
+        bd = _mm512_mask_mov_pd(bd, ok, dd);
     }
-    *thr = _mm512_min_pd(t[0], t[1]);
-    *gmin = _mm512_min_pd(gs[0], gs[1]);
-    *idle = (__mmask8)~(has[0] | has[1]);
+    /* s = bn / bd (-inf where none) without a division: 1 / bd to 14
+     * bits, then two Newton steps (to within ~2^-52 of 1 / bd: s lies
+     * within 1e-15 of bn / bd, far inside the margin below) */
+    __m512d y = _mm512_rcp14_pd(bd);
+    y = _mm512_mul_pd(y, _mm512_fnmadd_pd(bd, y, _mm512_set1_pd(2.0)));
+    y = _mm512_mul_pd(y, _mm512_fnmadd_pd(bd, y, _mm512_set1_pd(2.0)));
+    const __m512d s = _mm512_mul_pd(bn, y);
+    /* s - margin |s|; +inf, and a lower height of +inf, without a query */
+    const __mmask8 has = hc | hn;
+    *thr = _mm512_mask_mov_pd(inf, has, _mm512_fnmadd_pd(_mm512_abs_pd(s), _mm512_set1_pd(PRUNE_MARGIN), s));
+    *gmin = _mm512_min_pd(_mm512_mask_mov_pd(inf, hc, a->gc[q]), _mm512_mask_mov_pd(inf, hn, a->gn[q]));
+    *idle = (__mmask8)~has;
 }
 
 /* The ng groups of lines from g (bit q: group q) for which group idx of
