@@ -275,8 +275,6 @@ void ts_cap_lanes_step(ts_cap_lanes *r, const ts_lane_step *s, int nl,
             ts_cap_queries512(r, s, g0, g1);
             scan_groups(r, k, g0, g1);
             ts_cap_answers512(r, s, g0, g1, occ, rd, rg);
-            if (r->prune)
-                ts_cap_groups_add512(r, k, rd, rg);
             return;
         }
 #endif

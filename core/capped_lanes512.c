@@ -424,26 +424,19 @@ TS_AVX512 void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1)
     }
 }
 
-/* Step k's samples (ring slots rd, rg; d NaN: none) into their groups; a
- * group's first step empties it first. */
-TS_AVX512 void ts_cap_groups_add512(ts_cap_lanes *r, int k, const double *rd, const double *rg)
+/* Step k's samples (d, g; lanes has) of lines j.. j + 7 into their groups
+ * of both levels (entries at[l]). */
+TS_AVX512 static inline __attribute__((always_inline)) void
+groups_add(ts_cap_lanes *r, const size_t at[2], int j, __m512d d, __m512d g, __mmask8 has)
 {
     for (int l = 0; l < 2; l++) {
-        const int size = l ? TS_CAP_G1 : TS_CAP_G0;
-        const size_t at = (size_t)(k / size % r->groups[l]) * r->stride;
-        double *gm = r->gmax[l] + at, *lo = r->dlo[l] + at, *hi = r->dhi[l] + at;
-        if (k % size == 0)
-            ts_cap_groups_empty(gm, lo, hi, (size_t)r->stride);
-        for (int j = 0; j < r->stride; j += 8) {
-            const __m512d d = _mm512_load_pd(rd + j), g = _mm512_load_pd(rg + j);
-            const __m512d m = _mm512_load_pd(gm + j);
-            const __mmask8 has = _mm512_cmp_pd_mask(d, d, _CMP_ORD_Q);
-            /* lines' distances grow: a group's first sample is its oldest */
-            const __mmask8 first = _mm512_mask_cmp_pd_mask(has, m, _mm512_set1_pd(-INFINITY), _CMP_EQ_OQ);
-            _mm512_store_pd(lo + j, _mm512_mask_mov_pd(_mm512_load_pd(lo + j), first, d));
-            _mm512_store_pd(hi + j, _mm512_mask_mov_pd(_mm512_load_pd(hi + j), has, d));
-            _mm512_store_pd(gm + j, _mm512_mask_max_pd(m, has, m, g));
-        }
+        double *gm = r->gmax[l] + at[l] + j, *lo = r->dlo[l] + at[l] + j, *hi = r->dhi[l] + at[l] + j;
+        const __m512d m = _mm512_load_pd(gm);
+        /* lines' distances grow: a group's first sample is its oldest */
+        const __mmask8 first = _mm512_mask_cmp_pd_mask(has, m, _mm512_set1_pd(-INFINITY), _CMP_EQ_OQ);
+        _mm512_store_pd(lo, _mm512_mask_mov_pd(_mm512_load_pd(lo), first, d));
+        _mm512_store_pd(hi, _mm512_mask_mov_pd(_mm512_load_pd(hi), has, d));
+        _mm512_store_pd(gm, _mm512_mask_max_pd(m, has, m, g));
     }
 }
 
@@ -473,6 +466,16 @@ TS_AVX512 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0,
                                  const ts_lane_occluders *occ, double *rd, double *rg)
 {
     const __m512d c = _mm512_set1_pd(s->c), nan = _mm512_set1_pd(NAN);
+    /* the pruned scan's groups of the step's samples, each emptied at its
+     * first step */
+    size_t at[2];
+    for (int l = 0; l < 2 && r->prune; l++) {
+        const int size = l ? TS_CAP_G1 : TS_CAP_G0;
+        at[l] = (size_t)(s->k / size % r->groups[l]) * r->stride;
+        if (s->k % size == 0)
+            ts_cap_groups_empty(r->gmax[l] + at[l], r->dlo[l] + at[l], r->dhi[l] + at[l],
+                                (size_t)r->stride);
+    }
     for (int j = g0; j < g1; j += 8) {
         const __m512i idx = _mm512_add_epi64(_mm512_set1_epi64(j), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
         __mmask8 on = _mm512_cmpge_epi64_mask(idx, _mm512_set1_epi64(s->j0));
@@ -485,8 +488,11 @@ TS_AVX512 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0,
         const __m512d d = _mm512_maskz_loadu_pd(on, s->d + j);
         const __m512d hs = _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_maskz_loadu_ps(on, s->hs + j)));
         const __mmask8 has = _mm512_cmp_pd_mask(hs, hs, _CMP_ORD_Q);
+        const __m512d g = _mm512_sub_pd(hs, _mm512_mul_pd(_mm512_mul_pd(c, d), d));
         _mm512_mask_store_pd(rd + j, on, _mm512_mask_mov_pd(nan, has, d));
-        _mm512_mask_store_pd(rg + j, on, _mm512_sub_pd(hs, _mm512_mul_pd(_mm512_mul_pd(c, d), d)));
+        _mm512_mask_store_pd(rg + j, on, g);
+        if (r->prune)
+            groups_add(r, at, j, d, g, has & on);
     }
 }
 
