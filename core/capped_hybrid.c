@@ -4,7 +4,7 @@
  * capped_lanes.h (ts_cap_lanes_hybrid_step).
  *
  * Each line's hull takes its samples once they leave the near field (from
- * the ring, push_lag steps late: every sample that
+ * the ring, lag_lo steps late: on lines of equal steps every sample that
  * many steps back is beyond the near field), so it holds every sample
  * beyond the near field, and its query finds the steepest of them. Where
  * that one lies in the window (as the ring tests it: lag <= lag_hi,
@@ -29,9 +29,8 @@ int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_l
         r->hull_lost = 1;
         return 0;
     }
-    /* the samples that surely left the near field: those push_lag steps
-     * back (lag_lo on lines of equal steps) */
-    const int kp = k - r->push_lag;
+    /* the samples that leave the near field: those lag_lo steps back */
+    const int kp = k - r->lag_lo;
     const size_t at = (size_t)((kp % r->slots + r->slots) % r->slots) * r->stride;
     ts_lane_step hs = *s;
     hs.push_d = r->d + at;

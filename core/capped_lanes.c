@@ -39,10 +39,6 @@ static void *zalloc(size_t n)
 #ifndef PRUNE_FROM
 #define PRUNE_FROM 64
 #endif
-/* The lags the hybrid's hulls may lack at the window's near end. */
-#ifndef HYBRID_NEWER
-#define HYBRID_NEWER 16
-#endif
 
 int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, const int lags[4], double near, double cap)
 {
@@ -52,7 +48,6 @@ int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, const int lags[4], double nea
     r->lag_hi = lags[1];
     r->sure_lo = lags[2];
     r->sure_hi = lags[3];
-    r->push_lag = r->sure_lo > r->lag_lo ? r->sure_lo : r->lag_lo;
     /* a multiple of TS_CAP_G0, so that a level-0 group's slots lie together;
      * more than lag_hi, so that a group is reset only once out of the window */
     r->groups[0] = (r->lag_hi + TS_CAP_G0 - 1) / TS_CAP_G0 + 1;
@@ -226,11 +221,10 @@ int ts_cap_lanes_hybrid_pays(const int lags[4])
     /* measured (docs/performance.md, "Bounded sweep: unbounded hull first"):
      * 0.80-0.89x the line-by-line window's CPU time at 300-2000 lags. The
      * ring's pruned scan holds for windows of up to 10^5 lags; the hulls
-     * take the samples that are surely beyond the near field, lags[2]
-     * steps back, and the few lags from lags[0] follow their answers
-     * (lines of unequal steps: at most HYBRID_NEWER of them) */
+     * take the samples lags[0] steps back, which must be surely beyond the
+     * near field (lines of equal steps). */
     return ts_lane_vector_level() == 2 && lags[1] - lags[0] + 1 >= PRUNE_FROM &&
-           lags[1] <= 100000 && lags[2] - lags[0] <= HYBRID_NEWER;
+           lags[1] <= 100000 && lags[2] <= lags[0];
 }
 
 static void scan_groups(const ts_cap_lanes *r, int k, int g0, int g1)

@@ -45,10 +45,6 @@ typedef struct {
     /* ts_cap_lanes_hybrid_step's hulls miss samples (a step without lines
      * pushed none): the block's other steps take the scan alone */
     int hull_lost;
-    /* the hybrid's hulls take the samples this many steps back (surely
-     * beyond the near field); the lags from lag_lo to it follow the hull's
-     * answer as the scan would */
-    int push_lag;
 } ts_cap_lanes;
 
 /* Level 0 and level 1 groups of the pruned scan, in steps. */

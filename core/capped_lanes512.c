@@ -496,35 +496,6 @@ TS_AVX512 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0,
     }
 }
 
-/* The window's samples of lags push_lag - 1 .. lag_lo (newer than the
- * hull's), oldest first, after the hull's answer (step kk, distance d - dd,
- * height gp) of the lanes ok, for the query (d, gq) of lines j..j + 7: the
- * scan's operations, so that the answer is the whole window's scan's. */
-TS_AVX512 static inline __attribute__((always_inline)) void
-newer_lags(const ts_cap_lanes *r, int k, int j, __m512d d, __m512d gq, __m512d gp, __mmask8 ok,
-           __m512i *kk, __m512d *dd)
-{
-    const __m512d near = _mm512_set1_pd(r->near), cap = _mm512_set1_pd(r->cap);
-    __m512d bn = _mm512_sub_pd(gp, gq), bd = *dd;
-    __m512i bk = *kk;
-    for (int lag = r->push_lag - 1; lag >= r->lag_lo; lag--) {
-        if (lag > k)
-            continue; /* no samples before step 0 */
-        const size_t at = (size_t)((k - lag) % r->slots) * r->stride + j;
-        const __m512d ds = _mm512_sub_pd(d, _mm512_load_pd(r->d + at));
-        __mmask8 in = _mm512_mask_cmp_pd_mask(ok, ds, near, _CMP_GE_OQ);
-        in = _mm512_mask_cmp_pd_mask(in, ds, cap, _CMP_LE_OQ);
-        const __m512d n = _mm512_sub_pd(_mm512_load_pd(r->g + at), gq);
-        const __mmask8 w = _mm512_mask_cmp_pd_mask(in, _mm512_mul_pd(n, bd), _mm512_mul_pd(bn, ds),
-                                                   _CMP_GT_OQ);
-        bn = _mm512_mask_mov_pd(bn, w, n);
-        bd = _mm512_mask_mov_pd(bd, w, ds);
-        bk = _mm512_mask_mov_epi64(bk, w, _mm512_set1_epi64(k - lag));
-    }
-    *kk = bk;
-    *dd = bd;
-}
-
 /* The hull's answers (occ, from ts_lane_hull_step) to the queries of lines
  * [g0, g1) into r->kc, ddc, kn, ddn, where they lie in the window as the
  * scan tests it (lag <= lag_hi, d - d_p <= cap); lines without a query get
@@ -546,7 +517,7 @@ TS_AVX512 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
             double *ddo = q ? r->ddn : r->ddc;
             const __m512d gq = _mm512_load_pd((q ? r->qn : r->qc) + j);
             const __mmask8 has = _mm512_cmp_pd_mask(gq, gq, _CMP_ORD_Q);
-            __m512i kk = _mm512_cvtepi32_epi64(
+            const __m512i kk = _mm512_cvtepi32_epi64(
                 _mm512_castsi512_si256(_mm512_maskz_loadu_epi32((__mmask16)has, kq)));
             const __m512i lag = _mm512_sub_epi64(_mm512_set1_epi64(k), kk);
             __mmask8 ok = _mm512_mask_cmpge_epi64_mask(has, kk, zero);
@@ -557,10 +528,8 @@ TS_AVX512 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
                                          _mm512_set1_epi64(r->slots));
             const __m256i at = _mm256_add_epi32(
                 _mm256_mullo_epi32(_mm512_cvtepi64_epi32(slot), _mm256_set1_epi32(r->stride)), lane);
-            __m512d dd = _mm512_sub_pd(d, _mm512_mask_i32gather_pd(_mm512_set1_pd(NAN), ok, at, r->d, 8));
+            const __m512d dd = _mm512_sub_pd(d, _mm512_mask_i32gather_pd(_mm512_set1_pd(NAN), ok, at, r->d, 8));
             ok = _mm512_mask_cmp_pd_mask(ok, dd, cap, _CMP_LE_OQ);
-            if (r->push_lag > r->lag_lo)
-                newer_lags(r, k, j, d, gq, _mm512_mask_i32gather_pd(gq, ok, at, r->g, 8), ok, &kk, &dd);
             const __m512i kb = _mm512_mask_mov_epi64(none, has, _mm512_load_epi64(ko + j));
             const __m512d db = _mm512_mask_mov_pd(_mm512_set1_pd(1.0), has, _mm512_load_pd(ddo + j));
             _mm512_store_epi64(ko + j, _mm512_mask_mov_epi64(kb, ok, kk));
