@@ -2,7 +2,7 @@
  * ts_bench: throughput and memory of the core algorithms.
  *
  *   ts_bench [--size N] [--threads T] [--cell M] [--relief Z] [--dirs 16,64]
- *            [--max-distance 0,100] [--repeat R]
+ *            [--max-distance 0,100] [--repeat R] [--latitude L]
  *
  * Generates an N x N fractal DEM (fBm value noise, Hurst 0.8, Z metres of
  * relief, default 1500, M metre cells), then times the horizon sweep for
@@ -10,6 +10,9 @@
  * million pixel-directions per second, and the time relative to the
  * unbounded sweep, in wall and in CPU time) and the shadow height map for
  * 8 sun azimuths (million pixels per second), and reports peak memory.
+ * With --latitude, the DEM is geographic: rows M metres apart, centred on
+ * latitude L (degrees), each M cos(latitude) metres wide east-west, as a
+ * lat/lon GeoTIFF of square angular cells gives the core.
  */
 #include <math.h>
 #include <stdio.h>
@@ -73,7 +76,7 @@ static void die(const char *what, const ts_error *e)
 int main(int argc, char **argv)
 {
     int size = 4096, threads = 0, repeat = 3;
-    double cell = 10.0, relief = 1500.0;
+    double cell = 10.0, relief = 1500.0, latitude = NAN;
     char dirs_arg[256] = "16,64", dist_arg[256] = "0";
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--size") && i + 1 < argc)
@@ -88,16 +91,19 @@ int main(int argc, char **argv)
             relief = atof(argv[++i]);
         else if (!strcmp(argv[i], "--dirs") && i + 1 < argc)
             snprintf(dirs_arg, sizeof dirs_arg, "%s", argv[++i]);
+        else if (!strcmp(argv[i], "--latitude") && i + 1 < argc)
+            latitude = atof(argv[++i]);
         else if (!strcmp(argv[i], "--max-distance") && i + 1 < argc)
             snprintf(dist_arg, sizeof dist_arg, "%s", argv[++i]);
         else {
             fprintf(stderr, "usage: %s [--size N] [--threads T] [--cell M] [--relief Z] "
-                    "[--dirs 16,64] [--max-distance 0,100] [--repeat R]\n", argv[0]);
+                    "[--dirs 16,64] [--max-distance 0,100] [--repeat R] [--latitude L]\n", argv[0]);
             return 2;
         }
     }
-    if (size < 2 || repeat < 1 || !(cell > 0) || !(relief > 0)) {
-        fprintf(stderr, "ts_bench: --size must be >= 2, --repeat >= 1, --cell and --relief > 0\n");
+    if (size < 2 || repeat < 1 || !(cell > 0) || !(relief > 0) || fabs(latitude) > 80) {
+        fprintf(stderr, "ts_bench: --size must be >= 2, --repeat >= 1, --cell and --relief > 0, "
+                        "--latitude within 80 degrees\n");
         return 2;
     }
     double dists[16];
@@ -131,6 +137,22 @@ int main(int argc, char **argv)
     tdem_fbm(&g, 1234, 0.8, relief);
     printf("DEM: %d x %d fractal (fBm value noise, Hurst 0.8, %g m relief), %g m cells, "
            "generated in %.2f s\n", size, size, relief, cell, now() - t0);
+    if (latitude == latitude) {
+        double *cx = malloc((size_t)size * sizeof *cx);
+        const double deg = cell / 111320.0; /* a row's span in latitude */
+        for (int y = 0; y < size; y++) /* (row 0: the northern edge) */
+            cx[y] = cell * cos((latitude + (size / 2 - y) * deg) * M_PI / 180.0);
+        if (!cx) {
+            fprintf(stderr, "ts_bench: out of memory\n");
+            return 1;
+        }
+        if (ts_grid_set_row_spacing(&g, cx, &e))
+            die("row spacing", &e);
+        free(cx);
+        printf("geographic: rows centred on latitude %g, east-west cells %.4f-%.4f m\n", latitude,
+               cell * cos((fabs(latitude) + size / 2 * deg) * M_PI / 180.0),
+               cell * cos((fabs(latitude) - size / 2 * deg) * M_PI / 180.0));
+    }
     double cells = (double)size * size;
     double dem_mib = cells * 4 / 1048576.0;
     double base_mib = peak_mib();

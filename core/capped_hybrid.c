@@ -64,8 +64,6 @@ int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_l
         g = e;
     }
     ts_cap_answers512(r, s, g0, g1, occ, rd, rg);
-    if (r->prune)
-        ts_cap_groups_add512(r, k, rd, rg);
     return 1;
 }
 

@@ -58,7 +58,8 @@ int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, const int lags[4], double nea
     /* (the prune's margin holds for windows of up to 10^5 samples) */
     r->prune = ts_lane_vector_level() == 2 && r->lag_hi - r->lag_lo + 1 >= PRUNE_FROM &&
                r->lag_hi <= 100000;
-    const size_t ring = (size_t)r->slots * r->stride * sizeof(double);
+    /* (and a spare slot, never written: the pruned scan's padding) */
+    const size_t ring = (size_t)(r->slots + 1) * r->stride * sizeof(double);
     const size_t line = (size_t)r->stride * sizeof(double);
     r->d = zalloc(ring);
     r->g = zalloc(ring);
@@ -101,7 +102,7 @@ void ts_cap_lanes_free(ts_cap_lanes *r)
 
 void ts_cap_lanes_clear(ts_cap_lanes *r)
 {
-    const size_t n = (size_t)r->slots * r->stride;
+    const size_t n = (size_t)(r->slots + 1) * r->stride;
     for (size_t i = 0; i < n; i++)
         r->d[i] = NAN;
     for (int j = 0; j < r->stride; j++)
@@ -274,8 +275,6 @@ void ts_cap_lanes_step(ts_cap_lanes *r, const ts_lane_step *s, int nl,
             ts_cap_queries512(r, s, g0, g1);
             scan_groups(r, k, g0, g1);
             ts_cap_answers512(r, s, g0, g1, occ, rd, rg);
-            if (r->prune)
-                ts_cap_groups_add512(r, k, rd, rg);
             return;
         }
 #endif

@@ -14,8 +14,8 @@
  * Among equally steep samples the oldest (smallest step) wins, whatever
  * the block's first step, so a line's answers do not depend on where a
  * block or a tile begins. Long windows (with AVX-512) skip the groups of
- * slots whose bounds show they cannot change the answer
- * (capped_lanes512.c), with the same bits.
+ * slots, and then the samples, whose bounds show they cannot change the
+ * answer (capped_lanes512.c), with the same bits.
  */
 #ifndef TS_CAPPED_LANES_H
 #define TS_CAPPED_LANES_H

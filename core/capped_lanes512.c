@@ -20,35 +20,43 @@ typedef struct {
     __m512i bkc[NG], bkn[NG];
 } scan512;
 
+/* One slot of the window for group q of eight lines (its distances pd,
+ * heights pg, already at the group's lines; step ks): the operations of
+ * scan_scalar; the distance test only where `test`. */
+TS_AVX512 static inline __attribute__((always_inline)) void
+scan512_one(const ts_cap_lanes *r, int q, const double *pd, const double *pg, __m512i ks,
+            int test, scan512 *a)
+{
+    const __m512d dd = _mm512_sub_pd(a->d[q], _mm512_load_pd(pd));
+    __mmask8 in = 0xFF;
+    if (test) {
+        in = _mm512_cmp_pd_mask(dd, _mm512_set1_pd(r->near), _CMP_GE_OQ);
+        in = _mm512_mask_cmp_pd_mask(in, dd, _mm512_set1_pd(r->cap), _CMP_LE_OQ);
+    }
+    const __m512d sg = _mm512_load_pd(pg);
+    const __m512d nc = _mm512_sub_pd(sg, a->gc[q]), nn = _mm512_sub_pd(sg, a->gn[q]);
+    const __mmask8 wc = _mm512_mask_cmp_pd_mask(in, _mm512_mul_pd(nc, a->bdc[q]),
+                                                _mm512_mul_pd(a->bnc[q], dd), _CMP_GT_OQ);
+    const __mmask8 wn = _mm512_mask_cmp_pd_mask(in, _mm512_mul_pd(nn, a->bdn[q]),
+                                                _mm512_mul_pd(a->bnn[q], dd), _CMP_GT_OQ);
+    a->bnc[q] = _mm512_mask_mov_pd(a->bnc[q], wc, nc);
+    a->bdc[q] = _mm512_mask_mov_pd(a->bdc[q], wc, dd);
+    a->bkc[q] = _mm512_mask_mov_epi64(a->bkc[q], wc, ks);
+    a->bnn[q] = _mm512_mask_mov_pd(a->bnn[q], wn, nn);
+    a->bdn[q] = _mm512_mask_mov_pd(a->bdn[q], wn, dd);
+    a->bkn[q] = _mm512_mask_mov_epi64(a->bkn[q], wn, ks);
+}
+
 /* One slot of the window (its distances pd, heights pg, step ks) for ng
- * groups of eight lines: the operations of scan_scalar; the distance test
- * only where `test`. */
+ * groups of eight lines. */
 TS_AVX512 static inline __attribute__((always_inline)) void
 scan512_slot(const ts_cap_lanes *r, int ng, const double *pd, const double *pg, __m512i ks,
              int test, scan512 *a)
 {
-    const __m512d near = _mm512_set1_pd(r->near), cap = _mm512_set1_pd(r->cap);
     for (int q = 0; q < NG; q++) {
         if (q >= ng)
             break;
-        const __m512d dd = _mm512_sub_pd(a->d[q], _mm512_load_pd(pd + 8 * q));
-        __mmask8 in = 0xFF;
-        if (test) {
-            in = _mm512_cmp_pd_mask(dd, near, _CMP_GE_OQ);
-            in = _mm512_mask_cmp_pd_mask(in, dd, cap, _CMP_LE_OQ);
-        }
-        const __m512d sg = _mm512_load_pd(pg + 8 * q);
-        const __m512d nc = _mm512_sub_pd(sg, a->gc[q]), nn = _mm512_sub_pd(sg, a->gn[q]);
-        const __mmask8 wc = _mm512_mask_cmp_pd_mask(in, _mm512_mul_pd(nc, a->bdc[q]),
-                                                    _mm512_mul_pd(a->bnc[q], dd), _CMP_GT_OQ);
-        const __mmask8 wn = _mm512_mask_cmp_pd_mask(in, _mm512_mul_pd(nn, a->bdn[q]),
-                                                    _mm512_mul_pd(a->bnn[q], dd), _CMP_GT_OQ);
-        a->bnc[q] = _mm512_mask_mov_pd(a->bnc[q], wc, nc);
-        a->bdc[q] = _mm512_mask_mov_pd(a->bdc[q], wc, dd);
-        a->bkc[q] = _mm512_mask_mov_epi64(a->bkc[q], wc, ks);
-        a->bnn[q] = _mm512_mask_mov_pd(a->bnn[q], wn, nn);
-        a->bdn[q] = _mm512_mask_mov_pd(a->bdn[q], wn, dd);
-        a->bkn[q] = _mm512_mask_mov_epi64(a->bkn[q], wn, ks);
+        scan512_one(r, q, pd + 8 * q, pg + 8 * q, ks, test, a);
     }
 }
 
@@ -66,17 +74,6 @@ scan512_lags(const ts_cap_lanes *r, int k, int g, int ng, int lag_from, int lag_
         const int sure = lag >= r->sure_lo && lag <= r->sure_hi;
         scan512_slot(r, ng, r->d + at, r->g + at, _mm512_set1_epi64(k - lag), !sure, a);
     }
-}
-
-/* A whole level-0 group from step s0, all of whose lags are sure. */
-TS_AVX512 static inline __attribute__((always_inline)) void
-scan512_group(const ts_cap_lanes *r, int g, int ng, int s0, scan512 *a)
-{
-    const size_t at = (size_t)(s0 % r->slots) * r->stride + g;
-#pragma GCC unroll 8
-    for (int i = 0; i < TS_CAP_G0; i++)
-        scan512_slot(r, ng, r->d + at + (size_t)i * r->stride, r->g + at + (size_t)i * r->stride,
-                     _mm512_set1_epi64(s0 + i), 0, a);
 }
 
 /*
@@ -111,8 +108,8 @@ scan512_group(const ts_cap_lanes *r, int g, int ng, int s0, scan512 *a)
 
 /* For the eight lines from j: the prune threshold T (-inf: none known;
  * +inf: no query), the lower of the two query heights (+inf: no query) and
- * the lines without a query. T is the steepest (for the query of lower
- * slope) of four samples of the window, each taken only where the scan's
+ * the lines without a query. T is the steepest (for the higher query
+ * point) of four samples of the window, each taken only where the scan's
  * own tests put it in the window: the line's previous answers of both
  * queries, and its newest and oldest slot. */
 TS_AVX512 static inline __attribute__((always_inline)) void
@@ -147,56 +144,258 @@ prune_threshold(const ts_cap_lanes *r, int k, int lag_hi, int j, const scan512 *
         cg[i] = _mm512_load_pd(r->g + at);
         cok[i] = 0xFF;
     }
-    const __m512d gq[2] = {a->gc[q], a->gn[q]};
-    __m512d t[2], gs[2];
-    __mmask8 has[2];
-    for (int i = 0; i < 2; i++) {
-        __m512d bn = _mm512_set1_pd(-INFINITY), bd = _mm512_set1_pd(1.0);
-        for (int c = 0; c < 4; c++) {
-            const __m512d dd = _mm512_sub_pd(a->d[q], cd[c]), n = _mm512_sub_pd(cg[c], gq[i]);
-            __mmask8 ok = _mm512_mask_cmp_pd_mask(cok[c], dd, near, _CMP_GE_OQ);
-            ok = _mm512_mask_cmp_pd_mask(ok, dd, cap, _CMP_LE_OQ);
-            ok = _mm512_mask_cmp_pd_mask(ok, _mm512_mul_pd(n, bd), _mm512_mul_pd(bn, dd),
-                                         _CMP_GT_OQ);
-            bn = _mm512_mask_mov_pd(bn, ok, n);
-            bd = _mm512_mask_mov_pd(bd, ok, dd);
-        }
-        const __m512d s = _mm512_div_pd(bn, bd); /* -inf where none */
-        /* s - margin |s| */
-        t[i] = _mm512_fnmadd_pd(_mm512_abs_pd(s), _mm512_set1_pd(PRUNE_MARGIN), s);
-        has[i] = _mm512_cmp_pd_mask(gq[i], gq[i], _CMP_ORD_Q);
-        t[i] = _mm512_mask_mov_pd(_mm512_set1_pd(INFINITY), has[i], t[i]);
-        gs[i] = _mm512_mask_mov_pd(_mm512_set1_pd(INFINITY), has[i], gq[i]);
+    /* The threshold of the higher query point only: from it every
+     * sample's slope is at most its slope from the lower one, so the
+     * steepest candidate's is the lower of the two queries' (up to the
+     * compares' rounding: T is the slope of a window sample either way). */
+    const __mmask8 hc = _mm512_cmp_pd_mask(a->gc[q], a->gc[q], _CMP_ORD_Q);
+    const __mmask8 hn = _mm512_cmp_pd_mask(a->gn[q], a->gn[q], _CMP_ORD_Q);
+    const __m512d inf = _mm512_set1_pd(INFINITY);
+    const __m512d gc = _mm512_mask_mov_pd(_mm512_set1_pd(-INFINITY), hc, a->gc[q]);
+    const __m512d gn = _mm512_mask_mov_pd(_mm512_set1_pd(-INFINITY), hn, a->gn[q]);
+    const __m512d ghi = _mm512_max_pd(gc, gn);
+    __m512d bn = _mm512_set1_pd(-INFINITY), bd = _mm512_set1_pd(1.0);
+    for (int c = 0; c < 4; c++) {
+        const __m512d dd = _mm512_sub_pd(a->d[q], cd[c]), n = _mm512_sub_pd(cg[c], ghi);
+        __mmask8 ok = _mm512_mask_cmp_pd_mask(cok[c], dd, near, _CMP_GE_OQ);
+        ok = _mm512_mask_cmp_pd_mask(ok, dd, cap, _CMP_LE_OQ);
+        ok = _mm512_mask_cmp_pd_mask(ok, _mm512_mul_pd(n, bd), _mm512_mul_pd(bn, dd), _CMP_GT_OQ);
+        bn = _mm512_mask_mov_pd(bn, ok, n);
+        bd = _mm512_mask_mov_pd(bd, ok, dd);
     }
-    *thr = _mm512_min_pd(t[0], t[1]);
-    *gmin = _mm512_min_pd(gs[0], gs[1]);
-    *idle = (__mmask8)~(has[0] | has[1]);
+    /* s = bn / bd (-inf where none) without a division: 1 / bd to 14
+     * bits, then two Newton steps (to within ~2^-52 of 1 / bd: s lies
+     * within 1e-15 of bn / bd, far inside the margin below) */
+    __m512d y = _mm512_rcp14_pd(bd);
+    y = _mm512_mul_pd(y, _mm512_fnmadd_pd(bd, y, _mm512_set1_pd(2.0)));
+    y = _mm512_mul_pd(y, _mm512_fnmadd_pd(bd, y, _mm512_set1_pd(2.0)));
+    const __m512d s = _mm512_mul_pd(bn, y);
+    /* s - margin |s|; +inf, and a lower height of +inf, without a query */
+    const __mmask8 has = hc | hn;
+    *thr = _mm512_mask_mov_pd(inf, has, _mm512_fnmadd_pd(_mm512_abs_pd(s), _mm512_set1_pd(PRUNE_MARGIN), s));
+    *gmin = _mm512_min_pd(_mm512_mask_mov_pd(inf, hc, a->gc[q]), _mm512_mask_mov_pd(inf, hn, a->gn[q]));
+    *idle = (__mmask8)~has;
 }
 
-/* Whether group idx of level l may hold, for any of the ng groups of lines
- * from g, a sample at least as steep as the threshold: unless
- * gmax + T dsel < gmin + T d (above: rhs), dsel the group's newest
- * distance where T >= 0, its oldest where T < 0 (neg). */
-TS_AVX512 static inline __attribute__((always_inline)) int
-group_needed(const ts_cap_lanes *r, int l, int idx, int g, int ng, const __m512d *thr,
-             const __m512d *rhs, const __mmask8 *neg, const __mmask8 *idle)
+/* The ng groups of lines from g (bit q: group q) for which group idx of
+ * level l may hold a sample at least as steep as the threshold: unless
+ * gmax + T dsel < gmin + T d (above: rhs) on each of its lines with a
+ * query, dsel the group's newest distance where T >= 0, its oldest where
+ * T < 0 (neg). */
+TS_AVX512 static inline __attribute__((always_inline)) unsigned
+groups_needed(const ts_cap_lanes *r, int l, int idx, int g, int ng, const __m512d *thr,
+              const __m512d *rhs, const __mmask8 *neg, const __mmask8 *idle)
 {
     const size_t at = (size_t)idx * r->stride + g;
-    __mmask8 need = 0;
+    unsigned need = 0;
     for (int q = 0; q < NG; q++) {
         if (q >= ng)
             break;
         const __m512d dsel = _mm512_mask_load_pd(_mm512_load_pd(r->dhi[l] + at + 8 * q), neg[q],
                                                  r->dlo[l] + at + 8 * q);
         const __m512d lhs = _mm512_fmadd_pd(thr[q], dsel, _mm512_load_pd(r->gmax[l] + at + 8 * q));
-        need |= (__mmask8)~(_mm512_cmp_pd_mask(lhs, rhs[q], _CMP_LT_OQ) | idle[q]);
+        need |= (unsigned)(((__mmask8)~(_mm512_cmp_pd_mask(lhs, rhs[q], _CMP_LT_OQ) | idle[q])) != 0)
+                << q;
     }
-    return need != 0;
+    return need;
+}
+
+/* The slots each group of eight lines scans, oldest first: their steps and
+ * offsets in the ring (slot * stride). A level-1 group adds at most
+ * TS_CAP_G1 to a list; the lists have room for a vector's store beyond. */
+#define LIST_MAX 1024
+typedef struct {
+    int n[NG];
+    int step[NG][LIST_MAX + 16], off[NG][LIST_MAX + 16];
+} slot_lists;
+
+/* Scan the listed slots, each group of lines its own list, in lockstep (the
+ * chains of the groups stay independent, so that their latencies overlap),
+ * and empty the lists. A shorter list is padded with the ring's spare slot,
+ * which has no samples (d NaN: never taken). */
+TS_AVX512 static inline __attribute__((always_inline)) void
+scan512_lists(const ts_cap_lanes *r, int g, int ng, slot_lists *L, scan512 *a)
+{
+    /* the distance test, unless every lag of the window is sure (the spare
+     * slot's NaN fails the slope's compare too) */
+    const int test = r->lag_lo < r->sure_lo || r->lag_hi > r->sure_hi;
+    int n = 0;
+    for (int q = 0; q < ng; q++)
+        n = L->n[q] > n ? L->n[q] : n;
+    const __m512i spare = _mm512_set1_epi32(r->slots * r->stride);
+    for (int q = 0; q < ng; q++)
+        for (int i = L->n[q]; i < n; i += 16) {
+            _mm512_storeu_si512(L->off[q] + i, spare);
+            _mm512_storeu_si512(L->step[q] + i, _mm512_setzero_si512());
+        }
+    for (int i = 0; i < n; i++)
+        for (int q = 0; q < NG; q++) {
+            if (q >= ng)
+                break;
+            const size_t at = (size_t)L->off[q][i] + g + 8 * q;
+            scan512_one(r, q, r->d + at, r->g + at, _mm512_set1_epi64(L->step[q][i]), test, a);
+        }
+    for (int q = 0; q < ng; q++)
+        L->n[q] = 0;
+}
+
+/* Level-0 groups to scan for a group of lines: the group, its entry in
+ * the groups' rings, the group of lines. */
+#define PAIRS_MAX 64
+typedef struct {
+    int n;
+    int m0[PAIRS_MAX + 16], idx[PAIRS_MAX + 16], q[PAIRS_MAX + 16];
+} group_pairs;
+
+/* Bit i set where byte i of x is not 0. */
+static inline unsigned nonzero_bytes(unsigned long long x)
+{
+    const unsigned long long low7 = 0x7F7F7F7F7F7F7F7FULL;
+    const unsigned long long top = (((x & low7) + low7) | x) & 0x8080808080808080ULL;
+    return (unsigned)(((top >> 7) * 0x0102040810204080ULL) >> 56);
+}
+
+_Static_assert(TS_CAP_G0 <= 8 && TS_CAP_G1 / TS_CAP_G0 <= 8,
+               "a group's slots, a level-1 group's level-0 groups as the bytes of one word");
+
+/* Which of the count level-0 groups from entry idx0 on (at most the
+ * TS_CAP_G1 / TS_CAP_G0 of a level-1 group) group q of lines from g needs
+ * (bit i: the i-th), by groups_needed's test. */
+TS_AVX512 static inline __attribute__((always_inline)) unsigned
+level0_needed(const ts_cap_lanes *r, int idx0, int count, int g, int q, const __m512d *thr,
+              const __m512d *rhs, const __mmask8 *neg, const __mmask8 *idle)
+{
+    unsigned long long any = 0;
+    int idx = idx0;
+    for (int i = 0; i < count; i++) {
+        const size_t at = (size_t)idx * r->stride + g + 8 * q;
+        const __m512d dsel =
+            _mm512_mask_load_pd(_mm512_load_pd(r->dhi[0] + at), neg[q], r->dlo[0] + at);
+        const __m512d lhs = _mm512_fmadd_pd(thr[q], dsel, _mm512_load_pd(r->gmax[0] + at));
+        any |= (unsigned long long)(__mmask8)~(_mm512_cmp_pd_mask(lhs, rhs[q], _CMP_LT_OQ) | idle[q])
+               << (8 * i);
+        idx = idx + 1 == r->groups[0] ? 0 : idx + 1;
+    }
+    return nonzero_bytes(any);
+}
+
+/* Append to group q's list the steps a0..b0 of the level-0 group from step
+ * s0 (ring slot slot) whose samples some line of q may take: the group
+ * test with the group one sample (gmax = g_p, dsel = d_p), tt and rt the
+ * threshold and right side as there. */
+TS_AVX512 static inline __attribute__((always_inline)) void
+list_samples(const ts_cap_lanes *r, int slot, int s0, int a0, int b0, int g, int q, __m512d tt,
+             __m512d rt, __mmask8 idle, slot_lists *L)
+{
+    const __m512i iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 0, 0, 0, 0, 0, 0, 0, 0);
+    const unsigned full = (1u << TS_CAP_G0) - 1;
+    const unsigned range = (full << (a0 - s0)) & (full >> (s0 + TS_CAP_G0 - 1 - b0));
+    const double *pd = r->d + (size_t)slot * r->stride + g + 8 * q;
+    const double *pg = r->g + (size_t)slot * r->stride + g + 8 * q;
+    unsigned long long any = 0;
+#pragma GCC unroll 8
+    for (int i = 0; i < TS_CAP_G0; i++) {
+        const __m512d lhs = _mm512_fmadd_pd(tt, _mm512_load_pd(pd + (size_t)i * r->stride),
+                                            _mm512_load_pd(pg + (size_t)i * r->stride));
+        any |= (unsigned long long)_mm512_mask_cmp_pd_mask((__mmask8)~idle, lhs, rt, _CMP_GE_OQ)
+               << (8 * i);
+    }
+    const __mmask16 take = (__mmask16)(nonzero_bytes(any) & range);
+    const __m512i steps = _mm512_add_epi32(_mm512_set1_epi32(s0), iota);
+    const __m512i offs = _mm512_add_epi32(_mm512_set1_epi32(slot * r->stride),
+                                          _mm512_mullo_epi32(iota, _mm512_set1_epi32(r->stride)));
+    _mm512_storeu_si512(L->step[q] + L->n[q], _mm512_maskz_compress_epi32(take, steps));
+    _mm512_storeu_si512(L->off[q] + L->n[q], _mm512_maskz_compress_epi32(take, offs));
+    L->n[q] += __builtin_popcount(take);
+}
+
+/* The pruned scan of steps s_lo..s_hi for the ng groups of lines from g.
+ * Each group of lines lists the slots it must scan: those of the level-0
+ * groups that the level-1 and level-0 bounds leave (the newest PRUNE_NEAR
+ * steps untested), and of these the samples that the same bound, taken
+ * sample by sample (a group of one: gmax = g_p, dsel = d_p), leaves. */
+TS_AVX512 static inline __attribute__((always_inline)) void
+scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 *a)
+{
+    __m512d thr[NG], rhs[NG], tt[NG], rt[NG];
+    __mmask8 idle[NG], neg[NG];
+    for (int q = 0; q < ng; q++) {
+        __m512d gmin;
+        prune_threshold(r, k, lag_hi, g + 8 * q, a, q, &thr[q], &gmin, &idle[q]);
+        neg[q] = _mm512_cmp_pd_mask(thr[q], _mm512_setzero_pd(), _CMP_LT_OQ);
+        const __m512d td = _mm512_mul_pd(thr[q], a->d[q]);
+        const __m512d size = _mm512_add_pd(_mm512_abs_pd(gmin), _mm512_abs_pd(td));
+        rhs[q] = _mm512_fnmadd_pd(size, _mm512_set1_pd(1e-12), _mm512_fmadd_pd(thr[q], a->d[q], gmin));
+        /* sample by sample: T = -inf (no threshold) as T = 0 against -inf,
+         * so that every sample passes (a distance of 0 would give NaN),
+         * and a slot without a sample (d NaN) fails */
+        const __mmask8 none = _mm512_cmp_pd_mask(thr[q], _mm512_set1_pd(-INFINITY), _CMP_EQ_OQ);
+        tt[q] = _mm512_mask_mov_pd(thr[q], none, _mm512_setzero_pd());
+        rt[q] = _mm512_mask_mov_pd(rhs[q], none, _mm512_set1_pd(-INFINITY));
+    }
+    slot_lists L;
+    for (int q = 0; q < NG; q++)
+        L.n[q] = 0;
+    const unsigned all = (1u << ng) - 1;
+    const int s_lo = k - lag_hi, s_hi = k - r->lag_lo, s_near = s_hi - PRUNE_NEAR + 1;
+    const __m512i iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 0, 0, 0, 0, 0, 0, 0, 0);
+    /* the level-0 groups each group of lines needs, (group, its entry,
+     * lines) in step order; the groups' entries kept in step (no division
+     * per group) */
+    group_pairs P;
+    P.n = 0;
+    int idx1 = s_lo / TS_CAP_G1 % r->groups[1], idx0 = s_lo / TS_CAP_G0 % r->groups[0];
+    for (int m1 = s_lo / TS_CAP_G1; m1 <= s_hi / TS_CAP_G1; m1++) {
+        const int a1 = m1 * TS_CAP_G1 > s_lo ? m1 * TS_CAP_G1 : s_lo;
+        const int b1 = m1 * TS_CAP_G1 + TS_CAP_G1 - 1 < s_hi ? m1 * TS_CAP_G1 + TS_CAP_G1 - 1 : s_hi;
+        const unsigned need1 = b1 >= s_near ? all : groups_needed(r, 1, idx1, g, ng, thr, rhs, neg, idle);
+        idx1 = idx1 + 1 == r->groups[1] ? 0 : idx1 + 1;
+        /* its level-0 groups f0 .. f0 + count - 1, those from the first
+         * with a step from s_near on untested */
+        const int f0 = a1 / TS_CAP_G0, count = b1 / TS_CAP_G0 - f0 + 1;
+        if (need1) {
+            const int nb = s_near - TS_CAP_G0 + 1 - f0 * TS_CAP_G0;
+            const int first_near = nb <= 0 ? 0 : (nb + TS_CAP_G0 - 1) / TS_CAP_G0;
+            const unsigned near = first_near >= count ? 0 : 0xFFu << first_near;
+            const __m512i m0s = _mm512_add_epi32(_mm512_set1_epi32(f0), iota);
+            __m512i idxs = _mm512_add_epi32(_mm512_set1_epi32(idx0), iota);
+            idxs = _mm512_mask_sub_epi32(idxs, _mm512_cmpge_epi32_mask(idxs, _mm512_set1_epi32(r->groups[0])),
+                                         idxs, _mm512_set1_epi32(r->groups[0]));
+            for (int q = 0; q < NG; q++) {
+                if (q >= ng)
+                    break;
+                if (!(need1 >> q & 1))
+                    continue;
+                const __mmask16 need0 =
+                    (__mmask16)((level0_needed(r, idx0, count, g, q, thr, rhs, neg, idle) | near) &
+                                ((1u << count) - 1));
+                _mm512_storeu_si512(P.m0 + P.n, _mm512_maskz_compress_epi32(need0, m0s));
+                _mm512_storeu_si512(P.idx + P.n, _mm512_maskz_compress_epi32(need0, idxs));
+                _mm512_storeu_si512(P.q + P.n, _mm512_maskz_compress_epi32(need0, _mm512_set1_epi32(q)));
+                P.n += __builtin_popcount(need0);
+            }
+        }
+        idx0 = idx0 + count < r->groups[0] ? idx0 + count : idx0 + count - r->groups[0];
+        if (P.n > PAIRS_MAX - NG * 8 || m1 == s_hi / TS_CAP_G1) {
+            /* their samples that a line may take, then the scan of those */
+            for (int p = 0; p < P.n; p++) {
+                const int q = P.q[p], s0 = P.m0[p] * TS_CAP_G0;
+                const int a0 = s0 > s_lo ? s0 : s_lo, b0 = s0 + TS_CAP_G0 - 1 < s_hi ? s0 + TS_CAP_G0 - 1 : s_hi;
+                list_samples(r, P.idx[p] * TS_CAP_G0, s0, a0, b0, g, q, tt[q], rt[q], idle[q], &L);
+            }
+            P.n = 0;
+            int full = 0;
+            for (int q = 0; q < ng; q++)
+                full |= L.n[q] > LIST_MAX - PAIRS_MAX * TS_CAP_G0;
+            if (full || m1 == s_hi / TS_CAP_G1)
+                scan512_lists(r, g, ng, &L, a);
+        }
+    }
 }
 
 /* scan_scalar for up to NG groups from g (those below g1), eight lines
  * per AVX-512 vector: the same operations per line; with r->prune, only
- * the groups of slots that may change the answer. */
+ * the slots that may change the answer. */
 
 TS_AVX512 void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1)
 {
@@ -212,48 +411,10 @@ TS_AVX512 void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1)
         a.bdc[q] = a.bdn[q] = _mm512_set1_pd(1.0);
         a.bkc[q] = a.bkn[q] = _mm512_set1_epi64(-1);
     }
-    if (!r->prune || lag_hi < r->lag_lo) {
+    if (!r->prune || lag_hi < r->lag_lo)
         scan512_lags(r, k, g, ng, lag_hi, r->lag_lo, &a);
-    } else {
-        __m512d thr[NG], rhs[NG];
-        __mmask8 idle[NG], neg[NG];
-        for (int q = 0; q < ng; q++) {
-            __m512d gmin;
-            prune_threshold(r, k, lag_hi, g + 8 * q, &a, q, &thr[q], &gmin, &idle[q]);
-            neg[q] = _mm512_cmp_pd_mask(thr[q], _mm512_setzero_pd(), _CMP_LT_OQ);
-            const __m512d td = _mm512_mul_pd(thr[q], a.d[q]);
-            const __m512d size = _mm512_add_pd(_mm512_abs_pd(gmin), _mm512_abs_pd(td));
-            rhs[q] = _mm512_fnmadd_pd(size, _mm512_set1_pd(1e-12), _mm512_fmadd_pd(thr[q], a.d[q], gmin));
-        }
-        /* the window's steps, and those scanned without a test */
-        const int s_lo = k - lag_hi, s_hi = k - r->lag_lo, s_near = s_hi - PRUNE_NEAR + 1;
-        for (int m1 = s_lo / TS_CAP_G1; m1 <= s_hi / TS_CAP_G1; m1++) {
-            const int a1 = m1 * TS_CAP_G1 > s_lo ? m1 * TS_CAP_G1 : s_lo;
-            const int b1 = m1 * TS_CAP_G1 + TS_CAP_G1 - 1 < s_hi ? m1 * TS_CAP_G1 + TS_CAP_G1 - 1 : s_hi;
-            if (b1 < s_near &&
-                !group_needed(r, 1, m1 % r->groups[1], g, ng, thr, rhs, neg, idle))
-                continue;
-            /* which of its level-0 groups to scan, then those in order */
-            const int f0 = a1 / TS_CAP_G0, l0 = b1 / TS_CAP_G0;
-            unsigned scan = 0;
-            for (int m0 = f0; m0 <= l0; m0++) {
-                const int near_group = m0 * TS_CAP_G0 + TS_CAP_G0 - 1 >= s_near;
-                scan |= (unsigned)(near_group |
-                                   group_needed(r, 0, m0 % r->groups[0], g, ng, thr, rhs, neg, idle))
-                        << (m0 - f0);
-            }
-            while (scan) {
-                const int m0 = f0 + __builtin_ctz(scan);
-                scan &= scan - 1;
-                const int a0 = m0 * TS_CAP_G0 > a1 ? m0 * TS_CAP_G0 : a1;
-                const int b0 = m0 * TS_CAP_G0 + TS_CAP_G0 - 1 < b1 ? m0 * TS_CAP_G0 + TS_CAP_G0 - 1 : b1;
-                if (b0 - a0 == TS_CAP_G0 - 1 && k - b0 >= r->sure_lo && k - a0 <= r->sure_hi)
-                    scan512_group(r, g, ng, a0, &a);
-                else
-                    scan512_lags(r, k, g, ng, k - a0, k - b0, &a);
-            }
-        }
-    }
+    else
+        scan512_pruned(r, k, lag_hi, g, ng, &a);
     for (int q = 0; q < ng; q++) {
         const int o = g + 8 * q;
         _mm512_store_epi64(r->kc + o, a.bkc[q]);
@@ -263,26 +424,19 @@ TS_AVX512 void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1)
     }
 }
 
-/* Step k's samples (ring slots rd, rg; d NaN: none) into their groups; a
- * group's first step empties it first. */
-TS_AVX512 void ts_cap_groups_add512(ts_cap_lanes *r, int k, const double *rd, const double *rg)
+/* Step k's samples (d, g; lanes has) of lines j.. j + 7 into their groups
+ * of both levels (entries at[l]). */
+TS_AVX512 static inline __attribute__((always_inline)) void
+groups_add(ts_cap_lanes *r, const size_t at[2], int j, __m512d d, __m512d g, __mmask8 has)
 {
     for (int l = 0; l < 2; l++) {
-        const int size = l ? TS_CAP_G1 : TS_CAP_G0;
-        const size_t at = (size_t)(k / size % r->groups[l]) * r->stride;
-        double *gm = r->gmax[l] + at, *lo = r->dlo[l] + at, *hi = r->dhi[l] + at;
-        if (k % size == 0)
-            ts_cap_groups_empty(gm, lo, hi, (size_t)r->stride);
-        for (int j = 0; j < r->stride; j += 8) {
-            const __m512d d = _mm512_load_pd(rd + j), g = _mm512_load_pd(rg + j);
-            const __m512d m = _mm512_load_pd(gm + j);
-            const __mmask8 has = _mm512_cmp_pd_mask(d, d, _CMP_ORD_Q);
-            /* lines' distances grow: a group's first sample is its oldest */
-            const __mmask8 first = _mm512_mask_cmp_pd_mask(has, m, _mm512_set1_pd(-INFINITY), _CMP_EQ_OQ);
-            _mm512_store_pd(lo + j, _mm512_mask_mov_pd(_mm512_load_pd(lo + j), first, d));
-            _mm512_store_pd(hi + j, _mm512_mask_mov_pd(_mm512_load_pd(hi + j), has, d));
-            _mm512_store_pd(gm + j, _mm512_mask_max_pd(m, has, m, g));
-        }
+        double *gm = r->gmax[l] + at[l] + j, *lo = r->dlo[l] + at[l] + j, *hi = r->dhi[l] + at[l] + j;
+        const __m512d m = _mm512_load_pd(gm);
+        /* lines' distances grow: a group's first sample is its oldest */
+        const __mmask8 first = _mm512_mask_cmp_pd_mask(has, m, _mm512_set1_pd(-INFINITY), _CMP_EQ_OQ);
+        _mm512_store_pd(lo, _mm512_mask_mov_pd(_mm512_load_pd(lo), first, d));
+        _mm512_store_pd(hi, _mm512_mask_mov_pd(_mm512_load_pd(hi), has, d));
+        _mm512_store_pd(gm, _mm512_mask_max_pd(m, has, m, g));
     }
 }
 
@@ -312,6 +466,16 @@ TS_AVX512 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0,
                                  const ts_lane_occluders *occ, double *rd, double *rg)
 {
     const __m512d c = _mm512_set1_pd(s->c), nan = _mm512_set1_pd(NAN);
+    /* the pruned scan's groups of the step's samples, each emptied at its
+     * first step */
+    size_t at[2];
+    for (int l = 0; l < 2 && r->prune; l++) {
+        const int size = l ? TS_CAP_G1 : TS_CAP_G0;
+        at[l] = (size_t)(s->k / size % r->groups[l]) * r->stride;
+        if (s->k % size == 0)
+            ts_cap_groups_empty(r->gmax[l] + at[l], r->dlo[l] + at[l], r->dhi[l] + at[l],
+                                (size_t)r->stride);
+    }
     for (int j = g0; j < g1; j += 8) {
         const __m512i idx = _mm512_add_epi64(_mm512_set1_epi64(j), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
         __mmask8 on = _mm512_cmpge_epi64_mask(idx, _mm512_set1_epi64(s->j0));
@@ -324,8 +488,11 @@ TS_AVX512 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0,
         const __m512d d = _mm512_maskz_loadu_pd(on, s->d + j);
         const __m512d hs = _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_maskz_loadu_ps(on, s->hs + j)));
         const __mmask8 has = _mm512_cmp_pd_mask(hs, hs, _CMP_ORD_Q);
+        const __m512d g = _mm512_sub_pd(hs, _mm512_mul_pd(_mm512_mul_pd(c, d), d));
         _mm512_mask_store_pd(rd + j, on, _mm512_mask_mov_pd(nan, has, d));
-        _mm512_mask_store_pd(rg + j, on, _mm512_sub_pd(hs, _mm512_mul_pd(_mm512_mul_pd(c, d), d)));
+        _mm512_mask_store_pd(rg + j, on, g);
+        if (r->prune)
+            groups_add(r, at, j, d, g, has & on);
     }
 }
 

@@ -12,7 +12,9 @@
 #include "capped_lanes.h"
 
 /* Groups of eight lines that one scan takes together. */
+#ifndef TS_CAP_NG
 #define TS_CAP_NG 3
+#endif
 
 /* The window scan of lines [g, g + 8 * TS_CAP_NG), those below g1, at
  * step k: answers into r->kc, ddc, kn, ddn; only the groups of slots that
@@ -21,7 +23,8 @@ void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1);
 
 /* The queries of lines [g0, g1) of step s (r->qd, qc, qn), and after the
  * scan the answers of its lines j0..j1 into occ and their samples into the
- * ring's slots rd, rg. */
+ * ring's slots rd, rg and (where r->prune) their groups of both levels,
+ * each emptied at its first step. */
 void ts_cap_queries512(ts_cap_lanes *r, const ts_lane_step *s, int g0, int g1);
 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0, int g1,
                        const ts_lane_occluders *occ, double *rd, double *rg);
@@ -31,10 +34,6 @@ void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0, int g1,
  * query left to the scan. */
 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
                             const ts_lane_occluders *occ, unsigned char *need);
-
-/* Step k's samples (ring slots rd, rg; d NaN: none) into their groups of
- * both levels, each emptied at its first step. */
-void ts_cap_groups_add512(ts_cap_lanes *r, int k, const double *rd, const double *rg);
 
 /* Empty n groups' entries (no samples: -inf, 0, 0). */
 static inline void ts_cap_groups_empty(double *gmax, double *dlo, double *dhi, size_t n)

@@ -405,6 +405,9 @@ START_TEST(test_capped_scan_pruned)
     check_capped_scan(25.0, 5000.0, 0.0, 0.0, 6);
     check_capped_scan(25.0, 5000.0, curved, 0.0, 7);
     check_capped_scan(85.0, 30000.0, curved, 0.0, 8);
+    /* steps of 9-11 m, windows of 10..333 and 10..555 lags (pruned) */
+    check_capped_scan(105.0, 3000.0, 0.0, 0.1, 9);
+    check_capped_scan(105.0, 5000.0, curved, 0.1, 10);
 }
 END_TEST
 
