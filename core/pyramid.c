@@ -178,7 +178,8 @@ static int reconstruct(ts_pyramid *P, const coarse *lv, int j, int threads, ts_e
     const int W = P->grid->width;
     int *idx = malloc((size_t)W * 4 * sizeof *idx);
     double *w = malloc((size_t)W * 4 * sizeof *w);
-    P->level[j].hu = malloc((size_t)lv->h * W * sizeof(float));
+    /* on cache lines: the run loops read whole vectors of a row */
+    P->level[j].hu = ts_pyr_alloc((size_t)lv->h * W * sizeof(float));
     if (!idx || !w || !P->level[j].hu) {
         free(idx);
         free(w);

@@ -321,11 +321,14 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
     (void)worker;
     const batch_ctx *B = ctx;
     const int n = B->n, W = B->az[0].P->grid->width, levels = B->az[0].P->levels;
-    /* per azimuth s0, s1, s2, m: W each; T and the samples: W + 1 each */
-    float *buf = malloc((size_t)n * (6 * W + 2) * sizeof *buf);
-    float *own = malloc((size_t)3 * W * sizeof *own + sizeof *own);
-    double *tpp = malloc((size_t)3 * W * sizeof *tpp);
-    int *jd = malloc((size_t)n * W * sizeof *jd);
+    /* per azimuth s0, s1, s2, m, T and the samples (T and the samples
+     * W + 1), each on a cache line as the level rows (ts_pyr_alloc): the
+     * runs' vectors then lie within a line where a run starts on one */
+    const size_t P = ((size_t)W + 1 + 15) / 16 * 16;
+    float *buf = ts_pyr_alloc((size_t)n * 6 * P * sizeof *buf);
+    float *own = ts_pyr_alloc(3 * P * sizeof *own);
+    double *tpp = ts_pyr_alloc(3 * P * sizeof *tpp);
+    int *jd = ts_pyr_alloc((size_t)n * P * sizeof *jd);
     row_level *rl = malloc((size_t)n * ROW_BLOCK * levels * sizeof *rl);
     row_ws w[TS_PYRAMID_BATCH];
     if (!buf || !own || !tpp || !jd || !rl) {
@@ -338,9 +341,9 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
         return;
     }
     for (int a = 0; a < n; a++) {
-        float *f = buf + (size_t)a * (6 * W + 2);
-        w[a] = (row_ws){f, f + W, f + 2 * W, f + 3 * W, f + 4 * W, f + 5 * W + 1, tpp,
-                        jd + (size_t)a * W, NULL, 1, 0};
+        float *f = buf + (size_t)a * 6 * P;
+        w[a] = (row_ws){f, f + P, f + 2 * P, f + 3 * P, f + 4 * P, f + 5 * P, tpp,
+                        jd + (size_t)a * P, NULL, 1, 0};
     }
     for (long yb = y0; yb < y1; yb += ROW_BLOCK) {
         long ye = yb + ROW_BLOCK < y1 ? yb + ROW_BLOCK : y1;
@@ -357,7 +360,7 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
                 const row_level *rly[TS_PYRAMID_BATCH];
                 for (int a = 0; a < n; a++)
                     rly[a] = &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels];
-                batch_row(B, w, (int)y, c0, c1, rly, own, own + W, own + 2 * W);
+                batch_row(B, w, (int)y, c0, c1, rly, own, own + P, own + 2 * P);
             }
         }
     }
