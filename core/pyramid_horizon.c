@@ -402,7 +402,7 @@ static int az_ctx_init(const ts_pyramid *pyr, double azimuth, const ts_horizon_o
     if (fabs(ca) < 1e-12) ca = 0;
     double gx = sa / ts_grid_cell_x(g, H / 2), gy = -ca / g->cell_y;
     double major = fabs(gx) > fabs(gy) ? fabs(gx) : fabs(gy);
-    *C = (hz_ctx){pyr, gx / major, gy / major, NULL, 0, 0, 0, 0, NULL, out, failed};
+    *C = (hz_ctx){pyr, gx / major, gy / major, NULL, 0, 0, 0, 0, 0, NULL, out, failed};
     C->step = malloc((size_t)H * sizeof *C->step);
     level_az *lv = malloc((size_t)pyr->levels * sizeof *lv);
     C->lv = lv;
@@ -410,6 +410,9 @@ static int az_ctx_init(const ts_pyramid *pyr, double azimuth, const ts_horizon_o
         return 0;
     for (int y = 0; y < H; y++)
         C->step[y] = hypot(ts_grid_cell_x(g, y) * C->vx, g->cell_y * C->vy);
+    C->step_all = C->step[0];
+    for (int y = 1; y < H; y++)
+        C->step_all = C->step[y] == C->step[0] ? C->step_all : 0;
     C->c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
     C->cap = opts->max_distance;
     C->ko = pyr->opts.level_step * pyr->opts.offset;

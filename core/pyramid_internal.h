@@ -31,6 +31,10 @@ struct ts_pyramid {
      * that leave through a side end there (pyramid_drop.c), and a column
      * read down the DEM's rows misses the cache (and the TLB) at every row */
     float *side[2];
+    /* the pairs of columns 0, 1 and W - 2, W - 1, interleaved by row (2 H
+     * floats each; W >= 2): the y-major rays that leave through a side end
+     * between the two columns of its pair */
+    float *pair[2];
 };
 
 /* n bytes on a 64-byte boundary (a cache line, an AVX-512 vector): a
