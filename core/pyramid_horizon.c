@@ -231,6 +231,10 @@ static void row_finish(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const 
 typedef struct {
     int n;
     const hz_ctx *az; /* n */
+    /* whether two azimuths have the same vy: only such can read a level at
+     * the same rows with the same weights (share_level_row; an x-major
+     * batch has none, and its test would fail at every level) */
+    int share;
 } batch_ctx;
 
 /* Whether two entries read the same level rows with the same weights. */
@@ -303,7 +307,8 @@ static void batch_row(const batch_ctx *B, row_ws *w, int y, int c0, int c1,
             ts_pyr_combine_rows(rl[0][j].r, rl[0][j].wr, 4, lo, hi, R);
             Rj = R;
         }
-        share_level_row(B, w, rl, run, j, Tsh);
+        if (B->share)
+            share_level_row(B, w, rl, run, j, Tsh);
         int active = 0;
         for (int a = 0; a < B->n; a++) {
             row_sample(&B->az[a], &w[a], y, j, &rl[a][j], Rj, R0, &run[a]);
@@ -446,7 +451,10 @@ ts_status ts_pyramid_horizons(const ts_pyramid *pyr, int count, const double *az
     for (; ok && k < count; k++)
         ok = az_ctx_init(pyr, az[k], opts, out[k], &failed, &C[k]);
     if (ok) {
-        batch_ctx B = {count, C};
+        batch_ctx B = {count, C, 0};
+        for (int a = 0; a < count; a++)
+            for (int b = a + 1; b < count; b++)
+                B.share |= C[a].vy == C[b].vy;
         st = ts_parallel_for(ts_thread_count(opts->threads, g->height), g->height, rows_range,
                              &B, err);
     }
