@@ -115,17 +115,46 @@ static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int
         A[x] = tpp[x] > 1e-9 ? A[x] : NAN;
 }
 
-/* Whether the ends px[a..b] all lie between the columns of the side
- * that rays of direction vx leave through: [W - 2, W - 1] (vx > 0), or
- * [0, 1) (vx < 0: column 1 itself would need column 2). */
-static inline int ends_in_pair(const double *restrict px, int a, int b, double vx, double lim)
+/* The cells of [a, b] whose ends px lie between the columns of the side
+ * that rays of direction vx leave through, [W - 2, W - 1] (vx > 0) or
+ * [0, 1) (vx < 0: column 1 itself would need column 2): those that leave
+ * through the side, a suffix (vx > 0) or a prefix of the run; the rest
+ * end at the row's reach (t_row) within the grid. Returns the first cell
+ * after the prefix (vx < 0) or the last before the suffix (vx > 0). */
+static inline int pair_part(const double *restrict px, int a, int b, double vx, double lim)
 {
-    double lo = px[a], hi = px[a];
-    for (int x = a; x <= b; x++) {
-        lo = px[x] < lo ? px[x] : lo;
-        hi = px[x] > hi ? px[x] : hi;
+    if (vx < 0) {
+        while (a <= b && px[a] < 1)
+            a++;
+        return a;
     }
-    return vx > 0 ? lo >= lim - 1 : hi < 1;
+    while (b >= a && px[b] >= lim - 1)
+        b--;
+    return b;
+}
+
+/* drop_read for the cells of [a, b] (none when a > b), its constant
+ * arguments dispatched. */
+static inline __attribute__((always_inline)) void read_ends(const hz_ctx *C, int where, int y,
+                                                            int a, int b,
+                                                            const double *restrict tpp,
+                                                            float *restrict A)
+{
+    const ts_grid *g = C->P->grid;
+    int flat = C->step_all > 0;
+    if (a > b)
+        return;
+    if ((double)g->stride * g->height > INT_MAX)
+        drop_read(C, 0, ON_DEM, 0, y, a, b, tpp, A);
+    else if (where == ON_SIDE)
+        flat ? drop_read(C, 1, ON_SIDE, 1, y, a, b, tpp, A)
+             : drop_read(C, 1, ON_SIDE, 0, y, a, b, tpp, A);
+    else if (where == ON_PAIR)
+        flat ? drop_read(C, 1, ON_PAIR, 1, y, a, b, tpp, A)
+             : drop_read(C, 1, ON_PAIR, 0, y, a, b, tpp, A);
+    else
+        flat ? drop_read(C, 1, ON_DEM, 1, y, a, b, tpp, A)
+             : drop_read(C, 1, ON_DEM, 0, y, a, b, tpp, A);
 }
 
 /* The last sample A[x] of each cell of [a, b], its sample number jd[x]
@@ -193,24 +222,17 @@ void ts_pyr_drop_cells(const hz_ctx *C, row_ws *w, int y, int a, int b, double t
         drop_ends(C, 0, y, a, b, t_row, tpp);
     /* x-major rays that all end on their side (not earlier, at t_row) end
      * on a whole column: x + (lim - x) or x - x, exactly; other rays that
-     * all end within the two columns of a side read that side's pair */
+     * leave through a side end between the two columns of its pair */
     const double lim = g->width - 1;
-    int where = (vx == 1.0 && lim - a <= t_row) || (vx == -1.0 && b <= t_row) ? ON_SIDE
-                : vx != 0 && g->width >= 2 && ends_in_pair(tpp + g->width, a, b, vx, lim)
-                    ? ON_PAIR
-                    : ON_DEM;
-    int flat = C->step_all > 0;
-    if ((double)g->stride * g->height > INT_MAX)
-        drop_read(C, 0, ON_DEM, 0, y, a, b, tpp, A);
-    else if (where == ON_SIDE)
-        flat ? drop_read(C, 1, ON_SIDE, 1, y, a, b, tpp, A)
-             : drop_read(C, 1, ON_SIDE, 0, y, a, b, tpp, A);
-    else if (where == ON_PAIR)
-        flat ? drop_read(C, 1, ON_PAIR, 1, y, a, b, tpp, A)
-             : drop_read(C, 1, ON_PAIR, 0, y, a, b, tpp, A);
-    else
-        flat ? drop_read(C, 1, ON_DEM, 1, y, a, b, tpp, A)
-             : drop_read(C, 1, ON_DEM, 0, y, a, b, tpp, A);
+    if ((vx == 1.0 && lim - a <= t_row) || (vx == -1.0 && b <= t_row)) {
+        read_ends(C, ON_SIDE, y, a, b, tpp, A);
+    } else if (vx != 0 && g->width >= 2) {
+        int s = pair_part(tpp + g->width, a, b, vx, lim);
+        read_ends(C, vx < 0 ? ON_PAIR : ON_DEM, y, a, vx < 0 ? s - 1 : s, tpp, A);
+        read_ends(C, vx < 0 ? ON_DEM : ON_PAIR, y, vx < 0 ? s : s + 1, b, tpp, A);
+    } else {
+        read_ends(C, ON_DEM, y, a, b, tpp, A);
+    }
     if (C->bspline) {
 #pragma GCC ivdep
         for (int x = a; x <= b; x++)
