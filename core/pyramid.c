@@ -169,6 +169,8 @@ void ts_pyramid_free(ts_pyramid *pyr)
     free(pyr->level);
     free(pyr->side[0]);
     free(pyr->side[1]);
+    free(pyr->pair[0]);
+    free(pyr->pair[1]);
     free(pyr);
 }
 
@@ -178,7 +180,8 @@ static int reconstruct(ts_pyramid *P, const coarse *lv, int j, int threads, ts_e
     const int W = P->grid->width;
     int *idx = malloc((size_t)W * 4 * sizeof *idx);
     double *w = malloc((size_t)W * 4 * sizeof *w);
-    P->level[j].hu = malloc((size_t)lv->h * W * sizeof(float));
+    /* on cache lines: the run loops read whole vectors of a row */
+    P->level[j].hu = ts_pyr_alloc((size_t)lv->h * W * sizeof(float));
     if (!idx || !w || !P->level[j].hu) {
         free(idx);
         free(w);
@@ -229,10 +232,18 @@ ts_status ts_pyramid_build(const ts_grid *grid, const ts_pyramid_opts *opts, int
                         {malloc(most * sizeof(float)), malloc(most * sizeof(float))}};
     P->side[0] = malloc((size_t)H * sizeof(float));
     P->side[1] = malloc((size_t)H * sizeof(float));
-    int ok = buf[0][0] && buf[0][1] && buf[1][0] && buf[1][1] && P->side[0] && P->side[1];
+    P->pair[0] = malloc((size_t)2 * H * sizeof(float));
+    P->pair[1] = malloc((size_t)2 * H * sizeof(float));
+    int ok = buf[0][0] && buf[0][1] && buf[1][0] && buf[1][1] && P->side[0] && P->side[1] &&
+             P->pair[0] && P->pair[1];
     for (int y = 0; ok && y < H; y++) {
-        P->side[0][y] = grid->z[(ptrdiff_t)y * grid->stride];
-        P->side[1][y] = grid->z[(ptrdiff_t)y * grid->stride + W - 1];
+        const float *z = grid->z + (ptrdiff_t)y * grid->stride;
+        P->side[0][y] = z[0];
+        P->side[1][y] = z[W - 1];
+        P->pair[0][2 * y] = z[0];
+        P->pair[0][2 * y + 1] = z[W > 1];
+        P->pair[1][2 * y] = z[W > 1 ? W - 2 : 0];
+        P->pair[1][2 * y + 1] = z[W - 1];
     }
     for (int j = 1; ok && j < P->levels; j++) {
         double s = spacing(opts->level_step, j);

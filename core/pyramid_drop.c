@@ -50,32 +50,42 @@ static inline __attribute__((always_inline)) ptrdiff_t dem_index(int narrow, ptr
     return narrow ? k * (int)stride + i : k * stride + i;
 }
 
+/* How drop_read finds the DEM's corners at a ray's end. */
+enum {
+    ON_DEM,  /* anywhere: four reads of the DEM */
+    ON_SIDE, /* on a side column (vx = +-1): its copy, the neighbour has weight 0 */
+    ON_PAIR  /* between the two columns of a side: their copy (pyramid.c) */
+};
+
 /* The last samples at the ends tpp of the rays of cells [a, b] (tangents,
  * NaN where a ray ends at its cell), read bilinearly on the DEM, into A;
- * `on_col`: every end lies on a column (a side, vx = +-1), whose
- * neighbour has weight 0 and is not read. */
+ * `where`: how the corners are read; `flat`: every row has the same step
+ * (C->step_all; a projected grid), no look-up by row. */
 static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int narrow,
-                                                            int on_col, int y, int a, int b,
-                                                            const double *restrict tpp,
+                                                            int where, int flat, int y, int a,
+                                                            int b, const double *restrict tpp,
                                                             float *restrict A)
 {
     /* on a column: the pyramid's copy of that side of the DEM, read down */
-    const float *restrict col = C->P->side[C->vx > 0];
+    const float *restrict col = C->P->side[C->vx > 0], *restrict pair = C->P->pair[C->vx > 0];
     const ts_grid *g = C->P->grid;
-    const int W = g->width, H = g->height;
+    const int W = g->width, H = g->height, pair0 = C->vx > 0 ? W - 2 : 0;
     const float *restrict z = g->z, *restrict zrow = g->z + (ptrdiff_t)y * g->stride;
     const double *restrict step = C->step;
     const ptrdiff_t stride = g->stride;
-    const double vy = C->vy, c = C->c;
+    const double vy = C->vy, c = C->c, step_all = C->step_all;
     for (int x = a; x <= b; x++) {
         double t = tpp[x], px = tpp[W + x], py = tpp[2 * W + x];
         int i = (int)px, k = (int)py;
         float fx = (float)(px - i), fy = (float)(py - k);
         int i1 = i + 1 < W ? i + 1 : i, k1 = k + 1 < H ? k + 1 : k;
         float z00, z01, z10, z11;
-        if (on_col) {
+        if (where == ON_SIDE) {
             z00 = z01 = col[k];
             z10 = z11 = col[k1];
+        } else if (where == ON_PAIR) { /* i is pair0 or (right side) W - 1 = i1 */
+            z00 = pair[2 * k + (i - pair0)], z01 = pair[2 * k + 1];
+            z10 = pair[2 * k1 + (i - pair0)], z11 = pair[2 * k1 + 1];
         } else {
             z00 = z[dem_index(narrow, stride, k, i)], z01 = z[dem_index(narrow, stride, k, i1)];
             z10 = z[dem_index(narrow, stride, k1, i)], z11 = z[dem_index(narrow, stride, k1, i1)];
@@ -88,16 +98,63 @@ static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int
         float bot = fx > 0 ? bot_i : z10;
         float h_i = top + fy * (bot - top);
         float h = fy > 0 ? h_i : top;
-        int row = (int)(y + t * vy / 2 + 0.5);
-        row = row < 0 ? 0 : row;
-        row = row > H - 1 ? H - 1 : row;
-        double d = t * step[row];
+        double d;
+        if (flat) {
+            d = t * step_all;
+        } else {
+            int row = (int)(y + t * vy / 2 + 0.5);
+            row = row < 0 ? 0 : row;
+            row = row > H - 1 ? H - 1 : row;
+            d = t * step[row];
+        }
         float tan_w = (float)((h - zrow[x]) / d - c * d);
         A[x] = tan_w;
     }
     /* apart: a select in the loop above becomes a branch around tan_w */
     for (int x = a; x <= b; x++)
         A[x] = tpp[x] > 1e-9 ? A[x] : NAN;
+}
+
+/* The cells of [a, b] whose ends px lie between the columns of the side
+ * that rays of direction vx leave through, [W - 2, W - 1] (vx > 0) or
+ * [0, 1) (vx < 0: column 1 itself would need column 2): those that leave
+ * through the side, a suffix (vx > 0) or a prefix of the run; the rest
+ * end at the row's reach (t_row) within the grid. Returns the first cell
+ * after the prefix (vx < 0) or the last before the suffix (vx > 0). */
+static inline int pair_part(const double *restrict px, int a, int b, double vx, double lim)
+{
+    if (vx < 0) {
+        while (a <= b && px[a] < 1)
+            a++;
+        return a;
+    }
+    while (b >= a && px[b] >= lim - 1)
+        b--;
+    return b;
+}
+
+/* drop_read for the cells of [a, b] (none when a > b), its constant
+ * arguments dispatched. */
+static inline __attribute__((always_inline)) void read_ends(const hz_ctx *C, int where, int y,
+                                                            int a, int b,
+                                                            const double *restrict tpp,
+                                                            float *restrict A)
+{
+    const ts_grid *g = C->P->grid;
+    int flat = C->step_all > 0;
+    if (a > b)
+        return;
+    if ((double)g->stride * g->height > INT_MAX)
+        drop_read(C, 0, ON_DEM, 0, y, a, b, tpp, A);
+    else if (where == ON_SIDE)
+        flat ? drop_read(C, 1, ON_SIDE, 1, y, a, b, tpp, A)
+             : drop_read(C, 1, ON_SIDE, 0, y, a, b, tpp, A);
+    else if (where == ON_PAIR)
+        flat ? drop_read(C, 1, ON_PAIR, 1, y, a, b, tpp, A)
+             : drop_read(C, 1, ON_PAIR, 0, y, a, b, tpp, A);
+    else
+        flat ? drop_read(C, 1, ON_DEM, 1, y, a, b, tpp, A)
+             : drop_read(C, 1, ON_DEM, 0, y, a, b, tpp, A);
 }
 
 /* The last sample A[x] of each cell of [a, b], its sample number jd[x]
@@ -164,16 +221,17 @@ void ts_pyr_drop_cells(const hz_ctx *C, row_ws *w, int y, int a, int b, double t
     else
         drop_ends(C, 0, y, a, b, t_row, tpp);
     /* x-major rays that all end on their side (not earlier, at t_row) end
-     * on a whole column: x + (lim - x) or x - x, exactly */
+     * on a whole column: x + (lim - x) or x - x, exactly; other rays that
+     * leave through a side end between the two columns of its pair */
     const double lim = g->width - 1;
-    int on_col = (vx == 1.0 && lim - a <= t_row) || (vx == -1.0 && b <= t_row);
-    if ((double)g->stride * g->height <= INT_MAX) {
-        if (on_col)
-            drop_read(C, 1, 1, y, a, b, tpp, A);
-        else
-            drop_read(C, 1, 0, y, a, b, tpp, A);
+    if ((vx == 1.0 && lim - a <= t_row) || (vx == -1.0 && b <= t_row)) {
+        read_ends(C, ON_SIDE, y, a, b, tpp, A);
+    } else if (vx != 0 && g->width >= 2) {
+        int s = pair_part(tpp + g->width, a, b, vx, lim);
+        read_ends(C, vx < 0 ? ON_PAIR : ON_DEM, y, a, vx < 0 ? s - 1 : s, tpp, A);
+        read_ends(C, vx < 0 ? ON_DEM : ON_PAIR, y, vx < 0 ? s : s + 1, b, tpp, A);
     } else {
-        drop_read(C, 0, 0, y, a, b, tpp, A);
+        read_ends(C, ON_DEM, y, a, b, tpp, A);
     }
     if (C->bspline) {
 #pragma GCC ivdep

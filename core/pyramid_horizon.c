@@ -231,6 +231,10 @@ static void row_finish(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const 
 typedef struct {
     int n;
     const hz_ctx *az; /* n */
+    /* whether two azimuths have the same vy: only such can read a level at
+     * the same rows with the same weights (share_level_row; an x-major
+     * batch has none, and its test would fail at every level) */
+    int share;
 } batch_ctx;
 
 /* Whether two entries read the same level rows with the same weights. */
@@ -303,7 +307,8 @@ static void batch_row(const batch_ctx *B, row_ws *w, int y, int c0, int c1,
             ts_pyr_combine_rows(rl[0][j].r, rl[0][j].wr, 4, lo, hi, R);
             Rj = R;
         }
-        share_level_row(B, w, rl, run, j, Tsh);
+        if (B->share)
+            share_level_row(B, w, rl, run, j, Tsh);
         int active = 0;
         for (int a = 0; a < B->n; a++) {
             row_sample(&B->az[a], &w[a], y, j, &rl[a][j], Rj, R0, &run[a]);
@@ -321,11 +326,14 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
     (void)worker;
     const batch_ctx *B = ctx;
     const int n = B->n, W = B->az[0].P->grid->width, levels = B->az[0].P->levels;
-    /* per azimuth s0, s1, s2, m: W each; T and the samples: W + 1 each */
-    float *buf = malloc((size_t)n * (6 * W + 2) * sizeof *buf);
-    float *own = malloc((size_t)3 * W * sizeof *own + sizeof *own);
-    double *tpp = malloc((size_t)3 * W * sizeof *tpp);
-    int *jd = malloc((size_t)n * W * sizeof *jd);
+    /* per azimuth s0, s1, s2, m, T and the samples (T and the samples
+     * W + 1), each on a cache line as the level rows (ts_pyr_alloc): the
+     * runs' vectors then lie within a line where a run starts on one */
+    const size_t P = ((size_t)W + 1 + 15) / 16 * 16;
+    float *buf = ts_pyr_alloc((size_t)n * 6 * P * sizeof *buf);
+    float *own = ts_pyr_alloc(3 * P * sizeof *own);
+    double *tpp = ts_pyr_alloc(3 * P * sizeof *tpp);
+    int *jd = ts_pyr_alloc((size_t)n * P * sizeof *jd);
     row_level *rl = malloc((size_t)n * ROW_BLOCK * levels * sizeof *rl);
     row_ws w[TS_PYRAMID_BATCH];
     if (!buf || !own || !tpp || !jd || !rl) {
@@ -338,9 +346,9 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
         return;
     }
     for (int a = 0; a < n; a++) {
-        float *f = buf + (size_t)a * (6 * W + 2);
-        w[a] = (row_ws){f, f + W, f + 2 * W, f + 3 * W, f + 4 * W, f + 5 * W + 1, tpp,
-                        jd + (size_t)a * W, NULL, 1, 0};
+        float *f = buf + (size_t)a * 6 * P;
+        w[a] = (row_ws){f, f + P, f + 2 * P, f + 3 * P, f + 4 * P, f + 5 * P, tpp,
+                        jd + (size_t)a * P, NULL, 1, 0};
     }
     for (long yb = y0; yb < y1; yb += ROW_BLOCK) {
         long ye = yb + ROW_BLOCK < y1 ? yb + ROW_BLOCK : y1;
@@ -357,7 +365,7 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
                 const row_level *rly[TS_PYRAMID_BATCH];
                 for (int a = 0; a < n; a++)
                     rly[a] = &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels];
-                batch_row(B, w, (int)y, c0, c1, rly, own, own + W, own + 2 * W);
+                batch_row(B, w, (int)y, c0, c1, rly, own, own + P, own + 2 * P);
             }
         }
     }
@@ -399,7 +407,7 @@ static int az_ctx_init(const ts_pyramid *pyr, double azimuth, const ts_horizon_o
     if (fabs(ca) < 1e-12) ca = 0;
     double gx = sa / ts_grid_cell_x(g, H / 2), gy = -ca / g->cell_y;
     double major = fabs(gx) > fabs(gy) ? fabs(gx) : fabs(gy);
-    *C = (hz_ctx){pyr, gx / major, gy / major, NULL, 0, 0, 0, 0, NULL, out, failed};
+    *C = (hz_ctx){pyr, gx / major, gy / major, NULL, 0, 0, 0, 0, 0, NULL, out, failed};
     C->step = malloc((size_t)H * sizeof *C->step);
     level_az *lv = malloc((size_t)pyr->levels * sizeof *lv);
     C->lv = lv;
@@ -407,6 +415,9 @@ static int az_ctx_init(const ts_pyramid *pyr, double azimuth, const ts_horizon_o
         return 0;
     for (int y = 0; y < H; y++)
         C->step[y] = hypot(ts_grid_cell_x(g, y) * C->vx, g->cell_y * C->vy);
+    C->step_all = C->step[0];
+    for (int y = 1; y < H; y++)
+        C->step_all = C->step[y] == C->step[0] ? C->step_all : 0;
     C->c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
     C->cap = opts->max_distance;
     C->ko = pyr->opts.level_step * pyr->opts.offset;
@@ -440,7 +451,10 @@ ts_status ts_pyramid_horizons(const ts_pyramid *pyr, int count, const double *az
     for (; ok && k < count; k++)
         ok = az_ctx_init(pyr, az[k], opts, out[k], &failed, &C[k]);
     if (ok) {
-        batch_ctx B = {count, C};
+        batch_ctx B = {count, C, 0};
+        for (int a = 0; a < count; a++)
+            for (int b = a + 1; b < count; b++)
+                B.share |= C[a].vy == C[b].vy;
         st = ts_parallel_for(ts_thread_count(opts->threads, g->height), g->height, rows_range,
                              &B, err);
     }

@@ -21,6 +21,7 @@ typedef struct {
     const ts_pyramid *P;
     double vx, vy;      /* ray direction, DEM cells per step (major component +-1) */
     double *step;       /* metres per step, by row */
+    double step_all;    /* the step of every row where they are all equal, else 0 */
     double c;           /* curvature coefficient (1 - k) / 2R, 0 when off */
     double cap;         /* maximum distance in metres, 0 = none */
     double ko;          /* level offset k o */

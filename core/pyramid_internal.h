@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <stdlib.h>
 
 #include "terrashade.h"
 
@@ -30,7 +31,18 @@ struct ts_pyramid {
      * that leave through a side end there (pyramid_drop.c), and a column
      * read down the DEM's rows misses the cache (and the TLB) at every row */
     float *side[2];
+    /* the pairs of columns 0, 1 and W - 2, W - 1, interleaved by row (2 H
+     * floats each; W >= 2): the y-major rays that leave through a side end
+     * between the two columns of its pair */
+    float *pair[2];
 };
+
+/* n bytes on a 64-byte boundary (a cache line, an AVX-512 vector): a
+ * vector load or store across two lines costs about two; free() frees. */
+static inline void *ts_pyr_alloc(size_t n)
+{
+    return aligned_alloc(64, (n + 63) / 64 * 64);
+}
 
 /* Row r of level j, `width` floats (a DEM row for level 0). */
 static inline const float *ts_pyr_row(const ts_pyramid *p, int j, int r)

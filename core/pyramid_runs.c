@@ -9,10 +9,20 @@
 #include "cellmath/cm_fastmath.h"
 #include "pyramid_hz.h"
 
-/* dst[x] = sum of weights w[t] * rows r[t] at x, for x in [x0, x1]. */
-TS_SIMD_CLONES
-void ts_pyr_combine_rows(const float *const r[4], const float w[4], int taps, int x0, int x1,
-                         float *restrict dst)
+/* The first cell from x0 on whose vector starts a cache line (16
+ * floats; the buffers are on lines, ts_pyr_alloc), at most x1 + 1: a run
+ * is looped as its head [x0, that - 1] and its body, so that the body's
+ * vectors at x do not straddle two lines (the vectoriser does not peel
+ * for that by itself). */
+static inline int line_start(int x0, int x1)
+{
+    int a = (x0 + 15) & ~15;
+    return a < x1 + 1 ? a : x1 + 1;
+}
+
+static inline __attribute__((always_inline)) void
+combine_span(const float *const r[4], const float w[4], int taps, int x0, int x1,
+             float *restrict dst)
 {
     const float *r0 = r[0];
     const float w0 = w[0];
@@ -35,6 +45,16 @@ void ts_pyr_combine_rows(const float *const r[4], const float w[4], int taps, in
 #pragma GCC ivdep
     for (int x = x0; x <= x1; x++)
         dst[x] = w0 * r0[x] + w1 * r1[x] + w2 * r2[x] + w3 * r3[x];
+}
+
+/* dst[x] = sum of weights w[t] * rows r[t] at x, for x in [x0, x1]. */
+TS_SIMD_CLONES
+void ts_pyr_combine_rows(const float *const r[4], const float w[4], int taps, int x0, int x1,
+                         float *restrict dst)
+{
+    int a = line_start(x0, x1);
+    combine_span(r, w, taps, x0, a - 1, dst);
+    combine_span(r, w, taps, a, x1, dst);
 }
 
 /* spline_push on the state of cell x. */
@@ -89,10 +109,9 @@ void ts_pyr_push_run(row_ws *w, int bspline, int c, int x0, int x1, const float 
  * R, at d metres (1 / d = inv_d, curvature drop over d
  * = cd). Pushed as sample c in the same pass where the spline allows,
  * else left in w->A for push_run (returns 0 then). */
-TS_SIMD_CLONES
-int ts_pyr_level_run(row_ws *w, const float *restrict T, int ix, float fx,
-                     const float *restrict R, float inv_d, float cd, int bspline, int c, int x0,
-                     int x1)
+static inline __attribute__((always_inline)) int
+level_span(row_ws *w, const float *restrict T, int ix, float fx, const float *restrict R,
+           float inv_d, float cd, int bspline, int c, int x0, int x1)
 {
     float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
     float *restrict m = w->m, *restrict A = w->A;
@@ -102,7 +121,7 @@ int ts_pyr_level_run(row_ws *w, const float *restrict T, int ix, float fx,
 #pragma GCC ivdep
         for (int x = x0; x <= x1; x++) {
             float h = gx * Ta[x] + fx * Ta[x + 1];
-                spline_step(s0, s1, s2, m, x, ts_atan_deg((h - R[x]) * inv_d - cd));
+            spline_step(s0, s1, s2, m, x, ts_atan_deg((h - R[x]) * inv_d - cd));
         }
         return 1;
     }
@@ -110,7 +129,7 @@ int ts_pyr_level_run(row_ws *w, const float *restrict T, int ix, float fx,
 #pragma GCC ivdep
         for (int x = x0; x <= x1; x++) {
             float h = gx * Ta[x] + fx * Ta[x + 1];
-                float t = (h - R[x]) * inv_d - cd;
+            float t = (h - R[x]) * inv_d - cd;
             m[x] = t > m[x] ? t : m[x];
         }
         return 1;
@@ -121,6 +140,16 @@ int ts_pyr_level_run(row_ws *w, const float *restrict T, int ix, float fx,
         A[x] = ts_atan_deg((h - R[x]) * inv_d - cd);
     }
     return 0;
+}
+
+TS_SIMD_CLONES
+int ts_pyr_level_run(row_ws *w, const float *restrict T, int ix, float fx,
+                     const float *restrict R, float inv_d, float cd, int bspline, int c, int x0,
+                     int x1)
+{
+    int a = line_start(x0, x1);
+    level_span(w, T, ix, fx, R, inv_d, cd, bspline, c, x0, a - 1);
+    return level_span(w, T, ix, fx, R, inv_d, cd, bspline, c, a, x1);
 }
 
 /* The horizons of cells [x0, x1] after `count` >= 1 samples, into out. */
