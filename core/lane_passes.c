@@ -33,12 +33,6 @@ sample_run(const float *restrict zk, ptrdiff_t vs, float F, int j0, int j1, int 
 #if defined(__GNUC__) && defined(__x86_64__)
 #include <immintrin.h>
 
-/* The first n of sixteen lanes: none for n <= 0, all for n >= 16. */
-static inline __mmask16 first_lanes16(int n)
-{
-    return n >= 16 ? 0xFFFF : n <= 0 ? 0 : (__mmask16)((1u << n) - 1);
-}
-
 /* sample_run with the lines' cells vs apart, sixteen lines at a time with
  * gathers (gcc's clones load the cells one by one), or plain loads where
  * vs = 1 (gcc's copy of the row's cells is a call to memmove); the same
@@ -49,7 +43,7 @@ TS_AVX512 static void sample_avx512(const float *zk, int vs, float F, int j0, in
     const __m512i step = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
     const __m512 nan = _mm512_set1_ps((float)NAN), f = _mm512_set1_ps(F);
     for (int j = j0; j <= j1; j += 16) {
-        const __mmask16 lanes = first_lanes16(j1 - j + 1);
+        const __mmask16 lanes = ts_first_lanes16(j1 - j + 1);
         const __m512i at = _mm512_mullo_epi32(_mm512_add_epi32(_mm512_set1_epi32(j), step),
                                               _mm512_set1_epi32(vs));
         /* along rows (vs = 1) the cells are contiguous: plain loads */
@@ -62,7 +56,7 @@ TS_AVX512 static void sample_avx512(const float *zk, int vs, float F, int j0, in
             continue;
         }
         /* the lines with a next cell */
-        const __mmask16 next = lanes & first_lanes16(jn - j + 1);
+        const __mmask16 next = lanes & ts_first_lanes16(jn - j + 1);
         const __m512i at_n = _mm512_add_epi32(at, _mm512_set1_epi32(vs));
         const __m512 n = vs == 1 ? _mm512_mask_loadu_ps(nan, next, zk + j + 1)
                                  : _mm512_mask_i32gather_ps(nan, next, at_n, zk, 4);
@@ -221,7 +215,7 @@ TS_AVX512 static void far_run32_avx512(FAR_PARAMS, int ostride)
     const __m512i kv = _mm512_set1_epi32(k), step = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8,
                                                                      9, 10, 11, 12, 13, 14, 15);
     for (int j = j0; j <= j1; j += 16) {
-        const __mmask16 lanes = first_lanes16(j1 - j + 1);
+        const __mmask16 lanes = ts_first_lanes16(j1 - j + 1);
         const __m512 h = _mm512_maskz_loadu_ps(lanes, hc + j);
         const __m512i i = _mm512_add_epi32(_mm512_set1_epi32(i0 + j), step);
         const __m512i kl = _mm512_maskz_loadu_epi32(lanes, lo_k + j);

@@ -32,11 +32,6 @@ float ts_near_fast_cell(const ts_near_plan *p, const float *zrow, int x, float L
 #if defined(__GNUC__) && defined(__x86_64__)
 #include <immintrin.h>
 
-static inline __mmask16 first16(int n)
-{
-    return n >= 16 ? 0xFFFF : n <= 0 ? 0 : (__mmask16)((1u << n) - 1);
-}
-
 /* The peaks of one piece's queued cells (n of them: cells x = qx[e], whose
  * P, beta, gamma are qP[x], qb[x], qg[x]) by cm_fast_piece_slope's float
  * operations: where the peak lies inside the piece, best[x] = fs > best[x]
@@ -52,7 +47,7 @@ TS_AVX512 static int piece_peaks(const cm_fast_piece *q, float L, float c, const
     const __m512 cv = _mm512_set1_ps(c), Lv = _mm512_set1_ps(L);
     const __m512 sa = _mm512_set1_ps(q->sa), sb = _mm512_set1_ps(q->sb);
     for (int e = 0; e < n; e += 16) {
-        const __mmask16 lanes = first16(n - e);
+        const __mmask16 lanes = ts_first_lanes16(n - e);
         const __m512i x = _mm512_maskz_loadu_epi32(lanes, qx + e);
         const __m512 P = _mm512_mask_i32gather_ps(zero, lanes, x, qP, 4);
         const __m512 beta = _mm512_mask_i32gather_ps(zero, lanes, x, qb, 4);
@@ -120,7 +115,7 @@ TS_AVX512 static void run(const ts_near_plan *p, const float *restrict zrow, int
         const __m512 tiny = _mm512_set1_ps(-0x1p-60f);
         int nq = 0;
         for (int x = x0; x < x1; x += 16) {
-            const __mmask16 lanes = first16(x1 - x);
+            const __mmask16 lanes = ts_first_lanes16(x1 - x);
             const __m512 h0 = _mm512_maskz_loadu_ps(lanes, c00 + x);
             const __m512 h1 = _mm512_maskz_loadu_ps(lanes, c10 + x);
             const __m512 h2 = _mm512_maskz_loadu_ps(lanes, c01 + x);

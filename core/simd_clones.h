@@ -16,6 +16,14 @@
  * called only where ts_lane_vector_level() says the CPU has it. */
 #if defined(__GNUC__) && defined(__x86_64__)
 #define TS_AVX512 __attribute__((target("avx512f")))
+#include <immintrin.h>
+
+/* The first n of sixteen AVX-512 lanes: none for n <= 0, all for n >= 16
+ * (the mask of a vector's tail). */
+static inline __mmask16 ts_first_lanes16(int n)
+{
+    return n >= 16 ? 0xFFFF : n <= 0 ? 0 : (__mmask16)((1u << n) - 1);
+}
 #endif
 
 #endif
