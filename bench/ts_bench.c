@@ -139,13 +139,13 @@ int main(int argc, char **argv)
            "generated in %.2f s\n", size, size, relief, cell, now() - t0);
     if (latitude == latitude) {
         double *cx = malloc((size_t)size * sizeof *cx);
-        const double deg = cell / 111320.0; /* a row's span in latitude */
-        for (int y = 0; y < size; y++) /* (row 0: the northern edge) */
-            cx[y] = cell * cos((latitude + (size / 2 - y) * deg) * M_PI / 180.0);
         if (!cx) {
             fprintf(stderr, "ts_bench: out of memory\n");
             return 1;
         }
+        const double deg = cell / 111320.0; /* a row's span in latitude */
+        for (int y = 0; y < size; y++) /* (row 0: the northern edge) */
+            cx[y] = cell * cos((latitude + (size / 2 - y) * deg) * M_PI / 180.0);
         if (ts_grid_set_row_spacing(&g, cx, &e))
             die("row spacing", &e);
         free(cx);
