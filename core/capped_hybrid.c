@@ -14,8 +14,6 @@
  * a sample still in the near field hide older ones, ~100 steps of them on
  * fractal terrain.)
  */
-#include <math.h>
-
 #include "capped_lanes.h"
 #include "capped_lanes512.h"
 
@@ -41,10 +39,8 @@ int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_l
         r->hull_lost = 1;
         return 0;
     }
-    double *rd = r->d + (size_t)(k % r->slots) * r->stride;
-    double *rg = r->g + (size_t)(k % r->slots) * r->stride;
-    for (int j = 0; j < nl; j++)
-        rd[j] = NAN;
+    double *rd, *rg;
+    ts_cap_ring_slot(r, k, nl, &rd, &rg);
     const int g0 = j0 / 8 * 8, g1 = (j1 + 8) / 8 * 8;
     ts_cap_queries512(r, s, g0, g1);
     /* the hull's answers, where they are the window's; the groups of eight

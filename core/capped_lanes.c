@@ -36,6 +36,9 @@ static void *zalloc(size_t n)
 #ifndef PRUNE_TO
 #define PRUNE_TO 256
 #endif
+/* The prune's margin (capped_lanes512.c) holds for windows of up to this
+ * many lags. */
+#define PRUNE_MAX_LAGS 100000
 #ifndef PRUNE_FROM
 #define PRUNE_FROM 64
 #endif
@@ -55,9 +58,8 @@ int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, const int lags[4], double nea
     r->slots = r->groups[0] * TS_CAP_G0;
     r->near = near;
     r->cap = cap;
-    /* (the prune's margin holds for windows of up to 10^5 samples) */
     r->prune = ts_lane_vector_level() == 2 && r->lag_hi - r->lag_lo + 1 >= PRUNE_FROM &&
-               r->lag_hi <= 100000;
+               r->lag_hi <= PRUNE_MAX_LAGS;
     /* (and a spare slot, never written: the pruned scan's padding) */
     const size_t ring = (size_t)(r->slots + 1) * r->stride * sizeof(double);
     const size_t line = (size_t)r->stride * sizeof(double);
@@ -220,11 +222,11 @@ int ts_cap_lanes_hybrid_pays(const int lags[4])
 {
     /* measured (docs/performance.md, "Bounded sweep: unbounded hull first"):
      * 0.80-0.89x the line-by-line window's CPU time at 300-2000 lags. The
-     * ring's pruned scan holds for windows of up to 10^5 lags; the hulls
+     * ring's pruned scan holds for windows of up to PRUNE_MAX_LAGS; the hulls
      * take the samples lags[0] steps back, which must be surely beyond the
      * near field (lines of equal steps). */
     return ts_lane_vector_level() == 2 && lags[1] - lags[0] + 1 >= PRUNE_FROM &&
-           lags[1] <= 100000 && lags[2] <= lags[0];
+           lags[1] <= PRUNE_MAX_LAGS && lags[2] <= lags[0];
 }
 
 static void scan_groups(const ts_cap_lanes *r, int k, int g0, int g1)
@@ -258,15 +260,22 @@ static void scan_groups(const ts_cap_lanes *r, int k, int g0, int g1)
 }
 #endif
 
+void ts_cap_ring_slot(ts_cap_lanes *r, int k, int nl, double **rd, double **rg)
+{
+    const size_t at = (size_t)(k % r->slots) * r->stride;
+    *rd = r->d + at;
+    *rg = r->g + at;
+    for (int j = 0; j < nl; j++)
+        (*rd)[j] = NAN;
+}
+
 void ts_cap_lanes_step(ts_cap_lanes *r, const ts_lane_step *s, int nl,
                        const ts_lane_occluders *occ)
 {
     const int k = s->k, j0 = s->j0, j1 = s->j1;
     const double c = s->c;
-    double *rd = r->d + (size_t)(k % r->slots) * r->stride;
-    double *rg = r->g + (size_t)(k % r->slots) * r->stride;
-    for (int j = 0; j < nl; j++)
-        rd[j] = NAN;
+    double *rd, *rg;
+    ts_cap_ring_slot(r, k, nl, &rd, &rg);
     r->hull_lost = 1; /* (a step a hybrid's hulls did not take) */
     if (j0 <= j1) {
         const int g0 = j0 / 8 * 8, g1 = (j1 + 8) / 8 * 8;

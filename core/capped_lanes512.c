@@ -177,11 +177,23 @@ prune_threshold(const ts_cap_lanes *r, int k, int lag_hi, int j, const scan512 *
     *idle = (__mmask8)~has;
 }
 
+/* The lines of group q (entry at of level l's groups, at the group of
+ * lines) for which the group may hold a sample at least as steep as the
+ * threshold: unless gmax + T dsel < gmin + T d (above: rhs) or the line
+ * has no query, dsel the group's newest distance where T >= 0, its oldest
+ * where T < 0 (neg). */
+TS_AVX512 static inline __attribute__((always_inline)) __mmask8
+group_may_hold(const ts_cap_lanes *r, int l, size_t at, int q, const __m512d *thr,
+               const __m512d *rhs, const __mmask8 *neg, const __mmask8 *idle)
+{
+    const __m512d dsel =
+        _mm512_mask_load_pd(_mm512_load_pd(r->dhi[l] + at), neg[q], r->dlo[l] + at);
+    const __m512d lhs = _mm512_fmadd_pd(thr[q], dsel, _mm512_load_pd(r->gmax[l] + at));
+    return (__mmask8)~(_mm512_cmp_pd_mask(lhs, rhs[q], _CMP_LT_OQ) | idle[q]);
+}
+
 /* The ng groups of lines from g (bit q: group q) for which group idx of
- * level l may hold a sample at least as steep as the threshold: unless
- * gmax + T dsel < gmin + T d (above: rhs) on each of its lines with a
- * query, dsel the group's newest distance where T >= 0, its oldest where
- * T < 0 (neg). */
+ * level l may hold such a sample on some line (group_may_hold). */
 TS_AVX512 static inline __attribute__((always_inline)) unsigned
 groups_needed(const ts_cap_lanes *r, int l, int idx, int g, int ng, const __m512d *thr,
               const __m512d *rhs, const __mmask8 *neg, const __mmask8 *idle)
@@ -191,11 +203,7 @@ groups_needed(const ts_cap_lanes *r, int l, int idx, int g, int ng, const __m512
     for (int q = 0; q < NG; q++) {
         if (q >= ng)
             break;
-        const __m512d dsel = _mm512_mask_load_pd(_mm512_load_pd(r->dhi[l] + at + 8 * q), neg[q],
-                                                 r->dlo[l] + at + 8 * q);
-        const __m512d lhs = _mm512_fmadd_pd(thr[q], dsel, _mm512_load_pd(r->gmax[l] + at + 8 * q));
-        need |= (unsigned)(((__mmask8)~(_mm512_cmp_pd_mask(lhs, rhs[q], _CMP_LT_OQ) | idle[q])) != 0)
-                << q;
+        need |= (unsigned)(group_may_hold(r, l, at + 8 * q, q, thr, rhs, neg, idle) != 0) << q;
     }
     return need;
 }
@@ -260,7 +268,7 @@ _Static_assert(TS_CAP_G0 <= 8 && TS_CAP_G1 / TS_CAP_G0 <= 8,
 
 /* Which of the count level-0 groups from entry idx0 on (at most the
  * TS_CAP_G1 / TS_CAP_G0 of a level-1 group) group q of lines from g needs
- * (bit i: the i-th), by groups_needed's test. */
+ * (bit i: the i-th), by group_may_hold. */
 TS_AVX512 static inline __attribute__((always_inline)) unsigned
 level0_needed(const ts_cap_lanes *r, int idx0, int count, int g, int q, const __m512d *thr,
               const __m512d *rhs, const __mmask8 *neg, const __mmask8 *idle)
@@ -269,11 +277,7 @@ level0_needed(const ts_cap_lanes *r, int idx0, int count, int g, int q, const __
     int idx = idx0;
     for (int i = 0; i < count; i++) {
         const size_t at = (size_t)idx * r->stride + g + 8 * q;
-        const __m512d dsel =
-            _mm512_mask_load_pd(_mm512_load_pd(r->dhi[0] + at), neg[q], r->dlo[0] + at);
-        const __m512d lhs = _mm512_fmadd_pd(thr[q], dsel, _mm512_load_pd(r->gmax[0] + at));
-        any |= (unsigned long long)(__mmask8)~(_mm512_cmp_pd_mask(lhs, rhs[q], _CMP_LT_OQ) | idle[q])
-               << (8 * i);
+        any |= (unsigned long long)group_may_hold(r, 0, at, q, thr, rhs, neg, idle) << (8 * i);
         idx = idx + 1 == r->groups[0] ? 0 : idx + 1;
     }
     return nonzero_bytes(any);

@@ -12,9 +12,6 @@
 #define DEG2RAD (M_PI / 180.0)
 #define RAD2DEG (180.0 / M_PI)
 
-typedef ts_edge_ray edge_ray;
-typedef ts_edge_job edge_job;
-
 /* The tangent of the elevation of the highest sea-level point over s in
  * [s0, s1] seen from height h, for a drop c s^2 (c = 0: no curvature). */
 static inline double edge_tangent(double h, double s0, double s1, double c)
@@ -42,7 +39,7 @@ double ts_edge_horizon(double height_m, double edge_m, const ts_horizon_opts *op
     return atan(edge_tangent(height_m, edge_m, s1, c)) * RAD2DEG;
 }
 
-static edge_ray edge_ray_of(const ts_grid *grid, double azimuth)
+static ts_edge_ray edge_ray_of(const ts_grid *grid, double azimuth)
 {
     double a = azimuth * DEG2RAD;
     double sa = sin(a), ca = cos(a);
@@ -50,14 +47,14 @@ static edge_ray edge_ray_of(const ts_grid *grid, double azimuth)
     if (fabs(ca) < 1e-12) ca = 0;
     double cx = grid->origin ? grid->origin->ref_cell_x : ts_grid_cell_x(grid, grid->height / 2);
     double gx = sa / cx, gy = -ca / grid->cell_y;
-    edge_ray r = {gx != 0 ? 1.0 / fabs(gx) : INFINITY, gy != 0 ? 1.0 / fabs(gy) : INFINITY,
+    ts_edge_ray r = {gx != 0 ? 1.0 / fabs(gx) : INFINITY, gy != 0 ? 1.0 / fabs(gy) : INFINITY,
                   gx > 0, gy > 0};
     return r;
 }
 
 /* Metres from the centre of cell (x, y) to the grid's outer boundary: the
  * larger DEM's for a window, whose own edges are not the world's. */
-static inline double edge_ray_distance(const edge_ray *r, const ts_grid *grid, int x, int y)
+static inline double edge_ray_distance(const ts_edge_ray *r, const ts_grid *grid, int x, int y)
 {
     const ts_grid_origin *o = grid->origin;
     double px = x + 0.5, py = y + 0.5; /* the grid is [0, W] x [0, H] */
@@ -75,14 +72,14 @@ static inline double edge_ray_distance(const edge_ray *r, const ts_grid *grid, i
 
 double ts_edge_distance(const ts_grid *grid, int x, int y, double azimuth)
 {
-    edge_ray r = edge_ray_of(grid, azimuth);
+    ts_edge_ray r = edge_ray_of(grid, azimuth);
     return edge_ray_distance(&r, grid, x, y);
 }
 
-static edge_job edge_job_of(const ts_grid *grid, double azimuth, const ts_horizon_opts *o,
+static ts_edge_job edge_job_of(const ts_grid *grid, double azimuth, const ts_horizon_opts *o,
                             float *plane, double sun_elevation)
 {
-    edge_job j = {grid, o, edge_ray_of(grid, azimuth),
+    ts_edge_job j = {grid, o, edge_ray_of(grid, azimuth),
                   o->max_distance > 0 ? o->max_distance : INFINITY,
                   o->curvature ? (1.0 - o->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0, plane,
                   sun_elevation, 0};
@@ -101,7 +98,7 @@ static inline double atan_deg_above(double t)
 }
 
 /* Horizon v of valid cell (x, y) with the world beyond the edge. */
-static inline float edge_raise(const edge_job *j, int x, int y, float v)
+static inline float edge_raise(const ts_edge_job *j, int x, int y, float v)
 {
     double s = edge_ray_distance(&j->ray, j->grid, x, y);
     if (j->opts->edge == TS_EDGE_NODATA)
@@ -138,7 +135,7 @@ static int row_needs_raise(const float *restrict row, const float *restrict z, i
     return need;
 }
 
-void ts_edge_row(const edge_job *j, int y)
+void ts_edge_row(const ts_edge_job *j, int y)
 {
     const int above_stays = j->opts->edge == TS_EDGE_HORIZON && j->c >= 0;
     float *row = j->plane + (size_t)y * j->grid->width;
@@ -157,7 +154,7 @@ static void edge_rows(void *ctx, int worker, long begin, long end)
         ts_edge_row(ctx, (int)y);
 }
 
-int ts_edge_rows_init(edge_job *j, const ts_grid *grid, double azimuth,
+int ts_edge_rows_init(ts_edge_job *j, const ts_grid *grid, double azimuth,
                       const ts_horizon_opts *opts, float *plane)
 {
     *j = edge_job_of(grid, azimuth, opts, plane, 0.0);
@@ -176,7 +173,7 @@ static inline float earth_floor(const ts_horizon_opts *o, float h, float v)
 static void sun_rows(void *ctx, int worker, long begin, long end)
 {
     (void)worker;
-    const edge_job *j = ctx;
+    const ts_edge_job *j = ctx;
     for (long y = begin; y < end; y++) {
         float *vis = j->plane + (size_t)y * j->grid->width;
         for (int x = 0; x < j->grid->width; x++) {
@@ -212,7 +209,7 @@ ts_status ts_horizon_edge_apply(const ts_grid *grid, double azimuth,
                        azimuth);
     if (opts->edge == TS_EDGE_OPEN)
         return ts_ok(err);
-    edge_job j = edge_job_of(grid, azimuth, opts, plane, 0.0);
+    ts_edge_job j = edge_job_of(grid, azimuth, opts, plane, 0.0);
     return ts_parallel_for(ts_thread_count(opts->threads, grid->height), grid->height,
                            edge_rows, &j, err);
 }
@@ -228,7 +225,7 @@ ts_status ts_horizon_edge_sun(const ts_grid *grid, double azimuth, double elevat
                        "within -90..90 degrees, got %g and %g", azimuth, elevation);
     if (opts->edge == TS_EDGE_OPEN)
         return ts_ok(err);
-    edge_job j = edge_job_of(grid, azimuth, opts, vis, elevation);
+    ts_edge_job j = edge_job_of(grid, azimuth, opts, vis, elevation);
     return ts_parallel_for(ts_thread_count(opts->threads, grid->height), grid->height,
                            sun_rows, &j, err);
 }
