@@ -167,8 +167,6 @@ void ts_pyramid_free(ts_pyramid *pyr)
     for (int j = 0; pyr->level && j < pyr->levels; j++)
         free(pyr->level[j].hu);
     free(pyr->level);
-    free(pyr->side[0]);
-    free(pyr->side[1]);
     free(pyr->pair[0]);
     free(pyr->pair[1]);
     free(pyr);
@@ -230,16 +228,11 @@ ts_status ts_pyramid_build(const ts_grid *grid, const ts_pyramid_opts *opts, int
                                 : 1;
     float *buf[2][2] = {{malloc(most * sizeof(float)), malloc(most * sizeof(float))},
                         {malloc(most * sizeof(float)), malloc(most * sizeof(float))}};
-    P->side[0] = malloc((size_t)H * sizeof(float));
-    P->side[1] = malloc((size_t)H * sizeof(float));
     P->pair[0] = malloc((size_t)2 * H * sizeof(float));
     P->pair[1] = malloc((size_t)2 * H * sizeof(float));
-    int ok = buf[0][0] && buf[0][1] && buf[1][0] && buf[1][1] && P->side[0] && P->side[1] &&
-             P->pair[0] && P->pair[1];
+    int ok = buf[0][0] && buf[0][1] && buf[1][0] && buf[1][1] && P->pair[0] && P->pair[1];
     for (int y = 0; ok && y < H; y++) {
         const float *z = grid->z + (ptrdiff_t)y * grid->stride;
-        P->side[0][y] = z[0];
-        P->side[1][y] = z[W - 1];
         P->pair[0][2 * y] = z[0];
         P->pair[0][2 * y + 1] = z[W > 1];
         P->pair[1][2 * y] = z[W > 1 ? W - 2 : 0];

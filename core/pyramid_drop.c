@@ -66,8 +66,9 @@ static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int
                                                             int b, const double *restrict tpp,
                                                             float *restrict A)
 {
-    /* on a column: the pyramid's copy of that side of the DEM, read down */
-    const float *restrict col = C->P->side[C->vx > 0], *restrict pair = C->P->pair[C->vx > 0];
+    /* on a column: the pyramid's copy of that side of the DEM, read down
+     * (the outer column of the pair: 0 on the left, W - 1 on the right) */
+    const float *restrict pair = C->P->pair[C->vx > 0], *restrict col = pair + (C->vx > 0);
     const ts_grid *g = C->P->grid;
     const int W = g->width, H = g->height, pair0 = C->vx > 0 ? W - 2 : 0;
     const float *restrict z = g->z, *restrict zrow = g->z + (ptrdiff_t)y * g->stride;
@@ -81,8 +82,8 @@ static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int
         int i1 = i + 1 < W ? i + 1 : i, k1 = k + 1 < H ? k + 1 : k;
         float z00, z01, z10, z11;
         if (where == ON_SIDE) {
-            z00 = z01 = col[k];
-            z10 = z11 = col[k1];
+            z00 = z01 = col[2 * k];
+            z10 = z11 = col[2 * k1];
         } else if (where == ON_PAIR) { /* i is pair0 or (right side) W - 1 = i1 */
             z00 = pair[2 * k + (i - pair0)], z01 = pair[2 * k + 1];
             z10 = pair[2 * k1 + (i - pair0)], z11 = pair[2 * k1 + 1];

@@ -27,13 +27,11 @@ struct ts_pyramid {
     ts_pyramid_opts opts;
     int levels;
     ts_pyr_level *level;
-    /* the DEM's first and last columns, H floats each: the x-major rays
-     * that leave through a side end there (pyramid_drop.c), and a column
-     * read down the DEM's rows misses the cache (and the TLB) at every row */
-    float *side[2];
-    /* the pairs of columns 0, 1 and W - 2, W - 1, interleaved by row (2 H
-     * floats each; W >= 2): the y-major rays that leave through a side end
-     * between the two columns of its pair */
+    /* the pairs of columns 0, 1 and W - 2, W - 1 (0, 0 and 0, 0 where
+     * W = 1), interleaved by row, 2 H floats each: the rays that leave
+     * through a side end on its outer column (x-major) or between its two
+     * (y-major), pyramid_drop.c; a column read down the DEM's rows misses
+     * the cache (and the TLB) at every row */
     float *pair[2];
 };
 
