@@ -32,7 +32,7 @@
 
 #define DEG2RAD (M_PI / 180.0)
 #ifndef CHUNK
-#define CHUNK 768 /* columns: the rows of every level a chunk reads stay in L2 */
+#define CHUNK 1024 /* columns: the rows of every level a chunk reads stay in L2 */
 #endif
 #define ROW_BLOCK 32 /* rows whose per-level entries are filled at a time */
 
