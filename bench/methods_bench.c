@@ -104,7 +104,7 @@ static const char *const NAMES[3] = {"exact", "pyramid (B-spline)", "pyramid (le
 
 /* Directions az[0..count) of method i into its planes and svf
  * accumulator: the sweep one at a time, the pyramid count at once (as the
- * driver does). */
+ * driver does, the svf summed as the rows are done). */
 static void run_method(int i, method *m, const ts_grid *g, const float *nx, const float *ny,
                        const float *nz, int count, const double *az, const ts_horizon_opts *o,
                        int dirs)
@@ -119,9 +119,12 @@ static void run_method(int i, method *m, const ts_grid *g, const float *nx, cons
     if (i == 0)
         for (int k = 0; st == TS_OK && k < count; k++)
             st = ts_horizon_sweep(g, az[k], o, planes[k], &err);
-    else
-        st = ts_pyramid_horizons(m->pyr, count, az, o, planes, &err);
-    for (int k = 0; st == TS_OK && k < count; k++)
+    else {
+        /* the svf summed row by row as the pyramid writes them */
+        ts_pyramid_sky sky = {nx, ny, nz, dirs, TS_SVF_RADIATIVE, m->svf_acc, NULL, NULL};
+        st = ts_pyramid_horizons_sky(m->pyr, count, az, o, &sky, planes, &err);
+    }
+    for (int k = 0; st == TS_OK && i == 0 && k < count; k++)
         st = ts_sky_accumulate(g, nx, ny, nz, planes[k], az[k], dirs, m->svf_acc, NULL, NULL,
                                &err);
     if (st != TS_OK)

@@ -135,16 +135,21 @@ static int row_needs_raise(const float *restrict row, const float *restrict z, i
     return need;
 }
 
-void ts_edge_row(const ts_edge_job *j, int y)
+void ts_edge_span(const ts_edge_job *j, int y, int x0, int x1)
 {
     const int above_stays = j->opts->edge == TS_EDGE_HORIZON && j->c >= 0;
     float *row = j->plane + (size_t)y * j->grid->width;
     const float *z = j->grid->z + (ptrdiff_t)y * j->grid->stride;
-    if (!row_needs_raise(row, z, j->grid->width, j->skip_nonneg, above_stays))
+    if (!row_needs_raise(row + x0, z + x0, x1 - x0, j->skip_nonneg, above_stays))
         return;
-    for (int x = 0; x < j->grid->width; x++)
+    for (int x = x0; x < x1; x++)
         if (!edge_stays(row[x], z[x], j->skip_nonneg, above_stays))
             row[x] = edge_raise(j, x, y, row[x]);
+}
+
+void ts_edge_row(const ts_edge_job *j, int y)
+{
+    ts_edge_span(j, y, 0, j->grid->width);
 }
 
 static void edge_rows(void *ctx, int worker, long begin, long end)

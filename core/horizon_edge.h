@@ -35,4 +35,8 @@ int ts_edge_rows_init(ts_edge_job *j, const ts_grid *grid, double azimuth,
 /* Row y of the job's plane, in degrees, with the world beyond the edge. */
 void ts_edge_row(const ts_edge_job *j, int y);
 
+/* The cells [x0, x1) of row y alone, as ts_edge_row does them (each cell
+ * on its own: a row done span by span has the same values). */
+void ts_edge_span(const ts_edge_job *j, int y, int x0, int x1);
+
 #endif

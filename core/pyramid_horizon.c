@@ -24,13 +24,15 @@
 #include <stdlib.h>
 
 #include "arg_checks.h"
+#include "horizon_edge.h"
 #include "parallel.h"
 #include "pyramid_hz.h"
+#include "sky_plane.h"
 #include "status_internal.h"
 
 #define DEG2RAD (M_PI / 180.0)
 #ifndef CHUNK
-#define CHUNK 768 /* columns: the rows of every level a chunk reads stay in L2 */
+#define CHUNK 1024 /* columns: the rows of every level a chunk reads stay in L2 */
 #endif
 #define ROW_BLOCK 32 /* rows whose per-level entries are filled at a time */
 
@@ -235,6 +237,11 @@ typedef struct {
      * the same rows with the same weights (share_level_row; an x-major
      * batch has none, and its test would fail at every level) */
     int share;
+    /* what each row span gets as soon as it is done, per azimuth, while
+     * it is in the cache: the world beyond the edge (NULL: TS_EDGE_OPEN),
+     * then the sky terms (NULL: none; ts_pyramid_horizons_sky) */
+    const ts_edge_job *edge;
+    const ts_sky_plane *sky;
 } batch_ctx;
 
 /* Whether two entries read the same level rows with the same weights. */
@@ -321,6 +328,17 @@ static void batch_row(const batch_ctx *B, row_ws *w, int y, int c0, int c1,
         row_finish(&B->az[a], &w[a], y, c0, c1, &run[a]);
 }
 
+/* The cells [c0, c1) of row y, just computed for the batch: the edge,
+ * then the sky terms azimuth by azimuth (the order of the planes). */
+static void span_done(const batch_ctx *B, int y, int c0, int c1)
+{
+    size_t at = (size_t)y * B->az[0].P->grid->width;
+    for (int a = 0; B->edge && a < B->n; a++)
+        ts_edge_span(&B->edge[a], y, c0, c1);
+    for (int a = 0; B->sky && a < B->n; a++)
+        ts_sky_plane_add(&B->sky[a], at + c0, at + c1);
+}
+
 static void rows_range(void *ctx, int worker, long y0, long y1)
 {
     (void)worker;
@@ -366,6 +384,7 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
                 for (int a = 0; a < n; a++)
                     rly[a] = &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels];
                 batch_row(B, w, (int)y, c0, c1, rly, own, own + P, own + 2 * P);
+                span_done(B, (int)y, c0, c1);
             }
         }
     }
@@ -426,8 +445,11 @@ static int az_ctx_init(const ts_pyramid *pyr, double azimuth, const ts_horizon_o
     return 1;
 }
 
-ts_status ts_pyramid_horizons(const ts_pyramid *pyr, int count, const double *azimuths,
-                              const ts_horizon_opts *opts, float *const *out, ts_error *err)
+/* ts_pyramid_horizons, and with sky the sky terms of each plane added
+ * span by span (ts_pyramid_horizons_sky; checked). */
+static ts_status horizons_run(const ts_pyramid *pyr, int count, const double *azimuths,
+                              const ts_horizon_opts *opts, const ts_pyramid_sky *sky,
+                              float *const *out, ts_error *err)
 {
     if (!pyr)
         return ts_fail(err, TS_ERR_ARG, "pyramid is NULL");
@@ -446,12 +468,25 @@ ts_status ts_pyramid_horizons(const ts_pyramid *pyr, int count, const double *az
         if ((st = ts_check_sweep_args(g, &az[k], opts, err)) != TS_OK)
             return st;
     }
+    /* the edge as ts_horizon_edge_apply after the rows would, and the sky
+     * terms at the caller's azimuths, as ts_sky_accumulate_model of each
+     * plane in turn: each cell on its own, the same values */
+    ts_edge_job edge[TS_PYRAMID_BATCH];
+    ts_sky_plane terms[TS_PYRAMID_BATCH];
+    int edged = 0;
+    for (int k = 0; k < count; k++) {
+        edged = ts_edge_rows_init(&edge[k], g, az[k], opts, out[k]);
+        if (sky)
+            ts_sky_plane_init(&terms[k], sky->nx, sky->ny, sky->nz, out[k], azimuths[k],
+                              sky->directions, sky->svf_model, sky->svf, sky->sky,
+                              sky->openness);
+    }
     hz_ctx C[TS_PYRAMID_BATCH];
     int failed = 0, ok = 1, k = 0;
     for (; ok && k < count; k++)
         ok = az_ctx_init(pyr, az[k], opts, out[k], &failed, &C[k]);
     if (ok) {
-        batch_ctx B = {count, C, 0};
+        batch_ctx B = {count, C, 0, edged ? edge : NULL, sky ? terms : NULL};
         for (int a = 0; a < count; a++)
             for (int b = a + 1; b < count; b++)
                 B.share |= C[a].vy == C[b].vy;
@@ -468,10 +503,29 @@ ts_status ts_pyramid_horizons(const ts_pyramid *pyr, int count, const double *az
         return st;
     if (failed)
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the pyramid's row workspace");
-    /* what lies beyond the DEM's edge, as after the exact sweep */
-    for (int i = 0; i < count && st == TS_OK; i++)
-        st = ts_horizon_edge_apply(g, az[i], opts, out[i], err);
-    return st;
+    return ts_ok(err);
+}
+
+ts_status ts_pyramid_horizons(const ts_pyramid *pyr, int count, const double *azimuths,
+                              const ts_horizon_opts *opts, float *const *out, ts_error *err)
+{
+    return horizons_run(pyr, count, azimuths, opts, NULL, out, err);
+}
+
+ts_status ts_pyramid_horizons_sky(const ts_pyramid *pyr, int count, const double *azimuths,
+                                  const ts_horizon_opts *opts, const ts_pyramid_sky *sky,
+                                  float *const *out, ts_error *err)
+{
+    if (!pyr || !sky)
+        return ts_fail(err, TS_ERR_ARG, pyr ? "sky terms are NULL" : "pyramid is NULL");
+    ts_status st = ts_check_svf_model(sky->svf_model, err);
+    if (st == TS_OK)
+        st = ts_check_sky_args(pyr->grid, sky->nx, sky->ny, sky->nz, sky->directions, err);
+    for (int k = 0; st == TS_OK && azimuths && k < count && k < TS_PYRAMID_BATCH; k++)
+        if (!isfinite(azimuths[k]))
+            st = ts_fail(err, TS_ERR_ARG, "azimuth must be a finite number of degrees, got %g",
+                         azimuths[k]);
+    return st == TS_OK ? horizons_run(pyr, count, azimuths, opts, sky, out, err) : st;
 }
 
 ts_status ts_pyramid_horizon(const ts_pyramid *pyr, double azimuth, const ts_horizon_opts *opts,

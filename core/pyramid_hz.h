@@ -6,6 +6,17 @@
 #include "pyramid_internal.h"
 #include "simd_clones.h"
 
+/* The clones of the loops with fused multiply-adds (pyramid_runs.c: the
+ * level rows' vertical B-spline, the samples' interpolation and tangent):
+ * each fmaf one instruction wherever the CPU has FMA (every AVX2 CPU has),
+ * so that every clone computes the same bits; the baseline x86-64 clone
+ * (no FMA) calls the library's fmaf, the same bits, slowly. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define TS_PYR_FMA_CLONES __attribute__((target_clones("avx512f", "fma", "default")))
+#else
+#define TS_PYR_FMA_CLONES
+#endif
+
 /* What sample j of every cell shares for one azimuth: its offset in
  * cells, split into a whole column ix and a fraction fx, the columns
  * [xa, xb] whose sample is on the grid, and the level it reads. */

@@ -20,6 +20,8 @@ static inline int line_start(int x0, int x1)
     return a < x1 + 1 ? a : x1 + 1;
 }
 
+/* The sums in fused multiply-adds (TS_PYR_FMA_CLONES): fewer operations
+ * in the loops that bound the pyramid, and one rounding for each. */
 static inline __attribute__((always_inline)) void
 combine_span(const float *const r[4], const float w[4], int taps, int x0, int x1,
              float *restrict dst)
@@ -37,18 +39,18 @@ combine_span(const float *const r[4], const float w[4], int taps, int x0, int x1
     if (taps == 2) {
 #pragma GCC ivdep
         for (int x = x0; x <= x1; x++)
-            dst[x] = w0 * r0[x] + w1 * r1[x];
+            dst[x] = fmaf(w1, r1[x], w0 * r0[x]);
         return;
     }
     const float *r2 = r[2], *r3 = r[3];
     const float w2 = w[2], w3 = w[3];
 #pragma GCC ivdep
     for (int x = x0; x <= x1; x++)
-        dst[x] = w0 * r0[x] + w1 * r1[x] + w2 * r2[x] + w3 * r3[x];
+        dst[x] = fmaf(w3, r3[x], fmaf(w2, r2[x], fmaf(w1, r1[x], w0 * r0[x])));
 }
 
 /* dst[x] = sum of weights w[t] * rows r[t] at x, for x in [x0, x1]. */
-TS_SIMD_CLONES
+TS_PYR_FMA_CLONES
 void ts_pyr_combine_rows(const float *const r[4], const float w[4], int taps, int x0, int x1,
                          float *restrict dst)
 {
@@ -120,29 +122,29 @@ level_span(row_ws *w, const float *restrict T, int ix, float fx, const float *re
     if (bspline && c >= 2) {
 #pragma GCC ivdep
         for (int x = x0; x <= x1; x++) {
-            float h = gx * Ta[x] + fx * Ta[x + 1];
-            spline_step(s0, s1, s2, m, x, ts_atan_deg((h - R[x]) * inv_d - cd));
+            float h = fmaf(fx, Ta[x + 1], gx * Ta[x]);
+            spline_step(s0, s1, s2, m, x, ts_atan_deg(fmaf(h - R[x], inv_d, -cd)));
         }
         return 1;
     }
     if (!bspline) { /* the maximum of the tangents; one arctangent at the end */
 #pragma GCC ivdep
         for (int x = x0; x <= x1; x++) {
-            float h = gx * Ta[x] + fx * Ta[x + 1];
-            float t = (h - R[x]) * inv_d - cd;
+            float h = fmaf(fx, Ta[x + 1], gx * Ta[x]);
+            float t = fmaf(h - R[x], inv_d, -cd);
             m[x] = t > m[x] ? t : m[x];
         }
         return 1;
     }
 #pragma GCC ivdep
     for (int x = x0; x <= x1; x++) {
-        float h = gx * Ta[x] + fx * Ta[x + 1];
-        A[x] = ts_atan_deg((h - R[x]) * inv_d - cd);
+        float h = fmaf(fx, Ta[x + 1], gx * Ta[x]);
+        A[x] = ts_atan_deg(fmaf(h - R[x], inv_d, -cd));
     }
     return 0;
 }
 
-TS_SIMD_CLONES
+TS_PYR_FMA_CLONES
 int ts_pyr_level_run(row_ws *w, const float *restrict T, int ix, float fx,
                      const float *restrict R, float inv_d, float cd, int bspline, int c, int x0,
                      int x1)

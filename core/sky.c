@@ -13,26 +13,25 @@
 #include "cellmath/cm_sky.h"
 #include "parallel.h"
 #include "simd_clones.h"
+#include "sky_plane.h"
 #include "status_internal.h"
 
 #define DEG2RAD (M_PI / 180.0)
 
-typedef struct {
-    const ts_grid *g;
-    const float *nx, *ny, *nz, *plane;
-    float sa, ca;       /* sin, cos of the azimuth */
-    float w1, w2;       /* 1/n and sin(pi/n)/pi */
-    ts_svf_model svf_model;
-    float *svf, *sky, *open;
-} sky_ctx;
+void ts_sky_plane_init(ts_sky_plane *p, const float *nx, const float *ny, const float *nz,
+                       const float *plane, double azimuth, int directions,
+                       ts_svf_model svf_model, float *svf, float *sky, float *open)
+{
+    *p = (ts_sky_plane){nx, ny, nz, plane,
+                        (float)sin(azimuth * DEG2RAD), (float)cos(azimuth * DEG2RAD),
+                        (float)(1.0 / directions), (float)(sin(M_PI / directions) / M_PI),
+                        svf_model, svf, sky, open};
+}
 
 /* One loop per term, each vectorised (cm_sky.h carries NaN explicitly,
  * because the comparisons drop it); AVX-512/AVX2 clones, the same bits. */
-TS_SIMD_CLONES static void sky_rows(void *ctx, int worker, long y0, long y1)
+TS_SIMD_CLONES void ts_sky_plane_add(const ts_sky_plane *C, size_t i0, size_t i1)
 {
-    (void)worker;
-    const sky_ctx *C = ctx;
-    size_t W = (size_t)C->g->width, i0 = (size_t)y0 * W, i1 = (size_t)y1 * W;
     const float *restrict nx = C->nx, *restrict ny = C->ny, *restrict nz = C->nz;
     const float *restrict plane = C->plane;
     const float sa = C->sa, ca = C->ca, w1 = C->w1, w2 = C->w2;
@@ -55,6 +54,18 @@ TS_SIMD_CLONES static void sky_rows(void *ctx, int worker, long y0, long y1)
         for (size_t i = i0; i < i1; i++)
             open[i] += cm_openness_term(plane[i], nz[i]);
     }
+}
+
+typedef struct {
+    size_t width;
+    ts_sky_plane p;
+} sky_ctx;
+
+static void sky_rows(void *ctx, int worker, long y0, long y1)
+{
+    (void)worker;
+    const sky_ctx *C = ctx;
+    ts_sky_plane_add(&C->p, (size_t)y0 * C->width, (size_t)y1 * C->width);
 }
 
 ts_status ts_sky_accumulate(const ts_grid *grid, const float *nx, const float *ny,
@@ -92,10 +103,10 @@ ts_status ts_sky_accumulate_model(const ts_grid *grid, const float *nx, const fl
     if (!isfinite(azimuth))
         return ts_fail(err, TS_ERR_ARG, "azimuth must be a finite number of degrees, got %g",
                        azimuth);
-    sky_ctx C = {grid, nx, ny, nz, plane,
-                 (float)sin(azimuth * DEG2RAD), (float)cos(azimuth * DEG2RAD),
-                 (float)(1.0 / directions), (float)(sin(M_PI / directions) / M_PI),
-                 svf_model, svf_acc, sky_acc, openness_acc};
+    sky_ctx C;
+    C.width = (size_t)grid->width;
+    ts_sky_plane_init(&C.p, nx, ny, nz, plane, azimuth, directions, svf_model, svf_acc, sky_acc,
+                      openness_acc);
     return ts_parallel_for(ts_thread_count(threads, grid->height), grid->height, sky_rows, &C,
                            err);
 }

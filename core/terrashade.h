@@ -542,6 +542,25 @@ ts_status ts_pyramid_horizon(const ts_pyramid *pyr, double azimuth,
 ts_status ts_pyramid_horizons(const ts_pyramid *pyr, int count, const double *azimuths,
                               const ts_horizon_opts *opts, float *const *out, ts_error *err);
 
+/** What ts_pyramid_horizons_sky adds each plane's sky terms to. */
+typedef struct {
+    const float *nx, *ny, *nz; /**< unit normals from ts_normals, width*height each */
+    int directions;            /**< as ts_sky_accumulate_model's */
+    ts_svf_model svf_model;    /**< which sky-view factor svf sums */
+    float *svf, *sky, *openness; /**< width*height each, added to; NULL: not wanted */
+} ts_pyramid_sky;
+
+/**
+ * ts_pyramid_horizons (the planes written as it writes them), and each
+ * plane's sky terms added to sky's accumulators bit for bit as
+ * ts_sky_accumulate_model of the planes in order (at `azimuths`) would,
+ * each row span summed as soon as it is done, while it is in the cache.
+ * Finish the sums with ts_sky_finish.
+ */
+ts_status ts_pyramid_horizons_sky(const ts_pyramid *pyr, int count, const double *azimuths,
+                                  const ts_horizon_opts *opts, const ts_pyramid_sky *sky,
+                                  float *const *out, ts_error *err);
+
 /** Build a pyramid and compute opts->directions planes, as
  * ts_horizon_compute (with its progress reports). */
 ts_status ts_pyramid_horizon_compute(const ts_grid *grid, const ts_pyramid_opts *popts,

@@ -193,7 +193,11 @@ static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const ts
         cflat.opts = &flat;
         c = &cflat;
     }
-    if ((st = tsd_compute_stream(c, g, sky_add, &a)) != TS_OK)
+    /* the pyramid sums each row span as it is done (the same sums) */
+    ts_pyramid_sky fused = {nm->nx, nm->ny, nm->nz, a.directions, a.model, a.svf, a.sky, a.open};
+    st = c->opts->horizon_method == TSD_HORIZON_PYRAMID ? tsd_pyramid_sky(c, g, &fused)
+                                                        : tsd_compute_stream(c, g, sky_add, &a);
+    if (st != TS_OK)
         return st;
     if (ts_sky_finish(g, a.directions, a.svf, a.sky, a.open, &err) != TS_OK)
         return core_fail(c, &err);

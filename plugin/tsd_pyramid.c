@@ -91,11 +91,12 @@ static ts_status note_backend(const tsd_compute_ctx *c)
 }
 
 /* The planes of the pyramid read with `rec`, TS_PYRAMID_BATCH at a time
- * (one at a time where memory is short), to `add` in order: at the
- * `count` azimuths `az` (degrees), or at DIRECTIONS' when az is NULL. */
+ * (one at a time where memory is short), to `add` in order, or with `sky`
+ * their sky terms summed as the rows are done (add unused): at the `count`
+ * azimuths `az` (degrees), or at DIRECTIONS' when az is NULL. */
 static ts_status pyramid_run(const tsd_compute_ctx *c, const ts_grid *g,
                              ts_pyramid_reconstruction rec, int count, const double *azimuths,
-                             tsd_plane_fn add, void *user)
+                             const ts_pyramid_sky *sky, tsd_plane_fn add, void *user)
 {
     const tsd_options *o = c->opts;
     ts_horizon_opts h;
@@ -134,9 +135,10 @@ static ts_status pyramid_run(const tsd_compute_ctx *c, const ts_grid *g,
         }
         if ((st = tsd_compute_report(c, (double)k / count)) != TS_OK)
             break;
-        if (ts_pyramid_horizons(pyr, n, az, &h, out, &err) != TS_OK)
+        if ((sky ? ts_pyramid_horizons_sky(pyr, n, az, &h, sky, out, &err)
+                 : ts_pyramid_horizons(pyr, n, az, &h, out, &err)) != TS_OK)
             st = tsd_fail_core(c->msg, c->msg_size, NULL, &err);
-        for (int i = 0; st == TS_OK && i < n; i++)
+        for (int i = 0; st == TS_OK && !sky && i < n; i++)
             if (add(user, g, k + i, az[i], out[i], &err) != TS_OK)
                 st = tsd_fail_core(c->msg, c->msg_size, NULL, &err);
     }
@@ -158,12 +160,17 @@ static ts_status copy_plane(void *user, const ts_grid *g, int k, double azimuth,
 ts_status tsd_pyramid_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_plane_fn add,
                              void *user)
 {
-    return pyramid_run(c, g, TS_PYRAMID_LEVEL_MAX, 0, NULL, add, user);
+    return pyramid_run(c, g, TS_PYRAMID_LEVEL_MAX, 0, NULL, NULL, add, user);
+}
+
+ts_status tsd_pyramid_sky(const tsd_compute_ctx *c, const ts_grid *g, const ts_pyramid_sky *sky)
+{
+    return pyramid_run(c, g, TS_PYRAMID_LEVEL_MAX, 0, NULL, sky, NULL, NULL);
 }
 
 ts_status tsd_pyramid_planes(const tsd_compute_ctx *c, const ts_grid *g, float *out)
 {
-    return pyramid_run(c, g, TS_PYRAMID_BSPLINE, 0, NULL, copy_plane, out);
+    return pyramid_run(c, g, TS_PYRAMID_BSPLINE, 0, NULL, NULL, copy_plane, out);
 }
 
 static ts_status copy_to_planes(void *user, const ts_grid *g, int k, double azimuth,
@@ -178,5 +185,5 @@ static ts_status copy_to_planes(void *user, const ts_grid *g, int k, double azim
 ts_status tsd_pyramid_planes_at(const tsd_compute_ctx *c, const ts_grid *g, int count,
                                 const double *azimuths, float **planes)
 {
-    return pyramid_run(c, g, TS_PYRAMID_BSPLINE, count, azimuths, copy_to_planes, planes);
+    return pyramid_run(c, g, TS_PYRAMID_BSPLINE, count, azimuths, NULL, copy_to_planes, planes);
 }

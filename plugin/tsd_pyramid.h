@@ -32,6 +32,12 @@ double tsd_pyramid_bytes(const tsd_options *o, int width, int height);
 ts_status tsd_pyramid_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_plane_fn add,
                              void *user);
 
+/** tsd_pyramid_stream for the sky products (svf of either model, sky,
+ * openness): each plane's terms added to sky's accumulators as the rows
+ * are done (ts_pyramid_horizons_sky), the same sums as tsd_pyramid_stream
+ * to ts_sky_accumulate_model, bit for bit. */
+ts_status tsd_pyramid_sky(const tsd_compute_ctx *c, const ts_grid *g, const ts_pyramid_sky *sky);
+
 /** The DIRECTIONS planes of PRODUCT=horizon into out: the B-spline in log
  * distance and its maximum (S&N eq. 4-5). */
 ts_status tsd_pyramid_planes(const tsd_compute_ctx *c, const ts_grid *g, float *out);

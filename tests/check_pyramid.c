@@ -306,6 +306,121 @@ START_TEST(test_batch_identical)
 }
 END_TEST
 
+/* What the sky terms are summed from and into (test_sky_fused_identical). */
+typedef struct {
+    const ts_grid *g;
+    const float *nx, *ny, *nz;
+    ts_svf_model model;
+    int wanted[3]; /* svf, sky light, openness */
+} sky_case;
+
+/* The batch az[0..count) as before the sums were fused: the planes without
+ * the edge, the edge applied after the rows (ts_horizon_edge_apply), then
+ * each plane's terms in turn (ts_sky_accumulate_model) into acc. Returns
+ * how many cells the edge changed. */
+static size_t sky_by_planes(const ts_pyramid *pyr, const sky_case *c, const ts_horizon_opts *o,
+                            int count, const double *az, float *const *planes,
+                            float *const *acc)
+{
+    ts_error err;
+    ts_horizon_opts open = *o;
+    open.edge = TS_EDGE_OPEN;
+    size_t cells = (size_t)c->g->width * c->g->height, changed = 0;
+    float *before = tdem_floats(cells);
+    ck_assert(ts_pyramid_horizons(pyr, count, az, &open, planes, &err) == TS_OK);
+    for (int i = 0; i < count; i++) {
+        memcpy(before, planes[i], cells * sizeof *before);
+        ck_assert(ts_horizon_edge_apply(c->g, az[i], o, planes[i], &err) == TS_OK);
+        for (size_t j = 0; j < cells; j++)
+            changed += memcmp(&before[j], &planes[i][j], sizeof *before) != 0;
+        ck_assert(ts_sky_accumulate_model(c->g, c->nx, c->ny, c->nz, planes[i], az[i],
+                                          o->directions, c->model, o->threads, acc[0], acc[1],
+                                          acc[2], &err) == TS_OK);
+    }
+    free(before);
+    return changed;
+}
+
+/* ts_pyramid_horizons_sky against sky_by_planes over every direction of o:
+ * the planes and each sum memcmp-equal; and ts_pyramid_horizons, which
+ * applies the edge span by span too, gives the same planes. */
+static void check_sky_fused(const ts_pyramid *pyr, const sky_case *c, const ts_horizon_opts *o)
+{
+    size_t cells = (size_t)c->g->width * c->g->height;
+    float *a = tdem_floats(cells * TS_PYRAMID_BATCH), *b = tdem_floats(cells * TS_PYRAMID_BATCH);
+    float *sums = tdem_floats(cells * 6), *acc_a[3], *acc_b[3];
+    memset(sums, 0, cells * 6 * sizeof *sums);
+    for (int t = 0; t < 3; t++) {
+        acc_a[t] = c->wanted[t] ? sums + cells * t : NULL;
+        acc_b[t] = c->wanted[t] ? sums + cells * (3 + t) : NULL;
+    }
+    ts_pyramid_sky sky = {c->nx, c->ny, c->nz, o->directions, c->model, acc_b[0], acc_b[1],
+                          acc_b[2]};
+    ts_error err;
+    size_t changed = 0;
+    for (int k = 0; k < o->directions; k += TS_PYRAMID_BATCH) {
+        int count = o->directions - k < TS_PYRAMID_BATCH ? o->directions - k : TS_PYRAMID_BATCH;
+        double az[TS_PYRAMID_BATCH];
+        float *pa[TS_PYRAMID_BATCH], *pb[TS_PYRAMID_BATCH];
+        for (int i = 0; i < count; i++) {
+            az[i] = ts_horizon_azimuth(o, k + i);
+            pa[i] = a + cells * i, pb[i] = b + cells * i;
+        }
+        changed += sky_by_planes(pyr, c, o, count, az, pa, acc_a);
+        ck_assert_msg(ts_pyramid_horizons_sky(pyr, count, az, o, &sky, pb, &err) == TS_OK,
+                      "%s", err.message);
+        ck_assert_msg(memcmp(a, b, cells * count * sizeof *a) == 0, "edge %d: planes differ",
+                      (int)o->edge);
+        ck_assert(ts_pyramid_horizons(pyr, count, az, o, pb, &err) == TS_OK);
+        ck_assert(memcmp(a, b, cells * count * sizeof *a) == 0);
+    }
+    /* the edge had cells to change (none with TS_EDGE_OPEN) */
+    ck_assert((o->edge == TS_EDGE_OPEN) == (changed == 0));
+    for (int t = 0; t < 3; t++)
+        ck_assert_msg(!c->wanted[t] || memcmp(acc_a[t], acc_b[t], cells * sizeof(float)) == 0,
+                      "edge %d, model %d: sum %d differs", (int)o->edge, (int)c->model, t);
+    free(a), free(b), free(sums);
+}
+
+/* ts_pyramid_horizons_sky: the planes, and the sums of svf (both models),
+ * sky light and openness, bit for bit those of the planes summed one by
+ * one after the edge, with nodata (lux_elev), 3 threads, batches of 8 and
+ * 5, both reconstructions and every edge (one capped by a distance). */
+START_TEST(test_sky_fused_identical)
+{
+    ts_grid g;
+    tdem_load(&g, "lux_elev");
+    size_t cells = (size_t)g.width * g.height;
+    float *nx = tdem_floats(cells), *ny = tdem_floats(cells), *nz = tdem_floats(cells);
+    ts_error err;
+    ck_assert(ts_normals(&g, nx, ny, nz, &err) == TS_OK);
+    for (int rec = TS_PYRAMID_BSPLINE; rec <= TS_PYRAMID_LEVEL_MAX; rec++) {
+        ts_pyramid_opts p = popts(4, 0, (ts_pyramid_reconstruction)rec);
+        ts_pyramid *pyr;
+        ck_assert_msg(ts_pyramid_build(&g, &p, 0, &pyr, &err) == TS_OK, "%s", err.message);
+        for (int edge = TS_EDGE_OPEN; edge <= TS_EDGE_NODATA; edge++) {
+            ts_horizon_opts o = hopts(2 * TS_PYRAMID_BATCH - 3, 1);
+            o.threads = 3;
+            o.edge = (ts_edge_mode)edge;
+            o.max_distance = edge == TS_EDGE_NODATA ? 3000.0 : 0.0;
+            sky_case c = {&g, nx, ny, nz, TS_SVF_RADIATIVE, {1, 1, 1}};
+            check_sky_fused(pyr, &c, &o);
+            c = (sky_case){&g, nx, ny, nz, TS_SVF_SOLID_ANGLE, {1, 0, 1}};
+            check_sky_fused(pyr, &c, &o);
+        }
+        ts_pyramid_sky bad = {nx, ny, nz, 0, TS_SVF_RADIATIVE, NULL, NULL, NULL};
+        double az0 = 0;
+        float *one = tdem_floats(cells);
+        ck_assert(ts_pyramid_horizons_sky(pyr, 1, &az0, NULL, &bad, &one, &err) == TS_ERR_ARG);
+        ck_assert(ts_pyramid_horizons_sky(pyr, 1, &az0, NULL, NULL, &one, &err) == TS_ERR_ARG);
+        free(one);
+        ts_pyramid_free(pyr);
+    }
+    free(nx), free(ny), free(nz);
+    ts_grid_free(&g);
+}
+END_TEST
+
 /* MAX_DISTANCE: the rays end at the distance, where their last sample
  * is; on jacksboro (curvature on) the capped pyramid stays as close to
  * the capped sweep as the unbounded ones are to each other. */
@@ -410,6 +525,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_flat_plane);
     tcase_add_test(tc, test_threads_identical);
     tcase_add_test(tc, test_batch_identical);
+    tcase_add_test(tc, test_sky_fused_identical);
     tcase_add_test(tc, test_max_distance);
     tcase_add_test(tc, test_bad_input);
     suite_add_tcase(s, tc);
