@@ -35,10 +35,6 @@ int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_l
     hs.push_g = r->g + at;
     hs.push_k = kp;
     hs.near_skip = 0.0; /* every point of the hull is beyond the near field */
-    hs.gabs = r->hull_gabs;
-    hs.span = r->hull_span;
-    hs.around = r->hull_around;
-    hs.around_stride = r->stride;
     if (!ts_lane_hull_step(h, &hs, occ)) {
         r->hull_lost = 1;
         return 0;

@@ -72,10 +72,7 @@ int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, const int lags[4], double nea
     r->ddn = zalloc(line);
     r->kc = zalloc(line);
     r->kn = zalloc(line);
-    r->hull_gabs = zalloc(line);
-    r->hull_around = zalloc(6 * line);
-    int ok = r->d && r->g && r->qd && r->qc && r->qn && r->ddc && r->ddn && r->kc && r->kn &&
-             r->hull_gabs && r->hull_around;
+    int ok = r->d && r->g && r->qd && r->qc && r->qn && r->ddc && r->ddn && r->kc && r->kn;
     for (int l = 0; l < 2 && r->prune; l++) {
         const size_t n = (size_t)r->groups[l] * line;
         r->gmax[l] = zalloc(n);
@@ -97,8 +94,6 @@ void ts_cap_lanes_free(ts_cap_lanes *r)
     free(r->ddn);
     free(r->kc);
     free(r->kn);
-    free(r->hull_gabs);
-    free(r->hull_around);
     for (int l = 0; l < 2; l++) {
         free(r->gmax[l]);
         free(r->dlo[l]);
@@ -112,10 +107,8 @@ void ts_cap_lanes_clear(ts_cap_lanes *r)
     const size_t n = (size_t)(r->slots + 1) * r->stride;
     for (size_t i = 0; i < n; i++)
         r->d[i] = NAN;
-    for (int j = 0; j < r->stride; j++) {
+    for (int j = 0; j < r->stride; j++)
         r->kc[j] = r->kn[j] = -1; /* no previous answers */
-        r->hull_gabs[j] = 0.0;    /* empty hulls */
-    }
     r->hull_lost = 0;
     for (int l = 0; l < 2 && r->prune; l++)
         ts_cap_groups_empty(r->gmax[l], r->dlo[l], r->dhi[l], (size_t)r->groups[l] * r->stride);

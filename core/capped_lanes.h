@@ -45,9 +45,6 @@ typedef struct {
     /* ts_cap_lanes_hybrid_step's hulls miss samples (a step without lines
      * pushed none): the block's other steps take the scan alone */
     int hull_lost;
-    /* its hulls' bounds for ts_lane_step's gabs (per line) and span, and
-     * the points around their previous answers (ts_lane_step's around) */
-    double *hull_gabs, hull_span, *hull_around;
 } ts_cap_lanes;
 
 /* Level 0 and level 1 groups of the pruned scan, in steps. */

@@ -73,8 +73,6 @@ typedef struct {
     cm_ray_grid ray;    /* the grid as the geometry sees it, for cm_ray_slope */
     int lags[4];        /* with a maximum distance: the steps back a window spans
                            (ts_cap_lanes_lags) */
-    double hull_span;   /* and a bound on (d - d_p) / (d_q - d_p') over a line's
-                           samples p and any two of them p' < q (ts_lane_step) */
     ts_edge_job edge;   /* the world beyond the edge, raised row by row */
     int edge_rows;      /* whether finish_rows raises (not TS_EDGE_OPEN) */
 } sweep_ctx;
@@ -406,7 +404,7 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         w->lo_dd[j0] = lo0.dd;
         const int last_inside = G->fr[k] == 0.0f ? j1 : G->V - 2 - (int)i0;
         const ts_lane_step step = {k, j0, j1, prime, last_inside, w->lane_d, w->hs, w->hc,
-                                   w->hn, c, C->near_skip, NULL, NULL, 0, NULL, 0.0, NULL, 0};
+                                   w->hn, c, C->near_skip, NULL, NULL, 0};
         const int hybrid = w->hybrid && ts_cap_lanes_hybrid_step(&w->capl, &hulls, &step, nl, &occ);
         if (!hybrid && C->cap > 0)
             ts_cap_lanes_step(&w->capl, &step, nl, &occ);
@@ -482,10 +480,8 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
         const occluder none = {-1, 0.0f};
         /* capped lines keep windows (rings) instead of hulls, the hybrid's
          * both */
-        if (capped) {
+        if (capped)
             ok = ts_cap_lanes_alloc(&w->capl, LOCKSTEP_LINES + 1, C->lags, C->near_skip, C->cap);
-            w->capl.hull_span = C->hull_span;
-        }
         if (!capped || w->hybrid) {
             w->lane_n = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_n);
             w->lane_far = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_far);
@@ -621,12 +617,8 @@ static ts_status sweep_setup(const ts_grid *grid, double azimuth,
     C->cap = opts->max_distance > longest * geom->U ? 0.0 : opts->max_distance;
     /* Within the near field of every row, the near field is all there is. */
     C->near_only = C->cap > 0 && C->cap <= TS_NEAR_STEPS * shortest;
-    if (C->cap > 0) {
+    if (C->cap > 0)
         ts_cap_lanes_lags(C->near_skip, C->cap, shortest, longest, C->lags);
-        /* at most U steps of at most longest metres, any two samples at
-         * least a step of shortest apart (rounded distances: 1.25) */
-        C->hull_span = 1.25 * (geom->U + 1.0) * (longest / shortest);
-    }
     return TS_OK;
 }
 

@@ -17,7 +17,7 @@
 
 /* The block's hulls: line j's points at pts + j * stride, n[j] of them,
  * far[j] the top-most one at least near_skip behind the line's sample
- * (-1: none; with push_d, the line's previous answer, -1: none). */
+ * (-1: none). */
 typedef struct {
     ts_hull_pt *pts;
     int stride;
@@ -40,19 +40,6 @@ typedef struct {
      * push_k, instead of its sample */
     const double *push_d, *push_g;
     int push_k;
-    /* with push_d: per line, a bound on |g| of its hull's points (raised
-     * by the pushes; 0 for an empty hull), and span, a bound on
-     * (d - d_p) / (d_q - d_p') for any points p of a line and neighbours
-     * p' < q of its hull; the queries then start at far, each line's
-     * previous answer, where these bounds prove that a walk from the top
-     * pops every point above it (lane_hull.c, start_below_top) */
-    double *gabs;
-    double span;
-    /* with push_d: the fields d, g of the points below, at and above
-     * line j's far, as the previous step's walks left them: field f at
-     * around[f * around_stride + j] */
-    double *around;
-    int around_stride;
 } ts_lane_step;
 
 /* The widest vectors the CPU and the build run (asked once): 2 AVX-512,
