@@ -80,12 +80,6 @@ int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, const int lags[4], double nea
         r->dhi[l] = zalloc(n);
         ok = ok && r->gmax[l] && r->dlo[l] && r->dhi[l];
     }
-    if (r->prune) {
-        r->lean = zalloc((size_t)r->groups[0] * line);
-        r->lean_max = zalloc((size_t)r->groups[0] * line);
-        r->thr_last = zalloc(line);
-        ok = ok && r->lean && r->lean_max && r->thr_last;
-    }
     return ok;
 }
 
@@ -105,9 +99,6 @@ void ts_cap_lanes_free(ts_cap_lanes *r)
         free(r->dlo[l]);
         free(r->dhi[l]);
     }
-    free(r->lean);
-    free(r->lean_max);
-    free(r->thr_last);
     *r = (ts_cap_lanes){0};
 }
 
@@ -121,8 +112,6 @@ void ts_cap_lanes_clear(ts_cap_lanes *r)
     r->hull_lost = 0;
     for (int l = 0; l < 2 && r->prune; l++)
         ts_cap_groups_empty(r->gmax[l], r->dlo[l], r->dhi[l], (size_t)r->groups[l] * r->stride);
-    for (size_t i = 0; r->prune && i < (size_t)r->groups[0] * r->stride; i++)
-        r->lean_max[i] = INFINITY;
 }
 
 /* Lines [g0, g1) (multiples of 8) at step k: for each query height (NaN:

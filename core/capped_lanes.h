@@ -38,12 +38,6 @@ typedef struct {
     int prune;
     int groups[2];
     double *gmax[2], *dlo[2], *dhi[2];
-    /* Per level-0 group and line, once the group is complete: a slope S
-     * (the line's latest threshold, thr_last) and lean_max, at least
-     * max (g_p + S d_p) over its samples (+inf until then), which bounds
-     * g_p + T d_p by lean_max + (T - S) dsel for T near S far more
-     * tightly than gmax + T dsel does. */
-    double *lean, *lean_max, *thr_last;
     /* per line, padded to stride: the step's distance and query heights,
      * and the answers (steps, -1: none; distances) */
     double *qd, *qc, *qn, *ddc, *ddn;

@@ -186,14 +186,6 @@ TS_AVX512 static inline __attribute__((always_inline)) __mmask8
 group_may_hold(const ts_cap_lanes *r, int l, size_t at, int q, const __m512d *thr,
                const __m512d *rhs, const __mmask8 *neg, const __mmask8 *idle)
 {
-    if (l == 0) {
-        /* level 0: lean_max + (T - S) dsel, dsel by the sign of T - S */
-        const __m512d tms = _mm512_sub_pd(thr[q], _mm512_load_pd(r->lean + at));
-        const __mmask8 below = _mm512_cmp_pd_mask(tms, _mm512_setzero_pd(), _CMP_LT_OQ);
-        const __m512d dsel = _mm512_mask_load_pd(_mm512_load_pd(r->dhi[0] + at), below, r->dlo[0] + at);
-        const __m512d lhs = _mm512_fmadd_pd(tms, dsel, _mm512_load_pd(r->lean_max + at));
-        return (__mmask8)~(_mm512_cmp_pd_mask(lhs, rhs[q], _CMP_LT_OQ) | idle[q]);
-    }
     const __m512d dsel =
         _mm512_mask_load_pd(_mm512_load_pd(r->dhi[l] + at), neg[q], r->dlo[l] + at);
     const __m512d lhs = _mm512_fmadd_pd(thr[q], dsel, _mm512_load_pd(r->gmax[l] + at));
@@ -334,7 +326,6 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
     for (int q = 0; q < ng; q++) {
         __m512d gmin;
         prune_threshold(r, k, lag_hi, g + 8 * q, a, q, &thr[q], &gmin, &idle[q]);
-        _mm512_store_pd(r->thr_last + g + 8 * q, thr[q]);
         neg[q] = _mm512_cmp_pd_mask(thr[q], _mm512_setzero_pd(), _CMP_LT_OQ);
         const __m512d td = _mm512_mul_pd(thr[q], a->d[q]);
         const __m512d size = _mm512_add_pd(_mm512_abs_pd(gmin), _mm512_abs_pd(td));
@@ -453,31 +444,6 @@ groups_add(ts_cap_lanes *r, const size_t at[2], int j, __m512d d, __m512d g, __m
     }
 }
 
-/* Lines j..j + 7 of the level-0 group just completed (entry at, ring
- * slots from slot): its lean S, the line's latest threshold (0 where that
- * is not finite), and lean_max = max (g_p + S d_p), raised by 1e-12 of
- * |lean_max| + |S| dhi: above the roundings of these sums and of the
- * bound's own lean_max + (T - S) dsel (those of T d are the right side's). */
-TS_AVX512 static inline __attribute__((always_inline)) void
-group_lean(ts_cap_lanes *r, size_t at, int slot, int j)
-{
-    const __m512d t = _mm512_load_pd(r->thr_last + j), inf = _mm512_set1_pd(INFINITY);
-    const __m512d lean = _mm512_maskz_mov_pd(_mm512_cmp_pd_mask(_mm512_abs_pd(t), inf, _CMP_LT_OQ), t);
-    __m512d m = _mm512_set1_pd(-INFINITY);
-#pragma GCC unroll 8
-    for (int i = 0; i < TS_CAP_G0; i++) {
-        const size_t o = (size_t)(slot + i) * r->stride + j;
-        /* (max_pd gives its second operand where the first is NaN: no sample) */
-        m = _mm512_max_pd(_mm512_fmadd_pd(lean, _mm512_load_pd(r->d + o), _mm512_load_pd(r->g + o)), m);
-    }
-    const __m512d size = _mm512_fmadd_pd(_mm512_abs_pd(lean), _mm512_load_pd(r->dhi[0] + at + j),
-                                         _mm512_abs_pd(m));
-    const __mmask8 has = _mm512_cmp_pd_mask(m, _mm512_set1_pd(-INFINITY), _CMP_NEQ_OQ);
-    _mm512_store_pd(r->lean + at + j, lean);
-    _mm512_store_pd(r->lean_max + at + j,
-                    _mm512_mask_mov_pd(m, has, _mm512_fmadd_pd(size, _mm512_set1_pd(1e-12), m)));
-}
-
 /* ts_cap_lanes_step's work before and after the scan, eight lines per
  * vector (the same operations per line): the queries of lines [g0, g1),
  * then the answers and the step's samples of lines j0..j1. */
@@ -513,11 +479,7 @@ TS_AVX512 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0,
         if (s->k % size == 0)
             ts_cap_groups_empty(r->gmax[l] + at[l], r->dlo[l] + at[l], r->dhi[l] + at[l],
                                 (size_t)r->stride);
-        if (s->k % size == 0 && l == 0)
-            for (int j = 0; j < r->stride; j++)
-                r->lean_max[at[0] + j] = INFINITY;
     }
-    const int complete = r->prune && s->k % TS_CAP_G0 == TS_CAP_G0 - 1;
     for (int j = g0; j < g1; j += 8) {
         const __m512i idx = _mm512_add_epi64(_mm512_set1_epi64(j), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
         __mmask8 on = _mm512_cmpge_epi64_mask(idx, _mm512_set1_epi64(s->j0));
@@ -535,8 +497,6 @@ TS_AVX512 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0,
         _mm512_mask_store_pd(rg + j, on, g);
         if (r->prune)
             groups_add(r, at, j, d, g, has & on);
-        if (complete)
-            group_lean(r, at[0], (s->k % r->slots) - (TS_CAP_G0 - 1), j);
     }
 }
 
