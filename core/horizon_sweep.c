@@ -23,7 +23,8 @@
  * for long ones, with AVX-512, each line in the blocks also keeps the hull
  * of its samples beyond the near field, whose answer is the window's
  * wherever it lies in the window (capped_lanes.h, the hybrid); else each
- * line keeps the hull of a sliding window of its samples (window_hull.h),
+ * line keeps the hull of a sliding window of its samples (window_hull.h,
+ * one line at a time: sweep_line.c),
  * in amortised O(1) per sample like the unbounded hull. The near field is
  * cut at the distance, and the last part of a step before it is solved
  * exactly on each cell's ray.
@@ -33,274 +34,14 @@
 #include <stdlib.h>
 
 #include "arg_checks.h"
-#include "capped_lanes.h"
 #include "cellmath/cm_fastmath.h"
-#include "horizon_edge.h"
 #include "lane_hull.h"
 #include "lane_passes.h"
-#include "line_geometry.h"
-#include "near_field.h"
 #include "parallel.h"
 #include "simd_clones.h"
 #include "status_internal.h"
 #include "sweep_cap_tail.h"
-#include "window_hull.h"
-
-typedef ts_hull_pt hull_pt;
-
-/* The far-field occluder a hull query found: its step index on the line and
- * its distance from the query point; k < 0 when there is none. */
-typedef struct {
-    int k;
-    float dd;
-} occluder;
-
-typedef struct {
-    const ts_grid *grid;
-    const ts_line_geom *geom;
-    double c;           /* curvature coefficient (1-k)/(2R), 0 when off */
-    double cap;         /* max distance in metres, 0 = none */
-    float *out;         /* slopes, row stride = width */
-    ptrdiff_t o_origin, o_u_stride, o_v_stride;
-    long b0;            /* first line */
-    /* visitor mode (single-threaded) */
-    ts_line_visitor visit;
-    void *user;
-    int *alloc_failed;  /* set by a worker that cannot get its workspace */
-    ts_near_plan near;
-    double near_skip;   /* hull points closer than this are near field */
-    int near_only;      /* the distance ends inside the near field: no lines */
-    cm_ray_grid ray;    /* the grid as the geometry sees it, for cm_ray_slope */
-    int lags[4];        /* with a maximum distance: the steps back a window spans
-                           (ts_cap_lanes_lags) */
-    ts_edge_job edge;   /* the world beyond the edge, raised row by row */
-    int edge_rows;      /* whether finish_rows raises (not TS_EDGE_OPEN) */
-} sweep_ctx;
-
-typedef struct {
-    hull_pt *stack;
-    int n;
-    hull_pt *raw;       /* with a maximum distance: the line's valid samples */
-    int raw_n;
-    ts_window_hull win; /* with a maximum distance: the far-field window */
-    ts_window_hull vwin; /* and the visitor's (all samples within the distance) */
-    int finger[3][2];   /* where the window queries of each kind last ended */
-    ts_line_pair lo;    /* occluders of the far side (occluder entries) */
-    /* visitor buffers */
-    float *vx, *vy, *vh, *vs;
-    double *vd;
-    /* unbounded sweep: the lines of a block, swept in lockstep */
-    hull_pt *lane_stacks; /* line j's hull at lane_stacks + j * (U + 1) */
-    int *lane_n, *lane_far; /* its size, its top-most point beyond the near field */
-    occluder *carry, *carry_next; /* far-side occluders from the line before */
-    /* the block's current step, by line (one entry more than lines) */
-    float *lane_f;      /* holds: */
-    float *hc, *hn, *hs, *slope; /* samples (lane_passes.h), far-field slopes */
-    float *lo_dd, *hi_dd;
-    int *lane_i;        /* holds: */
-    int *lo_k, *hi_k;   /* far-field occluders; lo_k[j]: from line j - 1 */
-    int *lane_k0;       /* each line's first step */
-    double *lane_d;     /* and the distance of its current sample from it */
-    ts_cap_lanes capl;  /* capped lines in lockstep: their windows */
-    int lockstep;       /* lines in lockstep blocks (sweep_block), not one by one */
-    int hybrid;         /* capped lines in lockstep keep unbounded hulls too */
-} sweep_ws;
-
-/* The far-field occluder of a point at distance d and hull height g among
- * the points 0..far of an unbounded line's hull S: walk to nearer points
- * while the slope grows (the slopes to an upper convex hull from a point
- * beyond it are unimodal). */
-static inline occluder stack_query(const hull_pt *S, int far, double d, double g)
-{
-    if (far < 0)
-        return (occluder){-1, 0.0f};
-    int j = far;
-    while (j > 0 && (S[j - 1].g - g) * (d - S[j].d) >= (S[j].g - g) * (d - S[j - 1].d))
-        j--;
-    return (occluder){S[j].k, (float)(d - S[j].d)};
-}
-
-/* Move far (the top-most hull point at least near_skip behind d) up: d
- * only grows, so it moves in O(1) amortised. */
-static inline int far_advance(const hull_pt *S, int n, int far, double d, double near_skip)
-{
-    while (far + 1 < n && d - S[far + 1].d >= near_skip)
-        far++;
-    return far;
-}
-
-/* Push (d, gs, k) onto the unbounded hull S of *n points, popping the points
- * it hides, and keep *far; returns the hull's size before the push (its top
- * is the sample's own occluder on the line). */
-static inline int hull_push(hull_pt *S, int *n, int *far, double d, double gs, int k,
-                            double near_skip)
-{
-    int m = *n;
-    while (m >= 2 && (S[m - 2].g - gs) * (d - S[m - 1].d) >= (S[m - 1].g - gs) * (d - S[m - 2].d))
-        m--;
-    /* Pops only take from the top, so far is at most the new top. */
-    int f = *far > m - 1 ? m - 1 : *far;
-    *far = far_advance(S, m, f, d, near_skip);
-    S[m].d = d;
-    S[m].g = gs;
-    S[m].k = k;
-    *n = m + 1;
-    return m;
-}
-
-/* The far-field occluder of a point at distance d, height h, among the
- * hull points 0..far (those beyond the near field): walk to farther points
- * while the slope grows (the slopes to an upper convex hull from a point
- * beyond it are unimodal). With a maximum distance, the window's. */
-static inline __attribute__((always_inline)) occluder
-hull_query(const sweep_ctx *C, sweep_ws *w, int far, double d, float h, int finger[2])
-{
-    occluder none = {-1, 0.0f};
-    double g = h - C->c * d * d;
-    if (C->cap > 0) {
-        const hull_pt *p = ts_window_hull_query(&w->win, d, g, finger);
-        return p ? (occluder){p->k, (float)(d - p->d)} : none;
-    }
-    return stack_query(w->stack, far, d, g);
-}
-
-/* Slope from cell (k, i) at height h to its own ray, dk steps back (at
- * distance dd), where the ray crosses that column; -inf if the ray is off
- * the grid there or touches nodata. */
-static inline float ray_slope(const sweep_ctx *C, int k, int i, float h, int dk, float dd)
-{
-    if (dk <= 0 || dk > k)
-        return -INFINITY;
-    return cm_ray_slope_at(&C->ray, k, i, h, dk, C->geom->ray_o[dk], C->geom->ray_f[dk], dd,
-                           (float)C->c);
-}
-
-/* Steps on either side of a line's occluder at which the cell's ray is
- * also sampled. */
-#ifndef FAR_SPREAD
-#define FAR_SPREAD 0
-#endif
-
-/* Far field of cell (k, i): its own ray evaluated at and beside the
- * occluders that the hulls of the two neighbouring lines found. Taking the
- * maximum of each line's horizon and interpolating would overestimate (the
- * maximum of a mean is at most the mean of the maxima); sampling the
- * cell's ray where the lines see their occluders does not. */
-static float far_field(const sweep_ctx *C, int k, int i, float h, occluder lo, occluder hi,
-                       double step)
-{
-    float best = -INFINITY;
-    const occluder cand[2] = {lo, hi};
-    for (int c = 0; c < 2; c++) {
-        if (cand[c].k < 0 || (c == 1 && cand[1].k == cand[0].k))
-            continue;
-        int dk = k - cand[c].k;
-        for (int e = -FAR_SPREAD; e <= FAR_SPREAD; e++) {
-            if (dk + e <= TS_NEAR_STEPS)
-                continue;
-            /* e = 0 adds exactly +0 to the distance: skip the conversion. */
-            float dd = e ? cand[c].dd + (float)(e * step) : cand[c].dd;
-            float s = ray_slope(C, k, i, h, dk + e, dd);
-            best = s > best ? s : best;
-        }
-    }
-    return best;
-}
-
-#ifndef PREFETCH_AHEAD
-#define PREFETCH_AHEAD 8
-#endif
-
-static void process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
-{
-    const ts_line_geom *G = C->geom;
-    const float *z = C->grid->z;
-    const int pk0 = w->lo.prev_k0, pk1 = w->lo.prev_k1;
-    int k0, k1;
-    if (!ts_line_pair_next(&w->lo, G, b, &k0, &k1))
-        return;
-    const occluder *prev_lo = w->lo.prev;
-    occluder *cur_lo = w->lo.cur;
-    w->n = 0;
-    w->raw_n = 0;
-    ts_window_hull_reset(&w->win);
-    ts_window_hull_reset(&w->vwin);
-    const double c = C->c;
-    double d = 0.0;
-    int nv = 0;
-    int far = -1; /* top-most hull point beyond the near field */
-    for (int k = k0; k <= k1; k++) {
-        /* A line crosses a grid row per step: fetch the DEM and the output
-         * a few steps ahead, as no hardware prefetcher follows this path. */
-        if (k + PREFETCH_AHEAD <= k1) {
-            int ka = k + PREFETCH_AHEAD, ia = (int)(b + G->fl[ka]);
-            __builtin_prefetch(z + G->origin + (ptrdiff_t)ka * G->u_stride +
-                               (ptrdiff_t)ia * G->v_stride);
-            if (write)
-                __builtin_prefetch(C->out + C->o_origin + (ptrdiff_t)ka * C->o_u_stride +
-                                   (ptrdiff_t)ia * C->o_v_stride, 1);
-        }
-        ts_line_sample ls;
-        ts_line_sample_at(G, z, b, k, k0, 0.0f, &d, &ls);
-        const int i = ls.i, has_next = ls.has_next, inside = ls.inside;
-        const float F = ls.F, hc = ls.hc, hn = ls.hn, hs = ls.hs;
-
-        int pushed = 0;
-        float slope = -INFINITY;
-        if (C->cap > 0) {
-            if (!isnan(hs)) {
-                double gs = hs - c * d * d;
-                if (w->vs) {
-                    ts_window_hull_slide(&w->vwin, w->raw, w->raw_n, d, 0.0, C->cap);
-                    const hull_pt *p = ts_window_hull_query(&w->vwin, d, gs, w->finger[2]);
-                    if (p)
-                        slope = (float)((p->g - gs) / (d - p->d) - 2.0 * c * d);
-                }
-                w->raw[w->raw_n++] = (hull_pt){d, gs, k};
-            }
-            ts_window_hull_slide(&w->win, w->raw, w->raw_n, d, C->near_skip, C->cap);
-            pushed = 1;
-        } else if (!isnan(hs)) {
-            double gs = hs - c * d * d;
-            const hull_pt *S = w->stack;
-            int n = hull_push(w->stack, &w->n, &far, d, gs, k, C->near_skip);
-            if (w->vs && n > 0)
-                slope = (float)((S[n - 1].g - gs) / (d - S[n - 1].d) - 2.0 * c * d);
-            pushed = 1;
-        }
-        if (!pushed)
-            far = far_advance(w->stack, w->n, far, d, C->near_skip);
-        occluder none = {-1, 0.0f};
-        if (write) {
-            float s_out = NAN;
-            if (!isnan(hc)) {
-                occluder hi = inside ? hull_query(C, w, far, d, hc, w->finger[0]) : none;
-                occluder lo = (F > 0.0f && k >= pk0 && k <= pk1) ? prev_lo[k] : none;
-                int row = G->x_major ? i : G->u_start + k * G->u_step;
-                double step = G->step_row ? G->step_row[row] : G->step_m;
-                s_out = far_field(C, k, i, hc, lo, hi, step); /* near field later */
-            }
-            C->out[C->o_origin + (ptrdiff_t)k * C->o_u_stride + (ptrdiff_t)i * C->o_v_stride] = s_out;
-        }
-        cur_lo[k] = (has_next && !isnan(hn)) ? hull_query(C, w, far, d, hn, w->finger[1]) : none;
-        if (w->vs) {
-            w->vx[nv] = G->x_major ? (float)(G->u_start + k * G->u_step) : (float)i + F;
-            w->vy[nv] = G->x_major ? (float)i + F : (float)(G->u_start + k * G->u_step);
-            w->vh[nv] = hs;
-            w->vd[nv] = d;
-            w->vs[nv] = isnan(hs) ? NAN : slope;
-            nv++;
-        }
-    }
-    if (w->vs && nv > 0)
-        C->visit(C->user, nv, w->vx, w->vy, w->vh, w->vd, w->vs);
-}
-
-/* Lines swept together in one block: at each step they read and write
- * neighbouring cells of one grid row (or column), so memory streams. */
-#ifndef LOCKSTEP_LINES
-#define LOCKSTEP_LINES 64
-#endif
+#include "sweep_internal.h"
 
 /* Step k of lines j0..j1 of a block (rows i0 + j): each line's distance
  * from its first sample, as ts_line_sample_at advances it. */
@@ -355,7 +96,7 @@ static void lane_hulls_scalar(const ts_lane_hulls *h, const ts_lane_step *s,
  * only primed (not written) when `prime`. w->carry holds what the line
  * before the block found; on return it holds the block's last line's.
  * Each step samples the lines together (lane_passes.h), pushes and queries
- * each line's hull in the same order as process_line, then evaluates the
+ * each line's hull in the same order as ts_sweep_process_line, then evaluates the
  * far field of the step's cells together: the cell between lines j - 1 and
  * j takes its far-side occluder from line j - 1 and its own from line j. */
 static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int prime)
@@ -537,9 +278,9 @@ static void sweep_range(void *ctx, int worker, long begin, long end)
         return;
     }
     if (begin > 0)
-        process_line(C, &w, C->b0 + begin - 1, 0);
+        ts_sweep_process_line(C, &w, C->b0 + begin - 1, 0);
     for (long b = C->b0 + begin; b < C->b0 + end; b++)
-        process_line(C, &w, b, 1);
+        ts_sweep_process_line(C, &w, b, 1);
     ws_free(&w);
 }
 
