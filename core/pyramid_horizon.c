@@ -212,8 +212,10 @@ static void row_sample(const hz_ctx *C, row_ws *w, int y, int j, const row_level
     r->pa = 1, r->pb = 0;
 }
 
-/* The horizons of the cells of row y that dropped out, and nodata. */
-static void row_finish(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const row_run *r)
+/* The horizons of the cells of row y that dropped out, and nodata where
+ * the span has any (`holes`). */
+static void row_finish(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const row_run *r,
+                       int holes)
 {
     const ts_grid *g = C->P->grid;
     float *out = C->out + (size_t)y * g->width;
@@ -222,6 +224,8 @@ static void row_finish(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const 
     ts_pyr_drop_cells(C, w, y, c0, r->fa - 1, r->t_row, out);
     ts_pyr_drop_cells(C, w, y, r->fb + 1, c1 - 1, r->t_row, out);
     const float *z = g->z + (ptrdiff_t)y * g->stride;
+    if (!holes)
+        return;
     for (int x = c0; x < c1; x++) {
         float o = out[x]; /* a select, not a branch: the loop vectorises */
         out[x] = z[x] == z[x] ? o : NAN;
@@ -324,8 +328,14 @@ static void batch_row(const batch_ctx *B, row_ws *w, int y, int c0, int c1,
         if (!active)
             break;
     }
+    /* whether the span has nodata: looked for once, not per azimuth */
+    const ts_grid *g = B->az[0].P->grid;
+    const float *z = g->z + (ptrdiff_t)y * g->stride;
+    int holes = 0;
+    for (int x = c0; x < c1; x++)
+        holes |= z[x] != z[x];
     for (int a = 0; a < B->n; a++)
-        row_finish(&B->az[a], &w[a], y, c0, c1, &run[a]);
+        row_finish(&B->az[a], &w[a], y, c0, c1, &run[a], holes);
 }
 
 /* The cells [c0, c1) of row y, just computed for the batch: the edge,
