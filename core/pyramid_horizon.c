@@ -64,17 +64,26 @@ static int level_taps(const ts_pyramid *P, int lev, double row, int idx[4], doub
 }
 
 /* The row-level entry of row y for samples at `dist` steps on level lev;
- * the cells' own rows only with `own` (batch_row reads azimuth 0's). */
-static void row_level_fill(const hz_ctx *C, int y, int lev, double dist, int own, row_level *e)
+ * the cells' own rows only with `own` (batch_row reads azimuth 0's). The
+ * samples' rows and weights are those of `same` where it is given (an
+ * azimuth of the batch with the same vy: the same rows and weights). */
+static void row_level_fill(const hz_ctx *C, int y, int lev, double dist, int own,
+                           const row_level *same, row_level *e)
 {
     const ts_pyramid *P = C->P;
     double oy = dist * C->vy;
     int idx[4];
     double wd[4];
-    e->taps = level_taps(P, lev, y + oy, idx, wd);
-    for (int t = 0; t < 4; t++) {
-        e->t[t] = ts_pyr_row(P, lev, idx[t < e->taps ? t : 0]);
-        e->wt[t] = (float)wd[t < e->taps ? t : 0];
+    if (same) {
+        e->taps = same->taps;
+        for (int t = 0; t < 4; t++)
+            e->t[t] = same->t[t], e->wt[t] = same->wt[t];
+    } else {
+        e->taps = level_taps(P, lev, y + oy, idx, wd);
+        for (int t = 0; t < 4; t++) {
+            e->t[t] = ts_pyr_row(P, lev, idx[t < e->taps ? t : 0]);
+            e->wt[t] = (float)wd[t < e->taps ? t : 0];
+        }
     }
     /* the cells' own heights on the level: the DEM row itself on level 0 */
     int taps = own ? level_taps(P, lev, y, idx, wd) : 0;
@@ -127,7 +136,7 @@ static void sample_run(const hz_ctx *C, row_ws *w, int y, const float *R, double
     double ox = dist * C->vx;
     double fl = floor(ox);
     row_level e;
-    row_level_fill(C, y, 0, dist, 0, &e);
+    row_level_fill(C, y, 0, dist, 0, NULL, &e);
     sample_level(C, w, &e, R, (int)fl, (float)(ox - fl), c, x0, x1);
 }
 
@@ -160,8 +169,7 @@ typedef struct {
 
 static void row_start(const hz_ctx *C, row_ws *w, int y, int c0, int c1, row_run *r)
 {
-    for (int x = c0; x < c1; x++)
-        w->m[x] = -INFINITY;
+    ts_pyr_clear_max(w, c0, c1 - 1);
     *r = (row_run){c0, c1 - 1, c1, c1 - 1, row_reach(C, y)};
 }
 
@@ -212,8 +220,10 @@ static void row_sample(const hz_ctx *C, row_ws *w, int y, int j, const row_level
     r->pa = 1, r->pb = 0;
 }
 
-/* The horizons of the cells of row y that dropped out, and nodata. */
-static void row_finish(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const row_run *r)
+/* The horizons of the cells of row y that dropped out, and nodata where
+ * the span has any (`holes`). */
+static void row_finish(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const row_run *r,
+                       int holes)
 {
     const ts_grid *g = C->P->grid;
     float *out = C->out + (size_t)y * g->width;
@@ -222,6 +232,8 @@ static void row_finish(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const 
     ts_pyr_drop_cells(C, w, y, c0, r->fa - 1, r->t_row, out);
     ts_pyr_drop_cells(C, w, y, r->fb + 1, c1 - 1, r->t_row, out);
     const float *z = g->z + (ptrdiff_t)y * g->stride;
+    if (!holes)
+        return;
     for (int x = c0; x < c1; x++) {
         float o = out[x]; /* a select, not a branch: the loop vectorises */
         out[x] = z[x] == z[x] ? o : NAN;
@@ -324,8 +336,12 @@ static void batch_row(const batch_ctx *B, row_ws *w, int y, int c0, int c1,
         if (!active)
             break;
     }
+    /* whether the span has nodata: looked for once, not per azimuth */
+    const ts_grid *g = B->az[0].P->grid;
+    const float *z = g->z + (ptrdiff_t)y * g->stride;
+    int holes = ts_pyr_has_nodata(z, c0, c1 - 1);
     for (int a = 0; a < B->n; a++)
-        row_finish(&B->az[a], &w[a], y, c0, c1, &run[a]);
+        row_finish(&B->az[a], &w[a], y, c0, c1, &run[a], holes);
 }
 
 /* The cells [c0, c1) of row y, just computed for the batch: the edge,
@@ -370,11 +386,22 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
     }
     for (long yb = y0; yb < y1; yb += ROW_BLOCK) {
         long ye = yb + ROW_BLOCK < y1 ? yb + ROW_BLOCK : y1;
-        for (int a = 0; a < n; a++)
+        for (int a = 0; a < n; a++) {
+            /* an earlier azimuth with the same vy reads the same level rows */
+            int b = 0;
+            while (b < a && B->az[b].vy != B->az[a].vy)
+                b++;
             for (long y = yb; y < ye; y++)
-                for (int j = 0; j < levels; j++)
-                    row_level_fill(&B->az[a], (int)y, B->az[a].lv[j].lev, B->az[a].lv[j].s,
-                                   a == 0, &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels + j]);
+                for (int j = 0; j < levels; j++) {
+                    const level_az *L = &B->az[a].lv[j], *Lb = &B->az[b].lv[j];
+                    size_t at = (size_t)(y - yb) * levels + j;
+                    const row_level *same = b < a && Lb->lev == L->lev && Lb->s == L->s
+                                                ? &rl[(size_t)b * ROW_BLOCK * levels + at]
+                                                : NULL;
+                    row_level_fill(&B->az[a], (int)y, L->lev, L->s, a == 0, same,
+                                   &rl[(size_t)a * ROW_BLOCK * levels + at]);
+                }
+        }
         /* a chunk of columns down the rows, then the next: the level rows
          * that the cells of a chunk read stay in the cache from row to row */
         for (int c0 = 0; c0 < W; c0 += CHUNK) {

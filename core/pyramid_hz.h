@@ -78,6 +78,12 @@ static inline void spline_push(float *p0, float *p1, float *p2, float *m, float 
 void ts_pyr_combine_rows(const float *const r[4], const float w[4], int taps, int x0, int x1,
                          float *restrict dst);
 
+/* A row's start: m = -inf over the cells [x0, x1]. */
+void ts_pyr_clear_max(row_ws *w, int x0, int x1);
+
+/* Whether z[x0..x1] holds nodata (NaN). */
+int ts_pyr_has_nodata(const float *z, int x0, int x1);
+
 /* Add sample number c (value a_in[x]) to the spline (or the maximum). */
 void ts_pyr_push_run(row_ws *w, int bspline, int c, int x0, int x1, const float *restrict a_in);
 

@@ -59,6 +59,25 @@ void ts_pyr_combine_rows(const float *const r[4], const float w[4], int taps, in
     combine_span(r, w, taps, a, x1, dst);
 }
 
+/* The two plain loops of each row span (core/pyramid_horizon.c), cloned
+ * so that they run on the widest vectors. */
+TS_SIMD_CLONES
+void ts_pyr_clear_max(row_ws *w, int x0, int x1)
+{
+    float *restrict m = w->m;
+    for (int x = x0; x <= x1; x++)
+        m[x] = -INFINITY;
+}
+
+TS_SIMD_CLONES
+int ts_pyr_has_nodata(const float *z, int x0, int x1)
+{
+    int holes = 0;
+    for (int x = x0; x <= x1; x++)
+        holes |= z[x] != z[x];
+    return holes;
+}
+
 /* spline_push on the state of cell x. */
 static inline void spline_step(float *restrict s0, float *restrict s1, float *restrict s2,
                                float *restrict m, int x, float a)
