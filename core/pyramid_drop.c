@@ -74,8 +74,7 @@ static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int
     const float *restrict z = g->z, *restrict zrow = g->z + (ptrdiff_t)y * g->stride;
     const double *restrict step = C->step;
     const ptrdiff_t stride = g->stride;
-    const double vy = C->vy, step_all = C->step_all;
-    const float cf = (float)C->c;
+    const double vy = C->vy, c = C->c, step_all = C->step_all;
     for (int x = a; x <= b; x++) {
         double t = tpp[x], px = tpp[W + x], py = tpp[2 * W + x];
         int i = (int)px, k = (int)py;
@@ -109,10 +108,7 @@ static inline __attribute__((always_inline)) void drop_read(const hz_ctx *C, int
             row = row > H - 1 ? H - 1 : row;
             d = t * step[row];
         }
-        /* in float: a double division was ~17 % of drop_cells' samples;
-         * the tangent is stored as a float anyway (rounding-level change) */
-        float df = (float)d;
-        float tan_w = (h - zrow[x]) / df - cf * df;
+        float tan_w = (float)((h - zrow[x]) / d - c * d);
         A[x] = tan_w;
     }
     /* apart: a select in the loop above becomes a branch around tan_w */
