@@ -245,9 +245,12 @@ static void row_finish(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const 
 typedef struct {
     int n;
     const hz_ctx *az; /* n */
-    /* whether two azimuths have the same vy: only such can read a level at
-     * the same rows with the same weights (share_level_row; an x-major
-     * batch has none, and its test would fail at every level) */
+    /* per azimuth, the first of the batch with its vy (itself where none
+     * comes earlier): only such can read a level at the same rows with the
+     * same weights (row_level_fill's `same`, share_level_row) */
+    int same_vy[TS_PYRAMID_BATCH];
+    /* whether any two share a vy (share_level_row; an x-major batch has
+     * none, and its test would fail at every level) */
     int share;
     /* what each row span gets as soon as it is done, per azimuth, while
      * it is in the cache: the world beyond the edge (NULL: TS_EDGE_OPEN),
@@ -388,9 +391,7 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
         long ye = yb + ROW_BLOCK < y1 ? yb + ROW_BLOCK : y1;
         for (int a = 0; a < n; a++) {
             /* an earlier azimuth with the same vy reads the same level rows */
-            int b = 0;
-            while (b < a && B->az[b].vy != B->az[a].vy)
-                b++;
+            const int b = B->same_vy[a];
             for (long y = yb; y < ye; y++)
                 for (int j = 0; j < levels; j++) {
                     const level_az *L = &B->az[a].lv[j], *Lb = &B->az[b].lv[j];
@@ -513,10 +514,14 @@ static ts_status horizons_run(const ts_pyramid *pyr, int count, const double *az
     for (; ok && k < count; k++)
         ok = az_ctx_init(pyr, az[k], opts, out[k], &failed, &C[k]);
     if (ok) {
-        batch_ctx B = {count, C, 0, edged ? edge : NULL, sky ? terms : NULL};
-        for (int a = 0; a < count; a++)
-            for (int b = a + 1; b < count; b++)
-                B.share |= C[a].vy == C[b].vy;
+        batch_ctx B = {count, C, {0}, 0, edged ? edge : NULL, sky ? terms : NULL};
+        for (int a = 0; a < count; a++) {
+            int b = 0;
+            while (b < a && C[b].vy != C[a].vy)
+                b++;
+            B.same_vy[a] = b;
+            B.share |= b < a;
+        }
         st = ts_parallel_for(ts_thread_count(opts->threads, g->height), g->height, rows_range,
                              &B, err);
     }
@@ -545,13 +550,11 @@ ts_status ts_pyramid_horizons_sky(const ts_pyramid *pyr, int count, const double
 {
     if (!pyr || !sky)
         return ts_fail(err, TS_ERR_ARG, pyr ? "sky terms are NULL" : "pyramid is NULL");
+    /* the azimuths are checked with the rest in horizons_run, before the
+     * sky terms read them */
     ts_status st = ts_check_svf_model(sky->svf_model, err);
     if (st == TS_OK)
         st = ts_check_sky_args(pyr->grid, sky->nx, sky->ny, sky->nz, sky->directions, err);
-    for (int k = 0; st == TS_OK && azimuths && k < count && k < TS_PYRAMID_BATCH; k++)
-        if (!isfinite(azimuths[k]))
-            st = ts_fail(err, TS_ERR_ARG, "azimuth must be a finite number of degrees, got %g",
-                         azimuths[k]);
     return st == TS_OK ? horizons_run(pyr, count, azimuths, opts, sky, out, err) : st;
 }
 

@@ -413,6 +413,14 @@ START_TEST(test_sky_fused_identical)
         float *one = tdem_floats(cells);
         ck_assert(ts_pyramid_horizons_sky(pyr, 1, &az0, NULL, &bad, &one, &err) == TS_ERR_ARG);
         ck_assert(ts_pyramid_horizons_sky(pyr, 1, &az0, NULL, NULL, &one, &err) == TS_ERR_ARG);
+        ts_horizon_opts o1;
+        ts_horizon_opts_default(&o1);
+        ts_pyramid_sky good = {nx, ny, nz, 1, TS_SVF_RADIATIVE, NULL, NULL, NULL};
+        for (int k = 0; k < 2; k++) {
+            double az_bad = k ? INFINITY : NAN;
+            ck_assert(ts_pyramid_horizons_sky(pyr, 1, &az_bad, &o1, &good, &one, &err) ==
+                      TS_ERR_ARG);
+        }
         free(one);
         ts_pyramid_free(pyr);
     }
