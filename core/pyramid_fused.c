@@ -65,12 +65,15 @@ combine16(const level_rows *L, int q, const int taps, const int masked)
 }
 
 /* combine16 where the columns q..q+15 may leave the row, for the run's
- * number of taps. */
-TS_AVX512 static __m512 combine16_edge(const level_rows *L, int q)
+ * number of taps (masked loads only where they do). */
+TS_AVX512 static inline __m512 combine16_edge(const level_rows *L, int q)
 {
-    return L->taps == 4   ? combine16(L, q, 4, 1)
-           : L->taps == 2 ? combine16(L, q, 2, 1)
-                          : combine16(L, q, 1, 1);
+    const int in = q >= 0 && q + 15 <= L->W - 1;
+    if (L->taps == 4)
+        return in ? combine16(L, q, 4, 0) : combine16(L, q, 4, 1);
+    if (L->taps == 2)
+        return in ? combine16(L, q, 2, 0) : combine16(L, q, 2, 1);
+    return in ? combine16(L, q, 1, 0) : combine16(L, q, 1, 1);
 }
 
 /* Lane i of v in every lane. */
