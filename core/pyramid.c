@@ -95,6 +95,10 @@ typedef struct {
 typedef struct {
     const coarse *src;
     coarse *dst;
+    /* each column's taps on src (ts_pyr_taps, linear): their number, 4
+     * columns and 4 weights; the same for every row, so found once */
+    const int *nx, *cx;
+    const double *cw;
 } decimate_ctx;
 
 /* Rows [r0, r1) of dst from src by bilinear decimation. */
@@ -106,11 +110,12 @@ static void decimate_rows(void *ctx, int worker, long r0, long r1)
     coarse *D = C->dst;
     const double ratio = D->s / S->s;
     for (long r = r0; r < r1; r++) {
-        int ry[4], rx[4];
-        double wy[4], wx[4];
+        int ry[4];
+        double wy[4];
         int ny = ts_pyr_taps((r + 0.5) * ratio - 0.5, S->h, 1, ry, wy);
         for (int i = 0; i < D->w; i++) {
-            int nx = ts_pyr_taps((i + 0.5) * ratio - 0.5, S->w, 1, rx, wx);
+            const int nx = C->nx[i], *rx = C->cx + 4 * (size_t)i;
+            const double *wx = C->cw + 4 * (size_t)i;
             double sum = 0, wsum = 0, cov = 0;
             for (int a = 0; a < ny; a++)
                 for (int b = 0; b < nx; b++) {
@@ -238,11 +243,20 @@ ts_status ts_pyramid_build(const ts_grid *grid, const ts_pyramid_opts *opts, int
         P->pair[1][2 * y] = z[W > 1 ? W - 2 : 0];
         P->pair[1][2 * y + 1] = z[W - 1];
     }
+    /* the column taps of the largest coarse level */
+    const size_t most_w = P->levels > 1 ? (size_t)level_size(W, spacing(opts->level_step, 1)) : 1;
+    int *nx = malloc(most_w * sizeof *nx), *cx = malloc(4 * most_w * sizeof *cx);
+    double *cw = malloc(4 * most_w * sizeof *cw);
+    ok = ok && nx && cx && cw;
     for (int j = 1; ok && j < P->levels; j++) {
         double s = spacing(opts->level_step, j);
         coarse cur = {level_size(W, s), level_size(H, s), s, buf[j % 2][0], buf[j % 2][1], 0};
         cur.stride = cur.w;
-        decimate_ctx dc = {&prev, &cur};
+        const double ratio = cur.s / prev.s;
+        for (int i = 0; i < cur.w; i++)
+            nx[i] = ts_pyr_taps((i + 0.5) * ratio - 0.5, prev.w, 1, cx + 4 * (size_t)i,
+                                cw + 4 * (size_t)i);
+        decimate_ctx dc = {&prev, &cur, nx, cx, cw};
         ts_parallel_for(ts_thread_count(threads, cur.h), cur.h, decimate_rows, &dc, err);
         P->level[j] = (ts_pyr_level){s, cur.h, NULL};
         ok = reconstruct(P, &cur, j, threads, err);
@@ -250,6 +264,9 @@ ts_status ts_pyramid_build(const ts_grid *grid, const ts_pyramid_opts *opts, int
     }
     for (int i = 0; i < 4; i++)
         free(buf[i / 2][i % 2]);
+    free(nx);
+    free(cx);
+    free(cw);
     if (!ok) {
         ts_pyramid_free(P);
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the pyramid's levels (%.0f MiB)",

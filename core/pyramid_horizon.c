@@ -114,10 +114,16 @@ static void sample_level(const hz_ctx *C, row_ws *w, const row_level *e, const f
                          float fx, int c, int x0, int x1)
 {
     int t0, t1;
-    if (!sample_cols(C->P->grid->width, ix, fx, x0, x1, &t0, &t1))
+    const int W = C->P->grid->width;
+    if (!sample_cols(W, ix, fx, x0, x1, &t0, &t1))
         return;
     const float *T = w->Tsh;
     if (t0 < w->t_lo || t1 > w->t_hi) {
+        if (!C->bspline && ts_pyr_level_max_rows(w, e->t, e->wt, e->taps, W, t1, ix, fx, R,
+                                                 e->inv_d, e->cd, x0, x1)) {
+            w->t_lo = 1, w->t_hi = 0;
+            return; /* the level maximum, its row kept in registers */
+        }
         ts_pyr_combine_rows(e->t, e->wt, e->taps, t0, t1, w->T);
         w->T[t1 + 1] = w->T[t1]; /* a weight of fx = 0 there: no NaN from beyond */
         T = w->T;

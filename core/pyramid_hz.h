@@ -96,6 +96,16 @@ int ts_pyr_level_run(row_ws *w, const float *restrict T, int ix, float fx,
                      const float *restrict R, float inv_d, float cd, int bspline, int c, int x0,
                      int x1);
 
+/* ts_pyr_combine_rows of the rows r (weights wt, `taps` of them, rows of W
+ * columns) over [x0 + ix, t1] into T, T[t1 + 1] = T[t1], then
+ * ts_pyr_level_run of the level maximum (bspline 0): the same maxima, with
+ * the level row kept in registers and T not written (core/pyramid_fused.c;
+ * R and w->m on cache lines, ts_pyr_alloc). Returns 0, doing nothing,
+ * where the CPU has no AVX-512. */
+int ts_pyr_level_max_rows(row_ws *w, const float *const r[4], const float wt[4], int taps, int W,
+                          int t1, int ix, float fx, const float *R, float inv_d, float cd, int x0,
+                          int x1);
+
 /* The horizons of the cells after `count` >= 1 samples, into out. */
 void ts_pyr_finish_run(row_ws *w, int bspline, int count, int x0, int x1, float *restrict out);
 

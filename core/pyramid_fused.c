@@ -1,0 +1,200 @@
+/*
+ * One level's samples of the level maximum with the level row combined in
+ * registers (AVX-512): ts_pyr_combine_rows into w->T, then
+ * ts_pyr_level_run reading T back at x + ix and x + ix + 1, in one pass.
+ *
+ * The level row is combined 16 columns at a time at columns q that are a
+ * multiple of 16 (each of its rows' loads within one cache line where the
+ * rows start on one), and the samples' two neighbours T[x + ix] and
+ * T[x + ix + 1] of 16 cells x come out of two such vectors by a lane
+ * permute; so T is neither stored nor read back at an unaligned column,
+ * and the cells' own vectors (R, the maxima) stay on their lines. The sums
+ * are the same operations in the same order as those two functions (each
+ * column's fused multiply-adds, the samples' interpolation and tangent),
+ * so the maxima have the same bits.
+ */
+#include "pyramid_hz.h"
+
+#if defined(__GNUC__) && defined(__x86_64__)
+#include "lane_hull.h" /* ts_lane_vector_level: whether the CPU has AVX-512 */
+
+/* The lanes of the 16 columns from q that lie in [lo, hi]. */
+TS_AVX512 static inline __mmask16 lanes_within(int q, int lo, int hi)
+{
+    return ts_first_lanes16(hi - q + 1) & (__mmask16)~ts_first_lanes16(lo - q);
+}
+
+/* Columns q..q+15 of row r: where `masked`, only the lanes of `in` (zeros
+ * elsewhere), the columns before 0 (only where q < 0) not addressed at all;
+ * else all 16, plainly. */
+TS_AVX512 static inline __attribute__((always_inline)) __m512
+row16(const float *r, int q, __mmask16 in, const int masked)
+{
+    if (!masked)
+        return _mm512_loadu_ps(r + q);
+    if (q >= 0)
+        return _mm512_maskz_loadu_ps(in, r + q);
+    /* `in` is then the lanes from -q on: columns 0.. packed into them */
+    return _mm512_maskz_expandloadu_ps(in, r);
+}
+
+/* The level row of a sample: its rows, their weights, the row's width and
+ * the last column the samples read (sample_cols' t1). */
+typedef struct {
+    const float *r[4];
+    __m512 w[4];
+    int taps, W, t1;
+} level_rows;
+
+/* The level row at columns q..q+15: ts_pyr_combine_rows' sums, the same
+ * fused multiply-adds in the same order; `masked` as row16 (the columns
+ * within the row), else all 16 columns lie within it. */
+TS_AVX512 static inline __attribute__((always_inline)) __m512
+combine16(const level_rows *L, int q, const int taps, const int masked)
+{
+    const __mmask16 in = masked ? lanes_within(q, 0, L->W - 1) : 0xFFFF;
+    __m512 s = row16(L->r[0], q, in, masked);
+    if (taps == 1)
+        return s;
+    s = _mm512_mul_ps(L->w[0], s);
+    s = _mm512_fmadd_ps(L->w[1], row16(L->r[1], q, in, masked), s);
+    if (taps == 2)
+        return s;
+    s = _mm512_fmadd_ps(L->w[2], row16(L->r[2], q, in, masked), s);
+    return _mm512_fmadd_ps(L->w[3], row16(L->r[3], q, in, masked), s);
+}
+
+/* combine16 where the columns q..q+15 may leave the row, for the run's
+ * number of taps (masked loads only where they do). */
+TS_AVX512 static inline __m512 combine16_edge(const level_rows *L, int q)
+{
+    const int in = q >= 0 && q + 15 <= L->W - 1;
+    if (L->taps == 4)
+        return in ? combine16(L, q, 4, 0) : combine16(L, q, 4, 1);
+    if (L->taps == 2)
+        return in ? combine16(L, q, 2, 0) : combine16(L, q, 2, 1);
+    return in ? combine16(L, q, 1, 0) : combine16(L, q, 1, 1);
+}
+
+/* Lane i of v in every lane. */
+TS_AVX512 static inline __m512 lane_all(__m512 v, int i)
+{
+    return _mm512_permutexvar_ps(_mm512_set1_epi32(i), v);
+}
+
+/* What every block of a run shares. */
+typedef struct {
+    __m512i at0, at1; /* lanes of T[x + ix], T[x + ix + 1] in the pair (cur, next) */
+    __m512 fx, gx, inv_d, ncd;
+    const float *R;
+    float *m;
+} run_consts;
+
+/* The samples of the 16 cells from x (those of `cells`) from the level
+ * row's columns q..q+31 in cur, next: the maximum's update. */
+TS_AVX512 static inline __attribute__((always_inline)) void
+block16(const run_consts *k, __m512 cur, __m512 next, int x, __mmask16 cells, int full)
+{
+    const __m512 ta = _mm512_permutex2var_ps(cur, k->at0, next);
+    const __m512 tb = _mm512_permutex2var_ps(cur, k->at1, next);
+    const __m512 h = _mm512_fmadd_ps(k->fx, tb, _mm512_mul_ps(k->gx, ta));
+    if (full) {
+        const __m512 t = _mm512_fmadd_ps(_mm512_sub_ps(h, _mm512_load_ps(k->R + x)), k->inv_d,
+                                         k->ncd);
+        _mm512_store_ps(k->m + x, _mm512_max_ps(t, _mm512_load_ps(k->m + x))); /* t > m ? t : m */
+        return;
+    }
+    const __m512 d = _mm512_sub_ps(h, _mm512_maskz_loadu_ps(cells, k->R + x));
+    const __m512 t = _mm512_fmadd_ps(d, k->inv_d, k->ncd);
+    const __m512 mm = _mm512_maskz_loadu_ps(cells, k->m + x);
+    _mm512_mask_storeu_ps(k->m + x, cells, _mm512_max_ps(t, mm));
+}
+
+/* The blocks from x (the level row's vector at q in *cur) while their
+ * cells and the next vector's columns are all in range (x + 15 <= x1,
+ * q + 31 <= t1), for a constant number of taps; returns the next x. */
+TS_AVX512 static inline __attribute__((always_inline)) int
+body_blocks(const level_rows *L, const run_consts *k, __m512 *cur, int x, int x1, int ix,
+            const int taps)
+{
+    const int sh = ix & 15;
+    __m512 c = *cur;
+    int q = x + ix - sh;
+    for (; x + 15 <= x1 && q + 31 <= L->t1; x += 16, q += 16) {
+        const __m512 next = combine16(L, q + 16, taps, 0);
+        block16(k, c, next, x, 0xFFFF, 1);
+        c = next;
+    }
+    *cur = c;
+    return x;
+}
+
+/* ts_pyr_level_max_rows: the blocks of 16 cells from x0's line to x1, the
+ * first and the last masked to the run's cells and to the row's columns. */
+TS_AVX512 static void level_max_avx512(row_ws *w, const float *const r[4], const float wt[4],
+                                       int taps, int W, int t1, int ix, float fx,
+                                       const float *R, float inv_d, float cd, int x0, int x1)
+{
+    const level_rows rows = {{r[0], r[1], r[2], r[3]},
+                             {_mm512_set1_ps(wt[0]), _mm512_set1_ps(wt[1]),
+                              _mm512_set1_ps(wt[2]), _mm512_set1_ps(wt[3])},
+                             taps,
+                             W,
+                             t1};
+    const level_rows *L = &rows;
+    const int sh = ix & 15; /* x + ix is lane sh of the vector at x + ix - sh */
+    const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    const __m512i at0 = _mm512_add_epi32(lane, _mm512_set1_epi32(sh));
+    const run_consts k = {at0,
+                          _mm512_add_epi32(at0, _mm512_set1_epi32(1)),
+                          _mm512_set1_ps(fx),
+                          _mm512_set1_ps(1.0f - fx),
+                          _mm512_set1_ps(inv_d),
+                          _mm512_set1_ps(-cd),
+                          R,
+                          w->m};
+    int x = x0 & ~15, q = x + ix - sh;
+    __m512 cur = combine16_edge(L, q);
+    if (q + 15 > t1)
+        cur = _mm512_mask_mov_ps(cur, (__mmask16)~ts_first_lanes16(t1 - q + 1),
+                                 lane_all(cur, t1 - q));
+    for (; x <= x1; x += 16, q += 16) {
+        if (x >= x0 && x + 15 <= x1 && q + 31 <= t1) {
+            /* the run's inner blocks: no masks, no pad, the rows' loads
+             * and the cells' on their lines where the rows start on one */
+            x = taps == 4   ? body_blocks(L, &k, &cur, x, x1, ix, 4)
+                : taps == 2 ? body_blocks(L, &k, &cur, x, x1, ix, 2)
+                            : body_blocks(L, &k, &cur, x, x1, ix, 1);
+            q = x + ix - sh;
+            if (x > x1)
+                break;
+        }
+        __m512 next = q + 16 <= t1 ? combine16_edge(L, q + 16) : cur;
+        if (q + 31 > t1) { /* columns past t1: column t1's value */
+            __m512 pad = t1 >= q + 16 ? lane_all(next, t1 - q - 16) : lane_all(cur, t1 - q);
+            next = _mm512_mask_mov_ps(next, (__mmask16)~ts_first_lanes16(t1 - q - 15), pad);
+        }
+        block16(&k, cur, next, x, lanes_within(x, x0, x1), 0);
+        cur = next;
+    }
+}
+
+int ts_pyr_level_max_rows(row_ws *w, const float *const r[4], const float wt[4], int taps, int W,
+                          int t1, int ix, float fx, const float *R, float inv_d, float cd, int x0,
+                          int x1)
+{
+    if (ts_lane_vector_level() != 2)
+        return 0;
+    level_max_avx512(w, r, wt, taps, W, t1, ix, fx, R, inv_d, cd, x0, x1);
+    return 1;
+}
+#else
+int ts_pyr_level_max_rows(row_ws *w, const float *const r[4], const float wt[4], int taps, int W,
+                          int t1, int ix, float fx, const float *R, float inv_d, float cd, int x0,
+                          int x1)
+{
+    (void)w, (void)r, (void)wt, (void)taps, (void)W, (void)t1, (void)ix, (void)fx, (void)R;
+    (void)inv_d, (void)cd, (void)x0, (void)x1;
+    return 0;
+}
+#endif

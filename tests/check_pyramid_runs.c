@@ -1,0 +1,109 @@
+/* The pyramid's loops against each other (core/pyramid_runs.c,
+ * core/pyramid_fused.c): the level maximum with the level row kept in
+ * registers (ts_pyr_level_max_rows) must give the maxima of the level row
+ * combined into T (ts_pyr_combine_rows, T[t1 + 1] = T[t1] as sample_level
+ * pads it) then read back by ts_pyr_level_run, bit for bit: every tap
+ * count, rows with nodata, runs at any column and offset, the fraction 0
+ * at the grid's last column. */
+#include <check.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "pyramid_hz.h"
+#include "terrashade.h"
+#include "test_grid.h"
+#include "test_run.h"
+
+enum { ROWS = 4, MAXW = 1100 };
+
+/* n floats of heights in [-50, 1450), every `holes`-th NaN (0: none) */
+static void fill(float *v, int n, uint64_t *seed, int holes)
+{
+    for (int i = 0; i < n; i++)
+        v[i] = holes && i % holes == 3 ? NAN : (float)(1500.0 * tdem_uniform(seed) - 50.0);
+}
+
+/* One run both ways; returns whether the maxima are the same bits (1 also
+ * where the CPU has no AVX-512: nothing to compare; *compared says). */
+static int one_run(const float *const r[4], const float wt[4], int taps, int W, int ix, float fx,
+                   const float *R, int x0, int x1, uint64_t *seed, int *compared)
+{
+    row_ws a = {0}, b = {0};
+    float *T = ts_pyr_alloc((MAXW + 16) * sizeof *T);
+    a.m = ts_pyr_alloc((MAXW + 16) * sizeof *a.m);
+    a.A = ts_pyr_alloc((MAXW + 16) * sizeof *a.A);
+    b.m = ts_pyr_alloc((MAXW + 16) * sizeof *b.m);
+    ck_assert(T && a.m && a.A && b.m);
+    for (int x = 0; x < MAXW + 16; x++) /* some cells at -inf: no sample yet */
+        a.m[x] = tdem_uniform(seed) < 0.2 ? -INFINITY : (float)(tdem_uniform(seed) - 0.5);
+    memcpy(b.m, a.m, (MAXW + 16) * sizeof *a.m);
+    const float inv_d = (float)(1.0 / (40.0 + 900.0 * tdem_uniform(seed)));
+    const float cd = (float)(1e-6 * tdem_uniform(seed));
+    int t0 = x0 + ix, t1 = x1 + ix + (fx > 0.0f);
+    t1 = t1 > W - 1 ? W - 1 : t1;
+    ts_pyr_combine_rows(r, wt, taps, t0, t1, T);
+    T[t1 + 1] = T[t1];
+    ts_pyr_level_run(&a, T, ix, fx, R, inv_d, cd, 0, 1, x0, x1);
+    *compared = ts_pyr_level_max_rows(&b, r, wt, taps, W, t1, ix, fx, R, inv_d, cd, x0, x1);
+    int same = !*compared || !memcmp(a.m, b.m, (MAXW + 16) * sizeof *a.m);
+    free(T), free(a.m), free(a.A), free(b.m);
+    return same;
+}
+
+START_TEST(test_level_max_rows_identical)
+{
+    uint64_t seed = 12345;
+    float *rows = ts_pyr_alloc(ROWS * MAXW * sizeof *rows);
+    float *R = ts_pyr_alloc((MAXW + 16) * sizeof *R);
+    ck_assert(rows && R);
+    static const int widths[] = {1, 17, 100, 1024, 1093};
+    int runs = 0, compared = 0, differ = 0;
+    char first[160] = "";
+    for (int wi = 0; wi < 5; wi++) {
+        const int W = widths[wi];
+        for (int k = 0; k < 200; k++) {
+            int holes = k % 3 == 0 ? 0 : 5 + k % 17;
+            fill(rows, ROWS * W, &seed, holes);
+            fill(R, W, &seed, k % 4 == 1 ? 7 : 0);
+            const int taps = k % 3 == 0 ? 1 : k % 3 == 1 ? 2 : 4;
+            const float *r[4] = {rows, rows + W, rows + 2 * W, rows + 3 * W};
+            float wt[4];
+            for (int t = 0; t < 4; t++)
+                wt[t] = (float)tdem_uniform(&seed);
+            /* the offset ix + fx of a sample on the grid for cells [x0, x1]
+             * of the row: x + ix + fx in [0, W - 1] (the runs keep such cells) */
+            int ix = (int)((2.0 * tdem_uniform(&seed) - 1.0) * W);
+            float fx = k % 5 == 0 ? 0.0f : (float)tdem_uniform(&seed);
+            int lo = ix < 0 ? -ix : 0, hi = W - 1 - ix - (fx > 0.0f);
+            hi = hi > W - 1 ? W - 1 : hi;
+            if (lo > hi)
+                continue;
+            int x0 = lo + (int)(tdem_uniform(&seed) * (hi - lo + 1));
+            int x1 = k % 7 == 0 ? hi : x0 + (int)(tdem_uniform(&seed) * (hi - x0 + 1));
+            int c;
+            runs++;
+            if (!one_run(r, wt, taps, W, ix, fx, R, x0, x1, &seed, &c) && !differ++)
+                snprintf(first, sizeof first, "W %d taps %d ix %d fx %g cells [%d, %d]", W,
+                         taps, ix, fx, x0, x1);
+            compared += c;
+        }
+    }
+    printf("level max, row in registers against combine + level run: %d runs, %d compared "
+           "(0: no AVX-512 here), %d differ\n",
+           runs, compared, differ);
+    ck_assert_msg(!differ, "%d runs differ, the first: %s", differ, first);
+    ck_assert_int_gt(runs, 800);
+    free(rows), free(R);
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("pyramid_runs");
+    TCase *tc = tcase_create("core");
+    tcase_add_test(tc, test_level_max_rows_identical);
+    suite_add_tcase(s, tc);
+    return test_run_suite(s);
+}
