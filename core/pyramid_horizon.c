@@ -189,28 +189,26 @@ static int row_keeps(const hz_ctx *C, const row_run *r, int j, int *xa, int *xb)
     return L->s <= r->t_row;
 }
 
-/* Sample j of the run of row y (e: the row's entry; R and R0: the cells'
- * heights on its level and on the DEM), or the last one where the rays
- * end before it; the cells whose rays leave the grid drop out. */
-static void row_sample(const hz_ctx *C, row_ws *w, int y, int j, const row_level *e,
-                       const float *R, const float *R0, row_run *r)
+/* Sample j of the run of row y (R0: the cells' heights on the DEM): the
+ * cells whose rays leave the grid drop out, and where the rays end before
+ * the sample, their last one; returns 1 where the sample is instead read
+ * on level j for the cells [r->pa, r->pb] (sample_level, the caller's). */
+static int row_advance(const hz_ctx *C, row_ws *w, int y, int j, const float *R0, row_run *r)
 {
     int pa = r->pa, pb = r->pb, xa, xb;
     if (pa > pb)
-        return;
+        return 0;
     int on_level = row_keeps(C, r, j, &xa, &xb);
     if (xa > xb) {
         mark_drop(C, w, pa, pb, j);
         r->pa = 1, r->pb = 0;
-        return;
+        return 0;
     }
     mark_drop(C, w, pa, xa - 1, j);
     mark_drop(C, w, xb + 1, pb, j);
     pa = r->pa = xa, pb = r->pb = xb;
-    if (on_level) {
-        sample_level(C, w, e, R, C->lv[j].ix, C->lv[j].fx, j, pa, pb);
-        return;
-    }
+    if (on_level)
+        return 1;
     /* the row's rays end here: one last sample on the DEM */
     float *out = C->out + (size_t)y * C->P->grid->width;
     if (r->t_row > 1e-9) {
@@ -224,6 +222,7 @@ static void row_sample(const hz_ctx *C, row_ws *w, int y, int j, const row_level
     }
     r->fa = pa, r->fb = pb;
     r->pa = 1, r->pb = 0;
+    return 0;
 }
 
 /* The horizons of the cells of row y that dropped out, and nodata where
@@ -265,13 +264,14 @@ typedef struct {
     const ts_sky_plane *sky;
 } batch_ctx;
 
-/* Whether two entries read the same level rows with the same weights. */
-static int same_rows(const row_level *a, const row_level *b)
+/* Whether two entries read the same level rows (and with `weights`, with
+ * the same weights). */
+static int same_rows(const row_level *a, const row_level *b, int weights)
 {
     if (a->taps != b->taps)
         return 0;
     for (int t = 0; t < a->taps; t++)
-        if (a->t[t] != b->t[t] || a->wt[t] != b->wt[t])
+        if (a->t[t] != b->t[t] || (weights && a->wt[t] != b->wt[t]))
             return 0;
     return 1;
 }
@@ -292,7 +292,7 @@ static void share_level_row(const batch_ctx *B, row_ws *w, const row_level *cons
         in[a] = run[a].pa <= run[a].pb && row_keeps(&B->az[a], &run[a], j, &xa, &xb) &&
                 xa <= xb && L->fx > 0.0f &&
                 sample_cols(B->az[a].P->grid->width, L->ix, L->fx, xa, xb, &t0[a], &t1[a]) &&
-                (!e0 || same_rows(e0, &rl[a][j]));
+                (!e0 || same_rows(e0, &rl[a][j], 1));
         if (!in[a])
             continue;
         e0 = e0 ? e0 : &rl[a][j];
@@ -309,48 +309,106 @@ static void share_level_row(const batch_ctx *B, row_ws *w, const row_level *cons
             w[a].Tsh = Tsh, w[a].t_lo = lo, w[a].t_hi = hi;
 }
 
-/* The cells [c0, c1) of row y for every azimuth of B, level by level: the
- * cells' own heights on a level (the same rows and weights for every
- * azimuth, from azimuth 0's entries rl[n][j]) are computed once, over
- * the runs that read them, into R (on the DEM: R0, kept for the rays
- * that end early). */
-static void batch_row(const batch_ctx *B, row_ws *w, int y, int c0, int c1,
-                      const row_level *const *rl, float *R0, float *R, float *Tsh)
+/* A grid row that batch_rows computes: its azimuths' states w (n) and
+ * row-level entries rl (n), the cells' heights on the DEM (R0) and on the
+ * level being read (R, or R0: Rj), the shared level row (Tsh), the runs. */
+typedef struct {
+    int y;
+    row_ws *w;
+    const row_level *rl[TS_PYRAMID_BATCH];
+    float *R0, *R, *Tsh;
+    const float *Rj;
+    row_run run[TS_PYRAMID_BATCH];
+} grid_row;
+
+/* Sample j of azimuth a for the two grid rows g at once where their
+ * samples read the same level rows at the same cells, each row for its
+ * own (the level maximum in registers; not the rows shared with other
+ * azimuths): the rows loaded once for both. Returns 0 where not done. */
+static int sample_pair(const hz_ctx *C, grid_row g[2], int a, int j)
+{
+    const row_run *r0 = &g[0].run[a], *r1 = &g[1].run[a];
+    const row_level *e0 = &g[0].rl[a][j], *e1 = &g[1].rl[a][j];
+    const int W = C->P->grid->width, ix = C->lv[j].ix;
+    const float fx = C->lv[j].fx;
+    int t0, t1;
+    if (C->bspline || r0->pa != r1->pa || r0->pb != r1->pb || !same_rows(e0, e1, 0) ||
+        !sample_cols(W, ix, fx, r0->pa, r0->pb, &t0, &t1))
+        return 0;
+    for (int i = 0; i < 2; i++)
+        if (t0 >= g[i].w[a].t_lo && t1 <= g[i].w[a].t_hi)
+            return 0;
+    const level_max_row m[2] = {{g[0].w[a].m, g[0].Rj, e0->wt, e0->inv_d, e0->cd},
+                                {g[1].w[a].m, g[1].Rj, e1->wt, e1->inv_d, e1->cd}};
+    if (!ts_pyr_level_max_rows2(m, e0->t, e0->taps, W, t1, ix, fx, r0->pa, r0->pb))
+        return 0;
+    g[0].w[a].t_lo = g[1].w[a].t_lo = 1;
+    g[0].w[a].t_hi = g[1].w[a].t_hi = 0;
+    return 1;
+}
+
+/* Level j's heights of the cells of grid row g (the same rows and weights
+ * for every azimuth, from azimuth 0's entries) over the runs that read
+ * them, into g->R (g->Rj; on the DEM: R0), and the shared level rows. */
+static void level_heights(const batch_ctx *B, grid_row *g, int j, int c0, int c1)
+{
+    int lo = c1, hi = c0 - 1, xa, xb;
+    for (int a = 0; a < B->n; a++)
+        if (g->run[a].pa <= g->run[a].pb && row_keeps(&B->az[a], &g->run[a], j, &xa, &xb)) {
+            lo = xa < lo ? xa : lo;
+            hi = xb > hi ? xb : hi;
+        }
+    g->Rj = g->R0;
+    if (lo <= hi && B->az[0].lv[j].lev > 0) {
+        ts_pyr_combine_rows(g->rl[0][j].r, g->rl[0][j].wr, 4, lo, hi, g->R);
+        g->Rj = g->R;
+    }
+    if (B->share)
+        share_level_row(B, g->w, g->rl, g->run, j, g->Tsh);
+}
+
+/* The cells [c0, c1) of the `rows` (1 or 2) grid rows g for every azimuth
+ * of B, level by level: the cells' own heights on a level are computed
+ * once per row for all azimuths (level_heights), and two rows whose
+ * samples read the same level rows read them once (sample_pair). */
+static void batch_rows(const batch_ctx *B, grid_row *g, int rows, int c0, int c1)
 {
     const int levels = B->az[0].P->levels;
-    row_run run[TS_PYRAMID_BATCH];
-    for (int a = 0; a < B->n; a++)
-        row_start(&B->az[a], &w[a], y, c0, c1, &run[a]);
-    /* 4 taps, weight 0 unused: as the one-azimuth sums */
-    ts_pyr_combine_rows(rl[0][0].r, rl[0][0].wr, 4, c0, c1 - 1, R0);
-    for (int j = 0; j < levels; j++) {
-        int lo = c1, hi = c0 - 1, xa, xb;
+    for (int i = 0; i < rows; i++) {
         for (int a = 0; a < B->n; a++)
-            if (run[a].pa <= run[a].pb && row_keeps(&B->az[a], &run[a], j, &xa, &xb)) {
-                lo = xa < lo ? xa : lo;
-                hi = xb > hi ? xb : hi;
-            }
-        const float *Rj = R0;
-        if (lo <= hi && B->az[0].lv[j].lev > 0) {
-            ts_pyr_combine_rows(rl[0][j].r, rl[0][j].wr, 4, lo, hi, R);
-            Rj = R;
-        }
-        if (B->share)
-            share_level_row(B, w, rl, run, j, Tsh);
+            row_start(&B->az[a], &g[i].w[a], g[i].y, c0, c1, &g[i].run[a]);
+        /* 4 taps, weight 0 unused: as the one-azimuth sums */
+        ts_pyr_combine_rows(g[i].rl[0][0].r, g[i].rl[0][0].wr, 4, c0, c1 - 1, g[i].R0);
+    }
+    for (int j = 0; j < levels; j++) {
+        for (int i = 0; i < rows; i++)
+            level_heights(B, &g[i], j, c0, c1);
         int active = 0;
         for (int a = 0; a < B->n; a++) {
-            row_sample(&B->az[a], &w[a], y, j, &rl[a][j], Rj, R0, &run[a]);
-            active |= run[a].pa <= run[a].pb;
+            const hz_ctx *C = &B->az[a];
+            int due[2] = {0, 0};
+            for (int i = 0; i < rows; i++)
+                due[i] = row_advance(C, &g[i].w[a], g[i].y, j, g[i].R0, &g[i].run[a]);
+            if (rows == 2 && due[0] && due[1] && sample_pair(C, g, a, j))
+                due[0] = due[1] = 0;
+            for (int i = 0; i < rows; i++) {
+                if (due[i])
+                    sample_level(C, &g[i].w[a], &g[i].rl[a][j], g[i].Rj, C->lv[j].ix,
+                                 C->lv[j].fx, j, g[i].run[a].pa, g[i].run[a].pb);
+                active |= g[i].run[a].pa <= g[i].run[a].pb;
+            }
         }
         if (!active)
             break;
     }
     /* whether the span has nodata: looked for once, not per azimuth */
-    const ts_grid *g = B->az[0].P->grid;
-    const float *z = g->z + (ptrdiff_t)y * g->stride;
-    int holes = ts_pyr_has_nodata(z, c0, c1 - 1);
-    for (int a = 0; a < B->n; a++)
-        row_finish(&B->az[a], &w[a], y, c0, c1, &run[a], holes);
+    const ts_grid *grid = B->az[0].P->grid;
+    for (int i = 0; i < rows; i++) {
+        const float *z = grid->z + (ptrdiff_t)g[i].y * grid->stride;
+        int holes = ts_pyr_has_nodata(z, c0, c1 - 1);
+        for (int a = 0; a < B->n; a++)
+            row_finish(&B->az[a], &g[i].w[a], g[i].y, c0, c1, &g[i].run[a], holes);
+    }
 }
 
 /* The cells [c0, c1) of row y, just computed for the batch: the edge,
@@ -369,16 +427,17 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
     (void)worker;
     const batch_ctx *B = ctx;
     const int n = B->n, W = B->az[0].P->grid->width, levels = B->az[0].P->levels;
-    /* per azimuth s0, s1, s2, m, T and the samples (T and the samples
-     * W + 1), each on a cache line as the level rows (ts_pyr_alloc): the
-     * runs' vectors then lie within a line where a run starts on one */
+    /* per grid row of a pair and azimuth s0, s1, s2, m, T and the samples
+     * (T and the samples W + 1), each on a cache line as the level rows
+     * (ts_pyr_alloc): the runs' vectors then lie within a line where a run
+     * starts on one */
     const size_t P = ((size_t)W + 1 + 15) / 16 * 16;
-    float *buf = ts_pyr_alloc((size_t)n * 6 * P * sizeof *buf);
-    float *own = ts_pyr_alloc(3 * P * sizeof *own);
+    float *buf = ts_pyr_alloc((size_t)2 * n * 6 * P * sizeof *buf);
+    float *own = ts_pyr_alloc(2 * 3 * P * sizeof *own);
     double *tpp = ts_pyr_alloc(3 * P * sizeof *tpp);
-    int *jd = ts_pyr_alloc((size_t)n * P * sizeof *jd);
+    int *jd = ts_pyr_alloc((size_t)2 * n * P * sizeof *jd);
     row_level *rl = malloc((size_t)n * ROW_BLOCK * levels * sizeof *rl);
-    row_ws w[TS_PYRAMID_BATCH];
+    row_ws w[2][TS_PYRAMID_BATCH];
     if (!buf || !own || !tpp || !jd || !rl) {
         free(buf);
         free(own);
@@ -388,11 +447,12 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
         __atomic_store_n(B->az[0].alloc_failed, 1, __ATOMIC_RELAXED);
         return;
     }
-    for (int a = 0; a < n; a++) {
-        float *f = buf + (size_t)a * 6 * P;
-        w[a] = (row_ws){f, f + P, f + 2 * P, f + 3 * P, f + 4 * P, f + 5 * P, tpp,
-                        jd + (size_t)a * P, NULL, 1, 0};
-    }
+    for (int i = 0; i < 2; i++)
+        for (int a = 0; a < n; a++) {
+            float *f = buf + ((size_t)i * n + a) * 6 * P;
+            w[i][a] = (row_ws){f, f + P, f + 2 * P, f + 3 * P, f + 4 * P, f + 5 * P, tpp,
+                               jd + ((size_t)i * n + a) * P, NULL, 1, 0};
+        }
     for (long yb = y0; yb < y1; yb += ROW_BLOCK) {
         long ye = yb + ROW_BLOCK < y1 ? yb + ROW_BLOCK : y1;
         for (int a = 0; a < n; a++) {
@@ -409,16 +469,25 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
                                    &rl[(size_t)a * ROW_BLOCK * levels + at]);
                 }
         }
-        /* a chunk of columns down the rows, then the next: the level rows
-         * that the cells of a chunk read stay in the cache from row to row */
+        /* a chunk of columns down the rows, two rows at a time, then the
+         * next chunk: the level rows that the cells of a chunk read stay in
+         * the cache from row to row */
         for (int c0 = 0; c0 < W; c0 += CHUNK) {
             int c1 = c0 + CHUNK < W ? c0 + CHUNK : W;
-            for (long y = yb; y < ye; y++) {
-                const row_level *rly[TS_PYRAMID_BATCH];
-                for (int a = 0; a < n; a++)
-                    rly[a] = &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels];
-                batch_row(B, w, (int)y, c0, c1, rly, own, own + P, own + 2 * P);
-                span_done(B, (int)y, c0, c1);
+            for (long y = yb; y < ye; y += 2) {
+                const int rows = y + 1 < ye ? 2 : 1;
+                grid_row g[2];
+                for (int i = 0; i < rows; i++) {
+                    float *o = own + (size_t)i * 3 * P;
+                    g[i].y = (int)y + i;
+                    g[i].w = w[i];
+                    g[i].R0 = o, g[i].R = o + P, g[i].Tsh = o + 2 * P;
+                    for (int a = 0; a < n; a++)
+                        g[i].rl[a] = &rl[((size_t)a * ROW_BLOCK + (y + i - yb)) * levels];
+                }
+                batch_rows(B, g, rows, c0, c1);
+                for (int i = 0; i < rows; i++)
+                    span_done(B, (int)y + i, c0, c1);
             }
         }
     }

@@ -106,6 +106,23 @@ int ts_pyr_level_max_rows(row_ws *w, const float *const r[4], const float wt[4],
                           int t1, int ix, float fx, const float *R, float inv_d, float cd, int x0,
                           int x1);
 
+/* One grid row's share of ts_pyr_level_max_rows2: its maxima, its cells'
+ * heights on the level, the level rows' weights at its samples' row, 1 / d
+ * and the curvature drop over d. */
+typedef struct {
+    float *m;
+    const float *R;
+    const float *wt;
+    float inv_d, cd;
+} level_max_row;
+
+/* ts_pyr_level_max_rows for two grid rows whose samples read the same level
+ * rows r (with their own weights) at the same cells [x0, x1] and offset:
+ * each row loaded once for both; each row's maxima the bits of
+ * ts_pyr_level_max_rows. Returns 0, doing nothing, without AVX-512. */
+int ts_pyr_level_max_rows2(const level_max_row g[2], const float *const r[4], int taps, int W,
+                           int t1, int ix, float fx, int x0, int x1);
+
 /* The horizons of the cells after `count` >= 1 samples, into out. */
 void ts_pyr_finish_run(row_ws *w, int bspline, int count, int x0, int x1, float *restrict out);
 
