@@ -3,8 +3,10 @@
 #ifndef TS_PYRAMID_HZ_H
 #define TS_PYRAMID_HZ_H
 
+#include "horizon_edge.h"
 #include "pyramid_internal.h"
 #include "simd_clones.h"
+#include "sky_plane.h"
 
 /* The clones of the loops with fused multiply-adds (pyramid_runs.c: the
  * level rows' vertical B-spline, the samples' interpolation and tangent):
@@ -41,6 +43,30 @@ typedef struct {
     float *out;
     int *alloc_failed;
 } hz_ctx;
+
+/* Azimuths computed together: the cells' own heights on each level are
+ * the same for all of them. */
+typedef struct {
+    int n;
+    const hz_ctx *az; /* n */
+    /* per azimuth, the first of the batch with its vy (itself where none
+     * comes earlier): only such can read a level at the same rows with the
+     * same weights (row_level_fill's `same`, share_level_row) */
+    int same_vy[TS_PYRAMID_BATCH];
+    /* whether any two share a vy (share_level_row; an x-major batch has
+     * none, and its test would fail at every level) */
+    int share;
+    /* what each row span gets as soon as it is done, per azimuth, while
+     * it is in the cache: the world beyond the edge (NULL: TS_EDGE_OPEN),
+     * then the sky terms (NULL: none; ts_pyramid_horizons_sky) */
+    const ts_edge_job *edge;
+    const ts_sky_plane *sky;
+} batch_ctx;
+
+/* The rows [y0, y1) of the batch ctx (a batch_ctx) for ts_parallel_for:
+ * every azimuth's horizons, then each row span's edge and sky terms
+ * (core/pyramid_horizon.c). */
+void ts_pyr_rows_range(void *ctx, int worker, long y0, long y1);
 
 /* Per-thread rows of state, one entry per cell of the grid row. */
 typedef struct {
