@@ -38,42 +38,52 @@ row16(const float *r, int q, __mmask16 in, const int masked)
     return _mm512_maskz_expandloadu_ps(in, r);
 }
 
-/* The level row of a sample: its rows, their weights, the row's width and
- * the last column the samples read (sample_cols' t1). */
+/* The level row of a sample: its rows, their weights (one set per grid
+ * row: two where two grid rows read the same level rows), the row's width
+ * and the last column the samples read (sample_cols' t1). */
 typedef struct {
     const float *r[4];
-    __m512 w[4];
+    __m512 w[2][4];
     int taps, W, t1;
 } level_rows;
 
-/* The level row at columns q..q+15: ts_pyr_combine_rows' sums, the same
- * fused multiply-adds in the same order; `masked` as row16 (the columns
- * within the row), else all 16 columns lie within it. */
-TS_AVX512 static inline __attribute__((always_inline)) __m512
-combine16(const level_rows *L, int q, const int taps, const int masked)
+/* The level row at columns q..q+15 into s[0] (and s[1] with `two`, the
+ * second weights): ts_pyr_combine_rows' sums, the same fused multiply-adds
+ * in the same order, each row loaded once for both; `masked` as row16
+ * (the columns within the row), else all 16 columns lie within it. */
+TS_AVX512 static inline __attribute__((always_inline)) void
+combine16(const level_rows *L, int q, const int taps, const int masked, const int two,
+          __m512 s[2])
 {
     const __mmask16 in = masked ? lanes_within(q, 0, L->W - 1) : 0xFFFF;
-    __m512 s = row16(L->r[0], q, in, masked);
-    if (taps == 1)
-        return s;
-    s = _mm512_mul_ps(L->w[0], s);
-    s = _mm512_fmadd_ps(L->w[1], row16(L->r[1], q, in, masked), s);
-    if (taps == 2)
-        return s;
-    s = _mm512_fmadd_ps(L->w[2], row16(L->r[2], q, in, masked), s);
-    return _mm512_fmadd_ps(L->w[3], row16(L->r[3], q, in, masked), s);
+    const __m512 v0 = row16(L->r[0], q, in, masked);
+    if (taps == 1) {
+        s[0] = s[1] = v0;
+        return;
+    }
+    s[0] = _mm512_mul_ps(L->w[0][0], v0);
+    if (two)
+        s[1] = _mm512_mul_ps(L->w[1][0], v0);
+    for (int t = 1; t < taps; t++) {
+        const __m512 v = row16(L->r[t], q, in, masked);
+        s[0] = _mm512_fmadd_ps(L->w[0][t], v, s[0]);
+        if (two)
+            s[1] = _mm512_fmadd_ps(L->w[1][t], v, s[1]);
+    }
 }
 
 /* combine16 where the columns q..q+15 may leave the row, for the run's
  * number of taps (masked loads only where they do). */
-TS_AVX512 static inline __m512 combine16_edge(const level_rows *L, int q)
+TS_AVX512 static inline __attribute__((always_inline)) void
+combine16_edge(const level_rows *L, int q, const int two, __m512 s[2])
 {
     const int in = q >= 0 && q + 15 <= L->W - 1;
     if (L->taps == 4)
-        return in ? combine16(L, q, 4, 0) : combine16(L, q, 4, 1);
-    if (L->taps == 2)
-        return in ? combine16(L, q, 2, 0) : combine16(L, q, 2, 1);
-    return in ? combine16(L, q, 1, 0) : combine16(L, q, 1, 1);
+        in ? combine16(L, q, 4, 0, two, s) : combine16(L, q, 4, 1, two, s);
+    else if (L->taps == 2)
+        in ? combine16(L, q, 2, 0, two, s) : combine16(L, q, 2, 1, two, s);
+    else
+        in ? combine16(L, q, 1, 0, two, s) : combine16(L, q, 1, 1, two, s);
 }
 
 /* Lane i of v in every lane. */
@@ -82,13 +92,28 @@ TS_AVX512 static inline __m512 lane_all(__m512 v, int i)
     return _mm512_permutexvar_ps(_mm512_set1_epi32(i), v);
 }
 
-/* What every block of a run shares. */
+/* What every block of a grid row's run shares. */
 typedef struct {
     __m512i at0, at1; /* lanes of T[x + ix], T[x + ix + 1] in the pair (cur, next) */
     __m512 fx, gx, inv_d, ncd;
     const float *R;
     float *m;
 } run_consts;
+
+TS_AVX512 static inline __attribute__((always_inline)) run_consts
+run_set(int ix, float fx, const float *R, float inv_d, float cd, float *m)
+{
+    const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    const __m512i at0 = _mm512_add_epi32(lane, _mm512_set1_epi32(ix & 15));
+    return (run_consts){at0,
+                        _mm512_add_epi32(at0, _mm512_set1_epi32(1)),
+                        _mm512_set1_ps(fx),
+                        _mm512_set1_ps(1.0f - fx),
+                        _mm512_set1_ps(inv_d),
+                        _mm512_set1_ps(-cd),
+                        R,
+                        m};
+}
 
 /* The samples of the 16 cells from x (those of `cells`) from the level
  * row's columns q..q+31 in cur, next: the maximum's update. */
@@ -110,73 +135,98 @@ block16(const run_consts *k, __m512 cur, __m512 next, int x, __mmask16 cells, in
     _mm512_mask_storeu_ps(k->m + x, cells, _mm512_max_ps(t, mm));
 }
 
-/* The blocks from x (the level row's vector at q in *cur) while their
+/* The blocks from x (the level row's vector at q in cur) while their
  * cells and the next vector's columns are all in range (x + 15 <= x1,
  * q + 31 <= t1), for a constant number of taps; returns the next x. */
 TS_AVX512 static inline __attribute__((always_inline)) int
-body_blocks(const level_rows *L, const run_consts *k, __m512 *cur, int x, int x1, int ix,
-            const int taps)
+body_blocks(const level_rows *L, const run_consts *k, __m512 cur[2], int x, int x1, int ix,
+            const int taps, const int two)
 {
     const int sh = ix & 15;
-    __m512 c = *cur;
+    __m512 c0 = cur[0], c1 = cur[1];
     int q = x + ix - sh;
     for (; x + 15 <= x1 && q + 31 <= L->t1; x += 16, q += 16) {
-        const __m512 next = combine16(L, q + 16, taps, 0);
-        block16(k, c, next, x, 0xFFFF, 1);
-        c = next;
+        __m512 next[2];
+        combine16(L, q + 16, taps, 0, two, next);
+        block16(&k[0], c0, next[0], x, 0xFFFF, 1);
+        c0 = next[0];
+        if (two) {
+            block16(&k[1], c1, next[1], x, 0xFFFF, 1);
+            c1 = next[1];
+        }
     }
-    *cur = c;
+    cur[0] = c0, cur[1] = c1;
     return x;
 }
 
-/* ts_pyr_level_max_rows: the blocks of 16 cells from x0's line to x1, the
- * first and the last masked to the run's cells and to the row's columns. */
-TS_AVX512 static void level_max_avx512(row_ws *w, const float *const r[4], const float wt[4],
-                                       int taps, int W, int t1, int ix, float fx,
-                                       const float *R, float inv_d, float cd, int x0, int x1)
+/* Columns past t1 of the vector at q (t1 >= q): column t1's value, taken
+ * from `from` (lane t1 - p of the vector at p). */
+TS_AVX512 static inline __m512 pad_past(__m512 v, int q, int t1, __m512 from, int p)
 {
-    const level_rows rows = {{r[0], r[1], r[2], r[3]},
-                             {_mm512_set1_ps(wt[0]), _mm512_set1_ps(wt[1]),
-                              _mm512_set1_ps(wt[2]), _mm512_set1_ps(wt[3])},
-                             taps,
-                             W,
-                             t1};
-    const level_rows *L = &rows;
+    return _mm512_mask_mov_ps(v, (__mmask16)~ts_first_lanes16(t1 - q + 1),
+                              lane_all(from, t1 - p));
+}
+
+/* ts_pyr_level_max_rows (and with `two` the second grid row's maxima, k[1],
+ * from the same level rows): the blocks of 16 cells from x0's line to x1,
+ * the first and the last masked to the run's cells and to the row's
+ * columns. */
+TS_AVX512 static inline __attribute__((always_inline)) void
+level_max_n(const level_rows *L, const run_consts *k, int ix, int x0, int x1, const int two)
+{
+    const int t1 = L->t1, taps = L->taps, n = 1 + two;
     const int sh = ix & 15; /* x + ix is lane sh of the vector at x + ix - sh */
-    const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-    const __m512i at0 = _mm512_add_epi32(lane, _mm512_set1_epi32(sh));
-    const run_consts k = {at0,
-                          _mm512_add_epi32(at0, _mm512_set1_epi32(1)),
-                          _mm512_set1_ps(fx),
-                          _mm512_set1_ps(1.0f - fx),
-                          _mm512_set1_ps(inv_d),
-                          _mm512_set1_ps(-cd),
-                          R,
-                          w->m};
     int x = x0 & ~15, q = x + ix - sh;
-    __m512 cur = combine16_edge(L, q);
-    if (q + 15 > t1)
-        cur = _mm512_mask_mov_ps(cur, (__mmask16)~ts_first_lanes16(t1 - q + 1),
-                                 lane_all(cur, t1 - q));
+    __m512 cur[2] = {_mm512_setzero_ps(), _mm512_setzero_ps()}, next[2];
+    combine16_edge(L, q, two, cur);
+    for (int i = 0; q + 15 > t1 && i < n; i++)
+        cur[i] = pad_past(cur[i], q, t1, cur[i], q);
     for (; x <= x1; x += 16, q += 16) {
         if (x >= x0 && x + 15 <= x1 && q + 31 <= t1) {
             /* the run's inner blocks: no masks, no pad, the rows' loads
              * and the cells' on their lines where the rows start on one */
-            x = taps == 4   ? body_blocks(L, &k, &cur, x, x1, ix, 4)
-                : taps == 2 ? body_blocks(L, &k, &cur, x, x1, ix, 2)
-                            : body_blocks(L, &k, &cur, x, x1, ix, 1);
+            x = taps == 4   ? body_blocks(L, k, cur, x, x1, ix, 4, two)
+                : taps == 2 ? body_blocks(L, k, cur, x, x1, ix, 2, two)
+                            : body_blocks(L, k, cur, x, x1, ix, 1, two);
             q = x + ix - sh;
             if (x > x1)
                 break;
         }
-        __m512 next = q + 16 <= t1 ? combine16_edge(L, q + 16) : cur;
-        if (q + 31 > t1) { /* columns past t1: column t1's value */
-            __m512 pad = t1 >= q + 16 ? lane_all(next, t1 - q - 16) : lane_all(cur, t1 - q);
-            next = _mm512_mask_mov_ps(next, (__mmask16)~ts_first_lanes16(t1 - q - 15), pad);
+        if (q + 16 <= t1)
+            combine16_edge(L, q + 16, two, next);
+        else
+            next[0] = cur[0], next[1] = cur[1];
+        for (int i = 0; q + 31 > t1 && i < n; i++) /* columns past t1: column t1's value */
+            next[i] = t1 >= q + 16 ? pad_past(next[i], q + 16, t1, next[i], q + 16)
+                                   : pad_past(next[i], q + 16, t1, cur[i], q);
+        for (int i = 0; i < n; i++) {
+            block16(&k[i], cur[i], next[i], x, lanes_within(x, x0, x1), 0);
+            cur[i] = next[i];
         }
-        block16(&k, cur, next, x, lanes_within(x, x0, x1), 0);
-        cur = next;
     }
+}
+
+TS_AVX512 static void level_max1(row_ws *w, const float *const r[4], const float wt[4], int taps,
+                                 int W, int t1, int ix, float fx, const float *R, float inv_d,
+                                 float cd, int x0, int x1)
+{
+    level_rows L = {.r = {r[0], r[1], r[2], r[3]}, .taps = taps, .W = W, .t1 = t1};
+    for (int t = 0; t < 4; t++)
+        L.w[0][t] = _mm512_set1_ps(wt[t]);
+    const run_consts k[2] = {run_set(ix, fx, R, inv_d, cd, w->m)};
+    level_max_n(&L, k, ix, x0, x1, 0);
+}
+
+TS_AVX512 static void level_max2(const level_max_row g[2], const float *const r[4], int taps,
+                                 int W, int t1, int ix, float fx, int x0, int x1)
+{
+    level_rows L = {.r = {r[0], r[1], r[2], r[3]}, .taps = taps, .W = W, .t1 = t1};
+    for (int i = 0; i < 2; i++)
+        for (int t = 0; t < 4; t++)
+            L.w[i][t] = _mm512_set1_ps(g[i].wt[t]);
+    const run_consts k[2] = {run_set(ix, fx, g[0].R, g[0].inv_d, g[0].cd, g[0].m),
+                             run_set(ix, fx, g[1].R, g[1].inv_d, g[1].cd, g[1].m)};
+    level_max_n(&L, k, ix, x0, x1, 1);
 }
 
 int ts_pyr_level_max_rows(row_ws *w, const float *const r[4], const float wt[4], int taps, int W,
@@ -185,7 +235,16 @@ int ts_pyr_level_max_rows(row_ws *w, const float *const r[4], const float wt[4],
 {
     if (ts_lane_vector_level() != 2)
         return 0;
-    level_max_avx512(w, r, wt, taps, W, t1, ix, fx, R, inv_d, cd, x0, x1);
+    level_max1(w, r, wt, taps, W, t1, ix, fx, R, inv_d, cd, x0, x1);
+    return 1;
+}
+
+int ts_pyr_level_max_rows2(const level_max_row g[2], const float *const r[4], int taps, int W,
+                           int t1, int ix, float fx, int x0, int x1)
+{
+    if (ts_lane_vector_level() != 2)
+        return 0;
+    level_max2(g, r, taps, W, t1, ix, fx, x0, x1);
     return 1;
 }
 #else
@@ -195,6 +254,13 @@ int ts_pyr_level_max_rows(row_ws *w, const float *const r[4], const float wt[4],
 {
     (void)w, (void)r, (void)wt, (void)taps, (void)W, (void)t1, (void)ix, (void)fx, (void)R;
     (void)inv_d, (void)cd, (void)x0, (void)x1;
+    return 0;
+}
+
+int ts_pyr_level_max_rows2(const level_max_row g[2], const float *const r[4], int taps, int W,
+                           int t1, int ix, float fx, int x0, int x1)
+{
+    (void)g, (void)r, (void)taps, (void)W, (void)t1, (void)ix, (void)fx, (void)x0, (void)x1;
     return 0;
 }
 #endif

@@ -23,14 +23,10 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "arg_checks.h"
 #include "horizon_edge.h"
-#include "parallel.h"
 #include "pyramid_hz.h"
 #include "sky_plane.h"
-#include "status_internal.h"
 
-#define DEG2RAD (M_PI / 180.0)
 #ifndef CHUNK
 #define CHUNK 1024 /* columns: the rows of every level a chunk reads stay in L2 */
 #endif
@@ -189,28 +185,26 @@ static int row_keeps(const hz_ctx *C, const row_run *r, int j, int *xa, int *xb)
     return L->s <= r->t_row;
 }
 
-/* Sample j of the run of row y (e: the row's entry; R and R0: the cells'
- * heights on its level and on the DEM), or the last one where the rays
- * end before it; the cells whose rays leave the grid drop out. */
-static void row_sample(const hz_ctx *C, row_ws *w, int y, int j, const row_level *e,
-                       const float *R, const float *R0, row_run *r)
+/* Sample j of the run of row y (R0: the cells' heights on the DEM): the
+ * cells whose rays leave the grid drop out, and where the rays end before
+ * the sample, their last one; returns 1 where the sample is instead read
+ * on level j for the cells [r->pa, r->pb] (sample_level, the caller's). */
+static int row_advance(const hz_ctx *C, row_ws *w, int y, int j, const float *R0, row_run *r)
 {
     int pa = r->pa, pb = r->pb, xa, xb;
     if (pa > pb)
-        return;
+        return 0;
     int on_level = row_keeps(C, r, j, &xa, &xb);
     if (xa > xb) {
         mark_drop(C, w, pa, pb, j);
         r->pa = 1, r->pb = 0;
-        return;
+        return 0;
     }
     mark_drop(C, w, pa, xa - 1, j);
     mark_drop(C, w, xb + 1, pb, j);
     pa = r->pa = xa, pb = r->pb = xb;
-    if (on_level) {
-        sample_level(C, w, e, R, C->lv[j].ix, C->lv[j].fx, j, pa, pb);
-        return;
-    }
+    if (on_level)
+        return 1;
     /* the row's rays end here: one last sample on the DEM */
     float *out = C->out + (size_t)y * C->P->grid->width;
     if (r->t_row > 1e-9) {
@@ -224,6 +218,7 @@ static void row_sample(const hz_ctx *C, row_ws *w, int y, int j, const row_level
     }
     r->fa = pa, r->fb = pb;
     r->pa = 1, r->pb = 0;
+    return 0;
 }
 
 /* The horizons of the cells of row y that dropped out, and nodata where
@@ -246,32 +241,14 @@ static void row_finish(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const 
     }
 }
 
-/* Azimuths computed together: the cells' own heights on each level are
- * the same for all of them. */
-typedef struct {
-    int n;
-    const hz_ctx *az; /* n */
-    /* per azimuth, the first of the batch with its vy (itself where none
-     * comes earlier): only such can read a level at the same rows with the
-     * same weights (row_level_fill's `same`, share_level_row) */
-    int same_vy[TS_PYRAMID_BATCH];
-    /* whether any two share a vy (share_level_row; an x-major batch has
-     * none, and its test would fail at every level) */
-    int share;
-    /* what each row span gets as soon as it is done, per azimuth, while
-     * it is in the cache: the world beyond the edge (NULL: TS_EDGE_OPEN),
-     * then the sky terms (NULL: none; ts_pyramid_horizons_sky) */
-    const ts_edge_job *edge;
-    const ts_sky_plane *sky;
-} batch_ctx;
-
-/* Whether two entries read the same level rows with the same weights. */
-static int same_rows(const row_level *a, const row_level *b)
+/* Whether two entries read the same level rows (and with `weights`, with
+ * the same weights). */
+static int same_rows(const row_level *a, const row_level *b, int weights)
 {
     if (a->taps != b->taps)
         return 0;
     for (int t = 0; t < a->taps; t++)
-        if (a->t[t] != b->t[t] || a->wt[t] != b->wt[t])
+        if (a->t[t] != b->t[t] || (weights && a->wt[t] != b->wt[t]))
             return 0;
     return 1;
 }
@@ -292,7 +269,7 @@ static void share_level_row(const batch_ctx *B, row_ws *w, const row_level *cons
         in[a] = run[a].pa <= run[a].pb && row_keeps(&B->az[a], &run[a], j, &xa, &xb) &&
                 xa <= xb && L->fx > 0.0f &&
                 sample_cols(B->az[a].P->grid->width, L->ix, L->fx, xa, xb, &t0[a], &t1[a]) &&
-                (!e0 || same_rows(e0, &rl[a][j]));
+                (!e0 || same_rows(e0, &rl[a][j], 1));
         if (!in[a])
             continue;
         e0 = e0 ? e0 : &rl[a][j];
@@ -309,48 +286,106 @@ static void share_level_row(const batch_ctx *B, row_ws *w, const row_level *cons
             w[a].Tsh = Tsh, w[a].t_lo = lo, w[a].t_hi = hi;
 }
 
-/* The cells [c0, c1) of row y for every azimuth of B, level by level: the
- * cells' own heights on a level (the same rows and weights for every
- * azimuth, from azimuth 0's entries rl[n][j]) are computed once, over
- * the runs that read them, into R (on the DEM: R0, kept for the rays
- * that end early). */
-static void batch_row(const batch_ctx *B, row_ws *w, int y, int c0, int c1,
-                      const row_level *const *rl, float *R0, float *R, float *Tsh)
+/* A grid row that batch_rows computes: its azimuths' states w (n) and
+ * row-level entries rl (n), the cells' heights on the DEM (R0) and on the
+ * level being read (R, or R0: Rj), the shared level row (Tsh), the runs. */
+typedef struct {
+    int y;
+    row_ws *w;
+    const row_level *rl[TS_PYRAMID_BATCH];
+    float *R0, *R, *Tsh;
+    const float *Rj;
+    row_run run[TS_PYRAMID_BATCH];
+} grid_row;
+
+/* Sample j of azimuth a for the two grid rows g at once where their
+ * samples read the same level rows at the same cells, each row for its
+ * own (the level maximum in registers; not the rows shared with other
+ * azimuths): the rows loaded once for both. Returns 0 where not done. */
+static int sample_pair(const hz_ctx *C, grid_row g[2], int a, int j)
+{
+    const row_run *r0 = &g[0].run[a], *r1 = &g[1].run[a];
+    const row_level *e0 = &g[0].rl[a][j], *e1 = &g[1].rl[a][j];
+    const int W = C->P->grid->width, ix = C->lv[j].ix;
+    const float fx = C->lv[j].fx;
+    int t0, t1;
+    if (C->bspline || r0->pa != r1->pa || r0->pb != r1->pb || !same_rows(e0, e1, 0) ||
+        !sample_cols(W, ix, fx, r0->pa, r0->pb, &t0, &t1))
+        return 0;
+    for (int i = 0; i < 2; i++)
+        if (t0 >= g[i].w[a].t_lo && t1 <= g[i].w[a].t_hi)
+            return 0;
+    const level_max_row m[2] = {{g[0].w[a].m, g[0].Rj, e0->wt, e0->inv_d, e0->cd},
+                                {g[1].w[a].m, g[1].Rj, e1->wt, e1->inv_d, e1->cd}};
+    if (!ts_pyr_level_max_rows2(m, e0->t, e0->taps, W, t1, ix, fx, r0->pa, r0->pb))
+        return 0;
+    g[0].w[a].t_lo = g[1].w[a].t_lo = 1;
+    g[0].w[a].t_hi = g[1].w[a].t_hi = 0;
+    return 1;
+}
+
+/* Level j's heights of the cells of grid row g (the same rows and weights
+ * for every azimuth, from azimuth 0's entries) over the runs that read
+ * them, into g->R (g->Rj; on the DEM: R0), and the shared level rows. */
+static void level_heights(const batch_ctx *B, grid_row *g, int j, int c0, int c1)
+{
+    int lo = c1, hi = c0 - 1, xa, xb;
+    for (int a = 0; a < B->n; a++)
+        if (g->run[a].pa <= g->run[a].pb && row_keeps(&B->az[a], &g->run[a], j, &xa, &xb)) {
+            lo = xa < lo ? xa : lo;
+            hi = xb > hi ? xb : hi;
+        }
+    g->Rj = g->R0;
+    if (lo <= hi && B->az[0].lv[j].lev > 0) {
+        ts_pyr_combine_rows(g->rl[0][j].r, g->rl[0][j].wr, 4, lo, hi, g->R);
+        g->Rj = g->R;
+    }
+    if (B->share)
+        share_level_row(B, g->w, g->rl, g->run, j, g->Tsh);
+}
+
+/* The cells [c0, c1) of the `rows` (1 or 2) grid rows g for every azimuth
+ * of B, level by level: the cells' own heights on a level are computed
+ * once per row for all azimuths (level_heights), and two rows whose
+ * samples read the same level rows read them once (sample_pair). */
+static void batch_rows(const batch_ctx *B, grid_row *g, int rows, int c0, int c1)
 {
     const int levels = B->az[0].P->levels;
-    row_run run[TS_PYRAMID_BATCH];
-    for (int a = 0; a < B->n; a++)
-        row_start(&B->az[a], &w[a], y, c0, c1, &run[a]);
-    /* 4 taps, weight 0 unused: as the one-azimuth sums */
-    ts_pyr_combine_rows(rl[0][0].r, rl[0][0].wr, 4, c0, c1 - 1, R0);
-    for (int j = 0; j < levels; j++) {
-        int lo = c1, hi = c0 - 1, xa, xb;
+    for (int i = 0; i < rows; i++) {
         for (int a = 0; a < B->n; a++)
-            if (run[a].pa <= run[a].pb && row_keeps(&B->az[a], &run[a], j, &xa, &xb)) {
-                lo = xa < lo ? xa : lo;
-                hi = xb > hi ? xb : hi;
-            }
-        const float *Rj = R0;
-        if (lo <= hi && B->az[0].lv[j].lev > 0) {
-            ts_pyr_combine_rows(rl[0][j].r, rl[0][j].wr, 4, lo, hi, R);
-            Rj = R;
-        }
-        if (B->share)
-            share_level_row(B, w, rl, run, j, Tsh);
+            row_start(&B->az[a], &g[i].w[a], g[i].y, c0, c1, &g[i].run[a]);
+        /* 4 taps, weight 0 unused: as the one-azimuth sums */
+        ts_pyr_combine_rows(g[i].rl[0][0].r, g[i].rl[0][0].wr, 4, c0, c1 - 1, g[i].R0);
+    }
+    for (int j = 0; j < levels; j++) {
+        for (int i = 0; i < rows; i++)
+            level_heights(B, &g[i], j, c0, c1);
         int active = 0;
         for (int a = 0; a < B->n; a++) {
-            row_sample(&B->az[a], &w[a], y, j, &rl[a][j], Rj, R0, &run[a]);
-            active |= run[a].pa <= run[a].pb;
+            const hz_ctx *C = &B->az[a];
+            int due[2] = {0, 0};
+            for (int i = 0; i < rows; i++)
+                due[i] = row_advance(C, &g[i].w[a], g[i].y, j, g[i].R0, &g[i].run[a]);
+            if (rows == 2 && due[0] && due[1] && sample_pair(C, g, a, j))
+                due[0] = due[1] = 0;
+            for (int i = 0; i < rows; i++) {
+                if (due[i])
+                    sample_level(C, &g[i].w[a], &g[i].rl[a][j], g[i].Rj, C->lv[j].ix,
+                                 C->lv[j].fx, j, g[i].run[a].pa, g[i].run[a].pb);
+                active |= g[i].run[a].pa <= g[i].run[a].pb;
+            }
         }
         if (!active)
             break;
     }
     /* whether the span has nodata: looked for once, not per azimuth */
-    const ts_grid *g = B->az[0].P->grid;
-    const float *z = g->z + (ptrdiff_t)y * g->stride;
-    int holes = ts_pyr_has_nodata(z, c0, c1 - 1);
-    for (int a = 0; a < B->n; a++)
-        row_finish(&B->az[a], &w[a], y, c0, c1, &run[a], holes);
+    const ts_grid *grid = B->az[0].P->grid;
+    for (int i = 0; i < rows; i++) {
+        const float *z = grid->z + (ptrdiff_t)g[i].y * grid->stride;
+        int holes = ts_pyr_has_nodata(z, c0, c1 - 1);
+        for (int a = 0; a < B->n; a++)
+            row_finish(&B->az[a], &g[i].w[a], g[i].y, c0, c1, &g[i].run[a], holes);
+    }
 }
 
 /* The cells [c0, c1) of row y, just computed for the batch: the edge,
@@ -364,21 +399,22 @@ static void span_done(const batch_ctx *B, int y, int c0, int c1)
         ts_sky_plane_add(&B->sky[a], at + c0, at + c1);
 }
 
-static void rows_range(void *ctx, int worker, long y0, long y1)
+void ts_pyr_rows_range(void *ctx, int worker, long y0, long y1)
 {
     (void)worker;
     const batch_ctx *B = ctx;
     const int n = B->n, W = B->az[0].P->grid->width, levels = B->az[0].P->levels;
-    /* per azimuth s0, s1, s2, m, T and the samples (T and the samples
-     * W + 1), each on a cache line as the level rows (ts_pyr_alloc): the
-     * runs' vectors then lie within a line where a run starts on one */
+    /* per grid row of a pair and azimuth s0, s1, s2, m, T and the samples
+     * (T and the samples W + 1), each on a cache line as the level rows
+     * (ts_pyr_alloc): the runs' vectors then lie within a line where a run
+     * starts on one */
     const size_t P = ((size_t)W + 1 + 15) / 16 * 16;
-    float *buf = ts_pyr_alloc((size_t)n * 6 * P * sizeof *buf);
-    float *own = ts_pyr_alloc(3 * P * sizeof *own);
+    float *buf = ts_pyr_alloc((size_t)2 * n * 6 * P * sizeof *buf);
+    float *own = ts_pyr_alloc(2 * 3 * P * sizeof *own);
     double *tpp = ts_pyr_alloc(3 * P * sizeof *tpp);
-    int *jd = ts_pyr_alloc((size_t)n * P * sizeof *jd);
+    int *jd = ts_pyr_alloc((size_t)2 * n * P * sizeof *jd);
     row_level *rl = malloc((size_t)n * ROW_BLOCK * levels * sizeof *rl);
-    row_ws w[TS_PYRAMID_BATCH];
+    row_ws w[2][TS_PYRAMID_BATCH];
     if (!buf || !own || !tpp || !jd || !rl) {
         free(buf);
         free(own);
@@ -388,11 +424,12 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
         __atomic_store_n(B->az[0].alloc_failed, 1, __ATOMIC_RELAXED);
         return;
     }
-    for (int a = 0; a < n; a++) {
-        float *f = buf + (size_t)a * 6 * P;
-        w[a] = (row_ws){f, f + P, f + 2 * P, f + 3 * P, f + 4 * P, f + 5 * P, tpp,
-                        jd + (size_t)a * P, NULL, 1, 0};
-    }
+    for (int i = 0; i < 2; i++)
+        for (int a = 0; a < n; a++) {
+            float *f = buf + ((size_t)i * n + a) * 6 * P;
+            w[i][a] = (row_ws){f, f + P, f + 2 * P, f + 3 * P, f + 4 * P, f + 5 * P, tpp,
+                               jd + ((size_t)i * n + a) * P, NULL, 1, 0};
+        }
     for (long yb = y0; yb < y1; yb += ROW_BLOCK) {
         long ye = yb + ROW_BLOCK < y1 ? yb + ROW_BLOCK : y1;
         for (int a = 0; a < n; a++) {
@@ -409,16 +446,25 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
                                    &rl[(size_t)a * ROW_BLOCK * levels + at]);
                 }
         }
-        /* a chunk of columns down the rows, then the next: the level rows
-         * that the cells of a chunk read stay in the cache from row to row */
+        /* a chunk of columns down the rows, two rows at a time, then the
+         * next chunk: the level rows that the cells of a chunk read stay in
+         * the cache from row to row */
         for (int c0 = 0; c0 < W; c0 += CHUNK) {
             int c1 = c0 + CHUNK < W ? c0 + CHUNK : W;
-            for (long y = yb; y < ye; y++) {
-                const row_level *rly[TS_PYRAMID_BATCH];
-                for (int a = 0; a < n; a++)
-                    rly[a] = &rl[((size_t)a * ROW_BLOCK + (y - yb)) * levels];
-                batch_row(B, w, (int)y, c0, c1, rly, own, own + P, own + 2 * P);
-                span_done(B, (int)y, c0, c1);
+            for (long y = yb; y < ye; y += 2) {
+                const int rows = y + 1 < ye ? 2 : 1;
+                grid_row g[2];
+                for (int i = 0; i < rows; i++) {
+                    float *o = own + (size_t)i * 3 * P;
+                    g[i].y = (int)y + i;
+                    g[i].w = w[i];
+                    g[i].R0 = o, g[i].R = o + P, g[i].Tsh = o + 2 * P;
+                    for (int a = 0; a < n; a++)
+                        g[i].rl[a] = &rl[((size_t)a * ROW_BLOCK + (y + i - yb)) * levels];
+                }
+                batch_rows(B, g, rows, c0, c1);
+                for (int i = 0; i < rows; i++)
+                    span_done(B, (int)y + i, c0, c1);
             }
         }
     }
@@ -427,172 +473,4 @@ static void rows_range(void *ctx, int worker, long y0, long y1)
     free(tpp);
     free(own);
     free(buf);
-}
-
-/* Sample j's shares for the azimuth of C (vx, ko set). */
-static void level_az_fill(const hz_ctx *C, level_az *lv)
-{
-    const ts_pyramid *P = C->P;
-    const int W = P->grid->width;
-    for (int j = 0; j < P->levels; j++) {
-        double s = P->level[j].spacing, ox = s * C->vx;
-        double fl = floor(ox), lf = floor(j - C->ko + 1e-9);
-        lv[j] = (level_az){s,
-                           (int)fl,
-                           (float)(ox - fl),
-                           C->vx < 0 ? (int)ceil(-ox) : 0,
-                           C->vx > 0 ? (int)floor(W - 1 - ox) : W - 1,
-                           lf < 0 ? 0 : (int)lf};
-    }
-}
-
-/* The context of azimuth `azimuth` (checked) into C: its step table and
- * level shares allocated; 0 when out of memory. */
-static int az_ctx_init(const ts_pyramid *pyr, double azimuth, const ts_horizon_opts *opts,
-                       float *out, int *failed, hz_ctx *C)
-{
-    const ts_grid *g = pyr->grid;
-    const int H = g->height;
-    double a = azimuth * DEG2RAD, sa = sin(a), ca = cos(a);
-    /* as the sweep: exact axis directions, the direction in cells taken at
-     * the central row of a geographic grid */
-    if (fabs(sa) < 1e-12) sa = 0;
-    if (fabs(ca) < 1e-12) ca = 0;
-    double gx = sa / ts_grid_cell_x(g, H / 2), gy = -ca / g->cell_y;
-    double major = fabs(gx) > fabs(gy) ? fabs(gx) : fabs(gy);
-    *C = (hz_ctx){pyr, gx / major, gy / major, NULL, 0, 0, 0, 0, 0, NULL, out, failed};
-    C->step = malloc((size_t)H * sizeof *C->step);
-    level_az *lv = malloc((size_t)pyr->levels * sizeof *lv);
-    C->lv = lv;
-    if (!C->step || !lv)
-        return 0;
-    for (int y = 0; y < H; y++)
-        C->step[y] = hypot(ts_grid_cell_x(g, y) * C->vx, g->cell_y * C->vy);
-    C->step_all = C->step[0];
-    for (int y = 1; y < H; y++)
-        C->step_all = C->step[y] == C->step[0] ? C->step_all : 0;
-    C->c = opts->curvature ? (1.0 - opts->refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
-    C->cap = opts->max_distance;
-    C->ko = pyr->opts.level_step * pyr->opts.offset;
-    C->bspline = pyr->opts.reconstruction == TS_PYRAMID_BSPLINE;
-    level_az_fill(C, lv);
-    return 1;
-}
-
-/* ts_pyramid_horizons, and with sky the sky terms of each plane added
- * span by span (ts_pyramid_horizons_sky; checked). */
-static ts_status horizons_run(const ts_pyramid *pyr, int count, const double *azimuths,
-                              const ts_horizon_opts *opts, const ts_pyramid_sky *sky,
-                              float *const *out, ts_error *err)
-{
-    if (!pyr)
-        return ts_fail(err, TS_ERR_ARG, "pyramid is NULL");
-    if (count < 1 || count > TS_PYRAMID_BATCH)
-        return ts_fail(err, TS_ERR_ARG, "azimuths at once must be 1 to %d, got %d",
-                       TS_PYRAMID_BATCH, count);
-    if (!azimuths)
-        return ts_fail(err, TS_ERR_ARG, "azimuths are NULL");
-    const ts_grid *g = pyr->grid;
-    double az[TS_PYRAMID_BATCH];
-    ts_status st;
-    for (int k = 0; k < count; k++) {
-        if (!out || !out[k])
-            return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
-        az[k] = azimuths[k];
-        if ((st = ts_check_sweep_args(g, &az[k], opts, err)) != TS_OK)
-            return st;
-    }
-    /* the edge as ts_horizon_edge_apply after the rows would, and the sky
-     * terms at the caller's azimuths, as ts_sky_accumulate_model of each
-     * plane in turn: each cell on its own, the same values */
-    ts_edge_job edge[TS_PYRAMID_BATCH];
-    ts_sky_plane terms[TS_PYRAMID_BATCH];
-    int edged = 0;
-    for (int k = 0; k < count; k++) {
-        edged = ts_edge_rows_init(&edge[k], g, az[k], opts, out[k]);
-        if (sky)
-            ts_sky_plane_init(&terms[k], sky->nx, sky->ny, sky->nz, out[k], azimuths[k],
-                              sky->directions, sky->svf_model, sky->svf, sky->sky,
-                              sky->openness);
-    }
-    hz_ctx C[TS_PYRAMID_BATCH];
-    int failed = 0, ok = 1, k = 0;
-    for (; ok && k < count; k++)
-        ok = az_ctx_init(pyr, az[k], opts, out[k], &failed, &C[k]);
-    if (ok) {
-        batch_ctx B = {count, C, {0}, 0, edged ? edge : NULL, sky ? terms : NULL};
-        for (int a = 0; a < count; a++) {
-            int b = 0;
-            while (b < a && C[b].vy != C[a].vy)
-                b++;
-            B.same_vy[a] = b;
-            B.share |= b < a;
-        }
-        st = ts_parallel_for(ts_thread_count(opts->threads, g->height), g->height, rows_range,
-                             &B, err);
-    }
-    for (int i = 0; i < k; i++) {
-        free(C[i].step);
-        free((level_az *)C[i].lv);
-    }
-    if (!ok)
-        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the pyramid's step tables");
-    if (st != TS_OK)
-        return st;
-    if (failed)
-        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the pyramid's row workspace");
-    return ts_ok(err);
-}
-
-ts_status ts_pyramid_horizons(const ts_pyramid *pyr, int count, const double *azimuths,
-                              const ts_horizon_opts *opts, float *const *out, ts_error *err)
-{
-    return horizons_run(pyr, count, azimuths, opts, NULL, out, err);
-}
-
-ts_status ts_pyramid_horizons_sky(const ts_pyramid *pyr, int count, const double *azimuths,
-                                  const ts_horizon_opts *opts, const ts_pyramid_sky *sky,
-                                  float *const *out, ts_error *err)
-{
-    if (!pyr || !sky)
-        return ts_fail(err, TS_ERR_ARG, pyr ? "sky terms are NULL" : "pyramid is NULL");
-    /* the azimuths are checked with the rest in horizons_run, before the
-     * sky terms read them */
-    ts_status st = ts_check_svf_model(sky->svf_model, err);
-    if (st == TS_OK)
-        st = ts_check_sky_args(pyr->grid, sky->nx, sky->ny, sky->nz, sky->directions, err);
-    return st == TS_OK ? horizons_run(pyr, count, azimuths, opts, sky, out, err) : st;
-}
-
-ts_status ts_pyramid_horizon(const ts_pyramid *pyr, double azimuth, const ts_horizon_opts *opts,
-                             float *out, ts_error *err)
-{
-    return ts_pyramid_horizons(pyr, 1, &azimuth, opts, &out, err);
-}
-
-ts_status ts_pyramid_horizon_compute(const ts_grid *grid, const ts_pyramid_opts *popts,
-                                     const ts_horizon_opts *opts, float *out, ts_error *err)
-{
-    ts_status st = ts_check_horizon_compute_args(grid, opts, out, err);
-    if (st != TS_OK)
-        return st;
-    ts_pyramid *pyr;
-    if ((st = ts_pyramid_build(grid, popts, opts->threads, &pyr, err)) != TS_OK)
-        return st;
-    size_t plane = (size_t)grid->width * (size_t)grid->height;
-    for (int k = 0; st == TS_OK && k < opts->directions; k += TS_PYRAMID_BATCH) {
-        int n = opts->directions - k < TS_PYRAMID_BATCH ? opts->directions - k : TS_PYRAMID_BATCH;
-        double az[TS_PYRAMID_BATCH];
-        float *planes[TS_PYRAMID_BATCH];
-        for (int i = 0; i < n; i++) {
-            az[i] = ts_horizon_azimuth(opts, k + i);
-            planes[i] = out + plane * (k + i);
-        }
-        if ((st = ts_progress(opts, (double)k / opts->directions, err)) == TS_OK)
-            st = ts_pyramid_horizons(pyr, n, az, opts, planes, err);
-    }
-    ts_pyramid_free(pyr);
-    if (st == TS_OK)
-        st = ts_progress(opts, 1.0, err);
-    return st == TS_OK ? ts_ok(err) : st;
 }

@@ -3,8 +3,10 @@
 #ifndef TS_PYRAMID_HZ_H
 #define TS_PYRAMID_HZ_H
 
+#include "horizon_edge.h"
 #include "pyramid_internal.h"
 #include "simd_clones.h"
+#include "sky_plane.h"
 
 /* The clones of the loops with fused multiply-adds (pyramid_runs.c: the
  * level rows' vertical B-spline, the samples' interpolation and tangent):
@@ -41,6 +43,30 @@ typedef struct {
     float *out;
     int *alloc_failed;
 } hz_ctx;
+
+/* Azimuths computed together: the cells' own heights on each level are
+ * the same for all of them. */
+typedef struct {
+    int n;
+    const hz_ctx *az; /* n */
+    /* per azimuth, the first of the batch with its vy (itself where none
+     * comes earlier): only such can read a level at the same rows with the
+     * same weights (row_level_fill's `same`, share_level_row) */
+    int same_vy[TS_PYRAMID_BATCH];
+    /* whether any two share a vy (share_level_row; an x-major batch has
+     * none, and its test would fail at every level) */
+    int share;
+    /* what each row span gets as soon as it is done, per azimuth, while
+     * it is in the cache: the world beyond the edge (NULL: TS_EDGE_OPEN),
+     * then the sky terms (NULL: none; ts_pyramid_horizons_sky) */
+    const ts_edge_job *edge;
+    const ts_sky_plane *sky;
+} batch_ctx;
+
+/* The rows [y0, y1) of the batch ctx (a batch_ctx) for ts_parallel_for:
+ * every azimuth's horizons, then each row span's edge and sky terms
+ * (core/pyramid_horizon.c). */
+void ts_pyr_rows_range(void *ctx, int worker, long y0, long y1);
 
 /* Per-thread rows of state, one entry per cell of the grid row. */
 typedef struct {
@@ -105,6 +131,23 @@ int ts_pyr_level_run(row_ws *w, const float *restrict T, int ix, float fx,
 int ts_pyr_level_max_rows(row_ws *w, const float *const r[4], const float wt[4], int taps, int W,
                           int t1, int ix, float fx, const float *R, float inv_d, float cd, int x0,
                           int x1);
+
+/* One grid row's share of ts_pyr_level_max_rows2: its maxima, its cells'
+ * heights on the level, the level rows' weights at its samples' row, 1 / d
+ * and the curvature drop over d. */
+typedef struct {
+    float *m;
+    const float *R;
+    const float *wt;
+    float inv_d, cd;
+} level_max_row;
+
+/* ts_pyr_level_max_rows for two grid rows whose samples read the same level
+ * rows r (with their own weights) at the same cells [x0, x1] and offset:
+ * each row loaded once for both; each row's maxima the bits of
+ * ts_pyr_level_max_rows. Returns 0, doing nothing, without AVX-512. */
+int ts_pyr_level_max_rows2(const level_max_row g[2], const float *const r[4], int taps, int W,
+                           int t1, int ix, float fx, int x0, int x1);
 
 /* The horizons of the cells after `count` >= 1 samples, into out. */
 void ts_pyr_finish_run(row_ws *w, int bspline, int count, int x0, int x1, float *restrict out);

@@ -4,7 +4,9 @@
  * combined into T (ts_pyr_combine_rows, T[t1 + 1] = T[t1] as sample_level
  * pads it) then read back by ts_pyr_level_run, bit for bit: every tap
  * count, rows with nodata, runs at any column and offset, the fraction 0
- * at the grid's last column. */
+ * at the grid's last column; and ts_pyr_level_max_rows2, two grid rows
+ * reading the same level rows with their own weights, each row's maxima
+ * those of the reference. */
 #include <check.h>
 #include <math.h>
 #include <stdint.h>
@@ -25,30 +27,71 @@ static void fill(float *v, int n, uint64_t *seed, int holes)
         v[i] = holes && i % holes == 3 ? NAN : (float)(1500.0 * tdem_uniform(seed) - 50.0);
 }
 
-/* One run both ways; returns whether the maxima are the same bits (1 also
- * where the CPU has no AVX-512: nothing to compare; *compared says). */
-static int one_run(const float *const r[4], const float wt[4], int taps, int W, int ix, float fx,
-                   const float *R, int x0, int x1, uint64_t *seed, int *compared)
+/* The maxima m (W + 16 cells, some at -inf: no sample yet) of one grid
+ * row's run the reference way: the level row combined into T, padded at
+ * t1 + 1 as sample_level does, read back by ts_pyr_level_run. */
+static void reference_run(const float *const r[4], const float wt[4], int taps, int ix, float fx,
+                          int t1, const float *R, float inv_d, float cd, int x0, int x1,
+                          float *m)
 {
-    row_ws a = {0}, b = {0};
+    row_ws a = {0};
     float *T = ts_pyr_alloc((MAXW + 16) * sizeof *T);
-    a.m = ts_pyr_alloc((MAXW + 16) * sizeof *a.m);
+    a.m = m;
     a.A = ts_pyr_alloc((MAXW + 16) * sizeof *a.A);
-    b.m = ts_pyr_alloc((MAXW + 16) * sizeof *b.m);
-    ck_assert(T && a.m && a.A && b.m);
-    for (int x = 0; x < MAXW + 16; x++) /* some cells at -inf: no sample yet */
-        a.m[x] = tdem_uniform(seed) < 0.2 ? -INFINITY : (float)(tdem_uniform(seed) - 0.5);
-    memcpy(b.m, a.m, (MAXW + 16) * sizeof *a.m);
-    const float inv_d = (float)(1.0 / (40.0 + 900.0 * tdem_uniform(seed)));
-    const float cd = (float)(1e-6 * tdem_uniform(seed));
-    int t0 = x0 + ix, t1 = x1 + ix + (fx > 0.0f);
-    t1 = t1 > W - 1 ? W - 1 : t1;
-    ts_pyr_combine_rows(r, wt, taps, t0, t1, T);
+    ck_assert(T && a.A);
+    ts_pyr_combine_rows(r, wt, taps, x0 + ix, t1, T);
     T[t1 + 1] = T[t1];
     ts_pyr_level_run(&a, T, ix, fx, R, inv_d, cd, 0, 1, x0, x1);
+    free(T), free(a.A);
+}
+
+/* Maxima to start from: some at -inf, the others in [-0.5, 0.5). */
+static float *start_max(uint64_t *seed)
+{
+    float *m = ts_pyr_alloc((MAXW + 16) * sizeof *m);
+    ck_assert(m);
+    for (int x = 0; x < MAXW + 16; x++)
+        m[x] = tdem_uniform(seed) < 0.2 ? -INFINITY : (float)(tdem_uniform(seed) - 0.5);
+    return m;
+}
+
+static float *copy_max(const float *m)
+{
+    float *c = ts_pyr_alloc((MAXW + 16) * sizeof *c);
+    ck_assert(c);
+    memcpy(c, m, (MAXW + 16) * sizeof *c);
+    return c;
+}
+
+/* One run three ways: the reference for two grid rows reading the same
+ * level rows r with their own weights (wt, wt2) and heights (R, R2);
+ * ts_pyr_level_max_rows for the first; ts_pyr_level_max_rows2 for both.
+ * Returns whether all give the same bits (1 also where the CPU has no
+ * AVX-512: nothing to compare; *compared says). */
+static int one_run(const float *const r[4], const float wt[4], const float wt2[4], int taps,
+                   int W, int ix, float fx, const float *R, const float *R2, int x0, int x1,
+                   uint64_t *seed, int *compared)
+{
+    float *ref = start_max(seed), *ref2 = start_max(seed);
+    float *one = copy_max(ref), *pair = copy_max(ref), *pair2 = copy_max(ref2);
+    const float inv_d = (float)(1.0 / (40.0 + 900.0 * tdem_uniform(seed)));
+    const float cd = (float)(1e-6 * tdem_uniform(seed));
+    const float inv_d2 = (float)(1.0 / (40.0 + 900.0 * tdem_uniform(seed)));
+    const float cd2 = (float)(1e-6 * tdem_uniform(seed));
+    int t1 = x1 + ix + (fx > 0.0f);
+    t1 = t1 > W - 1 ? W - 1 : t1;
+    reference_run(r, wt, taps, ix, fx, t1, R, inv_d, cd, x0, x1, ref);
+    reference_run(r, wt2, taps, ix, fx, t1, R2, inv_d2, cd2, x0, x1, ref2);
+    row_ws b = {0};
+    b.m = one;
     *compared = ts_pyr_level_max_rows(&b, r, wt, taps, W, t1, ix, fx, R, inv_d, cd, x0, x1);
-    int same = !*compared || !memcmp(a.m, b.m, (MAXW + 16) * sizeof *a.m);
-    free(T), free(a.m), free(a.A), free(b.m);
+    const level_max_row g[2] = {{pair, R, wt, inv_d, cd}, {pair2, R2, wt2, inv_d2, cd2}};
+    int paired = ts_pyr_level_max_rows2(g, r, taps, W, t1, ix, fx, x0, x1);
+    ck_assert_int_eq(paired, *compared);
+    const size_t bytes = (MAXW + 16) * sizeof *ref;
+    int same = !*compared || (!memcmp(ref, one, bytes) && !memcmp(ref, pair, bytes) &&
+                              !memcmp(ref2, pair2, bytes));
+    free(ref), free(ref2), free(one), free(pair), free(pair2);
     return same;
 }
 
@@ -57,7 +100,8 @@ START_TEST(test_level_max_rows_identical)
     uint64_t seed = 12345;
     float *rows = ts_pyr_alloc(ROWS * MAXW * sizeof *rows);
     float *R = ts_pyr_alloc((MAXW + 16) * sizeof *R);
-    ck_assert(rows && R);
+    float *R2 = ts_pyr_alloc((MAXW + 16) * sizeof *R2);
+    ck_assert(rows && R && R2);
     static const int widths[] = {1, 17, 100, 1024, 1093};
     int runs = 0, compared = 0, differ = 0;
     char first[160] = "";
@@ -67,11 +111,12 @@ START_TEST(test_level_max_rows_identical)
             int holes = k % 3 == 0 ? 0 : 5 + k % 17;
             fill(rows, ROWS * W, &seed, holes);
             fill(R, W, &seed, k % 4 == 1 ? 7 : 0);
+            fill(R2, W, &seed, k % 4 == 2 ? 9 : 0);
             const int taps = k % 3 == 0 ? 1 : k % 3 == 1 ? 2 : 4;
             const float *r[4] = {rows, rows + W, rows + 2 * W, rows + 3 * W};
-            float wt[4];
+            float wt[4], wt2[4];
             for (int t = 0; t < 4; t++)
-                wt[t] = (float)tdem_uniform(&seed);
+                wt[t] = (float)tdem_uniform(&seed), wt2[t] = (float)tdem_uniform(&seed);
             /* the offset ix + fx of a sample on the grid for cells [x0, x1]
              * of the row: x + ix + fx in [0, W - 1] (the runs keep such cells) */
             int ix = (int)((2.0 * tdem_uniform(&seed) - 1.0) * W);
@@ -84,18 +129,19 @@ START_TEST(test_level_max_rows_identical)
             int x1 = k % 7 == 0 ? hi : x0 + (int)(tdem_uniform(&seed) * (hi - x0 + 1));
             int c;
             runs++;
-            if (!one_run(r, wt, taps, W, ix, fx, R, x0, x1, &seed, &c) && !differ++)
+            if (!one_run(r, wt, wt2, taps, W, ix, fx, R, R2, x0, x1, &seed, &c) && !differ++)
                 snprintf(first, sizeof first, "W %d taps %d ix %d fx %g cells [%d, %d]", W,
                          taps, ix, fx, x0, x1);
             compared += c;
         }
     }
-    printf("level max, row in registers against combine + level run: %d runs, %d compared "
+    printf("level max, row in registers (one grid row, and two sharing the level rows) against "
+           "combine + level run: %d runs, %d compared "
            "(0: no AVX-512 here), %d differ\n",
            runs, compared, differ);
     ck_assert_msg(!differ, "%d runs differ, the first: %s", differ, first);
     ck_assert_int_gt(runs, 800);
-    free(rows), free(R);
+    free(rows), free(R), free(R2);
 }
 END_TEST
 
