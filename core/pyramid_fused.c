@@ -206,61 +206,49 @@ level_max_n(const level_rows *L, const run_consts *k, int ix, int x0, int x1, co
     }
 }
 
-TS_AVX512 static void level_max1(row_ws *w, const float *const r[4], const float wt[4], int taps,
-                                 int W, int t1, int ix, float fx, const float *R, float inv_d,
-                                 float cd, int x0, int x1)
+/* level_max_n for the grid rows g (one, or two with `two`): their weights
+ * and run constants. */
+TS_AVX512 static inline __attribute__((always_inline)) void
+level_max_g(const level_max_row *g, const float *const r[4], int taps, int W, int t1, int ix,
+            float fx, int x0, int x1, const int two)
 {
     level_rows L = {.r = {r[0], r[1], r[2], r[3]}, .taps = taps, .W = W, .t1 = t1};
-    for (int t = 0; t < 4; t++)
-        L.w[0][t] = _mm512_set1_ps(wt[t]);
-    const run_consts k[2] = {run_set(ix, fx, R, inv_d, cd, w->m)};
-    level_max_n(&L, k, ix, x0, x1, 0);
-}
-
-TS_AVX512 static void level_max2(const level_max_row g[2], const float *const r[4], int taps,
-                                 int W, int t1, int ix, float fx, int x0, int x1)
-{
-    level_rows L = {.r = {r[0], r[1], r[2], r[3]}, .taps = taps, .W = W, .t1 = t1};
-    for (int i = 0; i < 2; i++)
+    run_consts k[2];
+    for (int i = 0; i <= two; i++) {
         for (int t = 0; t < 4; t++)
             L.w[i][t] = _mm512_set1_ps(g[i].wt[t]);
-    const run_consts k[2] = {run_set(ix, fx, g[0].R, g[0].inv_d, g[0].cd, g[0].m),
-                             run_set(ix, fx, g[1].R, g[1].inv_d, g[1].cd, g[1].m)};
-    level_max_n(&L, k, ix, x0, x1, 1);
+        k[i] = run_set(ix, fx, g[i].R, g[i].inv_d, g[i].cd, g[i].m);
+    }
+    level_max_n(&L, k, ix, x0, x1, two);
 }
 
-int ts_pyr_level_max_rows(row_ws *w, const float *const r[4], const float wt[4], int taps, int W,
-                          int t1, int ix, float fx, const float *R, float inv_d, float cd, int x0,
-                          int x1)
+/* level_max_g for one and for two rows, each its own constant-folded copy */
+TS_AVX512 static void level_max1(const level_max_row *g, const float *const r[4], int taps,
+                                 int W, int t1, int ix, float fx, int x0, int x1)
+{
+    level_max_g(g, r, taps, W, t1, ix, fx, x0, x1, 0);
+}
+
+TS_AVX512 static void level_max2(const level_max_row *g, const float *const r[4], int taps,
+                                 int W, int t1, int ix, float fx, int x0, int x1)
+{
+    level_max_g(g, r, taps, W, t1, ix, fx, x0, x1, 1);
+}
+
+int ts_pyr_level_max_rows(const level_max_row *g, int rows, const float *const r[4], int taps,
+                          int W, int t1, int ix, float fx, int x0, int x1)
 {
     if (ts_lane_vector_level() != 2)
         return 0;
-    level_max1(w, r, wt, taps, W, t1, ix, fx, R, inv_d, cd, x0, x1);
-    return 1;
-}
-
-int ts_pyr_level_max_rows2(const level_max_row g[2], const float *const r[4], int taps, int W,
-                           int t1, int ix, float fx, int x0, int x1)
-{
-    if (ts_lane_vector_level() != 2)
-        return 0;
-    level_max2(g, r, taps, W, t1, ix, fx, x0, x1);
+    (rows == 2 ? level_max2 : level_max1)(g, r, taps, W, t1, ix, fx, x0, x1);
     return 1;
 }
 #else
-int ts_pyr_level_max_rows(row_ws *w, const float *const r[4], const float wt[4], int taps, int W,
-                          int t1, int ix, float fx, const float *R, float inv_d, float cd, int x0,
-                          int x1)
+int ts_pyr_level_max_rows(const level_max_row *g, int rows, const float *const r[4], int taps,
+                          int W, int t1, int ix, float fx, int x0, int x1)
 {
-    (void)w, (void)r, (void)wt, (void)taps, (void)W, (void)t1, (void)ix, (void)fx, (void)R;
-    (void)inv_d, (void)cd, (void)x0, (void)x1;
-    return 0;
-}
-
-int ts_pyr_level_max_rows2(const level_max_row g[2], const float *const r[4], int taps, int W,
-                           int t1, int ix, float fx, int x0, int x1)
-{
-    (void)g, (void)r, (void)taps, (void)W, (void)t1, (void)ix, (void)fx, (void)x0, (void)x1;
+    (void)g, (void)rows, (void)r, (void)taps, (void)W, (void)t1, (void)ix, (void)fx, (void)x0;
+    (void)x1;
     return 0;
 }
 #endif

@@ -115,8 +115,8 @@ static void sample_level(const hz_ctx *C, row_ws *w, const row_level *e, const f
         return;
     const float *T = w->Tsh;
     if (t0 < w->t_lo || t1 > w->t_hi) {
-        if (!C->bspline && ts_pyr_level_max_rows(w, e->t, e->wt, e->taps, W, t1, ix, fx, R,
-                                                 e->inv_d, e->cd, x0, x1)) {
+        const level_max_row g = {w->m, R, e->wt, e->inv_d, e->cd};
+        if (!C->bspline && ts_pyr_level_max_rows(&g, 1, e->t, e->taps, W, t1, ix, fx, x0, x1)) {
             w->t_lo = 1, w->t_hi = 0;
             return; /* the level maximum, its row kept in registers */
         }
@@ -317,7 +317,7 @@ static int sample_pair(const hz_ctx *C, grid_row g[2], int a, int j)
             return 0;
     const level_max_row m[2] = {{g[0].w[a].m, g[0].Rj, e0->wt, e0->inv_d, e0->cd},
                                 {g[1].w[a].m, g[1].Rj, e1->wt, e1->inv_d, e1->cd}};
-    if (!ts_pyr_level_max_rows2(m, e0->t, e0->taps, W, t1, ix, fx, r0->pa, r0->pb))
+    if (!ts_pyr_level_max_rows(m, 2, e0->t, e0->taps, W, t1, ix, fx, r0->pa, r0->pb))
         return 0;
     g[0].w[a].t_lo = g[1].w[a].t_lo = 1;
     g[0].w[a].t_hi = g[1].w[a].t_hi = 0;

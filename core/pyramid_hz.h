@@ -122,19 +122,9 @@ int ts_pyr_level_run(row_ws *w, const float *restrict T, int ix, float fx,
                      const float *restrict R, float inv_d, float cd, int bspline, int c, int x0,
                      int x1);
 
-/* ts_pyr_combine_rows of the rows r (weights wt, `taps` of them, rows of W
- * columns) over [x0 + ix, t1] into T, T[t1 + 1] = T[t1], then
- * ts_pyr_level_run of the level maximum (bspline 0): the same maxima, with
- * the level row kept in registers and T not written (core/pyramid_fused.c;
- * R and w->m on cache lines, ts_pyr_alloc). Returns 0, doing nothing,
- * where the CPU has no AVX-512. */
-int ts_pyr_level_max_rows(row_ws *w, const float *const r[4], const float wt[4], int taps, int W,
-                          int t1, int ix, float fx, const float *R, float inv_d, float cd, int x0,
-                          int x1);
-
-/* One grid row's share of ts_pyr_level_max_rows2: its maxima, its cells'
- * heights on the level, the level rows' weights at its samples' row, 1 / d
- * and the curvature drop over d. */
+/* One grid row of ts_pyr_level_max_rows: its maxima, its cells' heights on
+ * the level, the level rows' weights at its samples' row, 1 / d and the
+ * curvature drop over d. */
 typedef struct {
     float *m;
     const float *R;
@@ -142,12 +132,16 @@ typedef struct {
     float inv_d, cd;
 } level_max_row;
 
-/* ts_pyr_level_max_rows for two grid rows whose samples read the same level
- * rows r (with their own weights) at the same cells [x0, x1] and offset:
- * each row loaded once for both; each row's maxima the bits of
- * ts_pyr_level_max_rows. Returns 0, doing nothing, without AVX-512. */
-int ts_pyr_level_max_rows2(const level_max_row g[2], const float *const r[4], int taps, int W,
-                           int t1, int ix, float fx, int x0, int x1);
+/* For each of the `rows` (1 or 2) grid rows g whose samples read the level
+ * rows r (`taps` of them, rows of W columns; each grid row with its own
+ * weights) at the same cells [x0, x1] and offset ix + fx:
+ * ts_pyr_combine_rows over [x0 + ix, t1] into T, T[t1 + 1] = T[t1], then
+ * ts_pyr_level_run of the level maximum (bspline 0). The same maxima, with
+ * the level row kept in registers, T not written, and each level row loaded
+ * once for both grid rows (core/pyramid_fused.c; R and m on cache lines,
+ * ts_pyr_alloc). Returns 0, doing nothing, where the CPU has no AVX-512. */
+int ts_pyr_level_max_rows(const level_max_row *g, int rows, const float *const r[4], int taps,
+                          int W, int t1, int ix, float fx, int x0, int x1);
 
 /* The horizons of the cells after `count` >= 1 samples, into out. */
 void ts_pyr_finish_run(row_ws *w, int bspline, int count, int x0, int x1, float *restrict out);

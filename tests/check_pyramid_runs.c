@@ -4,9 +4,8 @@
  * combined into T (ts_pyr_combine_rows, T[t1 + 1] = T[t1] as sample_level
  * pads it) then read back by ts_pyr_level_run, bit for bit: every tap
  * count, rows with nodata, runs at any column and offset, the fraction 0
- * at the grid's last column; and ts_pyr_level_max_rows2, two grid rows
- * reading the same level rows with their own weights, each row's maxima
- * those of the reference. */
+ * at the grid's last column; and with two grid rows reading the same level
+ * rows with their own weights, each row's maxima those of the reference. */
 #include <check.h>
 #include <math.h>
 #include <stdint.h>
@@ -65,7 +64,7 @@ static float *copy_max(const float *m)
 
 /* One run three ways: the reference for two grid rows reading the same
  * level rows r with their own weights (wt, wt2) and heights (R, R2);
- * ts_pyr_level_max_rows for the first; ts_pyr_level_max_rows2 for both.
+ * ts_pyr_level_max_rows of the first row alone, then of both rows.
  * Returns whether all give the same bits (1 also where the CPU has no
  * AVX-512: nothing to compare; *compared says). */
 static int one_run(const float *const r[4], const float wt[4], const float wt2[4], int taps,
@@ -82,11 +81,10 @@ static int one_run(const float *const r[4], const float wt[4], const float wt2[4
     t1 = t1 > W - 1 ? W - 1 : t1;
     reference_run(r, wt, taps, ix, fx, t1, R, inv_d, cd, x0, x1, ref);
     reference_run(r, wt2, taps, ix, fx, t1, R2, inv_d2, cd2, x0, x1, ref2);
-    row_ws b = {0};
-    b.m = one;
-    *compared = ts_pyr_level_max_rows(&b, r, wt, taps, W, t1, ix, fx, R, inv_d, cd, x0, x1);
+    const level_max_row g1 = {one, R, wt, inv_d, cd};
+    *compared = ts_pyr_level_max_rows(&g1, 1, r, taps, W, t1, ix, fx, x0, x1);
     const level_max_row g[2] = {{pair, R, wt, inv_d, cd}, {pair2, R2, wt2, inv_d2, cd2}};
-    int paired = ts_pyr_level_max_rows2(g, r, taps, W, t1, ix, fx, x0, x1);
+    int paired = ts_pyr_level_max_rows(g, 2, r, taps, W, t1, ix, fx, x0, x1);
     ck_assert_int_eq(paired, *compared);
     const size_t bytes = (MAXW + 16) * sizeof *ref;
     int same = !*compared || (!memcmp(ref, one, bytes) && !memcmp(ref, pair, bytes) &&
