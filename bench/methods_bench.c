@@ -3,7 +3,7 @@
  * error and time side by side (docs/methods.md).
  *
  *   methods_bench [--size N] [--dirs D] [--threads T] [--level-step K]
- *                 [--offset O] [--dems jacksboro,lux_elev,fractal] [--cpu]
+ *                 [--offset O] [--dems jacksboro,lux_elev,fractal] [--cpu | --user]
  *
  * For each DEM (the real ones of tests/data, and an N x N fractal: fBm
  * value noise, Hurst 0.8, 1500 m relief, 10 m cells, as ts_bench) it
@@ -15,26 +15,64 @@
  * SVF_MODEL's default), the time of each svf (horizons plus accumulation;
  * the pyramid's build included) on the C backend, and the memory each
  * keeps besides the DEM and the output. Times are wall-clock seconds, or
- * with --cpu the process's CPU seconds.
+ * with --cpu the process's CPU seconds, with --user its user CPU seconds
+ * (each method's kernel CPU seconds printed beside); the outputs' pages are touched
+ * before any timing, so that no method pays for the kernel's first mapping
+ * of them.
  */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/time.h>
 #include <time.h>
 
 #include "terrashade.h"
 #include "test_dem.h"
 
-/* --cpu: the process's CPU time instead of the wall clock, steadier
- * than wall time on a shared machine (with --threads 1, one core's time) */
-static clockid_t timer = CLOCK_MONOTONIC;
+/* --cpu: the process's CPU time (user and kernel) instead of the wall
+ * clock, steadier than wall time on a shared machine (with --threads 1,
+ * one core's time); --user: its user time only, which leaves out the
+ * kernel's work for the process, mostly the first mapping of each page it
+ * allocates (docs/performance.md: on the development VM that cost 4-23 us
+ * a page, depending on how long ago the host last backed the page). Every
+ * method's kernel time is printed beside it in any mode. */
+enum { TIME_WALL, TIME_CPU, TIME_USER };
+static int timer = TIME_WALL;
+
+static double tv_sec(struct timeval t)
+{
+    return t.tv_sec + t.tv_usec * 1e-6;
+}
 
 static double now(void)
 {
+    if (timer == TIME_USER) {
+        struct rusage ru;
+        getrusage(RUSAGE_SELF, &ru);
+        return tv_sec(ru.ru_utime);
+    }
     struct timespec ts;
-    clock_gettime(timer, &ts);
+    clock_gettime(timer == TIME_CPU ? CLOCK_PROCESS_CPUTIME_ID : CLOCK_MONOTONIC, &ts);
     return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* The process's kernel CPU seconds so far. */
+static double kernel_now(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return tv_sec(ru.ru_stime);
+}
+
+/* One write to every page of p (volatile: a memset of zeros right after
+ * malloc may be turned into calloc, which writes nothing). */
+static void touch_pages(void *p, size_t bytes)
+{
+    volatile unsigned char *b = p;
+    for (size_t i = 0; i < bytes; i += 4096)
+        b[i] = 0;
 }
 
 static void die(const char *what, const ts_error *e)
@@ -90,7 +128,7 @@ typedef struct {
 /* One method's errors against exact and time. */
 typedef struct {
     hist hor, svf;
-    double t, t_build;
+    double t, t_build, t_kernel; /* t_kernel: kernel CPU seconds within t */
     float *plane, *svf_acc;
     ts_pyramid *pyr;
 } method;
@@ -114,7 +152,7 @@ static void run_method(int i, method *m, const ts_grid *g, const float *nx, cons
     float *planes[TS_PYRAMID_BATCH];
     for (int k = 0; k < count; k++)
         planes[k] = m->plane + cells * k;
-    double t0 = now();
+    double t0 = now(), k0 = kernel_now();
     ts_status st = TS_OK;
     if (i == 0)
         for (int k = 0; st == TS_OK && k < count; k++)
@@ -130,6 +168,7 @@ static void run_method(int i, method *m, const ts_grid *g, const float *nx, cons
     if (st != TS_OK)
         die(NAMES[i], &err);
     m->t += now() - t0;
+    m->t_kernel += kernel_now() - k0;
 }
 
 /* Every method over every direction of g; errors and times into r. */
@@ -154,19 +193,28 @@ static void compare(const ts_grid *g, const setup *su, result *r)
         hist_init(&m->hor, 1e-3);
         hist_init(&m->svf, 1e-6);
         m->plane = malloc(n * TS_PYRAMID_BATCH * sizeof(float));
-        m->svf_acc = calloc(n, sizeof(float));
+        m->svf_acc = malloc(n * sizeof(float));
         if (!m->plane || !m->svf_acc) {
             fprintf(stderr, "methods_bench: out of memory\n");
             exit(1);
         }
+        /* Touch the outputs before any timing: the kernel maps a page on its
+         * first write, and on this development VM a fresh page's first write
+         * cost 4-23 us (the later the allocation, the dearer: the host backs
+         * it then), which would charge the 0.6 GiB of each method's planes to
+         * whichever method writes them first, not to the method itself. */
+        touch_pages(m->plane, n * TS_PYRAMID_BATCH * sizeof(float));
+        touch_pages(m->svf_acc, n * sizeof(float));
+        memset(m->svf_acc, 0, n * sizeof(float));
         if (i == 0)
             continue;
         ts_pyramid_opts po = su->pyr;
         po.reconstruction = i == 1 ? TS_PYRAMID_BSPLINE : TS_PYRAMID_LEVEL_MAX;
-        double t0 = now();
+        double t0 = now(), k0 = kernel_now();
         if (ts_pyramid_build(g, &po, su->threads, &m->pyr, &err) != TS_OK)
             die("pyramid", &err);
         m->t = m->t_build = now() - t0;
+        m->t_kernel = kernel_now() - k0;
     }
     r->bytes_pyramid = ts_pyramid_bytes(g->width, g->height, su->pyr.level_step);
     for (int k = 0; k < su->dirs; k += TS_PYRAMID_BATCH) {
@@ -183,10 +231,11 @@ static void compare(const ts_grid *g, const setup *su, result *r)
                     hist_add(&r->m[i].hor, fabs((double)pe[c] - r->m[i].plane[c]));
     }
     for (int i = 0; i < 3; i++) {
-        double t0 = now();
+        double t0 = now(), k0 = kernel_now();
         if (ts_sky_finish(g, su->dirs, r->m[i].svf_acc, NULL, NULL, &err) != TS_OK)
             die(NAMES[i], &err);
         r->m[i].t += now() - t0;
+        r->m[i].t_kernel += kernel_now() - k0;
     }
     const float *se = r->m[0].svf_acc;
     for (int i = 1; i < 3; i++)
@@ -213,14 +262,16 @@ static void report(const char *name, const ts_grid *g, const setup *su, const re
     printf("%s %d x %d, %d directions, k=%g o=%g, %d levels:\n", name, g->width, g->height,
            su->dirs, su->pyr.level_step, su->pyr.offset,
            ts_pyramid_level_count(g->width, g->height, su->pyr.level_step));
-    printf("  %-20s svf time (C) %8.3f s%s\n", NAMES[0], r->m[0].t,
-           timer == CLOCK_MONOTONIC ? "" : " (CPU time)");
+    static const char *const UNIT[3] = {"", " (CPU time)", " (user CPU time)"};
+    printf("  %-20s svf time (C) %8.3f s%s; kernel CPU %.3f s\n", NAMES[0], r->m[0].t,
+           UNIT[timer], r->m[0].t_kernel);
     for (int i = 1; i < 3; i++) {
         const method *m = &r->m[i];
-        printf("  %-20s svf time (C) %8.3f s (build %.3f s) = %.2f x exact; |horizon - exact| "
-               "median %.3f p99 %.3f max %.2f deg; |svf - exact| median %.4f p99 %.4f max "
-               "%.3f\n",
-               NAMES[i], m->t, m->t_build, m->t / r->m[0].t, hist_quantile(&m->hor, 0.5),
+        printf("  %-20s svf time (C) %8.3f s (build %.3f s) = %.2f x exact; kernel CPU %.3f s; "
+               "|horizon - exact| median %.3f p99 %.3f max %.2f deg; |svf - exact| median %.4f "
+               "p99 %.4f max %.3f\n",
+               NAMES[i], m->t, m->t_build, m->t / r->m[0].t, m->t_kernel,
+               hist_quantile(&m->hor, 0.5),
                hist_quantile(&m->hor, 0.99), m->hor.max, hist_quantile(&m->svf, 0.5),
                hist_quantile(&m->svf, 0.99), m->svf.max);
     }
@@ -253,10 +304,12 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--dems") && i + 1 < argc)
             snprintf(dems, sizeof dems, "%s", argv[++i]);
         else if (!strcmp(argv[i], "--cpu"))
-            timer = CLOCK_PROCESS_CPUTIME_ID;
+            timer = TIME_CPU;
+        else if (!strcmp(argv[i], "--user"))
+            timer = TIME_USER;
         else {
             fprintf(stderr, "usage: methods_bench [--size N] [--dirs D] [--threads T] "
-                            "[--level-step K] [--offset O] [--dems a,b,fractal] [--cpu]\n");
+                            "[--level-step K] [--offset O] [--dems a,b,fractal] [--cpu | --user]\n");
             return 2;
         }
     }
