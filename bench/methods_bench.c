@@ -28,6 +28,7 @@
 #include <sys/time.h>
 #include <time.h>
 
+#include "bench_pages.h"
 #include "terrashade.h"
 #include "test_dem.h"
 
@@ -64,15 +65,6 @@ static double kernel_now(void)
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
     return tv_sec(ru.ru_stime);
-}
-
-/* One write to every page of p (volatile: a memset of zeros right after
- * malloc may be turned into calloc, which writes nothing). */
-static void touch_pages(void *p, size_t bytes)
-{
-    volatile unsigned char *b = p;
-    for (size_t i = 0; i < bytes; i += 4096)
-        b[i] = 0;
 }
 
 static void die(const char *what, const ts_error *e)
@@ -198,13 +190,10 @@ static void compare(const ts_grid *g, const setup *su, result *r)
             fprintf(stderr, "methods_bench: out of memory\n");
             exit(1);
         }
-        /* Touch the outputs before any timing: the kernel maps a page on its
-         * first write, and on this development VM a fresh page's first write
-         * cost 4-23 us (the later the allocation, the dearer: the host backs
-         * it then), which would charge the 0.6 GiB of each method's planes to
-         * whichever method writes them first, not to the method itself. */
-        touch_pages(m->plane, n * TS_PYRAMID_BATCH * sizeof(float));
-        touch_pages(m->svf_acc, n * sizeof(float));
+        /* each method's 0.5 GiB of planes mapped before any timing, not by
+         * whichever method writes them first (bench_pages.h) */
+        bench_touch_pages(m->plane, n * TS_PYRAMID_BATCH * sizeof(float));
+        bench_touch_pages(m->svf_acc, n * sizeof(float));
         memset(m->svf_acc, 0, n * sizeof(float));
         if (i == 0)
             continue;

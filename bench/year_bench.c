@@ -24,6 +24,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "bench_pages.h"
 #include "day_cycle.h"
 #include "test_dem.h"
 
@@ -138,6 +139,7 @@ int main(int argc, char **argv)
     float *out = malloc(n * sizeof *out);
     if (!out)
         die("cannot allocate the output", NULL);
+    bench_touch_pages(out, n * sizeof *out); /* mapped before the day's run, not in it */
     double north = 0;
     ts_sun_sites s = {1, 1, 0, 0, 0, 0, &lon, &lat, &north};
     ts_day_opts o;
