@@ -137,8 +137,12 @@ static int row_needs_raise(const float *restrict row, const float *restrict z, i
 
 void ts_edge_span(const ts_edge_job *j, int y, int x0, int x1)
 {
+    ts_edge_span_row(j, y, j->plane + (size_t)y * j->grid->width, x0, x1);
+}
+
+void ts_edge_span_row(const ts_edge_job *j, int y, float *row, int x0, int x1)
+{
     const int above_stays = j->opts->edge == TS_EDGE_HORIZON && j->c >= 0;
-    float *row = j->plane + (size_t)y * j->grid->width;
     const float *z = j->grid->z + (ptrdiff_t)y * j->grid->stride;
     if (!row_needs_raise(row + x0, z + x0, x1 - x0, j->skip_nonneg, above_stays))
         return;

@@ -39,4 +39,8 @@ void ts_edge_row(const ts_edge_job *j, int y);
  * on its own: a row done span by span has the same values). */
 void ts_edge_span(const ts_edge_job *j, int y, int x0, int x1);
 
+/* The same with row y's horizons in `row` (its cell x at row[x]) instead
+ * of the job's plane, which may then be NULL. */
+void ts_edge_span_row(const ts_edge_job *j, int y, float *row, int x0, int x1);
+
 #endif

@@ -80,8 +80,9 @@ static ts_status horizons_run(const ts_pyramid *pyr, int count, const double *az
     const ts_grid *g = pyr->grid;
     double az[TS_PYRAMID_BATCH];
     ts_status st;
+    /* out NULL: no planes, only the sky sums (ts_pyramid_horizons_sky) */
     for (int k = 0; k < count; k++) {
-        if (!out || !out[k])
+        if ((!out && !sky) || (out && !out[k]))
             return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
         az[k] = azimuths[k];
         if ((st = ts_check_sweep_args(g, &az[k], opts, err)) != TS_OK)
@@ -94,16 +95,16 @@ static ts_status horizons_run(const ts_pyramid *pyr, int count, const double *az
     ts_sky_plane terms[TS_PYRAMID_BATCH];
     int edged = 0;
     for (int k = 0; k < count; k++) {
-        edged = ts_edge_rows_init(&edge[k], g, az[k], opts, out[k]);
+        edged = ts_edge_rows_init(&edge[k], g, az[k], opts, out ? out[k] : NULL);
         if (sky)
-            ts_sky_plane_init(&terms[k], sky->nx, sky->ny, sky->nz, out[k], azimuths[k],
+            ts_sky_plane_init(&terms[k], sky->nx, sky->ny, sky->nz, out ? out[k] : NULL, azimuths[k],
                               sky->directions, sky->svf_model, sky->svf, sky->sky,
                               sky->openness);
     }
     hz_ctx C[TS_PYRAMID_BATCH];
     int failed = 0, ok = 1, k = 0;
     for (; ok && k < count; k++)
-        ok = az_ctx_init(pyr, az[k], opts, out[k], &failed, &C[k]);
+        ok = az_ctx_init(pyr, az[k], opts, out ? out[k] : NULL, &failed, &C[k]);
     if (ok) {
         batch_ctx B = {count, C, {0}, 0, edged ? edge : NULL, sky ? terms : NULL};
         for (int a = 0; a < count; a++) {

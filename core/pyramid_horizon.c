@@ -206,7 +206,7 @@ static int row_advance(const hz_ctx *C, row_ws *w, int y, int j, const float *R0
     if (on_level)
         return 1;
     /* the row's rays end here: one last sample on the DEM */
-    float *out = C->out + (size_t)y * C->P->grid->width;
+    float *out = w->out;
     if (r->t_row > 1e-9) {
         sample_run(C, w, y, R0, r->t_row, j, pa, pb);
         ts_pyr_finish_run(w, C->bspline, j + 1, pa, pb, out);
@@ -227,7 +227,7 @@ static void row_finish(const hz_ctx *C, row_ws *w, int y, int c0, int c1, const 
                        int holes)
 {
     const ts_grid *g = C->P->grid;
-    float *out = C->out + (size_t)y * g->width;
+    float *out = w->out;
     if (r->pa <= r->pb) /* not reached: the coarsest spacing spans the grid */
         mark_drop(C, w, r->pa, r->pb, C->P->levels);
     ts_pyr_drop_cells(C, w, y, c0, r->fa - 1, r->t_row, out);
@@ -388,15 +388,16 @@ static void batch_rows(const batch_ctx *B, grid_row *g, int rows, int c0, int c1
     }
 }
 
-/* The cells [c0, c1) of row y, just computed for the batch: the edge,
- * then the sky terms azimuth by azimuth (the order of the planes). */
-static void span_done(const batch_ctx *B, int y, int c0, int c1)
+/* The cells [c0, c1) of row y, just computed for the batch (w: its
+ * azimuths' row states, whose out holds the row): the edge, then the sky
+ * terms azimuth by azimuth (the order of the planes). */
+static void span_done(const batch_ctx *B, const row_ws *w, int y, int c0, int c1)
 {
     size_t at = (size_t)y * B->az[0].P->grid->width;
     for (int a = 0; B->edge && a < B->n; a++)
-        ts_edge_span(&B->edge[a], y, c0, c1);
+        ts_edge_span_row(&B->edge[a], y, w[a].out, c0, c1);
     for (int a = 0; B->sky && a < B->n; a++)
-        ts_sky_plane_add(&B->sky[a], at + c0, at + c1);
+        ts_sky_plane_add_span(&B->sky[a], w[a].out + c0, at + c0, at + c1);
 }
 
 void ts_pyr_rows_range(void *ctx, int worker, long y0, long y1)
@@ -414,13 +415,18 @@ void ts_pyr_rows_range(void *ctx, int worker, long y0, long y1)
     double *tpp = ts_pyr_alloc(3 * P * sizeof *tpp);
     int *jd = ts_pyr_alloc((size_t)2 * n * P * sizeof *jd);
     row_level *rl = malloc((size_t)n * ROW_BLOCK * levels * sizeof *rl);
+    /* without planes (only the sky sums wanted), each grid row of a pair
+     * and azimuth is written to a row of scratch, summed, then reused */
+    const int planes = B->az[0].out != NULL;
+    float *scratch = planes ? NULL : ts_pyr_alloc((size_t)2 * n * P * sizeof *scratch);
     row_ws w[2][TS_PYRAMID_BATCH];
-    if (!buf || !own || !tpp || !jd || !rl) {
+    if (!buf || !own || !tpp || !jd || !rl || (!planes && !scratch)) {
         free(buf);
         free(own);
         free(tpp);
         free(jd);
         free(rl);
+        free(scratch);
         __atomic_store_n(B->az[0].alloc_failed, 1, __ATOMIC_RELAXED);
         return;
     }
@@ -428,7 +434,7 @@ void ts_pyr_rows_range(void *ctx, int worker, long y0, long y1)
         for (int a = 0; a < n; a++) {
             float *f = buf + ((size_t)i * n + a) * 6 * P;
             w[i][a] = (row_ws){f, f + P, f + 2 * P, f + 3 * P, f + 4 * P, f + 5 * P, tpp,
-                               jd + ((size_t)i * n + a) * P, NULL, 1, 0};
+                               jd + ((size_t)i * n + a) * P, NULL, 1, 0, NULL};
         }
     for (long yb = y0; yb < y1; yb += ROW_BLOCK) {
         long ye = yb + ROW_BLOCK < y1 ? yb + ROW_BLOCK : y1;
@@ -458,16 +464,20 @@ void ts_pyr_rows_range(void *ctx, int worker, long y0, long y1)
                     float *o = own + (size_t)i * 3 * P;
                     g[i].y = (int)y + i;
                     g[i].w = w[i];
+                    for (int a = 0; a < n; a++)
+                        w[i][a].out = planes ? B->az[a].out + (size_t)(y + i) * W
+                                             : scratch + ((size_t)i * n + a) * P;
                     g[i].R0 = o, g[i].R = o + P, g[i].Tsh = o + 2 * P;
                     for (int a = 0; a < n; a++)
                         g[i].rl[a] = &rl[((size_t)a * ROW_BLOCK + (y + i - yb)) * levels];
                 }
                 batch_rows(B, g, rows, c0, c1);
                 for (int i = 0; i < rows; i++)
-                    span_done(B, (int)y + i, c0, c1);
+                    span_done(B, w[i], (int)y + i, c0, c1);
             }
         }
     }
+    free(scratch);
     free(rl);
     free(jd);
     free(tpp);

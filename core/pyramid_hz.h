@@ -40,7 +40,7 @@ typedef struct {
     double ko;          /* level offset k o */
     int bspline;        /* 1: B-spline in log distance; 0: max over levels */
     const level_az *lv; /* by sample number j */
-    float *out;
+    float *out;         /* the plane; NULL: rows of scratch (only the sky sums wanted) */
     int *alloc_failed;
 } hz_ctx;
 
@@ -80,6 +80,7 @@ typedef struct {
      * Tsh with the other azimuths that read the same rows (t_lo > t_hi: no) */
     const float *Tsh;
     int t_lo, t_hi;
+    float *out; /* the grid row's horizons (cell x at out[x]): its plane's row, or scratch */
 } row_ws;
 
 /* Sample a (c >= 2) after p0, p1, p2: the spline's midpoint before the

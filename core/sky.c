@@ -29,31 +29,39 @@ void ts_sky_plane_init(ts_sky_plane *p, const float *nx, const float *ny, const 
 }
 
 /* One loop per term, each vectorised (cm_sky.h carries NaN explicitly,
- * because the comparisons drop it); AVX-512/AVX2 clones, the same bits. */
-TS_SIMD_CLONES void ts_sky_plane_add(const ts_sky_plane *C, size_t i0, size_t i1)
+ * because the comparisons drop it); AVX-512/AVX2 clones, the same bits.
+ * `plane` holds the horizons of cells [i0, i1) from its first float on. */
+TS_SIMD_CLONES void ts_sky_plane_add_span(const ts_sky_plane *C, const float *plane, size_t i0,
+                                          size_t i1)
 {
-    const float *restrict nx = C->nx, *restrict ny = C->ny, *restrict nz = C->nz;
-    const float *restrict plane = C->plane;
+    const size_t n = i1 - i0;
+    const float *restrict nx = C->nx + i0, *restrict ny = C->ny + i0, *restrict nz = C->nz + i0;
+    const float *restrict h = plane;
     const float sa = C->sa, ca = C->ca, w1 = C->w1, w2 = C->w2;
-    float *restrict acc[2] = {C->svf, C->sky};
+    float *restrict acc[2] = {C->svf ? C->svf + i0 : NULL, C->sky ? C->sky + i0 : NULL};
     if (C->svf && C->svf_model == TS_SVF_SOLID_ANGLE) {
-        float *restrict svf = C->svf;
-        for (size_t i = i0; i < i1; i++)
-            svf[i] += cm_svf_solid_term(plane[i], w1) + (nz[i] - nz[i]);
+        float *restrict svf = acc[0];
+        for (size_t i = 0; i < n; i++)
+            svf[i] += cm_svf_solid_term(h[i], w1) + (nz[i] - nz[i]);
         acc[0] = NULL;
     }
     for (int term = 0; term < 2; term++) {
         float *restrict out = acc[term];
         if (!out)
             continue;
-        for (size_t i = i0; i < i1; i++)
-            out[i] += cm_sky_term(nx[i], ny[i], nz[i], plane[i], sa, ca, w1, w2, term == 1);
+        for (size_t i = 0; i < n; i++)
+            out[i] += cm_sky_term(nx[i], ny[i], nz[i], h[i], sa, ca, w1, w2, term == 1);
     }
     if (C->open) {
-        float *restrict open = C->open;
-        for (size_t i = i0; i < i1; i++)
-            open[i] += cm_openness_term(plane[i], nz[i]);
+        float *restrict open = C->open + i0;
+        for (size_t i = 0; i < n; i++)
+            open[i] += cm_openness_term(h[i], nz[i]);
     }
+}
+
+void ts_sky_plane_add(const ts_sky_plane *C, size_t i0, size_t i1)
+{
+    ts_sky_plane_add_span(C, C->plane + i0, i0, i1);
 }
 
 typedef struct {

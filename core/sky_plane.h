@@ -1,7 +1,8 @@
 /* One horizon plane's sky terms added to the accumulators over a range of
  * cells (core/sky.c): ts_sky_accumulate_model over whole rows, and the
  * pyramid (core/pyramid_horizon.c) over each row span right after it has
- * written it, so that the span's planes, normals and sums are still in the
+ * written it (to its plane, or to a row of scratch where only the sums are
+ * wanted), so that the span's horizons, normals and sums are still in the
  * cache. The same loops either way: the sums have the same bits. */
 #ifndef TS_SKY_PLANE_H
 #define TS_SKY_PLANE_H
@@ -26,5 +27,10 @@ void ts_sky_plane_init(ts_sky_plane *p, const float *nx, const float *ny, const 
 
 /* The terms of cells [i0, i1) (indices into the planes) added. */
 void ts_sky_plane_add(const ts_sky_plane *p, size_t i0, size_t i1);
+
+/* The same with the horizons of those cells read from `plane` (its first
+ * float: cell i0's) instead of p's plane, which may then be NULL: the
+ * same operations on the same values, so the same bits. */
+void ts_sky_plane_add_span(const ts_sky_plane *p, const float *plane, size_t i0, size_t i1);
 
 #endif

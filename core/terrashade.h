@@ -555,7 +555,9 @@ typedef struct {
  * plane's sky terms added to sky's accumulators bit for bit as
  * ts_sky_accumulate_model of the planes in order (at `azimuths`) would,
  * each row span summed as soon as it is done, while it is in the cache.
- * Finish the sums with ts_sky_finish.
+ * With out NULL no plane is written (each row's horizons go to a row of
+ * scratch, summed, then reused): the same sums without count planes of
+ * memory. Finish the sums with ts_sky_finish.
  */
 ts_status ts_pyramid_horizons_sky(const ts_pyramid *pyr, int count, const double *azimuths,
                                   const ts_horizon_opts *opts, const ts_pyramid_sky *sky,

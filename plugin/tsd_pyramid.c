@@ -115,10 +115,11 @@ static ts_status pyramid_run(const tsd_compute_ctx *c, const ts_grid *g,
         count = h.directions;
     size_t cells = (size_t)g->width * g->height;
     int batch = count < TS_PYRAMID_BATCH ? count : TS_PYRAMID_BATCH;
-    float *planes = malloc(cells * batch * sizeof(float));
-    if (!planes && batch > 1)
+    /* the sky sums need no planes: the pyramid sums each row as it is done */
+    float *planes = sky ? NULL : malloc(cells * batch * sizeof(float));
+    if (!sky && !planes && batch > 1)
         planes = malloc(cells * (batch = 1) * sizeof(float));
-    if (!planes)
+    if (!sky && !planes)
         return tsd_fail(c->msg, c->msg_size, TS_ERR_NOMEM, "out of memory for a horizon plane");
     ts_pyramid *pyr = NULL;
     if (ts_pyramid_build(g, &po, o->threads, &pyr, &err) != TS_OK) {
@@ -131,11 +132,11 @@ static ts_status pyramid_run(const tsd_compute_ctx *c, const ts_grid *g,
         float *out[TS_PYRAMID_BATCH];
         for (int i = 0; i < n; i++) {
             az[i] = azimuths ? azimuths[k + i] : ts_horizon_azimuth(&h, k + i);
-            out[i] = planes + cells * i;
+            out[i] = planes ? planes + cells * i : NULL;
         }
         if ((st = tsd_compute_report(c, (double)k / count)) != TS_OK)
             break;
-        if ((sky ? ts_pyramid_horizons_sky(pyr, n, az, &h, sky, out, &err)
+        if ((sky ? ts_pyramid_horizons_sky(pyr, n, az, &h, sky, NULL, &err)
                  : ts_pyramid_horizons(pyr, n, az, &h, out, &err)) != TS_OK)
             st = tsd_fail_core(c->msg, c->msg_size, NULL, &err);
         for (int i = 0; st == TS_OK && !sky && i < n; i++)

@@ -342,20 +342,24 @@ static size_t sky_by_planes(const ts_pyramid *pyr, const sky_case *c, const ts_h
 }
 
 /* ts_pyramid_horizons_sky against sky_by_planes over every direction of o:
- * the planes and each sum memcmp-equal; and ts_pyramid_horizons, which
- * applies the edge span by span too, gives the same planes. */
+ * the planes and each sum memcmp-equal, also the sums without planes (out
+ * NULL: each row in scratch); and ts_pyramid_horizons, which applies the
+ * edge span by span too, gives the same planes. */
 static void check_sky_fused(const ts_pyramid *pyr, const sky_case *c, const ts_horizon_opts *o)
 {
     size_t cells = (size_t)c->g->width * c->g->height;
     float *a = tdem_floats(cells * TS_PYRAMID_BATCH), *b = tdem_floats(cells * TS_PYRAMID_BATCH);
-    float *sums = tdem_floats(cells * 6), *acc_a[3], *acc_b[3];
-    memset(sums, 0, cells * 6 * sizeof *sums);
+    float *sums = tdem_floats(cells * 9), *acc_a[3], *acc_b[3], *acc_c[3];
+    memset(sums, 0, cells * 9 * sizeof *sums);
     for (int t = 0; t < 3; t++) {
         acc_a[t] = c->wanted[t] ? sums + cells * t : NULL;
         acc_b[t] = c->wanted[t] ? sums + cells * (3 + t) : NULL;
+        acc_c[t] = c->wanted[t] ? sums + cells * (6 + t) : NULL;
     }
     ts_pyramid_sky sky = {c->nx, c->ny, c->nz, o->directions, c->model, acc_b[0], acc_b[1],
                           acc_b[2]};
+    ts_pyramid_sky sky_c = {c->nx, c->ny, c->nz, o->directions, c->model, acc_c[0], acc_c[1],
+                            acc_c[2]};
     ts_error err;
     size_t changed = 0;
     for (int k = 0; k < o->directions; k += TS_PYRAMID_BATCH) {
@@ -369,6 +373,8 @@ static void check_sky_fused(const ts_pyramid *pyr, const sky_case *c, const ts_h
         changed += sky_by_planes(pyr, c, o, count, az, pa, acc_a);
         ck_assert_msg(ts_pyramid_horizons_sky(pyr, count, az, o, &sky, pb, &err) == TS_OK,
                       "%s", err.message);
+        ck_assert_msg(ts_pyramid_horizons_sky(pyr, count, az, o, &sky_c, NULL, &err) == TS_OK,
+                      "%s", err.message);
         ck_assert_msg(memcmp(a, b, cells * count * sizeof *a) == 0, "edge %d: planes differ",
                       (int)o->edge);
         ck_assert(ts_pyramid_horizons(pyr, count, az, o, pb, &err) == TS_OK);
@@ -376,9 +382,13 @@ static void check_sky_fused(const ts_pyramid *pyr, const sky_case *c, const ts_h
     }
     /* the edge had cells to change (none with TS_EDGE_OPEN) */
     ck_assert((o->edge == TS_EDGE_OPEN) == (changed == 0));
-    for (int t = 0; t < 3; t++)
+    for (int t = 0; t < 3; t++) {
         ck_assert_msg(!c->wanted[t] || memcmp(acc_a[t], acc_b[t], cells * sizeof(float)) == 0,
                       "edge %d, model %d: sum %d differs", (int)o->edge, (int)c->model, t);
+        ck_assert_msg(!c->wanted[t] || memcmp(acc_a[t], acc_c[t], cells * sizeof(float)) == 0,
+                      "edge %d, model %d: sum %d without planes differs", (int)o->edge,
+                      (int)c->model, t);
+    }
     free(a), free(b), free(sums);
 }
 
@@ -422,6 +432,38 @@ START_TEST(test_sky_fused_identical)
                       TS_ERR_ARG);
         }
         free(one);
+        ts_pyramid_free(pyr);
+    }
+    free(nx), free(ny), free(nz);
+    ts_grid_free(&g);
+}
+END_TEST
+
+/* The sums without planes on a grid wider than a chunk of columns (1024),
+ * with nodata: each row of scratch serves several chunks and rows, and the
+ * sums stay those of the planes, level max and B-spline, 1 and 3 threads. */
+START_TEST(test_sky_without_planes_wide)
+{
+    ts_grid g;
+    ts_error err;
+    ck_assert(ts_grid_create(&g, 1300, 37, 10.0, 10.0, &err) == TS_OK);
+    tdem_fbm(&g, 77, 0.8, 900.0);
+    for (int x = 500; x < 540; x++)
+        g.z[(size_t)20 * g.stride + x] = NAN;
+    size_t cells = (size_t)g.width * g.height;
+    float *nx = tdem_floats(cells), *ny = tdem_floats(cells), *nz = tdem_floats(cells);
+    ck_assert(ts_normals(&g, nx, ny, nz, &err) == TS_OK);
+    for (int rec = TS_PYRAMID_BSPLINE; rec <= TS_PYRAMID_LEVEL_MAX; rec++) {
+        ts_pyramid_opts p = popts(4, 0, (ts_pyramid_reconstruction)rec);
+        ts_pyramid *pyr;
+        ck_assert_msg(ts_pyramid_build(&g, &p, 0, &pyr, &err) == TS_OK, "%s", err.message);
+        for (int threads = 1; threads <= 3; threads += 2) {
+            ts_horizon_opts o = hopts(TS_PYRAMID_BATCH + 3, 1);
+            o.threads = threads;
+            o.edge = TS_EDGE_HORIZON;
+            sky_case c = {&g, nx, ny, nz, TS_SVF_RADIATIVE, {1, 1, 1}};
+            check_sky_fused(pyr, &c, &o);
+        }
         ts_pyramid_free(pyr);
     }
     free(nx), free(ny), free(nz);
@@ -534,6 +576,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_threads_identical);
     tcase_add_test(tc, test_batch_identical);
     tcase_add_test(tc, test_sky_fused_identical);
+    tcase_add_test(tc, test_sky_without_planes_wide);
     tcase_add_test(tc, test_max_distance);
     tcase_add_test(tc, test_bad_input);
     suite_add_tcase(s, tc);
