@@ -464,12 +464,12 @@ void ts_pyr_rows_range(void *ctx, int worker, long y0, long y1)
                     float *o = own + (size_t)i * 3 * P;
                     g[i].y = (int)y + i;
                     g[i].w = w[i];
-                    for (int a = 0; a < n; a++)
+                    g[i].R0 = o, g[i].R = o + P, g[i].Tsh = o + 2 * P;
+                    for (int a = 0; a < n; a++) {
                         w[i][a].out = planes ? B->az[a].out + (size_t)(y + i) * W
                                              : scratch + ((size_t)i * n + a) * P;
-                    g[i].R0 = o, g[i].R = o + P, g[i].Tsh = o + 2 * P;
-                    for (int a = 0; a < n; a++)
                         g[i].rl[a] = &rl[((size_t)a * ROW_BLOCK + (y + i - yb)) * levels];
+                    }
                 }
                 batch_rows(B, g, rows, c0, c1);
                 for (int i = 0; i < rows; i++)

@@ -116,11 +116,15 @@ static ts_status pyramid_run(const tsd_compute_ctx *c, const ts_grid *g,
     size_t cells = (size_t)g->width * g->height;
     int batch = count < TS_PYRAMID_BATCH ? count : TS_PYRAMID_BATCH;
     /* the sky sums need no planes: the pyramid sums each row as it is done */
-    float *planes = sky ? NULL : malloc(cells * batch * sizeof(float));
-    if (!sky && !planes && batch > 1)
-        planes = malloc(cells * (batch = 1) * sizeof(float));
-    if (!sky && !planes)
-        return tsd_fail(c->msg, c->msg_size, TS_ERR_NOMEM, "out of memory for a horizon plane");
+    float *planes = NULL;
+    if (!sky) {
+        planes = malloc(cells * batch * sizeof(float));
+        if (!planes && batch > 1)
+            planes = malloc(cells * (batch = 1) * sizeof(float));
+        if (!planes)
+            return tsd_fail(c->msg, c->msg_size, TS_ERR_NOMEM,
+                            "out of memory for a horizon plane");
+    }
     ts_pyramid *pyr = NULL;
     if (ts_pyramid_build(g, &po, o->threads, &pyr, &err) != TS_OK) {
         free(planes);
