@@ -83,6 +83,15 @@ double ts_pyramid_bytes(int width, int height, double level_step)
     return rows * width * sizeof(float);
 }
 
+double ts_pyramid_build_bytes(int width, int height, double level_step)
+{
+    int levels = ts_pyramid_level_count(width, height, level_step);
+    double s = spacing(level_step, 1);
+    double most = levels > 1 ? (double)level_size(width, s) * level_size(height, s) : 1;
+    return ts_pyramid_bytes(width, height, level_step) +
+           (4 * most + 4.0 * height) * sizeof(float);
+}
+
 /* A level before reconstruction: its samples (rows `stride` floats apart)
  * and their valid fraction (NULL: all valid, as the DEM's). */
 typedef struct {

@@ -507,6 +507,11 @@ int ts_pyramid_level_count(int width, int height, double level_step);
  * 1 / (1 - 2^(-1/k)) times the DEM: 6.3 for k = 4). */
 double ts_pyramid_bytes(int width, int height, double level_step);
 
+/** Bytes ts_pyramid_build holds at its peak: what the pyramid keeps, and
+ * the four level-sized buffers (heights and valid fractions of two
+ * levels, each about 1 / 2^(2/k) of the DEM) it decimates through. */
+double ts_pyramid_build_bytes(int width, int height, double level_step);
+
 /** A built pyramid (opaque). */
 typedef struct ts_pyramid ts_pyramid;
 

@@ -2,9 +2,11 @@
 #include "tsd_products.h"
 
 #include "simd_clones.h"
+#include "terrashade_sh.h"
 #include "tsd_pyramid.h"
 #include "tsd_text.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
@@ -247,6 +249,47 @@ void tsd_products_taking(int option, const char *prefix, const char *last, char 
     }
 }
 
+/* Horizon planes a HORIZON_METHOD=pyramid run holds at once: none where it
+ * sums the sky terms row by row (svf, sky, openness, shade's uniform sky);
+ * METHOD=sh's swath, or a batch of DIRECTIONS, where it hands out planes. */
+static int pyramid_planes(const tsd_options *o, const tsd_product_def *p, int env_sky)
+{
+    int batch = o->directions < TS_PYRAMID_BATCH ? o->directions : TS_PYRAMID_BATCH;
+    if (o->method == TSD_METHOD_SH && tsd_product_takes(p, tsd_option_find("METHOD")))
+        return o->swath_directions < TS_PYRAMID_BATCH ? o->swath_directions : TS_PYRAMID_BATCH;
+    if (p->compute == tsd_compute_svf || p->compute == tsd_compute_sky ||
+        p->compute == tsd_compute_openness)
+        return 0;
+    if (p->compute == tsd_compute_shade)
+        return env_sky ? batch : 0;
+    return batch;
+}
+
+/* Bytes of the shading method's own buffers beside its planes:
+ * METHOD=shadowmap's map (SHADOWMAP_SCALE^2 int texels a cell of the DEM
+ * turned to face the sun, the relief's extra rows at a low sun left out)
+ * and its three projected-coordinate planes; METHOD=sh's folded wedge
+ * tables (core/sh_swath_light.c: 256 x 256 x 16 floats an interior slot). */
+static double method_bytes(const tsd_options *o, const tsd_product_def *p, int width,
+                           int height)
+{
+    if (!tsd_product_takes(p, tsd_option_find("METHOD")))
+        return 0;
+    const double w = width, h = height, plane = w * h * sizeof(float);
+    if (o->method == TSD_METHOD_SHADOWMAP) {
+        /* the sun's azimuth is known here unless DATETIME sets it: then
+         * the widest, a diagonal */
+        const double az = (o->datetime[0] ? 45.0 : o->sun_azimuth) * M_PI / 180;
+        const double ca = fabs(cos(az)), sa = fabs(sin(az)), k = o->shadowmap_scale;
+        const double texels = (k * (w * ca + h * sa) + 3) * (k * (w * sa + h * ca) + 3);
+        return 3 * plane + texels * (1 + 1.0 / 256) * sizeof(int);
+    }
+    if (o->method == TSD_METHOD_SH && o->swath_directions <= 8)
+        return (o->swath_directions - 1) * (double)TS_SH_WEDGE_STEPS * TS_SH_WEDGE_STEPS *
+               TS_SH_COEFFS * sizeof(float);
+    return 0;
+}
+
 double tsd_product_peak_bytes(const tsd_options *o, int width, int height, double *steady)
 {
     const tsd_product_def *p = tsd_product_of(o);
@@ -263,9 +306,15 @@ double tsd_product_peak_bytes(const tsd_options *o, int width, int height, doubl
                  : o->env_method == TSD_ENV_SH ? 18 : 0;
     int extra = p->planes + (o->sky_weight > 0 ? p->sky_planes : 0) + 2 * env_sky + sh +
                 (o->sun_position == TSD_SUN_PER_CELL ? p->per_cell_planes : 0);
+    /* the exact direct sun alone makes its normals row by row and takes
+     * the sun's horizons in the product (tsd_compute_shade) */
+    if (p->compute == tsd_compute_shade && o->method == TSD_METHOD_EXACT &&
+        !(o->sky_weight > 0) && o->sun_position != TSD_SUN_PER_CELL)
+        extra -= p->planes;
     if (steady)
         *steady = kept * plane;
-    return (1 + kept + extra) * plane + tsd_pyramid_bytes(o, width, height);
+    return (1 + kept + extra) * plane + method_bytes(o, p, width, height) +
+           tsd_pyramid_bytes(o, width, height, pyramid_planes(o, p, env_sky));
 }
 
 char *tsd_products_xml(void)

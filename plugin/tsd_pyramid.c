@@ -59,14 +59,14 @@ int tsd_options_check_pyramid(const tsd_options *o, char *msg, size_t n)
     return 0;
 }
 
-double tsd_pyramid_bytes(const tsd_options *o, int width, int height)
+double tsd_pyramid_bytes(const tsd_options *o, int width, int height, int planes)
 {
     if (o->horizon_method != TSD_HORIZON_PYRAMID)
         return 0;
-    /* pyramid_run's batch holds TS_PYRAMID_BATCH planes where the sweep
-     * holds one (counted with the product's) */
-    double extra = (TS_PYRAMID_BATCH - 1) * (double)width * height * sizeof(float);
-    return ts_pyramid_bytes(width, height, o->pyramid_level_step) + extra;
+    /* pyramid_run holds `planes` where the sweep holds one (counted with
+     * the product's): the sky sums hold none, so that one comes off */
+    double extra = (planes - 1) * (double)width * height * sizeof(float);
+    return ts_pyramid_build_bytes(width, height, o->pyramid_level_step) + extra;
 }
 
 /* The backend report of the pyramid: C, and why not OpenCL when OpenCL

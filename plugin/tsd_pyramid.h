@@ -20,9 +20,10 @@ extern "C" {
 int tsd_options_check_pyramid(const tsd_options *o, char *msg, size_t msg_size);
 
 /** Bytes of the pyramid of a width x height DEM under options o, and of the
- * horizon planes its batches add to the product's one (0 with
- * HORIZON_METHOD=exact). */
-double tsd_pyramid_bytes(const tsd_options *o, int width, int height);
+ * `planes` horizon planes its run holds at once, less the one the
+ * product's count already has for the sweep (so -1 plane where it holds
+ * none); 0 with HORIZON_METHOD=exact. */
+double tsd_pyramid_bytes(const tsd_options *o, int width, int height, int planes);
 
 /** tsd_compute_stream with pyramid horizons: the DIRECTIONS planes, one
  * at a time, to `add`, for the products that integrate the sky over the

@@ -1,0 +1,123 @@
+"""MAX_MEMORY's estimate against the memory a computation really takes
+(docs/driver.md, "Memory"): the driver refuses at open a product whose
+estimated peak exceeds MAX_MEMORY, so the estimate must not fall short of
+the real peak (or a limit that passes could still run out), nor exceed it
+by much (or it refuses DEMs that fit).
+
+For every product and every method with buffers of its own, on a 1024^2
+fractal computed whole (TILE_SIZE=0, BACKEND=c, THREADS=2, GDAL's block
+cache 1 MiB, so that its blocks do not count): the estimate is read from the refusal under MAX_MEMORY=1,
+and the real peak is the peak resident memory (the child's ru_maxrss from
+wait4) of gdal_translate on that DEM less that of the same command on a
+16^2 crop of it (GDAL, the plugin and the runtimes alone). The estimate
+must be at least 95 % of the real growth less 4 MiB, and at most 1.3 times
+it plus 8 MiB (a plane is 4 MiB here: the pyramid's seven horizon planes
+that the sky products never held, counted until session 15, fail it).
+"""
+import os
+import re
+import unittest
+
+import tsdriver as T
+
+N = 1024
+DAY = {"DATE": "2024-06-21", "TIMEZONE": "-05:00"}
+CASES = [
+    {"PRODUCT": "shade"},
+    {"PRODUCT": "shade", "SKY_WEIGHT": 0.3},
+    {"PRODUCT": "shade", "SKY_WEIGHT": 0.3, "SKY": "overcast"},
+    {"PRODUCT": "shade", "SUN_POSITION": "per_cell", "DATETIME": "2024-06-21T09:00:00-05:00"},
+    {"PRODUCT": "shade", "METHOD": "shm"},
+    {"PRODUCT": "shade", "METHOD": "sh"},
+    {"PRODUCT": "shade", "METHOD": "sh", "HORIZON_METHOD": "pyramid"},
+    {"PRODUCT": "shade", "METHOD": "shadowmap"},
+    {"PRODUCT": "shade", "METHOD": "shadowmap", "SUN_AZIMUTH": 180, "SHADOWMAP_SCALE": 3},
+    {"PRODUCT": "shade", "SKY_WEIGHT": 0.3, "HORIZON_METHOD": "pyramid"},
+    {"PRODUCT": "shadow"},
+    {"PRODUCT": "horizon", "DIRECTIONS": 8},
+    {"PRODUCT": "horizon", "DIRECTIONS": 8, "HORIZON_METHOD": "pyramid"},
+    {"PRODUCT": "svf"},
+    {"PRODUCT": "svf", "HORIZON_METHOD": "pyramid"},
+    {"PRODUCT": "sky", "HORIZON_METHOD": "pyramid"},
+    {"PRODUCT": "openness", "OPENNESS": "negative"},
+    {"PRODUCT": "openness", "HORIZON_METHOD": "pyramid"},
+    dict(PRODUCT="sunhours", **DAY),
+    dict(PRODUCT="insolation", **DAY),
+    {"PRODUCT": "insolation", "START_DATE": "2024-01-01", "END_DATE": "2024-12-31",
+     "TIMEZONE": "-05:00"},
+    dict(PRODUCT="daycycle", STEP_MINUTES=60, **DAY),
+    {"PRODUCT": "envlight", "SKY": "overcast"},
+    {"PRODUCT": "envlight", "SKY": "overcast", "ENV_METHOD": "sh"},
+    {"PRODUCT": "envlight", "SKY": "overcast", "HORIZON_METHOD": "pyramid"},
+]
+COMMON = {"TILE_SIZE": 0, "BACKEND": "c", "THREADS": 2}
+MIB = 1 << 20
+
+
+# Run a command from a lean process and print its peak resident KiB. Linux
+# keeps a process's peak across exec, and a child starts from its parent's:
+# run straight from this Python (numpy, GDAL loaded) every child would
+# start from this process's size; from a bare interpreter, from ~10 MiB.
+PEAK = """
+import os, sys
+pid = os.fork()
+if pid == 0:
+    os.execvp(sys.argv[1], sys.argv[1:])
+_, status, usage = os.wait4(pid, 0)
+print(usage.ru_maxrss)
+sys.exit(os.waitstatus_to_exitcode(status))
+"""
+
+
+def peak_rss(args):
+    """Peak resident bytes of a command (it must succeed)."""
+    p = T.run(["/usr/bin/python3", "-S", "-c", PEAK] + args, GDAL_CACHEMAX=1)
+    return int(p.stdout.split()[-1]) * 1024
+
+
+def estimate(dem, options, out):
+    p = T.run(["gdal_translate", "-q"] + T.oo_args(dict(options, MAX_MEMORY=1)) +
+              [T.conn(dem), out], ok=False)
+    m = re.search(r"needs about (\d+) MiB while computing", p.stderr)
+    if not m:
+        raise AssertionError("no estimate in the refusal:\n" + p.stderr)
+    return int(m.group(1)) * MIB
+
+
+class MemoryEstimate(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = T.TempDir()
+        d = cls.tmp.__enter__()
+        gt = (500000.0, 10.0, 0.0, 4000000.0, 0.0, -10.0)
+        cls.dem = T.write_tif(os.path.join(d, "dem.tif"), T.fractal_dem(N, relief=1200.0),
+                              gt, 32617)
+        cls.tiny = os.path.join(d, "tiny.tif")
+        T.run(["gdal_translate", "-q", "-srcwin", 0, 0, 16, 16, cls.dem, cls.tiny])
+        cls.out = os.path.join(d, "out.tif")
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.__exit__(None, None, None)
+
+    def test_estimate_brackets_the_peak(self):
+        rows = []
+        for case in CASES:
+            options = dict(COMMON, **case)
+            args = ["gdal_translate", "-q"] + T.oo_args(options)
+            grown = (peak_rss(args + [T.conn(self.dem), self.out]) -
+                     peak_rss(args + [T.conn(self.tiny), self.out]))
+            est = estimate(self.dem, options, self.out)
+            rows.append((case, est / MIB, grown / MIB))
+            print("%-90s estimate %5.0f MiB, grew %6.1f MiB" %
+                  (" ".join("%s=%s" % kv for kv in case.items()), est / MIB, grown / MIB))
+        for case, est, grown in rows:
+            with self.subTest(case=case):
+                self.assertGreaterEqual(est, 0.95 * grown - 4,
+                                        "the estimate falls short of the real peak")
+                self.assertLessEqual(est, 1.3 * grown + 8,
+                                     "the estimate is far above the real peak")
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
