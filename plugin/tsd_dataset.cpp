@@ -480,6 +480,31 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     return poDS.release();
 }
 
+/* Degrees of arc from the DEM's centre beyond which SUN_POSITION=center warns. */
+static const double SUN_REACH_WARN_DEG = 1.0;
+
+/* A warning when the DEM is so wide that the sun computed once at its
+ * centre (SUN_POSITION=center) is off by more than a degree at its edges,
+ * with what to do about it. */
+void TSDataset::WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfLon,
+                             double dfLat)
+{
+    const double dfReach = tsd_sites_reach(m_adfGT, W, H, hSRS, &m_sCells, dfLon, dfLat);
+    if (!(dfReach > SUN_REACH_WARN_DEG))
+        return;
+    const tsd_options &o = m_sOpts;
+    const bool bPerCell = tsd_product_takes(m_psProduct, tsd_option_find("SUN_POSITION")) &&
+                          o.method == TSD_METHOD_EXACT &&
+                          !tsd_options_given(&o, "LIGHT_RADIUS");
+    CPLError(CE_Warning, CPLE_AppDefined,
+             "TERRASHADE: the DEM reaches %.1f degrees of arc from its centre, where the "
+             "sun is computed for all its cells (SUN_POSITION=center): at its edges the "
+             "sun's elevation and azimuth can be off by about as much. %s",
+             dfReach,
+             bPerCell ? "SUN_POSITION=per_cell computes the sun across the DEM"
+                      : "Crop the DEM to compute the sun nearer its cells");
+}
+
 /* Everything that follows from the georeferencing (m_adfGT, m_bHasGT,
  * m_oSRS) of a W x H grid and the options: the cells, the sun, the memory
  * check, the bands, the metadata and (level 0) PAM. Shared by the DEM's
@@ -514,6 +539,8 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
                                 sizeof szMsg);
         if (eSt != TS_OK)
             return Fail(eSt, CPLSPrintf("%s: %s", pszWhat, szMsg)), false;
+        if (sOpts.sun_position != TSD_SUN_PER_CELL && m_nLevel == 0)
+            WarnSunReach(W, H, hSRS, sSites.lon[0], sSites.lat[0]);
         double dfMinCell = m_sCells.cell_y;
         for (int y = 0; y < H; y++)
             dfMinCell = std::min(dfMinCell, m_sCells.cell_x_row ? m_sCells.cell_x_row[y]

@@ -80,6 +80,7 @@ class TSDataset final : public GDALPamDataset
     const WindowChunk *Chunk(int cx, int cy);
     CPLErr WindowBlock(int iPlane, int x0, int y0, int nBW, int nBH, bool bByte, void *pImage);
     bool Setup(const char *pszConnection, int W, int H);
+    void WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfLon, double dfLat);
     static GDALDataset *OpenDEM(const char *pszDEM);
     ts_status LoadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg);
     void StartReadAhead();

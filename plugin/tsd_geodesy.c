@@ -241,6 +241,26 @@ ts_status tsd_sites_compute(const double gt[6], int width, int height,
     return rc;
 }
 
+double tsd_sites_reach(const double gt[6], int width, int height, OGRSpatialReferenceH srs,
+                       const tsd_cells *cells, double lon0, double lat0)
+{
+    tsd_sites s;
+    char msg[256];
+    if (tsd_sites_compute(gt, width, height, srs, cells, 1, &s, msg, sizeof msg) != TS_OK)
+        return 0;
+    const double rad = M_PI / 180;
+    double reach = 0;
+    for (size_t k = 0; k < (size_t)s.nx * s.ny; k++) {
+        /* the central angle, by the haversine (well conditioned when small) */
+        double sp = sin((s.lat[k] - lat0) * rad / 2), sl = sin((s.lon[k] - lon0) * rad / 2);
+        double a = sp * sp + cos(s.lat[k] * rad) * cos(lat0 * rad) * sl * sl;
+        double angle = 2 * asin(sqrt(a < 1 ? a : 1)) / rad;
+        reach = angle > reach ? angle : reach;
+    }
+    tsd_sites_free(&s);
+    return reach;
+}
+
 void tsd_sites_free(tsd_sites *s)
 {
     if (!s)

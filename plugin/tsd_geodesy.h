@@ -74,6 +74,15 @@ ts_status tsd_sites_compute(const double gt[6], int width, int height,
                       OGRSpatialReferenceH srs, const tsd_cells *cells,
                       int per_cell, tsd_sites *out, char *msg, size_t msg_size);
 
+/**
+ * How far, in degrees of arc, the farthest node of the DEM's per-cell lattice
+ * of sites (tsd_sites_compute with per_cell) lies from (lon0, lat0), the
+ * site of SUN_POSITION=center: about how far off the sun computed there is
+ * at the DEM's edges. 0 where the lattice cannot be computed.
+ */
+double tsd_sites_reach(const double gt[6], int width, int height, OGRSpatialReferenceH srs,
+                       const tsd_cells *cells, double lon0, double lat0);
+
 void tsd_sites_free(tsd_sites *s);
 
 #ifdef __cplusplus

@@ -8,7 +8,8 @@
   (against NOAA's sunrise equation, an independent reference) at latitudes
   from the equator to the Arctic circle; with SUNHOURS_RULE=fraction it is
   the time the sun's centre is up; per cell on a large extent
-  (SUN_POSITION=per_cell), 0 in the polar night, 24 in the polar day;
+  (SUN_POSITION=per_cell), 0 in the polar night, 24 in the polar day; at
+  the centre on such an extent, a warning that says so;
 - insolation is beam + diffuse, plausible in size, larger on south slopes
   in winter; daycycle bands carry their time and sun and add up to sunhours
   with SUNHOURS_RULE=fraction;
@@ -271,6 +272,44 @@ class Sun(unittest.TestCase):
                   "%.3f h" % (row, lat, per[row, n // 2], want, centre[row, n // 2]))
             self.assertLessEqual(abs(per[row, n // 2] - want) * 60, 5.0)
         self.assertGreater(per[0].mean(), per[-1].mean() + 1.5)
+
+    def test_centre_sun_on_a_large_extent_warns(self):
+        """SUN_POSITION=center on a DEM that reaches more than a degree of
+        arc from its centre: a warning that says how far and what to do
+        (SUN_POSITION=per_cell where the product and method take it, else
+        crop); none on a small extent, with per_cell, or with the sun given
+        by SUN_AZIMUTH / SUN_ELEVATION (no place is needed)."""
+        n, cell = 32, 0.5
+        wide = T.write_tif(os.path.join(self.dir, "wide.tif"),
+                           np.zeros((n, n), np.float32), (0.0, cell, 0, 56.0, 0, -cell), 4326)
+        small = flat_dem(os.path.join(self.dir, "small.tif"), 47.0, 8.0)
+        out = os.path.join(self.dir, "out.tif")
+        day = {"PRODUCT": "sunhours", "DATE": "2026-06-21", "TIMEZONE": "Z"}
+        instant = {"DATETIME": "2026-06-21T10:00:00Z"}
+
+        def arc(lon1, lat1, lon2, lat2):
+            r = math.radians
+            c = (math.sin(r(lat1)) * math.sin(r(lat2)) +
+                 math.cos(r(lat1)) * math.cos(r(lat2)) * math.cos(r(lon2 - lon1)))
+            return math.degrees(math.acos(c))
+
+        reach = max(arc(8.0, 48.0, lon, lat) for lon in (0.25, 15.75) for lat in (55.75, 40.25))
+        self.assertAlmostEqual(reach, 9.5, delta=0.3)
+        for oo, advice in ((day, "SUN_POSITION=per_cell computes the sun across the DEM"),
+                           (instant, "SUN_POSITION=per_cell"),
+                           (dict(instant, METHOD="shadowmap"), "Crop the DEM"),
+                           (dict(instant, PRODUCT="farshadow"), "Crop the DEM")):
+            p = T.run(["gdal_translate", "-q"] + T.oo_args(oo) + [T.conn(wide), out])
+            # from the centre (8 E, 48 N) to the farthest corner cell's centre
+            self.assertIn("the DEM reaches %.1f degrees of arc from its centre" % reach,
+                          p.stderr)
+            self.assertIn(advice, p.stderr)
+            self.assertEqual(p.stderr.count("Warning"), 1, p.stderr)
+        for dem, oo in ((small, day), (small, instant),
+                        (wide, dict(day, SUN_POSITION="per_cell")),
+                        (wide, {"SUN_AZIMUTH": 135, "SUN_ELEVATION": 30})):
+            p = T.run(["gdal_translate", "-q"] + T.oo_args(oo) + [T.conn(dem), out])
+            self.assertNotIn("degrees of arc", p.stderr)
 
     # ------------------------------------------------------------ insolation
 
