@@ -194,70 +194,121 @@ static void swath_cells(const swath_ctx *C, size_t c0, size_t c1)
     }
 }
 
-/* One slot's wedge from its folded tables, shade's 16 floats into acc and
- * share's one into *share (where the tables are there): an interior slot
- * bilinear at horizons (wa, wb), a boundary slot (rise or fall, 1D) linear
- * at wa. */
-static inline void add_folded_interior(const swath_ctx *C, int slot, float wa, float wb,
-                                       float *restrict acc, float *restrict share)
+/* Cells a block of folded_cells takes at once. */
+#define FOLD_BLOCK 16
+
+/* The nodes and weights of a block's cells on every slot's table (an
+ * interior slot bilinear at (wa, wb): weights of (ia, ib), (ia, ib + 1),
+ * (ia + 1, ib), (ia + 1, ib + 1); a boundary slot linear at wa: of nodes
+ * at and at + 1, the last two weights 0), cell by cell as bilinear_at and
+ * node_of, in loops over the cells that the compiler vectorises. */
+typedef struct {
+    int at[FOLD_MAX_SAMPLES + 1][FOLD_BLOCK];
+    float wt[FOLD_MAX_SAMPLES + 1][4][FOLD_BLOCK];
+} block_nodes;
+
+static inline void block_interior(const float *restrict pa, const float *restrict pb, int m,
+                                  int slot, block_nodes *restrict B)
 {
-    const size_t S = TS_SH_WEDGE_STEPS;
-    size_t at;
-    float wt[4];
-    bilinear_at(wa, wb, &at, wt);
+    for (int j = 0; j < m; j++) {
+        float fa, fb;
+        const int ia = node_of(pa[j], &fa), ib = node_of(pb[j], &fb);
+        B->at[slot][j] = ia * TS_SH_WEDGE_STEPS + ib;
+        B->wt[slot][0][j] = (1 - fa) * (1 - fb);
+        B->wt[slot][1][j] = (1 - fa) * fb;
+        B->wt[slot][2][j] = fa * (1 - fb);
+        B->wt[slot][3][j] = fa * fb;
+    }
+}
+
+static inline void block_boundary(const float *restrict pa, int m, int slot,
+                                  block_nodes *restrict B)
+{
+    for (int j = 0; j < m; j++) {
+        float f;
+        B->at[slot][j] = node_of(pa[j], &f);
+        B->wt[slot][0][j] = 1 - f;
+        B->wt[slot][1][j] = f;
+    }
+}
+
+/* Cell j's wedge of an interior slot from its folded tables: shade's 16
+ * floats into acc and share's one into *share (where the tables are there),
+ * the same sums as bilinear_at's weights applied node by node. */
+static inline void add_folded_interior(const swath_ctx *C, const block_nodes *B, int slot,
+                                       int j, float *restrict acc, float *restrict share)
+{
+    const size_t S = TS_SH_WEDGE_STEPS, at = (size_t)B->at[slot][j];
+    const float w0 = B->wt[slot][0][j], w1 = B->wt[slot][1][j];
+    const float w2 = B->wt[slot][2][j], w3 = B->wt[slot][3][j];
     if (C->fold_shade) {
         const float *t00 = C->fold_shade[slot] + at * N, *t01 = t00 + N, *t10 = t00 + S * N,
                     *t11 = t10 + N;
         for (int k = 0; k < N; k++)
-            acc[k] += (wt[0] * t00[k] + wt[1] * t01[k]) + (wt[2] * t10[k] + wt[3] * t11[k]);
+            acc[k] += (w0 * t00[k] + w1 * t01[k]) + (w2 * t10[k] + w3 * t11[k]);
     }
     if (C->fold_share) {
         const float *t = C->fold_share[slot] + at;
-        *share += (wt[0] * t[0] + wt[1] * t[1]) + (wt[2] * t[S] + wt[3] * t[S + 1]);
+        *share += (w0 * t[0] + w1 * t[1]) + (w2 * t[S] + w3 * t[S + 1]);
     }
 }
 
-static inline void add_folded_boundary(const swath_ctx *C, int slot, float w,
-                                       float *restrict acc, float *restrict share)
+/* The same for a boundary slot (rise or fall, 1D), linear. */
+static inline void add_folded_boundary(const swath_ctx *C, const block_nodes *B, int slot,
+                                       int j, float *restrict acc, float *restrict share)
 {
-    float f;
-    const size_t at = (size_t)node_of(w, &f);
+    const size_t at = (size_t)B->at[slot][j];
+    const float f0 = B->wt[slot][0][j], f1 = B->wt[slot][1][j];
     if (C->fold_shade) {
         const float *t0 = C->fold_shade[slot] + at * N, *t1 = t0 + N;
         for (int k = 0; k < N; k++)
-            acc[k] += (1 - f) * t0[k] + f * t1[k];
+            acc[k] += f0 * t0[k] + f1 * t1[k];
     }
     if (C->fold_share) {
         const float *t = C->fold_share[slot] + at;
-        *share += (1 - f) * t[0] + f * t[1];
+        *share += f0 * t[0] + f1 * t[1];
     }
 }
 
-/* Cells c0..c1 from the folded tables. */
+/* Cells c0..c1 from the folded tables, FOLD_BLOCK at a time: their nodes
+ * and weights first, over the cells (vectorised: a quarter less time than
+ * finding them cell by cell, session 15), then cell by cell the same sums. */
 TS_SIMD_CLONES
 static void folded_cells(const swath_ctx *C, size_t c0, size_t c1)
 {
     const float *const *P = C->planes;
     const int n = C->w->swath.n, complete = C->w->swath.complete;
-    for (size_t c = c0; c < c1; c++) {
-        if (cell_nodata(C, c))
-            continue;
-        float acc[N] = {0}, share = 0;
+    const int first = complete ? 0 : 1;
+    block_nodes B;
+    for (size_t b = c0; b < c1; b += FOLD_BLOCK) {
+        const int m = c1 - b < FOLD_BLOCK ? (int)(c1 - b) : FOLD_BLOCK;
         /* slot k: from sample k - 1 (the last, for the closing slot 0) to k */
-        for (int k = complete ? 0 : 1; k < n; k++)
-            add_folded_interior(C, k, P[k][c], P[k ? k - 1 : n - 1][c], acc, &share);
+        for (int k = first; k < n; k++)
+            block_interior(P[k] + b, P[k ? k - 1 : n - 1] + b, m, k, &B);
         if (!complete) {
-            add_folded_boundary(C, 0, P[0][c], acc, &share);
-            add_folded_boundary(C, n, P[n - 1][c], acc, &share);
+            block_boundary(P[0] + b, m, 0, &B);
+            block_boundary(P[n - 1] + b, m, n, &B);
         }
-        if (C->share)
-            store_share(C, c, share);
-        if (C->shade) {
-            float yn[N], p[N];
-            TS_SH_BASIS(float, C->nx[c], C->ny[c], C->nz[c], yn);
-            for (int k = 0; k < N; k++)
-                p[k] = acc[k] * yn[k];
-            store_shade(C, c, ts_sh_sum16(p));
+        for (int j = 0; j < m; j++) {
+            const size_t c = b + (size_t)j;
+            if (cell_nodata(C, c))
+                continue;
+            float acc[N] = {0}, share = 0;
+            for (int k = first; k < n; k++)
+                add_folded_interior(C, &B, k, j, acc, &share);
+            if (!complete) {
+                add_folded_boundary(C, &B, 0, j, acc, &share);
+                add_folded_boundary(C, &B, n, j, acc, &share);
+            }
+            if (C->share)
+                store_share(C, c, share);
+            if (C->shade) {
+                float yn[N], p[N];
+                TS_SH_BASIS(float, C->nx[c], C->ny[c], C->nz[c], yn);
+                for (int k = 0; k < N; k++)
+                    p[k] = acc[k] * yn[k];
+                store_shade(C, c, ts_sh_sum16(p));
+            }
         }
     }
 }
