@@ -24,6 +24,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "horn_row.h"
 #include "parallel.h"
 #include "sh_internal.h"
 #include "simd_clones.h"
@@ -47,7 +48,8 @@ typedef struct {
     slot_rotation *rot; /* n + 1: wedge k ends at sample k; [0] rise or closing; [n] fall */
     float mh[N][N];     /* product matrix with the clamped cosine's zonal factors */
     float l[N];
-    const float *nx, *ny, *nz;
+    const float *nx, *ny, *nz; /* NULL: each row's made from the grid */
+    float *rows_n;             /* then 3 x width floats a worker for them */
     float scale_shade, scale_share;
     float *shade, *share;
     /* folded per-slot tables (slot k as rot[k]); NULL: the general path */
@@ -159,9 +161,11 @@ static inline void store_shade(const swath_ctx *C, size_t c, float shade)
     C->shade[c] = t == t ? (t < 0 ? 0 : t) : NAN;
 }
 
-/* Cells c0..c1 (cloned for wider vectors where the CPU has them). */
+/* Cells c0..c1 (cloned for wider vectors where the CPU has them); their
+ * normals nx[c - c0], ny, nz. */
 TS_SIMD_CLONES
-static void swath_cells(const swath_ctx *C, size_t c0, size_t c1)
+static void swath_cells(const swath_ctx *C, size_t c0, size_t c1, const float *nx,
+                        const float *ny, const float *nz)
 {
     const ts_sh_wedges *w = C->w;
     const float *const *P = C->planes;
@@ -188,7 +192,7 @@ static void swath_cells(const swath_ctx *C, size_t c0, size_t c1)
         }
         if (C->shade) {
             float yn[N];
-            TS_SH_BASIS(float, C->nx[c], C->ny[c], C->nz[c], yn);
+            TS_SH_BASIS(float, nx[c - c0], ny[c - c0], nz[c - c0], yn);
             store_shade(C, c, ts_sh_triple_folded(C->mh, v, yn));
         }
     }
@@ -274,7 +278,8 @@ static inline void add_folded_boundary(const swath_ctx *C, const block_nodes *B,
  * and weights first, over the cells (vectorised: a quarter less time than
  * finding them cell by cell, session 15), then cell by cell the same sums. */
 TS_SIMD_CLONES
-static void folded_cells(const swath_ctx *C, size_t c0, size_t c1)
+static void folded_cells(const swath_ctx *C, size_t c0, size_t c1, const float *nx,
+                         const float *ny, const float *nz)
 {
     const float *const *P = C->planes;
     const int n = C->w->swath.n, complete = C->w->swath.complete;
@@ -304,7 +309,7 @@ static void folded_cells(const swath_ctx *C, size_t c0, size_t c1)
                 store_share(C, c, share);
             if (C->shade) {
                 float yn[N], p[N];
-                TS_SH_BASIS(float, C->nx[c], C->ny[c], C->nz[c], yn);
+                TS_SH_BASIS(float, nx[c - c0], ny[c - c0], nz[c - c0], yn);
                 for (int k = 0; k < N; k++)
                     p[k] = acc[k] * yn[k];
                 store_shade(C, c, ts_sh_sum16(p));
@@ -313,15 +318,31 @@ static void folded_cells(const swath_ctx *C, size_t c0, size_t c1)
     }
 }
 
+static void swath_span(const swath_ctx *C, size_t c0, size_t c1, const float *nx,
+                       const float *ny, const float *nz)
+{
+    if (C->fold_shade || C->fold_share)
+        folded_cells(C, c0, c1, nx, ny, nz);
+    else
+        swath_cells(C, c0, c1, nx, ny, nz);
+}
+
 static void swath_rows(void *ctx, int worker, long y0, long y1)
 {
-    (void)worker;
     const swath_ctx *C = ctx;
     const size_t W = (size_t)C->g->width;
-    if (C->fold_shade || C->fold_share)
-        folded_cells(C, (size_t)y0 * W, (size_t)y1 * W);
-    else
-        swath_cells(C, (size_t)y0 * W, (size_t)y1 * W);
+    if (!C->shade || C->nx) {
+        const size_t o = (size_t)y0 * W;
+        swath_span(C, o, (size_t)y1 * W, C->nx ? C->nx + o : NULL, C->nx ? C->ny + o : NULL,
+                   C->nx ? C->nz + o : NULL);
+        return;
+    }
+    /* the normals row by row, as ts_normals makes them (ts_horn_row) */
+    float *n = C->rows_n + (size_t)worker * 3 * W;
+    for (long y = y0; y < y1; y++) {
+        ts_horn_row(C->g, (int)y, n, n + W, n + 2 * W);
+        swath_span(C, (size_t)y * W, (size_t)(y + 1) * W, n, n + W, n + 2 * W);
+    }
 }
 
 /* The folded tables' slots: interior ones (1 .. n - 1, and 0 when complete)
@@ -438,9 +459,10 @@ ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
     if (st != TS_OK)
         return st;
     if (!w || !w->interior || !planes || !l || (!shade && !share) ||
-        (shade && (!nx || !ny || !nz)))
-        return ts_fail(err, TS_ERR_ARG, "the wedge tables, the horizon planes, the light, an "
-                       "output and, for shade, the normals must not be NULL");
+        (shade && (!nx != !ny || !nx != !nz)))
+        return ts_fail(err, TS_ERR_ARG, "the wedge tables, the horizon planes, the light and "
+                       "an output must not be NULL, and for shade the three planes of normals "
+                       "must be given or all NULL");
     const ts_sh_swath *s = &w->swath;
     for (int k = 0; k < s->n; k++)
         if (!planes[k])
@@ -459,7 +481,7 @@ ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
     az_start[s->n] = ts_sh_swath_azimuth(s, s->n - 1) + s->step / 2;
     for (int k = 0; k <= s->n; k++)
         slot_rotation_set(&rot[k], az_start[k]);
-    swath_ctx C = {grid, w, planes, rot, {{0}}, {0}, nx, ny, nz, (float)scale_shade,
+    swath_ctx C = {grid, w, planes, rot, {{0}}, {0}, nx, ny, nz, NULL, (float)scale_shade,
                    (float)scale_share, shade, share, NULL, NULL};
     for (int k = 0; k < N; k++)
         C.l[k] = (float)l[k];
@@ -475,9 +497,13 @@ ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
                                         (size_t)interior_slots * TS_SH_WEDGE_STEPS *
                                             TS_SH_WEDGE_STEPS)
         st = fold_tables(&C, az_start, err);
+    const int threads = ts_thread_count(w->threads, grid->height);
+    if (st == TS_OK && shade && !nx &&
+        !(C.rows_n = malloc((size_t)threads * 3 * grid->width * sizeof(float))))
+        st = ts_fail(err, TS_ERR_NOMEM, "out of memory for rows of normals");
     if (st == TS_OK)
-        st = ts_parallel_for(ts_thread_count(w->threads, grid->height), grid->height, swath_rows, &C,
-                             err);
+        st = ts_parallel_for(threads, grid->height, swath_rows, &C, err);
+    free(C.rows_n);
     fold_free(&C, slot_count(s));
     free(rot);
     free(az_start);

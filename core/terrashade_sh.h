@@ -221,7 +221,9 @@ ts_status ts_sh_visible_share(const ts_grid *grid, const double l[TS_SH_COEFFS],
  * light's): each cell's visibility summed from the same wedges as
  * ts_sh_visibility, then, where the output is not NULL,
  * shade = max(0, scale_shade * triple(l, V, clamped cosine of N)) and
- * share = clamp(scale_share * l . V, 0, 1); NaN stays NaN.
+ * share = clamp(scale_share * l . V, 0, 1); NaN stays NaN. The normals N:
+ * the planes nx, ny, nz (ts_normals), or, all three NULL, each row's made
+ * from the grid as ts_normals makes it (the same values, without 3 planes).
  */
 ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
                             const float *const *planes, const double l[TS_SH_COEFFS],

@@ -355,9 +355,11 @@ TSD_COMPUTE_FN(tsd_compute_shade)
     ts_error err;
     ts_status st;
     /* the exact method's direct sun alone makes its normals row by row,
-     * and takes the sun's horizons in out (a fresh plane costs page faults) */
-    int planes = !(c->opts->method == TSD_METHOD_EXACT && !sun_lattice(c) &&
-                   !(c->opts->sky_weight > 0));
+     * and takes the sun's horizons in out (a fresh plane costs page faults);
+     * METHOD=sh's alone makes them row by row too, and needs no work plane */
+    const int row_normals = c->opts->method == TSD_METHOD_EXACT ||
+                            c->opts->method == TSD_METHOD_SH;
+    int planes = !(row_normals && !sun_lattice(c) && !(c->opts->sky_weight > 0));
     float *work = planes ? malloc(cells * sizeof(float)) : out;
     if (!work)
         st = oom(c, "a horizon plane");

@@ -292,7 +292,8 @@ START_TEST(visibility_planes)
         for (size_t c = 0; c < cells; c++)
             ck_assert(c == 7 ? isnan(share[c]) && isnan(stored[c])
                              : fabsf(share[c] - stored[c]) < 1e-6f);
-        EXPECT_ARG(ts_sh_swath_light(&g, &w, planes, l, NULL, NULL, NULL, 1, share, 0, NULL,
+        /* shade with some planes of normals but not all */
+        EXPECT_ARG(ts_sh_swath_light(&g, &w, planes, l, plane, NULL, NULL, 1, share, 0, NULL,
                                      &err), &err);
         free(share), free(stored);
         /* a plane out of order is refused */
@@ -373,6 +374,64 @@ START_TEST(swath_light_folded)
 }
 END_TEST
 
+/* Without planes of normals (all three NULL), ts_sh_swath_light makes each
+ * row's from the grid as ts_normals does: bit for bit the same shade and
+ * share, on the folded path (a large grid, a key's swath) and the general
+ * one (a small grid), with one and two threads, nodata in the DEM. */
+START_TEST(swath_light_row_normals)
+{
+    const int sizes[2][2] = {{400, 340}, {37, 23}};
+    for (int z = 0; z < 2; z++) {
+        const int W = sizes[z][0], H = sizes[z][1];
+        const size_t cells = (size_t)W * H;
+        ts_grid g;
+        ts_error err;
+        tdem_create(&g, W, H, 10, 10);
+        tdem_fbm(&g, 7, 0.8, 400);
+        g.z[(size_t)(H / 2) * g.stride + W / 3] = NAN;
+        float *nx = tdem_floats(cells), *ny = tdem_floats(cells), *nz = tdem_floats(cells);
+        ck_assert(ts_normals(&g, nx, ny, nz, &err) == TS_OK);
+        ts_sh_swath sw;
+        ts_sh_swath_key(&sw, 3, 135, 25, 2);
+        double l[N];
+        ts_sh_key_light(135, 25, 2, l);
+        float *planes[3];
+        for (int k = 0; k < sw.n; k++) {
+            planes[k] = tdem_floats(cells);
+            for (size_t c = 0; c < cells; c++)
+                planes[k][c] = (float)(20 + 25 * sin(0.029 * (double)c + k));
+        }
+        for (int threads = 1; threads <= 2; threads++) {
+            ts_sh_wedges w;
+            ck_assert(ts_sh_wedges_build(&sw, threads, &w, &err) == TS_OK);
+            float *shade = tdem_floats(cells), *share = tdem_floats(cells);
+            float *shade_rows = tdem_floats(cells), *share_rows = tdem_floats(cells);
+            ck_assert(ts_sh_swath_light(&g, &w, (const float *const *)planes, l, nx, ny, nz, 1.5,
+                                        shade, 1.2, share, &err) == TS_OK);
+            ck_assert_msg(ts_sh_swath_light(&g, &w, (const float *const *)planes, l, NULL, NULL,
+                                            NULL, 1.5, shade_rows, 1.2, share_rows,
+                                            &err) == TS_OK, "%s", err.message);
+            ck_assert(memcmp(shade, shade_rows, cells * sizeof(float)) == 0);
+            ck_assert(memcmp(share, share_rows, cells * sizeof(float)) == 0);
+            size_t nodata = 0;
+            for (size_t c = 0; c < cells; c++)
+                nodata += isnan(shade[c]);
+            ck_assert(nodata > 0 && nodata < 20); /* the hole's neighbours */
+            /* one plane of normals without the others */
+            EXPECT_ARG(ts_sh_swath_light(&g, &w, (const float *const *)planes, l, nx, NULL, nz,
+                                         1, shade, 1, NULL, &err),
+                       &err);
+            free(shade), free(share), free(shade_rows), free(share_rows);
+            ts_sh_wedges_free(&w);
+        }
+        for (int k = 0; k < sw.n; k++)
+            free(planes[k]);
+        free(nx), free(ny), free(nz);
+        ts_grid_free(&g);
+    }
+}
+END_TEST
+
 /* Open flat ground under a constant sky: E/pi = 1 exactly in the
  * continuous case; state what order 4 gives. */
 START_TEST(flat_ground_constant_sky)
@@ -435,6 +494,7 @@ static Suite *suite(void)
     tcase_add_test(tc, wedges_brute_force);
     tcase_add_test(tc, visibility_planes);
     tcase_add_test(tc, swath_light_folded);
+    tcase_add_test(tc, swath_light_row_normals);
     tcase_add_test(tc, flat_ground_constant_sky);
     tcase_add_test(tc, key_light_reference);
     tcase_add_test(tc, bad_input);
