@@ -26,6 +26,7 @@
 
 #include "horn_row.h"
 #include "parallel.h"
+#include "sh_block512.h"
 #include "sh_internal.h"
 #include "simd_clones.h"
 #include "status_internal.h"
@@ -294,26 +295,40 @@ static void folded_cells(const swath_ctx *C, size_t c0, size_t c1, const float *
             block_boundary(P[0] + b, m, 0, &B);
             block_boundary(P[n - 1] + b, m, n, &B);
         }
+        float acc[FOLD_BLOCK][N] __attribute__((aligned(64)));
+        unsigned skip = 0;
         for (int j = 0; j < m; j++) {
             const size_t c = b + (size_t)j;
-            if (cell_nodata(C, c))
+            for (int k = 0; k < N; k++)
+                acc[j][k] = 0;
+            if (cell_nodata(C, c)) {
+                skip |= 1u << j;
                 continue;
-            float acc[N] = {0}, share = 0;
+            }
+            float share = 0;
             for (int k = first; k < n; k++)
-                add_folded_interior(C, &B, k, j, acc, &share);
+                add_folded_interior(C, &B, k, j, acc[j], &share);
             if (!complete) {
-                add_folded_boundary(C, &B, 0, j, acc, &share);
-                add_folded_boundary(C, &B, n, j, acc, &share);
+                add_folded_boundary(C, &B, 0, j, acc[j], &share);
+                add_folded_boundary(C, &B, n, j, acc[j], &share);
             }
             if (C->share)
                 store_share(C, c, share);
-            if (C->shade) {
-                float yn[N], p[N];
-                TS_SH_BASIS(float, nx[c - c0], ny[c - c0], nz[c - c0], yn);
-                for (int k = 0; k < N; k++)
-                    p[k] = acc[k] * yn[k];
-                store_shade(C, c, ts_sh_sum16(p));
-            }
+        }
+        if (!C->shade)
+            continue;
+        const size_t o = b - c0;
+        if (m == FOLD_BLOCK && ts_sh_block_shade512((const float(*)[N])acc, nx + o, ny + o,
+                                                    nz + o, C->scale_shade, skip, C->shade + b))
+            continue;
+        for (int j = 0; j < m; j++) {
+            if (skip >> j & 1)
+                continue;
+            float yn[N], p[N];
+            TS_SH_BASIS(float, nx[o + j], ny[o + j], nz[o + j], yn);
+            for (int k = 0; k < N; k++)
+                p[k] = acc[j][k] * yn[k];
+            store_shade(C, b + (size_t)j, ts_sh_sum16(p));
         }
     }
 }
