@@ -75,7 +75,9 @@ static void slot_rotation_set(slot_rotation *s, double az_start)
 static inline float clamp_node(float w)
 {
     const float scale = (TS_SH_WEDGE_STEPS - 1) / 90.0f;
-    return (w < 0 ? 0 : w > 90 ? 90 : w) * scale;
+    /* NaN (a nodata cell's, whose outputs are NaN anyway) as 0: its node
+     * must stay an index (folded_cells finds a block's before the test) */
+    return (w != w || w < 0 ? 0 : w > 90 ? 90 : w) * scale;
 }
 
 /* a1 += v p, a2 += v q' for the wedge v read bilinearly from the interior
