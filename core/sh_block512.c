@@ -5,6 +5,7 @@
 #include <math.h>
 
 #include "lane_hull.h"
+#include "sh_internal.h"
 #include "simd_clones.h"
 
 #if defined(__GNUC__) && defined(__x86_64__)
@@ -35,8 +36,7 @@ TS_AVX512 static inline __attribute__((always_inline)) void transpose16(__m512 r
     }
 }
 
-#define MUL _mm512_mul_ps
-#define SUB _mm512_sub_ps
+/* a constant as a vector, for TS_SH_BASIS_K */
 #define K(c) _mm512_set1_ps((float)(c))
 
 TS_AVX512 static void block_shade(const float (*acc)[TS_SH_COEFFS], const float *nx,
@@ -47,40 +47,20 @@ TS_AVX512 static void block_shade(const float (*acc)[TS_SH_COEFFS], const float 
     for (int j = 0; j < 16; j++)
         a[j] = _mm512_load_ps(acc[j]);
     transpose16(a);
-    const __m512 x = _mm512_loadu_ps(nx), y = _mm512_loadu_ps(ny), z = _mm512_loadu_ps(nz);
-    const __m512 zz = MUL(z, z), xx = MUL(x, x), yy = MUL(y, y), one = K(1);
-    /* TS_SH_BASIS term by term: the constant first, then left to right */
-    const __m512 c1 = K(0.488602511902919921), c4 = K(1.092548430592079070);
-    const __m512 c9 = K(0.590043589926643510), c11 = K(0.457045799464465737);
-    const __m512 z5 = MUL(K(5), zz);
+    /* the basis over the cells: TS_SH_BASIS's formulas on vectors */
     __m512 Y[16];
-    Y[0] = K(0.282094791773878143);
-    Y[1] = MUL(c1, y);
-    Y[2] = MUL(c1, z);
-    Y[3] = MUL(c1, x);
-    Y[4] = MUL(MUL(c4, x), y);
-    Y[5] = MUL(MUL(c4, y), z);
-    Y[6] = MUL(K(0.315391565252520002), SUB(MUL(K(3), zz), one));
-    Y[7] = MUL(MUL(c4, x), z);
-    Y[8] = MUL(K(0.546274215296039535), SUB(xx, yy));
-    Y[9] = MUL(MUL(c9, y), SUB(MUL(MUL(K(3), x), x), yy));
-    Y[10] = MUL(MUL(MUL(K(2.890611442640554055), x), y), z);
-    Y[11] = MUL(MUL(c11, y), SUB(z5, one));
-    Y[12] = MUL(MUL(K(0.373176332590115391), z), SUB(z5, K(3)));
-    Y[13] = MUL(MUL(c11, x), SUB(z5, one));
-    Y[14] = MUL(MUL(K(1.445305721320277027), z), SUB(xx, yy));
-    Y[15] = MUL(MUL(c9, x), SUB(xx, MUL(MUL(K(3), y), y)));
+    TS_SH_BASIS_K(__m512, K, _mm512_loadu_ps(nx), _mm512_loadu_ps(ny), _mm512_loadu_ps(nz), Y);
     /* ts_sh_sum16's tree over p_k = acc_k Y_k */
     __m512 p[16];
     for (int k = 0; k < 16; k++)
-        p[k] = MUL(a[k], Y[k]);
+        p[k] = _mm512_mul_ps(a[k], Y[k]);
     for (int k = 0; k < 8; k++)
         p[k] = _mm512_add_ps(p[k], p[k + 8]);
     for (int k = 0; k < 4; k++)
         p[k] = _mm512_add_ps(p[k], p[k + 4]);
     const __m512 s = _mm512_add_ps(_mm512_add_ps(p[0], p[2]), _mm512_add_ps(p[1], p[3]));
     /* store_shade: t < 0 ? 0 : t, NaN kept */
-    const __m512 t = MUL(s, _mm512_set1_ps(scale));
+    const __m512 t = _mm512_mul_ps(s, _mm512_set1_ps(scale));
     const __mmask16 neg = _mm512_cmp_ps_mask(t, _mm512_setzero_ps(), _CMP_LT_OQ);
     const __mmask16 nan = _mm512_cmp_ps_mask(t, t, _CMP_UNORD_Q);
     __m512 out = _mm512_mask_mov_ps(t, neg, _mm512_setzero_ps());

@@ -5,8 +5,9 @@
  * one cell's coefficients in a vector but its basis in scalars; here the 16
  * cells' coefficients are transposed so that the basis, the products and
  * the sums run over the cells, sixteen at a time. The same float operations
- * in the same order (TS_SH_BASIS's products left to right, ts_sh_sum16's
- * tree, store_shade's clamp), so the same bits.
+ * in the same order (TS_SH_BASIS's formulas themselves, through
+ * TS_SH_BASIS_K on vectors; ts_sh_sum16's tree; store_shade's clamp), so the
+ * same bits.
  */
 #ifndef TS_SH_BLOCK512_H
 #define TS_SH_BLOCK512_H

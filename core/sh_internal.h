@@ -18,26 +18,31 @@ void ts_sh_fold_cosine(const double m[TS_SH_COEFFS][TS_SH_COEFFS],
                        float mh[TS_SH_COEFFS][TS_SH_COEFFS]);
 
 /** The 16 basis functions at unit direction (x, y, z) in type T (double for
- *  ts_sh_eval, float in the per-cell loops): the one home of the formulas. */
-#define TS_SH_BASIS(T, x, y, z, out)                                                     \
+ *  ts_sh_eval, float in the per-cell loops, a vector of 16 floats in
+ *  core/sh_block512.c): the one home of the formulas. K(c) makes the
+ *  constant c a T: TS_SH_BASIS casts it; TS_SH_BASIS_K takes a maker for a
+ *  T that a cast cannot make (a vector). The products run left to right,
+ *  constant first, in any T: the same operations element by element. */
+#define TS_SH_BASIS(T, x, y, z, out) TS_SH_BASIS_K(T, (T), x, y, z, out)
+#define TS_SH_BASIS_K(T, K, x, y, z, out)                                                \
     do {                                                                                 \
         const T x_ = (x), y_ = (y), z_ = (z), zz_ = z_ * z_;                             \
-        (out)[0] = (T)0.282094791773878143;                                              \
-        (out)[1] = (T)0.488602511902919921 * y_;                                         \
-        (out)[2] = (T)0.488602511902919921 * z_;                                         \
-        (out)[3] = (T)0.488602511902919921 * x_;                                         \
-        (out)[4] = (T)1.092548430592079070 * x_ * y_;                                    \
-        (out)[5] = (T)1.092548430592079070 * y_ * z_;                                    \
-        (out)[6] = (T)0.315391565252520002 * (3 * zz_ - 1);                              \
-        (out)[7] = (T)1.092548430592079070 * x_ * z_;                                    \
-        (out)[8] = (T)0.546274215296039535 * (x_ * x_ - y_ * y_);                        \
-        (out)[9] = (T)0.590043589926643510 * y_ * (3 * x_ * x_ - y_ * y_);              \
-        (out)[10] = (T)2.890611442640554055 * x_ * y_ * z_;                              \
-        (out)[11] = (T)0.457045799464465737 * y_ * (5 * zz_ - 1);                        \
-        (out)[12] = (T)0.373176332590115391 * z_ * (5 * zz_ - 3);                        \
-        (out)[13] = (T)0.457045799464465737 * x_ * (5 * zz_ - 1);                        \
-        (out)[14] = (T)1.445305721320277027 * z_ * (x_ * x_ - y_ * y_);                  \
-        (out)[15] = (T)0.590043589926643510 * x_ * (x_ * x_ - 3 * y_ * y_);             \
+        (out)[0] = K(0.282094791773878143);                                              \
+        (out)[1] = K(0.488602511902919921) * y_;                                         \
+        (out)[2] = K(0.488602511902919921) * z_;                                         \
+        (out)[3] = K(0.488602511902919921) * x_;                                         \
+        (out)[4] = K(1.092548430592079070) * x_ * y_;                                    \
+        (out)[5] = K(1.092548430592079070) * y_ * z_;                                    \
+        (out)[6] = K(0.315391565252520002) * (3 * zz_ - 1);                              \
+        (out)[7] = K(1.092548430592079070) * x_ * z_;                                    \
+        (out)[8] = K(0.546274215296039535) * (x_ * x_ - y_ * y_);                        \
+        (out)[9] = K(0.590043589926643510) * y_ * (3 * x_ * x_ - y_ * y_);              \
+        (out)[10] = K(2.890611442640554055) * x_ * y_ * z_;                              \
+        (out)[11] = K(0.457045799464465737) * y_ * (5 * zz_ - 1);                        \
+        (out)[12] = K(0.373176332590115391) * z_ * (5 * zz_ - 3);                        \
+        (out)[13] = K(0.457045799464465737) * x_ * (5 * zz_ - 1);                        \
+        (out)[14] = K(1.445305721320277027) * z_ * (x_ * x_ - y_ * y_);                  \
+        (out)[15] = K(0.590043589926643510) * x_ * (x_ * x_ - 3 * y_ * y_);             \
     } while (0)
 
 /** Gauss-Legendre nodes and weights of n points (n <= 32) on [-1, 1]. */

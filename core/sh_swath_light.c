@@ -218,13 +218,12 @@ static inline void block_interior(const float *restrict pa, const float *restric
                                   int slot, block_nodes *restrict B)
 {
     for (int j = 0; j < m; j++) {
-        float fa, fb;
-        const int ia = node_of(pa[j], &fa), ib = node_of(pb[j], &fb);
-        B->at[slot][j] = ia * TS_SH_WEDGE_STEPS + ib;
-        B->wt[slot][0][j] = (1 - fa) * (1 - fb);
-        B->wt[slot][1][j] = (1 - fa) * fb;
-        B->wt[slot][2][j] = fa * (1 - fb);
-        B->wt[slot][3][j] = fa * fb;
+        size_t at;
+        float wt[4];
+        bilinear_at(pa[j], pb[j], &at, wt);
+        B->at[slot][j] = (int)at;
+        for (int i = 0; i < 4; i++)
+            B->wt[slot][i][j] = wt[i];
     }
 }
 
