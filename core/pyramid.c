@@ -83,13 +83,21 @@ double ts_pyramid_bytes(int width, int height, double level_step)
     return rows * width * sizeof(float);
 }
 
+/* Samples of the largest coarse level (level 1), which sizes the build's
+ * four decimation buffers; 1 where there is none. */
+static size_t level1_cells(int width, int height, double level_step)
+{
+    if (ts_pyramid_level_count(width, height, level_step) < 2)
+        return 1;
+    const double s = spacing(level_step, 1);
+    return (size_t)level_size(width, s) * level_size(height, s);
+}
+
 double ts_pyramid_build_bytes(int width, int height, double level_step)
 {
-    int levels = ts_pyramid_level_count(width, height, level_step);
-    double s = spacing(level_step, 1);
-    double most = levels > 1 ? (double)level_size(width, s) * level_size(height, s) : 1;
+    /* the four decimation buffers and the two edge-column pairs (2 x height each) */
     return ts_pyramid_bytes(width, height, level_step) +
-           (4 * most + 4.0 * height) * sizeof(float);
+           (4.0 * level1_cells(width, height, level_step) + 4.0 * height) * sizeof(float);
 }
 
 /* A level before reconstruction: its samples (rows `stride` floats apart)
@@ -237,9 +245,7 @@ ts_status ts_pyramid_build(const ts_grid *grid, const ts_pyramid_opts *opts, int
     const int W = grid->width, H = grid->height;
     coarse prev = {W, H, 1.0, grid->z, NULL, grid->stride};
     P->level[0] = (ts_pyr_level){1.0, H, NULL};
-    size_t most = P->levels > 1 ? (size_t)level_size(W, spacing(opts->level_step, 1)) *
-                                      level_size(H, spacing(opts->level_step, 1))
-                                : 1;
+    size_t most = level1_cells(W, H, opts->level_step);
     float *buf[2][2] = {{malloc(most * sizeof(float)), malloc(most * sizeof(float))},
                         {malloc(most * sizeof(float)), malloc(most * sizeof(float))}};
     P->pair[0] = malloc((size_t)2 * H * sizeof(float));

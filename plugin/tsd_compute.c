@@ -346,6 +346,15 @@ static ts_status shade_direct(const tsd_compute_ctx *c, const ts_grid *g, const 
     return TS_OK;
 }
 
+int tsd_shade_without_planes(const tsd_options *o, int sun_lattice)
+{
+    /* the exact method's direct sun alone makes its normals row by row,
+     * and takes the sun's horizons in out (a fresh plane costs page faults);
+     * METHOD=sh's alone makes them row by row too, and needs no work plane */
+    return (o->method == TSD_METHOD_EXACT || o->method == TSD_METHOD_SH) && !sun_lattice &&
+           !(o->sky_weight > 0);
+}
+
 TSD_COMPUTE_FN(tsd_compute_shade)
 {
     (void)bytes;
@@ -354,12 +363,7 @@ TSD_COMPUTE_FN(tsd_compute_shade)
     tsd_normals nm = {0};
     ts_error err;
     ts_status st;
-    /* the exact method's direct sun alone makes its normals row by row,
-     * and takes the sun's horizons in out (a fresh plane costs page faults);
-     * METHOD=sh's alone makes them row by row too, and needs no work plane */
-    const int row_normals = c->opts->method == TSD_METHOD_EXACT ||
-                            c->opts->method == TSD_METHOD_SH;
-    int planes = !(row_normals && !sun_lattice(c) && !(c->opts->sky_weight > 0));
+    int planes = !tsd_shade_without_planes(c->opts, sun_lattice(c));
     float *work = planes ? malloc(cells * sizeof(float)) : out;
     if (!work)
         st = oom(c, "a horizon plane");

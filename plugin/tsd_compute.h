@@ -98,6 +98,13 @@ ts_status tsd_product_compute(const tsd_compute_ctx *ctx, const tsd_region *regi
 #define TSD_COMPUTE_FN(name)                                                             \
     ts_status name(const tsd_compute_ctx *c, const tsd_region *r, float *out, uint8_t *bytes)
 
+/* 1 if `shade` under options o, with the sun on a lattice of sites
+ * (SUN_POSITION=per_cell) or not, computes its direct sun alone without
+ * planes of normals or a work plane (the exact method and METHOD=sh make
+ * their normals row by row; without a sky term): what tsd_compute_shade
+ * does and the memory estimate counts. */
+int tsd_shade_without_planes(const tsd_options *o, int sun_lattice);
+
 /* The products' compute functions (tsd_compute.c, tsd_compute_day.c). */
 TSD_COMPUTE_FN(tsd_compute_shade);
 TSD_COMPUTE_FN(tsd_compute_shadow);

@@ -306,12 +306,8 @@ double tsd_product_peak_bytes(const tsd_options *o, int width, int height, doubl
                  : o->env_method == TSD_ENV_SH ? 18 : 0;
     int extra = p->planes + (o->sky_weight > 0 ? p->sky_planes : 0) + 2 * env_sky + sh +
                 (o->sun_position == TSD_SUN_PER_CELL ? p->per_cell_planes : 0);
-    /* the exact direct sun alone makes its normals row by row and takes
-     * the sun's horizons in the product, METHOD=sh's its normals row by row
-     * (tsd_compute_shade) */
     if (p->compute == tsd_compute_shade &&
-        (o->method == TSD_METHOD_EXACT || o->method == TSD_METHOD_SH) &&
-        !(o->sky_weight > 0) && o->sun_position != TSD_SUN_PER_CELL)
+        tsd_shade_without_planes(o, o->sun_position == TSD_SUN_PER_CELL))
         extra -= p->planes;
     if (steady)
         *steady = kept * plane;
