@@ -492,10 +492,15 @@ void TSDataset::WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfL
     const double dfReach = tsd_sites_reach(m_adfGT, W, H, hSRS, &m_sCells, dfLon, dfLat);
     if (!(dfReach > SUN_REACH_WARN_DEG))
         return;
-    const tsd_options &o = m_sOpts;
-    const bool bPerCell = tsd_product_takes(m_psProduct, tsd_option_find("SUN_POSITION")) &&
-                          o.method == TSD_METHOD_EXACT &&
-                          !tsd_options_given(&o, "LIGHT_RADIUS");
+    // per_cell where the product takes it and the options' own checks
+    // accept it beside the others given (METHOD, LIGHT_RADIUS, ...)
+    const int iSunPosition = tsd_option_find("SUN_POSITION");
+    tsd_options sPerCell = m_sOpts;
+    sPerCell.sun_position = TSD_SUN_PER_CELL;
+    sPerCell.given |= 1ULL << iSunPosition;
+    char szWhyNot[512];
+    const bool bPerCell = tsd_product_takes(m_psProduct, iSunPosition) &&
+                          tsd_options_check(&sPerCell, szWhyNot, sizeof szWhyNot) == 0;
     CPLError(CE_Warning, CPLE_AppDefined,
              "TERRASHADE: the DEM reaches %.1f degrees of arc from its centre, where the "
              "sun is computed for all its cells (SUN_POSITION=center): at its edges the "

@@ -297,7 +297,9 @@ class Sun(unittest.TestCase):
         self.assertAlmostEqual(reach, 9.5, delta=0.3)
         for oo, advice in ((day, "SUN_POSITION=per_cell computes the sun across the DEM"),
                            (instant, "SUN_POSITION=per_cell"),
+                           (dict(instant, METHOD="shm"), "SUN_POSITION=per_cell"),
                            (dict(instant, METHOD="shadowmap"), "Crop the DEM"),
+                           (dict(instant, LIGHT_RADIUS=1), "Crop the DEM"),
                            (dict(instant, PRODUCT="farshadow"), "Crop the DEM")):
             p = T.run(["gdal_translate", "-q"] + T.oo_args(oo) + [T.conn(wide), out])
             # from the centre (8 E, 48 N) to the farthest corner cell's centre
