@@ -10,17 +10,11 @@ directory). Needs numpy and PIL.
 """
 import os
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-BUILD = os.path.abspath(os.environ.get("BUILDDIR", "."))
-os.environ["GDAL_DRIVER_PATH"] = os.path.join(BUILD, "plugin", ".libs")
-os.environ["GDAL_PAM_ENABLED"] = "NO"
+import numpy as np
+from PIL import Image, ImageDraw, ImageFont
 
-import numpy as np  # noqa: E402
-from osgeo import gdal  # noqa: E402
-from PIL import Image, ImageDraw, ImageFont  # noqa: E402
+from plugin_env import HERE, JACKSBORO as DEM, gdal
 
-gdal.UseExceptions()
-DEM = os.path.join(HERE, "..", "..", "samples", "jacksboro.tif")
 BASE = {"PRODUCT": "svf", "DIRECTIONS": "32", "OUTPUT_TYPE": "Float32"}
 
 
