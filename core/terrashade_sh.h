@@ -151,6 +151,12 @@ typedef struct {
     float *rise, *fall; /**< NULL for a complete swath */
     int threads;        /**< what ts_sh_wedges_build was given: the passes
                              that take these tables use as many */
+    /** The cell count by which ts_sh_swath_light decides whether to fold
+     *  the tables with the light (its faster path, which differs from the
+     *  other by float rounding); 0 (ts_sh_wedges_build's): the grid's own.
+     *  A caller computing a large grid window by window gives the whole
+     *  grid's, so that every window takes the path the whole would. */
+    double fold_cells;
 } ts_sh_wedges;
 
 /** Build the tables of swath s (threads: 0 = all cores; the visibility and

@@ -376,6 +376,87 @@ START_TEST(swath_light_folded)
 }
 END_TEST
 
+/* A key light of SWATH_DIRECTIONS=3: its swath and its SH coefficients. */
+static void key_of(double az, double el, double radius, ts_sh_swath *sw, double l[N])
+{
+    ts_sh_swath_key(sw, 3, az, el, radius);
+    ts_sh_key_light(az, el, radius, l);
+}
+
+/* ts_sh_wedges.fold_cells: a window of a large grid, given the whole grid's
+ * cell count, takes the path the whole grid takes (the folded tables), so
+ * that its cells are the whole's bit for bit; on its own it takes the
+ * general path, within float rounding of them. */
+START_TEST(swath_light_fold_cells)
+{
+    const int W = 400, H = 340, x0 = 123, y0 = 77, w = 61, h = 45;
+    const size_t cells = (size_t)W * H, wcells = (size_t)w * h;
+    ts_grid g, win;
+    ts_error err;
+    tdem_create(&g, W, H, 10, 10);
+    tdem_fbm(&g, 11, 0.8, 400);
+    tdem_create(&win, w, h, 10, 10);
+    float *nx = tdem_floats(cells), *ny = tdem_floats(cells), *nz = tdem_floats(cells);
+    ck_assert(ts_normals(&g, nx, ny, nz, &err) == TS_OK);
+    ts_sh_swath sw;
+    double l[N];
+    key_of(200, 30, 1, &sw, l);
+    float *planes[3], *wplanes[3], *wn[3];
+    for (int k = 0; k < sw.n; k++) {
+        planes[k] = tdem_floats(cells);
+        wplanes[k] = tdem_floats(wcells);
+        for (size_t c = 0; c < cells; c++)
+            planes[k][c] = (float)(30 + 35 * sin(0.017 * (double)c + 0.9 * k));
+    }
+    for (int k = 0; k < 3; k++)
+        wn[k] = tdem_floats(wcells);
+    /* the window's heights, horizons and normals: a crop */
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const size_t c = (size_t)(y0 + y) * W + x0 + x, cw = (size_t)y * w + x;
+            win.z[(size_t)y * win.stride + x] = g.z[(size_t)(y0 + y) * g.stride + x0 + x];
+            for (int k = 0; k < sw.n; k++)
+                wplanes[k][cw] = planes[k][c];
+            wn[0][cw] = nx[c], wn[1][cw] = ny[c], wn[2][cw] = nz[c];
+        }
+    ts_sh_wedges wt;
+    ck_assert(ts_sh_wedges_build(&sw, 2, &wt, &err) == TS_OK);
+    ck_assert(wt.fold_cells == 0);
+    float *shade = tdem_floats(cells), *share = tdem_floats(cells);
+    float *wshade = tdem_floats(wcells), *wshare = tdem_floats(wcells);
+    ck_assert(ts_sh_swath_light(&g, &wt, (const float *const *)planes, l, nx, ny, nz, 1.3, shade,
+                                1.1, share, &err) == TS_OK);
+    double worst = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        wt.fold_cells = pass ? (double)cells : 0; /* the whole grid's, or its own */
+        ck_assert(ts_sh_swath_light(&win, &wt, (const float *const *)wplanes, l, wn[0], wn[1],
+                                    wn[2], 1.3, wshade, 1.1, wshare, &err) == TS_OK);
+        int same = 1;
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                const size_t c = (size_t)(y0 + y) * W + x0 + x, cw = (size_t)y * w + x;
+                same &= wshade[cw] == shade[c] && wshare[cw] == share[c];
+                if (!pass)
+                    worst = fmax(worst, fmax(fabs(wshade[cw] - shade[c]),
+                                             fabs(wshare[cw] - share[c])));
+            }
+        if (pass)
+            ck_assert_msg(same, "the window given fold_cells is not the whole's bit for bit");
+    }
+    printf("a %d x %d window on its own path: within %.2e of the whole grid's cells; given "
+           "fold_cells, equal\n", w, h, worst);
+    ck_assert(worst > 0 && worst < 2e-6); /* the general path: another rounding */
+    for (int k = 0; k < sw.n; k++)
+        free(planes[k]), free(wplanes[k]);
+    for (int k = 0; k < 3; k++)
+        free(wn[k]);
+    free(shade), free(share), free(wshade), free(wshare), free(nx), free(ny), free(nz);
+    ts_sh_wedges_free(&wt);
+    ts_grid_free(&g);
+    ts_grid_free(&win);
+}
+END_TEST
+
 /* Without planes of normals (all three NULL), ts_sh_swath_light makes each
  * row's from the grid as ts_normals does: bit for bit the same shade and
  * share, on the folded path (a large grid, a key's swath) and the general
@@ -394,9 +475,8 @@ START_TEST(swath_light_row_normals)
         float *nx = tdem_floats(cells), *ny = tdem_floats(cells), *nz = tdem_floats(cells);
         ck_assert(ts_normals(&g, nx, ny, nz, &err) == TS_OK);
         ts_sh_swath sw;
-        ts_sh_swath_key(&sw, 3, 135, 25, 2);
         double l[N];
-        ts_sh_key_light(135, 25, 2, l);
+        key_of(135, 25, 2, &sw, l);
         float *planes[3];
         for (int k = 0; k < sw.n; k++) {
             planes[k] = tdem_floats(cells);
@@ -539,6 +619,7 @@ static Suite *suite(void)
     tcase_add_test(tc, wedges_brute_force);
     tcase_add_test(tc, visibility_planes);
     tcase_add_test(tc, swath_light_folded);
+    tcase_add_test(tc, swath_light_fold_cells);
     tcase_add_test(tc, swath_light_row_normals);
     tcase_add_test(tc, block_shade_avx512);
     tcase_add_test(tc, flat_ground_constant_sky);
