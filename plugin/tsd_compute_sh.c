@@ -65,6 +65,8 @@ static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
     ts_sh_key_light(az, el, r, l);
     if ((st = ts_sh_wedges_build(&s, o->threads, &w, &err)) != TS_OK)
         return core_fail(c, &err);
+    if (g->origin) /* a window: the SH pass the whole DEM would take */
+        w.fold_cells = (double)g->origin->full_width * g->origin->full_height;
     ts_sh_key_reference(&w, l, az, el, &shade_ref, &share_ref);
     float **planes = calloc((size_t)s.n, sizeof *planes);
     for (int i = 0; planes && i < s.n; i++)
@@ -97,6 +99,8 @@ static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
             tsd_backend_summary_add(c->backend, &rep);
         if (st != TS_OK)
             st = core_fail(c, &err);
+        else /* a window's: raised to the far field and the DEM's edge */
+            st = tsd_compute_far(c, g, ts_sh_swath_azimuth(&s, i), 0, planes[i]);
     }
     if (st == TS_OK &&
         (st = ts_sh_swath_light(g, &w, (const float *const *)planes, l, nm ? nm->nx : NULL,

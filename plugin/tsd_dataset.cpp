@@ -397,6 +397,9 @@ static bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window
         if (dfLimit <= 0)
             dfLimit = static_cast<double>(std::numeric_limits<size_t>::max()) / 2;
     }
+    CPLDebug(DRIVER, "memory: about %.0f MiB while computing (%.0f MiB kept)%s, limit %.0f MiB",
+             dfPeak / 1048576.0, dfSteady / 1048576.0, psPlan ? " by window" : "",
+             dfLimit / 1048576.0);
     if (dfPeak <= dfLimit && dfPeak < static_cast<double>(std::numeric_limits<size_t>::max()) / 2)
         return true;
     Fail(TS_ERR_NOMEM,

@@ -80,8 +80,6 @@ int tsd_window_plan_make(const tsd_options *o, int per_cell_sun, int W, int H,
         p->why_whole = "METHOD=shm carries shadows across the whole DEM";
     else if (o->method == TSD_METHOD_SHADOWMAP && is(d, "shade", "shadow"))
         p->why_whole = "METHOD=shadowmap renders one depth map of the whole DEM";
-    else if (o->method == TSD_METHOD_SH && is(d, "shade", "shadow"))
-        p->why_whole = "METHOD=sh sweeps its key light's swath over the whole DEM";
     else if (o->horizon_method == TSD_HORIZON_PYRAMID)
         p->why_whole = "HORIZON_METHOD=pyramid reads one pyramid of the whole DEM";
     else if (o->env_method == TSD_ENV_SH && is(d, "envlight", NULL))
@@ -124,10 +122,14 @@ int tsd_window_plan_make(const tsd_options *o, int per_cell_sun, int W, int H,
     /* a cache that holds a row of chunks: GDAL reads blocks row by row */
     p->cache_chunks = (W + p->tile - 1) / p->tile + 1;
     if (p->far) {
-        /* the sweeps of a chunk: the sun's, DIRECTIONS, or both */
+        /* the sweeps of a chunk: the sun's (METHOD=sh: its swath's),
+         * DIRECTIONS, or both */
+        const int sun = !is(d, "shade", "shadow")          ? 0
+                        : o->method == TSD_METHOD_SH ? o->swath_directions
+                                                     : 1;
         p->far_planes = is(d, "shadow", NULL) || (is(d, "shade", NULL) && o->sky_weight == 0)
-                            ? 1
-                            : o->directions + is(d, "shade", NULL);
+                            ? sun
+                            : o->directions + sun;
         int f = far_factor(o, W, H, f_mem, near / cell, p->far_planes);
         p->far_w = (W + f - 1) / f;
         p->far_h = (H + f - 1) / f;
