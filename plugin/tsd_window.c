@@ -82,8 +82,6 @@ int tsd_window_plan_make(const tsd_options *o, int per_cell_sun, int W, int H,
         p->why_whole = "METHOD=shadowmap renders one depth map of the whole DEM";
     else if (o->horizon_method == TSD_HORIZON_PYRAMID)
         p->why_whole = "HORIZON_METHOD=pyramid reads one pyramid of the whole DEM";
-    else if (o->env_method == TSD_ENV_SH && is(d, "envlight", NULL))
-        p->why_whole = "ENV_METHOD=sh sweeps the whole DEM";
     else if (per_cell_sun)
         p->why_whole = "SUN_POSITION=per_cell places the sun on the whole DEM's lattice";
     else if (o->openness_negative && is(d, "openness", NULL))
