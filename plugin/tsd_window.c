@@ -84,8 +84,6 @@ int tsd_window_plan_make(const tsd_options *o, int per_cell_sun, int W, int H,
         p->why_whole = "HORIZON_METHOD=pyramid reads one pyramid of the whole DEM";
     else if (per_cell_sun)
         p->why_whole = "SUN_POSITION=per_cell places the sun on the whole DEM's lattice";
-    else if (o->openness_negative && is(d, "openness", NULL))
-        p->why_whole = "negative openness sweeps the negated DEM";
     if (p->why_whole)
         return 0;
     double cell = cells_min_x < cell_y ? cells_min_x : cell_y;
@@ -165,6 +163,14 @@ void tsd_far_field_init(tsd_far_field *f, ts_grid *coarse, int fine_w, int fine_
     f->hopts.curvature = o->curvature;
     f->hopts.refraction = o->refraction;
     f->hopts.threads = o->threads;
+    if (o->openness_negative && is(tsd_product_of(o), "openness", NULL)) {
+        /* negative openness sweeps the negated DEM, flat (tsd_compute.c's
+         * sky_stream): its far grid is the negated coarse grid's */
+        f->hopts.curvature = 0;
+        for (int y = 0; y < f->coarse.height; y++)
+            for (int x = 0; x < f->coarse.width; x++)
+                f->coarse.z[(ptrdiff_t)y * f->coarse.stride + x] *= -1.0f;
+    }
     f->zmax = -INFINITY;
     for (int y = 0; y < f->coarse.height; y++)
         for (int x = 0; x < f->coarse.width; x++) {
