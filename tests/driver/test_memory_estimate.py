@@ -18,7 +18,7 @@ The same bounds hold window by window (TILE_SIZE=512 on the same DEM: the
 chunk with its margin, the cache of chunks and the far grid every chunk
 shares), the estimate read from CPL_DEBUG=TERRASHADE's log, since a limit
 as low as MAX_MEMORY=1 changes the windows' plan (their far grid takes at
-most a quarter of it). Measured (session 16): 1.13-1.85 x the growth at
+most a quarter of it). Measured (session 16): 1.1-1.9 x the growth at
 TILE_SIZE=512; at 256, 0.90 x for horizon and 0.91 x for ENV_METHOD=sh, inside
 the 4 MiB of slack but too close to it to test.
 """
