@@ -509,7 +509,10 @@ ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
     /* the tables only pay on a large grid: an interior slot's costs some
      * S^2 x 290 multiply-adds to build, against about 300 saved a cell */
     const int interior_slots = s->complete ? s->n : s->n - 1;
-    const double cells = w->fold_cells > 0 ? w->fold_cells : (double)grid->width * grid->height;
+    /* a window's: the whole DEM's, so that every window takes its path */
+    const ts_grid_origin *o = grid->origin;
+    const double cells = o ? (double)o->full_width * o->full_height
+                           : (double)grid->width * grid->height;
     if (s->n <= FOLD_MAX_SAMPLES &&
         cells >= (double)interior_slots * TS_SH_WEDGE_STEPS * TS_SH_WEDGE_STEPS)
         st = fold_tables(&C, az_start, err);

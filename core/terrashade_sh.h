@@ -151,12 +151,6 @@ typedef struct {
     float *rise, *fall; /**< NULL for a complete swath */
     int threads;        /**< what ts_sh_wedges_build was given: the passes
                              that take these tables use as many */
-    /** The cell count by which ts_sh_swath_light decides whether to fold
-     *  the tables with the light (its faster path, which differs from the
-     *  other by float rounding); 0 (ts_sh_wedges_build's): the grid's own.
-     *  A caller computing a large grid window by window gives the whole
-     *  grid's, so that every window takes the path the whole would. */
-    double fold_cells;
 } ts_sh_wedges;
 
 /** Build the tables of swath s (threads: 0 = all cores; the visibility and
@@ -230,6 +224,10 @@ ts_status ts_sh_visible_share(const ts_grid *grid, const double l[TS_SH_COEFFS],
  * share = clamp(scale_share * l . V, 0, 1); NaN stays NaN. The normals N:
  * the planes nx, ny, nz (ts_normals), or, all three NULL, each row's made
  * from the grid as ts_normals makes it (the same values, without 3 planes).
+ * A large grid takes a faster path (the tables folded with the light) that
+ * differs from the other by float rounding; a window of a larger DEM (the
+ * grid's `origin`) takes the path the whole DEM would, so that its cells
+ * are the whole's bit for bit.
  */
 ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
                             const float *const *planes, const double l[TS_SH_COEFFS],

@@ -65,8 +65,6 @@ static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
     ts_sh_key_light(az, el, r, l);
     if ((st = ts_sh_wedges_build(&s, o->threads, &w, &err)) != TS_OK)
         return core_fail(c, &err);
-    if (g->origin) /* a window: the SH pass the whole DEM would take */
-        w.fold_cells = (double)g->origin->full_width * g->origin->full_height;
     ts_sh_key_reference(&w, l, az, el, &shade_ref, &share_ref);
     float **planes = calloc((size_t)s.n, sizeof *planes);
     for (int i = 0; planes && i < s.n; i++)

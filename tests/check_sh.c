@@ -383,11 +383,11 @@ static void key_of(double az, double el, double radius, ts_sh_swath *sw, double 
     ts_sh_key_light(az, el, radius, l);
 }
 
-/* ts_sh_wedges.fold_cells: a window of a large grid, given the whole grid's
- * cell count, takes the path the whole grid takes (the folded tables), so
- * that its cells are the whole's bit for bit; on its own it takes the
- * general path, within float rounding of them. */
-START_TEST(swath_light_fold_cells)
+/* A window of a large grid, its origin set (ts_grid_origin: the whole
+ * grid's size), takes the path the whole grid takes (the folded tables), so
+ * that its cells are the whole's bit for bit; as a grid of its own it takes
+ * the general path, within float rounding of them. */
+START_TEST(swath_light_window_path)
 {
     const int W = 400, H = 340, x0 = 123, y0 = 77, w = 61, h = 45;
     const size_t cells = (size_t)W * H, wcells = (size_t)w * h;
@@ -421,14 +421,14 @@ START_TEST(swath_light_fold_cells)
         }
     ts_sh_wedges wt;
     ck_assert(ts_sh_wedges_build(&sw, 2, &wt, &err) == TS_OK);
-    ck_assert(wt.fold_cells == 0);
+    const ts_grid_origin whole = {x0, y0, 10, W, H};
     float *shade = tdem_floats(cells), *share = tdem_floats(cells);
     float *wshade = tdem_floats(wcells), *wshare = tdem_floats(wcells);
     ck_assert(ts_sh_swath_light(&g, &wt, (const float *const *)planes, l, nx, ny, nz, 1.3, shade,
                                 1.1, share, &err) == TS_OK);
     double worst = 0;
     for (int pass = 0; pass < 2; pass++) {
-        wt.fold_cells = pass ? (double)cells : 0; /* the whole grid's, or its own */
+        win.origin = pass ? &whole : NULL; /* a window of the whole grid, or its own */
         ck_assert(ts_sh_swath_light(&win, &wt, (const float *const *)wplanes, l, wn[0], wn[1],
                                     wn[2], 1.3, wshade, 1.1, wshare, &err) == TS_OK);
         int same = 1;
@@ -441,10 +441,10 @@ START_TEST(swath_light_fold_cells)
                                              fabs(wshare[cw] - share[c])));
             }
         if (pass)
-            ck_assert_msg(same, "the window given fold_cells is not the whole's bit for bit");
+            ck_assert_msg(same, "the window with its origin is not the whole's bit for bit");
     }
-    printf("a %d x %d window on its own path: within %.2e of the whole grid's cells; given "
-           "fold_cells, equal\n", w, h, worst);
+    printf("a %d x %d window on its own path: within %.2e of the whole grid's cells; with its "
+           "origin, equal\n", w, h, worst);
     ck_assert(worst > 0 && worst < 2e-6); /* the general path: another rounding */
     for (int k = 0; k < sw.n; k++)
         free(planes[k]), free(wplanes[k]);
@@ -619,7 +619,7 @@ static Suite *suite(void)
     tcase_add_test(tc, wedges_brute_force);
     tcase_add_test(tc, visibility_planes);
     tcase_add_test(tc, swath_light_folded);
-    tcase_add_test(tc, swath_light_fold_cells);
+    tcase_add_test(tc, swath_light_window_path);
     tcase_add_test(tc, swath_light_row_normals);
     tcase_add_test(tc, block_shade_avx512);
     tcase_add_test(tc, flat_ground_constant_sky);
