@@ -17,6 +17,16 @@
 
 /* ---------------------------------------------------- sun on the grid */
 
+ts_status ts_day_sweep(const ts_grid *g, double azimuth, const ts_horizon_opts *h,
+                       const ts_day_opts *o, double sun_elevation, float *plane,
+                       ts_error *err)
+{
+    ts_status st = ts_horizon_sweep(g, azimuth, h, plane, err);
+    if (st == TS_OK && o->plane_hook)
+        st = o->plane_hook(o->plane_hook_user, g, azimuth, sun_elevation, plane, err);
+    return st;
+}
+
 /* What stays the same from one instant to the next. */
 typedef struct {
     const ts_grid *g;
@@ -145,7 +155,7 @@ static ts_status vis_step(vis_ctx *c, double t, float *vis, float *az, float *el
                     vis[(size_t)y * W + x] = isnan(ts_grid_at(g, x, y)) ? NAN : 0.0f;
             return TS_OK;
         }
-        if ((st = ts_horizon_sweep(g, a, &ho, c->pa, err)) != TS_OK)
+        if ((st = ts_day_sweep(g, a, &ho, c->o, e, c->pa, err)) != TS_OK)
             return st;
         for (size_t i = 0; i < c->cells; i++)
             vis[i] = cell_vis(e, c->pa[i], c->floor ? c->floor[i] : NAN);
@@ -196,7 +206,7 @@ static ts_status vis_step(vis_ctx *c, double t, float *vis, float *az, float *el
     double span = hi - lo;
     int K = span < 1e-9 ? 1 : (int)ceil(span / LATTICE_AZ_STEP) + 1;
     double step = K > 1 ? span / (K - 1) : 0.0;
-    if ((st = ts_horizon_sweep(g, a_ref + lo, &ho, c->pa, err)) != TS_OK)
+    if ((st = ts_day_sweep(g, a_ref + lo, &ho, c->o, NAN, c->pa, err)) != TS_OK)
         return st;
     if (K == 1) {
         for (size_t i = 0; i < c->cells; i++)
@@ -204,7 +214,8 @@ static ts_status vis_step(vis_ctx *c, double t, float *vis, float *az, float *el
         return TS_OK;
     }
     for (int j = 1; j < K; j++) {
-        if ((st = ts_horizon_sweep(g, a_ref + lo + j * step, &ho, c->pb, err)) != TS_OK)
+        if ((st = ts_day_sweep(g, a_ref + lo + j * step, &ho, c->o, NAN, c->pb,
+                                    err)) != TS_OK)
             return st;
         for (size_t i = 0; i < c->cells; i++) {
             double u = (c->caz[i] - lo) / step;
@@ -380,7 +391,7 @@ ts_status ts_insolation(const ts_grid *grid, const ts_sun_sites *sites,
             double a = ts_horizon_azimuth(&h, k);
             if ((st = ts_progress(&o->horizon, (double)k / (sweeps + n), err)) !=
                     TS_OK ||
-                (st = ts_horizon_sweep(grid, a, &h, c.pa, err)) != TS_OK ||
+                (st = ts_day_sweep(grid, a, &h, o, NAN, c.pa, err)) != TS_OK ||
                 (st = ts_sky_accumulate(grid, nx, ny, nz, c.pa, a, h.directions, NULL,
                                         sky, NULL, err)) != TS_OK)
                 goto done;

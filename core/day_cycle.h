@@ -79,6 +79,18 @@ typedef enum {
     TS_SUN_HOURS_DISK_FRACTION = 1
 } ts_sun_hours_rule;
 
+/**
+ * A horizon plane's last step before a day computation reads it: the plane
+ * of `azimuth` (grid degrees) just swept on `grid`, changed in place. The
+ * driver's windows raise it to the far field beyond the window's near
+ * field (docs/windows.md). `sun_elevation` is the apparent elevation of
+ * the sun when the plane is read only through the sun's disk at that
+ * elevation, NaN when it serves other directions too (the sky term, a
+ * date range's planes).
+ */
+typedef ts_status (*ts_day_plane_fn)(void *user, const ts_grid *grid, double azimuth,
+                                     double sun_elevation, float *plane, ts_error *err);
+
 /** Options of the day computations. Fill with ts_day_opts_default. */
 typedef struct {
     ts_horizon_opts horizon; /**< curvature, refraction, max_distance, threads;
@@ -93,10 +105,19 @@ typedef struct {
                                   of the sea-level horizon seen from its height
                                   (ts_earth_horizon); 0: terrain only */
     ts_sun_hours_rule sun_hours_rule; /**< what a step of ts_sun_hours counts */
+    /** 1: the date range's beam transmittance tables span heights
+     * table_height_min..max (metres) instead of the grid's own lowest and
+     * highest cell; a window of a larger DEM gives the whole DEM's, so that
+     * every window reads the same tables (heights beyond take the end
+     * values). */
+    int table_heights_given;
+    double table_height_min, table_height_max;
+    ts_day_plane_fn plane_hook; /**< after each horizon sweep; NULL = none */
+    void *plane_hook_user;      /**< passed to plane_hook */
 } ts_day_opts;
 
 /** Defaults: ts_horizon_opts_default, ts_sun_input_default, Linke turbidity
- * 3, Earth horizon on, sun hours TS_SUN_HOURS_VISIBLE. */
+ * 3, Earth horizon on, sun hours TS_SUN_HOURS_VISIBLE, no plane hook. */
 void ts_day_opts_default(ts_day_opts *o);
 
 /** Check options and sites (counts, finite coordinates, latitudes within

@@ -11,6 +11,12 @@
  * turbidity, sun-hours rule); the message names what is wrong. */
 ts_status ts_day_opts_check(const ts_day_opts *o, ts_error *err);
 
+/* The horizon sweep of a day product: ts_horizon_sweep of `azimuth` with
+ * options h into plane, then o->plane_hook (sun_elevation as it says). */
+ts_status ts_day_sweep(const ts_grid *g, double azimuth, const ts_horizon_opts *h,
+                       const ts_day_opts *o, double sun_elevation, float *plane,
+                       ts_error *err);
+
 /* The sun (SPA) at lattice node i of s at unix time t. */
 ts_status ts_day_node_sun(const ts_sun_sites *s, const ts_day_opts *o, int i,
                           double t, ts_sun_sample *out, ts_error *err);

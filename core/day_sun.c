@@ -160,6 +160,12 @@ ts_status ts_day_opts_check(const ts_day_opts *o, ts_error *err)
         return ts_fail(err, TS_ERR_ARG,
                        "unknown sun-hours rule %d (visible or disk fraction)",
                        (int)o->sun_hours_rule);
+    if (o->table_heights_given &&
+        !(isfinite(o->table_height_min) && isfinite(o->table_height_max) &&
+          o->table_height_min <= o->table_height_max))
+        return ts_fail(err, TS_ERR_ARG,
+                       "the transmittance tables' heights must be finite, lowest first, "
+                       "got %g to %g m", o->table_height_min, o->table_height_max);
     return ts_ok(err);
 }
 

@@ -250,7 +250,7 @@ static ts_status sweep_plane(const range_ctx *c, const ts_horizon_opts *h, int k
     double a = ts_horizon_azimuth(h, k);
     ts_status st = ts_progress(&c->o->horizon, done, err);
     if (st == TS_OK)
-        st = ts_horizon_sweep(c->g, a, h, out, err);
+        st = ts_day_sweep(c->g, a, h, c->o, NAN, out, err);
     for (size_t i = 0; st == TS_OK && c->blank && i < c->cells; i++)
         c->blank[i] |= isnan(out[i]); /* EDGE=nodata: the ray leaves the grid */
     if (st == TS_OK && on_plane)
@@ -400,6 +400,10 @@ static ts_status beam_tables(range_ctx *c, float *pc, ts_range_bucket *b, ts_err
                 hi = v > hi ? v : hi;
             }
         }
+    if (c->o->table_heights_given) {
+        lo = (float)exp(-c->o->table_height_max / 8434.5);
+        hi = (float)exp(-c->o->table_height_min / 8434.5);
+    }
     if (!(lo <= hi))
         lo = hi = 1.0;
     const int N = TS_RANGE_TABLE;
@@ -459,7 +463,7 @@ ts_status ts_insolation_range(const ts_grid *grid, const ts_sun_sites *sites,
         for (int k = 0; k < h.directions && st == TS_OK; k++) {
             double a = ts_horizon_azimuth(&h, k);
             if ((st = ts_progress(&o->horizon, p0 * k / h.directions, err)) == TS_OK &&
-                (st = ts_horizon_sweep(grid, a, &h, plane, err)) == TS_OK)
+                (st = ts_day_sweep(grid, a, &h, o, NAN, plane, err)) == TS_OK)
                 st = sky_plane(&(sky_share){grid, nx, ny, nz, sky, 1, h.directions}, k, a,
                                plane, err);
         }
