@@ -147,6 +147,12 @@ ts_status tsd_compute_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_pla
 ts_status tsd_compute_far(const tsd_compute_ctx *c, const ts_grid *g, double azimuth, int sun,
                           float *plane);
 
+/* tsd_compute_far for a light at `elevation` degrees of angular radius
+ * `radius` that alone reads the plane (NaN elevation: no such light, the
+ * plane serves every direction): the day products' sweeps. */
+ts_status tsd_compute_far_light(const tsd_compute_ctx *c, const ts_grid *g, double azimuth,
+                                double elevation, double radius, float *plane);
+
 #ifdef __cplusplus
 }
 #endif

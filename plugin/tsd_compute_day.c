@@ -4,6 +4,7 @@
 #include "shadow_atlas.h"
 #include "tsd_products.h"
 #include "tsd_text.h"
+#include "tsd_window.h"
 
 #include <stdio.h>
 
@@ -17,12 +18,41 @@ static const tsd_sun *day_sun(const tsd_compute_ctx *c)
     return c->run->sun;
 }
 
-/* The core's day options, reporting the day's steps to the run's progress. */
+/* A window's day sweep: raised to the far field beyond its near field
+ * (ts_day_opts.plane_hook; tsd_window.h). */
+static ts_status far_hook(void *user, const ts_grid *g, double azimuth, double sun_elevation,
+                          float *plane, ts_error *err)
+{
+    const tsd_compute_ctx *c = user;
+    ts_status st = tsd_compute_far_light(c, g, azimuth, sun_elevation, TS_SUN_RADIUS_DEG, plane);
+    if (st != TS_OK) {
+        err->code = st;
+        snprintf(err->message, sizeof err->message, "%s", c->msg);
+    }
+    return st;
+}
+
+/* The core's day options, reporting the day's steps to the run's progress;
+ * in a window, its sweeps reach the near field and the far field joins
+ * after each (as tsd_compute_stream's). */
 static ts_day_opts day_opts(const tsd_compute_ctx *c, const tsd_sun *sun)
 {
     ts_day_opts day = sun->day;
+    ts_horizon_opts h;
+    tsd_compute_horizon_opts(c, &h);
+    day.horizon.max_distance = h.max_distance;
+    day.horizon.edge = h.edge;
     day.horizon.progress = c->run->progress;
     day.horizon.progress_user = c->run->progress_user;
+    if (c->run->near_distance > 0) {
+        day.table_heights_given = 1;
+        day.table_height_min = TSD_DAY_TABLE_Z_MIN;
+        day.table_height_max = TSD_DAY_TABLE_Z_MAX;
+    }
+    if (c->run->far) {
+        day.plane_hook = far_hook;
+        day.plane_hook_user = (void *)c;
+    }
     return day;
 }
 
@@ -98,10 +128,11 @@ static ts_status visibility_step(const tsd_compute_ctx *c, const tsd_region *r,
                                  const tsd_sun *sun, int k, size_t offset, float *out,
                                  uint8_t *bytes, ts_error *err)
 {
-    (void)c;
     (void)bytes;
-    return ts_sun_visibility(r->dem, &sun->sites, &sun->day, sun->times[k], out + offset,
-                             NULL, NULL, NULL, err);
+    ts_day_opts day = day_opts(c, sun);
+    day.horizon.progress = NULL; /* each_step reports the steps */
+    return ts_sun_visibility(r->dem, &sun->sites, &day, sun->times[k], out + offset, NULL,
+                             NULL, NULL, err);
 }
 
 /* farshadow: the far shadows of the sun at step k */

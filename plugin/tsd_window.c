@@ -63,19 +63,48 @@ static int far_factor(const tsd_options *o, int W, int H, int f_mem, double near
     return f < 1 ? 1 : f;
 }
 
-int tsd_window_plan_make(const tsd_options *o, int per_cell_sun, int W, int H,
+/* The far planes of a day product's sun: one per time step with the sun
+ * up at the centre (its upper limb above the lowest Earth horizon any
+ * land can see, TSD_DAY_SUN_UP_DEG), or a date range's horizon azimuths. */
+static int day_sweeps(const tsd_options *o, const tsd_sun *sun)
+{
+    if (!sun)
+        return 0;
+    if (sun->is_range)
+        return sun->range.horizon_directions;
+    const double step = tsd_options_step_minutes(o) * 60.0;
+    const int n = ts_day_step_count(sun->day_length, step);
+    double *mid = malloc((size_t)n * sizeof *mid), *dur = malloc((size_t)n * sizeof *dur);
+    ts_error err;
+    int up = n; /* when in doubt, every step */
+    if (mid && dur && ts_day_uniform_times(sun->day_start, sun->day_length, step, mid, dur,
+                                           &err) == TS_OK) {
+        up = 0;
+        for (int k = 0; k < n; k++) {
+            ts_sun_sample at;
+            up += ts_sun_at_site(&sun->sites, &sun->day, mid[k], &at, &err) != TS_OK ||
+                  at.elevation + TS_SUN_RADIUS_DEG > TSD_DAY_SUN_UP_DEG;
+        }
+    }
+    free(mid);
+    free(dur);
+    return up;
+}
+
+int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
                          double cells_min_x, double cell_y, tsd_window_plan *p, char *msg,
                          size_t n)
 {
     const tsd_product_def *d = tsd_product_of(o);
+    const int per_cell_sun = sun && sun->sites.nx * sun->sites.ny > 1;
     memset(p, 0, sizeof *p);
     p->tile = o->tile_size;
     if (o->tile_size == 0)
         p->why_whole = "TILE_SIZE=0";
     else if (W <= o->tile_size && H <= o->tile_size)
         p->why_whole = "the DEM fits in one tile";
-    else if (d->daily)
-        p->why_whole = "a product of a day follows the sun over the whole DEM";
+    else if (is(d, "farshadow", NULL))
+        p->why_whole = "PRODUCT=farshadow's far shadows are the whole DEM's far field";
     else if (o->method == TSD_METHOD_SHM && is(d, "shade", "shadow"))
         p->why_whole = "METHOD=shm carries shadows across the whole DEM";
     else if (o->method == TSD_METHOD_SHADOWMAP && is(d, "shade", "shadow"))
@@ -118,14 +147,20 @@ int tsd_window_plan_make(const tsd_options *o, int per_cell_sun, int W, int H,
     /* a cache that holds a row of chunks: GDAL reads blocks row by row */
     p->cache_chunks = (W + p->tile - 1) / p->tile + 1;
     if (p->far) {
-        /* the sweeps of a chunk: the sun's (METHOD=sh: its swath's),
+        /* the sweeps of a chunk: the sun's (METHOD=sh: its swath's; a
+         * day's: one per step at most, a date range's HORIZON_DIRECTIONS),
          * DIRECTIONS, or both */
-        const int sun = !is(d, "shade", "shadow")          ? 0
+        const int sun_planes = d->daily ? day_sweeps(o, sun)
+                        : !is(d, "shade", "shadow")  ? 0
                         : o->method == TSD_METHOD_SH ? o->swath_directions
                                                      : 1;
-        p->far_planes = is(d, "shadow", NULL) || (is(d, "shade", NULL) && o->sky_weight == 0)
-                            ? sun
-                            : o->directions + sun;
+        p->far_planes = is(d, "shadow", NULL) || is(d, "sunhours", "daycycle") ||
+                                (is(d, "shade", NULL) && o->sky_weight == 0) ||
+                                /* a range's insolation: the sky term's azimuths
+                                 * among the range's (core/sun_range.c) */
+                                (sun && sun->is_range && sun_planes % o->directions == 0)
+                            ? sun_planes
+                            : o->directions + sun_planes;
         int f = far_factor(o, W, H, f_mem, near / cell, p->far_planes);
         p->far_w = (W + f - 1) / f;
         p->far_h = (H + f - 1) / f;
@@ -282,37 +317,45 @@ static int sun_clears_far(const tsd_far_field *f, const ts_grid *g, double eleva
 
 static ts_status far_raise(const tsd_compute_ctx *c, const ts_grid *g, double azimuth,
                            float *plane);
-static ts_status far_edge(const tsd_compute_ctx *c, const ts_grid *g, double azimuth, int sun,
-                          float *plane);
+static ts_status far_edge(const tsd_compute_ctx *c, const ts_grid *g, double azimuth,
+                          double elevation, double radius, float *plane);
 
 ts_status tsd_compute_far(const tsd_compute_ctx *c, const ts_grid *g, double azimuth, int sun,
                           float *plane)
 {
+    return tsd_compute_far_light(c, g, azimuth, sun ? c->run->sun_elevation : NAN,
+                                 c->opts->light_radius, plane);
+}
+
+ts_status tsd_compute_far_light(const tsd_compute_ctx *c, const ts_grid *g, double azimuth,
+                                double elevation, double radius, float *plane)
+{
     tsd_far_field *f = c->run->far;
     if (!f || !g->origin)
         return TS_OK;
-    if (!(sun && sun_clears_far(f, g, c->run->sun_elevation, c->opts->light_radius))) {
+    if (!(!isnan(elevation) && sun_clears_far(f, g, elevation, radius))) {
         ts_status st = far_raise(c, g, azimuth, plane);
         if (st != TS_OK)
             return st;
     }
-    return far_edge(c, g, azimuth, sun, plane);
+    return far_edge(c, g, azimuth, elevation, radius, plane);
 }
 
 /* The world beyond the DEM's edge over the whole reach (EDGE), and the
- * Earth's horizon under the sun, which the near field's sweep left out
- * (tsd_compute_horizon_opts): the DEM's edges, not the window's. */
-static ts_status far_edge(const tsd_compute_ctx *c, const ts_grid *g, double azimuth, int sun,
-                          float *plane)
+ * Earth's horizon under a light (elevation not NaN), which the near field's
+ * sweep left out (tsd_compute_horizon_opts): the DEM's edges, not the
+ * window's. */
+static ts_status far_edge(const tsd_compute_ctx *c, const ts_grid *g, double azimuth,
+                          double elevation, double radius, float *plane)
 {
     ts_horizon_opts h;
     ts_error err;
+    const int sun = !isnan(elevation);
     tsd_compute_horizon_opts(c, &h);
     h.max_distance = c->opts->max_distance;
     h.edge = tsd_options_edge(c->opts);
     /* under the sun, read only through its disk (sun_horizon) */
-    h.nonpositive_moot = sun && ts_light_clears_horizontal(c->run->sun_elevation,
-                                                           c->opts->light_radius);
+    h.nonpositive_moot = sun && ts_light_clears_horizontal(elevation, radius);
     if (ts_horizon_edge_apply(g, azimuth, &h, plane, &err) != TS_OK ||
         (sun && ts_horizon_earth_floor(g, &h, plane, &err) != TS_OK))
         return tsd_fail_core(c->msg, c->msg_size, NULL, &err);

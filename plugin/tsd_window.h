@@ -15,6 +15,7 @@
 #include "terrashade.h"
 #include "tsd_compute.h"
 #include "tsd_options.h"
+#include "tsd_sun.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -42,6 +43,18 @@ extern "C" {
 #define TSD_FAR_BUDGET_MB 1024.0
 #define TSD_FAR_CELLS_PER_NEAR 32
 
+/** A window of a date range's insolation reads transmittance tables over
+ * these heights, every window the same (the whole DEM's lowest and highest
+ * cells are not known to a window): the Earth's land, from the Dead Sea's
+ * shore to above Everest. Linear interpolation in 256 entries over them
+ * moves the insolation by 4e-7 of itself at most (tests/check_day_hooks.c). */
+#define TSD_DAY_TABLE_Z_MIN -500.0
+#define TSD_DAY_TABLE_Z_MAX 9000.0
+/** A day product's sun needs a far plane while its upper limb is above
+ * this elevation (degrees): the Earth's horizon seen from 9000 m is 3.0
+ * degrees down. */
+#define TSD_DAY_SUN_UP_DEG -3.5
+
 /** How a dataset is computed window by window; see tsd_window_plan. */
 typedef struct {
     int windowed;          /* 0: the whole DEM at once */
@@ -61,11 +74,12 @@ typedef struct {
  * `cells_min_x` (the smallest east-west cell size over its rows) by
  * `cell_y` metres: windowed when TILE_SIZE > 0, the DEM is larger than one
  * tile and the product is one whose value depends only on nearby terrain
- * and horizons (not the day products, METHOD=shm, negative openness or a
- * per-cell sun: `per_cell_sun`). 0, or -1 with a sentence in msg
- * (NEAR_DISTANCE too short for this DEM).
+ * and horizons (not farshadow, METHOD=shm or shadowmap, the pyramid or a
+ * per-cell sun). `sun` (NULL for the products without one): the sun's
+ * sites and day, whose steps count the day products' far planes. 0, or -1
+ * with a sentence in msg (NEAR_DISTANCE too short for this DEM).
  */
-int tsd_window_plan_make(const tsd_options *o, int per_cell_sun, int W, int H,
+int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
                          double cells_min_x, double cell_y, tsd_window_plan *plan, char *msg,
                          size_t msg_size);
 

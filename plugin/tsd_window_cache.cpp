@@ -142,9 +142,8 @@ bool TSDataset::SetupWindow(int W, int H)
     for (int y = 0; m_sCells.cell_x_row && y < H; y++)
         dfMinX = std::min(dfMinX, m_sCells.cell_x_row[y]);
     poState->refCellX = m_sCells.cell_x_row ? m_sCells.cell_x_row[H / 2] : m_sCells.cell_x;
-    const bool bPerCell = m_bHasSun && m_sSun.sites.nx * m_sSun.sites.ny > 1;
     char szMsg[512];
-    if (tsd_window_plan_make(&m_sOpts, bPerCell, W, H, dfMinX, m_sCells.cell_y,
+    if (tsd_window_plan_make(&m_sOpts, m_bHasSun ? &m_sSun : nullptr, W, H, dfMinX, m_sCells.cell_y,
                              &poState->plan, szMsg, sizeof szMsg) != 0)
         return Fail(TS_ERR_ARG, szMsg), false;
     if (m_nLevel > 0 && poState->plan.windowed)
