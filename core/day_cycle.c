@@ -118,6 +118,50 @@ static inline float cell_vis(double e, float h, float fl)
     return (float)ts_sun_disk_fraction(e, h);
 }
 
+/* The azimuths of a lattice's suns, as offsets lo..hi from a_ref, and
+ * their highest elevation. */
+static void lattice_span(const ts_sun_sample *ns, int nodes, double a_ref, double *lo,
+                         double *hi, double *emax)
+{
+    *lo = INFINITY;
+    *hi = *emax = -INFINITY;
+    for (int i = 0; i < nodes; i++) {
+        double d = ts_wrap180(ns[i].grid_azimuth - a_ref);
+        *lo = fmin(*lo, d);
+        *hi = fmax(*hi, d);
+        *emax = fmax(*emax, ns[i].elevation);
+    }
+}
+
+/* Sweeps across a lattice's azimuths lo..hi: LATTICE_AZ_STEP apart or less. */
+static int lattice_sweeps(double lo, double hi)
+{
+    double span = hi - lo;
+    return span < 1e-9 ? 1 : (int)ceil(span / LATTICE_AZ_STEP) + 1;
+}
+
+int ts_sun_visibility_sweeps(const ts_sun_sites *sites, const ts_day_opts *o,
+                             double unix_time)
+{
+    ts_error err;
+    int nodes = sites->nx * sites->ny;
+    if (nodes == 1)
+        return 1;
+    ts_sun_sample *ns = malloc((size_t)nodes * sizeof *ns);
+    int K = -1;
+    for (int i = 0; ns && i < nodes; i++)
+        if (ts_day_node_sun(sites, o, i, unix_time, &ns[i], &err) != TS_OK)
+            goto done;
+    if (ns) {
+        double lo, hi, emax;
+        lattice_span(ns, nodes, ns[ts_day_ref_node(sites)].grid_azimuth, &lo, &hi, &emax);
+        K = lattice_sweeps(lo, hi);
+    }
+done:
+    free(ns);
+    return K;
+}
+
 /*
  * Visibility at instant t into vis; az/el (may be NULL) per cell. Returns
  * *dark = 1 when the sun is below every cell's horizon (vis = 0 for valid
@@ -163,13 +207,8 @@ static ts_status vis_step(vis_ctx *c, double t, float *vis, float *az, float *el
     }
 
     /* Lattice: azimuths as offsets from the reference node's. */
-    double a_ref = r->grid_azimuth, lo = INFINITY, hi = -INFINITY, emax = -INFINITY;
-    for (int i = 0; i < c->nodes; i++) {
-        double d = ts_wrap180(c->ns[i].grid_azimuth - a_ref);
-        lo = fmin(lo, d);
-        hi = fmax(hi, d);
-        emax = fmax(emax, c->ns[i].elevation);
-    }
+    double a_ref = r->grid_azimuth, lo, hi, emax;
+    lattice_span(c->ns, c->nodes, a_ref, &lo, &hi, &emax);
     for (int y = 0; y < H; y++) {
         int j;
         double fy;
@@ -203,9 +242,8 @@ static ts_status vis_step(vis_ctx *c, double t, float *vis, float *az, float *el
                 vis[(size_t)y * W + x] = isnan(ts_grid_at(g, x, y)) ? NAN : 0.0f;
         return TS_OK;
     }
-    double span = hi - lo;
-    int K = span < 1e-9 ? 1 : (int)ceil(span / LATTICE_AZ_STEP) + 1;
-    double step = K > 1 ? span / (K - 1) : 0.0;
+    const int K = lattice_sweeps(lo, hi);
+    double step = K > 1 ? (hi - lo) / (K - 1) : 0.0;
     if ((st = ts_day_sweep(g, a_ref + lo, &ho, c->o, NAN, c->pa, err)) != TS_OK)
         return st;
     if (K == 1) {

@@ -196,6 +196,15 @@ ts_status ts_sun_visibility(const ts_grid *grid, const ts_sun_sites *sites,
                             ts_error *err);
 
 /**
+ * The horizon sweeps ts_sun_visibility runs at `unix_time` for `sites`:
+ * 1 for one site; for a lattice, enough for its suns' azimuths 1 degree
+ * apart or less (none are run while the sun is below every cell's
+ * horizon). -1 if the sun cannot be computed or memory runs out.
+ */
+int ts_sun_visibility_sweeps(const ts_sun_sites *sites, const ts_day_opts *o,
+                             double unix_time);
+
+/**
  * Hours of direct sun over [start, start + length): the sum over uniform
  * steps of step_s seconds of the step's length times, at the middle of the
  * step, 1 if any of the sun's disk is visible (o->sun_hours_rule

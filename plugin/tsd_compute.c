@@ -289,9 +289,11 @@ static ts_status sun_per_cell(const tsd_compute_ctx *c, const ts_grid *g, float 
 {
     ts_error err;
     const tsd_sun *sun = c->run->sun;
-    ts_day_opts d = sun->day;
+    ts_day_opts d = tsd_compute_day_opts(c, sun);
+    ts_sun_sites sites = tsd_compute_sun_sites(sun, g);
+    d.horizon.progress = NULL; /* a few sweeps */
     d.earth_horizon = tsd_options_edge(c->opts) == TS_EDGE_HORIZON;
-    if (ts_sun_visibility(g, &sun->sites, &d, sun->instant, vis, az, el, NULL, &err) !=
+    if (ts_sun_visibility(g, &sites, &d, sun->instant, vis, az, el, NULL, &err) !=
         TS_OK)
         return core_fail(c, &err);
     return TS_OK;

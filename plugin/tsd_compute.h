@@ -153,6 +153,17 @@ ts_status tsd_compute_far(const tsd_compute_ctx *c, const ts_grid *g, double azi
 ts_status tsd_compute_far_light(const tsd_compute_ctx *c, const ts_grid *g, double azimuth,
                                 double elevation, double radius, float *plane);
 
+/* The core's day options of `sun` for a computation: the run's progress;
+ * in a window, sweeps that reach the near field, the far field joined
+ * after each through the core's plane hook (tsd_compute_far_light), and a
+ * date range's tables over fixed heights (tsd_window.h). */
+ts_day_opts tsd_compute_day_opts(const tsd_compute_ctx *c, const tsd_sun *sun);
+
+/* The sun's sites seen from grid g: a window's lattice (SUN_POSITION=
+ * per_cell) shifted to its first cell, so that every node stays where it
+ * is on the whole DEM. */
+ts_sun_sites tsd_compute_sun_sites(const tsd_sun *sun, const ts_grid *g);
+
 #ifdef __cplusplus
 }
 #endif

@@ -32,10 +32,7 @@ static ts_status far_hook(void *user, const ts_grid *g, double azimuth, double s
     return st;
 }
 
-/* The core's day options, reporting the day's steps to the run's progress;
- * in a window, its sweeps reach the near field and the far field joins
- * after each (as tsd_compute_stream's). */
-static ts_day_opts day_opts(const tsd_compute_ctx *c, const tsd_sun *sun)
+ts_day_opts tsd_compute_day_opts(const tsd_compute_ctx *c, const tsd_sun *sun)
 {
     ts_day_opts day = sun->day;
     ts_horizon_opts h;
@@ -56,6 +53,16 @@ static ts_day_opts day_opts(const tsd_compute_ctx *c, const tsd_sun *sun)
     return day;
 }
 
+ts_sun_sites tsd_compute_sun_sites(const tsd_sun *sun, const ts_grid *g)
+{
+    ts_sun_sites s = sun->sites;
+    if (g->origin) { /* node (i, j) stays where it is on the whole DEM */
+        s.x0 -= g->origin->x0;
+        s.y0 -= g->origin->y0;
+    }
+    return s;
+}
+
 static ts_status done(const tsd_compute_ctx *c, ts_status st, const ts_error *err)
 {
     return st == TS_OK ? TS_OK : tsd_fail_core(c->msg, c->msg_size, NULL, err);
@@ -70,12 +77,13 @@ TSD_COMPUTE_FN(tsd_compute_sunhours)
     ts_error err;
     if (!sun)
         return TS_ERR_INTERNAL;
-    ts_day_opts day = day_opts(c, sun);
+    ts_day_opts day = tsd_compute_day_opts(c, sun);
+    ts_sun_sites sites = tsd_compute_sun_sites(sun, r->dem);
     if (sun->is_range)
-        return done(c, ts_sun_hours_range(r->dem, &sun->sites, &day, &sun->range, out, &err),
+        return done(c, ts_sun_hours_range(r->dem, &sites, &day, &sun->range, out, &err),
                     &err);
     return done(c,
-                ts_sun_hours(r->dem, &sun->sites, &day, sun->day_start, sun->day_length,
+                ts_sun_hours(r->dem, &sites, &day, sun->day_start, sun->day_length,
                              tsd_options_step_minutes(c->opts) * 60.0, out, &err),
                 &err);
 }
@@ -88,14 +96,15 @@ TSD_COMPUTE_FN(tsd_compute_insolation)
     ts_error err;
     if (!sun)
         return TS_ERR_INTERNAL;
-    ts_day_opts day = day_opts(c, sun);
+    ts_day_opts day = tsd_compute_day_opts(c, sun);
+    ts_sun_sites sites = tsd_compute_sun_sites(sun, r->dem);
     if (sun->is_range)
         return done(c,
-                    ts_insolation_range(r->dem, &sun->sites, &day, &sun->range, out,
+                    ts_insolation_range(r->dem, &sites, &day, &sun->range, out,
                                         out + cells, out + 2 * cells, &err),
                     &err);
     return done(c,
-                ts_insolation(r->dem, &sun->sites, &day, sun->day_start, sun->day_length,
+                ts_insolation(r->dem, &sites, &day, sun->day_start, sun->day_length,
                               tsd_options_step_minutes(c->opts) * 60.0, out, out + cells,
                               out + 2 * cells, &err),
                 &err);
@@ -129,9 +138,10 @@ static ts_status visibility_step(const tsd_compute_ctx *c, const tsd_region *r,
                                  uint8_t *bytes, ts_error *err)
 {
     (void)bytes;
-    ts_day_opts day = day_opts(c, sun);
+    ts_day_opts day = tsd_compute_day_opts(c, sun);
+    ts_sun_sites sites = tsd_compute_sun_sites(sun, r->dem);
     day.horizon.progress = NULL; /* each_step reports the steps */
-    return ts_sun_visibility(r->dem, &sun->sites, &day, sun->times[k], out + offset, NULL,
+    return ts_sun_visibility(r->dem, &sites, &day, sun->times[k], out + offset, NULL,
                              NULL, NULL, err);
 }
 

@@ -63,8 +63,16 @@ static int far_factor(const tsd_options *o, int W, int H, int f_mem, double near
     return f < 1 ? 1 : f;
 }
 
-/* The far planes of a day product's sun: one per time step with the sun
- * up at the centre (its upper limb above the lowest Earth horizon any
+/* The far planes of a sun at `t`: one sweep, or a lattice's several
+ * (SUN_POSITION=per_cell); when in doubt, 4. */
+static int sun_sweeps(const tsd_sun *sun, double t)
+{
+    int k = ts_sun_visibility_sweeps(&sun->sites, &sun->day, t);
+    return k > 0 ? k : 4;
+}
+
+/* The far planes of a day product's sun: those of each time step with the
+ * sun up at the centre (its upper limb above the lowest Earth horizon any
  * land can see, TSD_DAY_SUN_UP_DEG), or a date range's horizon azimuths. */
 static int day_sweeps(const tsd_options *o, const tsd_sun *sun)
 {
@@ -76,14 +84,15 @@ static int day_sweeps(const tsd_options *o, const tsd_sun *sun)
     const int n = ts_day_step_count(sun->day_length, step);
     double *mid = malloc((size_t)n * sizeof *mid), *dur = malloc((size_t)n * sizeof *dur);
     ts_error err;
-    int up = n; /* when in doubt, every step */
+    int up = 4 * n; /* when in doubt, every step */
     if (mid && dur && ts_day_uniform_times(sun->day_start, sun->day_length, step, mid, dur,
                                            &err) == TS_OK) {
         up = 0;
         for (int k = 0; k < n; k++) {
             ts_sun_sample at;
-            up += ts_sun_at_site(&sun->sites, &sun->day, mid[k], &at, &err) != TS_OK ||
-                  at.elevation + TS_SUN_RADIUS_DEG > TSD_DAY_SUN_UP_DEG;
+            if (ts_sun_at_site(&sun->sites, &sun->day, mid[k], &at, &err) != TS_OK ||
+                at.elevation + TS_SUN_RADIUS_DEG > TSD_DAY_SUN_UP_DEG)
+                up += sun_sweeps(sun, mid[k]);
         }
     }
     free(mid);
@@ -111,8 +120,6 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
         p->why_whole = "METHOD=shadowmap renders one depth map of the whole DEM";
     else if (o->horizon_method == TSD_HORIZON_PYRAMID)
         p->why_whole = "HORIZON_METHOD=pyramid reads one pyramid of the whole DEM";
-    else if (per_cell_sun)
-        p->why_whole = "SUN_POSITION=per_cell places the sun on the whole DEM's lattice";
     if (p->why_whole)
         return 0;
     double cell = cells_min_x < cell_y ? cells_min_x : cell_y;
@@ -153,6 +160,7 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
         const int sun_planes = d->daily ? day_sweeps(o, sun)
                         : !is(d, "shade", "shadow")  ? 0
                         : o->method == TSD_METHOD_SH ? o->swath_directions
+                        : per_cell_sun               ? sun_sweeps(sun, sun->instant)
                                                      : 1;
         p->far_planes = is(d, "shadow", NULL) || is(d, "sunhours", "daycycle") ||
                                 (is(d, "shade", NULL) && o->sky_weight == 0) ||

@@ -74,9 +74,9 @@ typedef struct {
  * `cells_min_x` (the smallest east-west cell size over its rows) by
  * `cell_y` metres: windowed when TILE_SIZE > 0, the DEM is larger than one
  * tile and the product is one whose value depends only on nearby terrain
- * and horizons (not farshadow, METHOD=shm or shadowmap, the pyramid or a
- * per-cell sun). `sun` (NULL for the products without one): the sun's
- * sites and day, whose steps count the day products' far planes. 0, or -1
+ * and horizons (not farshadow, METHOD=shm or shadowmap, the pyramid).
+ * `sun` (NULL for the products without one): the sun's sites and day,
+ * whose steps and lattice count the far planes of its sweeps. 0, or -1
  * with a sentence in msg (NEAR_DISTANCE too short for this DEM).
  */
 int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,

@@ -74,6 +74,7 @@ WINDOWED = [
     {"PRODUCT": "openness", "OPENNESS": "negative"},
     {"PRODUCT": "envlight", "SKY": "overcast"},
     {"PRODUCT": "envlight", "SKY": "overcast", "ENV_METHOD": "sh"},
+    {"PRODUCT": "shade", "SUN_POSITION": "per_cell", "DATETIME": "2024-06-21T09:00:00-05:00"},
 ]
 # A day in windows keeps a far plane for each step whose sun the far field
 # may shade; the estimate counts every step with the sun up, since which
