@@ -64,10 +64,24 @@ static int far_factor(const tsd_options *o, int W, int H, int f_mem, double near
 }
 
 /* The far planes of a sun at `t`: one sweep, or a lattice's several
- * (SUN_POSITION=per_cell); when in doubt, 4. */
+ * (SUN_POSITION=per_cell), counted from the lattice's four corners (the
+ * suns' azimuths vary smoothly over it; its thousands of nodes, for every
+ * step of a day, would hold up the dataset's opening); when in doubt, 4. */
 static int sun_sweeps(const tsd_sun *sun, double t)
 {
-    int k = ts_sun_visibility_sweeps(&sun->sites, &sun->day, t);
+    const ts_sun_sites *s = &sun->sites;
+    if (s->nx * s->ny == 1)
+        return 1;
+    double lon[4], lat[4], north[4];
+    for (int k = 0; k < 4; k++) {
+        int i = (k & 1) * (s->nx - 1), j = (k >> 1) * (s->ny - 1);
+        lon[k] = s->longitude[j * s->nx + i];
+        lat[k] = s->latitude[j * s->nx + i];
+        north[k] = s->north_azimuth ? s->north_azimuth[j * s->nx + i] : 0.0;
+    }
+    ts_sun_sites corners = {2, 2, s->x0, s->y0, s->dx * (s->nx - 1), s->dy * (s->ny - 1),
+                            lon, lat, north};
+    int k = ts_sun_visibility_sweeps(&corners, &sun->day, t);
     return k > 0 ? k : 4;
 }
 

@@ -29,6 +29,10 @@ PYTHONPATH = os.path.join(T.SRCDIR, "python")
 sys.path.insert(0, PYTHONPATH)
 HORIZON = {"PRODUCT": "horizon", "DIRECTIONS": 4}
 SHADE = {"PRODUCT": "shade", "SUN_AZIMUTH": 300, "SUN_ELEVATION": 20}
+# a day product computed by the driver window by window too (chunks of 64
+# with their near field and the far grid): the windows still join bit for bit
+SUNHOURS = {"PRODUCT": "sunhours", "DATE": "2024-12-21", "TIMEZONE": "-05:00",
+            "STEP_MINUTES": 60, "TILE_SIZE": 64}
 
 
 def distributed(args, ok=True, **env):
@@ -99,8 +103,8 @@ class Distributed(unittest.TestCase):
         self.assertEqual([D.block_size(t) for t in (16, 64, 496, 512, 1024, 1040, 3072)],
                          [16, 64, 496, 512, 512, 16, 512])
 
-    def test_local_cluster_shade_and_horizon(self):
-        for name, options in (("shade", SHADE), ("horizon", HORIZON)):
+    def test_local_cluster_products(self):
+        for name, options in (("shade", SHADE), ("horizon", HORIZON), ("sunhours", SUNHOURS)):
             with self.subTest(product=name):
                 dest = self.path("local_%s.tif" % name)
                 p = distributed(["--workers", 2, "--tile-size", 64] + T.oo_args(options)
