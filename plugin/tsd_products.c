@@ -150,7 +150,8 @@ static const tsd_product_def PRODUCTS[] = {
      * date range Earth horizon, three horizon planes, double accumulator */
     {"sunhours", "hours of direct sun on DATE, or in total from START_DATE to END_DATE",
      "hour", "hours", one_band, NULL, band_named, TSD_BYTE_NEVER, 0, 1, TSD_STEPS_NONE, 6, 0,
-     3, NULL, "MAX_DISTANCE EDGE " DAY "STEP_MINUTES SUN_POSITION SUNHOURS_RULE " RANGE, NULL,
+     3, NULL, "MAX_DISTANCE EDGE " WINDOW DAY "STEP_MINUTES SUN_POSITION SUNHOURS_RULE " RANGE,
+     NULL,
      NULL, tsd_compute_sunhours},
     /* normals, sky, visibility, pressure factor, two double accumulators,
      * Earth horizon, horizon plane (a date range: three horizon planes,
@@ -159,13 +160,13 @@ static const tsd_product_def PRODUCTS[] = {
      "END_DATE, Wh/m2: total, beam, diffuse", "Wh/m2",
      "Wh/m2", insolation_bands, NULL, band_insolation, TSD_BYTE_NEVER, 0, 1,
      TSD_STEPS_NONE, 12, 0, 5, NULL,
-     SWEEP DAY "STEP_MINUTES SUN_POSITION LINKE_TURBIDITY " RANGE, "CLEAR_SKY_MODEL",
+     SWEEP WINDOW DAY "STEP_MINUTES SUN_POSITION LINKE_TURBIDITY " RANGE, "CLEAR_SKY_MODEL",
      "ESRA (Rigollier et al. 2000): beam on the tilted surface x visible "
      "fraction of the sun + diffuse horizontal x sky-view factor (sky term)",
      tsd_compute_insolation},
     {"daycycle", "visible fraction of the sun, one band per STEP_MINUTES", "", "0..1",
      per_step, "STEP_MINUTES", NULL, TSD_BYTE_ALLOWED, 0, 1, TSD_STEPS_UNIFORM, 2, 0, 3,
-     NULL, "MAX_DISTANCE EDGE OUTPUT_TYPE " DAY "STEP_MINUTES SUN_POSITION", NULL, NULL,
+     NULL, "MAX_DISTANCE EDGE OUTPUT_TYPE " WINDOW DAY "STEP_MINUTES SUN_POSITION", NULL, NULL,
      tsd_compute_daycycle},
     /* the far-field slopes */
     {"farshadow", "binary far-shadow maps of ATLAS_STEPS sun positions", "", "0, 1",
