@@ -277,8 +277,7 @@ static ts_status sun_horizon(const tsd_compute_ctx *c, const ts_grid *g, ts_hori
 /* 1 if the sun is computed per cell (SUN_POSITION=per_cell: a lattice). */
 static int sun_lattice(const tsd_compute_ctx *c)
 {
-    const tsd_sun *sun = c->run->sun;
-    return sun && sun->sites.nx * sun->sites.ny > 1;
+    return tsd_sun_per_cell(c->run->sun);
 }
 
 /* Per-cell sun (SUN_POSITION=per_cell): visibility of the disk, and the

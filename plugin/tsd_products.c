@@ -102,8 +102,7 @@ static int backend_always(const tsd_options *o, const tsd_sun *sun)
  * ts_sun_visibility, C only) */
 static int shadow_uses_backend(const tsd_options *o, const tsd_sun *sun)
 {
-    int lattice = sun && sun->sites.nx * sun->sites.ny > 1;
-    return !(lattice && o->method == TSD_METHOD_EXACT);
+    return !(tsd_sun_per_cell(sun) && o->method == TSD_METHOD_EXACT);
 }
 
 /* Option groups of the rows below. */

@@ -42,6 +42,11 @@ void tsd_format_time(double t, int offset, char *buf, size_t n)
              sec / 60 % 60, sec % 60, off);
 }
 
+int tsd_sun_per_cell(const tsd_sun *sun)
+{
+    return sun && sun->sites.nx * sun->sites.ny > 1;
+}
+
 void tsd_sun_free(tsd_sun *s)
 {
     if (!s)

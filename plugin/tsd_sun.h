@@ -63,6 +63,10 @@ ts_status tsd_sun_setup(const tsd_options *o, tsd_sites *sites, double min_cell_
 
 void tsd_sun_free(tsd_sun *s);
 
+/** 1 if `sun` (may be NULL) is computed per cell: SUN_POSITION=per_cell's
+ * lattice of sites. */
+int tsd_sun_per_cell(const tsd_sun *sun);
+
 /** ISO 8601 local time with its offset, whole seconds:
  * 2026-06-21T07:30:00+02:00 (or ...Z for offset 0). */
 void tsd_format_time(double unix_time, int offset_minutes, char *buf, size_t n);

@@ -70,7 +70,7 @@ static int far_factor(const tsd_options *o, int W, int H, int f_mem, double near
 static int sun_sweeps(const tsd_sun *sun, double t)
 {
     const ts_sun_sites *s = &sun->sites;
-    if (s->nx * s->ny == 1)
+    if (!tsd_sun_per_cell(sun))
         return 1;
     double lon[4], lat[4], north[4];
     for (int k = 0; k < 4; k++) {
@@ -119,7 +119,6 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
                          size_t n)
 {
     const tsd_product_def *d = tsd_product_of(o);
-    const int per_cell_sun = sun && sun->sites.nx * sun->sites.ny > 1;
     memset(p, 0, sizeof *p);
     p->tile = o->tile_size;
     if (o->tile_size == 0)
@@ -174,7 +173,7 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
         const int sun_planes = d->daily ? day_sweeps(o, sun)
                         : !is(d, "shade", "shadow")  ? 0
                         : o->method == TSD_METHOD_SH ? o->swath_directions
-                        : per_cell_sun               ? sun_sweeps(sun, sun->instant)
+                        : tsd_sun_per_cell(sun)      ? sun_sweeps(sun, sun->instant)
                                                      : 1;
         p->far_planes = is(d, "shadow", NULL) || is(d, "sunhours", "daycycle") ||
                                 (is(d, "shade", NULL) && o->sky_weight == 0) ||
