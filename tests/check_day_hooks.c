@@ -12,22 +12,7 @@
 #include "test_dem.h"
 #include "test_grid.h"
 #include "test_run.h"
-
-typedef struct {
-    double lon, lat, north;
-    ts_sun_sites s;
-} site;
-
-static void site_init(site *p, double lat, double lon)
-{
-    memset(p, 0, sizeof *p);
-    p->lon = lon;
-    p->lat = lat;
-    p->s.nx = p->s.ny = 1;
-    p->s.longitude = &p->lon;
-    p->s.latitude = &p->lat;
-    p->s.north_azimuth = &p->north;
-}
+#include "test_site.h"
 
 /* What the hook saw, and what it does to the planes. */
 typedef struct {
@@ -60,7 +45,7 @@ static ts_status hook(void *user, const ts_grid *g, double azimuth, double sun_e
 
 /* Steps of `step_s` over the local day from `start` whose sun's upper limb
  * is above the flat horizon of a plane at sea level. */
-static int steps_with_sun(const site *p, const ts_day_opts *o, double start, double step_s)
+static int steps_with_sun(const test_site *p, const ts_day_opts *o, double start, double step_s)
 {
     int n = 0;
     for (double t = start + step_s / 2; t < start + 86400; t += step_s) {
@@ -78,8 +63,8 @@ static int steps_with_sun(const site *p, const ts_day_opts *o, double start, dou
 START_TEST(test_plane_hook_day)
 {
     ts_error err;
-    site p;
-    site_init(&p, 46.5, 7.9);
+    test_site p;
+    test_site_init(&p, 46.5, 7.9);
     ts_day_opts o;
     ts_day_opts_default(&o);
     o.horizon.directions = 4;
@@ -149,8 +134,8 @@ static void range_set(ts_date_range *r)
 START_TEST(test_range_hook_and_tables)
 {
     ts_error err;
-    site p;
-    site_init(&p, 46.5, 7.9);
+    test_site p;
+    test_site_init(&p, 46.5, 7.9);
     ts_day_opts o;
     ts_day_opts_default(&o);
     o.horizon.directions = 8;

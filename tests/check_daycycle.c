@@ -12,29 +12,12 @@
 #include "test_expect.h"
 #include "test_grid.h"
 #include "test_run.h"
+#include "test_site.h"
 
 #define CK_NEAR(got, want, tol, what)                                                 \
     ck_assert_msg(fabs((double)(got) - (double)(want)) <= (tol),                      \
                   "%s: got %.6f, want %.6f +/- %g", what, (double)(got), (double)(want), \
                   (double)(tol))
-
-/* One site. */
-typedef struct {
-    double lon, lat, north;
-    ts_sun_sites s;
-} site;
-
-static void site_init(site *p, double lat, double lon)
-{
-    p->lon = lon;
-    p->lat = lat;
-    p->north = 0;
-    memset(&p->s, 0, sizeof p->s);
-    p->s.nx = p->s.ny = 1;
-    p->s.longitude = &p->lon;
-    p->s.latitude = &p->lat;
-    p->s.north_azimuth = &p->north;
-}
 
 static void flat(ts_grid *g, int n, double cell, float z)
 {
@@ -198,8 +181,8 @@ static void day_length_case(double lat, double lon, const char *date, int offset
     ts_error err;
     ck_assert(ts_parse_date(date, &y, &m, &d, &err) == TS_OK);
     double start = ts_local_midnight(y, m, d, offset);
-    site p;
-    site_init(&p, lat, lon);
+    test_site p;
+    test_site_init(&p, lat, lon);
     ts_day_opts o;
     ts_day_opts_default(&o);
     double astro = time_above(&p.s, &o, start, -TS_SUN_RADIUS_DEG) / 3600.0;
@@ -245,8 +228,8 @@ static int count_progress(double done, void *user)
 START_TEST(test_day_progress_and_cancel)
 {
     ts_error err;
-    site p;
-    site_init(&p, 46.5, 7.9);
+    test_site p;
+    test_site_init(&p, 46.5, 7.9);
     ts_day_opts o;
     ts_day_opts_default(&o);
     o.horizon.directions = 4;
@@ -277,8 +260,8 @@ END_TEST
 START_TEST(test_polar_night_and_day)
 {
     ts_error err;
-    site p;
-    site_init(&p, 78.2, 15.6); /* Longyearbyen */
+    test_site p;
+    test_site_init(&p, 78.2, 15.6); /* Longyearbyen */
     ts_day_opts o;
     ts_day_opts_default(&o);
     ts_grid g;
@@ -313,8 +296,8 @@ END_TEST
 START_TEST(test_bad_sites)
 {
     ts_error err;
-    site p;
-    site_init(&p, 91.0, 0.0);
+    test_site p;
+    test_site_init(&p, 91.0, 0.0);
     ts_day_opts o;
     ts_day_opts_default(&o);
     ts_grid g;
@@ -322,13 +305,13 @@ START_TEST(test_bad_sites)
     float out[16];
     EXPECT_ARG(ts_sun_hours(&g, &p.s, &o, 0, 86400, 300, out, &err), &err);
     ck_assert(strstr(err.message, "latitude 91 is beyond +/-90"));
-    site_init(&p, -90.5, 0.0);
+    test_site_init(&p, -90.5, 0.0);
     EXPECT_ARG(ts_sun_visibility(&g, &p.s, &o, 0, out, NULL, NULL, NULL, &err), &err);
-    site_init(&p, 45.0, 200.0);
+    test_site_init(&p, 45.0, 200.0);
     EXPECT_ARG(ts_sun_visibility(&g, &p.s, &o, 0, out, NULL, NULL, NULL, &err), &err);
-    site_init(&p, NAN, 0.0);
+    test_site_init(&p, NAN, 0.0);
     EXPECT_ARG(ts_sun_visibility(&g, &p.s, &o, 0, out, NULL, NULL, NULL, &err), &err);
-    site_init(&p, 45.0, 0.0);
+    test_site_init(&p, 45.0, 0.0);
     EXPECT_ARG(ts_sun_hours(&g, &p.s, &o, 0, 86400, 0, out, &err), &err);
     o.linke_turbidity = 0.5;
     EXPECT_ARG(ts_insolation(&g, &p.s, &o, 0, 86400, 300, out, NULL, NULL, &err), &err);
@@ -354,8 +337,8 @@ START_TEST(test_shadows_cut_sun_hours)
     for (int y = 10; y < 14; y++)
         for (int x = 10; x < 14; x++)
             g.z[y * n + x] = -2000.0f; /* deep 4 x 4 pit, 120 m wide */
-    site p;
-    site_init(&p, 46.5, 7.9);
+    test_site p;
+    test_site_init(&p, 46.5, 7.9);
     ts_day_opts o;
     ts_day_opts_default(&o);
     float *h = malloc(n * n * sizeof *h);
@@ -404,8 +387,8 @@ START_TEST(test_per_cell_sites)
     ts_day_opts o;
     ts_day_opts_default(&o);
     double start = ts_local_midnight(2026, 6, 21, 0);
-    site p;
-    site_init(&p, 48.0, 0.0);
+    test_site p;
+    test_site_init(&p, 48.0, 0.0);
     float *a = malloc(n * n * sizeof *a), *b = malloc(n * n * sizeof *b);
     ck_assert(ts_sun_hours(&g, &p.s, &o, start, 86400, 600, a, &err) == TS_OK);
     double lon[9], lat[9], north[9];
@@ -426,8 +409,8 @@ START_TEST(test_per_cell_sites)
     ck_assert(ts_sun_hours(&g, &s, &o, start, 86400, 300, b, &err) == TS_OK);
     for (int y = 0; y < n; y += n - 1) {
         double la = 56.0 - 16.0 * (y + 0.5 - 0.5) / (n - 1);
-        site q;
-        site_init(&q, la, 2.0);
+        test_site q;
+        test_site_init(&q, la, 2.0);
         double want = time_above(&q.s, &o, start, 0.0) / 3600.0;
         printf("per cell: row %d (lat %.2f): %.3f h, centre above the horizon %.3f h\n", y,
                la, b[y * n + n / 2], want);
@@ -452,8 +435,8 @@ START_TEST(test_grid_north)
     flat(&g, n, 30.0, 0.0f);
     for (int x = 12; x <= 20; x++)
         g.z[3 * n + x] = 300.0f; /* a wall on row 3, north of cell (16, 8) */
-    site p;
-    site_init(&p, 46.5, 7.9);
+    test_site p;
+    test_site_init(&p, 46.5, 7.9);
     ts_day_opts o;
     ts_day_opts_default(&o);
     double t;
@@ -520,8 +503,8 @@ START_TEST(test_insolation_flat)
     ts_error err;
     ts_grid g;
     flat(&g, 16, 30.0, 400.0f);
-    site p;
-    site_init(&p, 46.5, 7.9);
+    test_site p;
+    test_site_init(&p, 46.5, 7.9);
     ts_day_opts o;
     ts_day_opts_default(&o);
     o.horizon.directions = 8;
@@ -568,8 +551,8 @@ START_TEST(test_insolation_lattice)
     ts_day_opts_default(&o);
     o.horizon.directions = 8;
     double start = ts_local_midnight(2026, 3, 1, 60);
-    site p;
-    site_init(&p, 46.5, 7.9);
+    test_site p;
+    test_site_init(&p, 46.5, 7.9);
     p.north = 1.5;
     double lon[4] = {7.9, 7.9, 7.9, 7.9}, lat[4] = {46.5, 46.5, 46.5, 46.5},
            north[4] = {1.5, 1.5, 1.5, 1.5};
@@ -601,8 +584,8 @@ START_TEST(test_insolation_slopes)
             double yy = y < n / 2 ? y : n - 1 - y; /* a roof: ridge at the middle */
             g.z[y * n + x] = (float)(1000.0 + 30.0 * yy * tan(30 * M_PI / 180));
         }
-    site p;
-    site_init(&p, 46.5, 7.9);
+    test_site p;
+    test_site_init(&p, 46.5, 7.9);
     ts_day_opts o;
     ts_day_opts_default(&o);
     o.horizon.directions = 16;
@@ -628,8 +611,8 @@ END_TEST
 START_TEST(test_atlas_times)
 {
     ts_error err;
-    site p;
-    site_init(&p, 46.5, 7.9);
+    test_site p;
+    test_site_init(&p, 46.5, 7.9);
     ts_day_opts o;
     ts_day_opts_default(&o);
     double start = ts_local_midnight(2026, 6, 21, 120);

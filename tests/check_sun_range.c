@@ -13,30 +13,15 @@
 #include "day_cycle.h"
 #include "test_grid.h"
 #include "test_run.h"
-
-typedef struct {
-    double lon, lat, north;
-    ts_sun_sites s;
-} site;
-
-static void site_init(site *p, double lat, double lon)
-{
-    memset(p, 0, sizeof *p);
-    p->lon = lon;
-    p->lat = lat;
-    p->s.nx = p->s.ny = 1;
-    p->s.longitude = &p->lon;
-    p->s.latitude = &p->lat;
-    p->s.north_azimuth = &p->north;
-}
+#include "test_site.h"
 
 /* A fractal DEM of w x h 30 m cells at 46.5 N 7.4 E, default day options. */
-static void fixture(ts_grid *g, int w, int h, uint64_t seed, double relief, site *p,
+static void fixture(ts_grid *g, int w, int h, uint64_t seed, double relief, test_site *p,
                     ts_day_opts *o)
 {
     tdem_create(g, w, h, 30.0, 30.0);
     tdem_fractal(g, seed, relief);
-    site_init(p, 46.5, 7.4);
+    test_site_init(p, 46.5, 7.4);
     ts_day_opts_default(o);
 }
 
@@ -55,7 +40,7 @@ static void range_set(ts_date_range *r, int y0, int m0, int d0, int y1, int m1, 
 }
 
 /* Per-step exact day products summed over the range's days (interval 1). */
-static void exact_sum(const ts_grid *g, const site *p, const ts_day_opts *o,
+static void exact_sum(const ts_grid *g, const test_site *p, const ts_day_opts *o,
                       const ts_date_range *r, int insolation, double *sum)
 {
     size_t n = (size_t)g->width * g->height;
@@ -82,7 +67,7 @@ typedef struct {
     double mean_abs, max_abs, mean_ref;
 } range_error;
 
-static range_error compare(const ts_grid *g, const site *p, const ts_day_opts *o,
+static range_error compare(const ts_grid *g, const test_site *p, const ts_day_opts *o,
                            const ts_date_range *r, int insolation, const double *ref)
 {
     size_t n = (size_t)g->width * g->height;
@@ -113,7 +98,7 @@ static range_error compare(const ts_grid *g, const site *p, const ts_day_opts *o
 /* Range vs per-step sweeps for several HORIZON_DIRECTIONS; bounds at the
  * default: mean error under mean_tol (relative to the mean), max under
  * max_tol (relative to the mean). */
-static void against_exact(const char *what, const ts_grid *g, const site *p, int insolation,
+static void against_exact(const char *what, const ts_grid *g, const test_site *p, int insolation,
                           ts_sun_hours_rule rule, ts_date_range *r, double mean_tol,
                           double max_tol)
 {
@@ -178,8 +163,8 @@ START_TEST(test_fractal_against_exact)
     ts_grid g;
     tdem_create(&g, 64, 64, 30.0, 30.0);
     tdem_fractal(&g, 7, 400.0);
-    site p;
-    site_init(&p, 46.5, 7.4);
+    test_site p;
+    test_site_init(&p, 46.5, 7.4);
     ts_date_range r;
     range_set(&r, 2026, 11, 20, 2026, 11, 22, 60, 1);
     against_exact("fractal 64x64", &g, &p, 0, TS_SUN_HOURS_VISIBLE, &r, 0.006, 0.13);
@@ -201,8 +186,8 @@ START_TEST(test_jacksboro_against_exact)
     g.z = full.z + (ptrdiff_t)y0 * full.stride + x0;
     g.cell_x_row = full.cell_x_row ? full.cell_x_row + y0 : NULL;
     g.owns_memory = 0;
-    site p;
-    site_init(&p, 36.589, -84.245);
+    test_site p;
+    test_site_init(&p, 36.589, -84.245);
     ts_date_range r;
     range_set(&r, 2026, 3, 19, 2026, 3, 21, -300, 1);
     against_exact("jacksboro 100x80", &g, &p, 0, TS_SUN_HOURS_VISIBLE, &r, 0.002, 0.06);
@@ -212,7 +197,7 @@ START_TEST(test_jacksboro_against_exact)
 END_TEST
 
 /* Apparent elevation of the sun's centre at t. */
-static double elev(const site *p, const ts_day_opts *o, double t)
+static double elev(const test_site *p, const ts_day_opts *o, double t)
 {
     ts_sun_sample s;
     ts_error err;
@@ -222,7 +207,7 @@ static double elev(const site *p, const ts_day_opts *o, double t)
 
 /* Sunrise-to-sunset of the upper limb over one local day, seconds: scanned
  * every 20 minutes, each crossing refined by bisection. */
-static double day_length(const site *p, const ts_day_opts *o, double start)
+static double day_length(const test_site *p, const ts_day_opts *o, double start)
 {
     const double target = -TS_SUN_RADIUS_DEG;
     double total = 0, since = NAN, prev = start;
@@ -263,8 +248,8 @@ START_TEST(test_flat_year)
     ts_grid g;
     tdem_create(&g, 8, 8, 30.0, 30.0);
     tdem_fill(&g, 0.0f);
-    site p;
-    site_init(&p, 46.5, 7.4);
+    test_site p;
+    test_site_init(&p, 46.5, 7.4);
     ts_day_opts o;
     ts_day_opts_default(&o);
     float out[64];
@@ -297,7 +282,7 @@ END_TEST
 START_TEST(test_interval_weights)
 {
     ts_grid g;
-    site p;
+    test_site p;
     ts_day_opts o;
     fixture(&g, 48, 40, 3, 300.0, &p, &o);
     size_t n = (size_t)g.width * g.height;
@@ -358,7 +343,7 @@ static int on_progress(double done, void *user)
 START_TEST(test_progress_and_cancel)
 {
     ts_grid g;
-    site p;
+    test_site p;
     ts_day_opts o;
     fixture(&g, 32, 32, 5, 200.0, &p, &o);
     progress_log log = {0, -1, 0.0, 1};
@@ -397,8 +382,8 @@ START_TEST(test_bad_arguments)
     ts_grid g;
     tdem_create(&g, 16, 16, 30.0, 30.0);
     tdem_fill(&g, 100.0f);
-    site p;
-    site_init(&p, 46.5, 7.4);
+    test_site p;
+    test_site_init(&p, 46.5, 7.4);
     ts_date_range r;
     range_set(&r, 2026, 6, 10, 2026, 6, 9, 0, 1);
     expect_bad(&g, &p.s, &r, "is before its first");
