@@ -379,8 +379,10 @@ CPLErr TSDataset::EnsureComputed()
     return CE_None;
 }
 
-/* Refuse products that cannot fit, with a sentence saying what to do. */
-static bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *psPlan)
+/* Refuse products that cannot fit, with a sentence saying what to do.
+ * psSun, the cells and nLevel serve the advice on windows (level 0). */
+static bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *psPlan,
+                        const tsd_sun *psSun, const tsd_cells &sCells, int nLevel)
 {
     double dfSteady = 0;
     // windowed: the chunk with its margin, the cache and the far field
@@ -402,14 +404,18 @@ static bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window
              dfLimit / 1048576.0);
     if (dfPeak <= dfLimit && dfPeak < static_cast<double>(std::numeric_limits<size_t>::max()) / 2)
         return true;
+    char szAdvice[512] = "";
+    if (nLevel == 0)
+        tsd_window_advice(&sOpts, psSun, W, H, tsd_cells_min_x(&sCells, H), sCells.cell_y,
+                          dfLimit, szAdvice, sizeof szAdvice);
     Fail(TS_ERR_NOMEM,
          CPLSPrintf("PRODUCT=%s with %d band(s) on this %d x %d DEM needs "
                     "about %.0f MiB while computing (%.0f MiB kept), more than the "
-                    "limit of %.0f MiB (%s); crop or downsample the DEM, use fewer "
+                    "limit of %.0f MiB (%s)%s; crop or downsample the DEM, use fewer "
                     "DIRECTIONS, or raise MAX_MEMORY",
                     tsd_options_product_name(&sOpts), tsd_options_band_count(&sOpts), W,
                     H, dfPeak / 1048576.0, dfSteady / 1048576.0, dfLimit / 1048576.0,
-                    pszWhy));
+                    pszWhy, szAdvice));
     return false;
 }
 
@@ -549,10 +555,7 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
             return Fail(eSt, CPLSPrintf("%s: %s", pszWhat, szMsg)), false;
         if (sOpts.sun_position != TSD_SUN_PER_CELL && m_nLevel == 0)
             WarnSunReach(W, H, hSRS, sSites.lon[0], sSites.lat[0]);
-        double dfMinCell = m_sCells.cell_y;
-        for (int y = 0; y < H; y++)
-            dfMinCell = std::min(dfMinCell, m_sCells.cell_x_row ? m_sCells.cell_x_row[y]
-                                                                : m_sCells.cell_x);
+        const double dfMinCell = std::min(m_sCells.cell_y, tsd_cells_min_x(&m_sCells, H));
         eSt = tsd_sun_setup(&sOpts, &sSites, dfMinCell, &m_sSun, szMsg, sizeof szMsg);
         if (eSt != TS_OK)
             return Fail(eSt, szMsg), false;
@@ -565,7 +568,8 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     if (m_sCells.warning[0] && m_nLevel == 0) // said once, for the DEM itself
         CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", m_sCells.warning);
     if (!SetupWindow(W, H) ||
-        !CheckMemory(sOpts, W, H, WindowPlan(m_poWindow)))
+        !CheckMemory(sOpts, W, H, WindowPlan(m_poWindow), m_bHasSun ? &m_sSun : nullptr,
+                     m_sCells, m_nLevel))
         return false;
     /* a bad TERRASHADE_BACKEND is an error here (without probing OpenCL) */
     m_bUsesBackend = m_psProduct->uses_backend && m_psProduct->uses_backend(&sOpts, psSun);

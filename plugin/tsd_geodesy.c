@@ -111,6 +111,14 @@ ts_status tsd_cells_compute(const double gt[6], int width, int height,
     return TS_OK;
 }
 
+double tsd_cells_min_x(const tsd_cells *c, int height)
+{
+    double m = c->cell_x;
+    for (int y = 0; c->cell_x_row && y < height; y++)
+        m = c->cell_x_row[y] < m ? c->cell_x_row[y] : m;
+    return m;
+}
+
 void tsd_cells_free(tsd_cells *c)
 {
     if (c) {

@@ -48,6 +48,10 @@ ts_status tsd_cells_compute(const double gt[6], int width, int height,
 
 void tsd_cells_free(tsd_cells *c);
 
+/** The smallest east-west cell size over the rows of a DEM of `height`
+ * rows (cell_x where the rows do not differ), metres. */
+double tsd_cells_min_x(const tsd_cells *c, int height);
+
 /**
  * Where the sun is seen from, in the core grid's frame (row 0 north, after
  * the flips of tsd_cells): one site at the DEM's centre, or (per_cell) a

@@ -7,6 +7,7 @@
 #include "tsd_text.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -114,6 +115,21 @@ static int day_sweeps(const tsd_options *o, const tsd_sun *sun)
     return up;
 }
 
+/* Why the product or method of o needs the whole DEM (NULL: it does
+ * not). */
+static const char *whole_by_method(const tsd_options *o, const tsd_product_def *d)
+{
+    if (is(d, "farshadow", NULL))
+        return "PRODUCT=farshadow's far shadows are the whole DEM's far field";
+    if (o->method == TSD_METHOD_SHM && is(d, "shade", "shadow"))
+        return "METHOD=shm carries shadows across the whole DEM";
+    if (o->method == TSD_METHOD_SHADOWMAP && is(d, "shade", "shadow"))
+        return "METHOD=shadowmap renders one depth map of the whole DEM";
+    if (o->horizon_method == TSD_HORIZON_PYRAMID)
+        return "HORIZON_METHOD=pyramid reads one pyramid of the whole DEM";
+    return NULL;
+}
+
 int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
                          double cells_min_x, double cell_y, tsd_window_plan *p, char *msg,
                          size_t n)
@@ -125,14 +141,8 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
         p->why_whole = "TILE_SIZE=0";
     else if (W <= o->tile_size && H <= o->tile_size)
         p->why_whole = "the DEM fits in one tile";
-    else if (is(d, "farshadow", NULL))
-        p->why_whole = "PRODUCT=farshadow's far shadows are the whole DEM's far field";
-    else if (o->method == TSD_METHOD_SHM && is(d, "shade", "shadow"))
-        p->why_whole = "METHOD=shm carries shadows across the whole DEM";
-    else if (o->method == TSD_METHOD_SHADOWMAP && is(d, "shade", "shadow"))
-        p->why_whole = "METHOD=shadowmap renders one depth map of the whole DEM";
-    else if (o->horizon_method == TSD_HORIZON_PYRAMID)
-        p->why_whole = "HORIZON_METHOD=pyramid reads one pyramid of the whole DEM";
+    if (!p->why_whole)
+        p->why_whole = whole_by_method(o, d);
     if (p->why_whole)
         return 0;
     double cell = cells_min_x < cell_y ? cells_min_x : cell_y;
@@ -188,6 +198,67 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
         p->far_own = f == 1;
     }
     return 0;
+}
+
+/* The largest of a few chunk sizes with which options o window a W x H
+ * DEM within `limit` bytes: 1 with *tile and *bytes, else 0. */
+static int tile_that_fits(const tsd_options *o, const tsd_sun *sun, int W, int H,
+                          double cells_min_x, double cell_y, double limit, int *tile,
+                          double *bytes)
+{
+    static const int tiles[] = {4096, 2048, 1024, 512, 256};
+    for (size_t i = 0; i < sizeof tiles / sizeof tiles[0]; i++) {
+        tsd_options t = *o;
+        t.tile_size = tiles[i];
+        tsd_window_plan p;
+        char msg[256];
+        if (tiles[i] < TSD_TILE_MIN || (W <= tiles[i] && H <= tiles[i]) ||
+            tsd_window_plan_make(&t, sun, W, H, cells_min_x, cell_y, &p, msg, sizeof msg) != 0 ||
+            !p.windowed)
+            continue;
+        double steady;
+        const double peak = tsd_window_peak_bytes(&t, &p, &steady);
+        if (peak <= limit) {
+            *tile = tiles[i];
+            *bytes = peak;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+void tsd_window_advice(const tsd_options *o, const tsd_sun *sun, int W, int H,
+                       double cells_min_x, double cell_y, double limit, char *out, size_t n)
+{
+    int tile;
+    double bytes;
+    const tsd_product_def *d = tsd_product_of(o);
+    const char *why = whole_by_method(o, d);
+    out[0] = '\0';
+    if (!why) {
+        if (tile_that_fits(o, sun, W, H, cells_min_x, cell_y, limit, &tile, &bytes))
+            snprintf(out, n, "; TILE_SIZE=%d computes it window by window in about %.0f MiB",
+                     tile, bytes / 1048576.0);
+        return;
+    }
+    /* the exact methods, windowed (farshadow has none) */
+    tsd_options e = *o;
+    e.method = o->method == TSD_METHOD_SHM || o->method == TSD_METHOD_SHADOWMAP
+                   ? TSD_METHOD_EXACT
+                   : o->method;
+    e.horizon_method = TSD_HORIZON_EXACT;
+    const char *instead = e.method != o->method && o->horizon_method == TSD_HORIZON_PYRAMID
+                              ? "METHOD=exact and HORIZON_METHOD=exact"
+                          : e.method != o->method ? "METHOD=exact"
+                                                  : "HORIZON_METHOD=exact";
+    if (!whole_by_method(&e, d) &&
+        tile_that_fits(&e, sun, W, H, cells_min_x, cell_y, limit, &tile, &bytes))
+        snprintf(out, n,
+                 "; it is computed on the whole DEM (%s): %s with TILE_SIZE=%d computes it "
+                 "window by window in about %.0f MiB",
+                 why, instead, tile, bytes / 1048576.0);
+    else
+        snprintf(out, n, "; it is computed on the whole DEM (%s)", why);
 }
 
 double tsd_window_peak_bytes(const tsd_options *o, const tsd_window_plan *p, double *steady)

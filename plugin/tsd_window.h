@@ -83,6 +83,16 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
                          double cells_min_x, double cell_y, tsd_window_plan *plan, char *msg,
                          size_t msg_size);
 
+/**
+ * For a product that needs more than `limit` bytes as planned: a clause
+ * for the error that says how windows would fit it ("; TILE_SIZE=1024
+ * computes it window by window in about 310 MiB"), or why it needs the
+ * whole DEM and which method would window it; empty where windows do not
+ * help. The arguments as tsd_window_plan_make's.
+ */
+void tsd_window_advice(const tsd_options *o, const tsd_sun *sun, int W, int H,
+                       double cells_min_x, double cell_y, double limit, char *out, size_t n);
+
 /** Bytes a windowed computation keeps at most: one chunk with its margin
  * while computing, the cache, and the far grid with its planes. */
 double tsd_window_peak_bytes(const tsd_options *o, const tsd_window_plan *plan,

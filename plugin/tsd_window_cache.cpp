@@ -138,9 +138,7 @@ static bool OverviewsAgree(GDALRasterBand *poBand, int w, const std::string &osD
 bool TSDataset::SetupWindow(int W, int H)
 {
     auto poState = std::unique_ptr<WindowState>(new WindowState());
-    double dfMinX = m_sCells.cell_x;
-    for (int y = 0; m_sCells.cell_x_row && y < H; y++)
-        dfMinX = std::min(dfMinX, m_sCells.cell_x_row[y]);
+    const double dfMinX = tsd_cells_min_x(&m_sCells, H);
     poState->refCellX = m_sCells.cell_x_row ? m_sCells.cell_x_row[H / 2] : m_sCells.cell_x;
     char szMsg[512];
     if (tsd_window_plan_make(&m_sOpts, m_bHasSun ? &m_sSun : nullptr, W, H, dfMinX, m_sCells.cell_y,

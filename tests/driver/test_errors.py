@@ -105,6 +105,49 @@ class Errors(unittest.TestCase):
         self.assertIn("needs about", p.stderr)
         self.assertIn("raise MAX_MEMORY", p.stderr)
 
+    def test_memory_limit_says_how_windows_fit(self):
+        """Over MAX_MEMORY, the message says which TILE_SIZE (and, for the
+        whole-DEM methods, which method) fits the limit, and that advice
+        opens within it; farshadow, which has no windows, says so."""
+        import re
+        import tempfile
+        import numpy as np
+
+        def oo(opts):
+            return [a for o in opts for a in ("-oo", o)]
+        with tempfile.TemporaryDirectory() as tmp:
+            dem = T.write_tif(os.path.join(tmp, "flat.tif"),
+                              np.zeros((2048, 2048), np.float32),
+                              (500000, 10, 0, 5000000, 0, -10), 32632)
+            advice = re.compile(r"(?:(METHOD=exact) with )?TILE_SIZE=(\d+) computes it "
+                                r"window by window in about (\d+) MiB")
+            for opts, why in ((["PRODUCT=svf", "TILE_SIZE=0"], None),
+                              (["METHOD=shm"], "METHOD=shm carries shadows"),
+                              (["METHOD=shadowmap"], "METHOD=shadowmap renders")):
+                with self.subTest(opts=opts):
+                    limit = ["MAX_MEMORY=60"]
+                    p = T.run(["gdalinfo"] + oo(opts + limit) + [T.conn(dem)],
+                              ok=False)
+                    print(p.stderr.strip())
+                    self.assertNotEqual(p.returncode, 0)
+                    self.assertIn("more than the limit of 60 MiB", p.stderr)
+                    m = advice.search(p.stderr)
+                    self.assertIsNotNone(m, p.stderr)
+                    self.assertLessEqual(int(m.group(3)), 60)
+                    if why:
+                        self.assertIn("it is computed on the whole DEM (" + why, p.stderr)
+                        self.assertEqual(m.group(1), "METHOD=exact")
+                    # the advice, taken, opens within the same limit
+                    taken = [o for o in opts if not o.startswith(("TILE_SIZE", "METHOD"))]
+                    taken += ["TILE_SIZE=" + m.group(2)] + (["METHOD=exact"] if why else [])
+                    T.run(["gdalinfo"] + oo(taken + limit) + [T.conn(dem)])
+            p = T.run(["gdalinfo"] + oo(["PRODUCT=farshadow", "DATE=2024-06-21",
+                                         "TIMEZONE=+01:00", "MAX_MEMORY=10"])
+                      + [T.conn(dem)], ok=False)
+            print(p.stderr.strip())
+            self.assertIn("it is computed on the whole DEM (PRODUCT=farshadow", p.stderr)
+            self.assertNotIn("computes it window by window", p.stderr)
+
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)
