@@ -182,11 +182,10 @@ static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const ts
     sky_acc a = {nm, c->opts->directions,
                  which == 0 ? (ts_svf_model)c->opts->svf_model : TS_SVF_RADIATIVE,
                  c->opts->threads, which == 0 ? acc : NULL, which == 1 ? acc : NULL, which == 2 ? acc : NULL};
-    /* Curvature lowers far terrain; on the negated DEM it would raise it,
-     * so the sweep over the negated DEM (negative openness) runs without. */
+    /* the negated DEM of negative openness is swept without curvature */
     tsd_options flat;
     tsd_compute_ctx cflat;
-    if (which == 2 && c->opts->openness_negative) {
+    if (which == 2 && tsd_sweeps_negated_dem(c->opts)) {
         flat = *c->opts;
         flat.curvature = 0;
         cflat = *c;
@@ -423,9 +422,8 @@ TSD_COMPUTE_FN(tsd_compute_horizon)
     return st;
 }
 
-/* A copy of `dem` with its heights negated (NaN stays NaN), the surface
- * whose openness is the negative openness (Yokoyama et al. 2002, as RVT_py
- * computes it); free its z. */
+/* A copy of `dem` with its heights negated (tsd_negate_heights), the
+ * surface negative openness sweeps; free its z. */
 static ts_status negated_dem(const tsd_compute_ctx *c, const ts_grid *dem, ts_grid *neg)
 {
     *neg = *dem;
@@ -435,8 +433,9 @@ static ts_status negated_dem(const tsd_compute_ctx *c, const ts_grid *dem, ts_gr
     if (!neg->z)
         return oom(c, "the negated DEM of negative openness");
     for (int y = 0; y < dem->height; y++)
-        for (int x = 0; x < dem->width; x++)
-            neg->z[(size_t)y * dem->width + x] = -dem->z[(ptrdiff_t)y * dem->stride + x];
+        memcpy(neg->z + (size_t)y * dem->width, dem->z + (ptrdiff_t)y * dem->stride,
+               (size_t)dem->width * sizeof(float));
+    tsd_negate_heights(neg);
     return TS_OK;
 }
 
@@ -446,7 +445,7 @@ static ts_status sky_product(const tsd_compute_ctx *c, const tsd_region *r, int 
     tsd_normals nm = {0};
     ts_grid neg = {0};
     ts_status st;
-    const int negative = which == 2 && c->opts->openness_negative;
+    const int negative = which == 2 && tsd_sweeps_negated_dem(c->opts);
     memset(out, 0, (size_t)r->width * r->height * sizeof(float));
     if ((st = tsd_normals_make(c, r->dem, &nm)) == TS_OK && negative)
         st = negated_dem(c, r->dem, &neg);

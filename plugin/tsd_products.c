@@ -364,3 +364,16 @@ void tsd_row_to_byte(const float *restrict v, int n, unsigned char *restrict out
         out[i] = (unsigned char)(((b & ~big) | (255u & big)) & ~nan);
     }
 }
+
+int tsd_sweeps_negated_dem(const tsd_options *o)
+{
+    /* OPENNESS is refused on every product but openness (tsd_options_check) */
+    return o->openness_negative && strcmp(tsd_product_of(o)->name, "openness") == 0;
+}
+
+void tsd_negate_heights(ts_grid *g)
+{
+    for (int y = 0; y < g->height; y++)
+        for (int x = 0; x < g->width; x++)
+            g->z[(ptrdiff_t)y * g->stride + x] *= -1.0f;
+}

@@ -114,6 +114,18 @@ double tsd_product_peak_bytes(const tsd_options *o, int width, int height,
  */
 char *tsd_products_xml(void);
 
+/** OPENNESS=negative: the openness of the DEM with its heights negated
+ * (Yokoyama et al. 2002, as RVT_py computes it), swept without curvature,
+ * which lowers far terrain and on the negated DEM would raise it. The one
+ * home of that rule for the whole DEM's sweeps (tsd_compute.c) and the
+ * windows' far grid (tsd_window.c): 1 where options o sweep the negated
+ * DEM. */
+int tsd_sweeps_negated_dem(const tsd_options *o);
+
+/** The heights of g negated in place (NaN stays NaN): the surface that
+ * options for which tsd_sweeps_negated_dem holds sweep. */
+void tsd_negate_heights(ts_grid *g);
+
 /** Byte value of a 0..1 product as gdaldem writes it: 0 for nodata, else
  * 1 + 254 v rounded, 1 for v <= 0 (the mapping of TSD_BYTE_AUTO and
  * TSD_BYTE_ALLOWED). */

@@ -290,13 +290,10 @@ void tsd_far_field_init(tsd_far_field *f, ts_grid *coarse, int fine_w, int fine_
     f->hopts.curvature = o->curvature;
     f->hopts.refraction = o->refraction;
     f->hopts.threads = o->threads;
-    if (o->openness_negative && is(tsd_product_of(o), "openness", NULL)) {
-        /* negative openness sweeps the negated DEM, flat (tsd_compute.c's
-         * sky_stream): its far grid is the negated coarse grid's */
+    if (tsd_sweeps_negated_dem(o)) {
+        /* its far grid is the negated coarse grid's, swept flat */
         f->hopts.curvature = 0;
-        for (int y = 0; y < f->coarse.height; y++)
-            for (int x = 0; x < f->coarse.width; x++)
-                f->coarse.z[(ptrdiff_t)y * f->coarse.stride + x] *= -1.0f;
+        tsd_negate_heights(&f->coarse);
     }
     f->zmax = -INFINITY;
     for (int y = 0; y < f->coarse.height; y++)
