@@ -27,14 +27,8 @@
 
 #include "day_cycle.h"
 #include "shadow_atlas.h"
+#include "bench_clock.h"
 #include "test_dem.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
 
 static void die(const char *what, const ts_error *e)
 {
@@ -87,14 +81,14 @@ static void one_day(const char *name, const ts_grid *g, double lon, double lat,
         ts_sun_sample sun;
         if (ts_sun_at_site(&s, &o, t[k], &sun, &err))
             die("sun", &err);
-        double t0 = now();
+        double t0 = bench_now();
         if (ts_far_shadow(g, sun.grid_azimuth, sun.elevation, T, &o.horizon, map, &err))
             die("far shadow", &err);
-        double t1 = now();
+        double t1 = bench_now();
         ts_atlas_step rec = {t[k], sun.azimuth, sun.grid_azimuth, sun.elevation, offset};
         if (ts_atlas_writer_add(w, map, g->width, &rec, &err))
             die("add", &err);
-        t_tile += now() - t1;
+        t_tile += bench_now() - t1;
         t_far += t1 - t0;
         size_t c = 0;
         for (size_t i = 0; i < cells; i++)
@@ -114,16 +108,16 @@ static void one_day(const char *name, const ts_grid *g, double lon, double lat,
     info.threshold_m = T;
     uint8_t *file;
     size_t size;
-    double t0 = now();
+    double t0 = bench_now();
     if (ts_atlas_writer_finish(w, &info, &file, &size, &err))
         die("finish", &err);
-    double t_lzma = now() - t0;
+    double t_lzma = bench_now() - t0;
     ts_atlas_writer_free(w);
-    t0 = now();
+    t0 = bench_now();
     ts_atlas *a;
     if (ts_atlas_open(file, size, &a, &err))
         die("open", &err);
-    double t_open = now() - t0;
+    double t_open = bench_now() - t0;
     const ts_atlas_info *ai = ts_atlas_get_info(a);
     int same = 1;
     for (int k = 0; k < n; k++) {

@@ -24,3 +24,13 @@ bench_setup() {
     WORK=$(mktemp -d "${TMPDIR:-/tmp}/$1.XXXXXX")
     trap 'rm -rf "$WORK"' EXIT INT TERM
 }
+
+# bench_machine: the machine in one line (CPUs, model, load, GDAL) and
+# where the plugin comes from, as every driver bench prints it.
+bench_machine() {
+    echo "== machine: $(nproc 2>/dev/null || echo "?") CPU(s)," \
+         "$(sed -n 's/^model name[^:]*: //p' /proc/cpuinfo | head -n 1);" \
+         "load $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null);" \
+         "GDAL $(gdal-config --version 2>/dev/null || gdalinfo --version)"
+    echo "   GDAL_DRIVER_PATH=${GDAL_DRIVER_PATH:-<default>}"
+}

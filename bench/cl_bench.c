@@ -38,17 +38,11 @@
 #include "terrashade_cl.h"
 #include "terrashade_env.h"
 #include "bench_pages.h"
+#include "bench_clock.h"
 #include "test_dem.h"
 #ifdef HAVE_OPENCL
 #include "cl_internal.h"
 #endif
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
 
 static void die(const char *what, const ts_error *e)
 {
@@ -96,11 +90,11 @@ static double readback_seconds(void *dst, size_t bytes, size_t plane, int repeat
         clFinish(J.d->queue);
     double best = 1e30;
     for (int r = 0; r < repeat && J.st == TS_OK; r++) {
-        double t = now();
+        double t = bench_now();
         for (size_t off = 0; off < bytes; off += chunk)
             ts_cl_job_read(&J, m, 0, bytes - off < chunk ? bytes - off : chunk,
                            (char *)dst + off, "read-back test");
-        t = now() - t;
+        t = bench_now() - t;
         best = t < best ? t : best;
     }
     return ts_cl_job_end(&J) == TS_OK ? best : -1;
@@ -235,10 +229,10 @@ int main(int argc, char **argv)
     }
     ts_error e;
     ts_cl_info info;
-    double t0 = now();
+    double t0 = bench_now();
     if (ts_cl_available(&info, &e) != TS_OK)
         die("OpenCL", &e);
-    double t_init = now() - t0;
+    double t_init = bench_now() - t0;
     printf("OpenCL device %d: %s (%s), %s, %d compute units, %.1f GiB, fp64 %s\n", info.index,
            info.device, info.platform, info.type, info.compute_units,
            info.global_mem / 1073741824.0, info.fp64 ? "yes" : "no");
@@ -299,9 +293,9 @@ int main(int argc, char **argv)
         double diff = 0;
         for (int b = 0; b < 2; b++)
             for (int r = 0; r < repeat; r++) {
-                double t = now();
+                double t = bench_now();
                 run(&c, p, b, b ? hz_cl : c.hz);
-                t = now() - t;
+                t = bench_now() - t;
                 if (t < best[b])
                     best[b] = t;
                 if (r == 0 && b == 0 && p != P_HORIZON)

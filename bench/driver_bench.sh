@@ -29,9 +29,7 @@ echo "   synthesis: spectral (FFT) fractal surface, amplitude ~ f^-1.1"
 echo "   (power spectrum f^-2.2), fixed seed 42, scaled to 100..1500 m"
 "$PYTHON" "$(dirname "$0")/fractal_tif.py" "$SIZE" "$DEM"
 
-CPUS=$(nproc 2>/dev/null || echo "?")
-echo "== machine: $CPUS CPU(s); GDAL $(gdal-config --version 2>/dev/null || gdalinfo --version)"
-echo "   GDAL_DRIVER_PATH=${GDAL_DRIVER_PATH:-<default>}"
+bench_machine
 
 # best wall time of REPEATS runs of a command, in seconds
 best_time() {

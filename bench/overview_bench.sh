@@ -29,8 +29,7 @@ DEM="$WORK/fractal_${SIZE}.tif"
 echo "== DEM: $SIZE x $SIZE cells of 10 m, EPSG:32617, Float32 (fractal, seed 42)"
 "$PYTHON" "$(dirname "$0")/fractal_tif.py" "$SIZE" "$DEM"
 
-echo "== machine: $(nproc 2>/dev/null || echo '?') CPU(s), load $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null);" \
-     "GDAL $(gdal-config --version 2>/dev/null || gdalinfo --version)"
+bench_machine
 echo "== options: $*"
 LEVELS=$(gdalinfo "$@" "TERRASHADE:$DEM" | sed -n 's/^ *Overviews: //p' | head -n 1 |
          tr ',' '\n' | grep -c x || true)

@@ -34,8 +34,7 @@ RVT_PY=$(sh "$SRCDIR/tests/rvt-venv.sh" "$BUILDDIR/tests/rvt-venv") || {
 
 echo "== DEM: $SIZE x $SIZE cells of 10 m (bench/fractal_tif.py, seed 42)"
 "$PYTHON" "$SRCDIR/bench/fractal_tif.py" "$SIZE" "$DEM"
-echo "== machine: $(nproc) CPU(s), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 |
-    sed 's/^ *//'); load $(cut -d' ' -f1-3 /proc/loadavg); GDAL $(gdal-config --version)"
+bench_machine
 
 cat >"$WORK/rvt_svf.py" <<EOF
 import sys

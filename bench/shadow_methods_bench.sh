@@ -27,6 +27,5 @@ echo "== DEMs: $SIZE x $SIZE cells of 10 m, EPSG:32617, Float32 (bench/fractal_t
 echo "   rough (amplitude f^-1.1, driver_bench.sh's) and fBm (f^-1.8, Hurst 0.8)"
 "$PYTHON" "$(dirname "$0")/fractal_tif.py" "$SIZE" "$DEM"
 "$PYTHON" "$(dirname "$0")/fractal_tif.py" "$SIZE" "$FBM" 1.8
-echo "== machine: $(nproc 2>/dev/null || echo "?") CPU(s),$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2); load $(cut -d' ' -f1-3 /proc/loadavg); GDAL $(gdal-config --version 2>/dev/null || echo "?")"
-echo "   GDAL_DRIVER_PATH=${GDAL_DRIVER_PATH:-<default>}"
+bench_machine
 "$PYTHON" "$(dirname "$0")/shadow_methods.py" "$DEM" "$FBM" "$WORK" "$REPEATS"

@@ -25,7 +25,7 @@ DEM="$WORK/fractal_${SIZE}.tif"
 
 echo "== DEM: $SIZE x $SIZE cells of 10 m, EPSG:32617, Float32 (bench/fractal_tif.py, seed 42)"
 "$PYTHON" "$(dirname "$0")/fractal_tif.py" "$SIZE" "$DEM"
-echo "== machine: $(nproc 2>/dev/null || echo "?") CPU(s),$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2); load $(cut -d' ' -f1-3 /proc/loadavg); GDAL $(gdal-config --version 2>/dev/null || echo "?")"
+bench_machine
 
 # one run: "wall cpu" in seconds
 one_run() {

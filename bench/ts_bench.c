@@ -24,23 +24,8 @@
 
 #include "bench_pages.h"
 #include "terrashade.h"
+#include "bench_clock.h"
 #include "test_dem.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
-/* CPU seconds of all the process's threads: on a shared machine the
- * threads' work, where wall time also counts the waits for a core. */
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
 
 static double peak_mib(void)
 {
@@ -134,10 +119,10 @@ int main(int argc, char **argv)
     ts_grid g;
     if (ts_grid_create(&g, size, size, cell, cell, &e))
         die("grid", &e);
-    double t0 = now();
+    double t0 = bench_now();
     tdem_fbm(&g, 1234, 0.8, relief);
     printf("DEM: %d x %d fractal (fBm value noise, Hurst 0.8, %g m relief), %g m cells, "
-           "generated in %.2f s\n", size, size, relief, cell, now() - t0);
+           "generated in %.2f s\n", size, size, relief, cell, bench_now() - t0);
     if (latitude == latitude) {
         double *cx = malloc((size_t)size * sizeof *cx);
         if (!cx) {
@@ -181,11 +166,11 @@ int main(int argc, char **argv)
         for (int r = 0; r < repeat; r++)
             for (int m = 0; m < ndist; m++) {
                 o.max_distance = dists[m];
-                t0 = now();
-                double c0 = cpu_now();
+                t0 = bench_now();
+                double c0 = bench_cpu_now();
                 if (ts_horizon_compute(&g, &o, out, &e))
                     die("horizon", &e);
-                double dt = now() - t0, dc = cpu_now() - c0;
+                double dt = bench_now() - t0, dc = bench_cpu_now() - c0;
                 best[m] = dt < best[m] ? dt : best[m];
                 best_cpu[m] = dc < best_cpu[m] ? dc : best_cpu[m];
             }
@@ -220,10 +205,10 @@ int main(int argc, char **argv)
     for (int a = 0; a < 8; a++) {
         double best = INFINITY;
         for (int r = 0; r < repeat; r++) {
-            t0 = now();
+            t0 = bench_now();
             if (ts_shm_compute(&g, az[a] + 17.0, 25.0, 0.0, threads, vis, NULL, &e))
                 die("shadow height map", &e);
-            double dt = now() - t0;
+            double dt = bench_now() - t0;
             best = dt < best ? dt : best;
         }
         total += best;

@@ -26,22 +26,8 @@
 
 #include "bench_pages.h"
 #include "day_cycle.h"
+#include "bench_clock.h"
 #include "test_dem.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
-/* CPU seconds of the process, all threads: the work, whatever the load. */
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
 
 static void die(const char *what, const ts_error *e)
 {
@@ -131,10 +117,10 @@ int main(int argc, char **argv)
     ts_grid g;
     if (ts_grid_create(&g, size, size, cell, cell, &err))
         die("grid", &err);
-    double t0 = now();
+    double t0 = bench_now();
     tdem_fbm(&g, 1, 0.8, 1500.0);
     printf("DEM: %d x %d fBm, %g m cells, 1500 m relief, at %.2f N %.2f E, UTC+1 (%.1f s to "
-           "make)\n", size, size, cell, lat, lon, now() - t0);
+           "make)\n", size, size, cell, lat, lon, bench_now() - t0);
     size_t n = (size_t)size * size;
     float *out = malloc(n * sizeof *out);
     if (!out)
@@ -150,11 +136,11 @@ int main(int argc, char **argv)
     int y, m, d;
     if (ts_parse_date(day, &y, &m, &d, &err))
         die("--day", &err);
-    t0 = now();
-    double c0 = cpu_now();
+    t0 = bench_now();
+    double c0 = bench_cpu_now();
     if (ts_sun_hours(&g, &s, &o, ts_local_midnight(y, m, d, 60), 86400, step * 60, out, &err))
         die("ts_sun_hours", &err);
-    double t_day = now() - t0, c_day = cpu_now() - c0;
+    double t_day = bench_now() - t0, c_day = bench_cpu_now() - c0;
     printf("one day %s, %g-min steps, ts_sun_hours (a sweep per sun position): %.1f s wall, "
            "%.1f s CPU, mean %.2f h\n", day, step, t_day, c_day, mean_of(out, n));
     print_load("after the day");
@@ -174,20 +160,20 @@ int main(int argc, char **argv)
         snprintf(list, sizeof list, "%d", TS_RANGE_HORIZON_DIRECTIONS);
     for (char *tok = strtok(list, ","); tok; tok = strtok(NULL, ",")) {
         r.horizon_directions = atoi(tok);
-        t0 = now();
-        c0 = cpu_now();
+        t0 = bench_now();
+        c0 = bench_cpu_now();
         if (ts_sun_hours_range(&g, &s, &o, &r, out, &err))
             die("ts_sun_hours_range", &err);
-        double t_sh = now() - t0, c_sh = cpu_now() - c0;
+        double t_sh = bench_now() - t0, c_sh = bench_cpu_now() - c0;
         printf("year %d, interval %d d, %g-min steps, HORIZON_DIRECTIONS %d: sun hours %.1f s "
                "wall (%.2fx the day), %.1f s CPU (%.2fx), mean %.1f h\n", year, interval, step,
                r.horizon_directions, t_sh, t_sh / t_day, c_sh, c_sh / c_day, mean_of(out, n));
         if (insol) {
-            t0 = now();
-            c0 = cpu_now();
+            t0 = bench_now();
+            c0 = bench_cpu_now();
             if (ts_insolation_range(&g, &s, &o, &r, out, NULL, NULL, &err))
                 die("ts_insolation_range", &err);
-            double t_in = now() - t0, c_in = cpu_now() - c0;
+            double t_in = bench_now() - t0, c_in = bench_cpu_now() - c0;
             printf("year %d, interval %d d, %g-min steps, HORIZON_DIRECTIONS %d: insolation "
                    "%.1f s wall (%.2fx the day), %.1f s CPU (%.2fx), mean %.1f kWh/m2\n", year,
                    interval, step, r.horizon_directions, t_in, t_in / t_day, c_in, c_in / c_day,
