@@ -45,6 +45,7 @@ typedef struct {
 typedef struct {
     fpt *hull, *raw;
     int n, raw_n, pending;
+    int tan_c, tan_n; /* the last tangents of the cells' and next cells' queries */
     ts_line_pair lo;   /* far-side tangent vertices (fvertex entries) */
 } far_ws;
 
@@ -60,40 +61,52 @@ static inline void hull_push(far_ws *w, fpt p)
     w->n = n + 1;
 }
 
+/* Whether hull vertex j + 1 is at least as steep as vertex j from (d, g)
+ * (cross-multiplied: both lie behind d). */
+static inline int steeper_next(const fpt *S, int j, double d, double g)
+{
+    return (S[j + 1].g - g) * (d - S[j].d) >= (S[j].g - g) * (d - S[j + 1].d);
+}
+
 /* The vertex of largest slope from (d, g) to the hull, which lies entirely
- * behind d: the slopes to the vertices rise and then fall, so a binary
- * search finds it. */
-static inline int hull_tangent(const far_ws *w, double d, double g)
+ * behind d: the slopes to the vertices rise and then fall, so the answer
+ * is the first vertex whose next is less steep. It moves little from one
+ * sample to the next, so the search walks from the line's last answer
+ * *at (kept within the hull): a step or two where a binary search takes
+ * log2 of the hull's size. */
+static inline int hull_tangent(const far_ws *w, double d, double g, int *at)
 {
     const fpt *S = w->hull;
-    int lo = 0, hi = w->n - 1; /* answer in [lo, hi] */
-    while (lo < hi) {
-        int j = (lo + hi) / 2;
-        if ((S[j + 1].g - g) * (d - S[j].d) >= (S[j].g - g) * (d - S[j + 1].d))
-            lo = j + 1;
-        else
-            hi = j;
-    }
-    return lo;
+    int j = *at < w->n - 1 ? *at : w->n - 1;
+    j = j < 0 ? 0 : j;
+    if (j + 1 < w->n && steeper_next(S, j, d, g))
+        do
+            j++;
+        while (j + 1 < w->n && steeper_next(S, j, d, g));
+    else
+        while (j > 0 && !steeper_next(S, j - 1, d, g))
+            j--;
+    *at = j;
+    return j;
 }
 
 /* The tangent vertex of an observer at height h, d along the line. */
-static inline fvertex far_vertex(const far_ctx *C, const far_ws *w, double d, float h)
+static inline fvertex far_vertex(const far_ctx *C, far_ws *w, double d, float h, int *at)
 {
     if (w->n == 0)
         return (fvertex){0.0, -1};
-    const fpt *v = &w->hull[hull_tangent(w, d, h + C->dz - C->c * d * d)];
+    const fpt *v = &w->hull[hull_tangent(w, d, h + C->dz - C->c * d * d, at)];
     return (fvertex){d - v->d, v->k};
 }
 
 /* Slope from an observer at height h, d along the line, to the line's own
  * vertex: (h' - h) / D - c D with D = d - d'. */
-static inline float line_slope(const far_ctx *C, const far_ws *w, double d, float h)
+static inline float line_slope(const far_ctx *C, far_ws *w, double d, float h)
 {
     if (w->n == 0)
         return -INFINITY;
     double g = h + C->dz - C->c * d * d;
-    const fpt *v = &w->hull[hull_tangent(w, d, g)];
+    const fpt *v = &w->hull[hull_tangent(w, d, g, &w->tan_c)];
     return (float)((v->g - g) / (d - v->d) - 2.0 * C->c * d);
 }
 
@@ -130,6 +143,7 @@ static void far_line(const far_ctx *C, far_ws *w, long b, int write)
     const fvertex *prev_lo = w->lo.prev;
     fvertex *cur_lo = w->lo.cur;
     w->n = w->raw_n = w->pending = 0;
+    w->tan_c = w->tan_n = 0;
     double d = 0.0;
     for (int k = k0; k <= k1; k++) {
         /* A diagonal's t is a hair off +/-1, which leaves F ~ 1e-16 rather
@@ -146,7 +160,7 @@ static void far_line(const far_ctx *C, far_ws *w, long b, int write)
             } else if (s.F == 0.0f) { /* the cell is on the line */
                 s_out = line_slope(C, w, d, s.hc);
             } else {
-                fvertex hi = s.inside ? far_vertex(C, w, d, s.hc) : (fvertex){0.0, -1};
+                fvertex hi = s.inside ? far_vertex(C, w, d, s.hc, &w->tan_c) : (fvertex){0.0, -1};
                 fvertex lo = (k >= pk0 && k <= pk1) ? prev_lo[k] : (fvertex){0.0, -1};
                 double a = ray_slope(C, k, s.i, s.hc, lo);
                 double b = ray_slope(C, k, s.i, s.hc, hi);
@@ -155,7 +169,8 @@ static void far_line(const far_ctx *C, far_ws *w, long b, int write)
             C->out[C->o_origin + (ptrdiff_t)k * C->o_u_stride +
                    (ptrdiff_t)s.i * C->o_v_stride] = s_out;
         }
-        cur_lo[k] = (s.has_next && !isnan(s.hn)) ? far_vertex(C, w, d, s.hn) : (fvertex){0.0, -1};
+        cur_lo[k] = (s.has_next && !isnan(s.hn)) ? far_vertex(C, w, d, s.hn, &w->tan_n)
+                                                  : (fvertex){0.0, -1};
         if (!isnan(s.hs))
             w->raw[w->raw_n++] = (fpt){d, s.hs - C->c * d * d, k};
     }
