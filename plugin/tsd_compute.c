@@ -432,10 +432,7 @@ static ts_status negated_dem(const tsd_compute_ctx *c, const ts_grid *dem, ts_gr
     neg->z = malloc((size_t)dem->width * dem->height * sizeof(float));
     if (!neg->z)
         return oom(c, "the negated DEM of negative openness");
-    for (int y = 0; y < dem->height; y++)
-        memcpy(neg->z + (size_t)y * dem->width, dem->z + (ptrdiff_t)y * dem->stride,
-               (size_t)dem->width * sizeof(float));
-    tsd_negate_heights(neg);
+    tsd_negate_heights(dem, neg);
     return TS_OK;
 }
 

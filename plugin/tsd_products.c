@@ -371,9 +371,10 @@ int tsd_sweeps_negated_dem(const tsd_options *o)
     return o->openness_negative && strcmp(tsd_product_of(o)->name, "openness") == 0;
 }
 
-void tsd_negate_heights(ts_grid *g)
+void tsd_negate_heights(const ts_grid *from, ts_grid *to)
 {
-    for (int y = 0; y < g->height; y++)
-        for (int x = 0; x < g->width; x++)
-            g->z[(ptrdiff_t)y * g->stride + x] *= -1.0f;
+    for (int y = 0; y < from->height; y++)
+        for (int x = 0; x < from->width; x++)
+            to->z[(ptrdiff_t)y * to->stride + x] =
+                from->z[(ptrdiff_t)y * from->stride + x] * -1.0f;
 }

@@ -122,9 +122,10 @@ char *tsd_products_xml(void);
  * DEM. */
 int tsd_sweeps_negated_dem(const tsd_options *o);
 
-/** The heights of g negated in place (NaN stays NaN): the surface that
- * options for which tsd_sweeps_negated_dem holds sweep. */
-void tsd_negate_heights(ts_grid *g);
+/** The heights of `from` negated into `to` (the same size; may be the
+ * same grid; NaN stays NaN): the surface that options for which
+ * tsd_sweeps_negated_dem holds sweep. */
+void tsd_negate_heights(const ts_grid *from, ts_grid *to);
 
 /** Byte value of a 0..1 product as gdaldem writes it: 0 for nodata, else
  * 1 + 254 v rounded, 1 for v <= 0 (the mapping of TSD_BYTE_AUTO and

@@ -206,13 +206,13 @@ static int tile_that_fits(const tsd_options *o, const tsd_sun *sun, int W, int H
                           double cells_min_x, double cell_y, double limit, int *tile,
                           double *bytes)
 {
-    static const int tiles[] = {4096, 2048, 1024, 512, 256};
+    static const int tiles[] = {4096, 2048, 1024, 512, 256}; /* all >= TSD_TILE_MIN */
     for (size_t i = 0; i < sizeof tiles / sizeof tiles[0]; i++) {
         tsd_options t = *o;
         t.tile_size = tiles[i];
         tsd_window_plan p;
         char msg[256];
-        if (tiles[i] < TSD_TILE_MIN || (W <= tiles[i] && H <= tiles[i]) ||
+        if ((W <= tiles[i] && H <= tiles[i]) ||
             tsd_window_plan_make(&t, sun, W, H, cells_min_x, cell_y, &p, msg, sizeof msg) != 0 ||
             !p.windowed)
             continue;
@@ -293,7 +293,7 @@ void tsd_far_field_init(tsd_far_field *f, ts_grid *coarse, int fine_w, int fine_
     if (tsd_sweeps_negated_dem(o)) {
         /* its far grid is the negated coarse grid's, swept flat */
         f->hopts.curvature = 0;
-        tsd_negate_heights(&f->coarse);
+        tsd_negate_heights(&f->coarse, &f->coarse);
     }
     f->zmax = -INFINITY;
     for (int y = 0; y < f->coarse.height; y++)

@@ -1,7 +1,11 @@
 """Bad inputs: each gives a clear message and a non-zero exit, never a crash,
 through gdal_translate, gdalinfo and Python."""
 import os
+import re
+import tempfile
 import unittest
+
+import numpy as np
 
 import tsdriver as T
 from tsdriver import gdal
@@ -109,10 +113,6 @@ class Errors(unittest.TestCase):
         """Over MAX_MEMORY, the message says which TILE_SIZE (and, for the
         whole-DEM methods, which method) fits the limit, and that advice
         opens within it; farshadow, which has no windows, says so."""
-        import re
-        import tempfile
-        import numpy as np
-
         def oo(opts):
             return [a for o in opts for a in ("-oo", o)]
         with tempfile.TemporaryDirectory() as tmp:
