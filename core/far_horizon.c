@@ -7,7 +7,16 @@
  * the whole sweep, a cell between two lines takes its own ray's slope at
  * the occluders the two lines' hulls find (the lines' own slopes, mixed,
  * were up to a degree off on rough terrain at odd azimuths).
- * See shadow_atlas.h.
+ *
+ * Where the lines have equal steps (every grid but a geographic one) and
+ * the threshold spans more than the near field's steps, the sweep's own
+ * lockstep blocks do this work (ts_sweep_far_lanes: each line's hull takes
+ * its samples the threshold's steps late, eight lines to a vector), about
+ * twice as fast; far_line below, one line at a time, does the rest. The
+ * two agree but for float rounding. Both put a line's or a cell's ray's
+ * sample within 1e-6 of a cell on the cell (ts_line_geom_snap; the rays
+ * were not, and cells whose ray met the grid's last row or column there
+ * missed that occluder). See shadow_atlas.h.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -16,6 +25,7 @@
 #include "parallel.h"
 #include "shadow_atlas.h"
 #include "status_internal.h"
+#include "sweep_far.h"
 
 typedef struct {
     double d, g;
@@ -146,10 +156,9 @@ static void far_line(const far_ctx *C, far_ws *w, long b, int write)
     w->tan_c = w->tan_n = 0;
     double d = 0.0;
     for (int k = k0; k <= k1; k++) {
-        /* A diagonal's t is a hair off +/-1, which leaves F ~ 1e-16 rather
-         * than 0: the sample is on the cell. */
+        /* (the geometry's fractions are snapped: ts_line_geom_snap) */
         ts_line_sample s;
-        ts_line_sample_at(G, C->grid->z, b, k, k0, 1e-6f, &d, &s);
+        ts_line_sample_at(G, C->grid->z, b, k, k0, 0.0f, &d, &s);
         /* Samples at least T behind join the hull, in order. */
         while (w->pending < w->raw_n && d - w->raw[w->pending].d >= C->T)
             hull_push(w, w->raw[w->pending++]);
@@ -206,11 +215,9 @@ static void to_degrees(void *ctx, int worker, long y0, long y1)
 {
     (void)worker;
     const far_ctx *C = ctx;
-    size_t W = (size_t)C->grid->width;
-    for (size_t i = (size_t)y0 * W; i < (size_t)y1 * W; i++) {
-        float s = C->out[i];
-        C->out[i] = isnan(s) ? NAN : (float)(atan((double)s) * (180.0 / M_PI));
-    }
+    const int W = C->grid->width;
+    for (long y = y0; y < y1; y++)
+        ts_slopes_to_degrees(C->out + (size_t)y * W, W);
 }
 
 /* The far-field sweep: slopes (tangents) into out, or, with `degrees`,
@@ -235,17 +242,24 @@ static ts_status far_sweep(const ts_grid *grid, double azimuth, double threshold
     if (!(threshold_m > 0) || !isfinite(threshold_m))
         return ts_fail(err, TS_ERR_ARG, "the far-shadow threshold must be a positive "
                        "distance in metres, got %g", threshold_m);
+    far_ctx C = {0};
+    C.grid = grid;
+    C.out = out;
+    if (ts_sweep_far_lanes(grid, azimuth, threshold_m, dz, &o, out, &st, err)) {
+        if (st == TS_OK && degrees)
+            st = ts_parallel_for(ts_thread_count(o.threads, grid->height), grid->height,
+                                 to_degrees, &C, err);
+        return st == TS_OK ? ts_ok(err) : st;
+    }
     ts_line_geom geom;
     if ((st = ts_line_geom_init(&geom, grid, azimuth, err)) != TS_OK)
         return st;
+    ts_line_geom_snap(&geom, TS_FAR_SNAP);
     int failed = 0;
-    far_ctx C = {0};
-    C.grid = grid;
     C.geom = &geom;
     C.c = o.curvature ? (1.0 - o.refraction) / (2.0 * TS_EARTH_RADIUS) : 0.0;
     C.T = threshold_m;
     C.dz = dz;
-    C.out = out;
     ts_line_out_strides(&geom, grid->width, &C.o_origin, &C.o_u_stride, &C.o_v_stride);
     C.b0 = geom.b_lo;
     C.failed = &failed;

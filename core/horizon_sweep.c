@@ -41,6 +41,7 @@
 #include "simd_clones.h"
 #include "status_internal.h"
 #include "sweep_cap_tail.h"
+#include "sweep_far.h"
 #include "sweep_internal.h"
 
 /* Step k of lines j0..j1 of a block (rows i0 + j): each line's distance
@@ -76,10 +77,15 @@ static void lane_hulls_scalar(const ts_lane_hulls *h, const ts_lane_step *s,
         hull_pt *S = h->pts + (size_t)j * h->stride;
         const double d = s->d[j];
         const float hs = s->hs[j], hc = s->hc[j], hn = s->hn[j];
-        if (!isnan(hs))
+        if (s->push_d) { /* another step's point; every point is beyond the near field */
+            if (!isnan(s->push_d[j]))
+                hull_push(S, &h->n[j], &h->far[j], s->push_d[j], s->push_g[j], s->push_k, 0.0);
+            h->far[j] = h->n[j] - 1;
+        } else if (!isnan(hs)) {
             hull_push(S, &h->n[j], &h->far[j], d, hs - c * d * d, s->k, s->near_skip);
-        else
+        } else {
             h->far[j] = far_advance(S, h->n[j], h->far[j], d, s->near_skip);
+        }
         const int far = h->far[j];
         occluder hi = !isnan(hc) && j >= s->hi_from && j <= s->hi_to
                           ? stack_query(S, far, d, hc - c * d * d)
@@ -90,6 +96,36 @@ static void lane_hulls_scalar(const ts_lane_hulls *h, const ts_lane_step *s,
         occ->lo_k[j + 1] = lo.k;
         occ->lo_dd[j + 1] = lo.dd;
     }
+}
+
+/* The far-only sweep's part of step k (C->far_lag > 0): the step's samples
+ * into its ring slot (lines without one: NaN), the observers raised; sets
+ * the step's pushes, each line's sample far_lag steps back (none before
+ * the block's first step kmin: the spare slot, all NaN). */
+static void far_ring_step(const sweep_ctx *C, sweep_ws *w, int k, int kmin, int nl, int j0,
+                          int j1, ts_lane_step *step)
+{
+    const size_t row = 2 * (size_t)w->far_stride;
+    double *rd = w->far_ring + (size_t)(k % w->far_slots) * row, *rg = rd + w->far_stride;
+    for (int j = 0; j < nl; j++)
+        rd[j] = NAN;
+    for (int j = j0; j <= j1; j++)
+        if (!isnan(w->hs[j])) {
+            const double d = w->lane_d[j];
+            rd[j] = d;
+            rg[j] = w->hs[j] - C->c * d * d;
+        }
+    if (C->far_dz != 0.0f)
+        for (int j = j0; j <= j1; j++) {
+            w->hc[j] += C->far_dz;
+            w->hn[j] += C->far_dz;
+        }
+    const int kp = k - C->far_lag;
+    const double *pd = w->far_ring + (kp >= kmin ? (size_t)(kp % w->far_slots) : (size_t)w->far_slots) * row;
+    step->push_d = pd;
+    step->push_g = pd + w->far_stride;
+    step->push_k = kp;
+    step->near_skip = 0.0;
 }
 
 /* Lines bs .. bs + nl - 1 of an unbounded sweep, step by step; the first is
@@ -132,6 +168,9 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         const int j0 = i0 < 0 ? (int)-i0 : 0;
         const int j1 = G->V - 1 - i0 < nl - 1 ? (int)(G->V - 1 - i0) : nl - 1;
         if (j0 > j1) {
+            if (C->far_lag > 0) /* no samples: its slot is empty */
+                for (int j = 0; j < nl; j++)
+                    w->far_ring[(size_t)(k % w->far_slots) * 2 * w->far_stride + j] = NAN;
             if (C->cap > 0) /* no samples: the rings forget this step */
                 ts_cap_lanes_step(&w->capl, &(ts_lane_step){.k = k, .j0 = 1, .j1 = 0}, nl, NULL);
             continue;
@@ -144,8 +183,10 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         w->lo_k[j0] = lo0.k;
         w->lo_dd[j0] = lo0.dd;
         const int last_inside = G->fr[k] == 0.0f ? j1 : G->V - 2 - (int)i0;
-        const ts_lane_step step = {k, j0, j1, prime, last_inside, w->lane_d, w->hs, w->hc,
-                                   w->hn, c, C->near_skip, NULL, NULL, 0};
+        ts_lane_step step = {k, j0, j1, prime, last_inside, w->lane_d, w->hs, w->hc,
+                             w->hn, c, C->near_skip, NULL, NULL, 0};
+        if (C->far_lag > 0)
+            far_ring_step(C, w, k, kmin, nl, j0, j1, &step);
         const int hybrid = w->hybrid && ts_cap_lanes_hybrid_step(&w->capl, &hulls, &step, nl, &occ);
         if (!hybrid && C->cap > 0)
             ts_cap_lanes_step(&w->capl, &step, nl, &occ);
@@ -184,6 +225,7 @@ static void ws_free(sweep_ws *w)
     free(w->lane_f);
     free(w->lane_i);
     free(w->lane_d);
+    free(w->far_ring);
     ts_cap_lanes_free(&w->capl);
 }
 
@@ -251,6 +293,16 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
         }
         for (int k = 0; ok && k < U; k++)
             w->carry[k] = none;
+        if (ok && C->far_lag > 0) {
+            /* far_lag + 1 slots and a spare one, all NaN */
+            w->far_slots = C->far_lag + 1;
+            w->far_stride = LOCKSTEP_LINES + 8;
+            const size_t n = (size_t)(w->far_slots + 1) * 2 * w->far_stride;
+            if ((w->far_ring = malloc(n * sizeof *w->far_ring)))
+                for (size_t i = 0; i < n; i++)
+                    w->far_ring[i] = NAN;
+            ok = w->far_ring != NULL;
+        }
     }
     return ok && w->stack && w->lo.prev && w->lo.cur &&
            (!need_visit || (w->vx && w->vy && w->vh && w->vs && w->vd));
@@ -291,6 +343,11 @@ static void degrees_row(float *restrict o, int n)
 {
     for (int x = 0; x < n; x++)
         o[x] = ts_atan_deg(o[x]);
+}
+
+void ts_slopes_to_degrees(float *o, int n)
+{
+    degrees_row(o, n);
 }
 
 /* Rows [y0, y1): add each cell's near field to the far-field slope the
@@ -396,6 +453,35 @@ ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
     /* the world beyond the edge was raised row by row (finish_rows),
      * before anyone reads the horizons */
     return ts_ok(err);
+}
+
+int ts_sweep_far_lanes(const ts_grid *grid, double azimuth, double threshold_m, double dz,
+                       const ts_horizon_opts *opts, float *out, ts_status *st, ts_error *err)
+{
+    ts_line_geom geom;
+    sweep_ctx C;
+    if ((*st = sweep_setup(grid, azimuth, opts, &geom, &C, err)) != TS_OK)
+        return 1;
+    /* the samples at least threshold_m behind, on lines of equal steps:
+     * those at least lag steps back (1e-12: a threshold of whole steps
+     * takes its own step) */
+    const double lag = ceil(threshold_m / geom.step_m * (1.0 - 1e-12));
+    if (geom.step_row || C.cap > 0 || !(lag > TS_NEAR_STEPS) || lag >= geom.U) {
+        ts_line_geom_free(&geom);
+        return 0;
+    }
+    ts_line_geom_snap(&geom, TS_FAR_SNAP);
+    int failed = 0;
+    C.far_lag = (int)lag;
+    C.far_dz = (float)dz;
+    C.out = out;
+    C.alloc_failed = &failed;
+    const long lines = geom.b_hi - geom.b_lo + 1;
+    *st = ts_parallel_for(ts_thread_count(opts->threads, lines), lines, sweep_range, &C, err);
+    ts_line_geom_free(&geom);
+    if (*st == TS_OK && failed)
+        *st = ts_fail(err, TS_ERR_NOMEM, "cannot allocate the far-field sweep workspace");
+    return 1;
 }
 
 ts_status ts_horizon_sweep_lines(const ts_grid *grid, double azimuth,

@@ -119,6 +119,19 @@ void ts_line_geom_free(ts_line_geom *g)
     memset(g, 0, sizeof *g);
 }
 
+void ts_line_geom_snap(ts_line_geom *g, float snap)
+{
+    for (int k = 0; k < g->U; k++) {
+        g->fr[k] = g->fr[k] < snap ? 0.0f : g->fr[k];
+        if (g->ray_f[k] < snap) {
+            g->ray_f[k] = 0.0f;
+        } else if (g->ray_f[k] > 1.0f - snap) {
+            g->ray_o[k] += 1;
+            g->ray_f[k] = 0.0f;
+        }
+    }
+}
+
 void ts_line_geom_step_range(const ts_line_geom *g, int height, double *shortest,
                              double *longest)
 {

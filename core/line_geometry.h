@@ -43,6 +43,12 @@ ts_status ts_line_geom_init(ts_line_geom *g, const ts_grid *grid, double azimuth
                             ts_error *err);
 void ts_line_geom_free(ts_line_geom *g);
 
+/* The far-field sweeps' fractions (core/far_horizon.c): a line's or a
+ * ray's fraction within `snap` of a cell (t a rational, or a hair off
+ * +/-1, leaves ~1e-16 rather than 0) is put on the cell, so that a line or
+ * a cell's ray on the grid's last row or column keeps its sample there. */
+void ts_line_geom_snap(ts_line_geom *g, float snap);
+
 /* The shortest and longest metres per step over the grid's `height` rows.
  * No two samples of a line (nor a ray on the grid) are farther apart than
  * longest * U: a maximum distance beyond that caps nothing. */

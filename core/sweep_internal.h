@@ -45,6 +45,10 @@ typedef struct {
                            (ts_cap_lanes_lags) */
     ts_edge_job edge;   /* the world beyond the edge, raised row by row */
     int edge_rows;      /* whether finish_rows raises (not TS_EDGE_OPEN) */
+    /* the far-only sweep (ts_sweep_far_lanes): a sample joins its line's
+     * hull far_lag steps late, observers stand far_dz above the cells */
+    int far_lag;
+    float far_dz;
 } sweep_ctx;
 
 typedef struct {
@@ -72,6 +76,9 @@ typedef struct {
     int *lane_k0;       /* each line's first step */
     double *lane_d;     /* and the distance of its current sample from it */
     ts_cap_lanes capl;  /* capped lines in lockstep: their windows */
+    double *far_ring;   /* far-only: the block's samples (d, then g) by step
+                           k % far_slots, far_stride lines a slot */
+    int far_slots, far_stride;
     int lockstep;       /* lines in lockstep blocks (sweep_block), not one by one */
     int hybrid;         /* capped lines in lockstep keep unbounded hulls too */
 } sweep_ws;
