@@ -4,9 +4,10 @@
  * capped_lanes.h (ts_cap_lanes_hybrid_step).
  *
  * Each line's hull takes its samples once they leave the near field (from
- * the ring, lag_lo steps late: on lines of equal steps every sample that
- * many steps back is beyond the near field), so it holds every sample
- * beyond the near field, and its query finds the steepest of them. Where
+ * the ring, ts_lane_delayed_pushes: once the line is the near field's
+ * distance past them, so on lines of any steps), so it holds every sample
+ * beyond the near field,
+ * and its query finds the steepest of them. Where
  * that one lies in the window (as the ring tests it: lag <= lag_hi,
  * d - d_p <= cap), it is the window's steepest, the window being a subset
  * of what the hull saw; else the ring's (pruned) scan answers, by group of
@@ -27,15 +28,15 @@ int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_l
         r->hull_lost = 1;
         return 0;
     }
-    /* the samples that leave the near field: those lag_lo steps back */
-    const int kp = k - r->lag_lo;
-    const size_t at = (size_t)((kp % r->slots + r->slots) % r->slots) * r->stride;
+    /* the ring's samples the near field's distance behind, in as many
+     * passes as a line has ready */
     ts_lane_step hs = *s;
-    hs.push_d = r->d + at;
-    hs.push_g = r->g + at;
-    hs.push_k = kp;
-    hs.near_skip = 0.0; /* every point of the hull is beyond the near field */
-    if (!ts_lane_hull_step(h, &hs, occ)) {
+    int more, pushed;
+    do {
+        more = ts_lane_delayed_pushes(&r->push, r->d, r->g, r->stride, r->slots, r->near, &hs);
+        pushed = ts_lane_hull_step(h, &hs, occ);
+    } while (pushed && more);
+    if (!pushed) {
         r->hull_lost = 1;
         return 0;
     }

@@ -72,7 +72,8 @@ int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, const int lags[4], double nea
     r->ddn = zalloc(line);
     r->kc = zalloc(line);
     r->kn = zalloc(line);
-    int ok = r->d && r->g && r->qd && r->qc && r->qn && r->ddc && r->ddn && r->kc && r->kn;
+    int ok = r->d && r->g && r->qd && r->qc && r->qn && r->ddc && r->ddn && r->kc && r->kn &&
+             ts_lane_pushes_alloc(&r->push, r->stride);
     for (int l = 0; l < 2 && r->prune; l++) {
         const size_t n = (size_t)r->groups[l] * line;
         r->gmax[l] = zalloc(n);
@@ -94,6 +95,7 @@ void ts_cap_lanes_free(ts_cap_lanes *r)
     free(r->ddn);
     free(r->kc);
     free(r->kn);
+    ts_lane_pushes_free(&r->push);
     for (int l = 0; l < 2; l++) {
         free(r->gmax[l]);
         free(r->dlo[l]);
@@ -110,6 +112,7 @@ void ts_cap_lanes_clear(ts_cap_lanes *r)
     for (int j = 0; j < r->stride; j++)
         r->kc[j] = r->kn[j] = -1; /* no previous answers */
     r->hull_lost = 0;
+    ts_lane_pushes_reset(&r->push, r->stride);
     for (int l = 0; l < 2 && r->prune; l++)
         ts_cap_groups_empty(r->gmax[l], r->dlo[l], r->dhi[l], (size_t)r->groups[l] * r->stride);
 }
@@ -222,11 +225,9 @@ int ts_cap_lanes_hybrid_pays(const int lags[4])
 {
     /* measured (docs/performance.md, "Bounded sweep: unbounded hull first"):
      * 0.80-0.89x the line-by-line window's CPU time at 300-2000 lags. The
-     * ring's pruned scan holds for windows of up to PRUNE_MAX_LAGS; the hulls
-     * take the samples lags[0] steps back, which must be surely beyond the
-     * near field (lines of equal steps). */
+     * ring's pruned scan holds for windows of up to PRUNE_MAX_LAGS. */
     return ts_lane_vector_level() == 2 && lags[1] - lags[0] + 1 >= PRUNE_FROM &&
-           lags[1] <= PRUNE_MAX_LAGS && lags[2] <= lags[0];
+           lags[1] <= PRUNE_MAX_LAGS;
 }
 
 static void scan_groups(const ts_cap_lanes *r, int k, int g0, int g1)

@@ -45,6 +45,8 @@ typedef struct {
     /* ts_cap_lanes_hybrid_step's hulls miss samples (a step without lines
      * pushed none): the block's other steps take the scan alone */
     int hull_lost;
+    /* the hybrid's delayed pushes from the ring (those near behind) */
+    ts_lane_pushes push;
 } ts_cap_lanes;
 
 /* Level 0 and level 1 groups of the pruned scan, in steps. */
@@ -99,12 +101,14 @@ int ts_cap_lanes_hybrid_pays(const int lags[4]);
  * (ts_lane_hull_step's, emptied with the block) of its samples beyond the
  * near field: where the hull's steepest sample lies in the window, it is
  * the window's; the ring's scan answers the rest, by group of eight lines
- * (capped_hybrid.c). Only for windows whose lags[0] steps are surely beyond
- * the near field (ts_cap_lanes_hybrid_pays). The answers differ from
- * ts_cap_lanes_step's only between equally steep samples (up to rounding).
- * Returns 0, having done nothing, where the CPU has no AVX-512, the block
- * too many lines, or the hulls missed a step (hull_lost): the caller then
- * runs ts_cap_lanes_step. */
+ * (capped_hybrid.c). The step's pushes (s->push_d, ...) are the caller's:
+ * each line's samples from the ring once the line is the near field's
+ * distance past them (every sample beyond the near field, none within),
+ * with near_skip 0. The answers differ from ts_cap_lanes_step's only
+ * between equally steep samples (up to rounding). Returns 0, having done
+ * nothing, where the CPU has no AVX-512, the block too many lines, the
+ * step no pushes set, or the hulls missed a step (hull_lost): the caller
+ * then runs ts_cap_lanes_step. */
 int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_lane_step *s,
                              int nl, const ts_lane_occluders *occ);
 

@@ -79,7 +79,8 @@ static void lane_hulls_scalar(const ts_lane_hulls *h, const ts_lane_step *s,
         const float hs = s->hs[j], hc = s->hc[j], hn = s->hn[j];
         if (s->push_d) { /* another step's point; every point is beyond the near field */
             if (!isnan(s->push_d[j]))
-                hull_push(S, &h->n[j], &h->far[j], s->push_d[j], s->push_g[j], s->push_k, 0.0);
+                hull_push(S, &h->n[j], &h->far[j], s->push_d[j], s->push_g[j],
+                          s->push_ks ? s->push_ks[j] : s->push_k, 0.0);
             h->far[j] = h->n[j] - 1;
         } else if (!isnan(hs)) {
             hull_push(S, &h->n[j], &h->far[j], d, hs - c * d * d, s->k, s->near_skip);
@@ -98,38 +99,9 @@ static void lane_hulls_scalar(const ts_lane_hulls *h, const ts_lane_step *s,
     }
 }
 
-/* The far-only sweep's part of step k (C->far_lag > 0): the step's samples
- * into its ring slot (lines without one: NaN), the observers raised; sets
- * the step's pushes, each line's sample far_lag steps back (none before
- * the block's first step kmin: the spare slot, all NaN). */
-static void far_ring_step(const sweep_ctx *C, sweep_ws *w, int k, int kmin, int nl, int j0,
-                          int j1, ts_lane_step *step)
-{
-    const size_t row = 2 * (size_t)w->far_stride;
-    double *rd = w->far_ring + (size_t)(k % w->far_slots) * row, *rg = rd + w->far_stride;
-    for (int j = 0; j < nl; j++)
-        rd[j] = NAN;
-    for (int j = j0; j <= j1; j++)
-        if (!isnan(w->hs[j])) {
-            const double d = w->lane_d[j];
-            rd[j] = d;
-            rg[j] = w->hs[j] - C->c * d * d;
-        }
-    if (C->far_dz != 0.0f)
-        for (int j = j0; j <= j1; j++) {
-            w->hc[j] += C->far_dz;
-            w->hn[j] += C->far_dz;
-        }
-    const int kp = k - C->far_lag;
-    const double *pd = w->far_ring + (kp >= kmin ? (size_t)(kp % w->far_slots) : (size_t)w->far_slots) * row;
-    step->push_d = pd;
-    step->push_g = pd + w->far_stride;
-    step->push_k = kp;
-    step->near_skip = 0.0;
-}
-
-/* Lines bs .. bs + nl - 1 of an unbounded sweep, step by step; the first is
- * only primed (not written) when `prime`. w->carry holds what the line
+/* Lines bs .. bs + nl - 1 of an unbounded sweep (or a bounded one, in the
+ * rings of capped_lanes.h; or the far-only one, C->far_T, sweep_far.c),
+ * step by step; the first is only primed (not written) when `prime`. w->carry holds what the line
  * before the block found; on return it holds the block's last line's.
  * Each step samples the lines together (lane_passes.h), pushes and queries
  * each line's hull in the same order as ts_sweep_process_line, then evaluates the
@@ -159,6 +131,8 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         next[k] = none;
     if (C->cap > 0)
         ts_cap_lanes_clear(&w->capl);
+    if (C->far_T > 0)
+        ts_lane_pushes_reset(&w->far_push, nl);
     const ts_lane_occluders occ = {w->lo_k, w->hi_k, w->lo_dd, w->hi_dd};
     const ts_lane_hulls hulls = {w->lane_stacks, G->U + 1, w->lane_n, w->lane_far};
     const double c = C->c;
@@ -168,9 +142,8 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         const int j0 = i0 < 0 ? (int)-i0 : 0;
         const int j1 = G->V - 1 - i0 < nl - 1 ? (int)(G->V - 1 - i0) : nl - 1;
         if (j0 > j1) {
-            if (C->far_lag > 0) /* no samples: its slot is empty */
-                for (int j = 0; j < nl; j++)
-                    w->far_ring[(size_t)(k % w->far_slots) * 2 * w->far_stride + j] = NAN;
+            if (C->far_T > 0) /* no samples: its slot is empty */
+                ts_far_store(C, w, k, nl, 0, -1);
             if (C->cap > 0) /* no samples: the rings forget this step */
                 ts_cap_lanes_step(&w->capl, &(ts_lane_step){.k = k, .j0 = 1, .j1 = 0}, nl, NULL);
             continue;
@@ -184,21 +157,33 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         w->lo_dd[j0] = lo0.dd;
         const int last_inside = G->fr[k] == 0.0f ? j1 : G->V - 2 - (int)i0;
         ts_lane_step step = {k, j0, j1, prime, last_inside, w->lane_d, w->hs, w->hc,
-                             w->hn, c, C->near_skip, NULL, NULL, 0};
-        if (C->far_lag > 0)
-            far_ring_step(C, w, k, kmin, nl, j0, j1, &step);
-        const int hybrid = w->hybrid && ts_cap_lanes_hybrid_step(&w->capl, &hulls, &step, nl, &occ);
-        if (!hybrid && C->cap > 0)
-            ts_cap_lanes_step(&w->capl, &step, nl, &occ);
-        else if (!hybrid && !ts_lane_hull_step(&hulls, &step, &occ))
-            lane_hulls_scalar(&hulls, &step, &occ);
+                             w->hn, c, C->near_skip, NULL, NULL, 0, NULL};
+        if (C->far_T > 0) {
+            /* far-only: the hulls take the samples far_T behind, one per
+             * line and pass (the passes' queries are the same: the last
+             * stands) */
+            ts_far_store(C, w, k, nl, j0, j1);
+            for (int more = 1; more;) {
+                more = ts_far_pushes(C, w, &step);
+                if (!ts_lane_hull_step(&hulls, &step, &occ))
+                    lane_hulls_scalar(&hulls, &step, &occ);
+            }
+        } else {
+            const int hybrid =
+                w->hybrid && ts_cap_lanes_hybrid_step(&w->capl, &hulls, &step, nl, &occ);
+            if (!hybrid && C->cap > 0)
+                ts_cap_lanes_step(&w->capl, &step, nl, &occ);
+            else if (!hybrid && !ts_lane_hull_step(&hulls, &step, &occ))
+                lane_hulls_scalar(&hulls, &step, &occ);
+        }
         if (j1 == nl - 1)
             next[k] = (occluder){w->lo_k[nl], w->lo_dd[nl]};
         const int jw = prime && j0 == 0 ? 1 : j0;
         float *o = C->out + C->o_origin + (ptrdiff_t)k * C->o_u_stride +
                    (i0 + jw) * C->o_v_stride; /* cell (k, i0 + jw) */
-        ts_lane_far_field(G, C->grid->z, (float)c, k, (int)i0, jw, j1, w->hc, &occ, w->slope, o,
-                          C->o_v_stride);
+        /* (far-only: every occluder lies beyond the threshold) */
+        ts_lane_far_field(G, C->grid->z, (float)c, C->far_T > 0 ? 0 : TS_NEAR_STEPS, k, (int)i0,
+                          jw, j1, w->hc, &occ, w->slope, o, C->o_v_stride);
     }
     w->carry_next = w->carry;
     w->carry = next;
@@ -225,7 +210,7 @@ static void ws_free(sweep_ws *w)
     free(w->lane_f);
     free(w->lane_i);
     free(w->lane_d);
-    free(w->far_ring);
+    ts_far_ws_free(w);
     ts_cap_lanes_free(&w->capl);
 }
 
@@ -293,23 +278,13 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
         }
         for (int k = 0; ok && k < U; k++)
             w->carry[k] = none;
-        if (ok && C->far_lag > 0) {
-            /* far_lag + 1 slots and a spare one, all NaN */
-            w->far_slots = C->far_lag + 1;
-            w->far_stride = LOCKSTEP_LINES + 8;
-            const size_t n = (size_t)(w->far_slots + 1) * 2 * w->far_stride;
-            if ((w->far_ring = malloc(n * sizeof *w->far_ring)))
-                for (size_t i = 0; i < n; i++)
-                    w->far_ring[i] = NAN;
-            ok = w->far_ring != NULL;
-        }
+        ok = ok && (C->far_T == 0 || ts_far_ws_init(w, C));
     }
     return ok && w->stack && w->lo.prev && w->lo.cur &&
            (!need_visit || (w->vx && w->vy && w->vh && w->vs && w->vd));
 }
 
-/* Lines [b0 + begin, b0 + end): prime with the line before, then write. */
-static void sweep_range(void *ctx, int worker, long begin, long end)
+void ts_sweep_range(void *ctx, int worker, long begin, long end)
 {
     (void)worker;
     const sweep_ctx *C = ctx;
@@ -388,10 +363,8 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
     free(scratch);
 }
 
-/* Shared set-up and checks of both sweep entry points. */
-static ts_status sweep_setup(const ts_grid *grid, double azimuth,
-                             const ts_horizon_opts *opts, ts_line_geom *geom,
-                             sweep_ctx *C, ts_error *err)
+ts_status ts_sweep_setup(const ts_grid *grid, double azimuth, const ts_horizon_opts *opts,
+                         ts_line_geom *geom, sweep_ctx *C, ts_error *err)
 {
     ts_status st = ts_check_sweep_args(grid, &azimuth, opts, err);
     if (st != TS_OK)
@@ -431,7 +404,7 @@ ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
         return st;
     ts_line_geom geom;
     sweep_ctx C;
-    if ((st = sweep_setup(grid, azimuth, opts, &geom, &C, err)) != TS_OK)
+    if ((st = ts_sweep_setup(grid, azimuth, opts, &geom, &C, err)) != TS_OK)
         return st;
     int failed = 0;
     C.out = out;
@@ -441,7 +414,7 @@ ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
     /* One chunk per thread: each chunk re-primes one line. */
     int threads = ts_thread_count(opts->threads, lines);
     if (!C.near_only)
-        st = ts_parallel_for(threads, lines, sweep_range, &C, err);
+        st = ts_parallel_for(threads, lines, ts_sweep_range, &C, err);
     if (st == TS_OK && !failed)
         st = ts_parallel_for(ts_thread_count(opts->threads, grid->height), grid->height,
                              finish_rows, &C, err);
@@ -455,35 +428,6 @@ ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
     return ts_ok(err);
 }
 
-int ts_sweep_far_lanes(const ts_grid *grid, double azimuth, double threshold_m, double dz,
-                       const ts_horizon_opts *opts, float *out, ts_status *st, ts_error *err)
-{
-    ts_line_geom geom;
-    sweep_ctx C;
-    if ((*st = sweep_setup(grid, azimuth, opts, &geom, &C, err)) != TS_OK)
-        return 1;
-    /* the samples at least threshold_m behind, on lines of equal steps:
-     * those at least lag steps back (1e-12: a threshold of whole steps
-     * takes its own step) */
-    const double lag = ceil(threshold_m / geom.step_m * (1.0 - 1e-12));
-    if (geom.step_row || C.cap > 0 || !(lag > TS_NEAR_STEPS) || lag >= geom.U) {
-        ts_line_geom_free(&geom);
-        return 0;
-    }
-    ts_line_geom_snap(&geom, TS_FAR_SNAP);
-    int failed = 0;
-    C.far_lag = (int)lag;
-    C.far_dz = (float)dz;
-    C.out = out;
-    C.alloc_failed = &failed;
-    const long lines = geom.b_hi - geom.b_lo + 1;
-    *st = ts_parallel_for(ts_thread_count(opts->threads, lines), lines, sweep_range, &C, err);
-    ts_line_geom_free(&geom);
-    if (*st == TS_OK && failed)
-        *st = ts_fail(err, TS_ERR_NOMEM, "cannot allocate the far-field sweep workspace");
-    return 1;
-}
-
 ts_status ts_horizon_sweep_lines(const ts_grid *grid, double azimuth,
                                  const ts_horizon_opts *opts, ts_line_visitor visit,
                                  void *user, ts_error *err)
@@ -492,7 +436,7 @@ ts_status ts_horizon_sweep_lines(const ts_grid *grid, double azimuth,
         return ts_fail(err, TS_ERR_ARG, "line visitor is NULL");
     ts_line_geom geom;
     sweep_ctx C;
-    ts_status st = sweep_setup(grid, azimuth, opts, &geom, &C, err);
+    ts_status st = ts_sweep_setup(grid, azimuth, opts, &geom, &C, err);
     if (st != TS_OK)
         return st;
     size_t n = (size_t)grid->width * grid->height;
@@ -506,7 +450,7 @@ ts_status ts_horizon_sweep_lines(const ts_grid *grid, double azimuth,
     C.visit = visit;
     C.user = user;
     C.alloc_failed = &failed;
-    sweep_range(&C, 0, 0, geom.b_hi - geom.b_lo + 1);
+    ts_sweep_range(&C, 0, 0, geom.b_hi - geom.b_lo + 1);
     free(scratch);
     ts_line_geom_free(&geom);
     if (failed)

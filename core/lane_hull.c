@@ -1,10 +1,92 @@
 /* A lockstep block's hull step, eight lines per AVX-512 vector; see
  * lane_hull.h. */
 #include <limits.h>
+#include <math.h>
 #include <stddef.h>
+#include <stdlib.h>
 
 #include "lane_hull.h"
 #include "simd_clones.h"
+
+int ts_lane_pushes_alloc(ts_lane_pushes *p, int lines)
+{
+    const size_t n = (size_t)lines + 8;
+    p->next = malloc(n * sizeof *p->next);
+    p->slot = malloc(n * sizeof *p->slot);
+    p->ks = malloc(n * sizeof *p->ks);
+    p->pd = malloc(n * sizeof *p->pd);
+    p->pg = malloc(n * sizeof *p->pg);
+    if (!p->next || !p->slot || !p->ks || !p->pd || !p->pg)
+        return 0;
+    for (size_t i = 0; i < n; i++) {
+        p->next[i] = -1;
+        p->slot[i] = 0;
+        p->ks[i] = 0;
+        p->pd[i] = NAN;
+        p->pg[i] = 0.0;
+    }
+    return 1;
+}
+
+void ts_lane_pushes_free(ts_lane_pushes *p)
+{
+    free(p->next);
+    free(p->slot);
+    free(p->ks);
+    free(p->pd);
+    free(p->pg);
+    *p = (ts_lane_pushes){0};
+}
+
+void ts_lane_pushes_reset(ts_lane_pushes *p, int lines)
+{
+    for (int j = 0; j < lines; j++)
+        p->next[j] = -1;
+}
+
+/* Line j's oldest waiting sample from step *q on (at ring slot *slot),
+ * skipping steps without one, before step k: moves *q and *slot to it, or
+ * to k where there is none. */
+static inline void oldest_waiting(const double *d_ring, size_t slot_stride, int slots, int j,
+                                  int k, int *q, int *slot)
+{
+    while (*q < k && isnan(d_ring[(size_t)*slot * slot_stride + j])) {
+        ++*q;
+        *slot = *slot + 1 == slots ? 0 : *slot + 1;
+    }
+}
+
+int ts_lane_delayed_pushes(ts_lane_pushes *p, const double *d_ring, const double *g_ring,
+                           size_t slot_stride, int slots, double behind, ts_lane_step *s)
+{
+    const int k = s->k;
+    int more = 0;
+    for (int j = s->j0; j <= s->j1; j++) {
+        const double d = s->d[j];
+        int q = p->next[j], slot = p->slot[j];
+        if (q < 0) /* a line first met now has no sample before: its slots are empty */
+            q = k, slot = k % slots;
+        oldest_waiting(d_ring, slot_stride, slots, j, k, &q, &slot);
+        size_t at = (size_t)slot * slot_stride + j;
+        p->pd[j] = NAN;
+        if (q < k && d - d_ring[at] >= behind) {
+            p->pd[j] = d_ring[at];
+            p->pg[j] = g_ring[at];
+            p->ks[j] = q;
+            ++q;
+            slot = slot + 1 == slots ? 0 : slot + 1;
+            oldest_waiting(d_ring, slot_stride, slots, j, k, &q, &slot);
+            more |= q < k && d - d_ring[(size_t)slot * slot_stride + j] >= behind;
+        }
+        p->next[j] = q;
+        p->slot[j] = slot;
+    }
+    s->push_d = p->pd;
+    s->push_g = p->pg;
+    s->push_ks = p->ks;
+    s->near_skip = 0.0; /* every point of the hull is beyond the near field */
+    return more;
+}
 
 #if defined(__GNUC__) && defined(__x86_64__)
 #include <immintrin.h>
@@ -231,9 +313,10 @@ AVX512VL static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, 
         _mm512_mask_i32scatter_pd((double *)H->pts, push[q], at, GP[q]->d, 8);
         _mm512_mask_i32scatter_pd((double *)H->pts, push[q], _mm256_add_epi32(at, one), gs[q], 8);
         const __m256i kat = _mm256_add_epi32(_mm256_add_epi32(at, at), _mm256_set1_epi32(4));
+        const __m512i kp = s->push_ks ? _mm512_castsi256_si512(load8i(push[q], s->push_ks + jq))
+                                      : _mm512_set1_epi32(s->push_d ? s->push_k : s->k);
         _mm512_mask_i32scatter_epi32((int *)H->pts, (__mmask16)push[q],
-                                     _mm512_castsi256_si512(kat),
-                                     _mm512_set1_epi32(s->push_d ? s->push_k : s->k), 4);
+                                     _mm512_castsi256_si512(kat), kp, 4);
         store8i(H->n + jq, lanes[q], _mm256_mask_add_epi32(m[q], push[q], m[q], one));
         store8i(H->far + jq, lanes[q], far[q]);
         /* the occluders of the cells below (hi, when asked) and above (lo) */

@@ -35,12 +35,40 @@ typedef struct {
     const double *d;
     const float *hs, *hc, *hn;
     double c, near_skip;
-    /* where set (ts_lane_hull_step only): line j pushes the point of
-     * distance push_d[j] (NaN: none) and hull height push_g[j], of step
-     * push_k, instead of its sample */
+    /* where set: line j pushes the point of distance push_d[j] (NaN:
+     * none) and hull height push_g[j], of step push_k (or push_ks[j]
+     * where that is set), instead of its sample */
     const double *push_d, *push_g;
     int push_k;
+    const int *push_ks;
 } ts_lane_step;
+
+/*
+ * Delayed pushes, for hulls that must hold exactly the samples at least
+ * `behind` metres back (the far-only sweep; the bounded sweep's hybrid):
+ * each line's samples wait in a ring (slot k % slots of line j: distance
+ * d_ring[slot * slot_stride + j], NaN where it has none, and hull height
+ * g_ring[...]) until the line is that far past them, by the same doubles
+ * as far_horizon.c's lines did, so on lines of any steps. Per line: the
+ * step of its oldest sample not yet pushed (-1: from the step it is first
+ * met) and its ring slot, and the push of the current pass.
+ */
+typedef struct {
+    int *next, *slot, *ks;
+    double *pd, *pg;
+} ts_lane_pushes;
+
+/* For up to `lines` lines (+ a vector's loads beyond); 0 out of memory. */
+int ts_lane_pushes_alloc(ts_lane_pushes *p, int lines);
+void ts_lane_pushes_free(ts_lane_pushes *p);
+/* A new block: every line starts afresh. */
+void ts_lane_pushes_reset(ts_lane_pushes *p, int lines);
+/* A pass of step s (its k, lines j0..j1, distances d): sets s's pushes to
+ * each line's oldest waiting sample where it is ready (none elsewhere) and
+ * near_skip to 0; returns 1 where some line has another one ready, which
+ * then needs another pass of the hull step before the step's last. */
+int ts_lane_delayed_pushes(ts_lane_pushes *p, const double *d_ring, const double *g_ring,
+                           size_t slot_stride, int slots, double behind, ts_lane_step *s);
 
 /* The widest vectors the CPU and the build run (asked once): 2 AVX-512,
  * 1 AVX2, 0 neither. */

@@ -101,6 +101,7 @@ void ts_lane_sample(const ts_line_geom *G, const float *z, int k, int i0, int j0
 typedef struct {
     ptrdiff_t origin, u_stride, v_stride;
     int V;
+    int near; /* occluders at most this many steps back are left out */
 } ray_view;
 
 /* Slope from cell (k, i) at height h to its own ray at the occluder of
@@ -116,7 +117,7 @@ ray_at(ray_view R, int wide, const int *restrict ray_o, const float *restrict ra
        const float *restrict z, float cf, int k, int i, float h, int kc, float dd)
 {
     const int dk = k - kc;
-    int ok = (kc >= 0) & (dk > TS_NEAR_STEPS) & (dd > 0.0f);
+    int ok = (kc >= 0) & (dk > R.near) & (dd > 0.0f);
     const int dks = dk & -ok;
     const int r0 = i + ray_o[dks];
     const float f = ray_f[dks];
@@ -185,7 +186,7 @@ TS_AVX512 static inline __m512 ray16(const ray_view *R, const int *ray_o, const 
     const __m512 fzero = _mm512_setzero_ps();
     const __m512i dk = _mm512_sub_epi32(k, kc);
     __mmask16 ok = lanes & _mm512_cmpge_epi32_mask(kc, zero) &
-                   _mm512_cmpgt_epi32_mask(dk, _mm512_set1_epi32(TS_NEAR_STEPS)) &
+                   _mm512_cmpgt_epi32_mask(dk, _mm512_set1_epi32(R->near)) &
                    _mm512_cmp_ps_mask(dd, fzero, _CMP_GT_OQ);
     const __m512i dks = _mm512_maskz_mov_epi32(ok, dk); /* 0 where not ok: a valid entry */
     const __m512i r0 = _mm512_add_epi32(i, _mm512_i32gather_epi32(dks, ray_o, 4));
@@ -246,11 +247,11 @@ TS_AVX512 static void far_run32_avx512(FAR_PARAMS, int ostride)
 #define HAVE_FAR_AVX512 0
 #endif
 
-void ts_lane_far_field(const ts_line_geom *G, const float *z, float cf, int k, int i0, int j0,
-                       int j1, const float *hc, const ts_lane_occluders *occ, float *slope,
-                       float *out, ptrdiff_t ostride)
+void ts_lane_far_field(const ts_line_geom *G, const float *z, float cf, int near, int k, int i0,
+                       int j0, int j1, const float *hc, const ts_lane_occluders *occ,
+                       float *slope, float *out, ptrdiff_t ostride)
 {
-    const ray_view R = {G->origin, G->u_stride, G->v_stride, G->V};
+    const ray_view R = {G->origin, G->u_stride, G->v_stride, G->V, near};
     /* Every element the ray reads lies within U x V cells of the grid. */
     const ptrdiff_t span = (ptrdiff_t)(G->U - 1) * (G->u_stride < 0 ? -G->u_stride : G->u_stride) +
                            (ptrdiff_t)(G->V - 1) * G->v_stride + 1;

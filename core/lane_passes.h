@@ -32,11 +32,11 @@ typedef struct {
 /* The far-field slope of cells (k, i0 + j), j0 <= j <= j1, at heights
  * hc[j] into out[(j - j0) * ostride]: the larger of the cell's own ray sampled at
  * the two occluders (the second skipped when it is the first's step;
- * either skipped within the near field), -inf when none counts, NaN where
- * hc is nodata; cf is the curvature coefficient; slope: scratch of j1 + 1
- * floats. */
-void ts_lane_far_field(const ts_line_geom *G, const float *z, float cf, int k, int i0, int j0,
-                       int j1, const float *hc, const ts_lane_occluders *occ, float *slope,
-                       float *out, ptrdiff_t ostride);
+ * either skipped within the near field, at most `near` steps back), -inf
+ * when none counts, NaN where hc is nodata; cf is the curvature
+ * coefficient; slope: scratch of j1 + 1 floats. */
+void ts_lane_far_field(const ts_line_geom *G, const float *z, float cf, int near, int k, int i0,
+                       int j0, int j1, const float *hc, const ts_lane_occluders *occ,
+                       float *slope, float *out, ptrdiff_t ostride);
 
 #endif

@@ -45,10 +45,12 @@ typedef struct {
                            (ts_cap_lanes_lags) */
     ts_edge_job edge;   /* the world beyond the edge, raised row by row */
     int edge_rows;      /* whether finish_rows raises (not TS_EDGE_OPEN) */
-    /* the far-only sweep (ts_sweep_far_lanes): a sample joins its line's
-     * hull far_lag steps late, observers stand far_dz above the cells */
-    int far_lag;
+    /* the far-only sweep (sweep_far.c; far_T > 0): a sample joins its
+     * line's hull once the line is far_T metres past it, observers stand
+     * far_dz above the cells, a line's samples wait in far_slots steps */
+    double far_T;
     float far_dz;
+    int far_slots;
 } sweep_ctx;
 
 typedef struct {
@@ -78,7 +80,8 @@ typedef struct {
     ts_cap_lanes capl;  /* capped lines in lockstep: their windows */
     double *far_ring;   /* far-only: the block's samples (d, then g) by step
                            k % far_slots, far_stride lines a slot */
-    int far_slots, far_stride;
+    int far_stride;
+    ts_lane_pushes far_push; /* and the hulls' delayed pushes from it */
     int lockstep;       /* lines in lockstep blocks (sweep_block), not one by one */
     int hybrid;         /* capped lines in lockstep keep unbounded hulls too */
 } sweep_ws;
@@ -141,5 +144,21 @@ static inline int hull_push(hull_pt *S, int *n, int *far, double d, double gs, i
  * and writes the far field of its cells when `write` (a line before a
  * thread's first is only primed); with a visitor, hands it the samples. */
 void ts_sweep_process_line(const sweep_ctx *C, sweep_ws *w, long b, int write);
+
+/* The sweep's set-up and checks (every entry point's), and its lines
+ * [b0 + begin, b0 + end) of a worker (a ts_range_fn: the line before is
+ * primed, then each is written) (horizon_sweep.c). */
+ts_status ts_sweep_setup(const ts_grid *grid, double azimuth, const ts_horizon_opts *opts,
+                         ts_line_geom *geom, sweep_ctx *C, ts_error *err);
+void ts_sweep_range(void *ctx, int worker, long begin, long end);
+
+/* The far-only sweep's parts of a lockstep block (sweep_far.c): its
+ * workspace; step k's samples of lines j0..j1 into its ring slot (the
+ * block's other nl lines none) with the observers raised; a pass of the
+ * step's pushes (ts_lane_delayed_pushes). */
+int ts_far_ws_init(sweep_ws *w, const sweep_ctx *C);
+void ts_far_ws_free(sweep_ws *w);
+void ts_far_store(const sweep_ctx *C, sweep_ws *w, int k, int nl, int j0, int j1);
+int ts_far_pushes(const sweep_ctx *C, sweep_ws *w, ts_lane_step *step);
 
 #endif

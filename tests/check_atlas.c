@@ -43,49 +43,92 @@ static double brute_far(const ts_grid *g, int x, int y, int dx, int dy, double s
     return best == -INFINITY ? -90.0 : atan(best) * 180.0 / M_PI;
 }
 
-START_TEST(test_far_horizon_brute_force)
+/* An axis or diagonal direction, in grid steps. */
+typedef struct {
+    double az;
+    int dx, dy;
+} axis_dir;
+
+/* ts_far_horizon against brute_far for every cell, direction, threshold
+ * (metres) and curvature on and off, each within 1e-3 deg; the largest
+ * difference. Steps: the row's cell width east-west, cell_y north-south,
+ * their hypotenuse on diagonals. */
+static double far_vs_brute(const ts_grid *g, const axis_dir *dirs, int ndirs, const double *T,
+                           int nt)
 {
     ts_error err;
-    ts_grid g;
-    tdem_create(&g, 97, 83, 25.0, 25.0);
-    tdem_sines_rng_noise(&g, &rng_state);
-    g.z[40 * 97 + 40] = NAN; /* nodata: no occluder, NaN out */
-    float *out = malloc(97 * 83 * sizeof *out);
+    const int W = g->width, H = g->height;
+    float *out = malloc((size_t)W * H * sizeof *out);
     ts_horizon_opts o;
     ts_horizon_opts_default(&o);
-    struct {
-        double az;
-        int dx, dy;
-    } dirs[] = {{90, 1, 0}, {270, -1, 0}, {0, 0, -1}, {180, 0, 1},
-                {45, 1, -1}, {225, -1, 1}, {135, 1, 1}, {315, -1, -1}};
     double worst = 0;
     for (int curv = 0; curv < 2; curv++) {
         o.curvature = curv;
         double c = curv ? (1 - o.refraction) / (2 * TS_EARTH_RADIUS) : 0;
-        for (size_t k = 0; k < sizeof dirs / sizeof dirs[0]; k++)
-            for (int ti = 0; ti < 3; ti++) {
-                double T = (double[]){10.0, 400.0, 1500.0}[ti];
-                o.threads = 1 + (int)(k % 3);
-                ck_assert(ts_far_horizon(&g, dirs[k].az, T, &o, out, &err) == TS_OK);
-                double step = (dirs[k].dx && dirs[k].dy) ? hypot(25.0, 25.0) : 25.0;
-                for (int y = 0; y < 83; y++)
-                    for (int x = 0; x < 97; x++) {
-                        float got = out[y * 97 + x];
-                        if (isnan(g.z[y * 97 + x])) {
+        for (int k = 0; k < ndirs; k++)
+            for (int ti = 0; ti < nt; ti++) {
+                o.threads = 1 + k % 3;
+                ck_assert(ts_far_horizon(g, dirs[k].az, T[ti], &o, out, &err) == TS_OK);
+                for (int y = 0; y < H; y++) {
+                    const double cx = g->cell_x_row ? g->cell_x_row[y] : g->cell_x;
+                    const double step = dirs[k].dx && dirs[k].dy ? hypot(cx, g->cell_y)
+                                        : dirs[k].dx             ? cx
+                                                                 : g->cell_y;
+                    for (int x = 0; x < W; x++) {
+                        float got = out[y * W + x];
+                        if (isnan(g->z[y * W + x])) {
                             ck_assert(isnan(got));
                             continue;
                         }
-                        double want = brute_far(&g, x, y, dirs[k].dx, dirs[k].dy, step, T, c);
+                        double want = brute_far(g, x, y, dirs[k].dx, dirs[k].dy, step, T[ti], c);
                         double e = fabs(got - want);
-                        if (e > worst)
-                            worst = e;
+                        worst = e > worst ? e : worst;
                         ck_assert_msg(e < 1e-3, "az %g T %g (%d,%d): got %g want %g",
-                                      dirs[k].az, T, x, y, got, want);
+                                      dirs[k].az, T[ti], x, y, got, want);
                     }
+                }
             }
     }
-    printf("far horizon vs brute force on axes and diagonals: max |diff| %.2g deg\n", worst);
     free(out);
+    return worst;
+}
+
+START_TEST(test_far_horizon_brute_force)
+{
+    ts_grid g;
+    tdem_create(&g, 97, 83, 25.0, 25.0);
+    tdem_sines_rng_noise(&g, &rng_state);
+    g.z[40 * 97 + 40] = NAN; /* nodata: no occluder, NaN out */
+    const axis_dir dirs[] = {{90, 1, 0},  {270, -1, 0}, {0, 0, -1}, {180, 0, 1},
+                             {45, 1, -1}, {225, -1, 1}, {135, 1, 1}, {315, -1, -1}};
+    const double T[] = {10.0, 400.0, 1500.0};
+    printf("far horizon vs brute force on axes and diagonals: max |diff| %.2g deg\n",
+           far_vs_brute(&g, dirs, 8, T, 3));
+    ts_grid_free(&g);
+}
+END_TEST
+
+/* A geographic grid (east-west cells narrowing northward, as at 47-49 deg N),
+ * along the axes, where the lines pass through cell centres: east-west a
+ * line keeps its row, so its steps are that row's cell width and the
+ * lines of one block step differently; north-south the steps are the
+ * rows' height. Thresholds of 8, 20 and 60 cells. */
+START_TEST(test_far_horizon_geographic_brute_force)
+{
+    ts_error err;
+    ts_grid g;
+    const int W = 90, H = 140;
+    tdem_create(&g, W, H, 30.0, 30.0);
+    tdem_sines_rng_noise(&g, &rng_state);
+    g.z[70 * W + 45] = NAN;
+    double cx[140];
+    for (int y = 0; y < H; y++)
+        cx[y] = 30.0 * cos((47.0 + 2.0 * (H - 1 - y) / (H - 1)) * M_PI / 180.0);
+    ck_assert(ts_grid_set_row_spacing(&g, cx, &err) == TS_OK);
+    const axis_dir dirs[] = {{90, 1, 0}, {270, -1, 0}, {0, 0, -1}, {180, 0, 1}};
+    const double T[] = {8 * 30.0, 20 * 30.0, 60 * 30.0};
+    printf("geographic far horizon vs brute force on the axes: max |diff| %.2g deg\n",
+           far_vs_brute(&g, dirs, 4, T, 3));
     ts_grid_free(&g);
 }
 END_TEST
@@ -509,6 +552,7 @@ static Suite *suite(void)
     TCase *tc = tcase_create("core");
     tcase_set_timeout(tc, 60);
     tcase_add_test(tc, test_far_horizon_brute_force);
+    tcase_add_test(tc, test_far_horizon_geographic_brute_force);
     tcase_add_test(tc, test_far_horizon_against_full);
     tcase_add_test(tc, test_far_shadow_bits);
     tcase_add_test(tc, test_round_trip);
