@@ -6,8 +6,7 @@
  * Each line's hull takes its samples once they leave the near field (from
  * the ring, ts_lane_delayed_pushes: once the line is the near field's
  * distance past them, so on lines of any steps), so it holds every sample
- * beyond the near field,
- * and its query finds the steepest of them. Where
+ * beyond the near field, and its query finds the steepest of them. Where
  * that one lies in the window (as the ring tests it: lag <= lag_hi,
  * d - d_p <= cap), it is the window's steepest, the window being a subset
  * of what the hull saw; else the ring's (pruned) scan answers, by group of

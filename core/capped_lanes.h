@@ -101,14 +101,13 @@ int ts_cap_lanes_hybrid_pays(const int lags[4]);
  * (ts_lane_hull_step's, emptied with the block) of its samples beyond the
  * near field: where the hull's steepest sample lies in the window, it is
  * the window's; the ring's scan answers the rest, by group of eight lines
- * (capped_hybrid.c). The step's pushes (s->push_d, ...) are the caller's:
- * each line's samples from the ring once the line is the near field's
- * distance past them (every sample beyond the near field, none within),
- * with near_skip 0. The answers differ from ts_cap_lanes_step's only
- * between equally steep samples (up to rounding). Returns 0, having done
- * nothing, where the CPU has no AVX-512, the block too many lines, the
- * step no pushes set, or the hulls missed a step (hull_lost): the caller
- * then runs ts_cap_lanes_step. */
+ * (capped_hybrid.c). The hulls take the ring's samples themselves, each
+ * once its line is the near field's distance past it (r->push: every
+ * sample beyond the near field, none within). The answers differ from
+ * ts_cap_lanes_step's only between equally steep samples (up to
+ * rounding). Returns 0, having done nothing, where the CPU has no
+ * AVX-512, the block too many lines, or the hulls missed a step
+ * (hull_lost): the caller then runs ts_cap_lanes_step. */
 int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_lane_step *s,
                              int nl, const ts_lane_occluders *occ);
 

@@ -79,8 +79,8 @@ static void lane_hulls_scalar(const ts_lane_hulls *h, const ts_lane_step *s,
         const float hs = s->hs[j], hc = s->hc[j], hn = s->hn[j];
         if (s->push_d) { /* another step's point; every point is beyond the near field */
             if (!isnan(s->push_d[j]))
-                hull_push(S, &h->n[j], &h->far[j], s->push_d[j], s->push_g[j],
-                          s->push_ks ? s->push_ks[j] : s->push_k, 0.0);
+                hull_push(S, &h->n[j], &h->far[j], s->push_d[j], s->push_g[j], s->push_ks[j],
+                          0.0);
             h->far[j] = h->n[j] - 1;
         } else if (!isnan(hs)) {
             hull_push(S, &h->n[j], &h->far[j], d, hs - c * d * d, s->k, s->near_skip);
@@ -101,8 +101,9 @@ static void lane_hulls_scalar(const ts_lane_hulls *h, const ts_lane_step *s,
 
 /* Lines bs .. bs + nl - 1 of an unbounded sweep (or a bounded one, in the
  * rings of capped_lanes.h; or the far-only one, C->far_T, sweep_far.c),
- * step by step; the first is only primed (not written) when `prime`. w->carry holds what the line
- * before the block found; on return it holds the block's last line's.
+ * step by step; the first is only primed (not written) when `prime`.
+ * w->carry holds what the line before the block found; on return it holds
+ * the block's last line's.
  * Each step samples the lines together (lane_passes.h), pushes and queries
  * each line's hull in the same order as ts_sweep_process_line, then evaluates the
  * far field of the step's cells together: the cell between lines j - 1 and
@@ -157,7 +158,7 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         w->lo_dd[j0] = lo0.dd;
         const int last_inside = G->fr[k] == 0.0f ? j1 : G->V - 2 - (int)i0;
         ts_lane_step step = {k, j0, j1, prime, last_inside, w->lane_d, w->hs, w->hc,
-                             w->hn, c, C->near_skip, NULL, NULL, 0, NULL};
+                             w->hn, c, C->near_skip, NULL, NULL, NULL};
         if (C->far_T > 0) {
             /* far-only: the hulls take the samples far_T behind, one per
              * line and pass (the passes' queries are the same: the last

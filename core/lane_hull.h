@@ -35,11 +35,10 @@ typedef struct {
     const double *d;
     const float *hs, *hc, *hn;
     double c, near_skip;
-    /* where set: line j pushes the point of distance push_d[j] (NaN:
-     * none) and hull height push_g[j], of step push_k (or push_ks[j]
-     * where that is set), instead of its sample */
+    /* where set (ts_lane_delayed_pushes sets them): line j pushes the
+     * point of distance push_d[j] (NaN: none), hull height push_g[j] and
+     * step push_ks[j], instead of its sample */
     const double *push_d, *push_g;
-    int push_k;
     const int *push_ks;
 } ts_lane_step;
 

@@ -43,7 +43,7 @@ ts_status ts_line_geom_init(ts_line_geom *g, const ts_grid *grid, double azimuth
                             ts_error *err);
 void ts_line_geom_free(ts_line_geom *g);
 
-/* The far-field sweeps' fractions (core/far_horizon.c): a line's or a
+/* The far-only sweep's fractions (core/sweep_far.c): a line's or a
  * ray's fraction within `snap` of a cell (t a rational, or a hair off
  * +/-1, leaves ~1e-16 rather than 0) is put on the cell, so that a line or
  * a cell's ray on the grid's last row or column keeps its sample there. */

@@ -22,6 +22,9 @@
 #include "sweep_far.h"
 #include "sweep_internal.h"
 
+/* The snap of the lines' and rays' fractions onto cells (ts_line_geom_snap). */
+#define FAR_SNAP 1e-6f
+
 int ts_far_ws_init(sweep_ws *w, const sweep_ctx *C)
 {
     w->far_stride = LOCKSTEP_LINES + 8; /* a block's, and a vector's loads beyond */
@@ -73,7 +76,7 @@ ts_status ts_sweep_far_lanes(const ts_grid *grid, double azimuth, double thresho
     /* a sample waits at most T / shortest + 1 steps (+2: rounding), and no
      * longer than its line */
     const double wait = ceil(threshold_m / shortest) + 3;
-    ts_line_geom_snap(&geom, TS_FAR_SNAP);
+    ts_line_geom_snap(&geom, FAR_SNAP);
     int failed = 0;
     C.far_T = threshold_m;
     C.far_dz = (float)dz;

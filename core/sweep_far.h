@@ -8,9 +8,6 @@
 
 #include "terrashade.h"
 
-/* The far sweeps' snap of lines' and rays' fractions (ts_line_geom_snap). */
-#define TS_FAR_SNAP 1e-6f
-
 /* The far field of core/far_horizon.c in the sweep's lockstep blocks: the
  * slope (tangent, curvature included) from each cell, raised by dz, to the
  * steepest terrain at least threshold_m behind it along azimuth, into out
