@@ -227,7 +227,8 @@ ts_status ts_sh_visible_share(const ts_grid *grid, const double l[TS_SH_COEFFS],
  * A large grid takes a faster path (the tables folded with the light) that
  * differs from the other by float rounding; a window of a larger DEM (the
  * grid's `origin`) takes the path the whole DEM would, so that its cells
- * are the whole's bit for bit.
+ * are the whole's bit for bit. shade or share may be the same array as a
+ * plane: each cell's horizons are read before its outputs are written.
  */
 ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
                             const float *const *planes, const double l[TS_SH_COEFFS],

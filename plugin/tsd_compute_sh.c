@@ -47,8 +47,8 @@ static ts_status pyramid_planes(const tsd_compute_ctx *c, const ts_grid *g,
 
 /* The key light of METHOD=sh: its swath's SWATH_DIRECTIONS horizons (sweeps
  * on the backend, or the pyramid's with HORIZON_METHOD=pyramid), all kept,
- * then one pass of ts_sh_swath_light into shade (with the normals nm) or
- * share. */
+ * the first in the output, then one pass of ts_sh_swath_light into shade
+ * (with the normals nm) or share (one of them NULL). */
 static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd_normals *nm,
                            float *shade, float *share)
 {
@@ -66,10 +66,15 @@ static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
     if ((st = ts_sh_wedges_build(&s, o->threads, &w, &err)) != TS_OK)
         return core_fail(c, &err);
     ts_sh_key_reference(&w, l, az, el, &shade_ref, &share_ref);
+    /* the first horizon plane is the output itself (ts_sh_swath_light reads
+     * a cell's planes before it writes the cell): one fresh plane fewer, and
+     * its page faults */
     float **planes = calloc((size_t)s.n, sizeof *planes);
-    for (int i = 0; planes && i < s.n; i++)
+    if (planes)
+        planes[0] = shade ? shade : share;
+    for (int i = 1; planes && i < s.n; i++)
         if (!(planes[i] = malloc(cells * sizeof(float)))) {
-            for (int j = 0; j < i; j++)
+            for (int j = 1; j < i; j++)
                 free(planes[j]);
             free(planes);
             planes = NULL;
@@ -108,7 +113,7 @@ static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
                                 &err)) != TS_OK)
         st = core_fail(c, &err);
     note_c_part(c, "METHOD=sh");
-    for (int i = 0; i < s.n; i++)
+    for (int i = 1; i < s.n; i++)
         free(planes[i]);
     free(planes);
     ts_sh_wedges_free(&w);
