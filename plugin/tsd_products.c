@@ -299,10 +299,11 @@ double tsd_product_peak_bytes(const tsd_options *o, int width, int height, doubl
     double kept = p->byte == TSD_BYTE_ALWAYS ? bands / 4 : bands;
     /* shade's sky term from SKY or ENV_MAP: two more colour accumulators */
     int env_sky = o->sky_weight > 0 && p->sky_planes > 0 && (o->sky[0] || o->env_map[0]);
-    /* SH: METHOD=sh keeps its SWATH_DIRECTIONS horizon planes; ENV_METHOD=sh
-     * 16 visibility floats a cell and the first and last horizon planes */
+    /* SH: METHOD=sh keeps its SWATH_DIRECTIONS horizon planes, the first in
+     * the product; ENV_METHOD=sh 16 visibility floats a cell and the first
+     * and last horizon planes */
     int sh = o->method == TSD_METHOD_SH && tsd_product_takes(p, tsd_option_find("METHOD"))
-                 ? o->swath_directions
+                 ? o->swath_directions - 1
                  : o->env_method == TSD_ENV_SH ? 18 : 0;
     int extra = p->planes + (o->sky_weight > 0 ? p->sky_planes : 0) + 2 * env_sky + sh +
                 (o->sun_position == TSD_SUN_PER_CELL ? p->per_cell_planes : 0);
