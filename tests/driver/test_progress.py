@@ -10,6 +10,9 @@ progress callback, so the driver prints its own line to stderr:
 - auto with stderr a terminal: the line, once the work has taken
   TERRASHADE_PROGRESS_AFTER seconds (default 1; 0 here, so that the test
   does not depend on the machine's speed);
+- windowed (TILE_SIZE): a line per chunk, each computed inside a block read:
+  "TERRASHADE: computing svf of chunk 2 of 4 (100 x 100 cells from column
+  100, row 0): 0...100 - done in 0.1 s.";
 - the result does not depend on the option; a bad value is an error.
 """
 import os
@@ -24,6 +27,9 @@ from tsdriver import np
 UTM_GT = (600000.0, 30.0, 0.0, 4000000.0, 0.0, -30.0)
 LINE = re.compile(r"TERRASHADE: computing (\w+) of (\d+) x (\d+) cells: "
                   r"0((?:\.\.\.\d+)+) - done in [\d.]+ s\.")
+CHUNK_LINE = re.compile(r"TERRASHADE: computing (\w+) of chunk (\d+) of (\d+) "
+                        r"\((\d+) x (\d+) cells from column (\d+), row (\d+)\): "
+                        r"0((?:\.\.\.\d+)+) - done in [\d.]+ s\.")
 DAY = {"DATE": "2026-06-21", "TIMEZONE": "-04:00"}
 
 
@@ -105,6 +111,29 @@ class Progress(unittest.TestCase):
         m = LINE.search(text)
         self.assertIsNotNone(m, "no progress line on the terminal: %r" % text)
         self.assertTrue(m.group(4).endswith("...100"))
+
+    def test_windows_a_line_per_chunk(self):
+        """TILE_SIZE=100 on 200 x 200 cells: four chunks, a line each (the
+        first also sweeps the far field); nothing without a terminal under
+        auto; the same product either way."""
+        opts = {"PRODUCT": "svf", "DIRECTIONS": 8, "TILE_SIZE": 100}
+        err, a = self.translate(dict(opts, PROGRESS="yes"))
+        print(err.strip())
+        lines = CHUNK_LINE.findall(err)
+        self.assertEqual(len(lines), 4, err)
+        seen = set()
+        for product, k, n, w, h, x0, y0, ticks in lines:
+            self.assertEqual((product, n, w, h), ("svf", "4", "100", "100"))
+            # chunk k is the k-th in row-major order of the 2 x 2 chunks
+            self.assertEqual(int(k) - 1, int(y0) // 100 * 2 + int(x0) // 100)
+            self.assertEqual([int(v) for v in ticks.split("...")[1:]], list(range(10, 101, 10)))
+            seen.add(int(k))
+        self.assertEqual(seen, {1, 2, 3, 4})
+        p = T.run(["gdal_translate", "-q"] + T.oo_args(dict(opts, PROGRESS="auto")) +
+                  [T.conn(self.dem), os.path.join(self.dir, "quiet_w.tif")],
+                  TERRASHADE_PROGRESS_AFTER=0)
+        self.assertNotIn("computing", p.stderr)
+        np.testing.assert_array_equal(T.read(a), T.read(os.path.join(self.dir, "quiet_w.tif")))
 
     def test_same_result_and_bad_value(self):
         _, a = self.translate({"PRODUCT": "svf", "DIRECTIONS": 8, "PROGRESS": "yes"})
