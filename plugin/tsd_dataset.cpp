@@ -28,7 +28,6 @@
 #include "tsd_dataset.h"
 #include "tsd_dem.h"
 #include "tsd_gdal.h"
-#include "tsd_progress.h"
 #include "tsd_window.h"
 
 namespace tsd
@@ -286,6 +285,17 @@ ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
     return LoadDEM(psGrid, pszMsg, nMsg);
 }
 
+/* Start the progress line of a computation run by psRun (PROGRESS, after
+ * TERRASHADE_PROGRESS_AFTER seconds under auto) and hook it to the run. */
+void TSDataset::StartProgress(tsd_progress *psProgress, const char *pszLabel,
+                              tsd_run *psRun) const
+{
+    tsd_progress_begin(psProgress, m_sOpts.progress_mode, nullptr, pszLabel,
+                       CPLAtof(CPLGetConfigOption("TERRASHADE_PROGRESS_AFTER", "1")));
+    psRun->progress = tsd_progress_report;
+    psRun->progress_user = psProgress;
+}
+
 /* Compute the product once; later calls return the same outcome. */
 CPLErr TSDataset::EnsureComputed()
 {
@@ -305,13 +315,9 @@ CPLErr TSDataset::EnsureComputed()
         // The whole product is computed here, inside the first block read,
         // where GDAL passes no progress callback: report on stderr.
         tsd_progress sProgress;
-        const std::string osLabel =
-            CPLSPrintf("computing %s of %d x %d cells", pszName, W, H);
-        tsd_progress_begin(&sProgress, m_sOpts.progress_mode, nullptr, osLabel.c_str(),
-                           CPLAtof(CPLGetConfigOption("TERRASHADE_PROGRESS_AFTER", "1")));
         tsd_run sRun = m_sRun;
-        sRun.progress = tsd_progress_report;
-        sRun.progress_user = &sProgress;
+        StartProgress(&sProgress, CPLSPrintf("computing %s of %d x %d cells", pszName, W, H),
+                      &sRun);
         ts_grid sGrid;
         const bool bAhead = m_oReadAhead.joinable();
         eStatus = ReadDEM(&sGrid, szMsg, sizeof szMsg);

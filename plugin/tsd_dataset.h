@@ -21,6 +21,7 @@
 #include "tsd_geodesy.h"
 #include "tsd_options.h"
 #include "tsd_products.h"
+#include "tsd_progress.h"
 #include "tsd_sun.h"
 #include "tsd_window.h"
 
@@ -74,6 +75,7 @@ class TSDataset final : public GDALPamDataset
     std::string m_osReadMsg{};
 
     CPLErr EnsureComputed();
+    void StartProgress(tsd_progress *psProgress, const char *pszLabel, tsd_run *psRun) const;
     bool SetupWindow(int W, int H);
     bool EnsureFarField();
     bool ComputeChunk(int cx, int cy, WindowChunk &c);

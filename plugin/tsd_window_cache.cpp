@@ -22,7 +22,6 @@
 #include "tsd_dataset.h"
 #include "tsd_dem.h"
 #include "tsd_gdal.h"
-#include "tsd_progress.h"
 #include "tsd_window.h"
 
 namespace tsd
@@ -239,22 +238,21 @@ bool TSDataset::ComputeChunk(int cx, int cy, WindowChunk &c)
     {
         // Each chunk is computed inside a block read, where GDAL passes no
         // progress callback: a line of its own on stderr, as the whole
-        // DEM's (PROGRESS; the first chunk also sweeps the far field)
-        // (numbered in the grid's order, placed in the raster's columns and rows)
+        // DEM's (the first chunk also sweeps the far field); numbered in the
+        // grid's order, placed in the raster's columns and rows
         const int nx = (W + p.tile - 1) / p.tile, ny = (H + p.tile - 1) / p.tile;
         const int rx0 = m_sCells.flip_x ? W - gx0 - c.w : gx0;
         const int ry0 = m_sCells.flip_y ? H - gy0 - c.h : gy0;
-        const std::string osLabel = CPLSPrintf(
-            "computing %s of chunk %d of %d (%d x %d cells from column %d, row %d)",
-            m_psProduct->name, cy * nx + cx + 1, nx * ny, c.w, c.h, rx0, ry0);
         tsd_progress sProgress;
-        tsd_progress_begin(&sProgress, m_sOpts.progress_mode, nullptr, osLabel.c_str(),
-                           CPLAtof(CPLGetConfigOption("TERRASHADE_PROGRESS_AFTER", "1")));
         tsd_run sRun = m_sRun;
+        StartProgress(&sProgress,
+                      CPLSPrintf("computing %s of chunk %d of %d (%d x %d cells from column "
+                                 "%d, row %d)",
+                                 m_psProduct->name, cy * nx + cx + 1, nx * ny, c.w, c.h, rx0,
+                                 ry0),
+                      &sRun);
         sRun.near_distance = p.near_m;
         sRun.far = p.far ? &s.far : nullptr;
-        sRun.progress = tsd_progress_report;
-        sRun.progress_user = &sProgress;
         tsd_backend_summary sRan{};
         tsd_region sRegion;
         tsd_region_whole(&sRegion, &sGrid);
