@@ -196,12 +196,14 @@ cm_near_tables ts_near_tables(__global const int *P, __global const real *Q)
 }
 
 /* The float fast path of near_run (near_field.c) for one interior cell zc
- * at height h, piece by piece as there. *flag: a NaN was met (the cell is
+ * at height h, piece by piece as there (cm_fast_piece's slopes), +0 for a
+ * -0 as near_merge. *flag: a corner was nodata or infinite (the cell is
  * then redone by cm_near_exact). */
 float ts_near_fast(__global const float *zc, __global const int *P, __global const real *Q,
                    long u_stride, long v_stride, float h, float L, float c, int *flag)
 {
-    float best = -INFINITY, nans = 0.0f;
+    float best = -INFINITY, prev = 0.0f;
+    int bad = 0;
     const real pt = Q[TS_CLD_T];
     const float t = (float)pt;
     const int flat_v = fabs(pt) <= RC(1e-12);
@@ -209,14 +211,24 @@ float ts_near_fast(__global const float *zc, __global const int *P, __global con
         __global const float *q0 =
             zc + (long)P[TS_CLI_PDU + n] * u_stride + (long)P[TS_CLI_PDV + n] * v_stride;
         cm_fast_piece q = cm_fast_piece_init(P[TS_CLI_PDU + n], P[TS_CLI_PDV + n], flat_v,
-                                             Q[TS_CLD_PSA + n], Q[TS_CLD_PSB + n], L, c);
-        float m = cm_fast_piece_slope(q, t, q0[0], q0[u_stride], q0[v_stride],
-                                      q0[u_stride + v_stride], h, L, c);
+                                             Q[TS_CLD_PSA + n], Q[TS_CLD_PSB + n], pt, L, c);
+        const float k[4] = {q0[0], q0[u_stride], q0[v_stride], q0[u_stride + v_stride]};
+        const float X = cm_fast_twist(k[0], k[1], k[2], k[3]);
+        const float f = cm_fast_cross(q, k[q.e0], k[q.e1], h);
+        float m = f;
+        if (!q.has_sa) {
+            const float s0 = cm_fast_start(q, t, k[0], k[1], k[2], k[3]);
+            m = s0 > m ? s0 : m;
+        } else if (cm_fast_peak_test(q, t, X, prev, f)) {
+            const float fs = cm_fast_peak(q, t, k[0], k[1], k[2], k[3], h, L, c);
+            m = fs > m ? fs : m;
+        }
         best = m > best ? m : best;
-        nans += (m != m) ? 1.0f : 0.0f;
+        prev = f;
+        bad |= !(X - X == 0.0f);
     }
-    *flag = nans != 0.0f;
-    return best;
+    *flag = bad;
+    return best + 0.0f;
 }
 
 /* Pass 2: global size (cells rounded up, azimuths in the batch); work-item

@@ -78,12 +78,13 @@ float ts_ray_exact(const ts_line_geom *g, const float *z, int k, int i, float h,
 }
 
 /* The pieces over a run of cells, one piece at a time: plain float
- * arithmetic in loops the compiler vectorises. NaN corners make the slope
- * NaN, which the comparison ignores; such cells are flagged and redone in
- * scalar code. */
+ * arithmetic in loops the compiler vectorises (cm_fast_piece's slopes;
+ * prev: the slopes at the previous piece's end). Cells with a corner that
+ * is nodata or infinite are flagged and redone in scalar code. */
 TS_SIMD_CLONES
 static void near_run(const ts_near_plan *p, const float *restrict zrow, int x0, int x1,
-                     float L, float c, float *restrict best, float *restrict flag)
+                     float L, float c, float *restrict best, float *restrict flag,
+                     float *restrict prev)
 {
     for (int x = x0; x < x1; x++) {
         best[x] = -INFINITY;
@@ -97,11 +98,23 @@ static void near_run(const ts_near_plan *p, const float *restrict zrow, int x0, 
         const float *restrict c01 = zrow + p->piece_off[n][2];
         const float *restrict c11 = zrow + p->piece_off[n][3];
         const cm_fast_piece q = cm_fast_piece_init(p->piece_du[n], p->piece_dv[n], flat_v,
-                                                   p->piece_sa[n], p->piece_sb[n], L, c);
+                                                   p->piece_sa[n], p->piece_sb[n], p->t, L, c);
+        const float *cn[4] = {c00, c10, c01, c11};
+        const float *restrict n0 = cn[q.e0], *restrict n1 = cn[q.e1];
         for (int x = x0; x < x1; x++) {
-            float m = cm_fast_piece_slope(q, t, c00[x], c10[x], c01[x], c11[x], zrow[x], L, c);
+            const float X = cm_fast_twist(c00[x], c10[x], c01[x], c11[x]);
+            const float f = cm_fast_cross(q, n0[x], n1[x], zrow[x]);
+            float m = f;
+            if (!q.has_sa) {
+                const float s0 = cm_fast_start(q, t, c00[x], c10[x], c01[x], c11[x]);
+                m = s0 > m ? s0 : m;
+            } else if (cm_fast_peak_test(q, t, X, prev[x], f)) {
+                const float fs = cm_fast_peak(q, t, c00[x], c10[x], c01[x], c11[x], zrow[x], L, c);
+                m = fs > m ? fs : m;
+            }
             best[x] = m > best[x] ? m : best[x];
-            flag[x] += (m != m) ? 1.0f : 0.0f;
+            prev[x] = f;
+            flag[x] += X - X == 0.0f ? 0.0f : 1.0f;
         }
     }
 }
@@ -114,7 +127,7 @@ static int near_merge(const float *restrict zrow, const float *restrict best,
 {
     int flagged = 0;
     for (int x = x0; x < x1; x++) {
-        const float o = out[x], b = best[x];
+        const float o = out[x], b = best[x] + 0.0f; /* +0 for -0, which the fold may give */
         const int take = (zrow[x] == zrow[x]) & (flag[x] == 0.0f) & (b > o);
         out[x] = take ? b : o;
         flagged |= flag[x] != 0.0f;
@@ -128,7 +141,7 @@ void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
 {
     float *best = scratch, *flag = scratch + x1;
     if (!ts_near_run_avx512(p, zrow, x0, x1, (float)step, (float)c, best, flag, scratch + 2 * x1))
-        near_run(p, zrow, x0, x1, (float)step, (float)c, best, flag);
+        near_run(p, zrow, x0, x1, (float)step, (float)c, best, flag, scratch + 2 * x1);
     if (!near_merge(zrow, best, flag, x0, x1, out))
         return;
     /* cells whose near field touches nodata: the scalar near field */

@@ -242,18 +242,33 @@ CM_FN float cm_ray_slope(const cm_ray_grid *r, int k, int i, float h, int dk, fl
 }
 
 /*
- * The float fast path for interior cells whose near field has no nodata:
- * per piece, constants that depend only on the direction (cm_fast_piece),
- * then per cell the piece's largest slope; NaN where a corner is nodata
- * (the caller then redoes the cell with cm_near_exact).
+ * The float fast path for interior cells whose near field has no nodata.
+ * A cell's largest slope over its ray's pieces is the largest of
+ *  - the slope at each piece's end (where the ray crosses a grid line, so
+ *    the height there is read off that edge's two nodes: cm_fast_cross),
+ *  - the ray's start (the surface's own slope there: cm_fast_start), and
+ *  - a piece's inner peak, where the slope along it rises and then falls
+ *    (cm_fast_peak_test; then cm_fast_peak).
+ * Per piece, the constants depend only on the direction (cm_fast_piece).
+ * Every backend takes the same float operations and folds the maximum,
+ * which does not depend on the order, then adds +0 (a -0 becomes +0), so
+ * that the bits agree. A corner with nodata or an infinity makes the
+ * twist (cm_fast_twist) not finite: the caller then flags the cell and
+ * redoes it with cm_near_exact.
  */
 typedef struct {
-    float a0, b0, sa, sb, inv_b, cb, cLL, invL, ka, kb, kc, ca;
-    int has_sa;
+    float a0, b0;      /* the cell in the piece's patch */
+    float sa, sb;      /* the piece's ends, in steps */
+    float inv_b, cb;   /* 1 / (sb L) and the curvature term at sb */
+    float cLL, invL;
+    int e0, e1;        /* the end's edge: corners (0: 00, 1: 10, 2: 01, 3: 11) */
+    float frac;        /* where along it, from e0 */
+    float ka, kbn;     /* the inner-peak test's factors (cm_fast_peak_test) */
+    int has_sa;        /* the piece starts beyond the cell: it may have a peak */
 } cm_fast_piece;
 
 CM_FN cm_fast_piece cm_fast_piece_init(int du, int dv, int flat_v, cm_real sa, cm_real sb,
-                                       float L, float c)
+                                       cm_real t, float L, float c)
 {
     cm_fast_piece q;
     q.a0 = (float)-du;
@@ -264,37 +279,83 @@ CM_FN cm_fast_piece cm_fast_piece_init(int du, int dv, int flat_v, cm_real sa, c
     q.cb = c * q.sb * L;
     q.cLL = c * L * L;
     q.invL = 1.0f / L;
-    /* fa = P ka + beta kb + gamma kc - ca; at s = 0 it is the limit
-     * beta / L, since P is 0 there. */
     q.has_sa = q.sa > 0;
-    q.ka = q.has_sa ? 1.0f / (q.sa * L) : 0.0f;
-    q.kb = q.has_sa ? q.sa * q.ka : q.invL;
-    q.kc = q.has_sa ? q.sa * q.sa * q.ka : 0.0f;
-    q.ca = q.has_sa ? c * q.sa * L : 0.0f;
+    /* The end in the patch's (a, b): on its edge a = 0 (a new step) or on
+     * b = 0 or 1 (a new row); the nearer node first, so that an end on a
+     * corner reads that corner exactly. */
+    const cm_real ae = -sb - du, be = flat_v ? 0 : -t * sb - dv;
+    cm_real f;
+    if (fabs(ae) < CM_R(1e-9)) {
+        q.e0 = 0;
+        q.e1 = 2;
+        f = be;
+    } else {
+        q.e0 = be < CM_R(0.5) ? 0 : 2;
+        q.e1 = q.e0 + 1;
+        f = ae;
+    }
+    if (f > CM_R(0.5)) {
+        const int e = q.e0;
+        q.e0 = q.e1;
+        q.e1 = e;
+        f = CM_R(1.0) - f;
+    }
+    q.frac = f > CM_R(0.0) ? (float)f : 0.0f;
+    /* With D = (slope at sa) - (slope at sb) and g2 = gamma - c L^2, the
+     * slope P / s + beta + gamma s - c L^2 s (over L) peaks inside the piece,
+     * at s^2 = P / g2 in (sa^2, sb^2), exactly where g2 < 0 and
+     * g2 (sb - sa)^2 / (sa L) < D < -g2 (sb - sa)^2 / (sb L). */
+    const cm_real d2 = (sb - sa) * (sb - sa);
+    q.ka = q.has_sa ? (float)(d2 / (sa * L)) : 0.0f;
+    q.kbn = q.has_sa ? (float)(-d2 / (sb * L)) : 0.0f;
     return q;
 }
 
-/* The piece's largest slope from a cell at height h, corners c00..c11;
- * branch-free, so that loops over cells vectorise. */
-CM_FN float cm_fast_piece_slope(cm_fast_piece q, float t, float c00, float c10, float c01,
-                                float c11, float h, float L, float c)
+/* The patch's twist c11 - c10 - c01 + c00: not finite where a corner is
+ * nodata or infinite. */
+CM_FN float cm_fast_twist(float c00, float c10, float c01, float c11)
 {
-    float A = c10 - c00, B = c01 - c00;
-    float X = c11 - c10 - c01 + c00;
-    float alpha = c00 + A * q.a0 + B * q.b0 + X * q.a0 * q.b0;
-    float beta = -(A + B * t + X * (q.a0 * t + q.b0));
-    float gamma = X * t;
-    float P = alpha - h;
-    float fb = (P + beta * q.sb + gamma * q.sb * q.sb) * q.inv_b - q.cb;
-    float fa = P * q.ka + beta * q.kb + gamma * q.kc - q.ca;
-    float m = fa > fb ? fa : fb;
-    float g2 = gamma - q.cLL;
-    float r = P / g2;
-    float ss = CM_SQRTF(r > 0.0f ? r : 0.0f);
-    float sd = ss > 0.0f ? ss : 1.0f;
-    float fs = (P / sd + beta + gamma * ss) * q.invL - c * ss * L;
-    int inner = q.has_sa & (P < 0.0f) & (g2 < 0.0f) & (ss > q.sa) & (ss < q.sb) & (fs > m);
-    return inner ? fs : m;
+    return c11 - c10 - c01 + c00;
+}
+
+/* The slope at the piece's end from a cell at height h, n0 and n1 its
+ * edge's nodes (corners e0, e1). */
+CM_FN float cm_fast_cross(cm_fast_piece q, float n0, float n1, float h)
+{
+    /* the height above the cell's: n0 - h first, exact for nearby heights */
+    return ((n0 - h) + (n1 - n0) * q.frac) * q.inv_b - q.cb;
+}
+
+/* The ray's start (piece 0, sa = 0): the limit of the slope, the surface's
+ * own slope along the ray. */
+CM_FN float cm_fast_start(cm_fast_piece q, float t, float c00, float c10, float c01, float c11)
+{
+    const float A = c10 - c00, B = c01 - c00, X = cm_fast_twist(c00, c10, c01, c11);
+    const float beta = -(A + B * t + X * (q.a0 * t + q.b0));
+    return beta * q.invL;
+}
+
+/* Whether the piece (has_sa) peaks inside: X its twist, fa and fb the
+ * slopes at its ends. */
+CM_FN int cm_fast_peak_test(cm_fast_piece q, float t, float X, float fa, float fb)
+{
+    const float g2 = X * t - q.cLL, D = fa - fb;
+    return (g2 < 0.0f) & (D > g2 * q.ka) & (D < g2 * q.kbn);
+}
+
+/* The slope at the piece's inner peak (cm_fast_peak_test), its distance
+ * held inside the piece. */
+CM_FN float cm_fast_peak(cm_fast_piece q, float t, float c00, float c10, float c01, float c11,
+                         float h, float L, float c)
+{
+    const float A = c10 - c00, B = c01 - c00, X = cm_fast_twist(c00, c10, c01, c11);
+    const float alpha = c00 + A * q.a0 + B * q.b0 + X * q.a0 * q.b0;
+    const float beta = -(A + B * t + X * (q.a0 * t + q.b0));
+    const float gamma = X * t, P = alpha - h, g2 = gamma - q.cLL;
+    float ss = CM_SQRTF(P / g2 > 0.0f ? P / g2 : 0.0f);
+    ss = ss > q.sa ? ss : q.sa;
+    ss = ss < q.sb ? ss : q.sb;
+    return (P / ss + beta + gamma * ss) * q.invL - c * ss * L;
 }
 
 #endif
