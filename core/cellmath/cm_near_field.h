@@ -352,7 +352,8 @@ CM_FN float cm_fast_peak(cm_fast_piece q, float t, float c00, float c10, float c
     const float alpha = c00 + A * q.a0 + B * q.b0 + X * q.a0 * q.b0;
     const float beta = -(A + B * t + X * (q.a0 * t + q.b0));
     const float gamma = X * t, P = alpha - h, g2 = gamma - q.cLL;
-    float ss = CM_SQRTF(P / g2 > 0.0f ? P / g2 : 0.0f);
+    const float r = P / g2;
+    float ss = CM_SQRTF(r > 0.0f ? r : 0.0f);
     ss = ss > q.sa ? ss : q.sa;
     ss = ss < q.sb ? ss : q.sb;
     return (P / ss + beta + gamma * ss) * q.invL - c * ss * L;
