@@ -2,6 +2,7 @@
  * per-cell formulas are core/cellmath/cm_near_field.h, shared with the
  * OpenCL kernels; this file holds the plan and the C loops. */
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 
 #include "near_field.h"
@@ -139,9 +140,12 @@ void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
                  const float *zrow, int y, int x0, int x1, double step, double c,
                  float *out, float *scratch)
 {
-    float *best = scratch, *flag = scratch + x1;
-    if (!ts_near_run_avx512(p, zrow, x0, x1, (float)step, (float)c, best, flag, scratch + 2 * x1))
-        near_run(p, zrow, x0, x1, (float)step, (float)c, best, flag, scratch + 2 * x1);
+    /* best in zrow's phase on 64-byte lines (ts_near_run_avx512's aligned
+     * vectors) */
+    const size_t phase = (((uintptr_t)zrow - (uintptr_t)scratch) / sizeof(float)) & 15;
+    float *best = scratch + phase, *flag = best + x1, *queue = flag + x1;
+    if (!ts_near_run_avx512(p, zrow, x0, x1, (float)step, (float)c, best, flag, queue))
+        near_run(p, zrow, x0, x1, (float)step, (float)c, best, flag, queue);
     if (!near_merge(zrow, best, flag, x0, x1, out))
         return;
     /* cells whose near field touches nodata: the scalar near field */

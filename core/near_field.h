@@ -53,7 +53,7 @@ float ts_ray_exact(const ts_line_geom *g, const float *z, int k, int i, float h,
  * Cells whose near field touches nodata are redone by ts_near_field.
  * scratch: TS_NEAR_ROW_SCRATCH(x1) floats.
  */
-#define TS_NEAR_ROW_SCRATCH(x1) (7 * (size_t)(x1) + 80)
+#define TS_NEAR_ROW_SCRATCH(x1) (7 * (size_t)(x1) + 160)
 void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
                  const float *zrow, int y, int x0, int x1, double step, double c,
                  float *out, float *scratch);

@@ -2,6 +2,7 @@
  * each piece's inner peak solved only for the few cells that have one;
  * see near_run512.h. */
 #include <math.h>
+#include <stdint.h>
 
 #include "near_run512.h"
 #include "lane_hull.h"
@@ -73,7 +74,7 @@ TS_AVX512 static void piece_peaks(const cm_fast_piece *q, float t, float L, floa
  * block by block in turn (two shorter chains of counts), nq their counts. */
 TS_AVX512 static inline __attribute__((always_inline)) void
 piece_cells(const cm_fast_piece *q, const float *const cn[4], const int e0, const int e1,
-            float t, const float *restrict zrow, int x0, int x1, float *restrict best,
+            float t, const float *restrict zrow, int xs, int x0, int x1, float *restrict best,
             float *restrict flag, float *restrict prev, int *const qx[2], int nq[2])
 {
     const __m512 tv = _mm512_set1_ps(t), one = _mm512_set1_ps(1.0f);
@@ -84,8 +85,8 @@ piece_cells(const cm_fast_piece *q, const float *const cn[4], const int e0, cons
     const __m512 ka = _mm512_set1_ps(q->ka), kbn = _mm512_set1_ps(q->kbn);
     const __m512 xt = _mm512_set1_ps(q->a0 * t + q->b0), invL = _mm512_set1_ps(q->invL);
     const int has_sa = q->has_sa;
-    for (int x = x0; x < x1; x += 16) {
-        const __mmask16 lanes = ts_first_lanes16(x1 - x);
+    for (int x = xs; x < x1; x += 16) {
+        const __mmask16 lanes = ts_first_lanes16(x1 - x) & ~ts_first_lanes16(x0 - x);
         __m512 c[4];
         for (int i = 0; i < 4; i++)
             c[i] = _mm512_maskz_loadu_ps(lanes, cn[i] + x);
@@ -108,7 +109,7 @@ piece_cells(const cm_fast_piece *q, const float *const cn[4], const int e0, cons
             __mmask16 k = _mm512_mask_cmp_ps_mask(lanes, g2, _mm512_setzero_ps(), _CMP_LT_OQ);
             k = _mm512_mask_cmp_ps_mask(k, D, _mm512_mul_ps(g2, ka), _CMP_GT_OQ);
             k = _mm512_mask_cmp_ps_mask(k, D, _mm512_mul_ps(g2, kbn), _CMP_LT_OQ);
-            const int b = ((x - x0) >> 4) & 1;
+            const int b = ((x - xs) >> 4) & 1;
             _mm512_storeu_si512(qx[b] + nq[b],
                                 _mm512_maskz_compress_epi32(
                                     k, _mm512_add_epi32(_mm512_set1_epi32(x), step)));
@@ -129,10 +130,17 @@ TS_AVX512 static void run(const ts_near_plan *p, const float *restrict zrow, int
                           float L, float c, float *restrict best, float *restrict flag,
                           float *restrict queue)
 {
-    const int len = x1 - x0;
-    /* the slopes at the previous piece's end by cell; the queued cells */
-    float *prev = queue - x0;
-    int *const qx[2] = {(int *)(queue + (len + 16)), (int *)(queue + (len + 16)) + len / 2 + 32};
+    /* The cells' vectors start where zrow's heights start a 64-byte line
+     * (the first one's lanes below x0 masked off), so that the loads of h,
+     * and of best and prev where the caller put best in zrow's phase, do
+     * not straddle two lines: 3-10 % of the run (docs/performance.md). */
+    const int xs = x0 - (int)(((uintptr_t)(zrow + x0) / sizeof(float)) & 15);
+    const int len = x1 - xs;
+    /* the slopes at the previous piece's end by cell (in zrow's phase too);
+     * the queued cells */
+    float *prev = (float *)(((uintptr_t)queue + 63) & ~(uintptr_t)63) - xs;
+    int *const q0 = (int *)(prev + xs + len + 16);
+    int *const qx[2] = {q0, q0 + len / 2 + 32};
     for (int x = x0; x < x1; x++) {
         best[x] = -INFINITY;
         flag[x] = 0.0f;
@@ -146,7 +154,7 @@ TS_AVX512 static void run(const ts_near_plan *p, const float *restrict zrow, int
         int nq[2] = {0, 0};
         /* the end's edge: 00-01 (a new step), 00-10 or 01-11 (a new row) */
 #define PIECE_CELLS(a, b)                                                                      \
-    piece_cells(&q, cn, a, b, t, zrow, x0, x1, best, flag, prev, qx, nq)
+    piece_cells(&q, cn, a, b, t, zrow, xs, x0, x1, best, flag, prev, qx, nq)
         switch (q.e0 * 4 + q.e1) {
         case 0 * 4 + 2: PIECE_CELLS(0, 2); break;
         case 2 * 4 + 0: PIECE_CELLS(2, 0); break;

@@ -14,9 +14,10 @@
 #include "near_field.h"
 
 /* near_run over cells x0 <= x < x1 (best[x], flag[x] as near_run leaves
- * them); queue: 2 (x1 - x0) + 64 floats of scratch (the previous piece's
- * slopes, then two queues of cells). Returns 0, having done
- * nothing, where the CPU (or the build) has no AVX-512. */
+ * them; faster where best + x and zrow + x lie alike on 64-byte lines);
+ * queue: 2 (x1 - x0) + 128 floats of scratch (the previous piece's slopes,
+ * then two queues of cells). Returns 0, having done nothing, where the CPU
+ * (or the build) has no AVX-512. */
 int ts_near_run_avx512(const ts_near_plan *p, const float *restrict zrow, int x0, int x1,
                        float L, float c, float *restrict best, float *restrict flag,
                        float *restrict queue);
