@@ -441,8 +441,9 @@ static ts_status fold_tables(swath_ctx *C, const double *az_start, ts_error *err
         ok = (C->fold_share = calloc((size_t)slots, sizeof *C->fold_share)) != NULL;
     for (int k = 0; ok && k < slots; k++) {
         size_t nodes = slot_interior(s, k) ? (size_t)S * S : (size_t)S;
+        /* a node's 16 floats on one cache line, not across two */
         if (C->fold_shade)
-            ok = (C->fold_shade[k] = malloc(nodes * N * sizeof(float))) != NULL;
+            ok = (C->fold_shade[k] = aligned_alloc(64, nodes * N * sizeof(float))) != NULL;
         if (ok && C->fold_share)
             ok = (C->fold_share[k] = malloc(nodes * sizeof(float))) != NULL;
         if (ok)
