@@ -196,10 +196,12 @@ ts_status ts_sh_wedges_build(const ts_sh_swath *s, int threads, ts_sh_wedges *w,
                        "extent of at most 360 degrees");
     w->swath = *s;
     w->threads = threads;
-    w->interior = malloc(sizeof(float) * N_STEPS * N_STEPS * TS_SH_COEFFS);
+    /* each node's 16 floats on one 64-byte cache line, as the folded tables
+     * (core/sh_swath_light.c): malloc's 16-byte alignment splits every read */
+    w->interior = aligned_alloc(64, sizeof(float) * N_STEPS * N_STEPS * TS_SH_COEFFS);
     if (!s->complete) {
-        w->rise = malloc(sizeof(float) * N_STEPS * TS_SH_COEFFS);
-        w->fall = malloc(sizeof(float) * N_STEPS * TS_SH_COEFFS);
+        w->rise = aligned_alloc(64, sizeof(float) * N_STEPS * TS_SH_COEFFS);
+        w->fall = aligned_alloc(64, sizeof(float) * N_STEPS * TS_SH_COEFFS);
     }
     if (!w->interior || (!s->complete && (!w->rise || !w->fall))) {
         ts_sh_wedges_free(w);
