@@ -160,14 +160,14 @@ void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
     }
 }
 
-/* cm_near_exact over cells x0 <= x < x1 of a row whose every piece is on
- * the grid: the pieces before smax steps (with sb cut there), each by
- * cm_near_piece's arithmetic for corners without nodata, in loops the
- * compiler vectorises; cells with a nodata corner (where cm_near_piece
- * takes its other branch) are flagged. best: doubles. */
+/* cm_near_exact over cells x0 <= x < x1 of a row whose pieces before
+ * n_end are on the grid: those pieces before smax steps (with sb cut
+ * there), each by cm_near_piece's arithmetic for corners without nodata,
+ * in loops the compiler vectorises; cells with a nodata corner (where
+ * cm_near_piece takes its other branch) are flagged. best: doubles. */
 TS_SIMD_CLONES
 static void exact_run(const ts_near_plan *p, const float *restrict zrow, int x0, int x1,
-                      double smax, double L, double c, double *restrict best,
+                      int n_end, double smax, double L, double c, double *restrict best,
                       float *restrict flag)
 {
     for (int x = x0; x < x1; x++) {
@@ -176,7 +176,7 @@ static void exact_run(const ts_near_plan *p, const float *restrict zrow, int x0,
     }
     const int flat_v = fabs(p->t) <= 1e-12; /* along a grid line: 01, 11 weigh nothing */
     const double t = flat_v ? 0 : p->t;
-    for (int n = 0; n < p->npieces && p->piece_sa[n] < smax; n++) {
+    for (int n = 0; n < n_end && p->piece_sa[n] < smax; n++) {
         const float *restrict c00 = zrow + p->piece_off[n][0];
         const float *restrict c10 = zrow + p->piece_off[n][1];
         const float *restrict c01 = flat_v ? c00 : zrow + p->piece_off[n][2];
@@ -211,6 +211,24 @@ static int near_on_grid(const ts_near_plan *p, const ts_line_geom *g, int y, int
     return k + p->du_min >= 0 && i + p->dv_min >= 0 && i + p->dv_max <= g->V - 1;
 }
 
+/* The first piece of cell x of row y whose patch is off the grid, as
+ * cm_near_exact tests them (npieces: none). */
+static int near_first_off(const ts_near_plan *p, const ts_line_geom *g, int y, int x)
+{
+    int u = g->x_major ? x : y, i = g->x_major ? y : x, k = (u - g->u_start) * g->u_step;
+    const int V = g->V, flat_v = fabs(p->t) <= 1e-12;
+    for (int n = 0; n < p->npieces; n++) {
+        const int k0 = k + p->piece_du[n], r0 = i + p->piece_dv[n];
+        if (k0 < 0 || r0 < 0 || r0 > V - 1 || (!flat_v && r0 + 1 > V - 1))
+            return n;
+    }
+    return p->npieces;
+}
+
+/* Cells whose rays leave the grid at the same piece (along an edge the
+ * ray heads for) take exact_run from this many on; fewer, ts_near_field. */
+#define OFF_RUN_MIN 8
+
 void ts_near_edges(const ts_near_plan *p, const ts_line_geom *g, const float *z,
                    const float *zrow, int y, int xa, int xb, int W, double step, double c,
                    double cap, float *out, float *scratch)
@@ -218,6 +236,9 @@ void ts_near_edges(const ts_near_plan *p, const ts_line_geom *g, const float *z,
     double *best = (double *)scratch;
     float *flag = scratch + 2 * (size_t)W;
     const double smax = cap > 0 ? cap / step : INFINITY; /* as cm_near_exact */
+    int nsmax = 0; /* the first piece cm_near_exact stops at for the cap */
+    while (nsmax < p->npieces && p->piece_sa[nsmax] < smax)
+        nsmax++;
     for (int x = 0; x < W;) {
         if (x == xa) {
             x = xb;
@@ -229,7 +250,7 @@ void ts_near_edges(const ts_near_plan *p, const ts_line_geom *g, const float *z,
         while (x1 < end && near_on_grid(p, g, y, x1))
             x1++;
         if (x1 > x) {
-            exact_run(p, zrow, x, x1, smax, step, c, best, flag);
+            exact_run(p, zrow, x, x1, p->npieces, smax, step, c, best, flag);
             for (; x < x1; x++) {
                 if (isnan(zrow[x]))
                     continue;
@@ -239,13 +260,34 @@ void ts_near_edges(const ts_near_plan *p, const ts_line_geom *g, const float *z,
                                : near_cell(p, g, z, zrow, y, x, step, c, cap, &left);
                 out[x] = fmaxf(nf, out[x]);
             }
-        } else { /* a piece off the grid: ts_near_field tells where the ray left */
+            continue;
+        }
+        /* a piece off the grid: the run of cells whose rays leave at the
+         * same piece off; cm_near_exact returns what it found before it,
+         * and says the ray left where the cap did not stop it first */
+        const int off = near_first_off(p, g, y, x);
+        x1 = x + 1;
+        while (x1 < end && !near_on_grid(p, g, y, x1) && near_first_off(p, g, y, x1) == off)
+            x1++;
+        if (x1 - x >= OFF_RUN_MIN) {
+            exact_run(p, zrow, x, x1, off, smax, step, c, best, flag);
+            const int left_all = off < p->npieces && off <= nsmax;
+            for (; x < x1; x++) {
+                if (isnan(zrow[x]))
+                    continue;
+                int left = left_all;
+                float nf = flag[x] == 0.0f
+                               ? (float)best[x]
+                               : near_cell(p, g, z, zrow, y, x, step, c, cap, &left);
+                out[x] = left ? nf : fmaxf(nf, out[x]);
+            }
+            continue;
+        }
+        for (; x < x1; x++) /* ts_near_field tells where the ray left */
             if (!isnan(zrow[x])) {
                 int left;
                 float nf = near_cell(p, g, z, zrow, y, x, step, c, cap, &left);
                 out[x] = left ? nf : fmaxf(nf, out[x]);
             }
-            x++;
-        }
     }
 }

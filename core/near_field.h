@@ -62,10 +62,11 @@ void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
  * Near field of the cells of row y outside [xa, xb) (the interior that
  * ts_near_row does), cap as ts_near_field: out[x] = the near field where
  * the ray leaves the grid inside it, else max(out[x], near field). Cells
- * whose near field lies on the grid and touches no nodata take the
- * vectorised form of ts_near_field's double arithmetic, the others
- * ts_near_field itself; the same bits either way. scratch: 4 W floats
- * (TS_NEAR_ROW_SCRATCH(W) is more).
+ * that touch no nodata take the vectorised form of ts_near_field's double
+ * arithmetic in runs: of cells whose pieces all lie on the grid, and of at
+ * least 8 cells whose rays leave the grid at the same piece (the pieces
+ * before it); the others take ts_near_field itself; the same bits either
+ * way. scratch: 3 W floats (TS_NEAR_ROW_SCRATCH(W) is more).
  */
 void ts_near_edges(const ts_near_plan *p, const ts_line_geom *g, const float *z,
                    const float *zrow, int y, int xa, int xb, int W, double step, double c,
