@@ -128,23 +128,24 @@ static inline int edge_stays(float v, float z, int skip_nonneg, int above_stays)
  * scalar loop runs only over the chunks that hold one. */
 #define EDGE_CHUNK 64
 
-/* need[i]: whether some cell of chunk i of the row (EDGE_CHUNK cells from
- * i * EDGE_CHUNK) needs edge_raise; returns whether any does. Branch-free
- * per chunk, so that a chunk where none does is one vectorised pass. */
+/* ts_edge_span_row's cells x0 <= x < x1: each chunk first tested
+ * branch-free, so that a chunk where no cell needs edge_raise is one
+ * vectorised pass, not a scalar loop. */
 TS_SIMD_CLONES
-static int chunks_need_raise(const float *restrict row, const float *restrict z, int w,
-                             int skip_nonneg, int above_stays, unsigned char *restrict need)
+static void raise_span(const ts_edge_job *j, int y, float *restrict row, const float *restrict z,
+                       int x0, int x1, int skip_nonneg, int above_stays)
 {
-    int any = 0;
-    for (int c0 = 0, i = 0; c0 < w; c0 += EDGE_CHUNK, i++) {
-        const int c1 = w - c0 < EDGE_CHUNK ? w : c0 + EDGE_CHUNK;
-        int n = 0;
+    for (int c0 = x0; c0 < x1; c0 += EDGE_CHUNK) {
+        const int c1 = x1 - c0 < EDGE_CHUNK ? x1 : c0 + EDGE_CHUNK;
+        int need = 0;
         for (int x = c0; x < c1; x++)
-            n |= !edge_stays(row[x], z[x], skip_nonneg, above_stays);
-        need[i] = (unsigned char)n;
-        any |= n;
+            need |= !edge_stays(row[x], z[x], skip_nonneg, above_stays);
+        if (!need)
+            continue;
+        for (int x = c0; x < c1; x++)
+            if (!edge_stays(row[x], z[x], skip_nonneg, above_stays))
+                row[x] = edge_raise(j, x, y, row[x]);
     }
-    return any;
 }
 
 void ts_edge_span(const ts_edge_job *j, int y, int x0, int x1)
@@ -155,21 +156,8 @@ void ts_edge_span(const ts_edge_job *j, int y, int x0, int x1)
 void ts_edge_span_row(const ts_edge_job *j, int y, float *row, int x0, int x1)
 {
     const int above_stays = j->opts->edge == TS_EDGE_HORIZON && j->c >= 0;
-    const float *z = j->grid->z + (ptrdiff_t)y * j->grid->stride;
-    unsigned char need[256];
-    for (int s0 = x0; s0 < x1; s0 += 256 * EDGE_CHUNK) {
-        const int s1 = x1 - s0 < 256 * EDGE_CHUNK ? x1 : s0 + 256 * EDGE_CHUNK;
-        if (!chunks_need_raise(row + s0, z + s0, s1 - s0, j->skip_nonneg, above_stays, need))
-            continue;
-        for (int c0 = s0, i = 0; c0 < s1; c0 += EDGE_CHUNK, i++) {
-            if (!need[i])
-                continue;
-            const int c1 = s1 - c0 < EDGE_CHUNK ? s1 : c0 + EDGE_CHUNK;
-            for (int x = c0; x < c1; x++)
-                if (!edge_stays(row[x], z[x], j->skip_nonneg, above_stays))
-                    row[x] = edge_raise(j, x, y, row[x]);
-        }
-    }
+    raise_span(j, y, row, j->grid->z + (ptrdiff_t)y * j->grid->stride, x0, x1, j->skip_nonneg,
+               above_stays);
 }
 
 void ts_edge_row(const ts_edge_job *j, int y)
