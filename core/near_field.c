@@ -217,11 +217,9 @@ static int near_first_off(const ts_near_plan *p, const ts_line_geom *g, int y, i
 {
     int u = g->x_major ? x : y, i = g->x_major ? y : x, k = (u - g->u_start) * g->u_step;
     const int V = g->V, flat_v = fabs(p->t) <= 1e-12;
-    for (int n = 0; n < p->npieces; n++) {
-        const int k0 = k + p->piece_du[n], r0 = i + p->piece_dv[n];
-        if (k0 < 0 || r0 < 0 || r0 > V - 1 || (!flat_v && r0 + 1 > V - 1))
+    for (int n = 0; n < p->npieces; n++)
+        if (cm_piece_off_grid(k + p->piece_du[n], i + p->piece_dv[n], V, flat_v))
             return n;
-    }
     return p->npieces;
 }
 
@@ -244,50 +242,38 @@ void ts_near_edges(const ts_near_plan *p, const ts_line_geom *g, const float *z,
             x = xb;
             continue;
         }
-        /* the run of cells from x whose pieces are all on the grid, together */
+        /* the run of cells from x whose pieces are all on the grid, or
+         * else whose rays leave it at the same piece n_end, together;
+         * cm_near_exact returns what it found before that piece, and says
+         * the ray left where the cap did not stop it first */
         const int end = x < xa ? xa : W;
-        int x1 = x;
+        int x1 = x, n_end = p->npieces, left_all = 0;
         while (x1 < end && near_on_grid(p, g, y, x1))
             x1++;
-        if (x1 > x) {
-            exact_run(p, zrow, x, x1, p->npieces, smax, step, c, best, flag);
-            for (; x < x1; x++) {
-                if (isnan(zrow[x]))
-                    continue;
-                int left; /* 0 on the grid */
-                float nf = flag[x] == 0.0f
-                               ? (float)best[x]
-                               : near_cell(p, g, z, zrow, y, x, step, c, cap, &left);
-                out[x] = fmaxf(nf, out[x]);
+        if (x1 == x) {
+            n_end = near_first_off(p, g, y, x);
+            x1 = x + 1;
+            while (x1 < end && !near_on_grid(p, g, y, x1) && near_first_off(p, g, y, x1) == n_end)
+                x1++;
+            left_all = n_end < p->npieces && n_end <= nsmax;
+            if (x1 - x < OFF_RUN_MIN) {
+                for (; x < x1; x++) /* ts_near_field tells where the ray left */
+                    if (!isnan(zrow[x])) {
+                        int left;
+                        float nf = near_cell(p, g, z, zrow, y, x, step, c, cap, &left);
+                        out[x] = left ? nf : fmaxf(nf, out[x]);
+                    }
+                continue;
             }
-            continue;
         }
-        /* a piece off the grid: the run of cells whose rays leave at the
-         * same piece off; cm_near_exact returns what it found before it,
-         * and says the ray left where the cap did not stop it first */
-        const int off = near_first_off(p, g, y, x);
-        x1 = x + 1;
-        while (x1 < end && !near_on_grid(p, g, y, x1) && near_first_off(p, g, y, x1) == off)
-            x1++;
-        if (x1 - x >= OFF_RUN_MIN) {
-            exact_run(p, zrow, x, x1, off, smax, step, c, best, flag);
-            const int left_all = off < p->npieces && off <= nsmax;
-            for (; x < x1; x++) {
-                if (isnan(zrow[x]))
-                    continue;
-                int left = left_all;
-                float nf = flag[x] == 0.0f
-                               ? (float)best[x]
-                               : near_cell(p, g, z, zrow, y, x, step, c, cap, &left);
-                out[x] = left ? nf : fmaxf(nf, out[x]);
-            }
-            continue;
+        exact_run(p, zrow, x, x1, n_end, smax, step, c, best, flag);
+        for (; x < x1; x++) {
+            if (isnan(zrow[x]))
+                continue;
+            int left = left_all; /* near_cell's too: 0 on the grid */
+            float nf = flag[x] == 0.0f ? (float)best[x]
+                                       : near_cell(p, g, z, zrow, y, x, step, c, cap, &left);
+            out[x] = left ? nf : fmaxf(nf, out[x]);
         }
-        for (; x < x1; x++) /* ts_near_field tells where the ray left */
-            if (!isnan(zrow[x])) {
-                int left;
-                float nf = near_cell(p, g, z, zrow, y, x, step, c, cap, &left);
-                out[x] = left ? nf : fmaxf(nf, out[x]);
-            }
     }
 }

@@ -121,6 +121,14 @@ CM_FN cm_real cm_near_piece(float hc0, float hc1, float hc2, float hc3, cm_real 
     return cm_piece_max(alpha - h, beta, gamma, sa, sb, L, c);
 }
 
+/* Whether the patch of a piece with corner (k0, r0) leaves the grid of V
+ * cells across (its 01 and 11 corners too, unless the ray runs along a
+ * grid line: flat_v). */
+CM_FN int cm_piece_off_grid(int k0, int r0, int V, int flat_v)
+{
+    return k0 < 0 || r0 < 0 || r0 > V - 1 || (!flat_v && r0 + 1 > V - 1);
+}
+
 /*
  * Exact near field of cell (k, i) at height h: the largest slope over its
  * pieces, within cap metres (0 = none); step:
@@ -137,7 +145,7 @@ CM_FN float cm_near_exact(const cm_ray_grid *r, const cm_near_tables *q, int k, 
     *left = 0;
     for (int n = 0; n < q->npieces; n++) {
         int k0 = k + q->du[n], r0 = i + q->dv[n];
-        if (k0 < 0 || r0 < 0 || r0 > V - 1 || (!flat_v && r0 + 1 > V - 1)) {
+        if (cm_piece_off_grid(k0, r0, V, flat_v)) {
             *left = 1;
             return (float)best;
         }
