@@ -67,6 +67,18 @@ static void lane_distances(const sweep_ctx *C, sweep_ws *w, int k, int i0, int j
     }
 }
 
+/* stack_query, the occluder's step from its distance where s->k_step says
+ * so (as lane_hull.c's query: the vector steps leave the points' steps
+ * unwritten then). */
+static inline occluder lane_query(const ts_lane_step *s, const hull_pt *S, int far, double d,
+                                  double g)
+{
+    if (far < 0 || !(s->k_step > 0))
+        return stack_query(S, far, d, g);
+    const double dd = d - S[stack_tangent(S, far, d, g)].d;
+    return (occluder){s->k - (int)nearbyint(dd * (1.0 / s->k_step)), (float)dd};
+}
+
 /* ts_lane_hull_step in scalar code, line by line. */
 static void lane_hulls_scalar(const ts_lane_hulls *h, const ts_lane_step *s,
                               const ts_lane_occluders *occ)
@@ -89,9 +101,9 @@ static void lane_hulls_scalar(const ts_lane_hulls *h, const ts_lane_step *s,
         }
         const int far = h->far[j];
         occluder hi = !isnan(hc) && j >= s->hi_from && j <= s->hi_to
-                          ? stack_query(S, far, d, hc - c * d * d)
+                          ? lane_query(s, S, far, d, hc - c * d * d)
                           : none;
-        occluder lo = !isnan(hn) ? stack_query(S, far, d, hn - c * d * d) : none;
+        occluder lo = !isnan(hn) ? lane_query(s, S, far, d, hn - c * d * d) : none;
         occ->hi_k[j] = hi.k;
         occ->hi_dd[j] = hi.dd;
         occ->lo_k[j + 1] = lo.k;
@@ -158,7 +170,9 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         w->lo_dd[j0] = lo0.dd;
         const int last_inside = G->fr[k] == 0.0f ? j1 : G->V - 2 - (int)i0;
         ts_lane_step step = {k, j0, j1, prime, last_inside, w->lane_d, w->hs, w->hc,
-                             w->hn, c, C->near_skip, NULL, NULL, NULL};
+                             w->hn, c, C->near_skip, NULL, NULL, NULL, 0.0};
+        if (!G->step_row && C->far_T <= 0) /* lane_distances' products */
+            step.k_step = G->step_m;
         if (C->far_T > 0) {
             /* far-only: the hulls take the samples far_T behind, one per
              * line and pass (the passes' queries are the same: the last

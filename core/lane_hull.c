@@ -212,7 +212,8 @@ ALWAYS void advance(int Q, const group *G, const __mmask8 *lanes, __m256i *far,
  * first pass, the same operations); long_walks: where they do not (the
  * hybrid's hulls, all of whose points lie beyond the near field). */
 ALWAYS void query(int Q, const group *const *G, const __mmask8 *m, const __m256i *far,
-                  const __m512d *g, int long_walks, __m256i *k_out, __m256 *dd_out)
+                  const __m512d *g, int long_walks, int k_now, double k_step, __m256i *k_out,
+                  __m256 *dd_out)
 {
     const __m256i zero = _mm256_setzero_si256(), one = _mm256_set1_epi32(1);
     __mmask8 ok[QMAX], active[QMAX];
@@ -238,13 +239,25 @@ ALWAYS void query(int Q, const group *const *G, const __mmask8 *m, const __m256i
     }
     walk_down(Q, G, g, active, j, dj, gj, long_walks);
     for (int q = 0; q < Q; q++) {
-        /* the step k of point j: ints 6 (first + j) + 4 */
-        const __m256i j3 = times3(_mm256_add_epi32(G[q]->first, j[q]));
-        __m256i ki = _mm256_add_epi32(_mm256_slli_epi32(j3, 1), _mm256_set1_epi32(4));
-        __m512i k = _mm512_mask_i32gather_epi32(_mm512_set1_epi32(-1), (__mmask16)ok[q],
-                                                _mm512_castsi256_si512(ki), G[q]->pk, 4);
-        k_out[q] = _mm512_castsi512_si256(k);
-        dd_out[q] = _mm512_maskz_cvtpd_ps(ok[q], _mm512_sub_pd(G[q]->d, dj[q]));
+        const __m512d dd = _mm512_sub_pd(G[q]->d, dj[q]);
+        if (k_step > 0) {
+            /* the step k of point j from its distance: k_now - dd / k_step,
+             * rounded to the nearest (dd / k_step lies within ~1e-12 of an
+             * integer) */
+            const __m256i lag = _mm512_cvt_roundpd_epi32(
+                _mm512_mul_pd(dd, _mm512_set1_pd(1.0 / k_step)),
+                _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+            k_out[q] = _mm256_mask_sub_epi32(_mm256_set1_epi32(-1), ok[q],
+                                             _mm256_set1_epi32(k_now), lag);
+        } else {
+            /* the step k of point j: ints 6 (first + j) + 4 */
+            const __m256i j3 = times3(_mm256_add_epi32(G[q]->first, j[q]));
+            __m256i ki = _mm256_add_epi32(_mm256_slli_epi32(j3, 1), _mm256_set1_epi32(4));
+            __m512i k = _mm512_mask_i32gather_epi32(_mm512_set1_epi32(-1), (__mmask16)ok[q],
+                                                    _mm512_castsi256_si512(ki), G[q]->pk, 4);
+            k_out[q] = _mm512_castsi512_si256(k);
+        }
+        dd_out[q] = _mm512_maskz_cvtpd_ps(ok[q], dd);
     }
 }
 
@@ -315,8 +328,9 @@ AVX512VL static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, 
         const __m256i kat = _mm256_add_epi32(_mm256_add_epi32(at, at), _mm256_set1_epi32(4));
         const __m512i kp = s->push_d ? _mm512_castsi256_si512(load8i(push[q], s->push_ks + jq))
                                      : _mm512_set1_epi32(s->k);
-        _mm512_mask_i32scatter_epi32((int *)H->pts, (__mmask16)push[q],
-                                     _mm512_castsi256_si512(kat), kp, 4);
+        if (!(s->k_step > 0)) /* else a point's step is never read back */
+            _mm512_mask_i32scatter_epi32((int *)H->pts, (__mmask16)push[q],
+                                         _mm512_castsi256_si512(kat), kp, 4);
         store8i(H->n + jq, lanes[q], _mm256_mask_add_epi32(m[q], push[q], m[q], one));
         store8i(H->far + jq, lanes[q], far[q]);
         /* the occluders of the cells below (hi, when asked) and above (lo) */
@@ -332,7 +346,7 @@ AVX512VL static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, 
         qm[2 * q + 1] = _mm512_mask_cmp_pd_mask(lanes[q], hn, hn, _CMP_ORD_Q);
         qg[2 * q + 1] = _mm512_sub_pd(hn, cdd[q]);
     }
-    query(2 * NG, QG, qm, qfar, qg, s->push_d != NULL, k, dd);
+    query(2 * NG, QG, qm, qfar, qg, s->push_d != NULL, s->k, s->k_step, k, dd);
     for (int q = 0; q < NG; q++) {
         const int jq = j + 8 * q;
         store8i(occ->hi_k + jq, lanes[q], k[2 * q]);

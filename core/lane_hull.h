@@ -40,6 +40,12 @@ typedef struct {
      * step push_ks[j], instead of its sample */
     const double *push_d, *push_g;
     const int *push_ks;
+    /* > 0: every distance is (its step - its line's first) x k_step (or
+     * (its step + a constant) x k_step), each one rounding, so that an
+     * occluder's step follows from its distance to the query (to far less
+     * than half a step) and the points' steps are neither stored nor read;
+     * 0: they are (per-row steps). The same for every step of a sweep. */
+    double k_step;
 } ts_lane_step;
 
 /*

@@ -99,16 +99,23 @@ typedef struct {
 #endif
 
 /* The far-field occluder of a point at distance d and hull height g among
- * the points 0..far of an unbounded line's hull S: walk to nearer points
- * while the slope grows (the slopes to an upper convex hull from a point
- * beyond it are unimodal). */
+ * the points 0..far (far >= 0) of an unbounded line's hull S, its index:
+ * walk to nearer points while the slope grows (the slopes to an upper
+ * convex hull from a point beyond it are unimodal). */
+static inline int stack_tangent(const hull_pt *S, int far, double d, double g)
+{
+    int j = far;
+    while (j > 0 && (S[j - 1].g - g) * (d - S[j].d) >= (S[j].g - g) * (d - S[j - 1].d))
+        j--;
+    return j;
+}
+
+/* The same as (the occluder's step, its distance); k = -1: none. */
 static inline occluder stack_query(const hull_pt *S, int far, double d, double g)
 {
     if (far < 0)
         return (occluder){-1, 0.0f};
-    int j = far;
-    while (j > 0 && (S[j - 1].g - g) * (d - S[j].d) >= (S[j].g - g) * (d - S[j - 1].d))
-        j--;
+    const int j = stack_tangent(S, far, d, g);
     return (occluder){S[j].k, (float)(d - S[j].d)};
 }
 
