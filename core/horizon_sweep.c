@@ -171,7 +171,7 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         const int last_inside = G->fr[k] == 0.0f ? j1 : G->V - 2 - (int)i0;
         ts_lane_step step = {k, j0, j1, prime, last_inside, w->lane_d, w->hs, w->hc,
                              w->hn, c, C->near_skip, NULL, NULL, NULL, 0.0};
-        if (!G->step_row && C->far_T <= 0) /* lane_distances' products */
+        if (!G->step_row) /* lane_distances' products (ts_far_store keeps them) */
             step.k_step = G->step_m;
         if (C->far_T > 0) {
             /* far-only: the hulls take the samples far_T behind, one per
