@@ -325,12 +325,14 @@ AVX512VL static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, 
         const __m256i at = times3(_mm256_add_epi32(G[q].first, m[q]));
         _mm512_mask_i32scatter_pd((double *)H->pts, push[q], at, GP[q]->d, 8);
         _mm512_mask_i32scatter_pd((double *)H->pts, push[q], _mm256_add_epi32(at, one), gs[q], 8);
-        const __m256i kat = _mm256_add_epi32(_mm256_add_epi32(at, at), _mm256_set1_epi32(4));
-        const __m512i kp = s->push_d ? _mm512_castsi256_si512(load8i(push[q], s->push_ks + jq))
-                                     : _mm512_set1_epi32(s->k);
-        if (!(s->k_step > 0)) /* else a point's step is never read back */
+        if (!(s->k_step > 0)) { /* else a point's step is never read back */
+            const __m256i kat = _mm256_add_epi32(_mm256_add_epi32(at, at), _mm256_set1_epi32(4));
+            const __m512i kp = s->push_d
+                                   ? _mm512_castsi256_si512(load8i(push[q], s->push_ks + jq))
+                                   : _mm512_set1_epi32(s->k);
             _mm512_mask_i32scatter_epi32((int *)H->pts, (__mmask16)push[q],
                                          _mm512_castsi256_si512(kat), kp, 4);
+        }
         store8i(H->n + jq, lanes[q], _mm256_mask_add_epi32(m[q], push[q], m[q], one));
         store8i(H->far + jq, lanes[q], far[q]);
         /* the occluders of the cells below (hi, when asked) and above (lo) */
