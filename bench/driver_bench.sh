@@ -9,7 +9,9 @@
 #   gdal_translate TERRASHADE:dem.tif out.tif              (cast shadows)
 #   ... with METHOD=shm, METHOD=sh SWATH_DIRECTIONS=3 (sweeps, then pyramid
 #   horizons) and METHOD=shadowmap (docs/methods.md)
-# each REPEATS times, and prints the best wall time of each and the ratio.
+# in REPEATS rounds that each run every command once (so that all of them see
+# the host's speed of the same minutes), and prints the best wall time of each
+# and the ratios.
 # Goal: ratio <= 1.5.
 #
 # The plugin is taken from $BUILDDIR/plugin/.libs (BUILDDIR defaults to the
@@ -31,42 +33,52 @@ echo "   (power spectrum f^-2.2), fixed seed 42, scaled to 100..1500 m"
 
 bench_machine
 
-# best wall time of REPEATS runs of a command, in seconds
-best_time() {
-    best=""
-    i=0
-    while [ "$i" -lt "$REPEATS" ]; do
-        rm -f "$WORK/out.tif"
-        t0=$(date +%s.%N)
-        "$@" >/dev/null
-        t1=$(date +%s.%N)
-        best=$(awk -v a="$t0" -v b="$t1" -v best="$best" \
-            'BEGIN { t = b - a; if (best == "" || t < best) best = t; print best }')
-        i=$((i + 1))
-    done
-    printf '%.3f' "$best"
+# The commands, run in rounds: each round runs every one once, so that all
+# of them see the host's speed of the same minutes (it drifts by tens of
+# per cent from one minute to the next on shared machines); each keeps its
+# best wall time over the rounds.
+NAMES="DEM TS SHM SH SHP SM"
+cmd() {
+    case "$1" in
+    DEM) echo "gdaldem hillshade -q $DEM $WORK/out.tif" ;;
+    TS) echo "gdal_translate -q TERRASHADE:$DEM $WORK/out.tif" ;;
+    SHM) echo "gdal_translate -q -oo METHOD=shm TERRASHADE:$DEM $WORK/out.tif" ;;
+    SH) echo "gdal_translate -q -oo METHOD=sh -oo SWATH_DIRECTIONS=3 TERRASHADE:$DEM $WORK/out.tif" ;;
+    SHP) echo "gdal_translate -q -oo METHOD=sh -oo HORIZON_METHOD=pyramid TERRASHADE:$DEM $WORK/out.tif" ;;
+    SM) echo "gdal_translate -q -oo METHOD=shadowmap TERRASHADE:$DEM $WORK/out.tif" ;;
+    esac
 }
 
-echo "== timing, best of $REPEATS"
-echo "\$ gdaldem hillshade -q $DEM $WORK/out.tif"
-T_DEM=$(best_time gdaldem hillshade -q "$DEM" "$WORK/out.tif")
+# wall time of one run of command $1, in seconds
+one_time() {
+    rm -f "$WORK/out.tif"
+    t0=$(date +%s.%N)
+    $(cmd "$1") >/dev/null
+    t1=$(date +%s.%N)
+    awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", b - a }'
+}
+
+echo "== timing: $REPEATS rounds, each running every command once; best of each"
+for n in $NAMES; do
+    echo "\$ $(cmd "$n")"
+done
+r=0
+while [ "$r" -lt "$REPEATS" ]; do
+    line="   round $((r + 1)):"
+    for n in $NAMES; do
+        t=$(one_time "$n")
+        line="$line $n $t"
+        eval "prev=\${T_$n:-}"
+        eval "T_$n=$(awk -v t="$t" -v p="$prev" 'BEGIN { print (p == "" || t < p) ? t : p }')"
+    done
+    echo "$line"
+    r=$((r + 1))
+done
 echo "   gdaldem hillshade:             ${T_DEM} s"
-echo "\$ gdal_translate -q TERRASHADE:$DEM $WORK/out.tif"
-T_TS=$(best_time gdal_translate -q "TERRASHADE:$DEM" "$WORK/out.tif")
 echo "   TERRASHADE shade (cast shadows): ${T_TS} s"
-echo "\$ gdal_translate -q -oo METHOD=shm TERRASHADE:$DEM $WORK/out.tif"
-T_SHM=$(best_time gdal_translate -q -oo METHOD=shm "TERRASHADE:$DEM" "$WORK/out.tif")
 echo "   TERRASHADE shade, METHOD=shm:    ${T_SHM} s  (for reference)"
-echo "\$ gdal_translate -q -oo METHOD=sh -oo SWATH_DIRECTIONS=3 TERRASHADE:$DEM $WORK/out.tif"
-T_SH=$(best_time gdal_translate -q -oo METHOD=sh -oo SWATH_DIRECTIONS=3 "TERRASHADE:$DEM" \
-    "$WORK/out.tif")
 echo "   TERRASHADE shade, METHOD=sh:     ${T_SH} s  (SH soft key light, 3 sweeps)"
-echo "\$ gdal_translate -q -oo METHOD=sh -oo HORIZON_METHOD=pyramid TERRASHADE:$DEM $WORK/out.tif"
-T_SHP=$(best_time gdal_translate -q -oo METHOD=sh -oo HORIZON_METHOD=pyramid "TERRASHADE:$DEM" \
-    "$WORK/out.tif")
 echo "   TERRASHADE shade, METHOD=sh, pyramid: ${T_SHP} s  (the swath's horizons from the pyramid)"
-echo "\$ gdal_translate -q -oo METHOD=shadowmap TERRASHADE:$DEM $WORK/out.tif"
-T_SM=$(best_time gdal_translate -q -oo METHOD=shadowmap "TERRASHADE:$DEM" "$WORK/out.tif")
 echo "   TERRASHADE shade, METHOD=shadowmap: ${T_SM} s  (docs/methods.md)"
 awk -v a="$T_TS" -v b="$T_DEM" -v c="$T_SHM" -v d="$T_SH" -v e="$T_SM" -v f="$T_SHP" 'BEGIN {
     printf "== ratio TERRASHADE / gdaldem = %.2f (goal <= 1.5)\n", a / b
