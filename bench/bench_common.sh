@@ -34,3 +34,38 @@ bench_machine() {
          "GDAL $(gdal-config --version 2>/dev/null || gdalinfo --version)"
     echo "   GDAL_DRIVER_PATH=${GDAL_DRIVER_PATH:-<default>}"
 }
+
+# bench_key NAME: NAME as part of a shell variable's name.
+bench_key() {
+    echo "$1" | tr -c 'A-Za-z0-9_\n' '_'
+}
+
+# bench_rounds "NAME ...": runs each named command (the caller's `cmd NAME`
+# prints it; it writes $WORK/out.tif) once per round, $REPEATS rounds, so
+# that all of them see the host's speed of the same minutes (it drifts by
+# tens of per cent from one minute to the next on shared machines); prints
+# the commands and each round's wall times, and leaves each command's best
+# in T_<bench_key NAME>, in seconds.
+bench_rounds() {
+    echo "== timing: $REPEATS rounds, each running every command once; best of each"
+    for n in $1; do
+        echo "\$ $(cmd "$n")"
+    done
+    r=0
+    while [ "$r" -lt "$REPEATS" ]; do
+        line="   round $((r + 1)):"
+        for n in $1; do
+            rm -f "$WORK/out.tif"
+            t0=$(date +%s.%N)
+            $(cmd "$n") >/dev/null
+            t1=$(date +%s.%N)
+            t=$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", b - a }')
+            line="$line $n $t"
+            k=$(bench_key "$n")
+            eval "prev=\${T_$k:-}"
+            eval "T_$k=$(awk -v t="$t" -v p="$prev" 'BEGIN { print (p == "" || t < p) ? t : p }')"
+        done
+        echo "$line"
+        r=$((r + 1))
+    done
+}

@@ -33,10 +33,7 @@ echo "   (power spectrum f^-2.2), fixed seed 42, scaled to 100..1500 m"
 
 bench_machine
 
-# The commands, run in rounds: each round runs every one once, so that all
-# of them see the host's speed of the same minutes (it drifts by tens of
-# per cent from one minute to the next on shared machines); each keeps its
-# best wall time over the rounds.
+# The commands, run in rounds (bench_rounds), each keeping its best.
 NAMES="DEM TS SHM SH SHP SM"
 cmd() {
     case "$1" in
@@ -48,32 +45,7 @@ cmd() {
     SM) echo "gdal_translate -q -oo METHOD=shadowmap TERRASHADE:$DEM $WORK/out.tif" ;;
     esac
 }
-
-# wall time of one run of command $1, in seconds
-one_time() {
-    rm -f "$WORK/out.tif"
-    t0=$(date +%s.%N)
-    $(cmd "$1") >/dev/null
-    t1=$(date +%s.%N)
-    awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", b - a }'
-}
-
-echo "== timing: $REPEATS rounds, each running every command once; best of each"
-for n in $NAMES; do
-    echo "\$ $(cmd "$n")"
-done
-r=0
-while [ "$r" -lt "$REPEATS" ]; do
-    line="   round $((r + 1)):"
-    for n in $NAMES; do
-        t=$(one_time "$n")
-        line="$line $n $t"
-        eval "prev=\${T_$n:-}"
-        eval "T_$n=$(awk -v t="$t" -v p="$prev" 'BEGIN { print (p == "" || t < p) ? t : p }')"
-    done
-    echo "$line"
-    r=$((r + 1))
-done
+bench_rounds "$NAMES"
 echo "   gdaldem hillshade:             ${T_DEM} s"
 echo "   TERRASHADE shade (cast shadows): ${T_TS} s"
 echo "   TERRASHADE shade, METHOD=shm:    ${T_SHM} s  (for reference)"
