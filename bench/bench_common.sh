@@ -41,7 +41,7 @@ bench_key() {
 }
 
 # bench_rounds "NAME ...": runs each named command (the caller's `cmd NAME`
-# prints it; it writes $WORK/out.tif) once per round, $REPEATS rounds, so
+# prints it, its paths in single quotes; it writes $WORK/out.tif) once per round, $REPEATS rounds, so
 # that all of them see the host's speed of the same minutes (it drifts by
 # tens of per cent from one minute to the next on shared machines); prints
 # the commands and each round's wall times, and leaves each command's best
@@ -57,7 +57,7 @@ bench_rounds() {
         for n in $1; do
             rm -f "$WORK/out.tif"
             t0=$(date +%s.%N)
-            $(cmd "$n") >/dev/null
+            eval "$(cmd "$n")" >/dev/null
             t1=$(date +%s.%N)
             t=$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", b - a }')
             line="$line $n $t"

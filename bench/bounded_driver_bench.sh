@@ -44,7 +44,7 @@ cmd() {
     dirs=$(echo "$1" | cut -d: -f2)
     dist=$(echo "$1" | cut -d: -f3)
     echo "gdal_translate -q -oo PRODUCT=$product -oo DIRECTIONS=$dirs -oo MAX_DISTANCE=$dist" \
-         "TERRASHADE:$DEM $WORK/out.tif"
+         "'TERRASHADE:$DEM' '$WORK/out.tif'"
 }
 
 bench_rounds "$RUNS"

@@ -37,12 +37,12 @@ bench_machine
 NAMES="DEM TS SHM SH SHP SM"
 cmd() {
     case "$1" in
-    DEM) echo "gdaldem hillshade -q $DEM $WORK/out.tif" ;;
-    TS) echo "gdal_translate -q TERRASHADE:$DEM $WORK/out.tif" ;;
-    SHM) echo "gdal_translate -q -oo METHOD=shm TERRASHADE:$DEM $WORK/out.tif" ;;
-    SH) echo "gdal_translate -q -oo METHOD=sh -oo SWATH_DIRECTIONS=3 TERRASHADE:$DEM $WORK/out.tif" ;;
-    SHP) echo "gdal_translate -q -oo METHOD=sh -oo HORIZON_METHOD=pyramid TERRASHADE:$DEM $WORK/out.tif" ;;
-    SM) echo "gdal_translate -q -oo METHOD=shadowmap TERRASHADE:$DEM $WORK/out.tif" ;;
+    DEM) echo "gdaldem hillshade -q '$DEM' '$WORK/out.tif'" ;;
+    TS) echo "gdal_translate -q TERRASHADE:'$DEM' '$WORK/out.tif'" ;;
+    SHM) echo "gdal_translate -q -oo METHOD=shm TERRASHADE:'$DEM' '$WORK/out.tif'" ;;
+    SH) echo "gdal_translate -q -oo METHOD=sh -oo SWATH_DIRECTIONS=3 TERRASHADE:'$DEM' '$WORK/out.tif'" ;;
+    SHP) echo "gdal_translate -q -oo METHOD=sh -oo HORIZON_METHOD=pyramid TERRASHADE:'$DEM' '$WORK/out.tif'" ;;
+    SM) echo "gdal_translate -q -oo METHOD=shadowmap TERRASHADE:'$DEM' '$WORK/out.tif'" ;;
     esac
 }
 bench_rounds "$NAMES"
