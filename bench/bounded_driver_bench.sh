@@ -2,12 +2,12 @@
 # bounded_driver_bench.sh - MAX_DISTANCE through the driver against the
 # unbounded sweep: issue 10 item 3's own example, one run.
 #
-#   bench/bounded_driver_bench.sh [SIZE] [DISTANCES] [REPEATS]
-#                                 (defaults: 1000 30,100,500 2)
+#   bench/bounded_driver_bench.sh [SIZE] [DISTANCES] [REPEATS] [CELL] [RELIEF]
+#                                 (defaults: 1000 30,100,500 2 1 150)
 #
-# Generates a SIZE x SIZE DEM of 1 m cells, fBm of Hurst exponent 0.8 with
-# 150 m of relief (bench/fractal_tif.py, seed 42: the character of a lidar
-# DEM), then times whole gdal_translate processes of
+# Generates a SIZE x SIZE DEM of CELL m cells, fBm of Hurst exponent 0.8 with
+# RELIEF m of relief (bench/fractal_tif.py, seed 42; the defaults have the
+# character of a lidar DEM), then times whole gdal_translate processes of
 #   PRODUCT=horizon DIRECTIONS=4      (the issue: 4.4 s bounded, 0.6 s not)
 #   PRODUCT=svf DIRECTIONS=32         (the issue: 52 s bounded, 2 s not)
 # unbounded and with each MAX_DISTANCE (metres), in REPEATS rounds that each
@@ -21,13 +21,15 @@ set -eu
 SIZE=${1:-1000}
 DISTANCES=${2:-30,100,500}
 REPEATS=${3:-2}
+CELL=${4:-1}
+RELIEF=${5:-150}
 . "$(dirname "$0")/bench_common.sh"
 bench_setup bounded_driver_bench
-DEM="$WORK/lidar_${SIZE}.tif"
+DEM="$WORK/fbm_${SIZE}.tif"
 
-echo "== DEM: $SIZE x $SIZE cells of 1 m, EPSG:32617, Float32, fBm (Hurst 0.8), 150 m of relief"
-echo "   (bench/fractal_tif.py $SIZE DEM 1.8 1 150, seed 42)"
-"$PYTHON" "$(dirname "$0")/fractal_tif.py" "$SIZE" "$DEM" 1.8 1 150
+echo "== DEM: $SIZE x $SIZE cells of $CELL m, EPSG:32617, Float32, fBm (Hurst 0.8), $RELIEF m of relief"
+echo "   (bench/fractal_tif.py $SIZE DEM 1.8 $CELL $RELIEF, seed 42)"
+"$PYTHON" "$(dirname "$0")/fractal_tif.py" "$SIZE" "$DEM" 1.8 "$CELL" "$RELIEF"
 bench_machine
 
 # the commands: product:directions:distance (0: unbounded)
