@@ -1,7 +1,7 @@
 /* bench_pages.h - first mapping of a benchmark's buffers, outside its timings.
  *
  * The kernel maps a page of a fresh allocation on its first write. On the
- * development VM that cost 4-23 us a page (docs/performance.md, "Pyramid
+ * development VM that cost 4-23 us a page (docs/performance-history.md, "Pyramid
  * horizons, session 14"), charged to whichever timed run first writes the
  * buffer: in a bench that compares runs sharing one output, the first run's
  * time would include it and the others' not. Benches therefore write every

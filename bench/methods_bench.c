@@ -36,7 +36,7 @@
  * clock, steadier than wall time on a shared machine (with --threads 1,
  * one core's time); --user: its user time only, which leaves out the
  * kernel's work for the process, mostly the first mapping of each page it
- * allocates (docs/performance.md: on the development VM that cost 4-23 us
+ * allocates (docs/performance-history.md: on the development VM that cost 4-23 us
  * a page, depending on how long ago the host last backed the page). Every
  * method's kernel time is printed beside it in any mode. */
 enum { TIME_WALL, TIME_CPU, TIME_USER };

@@ -211,7 +211,7 @@ AVX2 static void scan_avx2(const ts_cap_lanes *r, int k, int g)
 
 int ts_cap_lanes_pays(const int lags[4])
 {
-    /* measured (docs/performance.md, "Bounded sweep", sessions 9 and 10):
+    /* measured (docs/performance-history.md, "Bounded sweep", sessions 9 and 10):
      * the brute force costs about the line-by-line window at ~96 steps
      * with AVX-512, ~40 with AVX2; pruned, from PRUNE_FROM steps on, at
      * ~200-300 (AVX-512 only) */
@@ -223,7 +223,7 @@ int ts_cap_lanes_pays(const int lags[4])
 
 int ts_cap_lanes_hybrid_pays(const int lags[4])
 {
-    /* measured (docs/performance.md, "Bounded sweep: unbounded hull first"):
+    /* measured (docs/performance-history.md, "Bounded sweep: unbounded hull first"):
      * 0.80-0.89x the line-by-line window's CPU time at 300-2000 lags. The
      * ring's pruned scan holds for windows of up to PRUNE_MAX_LAGS. */
     return ts_lane_vector_level() == 2 && lags[1] - lags[0] + 1 >= PRUNE_FROM &&

@@ -133,7 +133,7 @@ TS_AVX512 static void run(const ts_near_plan *p, const float *restrict zrow, int
     /* The cells' vectors start where zrow's heights start a 64-byte line
      * (the first one's lanes below x0 masked off), so that the loads of h,
      * and of best and prev where the caller put best in zrow's phase, do
-     * not straddle two lines: 0.5-15 % of the run (docs/performance.md,
+     * not straddle two lines: 0.5-15 % of the run (docs/performance-history.md,
      * session 22). */
     const int xs = x0 - (int)(((uintptr_t)(zrow + x0) / sizeof(float)) & 15);
     const int len = x1 - xs;
