@@ -138,7 +138,7 @@ ray_at(ray_view R, int wide, const int *restrict ray_o, const float *restrict ra
     }
     const float hz = a + f * (b - a);
     const float s = (hz - h) / dd - cf * dd;
-    return ok & (hz == hz) ? s : -INFINITY;
+    return (ok & (hz == hz)) ? s : -INFINITY;
 }
 
 /* ts_lane_far_field's loop, with 32- or 64-bit offsets: every array its

@@ -190,7 +190,7 @@ static void exact_run(const ts_near_plan *p, const float *restrict zrow, int x0,
             cm_patch_poly(h0, A, B, X, a0, b0, t, &alpha, &beta, &gamma);
             const double m = cm_piece_max(alpha - zrow[x], beta, gamma, sa, sb, L, c);
             best[x] = m > best[x] ? m : best[x];
-            flag[x] += (h0 != h0) | (h1 != h1) | (h2 != h2) | (h3 != h3) ? 1.0f : 0.0f;
+            flag[x] += ((h0 != h0) | (h1 != h1) | (h2 != h2) | (h3 != h3)) ? 1.0f : 0.0f;
         }
     }
 }
