@@ -208,7 +208,8 @@ CPLErr TSAtlasDataset::EnsureNear()
             OGRSpatialReferenceH hSRS =
                 poSRS ? OGRSpatialReference::ToHandle(const_cast<OGRSpatialReference *>(poSRS))
                       : nullptr;
-            ts_status eSt = tsd_cells_compute(adfGT, W, H, hSRS, &sCells, szMsg, sizeof szMsg);
+            ts_status eSt = tsd_cells_compute(adfGT, W, H, hSRS, m_sMetaOpts.cell_sizes, &sCells,
+                                              szMsg, sizeof szMsg);
             if (eSt == TS_OK)
                 eSt = tsd_dem_load(GDALRasterBand::ToHandle(poDEM->GetRasterBand(nBandDEM)),
                                    &sCells, m_sMetaOpts.z_factor, &sGrid, szMsg, sizeof szMsg);

@@ -536,7 +536,8 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     const tsd_options &sOpts = m_sOpts;
     OGRSpatialReferenceH hSRS =
         m_oSRS.IsEmpty() ? nullptr : OGRSpatialReference::ToHandle(&m_oSRS);
-    ts_status eSt = tsd_cells_compute(m_adfGT, W, H, hSRS, &m_sCells, szMsg, sizeof szMsg);
+    ts_status eSt = tsd_cells_compute(m_adfGT, W, H, hSRS, sOpts.cell_sizes, &m_sCells, szMsg,
+                                      sizeof szMsg);
     if (eSt != TS_OK)
         return Fail(eSt, szMsg), false;
     if (tsd_options_sun_from_time(&sOpts))

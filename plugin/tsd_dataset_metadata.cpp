@@ -104,6 +104,15 @@ void TSDataset::SetupMetadata()
     GDALDataset::SetMetadataItem("SOURCE_CRS_KIND", pszKind);
     GDALDataset::SetMetadataItem("CELL_SIZE_X", CPLSPrintf("%.6f", m_sCells.cell_x));
     GDALDataset::SetMetadataItem("CELL_SIZE_Y", CPLSPrintf("%.6f", m_sCells.cell_y));
+    std::string osSource =
+        m_sCells.kind == TSD_CRS_GEOGRAPHIC ? "ground: geodesic on the CRS's ellipsoid"
+        : m_sCells.kind == TSD_CRS_NONE     ? "no CRS: the geotransform's units taken as metres"
+        : m_sCells.ground ? "ground: geodesic on the CRS's ellipsoid, along the central column"
+                          : "grid: the geotransform's pixel size in the CRS's unit";
+    if (m_sCells.kind == TSD_CRS_PROJECTED && m_sCells.scale_hi > 0)
+        osSource += CPLSPrintf(" (the projection's scale %.4f to %.4f over the DEM)",
+                               m_sCells.scale_lo, m_sCells.scale_hi);
+    GDALDataset::SetMetadataItem("CELL_SIZE_SOURCE", osSource.c_str());
     if (m_sCells.cell_x_row)
     {
         GDALDataset::SetMetadataItem(

@@ -3,6 +3,7 @@
 
 #include "tsd_text.h"
 
+#include <cpl_error.h>
 #include <geodesic.h>
 #include <math.h>
 #include <stdio.h>
@@ -49,9 +50,185 @@ static ts_status geographic(const double gt[6], int width, int height, double a,
     return TS_OK;
 }
 
+/* Lengths on the ground of a projected DEM: its CRS to longitude and
+ * latitude (traditional order) and the ellipsoid's geodesics. */
+typedef struct {
+    OGRSpatialReferenceH geo;
+    OGRCoordinateTransformationH fwd;
+    struct geod_geodesic g;
+} ground_ctx;
+
+static void ground_close(ground_ctx *t)
+{
+    if (t->fwd)
+        OCTDestroyCoordinateTransformation(t->fwd);
+    if (t->geo)
+        OSRDestroySpatialReference(t->geo);
+    t->fwd = NULL;
+    t->geo = NULL;
+}
+
+static int ground_open(ground_ctx *t, OGRSpatialReferenceH srs)
+{
+    memset(t, 0, sizeof *t);
+    OGRErr e1 = OGRERR_NONE, e2 = OGRERR_NONE;
+    double a = OSRGetSemiMajor(srs, &e1), invf = OSRGetInvFlattening(srs, &e2);
+    if (e1 != OGRERR_NONE || e2 != OGRERR_NONE || !(a > 0) || !(invf >= 0))
+        return 0;
+    geod_init(&t->g, a, invf != 0 ? 1.0 / invf : 0.0);
+    t->geo = OSRCloneGeogCS(srs);
+    if (!t->geo)
+        return 0;
+    OSRSetAxisMappingStrategy(t->geo, OAMS_TRADITIONAL_GIS_ORDER);
+    OGRSpatialReferenceH src = OSRClone(srs);
+    OSRSetAxisMappingStrategy(src, OAMS_TRADITIONAL_GIS_ORDER);
+    CPLPushErrorHandler(CPLQuietErrorHandler); /* a failure is ours to word */
+    t->fwd = OCTNewCoordinateTransformation(src, t->geo);
+    CPLPopErrorHandler();
+    OSRDestroySpatialReference(src);
+    if (!t->fwd)
+        ground_close(t);
+    return t->fwd != NULL;
+}
+
+/* The ground lengths of the n segments (x0, y0)-(x1, y1) of the DEM's pixel
+ * space (x, y: columns and rows from its top-left corner, as gt maps them)
+ * into len; 0 where PROJ cannot place an end. */
+static int ground_lengths(const ground_ctx *t, const double gt[6], int n, const double *x0,
+                          const double *y0, const double *x1, const double *y1, double *len)
+{
+    double *X = malloc((size_t)2 * n * sizeof *X), *Y = malloc((size_t)2 * n * sizeof *Y);
+    double *Z = calloc((size_t)2 * n, sizeof *Z);
+    int *ok = malloc((size_t)2 * n * sizeof *ok), good = X && Y && Z && ok;
+    for (int i = 0; good && i < n; i++) {
+        X[2 * i] = gt[0] + x0[i] * gt[1];
+        Y[2 * i] = gt[3] + y0[i] * gt[5];
+        X[2 * i + 1] = gt[0] + x1[i] * gt[1];
+        Y[2 * i + 1] = gt[3] + y1[i] * gt[5];
+    }
+    if (good) {
+        CPLPushErrorHandler(CPLQuietErrorHandler);
+        good = OCTTransformEx(t->fwd, 2 * n, X, Y, Z, ok) != 0;
+        CPLPopErrorHandler();
+    }
+    for (int i = 0; good && i < n; i++) {
+        const int a = 2 * i, b = 2 * i + 1;
+        if (!ok[a] || !ok[b] || !isfinite(X[a] + Y[a] + X[b] + Y[b]) || fabs(Y[a]) > 90 ||
+            fabs(Y[b]) > 90) {
+            good = 0;
+            break;
+        }
+        len[i] = 0;
+        geod_inverse(&t->g, Y[a], X[a], Y[b], X[b], &len[i], NULL, NULL);
+        good = len[i] > 0;
+    }
+    free(X);
+    free(Y);
+    free(Z);
+    free(ok);
+    return good;
+}
+
+/* The projection's scale (grid length over ground length) at nine cells
+ * of the DEM, east-west and north-south: its range into c->scale_lo/hi and
+ * how much it varies across the columns of the central row; 0 where PROJ
+ * cannot place a point. */
+static int ground_scale(const ground_ctx *t, const double gt[6], int width, int height,
+                        tsd_cells *c, double *across)
+{
+    const double fx[3] = {0.5, 0.5 * width, width - 0.5};
+    const double fy[3] = {0.5, 0.5 * height, height - 0.5};
+    double x0[18], y0[18], x1[18], y1[18], len[18], grid[18];
+    for (int j = 0, i = 0; j < 3; j++)
+        for (int k = 0; k < 3; k++, i += 2) {
+            x0[i] = fx[k] - 0.5, x1[i] = fx[k] + 0.5, y0[i] = y1[i] = fy[j];
+            grid[i] = fabs(gt[1]) * c->unit_to_m;
+            x0[i + 1] = x1[i + 1] = fx[k], y0[i + 1] = fy[j] - 0.5, y1[i + 1] = fy[j] + 0.5;
+            grid[i + 1] = fabs(gt[5]) * c->unit_to_m;
+        }
+    if (!ground_lengths(t, gt, 18, x0, y0, x1, y1, len))
+        return 0;
+    c->scale_lo = INFINITY;
+    c->scale_hi = 0;
+    for (int i = 0; i < 18; i++) {
+        const double k = grid[i] / len[i];
+        c->scale_lo = fmin(c->scale_lo, k);
+        c->scale_hi = fmax(c->scale_hi, k);
+    }
+    /* the central row's east-west cells: 6, 8 and 10 */
+    const double lo = fmin(len[6], fmin(len[8], len[10]));
+    *across = fmax(len[6], fmax(len[8], len[10])) / lo - 1;
+    return 1;
+}
+
+/* A projected DEM's cells on the ground (CELL_SIZES=ground, or auto where
+ * the scale departs from 1 by more than 1 %): east-west per row and the
+ * north-south mean, both along the central column, as geographic() does. */
+static ts_status projected(const double gt[6], int width, int height,
+                           OGRSpatialReferenceH srs, tsd_cell_sizes mode, tsd_cells *c,
+                           char *msg, size_t n)
+{
+    c->cell_x = fabs(gt[1]) * c->unit_to_m;
+    c->cell_y = fabs(gt[5]) * c->unit_to_m;
+    if (mode == TSD_CELLS_GRID || OSRIsLocal(srs))
+        return TS_OK;
+    ground_ctx t;
+    double across = 0;
+    if (!ground_open(&t, srs) || !ground_scale(&t, gt, width, height, c, &across)) {
+        ground_close(&t);
+        c->scale_lo = c->scale_hi = 0;
+        if (mode == TSD_CELLS_AUTO)
+            return TS_OK; /* nothing known against the grid's sizes */
+        return tsd_fail(msg, n, TS_ERR_ARG, "CELL_SIZES=ground: PROJ cannot take the DEM's "
+                        "cells to longitude and latitude; use CELL_SIZES=grid");
+    }
+    if (mode == TSD_CELLS_AUTO && fabs(c->scale_lo - 1) <= 0.01 && fabs(c->scale_hi - 1) <= 0.01) {
+        ground_close(&t);
+        return TS_OK;
+    }
+    c->ground = 1;
+    double *x0 = malloc((size_t)(height + 1) * sizeof *x0);
+    double *y0 = malloc((size_t)(height + 1) * sizeof *y0);
+    double *x1 = malloc((size_t)(height + 1) * sizeof *x1);
+    double *y1 = malloc((size_t)(height + 1) * sizeof *y1);
+    c->cell_x_row = malloc((size_t)(height + 1) * sizeof *c->cell_x_row);
+    ts_status st = TS_OK;
+    if (!x0 || !y0 || !x1 || !y1 || !c->cell_x_row) {
+        st = tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory for %d rows", height);
+        goto done;
+    }
+    const double xc = 0.5 * width;
+    for (int y = 0; y < height; y++) {
+        /* row y of the core's grid (row 0 = north) */
+        double py = c->flip_y ? height - (y + 0.5) : y + 0.5;
+        x0[y] = xc - 0.5, x1[y] = xc + 0.5, y0[y] = y1[y] = py;
+    }
+    x0[height] = x1[height] = xc, y0[height] = 0, y1[height] = height;
+    if (!ground_lengths(&t, gt, height + 1, x0, y0, x1, y1, c->cell_x_row)) {
+        st = tsd_fail(msg, n, TS_ERR_ARG, "CELL_SIZES=%s: PROJ cannot take every row of the "
+                      "DEM's central column to longitude and latitude; use CELL_SIZES=grid",
+                      mode == TSD_CELLS_AUTO ? "auto" : "ground");
+        goto done;
+    }
+    c->cell_y = c->cell_x_row[height] / height;
+    c->cell_x = c->cell_x_row[height / 2];
+    if (across > 0.01)
+        snprintf(c->warning, sizeof c->warning,
+                 "the projection's scale varies by %.1f %% across the DEM's columns; its "
+                 "cells are measured on the ground along the central column",
+                 100 * across);
+done:
+    free(x0);
+    free(y0);
+    free(x1);
+    free(y1);
+    ground_close(&t);
+    return st;
+}
+
 ts_status tsd_cells_compute(const double gt[6], int width, int height,
-                      OGRSpatialReferenceH srs, tsd_cells *c, char *msg,
-                      size_t n)
+                      OGRSpatialReferenceH srs, tsd_cell_sizes mode, tsd_cells *c,
+                      char *msg, size_t n)
 {
     memset(c, 0, sizeof *c);
     if (width < 1 || height < 1)
@@ -73,6 +250,10 @@ ts_status tsd_cells_compute(const double gt[6], int width, int height,
     c->flip_y = gt[5] > 0;
     c->unit_to_m = 1;
     if (srs && OSRIsGeographic(srs)) {
+        if (mode == TSD_CELLS_GRID)
+            return tsd_fail(msg, n, TS_ERR_ARG, "CELL_SIZES=grid: the DEM's CRS is "
+                            "geographic, whose cells (degrees) are not lengths; use "
+                            "CELL_SIZES=auto");
         OGRErr e1 = OGRERR_NONE, e2 = OGRERR_NONE;
         double a = OSRGetSemiMajor(srs, &e1);
         double invf = OSRGetInvFlattening(srs, &e2);
@@ -97,7 +278,17 @@ ts_status tsd_cells_compute(const double gt[6], int width, int height,
         if (!(c->unit_to_m > 0))
             return tsd_fail(msg, n, TS_ERR_ARG, "the DEM's CRS has an invalid linear unit "
                         "(%g metres)", c->unit_to_m);
-    } else if (srs && OSRIsGeocentric(srs)) {
+        if (mode == TSD_CELLS_GROUND && OSRIsLocal(srs))
+            return tsd_fail(msg, n, TS_ERR_ARG, "CELL_SIZES=ground: the DEM's CRS is a "
+                            "local one, without longitudes and latitudes; use "
+                            "CELL_SIZES=grid");
+        return projected(gt, width, height, srs, mode, c, msg, n);
+    }
+    if (mode == TSD_CELLS_GROUND && !(srs && OSRIsGeocentric(srs)))
+        return tsd_fail(msg, n, TS_ERR_ARG, "CELL_SIZES=ground: the DEM has no CRS, so its "
+                        "cells cannot be measured on the ground; give it one "
+                        "(gdal_edit.py -a_srs)");
+    if (srs && OSRIsGeocentric(srs)) {
         return tsd_fail(msg, n, TS_ERR_ARG, "the DEM's CRS is neither projected nor geographic "
                     "(it is geocentric); warp it to a projected CRS first");
     } else {
@@ -109,6 +300,13 @@ ts_status tsd_cells_compute(const double gt[6], int width, int height,
     c->cell_x = fabs(gt[1]) * c->unit_to_m;
     c->cell_y = fabs(gt[5]) * c->unit_to_m;
     return TS_OK;
+}
+
+tsd_cell_sizes tsd_cells_mode(const tsd_cells *c)
+{
+    if (c->kind != TSD_CRS_PROJECTED)
+        return TSD_CELLS_AUTO;
+    return c->ground ? TSD_CELLS_GROUND : TSD_CELLS_GRID;
 }
 
 double tsd_cells_min_x(const tsd_cells *c, int height)

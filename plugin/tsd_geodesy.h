@@ -3,7 +3,11 @@
  * geotransform and CRS (OSR + PROJ's geodesic routines).
  *
  *  - projected (or local) CRS: linear units converted to metres (metre,
- *    foot, US survey foot... anything OSR knows);
+ *    foot, US survey foot... anything OSR knows): the grid's sizes; or,
+ *    with CELL_SIZES=ground (and auto where the projection's scale departs
+ *    from 1 by more than 1 %, as Web Mercator's does away from the equator),
+ *    geodesic distances on the ellipsoid as for a geographic CRS, measured
+ *    along the DEM's central column;
  *  - geographic CRS: geodesic distances on the CRS's ellipsoid, per row
  *    for east-west (it shrinks with latitude) and the mean over the DEM for
  *    north-south;
@@ -19,6 +23,7 @@
 
 #include "ogr_srs_api.h"
 #include "terrashade.h"
+#include "tsd_options.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -35,16 +40,30 @@ typedef struct {
     int flip_x;         /* DEM column 0 is the eastern edge */
     int flip_y;         /* DEM row 0 is the southern edge */
     double unit_to_m;   /* projected: metres per CRS unit */
+    int ground;         /* projected: measured on the ground (CELL_SIZES) */
+    double scale_lo, scale_hi; /* projected: the projection's scale (grid length
+                                  over ground length) seen over the DEM; 0: not
+                                  measured (CELL_SIZES=grid, a local CRS) */
     char warning[256];  /* non-empty: something the user should know */
 } tsd_cells;
 
 /**
  * Compute the cell sizes of a width x height DEM. srs may be NULL (no CRS).
- * TS_OK, or the failure's status with a sentence in msg. Free with tsd_cells_free.
+ * mode (CELL_SIZES) says how a projected DEM's cells are measured; auto
+ * decides from the projection's scale at nine cells of the DEM (its
+ * corners, edges' midpoints and centre). grid with a
+ * geographic CRS, or ground without a CRS or through a CRS PROJ cannot take
+ * to longitude and latitude, is an error. TS_OK, or the failure's status
+ * with a sentence in msg. Free with tsd_cells_free.
  */
 ts_status tsd_cells_compute(const double gt[6], int width, int height,
-                      OGRSpatialReferenceH srs, tsd_cells *out, char *msg,
-                      size_t msg_size);
+                      OGRSpatialReferenceH srs, tsd_cell_sizes mode, tsd_cells *out,
+                      char *msg, size_t msg_size);
+
+/** The mode that measures another grid of the same DEM (an overview level,
+ * the far field's coarse grid) as c measured it: grid or ground for a
+ * projected DEM, auto (moot) otherwise. */
+tsd_cell_sizes tsd_cells_mode(const tsd_cells *c);
 
 void tsd_cells_free(tsd_cells *c);
 

@@ -78,6 +78,14 @@ const opt_def TSD_OPTION_ROWS[] = {
      "else the band's unit: 0.3048 for feet, 1200/3937 for US survey feet, "
      "1 for metres or no unit) or a number > 0 and <= 1e6; the band's scale "
      "and offset are applied first"},
+    {"CELL_SIZES", K_SELECT, FIELD(cell_sizes), "auto", 0, 0, 0, 0, "auto|grid|ground", 1,
+     P, ALL, NULL,
+     "How a projected DEM's cells are measured: grid (the geotransform's "
+     "pixel size in the CRS's unit, as gdaldem), ground (geodesic distances "
+     "on the ellipsoid: east-west per row, north-south over the DEM, as for "
+     "a geographic CRS) or auto: ground where the projection's scale on the "
+     "DEM departs from 1 by more than 1 % (Web Mercator beyond ~8 degrees of "
+     "latitude), else grid"},
     {"MAX_DISTANCE", K_FLOAT, FIELD(max_distance), "0", 0, 1e8, 0, 1, NULL, 1, P, LISTED,
      NULL,
      "Largest distance in metres at which terrain can cast a shadow or "

@@ -29,6 +29,8 @@ extern "C" {
 
 typedef enum { TSD_SUN_CENTER = 0, TSD_SUN_PER_CELL } tsd_sun_position;
 typedef enum { TSD_PROGRESS_AUTO = 0, TSD_PROGRESS_YES, TSD_PROGRESS_NO } tsd_progress_mode;
+/* CELL_SIZES: how a projected DEM's cells are measured (tsd_geodesy.h). */
+typedef enum { TSD_CELLS_AUTO = 0, TSD_CELLS_GRID, TSD_CELLS_GROUND } tsd_cell_sizes;
 typedef enum {
     TSD_METHOD_EXACT = 0,
     TSD_METHOD_SHM,
@@ -64,6 +66,7 @@ typedef struct {
     double pcf_kernel;       /* METHOD=shadowmap: PCF width in cells, NAN = auto */
     double z_factor;         /* multiplies the DEM's heights; NAN = AUTO, decided
                                 from the DEM (tsd_dem_z_factor) */
+    tsd_cell_sizes cell_sizes; /* CELL_SIZES: auto, grid or ground */
     double max_distance;     /* metres, 0 = unbounded */
     int curvature;           /* Earth curvature and refraction on/off */
     double refraction;       /* k */

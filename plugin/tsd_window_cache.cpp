@@ -187,7 +187,9 @@ bool TSDataset::EnsureFarField()
     char szMsg[1024] = "";
     tsd_cells sCells{};
     ts_grid sCoarse{};
-    ts_status eSt = tsd_cells_compute(adfGT, fw, fh, hSRS, &sCells, szMsg, sizeof szMsg);
+    // measured as the DEM's own cells were (CELL_SIZES decided once)
+    ts_status eSt = tsd_cells_compute(adfGT, fw, fh, hSRS, tsd_cells_mode(&m_sCells), &sCells,
+                                      szMsg, sizeof szMsg);
     if (eSt == TS_OK)
         eSt = tsd_dem_load_resampled(GDALRasterBand::ToHandle(m_poDEM->GetRasterBand(m_sOpts.band)),
                                      &sCells, m_sOpts.z_factor, fw, fh, &sCoarse, szMsg,

@@ -77,7 +77,7 @@ class ProductsItem(unittest.TestCase):
                 self.assertIn(name, opts, "%s lists %s" % (p["name"], name))
             for name in ("PRODUCT", "SHADOWS", "DEM"):
                 self.assertNotIn(name, listed, p["name"])
-            for general in ("BAND", "Z_FACTOR", "THREADS", "PROGRESS", "MAX_MEMORY"):
+            for general in ("BAND", "Z_FACTOR", "CELL_SIZES", "THREADS", "PROGRESS", "MAX_MEMORY"):
                 self.assertIn(general, listed, p["name"])
             # the byte rule and OUTPUT_TYPE say the same
             self.assertEqual("OUTPUT_TYPE" in listed, p["byte"] in ("auto", "allowed"),
