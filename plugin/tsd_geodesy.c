@@ -130,11 +130,12 @@ static int ground_lengths(const ground_ctx *t, const double gt[6], int n, const 
 }
 
 /* The projection's scale (grid length over ground length) at nine cells
- * of the DEM, east-west and north-south: its range into c->scale_lo/hi and
- * how much it varies across the columns of the central row; 0 where PROJ
- * cannot place a point. */
+ * of the DEM, east-west and north-south: its range into c->scale_lo/hi,
+ * how much the east-west length varies across the central row's columns
+ * (across) and the north-south length along the central column (along);
+ * 0 where PROJ cannot place a point. */
 static int ground_scale(const ground_ctx *t, const double gt[6], int width, int height,
-                        tsd_cells *c, double *across)
+                        tsd_cells *c, double *across, double *along)
 {
     const double fx[3] = {0.5, 0.5 * width, width - 0.5};
     const double fy[3] = {0.5, 0.5 * height, height - 0.5};
@@ -155,9 +156,10 @@ static int ground_scale(const ground_ctx *t, const double gt[6], int width, int 
         c->scale_lo = fmin(c->scale_lo, k);
         c->scale_hi = fmax(c->scale_hi, k);
     }
-    /* the central row's east-west cells: 6, 8 and 10 */
-    const double lo = fmin(len[6], fmin(len[8], len[10]));
-    *across = fmax(len[6], fmax(len[8], len[10])) / lo - 1;
+    /* the central row's east-west cells: 6, 8 and 10; the central
+     * column's north-south ones: 3, 9 and 15 */
+    *across = fmax(len[6], fmax(len[8], len[10])) / fmin(len[6], fmin(len[8], len[10])) - 1;
+    *along = fmax(len[3], fmax(len[9], len[15])) / fmin(len[3], fmin(len[9], len[15])) - 1;
     return 1;
 }
 
@@ -173,8 +175,8 @@ static ts_status projected(const double gt[6], int width, int height,
     if (mode == TSD_CELLS_GRID || OSRIsLocal(srs))
         return TS_OK;
     ground_ctx t;
-    double across = 0;
-    if (!ground_open(&t, srs) || !ground_scale(&t, gt, width, height, c, &across)) {
+    double across = 0, along = 0;
+    if (!ground_open(&t, srs) || !ground_scale(&t, gt, width, height, c, &across, &along)) {
         ground_close(&t);
         c->scale_lo = c->scale_hi = 0;
         if (mode == TSD_CELLS_AUTO)
@@ -212,11 +214,15 @@ static ts_status projected(const double gt[6], int width, int height,
     }
     c->cell_y = c->cell_x_row[height] / height;
     c->cell_x = c->cell_x_row[height / 2];
-    if (across > 0.01)
+    /* what one length per row (east-west) and one for the whole DEM
+     * (north-south) cannot hold */
+    if (across > 0.01 || along > 0.05)
         snprintf(c->warning, sizeof c->warning,
-                 "the projection's scale varies by %.1f %% across the DEM's columns; its "
-                 "cells are measured on the ground along the central column",
-                 100 * across);
+                 "the projection's scale varies by %.1f %% across the DEM's columns and its "
+                 "cells' north-south length by %.1f %% along its rows; they are measured "
+                 "along the central column, north-south as their mean: crop the DEM or "
+                 "warp it to a local projection (e.g. UTM) for exact slopes at its edges",
+                 100 * across, 100 * along);
 done:
     free(x0);
     free(y0);

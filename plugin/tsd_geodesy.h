@@ -44,7 +44,7 @@ typedef struct {
     double scale_lo, scale_hi; /* projected: the projection's scale (grid length
                                   over ground length) seen over the DEM; 0: not
                                   measured (CELL_SIZES=grid, a local CRS) */
-    char warning[256];  /* non-empty: something the user should know */
+    char warning[512];  /* non-empty: something the user should know */
 } tsd_cells;
 
 /**

@@ -157,6 +157,17 @@ class CellSizes(unittest.TestCase):
             else:
                 self.assertGreater(abs(fa - fb), 4.0)
 
+    def test_what_one_length_per_row_cannot_hold_is_said(self):
+        """Web Mercator from 53 N to 70 N: the cells' north-south length varies
+        by 73 %, which their mean cannot hold: a warning; the 8 km planes: none."""
+        big = T.write_tif(os.path.join(self.dir, "tall.tif"), np.zeros((400, 40), "f4"),
+                          (0, 10000.0, 0, 11000000.0, 0, -10000.0), 3857)
+        p = T.run(["gdalinfo", T.conn(big)])
+        print(p.stderr.strip())
+        self.assertIn("north-south length by 73.", p.stderr)
+        self.assertIn("warp it to a local projection", p.stderr)
+        self.assertNotIn("Warning", T.run(["gdalinfo", T.conn(self.east)]).stderr)
+
     def test_utm_keeps_the_grid_unless_asked(self):
         """UTM at its central meridian: scale 0.9996, within 1 %: auto keeps
         the grid's 30 m (as gdaldem; every earlier result unchanged); ground
