@@ -33,10 +33,11 @@ echo "   (bench/fractal_tif.py $SIZE DEM 1.8 $CELL $RELIEF, seed 42)"
 bench_machine
 
 # the commands: product:directions:distance (0: unbounded)
+DLIST=$(echo "$DISTANCES" | tr ',' ' ')
 RUNS=""
 for p in horizon:4 svf:32; do
     RUNS="$RUNS $p:0"
-    for d in $(echo "$DISTANCES" | tr ',' ' '); do
+    for d in $DLIST; do
         RUNS="$RUNS $p:$d"
     done
 done
@@ -54,7 +55,7 @@ bench_rounds "$RUNS"
 for p in horizon:4 svf:32; do
     eval "base=\$T_$(bench_key "$p:0")"
     echo "   $(echo "$p" | cut -d: -f1), $(echo "$p" | cut -d: -f2) directions, unbounded: $base s"
-    for d in $(echo "$DISTANCES" | tr ',' ' '); do
+    for d in $DLIST; do
         eval "t=\$T_$(bench_key "$p:$d")"
         awk -v t="$t" -v b="$base" -v d="$d" \
             'BEGIN { printf "     MAX_DISTANCE=%-6s %7.3f s, %.2fx the unbounded (goal <= 1.5)\n", d, t, t / b }'
