@@ -207,9 +207,20 @@ static ts_status projected(const double gt[6], int width, int height,
     }
     x0[height] = x1[height] = xc, y0[height] = 0, y1[height] = height;
     if (!ground_lengths(&t, gt, height + 1, x0, y0, x1, y1, c->cell_x_row)) {
-        st = tsd_fail(msg, n, TS_ERR_ARG, "CELL_SIZES=%s: PROJ cannot take every row of the "
-                      "DEM's central column to longitude and latitude; use CELL_SIZES=grid",
-                      mode == TSD_CELLS_AUTO ? "auto" : "ground");
+        if (mode == TSD_CELLS_GROUND) {
+            st = tsd_fail(msg, n, TS_ERR_ARG, "CELL_SIZES=ground: PROJ cannot take every "
+                          "row of the DEM's central column to longitude and latitude; use "
+                          "CELL_SIZES=grid");
+            goto done;
+        }
+        /* auto: what the DEM opened with before CELL_SIZES, said */
+        free(c->cell_x_row);
+        c->cell_x_row = NULL;
+        c->ground = 0;
+        snprintf(c->warning, sizeof c->warning,
+                 "the projection's scale is %.4f to %.4f over the DEM, but PROJ cannot take "
+                 "every row of its central column to longitude and latitude, so its cells "
+                 "are the grid's, not the ground's", c->scale_lo, c->scale_hi);
         goto done;
     }
     c->cell_y = c->cell_x_row[height] / height;
