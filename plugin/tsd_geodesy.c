@@ -50,10 +50,41 @@ static ts_status geographic(const double gt[6], int width, int height, double a,
     return TS_OK;
 }
 
+/* A projected CRS's transform to its own geographic CRS (fwd) and back
+ * (inv, where asked), both in longitude-latitude order; 0, with neither
+ * left, where PROJ has none. */
+static int lonlat_transforms(OGRSpatialReferenceH srs, OGRCoordinateTransformationH *fwd,
+                             OGRCoordinateTransformationH *inv)
+{
+    *fwd = NULL;
+    if (inv)
+        *inv = NULL;
+    OGRSpatialReferenceH geo = OSRCloneGeogCS(srs);
+    if (!geo)
+        return 0;
+    OSRSetAxisMappingStrategy(geo, OAMS_TRADITIONAL_GIS_ORDER);
+    OGRSpatialReferenceH src = OSRClone(srs);
+    OSRSetAxisMappingStrategy(src, OAMS_TRADITIONAL_GIS_ORDER);
+    *fwd = OCTNewCoordinateTransformation(src, geo);
+    if (inv)
+        *inv = OCTNewCoordinateTransformation(geo, src);
+    OSRDestroySpatialReference(src);
+    OSRDestroySpatialReference(geo); /* the transforms hold their own */
+    if (*fwd && (!inv || *inv))
+        return 1;
+    if (*fwd)
+        OCTDestroyCoordinateTransformation(*fwd);
+    if (inv && *inv)
+        OCTDestroyCoordinateTransformation(*inv);
+    *fwd = NULL;
+    if (inv)
+        *inv = NULL;
+    return 0;
+}
+
 /* Lengths on the ground of a projected DEM: its CRS to longitude and
- * latitude (traditional order) and the ellipsoid's geodesics. */
+ * latitude and the ellipsoid's geodesics. */
 typedef struct {
-    OGRSpatialReferenceH geo;
     OGRCoordinateTransformationH fwd;
     struct geod_geodesic g;
 } ground_ctx;
@@ -62,10 +93,7 @@ static void ground_close(ground_ctx *t)
 {
     if (t->fwd)
         OCTDestroyCoordinateTransformation(t->fwd);
-    if (t->geo)
-        OSRDestroySpatialReference(t->geo);
     t->fwd = NULL;
-    t->geo = NULL;
 }
 
 static int ground_open(ground_ctx *t, OGRSpatialReferenceH srs)
@@ -76,19 +104,10 @@ static int ground_open(ground_ctx *t, OGRSpatialReferenceH srs)
     if (e1 != OGRERR_NONE || e2 != OGRERR_NONE || !(a > 0) || !(invf >= 0))
         return 0;
     geod_init(&t->g, a, invf != 0 ? 1.0 / invf : 0.0);
-    t->geo = OSRCloneGeogCS(srs);
-    if (!t->geo)
-        return 0;
-    OSRSetAxisMappingStrategy(t->geo, OAMS_TRADITIONAL_GIS_ORDER);
-    OGRSpatialReferenceH src = OSRClone(srs);
-    OSRSetAxisMappingStrategy(src, OAMS_TRADITIONAL_GIS_ORDER);
     CPLPushErrorHandler(CPLQuietErrorHandler); /* a failure is ours to word */
-    t->fwd = OCTNewCoordinateTransformation(src, t->geo);
+    const int ok = lonlat_transforms(srs, &t->fwd, NULL);
     CPLPopErrorHandler();
-    OSRDestroySpatialReference(src);
-    if (!t->fwd)
-        ground_close(t);
-    return t->fwd != NULL;
+    return ok;
 }
 
 /* The ground lengths of the n segments (x0, y0)-(x1, y1) of the DEM's pixel
@@ -301,19 +320,17 @@ ts_status tsd_cells_compute(const double gt[6], int width, int height,
                             "CELL_SIZES=grid");
         return projected(gt, width, height, srs, mode, c, msg, n);
     }
-    if (mode == TSD_CELLS_GROUND && !(srs && OSRIsGeocentric(srs)))
+    if (srs && OSRIsGeocentric(srs))
+        return tsd_fail(msg, n, TS_ERR_ARG, "the DEM's CRS is neither projected nor geographic "
+                    "(it is geocentric); warp it to a projected CRS first");
+    if (mode == TSD_CELLS_GROUND)
         return tsd_fail(msg, n, TS_ERR_ARG, "CELL_SIZES=ground: the DEM has no CRS, so its "
                         "cells cannot be measured on the ground; give it one "
                         "(gdal_edit.py -a_srs)");
-    if (srs && OSRIsGeocentric(srs)) {
-        return tsd_fail(msg, n, TS_ERR_ARG, "the DEM's CRS is neither projected nor geographic "
-                    "(it is geocentric); warp it to a projected CRS first");
-    } else {
-        c->kind = TSD_CRS_NONE;
-        snprintf(c->warning, sizeof c->warning,
-                 "the DEM has no CRS: its cell size (%g x %g) is taken as metres",
-                 fabs(gt[1]), fabs(gt[5]));
-    }
+    c->kind = TSD_CRS_NONE;
+    snprintf(c->warning, sizeof c->warning,
+             "the DEM has no CRS: its cell size (%g x %g) is taken as metres",
+             fabs(gt[1]), fabs(gt[5]));
     c->cell_x = fabs(gt[1]) * c->unit_to_m;
     c->cell_y = fabs(gt[5]) * c->unit_to_m;
     return TS_OK;
@@ -388,26 +405,11 @@ ts_status tsd_sites_compute(const double gt[6], int width, int height,
         tsd_sites_free(s);
         return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory for %zu sun sites", nodes);
     }
-    OGRSpatialReferenceH geo = NULL;
     OGRCoordinateTransformationH fwd = NULL, inv = NULL;
-    if (!geographic) {
-        geo = OSRCloneGeogCS(srs);
-        if (geo) {
-            OSRSetAxisMappingStrategy(geo, OAMS_TRADITIONAL_GIS_ORDER);
-            OGRSpatialReferenceH src = OSRClone(srs);
-            OSRSetAxisMappingStrategy(src, OAMS_TRADITIONAL_GIS_ORDER);
-            fwd = OCTNewCoordinateTransformation(src, geo);
-            inv = OCTNewCoordinateTransformation(geo, src);
-            OSRDestroySpatialReference(src);
-        }
-        if (!fwd || !inv) {
-            if (fwd) OCTDestroyCoordinateTransformation(fwd);
-            if (inv) OCTDestroyCoordinateTransformation(inv);
-            if (geo) OSRDestroySpatialReference(geo);
-            tsd_sites_free(s);
-            return tsd_fail(msg, n, TS_ERR_ARG, "PROJ cannot transform the DEM's CRS to longitude and "
-                        "latitude, so the sun's position over it is unknown");
-        }
+    if (!geographic && !lonlat_transforms(srs, &fwd, &inv)) {
+        tsd_sites_free(s);
+        return tsd_fail(msg, n, TS_ERR_ARG, "PROJ cannot transform the DEM's CRS to longitude and "
+                    "latitude, so the sun's position over it is unknown");
     }
     double deg = geographic ? OSRGetAngularUnits(srs, NULL) * 180.0 / M_PI : 1.0;
     ts_status rc = TS_OK;
@@ -458,7 +460,6 @@ ts_status tsd_sites_compute(const double gt[6], int width, int height,
         }
     if (fwd) OCTDestroyCoordinateTransformation(fwd);
     if (inv) OCTDestroyCoordinateTransformation(inv);
-    if (geo) OSRDestroySpatialReference(geo);
     if (rc != 0)
         tsd_sites_free(s);
     return rc;

@@ -50,8 +50,7 @@ TSDataset *TSDataset::MakeOverview(int nLevel)
     poOvr->m_osDEM = m_osDEM;
     poOvr->m_sOpts = m_sOpts;
     // measured as the DEM's own cells were (CELL_SIZES=auto decided once)
-    if (m_sCells.kind == TSD_CRS_PROJECTED)
-        poOvr->m_sOpts.cell_sizes = tsd_cells_mode(&m_sCells);
+    poOvr->m_sOpts.cell_sizes = tsd_cells_mode(&m_sCells);
     poOvr->m_psProduct = m_psProduct;
     poOvr->m_bHasGT = m_bHasGT;
     poOvr->m_oSRS = m_oSRS;
