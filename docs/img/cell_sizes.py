@@ -17,22 +17,17 @@ import tempfile
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-from plugin_env import HERE, JACKSBORO as DEM, gdal
+from plugin_env import HERE, JACKSBORO as DEM, gdal, grey
 
 SUN = ["PRODUCT=shadow", "SUN_AZIMUTH=135", "SUN_ELEVATION=10"]
 
 
-def shade(path, extra=()):
+def shadow(path, extra=()):
     ds = gdal.OpenEx("TERRASHADE:" + path, gdal.OF_RASTER, open_options=SUN + list(extra))
     a = ds.GetRasterBand(1).ReadAsArray().astype(np.float64)
     ds = None
     return a
 
-
-def grey(a):
-    """32 grey levels of [0, 1] (black: in shadow): a small PNG."""
-    q = np.round(31 * np.clip(np.nan_to_num(a), 0, 1)) * (255 / 31)
-    return Image.fromarray(q.astype(np.uint8))
 
 
 def main():
@@ -50,8 +45,8 @@ def main():
         gdal.Warp(back, geo, dstSRS="EPSG:3857", outputBounds=(gt[0], gt[3] + h * gt[5],
                   gt[0] + w * gt[1], gt[3]), xRes=gt[1], yRes=-gt[5], resampleAlg="near")
         panels = [("in degrees (reference)", gdal.Open(back).ReadAsArray().astype(np.float64)),
-                  ("Web Mercator, CELL_SIZES=grid", shade(merc, ["CELL_SIZES=grid"])),
-                  ("Web Mercator, CELL_SIZES=auto", shade(merc))]
+                  ("Web Mercator, CELL_SIZES=grid", shadow(merc, ["CELL_SIZES=grid"])),
+                  ("Web Mercator, CELL_SIZES=auto", shadow(merc))]
     pad, top = 6, 18
     img = Image.new("L", (len(panels) * (w + pad) + pad, h + top + 2 * pad), 255)
     d = ImageDraw.Draw(img)

@@ -13,7 +13,7 @@ import os
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-from plugin_env import HERE, JACKSBORO as DEM, gdal
+from plugin_env import HERE, JACKSBORO as DEM, gdal, grey
 
 BASE = {"PRODUCT": "svf", "DIRECTIONS": "32", "OUTPUT_TYPE": "Float32"}
 
@@ -23,11 +23,6 @@ def svf(**extra):
     ds = gdal.OpenEx("TERRASHADE:" + DEM, gdal.OF_RASTER, open_options=oo)
     return ds.GetRasterBand(1).ReadAsArray().astype(np.float64)
 
-
-def grey(a, lo, hi):
-    """32 grey levels: a small PNG."""
-    q = np.round(31 * np.clip((a - lo) / (hi - lo), 0, 1)) * (255 / 31)
-    return Image.fromarray(q.astype(np.uint8))
 
 
 def main():

@@ -13,7 +13,7 @@ import os
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-from plugin_env import HERE, JACKSBORO as DEM, gdal
+from plugin_env import HERE, JACKSBORO as DEM, gdal, grey
 
 METHODS = [("exact", {}), ("shm", {"METHOD": "shm"}), ("shadowmap", {"METHOD": "shadowmap"}),
            ("sh", {"METHOD": "sh"}),
@@ -29,11 +29,6 @@ def shade(sun, opts):
     ds = None
     return a
 
-
-def grey(a):
-    """32 grey levels of shade in [0, 1]: a small PNG."""
-    q = np.round(31 * np.clip(np.nan_to_num(a), 0, 1)) * (255 / 31)
-    return Image.fromarray(q.astype(np.uint8))
 
 
 def main():

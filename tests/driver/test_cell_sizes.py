@@ -29,7 +29,7 @@ def parallel_cell(px, y):
     """Ground length on the WGS 84 ellipsoid of px metres of Web Mercator
     easting at northing y: the arc of the parallel."""
     phi = mercator_lat(y)
-    return px / A * A * math.cos(phi) / math.sqrt(1 - E2 * math.sin(phi) ** 2)
+    return px * math.cos(phi) / math.sqrt(1 - E2 * math.sin(phi) ** 2)
 
 
 def meridian_arc(phi0, phi1, steps=200):
@@ -50,22 +50,29 @@ class CellSizes(unittest.TestCase):
         cls.dir = cls.tmp.__enter__()
         n, px, top = cls.N, cls.PX, cls.Y_TOP
         cls.gt = (1000000.0, px, 0, top, 0, -px)
-        rows = top - (np.arange(n) + 0.5) * px            # northings of the rows
-        cls.ew = np.array([parallel_cell(px, y) for y in rows])
+        cls.ew = cls.row_cells(n)
         cls.east = cls.east_plane("east.tif", n)
         # rising north: SLOPE x the ground distance along the meridian
         south = mercator_lat(top - n * px)
-        north = np.array([meridian_arc(south, mercator_lat(y)) for y in rows])
+        north = np.array([meridian_arc(south, mercator_lat(y)) for y in cls.rows(n)])
         cls.north = T.write_tif(os.path.join(cls.dir, "north.tif"),
                                 np.repeat((SLOPE * north)[:, None], n, 1), cls.gt, 3857)
+
+    @classmethod
+    def rows(cls, n):
+        """The northings of the grid's first n rows."""
+        return cls.Y_TOP - (np.arange(n) + 0.5) * cls.PX
+
+    @classmethod
+    def row_cells(cls, n):
+        """The ground east-west length of a cell in each of the first n rows."""
+        return np.array([parallel_cell(cls.PX, y) for y in cls.rows(n)])
 
     @classmethod
     def east_plane(cls, name, n):
         """n x n cells of the grid rising east: SLOPE x the ground distance
         along each row."""
-        rows = cls.Y_TOP - (np.arange(n) + 0.5) * cls.PX
-        ew = np.array([parallel_cell(cls.PX, y) for y in rows])
-        z = SLOPE * (np.arange(n)[None, :] + 0.5) * ew[:, None]
+        z = SLOPE * (np.arange(n)[None, :] + 0.5) * cls.row_cells(n)[:, None]
         return T.write_tif(os.path.join(cls.dir, name), z, cls.gt, 3857)
 
     @classmethod
