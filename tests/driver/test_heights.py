@@ -1,0 +1,148 @@
+"""Heights no terrain has: an undeclared nodata value (-32768, -3.4e38...) is
+an error that names the value, the cell and the remedy, never a silent
+raster shaded around a 33 km deep hole; real extremes, exaggeration,
+heights in another unit and other bodies are accepted."""
+import os
+import unittest
+
+import tsdriver as T
+from tsdriver import gdal, np
+
+GT = (600000, 30, 0, 4000000, 0, -30)
+UTM = 32617
+# Mars, geographic, IAU's sphere-ish ellipsoid (no EPSG code)
+MARS = "+proj=longlat +a=3396190 +b=3376200 +no_defs"
+
+
+def failure(conn, extra=()):
+    """gdal_translate of conn must fail; its stderr."""
+    with T.TempDir() as tmp:
+        p = T.run(["gdal_translate", "-q"] + list(extra)
+                  + [conn, os.path.join(tmp, "o.tif")], ok=False)
+    return p.stderr
+
+
+class ImpossibleHeights(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmpdir = T.TempDir()
+        cls.tmp = cls.tmpdir.__enter__()
+        cls.z = T.fractal_dem(96, seed=4, relief=800.0)  # 100 .. 900 m
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmpdir.__exit__(None, None, None)
+
+    def dem(self, name, z, srs=UTM, nodata=None, dtype=gdal.GDT_Float32):
+        return T.write_tif(os.path.join(self.tmp, name), z, GT, srs, nodata, dtype)
+
+    def with_void(self, value, rows=slice(40, 52), cols=slice(30, 47)):
+        z = self.z.copy()
+        z[rows, cols] = value
+        return z
+
+    def test_undeclared_int16_void_is_an_error_naming_it(self):
+        """-32768 in an Int16 DEM without a nodata value: an error with the
+        value, its first cell and the gdal_edit.py line that declares it."""
+        dem = self.dem("int16.tif", np.round(self.with_void(-32768)), dtype=gdal.GDT_Int16)
+        for p in ("shade", "svf", "horizon"):
+            with self.subTest(product=p):
+                err = failure(T.conn(dem, PRODUCT=p, DIRECTIONS=4))
+                print(err.strip().splitlines()[0])
+                self.assertIn("ERROR 5: TERRASHADE: the DEM", err)
+                self.assertIn("holds a height no terrain has: -32768 m in band 1 at "
+                              "column 30, row 40", err)
+                self.assertIn("gdal_edit.py -a_nodata -32768 " + dem, err)
+
+    def test_declared_it_is_nodata(self):
+        """The remedy the error gives works: the void is nodata in the output."""
+        z = self.with_void(-32768)
+        dem = self.dem("declared.tif", z, nodata=-32768)
+        out = T.read(T.conn(dem, PRODUCT="svf", DIRECTIONS=8), 1)
+        np.testing.assert_array_equal(np.isnan(out), z == -32768)
+        self.assertTrue(np.all((out[z != -32768] >= 0) & (out[z != -32768] <= 1)))
+
+    def test_float_extremes_in_every_path(self):
+        """-3.4e38 (ArcGIS's float nodata) and 1e30, through the whole DEM,
+        windows (TILE_SIZE) and an overview level (averaged: 'near')."""
+        for value in (-3.4028234663852886e38, 1e30):
+            dem = self.dem("f%g.tif" % value, self.with_void(value))
+            with self.subTest(value=value, path="whole"):
+                err = failure(T.conn(dem, TILE_SIZE=0))
+                self.assertIn("holds a height no terrain has: %.6g m in band 1 at column 30, "
+                              "row 40" % np.float32(value), err)
+                self.assertIn("-a_nodata %.9g" % np.float32(value), err)
+            with self.subTest(value=value, path="windows"):
+                err = failure(T.conn(dem, TILE_SIZE=64))
+                self.assertIn("holds a height no terrain has", err)
+        # an overview level (a 600 x 600 DEM has one of 300 x 300): the
+        # averaged cell says where it lies in the DEM
+        big = T.fractal_dem(600, seed=4, relief=800.0)
+        big[401:420, 333:350] = -3.4028234663852886e38
+        dem = self.dem("big.tif", big)
+        err = failure(T.conn(dem), ["-outsize", "50%", "0", "-r", "nearest"])
+        self.assertRegex(err, r"no terrain has: -\d\.\d+e\+3[78] m \(averaged\) in band 1 near "
+                              r"column 332, row 400")
+        self.assertNotIn("-a_nodata", err)  # an average is not the DEM's value
+
+    def test_the_deepest_and_highest_terrain_are_accepted(self):
+        """A trench to -10 935 m (the Challenger Deep) and a peak at 8 849 m
+        (Everest) are terrain: no error, finite output."""
+        z = self.z.copy()
+        z[10:20, 10:20] = -10935.0
+        z[60:64, 60:64] = 8849.0
+        dem = self.dem("extremes.tif", z)
+        out = T.read(T.conn(dem, PRODUCT="svf", DIRECTIONS=8), 1)
+        self.assertTrue(np.isfinite(out).all())
+
+    def test_exaggeration_widens_the_limits_with_it(self):
+        """Z_FACTOR=12 on heights up to 900 m (10.8 km) is an exaggeration the
+        user asked for, equal to the DEM with its heights times 12; the same
+        with an undeclared void is still an error, scaled."""
+        dem = self.dem("exaggerated.tif", self.z)
+        tall = self.dem("tall.tif", self.z * 12)
+        o = {"PRODUCT": "svf", "DIRECTIONS": 8, "CURVATURE": "NO"}
+        a = T.read(T.conn(dem, Z_FACTOR=12, **o), 1)
+        self.assertTrue(np.isfinite(a).all())
+        # the DEM made 10.8 km tall with no Z_FACTOR is beyond the Earth's terrain
+        err = failure(T.conn(tall, **o))
+        self.assertRegex(err, r"holds a height no terrain has: (9|10)\d\d\d(\.\d+)? m")
+        void = self.dem("exaggerated_void.tif", self.with_void(-32768))
+        err = failure(T.conn(void, Z_FACTOR=12))
+        self.assertIn("-393216 m in band 1 at column 30, row 40", err)
+        self.assertIn("times Z_FACTOR's exaggeration 12", err)
+        self.assertIn("-a_nodata -32768 ", err)
+
+    def test_feet_without_a_unit(self):
+        """Heights in feet to 14 000 (Colorado) with no unit in the DEM:
+        taken as metres they are higher than Everest, an error that names
+        the unit; Z_FACTOR=0.3048 or the band's unit set make them metres."""
+        ft = self.z / 900.0 * 14000.0
+        dem = self.dem("feet.tif", ft)
+        err = failure(T.conn(dem))
+        self.assertIn("gdal_edit.py -units ft", err)
+        a = T.read(T.conn(dem, PRODUCT="svf", DIRECTIONS=8, Z_FACTOR=0.3048), 1)
+        self.assertTrue(np.isfinite(a).all())
+        ds = gdal.Open(dem, gdal.GA_Update)
+        ds.GetRasterBand(1).SetUnitType("ft")
+        ds = None
+        b = T.read(T.conn(dem, PRODUCT="svf", DIRECTIONS=8), 1)
+        np.testing.assert_array_equal(a, b)
+
+    def test_another_body_is_held_to_its_radius(self):
+        """On Mars (a CRS whose ellipsoid is not the Earth's) Olympus Mons'
+        21 km is terrain; a height beyond the planet's radius is not."""
+        gt = (130.0, 0.01, 0, 20.0, 0, -0.01)
+        z = self.z / 900.0 * 21000.0
+        dem = T.write_tif(os.path.join(self.tmp, "mars.tif"), z, gt, MARS)
+        a = T.read(T.conn(dem, PRODUCT="svf", DIRECTIONS=8, CURVATURE="NO"), 1)
+        self.assertTrue(np.isfinite(a).all())
+        z[5, 7] = -1e7
+        dem = T.write_tif(os.path.join(self.tmp, "mars_void.tif"), z, gt, MARS)
+        err = failure(T.conn(dem, CURVATURE="NO"))
+        self.assertIn("-1e+07 m in band 1 at column 7, row 5, beyond the radius of the "
+                      "CRS's body (3396190 m)", err)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
