@@ -469,6 +469,22 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
                              CPLSPrintf("BAND=%d, but the DEM '%s' has %d band(s)",
                                         sOpts.band, osDEM.c_str(),
                                         poDEM->GetRasterCount()));
+    // a colour image's channel or a palette's class indices are not heights
+    const GDALColorInterp eInterp = poDEM->GetRasterBand(sOpts.band)->GetColorInterpretation();
+    if (eInterp != GCI_Undefined && eInterp != GCI_GrayIndex)
+    {
+        const std::string osWhat =
+            eInterp == GCI_PaletteIndex
+                ? std::string("the class indices of a palette")
+                : std::string("the ") + GDALGetColorInterpretationName(eInterp) +
+                      " channel of a colour image";
+        return FailOpen(TS_ERR_ARG,
+                        CPLSPrintf("band %d of '%s' holds %s, not heights: choose the band "
+                                   "that holds heights (BAND), or, if these values are "
+                                   "heights, say so (gdal_edit.py -colorinterp_%d gray '%s')",
+                                   sOpts.band, osDEM.c_str(), osWhat.c_str(), sOpts.band,
+                                   osDEM.c_str()));
+    }
     // Z_FACTOR=AUTO becomes the factor of the DEM's vertical unit here, so
     // that the metadata and the auxiliary-file key say the number used
     char szZWhy[256];

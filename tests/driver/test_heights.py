@@ -1,7 +1,8 @@
 """Heights no terrain has: an undeclared nodata value (-32768, -3.4e38...) is
 an error that names the value, the cell and the remedy, never a silent
 raster shaded around a 33 km deep hole; real extremes, exaggeration,
-heights in another unit and other bodies are accepted."""
+heights in another unit and other bodies are accepted. A colour image's
+channel or a palette's classes are not heights either."""
 import os
 import unittest
 
@@ -142,6 +143,40 @@ class ImpossibleHeights(unittest.TestCase):
         err = failure(T.conn(dem, CURVATURE="NO"))
         self.assertIn("-1e+07 m in band 1 at column 7, row 5, beyond the radius of the "
                       "CRS's body (3396190 m)", err)
+
+
+class NotHeights(unittest.TestCase):
+    def test_colour_and_palette_bands_are_refused(self):
+        """An RGB picture's red channel and a land-cover palette are not
+        heights: an error at open that names the band and the way out."""
+        with T.TempDir() as tmp:
+            rgb = os.path.join(tmp, "photo.tif")
+            ds = gdal.GetDriverByName("GTiff").Create(rgb, 40, 30, 3, gdal.GDT_Byte,
+                                                      ["PHOTOMETRIC=RGB"])
+            ds.SetGeoTransform(GT)
+            for b in range(3):
+                ds.GetRasterBand(b + 1).Fill(50 * b + 10)
+            ds = None
+            classes = os.path.join(tmp, "classes.tif")
+            ds = gdal.GetDriverByName("GTiff").Create(classes, 40, 30, 1, gdal.GDT_Byte)
+            ds.SetGeoTransform(GT)
+            ct = gdal.ColorTable()
+            ct.SetColorEntry(1, (0, 128, 0, 255))
+            ds.GetRasterBand(1).SetRasterColorTable(ct)
+            ds.GetRasterBand(1).Fill(1)
+            ds = None
+            for dem, band, what in ((rgb, 1, "the Red channel of a colour image"),
+                                    (rgb, 3, "the Blue channel of a colour image"),
+                                    (classes, 1, "the class indices of a palette")):
+                with self.subTest(dem=os.path.basename(dem), band=band):
+                    p = T.run(["gdalinfo", "-nomd", T.conn(dem, BAND=band)], ok=False)
+                    self.assertIn("ERROR 5: TERRASHADE: band %d of '%s' holds %s, not heights"
+                                  % (band, dem, what), p.stderr)
+                    self.assertIn("gdal_edit.py -colorinterp_%d gray" % band, p.stderr)
+            # said to be heights, they are computed
+            T.run(["gdal_edit.py", "-colorinterp_2", "gray", rgb])
+            out = T.read(T.conn(rgb, BAND=2, PRODUCT="svf", DIRECTIONS=4), 1)
+            np.testing.assert_allclose(out, 1.0, atol=1e-6)  # a flat band: open sky
 
 
 if __name__ == "__main__":
