@@ -590,6 +590,11 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
         return false;
     if (m_sCells.warning[0] && m_nLevel == 0) // said once, for the DEM itself
         CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", m_sCells.warning);
+    if (m_nLevel == 0 &&
+        tsd_dem_steepness_warning(GDALGetRasterBand(m_poDEM, sOpts.band), &m_sCells,
+                                  sOpts.z_factor, hSRS ? m_oSRS.GetName() : nullptr, szMsg,
+                                  sizeof szMsg))
+        CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szMsg);
     if (!SetupWindow(W, H) ||
         !CheckMemory(sOpts, W, H, WindowPlan(m_poWindow), m_bHasSun ? &m_sSun : nullptr,
                      m_sCells, m_nLevel))

@@ -361,6 +361,52 @@ ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
     return checked_and_flipped(band, &c, cells, grid, lo, hi, &p, msg, n);
 }
 
+/* Steeper than this nearly everywhere is not terrain at the DEM's scale. */
+#define STEEP_DEGREES 85.0
+#define STEEP_SAMPLE 256
+
+int tsd_dem_steepness_warning(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
+                              const char *crs_name, char *warning, size_t n)
+{
+    const int W = GDALGetRasterBandXSize(band), H = GDALGetRasterBandYSize(band);
+    const int w = W < STEEP_SAMPLE ? W : STEEP_SAMPLE, h = H < STEEP_SAMPLE ? H : STEEP_SAMPLE;
+    if (w < 3 || h < 3)
+        return 0;
+    const int x0 = (W - w) / 2, y0 = (H - h) / 2;
+    ts_grid g;
+    char msg[16];
+    /* a sample that cannot be read says nothing here: the reads will */
+    if (tsd_dem_load_window(band, cells, z_factor, x0, y0, w, h, &g, msg, sizeof msg) != TS_OK)
+        return 0;
+    const double limit = tan(STEEP_DEGREES * M_PI / 180.0);
+    long steep = 0, counted = 0;
+    for (int y = 1; y < h - 1; y++) {
+        const float *r = g.z + (ptrdiff_t)y * g.stride;
+        const double cx = cells->cell_x_row ? cells->cell_x_row[y0 + y] : cells->cell_x;
+        for (int x = 1; x < w - 1; x++) {
+            double dx = (r[x + 1] - r[x - 1]) / (2 * cx);
+            double dy = (r[x + g.stride] - r[x - g.stride]) / (2 * cells->cell_y);
+            if (isnan(dx) || isnan(dy))
+                continue;
+            counted++;
+            steep += hypot(dx, dy) > limit;
+        }
+    }
+    ts_grid_free(&g);
+    if (counted == 0 || steep * 2 <= counted)
+        return 0;
+    GDALDatasetH ds = GDALGetBandDataset(band);
+    snprintf(warning, n,
+             "the DEM '%s' is steeper than %.0f degrees at %.0f %% of the %d x %d cells at its "
+             "centre: its cells (%.6g x %.6g m) are small for its heights' changes, and its "
+             "shading will be black and white. Is it georeferenced in degrees under a "
+             "projected CRS%s%s%s, or are its heights in another unit (Z_FACTOR)?",
+             ds ? GDALGetDescription(ds) : "", STEEP_DEGREES, 100.0 * steep / counted, w, h,
+             cells->cell_x, cells->cell_y, crs_name && *crs_name ? " (" : "",
+             crs_name ? crs_name : "", crs_name && *crs_name ? ")" : "");
+    return 1;
+}
+
 /* Metres per unit of a unit's name (GDAL's band unit types, PROJ's and
  * GeoTIFF's names), or 0 if not known. */
 static double metres_per_unit(const char *unit)

@@ -40,6 +40,17 @@ ts_status tsd_dem_load_window(GDALRasterBandH band, const tsd_cells *cells, doub
                               size_t msg_size);
 
 /**
+ * 1 with a sentence in `warning` when more than half of the cells of a
+ * sample of up to 256 x 256 cells at the DEM's centre are steeper than 85
+ * degrees (central differences): not terrain at its cells' scale, as when
+ * a DEM in degrees is given a projected CRS (cells of 0.0008 "m") or its
+ * heights are in millimetres. 0 otherwise, or when the sample cannot be
+ * read. crs_name (may be NULL) names the CRS in the sentence.
+ */
+int tsd_dem_steepness_warning(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
+                              const char *crs_name, char *warning, size_t warning_size);
+
+/**
  * The Z_FACTOR that turns `band`'s heights (after its scale and offset)
  * into metres. A finite `requested` is the user's number and is kept; NAN
  * (AUTO) takes the vertical unit of the dataset's CRS (a compound or

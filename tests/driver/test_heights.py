@@ -8,6 +8,7 @@ import unittest
 
 import tsdriver as T
 from tsdriver import gdal, np
+from osgeo import osr
 
 GT = (600000, 30, 0, 4000000, 0, -30)
 UTM = 32617
@@ -177,6 +178,55 @@ class NotHeights(unittest.TestCase):
             T.run(["gdal_edit.py", "-colorinterp_2", "gray", rgb])
             out = T.read(T.conn(rgb, BAND=2, PRODUCT="svf", DIRECTIONS=4), 1)
             np.testing.assert_allclose(out, 1.0, atol=1e-6)  # a flat band: open sky
+
+
+class NotTerrainScale(unittest.TestCase):
+    """A DEM steeper than 85 degrees nearly everywhere is not terrain at its
+    cells' scale: a warning at open that says what is likely wrong."""
+
+    def warnings(self, dem, **options):
+        p = T.run(["gdalinfo", "-nomd", T.conn(dem, **options)])
+        return p.stderr
+
+    def test_degrees_under_a_projected_crs(self):
+        with T.TempDir() as tmp:
+            src = gdal.Open(T.JACKSBORO)
+            mistag = os.path.join(tmp, "mistag.tif")
+            ds = gdal.GetDriverByName("GTiff").CreateCopy(mistag, src)
+            srs = osr.SpatialReference()
+            srs.ImportFromEPSG(UTM)
+            ds.SetProjection(srs.ExportToWkt())
+            ds = None
+            err = self.warnings(mistag)
+            print(err.strip())
+            self.assertRegex(err, r"Warning 1: TERRASHADE: the DEM '.*mistag.tif' is steeper "
+                                  r"than 85 degrees at \d+ % of the 256 x 256 cells at its "
+                                  r"centre: its cells \(0.000833333 x 0.000833333 m\)")
+            self.assertIn("projected CRS (WGS 84 / UTM zone 17N)", err)
+
+    def test_heights_in_millimetres(self):
+        """A polder of 1 m cells, 0 to 5 m high, in millimetres (within the
+        Earth's heights, so only its slopes give it away)."""
+        with T.TempDir() as tmp:
+            z = T.fractal_dem(256, seed=2, relief=5.0) - 100.0
+            gt = (120000, 1, 0, 480000, 0, -1)
+            m = T.write_tif(os.path.join(tmp, "m.tif"), z, gt, 28992)
+            mm = T.write_tif(os.path.join(tmp, "mm.tif"), z * 1000, gt, 28992)
+            self.assertIn("steeper than 85 degrees", self.warnings(mm))
+            # in metres, or with the unit's factor, it is terrain
+            self.assertNotIn("steeper", self.warnings(m))
+            self.assertNotIn("steeper", self.warnings(mm, Z_FACTOR=0.001))
+
+    def test_real_and_rough_terrain_pass(self):
+        """jacksboro, lux_elev, and a 10 m fractal far rougher than terrain
+        (1400 m of relief, the benches' DEM) open without the warning."""
+        with T.TempDir() as tmp:
+            rough = os.path.join(tmp, "rough.tif")
+            T.run(["/usr/bin/python3", os.path.join(T.SRCDIR, "bench", "fractal_tif.py"),
+                   "512", rough])
+            for dem in (T.JACKSBORO, T.LUX, rough):
+                with self.subTest(dem=os.path.basename(dem)):
+                    self.assertNotIn("steeper", self.warnings(dem))
 
 
 if __name__ == "__main__":
