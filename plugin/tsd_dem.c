@@ -1,6 +1,7 @@
 /* Read a DEM band into a core grid. */
 #include "tsd_dem.h"
 
+#include "tsd_dem_check.h"
 #include "tsd_text.h"
 
 #include <math.h>
@@ -97,16 +98,9 @@ ts_status tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_fa
                                   GDALGetRasterBandYSize(band), grid, msg, n);
 }
 
-/* How a band's values become the grid's heights. */
-typedef struct {
-    double scale, offset; /* value * scale + offset: the band's own, times z_factor */
-    double z_factor;      /* Z_FACTOR as applied (AUTO resolved) */
-    double unit_factor;   /* metres per unit of the heights as the DEM's metadata says */
-} conversion;
-
-static conversion conversion_of(GDALRasterBandH band, double z_factor)
+static tsd_dem_conversion conversion_of(GDALRasterBandH band, double z_factor)
 {
-    conversion c;
+    tsd_dem_conversion c;
     int has_scale = 0, has_offset = 0;
     c.scale = GDALGetRasterScale(band, &has_scale);
     c.offset = GDALGetRasterOffset(band, &has_offset);
@@ -121,32 +115,18 @@ static conversion conversion_of(GDALRasterBandH band, double z_factor)
     return c;
 }
 
-/* An unsigned int per float bit pattern that orders as the floats do (NaN
- * aside), so that the lowest and highest heights reduce in integer lanes. */
-static inline uint32_t order_key(uint32_t bits)
-{
-    return bits ^ ((0u - (bits >> 31)) | 0x80000000u);
-}
-
-static float key_float(uint32_t key)
-{
-    uint32_t bits = key & 0x80000000u ? key ^ 0x80000000u : ~key;
-    float f;
-    memcpy(&f, &bits, sizeof f);
-    return f;
-}
-
 /* Heights in metres, NaN where the mask row says invalid or not finite:
  * r * scale + offset in double, as (float), selected on the bits (a float
  * or double compare would keep gcc from vectorising under trapping math;
- * the read ahead of the whole DEM waits on this loop). The order keys of
- * the lowest and highest valid heights are folded into *lo_key, *hi_key. */
+ * the read ahead of the whole DEM waits on this loop). What tsd_dem_check
+ * needs of the row is folded into *seen: its lowest and highest valid
+ * heights' order keys, its largest step between neighbours. */
 TS_SIMD_CLONES
 static void to_metres(float *restrict r, const unsigned char *restrict mr, int w, double scale,
-                      double offset, uint32_t *restrict lo_key, uint32_t *restrict hi_key)
+                      double offset, tsd_dem_seen *restrict seen)
 {
     const uint32_t nan_bits = 0x7fc00000u; /* NAN */
-    uint32_t lo = *lo_key, hi = *hi_key;
+    uint32_t lo = seen->lo_key, hi = seen->hi_key;
     for (int x = 0; x < w; x++) {
         double v = r[x] * scale + offset;
         float f = (float)v;
@@ -156,101 +136,26 @@ static void to_metres(float *restrict r, const unsigned char *restrict mr, int w
         memcpy(&fb, &f, sizeof fb);
         uint32_t finite = (uint32_t)((vb & 0x7ff0000000000000u) != 0x7ff0000000000000u);
         uint32_t keep = -(finite & (uint32_t)(!mr || mr[x]));
-        uint32_t key = order_key(fb);
+        uint32_t key = tsd_order_key(fb);
         uint32_t key_lo = key | ~keep, key_hi = key & keep; /* invalid: no bound */
         lo = key_lo < lo ? key_lo : lo;
         hi = key_hi > hi ? key_hi : hi;
         fb = (fb & keep) | (nan_bits & ~keep);
         memcpy(&r[x], &fb, sizeof fb);
     }
-    *lo_key = lo;
-    *hi_key = hi;
-}
-
-/* Beyond any terrain on Earth: the deepest ocean floor (the Challenger
- * Deep, -10.9 km) and Everest (8.85 km), with room for ellipsoidal heights.
- * Undeclared nodata values (-32768, 32767, 65535, -3.4e38...) lie beyond. */
-#define EARTH_LOWEST_M (-12000.0)
-#define EARTH_HIGHEST_M 9000.0
-
-/* Where a grid loaded (not yet flipped) lies in the band: its cell (gx, gy)
- * is about band cell (x0 + sx * gx, y0 + sy * gy). */
-typedef struct {
-    int x0, y0;
-    double sx, sy;
-} placement;
-
-/* The heights a grid of the band may hold, in metres: the Earth's, or on
- * another body (a CRS whose ellipsoid is not the Earth's) within its
- * radius; widened by a Z_FACTOR that exaggerates the heights beyond their
- * unit. Names them in `what`. */
-static void height_limits(GDALRasterBandH band, const conversion *c, double *low, double *high,
-                          char *what, size_t n)
-{
-    GDALDatasetH ds = GDALGetBandDataset(band);
-    OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
-    OGRErr err = OGRERR_FAILURE;
-    double a = srs ? OSRGetSemiMajor(srs, &err) : 0;
-    if (err == OGRERR_NONE && a > 0 && fabs(a - 6371000.0) > 100000.0) {
-        *low = -a;
-        *high = a;
-        snprintf(what, n, "the radius of the CRS's body (%.0f m)", a);
-    } else {
-        *low = EARTH_LOWEST_M;
-        *high = EARTH_HIGHEST_M;
-        snprintf(what, n, "any terrain on Earth (%.0f to %.0f m)", *low, *high);
+    /* |r[x] - r[x - 1]| as bits, 0 where either is NaN or it overflows */
+    uint32_t step = seen->step_bits;
+    for (int x = 1; x < w; x++) {
+        float d = r[x] - r[x - 1];
+        uint32_t db;
+        memcpy(&db, &d, sizeof db);
+        db &= 0x7fffffffu;
+        db &= -(uint32_t)(db < 0x7f800000u);
+        step = db > step ? db : step;
     }
-    double stretch = c->z_factor / c->unit_factor;
-    if (stretch > 1) {
-        *low *= stretch;
-        *high *= stretch;
-        size_t len = strlen(what);
-        snprintf(what + len, n - len, " times Z_FACTOR's exaggeration %g", stretch);
-    }
-}
-
-/* TS_OK if the valid heights of a grid just loaded (their order keys
- * lo_key .. hi_key) are some terrain's; else TS_ERR_ARG naming the first
- * cell that is not and what to do (an undeclared nodata value, a unit). */
-static ts_status check_heights(GDALRasterBandH band, const conversion *c, const ts_grid *g,
-                               uint32_t lo_key, uint32_t hi_key, const placement *p, char *msg,
-                               size_t n)
-{
-    if (lo_key > hi_key)
-        return TS_OK; /* no valid height */
-    double low, high;
-    char what[160];
-    height_limits(band, c, &low, &high, what, sizeof what);
-    if (key_float(lo_key) >= low && key_float(hi_key) <= high)
-        return TS_OK;
-    int gx = 0, gy = 0;
-    float z = NAN;
-    for (gy = 0; gy < g->height; gy++) {
-        const float *row = g->z + (ptrdiff_t)gy * g->stride;
-        for (gx = 0; gx < g->width; gx++)
-            if (row[gx] < low || row[gx] > high)
-                break;
-        if (gx < g->width) {
-            z = row[gx];
-            break;
-        }
-    }
-    const int bx = p->x0 + (int)(p->sx * gx), by = p->y0 + (int)(p->sy * gy);
-    const int full = p->sx == 1 && p->sy == 1; /* else a coarse cell: an average */
-    const double raw = ((double)z - c->offset) / c->scale; /* as the band holds it */
-    GDALDatasetH ds = GDALGetBandDataset(band);
-    const char *path = ds ? GDALGetDescription(ds) : "";
-    char declare[160] = "";
-    if (full && isfinite(raw))
-        snprintf(declare, sizeof declare, " (gdal_edit.py -a_nodata %.9g %s)", raw, path);
-    return tsd_fail(msg, n, TS_ERR_ARG,
-                    "the DEM '%s' holds a height no terrain has: %.6g m%s in band %d %s "
-                    "column %d, row %d, beyond %s. A nodata value the DEM does not "
-                    "declare? Declare it%s and those cells are nodata. Heights in "
-                    "another unit? Set the band's unit (gdal_edit.py -units ft) or "
-                    "Z_FACTOR",
-                    path, (double)z, full ? "" : " (averaged)", GDALGetBandNumber(band),
-                    full ? "at" : "near", bx, by, what, declare);
+    seen->lo_key = lo;
+    seen->hi_key = hi;
+    seen->step_bits = step;
 }
 
 static ts_status read_failed(ts_grid *grid, unsigned char *m, char *msg, size_t n)
@@ -277,13 +182,26 @@ static ts_status grid_of(const tsd_cells *cells, int w, int h, int row0, ts_grid
     return TS_OK;
 }
 
-/* The loads' end: the heights checked (check_heights; on failure the grid
- * is freed), then the grid turned to row 0 = north. */
-static ts_status checked_and_flipped(GDALRasterBandH band, const conversion *c,
-                                     const tsd_cells *cells, ts_grid *grid, uint32_t lo,
-                                     uint32_t hi, const placement *p, char *msg, size_t n)
+/* The largest east-west cell size of `h` grid rows from `row0` on. */
+static double largest_spacing(const tsd_cells *cells, int row0, int h)
 {
-    ts_status st = check_heights(band, c, grid, lo, hi, p, msg, n);
+    if (!cells->cell_x_row)
+        return cells->cell_x;
+    double m = 0;
+    for (int y = row0; y < row0 + h; y++)
+        m = cells->cell_x_row[y] > m ? cells->cell_x_row[y] : m;
+    return m;
+}
+
+/* The loads' end: the grid checked (tsd_dem_check; on failure it is
+ * freed), then turned to row 0 = north. */
+static ts_status checked_and_flipped(GDALRasterBandH band, const tsd_dem_conversion *c,
+                                     const tsd_cells *cells, int row0, ts_grid *grid,
+                                     const tsd_dem_seen *seen, const tsd_dem_placement *p,
+                                     char *msg, size_t n)
+{
+    ts_status st = tsd_dem_check(band, c, grid, seen,
+                                 largest_spacing(cells, row0, grid->height), p, msg, n);
     if (st != TS_OK) {
         ts_grid_free(grid);
         return st;
@@ -300,7 +218,7 @@ ts_status tsd_dem_load_window(GDALRasterBandH band, const tsd_cells *cells, doub
     ts_status st = grid_of(cells, w, h, y0, grid, msg, n);
     if (st != TS_OK)
         return st;
-    const conversion c = conversion_of(band, z_factor);
+    const tsd_dem_conversion c = conversion_of(band, z_factor);
     /* the grid's window in the band's own orientation */
     const int rx = cells->flip_x ? W - x0 - w : x0, ry = cells->flip_y ? H - y0 - h : y0;
     GDALRasterBandH mask =
@@ -314,13 +232,13 @@ ts_status tsd_dem_load_window(GDALRasterBandH band, const tsd_cells *cells, doub
                      (int)(grid->stride * sizeof(float))) != CE_None ||
         (mask && GDALRasterIO(mask, GF_Read, rx, ry, w, h, m, w, h, GDT_Byte, 0, w) != CE_None))
         return read_failed(grid, m, msg, n);
-    uint32_t lo = UINT32_MAX, hi = 0;
+    tsd_dem_seen seen = TSD_DEM_SEEN_NONE;
     for (int y = 0; y < h; y++)
         to_metres(grid->z + (ptrdiff_t)y * grid->stride, m ? m + (size_t)y * w : NULL, w,
-                  c.scale, c.offset, &lo, &hi);
+                  c.scale, c.offset, &seen);
     free(m);
-    const placement p = {rx, ry, 1, 1};
-    return checked_and_flipped(band, &c, cells, grid, lo, hi, &p, msg, n);
+    const tsd_dem_placement p = {rx, ry, 1, 1};
+    return checked_and_flipped(band, &c, cells, y0, grid, &seen, &p, msg, n);
 }
 
 ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
@@ -330,7 +248,7 @@ ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
     ts_status st = grid_of(cells, w, h, 0, grid, msg, n);
     if (st != TS_OK)
         return st;
-    const conversion c = conversion_of(band, z_factor);
+    const tsd_dem_conversion c = conversion_of(band, z_factor);
 
     int all_valid = GDALGetMaskFlags(band) == GMF_ALL_VALID || nodata_in_values(band, w, h);
     GDALRasterBandH mask = all_valid ? NULL : GDALGetMaskBand(band);
@@ -344,7 +262,7 @@ ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
         ts_grid_free(grid);
         return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory reading the DEM's mask");
     }
-    uint32_t lo = UINT32_MAX, hi = 0;
+    tsd_dem_seen seen = TSD_DEM_SEEN_NONE;
     for (int y0 = 0; y0 < h; y0 += strip) {
         int rows = h - y0 < strip ? h - y0 : strip;
         float *z = grid->z + (ptrdiff_t)y0 * grid->stride;
@@ -353,58 +271,12 @@ ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
             return read_failed(grid, m, msg, n);
         for (int y = 0; y < rows; y++)
             to_metres(z + (ptrdiff_t)y * grid->stride, m ? m + (size_t)y * w : NULL, w,
-                      c.scale, c.offset, &lo, &hi);
+                      c.scale, c.offset, &seen);
     }
     free(m);
-    const placement p = {0, 0, (double)GDALGetRasterBandXSize(band) / w,
-                         (double)GDALGetRasterBandYSize(band) / h};
-    return checked_and_flipped(band, &c, cells, grid, lo, hi, &p, msg, n);
-}
-
-/* Steeper than this nearly everywhere is not terrain at the DEM's scale. */
-#define STEEP_DEGREES 85.0
-#define STEEP_SAMPLE 256
-
-int tsd_dem_steepness_warning(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
-                              const char *crs_name, char *warning, size_t n)
-{
-    const int W = GDALGetRasterBandXSize(band), H = GDALGetRasterBandYSize(band);
-    const int w = W < STEEP_SAMPLE ? W : STEEP_SAMPLE, h = H < STEEP_SAMPLE ? H : STEEP_SAMPLE;
-    if (w < 3 || h < 3)
-        return 0;
-    const int x0 = (W - w) / 2, y0 = (H - h) / 2;
-    ts_grid g;
-    char msg[16];
-    /* a sample that cannot be read says nothing here: the reads will */
-    if (tsd_dem_load_window(band, cells, z_factor, x0, y0, w, h, &g, msg, sizeof msg) != TS_OK)
-        return 0;
-    const double limit = tan(STEEP_DEGREES * M_PI / 180.0);
-    long steep = 0, counted = 0;
-    for (int y = 1; y < h - 1; y++) {
-        const float *r = g.z + (ptrdiff_t)y * g.stride;
-        const double cx = cells->cell_x_row ? cells->cell_x_row[y0 + y] : cells->cell_x;
-        for (int x = 1; x < w - 1; x++) {
-            double dx = (r[x + 1] - r[x - 1]) / (2 * cx);
-            double dy = (r[x + g.stride] - r[x - g.stride]) / (2 * cells->cell_y);
-            if (isnan(dx) || isnan(dy))
-                continue;
-            counted++;
-            steep += hypot(dx, dy) > limit;
-        }
-    }
-    ts_grid_free(&g);
-    if (counted == 0 || steep * 2 <= counted)
-        return 0;
-    GDALDatasetH ds = GDALGetBandDataset(band);
-    snprintf(warning, n,
-             "the DEM '%s' is steeper than %.0f degrees at %.0f %% of the %d x %d cells at its "
-             "centre: its cells (%.6g x %.6g m) are small for its heights' changes, and its "
-             "shading will be black and white. Is it georeferenced in degrees under a "
-             "projected CRS%s%s%s, or are its heights in another unit (Z_FACTOR)?",
-             ds ? GDALGetDescription(ds) : "", STEEP_DEGREES, 100.0 * steep / counted, w, h,
-             cells->cell_x, cells->cell_y, crs_name && *crs_name ? " (" : "",
-             crs_name ? crs_name : "", crs_name && *crs_name ? ")" : "");
-    return 1;
+    const tsd_dem_placement p = {0, 0, (double)GDALGetRasterBandXSize(band) / w,
+                                 (double)GDALGetRasterBandYSize(band) / h};
+    return checked_and_flipped(band, &c, cells, 0, grid, &seen, &p, msg, n);
 }
 
 /* Metres per unit of a unit's name (GDAL's band unit types, PROJ's and

@@ -88,14 +88,41 @@ class ImpossibleHeights(unittest.TestCase):
         self.assertNotIn("-a_nodata", err)  # an average is not the DEM's value
 
     def test_the_deepest_and_highest_terrain_are_accepted(self):
-        """A trench to -10 935 m (the Challenger Deep) and a peak at 8 849 m
-        (Everest) are terrain: no error, finite output."""
-        z = self.z.copy()
-        z[10:20, 10:20] = -10935.0
-        z[60:64, 60:64] = 8849.0
-        dem = self.dem("extremes.tif", z)
+        """The Challenger Deep (-10 935 m) and Everest (8 849 m) are terrain:
+        a DEM of 1 km cells that climbs from one to the other (206 m between
+        neighbours) opens with no error and gives a finite result."""
+        z = np.linspace(-10935.0, 8849.0, 97, dtype=np.float32)[None, :].repeat(64, 0)
+        dem = T.write_tif(os.path.join(self.tmp, "extremes.tif"), z,
+                          (500000, 1000, 0, 4000000, 0, -1000), UTM)
         out = T.read(T.conn(dem, PRODUCT="svf", DIRECTIONS=8), 1)
         self.assertTrue(np.isfinite(out).all())
+
+    def test_an_undeclared_void_within_the_earths_heights_is_a_cliff(self):
+        """-9999 (a void no nodata value declares) beside land is a cliff of
+        10 km between cells 30 m apart: an error naming both cells and the
+        void's value to declare; declared, the cells are nodata. The same
+        in a geographic DEM (jacksboro, 3 arc-seconds)."""
+        z = self.with_void(-9999.0)
+        dem = self.dem("void9999.tif", z)
+        for options in ({}, {"TILE_SIZE": 64}):
+            with self.subTest(**options):
+                err = failure(T.conn(dem, **options))
+                print(err.strip().splitlines()[0])
+                self.assertRegex(err, r"holds a cliff no terrain has: \d+(\.\d+)? m beside "
+                                      r"-9999 m in band 1 at columns 29 and 30 of row 40, "
+                                      r"about 30 m apart \(more than 5000 m, and steeper than "
+                                      r"84 degrees\)")
+                self.assertIn("gdal_edit.py -a_nodata -9999 " + dem, err)
+        declared = self.dem("void9999_declared.tif", z, nodata=-9999)
+        out = T.read(T.conn(declared, PRODUCT="svf", DIRECTIONS=8), 1)
+        np.testing.assert_array_equal(np.isnan(out), z == -9999)
+        src = gdal.Open(T.JACKSBORO)
+        j = src.GetRasterBand(1).ReadAsArray().astype(np.float32)
+        j[200:230, 100:180] = -9999
+        geo = T.write_tif(os.path.join(self.tmp, "jacksboro_void.tif"), j,
+                          src.GetGeoTransform(), src.GetProjection())
+        err = failure(T.conn(geo))
+        self.assertIn("-9999 m in band 1 at columns 99 and 100 of row 200", err)
 
     def test_exaggeration_widens_the_limits_with_it(self):
         """Z_FACTOR=12 on heights up to 900 m (10.8 km) is an exaggeration the

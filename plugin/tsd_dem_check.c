@@ -1,0 +1,216 @@
+/* Is what a DEM read holds terrain? Heights and steps no terrain has (an
+ * undeclared nodata value, heights in another unit), and a DEM too steep
+ * at its cells' scale (degrees under a projected CRS). */
+#include "tsd_dem_check.h"
+
+#include "tsd_dem.h"
+#include "tsd_text.h"
+
+#include <math.h>
+#include <stdio.h>
+
+#include "ogr_srs_api.h"
+
+/* Beyond any terrain on Earth: the deepest ocean floor (the Challenger
+ * Deep, -10.9 km) and Everest (8.85 km), with room for ellipsoidal heights.
+ * Undeclared nodata values (-32768, 32767, 65535, -3.4e38...) lie beyond. */
+#define EARTH_LOWEST_M (-12000.0)
+#define EARTH_HIGHEST_M 9000.0
+/* No cliff on Earth drops this far between neighbours (Mount Thor's face,
+ * the highest vertical one, is 1.25 km; Nanga Parbat's Rupal face 4.6 km
+ * over several km), nor this steeply over larger cells (84 degrees). */
+#define CLIFF_M 5000.0
+#define CLIFF_SLOPE 10.0
+
+/* A Z_FACTOR beyond the heights' unit is an exaggeration: the limits grow
+ * with it (1 otherwise). */
+static double stretch_of(const tsd_dem_conversion *c)
+{
+    double s = c->z_factor / c->unit_factor;
+    return s > 1 ? s : 1;
+}
+
+/* The heights a grid of the band may hold, in metres: the Earth's, or on
+ * another body (a CRS whose ellipsoid is not the Earth's) within its
+ * radius; widened by an exaggeration. Names them in `what`; 1 on Earth. */
+static int height_limits(GDALRasterBandH band, const tsd_dem_conversion *c, double *low,
+                          double *high, char *what, size_t n)
+{
+    GDALDatasetH ds = GDALGetBandDataset(band);
+    OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
+    OGRErr err = OGRERR_FAILURE;
+    double a = srs ? OSRGetSemiMajor(srs, &err) : 0;
+    const int earth = !(err == OGRERR_NONE && a > 0 && fabs(a - 6371000.0) > 100000.0);
+    if (!earth) {
+        *low = -a;
+        *high = a;
+        snprintf(what, n, "the radius of the CRS's body (%.0f m)", a);
+    } else {
+        *low = EARTH_LOWEST_M;
+        *high = EARTH_HIGHEST_M;
+        snprintf(what, n, "any terrain on Earth (%.0f to %.0f m)", *low, *high);
+    }
+    const double stretch = stretch_of(c);
+    if (stretch > 1) {
+        *low *= stretch;
+        *high *= stretch;
+        size_t len = strlen(what);
+        snprintf(what + len, n - len, " times Z_FACTOR's exaggeration %g", stretch);
+    }
+    return earth;
+}
+
+/* The remedies' sentence: declare `z` (a grid height) as nodata when the
+ * grid holds the DEM's own values, or set a unit. */
+static void remedies(GDALRasterBandH band, const tsd_dem_conversion *c, int full, float z,
+                     char *out, size_t n)
+{
+    GDALDatasetH ds = GDALGetBandDataset(band);
+    const char *path = ds ? GDALGetDescription(ds) : "";
+    const double raw = ((double)z - c->offset) / c->scale; /* as the band holds it */
+    char declare[160] = "";
+    if (full && isfinite(raw))
+        snprintf(declare, sizeof declare, " (gdal_edit.py -a_nodata %.9g %s)", raw, path);
+    snprintf(out, n,
+             "A nodata value the DEM does not declare? Declare it%s and those cells are "
+             "nodata. Heights in another unit? Set the band's unit (gdal_edit.py -units ft) "
+             "or Z_FACTOR",
+             declare);
+}
+
+static ts_status height_error(GDALRasterBandH band, const tsd_dem_conversion *c,
+                              const ts_grid *g, const tsd_dem_placement *p, double low,
+                              double high, const char *what, char *msg, size_t n)
+{
+    int gx = 0, gy = 0;
+    float z = NAN;
+    for (gy = 0; gy < g->height; gy++) {
+        const float *row = g->z + (ptrdiff_t)gy * g->stride;
+        for (gx = 0; gx < g->width; gx++)
+            if (row[gx] < low || row[gx] > high)
+                break;
+        if (gx < g->width) {
+            z = row[gx];
+            break;
+        }
+    }
+    const int full = p->sx == 1 && p->sy == 1; /* else a coarse cell: an average */
+    char todo[320];
+    remedies(band, c, full, z, todo, sizeof todo);
+    GDALDatasetH ds = GDALGetBandDataset(band);
+    return tsd_fail(msg, n, TS_ERR_ARG,
+                    "the DEM '%s' holds a height no terrain has: %.6g m%s in band %d %s "
+                    "column %d, row %d, beyond %s. %s",
+                    ds ? GDALGetDescription(ds) : "", (double)z, full ? "" : " (averaged)",
+                    GDALGetBandNumber(band), full ? "at" : "near",
+                    p->x0 + (int)(p->sx * gx), p->y0 + (int)(p->sy * gy), what, todo);
+}
+
+/* The first step between neighbours in a row larger than `limit`, named
+ * with the side that looks like a void: the one its row repeats beyond
+ * the step, else the one farther from zero. */
+static ts_status cliff_error(GDALRasterBandH band, const tsd_dem_conversion *c,
+                             const ts_grid *g, const tsd_dem_placement *p, double limit,
+                             double spacing, char *msg, size_t n)
+{
+    int gx = 0, gy = 0;
+    const float *row = g->z;
+    for (gy = 0; gy < g->height; gy++) {
+        row = g->z + (ptrdiff_t)gy * g->stride;
+        for (gx = 0; gx + 1 < g->width; gx++)
+            if (fabsf(row[gx + 1] - row[gx]) > limit)
+                break;
+        if (gx + 1 < g->width)
+            break;
+    }
+    if (gy == g->height)
+        return TS_OK; /* not found again: cannot happen */
+    const float a = row[gx], b = row[gx + 1];
+    float v = fabsf(a) >= fabsf(b) ? a : b;
+    if (gx > 0 && row[gx - 1] == a)
+        v = a;
+    else if (gx + 2 < g->width && row[gx + 2] == b)
+        v = b;
+    const int full = p->sx == 1 && p->sy == 1;
+    char todo[320];
+    remedies(band, c, full, v, todo, sizeof todo);
+    GDALDatasetH ds = GDALGetBandDataset(band);
+    return tsd_fail(msg, n, TS_ERR_ARG,
+                    "the DEM '%s' holds a cliff no terrain has: %.6g m beside %.6g m%s in "
+                    "band %d %s columns %d and %d of row %d, about %.3g m apart (more than "
+                    "%.0f m, and steeper than %.0f degrees). %s",
+                    ds ? GDALGetDescription(ds) : "", (double)a, (double)b,
+                    full ? "" : " (averaged)", GDALGetBandNumber(band),
+                    full ? "at" : "near", p->x0 + (int)(p->sx * gx),
+                    p->x0 + (int)(p->sx * (gx + 1)), p->y0 + (int)(p->sy * gy),
+                    spacing, CLIFF_M * stretch_of(c),
+                    atan(CLIFF_SLOPE) * 180 / M_PI, todo);
+}
+
+ts_status tsd_dem_check(GDALRasterBandH band, const tsd_dem_conversion *c, const ts_grid *g,
+                        const tsd_dem_seen *seen, double spacing, const tsd_dem_placement *p,
+                        char *msg, size_t n)
+{
+    if (seen->lo_key > seen->hi_key)
+        return TS_OK; /* no valid height */
+    double low, high;
+    char what[160];
+    const int earth = height_limits(band, c, &low, &high, what, sizeof what);
+    if (!(tsd_key_float(seen->lo_key) >= low && tsd_key_float(seen->hi_key) <= high))
+        return height_error(band, c, g, p, low, high, what, msg, n);
+    if (!earth)
+        return TS_OK; /* a smaller body's cliffs are taller (Verona Rupes on Miranda) */
+    float step;
+    memcpy(&step, &seen->step_bits, sizeof step);
+    const double cliff = fmax(CLIFF_M, CLIFF_SLOPE * spacing) * stretch_of(c);
+    if (step > cliff)
+        return cliff_error(band, c, g, p, cliff, spacing, msg, n);
+    return TS_OK;
+}
+
+/* Steeper than this nearly everywhere is not terrain at the DEM's scale. */
+#define STEEP_DEGREES 85.0
+#define STEEP_SAMPLE 256
+
+int tsd_dem_steepness_warning(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
+                              const char *crs_name, char *warning, size_t n)
+{
+    const int W = GDALGetRasterBandXSize(band), H = GDALGetRasterBandYSize(band);
+    const int w = W < STEEP_SAMPLE ? W : STEEP_SAMPLE, h = H < STEEP_SAMPLE ? H : STEEP_SAMPLE;
+    if (w < 3 || h < 3)
+        return 0;
+    const int x0 = (W - w) / 2, y0 = (H - h) / 2;
+    ts_grid g;
+    char msg[16];
+    /* a sample that cannot be read (or holds no terrain) says nothing
+     * here: the reads will */
+    if (tsd_dem_load_window(band, cells, z_factor, x0, y0, w, h, &g, msg, sizeof msg) != TS_OK)
+        return 0;
+    const double limit = tan(STEEP_DEGREES * M_PI / 180.0);
+    long steep = 0, counted = 0;
+    for (int y = 1; y < h - 1; y++) {
+        const float *r = g.z + (ptrdiff_t)y * g.stride;
+        const double cx = cells->cell_x_row ? cells->cell_x_row[y0 + y] : cells->cell_x;
+        for (int x = 1; x < w - 1; x++) {
+            double dx = (r[x + 1] - r[x - 1]) / (2 * cx);
+            double dy = (r[x + g.stride] - r[x - g.stride]) / (2 * cells->cell_y);
+            if (isnan(dx) || isnan(dy))
+                continue;
+            counted++;
+            steep += hypot(dx, dy) > limit;
+        }
+    }
+    ts_grid_free(&g);
+    if (counted == 0 || steep * 2 <= counted)
+        return 0;
+    GDALDatasetH ds = GDALGetBandDataset(band);
+    snprintf(warning, n,
+             "the DEM '%s' is steeper than %.0f degrees at %.0f %% of the %d x %d cells at its "
+             "centre: its cells (%.6g x %.6g m) are small for its heights' changes, and its "
+             "shading will be black and white. Is it georeferenced in degrees under a "
+             "projected CRS%s%s%s, or are its heights in another unit (Z_FACTOR)?",
+             ds ? GDALGetDescription(ds) : "", STEEP_DEGREES, 100.0 * steep / counted, w, h,
+             cells->cell_x, cells->cell_y, crs_name && *crs_name ? " (" : "",
+             crs_name ? crs_name : "", crs_name && *crs_name ? ")" : "");
+    return 1;
+}

@@ -1,0 +1,79 @@
+/*
+ * tsd_dem_check.h - is what a DEM read holds terrain? Inside the plugin:
+ * tsd_dem.c folds what it needs into its conversion loop (the lowest and
+ * highest height, the largest step between neighbours in a row) and asks
+ * tsd_dem_check before it hands the grid on.
+ */
+#ifndef TSD_DEM_CHECK_H
+#define TSD_DEM_CHECK_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "gdal.h"
+#include "terrashade.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** How a band's values become the grid's heights. */
+typedef struct {
+    double scale, offset; /**< value * scale + offset: the band's own, times z_factor */
+    double z_factor;      /**< Z_FACTOR as applied (AUTO resolved) */
+    double unit_factor;   /**< metres per unit of the heights as the DEM's metadata says */
+} tsd_dem_conversion;
+
+/** Where a grid loaded (not yet flipped) lies in the band: its cell
+ * (gx, gy) is about band cell (x0 + sx * gx, y0 + sy * gy). */
+typedef struct {
+    int x0, y0;
+    double sx, sy;
+} tsd_dem_placement;
+
+/** What a load saw of its valid heights, folded row by row: the order
+ * keys (tsd_order_key) of the lowest and highest, and the bits of the
+ * largest absolute step between neighbours in a row (a finite float's). */
+typedef struct {
+    uint32_t lo_key, hi_key;
+    uint32_t step_bits;
+} tsd_dem_seen;
+
+/** Nothing seen yet. */
+#define TSD_DEM_SEEN_NONE {UINT32_MAX, 0, 0}
+
+/** An unsigned int per float bit pattern that orders as the floats do (NaN
+ * aside), so that the lowest and highest heights reduce in integer lanes. */
+static inline uint32_t tsd_order_key(uint32_t bits)
+{
+    return bits ^ ((0u - (bits >> 31)) | 0x80000000u);
+}
+
+static inline float tsd_key_float(uint32_t key)
+{
+    uint32_t bits = key & 0x80000000u ? key ^ 0x80000000u : ~key;
+    float f;
+    memcpy(&f, &bits, sizeof f);
+    return f;
+}
+
+/**
+ * TS_OK if the grid `g` just loaded from `band` (`seen` folded over it,
+ * `spacing` its largest east-west cell size in metres) holds terrain: no
+ * height beyond the Earth's (-12 000 to 9 000 m; on another body, its
+ * radius) and, on Earth, no cliff of more than 5 000 m, and steeper than 84
+ * degrees, between neighbours in a row; both widened by a Z_FACTOR that
+ * exaggerates. Else
+ * TS_ERR_ARG with a sentence naming the first cell at fault and what to do
+ * (declare the nodata value, the unit).
+ */
+ts_status tsd_dem_check(GDALRasterBandH band, const tsd_dem_conversion *c, const ts_grid *g,
+                        const tsd_dem_seen *seen, double spacing, const tsd_dem_placement *p,
+                        char *msg, size_t msg_size);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
