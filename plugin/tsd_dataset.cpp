@@ -497,9 +497,20 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
         poDS->m_bHasGT = false;
         const double adfTopDown[6] = {0, 1, 0, 0, 0, -1};
         memcpy(poDS->m_adfGT, adfTopDown, sizeof adfTopDown);
+        // georeferenced by control points or RPCs, it needs warping first
+        const int nGCPs = poDEM->GetGCPCount();
+        const bool bRPC = poDEM->GetMetadata("RPC") != nullptr;
         CPLError(CE_Warning, CPLE_AppDefined,
                  "TERRASHADE: the DEM '%s' has no geotransform: its cells are "
-                 "taken as 1 x 1 metre, row 0 north", osDEM.c_str());
+                 "taken as 1 x 1 metre, row 0 north%s", osDEM.c_str(),
+                 nGCPs > 0 || bRPC
+                     ? CPLSPrintf("; it is georeferenced by %s, which terrashade does not "
+                                  "follow: warp it to a north-up grid first (gdalwarp%s "
+                                  "dem.tif north_up.tif)",
+                                  nGCPs > 0 ? CPLSPrintf("%d ground control points", nGCPs)
+                                            : "rational polynomial coefficients (RPC)",
+                                  nGCPs > 0 ? "" : " -rpc")
+                     : "");
     }
     if (const OGRSpatialReference *poSRS = poDEM->GetSpatialRef())
         poDS->m_oSRS = *poSRS;

@@ -203,14 +203,26 @@ int tsd_dem_steepness_warning(GDALRasterBandH band, const tsd_cells *cells, doub
     ts_grid_free(&g);
     if (counted == 0 || steep * 2 <= counted)
         return 0;
+    /* what is likely wrong, by where the cells' sizes came from */
+    char question[256];
+    if (cells->kind == TSD_CRS_PROJECTED)
+        snprintf(question, sizeof question,
+                 "Is it georeferenced in degrees under a projected CRS%s%s%s, or are its "
+                 "heights in another unit (Z_FACTOR)?",
+                 crs_name && *crs_name ? " (" : "", crs_name ? crs_name : "",
+                 crs_name && *crs_name ? ")" : "");
+    else if (cells->kind == TSD_CRS_NONE)
+        snprintf(question, sizeof question,
+                 "Without a CRS its cells are taken as metres: are they? Or are its heights "
+                 "in another unit (Z_FACTOR)?");
+    else
+        snprintf(question, sizeof question, "Are its heights in another unit (Z_FACTOR)?");
     GDALDatasetH ds = GDALGetBandDataset(band);
     snprintf(warning, n,
              "the DEM '%s' is steeper than %.0f degrees at %.0f %% of the %d x %d cells at its "
              "centre: its cells (%.6g x %.6g m) are small for its heights' changes, and its "
-             "shading will be black and white. Is it georeferenced in degrees under a "
-             "projected CRS%s%s%s, or are its heights in another unit (Z_FACTOR)?",
+             "shading will be black and white. %s",
              ds ? GDALGetDescription(ds) : "", STEEP_DEGREES, 100.0 * steep / counted, w, h,
-             cells->cell_x, cells->cell_y, crs_name && *crs_name ? " (" : "",
-             crs_name ? crs_name : "", crs_name && *crs_name ? ")" : "");
+             cells->cell_x, cells->cell_y, question);
     return 1;
 }

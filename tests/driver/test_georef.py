@@ -203,6 +203,24 @@ class Georef(unittest.TestCase):
         np.testing.assert_array_equal(T.read(T.conn(path, **opts)),
                                       T.read(T.conn(one, **opts)))
 
+    def test_control_points_say_warp_first(self):
+        """A DEM georeferenced by ground control points (no geotransform) is
+        computed on 1 m cells, and the warning says to warp it first."""
+        z = T.fractal_dem(64, seed=6)
+        path = os.path.join(self.dir, "gcps.tif")
+        ds = gdal.GetDriverByName("GTiff").Create(path, 64, 64, 1, gdal.GDT_Float32)
+        ds.GetRasterBand(1).WriteArray(z)
+        srs = osr.SpatialReference()
+        srs.ImportFromEPSG(32617)
+        ds.SetGCPs([gdal.GCP(600000 + 30 * x, 4000000 - 30 * y, 0, x, y)
+                    for x, y in ((0, 0), (64, 0), (0, 64))], srs.ExportToWkt())
+        ds = None
+        p = T.run(["gdalinfo", T.conn(path)])
+        self.assertIn("has no geotransform: its cells are taken as 1 x 1 metre, row 0 north; "
+                      "it is georeferenced by 3 ground control points, which terrashade does "
+                      "not follow: warp it to a north-up grid first (gdalwarp dem.tif "
+                      "north_up.tif)", p.stderr)
+
     def test_any_gdal_name(self):
         """/vsizip, /vsimem, colons and '=' in names, drive letters."""
         ref = T.read(T.conn(T.LUX, PRODUCT="svf", DIRECTIONS=4))
