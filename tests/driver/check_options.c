@@ -15,7 +15,11 @@
  *   ones written before the tables made them;
  * - the block copies' vectorised tsd_row_to_byte equals tsd_to_byte on
  *   every float of a stride through all 2^32 bit patterns and on the
- *   values where it changes (0, 1, NaN, inf and each rounding boundary).
+ *   values where it changes (0, 1, NaN, inf and each rounding boundary);
+ * - the order keys that reduce a DEM read's lowest and highest heights in
+ *   integer lanes (tsd_dem_check.h) order as the floats do and give the
+ *   float back, on a stride through all non-NaN bit patterns and their
+ *   neighbours.
  */
 #include <math.h>
 #include <stdint.h>
@@ -24,6 +28,7 @@
 #include <string.h>
 
 #include "terrashade.h"
+#include "tsd_dem_check.h"
 #include "tsd_options.h"
 #include "tsd_products.h"
 
@@ -205,6 +210,38 @@ static void check_row_to_byte(void)
     expect_bytes(u, n);
 }
 
+/* f < g => key(f) < key(g); key(f) < key(g) => f <= g (-0 keys below +0) */
+static void expect_keys_order(uint32_t a, uint32_t b)
+{
+    float f, g;
+    memcpy(&f, &a, sizeof f);
+    memcpy(&g, &b, sizeof g);
+    if (isnan(f) || isnan(g))
+        return;
+    uint32_t ka = tsd_order_key(a), kb = tsd_order_key(b);
+    EXPECT(!(f < g) || ka < kb, "key(%a) = %#x not below key(%a) = %#x", f, ka, g, kb);
+    EXPECT(!(ka < kb) || f <= g, "key(%a) = %#x below key(%a) = %#x", f, ka, g, kb);
+    float back = tsd_key_float(ka);
+    EXPECT(memcmp(&back, &f, sizeof f) == 0, "key_float(key(%a)) = %a", f, back);
+}
+
+static void check_order_keys(void)
+{
+    const uint32_t special[] = {0, 0x80000000u, 1, 0x80000001u, 0x7f7fffffu, 0xff7fffffu,
+                                0x7f800000u, 0xff800000u, 0x3f800000u, 0xbf800000u};
+    const int ns = (int)(sizeof special / sizeof special[0]);
+    for (int i = 0; i < ns; i++)
+        for (int j = 0; j < ns; j++)
+            expect_keys_order(special[i], special[j]);
+    for (uint64_t b = 0; b <= UINT32_MAX; b += 65521) {
+        uint32_t u = (uint32_t)b;
+        expect_keys_order(u, u + 1);
+        expect_keys_order(u + 1, u);
+        expect_keys_order(u, u ^ 0x80000000u);
+        expect_keys_order(u, (uint32_t)(b * 2654435761u));
+    }
+}
+
 int main(void)
 {
     tsd_options d;
@@ -217,6 +254,7 @@ int main(void)
     check_xml();
     check_sentences();
     check_row_to_byte();
+    check_order_keys();
     EXPECT(d.refraction == TSD_REFRACTION_DEFAULT, "REFRACTION default %g", d.refraction);
     EXPECT(h.refraction == TSD_REFRACTION_DEFAULT,
            "the core's refraction default %g differs from the driver's %g", h.refraction,
