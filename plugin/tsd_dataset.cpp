@@ -469,22 +469,9 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
                              CPLSPrintf("BAND=%d, but the DEM '%s' has %d band(s)",
                                         sOpts.band, osDEM.c_str(),
                                         poDEM->GetRasterCount()));
-    // a colour image's channel or a palette's class indices are not heights
-    const GDALColorInterp eInterp = poDEM->GetRasterBand(sOpts.band)->GetColorInterpretation();
-    if (eInterp != GCI_Undefined && eInterp != GCI_GrayIndex)
-    {
-        const std::string osWhat =
-            eInterp == GCI_PaletteIndex
-                ? std::string("the class indices of a palette")
-                : std::string("the ") + GDALGetColorInterpretationName(eInterp) +
-                      " channel of a colour image";
-        return FailOpen(TS_ERR_ARG,
-                        CPLSPrintf("band %d of '%s' holds %s, not heights: choose the band "
-                                   "that holds heights (BAND), or, if these values are "
-                                   "heights, say so (gdal_edit.py -colorinterp_%d gray '%s')",
-                                   sOpts.band, osDEM.c_str(), osWhat.c_str(), sOpts.band,
-                                   osDEM.c_str()));
-    }
+    const std::string osNotHeights = NotHeights(poDEM, sOpts.band, osDEM);
+    if (!osNotHeights.empty())
+        return FailOpen(TS_ERR_ARG, osNotHeights.c_str());
     // Z_FACTOR=AUTO becomes the factor of the DEM's vertical unit here, so
     // that the metadata and the auxiliary-file key say the number used
     char szZWhy[256];
@@ -497,20 +484,7 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
         poDS->m_bHasGT = false;
         const double adfTopDown[6] = {0, 1, 0, 0, 0, -1};
         memcpy(poDS->m_adfGT, adfTopDown, sizeof adfTopDown);
-        // georeferenced by control points or RPCs, it needs warping first
-        const int nGCPs = poDEM->GetGCPCount();
-        const bool bRPC = poDEM->GetMetadata("RPC") != nullptr;
-        CPLError(CE_Warning, CPLE_AppDefined,
-                 "TERRASHADE: the DEM '%s' has no geotransform: its cells are "
-                 "taken as 1 x 1 metre, row 0 north%s", osDEM.c_str(),
-                 nGCPs > 0 || bRPC
-                     ? CPLSPrintf("; it is georeferenced by %s, which terrashade does not "
-                                  "follow: warp it to a north-up grid first (gdalwarp%s "
-                                  "dem.tif north_up.tif)",
-                                  nGCPs > 0 ? CPLSPrintf("%d ground control points", nGCPs)
-                                            : "rational polynomial coefficients (RPC)",
-                                  nGCPs > 0 ? "" : " -rpc")
-                     : "");
+        WarnNoGeoTransform(poDEM, osDEM);
     }
     if (const OGRSpatialReference *poSRS = poDEM->GetSpatialRef())
         poDS->m_oSRS = *poSRS;
@@ -520,36 +494,6 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     poDS->GDALDataset::SetMetadataItem("Z_FACTOR_SOURCE", szZWhy);
     poDS->m_nOverviews = OverviewCount(poDS->m_psProduct, W, H);
     return poDS.release();
-}
-
-/* Degrees of arc from the DEM's centre beyond which SUN_POSITION=center warns. */
-static const double SUN_REACH_WARN_DEG = 1.0;
-
-/* A warning when the DEM is so wide that the sun computed once at its
- * centre (SUN_POSITION=center) is off by more than a degree at its edges,
- * with what to do about it. */
-void TSDataset::WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfLon,
-                             double dfLat)
-{
-    const double dfReach = tsd_sites_reach(m_adfGT, W, H, hSRS, &m_sCells, dfLon, dfLat);
-    if (!(dfReach > SUN_REACH_WARN_DEG))
-        return;
-    // per_cell where the product takes it and the options' own checks
-    // accept it beside the others given (METHOD, LIGHT_RADIUS, ...)
-    const int iSunPosition = tsd_option_find("SUN_POSITION");
-    tsd_options sPerCell = m_sOpts;
-    sPerCell.sun_position = TSD_SUN_PER_CELL;
-    sPerCell.given |= 1ULL << iSunPosition;
-    char szWhyNot[512];
-    const bool bPerCell = tsd_product_takes(m_psProduct, iSunPosition) &&
-                          tsd_options_check(&sPerCell, szWhyNot, sizeof szWhyNot) == 0;
-    CPLError(CE_Warning, CPLE_AppDefined,
-             "TERRASHADE: the DEM reaches %.1f degrees of arc from its centre, where the "
-             "sun is computed for all its cells (SUN_POSITION=center): at its edges the "
-             "sun's elevation and azimuth can be off by about as much. %s",
-             dfReach,
-             bPerCell ? "SUN_POSITION=per_cell computes the sun across the DEM"
-                      : "Crop the DEM to compute the sun nearer its cells");
 }
 
 /* Everything that follows from the georeferencing (m_adfGT, m_bHasGT,
@@ -594,6 +538,8 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
         if (eSt != TS_OK)
             return Fail(eSt, szMsg), false;
         m_bHasSun = true;
+        if (m_nLevel == 0 && tsd_sun_night_warning(&m_sSun, &sOpts, szMsg, sizeof szMsg))
+            CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szMsg);
     }
     const tsd_sun *psSun = m_bHasSun ? &m_sSun : nullptr;
     tsd_run_init(&m_sRun, &sOpts, psSun);

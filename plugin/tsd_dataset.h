@@ -1,7 +1,8 @@
 /*
  * tsd_dataset.h - the classes of a TERRASHADE:<dem> dataset, shared by
- * tsd_dataset.cpp (opening, computing, blocks) and tsd_dataset_metadata.cpp
- * (metadata and PAM).
+ * tsd_dataset.cpp (opening, computing, blocks), tsd_dataset_metadata.cpp
+ * (metadata and PAM) and tsd_dataset_warnings.cpp (what a DEM or a sun
+ * deserves a word about).
  */
 #ifndef TSD_DATASET_H
 #define TSD_DATASET_H
@@ -34,6 +35,12 @@ struct WindowChunk;
 void FreeWindow(WindowState *p);
 /* The chunks' plan, or null when the whole DEM is computed at once. */
 const tsd_window_plan *WindowPlan(const WindowState *p);
+/* tsd_dataset_warnings.cpp: the sentence refusing band nBand of the DEM
+ * when its colour interpretation says it is not heights (a colour channel,
+ * a palette), else empty; the warning of a DEM without a geotransform
+ * (1 m cells), which names its control points or RPCs. */
+std::string NotHeights(GDALDataset *poDEM, int nBand, const std::string &osDEM);
+void WarnNoGeoTransform(GDALDataset *poDEM, const std::string &osDEM);
 
 /** A TERRASHADE:<dem> dataset: one product of a DEM. */
 class TSDataset final : public GDALPamDataset

@@ -197,3 +197,37 @@ ts_status tsd_sun_setup(const tsd_options *o, tsd_sites *sites, double min_cell_
     }
     return TS_OK;
 }
+
+/* No terrain on Earth rises higher, so no cell's horizon dips lower than
+ * the sea-level horizon seen from here. */
+#define HIGHEST_TERRAIN_M 9000.0
+
+int tsd_sun_night_warning(const tsd_sun *s, const tsd_options *o, char *warning, size_t n)
+{
+    const char *product = tsd_product_of(o)->name;
+    if (!isfinite(s->instant) || (strcmp(product, "shade") != 0 && strcmp(product, "shadow") != 0))
+        return 0;
+    const double lowest = ts_earth_horizon(HIGHEST_TERRAIN_M, &s->day.horizon);
+    if (!(s->sun.elevation + o->light_radius < lowest))
+        return 0;
+    /* mean solar time at the site: UTC plus 4 minutes per degree east */
+    const double lon = s->sites_owned.lon[0];
+    const long solar = lround(fmod(fmod(s->instant / 60.0 + lon * 4.0, 1440.0) + 1440.0, 1440.0));
+    const long offset = lround(lon * 4.0);
+    char when[64], given[32];
+    tsd_format_time(s->instant, s->offset_minutes, when, sizeof when);
+    if (s->offset_minutes == 0)
+        snprintf(given, sizeof given, "Z is UTC itself");
+    else
+        snprintf(given, sizeof given, "given as %c%02d:%02d", s->offset_minutes < 0 ? '-' : '+',
+                 abs(s->offset_minutes) / 60, abs(s->offset_minutes) % 60);
+    snprintf(warning, n,
+             "DATETIME=%s puts the sun's centre %.1f degrees below the horizon at the DEM's "
+             "centre (mean solar time %02ld:%02ld there): it is night, no terrain sees the "
+             "sun, and its direct light is nil everywhere. If that is not the time meant, check "
+             "DATETIME's offset from UTC (%s; mean solar time at longitude %.1f is "
+             "UTC%c%02ld:%02ld)",
+             when, -s->sun.elevation, solar / 60 % 24, solar % 60, given, lon,
+             offset < 0 ? '-' : '+', labs(offset) / 60, labs(offset) % 60);
+    return 1;
+}

@@ -67,6 +67,14 @@ void tsd_sun_free(tsd_sun *s);
  * lattice of sites. */
 int tsd_sun_per_cell(const tsd_sun *sun);
 
+/** 1 with a sentence in `warning` when DATETIME (shade, shadow) puts the
+ * whole sun below the lowest horizon any terrain on Earth has (the sea-level
+ * horizon seen from 9 000 m): a night no cell sees the sun in, most often a
+ * local time given with Z. It gives the mean solar time at the DEM's
+ * centre and its longitude's offset. 0 otherwise. */
+int tsd_sun_night_warning(const tsd_sun *s, const tsd_options *o, char *warning,
+                          size_t warning_size);
+
 /** ISO 8601 local time with its offset, whole seconds:
  * 2026-06-21T07:30:00+02:00 (or ...Z for offset 0). */
 void tsd_format_time(double unix_time, int offset_minutes, char *buf, size_t n);

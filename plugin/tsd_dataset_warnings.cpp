@@ -1,0 +1,80 @@
+/* What the driver says about a DEM and a sun that are likely not what the
+ * user meant: refusals at open (a band that is not heights) and warnings
+ * (no geotransform, a DEM too wide for one sun). */
+#include <string>
+
+#include "cpl_error.h"
+#include "cpl_string.h"
+
+#include "tsd_dataset.h"
+
+namespace tsd
+{
+
+std::string NotHeights(GDALDataset *poDEM, int nBand, const std::string &osDEM)
+{
+    const GDALColorInterp eInterp = poDEM->GetRasterBand(nBand)->GetColorInterpretation();
+    if (eInterp == GCI_Undefined || eInterp == GCI_GrayIndex)
+        return std::string();
+    const std::string osWhat = eInterp == GCI_PaletteIndex
+                                   ? std::string("the class indices of a palette")
+                                   : std::string("the ") +
+                                         GDALGetColorInterpretationName(eInterp) +
+                                         " channel of a colour image";
+    return CPLSPrintf("band %d of '%s' holds %s, not heights: choose the band that holds "
+                      "heights (BAND), or, if these values are heights, say so "
+                      "(gdal_edit.py -colorinterp_%d gray '%s')",
+                      nBand, osDEM.c_str(), osWhat.c_str(), nBand, osDEM.c_str());
+}
+
+void WarnNoGeoTransform(GDALDataset *poDEM, const std::string &osDEM)
+{
+    // georeferenced by control points or RPCs, it needs warping first
+    const int nGCPs = poDEM->GetGCPCount();
+    std::string osHow;
+    if (nGCPs > 0)
+        osHow = CPLSPrintf("; it is georeferenced by %d ground control points, which "
+                           "terrashade does not follow: warp it to a north-up grid first "
+                           "(gdalwarp dem.tif north_up.tif)",
+                           nGCPs);
+    else if (poDEM->GetMetadata("RPC") != nullptr)
+        osHow = "; it is georeferenced by rational polynomial coefficients (RPC), which "
+                "terrashade does not follow: warp it to a north-up grid first (gdalwarp -rpc "
+                "dem.tif north_up.tif)";
+    CPLError(CE_Warning, CPLE_AppDefined,
+             "TERRASHADE: the DEM '%s' has no geotransform: its cells are taken as 1 x 1 "
+             "metre, row 0 north%s",
+             osDEM.c_str(), osHow.c_str());
+}
+
+/* Degrees of arc from the DEM's centre beyond which SUN_POSITION=center warns. */
+static const double SUN_REACH_WARN_DEG = 1.0;
+
+/* A warning when the DEM is so wide that the sun computed once at its
+ * centre (SUN_POSITION=center) is off by more than a degree at its edges,
+ * with what to do about it. */
+void TSDataset::WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfLon,
+                             double dfLat)
+{
+    const double dfReach = tsd_sites_reach(m_adfGT, W, H, hSRS, &m_sCells, dfLon, dfLat);
+    if (!(dfReach > SUN_REACH_WARN_DEG))
+        return;
+    // per_cell where the product takes it and the options' own checks
+    // accept it beside the others given (METHOD, LIGHT_RADIUS, ...)
+    const int iSunPosition = tsd_option_find("SUN_POSITION");
+    tsd_options sPerCell = m_sOpts;
+    sPerCell.sun_position = TSD_SUN_PER_CELL;
+    sPerCell.given |= 1ULL << iSunPosition;
+    char szWhyNot[512];
+    const bool bPerCell = tsd_product_takes(m_psProduct, iSunPosition) &&
+                          tsd_options_check(&sPerCell, szWhyNot, sizeof szWhyNot) == 0;
+    CPLError(CE_Warning, CPLE_AppDefined,
+             "TERRASHADE: the DEM reaches %.1f degrees of arc from its centre, where the "
+             "sun is computed for all its cells (SUN_POSITION=center): at its edges the "
+             "sun's elevation and azimuth can be off by about as much. %s",
+             dfReach,
+             bPerCell ? "SUN_POSITION=per_cell computes the sun across the DEM"
+                      : "Crop the DEM to compute the sun nearer its cells");
+}
+
+} // namespace tsd
