@@ -41,6 +41,11 @@ const tsd_window_plan *WindowPlan(const WindowState *p);
  * (1 m cells), which names its control points or RPCs. */
 std::string NotHeights(GDALDataset *poDEM, int nBand, const std::string &osDEM);
 void WarnNoGeoTransform(GDALDataset *poDEM, const std::string &osDEM);
+/* The warning of heights taken as metres for want of a unit on a grid in
+ * another unit (US state planes in feet), with the Z_FACTOR that would
+ * take them in the grid's unit. */
+void WarnHeightUnit(const tsd_cells &sCells, const OGRSpatialReference &oSRS,
+                    const std::string &osDEM);
 
 /** A TERRASHADE:<dem> dataset: one product of a DEM. */
 class TSDataset final : public GDALPamDataset

@@ -1,6 +1,8 @@
 /* What the driver says about a DEM and a sun that are likely not what the
  * user meant: refusals at open (a band that is not heights) and warnings
- * (no geotransform, a DEM too wide for one sun). */
+ * (no geotransform, heights of unknown unit on a grid in feet, a DEM too
+ * wide for one sun). */
+#include <cmath>
 #include <string>
 
 #include "cpl_error.h"
@@ -45,6 +47,22 @@ void WarnNoGeoTransform(GDALDataset *poDEM, const std::string &osDEM)
              "TERRASHADE: the DEM '%s' has no geotransform: its cells are taken as 1 x 1 "
              "metre, row 0 north%s",
              osDEM.c_str(), osHow.c_str());
+}
+
+void WarnHeightUnit(const tsd_cells &sCells, const OGRSpatialReference &oSRS,
+                    const std::string &osDEM)
+{
+    if (sCells.kind != TSD_CRS_PROJECTED || std::fabs(sCells.unit_to_m - 1) < 1e-9)
+        return;
+    const char *pszUnit = nullptr;
+    oSRS.GetLinearUnits(&pszUnit);
+    CPLError(CE_Warning, CPLE_AppDefined,
+             "TERRASHADE: the DEM '%s' is gridded in %s (its CRS), but nothing says its "
+             "heights' unit: they are taken as metres. If they are in %s too, as on most "
+             "such grids, give Z_FACTOR=%.10g or say so (gdal_edit.py -units '%s' '%s')",
+             osDEM.c_str(), pszUnit ? pszUnit : "a unit other than metres",
+             pszUnit ? pszUnit : "that unit", sCells.unit_to_m, pszUnit ? pszUnit : "ft",
+             osDEM.c_str());
 }
 
 /* Degrees of arc from the DEM's centre beyond which SUN_POSITION=center warns. */

@@ -299,6 +299,38 @@ static double metres_per_unit(const char *unit)
     return 0.0;
 }
 
+/* The heights' unit as the DEM's metadata says it: the vertical axis of a
+ * compound (or vertical) CRS, else the band's unit type. 1 with *metres and
+ * why when it says one terrashade knows; 0 with why otherwise. */
+static int metadata_unit(GDALRasterBandH band, double *metres, char *why, size_t n)
+{
+    GDALDatasetH ds = GDALGetBandDataset(band);
+    OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
+    if (srs && (OSRIsCompound(srs) || OSRIsVertical(srs))) {
+        char *name = NULL;
+        double m = OSRGetTargetLinearUnits(srs, "VERT_CS", &name);
+        if (m > 0 && isfinite(m)) {
+            snprintf(why, n, "vertical unit %s, from the CRS", name ? name : "?");
+            *metres = m;
+            return 1;
+        }
+    }
+    const char *unit = GDALGetRasterUnitType(band);
+    if (unit && unit[0]) {
+        double m = metres_per_unit(unit);
+        if (m > 0) {
+            snprintf(why, n, "band unit %s", unit);
+            *metres = m;
+            return 1;
+        }
+        snprintf(why, n, "band unit '%s' not a length terrashade knows: heights taken "
+                         "as metres", unit);
+        return 0;
+    }
+    snprintf(why, n, "no vertical unit in the CRS or the band: heights taken as metres");
+    return 0;
+}
+
 double tsd_dem_z_factor(GDALRasterBandH band, double requested, char *why, size_t n)
 {
     char scratch[8];
@@ -310,28 +342,14 @@ double tsd_dem_z_factor(GDALRasterBandH band, double requested, char *why, size_
         snprintf(why, n, "given as Z_FACTOR");
         return requested;
     }
-    /* the vertical CRS of a compound (or vertical) CRS: its axis unit */
-    GDALDatasetH ds = GDALGetBandDataset(band);
-    OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
-    if (srs && (OSRIsCompound(srs) || OSRIsVertical(srs))) {
-        char *name = NULL;
-        double metres = OSRGetTargetLinearUnits(srs, "VERT_CS", &name);
-        if (metres > 0 && isfinite(metres)) {
-            snprintf(why, n, "vertical unit %s, from the CRS", name ? name : "?");
-            return metres;
-        }
-    }
-    const char *unit = GDALGetRasterUnitType(band);
-    if (unit && unit[0]) {
-        double metres = metres_per_unit(unit);
-        if (metres > 0) {
-            snprintf(why, n, "band unit %s", unit);
-            return metres;
-        }
-        snprintf(why, n, "band unit '%s' not a length terrashade knows: heights taken "
-                         "as metres", unit);
-        return 1.0;
-    }
-    snprintf(why, n, "no vertical unit in the CRS or the band: heights taken as metres");
-    return 1.0;
+    double metres = 1.0;
+    metadata_unit(band, &metres, why, n);
+    return metres;
+}
+
+int tsd_dem_height_unit_known(GDALRasterBandH band)
+{
+    double metres;
+    char why[256];
+    return metadata_unit(band, &metres, why, sizeof why);
 }

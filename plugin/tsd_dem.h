@@ -61,6 +61,11 @@ int tsd_dem_steepness_warning(GDALRasterBandH band, const tsd_cells *cells, doub
  */
 double tsd_dem_z_factor(GDALRasterBandH band, double requested, char *why, size_t why_size);
 
+/** 1 if the DEM's metadata says its heights' unit (as Z_FACTOR=AUTO reads
+ * it: a vertical CRS's axis, a band unit type terrashade knows), else 0:
+ * AUTO takes them as metres. */
+int tsd_dem_height_unit_known(GDALRasterBandH band);
+
 #ifdef __cplusplus
 }
 #endif

@@ -73,6 +73,24 @@ class VerticalUnits(unittest.TestCase):
                    "no vertical unit in the CRS or the band: heights taken as metres",
                    self.plain)
 
+    def test_no_unit_on_a_grid_in_feet_warns(self):
+        """A state plane grid in US survey feet whose heights say no unit: taken
+        as metres, with a warning that gives the factor of feet; none where the
+        unit is said (CRS, band) or Z_FACTOR is given, nor on a grid in metres."""
+        def warnings(dem, **oo):
+            return T.run(["gdalinfo", "-nomd"] + T.oo_args(oo) + [T.conn(dem)]).stderr
+        err = warnings(self.plain)
+        print(err.strip())
+        self.assertIn("Warning 1: TERRASHADE: the DEM '%s' is gridded in US survey foot (its "
+                      "CRS), but nothing says its heights' unit: they are taken as metres. If "
+                      "they are in US survey foot too, as on most such grids, give "
+                      "Z_FACTOR=0.3048006096 or say so (gdal_edit.py -units 'US survey foot' "
+                      "'%s')" % (self.plain, self.plain), err)
+        for dem, oo in ((self.ftus, {}), (self.ft, {}), (self.plain, {"Z_FACTOR": "1"}),
+                        (T.jacksboro_utm(self.dir), {})):
+            with self.subTest(dem=os.path.basename(dem), **oo):
+                self.assertNotIn("heights' unit", warnings(dem, **oo))
+
     def test_number_overrides(self):
         self.check(self.ftus, 1.0, "given as Z_FACTOR", self.plain, Z_FACTOR="1")
         self.check(self.ft, FT_US, "given as Z_FACTOR", self.m_ftus, Z_FACTOR=repr(FT_US))
