@@ -137,14 +137,12 @@ static ts_status cliff_error(GDALRasterBandH band, const tsd_dem_conversion *c,
     GDALDatasetH ds = GDALGetBandDataset(band);
     return tsd_fail(msg, n, TS_ERR_ARG,
                     "the DEM '%s' holds a cliff no terrain has: %.6g m beside %.6g m%s in "
-                    "band %d %s columns %d and %d of row %d, about %.3g m apart (more than "
-                    "%.0f m, and steeper than %.0f degrees). %s",
+                    "band %d %s columns %d and %d of row %d, cells about %.3g m apart, where "
+                    "no terrain steps more than %.0f m. %s",
                     ds ? GDALGetDescription(ds) : "", (double)a, (double)b,
-                    full ? "" : " (averaged)", GDALGetBandNumber(band),
-                    full ? "at" : "near", p->x0 + (int)(p->sx * gx),
-                    p->x0 + (int)(p->sx * (gx + 1)), p->y0 + (int)(p->sy * gy),
-                    spacing, CLIFF_M * stretch_of(c),
-                    atan(CLIFF_SLOPE) * 180 / M_PI, todo);
+                    full ? "" : " (averaged)", GDALGetBandNumber(band), full ? "at" : "near",
+                    p->x0 + (int)(p->sx * gx), p->x0 + (int)(p->sx * (gx + 1)),
+                    p->y0 + (int)(p->sy * gy), spacing, limit, todo);
 }
 
 ts_status tsd_dem_check(GDALRasterBandH band, const tsd_dem_conversion *c, const ts_grid *g,
