@@ -287,15 +287,25 @@ static double metres_per_unit(const char *unit)
         const char *name;
         double metres;
     } units[] = {
-        {"m", 1.0}, {"metre", 1.0}, {"meter", 1.0}, {"metres", 1.0}, {"meters", 1.0},
+        {"m", 1.0}, {"metre", 1.0}, {"meter", 1.0},
+        {"dm", 0.1}, {"decimetre", 0.1}, {"decimeter", 0.1},
+        {"cm", 0.01}, {"centimetre", 0.01}, {"centimeter", 0.01},
+        {"mm", 0.001}, {"millimetre", 0.001}, {"millimeter", 0.001},
+        {"km", 1000.0}, {"kilometre", 1000.0}, {"kilometer", 1000.0},
         {"ft", 0.3048}, {"foot", 0.3048}, {"feet", 0.3048}, {"international foot", 0.3048},
         {"US survey foot", 1200.0 / 3937.0}, {"US survey feet", 1200.0 / 3937.0},
-        {"ftUS", 1200.0 / 3937.0}, {"us-ft", 1200.0 / 3937.0},
-        {"foot_us", 1200.0 / 3937.0}, {"Foot_US", 1200.0 / 3937.0},
+        {"ftUS", 1200.0 / 3937.0}, {"us-ft", 1200.0 / 3937.0}, {"foot_us", 1200.0 / 3937.0},
     };
-    for (size_t i = 0; i < sizeof units / sizeof units[0]; i++)
-        if (strcasecmp(unit, units[i].name) == 0)
-            return units[i].metres;
+    /* a plural's trailing s aside (metres, centimeters; not "ms" or "cms") */
+    size_t len = strlen(unit);
+    for (int plural = 0; plural < 2; plural++)
+        for (size_t i = 0; i < sizeof units / sizeof units[0]; i++) {
+            size_t k = strlen(units[i].name);
+            if (plural ? k > 2 && len == k + 1 && (unit[k] == 's' || unit[k] == 'S') &&
+                             strncasecmp(unit, units[i].name, k) == 0
+                       : strcasecmp(unit, units[i].name) == 0)
+                return units[i].metres;
+        }
     return 0.0;
 }
 

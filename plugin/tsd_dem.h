@@ -54,7 +54,7 @@ int tsd_dem_steepness_warning(GDALRasterBandH band, const tsd_cells *cells, doub
  * The Z_FACTOR that turns `band`'s heights (after its scale and offset)
  * into metres. A finite `requested` is the user's number and is kept; NAN
  * (AUTO) takes the vertical unit of the dataset's CRS (a compound or
- * vertical CRS), else the band's unit type ("m", "metre", "ft", "foot",
+ * vertical CRS), else the band's unit type ("m", "metre", "cm", "mm", "ft", "foot",
  * "US survey foot", "ftUS"...), else 1 (no information: metres). Writes
  * why to `why` ("vertical unit US survey foot, from the CRS") and returns
  * the factor.

@@ -76,7 +76,7 @@ const opt_def TSD_OPTION_ROWS[] = {
      NULL,
      "Multiplies the heights: AUTO (from the vertical unit of the DEM's CRS, "
      "else the band's unit: 0.3048 for feet, 1200/3937 for US survey feet, "
-     "1 for metres or no unit) or a number > 0 and <= 1e6; the band's scale "
+     "0.01 for centimetres, 1 for metres or no unit) or a number > 0 and <= 1e6; the band's scale "
      "and offset are applied first"},
     {"CELL_SIZES", K_SELECT, FIELD(cell_sizes), "auto", 0, 0, 0, 0, "auto|grid|ground", 1,
      P, ALL, NULL,

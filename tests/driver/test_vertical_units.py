@@ -68,6 +68,25 @@ class VerticalUnits(unittest.TestCase):
     def test_band_unit_feet(self):
         self.check(self.ft, 0.3048, "band unit ft", self.m_ft)
 
+    def test_band_units_in_metric_multiples(self):
+        """Heights in centimetres or millimetres (integer DEMs often are), said
+        by the band's unit in any spelling: the terrain in metres."""
+        m = T.write_tif(os.path.join(self.dir, "m_small.tif"), self.z / 100.0, NC_GT, 32617)
+        for unit, factor in (("cm", 0.01), ("centimetres", 0.01), ("Millimeters", 0.001)):
+            with self.subTest(unit=unit):
+                path = T.write_tif(os.path.join(self.dir, "u_%s.tif" % unit),
+                                   self.z / 100.0 / factor, NC_GT, 32617)
+                ds = gdal.Open(path, gdal.GA_Update)
+                ds.GetRasterBand(1).SetUnitType(unit)
+                ds = None
+                ds = opened(path)
+                self.assertEqual(ds.GetMetadataItem("Z_FACTOR_SOURCE"), "band unit " + unit)
+                self.assertAlmostEqual(float(ds.GetMetadataItem("Z_FACTOR")), factor, 12)
+                got = ds.GetRasterBand(1).ReadAsArray()
+                ds = None
+                want = T.read(T.conn(m), band=1, options=OPTIONS)
+                np.testing.assert_allclose(got, want, atol=1e-5)
+
     def test_no_unit_is_metres(self):
         self.check(self.plain, 1.0,
                    "no vertical unit in the CRS or the band: heights taken as metres",
