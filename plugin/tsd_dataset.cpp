@@ -556,6 +556,8 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
                                   sOpts.z_factor, hSRS ? m_oSRS.GetName() : nullptr, szMsg,
                                   sizeof szMsg))
         CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szMsg);
+    if (m_nLevel == 0)
+        WarnShortDistance(H);
     if (!SetupWindow(W, H) ||
         !CheckMemory(sOpts, W, H, WindowPlan(m_poWindow), m_bHasSun ? &m_sSun : nullptr,
                      m_sCells, m_nLevel))

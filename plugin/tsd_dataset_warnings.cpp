@@ -1,7 +1,8 @@
 /* What the driver says about a DEM and a sun that are likely not what the
  * user meant: refusals at open (a band that is not heights) and warnings
- * (no geotransform, heights of unknown unit on a grid in feet, a DEM too
- * wide for one sun). */
+ * (no geotransform, heights of unknown unit on a grid in feet, a
+ * MAX_DISTANCE shorter than a cell, a DEM too wide for one sun). */
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -63,6 +64,23 @@ void WarnHeightUnit(const tsd_cells &sCells, const OGRSpatialReference &oSRS,
              osDEM.c_str(), pszUnit ? pszUnit : "a unit other than metres",
              pszUnit ? pszUnit : "that unit", sCells.unit_to_m, pszUnit ? pszUnit : "ft",
              osDEM.c_str());
+}
+
+/* A MAX_DISTANCE shorter than the DEM's cells holds no terrain: no
+ * shadow, no horizon above the cell's own slope. Most often a distance meant in cells (RVT's
+ * radius is in pixels) or kilometres. */
+void TSDataset::WarnShortDistance(int H)
+{
+    const double dfCell = std::min(m_sCells.cell_y, tsd_cells_min_x(&m_sCells, H));
+    if (!(m_sOpts.max_distance > 0 && m_sOpts.max_distance < dfCell) ||
+        !tsd_product_takes(m_psProduct, tsd_option_find("MAX_DISTANCE")))
+        return;
+    CPLError(CE_Warning, CPLE_AppDefined,
+             "TERRASHADE: MAX_DISTANCE=%g m is shorter than the DEM's cells (%.4g m): no "
+             "terrain lies within it, so nothing casts a shadow or raises a horizon. It is "
+             "in metres: %g cells are %.4g m",
+             m_sOpts.max_distance, dfCell, m_sOpts.max_distance,
+             m_sOpts.max_distance * dfCell);
 }
 
 /* Degrees of arc from the DEM's centre beyond which SUN_POSITION=center warns. */

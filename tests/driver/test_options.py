@@ -123,6 +123,22 @@ class Options(unittest.TestCase):
         self.assertTrue(np.all(near <= full + 1e-4))
         self.assertTrue(np.any(near < full - 0.5))
 
+    def test_max_distance_shorter_than_a_cell_warns(self):
+        """MAX_DISTANCE=10 on 30 m cells (10 cells meant, as RVT's radius is in
+        pixels?) holds no terrain: a warning that says so and what 10 cells
+        are; none at 30 m and beyond, nor for a product without it."""
+        def warned(**oo):
+            p = T.run(["gdalinfo", "-nomd"] + T.oo_args(oo) + [T.conn(self.dem)])
+            return "MAX_DISTANCE" in p.stderr and p.stderr
+        err = warned(PRODUCT="svf", MAX_DISTANCE=10)
+        print(err.strip())
+        self.assertIn("Warning 1: TERRASHADE: MAX_DISTANCE=10 m is shorter than the DEM's "
+                      "cells (30 m): no terrain lies within it, so nothing casts a shadow or "
+                      "raises a horizon. It is in metres: 10 cells are 300 m", err)
+        self.assertTrue(warned(PRODUCT="shadow", MAX_DISTANCE=10))
+        self.assertFalse(warned(PRODUCT="svf", MAX_DISTANCE=30))
+        self.assertFalse(warned(PRODUCT="svf"))
+
     def test_curvature_and_refraction(self):
         """On a big flat-topped DEM the Earth's curvature lowers far horizons;
         refraction k = 1 cancels it."""
