@@ -75,9 +75,13 @@ class Log(QgsProcessingFeedback):
     def __init__(self):
         super().__init__()
         self.lines = []
+        self.warnings = []
 
     def pushInfo(self, info):
         self.lines.append(info)
+
+    def pushWarning(self, warning):
+        self.warnings.append(warning)
 
 
 result = {"algorithms": sorted(a.id() for a in provider.algorithms()),
@@ -88,7 +92,7 @@ for name, alg, params in json.loads(sys.argv[2]):
     fb = Log()
     try:
         out = processing.run(alg, params, feedback=fb)
-        result[name] = {"output": out["OUTPUT"], "log": fb.lines}
+        result[name] = {"output": out["OUTPUT"], "log": fb.lines, "warnings": fb.warnings}
     except QgsProcessingException as e:
         result[name] = {"error": str(e)}
 plugin.unload()
@@ -117,6 +121,9 @@ CASES = [
       "CURVATURE": "NO"}),
     ("svf", "terrashade:svf", {"INPUT": J, "DIRECTIONS": 8},
      {"PRODUCT": "svf", "DIRECTIONS": 8}),
+    ("svf_short", "terrashade:svf",  # a warning of the driver, for the log
+     {"INPUT": J, "DIRECTIONS": 4, "MAX_DISTANCE": 5},
+     {"PRODUCT": "svf", "DIRECTIONS": 4, "MAX_DISTANCE": 5}),
     ("horizon", "terrashade:horizon", {"INPUT": J, "DIRECTIONS": 4},
      {"PRODUCT": "horizon", "DIRECTIONS": 4}),
     ("sunhours", "terrashade:sunhours", dict(DAY, INPUT=J),
@@ -250,6 +257,15 @@ class Processing(unittest.TestCase):
                 np.testing.assert_array_equal(T.read(self.out(name + "_log")), ref)
                 print("%-10s %s, equal to gdal_translate and to: %s" % (
                     name, got.shape, same[0][len("Same as: "):]))
+                # the driver's warnings reach the Processing log, once each
+                warned = result[name]["warnings"]
+                if name == "svf_short":
+                    self.assertEqual(len(warned), 1, warned)
+                    self.assertIn("TERRASHADE: MAX_DISTANCE=5 m is shorter than the DEM's "
+                                  "cells", warned[0])
+                    print("%-10s warned: %s" % (name, warned[0]))
+                else:
+                    self.assertEqual(warned, [])
         for name, _, _ in BAD:
             print("%-10s -> %s" % (name, result[name].get("error")))
         # no day: the driver's sentence names DATE (and DATETIME)

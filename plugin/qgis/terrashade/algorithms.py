@@ -129,11 +129,36 @@ def command_line(dem, options, out):
     return " ".join(shlex.quote(a) for a in args + ["%s:%s" % (DRIVER, dem), out])
 
 
+class Warnings:
+    """GDAL's warnings while it is pushed (gdal.PushErrorHandler), kept for the
+    Processing log, where GDAL's own handler (stderr) would not show them."""
+
+    def __init__(self):
+        self.messages = []
+
+    def __call__(self, level, _number, message):
+        if level == gdal.CE_Warning and message not in self.messages:
+            self.messages.append(message)
+
+
 def translate(dem, options, out, feedback=None):
     """gdal_translate -oo ... TERRASHADE:dem out, with the feedback's
-    progress and cancellation; raises QgsProcessingException on failure."""
+    progress and cancellation; the driver's warnings go to the feedback's
+    log; raises QgsProcessingException on failure."""
     if gdal.GetDriverByName(DRIVER) is None:
         raise QgsProcessingException("The TERRASHADE GDAL driver is not loaded any more.")
+    warnings = Warnings()
+    gdal.PushErrorHandler(warnings)
+    try:
+        write(dem, options, out, feedback)
+    finally:
+        gdal.PopErrorHandler()
+        if feedback is not None:
+            for message in warnings.messages:
+                feedback.pushWarning(message)
+
+
+def write(dem, options, out, feedback):
     gdal.ErrorReset()
     ds = gdal.OpenEx("%s:%s" % (DRIVER, dem), gdal.OF_RASTER,
                      open_options=["%s=%s" % kv for kv in options.items()])
