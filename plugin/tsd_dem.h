@@ -2,6 +2,9 @@
  * tsd_dem.h - read a DEM band through GDAL's C API into a core grid:
  * float metres, NaN where the band's mask (nodata, alpha, mask band) says
  * invalid, scale/offset and Z_FACTOR applied, flipped to row 0 = north.
+ * Every load refuses what no terrain holds (tsd_dem_check.h: heights beyond
+ * the Earth's, cliffs between neighbours, most often an undeclared nodata
+ * value) with TS_ERR_ARG and a sentence naming the cell and the remedy.
  */
 #ifndef TSD_DEM_H
 #define TSD_DEM_H
@@ -45,7 +48,8 @@ ts_status tsd_dem_load_window(GDALRasterBandH band, const tsd_cells *cells, doub
  * degrees (central differences): not terrain at its cells' scale, as when
  * a DEM in degrees is given a projected CRS (cells of 0.0008 "m") or its
  * heights are in millimetres. 0 otherwise, or when the sample cannot be
- * read. crs_name (may be NULL) names the CRS in the sentence.
+ * read. crs_name (may be NULL) names the CRS in the sentence. In
+ * tsd_dem_check.c, beside the loads' checks.
  */
 int tsd_dem_steepness_warning(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
                               const char *crs_name, char *warning, size_t warning_size);
