@@ -45,9 +45,9 @@ ts_status tsd_dem_load_window(GDALRasterBandH band, const tsd_cells *cells, doub
 /**
  * 1 with a sentence in `warning` when more than half of the cells of a
  * sample of up to 256 x 256 cells at the DEM's centre are steeper than 85
- * degrees (central differences): not terrain at its cells' scale, as when
- * a DEM in degrees is given a projected CRS (cells of 0.0008 "m") or its
- * heights are in millimetres. 0 otherwise, or when the sample cannot be
+ * degrees (by ts_normals, as the shading sees them): not terrain at its
+ * cells' scale, as when a DEM in degrees is given a projected CRS (cells of
+ * 0.0008 "m") or its heights are in millimetres. 0 otherwise, or when the sample cannot be
  * read. crs_name (may be NULL) names the CRS in the sentence. In
  * tsd_dem_check.c, beside the loads' checks.
  */

@@ -8,6 +8,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 
 #include "ogr_srs_api.h"
 
@@ -184,20 +185,23 @@ int tsd_dem_steepness_warning(GDALRasterBandH band, const tsd_cells *cells, doub
      * here: the reads will */
     if (tsd_dem_load_window(band, cells, z_factor, x0, y0, w, h, &g, msg, sizeof msg) != TS_OK)
         return 0;
-    const double limit = tan(STEEP_DEGREES * M_PI / 180.0);
-    long steep = 0, counted = 0;
-    for (int y = 1; y < h - 1; y++) {
-        const float *r = g.z + (ptrdiff_t)y * g.stride;
-        const double cx = cells->cell_x_row ? cells->cell_x_row[y0 + y] : cells->cell_x;
-        for (int x = 1; x < w - 1; x++) {
-            double dx = (r[x + 1] - r[x - 1]) / (2 * cx);
-            double dy = (r[x + g.stride] - r[x - g.stride]) / (2 * cells->cell_y);
-            if (isnan(dx) || isnan(dy))
-                continue;
-            counted++;
-            steep += hypot(dx, dy) > limit;
-        }
+    /* the shading's own normals (Horn's method, the grid's row spacing) */
+    const size_t cells_n = (size_t)w * h;
+    float *nz = malloc(3 * cells_n * sizeof *nz);
+    ts_error err;
+    if (!nz || ts_normals_threads(&g, 1, nz + cells_n, nz + 2 * cells_n, nz, &err) != TS_OK) {
+        free(nz);
+        ts_grid_free(&g);
+        return 0;
     }
+    const float limit = (float)cos(STEEP_DEGREES * M_PI / 180.0);
+    long steep = 0, counted = 0;
+    for (size_t i = 0; i < cells_n; i++)
+        if (!isnan(nz[i])) {
+            counted++;
+            steep += nz[i] < limit;
+        }
+    free(nz);
     ts_grid_free(&g);
     if (counted == 0 || steep * 2 <= counted)
         return 0;
