@@ -182,26 +182,25 @@ static ts_status grid_of(const tsd_cells *cells, int w, int h, int row0, ts_grid
     return TS_OK;
 }
 
-/* The largest east-west cell size of `h` grid rows from `row0` on. */
-static double largest_spacing(const tsd_cells *cells, int row0, int h)
+/* The largest east-west cell size of a grid's rows. */
+static double largest_spacing(const ts_grid *g)
 {
-    if (!cells->cell_x_row)
-        return cells->cell_x;
+    if (!g->cell_x_row)
+        return g->cell_x;
     double m = 0;
-    for (int y = row0; y < row0 + h; y++)
-        m = cells->cell_x_row[y] > m ? cells->cell_x_row[y] : m;
+    for (int y = 0; y < g->height; y++)
+        m = g->cell_x_row[y] > m ? g->cell_x_row[y] : m;
     return m;
 }
 
 /* The loads' end: the grid checked (tsd_dem_check; on failure it is
  * freed), then turned to row 0 = north. */
 static ts_status checked_and_flipped(GDALRasterBandH band, const tsd_dem_conversion *c,
-                                     const tsd_cells *cells, int row0, ts_grid *grid,
+                                     const tsd_cells *cells, ts_grid *grid,
                                      const tsd_dem_seen *seen, const tsd_dem_placement *p,
                                      char *msg, size_t n)
 {
-    ts_status st = tsd_dem_check(band, c, grid, seen,
-                                 largest_spacing(cells, row0, grid->height), p, msg, n);
+    ts_status st = tsd_dem_check(band, c, grid, seen, largest_spacing(grid), p, msg, n);
     if (st != TS_OK) {
         ts_grid_free(grid);
         return st;
@@ -238,7 +237,7 @@ ts_status tsd_dem_load_window(GDALRasterBandH band, const tsd_cells *cells, doub
                   c.scale, c.offset, &seen);
     free(m);
     const tsd_dem_placement p = {rx, ry, 1, 1};
-    return checked_and_flipped(band, &c, cells, y0, grid, &seen, &p, msg, n);
+    return checked_and_flipped(band, &c, cells, grid, &seen, &p, msg, n);
 }
 
 ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
@@ -276,7 +275,7 @@ ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
     free(m);
     const tsd_dem_placement p = {0, 0, (double)GDALGetRasterBandXSize(band) / w,
                                  (double)GDALGetRasterBandYSize(band) / h};
-    return checked_and_flipped(band, &c, cells, 0, grid, &seen, &p, msg, n);
+    return checked_and_flipped(band, &c, cells, grid, &seen, &p, msg, n);
 }
 
 /* Metres per unit of a unit's name (GDAL's band unit types, PROJ's and
