@@ -475,9 +475,9 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     // Z_FACTOR=AUTO becomes the factor of the DEM's vertical unit here, so
     // that the metadata and the auxiliary-file key say the number used
     char szZWhy[256];
-    const bool bZAuto = std::isnan(sOpts.z_factor);
+    int bUnitSaid = 0;
     sOpts.z_factor = tsd_dem_z_factor(GDALRasterBand::ToHandle(poDEM->GetRasterBand(sOpts.band)),
-                                      sOpts.z_factor, szZWhy, sizeof szZWhy);
+                                      sOpts.z_factor, &bUnitSaid, szZWhy, sizeof szZWhy);
     const int W = poDEM->GetRasterXSize(), H = poDEM->GetRasterYSize();
     if (poDEM->GetGeoTransform(poDS->m_adfGT) != CE_None)
     {
@@ -491,8 +491,7 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
         poDS->m_oSRS = *poSRS;
     if (!poDS->Setup(poOpenInfo->pszFilename, W, H))
         return nullptr;
-    if (bZAuto &&
-        !tsd_dem_height_unit_known(GDALRasterBand::ToHandle(poDEM->GetRasterBand(sOpts.band))))
+    if (!bUnitSaid)
         WarnHeightUnit(poDS->m_sCells, poDS->m_oSRS, osDEM);
     // not through PAM: it is derived, like the rest of the metadata
     poDS->GDALDataset::SetMetadataItem("Z_FACTOR_SOURCE", szZWhy);

@@ -108,7 +108,7 @@ static tsd_dem_conversion conversion_of(GDALRasterBandH band, double z_factor)
         c.scale = 1;
     if (!has_offset)
         c.offset = 0;
-    c.unit_factor = tsd_dem_z_factor(band, NAN, NULL, 0);
+    c.unit_factor = tsd_dem_z_factor(band, NAN, NULL, NULL, 0);
     c.z_factor = isnan(z_factor) ? c.unit_factor : z_factor;
     c.scale *= c.z_factor;
     c.offset *= c.z_factor;
@@ -340,25 +340,21 @@ static int metadata_unit(GDALRasterBandH band, double *metres, char *why, size_t
     return 0;
 }
 
-double tsd_dem_z_factor(GDALRasterBandH band, double requested, char *why, size_t n)
+double tsd_dem_z_factor(GDALRasterBandH band, double requested, int *said, char *why,
+                        size_t n)
 {
     char scratch[8];
     if (!why) {
         why = scratch;
         n = sizeof scratch;
     }
-    if (!isnan(requested)) {
+    double metres = requested;
+    int known = 1;
+    if (!isnan(requested))
         snprintf(why, n, "given as Z_FACTOR");
-        return requested;
-    }
-    double metres = 1.0;
-    metadata_unit(band, &metres, why, n);
+    else if (!(known = metadata_unit(band, &metres, why, n)))
+        metres = 1.0;
+    if (said)
+        *said = known;
     return metres;
-}
-
-int tsd_dem_height_unit_known(GDALRasterBandH band)
-{
-    double metres;
-    char why[256];
-    return metadata_unit(band, &metres, why, sizeof why);
 }

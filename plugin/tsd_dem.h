@@ -58,17 +58,14 @@ int tsd_dem_steepness_warning(GDALRasterBandH band, const tsd_cells *cells, doub
  * The Z_FACTOR that turns `band`'s heights (after its scale and offset)
  * into metres. A finite `requested` is the user's number and is kept; NAN
  * (AUTO) takes the vertical unit of the dataset's CRS (a compound or
- * vertical CRS), else the band's unit type ("m", "metre", "cm", "mm", "ft", "foot",
- * "US survey foot", "ftUS"...), else 1 (no information: metres). Writes
- * why to `why` ("vertical unit US survey foot, from the CRS") and returns
- * the factor.
+ * vertical CRS), else the band's unit type ("m", "metre", "cm", "mm", "ft",
+ * "foot", "US survey foot", "ftUS"...), else 1 (no information: metres).
+ * *said (may be NULL) is 1 when the number or the metadata said the unit, 0
+ * when the heights are taken as metres for want of one. Writes why to `why`
+ * ("vertical unit US survey foot, from the CRS") and returns the factor.
  */
-double tsd_dem_z_factor(GDALRasterBandH band, double requested, char *why, size_t why_size);
-
-/** 1 if the DEM's metadata says its heights' unit (as Z_FACTOR=AUTO reads
- * it: a vertical CRS's axis, a band unit type terrashade knows), else 0:
- * AUTO takes them as metres. */
-int tsd_dem_height_unit_known(GDALRasterBandH band);
+double tsd_dem_z_factor(GDALRasterBandH band, double requested, int *said, char *why,
+                        size_t why_size);
 
 #ifdef __cplusplus
 }
