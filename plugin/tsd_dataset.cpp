@@ -514,6 +514,7 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
                                       sizeof szMsg);
     if (eSt != TS_OK)
         return Fail(eSt, szMsg), false;
+    const double dfMinCell = std::min(m_sCells.cell_y, tsd_cells_min_x(&m_sCells, H));
     if (tsd_options_sun_from_time(&sOpts))
     {
         const char *pszWhat = sOpts.datetime[0]     ? "DATETIME"
@@ -536,7 +537,6 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
             return Fail(eSt, CPLSPrintf("%s: %s", pszWhat, szMsg)), false;
         if (sOpts.sun_position != TSD_SUN_PER_CELL && m_nLevel == 0)
             WarnSunReach(W, H, hSRS, sSites.lon[0], sSites.lat[0]);
-        const double dfMinCell = std::min(m_sCells.cell_y, tsd_cells_min_x(&m_sCells, H));
         eSt = tsd_sun_setup(&sOpts, &sSites, dfMinCell, &m_sSun, szMsg, sizeof szMsg);
         if (eSt != TS_OK)
             return Fail(eSt, szMsg), false;
@@ -556,7 +556,7 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
                                   sizeof szMsg))
         CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szMsg);
     if (m_nLevel == 0)
-        WarnShortDistance(H);
+        WarnShortDistance(dfMinCell);
     if (!SetupWindow(W, H) ||
         !CheckMemory(sOpts, W, H, WindowPlan(m_poWindow), m_bHasSun ? &m_sSun : nullptr,
                      m_sCells, m_nLevel))

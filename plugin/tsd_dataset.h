@@ -95,7 +95,7 @@ class TSDataset final : public GDALPamDataset
     CPLErr WindowBlock(int iPlane, int x0, int y0, int nBW, int nBH, bool bByte, void *pImage);
     bool Setup(const char *pszConnection, int W, int H);
     void WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfLon, double dfLat);
-    void WarnShortDistance(int H);
+    void WarnShortDistance(double dfMinCell);
     static GDALDataset *OpenDEM(const char *pszDEM);
     ts_status LoadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg);
     void StartReadAhead();

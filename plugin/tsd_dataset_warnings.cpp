@@ -2,7 +2,6 @@
  * user meant: refusals at open (a band that is not heights) and warnings
  * (no geotransform, heights of unknown unit on a grid in feet, a
  * MAX_DISTANCE shorter than a cell, a DEM too wide for one sun). */
-#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -66,12 +65,12 @@ void WarnHeightUnit(const tsd_cells &sCells, const OGRSpatialReference &oSRS,
              osDEM.c_str());
 }
 
-/* A MAX_DISTANCE shorter than the DEM's cells holds no terrain: no
- * shadow, no horizon above the cell's own slope. Most often a distance meant in cells (RVT's
- * radius is in pixels) or kilometres. */
-void TSDataset::WarnShortDistance(int H)
+/* A MAX_DISTANCE shorter than the DEM's cells (dfCell: its smallest side)
+ * holds no terrain: no shadow, no horizon above the cell's own slope. Most
+ * often a distance meant in cells (RVT's radius is in pixels) or
+ * kilometres. */
+void TSDataset::WarnShortDistance(double dfCell)
 {
-    const double dfCell = std::min(m_sCells.cell_y, tsd_cells_min_x(&m_sCells, H));
     if (!(m_sOpts.max_distance > 0 && m_sOpts.max_distance < dfCell) ||
         !tsd_product_takes(m_psProduct, tsd_option_find("MAX_DISTANCE")))
         return;
