@@ -12,11 +12,6 @@
 
 #include "ogr_srs_api.h"
 
-/* Beyond any terrain on Earth: the deepest ocean floor (the Challenger
- * Deep, -10.9 km) and Everest (8.85 km), with room for ellipsoidal heights.
- * Undeclared nodata values (-32768, 32767, 65535, -3.4e38...) lie beyond. */
-#define EARTH_LOWEST_M (-12000.0)
-#define EARTH_HIGHEST_M 9000.0
 /* No cliff on Earth drops this far between neighbours (Mount Thor's face,
  * the highest vertical one, is 1.25 km; Nanga Parbat's Rupal face 4.6 km
  * over several km), nor this steeply over larger cells (84 degrees). */
@@ -41,14 +36,14 @@ static int height_limits(GDALRasterBandH band, const tsd_dem_conversion *c, doub
     OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
     OGRErr err = OGRERR_FAILURE;
     double a = srs ? OSRGetSemiMajor(srs, &err) : 0;
-    const int earth = !(err == OGRERR_NONE && a > 0 && fabs(a - 6371000.0) > 100000.0);
+    const int earth = !(err == OGRERR_NONE && a > 0 && fabs(a - TS_EARTH_RADIUS) > 100000.0);
     if (!earth) {
         *low = -a;
         *high = a;
         snprintf(what, n, "the radius of the CRS's body (%.0f m)", a);
     } else {
-        *low = EARTH_LOWEST_M;
-        *high = EARTH_HIGHEST_M;
+        *low = TSD_EARTH_LOWEST_M;
+        *high = TSD_EARTH_HIGHEST_M;
         snprintf(what, n, "any terrain on Earth (%.0f to %.0f m)", *low, *high);
     }
     const double stretch = stretch_of(c);

@@ -18,6 +18,13 @@
 extern "C" {
 #endif
 
+/** Beyond any terrain on Earth: the deepest ocean floor (the Challenger
+ * Deep, -10.9 km) and Everest (8.85 km), with room for ellipsoidal heights.
+ * Undeclared nodata values (-32768, 32767, 65535, -3.4e38...) lie beyond;
+ * no cell's horizon dips below the sea-level one seen from the highest. */
+#define TSD_EARTH_LOWEST_M (-12000.0)
+#define TSD_EARTH_HIGHEST_M 9000.0
+
 /** How a band's values become the grid's heights. */
 typedef struct {
     double scale, offset; /**< value * scale + offset: the band's own, times z_factor */

@@ -2,6 +2,7 @@
 #include "tsd_sun.h"
 
 #include "tsd_datetime.h"
+#include "tsd_dem_check.h"
 #include "tsd_products.h"
 #include "tsd_text.h"
 
@@ -198,16 +199,13 @@ ts_status tsd_sun_setup(const tsd_options *o, tsd_sites *sites, double min_cell_
     return TS_OK;
 }
 
-/* No terrain on Earth rises higher, so no cell's horizon dips lower than
- * the sea-level horizon seen from here. */
-#define HIGHEST_TERRAIN_M 9000.0
-
 int tsd_sun_night_warning(const tsd_sun *s, const tsd_options *o, char *warning, size_t n)
 {
     const char *product = tsd_product_of(o)->name;
     if (!isfinite(s->instant) || (strcmp(product, "shade") != 0 && strcmp(product, "shadow") != 0))
         return 0;
-    const double lowest = ts_earth_horizon(HIGHEST_TERRAIN_M, &s->day.horizon);
+    /* no cell's horizon dips below the sea-level one from the highest terrain */
+    const double lowest = ts_earth_horizon(TSD_EARTH_HIGHEST_M, &s->day.horizon);
     if (!(s->sun.elevation + o->light_radius < lowest))
         return 0;
     /* mean solar time at the site: UTC plus 4 minutes per degree east */
