@@ -128,8 +128,8 @@ class Options(unittest.TestCase):
         pixels?) holds no terrain: a warning that says so and what 10 cells
         are; none at 30 m and beyond, nor for a product without it."""
         def warned(**oo):
-            p = T.run(["gdalinfo", "-nomd"] + T.oo_args(oo) + [T.conn(self.dem)])
-            return "MAX_DISTANCE" in p.stderr and p.stderr
+            err = T.open_stderr(self.dem, **oo)
+            return "MAX_DISTANCE" in err and err
         err = warned(PRODUCT="svf", MAX_DISTANCE=10)
         print(err.strip())
         self.assertIn("Warning 1: TERRASHADE: MAX_DISTANCE=10 m is shorter than the DEM's "

@@ -124,21 +124,19 @@ class Sun(unittest.TestCase):
         Just after sunset (-1 degree, a high summit may still see it) and at
         noon there is none."""
         conn = T.conn(T.JACKSBORO)
-        p = T.run(["gdalinfo", "-nomd", "-oo", "PRODUCT=shadow", "-oo",
-                   "DATETIME=2026-06-21T02:00:00Z", conn])
-        print(p.stderr.strip())
+        err = T.open_stderr(T.JACKSBORO, PRODUCT="shadow", DATETIME="2026-06-21T02:00:00Z")
+        print(err.strip())
         self.assertIn("Warning 1: TERRASHADE: DATETIME=2026-06-21T02:00:00Z puts the sun's "
                       "centre 10.9 degrees below the horizon at the DEM's centre (mean solar "
                       "time 20:23 there): it is night, no terrain sees the sun, and its direct "
                       "light is nil everywhere. If that is not the time meant, check "
                       "DATETIME's offset from UTC (Z is UTC itself; mean solar time at "
-                      "longitude -84.2 is UTC-05:37)", p.stderr)
+                      "longitude -84.2 is UTC-05:37)", err)
         night = T.read(conn, 1, {"PRODUCT": "shadow", "DATETIME": "2026-06-21T02:00:00Z"})
         self.assertEqual(np.nanmax(night), 0)
         for dt in ("2026-06-22T01:00:00Z", "2026-06-21T12:00:00-05:00"):
             with self.subTest(dt=dt):
-                p = T.run(["gdalinfo", "-nomd", "-oo", "DATETIME=" + dt, conn])
-                self.assertNotIn("below the horizon", p.stderr)
+                self.assertNotIn("below the horizon", T.open_stderr(T.JACKSBORO, DATETIME=dt))
 
     def test_per_cell_datetime_on_a_small_extent(self):
         """SUN_POSITION=per_cell over jacksboro (0.3 x 0.3 deg): the sun moves

@@ -79,6 +79,12 @@ def oo_args(options):
     return args
 
 
+def open_stderr(dem, **options):
+    """What `gdalinfo -nomd -oo KEY=VALUE ... TERRASHADE:dem` says on stderr
+    (the driver's warnings); the dataset must open."""
+    return run(["gdalinfo", "-nomd"] + oo_args(options) + [conn(dem)]).stderr
+
+
 def translate(dem, out, options=None, inline=None, extra=()):
     """gdal_translate TERRASHADE:... out.tif with -oo options; returns out."""
     run(["gdal_translate", "-q", "-of", "GTiff"] + oo_args(options or {})
