@@ -112,8 +112,9 @@ int main(int argc, char **argv)
     printf("command: ");
     for (int i = 0; i < argc; i++)
         printf("%s%s", argv[i], i + 1 < argc ? " " : "\n");
-    printf("machine: %s, %d cores, %s %s; threads: %d\n", cpu, ts_cpu_count(), u.sysname,
-           u.release, threads > 0 ? threads : ts_cpu_count());
+    printf("machine: %s, %d cores, %s %s; threads: %d; vectors: %s\n", cpu, ts_cpu_count(),
+           u.sysname, u.release, threads > 0 ? threads : ts_cpu_count(),
+           ts_cpu_vectors_name(ts_cpu_vector_level()));
 
     ts_error e;
     ts_grid g;

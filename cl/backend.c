@@ -73,7 +73,8 @@ static void report_c(ts_backend_report *r)
 {
     r->used = TS_BACKEND_C;
     snprintf(r->backend, sizeof r->backend, "c");
-    snprintf(r->device, sizeof r->device, "CPU, %d cores", ts_cpu_count());
+    snprintf(r->device, sizeof r->device, "CPU, %d cores, %s", ts_cpu_count(),
+             ts_cpu_vectors_name(ts_cpu_vector_level()));
 }
 
 /* Whether to try OpenCL for backend `eff`; fills the report either way. */

@@ -45,7 +45,7 @@ typedef struct {
     ts_backend used;      /**< TS_BACKEND_C or TS_BACKEND_OPENCL */
     char backend[16];     /**< "c" or "opencl" */
     char device[192];     /**< e.g. "pthread-skylake (Portable Computing Language)"
-                               or "CPU, 8 cores" */
+                               or "CPU, 8 cores, AVX-512" */
     int fell_back;        /**< 1: OpenCL was tried and failed, C ran */
     char reason[256];     /**< why OpenCL did not run (fell back, or not chosen) */
 } ts_backend_report;

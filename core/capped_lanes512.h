@@ -1,6 +1,6 @@
 /*
  * The AVX-512 part of the capped lines' lockstep blocks (capped_lanes.h),
- * called only where ts_lane_vector_level() is 2. Each gives the bits of the
+ * called only where ts_cpu_vector_level() is 2. Each gives the bits of the
  * scalar code in capped_lanes.c.
  */
 #ifndef TS_CAPPED_LANES512_H

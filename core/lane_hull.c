@@ -105,7 +105,7 @@ typedef struct {
 } group;
 
 /* AVX-512 with its 256-bit forms (every AVX-512 CPU but the Xeon Phi has
- * them; ts_lane_vector_level asks): mask compares and masked adds of the
+ * them; ts_cpu_vector_level asks): mask compares and masked adds of the
  * lines' indices, each one instruction on the walks' dependent chains. */
 #define AVX512VL __attribute__((target("avx512f,avx512vl")))
 
@@ -360,24 +360,10 @@ AVX512VL static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, 
     }
 }
 
-int ts_lane_vector_level(void)
-{
-    static int known = -1; /* the CPU's answer, once asked */
-    int level = __atomic_load_n(&known, __ATOMIC_RELAXED);
-    if (level < 0) {
-        __builtin_cpu_init();
-        level = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") ? 2
-                : __builtin_cpu_supports("avx2")                                        ? 1
-                                                                                        : 0;
-        __atomic_store_n(&known, level, __ATOMIC_RELAXED);
-    }
-    return level;
-}
-
 int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ)
 {
     /* 32-bit offsets: the last line's points, as ints */
-    if (ts_lane_vector_level() != 2 || (long long)(s->j1 + 1) * h->stride * 6 > INT_MAX)
+    if (ts_cpu_vector_level() != 2 || (long long)(s->j1 + 1) * h->stride * 6 > INT_MAX)
         return 0;
     for (int j = s->j0; j <= s->j1; j += 8 * NG) {
         __mmask8 lanes[NG];
@@ -391,11 +377,6 @@ int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_la
 }
 
 #else
-
-int ts_lane_vector_level(void)
-{
-    return 0;
-}
 
 int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ)
 {

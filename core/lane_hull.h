@@ -75,10 +75,6 @@ void ts_lane_pushes_reset(ts_lane_pushes *p, int lines);
 int ts_lane_delayed_pushes(ts_lane_pushes *p, const double *d_ring, const double *g_ring,
                            size_t slot_stride, int slots, double behind, ts_lane_step *s);
 
-/* The widest vectors the CPU and the build run (asked once): 2 AVX-512,
- * 1 AVX2, 0 neither. */
-int ts_lane_vector_level(void);
-
 /* The step, vectorised: returns 0, having done nothing, where the CPU (or
  * the build) has no AVX-512 or the hulls are too large for 32-bit
  * offsets; the caller then runs the scalar code. */

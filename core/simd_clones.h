@@ -13,7 +13,7 @@
 #endif
 
 /* TS_AVX512: a function compiled for AVX-512 only (hand-written intrinsics),
- * called only where ts_lane_vector_level() says the CPU has it. */
+ * called only where ts_cpu_vector_level() says the CPU has it. */
 #if defined(__GNUC__) && defined(__x86_64__)
 #define TS_AVX512 __attribute__((target("avx512f")))
 #include <immintrin.h>

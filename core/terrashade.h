@@ -579,6 +579,27 @@ ts_status ts_pyramid_horizon_compute(const ts_grid *grid, const ts_pyramid_opts 
 /** Number of online CPU cores (>= 1). */
 int ts_cpu_count(void);
 
+/** Levels of the hand-written vector code (ts_cpu_vector_level). */
+enum {
+    TS_CPU_VECTORS_NONE = 0,  /**< the portable C paths */
+    TS_CPU_VECTORS_AVX2 = 1,  /**< AVX2 where a path has it, else portable C */
+    TS_CPU_VECTORS_AVX512 = 2 /**< AVX-512 (with AVX-512VL) */
+};
+
+/** The widest hand-written vector code this process runs: the CPU's,
+ * capped by the environment variable TERRASHADE_SIMD (auto, avx512, avx2 or
+ * none; asked once per process, a bad value counts as auto). Every level
+ * gives the same results; the cap is for tests and timings of the paths a
+ * CPU without AVX-512 takes. */
+int ts_cpu_vector_level(void);
+
+/** Parse a TERRASHADE_SIMD value into the cap it sets (NULL, "" and auto:
+ * TS_CPU_VECTORS_AVX512, no cap); TS_ERR_ARG, naming the value, otherwise. */
+ts_status ts_cpu_vectors_parse(const char *text, int *cap, ts_error *err);
+
+/** "AVX-512", "AVX2" or "portable C", for a level. */
+const char *ts_cpu_vectors_name(int level);
+
 #ifdef __cplusplus
 }
 #endif

@@ -45,12 +45,15 @@ int tsd_backend_predict(const tsd_options *o, tsd_backend_summary *s, char *msg,
     return 0;
 }
 
-int tsd_backend_check_env(const tsd_options *o, char *msg, size_t n)
+int tsd_backend_check_env(const tsd_options *o, int uses_backend, char *msg, size_t n)
 {
     const char *env = getenv("TERRASHADE_BACKEND");
     ts_backend b;
     ts_error err;
-    if (o->backend != TSD_BACKEND_AUTO || !env || !*env ||
+    int cap;
+    if (ts_cpu_vectors_parse(getenv("TERRASHADE_SIMD"), &cap, &err) != TS_OK)
+        return (tsd_fail_core(msg, n, NULL, &err), -1);
+    if (!uses_backend || o->backend != TSD_BACKEND_AUTO || !env || !*env ||
         ts_backend_parse(env, &b, &err) == TS_OK)
         return 0;
     return (tsd_fail(msg, n, TS_ERR_ARG,

@@ -45,9 +45,12 @@ void tsd_backend_summary_add(tsd_backend_summary *s, const ts_backend_report *r)
 int tsd_backend_predict(const tsd_options *o, tsd_backend_summary *s, char *msg,
                         size_t msg_size);
 
-/** With BACKEND=auto: -1 with a sentence in msg if TERRASHADE_BACKEND is
- * not auto, c or opencl (probes nothing); else 0. */
-int tsd_backend_check_env(const tsd_options *o, char *msg, size_t msg_size);
+/** The environment's choices, checked at open (probes nothing): -1 with a
+ * sentence in msg if TERRASHADE_SIMD is not auto, avx512, avx2 or none
+ * (every product runs C code), or, for a product that chooses a backend
+ * (uses_backend) with BACKEND=auto, if TERRASHADE_BACKEND is not auto, c or
+ * opencl; else 0. */
+int tsd_backend_check_env(const tsd_options *o, int uses_backend, char *msg, size_t msg_size);
 
 /**
  * The metadata values of a summary: backend "c", "opencl" or "mixed" (some

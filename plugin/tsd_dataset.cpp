@@ -561,9 +561,9 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
         !CheckMemory(sOpts, W, H, WindowPlan(m_poWindow), m_bHasSun ? &m_sSun : nullptr,
                      m_sCells, m_nLevel))
         return false;
-    /* a bad TERRASHADE_BACKEND is an error here (without probing OpenCL) */
+    /* a bad TERRASHADE_BACKEND or _SIMD is an error here (without probing OpenCL) */
     m_bUsesBackend = m_psProduct->uses_backend && m_psProduct->uses_backend(&sOpts, psSun);
-    if (m_bUsesBackend && tsd_backend_check_env(&sOpts, szMsg, sizeof szMsg) != 0)
+    if (tsd_backend_check_env(&sOpts, m_bUsesBackend, szMsg, sizeof szMsg) != 0)
         return Fail(TS_ERR_ARG, szMsg), false;
 
     nRasterXSize = W;

@@ -78,10 +78,13 @@ static ts_status note_backend(const tsd_compute_ctx *c)
     if (ts_backend_choose(tsd_backend_to_ts(c->opts->backend), &r, &err) != TS_OK)
         return tsd_fail_core(c->msg, c->msg_size, NULL, &err);
     if (r.used == TS_BACKEND_OPENCL) {
+        ts_backend_report cpu;
+        if (ts_backend_choose(TS_BACKEND_C, &cpu, &err) != TS_OK)
+            return tsd_fail_core(c->msg, c->msg_size, NULL, &err);
         r.used = TS_BACKEND_C;
         r.fell_back = 1;
         snprintf(r.backend, sizeof r.backend, "c");
-        snprintf(r.device, sizeof r.device, "CPU, %d cores", ts_cpu_count());
+        snprintf(r.device, sizeof r.device, "%s", cpu.device);
         snprintf(r.reason, sizeof r.reason,
                  "HORIZON_METHOD=pyramid runs on the C backend (there is no OpenCL pyramid)");
     }
