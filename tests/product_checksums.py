@@ -113,6 +113,18 @@ YEAR_VARIANTS = {
                          "HORIZON_DIRECTIONS": "32"},
 }
 
+# The other users of the hand-written vector code (TERRASHADE_SIMD,
+# tests/driver/test_cpu_paths.py): METHOD=sh's 16-cell blocks, the bounded
+# sweep's short, pruned (64-256 lags) and long (hybrid) windows, the windowed
+# path's far field, the shadow map. Printed last.
+CPU_VARIANTS = {
+    "shade_sh": {"METHOD": "sh", "SUN_ELEVATION": "20", "OUTPUT_TYPE": "Float32"},
+    "shadow_shadowmap": {"METHOD": "shadowmap", "SUN_ELEVATION": "15"},
+    "horizon_bounded": {"DIRECTIONS": "8", "START_AZIMUTH": "10", "MAX_DISTANCE": "3000"},
+    "horizon_far": {"DIRECTIONS": "8", "START_AZIMUTH": "10", "MAX_DISTANCE": "20000"},
+    "svf_tiled": {"DIRECTIONS": "16", "TILE_SIZE": "128", "NEAR_DISTANCE": "2000"},
+}
+
 # Pyramid horizons (HORIZON_METHOD=pyramid, docs/methods.md): printed after
 # the above.
 PYRAMID_VARIANTS = {
@@ -188,6 +200,8 @@ def main():
     ap.add_argument("--compare", metavar="DIR", help="max |diff| against saved arrays")
     ap.add_argument("--only", help="comma-separated variant names")
     ap.add_argument("--backends", default="c,opencl")
+    ap.add_argument("--dems", default="jacksboro,lux,fractal",
+                    help="comma-separated DEMs of jacksboro, lux, fractal")
     ap.add_argument("--cross", action="store_true",
                     help="also print max |C - OpenCL| per DEM and variant")
     ap.add_argument("--cross-saved", metavar="DIR",
@@ -198,10 +212,15 @@ def main():
         return
     tmp = tempfile.mkdtemp(prefix="ts_cksum_")
     fractal = os.path.join(tmp, "fractal.tif")
-    fractal_dem(fractal)
     dems = {"jacksboro": T.JACKSBORO, "lux": T.LUX, "fractal": fractal}
+    wanted = args.dems.split(",")
+    if set(wanted) - set(dems):
+        ap.error("--dems: unknown %s" % ",".join(sorted(set(wanted) - set(dems))))
+    dems = {k: v for k, v in dems.items() if k in wanted}
+    if "fractal" in dems:
+        fractal_dem(fractal)
     variants = dict(VARIANTS, **ENV_VARIANTS, **YEAR_VARIANTS, **EDGE_VARIANTS,
-                    **PYRAMID_VARIANTS)
+                    **PYRAMID_VARIANTS, **CPU_VARIANTS)
     edge_products = takes_edge()
     names = args.only.split(",") if args.only else list(variants)
     if args.save:
@@ -210,7 +229,8 @@ def main():
     crossed = []
     # the variants of the first group come first in the record, each group
     # DEM by DEM, so that added groups append lines to it
-    for group in (VARIANTS, ENV_VARIANTS, YEAR_VARIANTS, EDGE_VARIANTS, PYRAMID_VARIANTS):
+    for group in (VARIANTS, ENV_VARIANTS, YEAR_VARIANTS, EDGE_VARIANTS, PYRAMID_VARIANTS,
+                  CPU_VARIANTS):
         for dem_name, dem in dems.items():
             kept = {}
             for backend in args.backends.split(","):
