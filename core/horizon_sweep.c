@@ -76,7 +76,10 @@ static inline occluder lane_query(const ts_lane_step *s, const hull_pt *S, int f
     if (far < 0 || !(s->k_step > 0))
         return stack_query(S, far, d, g);
     const double dd = d - S[stack_tangent(S, far, d, g)].d;
-    return (occluder){s->k - (int)nearbyint(dd * (1.0 / s->k_step)), (float)dd};
+    /* dd / k_step is >= 0 and within ~1e-12 of an integer: + 0.5 and the
+     * truncation round it as nearbyint did, without libm's call (baseline
+     * x86-64 has no roundsd) */
+    return (occluder){s->k - (int)(dd * (1.0 / s->k_step) + 0.5), (float)dd};
 }
 
 /* ts_lane_hull_step in scalar code, line by line. */
