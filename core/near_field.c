@@ -78,14 +78,30 @@ float ts_ray_exact(const ts_line_geom *g, const float *z, int k, int i, float h,
     return cm_ray_exact(&r, k, i, h, s_from, s_to, step, c);
 }
 
+/* The inner peaks of one piece at the queued cells qx[0..n) (few: the
+ * test finds one at a cell in a few per cent), in scalar code. */
+static void near_peaks(const cm_fast_piece *q, const float *const cn[4], const float *zrow,
+                       float t, float L, float c, const int *qx, int n, float *restrict best)
+{
+    for (int e = 0; e < n; e++) {
+        const int x = qx[e];
+        const float fs = cm_fast_peak(*q, t, cn[0][x], cn[1][x], cn[2][x], cn[3][x], zrow[x], L, c);
+        best[x] = fs > best[x] ? fs : best[x];
+    }
+}
+
 /* The pieces over a run of cells, one piece at a time: plain float
  * arithmetic in loops the compiler vectorises (cm_fast_piece's slopes;
- * prev: the slopes at the previous piece's end). Cells with a corner that
- * is nodata or infinite are flagged and redone in scalar code. */
+ * prev: the slopes at the previous piece's end). The cells whose inner
+ * peak the test finds are queued (qx) and their peaks solved after the
+ * loop, so that the loop does not compute a square root and two divisions
+ * at every cell for the few that need them (the AVX-512 run does the same;
+ * the maximum does not depend on the order). Cells with a corner that is
+ * nodata or infinite are flagged and redone in scalar code. */
 TS_SIMD_CLONES
 static void near_run(const ts_near_plan *p, const float *restrict zrow, int x0, int x1,
                      float L, float c, float *restrict best, float *restrict flag,
-                     float *restrict prev)
+                     float *restrict prev, unsigned char *restrict peak, int *restrict qx)
 {
     for (int x = x0; x < x1; x++) {
         best[x] = -INFINITY;
@@ -102,21 +118,32 @@ static void near_run(const ts_near_plan *p, const float *restrict zrow, int x0, 
                                                    p->piece_sa[n], p->piece_sb[n], p->t, L, c);
         const float *cn[4] = {c00, c10, c01, c11};
         const float *restrict n0 = cn[q.e0], *restrict n1 = cn[q.e1];
+        if (!q.has_sa) { /* the ray's start: no inner peak */
+            for (int x = x0; x < x1; x++) {
+                const float X = cm_fast_twist(c00[x], c10[x], c01[x], c11[x]);
+                const float f = cm_fast_cross(q, n0[x], n1[x], zrow[x]);
+                const float s0 = cm_fast_start(q, t, c00[x], c10[x], c01[x], c11[x]);
+                const float m = s0 > f ? s0 : f;
+                best[x] = m > best[x] ? m : best[x];
+                prev[x] = f;
+                flag[x] += X - X == 0.0f ? 0.0f : 1.0f;
+            }
+            continue;
+        }
         for (int x = x0; x < x1; x++) {
             const float X = cm_fast_twist(c00[x], c10[x], c01[x], c11[x]);
             const float f = cm_fast_cross(q, n0[x], n1[x], zrow[x]);
-            float m = f;
-            if (!q.has_sa) {
-                const float s0 = cm_fast_start(q, t, c00[x], c10[x], c01[x], c11[x]);
-                m = s0 > m ? s0 : m;
-            } else if (cm_fast_peak_test(q, t, X, prev[x], f)) {
-                const float fs = cm_fast_peak(q, t, c00[x], c10[x], c01[x], c11[x], zrow[x], L, c);
-                m = fs > m ? fs : m;
-            }
-            best[x] = m > best[x] ? m : best[x];
+            peak[x] = (unsigned char)cm_fast_peak_test(q, t, X, prev[x], f);
+            best[x] = f > best[x] ? f : best[x];
             prev[x] = f;
             flag[x] += X - X == 0.0f ? 0.0f : 1.0f;
         }
+        int nq = 0;
+        for (int x = x0; x < x1; x++) { /* branch-free: qx has room for every cell */
+            qx[nq] = x;
+            nq += peak[x];
+        }
+        near_peaks(&q, cn, zrow, t, L, c, qx, nq, best);
     }
 }
 
@@ -145,7 +172,10 @@ void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
     const size_t phase = (((uintptr_t)zrow - (uintptr_t)scratch) / sizeof(float)) & 15;
     float *best = scratch + phase, *flag = best + x1, *queue = flag + x1;
     if (!ts_near_run_avx512(p, zrow, x0, x1, (float)step, (float)c, best, flag, queue))
-        near_run(p, zrow, x0, x1, (float)step, (float)c, best, flag, queue);
+        /* prev, the queued cells and their tests in the queue's room
+         * (TS_NEAR_ROW_SCRATCH: 5 x1 floats and more) */
+        near_run(p, zrow, x0, x1, (float)step, (float)c, best, flag, queue,
+                 (unsigned char *)(queue + 2 * (size_t)x1), (int *)(queue + x1));
     if (!near_merge(zrow, best, flag, x0, x1, out))
         return;
     /* cells whose near field touches nodata: the scalar near field */
