@@ -13,7 +13,9 @@
  * each fmaf one instruction wherever the CPU has FMA (every AVX2 CPU has),
  * so that every clone computes the same bits; the baseline x86-64 clone
  * (no FMA) calls the library's fmaf, the same bits, slowly. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#if defined(TS_PYR_FMA_CLONES)
+/* given on the command line, as TS_SIMD_CLONES */
+#elif defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #define TS_PYR_FMA_CLONES __attribute__((target_clones("avx512f", "fma", "default")))
 #else
 #define TS_PYR_FMA_CLONES

@@ -6,7 +6,10 @@
 #ifndef TS_SIMD_CLONES_H
 #define TS_SIMD_CLONES_H
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#if defined(TS_SIMD_CLONES)
+/* given on the command line (bench/cpu_levels.sh: empty, to build one
+ * CPU's code alone) */
+#elif defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #define TS_SIMD_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define TS_SIMD_CLONES
