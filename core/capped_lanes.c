@@ -58,8 +58,8 @@ int ts_cap_lanes_alloc(ts_cap_lanes *r, int lines, const int lags[4], double nea
     r->slots = r->groups[0] * TS_CAP_G0;
     r->near = near;
     r->cap = cap;
-    r->prune = ts_cpu_vector_level() == 2 && r->lag_hi - r->lag_lo + 1 >= PRUNE_FROM &&
-               r->lag_hi <= PRUNE_MAX_LAGS;
+    r->prune = ts_cpu_vector_level() == TS_CPU_VECTORS_AVX512 &&
+               r->lag_hi - r->lag_lo + 1 >= PRUNE_FROM && r->lag_hi <= PRUNE_MAX_LAGS;
     /* (and a spare slot, never written: the pruned scan's padding) */
     const size_t ring = (size_t)(r->slots + 1) * r->stride * sizeof(double);
     const size_t line = (size_t)r->stride * sizeof(double);
@@ -217,8 +217,10 @@ int ts_cap_lanes_pays(const int lags[4])
      * ~200-300 (AVX-512 only) */
     const int span = lags[1] - lags[0] + 1;
     const int level = ts_cpu_vector_level();
-    return level == 2 ? span <= 96 || (span >= PRUNE_FROM && lags[1] <= PRUNE_TO)
-         : level == 1 ? span <= 40 : 0;
+    return level == TS_CPU_VECTORS_AVX512
+               ? span <= 96 || (span >= PRUNE_FROM && lags[1] <= PRUNE_TO)
+           : level == TS_CPU_VECTORS_AVX2 ? span <= 40
+                                          : 0;
 }
 
 int ts_cap_lanes_hybrid_pays(const int lags[4])
@@ -226,17 +228,17 @@ int ts_cap_lanes_hybrid_pays(const int lags[4])
     /* measured (docs/performance-history.md, "Bounded sweep: unbounded hull first"):
      * 0.80-0.89x the line-by-line window's CPU time at 300-2000 lags. The
      * ring's pruned scan holds for windows of up to PRUNE_MAX_LAGS. */
-    return ts_cpu_vector_level() == 2 && lags[1] - lags[0] + 1 >= PRUNE_FROM &&
-           lags[1] <= PRUNE_MAX_LAGS;
+    return ts_cpu_vector_level() == TS_CPU_VECTORS_AVX512 &&
+           lags[1] - lags[0] + 1 >= PRUNE_FROM && lags[1] <= PRUNE_MAX_LAGS;
 }
 
 static void scan_groups(const ts_cap_lanes *r, int k, int g0, int g1)
 {
     const int level = ts_cpu_vector_level();
-    if (level == 2)
+    if (level == TS_CPU_VECTORS_AVX512)
         for (int g = g0; g < g1; g += 8 * TS_CAP_NG)
             ts_cap_scan512(r, k, g, g1);
-    else if (level == 1)
+    else if (level == TS_CPU_VECTORS_AVX2)
         for (int g = g0; g < g1; g += 8)
             scan_avx2(r, k, g);
     else
@@ -281,7 +283,7 @@ void ts_cap_lanes_step(ts_cap_lanes *r, const ts_lane_step *s, int nl,
     if (j0 <= j1) {
         const int g0 = j0 / 8 * 8, g1 = (j1 + 8) / 8 * 8;
 #if defined(__GNUC__) && defined(__x86_64__)
-        if (ts_cpu_vector_level() == 2) {
+        if (ts_cpu_vector_level() == TS_CPU_VECTORS_AVX512) {
             ts_cap_queries512(r, s, g0, g1);
             scan_groups(r, k, g0, g1);
             ts_cap_answers512(r, s, g0, g1, occ, rd, rg);

@@ -10,18 +10,18 @@
 
 ts_status ts_cpu_vectors_parse(const char *text, int *cap, ts_error *err)
 {
-    static const char *const names[] = {"none", "avx2", "avx512"};
+    static const char *const names[] = {"none", "avx2", "avx512"}; /* by level */
     if (!text || !*text || !strcasecmp(text, "auto")) {
         *cap = TS_CPU_VECTORS_AVX512;
         return ts_ok(err);
     }
-    for (int level = 0; level < 3; level++)
+    for (int level = TS_CPU_VECTORS_NONE; level <= TS_CPU_VECTORS_AVX512; level++)
         if (!strcasecmp(text, names[level])) {
             *cap = level;
             return ts_ok(err);
         }
-    return ts_fail(err, TS_ERR_ARG, "TERRASHADE_SIMD must be auto, avx512, avx2 or none, got '%.40s'",
-                   text);
+    return ts_fail(err, TS_ERR_ARG,
+                   "TERRASHADE_SIMD must be auto, avx512, avx2 or none, got '%.40s'", text);
 }
 
 /* The CPU's own level: AVX-512 with its 256-bit forms (every AVX-512 CPU
@@ -30,11 +30,12 @@ static int cpu_level(void)
 {
 #if defined(__GNUC__) && defined(__x86_64__)
     __builtin_cpu_init();
-    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") ? 2
-           : __builtin_cpu_supports("avx2")                                        ? 1
-                                                                                   : 0;
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl")
+               ? TS_CPU_VECTORS_AVX512
+           : __builtin_cpu_supports("avx2") ? TS_CPU_VECTORS_AVX2
+                                            : TS_CPU_VECTORS_NONE;
 #else
-    return 0; /* the vectorised paths are x86-64 only */
+    return TS_CPU_VECTORS_NONE; /* the vectorised paths are x86-64 only */
 #endif
 }
 

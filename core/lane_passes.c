@@ -89,7 +89,7 @@ void ts_lane_sample(const ts_line_geom *G, const float *z, int k, int i0, int j0
     /* Every line has a next cell but one on the grid's last row. */
     int jn = G->V - 2 - i0 < j1 ? G->V - 2 - i0 : j1;
 #if HAVE_SAMPLE_AVX512
-    if (vs <= INT_MAX / (j1 + 2) && ts_cpu_vector_level() == 2) {
+    if (vs <= INT_MAX / (j1 + 2) && ts_cpu_vector_level() == TS_CPU_VECTORS_AVX512) {
         sample_avx512(zk, (int)vs, F, j0, j1, jn, hc, hn, hs);
         return;
     }
@@ -257,7 +257,8 @@ void ts_lane_far_field(const ts_line_geom *G, const float *z, float cf, int near
                            (ptrdiff_t)(G->V - 1) * G->v_stride + 1;
 #if HAVE_FAR_AVX512
     const ptrdiff_t omax = INT_MAX / (j1 + 16); /* the scatter's offsets in 32 bits */
-    if (span <= INT_MAX && ostride <= omax && ostride >= -omax && ts_cpu_vector_level() == 2) {
+    if (span <= INT_MAX && ostride <= omax && ostride >= -omax &&
+        ts_cpu_vector_level() == TS_CPU_VECTORS_AVX512) {
         far_run32_avx512(R, G->ray_o, G->ray_f, z, cf, k, i0, j0, j1, hc, occ->lo_k, occ->lo_dd,
                          occ->hi_k, occ->hi_dd, out, (int)ostride);
         return;

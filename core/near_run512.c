@@ -174,7 +174,7 @@ int ts_near_run_avx512(const ts_near_plan *p, const float *restrict zrow, int x0
                        float L, float c, float *restrict best, float *restrict flag,
                        float *restrict queue)
 {
-    if (ts_cpu_vector_level() != 2)
+    if (ts_cpu_vector_level() != TS_CPU_VECTORS_AVX512)
         return 0;
     run(p, zrow, x0, x1, L, c, best, flag, queue);
     return 1;

@@ -238,7 +238,7 @@ TS_AVX512 static void level_max2(const level_max_row *g, const float *const r[4]
 int ts_pyr_level_max_rows(const level_max_row *g, int rows, const float *const r[4], int taps,
                           int W, int t1, int ix, float fx, int x0, int x1)
 {
-    if (ts_cpu_vector_level() != 2)
+    if (ts_cpu_vector_level() != TS_CPU_VECTORS_AVX512)
         return 0;
     (rows == 2 ? level_max2 : level_max1)(g, r, taps, W, t1, ix, fx, x0, x1);
     return 1;

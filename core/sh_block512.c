@@ -71,7 +71,7 @@ TS_AVX512 static void block_shade(const float (*acc)[TS_SH_COEFFS], const float 
 int ts_sh_block_shade512(const float (*acc)[TS_SH_COEFFS], const float *nx, const float *ny,
                          const float *nz, float scale, unsigned skip, float *shade)
 {
-    if (ts_cpu_vector_level() != 2)
+    if (ts_cpu_vector_level() != TS_CPU_VECTORS_AVX512)
         return 0;
     block_shade(acc, nx, ny, nz, scale, skip, shade);
     return 1;
