@@ -36,10 +36,11 @@ from tsdriver import np  # noqa: E402
 CHECKSUMS = os.path.join(T.SRCDIR, "tests", "product_checksums.py")
 QEMU = shutil.which("qemu-x86_64")
 # the variants the AVX2 emulation runs (TCG's AVX2 is ~5x slower than its
-# SSE): the normals, shading, sky sums, sweeps (unbounded, bounded, far
-# field), SH key light, pyramid and environment light, each with its clones
+# SSE), chosen to reach every file with clones: the normals, shading, sky
+# sums, sweeps (unbounded, bounded, far field, EDGE raises), SH key light,
+# pyramid, environment light and a date range's sun positions
 HASWELL_VARIANTS = ("shade,shade_sky,svf,horizon_bounded,horizon_far,sunhours,"
-                    "shade_sh,svf_pyramid,envlight_map")
+                    "shade_sh,svf_pyramid,envlight_map,svf_edge,sunhours_range")
 
 
 def checksum_lines(*args, qemu_cpu=None, **env):
