@@ -93,7 +93,7 @@ class VectorLevels(unittest.TestCase):
 class PortableOracles(unittest.TestCase):
     def test_c_suites_on_portable_paths(self):
         for suite in ("check_horizon", "check_sweep_lines", "check_analytic", "check_edge",
-                      "check_shadow", "check_sh"):
+                      "check_shadow", "check_sh", "check_sh_swath_light"):
             p = T.run([os.path.join(T.BUILDDIR, "tests", suite)],
                       TERRASHADE_SIMD="none", CK_DEFAULT_TIMEOUT="600")
             summary = [line for line in p.stdout.splitlines() if "Checks:" in line]
