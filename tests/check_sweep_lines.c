@@ -315,7 +315,7 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
             dk[j] = d[k][j];
         const int hi_from = j0 + (k % 3 == 0), hi_to = j1 - (k % 5 == 0);
         const ts_lane_step st = {k, j0 <= j1 ? j0 : 1, j0 <= j1 ? j1 : 0, hi_from, hi_to,
-                                 dk, hs[k], hc[k], hn[k], c, near, NULL, NULL, NULL};
+                                 dk, hs[k], hc[k], hn[k], c, near, NULL, NULL, NULL, 0.0};
         for (int v = 0; v < 2; v++) {
             const ts_lane_occluders occ = {ok_k[v], hi_k[v], ok_dd[v], hi_dd[v]};
             ts_cap_lanes_step(v ? &full : &pruned, &st, CL_LINES, &occ);
