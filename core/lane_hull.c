@@ -362,10 +362,10 @@ AVX512VL static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, 
 
 int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ)
 {
-    /* 32-bit offsets: the last line's points, as ints */
-    if (ts_cpu_vector_level() != TS_CPU_VECTORS_AVX512 ||
-        (long long)(s->j1 + 1) * h->stride * 6 > INT_MAX)
-        return 0;
+    const int level = ts_cpu_vector_level();
+    /* 32-bit offsets: the last line's points, as ints (AVX2's are 64-bit) */
+    if (level != TS_CPU_VECTORS_AVX512 || (long long)(s->j1 + 1) * h->stride * 6 > INT_MAX)
+        return level >= TS_CPU_VECTORS_AVX2 && ts_lane_hull_step_avx2(h, s, occ);
     for (int j = s->j0; j <= s->j1; j += 8 * NG) {
         __mmask8 lanes[NG];
         for (int q = 0; q < NG; q++) {

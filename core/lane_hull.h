@@ -1,7 +1,7 @@
 /*
  * One step of the hulls of a lockstep block of sweep lines (the unbounded
  * sweep's sweep_block, core/horizon_sweep.c), eight lines per AVX-512
- * vector, several vectors at once so that their gathers overlap: each line pushes its sample onto its upper convex hull, popping
+ * vector (four per AVX2 one), several vectors at once so that their gathers overlap: each line pushes its sample onto its upper convex hull, popping
  * the points it hides (masked: a vector's pop loop runs while any of its
  * lines still pops), moves its first point beyond the near field, and asks
  * its hull for the far-field occluders of the cells below and above it.
@@ -75,9 +75,15 @@ void ts_lane_pushes_reset(ts_lane_pushes *p, int lines);
 int ts_lane_delayed_pushes(ts_lane_pushes *p, const double *d_ring, const double *g_ring,
                            size_t slot_stride, int slots, double behind, ts_lane_step *s);
 
-/* The step, vectorised: returns 0, having done nothing, where the CPU (or
- * the build) has no AVX-512 or the hulls are too large for 32-bit
- * offsets; the caller then runs the scalar code. */
+/* The step, vectorised: eight lines per AVX-512 vector (lane_hull.c) where
+ * the CPU has AVX-512 and the hulls fit 32-bit offsets, else four per AVX2
+ * vector (lane_hull256.c); returns 0, having done nothing, where the CPU
+ * (or the build, or TERRASHADE_SIMD) has neither; the caller then runs the
+ * scalar code. */
 int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ);
+/* The AVX2 step alone; only where ts_cpu_vector_level() is at least AVX2
+ * (0 in builds for other CPUs). */
+int ts_lane_hull_step_avx2(const ts_lane_hulls *h, const ts_lane_step *s,
+                           const ts_lane_occluders *occ);
 
 #endif
