@@ -199,7 +199,8 @@ int main(int argc, char **argv)
     printf("command:");
     for (int i = 0; i < argc; i++)
         printf(" %s", argv[i]);
-    printf("\ncores: %d, threads: %d\n", ts_cpu_count(), p.threads > 0 ? p.threads : ts_cpu_count());
+    printf("\ncores: %d, threads: %d\n", ts_cpu_count(),
+           p.threads > 0 ? p.threads : ts_cpu_count());
     const char *dates[] = {"2026-06-21", "2026-12-21"};
     int ndates = date ? 1 : 2;
     if (date)

@@ -298,7 +298,8 @@ int main(int argc, char **argv)
             timer = TIME_USER;
         else {
             fprintf(stderr, "usage: methods_bench [--size N] [--dirs D] [--threads T] "
-                            "[--level-step K] [--offset O] [--dems a,b,fractal] [--cpu | --user]\n");
+                            "[--level-step K] [--offset O] [--dems a,b,fractal] "
+                            "[--cpu | --user]\n");
             return 2;
         }
     }

@@ -30,8 +30,8 @@ ts_status ts_check_shm_args(const ts_grid *grid, double *azimuth, double elevati
                        elevation);
     if (!(penumbra_depth >= 0) || isinf(penumbra_depth))
         return ts_fail(err, TS_ERR_ARG,
-                       "penumbra depth must be 0 (hard shadows) or a positive number of metres, got %g",
-                       penumbra_depth);
+                       "penumbra depth must be 0 (hard shadows) or a positive number of "
+                       "metres, got %g", penumbra_depth);
     if (threads < 0)
         return ts_fail(err, TS_ERR_ARG, "threads must be 0 (all cores) or more, got %d", threads);
     if (!vis && !shadow_height)
@@ -143,8 +143,8 @@ ts_status ts_direct_setup_horn(const ts_direct_request *req, ts_direct_plan *pla
     plan->k1 = (plan->k0 + 1) % n;
     if (n == 1 && plan->w * step > 1e-9 && (1 - plan->w) * step > 1e-9)
         return ts_fail(err, TS_ERR_ARG,
-                       "the horizons were computed for azimuth %g only, not for the sun's azimuth %g",
-                       opts->start_azimuth, sun_azimuth);
+                       "the horizons were computed for azimuth %g only, not for the sun's "
+                       "azimuth %g", opts->start_azimuth, sun_azimuth);
     if (n == 1)
         plan->w = 0;
     double az = sun_azimuth * DEG2RAD, el = sun_elevation * DEG2RAD;

@@ -172,8 +172,10 @@ prune_threshold(const ts_cap_lanes *r, int k, int lag_hi, int j, const scan512 *
     const __m512d s = _mm512_mul_pd(bn, y);
     /* s - margin |s|; +inf, and a lower height of +inf, without a query */
     const __mmask8 has = hc | hn;
-    *thr = _mm512_mask_mov_pd(inf, has, _mm512_fnmadd_pd(_mm512_abs_pd(s), _mm512_set1_pd(PRUNE_MARGIN), s));
-    *gmin = _mm512_min_pd(_mm512_mask_mov_pd(inf, hc, a->gc[q]), _mm512_mask_mov_pd(inf, hn, a->gn[q]));
+    *thr = _mm512_mask_mov_pd(inf, has,
+                              _mm512_fnmadd_pd(_mm512_abs_pd(s), _mm512_set1_pd(PRUNE_MARGIN), s));
+    *gmin = _mm512_min_pd(_mm512_mask_mov_pd(inf, hc, a->gc[q]),
+                          _mm512_mask_mov_pd(inf, hn, a->gn[q]));
     *idle = (__mmask8)~has;
 }
 
@@ -329,7 +331,8 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
         neg[q] = _mm512_cmp_pd_mask(thr[q], _mm512_setzero_pd(), _CMP_LT_OQ);
         const __m512d td = _mm512_mul_pd(thr[q], a->d[q]);
         const __m512d size = _mm512_add_pd(_mm512_abs_pd(gmin), _mm512_abs_pd(td));
-        rhs[q] = _mm512_fnmadd_pd(size, _mm512_set1_pd(1e-12), _mm512_fmadd_pd(thr[q], a->d[q], gmin));
+        rhs[q] = _mm512_fnmadd_pd(size, _mm512_set1_pd(1e-12),
+                                  _mm512_fmadd_pd(thr[q], a->d[q], gmin));
         /* sample by sample: T = -inf (no threshold) as T = 0 against -inf,
          * so that every sample passes (a distance of 0 would give NaN),
          * and a slot without a sample (d NaN) fails */
@@ -351,8 +354,10 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
     int idx1 = s_lo / TS_CAP_G1 % r->groups[1], idx0 = s_lo / TS_CAP_G0 % r->groups[0];
     for (int m1 = s_lo / TS_CAP_G1; m1 <= s_hi / TS_CAP_G1; m1++) {
         const int a1 = m1 * TS_CAP_G1 > s_lo ? m1 * TS_CAP_G1 : s_lo;
-        const int b1 = m1 * TS_CAP_G1 + TS_CAP_G1 - 1 < s_hi ? m1 * TS_CAP_G1 + TS_CAP_G1 - 1 : s_hi;
-        const unsigned need1 = b1 >= s_near ? all : groups_needed(r, 1, idx1, g, ng, thr, rhs, neg, idle);
+        const int b1 =
+            m1 * TS_CAP_G1 + TS_CAP_G1 - 1 < s_hi ? m1 * TS_CAP_G1 + TS_CAP_G1 - 1 : s_hi;
+        const unsigned need1 =
+            b1 >= s_near ? all : groups_needed(r, 1, idx1, g, ng, thr, rhs, neg, idle);
         idx1 = idx1 + 1 == r->groups[1] ? 0 : idx1 + 1;
         /* its level-0 groups f0 .. f0 + count - 1, those from the first
          * with a step from s_near on untested */
@@ -363,8 +368,9 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
             const unsigned near = first_near >= count ? 0 : 0xFFu << first_near;
             const __m512i m0s = _mm512_add_epi32(_mm512_set1_epi32(f0), iota);
             __m512i idxs = _mm512_add_epi32(_mm512_set1_epi32(idx0), iota);
-            idxs = _mm512_mask_sub_epi32(idxs, _mm512_cmpge_epi32_mask(idxs, _mm512_set1_epi32(r->groups[0])),
-                                         idxs, _mm512_set1_epi32(r->groups[0]));
+            idxs = _mm512_mask_sub_epi32(
+                idxs, _mm512_cmpge_epi32_mask(idxs, _mm512_set1_epi32(r->groups[0])), idxs,
+                _mm512_set1_epi32(r->groups[0]));
             for (int q = 0; q < NG; q++) {
                 if (q >= ng)
                     break;
@@ -375,7 +381,8 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
                                 ((1u << count) - 1));
                 _mm512_storeu_si512(P.m0 + P.n, _mm512_maskz_compress_epi32(need0, m0s));
                 _mm512_storeu_si512(P.idx + P.n, _mm512_maskz_compress_epi32(need0, idxs));
-                _mm512_storeu_si512(P.q + P.n, _mm512_maskz_compress_epi32(need0, _mm512_set1_epi32(q)));
+                _mm512_storeu_si512(P.q + P.n,
+                                    _mm512_maskz_compress_epi32(need0, _mm512_set1_epi32(q)));
                 P.n += __builtin_popcount(need0);
             }
         }
@@ -384,7 +391,8 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
             /* their samples that a line may take, then the scan of those */
             for (int p = 0; p < P.n; p++) {
                 const int q = P.q[p], s0 = P.m0[p] * TS_CAP_G0;
-                const int a0 = s0 > s_lo ? s0 : s_lo, b0 = s0 + TS_CAP_G0 - 1 < s_hi ? s0 + TS_CAP_G0 - 1 : s_hi;
+                const int a0 = s0 > s_lo ? s0 : s_lo,
+                          b0 = s0 + TS_CAP_G0 - 1 < s_hi ? s0 + TS_CAP_G0 - 1 : s_hi;
                 list_samples(r, P.idx[p] * TS_CAP_G0, s0, a0, b0, g, q, tt[q], rt[q], idle[q], &L);
             }
             P.n = 0;
@@ -434,10 +442,12 @@ TS_AVX512 static inline __attribute__((always_inline)) void
 groups_add(ts_cap_lanes *r, const size_t at[2], int j, __m512d d, __m512d g, __mmask8 has)
 {
     for (int l = 0; l < 2; l++) {
-        double *gm = r->gmax[l] + at[l] + j, *lo = r->dlo[l] + at[l] + j, *hi = r->dhi[l] + at[l] + j;
+        double *gm = r->gmax[l] + at[l] + j, *lo = r->dlo[l] + at[l] + j,
+               *hi = r->dhi[l] + at[l] + j;
         const __m512d m = _mm512_load_pd(gm);
         /* lines' distances grow: a group's first sample is its oldest */
-        const __mmask8 first = _mm512_mask_cmp_pd_mask(has, m, _mm512_set1_pd(-INFINITY), _CMP_EQ_OQ);
+        const __mmask8 first =
+            _mm512_mask_cmp_pd_mask(has, m, _mm512_set1_pd(-INFINITY), _CMP_EQ_OQ);
         _mm512_store_pd(lo, _mm512_mask_mov_pd(_mm512_load_pd(lo), first, d));
         _mm512_store_pd(hi, _mm512_mask_mov_pd(_mm512_load_pd(hi), has, d));
         _mm512_store_pd(gm, _mm512_mask_max_pd(m, has, m, g));
@@ -451,15 +461,18 @@ TS_AVX512 void ts_cap_queries512(ts_cap_lanes *r, const ts_lane_step *s, int g0,
 {
     const __m512d c = _mm512_set1_pd(s->c), nan = _mm512_set1_pd(NAN);
     for (int j = g0; j < g1; j += 8) {
-        const __m512i idx = _mm512_add_epi64(_mm512_set1_epi64(j), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
+        const __m512i idx =
+            _mm512_add_epi64(_mm512_set1_epi64(j), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
         __mmask8 on = _mm512_cmpge_epi64_mask(idx, _mm512_set1_epi64(s->j0));
         on = _mm512_mask_cmple_epi64_mask(on, idx, _mm512_set1_epi64(s->j1));
         __mmask8 hi = _mm512_mask_cmpge_epi64_mask(on, idx, _mm512_set1_epi64(s->hi_from));
         hi = _mm512_mask_cmple_epi64_mask(hi, idx, _mm512_set1_epi64(s->hi_to));
         const __m512d d = _mm512_maskz_loadu_pd(on, s->d + j);
         const __m512d cdd = _mm512_mul_pd(_mm512_mul_pd(c, d), d);
-        const __m512d hc = _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_maskz_loadu_ps(hi, s->hc + j)));
-        const __m512d hn = _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_maskz_loadu_ps(on, s->hn + j)));
+        const __m512d hc =
+            _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_maskz_loadu_ps(hi, s->hc + j)));
+        const __m512d hn =
+            _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_maskz_loadu_ps(on, s->hn + j)));
         _mm512_store_pd(r->qd + j, d);
         _mm512_store_pd(r->qc + j, _mm512_mask_sub_pd(nan, hi, hc, cdd));
         _mm512_store_pd(r->qn + j, _mm512_mask_sub_pd(nan, on, hn, cdd));
@@ -481,16 +494,20 @@ TS_AVX512 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0,
                                 (size_t)r->stride);
     }
     for (int j = g0; j < g1; j += 8) {
-        const __m512i idx = _mm512_add_epi64(_mm512_set1_epi64(j), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
+        const __m512i idx =
+            _mm512_add_epi64(_mm512_set1_epi64(j), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
         __mmask8 on = _mm512_cmpge_epi64_mask(idx, _mm512_set1_epi64(s->j0));
         on = _mm512_mask_cmple_epi64_mask(on, idx, _mm512_set1_epi64(s->j1));
         _mm512_mask_cvtepi64_storeu_epi32(occ->hi_k + j, on, _mm512_load_epi64(r->kc + j));
         _mm512_mask_cvtepi64_storeu_epi32(occ->lo_k + j + 1, on, _mm512_load_epi64(r->kn + j));
-        _mm512_mask_storeu_ps(occ->hi_dd + j, on, _mm512_castps256_ps512(_mm512_cvtpd_ps(_mm512_load_pd(r->ddc + j))));
-        _mm512_mask_storeu_ps(occ->lo_dd + j + 1, on, _mm512_castps256_ps512(_mm512_cvtpd_ps(_mm512_load_pd(r->ddn + j))));
+        _mm512_mask_storeu_ps(occ->hi_dd + j, on,
+                              _mm512_castps256_ps512(_mm512_cvtpd_ps(_mm512_load_pd(r->ddc + j))));
+        _mm512_mask_storeu_ps(occ->lo_dd + j + 1, on,
+                              _mm512_castps256_ps512(_mm512_cvtpd_ps(_mm512_load_pd(r->ddn + j))));
         /* the step's own samples enter the ring after its queries */
         const __m512d d = _mm512_maskz_loadu_pd(on, s->d + j);
-        const __m512d hs = _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_maskz_loadu_ps(on, s->hs + j)));
+        const __m512d hs =
+            _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_maskz_loadu_ps(on, s->hs + j)));
         const __mmask8 has = _mm512_cmp_pd_mask(hs, hs, _CMP_ORD_Q);
         const __m512d g = _mm512_sub_pd(hs, _mm512_mul_pd(_mm512_mul_pd(c, d), d));
         _mm512_mask_store_pd(rd + j, on, _mm512_mask_mov_pd(nan, has, d));
@@ -531,11 +548,14 @@ TS_AVX512 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
             slot = _mm512_mask_add_epi64(slot, _mm512_cmplt_epi64_mask(slot, zero), slot,
                                          _mm512_set1_epi64(r->slots));
             const __m256i at = _mm256_add_epi32(
-                _mm256_mullo_epi32(_mm512_cvtepi64_epi32(slot), _mm256_set1_epi32(r->stride)), lane);
-            const __m512d dd = _mm512_sub_pd(d, _mm512_mask_i32gather_pd(_mm512_set1_pd(NAN), ok, at, r->d, 8));
+                _mm256_mullo_epi32(_mm512_cvtepi64_epi32(slot), _mm256_set1_epi32(r->stride)),
+                lane);
+            const __m512d dd =
+                _mm512_sub_pd(d, _mm512_mask_i32gather_pd(_mm512_set1_pd(NAN), ok, at, r->d, 8));
             ok = _mm512_mask_cmp_pd_mask(ok, dd, cap, _CMP_LE_OQ);
             const __m512i kb = _mm512_mask_mov_epi64(none, has, _mm512_load_epi64(ko + j));
-            const __m512d db = _mm512_mask_mov_pd(_mm512_set1_pd(1.0), has, _mm512_load_pd(ddo + j));
+            const __m512d db =
+                _mm512_mask_mov_pd(_mm512_set1_pd(1.0), has, _mm512_load_pd(ddo + j));
             _mm512_store_epi64(ko + j, _mm512_mask_mov_epi64(kb, ok, kk));
             _mm512_store_pd(ddo + j, _mm512_mask_mov_pd(db, ok, dd));
             left |= has & ~ok;

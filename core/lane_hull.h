@@ -1,7 +1,8 @@
 /*
  * One step of the hulls of a lockstep block of sweep lines (the unbounded
  * sweep's sweep_block, core/horizon_sweep.c), eight lines per AVX-512
- * vector (four per AVX2 one), several vectors at once so that their gathers overlap: each line pushes its sample onto its upper convex hull, popping
+ * vector (four per AVX2 one), several vectors at once so that their gathers
+ * overlap: each line pushes its sample onto its upper convex hull, popping
  * the points it hides (masked: a vector's pop loop runs while any of its
  * lines still pops), moves its first point beyond the near field, and asks
  * its hull for the far-field occluders of the cells below and above it.

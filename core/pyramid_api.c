@@ -97,8 +97,8 @@ static ts_status horizons_run(const ts_pyramid *pyr, int count, const double *az
     for (int k = 0; k < count; k++) {
         edged = ts_edge_rows_init(&edge[k], g, az[k], opts, out ? out[k] : NULL);
         if (sky)
-            ts_sky_plane_init(&terms[k], sky->nx, sky->ny, sky->nz, out ? out[k] : NULL, azimuths[k],
-                              sky->directions, sky->svf_model, sky->svf, sky->sky,
+            ts_sky_plane_init(&terms[k], sky->nx, sky->ny, sky->nz, out ? out[k] : NULL,
+                              azimuths[k], sky->directions, sky->svf_model, sky->svf, sky->sky,
                               sky->openness);
     }
     hz_ctx C[TS_PYRAMID_BATCH];

@@ -75,7 +75,8 @@ static inline void ts_sh_cell_wedge(const float *restrict table, int kind, float
         return;
     }
     float v[TS_SH_COEFFS], vp[TS_SH_COEFFS];
-    float ta = (wa < 0 ? 0 : wa > 90 ? 90 : wa) * scale, tb = (wb < 0 ? 0 : wb > 90 ? 90 : wb) * scale;
+    float ta = (wa < 0 ? 0 : wa > 90 ? 90 : wa) * scale,
+          tb = (wb < 0 ? 0 : wb > 90 ? 90 : wb) * scale;
     int ia = (int)ta, ib = (int)tb;
     ia = ia > N - 2 ? N - 2 : ia;
     ib = ib > N - 2 ? N - 2 : ib;

@@ -2,8 +2,9 @@
  * Shadow map with percentage-closer filtering, C backend: project the DEM's
  * vertices into light space, render its triangles into the depth map (each
  * thread a band of the map's rows, so no two threads write one texel), take
- * each tile's largest depth, then filter every cell against the map. The formulas are those of the OpenCL
- * kernels (core/cellmath/cm_shadowmap.h), so both render the same map.
+ * each tile's largest depth, then filter every cell against the map. The
+ * formulas are those of the OpenCL kernels (core/cellmath/cm_shadowmap.h),
+ * so both render the same map.
  */
 #include <math.h>
 #include <stdlib.h>

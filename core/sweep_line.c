@@ -134,7 +134,8 @@ void ts_sweep_process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
                 double step = G->step_row ? G->step_row[row] : G->step_m;
                 s_out = far_field(C, k, i, hc, lo, hi, step); /* near field later */
             }
-            C->out[C->o_origin + (ptrdiff_t)k * C->o_u_stride + (ptrdiff_t)i * C->o_v_stride] = s_out;
+            C->out[C->o_origin + (ptrdiff_t)k * C->o_u_stride + (ptrdiff_t)i * C->o_v_stride] =
+                s_out;
         }
         cur_lo[k] = (has_next && !isnan(hn)) ? hull_query(C, w, far, d, hn, w->finger[1]) : none;
         if (w->vs) {

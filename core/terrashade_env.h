@@ -103,9 +103,10 @@ ts_status ts_env_from_cube(const float *rgb, int face_size, double rotation_deg,
  * mip-map), half, float or uint channels, every OpenEXR compression: what
  * OpenEXRCore cannot decode yet (DWAA and DWAB before OpenEXR 3.2, e.g. the
  * Blender / Poly Haven maps) is decoded by OpenEXR's C++ library instead
- * (libterrashade.la lists -lstdc++ among its dependencies for it). Colour from the channels R, G and B (A and others are ignored),
- * or, without them, grey from Y (a luminance-chroma image's RY/BY are
- * ignored); the channels used must not be subsampled.
+ * (libterrashade.la lists -lstdc++ among its dependencies for it). Colour
+ * from the channels R, G and B (A and others are ignored), or, without
+ * them, grey from Y (a luminance-chroma image's RY/BY are ignored); the
+ * channels used must not be subsampled.
  *
  * Layout: the `envmap` attribute (lat-long or cube) when present, else the
  * aspect ratio: width = 2 height is lat-long, height = 6 width is cube

@@ -181,7 +181,8 @@ static ts_status sky_stream(const tsd_compute_ctx *c, const ts_grid *g, const ts
     ts_status st;
     sky_acc a = {nm, c->opts->directions,
                  which == 0 ? (ts_svf_model)c->opts->svf_model : TS_SVF_RADIATIVE,
-                 c->opts->threads, which == 0 ? acc : NULL, which == 1 ? acc : NULL, which == 2 ? acc : NULL};
+                 c->opts->threads, which == 0 ? acc : NULL, which == 1 ? acc : NULL,
+                 which == 2 ? acc : NULL};
     /* the negated DEM of negative openness is swept without curvature */
     tsd_options flat;
     tsd_compute_ctx cflat;

@@ -69,9 +69,10 @@ ts_status tsd_connstr_parse(const char *name, tsd_connstr *out, char *msg,
     int n_items = 0;
     if (is_option_segment(rest, seg_len)) {
         if (!colon)
-            return tsd_fail(msg, msg_size, TS_ERR_ARG, "'%s' names no DEM: write TERRASHADE:KEY=VALUE,...:<dem> "
-                        "(quote a DEM name that contains '=' before any ':')",
-                        name);
+            return tsd_fail(msg, msg_size, TS_ERR_ARG,
+                            "'%s' names no DEM: write TERRASHADE:KEY=VALUE,...:<dem> "
+                            "(quote a DEM name that contains '=' before any ':')",
+                            name);
         n_items = 1;
         for (size_t i = 0; i < seg_len; i++)
             n_items += rest[i] == ',';

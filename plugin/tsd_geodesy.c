@@ -428,9 +428,10 @@ ts_status tsd_sites_compute(const double gt[6], int width, int height,
             } else {
                 double x = X, y = Y, z = 0;
                 if (!OCTTransform(fwd, 1, &x, &y, &z) || !isfinite(x) || !isfinite(y)) {
-                    rc = tsd_fail(msg, n, TS_ERR_ARG, "PROJ cannot find the longitude and latitude of "
-                              "the DEM's point (%.10g, %.10g), so the sun's position "
-                              "over it is unknown", X, Y);
+                    rc = tsd_fail(msg, n, TS_ERR_ARG,
+                                  "PROJ cannot find the longitude and latitude of "
+                                  "the DEM's point (%.10g, %.10g), so the sun's position "
+                                  "over it is unknown", X, Y);
                     break;
                 }
                 lon = x;
@@ -439,17 +440,19 @@ ts_status tsd_sites_compute(const double gt[6], int width, int height,
                 double step = lat + 1e-4 <= 90.0 ? 1e-4 : -1e-4;
                 double x2 = lon, y2 = lat + step, z2 = 0;
                 if (!OCTTransform(inv, 1, &x2, &y2, &z2) || !isfinite(x2) || !isfinite(y2)) {
-                    rc = tsd_fail(msg, n, TS_ERR_ARG, "PROJ cannot transform a point north of (%.8g, "
-                              "%.8g) back into the DEM's CRS", lon, lat);
+                    rc = tsd_fail(msg, n, TS_ERR_ARG,
+                                  "PROJ cannot transform a point north of (%.8g, "
+                                  "%.8g) back into the DEM's CRS", lon, lat);
                     break;
                 }
                 double dx = (x2 - X) * (step > 0 ? 1 : -1), dy = (y2 - Y) * (step > 0 ? 1 : -1);
                 north = atan2(dx, dy) * 180.0 / M_PI;
             }
             if (!isfinite(lat) || lat < -90.0 - 1e-9 || lat > 90.0 + 1e-9) {
-                rc = tsd_fail(msg, n, TS_ERR_ARG, "the DEM's georeferencing puts a point at latitude %g, "
-                          "beyond +/-90 degrees: the geotransform or the CRS is wrong",
-                          lat);
+                rc = tsd_fail(msg, n, TS_ERR_ARG,
+                              "the DEM's georeferencing puts a point at latitude %g, "
+                              "beyond +/-90 degrees: the geotransform or the CRS is wrong",
+                              lat);
                 break;
             }
             lat = lat > 90.0 ? 90.0 : lat < -90.0 ? -90.0 : lat;

@@ -266,7 +266,8 @@ const opt_def TSD_OPTION_ROWS[] = {
     {"HORIZON_METHOD", K_SELECT, FIELD(horizon_method), "exact", 0, 0, 0, 0, "exact|pyramid",
      1, P, LISTED, NULL,
      "How the horizons of horizon, svf, openness, sky, envlight, the sky term "
-     "of shade and METHOD=sh's key light are found: exact (the sweep) or pyramid (Snyder & Nowrouzezahrai "
+     "of shade and METHOD=sh's key light are found: exact (the sweep) or pyramid "
+     "(Snyder & Nowrouzezahrai "
      "2008: a multi-resolution pyramid, approximate, smoother with distance; "
      "PYRAMID_LEVEL_STEP, PYRAMID_OFFSET; runs on the C backend)"},
     {"PYRAMID_LEVEL_STEP", K_FLOAT, FIELD(pyramid_level_step), "4", 1, 16, 0, 1, NULL, 1, P,
@@ -294,7 +295,8 @@ const int TSD_OPTION_COUNT = (int)(sizeof TSD_OPTION_ROWS / sizeof TSD_OPTION_RO
 
 
 /* tsd_options.given has a bit per option */
-_Static_assert(sizeof TSD_OPTION_ROWS / sizeof TSD_OPTION_ROWS[0] <= 64, "too many options for tsd_options.given");
+_Static_assert(sizeof TSD_OPTION_ROWS / sizeof TSD_OPTION_ROWS[0] <= 64,
+               "too many options for tsd_options.given");
 /* select fields are enums written through int pointers */
 _Static_assert(sizeof(tsd_method) == sizeof(int) && sizeof(tsd_output_type) == sizeof(int) &&
                    sizeof(tsd_sun_position) == sizeof(int) &&

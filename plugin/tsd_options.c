@@ -204,7 +204,8 @@ static void list_names(int scope, char *buf, size_t n)
         total += (TSD_OPTION_ROWS[i].scope & scope) != 0;
     for (int pass = atlas ? 0 : 1; pass < 2; pass++)
         for (int i = 0; i < TSD_OPTION_COUNT && used < n; i++) {
-            if (!(TSD_OPTION_ROWS[i].scope & scope) || (pass == 0 && TSD_OPTION_ROWS[i].scope != scope))
+            if (!(TSD_OPTION_ROWS[i].scope & scope) ||
+                (pass == 0 && TSD_OPTION_ROWS[i].scope != scope))
                 continue;
             if (atlas && pass == 1 && TSD_OPTION_ROWS[i].scope == scope)
                 continue; /* listed in pass 0 */
@@ -243,7 +244,8 @@ static int apply_scope(tsd_options *o, const char *const *kv, int scope, char *m
             const char *e = strchr(seen[id], '=');
             trim(e + 1, strlen(e + 1), before, sizeof before);
             if (strcasecmp(before, value) != 0)
-                REFUSE("%s is given twice, as %s and as %s", TSD_OPTION_ROWS[id].name, before, value);
+                REFUSE("%s is given twice, as %s and as %s", TSD_OPTION_ROWS[id].name, before,
+                       value);
         }
         seen[id] = item;
         if (!value[0])

@@ -100,7 +100,8 @@ static bool OverviewsAgree(GDALRasterBand *poBand, int w, const std::string &osD
             const float o = afOvr[static_cast<size_t>(j) * n + i];
             double s = 0;
             int c = 0;
-            const int x0 = static_cast<int>((ox + i) * rx) - fx, y0 = static_cast<int>((oy + j) * ry) - fy;
+            const int x0 = static_cast<int>((ox + i) * rx) - fx,
+                      y0 = static_cast<int>((oy + j) * ry) - fy;
             const int x1 = std::min(fw, static_cast<int>((ox + i + 1) * rx) - fx);
             const int y1 = std::min(fh, static_cast<int>((oy + j + 1) * ry) - fy);
             for (int y = y0; y < y1; y++)
@@ -222,9 +223,10 @@ bool TSDataset::ComputeChunk(int cx, int cy, WindowChunk &c)
     const int ah = std::min(H, gy0 + c.h + p.margin_y) - ay0;
     char szMsg[1024] = "";
     ts_grid sGrid{};
-    ts_status eSt = tsd_dem_load_window(GDALRasterBand::ToHandle(m_poDEM->GetRasterBand(m_sOpts.band)),
-                                        &m_sCells, m_sOpts.z_factor, ax0, ay0, aw, ah, &sGrid,
-                                        szMsg, sizeof szMsg);
+    ts_status eSt =
+        tsd_dem_load_window(GDALRasterBand::ToHandle(m_poDEM->GetRasterBand(m_sOpts.band)),
+                            &m_sCells, m_sOpts.z_factor, ax0, ay0, aw, ah, &sGrid,
+                            szMsg, sizeof szMsg);
     const ts_grid_origin sOrigin{ax0, ay0, s.refCellX, W, H};
     sGrid.origin = &sOrigin;
     const int nBands = tsd_options_band_count(&m_sOpts);

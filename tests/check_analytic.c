@@ -151,7 +151,12 @@ END_TEST
 #define V_W 401
 #define V_H 801
 #define V_X0 200
-typedef struct { ts_grid g; ts_horizon_opts o; size_t n; float *hor, *nx, *ny, *nz, *svf, *sky, *open; } valley;
+typedef struct {
+    ts_grid g;
+    ts_horizon_opts o;
+    size_t n;
+    float *hor, *nx, *ny, *nz, *svf, *sky, *open;
+} valley;
 
 static valley valley_make(void)
 {

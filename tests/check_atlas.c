@@ -458,9 +458,10 @@ START_TEST(test_bad_step_tables)
             ck_assert_msg(st == TS_ERR_ARG && err.code == TS_ERR_ARG, "case %zu: status %d", i,
                           (int)st);
             printf("forged step table, case %zu -> %s\n", i, err.message);
-            ck_assert_msg(strstr(err.message, "the atlas's step table is invalid: ") == err.message &&
-                              strstr(err.message, cases[i].cause),
-                          "case %zu: %s", i, err.message);
+            ck_assert_msg(
+                strstr(err.message, "the atlas's step table is invalid: ") == err.message &&
+                    strstr(err.message, cases[i].cause),
+                "case %zu: %s", i, err.message);
         }
         free(file);
     }

@@ -189,7 +189,8 @@ static double patch_vs_sun(const scene *s, double az, double el)
     float *sun = tdem_floats(s->n);
     env_light(s, &env, s->o.directions, TS_ENV_DEFAULT_NORMAL_STEPS,
               TS_ENV_DEFAULT_HORIZON_STEPS, 0, r, g, b);
-    const ts_direct_request dq = {&s->g, s->nx, s->ny, s->nz, s->hor, &s->o, az, el, sun, TS_SUN_RADIUS_DEG};
+    const ts_direct_request dq = {&s->g, s->nx, s->ny, s->nz, s->hor, &s->o, az, el, sun,
+                                  TS_SUN_RADIUS_DEG};
     ck_assert(ts_shade_direct(&dq, &err) == TS_OK);
     long shadowed = 0;
     for (size_t i = 0; i < s->n; i++)

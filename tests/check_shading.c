@@ -297,8 +297,8 @@ START_TEST(test_sky_flat_and_tilted)
         for (int y = 1; y < 29; y++)
             for (int x = 1; x < 39; x++) {
                 size_t i = (size_t)y * 40 + x;
-                ck_assert_msg(fabs(svf[i] - 1) < (tilted ? 1e-3 : 1e-5), "slope %g (%d,%d): svf %g", gam,
-                              x, y, svf[i]);
+                ck_assert_msg(fabs(svf[i] - 1) < (tilted ? 1e-3 : 1e-5), "slope %g (%d,%d): svf %g",
+                              gam, x, y, svf[i]);
                 ck_assert_msg(fabs(sky[i] - want_sky) < (tilted ? 1e-3 : 1e-5),
                               "slope %g (%d,%d): sky %g, "
                               "want %g", gam, x, y, sky[i], want_sky);

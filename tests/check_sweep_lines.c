@@ -366,7 +366,8 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
                         hyb_ties += good;
                     }
                     if (!good && bad++ == 0)
-                        printf("step %d line %d query %d (hybrid): step %d dd %.9g, want %ld %.9g\n",
+                        printf("step %d line %d query %d (hybrid): step %d dd %.9g, "
+                               "want %ld %.9g\n",
                                k, j, q, gk, gdd, bk, bd);
                 }
                 for (int v = 0; v < 2; v++) {
@@ -374,7 +375,8 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
                     const float gdd = q ? ok_dd[v][jo] : hi_dd[v][jo];
                     if (gk != bk || gdd != (float)bd) {
                         if (bad++ == 0)
-                            printf("step %d line %d query %d (%s): step %d dd %.9g, want %ld %.9g\n",
+                            printf("step %d line %d query %d (%s): step %d dd %.9g, "
+                                   "want %ld %.9g\n",
                                    k, j, q, v ? "unpruned" : "pruned", gk, gdd, bk, bd);
                     }
                 }

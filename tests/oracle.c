@@ -97,8 +97,12 @@ double oracle_horizon_ex(const ts_grid *g, int x, int y, double azimuth,
          * the next row or column line: the kinks of the bilinear surface,
          * where the maxima of piecewise-linear terrain lie */
         double ux = sa / oracle_cell_x(g, py), uy = -ca / g->cell_y;
-        double tx = ux > 0 ? (floor(px) + 1 - px) / ux : ux < 0 ? (ceil(px) - 1 - px) / ux : INFINITY;
-        double ty = uy > 0 ? (floor(py) + 1 - py) / uy : uy < 0 ? (ceil(py) - 1 - py) / uy : INFINITY;
+        double tx = ux > 0   ? (floor(px) + 1 - px) / ux
+                    : ux < 0 ? (ceil(px) - 1 - px) / ux
+                             : INFINITY;
+        double ty = uy > 0   ? (floor(py) + 1 - py) / uy
+                    : uy < 0 ? (ceil(py) - 1 - py) / uy
+                             : INFINITY;
         double step = fmin(s, fmin(tx, ty));
         /* and on max_distance itself, where a capped horizon often lies */
         double to_cap = opts->max_distance > 0 ? opts->max_distance - d : INFINITY;

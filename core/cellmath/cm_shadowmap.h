@@ -128,8 +128,8 @@ CM_FN float ts_sm_clampf(float x, float lo, float hi)
  * NaN corner (nodata) or no area (seen edge-on) are skipped.
  */
 CM_FN void ts_sm_triangle(CM_GLOBAL const float *P, CM_GLOBAL int *map, int mw, int mh,
-                          int vlo, int vhi, float u0, float v0, float d0, float u1, float v1, float d1,
-                          float u2, float v2, float d2)
+                          int vlo, int vhi, float u0, float v0, float d0, float u1, float v1,
+                          float d1, float u2, float v2, float d2)
 {
     float area = (u1 - u0) * (v2 - v0) - (u2 - u0) * (v1 - v0);
     if (!(area > 1e-12f || area < -1e-12f)) /* also NaN */

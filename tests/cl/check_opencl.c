@@ -335,7 +335,8 @@ START_TEST(test_direct)
         }
         /* one direction, the sun on it */
         sc.o.directions = 1;
-        const ts_direct_request qc = scene_direct(&sc, 5.0, 20, c), ql = scene_direct(&sc, 5.0, 20, l);
+        const ts_direct_request qc = scene_direct(&sc, 5.0, 20, c),
+                                ql = scene_direct(&sc, 5.0, 20, l);
         ck_assert_int_eq(ts_shade_direct(&qc, &e), TS_OK);
         ck_assert_int_eq(ts_cl_shade_direct(&ql, &e), TS_OK);
         expect_close("direct, one direction", c, l, sc.n, TOL);

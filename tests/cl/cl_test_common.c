@@ -94,8 +94,9 @@ void require_opencl(void)
 {
     ts_error e;
     ts_cl_info info;
-    ck_assert_msg(ts_cl_built(), "OpenCL support was not built: configure found no OpenCL "
-                                 "(apt-get install ocl-icd-opencl-dev opencl-headers pocl-opencl-icd)");
+    ck_assert_msg(ts_cl_built(),
+                  "OpenCL support was not built: configure found no OpenCL "
+                  "(apt-get install ocl-icd-opencl-dev opencl-headers pocl-opencl-icd)");
     ts_status st = ts_cl_available(&info, &e);
     ck_assert_msg(st == TS_OK, "no usable OpenCL device (PoCL is installed by setup.sh): %s",
                   e.message);

@@ -192,7 +192,8 @@ int main(int argc, char **argv)
             if (ts_horizon_sweep(&g, p.sun_az, &one, hz, &err) != TS_OK ||
                 ts_horizon_earth_floor(&g, &one, hz, &err) != TS_OK)
                 die("ts_horizon_sweep", &err);
-            const ts_direct_request req = {&g, nx, ny, nz, hz, &one, p.sun_az, p.sun_el, out, TS_SUN_RADIUS_DEG};
+            const ts_direct_request req = {&g, nx, ny, nz, hz, &one, p.sun_az, p.sun_el, out,
+                                           TS_SUN_RADIUS_DEG};
             if (ts_shade_direct(&req, &err) != TS_OK)
                 die("ts_shade_direct", &err);
         }

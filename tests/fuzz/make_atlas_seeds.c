@@ -4,7 +4,8 @@
  * changes (see docs/testing.md):
  *
  *   cc -std=c11 -D_GNU_SOURCE -Icore tests/fuzz/make_atlas_seeds.c core/shadow_atlas*.c \
- *      core/status.c core/datetime.c -llzma -lm -o /tmp/mas && /tmp/mas tests/fuzz/corpus/fuzz_atlas
+ *      core/status.c core/datetime.c -llzma -lm -o /tmp/mas &&
+ *      /tmp/mas tests/fuzz/corpus/fuzz_atlas
  */
 #include <stdio.h>
 #include <stdlib.h>
