@@ -67,53 +67,6 @@ static void lane_distances(const sweep_ctx *C, sweep_ws *w, int k, int i0, int j
     }
 }
 
-/* stack_query, the occluder's step from its distance where s->k_step says
- * so (as lane_hull.c's query: the vector steps leave the points' steps
- * unwritten then). */
-static inline occluder lane_query(const ts_lane_step *s, const hull_pt *S, int far, double d,
-                                  double g)
-{
-    if (far < 0 || !(s->k_step > 0))
-        return stack_query(S, far, d, g);
-    const double dd = d - S[stack_tangent(S, far, d, g)].d;
-    /* dd / k_step is >= 0 and within ~1e-12 of an integer: + 0.5 and the
-     * truncation round it as nearbyint did, without libm's call (baseline
-     * x86-64 has no roundsd) */
-    return (occluder){s->k - (int)(dd * (1.0 / s->k_step) + 0.5), (float)dd};
-}
-
-/* ts_lane_hull_step in scalar code, line by line. */
-static void lane_hulls_scalar(const ts_lane_hulls *h, const ts_lane_step *s,
-                              const ts_lane_occluders *occ)
-{
-    const occluder none = {-1, 0.0f};
-    const double c = s->c;
-    for (int j = s->j0; j <= s->j1; j++) {
-        hull_pt *S = h->pts + (size_t)j * h->stride;
-        const double d = s->d[j];
-        const float hs = s->hs[j], hc = s->hc[j], hn = s->hn[j];
-        if (s->push_d) { /* another step's point; every point is beyond the near field */
-            if (!isnan(s->push_d[j]))
-                hull_push(S, &h->n[j], &h->far[j], s->push_d[j], s->push_g[j], s->push_ks[j],
-                          0.0);
-            h->far[j] = h->n[j] - 1;
-        } else if (!isnan(hs)) {
-            hull_push(S, &h->n[j], &h->far[j], d, hs - c * d * d, s->k, s->near_skip);
-        } else {
-            h->far[j] = far_advance(S, h->n[j], h->far[j], d, s->near_skip);
-        }
-        const int far = h->far[j];
-        occluder hi = !isnan(hc) && j >= s->hi_from && j <= s->hi_to
-                          ? lane_query(s, S, far, d, hc - c * d * d)
-                          : none;
-        occluder lo = !isnan(hn) ? lane_query(s, S, far, d, hn - c * d * d) : none;
-        occ->hi_k[j] = hi.k;
-        occ->hi_dd[j] = hi.dd;
-        occ->lo_k[j + 1] = lo.k;
-        occ->lo_dd[j + 1] = lo.dd;
-    }
-}
-
 /* Lines bs .. bs + nl - 1 of an unbounded sweep (or a bounded one, in the
  * rings of capped_lanes.h; or the far-only one, C->far_T, sweep_far.c),
  * step by step; the first is only primed (not written) when `prime`.
@@ -184,7 +137,7 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
             for (int more = 1; more;) {
                 more = ts_far_pushes(C, w, &step);
                 if (!ts_lane_hull_step(&hulls, &step, &occ))
-                    lane_hulls_scalar(&hulls, &step, &occ);
+                    ts_lane_hull_step_scalar(&hulls, &step, &occ);
             }
         } else {
             const int hybrid =
@@ -192,7 +145,7 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
             if (!hybrid && C->cap > 0)
                 ts_cap_lanes_step(&w->capl, &step, nl, &occ);
             else if (!hybrid && !ts_lane_hull_step(&hulls, &step, &occ))
-                lane_hulls_scalar(&hulls, &step, &occ);
+                ts_lane_hull_step_scalar(&hulls, &step, &occ);
         }
         if (j1 == nl - 1)
             next[k] = (occluder){w->lo_k[nl], w->lo_dd[nl]};

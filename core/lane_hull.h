@@ -82,6 +82,10 @@ int ts_lane_delayed_pushes(ts_lane_pushes *p, const double *d_ring, const double
  * (or the build, or TERRASHADE_SIMD) has neither; the caller then runs the
  * scalar code. */
 int ts_lane_hull_step(const ts_lane_hulls *h, const ts_lane_step *s, const ts_lane_occluders *occ);
+/* The step in scalar code, line by line (any CPU): what the vector steps
+ * must equal bit for bit. */
+void ts_lane_hull_step_scalar(const ts_lane_hulls *h, const ts_lane_step *s,
+                              const ts_lane_occluders *occ);
 /* The AVX2 step alone; only where ts_cpu_vector_level() is at least AVX2
  * (0 in builds for other CPUs). */
 int ts_lane_hull_step_avx2(const ts_lane_hulls *h, const ts_lane_step *s,
