@@ -1,11 +1,12 @@
 /* A lockstep block's hull step, four lines per AVX2 vector: lane_hull.c's
- * AVX-512 step for CPUs without AVX-512 (most desktops and laptops), the
- * same double operations per line in the same order, so the same bits as
- * the scalar hull_push, far_advance and stack_query. AVX2 has no mask
- * registers and no scatters, and its gathers are slow on many of those
- * CPUs: masks are vectors of all-ones lanes, the lines' point indices are
- * 64-bit (so that a mask of doubles is also one of indices, and a pop is
- * an add of its mask), points are loaded and pushes stored lane by lane. */
+ * AVX-512 step for CPUs without AVX-512 (most desktops and laptops), and
+ * for hulls past that step's 32-bit offsets, with the same double
+ * operations per line in the same order, so the same bits as the scalar
+ * hull_push, far_advance and stack_query. AVX2 has no mask registers and
+ * no scatters, and its gathers are slow on many of those CPUs: masks are
+ * vectors of all-ones lanes, the lines' point indices are 64-bit (so that
+ * a mask of doubles is also one of indices, and a pop is an add of its
+ * mask), points are loaded and pushes stored lane by lane. */
 #include <stddef.h>
 
 #include "lane_hull.h"
