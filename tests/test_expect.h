@@ -3,10 +3,17 @@
 #define TS_TEST_EXPECT_H
 
 #include <check.h>
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "terrashade.h"
+
+/* Assert |got - want| <= tol, in double (what: the log's name for it). */
+#define CK_NEAR(got, want, tol, what)                                                    \
+    ck_assert_msg(fabs((double)(got) - (double)(want)) <= (tol),                         \
+                  "%s: got %.10f, want %.10f +/- %g", what, (double)(got), (double)(want), \
+                  (double)(tol))
 
 /* Assert that `call` refuses its arguments: it returns TS_ERR_ARG and
  * fills *errp (cleared first) with that code and a message, which goes to
