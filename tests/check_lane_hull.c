@@ -45,35 +45,24 @@ typedef struct {
     uint32_t seed;
 } block_case;
 
+/* The vector forms where ts_cpu_vector_level allows them (AVX2 at least:
+ * ts_lane_hull_step then runs AVX2's or AVX-512's). */
 static int form_available(int f)
 {
-    if (f == SCALAR)
-        return 1;
-#if defined(__GNUC__) && defined(__x86_64__)
-    if (f == AVX2) {
-        __builtin_cpu_init();
-        return __builtin_cpu_supports("avx2");
-    }
-#else
-    if (f == AVX2)
-        return 0;
-#endif
-    return ts_cpu_vector_level() > TS_CPU_VECTORS_NONE;
+    return f == SCALAR || ts_cpu_vector_level() >= TS_CPU_VECTORS_AVX2;
 }
 
 static void form_step(int f, form_state *st, const ts_lane_step *s)
 {
     const ts_lane_hulls h = {st->pts, STEPS + 1, st->n, st->far};
     const ts_lane_occluders occ = {st->lo_k, st->hi_k, st->lo_dd, st->hi_dd};
-    int done = 0;
-    if (f == AVX2)
-        done = ts_lane_hull_step_avx2(&h, s, &occ);
-    else if (f == NATIVE)
-        done = ts_lane_hull_step(&h, s, &occ);
-    if (f == SCALAR || !done) {
-        ck_assert_msg(f == SCALAR, "%s did not take the step", form_names[f]);
+    if (f == SCALAR) {
         ts_lane_hull_step_scalar(&h, s, &occ);
+        return;
     }
+    const int done = f == AVX2 ? ts_lane_hull_step_avx2(&h, s, &occ)
+                               : ts_lane_hull_step(&h, s, &occ);
+    ck_assert_msg(done, "%s did not take the step", form_names[f]);
 }
 
 /* Form f's answers and hulls against the scalar one's after step k (lines
@@ -219,7 +208,7 @@ START_TEST(test_forms_same_bits)
     };
     for (int f = 0; f < FORMS; f++)
         printf("%s: %s\n", form_names[f],
-               form_available(f) ? "compared" : "not on this CPU or level");
+               form_available(f) ? "compared" : "not at this CPU's level");
     printf("ts_lane_hull_step runs %s here\n", ts_cpu_vectors_name(ts_cpu_vector_level()));
     for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
         long found;
