@@ -1,6 +1,9 @@
 /* The rows of the option table: one per option, with the field it fills. */
 #include "tsd_option_table.h"
 
+#include <math.h>
+#include <stdlib.h>
+
 #include "day_cycle.h"
 #include "terrashade_env.h"
 #include "tsd_compute_env.h"
@@ -22,6 +25,7 @@ static int check_timezone(const char *v, char *msg, size_t n);
 static int check_sky(const char *v, char *msg, size_t n);
 static int check_exposure(const char *v, char *msg, size_t n);
 static int check_tile_size(const char *v, char *msg, size_t n);
+static int check_light_radius(const char *v, char *msg, size_t n);
 
 const opt_def TSD_OPTION_ROWS[] = {
     {"PRODUCT", K_PRODUCT, FIELD(product), "shade", 0, 0, 0, 0, NULL, 1, P,
@@ -36,8 +40,8 @@ const opt_def TSD_OPTION_ROWS[] = {
      "Sun elevation in degrees above the horizontal (as gdaldem -alt); not "
      "with DATETIME"},
     {"DIRECTIONS", K_INT, FIELD(directions), "16", 1, 3600, 0, 1, NULL, 1, P, LISTED, NULL,
-     "Number of azimuths of the horizon, svf, openness and sky products "
-     "and of the sky term of shade"},
+     "Number of azimuths of the horizon, svf, openness, sky and envlight "
+     "products and of the sky terms of shade and insolation"},
     {"START_AZIMUTH", K_FLOAT, FIELD(start_azimuth), "0", 0, 360, 0, 1, NULL, 1, P, LISTED,
      NULL,
      "First of the DIRECTIONS azimuths, degrees from north; the others "
@@ -55,7 +59,7 @@ const opt_def TSD_OPTION_ROWS[] = {
      "METHOD=shm: metres below the shadow height over which light fades; "
      "0 = hard shadows"},
     {"LIGHT_RADIUS", K_FLOAT, FIELD(light_radius), "0.2666", 0, 45, 1, 1, NULL, 1, P,
-     LISTED, NULL,
+     LISTED, check_light_radius,
      "Angular radius of the light's disk in degrees, greater than 0 and less "
      "than 45; 0.2666 = the sun. A wider disk casts softer shadows"},
     {"SWATH_DIRECTIONS", K_INT, FIELD(swath_directions), "3", 1, 3600, 0, 1, NULL, 1, P,
@@ -106,8 +110,9 @@ const opt_def TSD_OPTION_ROWS[] = {
     {"OUTPUT_TYPE", K_SELECT, FIELD(output_type), "AUTO", 0, 0, 0, 0, "AUTO|Byte|Float32",
      1, P, LISTED, NULL,
      "Data type: Byte (1..255, 0 = nodata, as gdaldem) or Float32 (0..1 or "
-     "degrees, NaN = nodata); AUTO = Byte for shade, Float32 otherwise. "
-     "Byte only for the 0..1 products (shade, shadow, svf, sky)"},
+     "degrees, NaN = nodata); AUTO = Byte for shade (and farshadow, Byte "
+     "only), Float32 otherwise. Byte only for the 0..1 products (shade, "
+     "shadow, svf, sky, daycycle, envlight)"},
     {"MAX_MEMORY", K_INT, FIELD(max_memory_mb), "0", 0, 1 << 30, 0, 1, NULL, 0, P, ALL,
      NULL,
      "Refuse to compute a product needing more than this many MiB; 0 = "
@@ -190,7 +195,7 @@ const opt_def TSD_OPTION_ROWS[] = {
     {"BACKEND", K_SELECT, FIELD(backend), "auto", 0, 0, 0, 0, "auto|opencl|c", 0, P,
      LISTED, NULL,
      "Where the horizon sweeps, shadow height maps, normals and direct sun "
-     "of shade, shadow, horizon, svf, openness and sky run: opencl (falls "
+     "of shade, shadow, horizon, svf, openness, sky and envlight run: opencl (falls "
      "back to c, with a warning, when OpenCL cannot run), c (the "
      "multithreaded C core), or auto (the environment variable "
      "TERRASHADE_BACKEND, else OpenCL on a GPU or accelerator or on a device "
@@ -384,4 +389,18 @@ static int check_tile_size(const char *v, char *msg, size_t n)
         return -1;
     }
     return 0;
+}
+
+/* LIGHT_RADIUS: the open interval (0, 45), whose upper end the table's
+ * inclusive bounds cannot say; one sentence for a value below, at or above
+ * it (not a number: the kind's check says so). */
+static int check_light_radius(const char *v, char *msg, size_t n)
+{
+    char *end;
+    double r = strtod(v, &end);
+    if (end == v || *end || !isfinite(r) || (r > 0 && r < TS_LIGHT_RADIUS_MAX))
+        return 0;
+    tsd_fail(msg, n, TS_ERR_ARG, "LIGHT_RADIUS must be greater than 0 and less than %g "
+             "degrees, got %s", TS_LIGHT_RADIUS_MAX, v);
+    return -1;
 }

@@ -147,7 +147,8 @@ static int set_option(tsd_options *o, int id, const char *v, char *msg, size_t n
         /* fall through - a number */
     case K_FLOAT:
     case K_INT:
-        if (parse_number(d, v, &x, msg, n) != 0 || (d->validate && d->validate(v, msg, n) != 0))
+        /* the row's own check first: it may word the range better (LIGHT_RADIUS) */
+        if ((d->validate && d->validate(v, msg, n) != 0) || parse_number(d, v, &x, msg, n) != 0)
             return -1;
         if (d->kind == K_INT) {
             k = (int)x;
