@@ -178,7 +178,10 @@ def start_cluster(args):
     if args.scheduler:
         try:
             client = Client(args.scheduler, timeout="%ds" % args.timeout)
-        except (OSError, TimeoutError, ValueError) as e:
+        except ValueError as e:  # not an address: no port, an unknown scheme...
+            raise Failure("--scheduler %s is not a Dask scheduler address such as "
+                          "tcp://host:8786 (%s)" % (args.scheduler, e), code=2)
+        except (OSError, TimeoutError) as e:
             raise Failure("cannot reach the Dask scheduler at %s within %d s: %s"
                           % (args.scheduler, args.timeout, e), code=2)
         # A worker has one task slot per thread, by default one per core.
@@ -293,6 +296,9 @@ def remove(path):
 def run(args):
     src = open_source(args.source, args.open_options)
     fmt = output_format(args)
+    if os.path.isdir(args.dest):  # found now, not when the result is renamed to it
+        raise Failure("cannot write %s: it is a directory; DEST names the output file"
+                      % args.dest)
     block = block_size(args.tile_size)
     partial = args.dest + (".tiles.partial" if fmt == "COG" else ".partial")
     out = create_like(src, partial, block, [] if fmt == "COG" else args.creation_options)
@@ -324,8 +330,9 @@ def run(args):
         if cluster is not None:
             cluster.close()
     if not args.quiet:
-        print("%s: wrote %s (%d x %d, %d bands, %s) from %d windows of %d on %d "
-              "worker%s in %.1f s" % (PROG, args.dest, size[0], size[1], size[2], fmt, n,
+        print("%s: wrote %s (%d x %d, %d band%s, %s) from %d window%s of %d on %d "
+              "worker%s in %.1f s" % (PROG, args.dest, size[0], size[1], size[2],
+                                       "s"[:size[2] > 1], fmt, n, "s"[:n > 1],
                                        args.tile_size, nworkers, "s"[:nworkers > 1],
                                        time.time() - t0),
               file=sys.stderr)

@@ -11,9 +11,10 @@ dask.distributed equals gdal_translate of the same source, bit for bit.
   and the result is still identical;
 - a window that fails (no retries allowed) fails the run: exit 1, the
   older DEST untouched, no DEST.partial;
-- bad input (an unreachable scheduler, an unwritable destination, a SOURCE
-  the driver refuses, bad tile sizes): a clear message, a non-zero exit and
-  neither DEST nor DEST.partial left behind.
+- bad input (an unreachable scheduler or one that is no address, an
+  unwritable destination or one that is a directory, a SOURCE the driver
+  refuses, bad tile sizes): a clear message, a non-zero exit and neither
+  DEST nor DEST.partial left behind.
 """
 import os
 import re
@@ -168,6 +169,33 @@ class Distributed(unittest.TestCase):
         self.assertIn("cannot reach the Dask scheduler at tcp://127.0.0.1:%d within 2 s"
                       % port, p.stderr)
         self.assert_nothing_left(dest)
+
+    def test_malformed_scheduler_address(self):
+        for address, reason in [("scheduler", "missing port number"),
+                                ("bogus://host:8786", "unknown address scheme")]:
+            with self.subTest(address):
+                dest = self.path("malformed.tif")
+                p = distributed(["--scheduler", address, "--timeout", 2, T.conn(self.dem),
+                                 dest], ok=False)
+                self.assertEqual(p.returncode, 2, p.stderr)
+                self.assertIn("--scheduler %s is not a Dask scheduler address such as "
+                              "tcp://host:8786 (%s" % (address, reason), p.stderr)
+                self.assertNotIn("Traceback", p.stderr)
+                self.assert_nothing_left(dest)
+
+    def test_destination_is_a_directory(self):
+        """Refused before any work, not when the finished result is renamed."""
+        dest = self.path("adir.tif")
+        os.mkdir(dest)
+        try:
+            p = distributed(["--workers", 1, T.conn(self.dem), dest], ok=False)
+            self.assertEqual(p.returncode, 1, p.stderr)
+            self.assertIn("cannot write %s: it is a directory" % dest, p.stderr)
+            self.assertNotIn("Traceback", p.stderr)
+            self.assertEqual(os.listdir(dest), [])
+            self.assertFalse(os.path.exists(dest + ".partial"))
+        finally:
+            os.rmdir(dest)
 
     def test_bad_input(self):
         missing_dir = self.path("no/such/dir/out.tif")
