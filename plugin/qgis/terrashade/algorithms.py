@@ -52,7 +52,7 @@ LABELS = {
 # Titles of the algorithms; a product not here is titled by its description.
 TITLES = {"shade": "Hillshade with cast shadows", "shadow": "Cast shadows",
           "horizon": "Horizon angles", "svf": "Sky-view factor",
-          "openness": "Positive openness", "sky": "Sky light", "sunhours": "Hours of sun",
+          "openness": "Openness", "sky": "Sky light", "sunhours": "Hours of sun",
           "insolation": "Clear-sky insolation", "envlight": "Environment light"}
 BYTE_HELP = {
     "auto": "Byte 1..255 by default (0 = nodata); OUTPUT_TYPE=Float32 for the values.",
