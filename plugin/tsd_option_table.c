@@ -361,8 +361,8 @@ static int check_sky(const char *v, char *msg, size_t n)
     ts_sky_kind kind;
     int type;
     ts_error err;
-    if (ts_sky_parse(v, &kind, &type, &err) != TS_OK)
-        return (tsd_fail_core(msg, n, "SKY", &err), -1);
+    if (ts_sky_parse(v, &kind, &type, &err) != TS_OK) /* its sentence names SKY */
+        return (tsd_fail_core(msg, n, NULL, &err), -1);
     return 0;
 }
 

@@ -249,7 +249,8 @@ class EnvLight(unittest.TestCase):
             ("3:1 without envmap", dict(ENV_MAP=wide), "neither 2:1 (lat-long) nor 1:6"),
             ("ENV_MAP with SKY", dict(ENV_MAP=SUNSET, SKY="clear"),
              "SKY=clear excludes ENV_MAP"),
-            ("cie:16", dict(SKY="cie:16"), "SKY"),
+            ("cie:16", dict(SKY="cie:16"), "TERRASHADE: SKY must be uniform, overcast, "
+             "clear or cie:N with N from 1 to 15, got 'cie:16'"),
             ("bad EXPOSURE", dict(SKY="uniform", OUTPUT_TYPE="Byte", EXPOSURE="bright"),
              "EXPOSURE must be AUTO or a number of stops"),
             ("EXPOSURE with Float32", dict(SKY="uniform", EXPOSURE="1"),
