@@ -20,9 +20,14 @@ import sys
 import threading
 import time
 
-from osgeo import gdal
+try:
+    from osgeo import gdal
+except ImportError as _e:  # a Python without GDAL's bindings: a sentence, not a traceback
+    sys.exit("terrashade.distributed: error: this Python (%s) cannot import GDAL's "
+             "bindings (%s); run it with one that can, e.g. /usr/bin/python3 with "
+             "Debian's python3-gdal" % (sys.executable, _e))
 
-from terrashade import windows as W
+from terrashade import windows as W  # noqa: E402 (after the check above)
 
 gdal.UseExceptions()
 

@@ -14,8 +14,9 @@ gdal.UseExceptions()
 
 # One open dataset per worker thread: GDAL datasets are not thread-safe, and
 # keeping the dataset open lets a worker's later windows reuse what the
-# driver has cached (today the whole product, later its chunks and its
-# far-field grid) instead of recomputing it for every window.
+# driver has cached (the far-field grid and recent chunks, or the whole
+# product where it is computed whole) instead of recomputing it for every
+# window.
 _open = threading.local()
 
 # Test hook (tests/driver/test_distributed.py): the path of a flag file. The

@@ -197,6 +197,22 @@ class Distributed(unittest.TestCase):
         finally:
             os.rmdir(dest)
 
+    def test_python_without_gdal(self):
+        """A Python that cannot import osgeo (python3 first on PATH is often
+        not the system one): a sentence and exit 1, even for --help."""
+        blocked = ("import sys, runpy; sys.modules['osgeo'] = None; "
+                   "sys.argv[0] = 'terrashade.distributed'; "
+                   "runpy.run_module('terrashade.distributed', run_name='__main__')")
+        for args in (["--help"], [T.conn(self.dem), self.path("nogdal.tif")]):
+            with self.subTest(args[0]):
+                p = T.run(["/usr/bin/python3", "-c", blocked] + args, ok=False,
+                          PYTHONPATH=PYTHONPATH)
+                self.assertEqual(p.returncode, 1, p.stderr)
+                self.assertIn("terrashade.distributed: error: this Python", p.stderr)
+                self.assertIn("cannot import GDAL's bindings", p.stderr)
+                self.assertNotIn("Traceback", p.stderr)
+        self.assert_nothing_left(self.path("nogdal.tif"))
+
     def test_bad_input(self):
         missing_dir = self.path("no/such/dir/out.tif")
         cases = [
