@@ -414,14 +414,19 @@ static bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window
     if (nLevel == 0)
         tsd_window_advice(&sOpts, psSun, W, H, tsd_cells_min_x(&sCells, H), sCells.cell_y,
                           dfLimit, szAdvice, sizeof szAdvice);
+    // fewer bands need less where an option sets their count (svf streams its DIRECTIONS)
+    const char *pszBands = tsd_product_of(&sOpts)->bands_option;
+    const std::string osFewer = !pszBands ? ""
+                                : EQUAL(pszBands, "STEP_MINUTES") ? "use a longer STEP_MINUTES, "
+                                : std::string("use fewer ") + pszBands + ", ";
     Fail(TS_ERR_NOMEM,
          CPLSPrintf("PRODUCT=%s with %d band(s) on this %d x %d DEM needs "
                     "about %.0f MiB while computing (%.0f MiB kept), more than the "
-                    "limit of %.0f MiB (%s)%s; crop or downsample the DEM, use fewer "
-                    "DIRECTIONS, or raise MAX_MEMORY",
-                    tsd_options_product_name(&sOpts), tsd_options_band_count(&sOpts), W,
-                    H, dfPeak / 1048576.0, dfSteady / 1048576.0, dfLimit / 1048576.0,
-                    pszWhy, szAdvice));
+                    "limit of %.0f MiB (%s)%s; crop or downsample the DEM, %sor raise "
+                    "MAX_MEMORY", tsd_options_product_name(&sOpts),
+                    tsd_options_band_count(&sOpts), W, H, dfPeak / 1048576.0,
+                    dfSteady / 1048576.0, dfLimit / 1048576.0, pszWhy, szAdvice,
+                    osFewer.c_str()));
     return false;
 }
 

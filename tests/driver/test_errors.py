@@ -107,7 +107,8 @@ class Errors(unittest.TestCase):
                    "-oo", "MAX_MEMORY=100", T.conn(T.JACKSBORO)], ok=False)
         print(p.stderr.strip())
         self.assertIn("needs about", p.stderr)
-        self.assertIn("raise MAX_MEMORY", p.stderr)
+        self.assertIn("crop or downsample the DEM, use fewer DIRECTIONS, or raise MAX_MEMORY",
+                      p.stderr)
 
     def test_memory_limit_says_how_windows_fit(self):
         """Over MAX_MEMORY, the message says which TILE_SIZE (and, for the
@@ -131,6 +132,8 @@ class Errors(unittest.TestCase):
                     print(p.stderr.strip())
                     self.assertNotEqual(p.returncode, 0)
                     self.assertIn("more than the limit of 60 MiB", p.stderr)
+                    # their directions are streamed: fewer save nothing, and are not advised
+                    self.assertIn("crop or downsample the DEM, or raise MAX_MEMORY", p.stderr)
                     m = advice.search(p.stderr)
                     self.assertIsNotNone(m, p.stderr)
                     self.assertLessEqual(int(m.group(3)), 60)
@@ -146,6 +149,7 @@ class Errors(unittest.TestCase):
                       + [T.conn(dem)], ok=False)
             print(p.stderr.strip())
             self.assertIn("it is computed on the whole DEM (PRODUCT=farshadow", p.stderr)
+            self.assertIn("use fewer ATLAS_STEPS, or raise MAX_MEMORY", p.stderr)
             self.assertNotIn("computes it window by window", p.stderr)
 
 
