@@ -306,6 +306,10 @@ def run(args):
                       % args.dest)
     block = block_size(args.tile_size)
     partial = args.dest + (".tiles.partial" if fmt == "COG" else ".partial")
+    dem = src.GetMetadataItem("SOURCE_DEM") or ""
+    if os.path.exists(dem) and os.path.exists(args.dest) and os.path.samefile(dem, args.dest):
+        raise Failure("DEST %s is the DEM itself: the product would replace it; write "
+                      "it to another file" % args.dest)
     out = create_like(src, partial, block, [] if fmt == "COG" else args.creation_options)
     size = (src.RasterXSize, src.RasterYSize, src.RasterCount)
     src = None

@@ -197,6 +197,20 @@ class Distributed(unittest.TestCase):
         finally:
             os.rmdir(dest)
 
+    def test_destination_is_the_dem(self):
+        """DEST naming the DEM (here by another path) is refused before any
+        work: the rename at the end would replace the DEM by the product."""
+        with open(self.dem, "rb") as f:
+            before = f.read()
+        dest = os.path.join(self.dir, ".", os.path.basename(self.dem))
+        p = distributed(["--workers", 1, T.conn(self.dem), dest], ok=False)
+        self.assertEqual(p.returncode, 1, p.stderr)
+        self.assertIn("is the DEM itself", p.stderr)
+        self.assertNotIn("Traceback", p.stderr)
+        with open(self.dem, "rb") as f:
+            self.assertEqual(f.read(), before)
+        self.assertFalse(os.path.exists(dest + ".partial"))
+
     def test_python_without_gdal(self):
         """A Python that cannot import osgeo (python3 first on PATH is often
         not the system one): a sentence and exit 1, even for --help."""
