@@ -104,6 +104,10 @@ static int check_range(const tsd_options *o, char *msg, size_t n)
         REFUSE("START_DATE=%s needs TIMEZONE, the offset from UTC of its local days (e.g. "
                "TIMEZONE=+02:00, or Z for UTC): without it the days' start is unknown",
                o->start_date);
+    /* at open, as the other combinations (the core refuses it too, on the first read) */
+    if (o->sun_position == TSD_SUN_PER_CELL)
+        REFUSE("SUN_POSITION=per_cell is not supported over a date range (START_DATE): its "
+               "sun is computed at one site, the DEM's centre; give SUN_POSITION=center");
     ts_date_range r;
     return tsd_sun_date_range(o, &r, NULL, NULL, msg, n) == TS_OK ? 0 : -1;
 }

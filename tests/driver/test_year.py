@@ -190,10 +190,15 @@ class Year(unittest.TestCase):
              "HORIZON_DIRECTIONS applies to a date range"),
             (["PRODUCT=sunhours", "START_DATE=1900-01-01", "END_DATE=2026-01-01"] + zone,
              "a century"),
-            # the core refuses a per-cell sun over a range: its sentence
+            # a per-cell sun over a range (refused at open too, below)
             (["PRODUCT=sunhours", "START_DATE=2026-03-19", "SUN_POSITION=per_cell"] + zone,
-             "not supported over a date range"),
+             "SUN_POSITION=per_cell is not supported over a date range (START_DATE)"),
         ]
+        # refused at open, as the other combinations: gdalinfo fails too
+        p = T.run(["gdalinfo", "-oo", "PRODUCT=insolation", "-oo", "START_DATE=2026-03-19",
+                   "-oo", "SUN_POSITION=per_cell"] + [a for o in zone for a in ("-oo", o)]
+                  + [T.conn(self.dem)], ok=False)
+        self.assertIn("SUN_POSITION=per_cell is not supported over a date range", p.stderr)
         out = os.path.join(self.dir, "bad.tif")
         for oo, text in cases:
             with self.subTest(oo=oo):
