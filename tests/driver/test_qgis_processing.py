@@ -38,6 +38,9 @@ PICKED = {"SKY": ["(none)", "uniform", "overcast", "clear"] + ["cie:%d" % n
                                                              for n in range(1, 16)]}
 SUNSET = os.path.join(T.DATA, "envmaps", "sunset.exr")
 SET_BY_PROVIDER = {"PRODUCT", "PROGRESS"}  # the algorithm's product; QGIS's progress bar
+# Numbers left empty by default, whose driver default depends on other options
+# (STEP_MINUTES: 5 for one day, 30 for a date range); a value given is passed.
+OPEN_DEFAULT = {"STEP_MINUTES"}
 DBL_MAX = 1.7976931348623157e308  # QgsProcessingParameterNumber's bounds when unbounded
 
 CHILD = r"""
@@ -104,6 +107,8 @@ os._exit(0)
 
 J = T.JACKSBORO
 DAY = {"DATE": "2026-12-21", "TIMEZONE": "-05:00", "STEP_MINUTES": 30}
+RANGE = {"START_DATE": "2026-06-01", "END_DATE": "2026-06-03", "DAY_INTERVAL": 2,
+         "TIMEZONE": "-05:00"}
 # name, algorithm, its parameters, the same as gdal_translate's open options
 CASES = [
     ("shade", "terrashade:shade",
@@ -128,6 +133,15 @@ CASES = [
      {"PRODUCT": "horizon", "DIRECTIONS": 4}),
     ("sunhours", "terrashade:sunhours", dict(DAY, INPUT=J),
      dict(DAY, PRODUCT="sunhours")),
+    # STEP_MINUTES: empty is the driver's default (5 for a day, 30 for a range);
+    # 5 given over a range is 5, although it is the option table's default
+    ("sunhours_day5", "terrashade:sunhours",
+     {"INPUT": J, "DATE": "2026-12-21", "TIMEZONE": "-05:00"},
+     {"PRODUCT": "sunhours", "DATE": "2026-12-21", "TIMEZONE": "-05:00"}),
+    ("range_step5", "terrashade:insolation", dict(RANGE, INPUT=J, STEP_MINUTES=5),
+     dict(RANGE, PRODUCT="insolation", STEP_MINUTES=5)),
+    ("range_default", "terrashade:insolation", dict(RANGE, INPUT=J),
+     dict(RANGE, PRODUCT="insolation")),
     ("envlight", "terrashade:envlight",  # a file, a rotation
      {"INPUT": J, "ENV_MAP": SUNSET, "ENV_ROTATION": 30, "DIRECTIONS": 8},
      {"PRODUCT": "envlight", "ENV_MAP": SUNSET, "ENV_ROTATION": 30, "DIRECTIONS": 8}),
@@ -165,6 +179,8 @@ def expected_parameter(option):
         return {"type": "file", "default": None}
     if option.get("name") in PICKED:
         return {"type": "enum", "options": PICKED[option.get("name")], "default": 0}
+    if option.get("name") in OPEN_DEFAULT:
+        default = None
     if kind in ("float", "int"):
         return {"type": "number", "integer": kind == "int",
                 "minimum": float(option.get("min", -DBL_MAX)),
@@ -266,6 +282,9 @@ class Processing(unittest.TestCase):
                     print("%-10s warned: %s" % (name, warned[0]))
                 else:
                     self.assertEqual(warned, [])
+        # the range's 5-minute step was not dropped as "the default" (30 there)
+        self.assertFalse(np.array_equal(T.read(result["range_step5"]["output"]),
+                                        T.read(result["range_default"]["output"])))
         for name, _, _ in BAD:
             print("%-10s -> %s" % (name, result[name].get("error")))
         # no day: the driver's sentence names DATE (and DATETIME)

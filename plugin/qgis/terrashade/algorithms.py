@@ -36,6 +36,10 @@ BASIC = ("SUN_AZIMUTH", "SUN_ELEVATION", "DATETIME", "METHOD", "SKY_WEIGHT", "DI
 # values (a choice whose first entry, NONE, leaves the option unset).
 FILES = {"ENV_MAP": "OpenEXR environment maps (*.exr *.EXR)"}
 NONE = "(none)"
+# Numbers whose driver default depends on the other options (STEP_MINUTES: 5
+# for one day, 30 for a date range): optional parameters with no value, which
+# leave the option to the driver; a value given is passed, even the table's.
+OPEN_DEFAULT = ("STEP_MINUTES",)
 PICKS = {"SKY": ["uniform", "overcast", "clear"] + ["cie:%d" % n for n in range(1, 16)]}
 # Short labels where the description's first clause is too long (see label()).
 LABELS = {
@@ -43,7 +47,7 @@ LABELS = {
     "SKY_WEIGHT": "Weight of the light of a uniform sky",
     "DATETIME": "Date and time (ISO 8601 with an offset)",
     "DATE": "Day (YYYY-MM-DD, local to the time zone)",
-    "STEP_MINUTES": "Time step (minutes)",
+    "STEP_MINUTES": "Time step (minutes; empty: 5 for one day, 30 for a date range)",
     "Z_FACTOR": "Z factor (multiplies the heights, e.g. 0.3048 for feet)",
     "BACKEND": "Backend",
     "ENV_MAP": "Environment map (OpenEXR, lat-long or cube)",
@@ -92,12 +96,14 @@ def default_value(option):
 
 def make_parameter(option):
     name, text, default = option.name, label(option), default_value(option)
+    if name in OPEN_DEFAULT:
+        default = None
     if option.kind in ("float", "int"):
         bounds = [-sys.float_info.max if option.minimum is None else option.minimum,
                   sys.float_info.max if option.maximum is None else option.maximum]
         p = QgsProcessingParameterNumber(
             name, text, QgsProcessingParameterNumber.Double if option.kind == "float"
-            else QgsProcessingParameterNumber.Integer, default, False, *bounds)
+            else QgsProcessingParameterNumber.Integer, default, name in OPEN_DEFAULT, *bounds)
     elif option.kind == "bool":
         p = QgsProcessingParameterBoolean(name, text, default)
     elif option.kind == "choice":
@@ -228,6 +234,8 @@ class TerrashadeAlgorithm(QgsProcessingAlgorithm):
     def option_text(self, option, parameters, context):
         """The open option a parameter stands for, or None for the driver's default."""
         name, kind = option.name, option.kind
+        if name in OPEN_DEFAULT and parameters.get(name) in (None, ""):
+            return None
         if name in PICKS:
             v = self.parameterAsEnum(parameters, name, context)
             return PICKS[name][v - 1] if v > 0 else None
@@ -250,6 +258,8 @@ class TerrashadeAlgorithm(QgsProcessingAlgorithm):
             v = text = (self.parameterAsString(parameters, name, context) or "").strip()
             if not text:
                 return None
+        if name in OPEN_DEFAULT:
+            return text
         return None if v == default_value(option) else text
 
     def open_options(self, parameters, context):
