@@ -38,6 +38,11 @@ int tsd_options_check_light(const tsd_options *o, char *msg, size_t n)
     if (shadowmap && o->sun_position == TSD_SUN_PER_CELL)
         REFUSE("METHOD=shadowmap renders one depth map for one light direction: it needs "
                "SUN_POSITION=center");
+    /* said at open (gdalinfo, a QGIS layer), not on the first read; DATETIME's
+     * sun is checked once it is computed (tsd_sun_setup) */
+    if (shadowmap && !tsd_options_sun_from_time(o) && !(o->sun_elevation > 0))
+        REFUSE("METHOD=shadowmap needs the light above the horizon: SUN_ELEVATION must be "
+               "greater than 0, got %g (METHOD=exact handles a low light)", o->sun_elevation);
     if (shadowmap && o->max_distance > 0)
         REFUSE("MAX_DISTANCE does not apply to METHOD=shadowmap (its depth map holds the "
                "whole DEM); use METHOD=exact");

@@ -134,6 +134,12 @@ ts_status tsd_sun_setup(const tsd_options *o, tsd_sites *sites, double min_cell_
         /* shade, shadow: the sun at DATETIME (tsd_run_init uses it) */
         if (ts_sun_at_site(&s->sites, &s->day, s->instant, &s->sun, &err) != TS_OK)
             return tsd_fail_core(msg, n, "cannot compute the sun's position", &err);
+        if (o->method == TSD_METHOD_SHADOWMAP && !(s->sun.elevation > 0))
+            return tsd_fail(msg, n, TS_ERR_ARG,
+                            "METHOD=shadowmap needs the light above the horizon: at DATETIME=%s "
+                            "the sun's elevation is %.2f degrees at the DEM's centre "
+                            "(METHOD=exact handles a low light)",
+                            o->datetime, s->sun.elevation);
         return TS_OK;
     }
 
