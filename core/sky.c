@@ -128,7 +128,7 @@ ts_status ts_sky_finish(const ts_grid *grid, int directions, float *svf_acc, flo
     if (directions < 1)
         return ts_fail(err, TS_ERR_ARG, "directions must be at least 1, got %d", directions);
     size_t n = (size_t)grid->width * grid->height;
-    /* Discretisation can overshoot 1 by ~1e-4 on steep open slopes. */
+    /* Into [0, 1] (cm_sky_clamp: discretisation and rounding leave it). */
     for (size_t i = 0; i < n; i++) {
         if (svf_acc)
             svf_acc[i] = cm_sky_clamp(svf_acc[i]);

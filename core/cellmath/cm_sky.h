@@ -65,10 +65,12 @@ CM_FN float cm_openness_term(float h, float nz)
 }
 
 /* The sums' last step: discretisation can overshoot 1 by ~1e-4 on steep
- * open slopes (svf and sky light); openness is the mean over directions. */
+ * open slopes (svf and sky light), and float rounding can leave ~-2e-8 on
+ * near-vertical cells (whose sum is 0); openness is the mean over
+ * directions. NaN (nodata) passes through. */
 CM_FN float cm_sky_clamp(float v)
 {
-    return v > 1.0f ? 1.0f : v;
+    return v > 1.0f ? 1.0f : v < 0.0f ? 0.0f : v;
 }
 
 #endif

@@ -168,5 +168,26 @@ class Products(unittest.TestCase):
             np.testing.assert_array_equal(hz[0, 0, :], -90)  # nothing beyond
 
 
+    def test_sky_terms_stay_in_range_on_near_vertical_cells(self):
+        """Spikes of up to 3000 m on 1 m cells: the svf and sky sums of
+        near-vertical cells are 0 but for float rounding, which once left
+        them at -1.4e-8 (and insolation's diffuse below 0); 0..1 and
+        >= 0 as documented."""
+        with T.TempDir() as tmp:
+            z = np.random.RandomState(0).rand(32, 32).astype(np.float32) * 3000
+            dem = T.write_tif(os.path.join(tmp, "spikes.tif"), z,
+                              (500000, 1, 0, 4000000, 0, -1), 32617)
+            for opts in ({"PRODUCT": "svf"}, {"PRODUCT": "sky"},
+                         {"PRODUCT": "svf", "TILE_SIZE": 64},
+                         {"PRODUCT": "svf", "HORIZON_METHOD": "pyramid"},
+                         {"PRODUCT": "insolation", "DATE": "2026-06-21",
+                          "TIMEZONE": "Z", "STEP_MINUTES": 60}):
+                with self.subTest(**opts):
+                    a = T.read(T.conn(dem, **opts))
+                    self.assertFalse(np.isnan(a).any())
+                    self.assertGreaterEqual(a.min(), 0)
+                    if opts["PRODUCT"] != "insolation":
+                        self.assertLessEqual(a.max(), 1)
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)
