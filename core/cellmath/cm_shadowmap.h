@@ -186,11 +186,48 @@ CM_FN int ts_sm_fetch(CM_GLOBAL const int *map, int mw, int mh, int a, int b)
     return a < 0 || b < 0 || a >= mw || b >= mh ? TS_SM_EMPTY : map[(long)b * mw + a];
 }
 
+/* A receiver: its projected centre (fu[0], fv[0], fd[0]) and the projected
+ * corners of its own triangles, the fan of the mesh around it (fu[1..6]:
+ * its neighbours E, SE, S, W, NW, N; triangle t joins corners t + 1 and
+ * t + 2, t = 5 corners 6 and 1; bit t of tri: all three corners valid). */
+typedef struct {
+    float fu[7], fv[7], fd[7];
+    int tri;
+} ts_sm_recv;
+
+/* The receiver's depth at texel (x, y): its own surface where a triangle of
+ * its fan covers the texel (the nearest the light of those that do), else
+ * its plane (depth slopes gu, gv). A tap compares the map with the
+ * receiver's surface, not its plane, where it can: the plane of a concave
+ * receiver (a valley floor) runs below its own fan, which then shadowed it
+ * through the map (under a light at 90 degrees, which nothing can hide,
+ * cells lost up to 0.61 of it). */
+CM_FN float ts_sm_recv_depth(const ts_sm_recv *r, float gu, float gv, float x, float y)
+{
+    float best = -INFINITY, px = x - r->fu[0], py = y - r->fv[0];
+    for (int t = 0; t < 6; t++) {
+        if (!((r->tri >> t) & 1))
+            continue;
+        int p = t + 1, q = t == 5 ? 1 : t + 2;
+        float au = r->fu[p] - r->fu[0], av = r->fv[p] - r->fv[0];
+        float bu = r->fu[q] - r->fu[0], bv = r->fv[q] - r->fv[0];
+        float det = au * bv - bu * av;
+        if (!(det > 1e-12f || det < -1e-12f)) /* seen edge-on */
+            continue;
+        float l1 = (px * bv - bu * py) / det, l2 = (au * py - px * av) / det;
+        if (!(l1 >= 0.0f && l2 >= 0.0f && l1 + l2 <= 1.0f))
+            continue;
+        float d = r->fd[0] + l1 * (r->fd[p] - r->fd[0]) + l2 * (r->fd[q] - r->fd[0]);
+        best = d > best ? d : best;
+    }
+    return best > -INFINITY ? best : r->fd[0] + gu * px + gv * py;
+}
+
 /* Lit share of one tap at (tu, tv): the comparisons at the four texels
  * around it, weighted bilinearly (the hardware filtering of shadow
- * textures), each against the receiver's plane at that texel. */
-CM_FN float ts_sm_tap(CM_GLOBAL const int *map, int mw, int mh, float u, float v, float depth,
-                      float gu, float gv, float tu, float tv)
+ * textures), each against the receiver at that texel (ts_sm_recv_depth). */
+CM_FN float ts_sm_tap(CM_GLOBAL const int *map, int mw, int mh, const ts_sm_recv *r, float gu,
+                      float gv, float tu, float tv)
 {
     float fa = floor(tu), fb = floor(tv);
     float wu = tu - fa, wv = tv - fb;
@@ -198,7 +235,7 @@ CM_FN float ts_sm_tap(CM_GLOBAL const int *map, int mw, int mh, float u, float v
     float dark = 0.0f; /* so that all lit is exactly 1 */
     for (int j = 0; j < 2; j++)
         for (int i = 0; i < 2; i++) {
-            float d = depth + gu * ((float)(a + i) - u) + gv * ((float)(b + j) - v);
+            float d = ts_sm_recv_depth(r, gu, gv, (float)(a + i), (float)(b + j));
             float w = (i ? wu : 1.0f - wu) * (j ? wv : 1.0f - wv);
             dark += ts_sm_fetch(map, mw, mh, a + i, b + j) > ts_sm_key(d) ? w : 0.0f;
         }
@@ -206,15 +243,16 @@ CM_FN float ts_sm_tap(CM_GLOBAL const int *map, int mw, int mh, float u, float v
 }
 
 /*
- * Lit fraction of a receiver at (u, v, depth) whose surface's depth slopes
- * by gu, gv metres per texel (receiver-plane bias: each tap compares the
- * map with the receiver's plane at that texel, so a wide kernel does not
- * shadow a slope by itself): the mean over nu x nv taps spread over a
+ * Lit fraction of the receiver r whose plane's depth slopes by gu, gv
+ * metres per texel (receiver-plane bias: each tap compares the map with
+ * the receiver at that texel, its fan or its plane, so a wide kernel does
+ * not shadow a slope by itself): the mean over nu x nv taps spread over a
  * ku x kv texel box around it.
  */
-CM_FN float ts_sm_pcf(CM_GLOBAL const int *map, int mw, int mh, float u, float v, float depth,
-                      float gu, float gv, float ku, float kv)
+CM_FN float ts_sm_pcf(CM_GLOBAL const int *map, int mw, int mh, const ts_sm_recv *r, float gu,
+                      float gv, float ku, float kv)
 {
+    const float u = r->fu[0], v = r->fv[0];
     int nu = (int)ceil(ku - 1e-3f), nv = (int)ceil(kv - 1e-3f);
     nu = nu < 1 ? 1 : nu > TS_SM_MAX_TAPS ? TS_SM_MAX_TAPS : nu;
     nv = nv < 1 ? 1 : nv > TS_SM_MAX_TAPS ? TS_SM_MAX_TAPS : nv;
@@ -223,7 +261,7 @@ CM_FN float ts_sm_pcf(CM_GLOBAL const int *map, int mw, int mh, float u, float v
         float tv = v + (((float)j + 0.5f) / (float)nv - 0.5f) * (nv > 1 ? kv : 0.0f);
         for (int i = 0; i < nu; i++) {
             float tu = u + (((float)i + 0.5f) / (float)nu - 0.5f) * (nu > 1 ? ku : 0.0f);
-            lit += ts_sm_tap(map, mw, mh, u, v, depth, gu, gv, tu, tv);
+            lit += ts_sm_tap(map, mw, mh, r, gu, gv, tu, tv);
         }
     }
     return lit / (float)(nu * nv);
@@ -235,9 +273,10 @@ CM_FN float ts_sm_pcf(CM_GLOBAL const int *map, int mw, int mh, float u, float v
  * (so that a straight edge across the light's view darkens the receiver
  * by the disk's area above it, as the exact method's disk does).
  */
-CM_FN float ts_sm_pcf_disk(CM_GLOBAL const int *map, int mw, int mh, float u, float v,
-                           float depth, float gu, float gv, float ru, float rv)
+CM_FN float ts_sm_pcf_disk(CM_GLOBAL const int *map, int mw, int mh, const ts_sm_recv *r,
+                           float gu, float gv, float ru, float rv)
 {
+    const float u = r->fu[0], v = r->fv[0];
     int nv = (int)ceil(2.0f * rv - 1e-3f);
     nv = nv < 1 ? 1 : nv > TS_SM_MAX_TAPS ? TS_SM_MAX_TAPS : nv;
     float lit = 0.0f, weight = 0.0f;
@@ -249,7 +288,7 @@ CM_FN float ts_sm_pcf_disk(CM_GLOBAL const int *map, int mw, int mh, float u, fl
         float row = 0.0f;
         for (int i = 0; i < nu; i++) {
             float x = nu > 1 ? (((float)i + 0.5f) / (float)nu * 2.0f - 1.0f) * chord : 0.0f;
-            row += ts_sm_tap(map, mw, mh, u, v, depth, gu, gv, u + x * ru, v + y * rv);
+            row += ts_sm_tap(map, mw, mh, r, gu, gv, u + x * ru, v + y * rv);
         }
         lit += chord * row / (float)nu;
         weight += chord;
@@ -260,14 +299,16 @@ CM_FN float ts_sm_pcf_disk(CM_GLOBAL const int *map, int mw, int mh, float u, fl
 /*
  * PCF_KERNEL=auto (percentage-closer soft shadows): search the map around
  * the receiver, over the width of the penumbra the farthest occluder could
- * cast, for blockers: texels nearer the light than the receiver's plane by
- * D, no farther than D tan(r) across (so that they hide part of the
- * light's disk). Their mean D sets the kernel to the penumbra of the disk
- * there, a disk of radius D tan(r) in light space. No blocker: fully lit.
+ * cast, for blockers: texels nearer the light than the receiver (its fan
+ * or its plane, ts_sm_recv_depth) by D, no farther than D tan(r) across
+ * (so that they hide part of the light's disk). Their mean D sets the
+ * kernel to the penumbra of the disk there, a disk of radius D tan(r) in
+ * light space. No blocker: fully lit.
  */
 CM_FN float ts_sm_pcf_auto(CM_GLOBAL const float *P, CM_GLOBAL const int *map, int mw, int mh,
-                           float u, float v, float depth, float gu, float gv)
+                           const ts_sm_recv *r, float gu, float gv)
 {
+    const float u = r->fu[0], v = r->fv[0], depth = r->fd[0];
     float tr = P[TS_SMP_TAN_R], cap = P[TS_SMP_SEARCH_CAP];
     float ds = 1.0f / P[TS_SMP_INV_DS], dt = 1.0f / P[TS_SMP_INV_DT];
     /* the nearest the light anything within the search's reach can be */
@@ -281,7 +322,7 @@ CM_FN float ts_sm_pcf_auto(CM_GLOBAL const float *P, CM_GLOBAL const int *map, i
                 top = k > top ? k : top;
             }
     if (top <= ts_sm_key(depth)) /* nothing near is nearer the light */
-        return ts_sm_tap(map, mw, mh, u, v, depth, gu, gv, u, v);
+        return ts_sm_tap(map, mw, mh, r, gu, gv, u, v);
     float reach = (ts_sm_unkey(top) - depth) * tr; /* metres */
     float hu = ts_sm_clampf(reach * P[TS_SMP_INV_DS], 0.0f, cap);
     float hv = ts_sm_clampf(reach * P[TS_SMP_INV_DT], 0.0f, cap);
@@ -296,7 +337,7 @@ CM_FN float ts_sm_pcf_auto(CM_GLOBAL const float *P, CM_GLOBAL const int *map, i
         for (int i = 0; i < nu; i++) {
             float tu = u + (nu > 1 ? ((float)i / (float)(nu - 1) * 2.0f - 1.0f) * hu : 0.0f);
             int a = (int)floor(tu + 0.5f);
-            float d = depth + gu * ((float)a - u) + gv * ((float)b - v);
+            float d = ts_sm_recv_depth(r, gu, gv, (float)a, (float)b);
             int k = ts_sm_fetch(map, mw, mh, a, b);
             if (!(k > ts_sm_key(d)))
                 continue;
@@ -313,28 +354,26 @@ CM_FN float ts_sm_pcf_auto(CM_GLOBAL const float *P, CM_GLOBAL const int *map, i
         }
     }
     if (blockers == 0) /* a hard shadow's edge at most */
-        return ts_sm_tap(map, mw, mh, u, v, depth, gu, gv, u, v);
+        return ts_sm_tap(map, mw, mh, r, gu, gv, u, v);
     float rad = sum * tr; /* the disk's radius there, metres */
-    return ts_sm_pcf_disk(map, mw, mh, u, v, depth, 0.0f, 0.0f, rad * P[TS_SMP_INV_DS],
+    return ts_sm_pcf_disk(map, mw, mh, r, 0.0f, 0.0f, rad * P[TS_SMP_INV_DS],
                           rad * P[TS_SMP_INV_DT]);
 }
 
 /*
- * Lit fraction of the cell whose projected centre is (u, v, depth), with
- * the projected centres of its neighbours west/east (uw..de) and
- * north/south (un..ds) (the cell itself where one is missing): they give
- * the receiver's depth slope. NaN for nodata.
+ * Lit fraction of the receiver r (its neighbours east, west, north and
+ * south, the cell itself where one is missing, give its plane's depth
+ * slope). NaN for nodata.
  */
 CM_FN float ts_sm_cell(CM_GLOBAL const float *P, CM_GLOBAL const int *map, int mw, int mh,
-                       float u, float v, float depth, float uw, float vw, float dw, float ue,
-                       float ve, float de, float un, float vn, float dn, float us, float vs,
-                       float ds)
+                       const ts_sm_recv *r)
 {
-    if (isnan(depth))
-        return depth;
-    /* the plane through the two central differences, in (u, v, depth) */
-    float au = ue - uw, av = ve - vw, ad = de - dw;
-    float bu = us - un, bv = vs - vn, bd = ds - dn;
+    if (isnan(r->fd[0]))
+        return r->fd[0];
+    /* the plane through the two central differences, E - W and S - N, in
+     * (u, v, depth) */
+    float au = r->fu[1] - r->fu[4], av = r->fv[1] - r->fv[4], ad = r->fd[1] - r->fd[4];
+    float bu = r->fu[3] - r->fu[6], bv = r->fv[3] - r->fv[6], bd = r->fd[3] - r->fd[6];
     float nu = av * bd - ad * bv, nv = ad * bu - au * bd, nd = au * bv - av * bu;
     float cap = P[TS_SMP_SLOPE_CAP], gu = 0.0f, gv = 0.0f;
     /* nd > 0: the surface faces the light (flat ground under a light above
@@ -347,8 +386,8 @@ CM_FN float ts_sm_cell(CM_GLOBAL const float *P, CM_GLOBAL const int *map, int m
     }
     float ku = P[TS_SMP_KERNEL_U];
     if (ku > 0.0f)
-        return ts_sm_pcf(map, mw, mh, u, v, depth, gu, gv, ku, P[TS_SMP_KERNEL_V]);
-    return ts_sm_pcf_auto(P, map, mw, mh, u, v, depth, gu, gv);
+        return ts_sm_pcf(map, mw, mh, r, gu, gv, ku, P[TS_SMP_KERNEL_V]);
+    return ts_sm_pcf_auto(P, map, mw, mh, r, gu, gv);
 }
 
 /* Render the two triangles of the quad whose north-west corner is vertex
@@ -423,9 +462,21 @@ CM_FN float ts_sm_cell_at(CM_GLOBAL const float *P, CM_GLOBAL const int *map, in
     float near = ts_sm_near(P, pu, pv, pd, i, ring);
     if (!(near > 0.0f)) /* in its own shadow: the map cannot add light */
         return 0.0f;
-    float lit = ts_sm_cell(P, map, mw, mh, pu[i], pv[i], pd[i], pu[ring[6]], pv[ring[6]],
-                           pd[ring[6]], pu[ring[2]], pv[ring[2]], pd[ring[2]], pu[ring[0]],
-                           pv[ring[0]], pd[ring[0]], pu[ring[4]], pv[ring[4]], pd[ring[4]]);
+    /* the fan: E, SE, S, W, NW, N (the mesh's diagonals run NW-SE) */
+    const int fan[6] = {2, 3, 4, 6, 7, 0};
+    ts_sm_recv r;
+    r.fu[0] = pu[i];
+    r.fv[0] = pv[i];
+    r.fd[0] = pd[i];
+    r.tri = 0;
+    for (int k = 0; k < 6; k++) {
+        long j = ring[fan[k]];
+        r.fu[k + 1] = pu[j];
+        r.fv[k + 1] = pv[j];
+        r.fd[k + 1] = pd[j];
+        r.tri |= (j != i && ring[fan[(k + 1) % 6]] != i) << k;
+    }
+    float lit = ts_sm_cell(P, map, mw, mh, &r);
     return near < lit ? near : lit;
 }
 
