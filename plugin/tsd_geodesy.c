@@ -10,13 +10,50 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* A grid-registered (node) grid, as ETOPO1's "_g_" ones, has rows centred
+ * on a pole, whose cells reach half a cell past it, and, global, a last
+ * column that repeats the first meridian. Where that is all that takes a
+ * geographic DEM (north-up gt) past the Earth's limits, say so in what and
+ * fill the crop (-projwin) that removes them; else 0. */
+static int grid_registered(const double gt[6], int width, int height, double crop[4],
+                           char *what, size_t n)
+{
+    double top = gt[3], bottom = gt[3] + height * gt[5], cell = fabs(gt[5]);
+    double dlon = fabs(gt[1]), x1 = gt[0] + width * gt[1];
+    int north = top > 90 + 1e-9 && top - 0.5 * cell <= 90 + 1e-9;
+    int south = bottom < -90 - 1e-9 && bottom + 0.5 * cell >= -90 - 1e-9;
+    int meridian = width * dlon > 360 + 1e-9 && (width - 1) * dlon <= 360 + 1e-9;
+    crop[0] = fmin(gt[0], x1);
+    crop[1] = north ? top - cell : top;
+    crop[2] = fmax(gt[0], x1) - (meridian ? dlon : 0);
+    crop[3] = south ? bottom + cell : bottom;
+    if (!(north || south || meridian) || fabs(crop[1]) > 90 + 1e-9 ||
+        fabs(crop[3]) > 90 + 1e-9 || !(crop[1] > crop[3]) || !(crop[2] > crop[0]))
+        return 0;
+    const char *rows = north && south ? "its northern and southern rows lie on the poles"
+                       : north             ? "its northern row lies on the pole"
+                       : south             ? "its southern row lies on the pole"
+                                           : "";
+    snprintf(what, n, "%s%s%s", rows, *rows && meridian ? ", " : "",
+             !meridian ? "" : *rows ? "its last column on the first meridian again"
+                                    : "its last column lies on the first meridian again");
+    return 1;
+}
+
 /* Geodesic cell sizes of a geographic DEM; gt in degrees. */
 static ts_status geographic(const double gt[6], int width, int height, double a,
                       double invf, tsd_cells *c, char *msg, size_t n)
 {
     struct geod_geodesic g;
     double top = gt[3], bottom = gt[3] + height * gt[5];
-    double dlon = fabs(gt[1]);
+    double dlon = fabs(gt[1]), crop[4];
+    char what[160];
+    if (grid_registered(gt, width, height, crop, what, sizeof what))
+        return tsd_fail(msg, n, TS_ERR_ARG,
+                    "the DEM reaches beyond the Earth (latitudes %g to %g, %g degrees of "
+                    "longitude): %s, as in a grid-registered grid; crop those cells off, e.g. "
+                    "gdal_translate -projwin %.10g %.10g %.10g %.10g dem.tif cropped.tif",
+                    bottom, top, width * dlon, what, crop[0], crop[1], crop[2], crop[3]);
     if (fabs(top) > 90 + 1e-9 || fabs(bottom) > 90 + 1e-9)
         return tsd_fail(msg, n, TS_ERR_ARG,
                     "the DEM reaches beyond the poles (latitudes %g to %g); its "

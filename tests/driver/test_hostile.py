@@ -347,7 +347,15 @@ class Hostile(unittest.TestCase):
         geo = [("beyond the pole", (0, 0.1, 0, 95, 0, -0.1),
                 "the DEM reaches beyond the poles (latitudes 88.6 to 95)"),
                ("more than 360 degrees", (-180, 10, 0, 80, 0, -1),
-                "the DEM spans 640 degrees of longitude")]
+                "the DEM spans 640 degrees of longitude"),
+               # grid-registered (node) grids: which rows and column to crop, and how
+               ("a row on the north pole", (0, 0.5, 0, 90.25, 0, -0.5),
+                "its northern row lies on the pole, as in a grid-registered grid; crop "
+                "those cells off, e.g. gdal_translate -projwin 0 89.75 32 58.25 "),
+               ("a row on the south pole, a repeated meridian",
+                (-180 - 180 / 63, 360 / 63, 0, -58.25, 0, -0.5),
+                "its southern row lies on the pole, its last column on the first "
+                "meridian again")]
         for i, (n, gt, t) in enumerate(geo):
             dem = T.write_tif(self.path("geo%d.tif" % i), z, gt, 4326)
             cases.append((n, ["gdal_translate", "-q", T.conn(dem),
