@@ -160,10 +160,12 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
     p->near_m = p->far ? near : o->max_distance;
     const int need = TSD_NEAR_MIN_CELLS;
     if (p->far && near < need * cell) {
+        /* cells rounded down and metres up, so that the message never says 16.0
+         * of 16 nor names a distance that is refused again */
         tsd_fail(msg, n, TS_ERR_ARG,
-                 "NEAR_DISTANCE=%g m is %.1f cells of this DEM; the near field needs at "
+                 "NEAR_DISTANCE=%g m is %.2f cells of this DEM; the near field needs at "
                  "least %d cells (%.0f m): give a larger NEAR_DISTANCE, or 0 for %d cells",
-                 near, near / cell, need, need * cell,
+                 near, floor(near / cell * 100) / 100, need, ceil(need * cell),
                  TSD_NEAR_AUTO_CELLS > TSD_FAR_CELLS_PER_NEAR * f_mem
                      ? TSD_NEAR_AUTO_CELLS
                      : TSD_FAR_CELLS_PER_NEAR * f_mem);

@@ -329,6 +329,18 @@ class Windows(unittest.TestCase):
         self.refused({"TILE_SIZE": 128, "NEAR_DISTANCE": 300},
                      ["NEAR_DISTANCE=300 m is", "cells of this DEM", "at least 16 cells"])
 
+    def test_near_distance_refusal_names_a_distance_that_is_accepted(self):
+        """Cells of 30.02 m: 16 cells are 480.32 m. The refusal of 480 m once
+        said "16.0 cells" and asked for "16 cells (480 m)", the distance it
+        had refused; now 15.98 cells, and 481 m, which opens."""
+        z = T.fractal_dem(300, seed=3)
+        dem = T.write_tif(os.path.join(self.tmp, "cells3002.tif"), z,
+                          (500000, 30.02, 0, 4000000, 0, -30.02), 32617)
+        opts = {"TILE_SIZE": 128, "PRODUCT": "svf", "DIRECTIONS": 4}
+        self.refused(dict(opts, NEAR_DISTANCE=480),
+                     ["NEAR_DISTANCE=480 m is 15.98 cells", "at least 16 cells (481 m)"], dem)
+        self.assertTrue(np.isfinite(product(dem, NEAR_DISTANCE=481, **opts)).all())
+
     def test_overviews_disagree(self):
         """A DEM whose overviews are of other heights would give a far field
         of other terrain: refused, with what to do. The far grid is this DEM
