@@ -34,10 +34,17 @@ static double clamp1(double x)
     return x < -1.0 ? -1.0 : x > 1.0 ? 1.0 : x;
 }
 
+/* Which part of a pixel a texel is: the pixel cut into nx x ny equal
+ * parts (in longitude and latitude, or in the face's u and v), part
+ * (ix, iy); 1 x 1 is the whole pixel at its own centre. */
+typedef struct {
+    int nx, ny, ix, iy;
+} pixel_part;
+
 /* LatLongMap::latLong and ::direction: pixel centres on the poles and on
  * longitude +-pi at both ends (spacings divide by w-1 and h-1); a pixel
  * covers half a spacing either side, clipped to the sphere. */
-static void latlong_pixel(int w, int h, int i, int j, pixel_geom *g)
+static void latlong_pixel(int w, int h, int i, int j, const pixel_part *q, pixel_geom *g)
 {
     double dlat = M_PI / (h - 1), dlon = 2.0 * M_PI / (w - 1);
     double lat = 0.5 * M_PI - j * dlat;
@@ -45,6 +52,14 @@ static void latlong_pixel(int w, int h, int i, int j, pixel_geom *g)
     double top = fmin(lat + 0.5 * dlat, 0.5 * M_PI);
     double bottom = fmax(lat - 0.5 * dlat, -0.5 * M_PI);
     double span = (i == 0 || i == w - 1) ? 0.5 * dlon : dlon;
+    if (q->nx * q->ny > 1) {
+        double east = i == 0 ? lon : lon + 0.5 * dlon, rise = (top - bottom) / q->ny;
+        span /= q->nx;
+        lon = east - (q->ix + 0.5) * span;
+        top -= q->iy * rise;
+        bottom = top - rise;
+        lat = 0.5 * (top + bottom);
+    }
     g->dir[0] = sin(lon) * cos(lat);
     g->dir[1] = sin(lat);
     g->dir[2] = cos(lon) * cos(lat);
@@ -62,7 +77,7 @@ static double face_rect_solid_angle(double u0, double v0, double u1, double v1)
 
 /* CubeMap: image pixel (x, y) of a w x 6w map. The face position (px, py)
  * inverts CubeMap::pixelPosition, the direction is CubeMap::direction. */
-static void cube_pixel(int w, int x, int y, pixel_geom *g)
+static void cube_pixel(int w, int x, int y, const pixel_part *q, pixel_geom *g)
 {
     int face = y / w, yf = y - face * w, m = w - 1;
     int px, py;
@@ -80,8 +95,15 @@ static void cube_pixel(int w, int x, int y, pixel_geom *g)
         v = 2.0 * py / m - 1.0;
         half = 1.0 / m;
     }
-    g->solid_angle = face_rect_solid_angle(clamp1(u - half), clamp1(v - half), clamp1(u + half),
-                                           clamp1(v + half));
+    double u0 = clamp1(u - half), v0 = clamp1(v - half), u1 = clamp1(u + half);
+    double v1 = clamp1(v + half);
+    if (q->nx * q->ny > 1) {
+        double du = (u1 - u0) / q->nx, dv = (v1 - v0) / q->ny;
+        u0 += q->ix * du, v0 += q->iy * dv;
+        u1 = u0 + du, v1 = v0 + dv;
+        u = 0.5 * (u0 + u1), v = 0.5 * (v0 + v1);
+    }
+    g->solid_angle = face_rect_solid_angle(u0, v0, u1, v1);
     double s = (face & 1) ? -1.0 : 1.0;
     switch (face / 2) {
     case 0: g->dir[0] = s; g->dir[1] = u; g->dir[2] = v; break;
@@ -126,6 +148,32 @@ static int block_size(const panel_split *p, size_t max_texels)
     return k;
 }
 
+/* Texels wider than this many degrees are cut into parts (with the
+ * pixel's radiance over each part's exact solid angle): a texel's light
+ * comes from its centre, so a coarse map put the light of whole caps and
+ * rows in one direction (a 4 x 2 map of radiance 1 lit flat ground as 2, a
+ * 1 x 6 cube as 0.67). One degree is the light table's default step. */
+#define TS_ENV_PART_DEG 1.0
+
+/* The parts of a pixel for img: 1 x 1 for maps of one-degree pixels or
+ * finer, else parts of at most TS_ENV_PART_DEG (their count kept within
+ * max_texels). */
+static pixel_part parts_of(const env_image *img, size_t pixels, size_t max_texels)
+{
+    pixel_part q = {1, 1, 0, 0};
+    double rad = TS_ENV_PART_DEG * M_PI / 180.0, sx, sy;
+    if (img->layout == ENV_CUBE) /* widest at the face's centre: du = 2 / (w - 1) */
+        sx = sy = (img->width > 1 ? 2.0 / (img->width - 1) : 2.0) / rad;
+    else
+        sx = 2.0 * M_PI / (img->width - 1) / rad, sy = M_PI / (img->height - 1) / rad;
+    sx = ceil(sx - 1e-9), sy = ceil(sy - 1e-9);
+    double f = (double)max_texels / ((double)pixels * sx * sy);
+    if (f < 1.0) /* within max_texels */
+        sx = fmax(1.0, floor(sx * sqrt(f))), sy = fmax(1.0, floor(sy * sqrt(f)));
+    q.nx = (int)sx, q.ny = (int)sy;
+    return q;
+}
+
 /* Accumulates the pixels of one block: solid angle, solid-angle-weighted
  * radiance, and the directions weighted by solid angle (dir) and by
  * power, r + g + b times solid angle (lit_dir). */
@@ -135,8 +183,8 @@ typedef struct {
 } block_sum;
 
 /* Add pixel (x, y); TS_ERR_ARG when it is not finite. */
-static ts_status add_pixel(const env_image *img, int x, int y, block_sum *b, const char *name,
-                           ts_error *err)
+static ts_status add_pixel(const env_image *img, int x, int y, const pixel_part *q, block_sum *b,
+                           const char *name, ts_error *err)
 {
     const float *px = img->rgb + ((size_t)y * (size_t)img->width + (size_t)x) * 3;
     for (int c = 0; c < 3; c++)
@@ -147,9 +195,9 @@ static ts_status add_pixel(const env_image *img, int x, int y, block_sum *b, con
                            name, x, y, isnan(px[c]) ? "NaN" : "infinite");
     pixel_geom g;
     if (img->layout == ENV_CUBE)
-        cube_pixel(img->width, x, y, &g);
+        cube_pixel(img->width, x, y, q, &g);
     else
-        latlong_pixel(img->width, img->height, x, y, &g);
+        latlong_pixel(img->width, img->height, x, y, q, &g);
     double len = sqrt(g.dir[0] * g.dir[0] + g.dir[1] * g.dir[1] + g.dir[2] * g.dir[2]);
     if (b->solid_angle == 0.0)
         for (int c = 0; c < 3; c++)
@@ -236,6 +284,10 @@ ts_status env_from_image(const env_image *img, double rotation_deg, size_t max_t
     panel_split p = split_of(img);
     int k = block_size(&p, max_texels);
     size_t count = texels_for_block(&p, k);
+    pixel_part q = {1, 1, 0, 0};
+    if (max_texels != 0 && k == 1) /* a map fit for lighting: coarse pixels cut */
+        q = parts_of(img, count, max_texels);
+    count *= (size_t)q.nx * (size_t)q.ny;
     ts_env_texel *texels = malloc(count * sizeof *texels);
     if (!texels)
         return ts_fail(err, TS_ERR_NOMEM, "no memory for the %zu texels of environment map '%s'",
@@ -245,21 +297,23 @@ ts_status env_from_image(const env_image *img, double rotation_deg, size_t max_t
     size_t n = 0;
     for (int panel = 0; panel < p.panels; panel++)
         for (int by = 0; by < p.panel_h; by += k)
-            for (int bx = 0; bx < p.panel_w; bx += k) {
-                block_sum b;
-                memset(&b, 0, sizeof b);
-                int y1 = by + k < p.panel_h ? by + k : p.panel_h;
-                int x1 = bx + k < p.panel_w ? bx + k : p.panel_w;
-                for (int y = by; y < y1; y++)
-                    for (int x = bx; x < x1; x++) {
-                        st = add_pixel(img, x, panel * p.panel_h + y, &b, name, err);
-                        if (st != TS_OK) {
-                            free(texels);
-                            return st;
+            for (int bx = 0; bx < p.panel_w; bx += k)
+                for (int part = 0; part < q.nx * q.ny; part++) {
+                    block_sum b;
+                    memset(&b, 0, sizeof b);
+                    q.ix = part % q.nx, q.iy = part / q.nx;
+                    int y1 = by + k < p.panel_h ? by + k : p.panel_h;
+                    int x1 = bx + k < p.panel_w ? bx + k : p.panel_w;
+                    for (int y = by; y < y1; y++)
+                        for (int x = bx; x < x1; x++) {
+                            st = add_pixel(img, x, panel * p.panel_h + y, &q, &b, name, err);
+                            if (st != TS_OK) {
+                                free(texels);
+                                return st;
+                            }
                         }
-                    }
-                block_texel(&b, cos_r, sin_r, &texels[n++]);
-            }
+                    block_texel(&b, cos_r, sin_r, &texels[n++]);
+                }
     out->count = n;
     out->texels = texels;
     return ts_ok(err);

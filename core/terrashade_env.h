@@ -120,7 +120,10 @@ ts_status ts_env_from_cube(const float *rgb, int face_size, double rotation_deg,
  * energy), its direction the mean of theirs weighted by power (r + g + b
  * times solid angle; by solid angle in a black block), normalised, so that
  * a bright spot (the sun) keeps its direction. A hint: a cube map keeps at
- * least 6 texels.
+ * least 6 texels. With max_texels, a map coarser than one degree a pixel
+ * is cut the other way: each pixel into parts of at most a degree (each
+ * the pixel's radiance over its exact solid angle, their count within
+ * max_texels), since a texel's light comes from its centre.
  *
  * Errors (TS_ERR_ARG, a sentence naming the file): missing or unreadable
  * file, not an OpenEXR file, damaged or truncated data, deep data, no

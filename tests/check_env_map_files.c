@@ -280,6 +280,42 @@ static const char *small_map(const char *name, int w, int h, int envmap,
     return path;
 }
 
+/* Maps coarser than a degree a pixel keep their light: with max_texels the
+ * pixels are cut into parts (a 4 x 2 map of radiance 1 lit a level plane
+ * as 2 from its one zenith texel, a 1 x 6 cube as 0.67); without, one
+ * texel per pixel as documented. */
+START_TEST(test_coarse_maps_cut)
+{
+    static const struct {
+        int w, h, envmap;
+        size_t pixels;
+    } maps[] = {{4, 2, EXR_ENVMAP_LATLONG, 8}, {2, 2, EXR_ENVMAP_LATLONG, 4},
+                {6, 3, EXR_ENVMAP_LATLONG, 18}, {1, 6, EXR_ENVMAP_CUBE, 6},
+                {2, 12, EXR_ENVMAP_CUBE, 24}, {3, 18, EXR_ENVMAP_CUBE, 54}};
+    const double up[3] = {0, 0, 1}, tilt[3] = {0, sin(0.7), cos(0.7)};
+    for (size_t k = 0; k < sizeof maps / sizeof maps[0]; k++) {
+        const char *p = small_map("coarse.exr", maps[k].w, maps[k].h, maps[k].envmap, RGB, 3,
+                                  1.0f);
+        ts_env e;
+        ts_error err;
+        ck_assert_int_eq(ts_env_load_exr_file(p, 0.0, 0, &e, &err), TS_OK);
+        ck_assert_uint_eq(e.count, maps[k].pixels);
+        ts_env_free(&e);
+        ck_assert_int_eq(ts_env_load_exr_file(p, 0.0, (size_t)1 << 21, &e, &err), TS_OK);
+        double flat[3], slope[3];
+        tenv_irradiance(&e, up, flat);
+        tenv_irradiance(&e, tilt, slope);
+        printf("%d x %d: %zu texels, level plane %.6f pi, slope %.6f pi\n", maps[k].w,
+               maps[k].h, e.count, flat[0] / M_PI, slope[0] / M_PI);
+        ck_assert_double_eq_tol(tenv_total_solid_angle(&e) / (4 * M_PI), 1.0, 1e-5);
+        ck_assert_double_eq_tol(flat[0] / M_PI, 1.0, 1e-3);
+        ck_assert_double_eq_tol(slope[0] / M_PI, 1.0, 1e-3); /* the whole sphere lit */
+        ck_assert_uint_le(e.count, (size_t)1 << 21);
+        ts_env_free(&e);
+    }
+}
+END_TEST
+
 /* ts_env_exr_info: the layout, channels and size from the header alone,
  * and the same refusals as the reader for what the header shows. */
 START_TEST(test_header_info)
@@ -435,6 +471,7 @@ int main(void)
     tcase_add_test(ok, test_variants_cube);
     tcase_add_test(ok, test_dwa_from_memory);
     tcase_add_test(ok, test_header_info);
+    tcase_add_test(ok, test_coarse_maps_cut);
     suite_add_tcase(s, ok);
     TCase *bad = tcase_create("bad input");
     tcase_add_test(bad, test_bad_files);

@@ -61,7 +61,7 @@ class EnvLight(unittest.TestCase):
 
     def test_constant_environment_is_the_sky_product(self):
         # a texel row cut by the horizon counts wholly on one side: maps of
-        # 0.18 degree rows and faces (1024 x 512: 1.4e-3; 128 x 64: 1 %)
+        # 0.18 degree rows and faces (1024 x 512: 1.4e-3; 128 x 64: 0.3 %)
         const = write_exr(self.path("const.exr"), np.ones((1024, 2048, 3)))
         cube = self.path("const_cube.exr")
         T.run(["exrenvmap", "-c", "-w", "512", const, cube])
@@ -78,6 +78,28 @@ class EnvLight(unittest.TestCase):
                           % (dirs, name, c + 1, d))
                     self.assertLessEqual(d, 1e-3)
                     self.assertTrue(np.array_equal(np.isnan(rgb[c]), np.isnan(sky)))
+
+    def test_coarse_maps_keep_their_light(self):
+        # pixels wider than a degree are cut into parts: each part's light
+        # came from the pixel's centre before (4 x 2 of radiance 1 lit flat
+        # ground as 2, 6 x 3 as 0.59, a cube of 1-pixel faces as 0.67)
+        sky = T.read(T.conn(T.JACKSBORO), band=1,
+                     options=dict(PRODUCT="sky", DIRECTIONS=8, PROGRESS="no"))
+        maps = [("latlong", 2, 4), ("latlong", 2, 2), ("latlong", 3, 6), ("latlong", 5, 10),
+                ("cube", 6, 1), ("cube", 12, 2), ("cube", 18, 3)]
+        for layout, h, w in maps:
+            img = np.ones((h, w, 3)) * [1.0, 2.0, 3.0]
+            path = write_exr(self.path("coarse_%s_%dx%d.exr" % (layout, w, h)), img,
+                             envmap=layout)
+            ds = gdal.OpenEx(T.conn(T.JACKSBORO), open_options=[
+                "PRODUCT=envlight", "ENV_MAP=" + path, "DIRECTIONS=8"])
+            flat = [float(v) for v in ds.GetMetadataItem("ENV_FLAT_LIGHT").split(",")]
+            rgb = envlight(T.JACKSBORO, ENV_MAP=path, DIRECTIONS=8)
+            worst = max(np.nanmax(np.abs(rgb[c] / (c + 1) - sky)) for c in range(3))
+            print("%s %d x %d: flat light %s, max |envlight / L - sky| %.2e"
+                  % (layout, w, h, flat, worst))
+            np.testing.assert_allclose(flat, [1, 2, 3], rtol=1e-4)
+            self.assertLessEqual(worst, 5e-3)
 
     def test_bright_patch_shades_like_the_sun_there(self):
         w, h = 1024, 512
