@@ -170,7 +170,9 @@ ts_status ts_day_uniform_times(double start_unix, double length_s,
  * above -TS_SUN_RADIUS_DEG, sampled more densely near dawn and dusk: the
  * instants are the midpoints of n equal shares of the integral of
  * w(t) = 1 / max(sin e(t), sin 2 deg) over the daylight (e = apparent sun
- * elevation, evaluated every minute and interpolated linearly). *n_out is
+ * elevation, evaluated every minute and interpolated linearly; the
+ * minutes of sunrise and sunset count from or up to that instant, so every
+ * instant has the sun's upper limb up). *n_out is
  * n, or 0 when the sun does not rise (polar night).
  */
 ts_status ts_day_atlas_times(const ts_sun_sites *sites, const ts_day_opts *o,

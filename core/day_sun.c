@@ -279,6 +279,28 @@ ts_status ts_day_uniform_times(double start_unix, double length_s, double step_s
     return ts_ok(err);
 }
 
+/* Where in [a, a + dt] the sun's upper limb crosses the horizon (it is up
+ * at one end only): the fraction of dt at the lit side of the crossing, by
+ * bisection (to 1e-6 of the minute). */
+static ts_status limb_crossing(const ts_sun_sites *sites, const ts_day_opts *o, int node,
+                               double a, double dt, int rising, double *frac, ts_error *err)
+{
+    double lo = 0.0, hi = 1.0;
+    for (int i = 0; i < 20; i++) {
+        double mid = 0.5 * (lo + hi);
+        ts_sun_sample s;
+        ts_status st = ts_day_node_sun(sites, o, node, a + mid * dt, &s, err);
+        if (st != TS_OK)
+            return st;
+        if ((s.elevation > -TS_SUN_RADIUS_DEG) == rising)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    *frac = rising ? hi : lo;
+    return TS_OK;
+}
+
 ts_status ts_day_atlas_times(const ts_sun_sites *sites, const ts_day_opts *o,
                              double start_unix, double length_s, int n,
                              double *times, int *n_out, ts_error *err)
@@ -295,27 +317,39 @@ ts_status ts_day_atlas_times(const ts_sun_sites *sites, const ts_day_opts *o,
     double dt = length_s / m;
     double *c = malloc((size_t)(m + 1) * sizeof *c);
     double *w = malloc((size_t)(m + 1) * sizeof *w);
-    if (!c || !w) {
-        free(c);
-        free(w);
+    double *lit = malloc(2 * (size_t)m * sizeof *lit); /* lit part of each minute */
+    if (!c || !w || !lit) {
+        free(c), free(w), free(lit);
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the sun's track");
     }
     const double wmax = 1.0 / sin(2.0 * DEG2RAD);
     int node = ts_day_ref_node(sites);
-    for (int k = 0; k <= m; k++) {
+    for (int k = 0; k <= m && st == TS_OK; k++) {
         ts_sun_sample s;
-        if ((st = ts_day_node_sun(sites, o, node, start_unix + k * dt, &s, err)) != TS_OK) {
-            free(c);
-            free(w);
-            return st;
-        }
+        if ((st = ts_day_node_sun(sites, o, node, start_unix + k * dt, &s, err)) != TS_OK)
+            break;
         double e = s.elevation;
         w[k] = e > -TS_SUN_RADIUS_DEG ? fmin(wmax, 1.0 / sin(fmax(e, 2.0) * DEG2RAD)) : 0.0;
     }
+    /* A minute in which the sun rises or sets counts from or up to the
+     * instant it does (w is wmax there), so that no instant falls while
+     * the sun is below the horizon: interpolated across the minute, a map
+     * could show the sun 0.9 deg down (the SPA's refraction starts there). */
     c[0] = 0;
-    for (int k = 0; k < m; k++)
-        c[k + 1] = c[k] + 0.5 * (w[k] + w[k + 1]) * dt;
-    double total = c[m];
+    for (int k = 0; k < m && st == TS_OK; k++) {
+        double a = 0.0, b = 1.0, wa = w[k], wb = w[k + 1];
+        if ((wa > 0) != (wb > 0)) {
+            double x = 0.5;
+            st = limb_crossing(sites, o, node, start_unix + k * dt, dt, wb > 0, &x, err);
+            if (wb > 0)
+                a = x, wa = wmax;
+            else
+                b = x, wb = wmax;
+        }
+        lit[2 * k] = a, lit[2 * k + 1] = b;
+        c[k + 1] = c[k] + 0.5 * (wa + wb) * (b - a) * dt;
+    }
+    double total = st == TS_OK ? c[m] : 0.0;
     if (total > 0) {
         int k = 0;
         for (int i = 0; i < n; i++) {
@@ -324,12 +358,10 @@ ts_status ts_day_atlas_times(const ts_sun_sites *sites, const ts_day_opts *o,
                 k++;
             double span = c[k + 1] - c[k];
             double f = span > 0 ? (target - c[k]) / span : 0.5;
-            times[i] = start_unix + (k + f) * dt;
+            times[i] = start_unix + (k + lit[2 * k] + f * (lit[2 * k + 1] - lit[2 * k])) * dt;
         }
         *n_out = n;
     }
-    free(c);
-    free(w);
-    return ts_ok(err);
+    free(c), free(w), free(lit);
+    return st == TS_OK ? ts_ok(err) : st;
 }
-

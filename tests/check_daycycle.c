@@ -389,6 +389,39 @@ START_TEST(test_atlas_times)
 }
 END_TEST
 
+/* Every atlas instant has the sun's upper limb up, also the first and last
+ * of many maps: the minute of sunrise counts from sunrise on. Before, an
+ * instant interpolated across that minute could fall while the sun was
+ * 0.9 deg down (36 N, 21 June: map 1 of the default 158 at -0.86 deg). */
+START_TEST(test_atlas_times_sun_up)
+{
+    ts_error err;
+    static const double sites[][3] = {{36.3, -84.2, -300}, {46.5, 7.9, 120}, {66.0, 25.0, 120}};
+    static const int dates[][2] = {{6, 21}, {12, 21}, {3, 20}};
+    static double t[1024];
+    for (int k = 0; k < 3; k++)
+        for (int d = 0; d < 3; d++)
+            for (int n = 158; n <= 1024; n += 866) {
+                test_site p;
+                test_site_init(&p, sites[k][0], sites[k][1]);
+                ts_day_opts o;
+                ts_day_opts_default(&o);
+                double start = ts_local_midnight(2026, dates[d][0], dates[d][1],
+                                                 (int)sites[k][2]);
+                int got;
+                ck_assert(ts_day_atlas_times(&p.s, &o, start, 86400, n, t, &got, &err) ==
+                          TS_OK);
+                ck_assert_int_eq(got, n);
+                double low = 90;
+                for (int i = 0; i < n; i++)
+                    low = fmin(low, elev_at(&p.s, &o, t[i]));
+                printf("atlas at %.1f N, %02d-%02d, %4d maps: lowest sun %.4f deg\n",
+                       sites[k][0], dates[d][0], dates[d][1], n, low);
+                ck_assert(low > -TS_SUN_RADIUS_DEG);
+            }
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("daycycle");
@@ -402,6 +435,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_bad_sites);
     tcase_add_test(tc, test_per_cell_sites);
     tcase_add_test(tc, test_atlas_times);
+    tcase_add_test(tc, test_atlas_times_sun_up);
     suite_add_tcase(s, tc);
     return s;
 }
