@@ -147,6 +147,14 @@ typedef struct {
 ts_status ts_sun_at_site(const ts_sun_sites *sites, const ts_day_opts *o,
                          double unix_time, ts_sun_sample *out, ts_error *err);
 
+/**
+ * The sun at the site of `sites` where it stands highest at `unix_time`
+ * (the single site, or the lattice node of largest elevation): whether any
+ * part of the DEM can see it. *node (may be NULL) receives the node's index.
+ */
+ts_status ts_sun_highest_site(const ts_sun_sites *sites, const ts_day_opts *o,
+                              double unix_time, ts_sun_sample *out, int *node, ts_error *err);
+
 /* ------------------------------------------------------- sampling times */
 
 /**

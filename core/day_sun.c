@@ -249,6 +249,27 @@ ts_status ts_sun_at_site(const ts_sun_sites *sites, const ts_day_opts *o,
     return ts_ok(err);
 }
 
+ts_status ts_sun_highest_site(const ts_sun_sites *sites, const ts_day_opts *o,
+                              double unix_time, ts_sun_sample *out, int *node, ts_error *err)
+{
+    ts_status st = ts_sun_sites_validate(sites, err);
+    if (st != TS_OK)
+        return st;
+    if (!o || !out)
+        return ts_fail(err, TS_ERR_ARG, "ts_sun_highest_site: NULL argument");
+    int best = -1;
+    for (int i = 0; i < sites->nx * sites->ny; i++) {
+        ts_sun_sample s;
+        if ((st = ts_day_node_sun(sites, o, i, unix_time, &s, err)) != TS_OK)
+            return st;
+        if (best < 0 || s.elevation > out->elevation)
+            best = i, *out = s;
+    }
+    if (node)
+        *node = best;
+    return ts_ok(err);
+}
+
 /* ------------------------------------------------------- sampling times */
 
 int ts_day_step_count(double length_s, double step_s)

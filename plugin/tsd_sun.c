@@ -210,12 +210,20 @@ int tsd_sun_night_warning(const tsd_sun *s, const tsd_options *o, char *warning,
     const char *product = tsd_product_of(o)->name;
     if (!isfinite(s->instant) || (strcmp(product, "shade") != 0 && strcmp(product, "shadow") != 0))
         return 0;
-    /* no cell's horizon dips below the sea-level one from the highest terrain */
+    /* no cell's horizon dips below the sea-level one from the highest terrain;
+     * per cell, night only where the sun is that low at every lattice node
+     * (the middle node's sun may have set while the DEM's west is in sun) */
     const double lowest = ts_earth_horizon(TSD_EARTH_HIGHEST_M, &s->day.horizon);
-    if (!(s->sun.elevation + o->light_radius < lowest))
+    ts_sun_sample sun = s->sun;
+    int node = 0;
+    ts_error err;
+    if (tsd_sun_per_cell(s) &&
+        ts_sun_highest_site(&s->sites, &s->day, s->instant, &sun, &node, &err) != TS_OK)
+        return 0;
+    if (!(sun.elevation + o->light_radius < lowest))
         return 0;
     /* mean solar time at the site: UTC plus 4 minutes per degree east */
-    const double lon = s->sites_owned.lon[0];
+    const double lon = s->sites_owned.lon[node];
     const long solar = lround(fmod(fmod(s->instant / 60.0 + lon * 4.0, 1440.0) + 1440.0, 1440.0));
     const long offset = lround(lon * 4.0);
     char when[64], given[32];
@@ -226,12 +234,15 @@ int tsd_sun_night_warning(const tsd_sun *s, const tsd_options *o, char *warning,
         snprintf(given, sizeof given, "given as %c%02d:%02d", s->offset_minutes < 0 ? '-' : '+',
                  abs(s->offset_minutes) / 60, abs(s->offset_minutes) % 60);
     snprintf(warning, n,
-             "DATETIME=%s puts the sun's centre %.1f degrees below the horizon at the DEM's "
-             "centre (mean solar time %02ld:%02ld there): it is night, no terrain sees the "
+             "DATETIME=%s puts the sun's centre %.1f degrees below the horizon at %s "
+             "(mean solar time %02ld:%02ld there): it is night, no terrain sees the "
              "sun, and its direct light is nil everywhere. If that is not the time meant, check "
              "DATETIME's offset from UTC (%s; mean solar time at longitude %.1f is "
              "UTC%c%02ld:%02ld)",
-             when, -s->sun.elevation, solar / 60 % 24, solar % 60, given, lon,
+             when, -sun.elevation,
+             tsd_sun_per_cell(s) ? "the highest of the SUN_POSITION=per_cell sites"
+                                 : "the DEM's centre",
+             solar / 60 % 24, solar % 60, given, lon,
              offset < 0 ? '-' : '+', labs(offset) / 60, labs(offset) % 60);
     return 1;
 }

@@ -138,6 +138,27 @@ class Sun(unittest.TestCase):
             with self.subTest(dt=dt):
                 self.assertNotIn("below the horizon", T.open_stderr(T.JACKSBORO, DATETIME=dt))
 
+    def test_a_per_cell_night_is_night_at_every_site(self):
+        """A 20 x 20 degree DEM at dusk, per cell: the sun has set in the east
+        (6.4 degrees down at the lattice's middle node) but not in the west,
+        which is lit: no night warning (there was one, from that node's sun,
+        with node 0's longitude). Later it has set everywhere: the warning
+        gives the highest site's depth and longitude."""
+        dem = os.path.join(self.dir, "wide.tif")
+        T.write_tif(dem, np.full((20, 20), 100.0), [0, 1, 0, 20, 0, -1], 4326)
+        opts = dict(PRODUCT="shadow", SUN_POSITION="per_cell")
+        dusk = dict(opts, DATETIME="2026-03-20T17:15:00Z")
+        err = T.open_stderr(dem, **dusk)
+        lit = T.read(T.conn(dem), 1, dusk)
+        print("dusk: %.0f%% lit; %s" % (100 * np.mean(lit > 0), err.strip()))
+        self.assertGreater(np.mean(lit > 0), 0.3)
+        self.assertNotIn("below the horizon", err)
+        err = T.open_stderr(dem, **dict(opts, DATETIME="2026-03-20T19:30:00Z"))
+        print(err.strip())
+        self.assertIn("puts the sun's centre 19.9 degrees below the horizon at the highest of "
+                      "the SUN_POSITION=per_cell sites (mean solar time 19:32 there)", err)
+        self.assertIn("mean solar time at longitude 0.5 is UTC+00:02", err)
+
     def test_per_cell_datetime_on_a_small_extent(self):
         """SUN_POSITION=per_cell over jacksboro (0.3 x 0.3 deg): the sun moves
         by ~0.2 deg across it, so the shadows barely change."""
