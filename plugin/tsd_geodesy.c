@@ -427,6 +427,10 @@ ts_status tsd_sites_compute(const double gt[6], int width, int height,
         s->ny = height < 2 ? 1 : height / 32 + 2;
         if (s->nx > 65) s->nx = 65;
         if (s->ny > 65) s->ny = 65;
+        /* odd counts: the middle node, whose sun the metadata reports, is
+         * the DEM's centre (with 2 nodes it was a corner) */
+        s->nx += s->nx > 1 && s->nx % 2 == 0;
+        s->ny += s->ny > 1 && s->ny % 2 == 0;
     } else {
         s->nx = s->ny = 1;
     }

@@ -159,6 +159,22 @@ class Sun(unittest.TestCase):
                       "the SUN_POSITION=per_cell sites (mean solar time 19:32 there)", err)
         self.assertIn("mean solar time at longitude 0.5 is UTC+00:02", err)
 
+    def test_per_cell_site_is_the_centre(self):
+        """The lattice has an odd number of nodes a side, so the middle node,
+        whose sun the metadata reports, is the DEM's centre, as without
+        per_cell (it was 15 cells off on jacksboro, a corner of a 20-cell
+        DEM)."""
+        wide = os.path.join(self.dir, "wide20.tif")
+        T.write_tif(wide, np.full((20, 20), 100.0), [0, 1, 0, 20, 0, -1], 4326)
+        for dem in (T.JACKSBORO, wide):
+            opts = {"PRODUCT": "shadow", "DATETIME": "2026-03-20T12:00:00Z"}
+            centre = md(T.conn(dem), opts)
+            per = md(T.conn(dem), dict(opts, SUN_POSITION="per_cell"))
+            for k in ("SUN_SITE_LONGITUDE", "SUN_SITE_LATITUDE", "SUN_ELEVATION"):
+                print("%s %s: centre %s, per cell %s" % (os.path.basename(dem), k, centre[k],
+                                                         per[k]))
+                self.assertAlmostEqual(float(per[k]), float(centre[k]), places=6)
+
     def test_per_cell_datetime_on_a_small_extent(self):
         """SUN_POSITION=per_cell over jacksboro (0.3 x 0.3 deg): the sun moves
         by ~0.2 deg across it, so the shadows barely change."""
