@@ -91,8 +91,10 @@ static const double SUN_REACH_WARN_DEG = 1.0;
 void TSDataset::WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfLon,
                              double dfLat)
 {
-    const double dfReach = tsd_sites_reach(m_adfGT, W, H, hSRS, &m_sCells, dfLon, dfLat);
-    if (!(dfReach > SUN_REACH_WARN_DEG))
+    double dfTurn = 0;
+    const double dfReach =
+        tsd_sites_reach(m_adfGT, W, H, hSRS, &m_sCells, dfLon, dfLat, &dfTurn);
+    if (!(dfReach > SUN_REACH_WARN_DEG) && !(dfTurn > SUN_REACH_WARN_DEG))
         return;
     // per_cell where the product takes it and the options' own checks
     // accept it beside the others given (METHOD, LIGHT_RADIUS, ...)
@@ -103,13 +105,21 @@ void TSDataset::WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfL
     char szWhyNot[512];
     const bool bPerCell = tsd_product_takes(m_psProduct, iSunPosition) &&
                           tsd_options_check(&sPerCell, szWhyNot, sizeof szWhyNot) == 0;
-    CPLError(CE_Warning, CPLE_AppDefined,
-             "TERRASHADE: the DEM reaches %.1f degrees of arc from its centre, where the "
-             "sun is computed for all its cells (SUN_POSITION=center): at its edges the "
-             "sun's elevation and azimuth can be off by about as much. %s",
-             dfReach,
-             bPerCell ? "SUN_POSITION=per_cell computes the sun across the DEM"
-                      : "Crop the DEM to compute the sun nearer its cells");
+    const char *pszDo = bPerCell ? "SUN_POSITION=per_cell computes the sun across the DEM"
+                                 : "Crop the DEM to compute the sun nearer its cells";
+    if (dfReach >= dfTurn)
+        CPLError(CE_Warning, CPLE_AppDefined,
+                 "TERRASHADE: the DEM reaches %.1f degrees of arc from its centre, where the "
+                 "sun is computed for all its cells (SUN_POSITION=center): at its edges the "
+                 "sun's elevation and azimuth can be off by about as much. %s",
+                 dfReach, pszDo);
+    else // a geographic grid near a pole: its columns' meridians converge
+        CPLError(CE_Warning, CPLE_AppDefined,
+                 "TERRASHADE: the DEM's meridians turn by up to %.1f degrees against its "
+                 "grid from its centre's (%.1f degrees of arc away), where the sun is "
+                 "computed for all its cells (SUN_POSITION=center): at its edges the sun's "
+                 "azimuth on the grid can be off by about as much. %s",
+                 dfTurn, dfReach, pszDo);
 }
 
 } // namespace tsd

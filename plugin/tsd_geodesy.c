@@ -510,22 +510,34 @@ ts_status tsd_sites_compute(const double gt[6], int width, int height,
 }
 
 double tsd_sites_reach(const double gt[6], int width, int height, OGRSpatialReferenceH srs,
-                       const tsd_cells *cells, double lon0, double lat0)
+                       const tsd_cells *cells, double lon0, double lat0, double *turn)
 {
     tsd_sites s;
     char msg[256];
+    if (turn)
+        *turn = 0;
     if (tsd_sites_compute(gt, width, height, srs, cells, 1, &s, msg, sizeof msg) != TS_OK)
         return 0;
     const double rad = M_PI / 180;
-    double reach = 0;
+    const double north0 = s.north[(size_t)(s.ny / 2) * s.nx + s.nx / 2]; /* the centre's */
+    double reach = 0, most = 0;
     for (size_t k = 0; k < (size_t)s.nx * s.ny; k++) {
         /* the central angle, by the haversine (well conditioned when small) */
         double sp = sin((s.lat[k] - lat0) * rad / 2), sl = sin((s.lon[k] - lon0) * rad / 2);
         double a = sp * sp + cos(s.lat[k] * rad) * cos(lat0 * rad) * sl * sl;
         double angle = 2 * asin(sqrt(a < 1 ? a : 1)) / rad;
         reach = angle > reach ? angle : reach;
+        /* a distant sun's true azimuth turns with the meridians, its grid
+         * azimuth by that plus the turn of grid north (they cancel on a
+         * conformal grid, not on a geographic one near a pole) */
+        double dlon = remainder(s.lon[k] - lon0, 360.0);
+        double t = fabs(remainder(dlon * sin(0.5 * (s.lat[k] + lat0) * rad) + s.north[k] -
+                                  north0, 360.0));
+        most = t > most ? t : most;
     }
     tsd_sites_free(&s);
+    if (turn)
+        *turn = most;
     return reach;
 }
 

@@ -101,10 +101,16 @@ ts_status tsd_sites_compute(const double gt[6], int width, int height,
  * How far, in degrees of arc, the farthest node of the DEM's per-cell lattice
  * of sites (tsd_sites_compute with per_cell) lies from (lon0, lat0), the
  * site of SUN_POSITION=center: about how far off the sun computed there is
- * at the DEM's edges. 0 where the lattice cannot be computed.
+ * at the DEM's edges. *turn (may be NULL) receives the most the sun's grid
+ * azimuth turns between the centre and a node from the frames alone: the
+ * meridians' convergence (longitude difference x sin latitude) less the
+ * change of the grid azimuth of true north. About 0 on a conformal grid; on
+ * a geographic grid near a pole it can far exceed the arc (4 degrees of
+ * longitude at 85 N: 2 degrees at the edges, 0.17 of arc). 0 where the
+ * lattice cannot be computed.
  */
 double tsd_sites_reach(const double gt[6], int width, int height, OGRSpatialReferenceH srs,
-                       const tsd_cells *cells, double lon0, double lat0);
+                       const tsd_cells *cells, double lon0, double lat0, double *turn);
 
 void tsd_sites_free(tsd_sites *s);
 

@@ -371,6 +371,29 @@ class Sun(unittest.TestCase):
             p = T.run(["gdal_translate", "-q"] + T.oo_args(oo) + [T.conn(dem), out])
             self.assertNotIn("degrees of arc", p.stderr)
 
+    def test_centre_sun_near_a_pole_warns_of_the_turn(self):
+        """A geographic DEM at 85 N, 0.1 x 4 degrees, lies within 0.2 degrees
+        of arc of its centre, but its columns' meridians turn by 2 degrees
+        against each other, and with them the sun's azimuth on the grid: it
+        warns (it did not). A UTM DEM as far from its central meridian at 80 N
+        does not (grid north turns with the meridians), nor per_cell."""
+        polar = T.write_tif(os.path.join(self.dir, "polar.tif"),
+                            np.full((100, 400), 100.0, np.float32),
+                            (0.0, 0.01, 0, 85.05, 0, -0.001), 4326)
+        utm = T.write_tif(os.path.join(self.dir, "utm80.tif"),
+                          np.full((100, 100), 100.0, np.float32),
+                          (600000.0, 30, 0, 8880000.0, 0, -30), 32633)
+        out = os.path.join(self.dir, "out.tif")
+        instant = {"PRODUCT": "shadow", "DATETIME": "2026-03-25T12:00:00Z"}
+        p = T.run(["gdal_translate", "-q"] + T.oo_args(instant) + [T.conn(polar), out])
+        print(p.stderr.strip())
+        self.assertIn("the DEM's meridians turn by up to 2.0 degrees against its grid from "
+                      "its centre's (0.2 degrees of arc away)", p.stderr)
+        self.assertIn("SUN_POSITION=per_cell computes the sun across the DEM", p.stderr)
+        for dem, oo in ((polar, dict(instant, SUN_POSITION="per_cell")), (utm, instant)):
+            p = T.run(["gdal_translate", "-q"] + T.oo_args(oo) + [T.conn(dem), out])
+            self.assertNotIn("Warning", p.stderr)
+
     # ------------------------------------------------------------ insolation
 
     def test_insolation(self):
