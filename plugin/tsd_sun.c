@@ -222,6 +222,25 @@ int tsd_sun_night_warning(const tsd_sun *s, const tsd_options *o, char *warning,
         return 0;
     if (!(sun.elevation + o->light_radius < lowest))
         return 0;
+    /* in the polar night no time of that day helps: say so, not the offset.
+     * The sun climbs highest at the site nearest the equator (per cell: the
+     * lattice's least or greatest latitude), sampled every 10 minutes. */
+    int ends[2] = {0, 0};
+    for (int k = 1; k < s->sites.nx * s->sites.ny; k++) {
+        ends[0] = s->sites.latitude[k] < s->sites.latitude[ends[0]] ? k : ends[0];
+        ends[1] = s->sites.latitude[k] > s->sites.latitude[ends[1]] ? k : ends[1];
+    }
+    double day_max = sun.elevation;
+    for (int e = 0; e < 2; e++) {
+        ts_sun_sites one = {1, 1, 0, 0, 1, 1, s->sites.longitude + ends[e],
+                            s->sites.latitude + ends[e], NULL};
+        for (int k = -72; k <= 72 && day_max + o->light_radius < lowest; k++) {
+            ts_sun_sample at;
+            if (ts_sun_at_site(&one, &s->day, s->instant + k * 600.0, &at, &err) == TS_OK)
+                day_max = fmax(day_max, at.elevation);
+        }
+    }
+    const int polar = day_max + o->light_radius < lowest;
     /* mean solar time at the site: UTC plus 4 minutes per degree east */
     const double lon = s->sites_owned.lon[node];
     const long solar = lround(fmod(fmod(s->instant / 60.0 + lon * 4.0, 1440.0) + 1440.0, 1440.0));
@@ -233,16 +252,24 @@ int tsd_sun_night_warning(const tsd_sun *s, const tsd_options *o, char *warning,
     else
         snprintf(given, sizeof given, "given as %c%02d:%02d", s->offset_minutes < 0 ? '-' : '+',
                  abs(s->offset_minutes) / 60, abs(s->offset_minutes) % 60);
-    snprintf(warning, n,
-             "DATETIME=%s puts the sun's centre %.1f degrees below the horizon at %s "
-             "(mean solar time %02ld:%02ld there): it is night, no terrain sees the "
-             "sun, and its direct light is nil everywhere. If that is not the time meant, check "
-             "DATETIME's offset from UTC (%s; mean solar time at longitude %.1f is "
-             "UTC%c%02ld:%02ld)",
-             when, -sun.elevation,
-             tsd_sun_per_cell(s) ? "the highest of the SUN_POSITION=per_cell sites"
-                                 : "the DEM's centre",
-             solar / 60 % 24, solar % 60, given, lon,
-             offset < 0 ? '-' : '+', labs(offset) / 60, labs(offset) % 60);
+    int len = snprintf(warning, n,
+                       "DATETIME=%s puts the sun's centre %.1f degrees below the horizon at %s "
+                       "(mean solar time %02ld:%02ld there): it is night, no terrain sees the "
+                       "sun, and its direct light is nil everywhere. ",
+                       when, -sun.elevation,
+                       tsd_sun_per_cell(s) ? "the highest of the SUN_POSITION=per_cell sites"
+                                           : "the DEM's centre",
+                       solar / 60 % 24, solar % 60);
+    if (len < 0 || (size_t)len >= n)
+        return 1;
+    if (polar)
+        snprintf(warning + len, n - (size_t)len,
+                 "The sun stays below every horizon for 12 hours either side (polar night): "
+                 "no time of that day lights the DEM");
+    else
+        snprintf(warning + len, n - (size_t)len,
+                 "If that is not the time meant, check DATETIME's offset from UTC (%s; mean "
+                 "solar time at longitude %.1f is UTC%c%02ld:%02ld)",
+                 given, lon, offset < 0 ? '-' : '+', labs(offset) / 60, labs(offset) % 60);
     return 1;
 }

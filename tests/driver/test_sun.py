@@ -137,6 +137,15 @@ class Sun(unittest.TestCase):
         for dt in ("2026-06-22T01:00:00Z", "2026-06-21T12:00:00-05:00"):
             with self.subTest(dt=dt):
                 self.assertNotIn("below the horizon", T.open_stderr(T.JACKSBORO, DATETIME=dt))
+        # noon of the polar night: no offset would help, the warning says why
+        polar = flat_dem(os.path.join(self.dir, "svalbard.tif"), 78.2, 15.6)
+        for sp in ("center", "per_cell"):
+            err = T.open_stderr(polar, PRODUCT="shadow", SUN_POSITION=sp,
+                                DATETIME="2026-12-21T12:00:00+01:00")
+            print(err.strip())
+            self.assertIn("The sun stays below every horizon for 12 hours either side (polar "
+                          "night): no time of that day lights the DEM", err)
+            self.assertNotIn("check DATETIME's offset", err)
 
     def test_a_per_cell_night_is_night_at_every_site(self):
         """A 20 x 20 degree DEM at dusk, per cell: the sun has set in the east
