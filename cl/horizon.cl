@@ -158,9 +158,10 @@ __kernel void ts_sweep_lines(__global const float *zr, __global const float *zt,
 #define TS_FAR_SPREAD 0
 #endif
 
-/* far_field: the cell's own ray at and beside the two lines' occluders;
- * when one lies past the distance cap, the exact ray over the far part of
- * the radius instead (cm_ray_exact). */
+/* far_field: the cell's own ray at and beside the two lines' occluders (at
+ * one it cannot be sampled at, the steps up to it: cm_ray_lost); when one
+ * lies past the distance cap, the exact ray over the far part of the radius
+ * instead (cm_ray_exact). */
 float ts_far_field(const cm_ray_grid *r, int k, int i, float h, int2 lo, int2 hi, real step,
                    real c, real cap)
 {
@@ -177,6 +178,8 @@ float ts_far_field(const cm_ray_grid *r, int k, int i, float h, int2 lo, int2 hi
                 continue;
             float s = cm_ray_slope(r, k, i, h, dk + e, as_float(cand.y) + (float)(e * step),
                                    (float)c);
+            if (e == 0 && s == -INFINITY) /* the ray cannot be sampled there */
+                s = cm_ray_lost(r, k, i, h, dk, TS_NEAR_STEPS, cap / step, step, c);
             best = s > best ? s : best;
         }
     }

@@ -104,6 +104,7 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         ts_lane_pushes_reset(&w->far_push, nl);
     const ts_lane_occluders occ = {w->lo_k, w->hi_k, w->lo_dd, w->hi_dd};
     const ts_lane_hulls hulls = {w->lane_stacks, G->U + 1, w->lane_n, w->lane_far};
+    const ts_lane_lost lost = {C->c, C->cap, w->lost};
     const double c = C->c;
     for (int k = kmin; k <= kmax; k++) {
         /* The lines on the grid at step k: rows i0 + j in [0, V - 1]. */
@@ -154,7 +155,7 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
                    (i0 + jw) * C->o_v_stride; /* cell (k, i0 + jw) */
         /* (far-only: every occluder lies beyond the threshold) */
         ts_lane_far_field(G, C->grid->z, (float)c, C->far_T > 0 ? 0 : TS_NEAR_STEPS, k, (int)i0,
-                          jw, j1, w->hc, &occ, w->slope, o, C->o_v_stride);
+                          jw, j1, w->hc, &occ, &lost, w->slope, o, C->o_v_stride);
     }
     w->carry_next = w->carry;
     w->carry = next;
@@ -233,7 +234,7 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
         /* a block has up to LOCKSTEP_LINES + 1 lines (with the primed one) */
         const size_t row = LOCKSTEP_LINES + 2;
         w->lane_f = malloc(6 * row * sizeof *w->lane_f);
-        w->lane_i = malloc(3 * row * sizeof *w->lane_i);
+        w->lane_i = calloc(4 * row, sizeof *w->lane_i); /* the lost flags start clear */
         w->lane_d = malloc(row * sizeof *w->lane_d);
         ok = ok && w->carry && w->carry_next && w->lane_f && w->lane_i && w->lane_d;
         if (ok) {
@@ -246,6 +247,7 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
             w->lo_k = w->lane_i;
             w->hi_k = w->lane_i + row;
             w->lane_k0 = w->lane_i + 2 * row;
+            w->lost = w->lane_i + 3 * row;
         }
         for (int k = 0; ok && k < U; k++)
             w->carry[k] = none;

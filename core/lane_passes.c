@@ -149,29 +149,38 @@ ray_at(ray_view R, int wide, const int *restrict ray_o, const float *restrict ra
         const float h = hc[j];                                                                 \
         const int kl = lo_k[j], kh = hi_k[j] | -(hi_k[j] == kl); /* -1: the same step */      \
         float best = -INFINITY;                                                                \
-        float s = ray_at(R, WIDE, ray_o, ray_f, z, cf, k, i0 + j, h, kl, lo_dd[j]);            \
-        best = s > best ? s : best;                                                            \
-        s = ray_at(R, WIDE, ray_o, ray_f, z, cf, k, i0 + j, h, kh, hi_dd[j]);                  \
-        best = s > best ? s : best;                                                            \
+        const float sl = ray_at(R, WIDE, ray_o, ray_f, z, cf, k, i0 + j, h, kl, lo_dd[j]);     \
+        best = sl > best ? sl : best;                                                          \
+        const float sh = ray_at(R, WIDE, ray_o, ray_f, z, cf, k, i0 + j, h, kh, hi_dd[j]);     \
+        best = sh > best ? sh : best;                                                          \
         slope[j] = h != h ? (float)NAN : best;                                                 \
+        /* an occluder beyond the near field that the ray cannot be sampled at */             \
+        lost[j] = ((sl == -INFINITY) & (kl >= 0) & (k - kl > R.near)) |                        \
+                  (((sh == -INFINITY) & (kh >= 0) & (k - kh > R.near)) << 1);                  \
+        any |= lost[j];                                                                        \
     }
 
 #define FAR_PARAMS                                                                             \
     ray_view R, const int *restrict ray_o, const float *restrict ray_f,                        \
         const float *restrict z, float cf, int k, int i0, int j0, int j1,                      \
         const float *restrict hc, const int *restrict lo_k, const float *restrict lo_dd,       \
-        const int *restrict hi_k, const float *restrict hi_dd, float *restrict slope
+        const int *restrict hi_k, const float *restrict hi_dd, float *restrict slope,            \
+        int *restrict lost
 
 TS_SIMD_CLONES
-static void far_run32(FAR_PARAMS)
+static int far_run32(FAR_PARAMS)
 {
+    int any = 0;
     FAR_LOOP(0)
+    return any;
 }
 
 TS_SIMD_CLONES
-static void far_run64(FAR_PARAMS)
+static int far_run64(FAR_PARAMS)
 {
+    int any = 0;
     FAR_LOOP(1)
+    return any;
 }
 
 #if defined(__GNUC__) && defined(__x86_64__)
@@ -180,7 +189,7 @@ static void far_run64(FAR_PARAMS)
  * with scalar loads, three instructions an element). */
 TS_AVX512 static inline __m512 ray16(const ray_view *R, const int *ray_o, const float *ray_f,
                                   const float *z, __m512 cf, __m512i k, __m512i i, __m512 h,
-                                  __m512i kc, __m512 dd, __mmask16 lanes)
+                                  __m512i kc, __m512 dd, __mmask16 lanes, __mmask16 *lost)
 {
     const __m512i zero = _mm512_setzero_si512(), last = _mm512_set1_epi32(R->V - 1);
     const __m512 fzero = _mm512_setzero_ps();
@@ -188,6 +197,7 @@ TS_AVX512 static inline __m512 ray16(const ray_view *R, const int *ray_o, const 
     __mmask16 ok = lanes & _mm512_cmpge_epi32_mask(kc, zero) &
                    _mm512_cmpgt_epi32_mask(dk, _mm512_set1_epi32(R->near)) &
                    _mm512_cmp_ps_mask(dd, fzero, _CMP_GT_OQ);
+    const __mmask16 counts = ok; /* an occluder beyond the near field */
     const __m512i dks = _mm512_maskz_mov_epi32(ok, dk); /* 0 where not ok: a valid entry */
     const __m512i r0 = _mm512_add_epi32(i, _mm512_i32gather_epi32(dks, ray_o, 4));
     const __m512 f = _mm512_i32gather_ps(dks, ray_f, 4);
@@ -204,14 +214,17 @@ TS_AVX512 static inline __m512 ray16(const ray_view *R, const int *ray_o, const 
     const __m512 b = _mm512_mask_i32gather_ps(a, two, _mm512_add_epi32(ia, vs), z, 4);
     const __m512 hz = _mm512_add_ps(a, _mm512_mul_ps(f, _mm512_sub_ps(b, a)));
     const __m512 s = _mm512_sub_ps(_mm512_div_ps(_mm512_sub_ps(hz, h), dd), _mm512_mul_ps(cf, dd));
-    return _mm512_mask_blend_ps(ok & _mm512_cmp_ps_mask(hz, hz, _CMP_ORD_Q),
-                                _mm512_set1_ps(-INFINITY), s);
+    ok &= _mm512_cmp_ps_mask(hz, hz, _CMP_ORD_Q);
+    *lost = counts & ~ok; /* where the ray cannot be sampled */
+    return _mm512_mask_blend_ps(ok, _mm512_set1_ps(-INFINITY), s);
 }
 
 /* far_run32 (FAR_LOOP's cells) sixteen at once, cell j's slope to
- * slope[(j - j0) * ostride] (straight into the output). */
-TS_AVX512 static void far_run32_avx512(FAR_PARAMS, int ostride)
+ * slope[(j - j0) * ostride] (straight into the output), its lost flags
+ * (FAR_LOOP's) where any is set; whether any is. */
+TS_AVX512 static int far_run32_avx512(FAR_PARAMS, int ostride)
 {
+    __mmask16 any = 0;
     const __m512 cfv = _mm512_set1_ps(cf);
     const __m512i kv = _mm512_set1_epi32(k), step = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8,
                                                                      9, 10, 11, 12, 13, 14, 15);
@@ -224,12 +237,19 @@ TS_AVX512 static void far_run32_avx512(FAR_PARAMS, int ostride)
         const __m512i kh = _mm512_mask_mov_epi32(khi, _mm512_cmpeq_epi32_mask(khi, kl),
                                                  _mm512_set1_epi32(-1)); /* the same step */
         __m512 best = _mm512_set1_ps(-INFINITY);
+        __mmask16 lost_l, lost_h;
         best = _mm512_max_ps(ray16(&R, ray_o, ray_f, z, cfv, kv, i, h, kl,
-                                   _mm512_maskz_loadu_ps(lanes, lo_dd + j), lanes),
+                                   _mm512_maskz_loadu_ps(lanes, lo_dd + j), lanes, &lost_l),
                              best);
         best = _mm512_max_ps(ray16(&R, ray_o, ray_f, z, cfv, kv, i, h, kh,
-                                   _mm512_maskz_loadu_ps(lanes, hi_dd + j), lanes),
+                                   _mm512_maskz_loadu_ps(lanes, hi_dd + j), lanes, &lost_h),
                              best);
+        if (lost_l | lost_h) { /* rare: at the DEM's edges and nodata */
+            const __m512i flags = _mm512_or_si512(_mm512_maskz_set1_epi32(lost_l, 1),
+                                                  _mm512_maskz_set1_epi32(lost_h, 2));
+            _mm512_mask_storeu_epi32(lost + j, lanes, flags);
+            any |= lost_l | lost_h;
+        }
         const __m512 out = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(h, h, _CMP_UNORD_Q), best,
                                                 _mm512_set1_ps((float)NAN));
         if (ostride == 1)
@@ -241,32 +261,69 @@ TS_AVX512 static void far_run32_avx512(FAR_PARAMS, int ostride)
                                    _mm512_set1_epi32(ostride)),
                 out, 4);
     }
+    return any != 0;
 }
 #define HAVE_FAR_AVX512 1
 #else
 #define HAVE_FAR_AVX512 0
 #endif
 
+/* Cells j0..j1 whose lost flags are set (FAR_LOOP's): each flagged
+ * occluder's slope by cm_ray_lost raises the cell's far field at
+ * out[(j - j0) * ostride]. */
+static void far_lost(const ts_line_geom *G, const float *z, int near, int k, int i0, int j0,
+                     int j1, const float *hc, const ts_lane_occluders *occ,
+                     const ts_lane_lost *lost, float *out, ptrdiff_t ostride)
+{
+    const cm_ray_grid ray = {z, G->V, G->t, G->origin, G->u_stride, G->v_stride};
+    for (int j = j0; j <= j1; j++) {
+        const int f = lost->flags[j];
+        lost->flags[j] = 0; /* the AVX-512 pass writes only vectors with a flag */
+        if (!f || hc[j] != hc[j])
+            continue;
+        const int i = i0 + j, row = G->x_major ? i : G->u_start + k * G->u_step;
+        const double step = G->step_row ? G->step_row[row] : G->step_m;
+        float *o = out + (j - j0) * ostride;
+        for (int e = 0; e < 2; e++) {
+            if (!(f >> e & 1))
+                continue;
+            const int kc = e ? occ->hi_k[j] : occ->lo_k[j];
+            const float s = cm_ray_lost(&ray, k, i, hc[j], k - kc, near, lost->cap / step, step,
+                                        lost->c);
+            *o = s > *o ? s : *o;
+        }
+    }
+}
+
 void ts_lane_far_field(const ts_line_geom *G, const float *z, float cf, int near, int k, int i0,
                        int j0, int j1, const float *hc, const ts_lane_occluders *occ,
-                       float *slope, float *out, ptrdiff_t ostride)
+                       const ts_lane_lost *lost, float *slope, float *out, ptrdiff_t ostride)
 {
     const ray_view R = {G->origin, G->u_stride, G->v_stride, G->V, near};
     /* Every element the ray reads lies within U x V cells of the grid. */
     const ptrdiff_t span = (ptrdiff_t)(G->U - 1) * (G->u_stride < 0 ? -G->u_stride : G->u_stride) +
                            (ptrdiff_t)(G->V - 1) * G->v_stride + 1;
+    int any;
 #if HAVE_FAR_AVX512
     const ptrdiff_t omax = INT_MAX / (j1 + 16); /* the scatter's offsets in 32 bits */
     if (span <= INT_MAX && ostride <= omax && ostride >= -omax &&
         ts_cpu_vector_level() == TS_CPU_VECTORS_AVX512) {
-        far_run32_avx512(R, G->ray_o, G->ray_f, z, cf, k, i0, j0, j1, hc, occ->lo_k, occ->lo_dd,
-                         occ->hi_k, occ->hi_dd, out, (int)ostride);
+        any = far_run32_avx512(R, G->ray_o, G->ray_f, z, cf, k, i0, j0, j1, hc, occ->lo_k,
+                               occ->lo_dd, occ->hi_k, occ->hi_dd, out, lost->flags,
+                               (int)ostride);
+        if (any && near > 0) /* the far-only sweep (near 0) keeps its threshold */
+            far_lost(G, z, near, k, i0, j0, j1, hc, occ, lost, out, ostride);
+        else if (any)
+            for (int j = j0; j <= j1; j++)
+                lost->flags[j] = 0;
         return;
     }
 #endif
-    (span > INT_MAX ? far_run64 : far_run32)(R, G->ray_o, G->ray_f, z, cf, k, i0, j0, j1, hc,
-                                             occ->lo_k, occ->lo_dd, occ->hi_k, occ->hi_dd,
-                                             slope);
+    any = (span > INT_MAX ? far_run64 : far_run32)(R, G->ray_o, G->ray_f, z, cf, k, i0, j0, j1,
+                                                   hc, occ->lo_k, occ->lo_dd, occ->hi_k,
+                                                   occ->hi_dd, slope, lost->flags);
     for (int j = j0; j <= j1; j++)
         out[(j - j0) * ostride] = slope[j];
+    if (any && near > 0)
+        far_lost(G, z, near, k, i0, j0, j1, hc, occ, lost, out, ostride);
 }

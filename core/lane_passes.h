@@ -29,14 +29,24 @@ typedef struct {
     float *lo_dd, *hi_dd;
 } ts_lane_occluders;
 
+/* Where an occluder lies where the cell's own ray cannot be sampled (off
+ * the grid or on nodata there; cm_ray_lost solves the ray's steps up to
+ * it): the curvature coefficient and the distance cap (metres, 0 = none)
+ * in double, as the near field takes them, and scratch of j1 + 1 ints. */
+typedef struct {
+    double c, cap;
+    int *flags;
+} ts_lane_lost;
+
 /* The far-field slope of cells (k, i0 + j), j0 <= j <= j1, at heights
  * hc[j] into out[(j - j0) * ostride]: the larger of the cell's own ray sampled at
  * the two occluders (the second skipped when it is the first's step;
- * either skipped within the near field, at most `near` steps back), -inf
- * when none counts, NaN where hc is nodata; cf is the curvature
- * coefficient; slope: scratch of j1 + 1 floats. */
+ * either skipped within the near field, at most `near` steps back; at one
+ * the ray cannot be sampled at, cm_ray_lost unless near is 0, the far-only
+ * sweep's), -inf when none counts, NaN where hc is nodata; cf is the
+ * curvature coefficient; slope: scratch of j1 + 1 floats. */
 void ts_lane_far_field(const ts_line_geom *G, const float *z, float cf, int near, int k, int i0,
                        int j0, int j1, const float *hc, const ts_lane_occluders *occ,
-                       float *slope, float *out, ptrdiff_t ostride);
+                       const ts_lane_lost *lost, float *slope, float *out, ptrdiff_t ostride);
 
 #endif

@@ -76,6 +76,7 @@ typedef struct {
     int *lane_i;        /* holds: */
     int *lo_k, *hi_k;   /* far-field occluders; lo_k[j]: from line j - 1 */
     int *lane_k0;       /* each line's first step */
+    int *lost;          /* the far field's lost flags (ts_lane_lost) */
     double *lane_d;     /* and the distance of its current sample from it */
     ts_cap_lanes capl;  /* capped lines in lockstep: their windows */
     double *far_ring;   /* far-only: the block's samples (d, then g) by step

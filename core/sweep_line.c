@@ -55,6 +55,9 @@ static float far_field(const sweep_ctx *C, int k, int i, float h, occluder lo, o
             /* e = 0 adds exactly +0 to the distance: skip the conversion. */
             float dd = e ? cand[c].dd + (float)(e * step) : cand[c].dd;
             float s = ray_slope(C, k, i, h, dk + e, dd);
+            if (e == 0 && s == -INFINITY && dk <= k) /* the ray cannot be sampled there */
+                s = cm_ray_lost(&C->ray, k, i, h, dk, TS_NEAR_STEPS, C->cap / step, step,
+                                C->c);
             best = s > best ? s : best;
         }
     }

@@ -249,6 +249,49 @@ CM_FN float cm_ray_slope(const cm_ray_grid *r, int k, int i, float h, int dk, fl
     return cm_ray_slope_at(r, k, i, h, dk, (int)o, (float)(pv - o), dd, cf);
 }
 
+/* Steps of a cell's own ray sampled where a line's occluder lies where the
+ * ray itself cannot be sampled (cm_ray_lost). */
+#ifndef TS_LOST_STEPS
+#define TS_LOST_STEPS 8
+#endif
+
+/*
+ * A line's occluder dk steps back at which the cell's own ray is off the
+ * grid or on nodata, while the line, up to a cell aside, is still on the
+ * data: the far field sampled only there lost that terrain (up to tens of
+ * degrees near a DEM's edge or a nodata hole). Instead: the ray sampled
+ * (cm_ray_slope, step metres a step, c the curvature coefficient) at the
+ * TS_LOST_STEPS whole steps up to that occluder, or up to where the ray
+ * leaves the grid before it, and solved exactly over the part of a step it
+ * has left there (cm_ray_exact); beyond `near` steps and within s_cap steps
+ * (0 = none); -inf if none counts. A few steps, not the whole ray, so that
+ * a DEM whose edge holds every line's occluder costs a few steps a cell.
+ */
+CM_FN float cm_ray_lost(const cm_ray_grid *r, int k, int i, float h, int dk, int near,
+                        cm_real s_cap, cm_real step, cm_real c)
+{
+    cm_real last = dk < k ? dk : k; /* and no farther than the grid's start along u */
+    cm_real exit = last;
+    if (fabs(r->t) > CM_R(1e-12)) { /* where v = i - t s leaves [0, V - 1] */
+        cm_real sv = r->t > 0 ? i / r->t : (i - (r->V - 1)) / r->t;
+        exit = sv < last ? sv : last;
+    }
+    if (s_cap > 0 && s_cap < exit)
+        exit = s_cap;
+    const int hi = (int)floor(exit), lo = hi - TS_LOST_STEPS > near ? hi - TS_LOST_STEPS : near;
+    float best = -INFINITY;
+    for (int s = hi; s > lo; s--) {
+        float v = cm_ray_slope(r, k, i, h, s, (float)(s * step), (float)c);
+        best = v > best ? v : best;
+    }
+    if (exit > hi && exit < last) { /* the ray leaves the grid (or the cap) within a step */
+        cm_real from = hi > near ? (cm_real)hi : (cm_real)near;
+        float v = exit > from ? cm_ray_exact(r, k, i, h, from, exit, step, c) : -INFINITY;
+        best = v > best ? v : best;
+    }
+    return best;
+}
+
 /*
  * The float fast path for interior cells whose near field has no nodata.
  * A cell's largest slope over its ray's pieces is the largest of
