@@ -75,12 +75,18 @@ static ts_status check_opts(const ts_env_table_opts *o, ts_error *err)
     if (!isfinite(o->start_azimuth))
         return ts_fail(err, TS_ERR_ARG, "the start azimuth must be finite, got %g",
                        o->start_azimuth);
-    if (o->normal_steps == 1 || o->normal_steps < 0 || o->normal_steps > TS_ENV_MAX_STEPS)
+    /* odd counts: a node at 0 degrees, the normal and the horizon of open
+     * flat ground, which else reads the mean of two nodes (a uniform sky lit
+     * it as 0.5 with 2 horizon steps, 0.875 with 4) */
+    if (o->normal_steps < 0 || o->normal_steps > TS_ENV_MAX_STEPS ||
+        (o->normal_steps && (o->normal_steps < 3 || o->normal_steps % 2 == 0)))
         return ts_fail(err, TS_ERR_ARG, "the normal-angle steps of the light table must be "
-                       "0 (exact) or from 2 to %d, got %d", TS_ENV_MAX_STEPS, o->normal_steps);
-    if (o->horizon_steps < 2 || o->horizon_steps > TS_ENV_MAX_STEPS)
+                       "0 (exact) or odd from 3 to %d (a node at 0 degrees), got %d",
+                       TS_ENV_MAX_STEPS, o->normal_steps);
+    if (o->horizon_steps < 3 || o->horizon_steps > TS_ENV_MAX_STEPS || o->horizon_steps % 2 == 0)
         return ts_fail(err, TS_ERR_ARG, "the horizon-angle steps of the light table must be "
-                       "from 2 to %d, got %d", TS_ENV_MAX_STEPS, o->horizon_steps);
+                       "odd from 3 to %d (a node at 0 degrees), got %d", TS_ENV_MAX_STEPS,
+                       o->horizon_steps);
     size_t rows = o->normal_steps ? (size_t)o->normal_steps : 1;
     if (rows * o->horizon_steps * 8 > INT32_MAX ||
         (size_t)o->directions * rows * o->horizon_steps * 8 > TS_ENV_MAX_TABLE_FLOATS)

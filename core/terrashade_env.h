@@ -237,8 +237,9 @@ typedef struct {
     int directions;       /**< azimuth sectors, >= 1 (DIRECTIONS) */
     double start_azimuth; /**< centre of sector 0, degrees from north */
     int normal_steps;     /**< samples of the projected normal angle over [-90, 90] deg,
-                               >= 2 (bilinear, as Timonen), or 0: exact (see ts_env_table) */
-    int horizon_steps;    /**< samples of the horizon angle over [-90, 90] deg, >= 2 */
+                               odd >= 3 (bilinear, as Timonen), or 0: exact (see
+                               ts_env_table); odd counts put a node at 0 */
+    int horizon_steps;    /**< samples of the horizon angle over [-90, 90] deg, odd >= 3 */
     int ground;           /**< 0: light from below the horizontal is ignored (the sky
                                ends at the horizontal, as the `sky` product);
                                1: it counts where the terrain's horizon is lower */

@@ -228,14 +228,14 @@ const opt_def TSD_OPTION_ROWS[] = {
      "(CIE general sky type N, 1..15), the sun from SUN_AZIMUTH and "
      "SUN_ELEVATION or DATETIME; not with ENV_MAP"},
     {"ENV_HORIZON_STEPS", K_INT, FIELD(env_horizon_steps),
-     TSD_XSTR(TS_ENV_DEFAULT_HORIZON_STEPS), 2, 3601, 0, 1, NULL, 1, P, LISTED, NULL,
+     TSD_XSTR(TS_ENV_DEFAULT_HORIZON_STEPS), 3, 3601, 0, 1, NULL, 1, P, LISTED, NULL,
      "ENV_MAP, SKY: nodes of the light table's horizon-angle axis over -90..90 "
-     "degrees (181: one degree)"},
+     "degrees, odd (a node at 0); 181: one degree"},
     {"ENV_NORMAL_STEPS", K_INT, FIELD(env_normal_steps),
      TSD_XSTR(TS_ENV_DEFAULT_NORMAL_STEPS), 0, 1025, 0, 1, NULL, 1, P, LISTED, NULL,
-     "ENV_MAP, SKY: nodes of the light table's normal-angle axis (2 or more, "
-     "bilinear as Timonen), or 0: exact in the normal angle (more accurate, "
-     "smaller, faster)"},
+     "ENV_MAP, SKY: nodes of the light table's normal-angle axis (odd, 3 or "
+     "more, bilinear as Timonen), or 0: exact in the normal angle (more "
+     "accurate, smaller, faster)"},
     {"EXPOSURE", K_TEXT, FIELD(exposure), "", 0, 0, 0, 0, NULL, 1, P, LISTED,
      check_exposure,
      "envlight with OUTPUT_TYPE=Byte: stops by which the light is scaled (x "

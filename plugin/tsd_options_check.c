@@ -144,8 +144,14 @@ static int check_environment(const tsd_options *o, char *msg, size_t n)
     if (!envlight && (o->env_map[0] || o->sky[0]) && !(o->sky_weight > 0))
         REFUSE("%s sets the sky term of PRODUCT=%s, which SKY_WEIGHT=0 leaves out: give "
                "SKY_WEIGHT > 0", o->env_map[0] ? "ENV_MAP" : "SKY", p->name);
-    if (o->env_normal_steps == 1)
-        REFUSE("ENV_NORMAL_STEPS must be 0 (exact) or at least 2, got 1");
+    /* a node at 0 degrees, where open flat ground has its normal and horizon */
+    if (o->env_normal_steps == 1 || (o->env_normal_steps && o->env_normal_steps % 2 == 0))
+        REFUSE("ENV_NORMAL_STEPS must be 0 (exact) or odd (3, 5, ...: a node at 0 degrees, "
+               "the normal of flat ground), got %d", o->env_normal_steps);
+    if (o->env_horizon_steps % 2 == 0)
+        REFUSE("ENV_HORIZON_STEPS must be odd (3, 5, ..., 181: a node at 0 degrees, the "
+               "horizon of open flat ground, which else reads too little light), got %d",
+               o->env_horizon_steps);
     if (o->exposure[0] && !tsd_options_output_byte(o))
         REFUSE("EXPOSURE applies to OUTPUT_TYPE=Byte (the display image); Float32 "
                "keeps the light's own values");

@@ -340,7 +340,7 @@ START_TEST(test_brute_force_reference)
         if (dirs[d] == 64)
             mean64 = mean, max64 = mx;
     }
-    const int nn[6] = {0, 5, 9, 17, 33, 65}, nh[6] = {46, 91, 181, 361, 721, 1441};
+    const int nn[6] = {0, 5, 9, 17, 33, 65}, nh[6] = {45, 91, 181, 361, 721, 1441};
     for (int j = 0; j < 6; j++) {
         env_light(&s, &env, 64, nn[j], TS_ENV_DEFAULT_HORIZON_STEPS, 0, got[0], got[1], got[2]);
         compare_rgb(&s, got, ref, &mean, &mx);
@@ -432,9 +432,12 @@ START_TEST(test_table_bad_input)
     ck_assert(ts_env_table_build(NULL, &o, &t, &err) == TS_ERR_ARG);
     ck_assert(ts_env_table_build(&env, NULL, &t, &err) == TS_ERR_ARG);
     ck_assert(ts_env_table_build(&env, &o, NULL, &err) == TS_ERR_ARG);
+    /* even steps: no node at 0 degrees, where flat ground has its normal and
+     * horizon */
     const int bad[][4] = {{0, 17, 181, 0}, {16, 1, 181, 0}, {16, 17, 1, 0},
-                          {16, 17, 181, 2}, {65536, 16384, 16384, 0}};
-    for (int i = 0; i < 5; i++) {
+                          {16, 17, 181, 2}, {65536, 16384, 16384, 0}, {16, 2, 181, 0},
+                          {16, 16, 181, 0}, {16, 0, 2, 0}, {16, 0, 180, 0}};
+    for (int i = 0; i < 9; i++) {
         o.directions = bad[i][0], o.normal_steps = bad[i][1], o.horizon_steps = bad[i][2];
         o.ground = bad[i][3];
         ck_assert_msg(ts_env_table_build(&env, &o, &t, &err) == TS_ERR_ARG, "case %d", i);

@@ -282,6 +282,14 @@ class EnvLight(unittest.TestCase):
              "ENV_ROTATION turns ENV_MAP"),
             ("normal steps 1", dict(SKY="uniform", ENV_NORMAL_STEPS=1),
              "ENV_NORMAL_STEPS must be 0"),
+            # even counts have no node at 0 degrees: flat open ground read 0.5 of a
+            # uniform sky with 2 horizon steps, 0.875 with 4, 0.5 with 2 normal steps
+            ("normal steps 2", dict(SKY="uniform", ENV_NORMAL_STEPS=2),
+             "ENV_NORMAL_STEPS must be 0 (exact) or odd"),
+            ("horizon steps 4", dict(SKY="uniform", ENV_HORIZON_STEPS=4),
+             "ENV_HORIZON_STEPS must be odd"),
+            ("horizon steps 2", dict(SKY="uniform", ENV_HORIZON_STEPS=2),
+             "between 3 and 3601"),
         ]
         for name, opts, words in cases:
             with self.subTest(name):
