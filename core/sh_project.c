@@ -14,6 +14,10 @@
 #define DEG2RAD (M_PI / 180.0)
 #define RAD2DEG (180.0 / M_PI)
 
+/* Largest SH light coefficient taken: far above any real sky, far below
+ * FLT_MAX once multiplied by the transfer's coefficients. */
+#define TS_SH_MAX_COEFF 1e36
+
 ts_status ts_sh_project_env(const ts_env *env, double out[3][TS_SH_COEFFS], ts_error *err)
 {
     if (!out)
@@ -35,6 +39,16 @@ ts_status ts_sh_project_env(const ts_env *env, double out[3][TS_SH_COEFFS], ts_e
                 out[c][i] += w * (y[i] + ym[i]);
         }
     }
+    /* the SH light runs in float: a map near FLT_MAX (a radiance of 1e38)
+     * lit every cell as inf; the sun's disk is some 2e7 W/m2/sr */
+    for (int c = 0; c < 3; c++)
+        for (int i = 0; i < TS_SH_COEFFS; i++)
+            if (!(fabs(out[c][i]) <= TS_SH_MAX_COEFF))
+                return ts_fail(err, TS_ERR_ARG,
+                               "the environment's light is too large for the spherical "
+                               "harmonics' single precision (coefficient %g; at most %g): "
+                               "scale the map down or use ENV_METHOD=table",
+                               fabs(out[c][i]), TS_SH_MAX_COEFF);
     return ts_ok(err);
 }
 

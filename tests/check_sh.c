@@ -284,6 +284,11 @@ START_TEST(bad_input)
     ts_env empty = {0};
     double c[3][N];
     EXPECT_ARG(ts_sh_project_env(&empty, c, &err), &err);
+    /* a radiance near FLT_MAX lit every cell as inf through the float light */
+    ts_env_texel huge = {.dir = {0, 0, 1}, .rgb = {1e38f, 1e38f, 1e38f}, .solid_angle = 1};
+    ts_env big = {1, &huge};
+    EXPECT_ARG(ts_sh_project_env(&big, c, &err), &err);
+    ck_assert_msg(strstr(err.message, "ENV_METHOD=table") != NULL, "%s", err.message);
     ts_grid g;
     tdem_create(&g, 4, 4, 1, 1);
     ts_sh_visibility v;
