@@ -33,6 +33,24 @@ void tsd_backend_summary_add(tsd_backend_summary *s, const ts_backend_report *r)
     s->fell_back |= r->fell_back;
 }
 
+void tsd_backend_summary_merge(tsd_backend_summary *s, const tsd_backend_summary *add)
+{
+    if (!add->calls)
+        return;
+    if (!s->calls)
+        s->requested = add->requested;
+    s->calls += add->calls;
+    s->opencl_calls += add->opencl_calls;
+    s->c_calls += add->c_calls;
+    if (add->device_opencl[0])
+        snprintf(s->device_opencl, sizeof s->device_opencl, "%s", add->device_opencl);
+    if (add->device_c[0])
+        snprintf(s->device_c, sizeof s->device_c, "%s", add->device_c);
+    if (add->reason[0] && (!s->reason[0] || (add->fell_back && !s->fell_back)))
+        snprintf(s->reason, sizeof s->reason, "%s", add->reason);
+    s->fell_back |= add->fell_back;
+}
+
 int tsd_backend_predict(const tsd_options *o, tsd_backend_summary *s, char *msg,
                         size_t n)
 {

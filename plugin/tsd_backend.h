@@ -37,6 +37,10 @@ ts_backend tsd_backend_to_ts(tsd_backend b);
 /** Add one call's report to a summary. */
 void tsd_backend_summary_add(tsd_backend_summary *s, const ts_backend_report *r);
 
+/** Add a summary (of one chunk of a windowed product) to another (of the
+ * chunks computed so far), as if its calls had been added one by one. */
+void tsd_backend_summary_merge(tsd_backend_summary *s, const tsd_backend_summary *add);
+
 /**
  * Predict, without computing, the summary of the product's calls
  * (ts_backend_choose: probes the OpenCL device). 0, or -1 with a sentence

@@ -104,7 +104,7 @@ class TSDataset final : public GDALPamDataset
     TSDataset *MakeOverview(int nLevel);
     void EnsureBackendMetadata();
     void SetupBackendMetadata();
-    void ReportBackend();
+    bool ReportBackend(bool bMayWarn = true);
     void SetupSunMetadata();
     void SetupMetadata();
     void SetupPam(const char *pszConnection);

@@ -63,13 +63,16 @@ void TSDataset::SetupBackendMetadata()
 }
 
 /* After computing: say where it ran; a warning when OpenCL was asked for
- * (BACKEND=opencl or TERRASHADE_BACKEND=opencl) and C ran. */
-void TSDataset::ReportBackend()
+ * (BACKEND=opencl or TERRASHADE_BACKEND=opencl) and C ran, unless bMayWarn
+ * is false (a windowed product warns at its first chunk that ran C only).
+ * true when it warned. */
+bool TSDataset::ReportBackend(bool bMayWarn)
 {
     const tsd_backend_summary &s = m_sBackend;
     char szBackend[16], szDevice[512];
     tsd_backend_summary_text(&s, szBackend, sizeof szBackend, szDevice, sizeof szDevice);
-    if (s.requested == TS_BACKEND_OPENCL && s.c_calls > 0)
+    const bool bWarn = bMayWarn && s.requested == TS_BACKEND_OPENCL && s.c_calls > 0;
+    if (bWarn)
         CPLError(CE_Warning, CPLE_AppDefined,
                  "TERRASHADE: BACKEND=opencl was requested, but %d of %d computation(s) "
                  "ran on the C backend instead: %s",
@@ -79,6 +82,7 @@ void TSDataset::ReportBackend()
                  ts_backend_name(s.requested), szDevice, s.reason);
     CPLDebug(DRIVER, "backend: %s on %s (%d call(s): %d OpenCL, %d C)", szBackend,
              szDevice, s.calls, s.opencl_calls, s.c_calls);
+    return bWarn;
 }
 
 void TSDataset::SetupMetadata()

@@ -44,6 +44,8 @@ struct WindowState
     tsd_far_field far{};
     bool farReady = false;
     std::list<WindowChunk> lru{}; // most recent first
+    tsd_backend_summary ran{};    // what the chunks computed so far ran
+    bool warned = false;          // BACKEND=opencl ran C: warned once
     ~WindowState()
     {
         if (farReady)
@@ -263,12 +265,15 @@ bool TSDataset::ComputeChunk(int cx, int cy, WindowChunk &c)
         const tsd_compute_ctx sCtx{&m_sOpts, &sRun, &sRan, szMsg, sizeof szMsg};
         eSt = tsd_product_compute(&sCtx, &sRegion, pafOut, nullptr);
         tsd_progress_end(&sProgress, eSt == TS_OK);
-        if (eSt == TS_OK && sRan.calls > 0 && !m_bBackendKnown)
+        if (eSt == TS_OK && sRan.calls > 0)
         {
-            m_sBackend = sRan;
+            // what the chunks computed so far ran (replacing the prediction
+            // gdal_translate asks for first), and one warning per dataset
+            tsd_backend_summary_merge(&s.ran, &sRan);
+            m_sBackend = s.ran;
             m_bBackendKnown = true;
             SetupBackendMetadata();
-            ReportBackend();
+            s.warned = ReportBackend(!s.warned) || s.warned;
         }
     }
     if (eSt == TS_OK)

@@ -9,7 +9,8 @@ C with a warning when OpenCL was asked for and cannot run, bad values.
 - BACKEND=opencl (option or TERRASHADE_BACKEND) with
   TERRASHADE_OPENCL_DEVICE=99 gives the C results, a warning on stderr,
   BACKEND=c and BACKEND_FALLBACK_REASON; with BACKEND=auto the same fall
-  back is silent (CPLDebug);
+  back is silent (CPLDebug); a product computed chunk by chunk
+  (TILE_SIZE) warns once and its BACKEND says what its chunks ran;
 - BACKEND=bogus and TERRASHADE_BACKEND=cuda: non-zero exit, clear message;
 - the default (auto) on a CPU OpenCL device runs C and says why.
 """
@@ -143,6 +144,43 @@ class Backend(unittest.TestCase):
                 self.assertTrue(md["BACKEND_DEVICE"].startswith("CPU"))
                 self.assertIn("TERRASHADE_OPENCL_DEVICE=99", md["BACKEND_FALLBACK_REASON"])
                 np.testing.assert_array_equal(T.read(out), ref)
+
+    def test_windowed_opencl_with_a_bad_device_falls_back_with_a_warning(self):
+        """A product computed chunk by chunk (TILE_SIZE) warns once too, also
+        when its metadata was asked for first (gdal_translate does), and its
+        BACKEND items say what the chunks ran. (Both were left to the first
+        chunk, and only when nothing had asked for the metadata before: no
+        warning from gdal_translate, BACKEND=opencl after a mixed run.)"""
+        dem = self.dems["jacksboro"]
+        options = {"PRODUCT": "svf", "DIRECTIONS": 4, "TILE_SIZE": 256}
+        ref = compute(dem, dict(options, BACKEND="c"))[0]
+        out = os.path.join(self.dir, "windowed.tif")
+        p = T.run(["gdal_translate", "-q"] + T.oo_args(dict(options, BACKEND="opencl"))
+                  + [T.conn(dem), out], TERRASHADE_OPENCL_DEVICE=99,
+                  CPL_DEBUG="TERRASHADE")
+        print(p.stderr)
+        self.assertIn("computed chunk (1, 1)", p.stderr)  # really windowed
+        self.assertEqual(p.stderr.count("BACKEND=opencl was requested"), 1)
+        self.assertIn("TERRASHADE_OPENCL_DEVICE=99", p.stderr)
+        np.testing.assert_array_equal(T.read(out), ref)
+        code = ("import sys; sys.path.insert(0, %r); import tsdriver as T; "
+                "from tsdriver import gdal; "
+                "ds = gdal.OpenEx(T.conn(%r), open_options=%r); "
+                "ds.GetRasterBand(1).Checksum(); "
+                "print('BACKEND=' + ds.GetMetadataItem('BACKEND'))"
+                % (os.path.dirname(os.path.abspath(__file__)), dem,
+                   T.oo_args(dict(options, BACKEND="opencl"))[1::2]))
+        p = T.run([sys.executable, "-c", code], TERRASHADE_OPENCL_DEVICE=99)
+        print(p.stdout, p.stderr)
+        self.assertIn("BACKEND=c\n", p.stdout)
+        self.assertEqual(p.stderr.count("BACKEND=opencl was requested"), 1)
+        # OpenCL runs the normals, C the capped sweeps: predicted opencl,
+        # computed mixed (it stayed opencl)
+        _, before, after, _ = compute(dem, dict(options, MAX_DISTANCE=500, BACKEND="opencl"))
+        print(before, after)
+        self.assertEqual(before["BACKEND"], "opencl")
+        self.assertEqual(after["BACKEND"], "mixed")
+        self.assertIn("MAX_DISTANCE", after["BACKEND_FALLBACK_REASON"])
 
     def test_env_opencl_with_a_bad_device_falls_back_with_a_warning(self):
         """TERRASHADE_BACKEND=opencl asks for OpenCL as the option does."""
