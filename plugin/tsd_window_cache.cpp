@@ -19,6 +19,7 @@
 #include "cpl_string.h"
 #include "gdal_priv.h"
 
+#include "terrashade_cl.h"
 #include "tsd_dataset.h"
 #include "tsd_dem.h"
 #include "tsd_gdal.h"
@@ -267,6 +268,13 @@ bool TSDataset::ComputeChunk(int cx, int cy, WindowChunk &c)
         tsd_progress_end(&sProgress, eSt == TS_OK);
         if (eSt == TS_OK && sRan.calls > 0)
         {
+            // a chunk's sweep is bounded by its near field, not MAX_DISTANCE
+            if (p.far && strcmp(sRan.reason, TS_CL_CAPPED_SWEEP_REASON) == 0)
+                snprintf(sRan.reason, sizeof sRan.reason,
+                         "a chunk's sweep, bounded by its near field of %.0f m (TILE_SIZE=%d, "
+                         "NEAR_DISTANCE), runs on the C backend (the OpenCL kernel has no "
+                         "bounded sweep yet)",
+                         p.near_m, p.tile);
             // what the chunks computed so far ran (replacing the prediction
             // gdal_translate asks for first), and one warning per dataset
             tsd_backend_summary_merge(&s.ran, &sRan);

@@ -175,12 +175,15 @@ class Backend(unittest.TestCase):
         self.assertIn("BACKEND=c\n", p.stdout)
         self.assertEqual(p.stderr.count("BACKEND=opencl was requested"), 1)
         # OpenCL runs the normals, C the capped sweeps: predicted opencl,
-        # computed mixed (it stayed opencl)
-        _, before, after, _ = compute(dem, dict(options, MAX_DISTANCE=500, BACKEND="opencl"))
-        print(before, after)
-        self.assertEqual(before["BACKEND"], "opencl")
-        self.assertEqual(after["BACKEND"], "mixed")
-        self.assertIn("MAX_DISTANCE", after["BACKEND_FALLBACK_REASON"])
+        # computed mixed (it stayed opencl); a chunk's sweep is capped by
+        # its near field, MAX_DISTANCE's by MAX_DISTANCE
+        for extra, why in [({}, "bounded by its near field of 9528 m (TILE_SIZE=256"),
+                           ({"MAX_DISTANCE": 500}, "a MAX_DISTANCE sweep runs on the C")]:
+            _, before, after, _ = compute(dem, dict(options, BACKEND="opencl", **extra))
+            print(before, after)
+            self.assertEqual(before["BACKEND"], "opencl")
+            self.assertEqual(after["BACKEND"], "mixed")
+            self.assertIn(why, after["BACKEND_FALLBACK_REASON"])
 
     def test_env_opencl_with_a_bad_device_falls_back_with_a_warning(self):
         """TERRASHADE_BACKEND=opencl asks for OpenCL as the option does."""
