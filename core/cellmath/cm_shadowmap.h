@@ -193,7 +193,24 @@ CM_FN int ts_sm_fetch(CM_GLOBAL const int *map, int mw, int mh, int a, int b)
 typedef struct {
     float fu[7], fv[7], fd[7];
     int tri;
+    float box[4]; /* the corners' u and v range, padded: no triangle reaches out of it */
 } ts_sm_recv;
+
+/* The receiver's box (ts_sm_recv_depth's quick reject): the range of its
+ * seven points, padded by far more than the barycentric test's rounding, so
+ * that a texel out of it is out of every triangle by that test too. */
+CM_FN void ts_sm_recv_box(ts_sm_recv *r)
+{
+    float u0 = r->fu[0], u1 = u0, v0 = r->fv[0], v1 = v0;
+    for (int k = 1; k < 7; k++) {
+        u0 = r->fu[k] < u0 ? r->fu[k] : u0;
+        u1 = r->fu[k] > u1 ? r->fu[k] : u1;
+        v0 = r->fv[k] < v0 ? r->fv[k] : v0;
+        v1 = r->fv[k] > v1 ? r->fv[k] : v1;
+    }
+    const float pad = 1e-2f;
+    r->box[0] = u0 - pad, r->box[1] = u1 + pad, r->box[2] = v0 - pad, r->box[3] = v1 + pad;
+}
 
 /* The receiver's depth at texel (x, y): its own surface where a triangle of
  * its fan covers the texel (the nearest the light of those that do), else
@@ -205,7 +222,8 @@ typedef struct {
 CM_FN float ts_sm_recv_depth(const ts_sm_recv *r, float gu, float gv, float x, float y)
 {
     float best = -INFINITY, px = x - r->fu[0], py = y - r->fv[0];
-    for (int t = 0; t < 6; t++) {
+    const int in_box = x >= r->box[0] && x <= r->box[1] && y >= r->box[2] && y <= r->box[3];
+    for (int t = 0; t < 6 * in_box; t++) {
         if (!((r->tri >> t) & 1))
             continue;
         int p = t + 1, q = t == 5 ? 1 : t + 2;
@@ -214,7 +232,11 @@ CM_FN float ts_sm_recv_depth(const ts_sm_recv *r, float gu, float gv, float x, f
         float det = au * bv - bu * av;
         if (!(det > 1e-12f || det < -1e-12f)) /* seen edge-on */
             continue;
-        float l1 = (px * bv - bu * py) / det, l2 = (au * py - px * av) / det;
+        float n1 = px * bv - bu * py, n2 = au * py - px * av;
+        /* the signs first: the divisions only where both can be >= 0 */
+        if (det > 0.0f ? (n1 < 0.0f || n2 < 0.0f) : (n1 > 0.0f || n2 > 0.0f))
+            continue;
+        float l1 = n1 / det, l2 = n2 / det;
         if (!(l1 >= 0.0f && l2 >= 0.0f && l1 + l2 <= 1.0f))
             continue;
         float d = r->fd[0] + l1 * (r->fd[p] - r->fd[0]) + l2 * (r->fd[q] - r->fd[0]);
@@ -476,6 +498,7 @@ CM_FN float ts_sm_cell_at(CM_GLOBAL const float *P, CM_GLOBAL const int *map, in
         r.fd[k + 1] = pd[j];
         r.tri |= (j != i && ring[fan[(k + 1) % 6]] != i) << k;
     }
+    ts_sm_recv_box(&r);
     float lit = ts_sm_cell(P, map, mw, mh, &r);
     return near < lit ? near : lit;
 }
