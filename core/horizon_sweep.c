@@ -104,7 +104,7 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         ts_lane_pushes_reset(&w->far_push, nl);
     const ts_lane_occluders occ = {w->lo_k, w->hi_k, w->lo_dd, w->hi_dd};
     const ts_lane_hulls hulls = {w->lane_stacks, G->U + 1, w->lane_n, w->lane_far};
-    const ts_lane_lost lost = {C->c, C->cap, w->lost};
+    const ts_lane_lost lost = {&C->ray, C->c, C->cap, w->lost};
     const double c = C->c;
     for (int k = kmin; k <= kmax; k++) {
         /* The lines on the grid at step k: rows i0 + j in [0, V - 1]. */

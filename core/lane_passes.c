@@ -268,28 +268,28 @@ TS_AVX512 static int far_run32_avx512(FAR_PARAMS, int ostride)
 #define HAVE_FAR_AVX512 0
 #endif
 
-/* Cells j0..j1 whose lost flags are set (FAR_LOOP's): each flagged
- * occluder's slope by cm_ray_lost raises the cell's far field at
- * out[(j - j0) * ostride]. */
-static void far_lost(const ts_line_geom *G, const float *z, int near, int k, int i0, int j0,
-                     int j1, const float *hc, const ts_lane_occluders *occ,
-                     const ts_lane_lost *lost, float *out, ptrdiff_t ostride)
+/* Cells j0..j1 whose lost flags are set (FAR_LOOP's), clearing them: each
+ * flagged occluder's slope by cm_ray_lost raises the cell's far field at
+ * out[(j - j0) * ostride], unless near is 0 (the far-only sweep keeps its
+ * threshold). */
+static void far_lost(const ts_line_geom *G, int near, int k, int i0, int j0, int j1,
+                     const float *hc, const ts_lane_occluders *occ, const ts_lane_lost *lost,
+                     float *out, ptrdiff_t ostride)
 {
-    const cm_ray_grid ray = {z, G->V, G->t, G->origin, G->u_stride, G->v_stride};
     for (int j = j0; j <= j1; j++) {
         const int f = lost->flags[j];
         lost->flags[j] = 0; /* the AVX-512 pass writes only vectors with a flag */
-        if (!f || hc[j] != hc[j])
+        if (!f || near == 0 || hc[j] != hc[j])
             continue;
-        const int i = i0 + j, row = G->x_major ? i : G->u_start + k * G->u_step;
-        const double step = G->step_row ? G->step_row[row] : G->step_m;
+        const int i = i0 + j;
+        const double step = ts_line_cell_step(G, k, i);
         float *o = out + (j - j0) * ostride;
         for (int e = 0; e < 2; e++) {
             if (!(f >> e & 1))
                 continue;
             const int kc = e ? occ->hi_k[j] : occ->lo_k[j];
-            const float s = cm_ray_lost(&ray, k, i, hc[j], k - kc, near, lost->cap / step, step,
-                                        lost->c);
+            const float s = cm_ray_lost(lost->ray, k, i, hc[j], k - kc, near, lost->cap / step,
+                                        step, lost->c);
             *o = s > *o ? s : *o;
         }
     }
@@ -311,11 +311,8 @@ void ts_lane_far_field(const ts_line_geom *G, const float *z, float cf, int near
         any = far_run32_avx512(R, G->ray_o, G->ray_f, z, cf, k, i0, j0, j1, hc, occ->lo_k,
                                occ->lo_dd, occ->hi_k, occ->hi_dd, out, lost->flags,
                                (int)ostride);
-        if (any && near > 0) /* the far-only sweep (near 0) keeps its threshold */
-            far_lost(G, z, near, k, i0, j0, j1, hc, occ, lost, out, ostride);
-        else if (any)
-            for (int j = j0; j <= j1; j++)
-                lost->flags[j] = 0;
+        if (any)
+            far_lost(G, near, k, i0, j0, j1, hc, occ, lost, out, ostride);
         return;
     }
 #endif
@@ -324,6 +321,6 @@ void ts_lane_far_field(const ts_line_geom *G, const float *z, float cf, int near
                                                    occ->hi_dd, slope, lost->flags);
     for (int j = j0; j <= j1; j++)
         out[(j - j0) * ostride] = slope[j];
-    if (any && near > 0)
-        far_lost(G, z, near, k, i0, j0, j1, hc, occ, lost, out, ostride);
+    if (any)
+        far_lost(G, near, k, i0, j0, j1, hc, occ, lost, out, ostride);
 }

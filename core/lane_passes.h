@@ -13,6 +13,7 @@
 
 #include <stddef.h>
 
+#include "cellmath/cm_near_field.h"
 #include "line_geometry.h"
 
 /* Step k's samples of lines j0..j1 (rows i0 + j, all on the grid): the
@@ -30,10 +31,12 @@ typedef struct {
 } ts_lane_occluders;
 
 /* Where an occluder lies where the cell's own ray cannot be sampled (off
- * the grid or on nodata there; cm_ray_lost solves the ray's steps up to
- * it): the curvature coefficient and the distance cap (metres, 0 = none)
- * in double, as the near field takes them, and scratch of j1 + 1 ints. */
+ * the grid or on nodata there; cm_ray_lost samples the ray's steps up to
+ * it): the grid as the rays see it, the curvature coefficient and the
+ * distance cap (metres, 0 = none) in double, as the near field takes them,
+ * and scratch of j1 + 1 ints, clear between calls. */
 typedef struct {
+    const cm_ray_grid *ray;
     double c, cap;
     int *flags;
 } ts_lane_lost;

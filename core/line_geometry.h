@@ -101,6 +101,13 @@ typedef struct {
     float hs;          /* height on the line; NaN off the grid or at nodata */
 } ts_line_sample;
 
+/* Metres a step of the ray from cell (k, i) (i: the row or column across
+ * the lines): its grid row's on a geographic grid, else the grid's. */
+static inline double ts_line_cell_step(const ts_line_geom *G, int k, int i)
+{
+    return G->step_row ? G->step_row[G->x_major ? i : G->u_start + k * G->u_step] : G->step_m;
+}
+
 /*
  * Sample k of line b, and the distance d (metres) along the line from its
  * first sample k0 to it: d is advanced from sample k - 1 (pass k0 first,

@@ -55,7 +55,7 @@ static float far_field(const sweep_ctx *C, int k, int i, float h, occluder lo, o
             /* e = 0 adds exactly +0 to the distance: skip the conversion. */
             float dd = e ? cand[c].dd + (float)(e * step) : cand[c].dd;
             float s = ray_slope(C, k, i, h, dk + e, dd);
-            if (e == 0 && s == -INFINITY && dk <= k) /* the ray cannot be sampled there */
+            if (e == 0 && s == -INFINITY) /* the ray cannot be sampled there */
                 s = cm_ray_lost(&C->ray, k, i, h, dk, TS_NEAR_STEPS, C->cap / step, step,
                                 C->c);
             best = s > best ? s : best;
@@ -133,9 +133,7 @@ void ts_sweep_process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
             if (!isnan(hc)) {
                 occluder hi = inside ? hull_query(C, w, far, d, hc, w->finger[0]) : none;
                 occluder lo = (F > 0.0f && k >= pk0 && k <= pk1) ? prev_lo[k] : none;
-                int row = G->x_major ? i : G->u_start + k * G->u_step;
-                double step = G->step_row ? G->step_row[row] : G->step_m;
-                s_out = far_field(C, k, i, hc, lo, hi, step); /* near field later */
+                s_out = far_field(C, k, i, hc, lo, hi, ts_line_cell_step(G, k, i));
             }
             C->out[C->o_origin + (ptrdiff_t)k * C->o_u_stride + (ptrdiff_t)i * C->o_v_stride] =
                 s_out;
