@@ -14,6 +14,14 @@ ts_backend tsd_backend_to_ts(tsd_backend b)
                                    : TS_BACKEND_AUTO;
 }
 
+/* The first reason; the first failure wins over a choice (auto on a CPU). */
+static void take_reason(tsd_backend_summary *s, const char *reason, int fell_back)
+{
+    if (reason[0] && (!s->reason[0] || (fell_back && !s->fell_back)))
+        snprintf(s->reason, sizeof s->reason, "%s", reason);
+    s->fell_back |= fell_back;
+}
+
 void tsd_backend_summary_add(tsd_backend_summary *s, const ts_backend_report *r)
 {
     if (!s->calls)
@@ -26,11 +34,7 @@ void tsd_backend_summary_add(tsd_backend_summary *s, const ts_backend_report *r)
     }
     s->c_calls++;
     snprintf(s->device_c, sizeof s->device_c, "%s", r->device);
-    /* the first reason; the first failure wins over a choice (auto on a CPU) */
-    if (r->requested != TS_BACKEND_C && r->reason[0] &&
-        (!s->reason[0] || (r->fell_back && !s->fell_back)))
-        snprintf(s->reason, sizeof s->reason, "%s", r->reason);
-    s->fell_back |= r->fell_back;
+    take_reason(s, r->requested != TS_BACKEND_C ? r->reason : "", r->fell_back);
 }
 
 void tsd_backend_summary_merge(tsd_backend_summary *s, const tsd_backend_summary *add)
@@ -46,9 +50,7 @@ void tsd_backend_summary_merge(tsd_backend_summary *s, const tsd_backend_summary
         snprintf(s->device_opencl, sizeof s->device_opencl, "%s", add->device_opencl);
     if (add->device_c[0])
         snprintf(s->device_c, sizeof s->device_c, "%s", add->device_c);
-    if (add->reason[0] && (!s->reason[0] || (add->fell_back && !s->fell_back)))
-        snprintf(s->reason, sizeof s->reason, "%s", add->reason);
-    s->fell_back |= add->fell_back;
+    take_reason(s, add->reason, add->fell_back);
 }
 
 int tsd_backend_predict(const tsd_options *o, tsd_backend_summary *s, char *msg,

@@ -18,10 +18,7 @@ int tsd_options_check_light(const tsd_options *o, char *msg, size_t n)
     tsd_options_defaults(&d);
     const int radius_given = o->light_radius != d.light_radius;
     const int shadowmap = o->method == TSD_METHOD_SHADOWMAP;
-    /* the table's upper bounds are inclusive; the disk must stay below 45 */
-    if (!(o->light_radius < TS_LIGHT_RADIUS_MAX))
-        REFUSE("LIGHT_RADIUS must be greater than 0 and less than %g degrees, got %g",
-               TS_LIGHT_RADIUS_MAX, o->light_radius);
+    /* (LIGHT_RADIUS's own range, open at both ends, is its row's check) */
     if (radius_given && !tsd_product_takes(p, tsd_option_find("LIGHT_RADIUS")))
         REFUSE("LIGHT_RADIUS applies to PRODUCT=shade and PRODUCT=shadow, not to "
                "PRODUCT=%s", p->name);
