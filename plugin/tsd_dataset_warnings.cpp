@@ -15,7 +15,24 @@ namespace tsd
 
 std::string NotHeights(GDALDataset *poDEM, int nBand, const std::string &osDEM)
 {
-    const GDALColorInterp eInterp = poDEM->GetRasterBand(nBand)->GetColorInterpretation();
+    GDALRasterBand *poBand = poDEM->GetRasterBand(nBand);
+    // values GDAL would not hand over as they are: the real part alone, or
+    // signed bytes as 0..255 (GDAL 3.6 has no Int8: -1 reads as 255)
+    const GDALDataType eType = poBand->GetRasterDataType();
+    if (GDALDataTypeIsComplex(eType))
+        return CPLSPrintf("band %d of '%s' is complex (%s), not heights: choose the band that "
+                          "holds heights (BAND), or, if its real part is the heights, write it "
+                          "alone first (gdal_translate -ot Float32 '%s' heights.tif)",
+                          nBand, osDEM.c_str(), GDALGetDataTypeName(eType), osDEM.c_str());
+    const char *pszPixelType = poBand->GetMetadataItem("PIXELTYPE", "IMAGE_STRUCTURE");
+    if (eType == GDT_Byte && pszPixelType && EQUAL(pszPixelType, "SIGNEDBYTE"))
+        return CPLSPrintf("band %d of '%s' holds signed bytes (PIXELTYPE=SIGNEDBYTE), which "
+                          "GDAL %s reads as 0..255 (-1 as 255, a cliff of 255 m between -1 "
+                          "and 0): write them as Int16 first (gdal_calc.py -A '%s' "
+                          "--type=Int16 --calc='A.astype(numpy.int16)-256*(A>127)' "
+                          "--outfile=heights.tif)",
+                          nBand, osDEM.c_str(), GDALVersionInfo("RELEASE_NAME"), osDEM.c_str());
+    const GDALColorInterp eInterp = poBand->GetColorInterpretation();
     if (eInterp == GCI_Undefined || eInterp == GCI_GrayIndex)
         return std::string();
     const std::string osWhat = eInterp == GCI_PaletteIndex

@@ -206,6 +206,41 @@ class NotHeights(unittest.TestCase):
             out = T.read(T.conn(rgb, BAND=2, PRODUCT="svf", DIRECTIONS=4), 1)
             np.testing.assert_allclose(out, 1.0, atol=1e-6)  # a flat band: open sky
 
+    def test_complex_and_signed_byte_bands_are_refused(self):
+        """A complex band (GDAL reads its real part alone) and signed bytes
+        (GDAL 3.6 reads -8 as 248: a 256 m cliff between -1 and 0) are not
+        heights GDAL hands over as they are: an error at open naming the
+        band, the type and the way out, not a silent product."""
+        z = T.fractal_dem(40, seed=3, relief=20.0) - 10.0  # -10 .. 10 m
+        with T.TempDir() as tmp:
+            for dtype in (gdal.GDT_CInt16, gdal.GDT_CInt32, gdal.GDT_CFloat32,
+                          gdal.GDT_CFloat64):
+                name = gdal.GetDataTypeName(dtype)
+                dem = T.write_tif(os.path.join(tmp, name + ".tif"), np.round(z), GT, UTM,
+                                  dtype=dtype)
+                with self.subTest(dtype=name):
+                    p = T.run(["gdalinfo", "-nomd", T.conn(dem)], ok=False)
+                    self.assertIn("ERROR 5: TERRASHADE: band 1 of '%s' is complex (%s), "
+                                  "not heights" % (dem, name), p.stderr)
+                    self.assertIn("gdal_translate -ot Float32", p.stderr)
+            signed = os.path.join(tmp, "signed.tif")
+            ds = gdal.GetDriverByName("GTiff").Create(signed, 40, 40, 1, gdal.GDT_Byte,
+                                                      ["PIXELTYPE=SIGNEDBYTE"])
+            ds.SetGeoTransform(GT)
+            ds.GetRasterBand(1).WriteArray(np.round(z).astype(np.int8).view(np.uint8))
+            ds = None
+            p = T.run(["gdalinfo", "-nomd", T.conn(signed)], ok=False)
+            self.assertIn("ERROR 5: TERRASHADE: band 1 of '%s' holds signed bytes "
+                          "(PIXELTYPE=SIGNEDBYTE)" % signed, p.stderr)
+            # the remedy it gives makes an Int16 DEM of the same heights
+            fixed = os.path.join(tmp, "fixed.tif")
+            T.run(["gdal_calc.py", "--quiet", "-A", signed, "--type=Int16",
+                   "--calc=A.astype(numpy.int16)-256*(A>127)", "--outfile=" + fixed])
+            self.assertIn("gdal_calc.py -A '%s' --type=Int16 "
+                          "--calc='A.astype(numpy.int16)-256*(A>127)'" % signed, p.stderr)
+            np.testing.assert_array_equal(T.read(fixed, 1), np.round(z))
+            T.read(T.conn(fixed, PRODUCT="svf", DIRECTIONS=4), 1)
+
 
 class NotTerrainScale(unittest.TestCase):
     """A DEM steeper than 85 degrees nearly everywhere is not terrain at its
