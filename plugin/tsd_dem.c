@@ -51,6 +51,18 @@ static int nodata_in_values(GDALRasterBandH band, int w, int h)
            GDALGetMaskFlags(band) == GMF_NODATA;
 }
 
+double tsd_dem_nodata(GDALRasterBandH band, int *has)
+{
+#if GDAL_VERSION_NUM >= GDAL_COMPUTE_VERSION(3, 5, 0)
+    const GDALDataType type = GDALGetRasterDataType(band);
+    if (type == GDT_Int64)
+        return (double)GDALGetRasterNoDataValueAsInt64(band, has);
+    if (type == GDT_UInt64)
+        return (double)GDALGetRasterNoDataValueAsUInt64(band, has);
+#endif
+    return GDALGetRasterNoDataValue(band, has);
+}
+
 /* Rows y0 .. y0 + rows - 1 of the band read at w x h cells: as they are at
  * the band's own size, else averaged over each coarse cell's footprint
  * (GDAL's average resampling, over the valid cells only) through a
@@ -80,7 +92,7 @@ static CPLErr read_rows(GDALRasterBandH band, int y0, int rows, int w, int h, vo
                        line, &extra) != CE_None)
         return CE_Failure;
     int has_nodata = 0;
-    const float nodata = (float)GDALGetRasterNoDataValue(band, &has_nodata);
+    const float nodata = (float)tsd_dem_nodata(band, &has_nodata);
     if (type == GDT_Float32 && has_nodata && nodata_in_values(band, w, h))
         for (int y = 0; y < rows; y++) {
             float *r = (float *)buf + (size_t)y * stride;

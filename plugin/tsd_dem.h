@@ -20,6 +20,11 @@
 extern "C" {
 #endif
 
+/** The band's nodata value as a double (*has: whether it has one); an
+ * Int64 or UInt64 band's through its own getter, which GDAL's double getter
+ * would warn about when the value is not exact as a double. */
+double tsd_dem_nodata(GDALRasterBandH band, int *has);
+
 /** Fill `grid` (created here; free with ts_grid_free) from `band`, its
  * heights times z_factor (NAN: AUTO, as tsd_dem_z_factor decides).
  * TS_OK, or the failure's status with a sentence in msg. */

@@ -94,7 +94,7 @@ static bool OverviewsAgree(GDALRasterBand *poBand, int w, const std::string &osD
                          nullptr) != CE_None)
         return true; // unreadable here: the reads that follow will say
     int bHasNoData = FALSE;
-    const double dfNoData = poBand->GetNoDataValue(&bHasNoData);
+    const double dfNoData = tsd_dem_nodata(GDALRasterBand::ToHandle(poBand), &bHasNoData);
     double dfSum = 0, dfMin = INFINITY, dfMax = -INFINITY;
     int nCompared = 0;
     for (int j = 0; j < n; j++)

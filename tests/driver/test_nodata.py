@@ -54,6 +54,61 @@ class Nodata(unittest.TestCase):
             out = T.read(T.conn(dem, PRODUCT="svf", DIRECTIONS=8), 1)
             np.testing.assert_array_equal(np.isnan(out), np.isnan(z))
 
+    def test_every_real_type_with_its_extreme_as_nodata(self):
+        """A DEM of each real GDAL type whose void holds the type's extreme,
+        declared as nodata: the same svf as the Float32 DEM of the same
+        heights with NaN in the void; an overview level the product of the
+        DEM as gdal_translate -ot Float32 -r average -outsize writes it; and
+        no warning but GDAL's own (the driver asked an Int64/UInt64 band for
+        its nodata as a double, and GDAL warned that it is approximate)."""
+        z = np.round(T.fractal_dem(300, seed=5, relief=200.0)) - 80  # 20 .. 220 m
+        void = np.zeros(z.shape, bool)
+        void[40:90, 100:180] = True
+        types = [(gdal.GDT_Byte, 255), (gdal.GDT_UInt16, 65535), (gdal.GDT_Int16, -32768),
+                 (gdal.GDT_UInt32, 4294967295), (gdal.GDT_Int32, -2147483648),
+                 (gdal.GDT_Int64, -2 ** 63), (gdal.GDT_UInt64, 2 ** 64 - 1),
+                 (gdal.GDT_Float32, -3.4028234663852886e38),
+                 (gdal.GDT_Float64, -1.7976931348623157e308)]
+        svf = {"PRODUCT": "svf", "DIRECTIONS": 8}
+        with T.TempDir() as tmp:
+            ref = z.astype(np.float32)
+            ref[void] = np.nan
+            ref_dem = T.write_tif(os.path.join(tmp, "ref.tif"), ref, GT, 32617)
+            want = T.read(T.translate(ref_dem, os.path.join(tmp, "ref_svf.tif"), svf), 1)
+            srs = gdal.Open(ref_dem).GetProjection()
+            for dtype, nodata in types:
+                name = gdal.GetDataTypeName(dtype)
+                with self.subTest(dtype=name):
+                    a = z.astype({"Int64": np.int64, "UInt64": np.uint64}.get(name, np.float64))
+                    a[void] = nodata
+                    dem = os.path.join(tmp, name + ".tif")
+                    ds = gdal.GetDriverByName("GTiff").Create(dem, 300, 300, 1, dtype)
+                    ds.SetGeoTransform(GT)
+                    ds.SetProjection(srs)
+                    rb = ds.GetRasterBand(1)
+                    {"Int64": rb.SetNoDataValueAsInt64,
+                     "UInt64": rb.SetNoDataValueAsUInt64}.get(name, rb.SetNoDataValue)(nodata)
+                    rb.WriteArray(a)
+                    ds = rb = None
+                    coarse = os.path.join(tmp, name + "_150.tif")
+                    # (GDAL 3.6's gdal_translate drops a 64-bit integer nodata there)
+                    keep = (["-a_nodata", repr(float(np.float32(nodata)))]
+                            if "Int64" in name else [])
+                    # GDAL's own warnings on that read (its resampling asks an
+                    # Int64/UInt64 band for its nodata as a double), not the driver's
+                    gdal_warnings = T.run(["gdal_translate", "-q", "-ot", "Float32", "-r",
+                                           "average", "-outsize", "150", "150"] + keep
+                                          + [dem, coarse]).stderr.count("Warning")
+                    want_ovr = T.read(T.translate(coarse, os.path.join(tmp, name + "_c.tif"),
+                                                  svf), 1)
+                    for extra, expected, warnings in (
+                            ([], want, 0), (["-outsize", "150", "150"], want_ovr, gdal_warnings)):
+                        out = os.path.join(tmp, name + "_svf.tif")
+                        p = T.run(["gdal_translate", "-q"] + T.oo_args(svf) + extra
+                                  + [T.conn(dem), out])
+                        self.assertLessEqual(p.stderr.count("Warning"), warnings, p.stderr)
+                        np.testing.assert_array_equal(T.read(out, 1), expected)
+
     def test_all_nodata(self):
         with T.TempDir() as tmp:
             dem = T.write_tif(os.path.join(tmp, "empty.tif"),
