@@ -141,6 +141,62 @@ static ts_status cliff_error(GDALRasterBandH band, const tsd_dem_conversion *c,
                     p->y0 + (int)(p->sy * gy), spacing, limit, todo);
 }
 
+/* The value an integer type's voids hold by custom: the minimum of a
+ * signed type (-32768), the maximum of an unsigned one (65535). 0 for the
+ * others: a Byte's 255 is as likely a height; the 64-bit ones' lie beyond
+ * any terrain at any usual scale; the float types' too. */
+static int customary_void(GDALDataType type, double *raw)
+{
+    switch (type) {
+    case GDT_Int16: *raw = -32768.0; return 1;
+    case GDT_UInt16: *raw = 65535.0; return 1;
+    case GDT_Int32: *raw = -2147483648.0; return 1;
+    case GDT_UInt32: *raw = 4294967295.0; return 1;
+    default: return 0;
+    }
+}
+
+/* A height the grid holds that is the band's type's customary void, once
+ * within the Earth's heights by the band's scale (Int16 centimetres:
+ * -327.68 m, UInt16 centimetres: 655.35 m): an error naming it and the
+ * first cell; TS_OK where no cell holds it. */
+static ts_status void_error(GDALRasterBandH band, const tsd_dem_conversion *c, const ts_grid *g,
+                            const tsd_dem_seen *seen, const tsd_dem_placement *p, char *msg,
+                            size_t n)
+{
+    double raw;
+    const GDALDataType type = GDALGetRasterDataType(band);
+    if (!customary_void(type, &raw))
+        return TS_OK;
+    const float z = (float)((double)(float)raw * c->scale + c->offset); /* as tsd_dem.c */
+    const double next = raw < 0 ? raw + 1 : raw - 1; /* a height it must differ from */
+    if ((z != tsd_key_float(seen->lo_key) && z != tsd_key_float(seen->hi_key)) ||
+        (float)((double)(float)next * c->scale + c->offset) == z)
+        return TS_OK;
+    for (int gy = 0; gy < g->height; gy++) {
+        const float *row = g->z + (ptrdiff_t)gy * g->stride;
+        for (int gx = 0; gx < g->width; gx++) {
+            if (row[gx] != z)
+                continue;
+            const int full = p->sx == 1 && p->sy == 1;
+            GDALDatasetH ds = GDALGetBandDataset(band);
+            const char *path = ds ? GDALGetDescription(ds) : "";
+            return tsd_fail(msg, n, TS_ERR_ARG,
+                            "the DEM '%s' holds %.0f, the value %s DEMs leave in their voids, "
+                            "in band %d %s column %d, row %d (%.6g m after its scale, offset "
+                            "and Z_FACTOR), and does not declare it as nodata: those cells "
+                            "would be terrain %.6g m %s. Declare it (gdal_edit.py -a_nodata "
+                            "%.0f %s) and those cells are nodata; if they are heights, write "
+                            "the DEM as Float32 (gdal_translate -ot Float32)",
+                            path, raw, GDALGetDataTypeName(type), GDALGetBandNumber(band),
+                            full ? "at" : "near", p->x0 + (int)(p->sx * gx),
+                            p->y0 + (int)(p->sy * gy), (double)z, fabs((double)z),
+                            z < 0 ? "deep" : "high", raw, path);
+        }
+    }
+    return TS_OK;
+}
+
 ts_status tsd_dem_check(GDALRasterBandH band, const tsd_dem_conversion *c, const ts_grid *g,
                         const tsd_dem_seen *seen, double spacing, const tsd_dem_placement *p,
                         char *msg, size_t n)
@@ -159,7 +215,7 @@ ts_status tsd_dem_check(GDALRasterBandH band, const tsd_dem_conversion *c, const
     const double cliff = fmax(CLIFF_M, CLIFF_SLOPE * spacing) * stretch_of(c);
     if (step > cliff)
         return cliff_error(band, c, g, p, cliff, spacing, msg, n);
-    return TS_OK;
+    return void_error(band, c, g, seen, p, msg, n);
 }
 
 /* Steeper than this nearly everywhere is not terrain at the DEM's scale. */

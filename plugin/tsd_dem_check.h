@@ -71,7 +71,8 @@ static inline float tsd_key_float(uint32_t key)
  * height beyond the Earth's (-12 000 to 9 000 m; on another body, its
  * radius) and, on Earth, no cliff of more than 5 000 m, and steeper than 84
  * degrees, between neighbours in a row; both widened by a Z_FACTOR that
- * exaggerates. Else
+ * exaggerates; on Earth, no integer band's customary void (Int16 -32768,
+ * UInt16 65535...) that its scale brings within those heights. Else
  * TS_ERR_ARG with a sentence naming the first cell at fault and what to do
  * (declare the nodata value, the unit).
  */

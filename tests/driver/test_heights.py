@@ -56,6 +56,65 @@ class ImpossibleHeights(unittest.TestCase):
                               "column 30, row 40", err)
                 self.assertIn("gdal_edit.py -a_nodata -32768 " + dem, err)
 
+    def test_scaled_integer_voids_are_an_error(self):
+        """The integer types' customary voids (Int16 -32768, UInt16 65535)
+        undeclared in a DEM whose scale brings them within the Earth's
+        heights (centimetres: a pit 327.68 m deep, a tower 655.35 m high;
+        decimetres: 3.3 km deep, too gentle a step for a cliff) are an error
+        naming the value and the cell, through the whole DEM, windows and an
+        overview level; declared, they are nodata; a Float32 copy of the same
+        values is taken as heights."""
+        z = self.z - 100.0  # 0 .. 800 m
+        for dtype, void, unit in ((gdal.GDT_Int16, -32768, 0.01),
+                                  (gdal.GDT_UInt16, 65535, 0.01),
+                                  (gdal.GDT_Int16, -32768, 0.1)):
+            name = "%s_%g" % (gdal.GetDataTypeName(dtype), unit)
+            raw = np.round(z / 0.1 if unit == 0.1 else z / 2.0 / unit)  # cm: 0 .. 400 m
+            raw[40:52, 30:47] = void
+            with self.subTest(dem=name):
+                dem = self.dem(name + ".tif", raw, dtype=dtype)
+                ds = gdal.Open(dem, gdal.GA_Update)
+                ds.GetRasterBand(1).SetScale(unit)
+                ds = None
+                for extra in ({"TILE_SIZE": 0}, {"TILE_SIZE": 64}):
+                    err = failure(T.conn(dem, PRODUCT="svf", DIRECTIONS=4, **extra))
+                    self.assertIn("holds %d, the value %s DEMs leave in their voids, in band 1 "
+                                  "at column 30, row 40 (%.6g m after its scale"
+                                  % (void, gdal.GetDataTypeName(dtype), void * unit), err)
+                    self.assertIn("gdal_edit.py -a_nodata %d %s" % (void, dem), err)
+                # declared: nodata
+                declared = self.dem(name + "_nd.tif", raw, dtype=dtype, nodata=void)
+                ds = gdal.Open(declared, gdal.GA_Update)
+                ds.GetRasterBand(1).SetScale(unit)
+                ds = None
+                out = T.read(T.conn(declared, PRODUCT="svf", DIRECTIONS=4), 1)
+                np.testing.assert_array_equal(np.isnan(out), raw == void)
+                # a Float32 copy: heights, as the message says
+                copy = os.path.join(self.tmp, name + "_f32.tif")
+                T.run(["gdal_translate", "-q", "-ot", "Float32", dem, copy])
+                out = T.read(T.conn(copy, PRODUCT="svf", DIRECTIONS=4), 1)
+                self.assertFalse(np.isnan(out).any())
+        # a scale that does not tell the void from other values (0: every
+        # height is the offset) names no void
+        flat = self.dem("scale0.tif", np.arange(96 * 96).reshape(96, 96), dtype=gdal.GDT_Int16)
+        ds = gdal.Open(flat, gdal.GA_Update)
+        ds.GetRasterBand(1).SetScale(0)
+        ds.GetRasterBand(1).SetOffset(100)
+        ds = None
+        np.testing.assert_allclose(T.read(T.conn(flat, PRODUCT="svf", DIRECTIONS=4), 1), 1.0,
+                                   atol=1e-6)
+        # an overview level (a 600 x 600 DEM has one of 300 x 300): a coarse
+        # cell all of whose cells are the void
+        big = np.round(T.fractal_dem(600, seed=4, relief=300.0) / 0.01)
+        big[401:420, 333:350] = -32768
+        dem = self.dem("big_cm.tif", big, dtype=gdal.GDT_Int16)
+        ds = gdal.Open(dem, gdal.GA_Update)
+        ds.GetRasterBand(1).SetScale(0.01)
+        ds = None
+        err = failure(T.conn(dem), ["-outsize", "50%", "0", "-r", "nearest"])
+        self.assertIn("holds -32768, the value Int16 DEMs leave in their voids, in band 1 "
+                      "near column 334, row 402", err)
+
     def test_declared_it_is_nodata(self):
         """The remedy the error gives works: the void is nodata in the output."""
         z = self.with_void(-32768)
