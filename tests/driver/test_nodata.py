@@ -46,13 +46,17 @@ class Nodata(unittest.TestCase):
             self.assertTrue(np.isnan(ds.GetRasterBand(1).GetNoDataValue()))
 
     def test_nan_heights_are_nodata(self):
-        """A float DEM with NaN and no declared nodata."""
+        """A float DEM with NaN, +inf and -inf and no declared nodata: those
+        cells are nodata (the whole DEM and windows)."""
         with T.TempDir() as tmp:
-            z = T.fractal_dem(64)
+            z = T.fractal_dem(160)
             z[10:20, 30:40] = np.nan
+            z[40, 5] = np.inf
+            z[70:72, 60:63] = -np.inf
             dem = T.write_tif(os.path.join(tmp, "nan.tif"), z, GT, 32617)
-            out = T.read(T.conn(dem, PRODUCT="svf", DIRECTIONS=8), 1)
-            np.testing.assert_array_equal(np.isnan(out), np.isnan(z))
+            for tile in (0, 64):
+                out = T.read(T.conn(dem, PRODUCT="svf", DIRECTIONS=8, TILE_SIZE=tile), 1)
+                np.testing.assert_array_equal(np.isnan(out), ~np.isfinite(z))
 
     def test_every_real_type_with_its_extreme_as_nodata(self):
         """A DEM of each real GDAL type whose void holds the type's extreme,
