@@ -33,7 +33,10 @@ gdal.UseExceptions()
 
 PROG = "terrashade.distributed"
 TILE_MIN, TILE_MAX = 16, 65536
-INLINE = re.compile(r"^([A-Za-z_]\w*=[^,:]*(?:,[A-Za-z_]\w*=[^,:]*)*):")
+# The driver's inline option segment (plugin/tsd_connstr.c): KEY=VALUE items,
+# an ASCII identifier as KEY with blanks allowed around it, up to the first ':'.
+_ITEM = r" *[A-Za-z_][A-Za-z0-9_]* *=[^,:]*"
+INLINE = re.compile(r"^(%s(?:,%s)*):" % (_ITEM, _ITEM))
 
 
 class Failure(Exception):
@@ -101,11 +104,11 @@ def parse_args(argv):
 
 def given_keys(source, open_options):
     """Upper-case names of the options given inline in SOURCE or by -oo."""
-    keys = {oo.split("=", 1)[0].upper() for oo in open_options}
+    items = list(open_options)
     m = INLINE.match(source[len("TERRASHADE:"):])
     if m:
-        keys |= {item.split("=", 1)[0].upper() for item in m.group(1).split(",")}
-    return keys
+        items += m.group(1).split(",")
+    return {item.split("=", 1)[0].strip().upper() for item in items}
 
 
 def open_source(source, open_options):

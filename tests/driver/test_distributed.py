@@ -117,6 +117,26 @@ class Distributed(unittest.TestCase):
                 self.assertEqual(gdal.Open(dest).GetRasterBand(1).GetBlockSize(), [64, 64])
                 self.assert_identical(dest, self.reference(options, "ref_%s.tif" % name))
 
+    def test_inline_options_as_the_driver_reads_them(self):
+        """THREADS and PROGRESS given inline are left to the user, also where
+        the driver's parser allows blanks around a key: the program added
+        its own THREADS=1 beside ' THREADS=2', and every task failed with
+        'THREADS is given twice'."""
+        from terrashade import distributed as D
+        for inline in ("PRODUCT=shade,THREADS=2,progress=no",
+                       "PRODUCT=shade, THREADS=2,PROGRESS =no",
+                       " PRODUCT=shade ,  THREADS  =2, progress=no"):
+            with self.subTest(inline):
+                self.assertEqual(D.given_keys("TERRASHADE:%s:%s" % (inline, self.dem), []),
+                                 {"PRODUCT", "THREADS", "PROGRESS"})
+        # no inline segment: a DEM name with '=' and ',' but no identifier key
+        self.assertEqual(D.given_keys("TERRASHADE:/d=1,e/dem.tif", ["threads=3"]), {"THREADS"})
+        dest = self.path("inline_blanks.tif")
+        distributed(["--workers", 2, "--tile-size", 64, "-q",
+                     "TERRASHADE:PRODUCT=shade, THREADS=2, PROGRESS=no:" + self.dem, dest])
+        self.assert_identical(dest, self.reference(
+            {"PRODUCT": "shade", "THREADS": 2, "PROGRESS": "no"}, "ref_inline.tif"))
+
     def test_existing_cluster_writes_cog(self):
         from dask.distributed import LocalCluster
         cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
