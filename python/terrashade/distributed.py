@@ -304,7 +304,11 @@ def remove(path):
 def run(args):
     src = open_source(args.source, args.open_options)
     fmt = output_format(args)
-    if os.path.isdir(args.dest):  # found now, not when the result is renamed to it
+    if args.dest.startswith("/vsi"):  # found now, not when the result is renamed to it
+        raise Failure("cannot write %s: DEST must be a file path, not a GDAL virtual file "
+                      "system: the result is written beside it and renamed into place; "
+                      "write it to a local file and copy that" % args.dest)
+    if os.path.isdir(args.dest):
         raise Failure("cannot write %s: it is a directory; DEST names the output file"
                       % args.dest)
     block = block_size(args.tile_size)

@@ -266,6 +266,12 @@ class Distributed(unittest.TestCase):
             ("tile size not a number", ["--tile-size", "big", T.conn(self.dem)],
              "must be a whole number, got 'big'", None),
             ("unknown format", [T.conn(self.dem)], "cannot tell the format", "out.png"),
+            # renamed into place at the end: a /vsi path failed only then, after
+            # all the work (/vsimem/), or left an empty archive (/vsizip/)
+            ("virtual DEST in memory", [T.conn(self.dem)],
+             "cannot write /vsimem/out.tif: DEST must be a file path", "/vsimem/out.tif"),
+            ("virtual DEST in a zip", [T.conn(self.dem)],
+             "DEST must be a file path", "/vsizip/" + self.path("out.zip") + "/out.tif"),
         ]
         for what, args, message, dest in cases:
             with self.subTest(what):
@@ -275,6 +281,7 @@ class Distributed(unittest.TestCase):
                 self.assertIn(message, p.stderr)
                 self.assertNotIn("Traceback", p.stderr)
                 self.assert_nothing_left(dest)
+        self.assertFalse(os.path.exists(self.path("out.zip")), "an archive was left behind")
 
 
 if __name__ == "__main__":
