@@ -10,7 +10,9 @@
   (shade from an azimuth and from a date and time, shadow with a choice and a
   boolean, svf, horizon, sunhours), and the gdal_translate command it logs
   writes the same pixels;
-- bad input gives a QgsProcessingException with the driver's sentence;
+- bad input gives a QgsProcessingException with the driver's sentence, and
+  a cancel one that says 'cancelled' (no output left), also with
+  gdal.UseExceptions() turned on by someone else;
 - qgis_process, QGIS's command line, finds the plugin through
   QGIS_PLUGINPATH, lists its algorithms and runs one.
 
@@ -57,6 +59,9 @@ from processing.core.Processing import Processing
 Processing.initialize()
 import processing
 import terrashade
+if sys.argv[3:] == ["exceptions"]:  # as another plugin or the console may set it
+    from osgeo import gdal
+    gdal.UseExceptions()
 plugin = terrashade.classFactory(None)
 plugin.initProcessing()
 reg = QgsApplication.processingRegistry()
@@ -75,10 +80,16 @@ def describe(p):
 
 
 class Log(QgsProcessingFeedback):
-    def __init__(self):
+    def __init__(self, cancel=False):
         super().__init__()
         self.lines = []
         self.warnings = []
+        self.cancel_on_progress = cancel  # the user's Cancel, once something is written
+
+    def setProgress(self, progress):
+        super().setProgress(progress)
+        if self.cancel_on_progress and progress > 0:
+            self.cancel()
 
     def pushInfo(self, info):
         self.lines.append(info)
@@ -92,12 +103,12 @@ result = {"algorithms": sorted(a.id() for a in provider.algorithms()),
           "parameters": {a.name(): {p.name(): describe(p) for p in a.parameterDefinitions()}
                          for a in provider.algorithms()}}
 for name, alg, params in json.loads(sys.argv[2]):
-    fb = Log()
+    fb = Log(cancel=name.startswith("cancel"))
     try:
         out = processing.run(alg, params, feedback=fb)
         result[name] = {"output": out["OUTPUT"], "log": fb.lines, "warnings": fb.warnings}
     except QgsProcessingException as e:
-        result[name] = {"error": str(e)}
+        result[name] = {"error": str(e), "warnings": fb.warnings}
 plugin.unload()
 result["unloaded"] = reg.providerById("terrashade") is None
 print("RESULT " + json.dumps(result))
@@ -153,6 +164,8 @@ BAD = [
     ("no_date", "terrashade:sunhours", {"INPUT": J, "TIMEZONE": "-05:00"}),
     ("bad_time", "terrashade:shade", {"INPUT": J, "DATETIME": "2026-12-21T09:00"}),
 ]
+# the user cancels once the progress bar moves (Log in CHILD, by the name)
+CANCEL = [("cancel_svf", "terrashade:svf", {"INPUT": J, "DIRECTIONS": 8})]
 
 
 def qgis_env(home):
@@ -202,14 +215,24 @@ class Processing(unittest.TestCase):
         cls.home = os.path.join(cls.dir, "home")
         os.mkdir(cls.home, 0o700)
         runs = [(n, a, dict(p, OUTPUT=cls.out(n))) for n, a, p, _ in CASES]
-        runs += [(n, a, dict(p, OUTPUT=cls.out(n))) for n, a, p in BAD]
-        p = subprocess.run([sys.executable, "-c", CHILD, PLUGINS, json.dumps(runs)],
-                           capture_output=True, text=True, timeout=600,
+        runs += [(n, a, dict(p, OUTPUT=cls.out(n))) for n, a, p in BAD + CANCEL]
+        cls.result, cls.child = cls.run_qgis(runs)
+        # again with gdal.UseExceptions(): the errors, a warning and a cancel
+        runs = [(n, a, dict(p, OUTPUT=cls.out(n + "_exc"))) for n, a, p, _ in CASES
+                if n == "svf_short"]
+        runs += [(n, a, dict(p, OUTPUT=cls.out(n + "_exc"))) for n, a, p in BAD + CANCEL]
+        cls.result_exc, cls.child_exc = cls.run_qgis(runs, "exceptions")
+
+    @classmethod
+    def run_qgis(cls, runs, *mode):
+        """(the child's result, what to say if there is none)."""
+        p = subprocess.run([sys.executable, "-c", CHILD, PLUGINS, json.dumps(runs)]
+                           + list(mode), capture_output=True, text=True, timeout=600,
                            env=qgis_env(cls.home))
         lines = [l for l in p.stdout.splitlines() if l.startswith("RESULT ")]
-        cls.result = json.loads(lines[-1][len("RESULT "):]) if lines else None
-        cls.child = "QGIS produced no result (exit %d):\n%s\n%s" % (
-            p.returncode, p.stdout, p.stderr)
+        return (json.loads(lines[-1][len("RESULT "):]) if lines else None,
+                "QGIS produced no result (exit %d):\n%s\n%s" % (p.returncode, p.stdout,
+                                                                  p.stderr))
 
     @classmethod
     def tearDownClass(cls):
@@ -293,6 +316,31 @@ class Processing(unittest.TestCase):
         # a time without an offset: the driver's sentence
         self.assertIn("TERRASHADE", result["bad_time"].get("error", ""))
         self.assertIn("offset", result["bad_time"]["error"])
+
+    def test_cancel(self):
+        """Cancel during the write: the algorithm fails with 'cancelled' and
+        leaves no output file."""
+        r = self.result["cancel_svf"]
+        self.assertEqual(r.get("error"), "cancelled", r)
+        self.assertFalse(os.path.exists(self.out("cancel_svf")))
+
+    def test_with_gdal_exceptions(self):
+        """gdal.UseExceptions() is global to osgeo.gdal, so another plugin or
+        the console may turn it on: the driver's errors are still the
+        algorithm's sentence, not a Python traceback ('Traceback ...
+        RuntimeError: TERRASHADE: ...'), its warnings still reach the log, and
+        a cancel is still 'cancelled'."""
+        r = self.result_exc
+        self.assertIsNotNone(r, self.child_exc)
+        for name, _, _ in BAD:
+            with self.subTest(case=name):
+                print("%-10s -> %s" % (name, r[name].get("error")))
+                self.assertEqual(r[name].get("error"), self.result[name]["error"])
+                self.assertNotIn("Traceback", r[name]["error"])
+        self.assertEqual(r["cancel_svf"].get("error"), "cancelled", r["cancel_svf"])
+        self.assertFalse(os.path.exists(self.out("cancel_svf_exc")))
+        self.assertIn("output", r["svf_short"], r["svf_short"].get("error"))
+        self.assertEqual(r["svf_short"]["warnings"], self.result["svf_short"]["warnings"])
 
     def test_qgis_process_command_line(self):
         """qgis_process.bin (Debian's qgis_process wrapper fails on a flag in

@@ -164,12 +164,23 @@ def translate(dem, options, out, feedback=None):
                 feedback.pushWarning(message)
 
 
-def write(dem, options, out, feedback):
+def gdal_call(function, *args, **kwargs):
+    """(function's result, GDAL's last error message), the result None on a
+    failure, whether or not gdal.UseExceptions() is on: it is global to
+    osgeo.gdal, so another plugin or the Python console may have turned it
+    on, and a RuntimeError would reach the user as a traceback."""
     gdal.ErrorReset()
-    ds = gdal.OpenEx("%s:%s" % (DRIVER, dem), gdal.OF_RASTER,
-                     open_options=["%s=%s" % kv for kv in options.items()])
+    try:
+        return function(*args, **kwargs), gdal.GetLastErrorMsg()
+    except RuntimeError as e:
+        return None, str(e)
+
+
+def write(dem, options, out, feedback):
+    ds, message = gdal_call(gdal.OpenEx, "%s:%s" % (DRIVER, dem), gdal.OF_RASTER,
+                            open_options=["%s=%s" % kv for kv in options.items()])
     if ds is None:
-        raise QgsProcessingException(gdal.GetLastErrorMsg() or "cannot open %s" % dem)
+        raise QgsProcessingException(message or "cannot open %s" % dem)
     ext = os.path.splitext(out)[1].lstrip(".")
     fmt = QgsRasterFileWriter.driverForExtension(ext) if ext else ""
     fmt = fmt or "GTiff"
@@ -181,14 +192,13 @@ def write(dem, options, out, feedback):
             return 0 if feedback.isCanceled() else 1
         return 1
 
-    gdal.ErrorReset()
-    res = gdal.Translate(out, ds, options=gdal.TranslateOptions(
+    res, message = gdal_call(gdal.Translate, out, ds, options=gdal.TranslateOptions(
         format=fmt, creationOptions=creation, callback=progress))
     ds = None
     if res is None:
         if feedback is not None and feedback.isCanceled():
             raise QgsProcessingException("cancelled")
-        raise QgsProcessingException(gdal.GetLastErrorMsg() or "gdal.Translate failed")
+        raise QgsProcessingException(message or "gdal.Translate failed")
     res.FlushCache()
     res = None
 
