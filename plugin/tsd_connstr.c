@@ -108,6 +108,46 @@ ts_status tsd_connstr_parse(const char *name, tsd_connstr *out, char *msg,
     return TS_OK;
 }
 
+void tsd_connstr_cut_time_hint(const tsd_connstr *c, char *hint, size_t hint_size)
+{
+    hint[0] = '\0';
+    if (!c->options || !c->options[0] || !c->dem)
+        return;
+    const char *last = c->options[0];
+    for (char **p = c->options; *p; p++)
+        last = *p;
+    last += strspn(last, " ");
+    int key_len = (int)strcspn(last, " =");
+    const char *value = strchr(last, '=') + 1; /* an item is KEY=VALUE */
+    size_t n = strlen(value);
+    const char *d = c->dem;
+    /* a time's key; its value ends in the hours (or minutes) and the DEM
+     * starts with the next two digits, then a ':', an offset, Z or nothing
+     * (strchr finds the '\0' too) */
+    if (key_len != 8 || (strncasecmp(last, "TIMEZONE", 8) && strncasecmp(last, "DATETIME", 8)))
+        return;
+    if (n == 0 || !isdigit((unsigned char)value[n - 1]) || !isdigit((unsigned char)d[0]) ||
+        !isdigit((unsigned char)d[1]) || !strchr(":+-Z", d[2]))
+        return;
+    snprintf(hint, hint_size,
+             "; the inline options end at the first ':', so %.*s ends at '%s' and the "
+             "rest, '%s', was taken as the DEM's name: write times without ':' inline "
+             "(TIMEZONE=-0500, DATETIME=2026-06-21T073000+0200) or give the option as an "
+             "open option (-oo)",
+             key_len, last, value, c->dem);
+}
+
+const char *tsd_connstr_add_hint(char *msg, size_t msg_size, const char *hint)
+{
+    size_t n = strlen(msg);
+    if (!hint[0])
+        return msg;
+    if (n > 0 && msg[n - 1] == '.')
+        msg[--n] = '\0';
+    snprintf(msg + n, msg_size - n, "%s", hint);
+    return msg;
+}
+
 void tsd_connstr_free(tsd_connstr *c)
 {
     if (!c)

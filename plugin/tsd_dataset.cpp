@@ -453,20 +453,23 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     for (char **p = poOpenInfo->papszOpenOptions; p && *p; p++)
         aosOptions.AddString(*p);
     const std::string osDEM = sConn.dem;
+    char szCut[512]; /* "" unless an inline time was cut at its ':' */
+    tsd_connstr_cut_time_hint(&sConn, szCut, sizeof szCut);
     tsd_connstr_free(&sConn);
 
     auto poDS = std::unique_ptr<TSDataset>(new TSDataset());
     tsd_options &sOpts = poDS->m_sOpts;
     tsd_options_defaults(&sOpts);
     if (tsd_options_apply(&sOpts, aosOptions.List(), szMsg, sizeof szMsg) != 0)
-        return FailOpen(TS_ERR_ARG, szMsg);
+        return FailOpen(TS_ERR_ARG, tsd_connstr_add_hint(szMsg, sizeof szMsg, szCut));
     poDS->m_psProduct = tsd_product_of(&sOpts);
 
     GDALDataset *poDEM = OpenDEM(osDEM.c_str());
     if (!poDEM)
-        return FailOpen(CPLE_OpenFailed,
-                             CPLSPrintf("cannot open the DEM '%s' as a raster",
-                                        osDEM.c_str()));
+    {
+        snprintf(szMsg, sizeof szMsg, "cannot open the DEM '%s' as a raster", osDEM.c_str());
+        return FailOpen(CPLE_OpenFailed, tsd_connstr_add_hint(szMsg, sizeof szMsg, szCut));
+    }
     poDS->m_poDEM = poDEM;
     poDS->m_osDEM = osDEM;
     if (sOpts.band > poDEM->GetRasterCount())

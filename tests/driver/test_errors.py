@@ -52,6 +52,16 @@ CASES = [
     ("empty name", "TERRASHADE:", [], "names no DEM"),
     ("options but no name", "TERRASHADE:PRODUCT=svf", [], "names no DEM"),
     ("options and empty name", "TERRASHADE:PRODUCT=svf:", [], "names no DEM"),
+    # the inline segment ends at the first ':', inside these times: the DEM's
+    # name became '00:<dem>', and nothing said why
+    ("inline TIMEZONE with ':'",
+     "TERRASHADE:PRODUCT=sunhours,DATE=2026-06-21,TIMEZONE=-05:00:" + DEM, [],
+     "cannot open the DEM '00:%s' as a raster; the inline options end at the first "
+     "':', so TIMEZONE ends at '-05' and the rest, '00:%s', was taken as the DEM's "
+     "name: write times without ':' inline (TIMEZONE=-0500" % (DEM, DEM)),
+    ("inline DATETIME with ':'", "TERRASHADE:datetime=2026-06-21T07:30:00+02:00:" + DEM, [],
+     "expected the time as hh:mm or hh:mm:ss; the inline options end at the first ':', "
+     "so datetime ends at '2026-06-21T07'"),
 ]
 
 
@@ -81,6 +91,22 @@ class Errors(unittest.TestCase):
                 with self.assertRaises(RuntimeError) as e:
                     gdal.OpenEx(connection, gdal.OF_RASTER, open_options=oo)
                 self.assertIn(text, str(e.exception))
+
+    def test_inline_time_hint_only_for_a_cut_time(self):
+        """The hint of a time cut at its ':' is for TIMEZONE and DATETIME only,
+        and the spellings it suggests open."""
+        for connection in ("TERRASHADE:DIRECTIONS=8:12:x.tif",
+                           "TERRASHADE:PRODUCT=sunhours,DATE=2026-06-21,TIMEZONE=-05:"
+                           "/nonexistent/00:x.tif"):
+            with self.subTest(connection):
+                with self.assertRaises(RuntimeError) as e:
+                    gdal.OpenEx(connection, gdal.OF_RASTER)
+                self.assertIn("cannot open the DEM", str(e.exception))
+                self.assertNotIn("inline options end", str(e.exception))
+        for inline in ("PRODUCT=sunhours,DATE=2026-06-21,TIMEZONE=-0500",
+                       "DATETIME=2026-06-21T073000+0200"):
+            ds = gdal.OpenEx("TERRASHADE:%s:%s" % (inline, DEM), gdal.OF_RASTER)
+            self.assertEqual(ds.RasterXSize, gdal.Open(DEM).RasterXSize)
 
     def test_not_a_raster(self):
         with T.TempDir() as tmp:
