@@ -33,6 +33,7 @@ gdal.UseExceptions()
 
 PROG = "terrashade.distributed"
 TILE_MIN, TILE_MAX = 16, 65536
+SIDE_FILES = (".aux.xml", ".ovr", ".msk")  # GDAL's beside a GeoTIFF
 # The driver's inline option segment (plugin/tsd_connstr.c): KEY=VALUE items,
 # an ASCII identifier as KEY with blanks allowed around it, up to the first ':'.
 _ITEM = r" *[A-Za-z_][A-Za-z0-9_]* *=[^,:]*"
@@ -290,6 +291,12 @@ def finish(partial, fmt, dest, block, creation_options):
         except RuntimeError as e:
             raise Failure("cannot write %s: %s" % (final, e))
         remove(partial)
+    # An older DEST's side files described the old product and would be read
+    # back for the new one (statistics, histograms, overviews, mask), as
+    # gdal_translate's overwrite deletes them.
+    for side in SIDE_FILES:
+        with contextlib.suppress(FileNotFoundError):
+            os.remove(dest + side)
     os.replace(final, dest)
     if os.path.exists(final + ".aux.xml"):
         os.replace(final + ".aux.xml", dest + ".aux.xml")

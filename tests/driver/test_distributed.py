@@ -137,6 +137,29 @@ class Distributed(unittest.TestCase):
         self.assert_identical(dest, self.reference(
             {"PRODUCT": "shade", "THREADS": 2, "PROGRESS": "no"}, "ref_inline.tif"))
 
+    def test_older_dest_sidecars_are_not_read_back(self):
+        """An older DEST's statistics (.aux.xml) and external overviews (.ovr)
+        go with it, as gdal_translate deletes them: they described the old
+        product and were read back for the new one (QGIS's statistics and
+        zoomed-out view: the svf's overview under a shade)."""
+        dest = self.path("rewritten.tif")
+        distributed(["--workers", 1, "-q", "-oo", "PRODUCT=svf", T.conn(self.dem), dest])
+        T.run(["gdalinfo", "-stats", dest])  # writes dest.aux.xml
+        T.run(["gdaladdo", "-q", "-ro", dest, "2"])  # writes dest.ovr
+        self.assertTrue(os.path.exists(dest + ".aux.xml") and os.path.exists(dest + ".ovr"))
+        shade = {"PRODUCT": "shade", "OUTPUT_TYPE": "Float32"}
+        distributed(["--workers", 1, "-q"] + T.oo_args(shade) + [T.conn(self.dem), dest])
+        ref = self.reference(shade, "ref_rewritten.tif")
+        T.run(["gdaladdo", "-q", "-ro", ref, "2"])
+        T.run(["gdalinfo", "-stats", ref])
+        got, want = gdal.Open(dest), gdal.Open(ref)
+        a, b = got.GetRasterBand(1), want.GetRasterBand(1)
+        # (the reference's read back from its .aux.xml, to 14 digits)
+        np.testing.assert_allclose(a.GetStatistics(False, True), b.GetStatistics(False, True),
+                                   rtol=1e-12)
+        self.assertEqual(a.GetOverviewCount(), 0)
+        self.assertFalse(os.path.exists(dest + ".ovr"))
+
     def test_existing_cluster_writes_cog(self):
         from dask.distributed import LocalCluster
         cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
