@@ -19,6 +19,7 @@ import re
 import sys
 import threading
 import time
+import uuid
 
 try:
     from osgeo import gdal
@@ -241,7 +242,8 @@ def _progress_bar(futures, ready):
 def compute(client, out, source, task_options, tile, quiet):
     from dask.distributed import as_completed
     wins = W.windows(out.RasterXSize, out.RasterYSize, tile)
-    futures = [client.submit(W.read_window, source, task_options, w, pure=False)
+    run = uuid.uuid4().hex  # no worker reuses a dataset opened for an earlier run
+    futures = [client.submit(W.read_window, source, task_options, w, run, pure=False)
                for w in wins]
     window_of = dict(zip((f.key for f in futures), wins))
     bar = None

@@ -16,7 +16,8 @@ gdal.UseExceptions()
 # keeping the dataset open lets a worker's later windows reuse what the
 # driver has cached (the far-field grid and recent chunks, or the whole
 # product where it is computed whole) instead of recomputing it for every
-# window.
+# window. Only within a run: a worker of an existing cluster outlives the
+# run, and the DEM may be rewritten at the same name before the next one.
 _open = threading.local()
 
 # Test hook (tests/driver/test_distributed.py): the path of a flag file. The
@@ -32,8 +33,8 @@ def windows(width, height, tile):
             for y in range(0, height, tile) for x in range(0, width, tile)]
 
 
-def _dataset(source, open_options):
-    key = (source, tuple(open_options))
+def _dataset(source, open_options, run):
+    key = (source, tuple(open_options), run)
     if getattr(_open, "key", None) != key:
         _open.ds = None  # close the previous one first: bounded memory
         _open.ds = gdal.OpenEx(source, gdal.OF_RASTER | gdal.OF_READONLY,
@@ -54,11 +55,12 @@ def _maybe_crash():
     os._exit(17)
 
 
-def read_window(source, open_options, window):
+def read_window(source, open_options, window, run):
     """The product's pixels in window (xoff, yoff, xsize, ysize) as an array
-    of shape (bands, ysize, xsize), read through the driver."""
+    of shape (bands, ysize, xsize), read through the driver; run names the
+    run (its tasks share a worker thread's dataset)."""
     _maybe_crash()
-    ds = _dataset(source, open_options)
+    ds = _dataset(source, open_options, run)
     xoff, yoff, xsize, ysize = window
     a = ds.ReadAsArray(xoff, yoff, xsize, ysize)
     if a is None:

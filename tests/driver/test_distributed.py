@@ -175,6 +175,33 @@ class Distributed(unittest.TestCase):
         self.assertEqual(gdal.Open(dest).GetMetadata("IMAGE_STRUCTURE").get("LAYOUT"), "COG")
         self.assert_identical(dest, self.reference(HORIZON, "ref_cog.tif"))
 
+    def test_existing_cluster_reads_the_dem_of_each_run(self):
+        """A worker keeps its dataset open between the tasks of a run, not
+        between runs: a DEM rewritten at the same path between two runs on
+        the same cluster gave the first run's product again, silently."""
+        from dask.distributed import LocalCluster
+        dem = self.path("rewritten_dem.tif")
+        with open(self.dem, "rb") as f, open(dem, "wb") as g:
+            g.write(f.read())
+        options = ["-oo", "PRODUCT=svf", "-oo", "DIRECTIONS=8"]
+        cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                               dashboard_address=None, scheduler_port=0)
+        try:
+            for run in (1, 2):
+                if run == 2:  # the same name, steeper terrain
+                    ds = gdal.Open(dem, gdal.GA_Update)
+                    band = ds.GetRasterBand(1)
+                    z = band.ReadAsArray()
+                    band.WriteArray(np.where(z == -9999, z, 3 * z))
+                    ds = None
+                dest = self.path("rerun%d.tif" % run)
+                distributed(["--scheduler", cluster.scheduler_address, "--tile-size", 64,
+                             "-q"] + options + [T.conn(dem), dest])
+                self.assert_identical(dest, T.translate(dem, self.path("ref_rerun%d.tif" % run),
+                                                        {"PRODUCT": "svf", "DIRECTIONS": 8}))
+        finally:
+            cluster.close()
+
     def test_killed_worker_is_retried(self):
         flag = self.path("crashed")
         dest = self.path("retried.tif")
