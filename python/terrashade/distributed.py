@@ -154,8 +154,9 @@ def block_size(tile):
 def create_like(src, path, block, creation_options):
     """A tiled GeoTIFF at path with src's size, bands, types, nodata,
     georeferencing and metadata (what gdal_translate would copy)."""
-    opts = ["TILED=YES", "BLOCKXSIZE=%d" % block, "BLOCKYSIZE=%d" % block,
-            "BIGTIFF=IF_SAFER"] + list(creation_options)
+    # the user's first: GDAL takes the first of a name given twice
+    opts = list(creation_options) + ["TILED=YES", "BLOCKXSIZE=%d" % block,
+                                     "BLOCKYSIZE=%d" % block, "BIGTIFF=IF_SAFER"]
     b1 = src.GetRasterBand(1)
     try:
         out = gdal.GetDriverByName("GTiff").Create(
@@ -289,7 +290,7 @@ def finish(partial, fmt, dest, block, creation_options):
         final = dest + ".partial"
         try:
             gdal.Translate(final, partial, format="COG",
-                           creationOptions=["BLOCKSIZE=%d" % block] + list(creation_options))
+                           creationOptions=list(creation_options) + ["BLOCKSIZE=%d" % block])
         except RuntimeError as e:
             raise Failure("cannot write %s: %s" % (final, e))
         remove(partial)

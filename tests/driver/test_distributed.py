@@ -160,6 +160,25 @@ class Distributed(unittest.TestCase):
         self.assertEqual(a.GetOverviewCount(), 0)
         self.assertFalse(os.path.exists(dest + ".ovr"))
 
+    def test_creation_options_are_the_users(self):
+        """-co overrides the program's own creation options: GDAL takes the
+        first of a repeated name, and the program put its own first, so
+        -co BIGTIFF=YES, -co BLOCKXSIZE=... (GeoTIFF) or -co BLOCKSIZE=... (COG)
+        were ignored without a word."""
+        for dest, co, block in (("co.tif", ["BIGTIFF=YES", "BLOCKXSIZE=32", "BLOCKYSIZE=32",
+                                            "COMPRESS=DEFLATE"], [32, 32]),
+                                ("co.cog.tif", ["BIGTIFF=YES", "BLOCKSIZE=128"], [128, 128])):
+            with self.subTest(dest):
+                dest = self.path(dest)
+                distributed(["--workers", 1, "--tile-size", 64, "-q"] + T.oo_args(SHADE)
+                            + [a for c in co for a in ("-co", c)] + [T.conn(self.dem), dest])
+                with open(dest, "rb") as f:
+                    self.assertEqual(f.read(4), b"II+\x00", "not a BigTIFF")
+                ds = gdal.Open(dest)
+                self.assertEqual(ds.GetRasterBand(1).GetBlockSize(), block)
+                ds = None
+                self.assert_identical(dest, self.reference(SHADE, "ref_co.tif"))
+
     def test_existing_cluster_writes_cog(self):
         from dask.distributed import LocalCluster
         cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
