@@ -16,6 +16,7 @@ import contextlib
 import logging
 import os
 import re
+import signal
 import sys
 import threading
 import time
@@ -327,12 +328,12 @@ def run(args):
     if os.path.exists(dem) and os.path.exists(args.dest) and os.path.samefile(dem, args.dest):
         raise Failure("DEST %s is the DEM itself: the product would replace it; write "
                       "it to another file" % args.dest)
-    out = create_like(src, partial, block, [] if fmt == "COG" else args.creation_options)
     size = (src.RasterXSize, src.RasterYSize, src.RasterCount)
-    src = None
-    client = cluster = None
+    out = client = cluster = None
     t0 = time.time()
-    try:
+    try:  # from the partial's creation on: a Ctrl-C may come at any time
+        out = create_like(src, partial, block, [] if fmt == "COG" else args.creation_options)
+        src = None
         client, cluster, threads = start_cluster(args)
         nworkers = check_workers(client)
         keys = given_keys(args.source, args.open_options)
@@ -364,8 +365,19 @@ def run(args):
               file=sys.stderr)
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (timeout, Slurm, systemd, Kubernetes...), cleaned up as Ctrl-C;
+    Python's default ends the program at once and left DEST.partial behind."""
+
+
+def _terminate(_signum, _frame):
+    raise Terminated()
+
+
 def main(argv=None):
     args = parse_args(argv)
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _terminate)
     try:
         run(args)
     except Failure as e:
@@ -375,9 +387,11 @@ def main(argv=None):
         print("%s: error: %s: %s (nothing written to %s)"
               % (PROG, type(e).__name__, e, args.dest), file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
-        print("%s: interrupted; nothing written to %s" % (PROG, args.dest), file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as e:
+        terminated = isinstance(e, Terminated)
+        print("%s: %s; nothing written to %s" % (
+            PROG, "terminated" if terminated else "interrupted", args.dest), file=sys.stderr)
+        return 128 + (signal.SIGTERM if terminated else signal.SIGINT)
     return 0
 
 

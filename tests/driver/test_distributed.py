@@ -18,8 +18,11 @@ dask.distributed equals gdal_translate of the same source, bit for bit.
 """
 import os
 import re
+import signal
 import socket
+import subprocess
 import sys
+import time
 import unittest
 
 import tsdriver as T
@@ -299,6 +302,39 @@ class Distributed(unittest.TestCase):
         with open(self.dem, "rb") as f:
             self.assertEqual(f.read(), before)
         self.assertFalse(os.path.exists(dest + ".partial"))
+
+    def test_interrupted_run_leaves_nothing(self):
+        """Ctrl-C (SIGINT) and SIGTERM (what timeout, Slurm, systemd or
+        Kubernetes send) during a run: the partial file is removed, an older
+        DEST stays as it was, exit 130 or 143. SIGTERM ended the program on
+        the spot and left DEST.partial behind."""
+        dest = self.path("interrupted.tif")
+        for sig, code, said in ((signal.SIGINT, 130, "interrupted"),
+                                (signal.SIGTERM, 143, "terminated")):
+            with self.subTest(said):
+                with open(dest, "w") as f:
+                    f.write("an older result")
+                # in its own session: the shell's job control may ignore SIGINT
+                p = subprocess.Popen(
+                    ["/usr/bin/python3", "-m", "terrashade.distributed", "--workers", "1",
+                     "--tile-size", "64", "-q"] + T.oo_args(HORIZON) + [T.conn(self.dem), dest],
+                    stderr=subprocess.PIPE, text=True, start_new_session=True,
+                    env=T.env(PYTHONPATH=PYTHONPATH),
+                    preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+                for _ in range(600):  # created before the cluster starts
+                    if os.path.exists(dest + ".partial") or p.poll() is not None:
+                        break
+                    time.sleep(0.05)
+                self.assertIsNone(p.poll(), "the run ended before the signal")
+                p.send_signal(sig)
+                err = p.communicate(timeout=120)[1]
+                self.assertEqual(p.returncode, code, err)
+                self.assertIn("terrashade.distributed: %s; nothing written to %s"
+                              % (said, dest), err)
+                with open(dest) as f:
+                    self.assertEqual(f.read(), "an older result")
+                os.remove(dest)
+                self.assert_nothing_left(dest)
 
     def test_python_without_gdal(self):
         """A Python that cannot import osgeo (python3 first on PATH is often
