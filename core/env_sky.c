@@ -88,10 +88,12 @@ ts_status ts_sky_parse(const char *name, ts_sky_kind *kind, int *cie_type, ts_er
             *kind = NAMED[i].kind;
             return ts_ok(err);
         }
-    if (!strncasecmp(name, "cie:", 4)) {
+    if (!strncasecmp(name, "cie", 3)) {
+        /* cie:N, or cieN where a ':' cannot go (an inline connection string) */
+        const char *num = name + 3 + (name[3] == ':');
         char *end;
-        long n = strtol(name + 4, &end, 10);
-        if (end != name + 4 && *end == '\0' && n >= 1 && n <= 15) {
+        long n = strtol(num, &end, 10);
+        if (end != num && *end == '\0' && n >= 1 && n <= 15) {
             *kind = TS_SKY_CIE;
             *cie_type = (int)n;
             return ts_ok(err);

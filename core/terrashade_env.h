@@ -196,8 +196,8 @@ double ts_cie_sky_relative(int type, double zenith_deg, double sun_distance_deg,
                            double sun_zenith_deg);
 
 /**
- * Parse a sky name: "uniform", "overcast", "clear" or "cie:N" (N in 1..15,
- * case-insensitive). Sets *kind and *cie_type (0 unless TS_SKY_CIE).
+ * Parse a sky name: "uniform", "overcast", "clear" or "cie:N" (N in 1..15;
+ * also "cieN", for inline connection strings; case-insensitive). Sets *kind and *cie_type (0 unless TS_SKY_CIE).
  */
 ts_status ts_sky_parse(const char *name, ts_sky_kind *kind, int *cie_type, ts_error *err);
 

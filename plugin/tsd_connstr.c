@@ -108,7 +108,23 @@ ts_status tsd_connstr_parse(const char *name, tsd_connstr *out, char *msg,
     return TS_OK;
 }
 
-void tsd_connstr_cut_time_hint(const tsd_connstr *c, char *hint, size_t hint_size)
+/* Was the last inline item key=value cut at a ':' of its value, leaving
+ * dem? A time (TIMEZONE, DATETIME) whose value ends in the hours or minutes,
+ * the DEM starting with the next two digits, then a ':', an offset, Z or
+ * nothing; or SKY=cie, the DEM starting with the sky type's digits, then a
+ * ':' or nothing. (strchr finds the '\0' too.) */
+static int cut_at_colon(const char *key, int key_len, const char *value, const char *dem)
+{
+    size_t n = strlen(value), digits = strspn(dem, "0123456789");
+    if (key_len == 3 && !strncasecmp(key, "SKY", 3))
+        return !strcasecmp(value, "cie") && digits > 0 && strchr(":", dem[digits]);
+    if (key_len != 8 || (strncasecmp(key, "TIMEZONE", 8) && strncasecmp(key, "DATETIME", 8)))
+        return 0;
+    return n > 0 && isdigit((unsigned char)value[n - 1]) && digits >= 2 &&
+           strchr(":+-Z", dem[2]);
+}
+
+void tsd_connstr_cut_colon_hint(const tsd_connstr *c, char *hint, size_t hint_size)
 {
     hint[0] = '\0';
     if (!c->options || !c->options[0] || !c->dem)
@@ -119,21 +135,13 @@ void tsd_connstr_cut_time_hint(const tsd_connstr *c, char *hint, size_t hint_siz
     last += strspn(last, " ");
     int key_len = (int)strcspn(last, " =");
     const char *value = strchr(last, '=') + 1; /* an item is KEY=VALUE */
-    size_t n = strlen(value);
-    const char *d = c->dem;
-    /* a time's key; its value ends in the hours (or minutes) and the DEM
-     * starts with the next two digits, then a ':', an offset, Z or nothing
-     * (strchr finds the '\0' too) */
-    if (key_len != 8 || (strncasecmp(last, "TIMEZONE", 8) && strncasecmp(last, "DATETIME", 8)))
-        return;
-    if (n == 0 || !isdigit((unsigned char)value[n - 1]) || !isdigit((unsigned char)d[0]) ||
-        !isdigit((unsigned char)d[1]) || !strchr(":+-Z", d[2]))
+    if (!cut_at_colon(last, key_len, value, c->dem))
         return;
     snprintf(hint, hint_size,
              "; the inline options end at the first ':', so %.*s ends at '%s' and the "
-             "rest, '%s', was taken as the DEM's name: write times without ':' inline "
-             "(TIMEZONE=-0500, DATETIME=2026-06-21T073000+0200) or give the option as an "
-             "open option (-oo)",
+             "rest, '%s', was taken as the DEM's name: write times and skies without ':' "
+             "inline (TIMEZONE=-0500, DATETIME=2026-06-21T073000+0200, SKY=cie9) or give "
+             "the option as an open option (-oo)",
              key_len, last, value, c->dem);
 }
 

@@ -40,11 +40,11 @@ ts_status tsd_connstr_parse(const char *name, tsd_connstr *out, char *msg,
                       size_t msg_size);
 
 /** Into hint ("" if not so): a sentence, starting "; ", for a connection
- * string whose last inline option is TIMEZONE or DATETIME cut at its ':'
- * (TIMEZONE=-05:00, DATETIME=...T07:30:00), which leaves the DEM's name
- * starting "dd:" ("00:dem.tif"). The caller appends it to the failure
- * that follows (tsd_connstr_add_hint). */
-void tsd_connstr_cut_time_hint(const tsd_connstr *c, char *hint, size_t hint_size);
+ * string whose last inline option is TIMEZONE, DATETIME or SKY cut at its
+ * ':' (TIMEZONE=-05:00, DATETIME=...T07:30:00, SKY=cie:9), which leaves the
+ * DEM's name starting with digits and ':' ("00:dem.tif"). The caller
+ * appends it to the failure that follows (tsd_connstr_add_hint). */
+void tsd_connstr_cut_colon_hint(const tsd_connstr *c, char *hint, size_t hint_size);
 
 /** msg with hint appended (msg's final '.' dropped, so the sentence goes on);
  * msg unchanged if hint is "". Returns msg. */

@@ -453,8 +453,8 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     for (char **p = poOpenInfo->papszOpenOptions; p && *p; p++)
         aosOptions.AddString(*p);
     const std::string osDEM = sConn.dem;
-    char szCut[512]; /* "" unless an inline time was cut at its ':' */
-    tsd_connstr_cut_time_hint(&sConn, szCut, sizeof szCut);
+    char szCut[512]; /* "" unless an inline value was cut at its ':' */
+    tsd_connstr_cut_colon_hint(&sConn, szCut, sizeof szCut);
     tsd_connstr_free(&sConn);
 
     auto poDS = std::unique_ptr<TSDataset>(new TSDataset());

@@ -225,7 +225,7 @@ const opt_def TSD_OPTION_ROWS[] = {
     {"SKY", K_TEXT, FIELD(sky), "", 0, 0, 0, 0, NULL, 1, P, LISTED, check_sky,
      "A standard sky lighting envlight (or the sky term of shade): uniform, "
      "overcast (CIE standard overcast), clear (CIE standard clear) or cie:N "
-     "(CIE general sky type N, 1..15), the sun from SUN_AZIMUTH and "
+     "(CIE general sky type N, 1..15; inline: cieN), the sun from SUN_AZIMUTH and "
      "SUN_ELEVATION or DATETIME; not with ENV_MAP"},
     {"ENV_HORIZON_STEPS", K_INT, FIELD(env_horizon_steps),
      TSD_XSTR(TS_ENV_DEFAULT_HORIZON_STEPS), 3, 3601, 0, 1, NULL, 1, P, LISTED, NULL,

@@ -197,8 +197,13 @@ START_TEST(test_sky_parse)
     ck_assert(ts_sky_parse("clear", &kind, &type, &err) == TS_OK && kind == TS_SKY_CLEAR);
     ck_assert(ts_sky_parse("cie:15", &kind, &type, &err) == TS_OK && kind == TS_SKY_CIE &&
               type == 15);
-    const char *bad[] = {"cie:0", "cie:16", "cie:", "cie:3x", "sunny", ""};
-    for (int i = 0; i < 6; i++) {
+    /* cieN: the form without ':' that an inline connection string can hold */
+    ck_assert(ts_sky_parse("cie9", &kind, &type, &err) == TS_OK && kind == TS_SKY_CIE &&
+              type == 9);
+    ck_assert(ts_sky_parse("CIE12", &kind, &type, &err) == TS_OK && type == 12);
+    const char *bad[] = {"cie:0", "cie:16", "cie:", "cie:3x", "sunny", "", "cie", "cie0",
+                         "cie16", "cie::3"};
+    for (int i = 0; i < 10; i++) {
         ck_assert(ts_sky_parse(bad[i], &kind, &type, &err) == TS_ERR_ARG);
         ck_assert(err.message[0] != 0);
     }

@@ -58,10 +58,14 @@ CASES = [
      "TERRASHADE:PRODUCT=sunhours,DATE=2026-06-21,TIMEZONE=-05:00:" + DEM, [],
      "cannot open the DEM '00:%s' as a raster; the inline options end at the first "
      "':', so TIMEZONE ends at '-05' and the rest, '00:%s', was taken as the DEM's "
-     "name: write times without ':' inline (TIMEZONE=-0500" % (DEM, DEM)),
+     "name: write times and skies without ':' inline (TIMEZONE=-0500" % (DEM, DEM)),
     ("inline DATETIME with ':'", "TERRASHADE:datetime=2026-06-21T07:30:00+02:00:" + DEM, [],
      "expected the time as hh:mm or hh:mm:ss; the inline options end at the first ':', "
      "so datetime ends at '2026-06-21T07'"),
+    ("inline SKY with ':'", "TERRASHADE:PRODUCT=envlight,SKY=cie:9:" + DEM, [],
+     "got 'cie'; the inline options end at the first ':', so SKY ends at 'cie' and the "
+     "rest, '9:%s', was taken as the DEM's name: write times and skies without ':' "
+     "inline (TIMEZONE=-0500, DATETIME=2026-06-21T073000+0200, SKY=cie9)" % DEM),
 ]
 
 
@@ -92,21 +96,30 @@ class Errors(unittest.TestCase):
                     gdal.OpenEx(connection, gdal.OF_RASTER, open_options=oo)
                 self.assertIn(text, str(e.exception))
 
-    def test_inline_time_hint_only_for_a_cut_time(self):
-        """The hint of a time cut at its ':' is for TIMEZONE and DATETIME only,
-        and the spellings it suggests open."""
+    def test_inline_colon_hint_only_for_a_cut_value(self):
+        """The hint of a value cut at its ':' is for TIMEZONE, DATETIME and
+        SKY only, and the spellings it suggests open: SKY=cie9 inline is
+        SKY=cie:9 (which a connection string, all a QGIS layer has, could
+        not hold)."""
         for connection in ("TERRASHADE:DIRECTIONS=8:12:x.tif",
+                           "TERRASHADE:PRODUCT=envlight,SKY=cie:/nonexistent/9:x.tif",
                            "TERRASHADE:PRODUCT=sunhours,DATE=2026-06-21,TIMEZONE=-05:"
                            "/nonexistent/00:x.tif"):
             with self.subTest(connection):
                 with self.assertRaises(RuntimeError) as e:
                     gdal.OpenEx(connection, gdal.OF_RASTER)
-                self.assertIn("cannot open the DEM", str(e.exception))
+                self.assertIn("TERRASHADE: ", str(e.exception))
                 self.assertNotIn("inline options end", str(e.exception))
         for inline in ("PRODUCT=sunhours,DATE=2026-06-21,TIMEZONE=-0500",
                        "DATETIME=2026-06-21T073000+0200"):
             ds = gdal.OpenEx("TERRASHADE:%s:%s" % (inline, DEM), gdal.OF_RASTER)
             self.assertEqual(ds.RasterXSize, gdal.Open(DEM).RasterXSize)
+        sky = {"PRODUCT": "envlight", "DIRECTIONS": 4}
+        inline = T.read(T.conn(DEM, SKY="cie9", **sky))
+        np.testing.assert_array_equal(inline,
+                                      T.read(T.conn(DEM), options=dict(sky, SKY="cie:9")))
+        self.assertFalse(np.array_equal(inline,
+                                        T.read(T.conn(DEM), options=dict(sky, SKY="cie:3"))))
 
     def test_not_a_raster(self):
         with T.TempDir() as tmp:
