@@ -164,7 +164,9 @@ def create_like(src, path, block, creation_options):
             path, src.RasterXSize, src.RasterYSize, src.RasterCount, b1.DataType, opts)
     except RuntimeError as e:
         raise Failure("cannot write %s: %s" % (path, e))
-    out.SetGeoTransform(src.GetGeoTransform())
+    gt = src.GetGeoTransform(can_return_null=True)
+    if gt is not None:  # else none, not the default, whose rows run south to north
+        out.SetGeoTransform(gt)
     if src.GetProjection():
         out.SetProjection(src.GetProjection())
     out.SetMetadata(src.GetMetadata())

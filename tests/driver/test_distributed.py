@@ -182,6 +182,24 @@ class Distributed(unittest.TestCase):
                 ds = None
                 self.assert_identical(dest, self.reference(SHADE, "ref_co.tif"))
 
+    def test_dem_without_georeferencing(self):
+        """A DEM with no geotransform (the driver takes its cells as 1 m,
+        row 0 north, and says so): the product has none either, as
+        gdal_translate writes it, not the default (0, 1, 0, 0, 0, 1), whose
+        rows run south to north."""
+        plain = self.path("plain.tif")
+        ds = gdal.GetDriverByName("GTiff").Create(plain, 60, 40, 1, gdal.GDT_Float32)
+        ds.GetRasterBand(1).WriteArray(T.fractal_dem(60, seed=2)[:40] * 0.05)
+        ds = None
+        dest = self.path("plain_shade.tif")
+        distributed(["--workers", 1, "--tile-size", 32, "-q", T.conn(plain), dest])
+        ref = T.translate(plain, self.path("ref_plain.tif"), {})
+        got, want = gdal.Open(dest), gdal.Open(ref)
+        self.assertIsNone(want.GetGeoTransform(can_return_null=True))
+        self.assertIsNone(got.GetGeoTransform(can_return_null=True))
+        got = want = None
+        self.assert_identical(dest, ref)
+
     def test_existing_cluster_writes_cog(self):
         from dask.distributed import LocalCluster
         cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
