@@ -80,6 +80,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         check_message(msg, sizeof msg);
     } else {
         fuzz_require(c.dem && c.dem[0] && c.options, "a parsed string has no DEM or list");
+        char hint[256];
+        tsd_connstr_cut_colon_hint(&c, hint, sizeof hint);
+        fuzz_require(memchr(hint, '\0', sizeof hint) != NULL, "a hint is not terminated");
+        fuzz_require(!hint[0] || !strncmp(hint, "; ", 2), "a hint does not go on a sentence");
         size_t k = 0;
         while (c.options[k])
             k++;
