@@ -243,10 +243,9 @@ def _progress_bar(futures, ready):
         ready.set()
 
 
-def compute(client, out, source, task_options, tile, quiet):
+def compute(client, out, source, task_options, tile, quiet, run):
     from dask.distributed import as_completed
     wins = W.windows(out.RasterXSize, out.RasterYSize, tile)
-    run = uuid.uuid4().hex  # no worker reuses a dataset opened for an earlier run
     futures = [client.submit(W.read_window, source, task_options, w, run, pure=False)
                for w in wins]
     window_of = dict(zip((f.key for f in futures), wins))
@@ -332,6 +331,7 @@ def run(args):
                       "it to another file" % args.dest)
     size = (src.RasterXSize, src.RasterYSize, src.RasterCount)
     out = client = cluster = None
+    run_id = uuid.uuid4().hex  # no worker reuses a dataset opened for an earlier run
     t0 = time.time()
     try:  # from the partial's creation on: a Ctrl-C may come at any time
         out = create_like(src, partial, block, [] if fmt == "COG" else args.creation_options)
@@ -344,7 +344,8 @@ def run(args):
             task_options.append("THREADS=%d" % threads)
         if "PROGRESS" not in keys:
             task_options.append("PROGRESS=no")  # the Dask bar says it
-        n = compute(client, out, args.source, task_options, args.tile_size, args.quiet)
+        n = compute(client, out, args.source, task_options, args.tile_size, args.quiet,
+                    run_id)
         out.FlushCache()
         out = None
         finish(partial, fmt, args.dest, block, args.creation_options)
@@ -355,6 +356,8 @@ def run(args):
         raise
     finally:
         if client is not None:
+            with contextlib.suppress(Exception):  # the workers close this run's datasets
+                client.run(W.forget, run_id)
             client.close()
         if cluster is not None:
             cluster.close()

@@ -17,8 +17,10 @@ gdal.UseExceptions()
 # driver has cached (the far-field grid and recent chunks, or the whole
 # product where it is computed whole) instead of recomputing it for every
 # window. Only within a run: a worker of an existing cluster outlives the
-# run, and the DEM may be rewritten at the same name before the next one.
-_open = threading.local()
+# run, and the DEM may be rewritten at the same name before the next one;
+# the client calls forget() at the end. {thread id: (key, dataset)}
+_open = {}
+_open_lock = threading.Lock()
 
 # Test hook (tests/driver/test_distributed.py): the path of a flag file. The
 # first task that manages to create it kills its own worker process, so the
@@ -34,13 +36,28 @@ def windows(width, height, tile):
 
 
 def _dataset(source, open_options, run):
-    key = (source, tuple(open_options), run)
-    if getattr(_open, "key", None) != key:
-        _open.ds = None  # close the previous one first: bounded memory
-        _open.ds = gdal.OpenEx(source, gdal.OF_RASTER | gdal.OF_READONLY,
-                               open_options=list(open_options))
-        _open.key = key
-    return _open.ds
+    key, me = (source, tuple(open_options), run), threading.get_ident()
+    with _open_lock:
+        held = _open.get(me)
+    if held is not None and held[0] == key:
+        return held[1]
+    with _open_lock:
+        _open.pop(me, None)  # close the previous one first: bounded memory
+    held = (key, gdal.OpenEx(source, gdal.OF_RASTER | gdal.OF_READONLY,
+                             open_options=list(open_options)))
+    with _open_lock:
+        _open[me] = held
+    return held[1]
+
+
+def forget(run):
+    """On a worker, after a run: drop the datasets its tasks opened, with
+    their far grid and cached chunks (GiB for a large horizon), which a
+    worker of an existing cluster would hold until the next run. A task
+    still reading keeps its own reference until it returns."""
+    with _open_lock:
+        for me in [me for me, (key, _) in _open.items() if key[2] == run]:
+            del _open[me]
 
 
 def _maybe_crash():

@@ -44,6 +44,18 @@ def distributed(args, ok=True, **env):
                  ok=ok, PYTHONPATH=PYTHONPATH, **env)
 
 
+def files_open(path):
+    """In this process (run on a worker): how many descriptors hold path open."""
+    fds = "/proc/self/fd"
+    count = 0
+    for fd in os.listdir(fds):
+        try:
+            count += os.path.realpath(os.readlink(os.path.join(fds, fd))) == path
+        except OSError:
+            pass
+    return count
+
+
 def bits(a):
     """The array's raw bits, so that NaN payloads and -0 compare too."""
     return a.view(np.uint8)
@@ -218,12 +230,14 @@ class Distributed(unittest.TestCase):
     def test_existing_cluster_reads_the_dem_of_each_run(self):
         """A worker keeps its dataset open between the tasks of a run, not
         between runs: a DEM rewritten at the same path between two runs on
-        the same cluster gave the first run's product again, silently."""
-        from dask.distributed import LocalCluster
+        the same cluster gave the first run's product again, silently; and
+        after a run the workers held its datasets (here the DEM's file) until
+        the next one."""
+        from dask.distributed import Client, LocalCluster
         dem = self.path("rewritten_dem.tif")
         with open(self.dem, "rb") as f, open(dem, "wb") as g:
             g.write(f.read())
-        options = ["-oo", "PRODUCT=svf", "-oo", "DIRECTIONS=8"]
+        svf = {"PRODUCT": "svf", "DIRECTIONS": 8, "TILE_SIZE": 64}  # windowed: holds the DEM
         cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                dashboard_address=None, scheduler_port=0)
         try:
@@ -236,9 +250,14 @@ class Distributed(unittest.TestCase):
                     ds = None
                 dest = self.path("rerun%d.tif" % run)
                 distributed(["--scheduler", cluster.scheduler_address, "--tile-size", 64,
-                             "-q"] + options + [T.conn(dem), dest])
+                             "-q"] + T.oo_args(svf) + [T.conn(dem), dest])
                 self.assert_identical(dest, T.translate(dem, self.path("ref_rerun%d.tif" % run),
-                                                        {"PRODUCT": "svf", "DIRECTIONS": 8}))
+                                                        svf))
+                # the workers outlive the run, but not its datasets (their far
+                # grid and cached chunks: GiB for a large horizon)
+                with Client(cluster) as client:
+                    held = client.run(files_open, os.path.realpath(dem))
+                self.assertEqual(sorted(held.values()), [0, 0], "the DEM held after the run")
         finally:
             cluster.close()
 
