@@ -308,8 +308,11 @@ def finish(partial, fmt, dest, block, creation_options):
 
 
 def remove(path):
+    """path and its .aux.xml, our own files, if there are: a directory by
+    that name, or any other cleanup failure, must not hide why the run
+    failed."""
     for p in (path, path + ".aux.xml"):
-        with contextlib.suppress(FileNotFoundError):
+        with contextlib.suppress(OSError):
             os.remove(p)
 
 

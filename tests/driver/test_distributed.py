@@ -326,6 +326,20 @@ class Distributed(unittest.TestCase):
         finally:
             os.rmdir(dest)
 
+    def test_partial_name_is_a_directory(self):
+        """DEST.partial taken by a directory: GDAL's reason, not the cleanup's
+        IsADirectoryError, and the directory is left alone."""
+        dest = self.path("taken.tif")
+        os.mkdir(dest + ".partial")
+        try:
+            p = distributed(["--workers", 1, T.conn(self.dem), dest], ok=False)
+            self.assertEqual(p.returncode, 1, p.stderr)
+            self.assertIn("cannot write %s.partial: " % dest, p.stderr)
+            self.assertTrue(os.path.isdir(dest + ".partial"))
+            self.assertFalse(os.path.exists(dest))
+        finally:
+            os.rmdir(dest + ".partial")
+
     def test_destination_is_the_dem(self):
         """DEST naming the DEM (here by another path) is refused before any
         work: the rename at the end would replace the DEM by the product."""
