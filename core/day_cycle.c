@@ -222,8 +222,11 @@ static ts_status vis_step(vis_ctx *c, double t, float *vis, float *az, float *el
                                 *n01 = &c->ns[j1 * s->nx + i], *n11 = &c->ns[j1 * s->nx + i1];
             double w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy,
                    w11 = fx * fy;
-            double e = w00 * n00->elevation + w10 * n10->elevation + w01 * n01->elevation +
-                       w11 * n11->elevation;
+            /* refracted after: the refraction jumps at its cut-off, which
+             * a lattice of sunrise and sunset straddles */
+            double e0 = w00 * n00->true_elevation + w10 * n10->true_elevation +
+                        w01 * n01->true_elevation + w11 * n11->true_elevation;
+            double e = e0 + ts_sun_refraction(e0, &c->o->sun);
             double d = w00 * ts_wrap180(n00->grid_azimuth - a_ref) +
                        w10 * ts_wrap180(n10->grid_azimuth - a_ref) +
                        w01 * ts_wrap180(n01->grid_azimuth - a_ref) +

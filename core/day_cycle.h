@@ -137,6 +137,7 @@ typedef struct {
     double azimuth;      /**< true azimuth, degrees from true north */
     double grid_azimuth; /**< azimuth + north_azimuth, in [0, 360) */
     double elevation;    /**< apparent (refracted) elevation of the centre */
+    double true_elevation; /**< its elevation without refraction (SPA e0) */
     double distance_au;  /**< Earth-Sun distance, astronomical units */
 } ts_sun_sample;
 

@@ -226,6 +226,7 @@ ts_status ts_day_node_sun(const ts_sun_sites *s, const ts_day_opts *o, int i,
     out->unix_time = t;
     out->azimuth = sun.azimuth;
     out->elevation = sun.elevation;
+    out->true_elevation = det.e0;
     out->grid_azimuth = ts_wrap360(sun.azimuth + (s->north_azimuth ? s->north_azimuth[i] : 0.0));
     out->distance_au = det.R;
     return TS_OK;

@@ -464,6 +464,16 @@ ts_status ts_sun_input_validate(const ts_sun_input *in, ts_error *err)
 
 /* ------------------------------------------------------------ the SPA */
 
+double ts_sun_refraction(double e0, const ts_sun_input *in)
+{
+    double de = 0.0;
+    if (e0 >= -(SPA_SUN_RADIUS + in->atmos_refraction))
+        de = in->pressure / 1010.0 * 283.0 / (273.0 + in->temperature) * 1.02 /
+             (60.0 * tan((e0 + 10.3 / (e0 + 5.11)) * DEG)); /* eq. 42 */
+    return isfinite(de) ? de : 0.0; /* e0 = -5.11 exactly, reachable with a large
+                                     * atmos_refraction */
+}
+
 ts_status ts_sun_position_detail(const ts_sun_input *in, ts_sun_output *out,
                                  ts_sun_detail *detail, ts_error *err)
 {
@@ -565,12 +575,7 @@ ts_status ts_sun_position_detail(const ts_sun_input *in, ts_sun_output *out,
     if (s_e0 < -1.0)
         s_e0 = -1.0;
     d.e0 = asin(s_e0) * RAD;                       /* eq. 41 */
-    d.delta_e = 0.0;
-    if (d.e0 >= -(SPA_SUN_RADIUS + in->atmos_refraction))
-        d.delta_e = in->pressure / 1010.0 * 283.0 / (273.0 + in->temperature) * 1.02 /
-                    (60.0 * tan((d.e0 + 10.3 / (d.e0 + 5.11)) * DEG)); /* eq. 42 */
-    if (!isfinite(d.delta_e)) /* e0 = -5.11 exactly, reachable with a large atmos_refraction */
-        d.delta_e = 0.0;
+    d.delta_e = ts_sun_refraction(d.e0, in);
     d.e = d.e0 + d.delta_e;                        /* eq. 43 */
     /* eq. 42 holds for the air at the Earth's surface; far outside it (a
      * temperature near -273 C, a large atmos_refraction) its tangent can

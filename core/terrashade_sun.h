@@ -181,6 +181,15 @@ ts_status ts_sun_input_validate(const ts_sun_input *in, ts_error *err);
 ts_status ts_sun_position(const ts_sun_input *in, ts_sun_output *out,
                           ts_error *err);
 
+/**
+ * The refraction (eq. 42) that ts_sun_position adds to the unrefracted
+ * elevation e0 (degrees), with its cut-off: 0 below -(sun radius +
+ * atmos_refraction), where it jumps (0.6 deg at the defaults), so
+ * elevations interpolated between sites are interpolated unrefracted and
+ * refracted after. `in` gives pressure, temperature and atmos_refraction.
+ */
+double ts_sun_refraction(double e0, const ts_sun_input *in);
+
 /** ts_sun_position that also fills `detail` (may be NULL). */
 ts_status ts_sun_position_detail(const ts_sun_input *in, ts_sun_output *out,
                                  ts_sun_detail *detail, ts_error *err);

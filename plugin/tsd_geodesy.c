@@ -407,6 +407,75 @@ static double wrap_lon(double lon)
     return lon - 180.0;
 }
 
+/* The lattice's nodes a side: every 32 cells or so, at most 65, unless
+ * grow_sites asks for more; odd, so that the middle node, whose sun the
+ * metadata reports, is the DEM's centre (with 2 nodes it was a corner). */
+static int site_nodes(int cells, int at_least)
+{
+    if (cells < 2)
+        return 1;
+    int k = cells / 32 + 2;
+    k = k > 65 ? 65 : k;
+    k = k < at_least ? at_least : k;
+    return k + (k % 2 == 0);
+}
+
+static void site_grid(tsd_sites *s, int width, int height)
+{
+    s->x0 = s->nx > 1 ? 0.5 : 0.5 * width;
+    s->y0 = s->ny > 1 ? 0.5 : 0.5 * height;
+    s->dx = s->nx > 1 ? (width - 1.0) / (s->nx - 1) : 1.0;
+    s->dy = s->ny > 1 ? (height - 1.0) / (s->ny - 1) : 1.0;
+}
+
+/* Degrees of arc, about, between sites a and b: the sun's elevation and
+ * azimuth curve with the hour angle and the latitude, so the bilinear
+ * interpolation's error grows as the square of this. */
+static double site_step(const tsd_sites *s, size_t a, size_t b)
+{
+    double lat = fabs(s->lat[b] - s->lat[a]);
+    double lon = fabs(remainder(s->lon[b] - s->lon[a], 360.0)) *
+                 cos(0.5 * (s->lat[a] + s->lat[b]) * M_PI / 180.0);
+    return lat > lon ? lat : lon;
+}
+
+/* Nodes a side so that neighbours lie at most SITE_MAX_STEP_DEG apart
+ * (one per cell at most, SITE_MAX_NODES a side): on a DEM of coarse cells
+ * or a continent, 32 cells can span tens of degrees, where interpolating
+ * the sun across them put it below the horizon for hours at noon.
+ * Returns 1 if nx or ny grew. */
+#define SITE_MAX_STEP_DEG 2.0
+#define SITE_MAX_NODES 181
+static int finer_nodes(int nodes, double step, int cells)
+{
+    int cap = cells < SITE_MAX_NODES ? cells : SITE_MAX_NODES;
+    if (step <= SITE_MAX_STEP_DEG || nodes >= cap)
+        return nodes;
+    int k = (nodes - 1) * (int)ceil(step / SITE_MAX_STEP_DEG) + 1;
+    return k < cap ? k : cap;
+}
+
+static int grow_sites(const tsd_sites *s, int width, int height, int *nx, int *ny)
+{
+    double sx = 0, sy = 0;
+    for (int j = 0; j < s->ny; j++)
+        for (int i = 0; i < s->nx; i++) {
+            size_t k = (size_t)j * s->nx + i;
+            if (i + 1 < s->nx)
+                sx = fmax(sx, site_step(s, k, k + 1));
+            if (j + 1 < s->ny)
+                sy = fmax(sy, site_step(s, k, k + s->nx));
+        }
+    *nx = site_nodes(width, finer_nodes(s->nx, sx, width));
+    *ny = site_nodes(height, finer_nodes(s->ny, sy, height));
+    return *nx != s->nx || *ny != s->ny;
+}
+
+static ts_status sites_fill(const double gt[6], int width, int height, int geographic,
+                            double deg, OGRCoordinateTransformationH fwd,
+                            OGRCoordinateTransformationH inv, const tsd_cells *cells,
+                            tsd_sites *s, char *msg, size_t n);
+
 ts_status tsd_sites_compute(const double gt[6], int width, int height,
                       OGRSpatialReferenceH srs, const tsd_cells *cells, int per_cell,
                       tsd_sites *s, char *msg, size_t n)
@@ -421,38 +490,43 @@ ts_status tsd_sites_compute(const double gt[6], int width, int height,
         return tsd_fail(msg, n, TS_ERR_ARG, "the DEM's CRS is neither geographic nor projected (a "
                     "local or engineering CRS), so its longitudes and latitudes are "
                     "unknown; use SUN_AZIMUTH and SUN_ELEVATION instead");
-    /* lattice: every 32 cells or so, at most 65 nodes a side */
-    if (per_cell) {
-        s->nx = width < 2 ? 1 : width / 32 + 2;
-        s->ny = height < 2 ? 1 : height / 32 + 2;
-        if (s->nx > 65) s->nx = 65;
-        if (s->ny > 65) s->ny = 65;
-        /* odd counts: the middle node, whose sun the metadata reports, is
-         * the DEM's centre (with 2 nodes it was a corner) */
-        s->nx += s->nx > 1 && s->nx % 2 == 0;
-        s->ny += s->ny > 1 && s->ny % 2 == 0;
-    } else {
-        s->nx = s->ny = 1;
+    OGRCoordinateTransformationH fwd = NULL, inv = NULL;
+    if (!geographic && !lonlat_transforms(srs, &fwd, &inv))
+        return tsd_fail(msg, n, TS_ERR_ARG, "PROJ cannot transform the DEM's CRS to longitude and "
+                    "latitude, so the sun's position over it is unknown");
+    double deg = geographic ? OSRGetAngularUnits(srs, NULL) * 180.0 / M_PI : 1.0;
+    int nx = per_cell ? site_nodes(width, 1) : 1, ny = per_cell ? site_nodes(height, 1) : 1;
+    ts_status rc;
+    /* a finer lattice where the first one's nodes lie too far apart (the
+     * second pass's spacing follows the first's, so it rarely grows again) */
+    for (int pass = 0;; pass++) {
+        s->nx = nx;
+        s->ny = ny;
+        site_grid(s, width, height);
+        rc = sites_fill(gt, width, height, geographic, deg, fwd, inv, cells, s, msg, n);
+        if (rc != TS_OK || !per_cell || pass == 3 || !grow_sites(s, width, height, &nx, &ny))
+            break;
+        tsd_sites_free(s);
     }
-    s->x0 = s->nx > 1 ? 0.5 : 0.5 * width;
-    s->y0 = s->ny > 1 ? 0.5 : 0.5 * height;
-    s->dx = s->nx > 1 ? (width - 1.0) / (s->nx - 1) : 1.0;
-    s->dy = s->ny > 1 ? (height - 1.0) / (s->ny - 1) : 1.0;
+    if (fwd) OCTDestroyCoordinateTransformation(fwd);
+    if (inv) OCTDestroyCoordinateTransformation(inv);
+    if (rc != TS_OK)
+        tsd_sites_free(s);
+    return rc;
+}
+
+/* The longitude, latitude and grid azimuth of true north of s's nodes. */
+static ts_status sites_fill(const double gt[6], int width, int height, int geographic,
+                            double deg, OGRCoordinateTransformationH fwd,
+                            OGRCoordinateTransformationH inv, const tsd_cells *cells,
+                            tsd_sites *s, char *msg, size_t n)
+{
     size_t nodes = (size_t)s->nx * s->ny;
     s->lon = malloc(nodes * sizeof *s->lon);
     s->lat = malloc(nodes * sizeof *s->lat);
     s->north = malloc(nodes * sizeof *s->north);
-    if (!s->lon || !s->lat || !s->north) {
-        tsd_sites_free(s);
+    if (!s->lon || !s->lat || !s->north)
         return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory for %zu sun sites", nodes);
-    }
-    OGRCoordinateTransformationH fwd = NULL, inv = NULL;
-    if (!geographic && !lonlat_transforms(srs, &fwd, &inv)) {
-        tsd_sites_free(s);
-        return tsd_fail(msg, n, TS_ERR_ARG, "PROJ cannot transform the DEM's CRS to longitude and "
-                    "latitude, so the sun's position over it is unknown");
-    }
-    double deg = geographic ? OSRGetAngularUnits(srs, NULL) * 180.0 / M_PI : 1.0;
     ts_status rc = TS_OK;
     for (int j = 0; j < s->ny && rc == 0; j++)
         for (int i = 0; i < s->nx && rc == 0; i++) {
@@ -502,10 +576,6 @@ ts_status tsd_sites_compute(const double gt[6], int width, int height,
             s->lat[k] = lat;
             s->north[k] = north;
         }
-    if (fwd) OCTDestroyCoordinateTransformation(fwd);
-    if (inv) OCTDestroyCoordinateTransformation(inv);
-    if (rc != 0)
-        tsd_sites_free(s);
     return rc;
 }
 

@@ -340,6 +340,31 @@ class Sun(unittest.TestCase):
             self.assertLessEqual(abs(per[row, n // 2] - want) * 60, 5.0)
         self.assertGreater(per[0].mean(), per[-1].mean() + 1.5)
 
+    def test_per_cell_sun_on_coarse_cells_is_each_cells_sun(self):
+        """A flat DEM of 3-degree cells from 50 S to 80 S, 0 to 90 E, on
+        2026-06-01 (the sun grazes the horizon there): each cell gets the sun
+        hours of a small DEM at its centre within one step. The lattice was 3 x
+        3 nodes 43 degrees apart, and it interpolated refracted elevations
+        across the refraction's cut-off (0.6 deg at sunrise): cells lost up to
+        1.8 h."""
+        n, cell = (10, 30), 3.0
+        dem = T.write_tif(os.path.join(self.dir, "south.tif"), np.zeros(n, np.float32),
+                          (0.0, cell, 0, -50.0, 0, -cell), 4326)
+        oo = {"PRODUCT": "sunhours", "DATE": "2026-06-01", "TIMEZONE": "Z",
+              "STEP_MINUTES": 10}
+        per = T.read(T.conn(dem), 1, dict(oo, SUN_POSITION="per_cell"))
+        worst = 0.0
+        for row in range(0, 7):
+            for col in (0, 10, 15, 29):
+                lat, lon = -50.0 - (row + 0.5) * cell, (col + 0.5) * cell
+                one = T.read(T.conn(flat_dem(os.path.join(self.dir, "one.tif"), lat, lon,
+                                             n=4)), 1, oo)
+                worst = max(worst, abs(per[row, col] - one.mean()))
+        print("3-degree cells, 50-71 S, per cell: sun hours within %.3f h of each cell's "
+              "own" % worst)
+        self.assertLessEqual(worst, 10 / 60 + 1e-4)
+        self.assertGreater(per[:6].min(), 3.0)  # the sun rises on every row to 66.5 S
+
     def test_centre_sun_on_a_large_extent_warns(self):
         """SUN_POSITION=center on a DEM that reaches more than a degree of
         arc from its centre: a warning that says how far and what to do
