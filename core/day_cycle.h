@@ -278,12 +278,13 @@ ts_status ts_insolation(const ts_grid *grid, const ts_sun_sites *sites,
 #define TS_RANGE_HORIZON_DIRECTIONS 64
 
 /**
- * A range of local days, first to last inclusive, at a fixed UTC offset;
- * every `day_interval`-th day from the first is sampled, each cut into
- * steps of `step_minutes` as ts_sun_hours does with one day. Sampled day i
- * (first + i x day_interval) stands for min(day_interval, days left from
- * it to the last day) days, so the weights add up to the range's length
- * and day_interval = 1 gives the exact sum over every day.
+ * A range of local days, first to last inclusive, at a fixed UTC offset,
+ * cut into blocks of `day_interval` days from the first (the last block
+ * shorter); each block's middle day (first + i x day_interval + (w - 1) / 2,
+ * w its length) is sampled, cut into steps of `step_minutes` as
+ * ts_sun_hours does with one day, and stands for the block's w days, so the
+ * weights add up to the range's length and day_interval = 1 gives the
+ * exact sum over every day.
  */
 typedef struct {
     int first_year, first_month, first_day;

@@ -207,8 +207,9 @@ void TSDataset::SetupSunMetadata()
         GDALDataset::SetMetadataItem("RANGE_DAYS", CPLSPrintf("%d", s.range_days));
         GDALDataset::SetMetadataItem("RANGE_SAMPLED_DAYS", CPLSPrintf("%d", s.range_sampled));
         GDALDataset::SetMetadataItem("RANGE_DAY_WEIGHT",
-                                     "each computed day counts min(DAY_INTERVAL, days from "
-                                     "it to END_DATE) times");
+                                     "the range is cut into blocks of DAY_INTERVAL days "
+                                     "from START_DATE (the last one shorter); each block's "
+                                     "middle day is computed and counts for its days");
     }
     if (m_psProduct->model_key)
         GDALDataset::SetMetadataItem(m_psProduct->model_key, m_psProduct->model);

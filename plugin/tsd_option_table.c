@@ -156,8 +156,8 @@ const opt_def TSD_OPTION_ROWS[] = {
      "one day, 30 for a date range (START_DATE)"},
     {"DAY_INTERVAL", K_INT, FIELD(day_interval), TSD_XSTR(TS_RANGE_DAY_INTERVAL), 1, 366, 0,
      1, NULL, 1, P, LISTED, NULL,
-     "Date range (START_DATE): every DAY_INTERVAL-th day is computed and "
-     "stands for itself and the days up to the next one (or the range's end)"},
+     "Date range (START_DATE): the range is cut into blocks of DAY_INTERVAL "
+     "days; the middle day of each is computed and stands for the block"},
     {"HORIZON_DIRECTIONS", K_INT, FIELD(horizon_directions),
      TSD_XSTR(TS_RANGE_HORIZON_DIRECTIONS), 4, 3600, 0, 1, NULL, 1, P, LISTED, NULL,
      "Date range (START_DATE): azimuths at which the horizons are swept once; "

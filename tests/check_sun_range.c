@@ -242,7 +242,7 @@ static double day_length(const test_site *p, const ts_day_opts *o, double start)
 
 /* A year on an open flat plane: the sun hours are the sum of the day lengths,
  * to within one step per day (half a step at each end); sampled every 14
- * days, the weighted sum of the sampled days' lengths. */
+ * days, the weighted sum of the sampled (middle) days' lengths. */
 START_TEST(test_flat_year)
 {
     ts_grid g;
@@ -261,8 +261,8 @@ START_TEST(test_flat_year)
                       err.message);
         double astro = 0;
         int days = 365;
-        for (int d = 0; d < days; d += interval) {
-            double w = days - d < interval ? days - d : interval;
+        for (int b = 0; b < days; b += interval) {
+            int w = days - b < interval ? days - b : interval, d = b + (w - 1) / 2;
             double start = (double)(ts_days_from_civil(2026, 1, 1) + d) * 86400.0 - 3600.0;
             astro += w * day_length(&p, &o, start) / 3600.0;
         }
@@ -278,7 +278,8 @@ START_TEST(test_flat_year)
 }
 END_TEST
 
-/* 30 days at interval 14: days 0, 14 and 28 weighted 14, 14 and 2. */
+/* 30 days at interval 14: blocks of 14, 14 and 2 days from day 0, 14 and
+ * 28, sampled at their middle days 6, 20 and 28. */
 START_TEST(test_interval_weights)
 {
     ts_grid g;
@@ -297,8 +298,8 @@ START_TEST(test_interval_weights)
     ck_assert_int_eq(sampled, 3);
     ck_assert(ts_sun_hours_range(&g, &p.s, &o, &r, got, &err) == TS_OK);
     ck_assert(ts_insolation_range(&g, &p.s, &o, &r, got_i, NULL, NULL, &err) == TS_OK);
-    /* 2026-04-10 + 0, 14, 28 days */
-    static const int month[] = {4, 4, 5}, mday[] = {10, 24, 8}, weight[] = {14, 14, 2};
+    /* 2026-04-10 + 6, 20, 28 days */
+    static const int month[] = {4, 4, 5}, mday[] = {16, 30, 8}, weight[] = {14, 14, 2};
     for (int k = 0; k < 3; k++) {
         ts_date_range one;
         range_set(&one, 2026, month[k], mday[k], 2026, month[k], mday[k], 120, 1);

@@ -101,10 +101,11 @@ class Year(unittest.TestCase):
                 opts["DAY_INTERVAL"] = interval  # 14 is the default
             got = float(np.nanmean(self.product(opts, dem, 1)))
             astro = 0.0
-            for d in range(0, days, interval):
+            for b in range(0, days, interval):  # blocks, sampled at their middle
+                d = b + (min(interval, days - b) - 1) // 2
                 day = np.datetime64("2026-01-01") + np.timedelta64(d, "D")
                 y, m, dd = (int(v) for v in str(day).split("-"))
-                astro += min(interval, days - d) * noaa_day_length(46.5, 7.4, y, m, dd)
+                astro += min(interval, days - b) * noaa_day_length(46.5, 7.4, y, m, dd)
             print("flat plane 46.5 N 7.4 E, 2026, DAY_INTERVAL %2d, 30-min steps: %.3f h of "
                   "sun; NOAA day lengths %.3f h (%+.2f min a day); the core %.1f h" % (
                       interval, got, astro, (got - astro) * 60 / days,
@@ -115,6 +116,21 @@ class Year(unittest.TestCase):
             self.assertLessEqual(abs(got - astro), days * 0.1)
             # the driver places the sun as the core's test does
             self.assertLessEqual(abs(got - CORE_FLAT_YEAR[interval]), 1.0)
+
+    def test_a_season_at_the_default_interval_is_its_days(self):
+        """Spring on a flat plane at 46.5 N: the default DAY_INTERVAL=14 gives the
+        every-day total within 0.5 %. Each sampled day stood for itself and the
+        13 days after it, the shortest of them while the days lengthen: -2.45 %
+        of sun hours and -4.96 % of insolation (a year's errors cancel)."""
+        dem = flat_dem(os.path.join(self.dir, "flat.tif"), 46.5, 7.4, n=8)
+        for product in ("sunhours", "insolation"):
+            opts = {"PRODUCT": product, "START_DATE": "2026-03-01",
+                    "END_DATE": "2026-05-31", "TIMEZONE": "+01:00"}
+            every = float(np.nanmean(self.product(dict(opts, DAY_INTERVAL=1), dem, 1)))
+            sampled = float(np.nanmean(self.product(opts, dem, 1)))
+            print("flat plane, 2026-03-01..05-31, %s: every day %.1f, DAY_INTERVAL=14 %.1f "
+                  "(%+.2f %%)" % (product, every, sampled, 100 * (sampled / every - 1)))
+            self.assertLessEqual(abs(sampled / every - 1), 0.005, product)
 
     def test_metadata_and_progress(self):
         oo = {"PRODUCT": "insolation", "START_DATE": "2026-06-01", "END_DATE": "2026-06-30",
