@@ -71,6 +71,13 @@ void tsd_cells_free(tsd_cells *c);
  * rows (cell_x where the rows do not differ), metres. */
 double tsd_cells_min_x(const tsd_cells *c, int height);
 
+/** A projected CRS's transform to its own geographic CRS (fwd) and back
+ * (inv, where asked; may be NULL), both in longitude-latitude order; 1, or
+ * 0 with neither left where PROJ has none. Destroy with
+ * OCTDestroyCoordinateTransformation. */
+int tsd_lonlat_transforms(OGRSpatialReferenceH srs, OGRCoordinateTransformationH *fwd,
+                          OGRCoordinateTransformationH *inv);
+
 /**
  * Where the sun is seen from, in the core grid's frame (row 0 north, after
  * the flips of tsd_cells): one site at the DEM's centre, or (per_cell) a
