@@ -109,8 +109,9 @@ const opt_def TSD_OPTION_ROWS[] = {
      "Worker threads; 0 = one per CPU core"},
     {"OUTPUT_TYPE", K_SELECT, FIELD(output_type), "AUTO", 0, 0, 0, 0, "AUTO|Byte|Float32",
      1, P, LISTED, NULL,
-     "Data type: Byte (1..255, 0 = nodata, as gdaldem) or Float32 (0..1 or "
-     "degrees, NaN = nodata); AUTO = Byte for shade (and farshadow, Byte "
+     "Data type: Byte (1..255, 0 = nodata, as gdaldem; farshadow 0/1, 255 = "
+     "nodata) or Float32 (the product's own unit: 0..1, degrees, hours, Wh/m2 "
+     "or E/pi; NaN = nodata); AUTO = Byte for shade (and farshadow, Byte "
      "only), Float32 otherwise. Byte only for the 0..1 products (shade, "
      "shadow, svf, sky, daycycle, envlight)"},
     {"MAX_MEMORY", K_INT, FIELD(max_memory_mb), "0", 0, 1 << 30, 0, 1, NULL, 0, P, ALL,
