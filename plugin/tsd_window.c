@@ -381,8 +381,18 @@ static const struct tsd_far_plane *far_plane(tsd_far_field *f, double azimuth,
         free(hi);
         return NULL;
     }
-    for (size_t i = 0; i < cells; i++) /* -inf - -inf: no far terrain, slope 0 */
-        hi[i] = isinf(lo[i]) ? 0.0f : (float)((hi[i] - lo[i]) / (2 * TSD_FAR_DZ));
+    /* The far-only sweep does not sample a cell's ray at an occluder it
+     * cannot reach (off the grid, or nodata: core/lane_passes.c far_lost),
+     * so one observer may find no far terrain (-inf) where the other finds
+     * some: a line through -inf would put the horizon at +-90 degrees.
+     * There, the slope the other observer found, whatever the height. */
+    for (size_t i = 0; i < cells; i++) {
+        if (isinf(lo[i]) || isinf(hi[i])) {
+            lo[i] = isinf(lo[i]) ? hi[i] : lo[i]; /* -inf both: no far terrain */
+            hi[i] = 0.0f;
+        } else
+            hi[i] = (float)((hi[i] - lo[i]) / (2 * TSD_FAR_DZ));
+    }
     f->planes[f->n] = (struct tsd_far_plane){azimuth, lo, hi, NULL};
     return &f->planes[f->n++];
 }

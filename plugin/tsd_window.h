@@ -118,8 +118,9 @@ typedef struct tsd_far_field {
     int n, cap;
     struct tsd_far_plane {
         double azimuth;
-        float *base;        /* slope seen from TSD_FAR_DZ below the coarse height */
-        float *per_m;       /* its change per metre of observer height */
+        float *base;        /* slope seen from TSD_FAR_DZ below the coarse height (or
+                             * above, where only that observer finds far terrain) */
+        float *per_m;       /* its change per metre of observer height (0 there) */
         uint16_t *angle;    /* own: 0 none, else 1 + (degrees + 90) * STEPS_PER_DEGREE */
     } *planes;
 } tsd_far_field;

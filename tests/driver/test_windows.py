@@ -308,6 +308,39 @@ class Windows(unittest.TestCase):
         self.assertGreater(np.nanmin(win), -1.0)
         self.assertAlmostEqual(np.nanmin(win), np.nanmin(whole), places=3)
 
+    def test_coarse_far_grid_never_straight_up(self):
+        """A coarse far grid (MAX_MEMORY leaves its 8 planes no room at full
+        resolution) holds each far plane as the slopes seen from 25 m below
+        and above a coarse cell, a line in the observer's height. The
+        far-only sweep drops an occluder that a cell's ray cannot reach (off
+        the grid), so near the DEM's edges one of the two found no far
+        terrain (-inf) and the line through it put horizons at exactly 90
+        degrees (6 cells of this DEM, 24 degrees off TILE_SIZE=0; on a 437 x
+        391 fractal with 32 directions 73 cells, 69 degrees off the exact
+        sweep) or at -90. Now that coarse cell takes the other observer's
+        slope: at most 10.9 degrees off here, no horizon straight up, and
+        -90 (no terrain beyond) exactly where TILE_SIZE=0 has it."""
+        z = T.fractal_dem(512, seed=8, relief=500.0)[:300, :300]
+        dem = T.write_tif(os.path.join(self.tmp, "coarse_far.tif"), z, GT, UTM)
+        o = dict(PRODUCT="horizon", DIRECTIONS=8, START_AZIMUTH=11.25, EDGE="open",
+                 MAX_MEMORY=8, NEAR_DISTANCE=640)
+        msgs = []
+        gdal.SetConfigOption("CPL_DEBUG", "TERRASHADE")
+        gdal.PushErrorHandler(lambda cls, no, msg: msgs.append(msg))
+        try:
+            win = product(dem, TILE_SIZE=128, **o)
+        finally:
+            gdal.PopErrorHandler()
+            gdal.SetConfigOption("CPL_DEBUG", None)
+        self.assertTrue(any("far grid 150 x 150" in m for m in msgs), msgs)
+        whole = product(dem, TILE_SIZE=0, **o)
+        d = np.abs(win - whole)
+        print("coarse far grid: horizons up to %.2f deg (TILE_SIZE=0: %.2f), |difference| "
+              "max %.2f, p99 %.3f deg" % (win.max(), whole.max(), d.max(), np.percentile(d, 99)))
+        self.assertLess(win.max(), whole.max() + 1.0)
+        np.testing.assert_array_equal(win == -90, whole == -90)
+        self.assertLess(d.max(), 15.0)
+
     def test_small_dem_whole(self):
         """A DEM within one tile is computed whole: TILE_SIZE changes nothing."""
         a = product(T.LUX, PRODUCT="horizon", DIRECTIONS=4, TILE_SIZE=0)
