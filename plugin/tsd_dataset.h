@@ -122,6 +122,10 @@ class TSDataset final : public GDALPamDataset
      * for PRODUCT=farshadow. */
     static int OverviewCount(const tsd_product_def *psProduct, int W, int H);
 
+    /* gdaladdo: refused with what to do (tsd_overview.cpp) */
+    CPLErr IBuildOverviews(const char *pszResampling, int nOverviews, const int *panOverviewList,
+                           int nListBands, const int *panBandList, GDALProgressFunc pfnProgress,
+                           void *pProgressData, CSLConstList papszOptions) override;
     CPLErr GetGeoTransform(double *padfGT) override;
     const OGRSpatialReference *GetSpatialRef() const override;
     char **GetMetadata(const char *pszDomain = "") override;

@@ -79,6 +79,22 @@ TSDataset *TSDataset::Overview(int i)
     return m_apoOverviews[i].get();
 }
 
+/* gdaladdo on a TERRASHADE:<dem> source: its levels are its own (each the
+ * product of the DEM at the level's size), and a read-only dataset has no
+ * file to add others to; GDAL's own refusal named neither. */
+CPLErr TSDataset::IBuildOverviews(const char *, int, const int *, int, const int *,
+                                  GDALProgressFunc, void *, CSLConstList)
+{
+    Fail(CPLE_NotSupported,
+         CPLSPrintf("%s: a product makes overview levels of its own (each the product of "
+                    "the DEM read at the level's size: docs/driver.md, \"Overviews\") when "
+                    "they are read, and gdaladdo can neither add nor remove them. Write the "
+                    "product with gdal_translate (-of COG copies these levels) and run gdaladdo "
+                    "on the file written",
+                    GetDescription()));
+    return CE_Failure;
+}
+
 int TSRasterBand::GetOverviewCount()
 {
     return static_cast<TSDataset *>(poDS)->m_nOverviews;

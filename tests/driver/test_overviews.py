@@ -227,6 +227,24 @@ class Overviews(unittest.TestCase):
                     self.assertFalse(np.array_equal(o, drv, equal_nan=True))
 
 
+    def test_gdaladdo_refused_with_what_to_do(self):
+        """gdaladdo on a TERRASHADE source: the product's levels are its own
+        and the dataset is read-only, so there is nothing to build; GDAL's
+        own refusal ("BuildOverviews() not supported for this dataset")
+        said neither. The refusal says why and what to do, also for -ro
+        (an external .ovr) and -clean, and writes no file."""
+        src = T.conn(self.dem)
+        before = set(os.listdir(self.tmp))
+        for args in (["-r", "average", src, "2", "4"], ["-ro", src, "2"], ["-clean", src]):
+            with self.subTest(args=args[:-1]):
+                p = T.run(["gdaladdo", "-q", "-oo", "PRODUCT=svf", "-oo", "DIRECTIONS=4"]
+                          + args, ok=False)
+                self.assertNotEqual(p.returncode, 0)
+                for words in ("overview levels of its own", "gdaladdo can neither add nor "
+                              "remove them", "gdal_translate"):
+                    self.assertIn(words, p.stderr)
+        self.assertEqual(set(os.listdir(self.tmp)), before)
+
 class Cost(unittest.TestCase):
     """A coarse level costs a fraction of the full level: time and memory."""
 
