@@ -338,12 +338,12 @@ END_TEST
 
 /* Largest and share over 1 degree of how far the horizons of 8 azimuths lie
  * below the oracle's (the kinder of its two nodata rules). */
-static void edge_gaps(const char *label, const ts_grid *g, double max_distance, double *worst,
-                      double *over1)
+static void edge_gaps(const char *label, const ts_grid *g, double max_distance, double start,
+                      double *worst, double *over1)
 {
     ts_horizon_opts o = opts_with(0, max_distance);
     o.directions = 8;
-    o.start_azimuth = 7.3;
+    o.start_azimuth = start;
     size_t n = (size_t)g->width * (size_t)g->height;
     float *out = tdem_floats(n * 8);
     ts_error err;
@@ -365,30 +365,45 @@ static void edge_gaps(const char *label, const ts_grid *g, double max_distance, 
                 *worst = fmax(*worst, gap);
             }
     *over1 = (double)over / (double)cells;
-    printf("%-40s below the oracle: largest %.3f deg, %ld of %ld over 1 deg (%.4f %%)\n", label,
-           *worst, over, cells, 100 * *over1);
+    printf("%-40s from %4.1f deg, below the oracle: largest %.3f deg, %ld of %ld over 1 deg "
+           "(%.4f %%)\n", label, start, *worst, over, cells, 100 * *over1);
     free(out);
 }
 
 START_TEST(test_far_field_at_edges_and_holes)
 {
     /* Where a line's occluder lies where the cell's own ray is off the grid
-     * or on nodata, the ray's last steps up to it count (cm_ray_lost); the
-     * far field lost that terrain before: 10.2 degrees at the edges of this
-     * fractal, 35.9 at its holes, 0.28 % and 0.34 % of the cells over 1. */
+     * or on nodata, the ray's steps up to it count, and on nodata those
+     * beyond it (cm_ray_lost); the far field lost that terrain before: 10.2
+     * degrees at the edges of this fractal, 35.9 at its holes, 0.28 % and
+     * 0.34 % of the cells over 1; a cell looking across a nodata block at
+     * a corner saw nothing (-90) where the terrain beyond stood tens of
+     * degrees up. */
+    enum { CASES = 5 };
     ts_grid g;
     tdem_create(&g, 200, 150, 10.0, 10.0);
     tdem_fractal(&g, 7, 400.0);
-    double worst[3], over[3];
-    edge_gaps("fractal 200x150, its edges", &g, 0, &worst[0], &over[0]);
+    double worst[CASES], over[CASES];
+    edge_gaps("fractal 200x150, its edges", &g, 0, 7.3, &worst[0], &over[0]);
+    ts_grid block;
+    tdem_create(&block, 200, 150, 10.0, 10.0);
     for (int y = 0; y < 150; y++)
-        for (int x = 0; x < 200; x++)
+        for (int x = 0; x < 200; x++) {
+            float z = g.z[y * g.stride + x];
+            block.z[y * block.stride + x] = y >= 110 && x >= 150 ? NAN : z;
             if (hypot(x - 70, y - 60) < 15 || (x > 120 && x < 125) || (y == 30 && x % 3 == 0))
-                g.z[y * g.stride + x] = NAN;
-    edge_gaps("the same with nodata holes", &g, 0, &worst[1], &over[1]);
-    edge_gaps("the same, max_distance 600 m", &g, 600, &worst[2], &over[2]);
+                z = NAN;
+            g.z[y * g.stride + x] = z;
+        }
+    edge_gaps("the same with nodata holes", &g, 0, 7.3, &worst[1], &over[1]);
+    edge_gaps("the same, max_distance 600 m", &g, 600, 7.3, &worst[2], &over[2]);
+    /* a 50 x 40 block at the south-east corner, seen across along and off
+     * the diagonals */
+    edge_gaps("fractal with a nodata corner block", &block, 0, 0.0, &worst[3], &over[3]);
+    edge_gaps("the same", &block, 0, 7.3, &worst[4], &over[4]);
+    ts_grid_free(&block);
     ts_grid_free(&g);
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < CASES; k++) {
         ck_assert_msg(worst[k] <= 4.0, "case %d: %.3f deg below the oracle", k, worst[k]);
         ck_assert_msg(over[k] <= 0.0005, "case %d: %.4f %% over 1 deg", k, 100 * over[k]);
     }

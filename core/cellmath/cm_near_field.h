@@ -263,9 +263,13 @@ CM_FN float cm_ray_slope(const cm_ray_grid *r, int k, int i, float h, int dk, fl
  * (cm_ray_slope, step metres a step, c the curvature coefficient) at the
  * TS_LOST_STEPS whole steps up to that occluder, or up to where the ray
  * leaves the grid before it, and solved exactly over the part of a step it
- * has left there (cm_ray_exact); beyond `near` steps and within s_cap steps
- * (0 = none); -inf if none counts. A few steps, not the whole ray, so that
- * a DEM whose edge holds every line's occluder costs a few steps a cell.
+ * has left there (cm_ray_exact), and, where the ray is on the grid there
+ * but on nodata, at the TS_LOST_STEPS whole steps beyond it (a hole's far
+ * side, where the lines found their terrain: a cell looking across a
+ * nodata block saw nothing, -90, where the terrain stood 16-25 deg up);
+ * beyond `near` steps and within s_cap steps (0 = none); -inf if none
+ * counts. A few steps, not the whole ray, so that a DEM whose edge holds
+ * every line's occluder costs a few steps a cell.
  */
 CM_FN float cm_ray_lost(const cm_ray_grid *r, int k, int i, float h, int dk, int near,
                         cm_real s_cap, cm_real step, cm_real c)
@@ -287,6 +291,21 @@ CM_FN float cm_ray_lost(const cm_ray_grid *r, int k, int i, float h, int dk, int
     if (exit > hi && exit < last) { /* the ray leaves the grid (or the cap) within a step */
         cm_real from = hi > near ? (cm_real)hi : (cm_real)near;
         float v = exit > from ? cm_ray_exact(r, k, i, h, from, exit, step, c) : -INFINITY;
+        best = v > best ? v : best;
+    }
+    /* On the grid at the occluder but on nodata: the hole's far side, where
+     * the line found its terrain, lies beyond it (empty where the ray has
+     * left the grid or the cap before dk) */
+    cm_real beyond = k < dk + TS_LOST_STEPS ? (cm_real)k : (cm_real)(dk + TS_LOST_STEPS);
+    if (fabs(r->t) > CM_R(1e-12)) {
+        cm_real sv = r->t > 0 ? i / r->t : (i - (r->V - 1)) / r->t;
+        beyond = sv < beyond ? sv : beyond;
+    }
+    if (s_cap > 0 && s_cap < beyond)
+        beyond = s_cap;
+    const int far_end = (int)floor(beyond);
+    for (int s = dk + 1; s <= far_end; s++) {
+        float v = cm_ray_slope(r, k, i, h, s, (float)(s * step), (float)c);
         best = v > best ? v : best;
     }
     return best;
