@@ -176,8 +176,11 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
     p->margin_x = mx < W ? (int)mx : W;
     p->margin_y = my < H ? (int)my : H;
     p->windowed = 1;
-    /* a cache that holds a row of chunks: GDAL reads blocks row by row */
+    /* a cache that holds a row of chunks (GDAL reads blocks row by row),
+     * and at least 4, so that a read that straddles a chunk corner keeps
+     * its four */
     p->cache_chunks = (W + p->tile - 1) / p->tile + 1;
+    p->cache_chunks = p->cache_chunks < 4 ? 4 : p->cache_chunks;
     if (p->far) {
         /* the sweeps of a chunk: the sun's (METHOD=sh: its swath's; a
          * day's: one per step at most, a date range's HORIZON_DIRECTIONS),

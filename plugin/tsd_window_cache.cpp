@@ -318,7 +318,7 @@ const WindowChunk *TSDataset::Chunk(int cx, int cy)
         }
     if (!EnsureFarField())
         return nullptr;
-    while (static_cast<int>(s.lru.size()) >= std::max(4, s.plan.cache_chunks))
+    while (static_cast<int>(s.lru.size()) >= s.plan.cache_chunks)
         s.lru.pop_back();
     WindowChunk c;
     const auto tStart = std::chrono::steady_clock::now();

@@ -174,6 +174,21 @@ class MemoryEstimate(unittest.TestCase):
     def test_windowed_day_estimate_is_an_upper_bound(self):
         self.brackets(WINDOWED_DAY, dict(COMMON, TILE_SIZE=512), estimate_logged, over=2.0)
 
+    def test_cache_the_estimate_counts_is_the_cache(self):
+        """The estimate counts the chunks the LRU cache keeps: a row of them
+        (width / TILE_SIZE + 1) and at least 4. A DEM at most two chunks wide
+        was estimated with the row alone (3 chunks) while the cache kept 4."""
+        for width, want in ((300, 4), (600, 4), (1100, 6)):
+            with self.subTest(width=width):
+                narrow = os.path.join(os.path.dirname(self.out), "narrow.tif")
+                T.run(["gdal_translate", "-q", "-srcwin", 0, 0, width, 300, self.dem, narrow])
+                p = T.run(["gdal_translate", "-q"] +
+                          T.oo_args(dict(COMMON, TILE_SIZE=256, PRODUCT="svf")) +
+                          [T.conn(narrow), self.out], CPL_DEBUG="TERRASHADE")
+                m = re.search(r"cache of (\d+) chunks", p.stderr)
+                self.assertIsNotNone(m, p.stderr)
+                self.assertEqual(int(m.group(1)), want)
+
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)
