@@ -23,6 +23,7 @@
 
 #include "shadow_atlas.h"
 #include "tsd_atlas_check.h"
+#include "tsd_dataset.h"
 #include "tsd_dem.h"
 #include "tsd_gdal.h"
 #include "tsd_geodesy.h"
@@ -182,6 +183,7 @@ CPLErr TSAtlasDataset::EnsureNear()
         sH.directions = 1;
         sH.max_distance = psInfo->threshold_m;
         double adfGT[6];
+        std::string osNotHeights;
         if (!(std::isfinite(psInfo->threshold_m) && psInfo->threshold_m > 0))
             m_osError = "SHADOWS=all needs the atlas's far threshold in "
                         "metres, which this atlas does not record";
@@ -200,6 +202,8 @@ CPLErr TSAtlasDataset::EnsureNear()
             m_osError = CPLSPrintf("SHADOWS=all: the atlas's metadata says BAND=%d, but the "
                                    "DEM '%s' has %d band(s)", nBandDEM, m_osDEM.c_str(),
                                    poDEM->GetRasterCount());
+        else if (!(osNotHeights = NotHeights(poDEM, nBandDEM, m_osDEM)).empty())
+            m_osError = "SHADOWS=all: " + osNotHeights; /* as a product's open says */
         else if (poDEM->GetGeoTransform(adfGT) != CE_None)
             m_osError = "SHADOWS=all: the DEM has no geotransform";
         else

@@ -354,6 +354,20 @@ class Atlas(unittest.TestCase):
         self.refused(path, "(the atlas's SOURCE_DEM) is a far-shadow atlas (.tsa), not a DEM",
                      ["SHADOWS=all"])
 
+    def test_shadows_all_refuses_what_are_not_heights(self):
+        """SHADOWS=all reads its DEM as a product's open does: a complex or
+        signed-byte band is refused (it was read silently: the real part
+        alone, or -8 m as 248 m)."""
+        for name, args, sentence in (
+                ("complex.tif", ["-ot", "CFloat32"], "is complex (CFloat32), not heights"),
+                ("sbyte.tif", ["-ot", "Byte", "-scale", "0", "1100", "0", "255",
+                               "-co", "PIXELTYPE=SIGNEDBYTE"], "holds signed bytes")):
+            with self.subTest(dem=name):
+                dem = os.path.join(self.dir, name)
+                T.run(["gdal_translate", "-q"] + args + [T.JACKSBORO, dem])
+                self.refused(self.tsa, "SHADOWS=all: band 1 of '%s' %s" % (dem, sentence),
+                             ["SHADOWS=all", "DEM=" + dem])
+
     def test_createcopy_refuses_other_sources(self):
         out = os.path.join(self.dir, "refused.tsa")
         # complex bands
