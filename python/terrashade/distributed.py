@@ -114,6 +114,22 @@ def given_keys(source, open_options):
     return {item.split("=", 1)[0].strip().upper() for item in items}
 
 
+def absolute_source(source):
+    """SOURCE with a relative DEM path that exists here made absolute: each
+    worker would resolve it in its own working directory (an existing
+    cluster's workers do not share the client's), and read another file of
+    that name, or none."""
+    rest = source[len("TERRASHADE:"):]
+    m = INLINE.match(rest)
+    head, dem = (rest[:m.end()], rest[m.end():]) if m else ("", rest)
+    quoted = len(dem) > 1 and dem[0] == dem[-1] == '"'
+    path = dem[1:-1] if quoted else dem
+    if not path or os.path.isabs(path) or path.startswith("/vsi") or not os.path.exists(path):
+        return source
+    path = os.path.abspath(path)
+    return "TERRASHADE:" + head + ('"%s"' % path if quoted else path)
+
+
 def open_source(source, open_options):
     if not source.upper().startswith("TERRASHADE:"):
         raise Failure("SOURCE must be a TERRASHADE connection string "
@@ -347,8 +363,8 @@ def run(args):
             task_options.append("THREADS=%d" % threads)
         if "PROGRESS" not in keys:
             task_options.append("PROGRESS=no")  # the Dask bar says it
-        n = compute(client, out, args.source, task_options, args.tile_size, args.quiet,
-                    run_id)
+        n = compute(client, out, absolute_source(args.source), task_options, args.tile_size,
+                    args.quiet, run_id)
         out.FlushCache()
         out = None
         finish(partial, fmt, args.dest, block, args.creation_options)

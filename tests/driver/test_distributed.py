@@ -39,9 +39,9 @@ SUNHOURS = {"PRODUCT": "sunhours", "DATE": "2024-12-21", "TIMEZONE": "-05:00",
             "STEP_MINUTES": 60, "TILE_SIZE": 64}
 
 
-def distributed(args, ok=True, **env):
+def distributed(args, ok=True, cwd=None, **env):
     return T.run(["/usr/bin/python3", "-m", "terrashade.distributed"] + list(args),
-                 ok=ok, PYTHONPATH=PYTHONPATH, **env)
+                 ok=ok, cwd=cwd, PYTHONPATH=PYTHONPATH, **env)
 
 
 def files_open(path):
@@ -260,6 +260,35 @@ class Distributed(unittest.TestCase):
                 self.assertEqual(sorted(held.values()), [0, 0], "the DEM held after the run")
         finally:
             cluster.close()
+
+    def test_existing_cluster_reads_the_clients_relative_dem(self):
+        """A relative DEM in SOURCE is the client's file: the workers of an
+        existing cluster, started elsewhere, resolved it in their own working
+        directory and read another DEM of that name there, silently."""
+        from dask.distributed import Client, LocalCluster
+        client_dir, worker_dir = self.path("client_dir"), self.path("worker_dir")
+        for d in (client_dir, worker_dir):
+            os.makedirs(d, exist_ok=True)
+        with open(self.dem, "rb") as f, open(os.path.join(client_dir, "rel.tif"), "wb") as g:
+            g.write(f.read())
+        other = os.path.join(worker_dir, "rel.tif")  # the same name, other terrain
+        T.run(["gdal_translate", "-q", "-scale", "0", "1", "0", "3", "-ot", "Float32",
+               self.dem, other])
+        cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                               dashboard_address=None, scheduler_port=0)
+        svf = {"PRODUCT": "svf", "DIRECTIONS": 4}
+        try:
+            with Client(cluster) as client:  # the workers' working directory
+                client.run(os.chdir, worker_dir)
+            dest = self.path("relative.tif")
+            distributed(["--scheduler", cluster.scheduler_address, "--tile-size", 64, "-q"]
+                        + T.oo_args(svf) + ["TERRASHADE:rel.tif", dest], cwd=client_dir)
+        finally:
+            cluster.close()
+        ref = self.path("ref_relative.tif")  # gdal_translate where the client runs
+        T.run(["gdal_translate", "-q"] + T.oo_args(svf) + ["TERRASHADE:rel.tif", ref],
+              cwd=client_dir)
+        self.assert_identical(dest, ref)
 
     def test_killed_worker_is_retried(self):
         flag = self.path("crashed")
