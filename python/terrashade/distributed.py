@@ -211,6 +211,11 @@ def start_cluster(args):
         except ValueError as e:  # not an address: no port, an unknown scheme...
             raise Failure("--scheduler %s is not a Dask scheduler address such as "
                           "tcp://host:8786 (%s)" % (args.scheduler, e), code=2)
+        except TypeError as e:  # tls:// without Dask's TLS settings (no SSL context)
+            raise Failure("--scheduler %s needs Dask's TLS settings: the CA, certificate and "
+                          "key in the Dask configuration (distributed.comm.tls.*, e.g. "
+                          "DASK_DISTRIBUTED__COMM__TLS__CA_FILE and __CLIENT__CERT/__KEY) "
+                          "(%s)" % (args.scheduler, e), code=2)
         except (OSError, TimeoutError) as e:
             raise Failure("cannot reach the Dask scheduler at %s within %d s: %s"
                           % (args.scheduler, args.timeout, e), code=2)

@@ -340,6 +340,14 @@ class Distributed(unittest.TestCase):
                               "tcp://host:8786 (%s" % (address, reason), p.stderr)
                 self.assertNotIn("Traceback", p.stderr)
                 self.assert_nothing_left(dest)
+        # a TLS address without Dask's TLS settings: what to set, not a TypeError
+        dest = self.path("tls.tif")
+        p = distributed(["--scheduler", "tls://127.0.0.1:8786", "--timeout", 2,
+                         T.conn(self.dem), dest], ok=False)
+        self.assertEqual(p.returncode, 2, p.stderr)
+        self.assertIn("--scheduler tls://127.0.0.1:8786 needs Dask's TLS settings", p.stderr)
+        self.assertNotIn("TypeError:", p.stderr.split("needs Dask's TLS settings")[0])
+        self.assert_nothing_left(dest)
 
     def test_destination_is_a_directory(self):
         """Refused before any work, not when the finished result is renamed."""
