@@ -274,14 +274,17 @@ CM_FN float cm_ray_slope(const cm_ray_grid *r, int k, int i, float h, int dk, fl
 CM_FN float cm_ray_lost(const cm_ray_grid *r, int k, int i, float h, int dk, int near,
                         cm_real s_cap, cm_real step, cm_real c)
 {
-    cm_real last = dk < k ? dk : k; /* and no farther than the grid's start along u */
-    cm_real exit = last;
-    if (fabs(r->t) > CM_R(1e-12)) { /* where v = i - t s leaves [0, V - 1] */
+    /* where the ray ends: the grid's start along u (k steps back), where
+     * v = i - t s leaves [0, V - 1], or the cap */
+    cm_real end = (cm_real)k;
+    if (fabs(r->t) > CM_R(1e-12)) {
         cm_real sv = r->t > 0 ? i / r->t : (i - (r->V - 1)) / r->t;
-        exit = sv < last ? sv : last;
+        end = sv < end ? sv : end;
     }
-    if (s_cap > 0 && s_cap < exit)
-        exit = s_cap;
+    if (s_cap > 0 && s_cap < end)
+        end = s_cap;
+    const cm_real last = dk < k ? dk : k;
+    const cm_real exit = dk < end ? (cm_real)dk : end;
     const int hi = (int)floor(exit), lo = hi - TS_LOST_STEPS > near ? hi - TS_LOST_STEPS : near;
     float best = -INFINITY;
     for (int s = hi; s > lo; s--) {
@@ -296,14 +299,8 @@ CM_FN float cm_ray_lost(const cm_ray_grid *r, int k, int i, float h, int dk, int
     /* On the grid at the occluder but on nodata: the hole's far side, where
      * the line found its terrain, lies beyond it (empty where the ray has
      * left the grid or the cap before dk) */
-    cm_real beyond = k < dk + TS_LOST_STEPS ? (cm_real)k : (cm_real)(dk + TS_LOST_STEPS);
-    if (fabs(r->t) > CM_R(1e-12)) {
-        cm_real sv = r->t > 0 ? i / r->t : (i - (r->V - 1)) / r->t;
-        beyond = sv < beyond ? sv : beyond;
-    }
-    if (s_cap > 0 && s_cap < beyond)
-        beyond = s_cap;
-    const int far_end = (int)floor(beyond);
+    const cm_real beyond = (cm_real)(dk + TS_LOST_STEPS);
+    const int far_end = (int)floor(beyond < end ? beyond : end);
     for (int s = dk + 1; s <= far_end; s++) {
         float v = cm_ray_slope(r, k, i, h, s, (float)(s * step), (float)c);
         best = v > best ? v : best;
