@@ -156,6 +156,13 @@ static int customary_void(GDALDataType type, double *raw)
     }
 }
 
+/* A raw value in metres as the loads make it (tsd_dem.c's to_metres: the
+ * float read times scale plus offset in double, as float). */
+static float raw_metres(double raw, const tsd_dem_conversion *c)
+{
+    return (float)((double)(float)raw * c->scale + c->offset);
+}
+
 /* A height the grid holds that is the band's type's customary void, once
  * within the Earth's heights by the band's scale (Int16 centimetres:
  * -327.68 m, UInt16 centimetres: 655.35 m): an error naming it and the
@@ -168,10 +175,10 @@ static ts_status void_error(GDALRasterBandH band, const tsd_dem_conversion *c, c
     const GDALDataType type = GDALGetRasterDataType(band);
     if (!customary_void(type, &raw))
         return TS_OK;
-    const float z = (float)((double)(float)raw * c->scale + c->offset); /* as tsd_dem.c */
+    const float z = raw_metres(raw, c);
     const double next = raw < 0 ? raw + 1 : raw - 1; /* a height it must differ from */
     if ((z != tsd_key_float(seen->lo_key) && z != tsd_key_float(seen->hi_key)) ||
-        (float)((double)(float)next * c->scale + c->offset) == z)
+        raw_metres(next, c) == z)
         return TS_OK;
     for (int gy = 0; gy < g->height; gy++) {
         const float *row = g->z + (ptrdiff_t)gy * g->stride;
