@@ -83,50 +83,6 @@ static int grow_sites(const tsd_sites *s, int width, int height, int *nx, int *n
     return *nx != s->nx || *ny != s->ny;
 }
 
-static ts_status sites_fill(const double gt[6], int width, int height, int geographic,
-                            double deg, OGRCoordinateTransformationH fwd,
-                            OGRCoordinateTransformationH inv, const tsd_cells *cells,
-                            tsd_sites *s, char *msg, size_t n);
-
-ts_status tsd_sites_compute(const double gt[6], int width, int height,
-                      OGRSpatialReferenceH srs, const tsd_cells *cells, int per_cell,
-                      tsd_sites *s, char *msg, size_t n)
-{
-    memset(s, 0, sizeof *s);
-    if (!srs)
-        return tsd_fail(msg, n, TS_ERR_ARG, "the DEM has no CRS, so the sun's position over it is "
-                    "unknown: give it a CRS (gdal_edit.py -a_srs) or use "
-                    "SUN_AZIMUTH and SUN_ELEVATION");
-    int geographic = OSRIsGeographic(srs);
-    if (!geographic && !OSRIsProjected(srs))
-        return tsd_fail(msg, n, TS_ERR_ARG, "the DEM's CRS is neither geographic nor projected (a "
-                    "local or engineering CRS), so its longitudes and latitudes are "
-                    "unknown; use SUN_AZIMUTH and SUN_ELEVATION instead");
-    OGRCoordinateTransformationH fwd = NULL, inv = NULL;
-    if (!geographic && !tsd_lonlat_transforms(srs, &fwd, &inv))
-        return tsd_fail(msg, n, TS_ERR_ARG, "PROJ cannot transform the DEM's CRS to longitude and "
-                    "latitude, so the sun's position over it is unknown");
-    double deg = geographic ? OSRGetAngularUnits(srs, NULL) * 180.0 / M_PI : 1.0;
-    int nx = per_cell ? site_nodes(width, 1) : 1, ny = per_cell ? site_nodes(height, 1) : 1;
-    ts_status rc;
-    /* a finer lattice where the first one's nodes lie too far apart (the
-     * second pass's spacing follows the first's, so it rarely grows again) */
-    for (int pass = 0;; pass++) {
-        s->nx = nx;
-        s->ny = ny;
-        site_grid(s, width, height);
-        rc = sites_fill(gt, width, height, geographic, deg, fwd, inv, cells, s, msg, n);
-        if (rc != TS_OK || !per_cell || pass == 3 || !grow_sites(s, width, height, &nx, &ny))
-            break;
-        tsd_sites_free(s);
-    }
-    if (fwd) OCTDestroyCoordinateTransformation(fwd);
-    if (inv) OCTDestroyCoordinateTransformation(inv);
-    if (rc != TS_OK)
-        tsd_sites_free(s);
-    return rc;
-}
-
 /* The longitude, latitude and grid azimuth of true north of s's nodes. */
 static ts_status sites_fill(const double gt[6], int width, int height, int geographic,
                             double deg, OGRCoordinateTransformationH fwd,
@@ -188,6 +144,45 @@ static ts_status sites_fill(const double gt[6], int width, int height, int geogr
             s->lat[k] = lat;
             s->north[k] = north;
         }
+    return rc;
+}
+
+ts_status tsd_sites_compute(const double gt[6], int width, int height,
+                      OGRSpatialReferenceH srs, const tsd_cells *cells, int per_cell,
+                      tsd_sites *s, char *msg, size_t n)
+{
+    memset(s, 0, sizeof *s);
+    if (!srs)
+        return tsd_fail(msg, n, TS_ERR_ARG, "the DEM has no CRS, so the sun's position over it is "
+                    "unknown: give it a CRS (gdal_edit.py -a_srs) or use "
+                    "SUN_AZIMUTH and SUN_ELEVATION");
+    int geographic = OSRIsGeographic(srs);
+    if (!geographic && !OSRIsProjected(srs))
+        return tsd_fail(msg, n, TS_ERR_ARG, "the DEM's CRS is neither geographic nor projected (a "
+                    "local or engineering CRS), so its longitudes and latitudes are "
+                    "unknown; use SUN_AZIMUTH and SUN_ELEVATION instead");
+    OGRCoordinateTransformationH fwd = NULL, inv = NULL;
+    if (!geographic && !tsd_lonlat_transforms(srs, &fwd, &inv))
+        return tsd_fail(msg, n, TS_ERR_ARG, "PROJ cannot transform the DEM's CRS to longitude and "
+                    "latitude, so the sun's position over it is unknown");
+    double deg = geographic ? OSRGetAngularUnits(srs, NULL) * 180.0 / M_PI : 1.0;
+    int nx = per_cell ? site_nodes(width, 1) : 1, ny = per_cell ? site_nodes(height, 1) : 1;
+    ts_status rc;
+    /* a finer lattice where the first one's nodes lie too far apart (the
+     * second pass's spacing follows the first's, so it rarely grows again) */
+    for (int pass = 0;; pass++) {
+        s->nx = nx;
+        s->ny = ny;
+        site_grid(s, width, height);
+        rc = sites_fill(gt, width, height, geographic, deg, fwd, inv, cells, s, msg, n);
+        if (rc != TS_OK || !per_cell || pass == 3 || !grow_sites(s, width, height, &nx, &ny))
+            break;
+        tsd_sites_free(s);
+    }
+    if (fwd) OCTDestroyCoordinateTransformation(fwd);
+    if (inv) OCTDestroyCoordinateTransformation(inv);
+    if (rc != TS_OK)
+        tsd_sites_free(s);
     return rc;
 }
 
