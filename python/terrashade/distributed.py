@@ -105,12 +105,17 @@ def parse_args(argv):
     return args
 
 
+def split_source(source):
+    """SOURCE's inline option segment with its ':' ("" if none) and the DEM."""
+    rest = source[len("TERRASHADE:"):]
+    m = INLINE.match(rest)
+    return (rest[:m.end()], rest[m.end():]) if m else ("", rest)
+
+
 def given_keys(source, open_options):
     """Upper-case names of the options given inline in SOURCE or by -oo."""
-    items = list(open_options)
-    m = INLINE.match(source[len("TERRASHADE:"):])
-    if m:
-        items += m.group(1).split(",")
+    inline = split_source(source)[0]
+    items = list(open_options) + (inline[:-1].split(",") if inline else [])
     return {item.split("=", 1)[0].strip().upper() for item in items}
 
 
@@ -119,9 +124,7 @@ def absolute_source(source):
     worker would resolve it in its own working directory (an existing
     cluster's workers do not share the client's), and read another file of
     that name, or none."""
-    rest = source[len("TERRASHADE:"):]
-    m = INLINE.match(rest)
-    head, dem = (rest[:m.end()], rest[m.end():]) if m else ("", rest)
+    head, dem = split_source(source)
     quoted = len(dem) > 1 and dem[0] == dem[-1] == '"'
     path = dem[1:-1] if quoted else dem
     if not path or os.path.isabs(path) or path.startswith("/vsi") or not os.path.exists(path):

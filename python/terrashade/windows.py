@@ -39,15 +39,14 @@ def _dataset(source, open_options, run):
     key, me = (source, tuple(open_options), run), threading.get_ident()
     with _open_lock:
         held = _open.get(me)
-    if held is not None and held[0] == key:
-        return held[1]
+        if held is not None and held[0] == key:
+            return held[1]
+        _open.pop(me, None)
+    del held  # the previous one closes before the next opens: bounded memory
+    ds = gdal.OpenEx(source, gdal.OF_RASTER | gdal.OF_READONLY, open_options=list(open_options))
     with _open_lock:
-        _open.pop(me, None)  # close the previous one first: bounded memory
-    held = (key, gdal.OpenEx(source, gdal.OF_RASTER | gdal.OF_READONLY,
-                             open_options=list(open_options)))
-    with _open_lock:
-        _open[me] = held
-    return held[1]
+        _open[me] = (key, ds)
+    return ds
 
 
 def forget(run):
