@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cellmath/cm_line.h"
+#include "cellmath/cm_near_field.h"
 #include "line_geometry.h"
 #include "status_internal.h"
 
@@ -71,17 +72,16 @@ ts_status ts_line_geom_init(ts_line_geom *g, const ts_grid *grid, double azimuth
         double p = g->t * (double)(k + g->k_anchor);
         double f = floor(p);
         float fr = (float)(p - f);
-        /* Rounding can land a hair below 1: fold it onto the next cell. */
+        /* Rounding can land a hair below 1: fold it onto the next cell;
+         * a hair above 0 is on the cell, as the rays' (cm_ray_offset). */
         if (fr >= 1.0f) {
             f += 1;
             fr = 0.0f;
         }
         g->fl[k] = (int)(f - f0);
-        g->fr[k] = fr;
-        /* The far field's ray: the same doubles as cm_ray_slope, no folding. */
-        double pv = -g->t * k, o = floor(pv);
-        g->ray_o[k] = (int)o;
-        g->ray_f[k] = (float)(pv - o);
+        g->fr[k] = p - f < CM_CELL_SNAP ? 0.0f : fr;
+        /* The far field's ray: as cm_ray_slope takes it. */
+        g->ray_o[k] = cm_ray_offset(g->t, k, &g->ray_f[k]);
     }
     int flmin = g->fl[0] < g->fl[g->U - 1] ? g->fl[0] : g->fl[g->U - 1];
     int flmax = g->fl[0] < g->fl[g->U - 1] ? g->fl[g->U - 1] : g->fl[0];

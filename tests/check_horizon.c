@@ -379,7 +379,7 @@ START_TEST(test_far_field_at_edges_and_holes)
      * 0.34 % of the cells over 1; a cell looking across a nodata block at
      * a corner saw nothing (-90) where the terrain beyond stood tens of
      * degrees up. */
-    enum { CASES = 5 };
+    enum { CASES = 6 };
     ts_grid g;
     tdem_create(&g, 200, 150, 10.0, 10.0);
     tdem_fractal(&g, 7, 400.0);
@@ -401,6 +401,17 @@ START_TEST(test_far_field_at_edges_and_holes)
      * the diagonals */
     edge_gaps("fractal with a nodata corner block", &block, 0, 0.0, &worst[3], &over[3]);
     edge_gaps("the same", &block, 0, 7.3, &worst[4], &over[4]);
+    ts_grid_free(&block);
+    /* At 225 degrees tan is 1 - 2e-16: a ray running along the block's
+     * west edge took its cell's nodata neighbour with a weight of 1e-16,
+     * and its sample there was nodata (88.2 degrees below the oracle
+     * north of the block, -90 for -1.6) */
+    tdem_create(&block, 190, 200, 10.0, 10.0);
+    tdem_fractal(&block, 7, 400.0);
+    for (int y = 160; y < 200; y++)
+        for (int x = 140; x < 190; x++)
+            block.z[y * block.stride + x] = NAN;
+    edge_gaps("190x200 with a nodata corner block", &block, 0, 45.0, &worst[5], &over[5]);
     ts_grid_free(&block);
     ts_grid_free(&g);
     for (int k = 0; k < CASES; k++) {

@@ -241,12 +241,34 @@ CM_FN float cm_ray_slope_at(const cm_ray_grid *r, int k, int i, float h, int dk,
     return (hz - h) / dd - cf * dd;
 }
 
-/* cm_ray_slope_at with the ray's offset dk steps back computed here:
- * o = floor(-t dk) whole cells along v and the fraction f beyond. */
+/* A fraction of a cell this close to 0 or 1 is on the cell: t a hair off
+ * +-1 (225 and 315 degrees on square cells: 1 - 2e-16) leaves ~1e-16, not
+ * 0, and a nodata neighbour given that weight made the sample nodata (the
+ * far field lost a ray along a nodata block's edge: -90 where the oracle
+ * saw -1.6 degrees, 3 degrees too low beside it). */
+#define CM_CELL_SNAP CM_R(1e-9)
+
+/* The v offset of a ray dk steps back, -t dk: the whole cells (returned)
+ * and the fraction beyond, in *f. */
+CM_FN int cm_ray_offset(cm_real t, int dk, float *f)
+{
+    const cm_real pv = -t * dk;
+    cm_real o = floor(pv), fr = pv - o;
+    if (fr > 1 - CM_CELL_SNAP) {
+        o += 1;
+        fr = 0;
+    }
+    *f = fr < CM_CELL_SNAP ? 0.0f : (float)fr;
+    return (int)o;
+}
+
+/* cm_ray_slope_at with the ray's offset dk steps back computed here
+ * (cm_ray_offset). */
 CM_FN float cm_ray_slope(const cm_ray_grid *r, int k, int i, float h, int dk, float dd, float cf)
 {
-    cm_real pv = -r->t * dk, o = floor(pv);
-    return cm_ray_slope_at(r, k, i, h, dk, (int)o, (float)(pv - o), dd, cf);
+    float f;
+    const int o = cm_ray_offset(r->t, dk, &f);
+    return cm_ray_slope_at(r, k, i, h, dk, o, f, dd, cf);
 }
 
 /* Steps of a cell's own ray sampled where a line's occluder lies where the
