@@ -28,6 +28,7 @@
 #include "tsd_gdal.h"
 #include "tsd_geodesy.h"
 #include "tsd_options.h"
+#include "tsd_pam_band.h"
 
 namespace tsd
 {
@@ -91,9 +92,18 @@ class TSAtlasDataset final : public GDALPamDataset
     }
 };
 
-class TSAtlasBand final : public GDALPamRasterBand
+/* Its nodata value and colour are the atlas's unless the user set them
+ * (tsd_pam_band.h). */
+class TSAtlasBand final : public TSPamBand
 {
     int m_nStep;
+
+  protected:
+    double OwnNoData() const override
+    {
+        // as PRODUCT=farshadow, whether or not the maps have nodata cells
+        return TS_ATLAS_NODATA;
+    }
 
   public:
     TSAtlasBand(TSAtlasDataset *poDSIn, int nBandIn) : m_nStep(nBandIn - 1)
@@ -106,17 +116,6 @@ class TSAtlasBand final : public GDALPamRasterBand
     }
 
     CPLErr IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage) override;
-    double GetNoDataValue(int *pbSuccess = nullptr) override
-    {
-        // as PRODUCT=farshadow, whether or not the maps have nodata cells
-        if (pbSuccess)
-            *pbSuccess = TRUE;
-        return TS_ATLAS_NODATA;
-    }
-    GDALColorInterp GetColorInterpretation() override
-    {
-        return GCI_GrayIndex;
-    }
 };
 
 TSAtlasDataset::~TSAtlasDataset()

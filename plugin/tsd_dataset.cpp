@@ -45,18 +45,34 @@ TSRasterBand::TSRasterBand(TSDataset *poDSIn, int nBandIn, GDALDataType eType)
     nBlockYSize = std::min(BLOCK, poDSIn->GetRasterYSize());
 }
 
-double TSRasterBand::GetNoDataValue(int *pbSuccess)
+double TSRasterBand::OwnNoData() const
 {
-    if (pbSuccess)
-        *pbSuccess = TRUE;
     if (eDataType != GDT_Byte)
         return std::numeric_limits<double>::quiet_NaN();
     return static_cast<TSDataset *>(poDS)->m_psProduct->byte_nodata;
 }
 
-const char *TSRasterBand::GetUnitType()
+const char *TSRasterBand::OwnUnit() const
 {
     return static_cast<TSDataset *>(poDS)->m_psProduct->unit;
+}
+
+/* An overview level has no PAM of its own: it reports what the user set
+ * on the full resolution, as a GeoTIFF's overviews share its nodata. */
+const GDALRasterBandPamInfo *TSRasterBand::UserPam()
+{
+    const TSDataset *ds = static_cast<TSDataset *>(poDS);
+    if (!ds->m_poBase)
+        return GetPamInfo();
+    return static_cast<TSRasterBand *>(ds->m_poBase->GetRasterBand(nBand))->GetPamInfo();
+}
+
+const char *TSRasterBand::NotHere() const
+{
+    if (!static_cast<TSDataset *>(poDS)->m_poBase)
+        return nullptr;
+    return "it is an overview level, which reports what is set on the full-resolution band: "
+           "set it there";
 }
 
 CPLErr TSRasterBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
@@ -437,7 +453,9 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     if (poOpenInfo->eAccess == GA_Update)
         return FailOpen(CPLE_NotSupported,
                              "TERRASHADE datasets are read-only; write the product "
-                             "with gdal_translate instead");
+                             "with gdal_translate instead (gdal_edit.py -ro sets a "
+                             "product's nodata value, unit or statistics in the DEM's "
+                             ".aux.xml)");
     char szMsg[1024] = "";
     tsd_connstr sConn;
     const ts_status eParsed =

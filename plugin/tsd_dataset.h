@@ -21,6 +21,7 @@
 #include "tsd_compute_env.h"
 #include "tsd_geodesy.h"
 #include "tsd_options.h"
+#include "tsd_pam_band.h"
 #include "tsd_products.h"
 #include "tsd_progress.h"
 #include "tsd_sun.h"
@@ -73,6 +74,7 @@ class TSDataset final : public GDALPamDataset
      * level k > 0 dataset is the product of the DEM read at its size (the
      * DEM reopened by name when it computes) */
     int m_nLevel = 0;
+    TSDataset *m_poBase = nullptr; // level 0, which owns a level k > 0 (its PAM is level 0's)
     int m_nOverviews = 0;   // levels offered (level 0 only)
     std::mutex m_oOvrMutex{};
     std::vector<std::unique_ptr<TSDataset>> m_apoOverviews{}; // made on first use
@@ -132,8 +134,9 @@ class TSDataset final : public GDALPamDataset
     const char *GetMetadataItem(const char *pszName, const char *pszDomain = "") override;
 };
 
-/** A band of it: one plane of the product. */
-class TSRasterBand final : public GDALPamRasterBand
+/** A band of it: one plane of the product. Its nodata value, unit and
+ * colour are the product's unless the user set them (tsd_pam_band.h). */
+class TSRasterBand final : public TSPamBand
 {
     int m_nPlane;
     GDALColorInterp m_eColor = GCI_GrayIndex;
@@ -145,6 +148,16 @@ class TSRasterBand final : public GDALPamRasterBand
     bool DirectRead(int nXOff, int nYOff, int nXSize, int nYSize, void *pData,
                     GSpacing nLineSpace, GDALRasterIOExtraArg *psExtraArg, CPLErr *peErr);
 
+  protected:
+    double OwnNoData() const override;
+    const char *OwnUnit() const override;
+    GDALColorInterp OwnColor() const override
+    {
+        return m_eColor;
+    }
+    const GDALRasterBandPamInfo *UserPam() override;
+    const char *NotHere() const override;
+
   public:
     TSRasterBand(TSDataset *poDSIn, int nBandIn, GDALDataType eType);
 
@@ -153,16 +166,10 @@ class TSRasterBand final : public GDALPamRasterBand
                      void *pData, int nBufXSize, int nBufYSize, GDALDataType eBufType,
                      GSpacing nPixelSpace, GSpacing nLineSpace,
                      GDALRasterIOExtraArg *psExtraArg) override;
-    double GetNoDataValue(int *pbSuccess = nullptr) override;
-    GDALColorInterp GetColorInterpretation() override
-    {
-        return m_eColor;
-    }
     void SetColor(GDALColorInterp eColor)
     {
         m_eColor = eColor;
     }
-    const char *GetUnitType() override;
     int GetOverviewCount() override;
     GDALRasterBand *GetOverview(int i) override;
 };

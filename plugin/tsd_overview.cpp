@@ -47,6 +47,7 @@ TSDataset *TSDataset::MakeOverview(int nLevel)
     const int H = (nRasterYSize + nFactor - 1) / nFactor;
     auto poOvr = std::unique_ptr<TSDataset>(new TSDataset());
     poOvr->m_nLevel = nLevel;
+    poOvr->m_poBase = this;
     poOvr->m_osDEM = m_osDEM;
     poOvr->m_sOpts = m_sOpts;
     // measured as the DEM's own cells were (CELL_SIZES=auto decided once)

@@ -1,12 +1,14 @@
 """PAM (.aux.xml) goes next to the DEM, one entry per set of options, never
-into the current directory."""
+into the current directory; a nodata value, unit or colour the user sets
+there is what the band reports, on that product and options only."""
+import math
 import os
 import shutil
 import unittest
 import xml.etree.ElementTree as ET
 
 import tsdriver as T
-from tsdriver import gdal
+from tsdriver import gdal, np
 
 
 class Pam(unittest.TestCase):
@@ -71,6 +73,100 @@ class Pam(unittest.TestCase):
         self.assertCwdClean()
         gdal.Unlink("/vsimem/pam_lux.tif")
         self.assertNotIn("ERROR", p.stderr)
+
+    @staticmethod
+    def band_says(ds_or_name):
+        """(nodata, unit, colour name) of band 1 of a dataset; NaN as "nan"
+        so that tuples compare."""
+        ds = gdal.Open(ds_or_name) if isinstance(ds_or_name, str) else ds_or_name
+        b = ds.GetRasterBand(1)
+        nd = b.GetNoDataValue()
+        return ("nan" if nd is not None and math.isnan(nd) else nd, b.GetUnitType(),
+                gdal.GetColorInterpretationName(b.GetColorInterpretation()))
+
+    def test_user_nodata_unit_and_colour(self):
+        """What SetNoDataValue, SetUnitType and SetColorInterpretation set
+        is reported by the dataset, by its overview levels and after
+        reopening; never by other options, another product or the DEM; the
+        pixels stay the product's."""
+        conn = T.conn(self.dem, PRODUCT="shade")
+        own = self.band_says(conn)
+        other_sun = T.conn(self.dem, PRODUCT="shade", SUN_AZIMUTH=200)
+        svf = T.conn(self.dem, PRODUCT="svf", DIRECTIONS=4)
+        others = {c: self.band_says(c) for c in (other_sun, svf, self.dem)}
+        print("before:", own, others)
+        self.assertEqual(own, (0.0, "", "Gray"))
+        fresh_ds = gdal.Open(conn)
+        fresh = fresh_ds.GetRasterBand(1).ReadAsArray()
+        fresh_ds = None
+        ds = gdal.Open(conn)
+        b = ds.GetRasterBand(1)
+        b.SetNoDataValue(7)
+        b.SetUnitType("brightness")
+        b.SetColorInterpretation(gdal.GCI_RedBand)
+        mine = (7.0, "brightness", "Red")
+        self.assertEqual(self.band_says(ds), mine)
+        self.assertEqual(b.GetOverview(0).GetNoDataValue(), 7.0)
+        self.assertEqual(b.GetOverview(0).GetUnitType(), "brightness")
+        np.testing.assert_array_equal(b.ReadAsArray(), fresh)
+        ds = b = None
+        self.assertEqual(self.band_says(conn), mine)
+        for c, said in others.items():
+            self.assertEqual(self.band_says(c), said, c)
+        # dropping the value set gives back the product's own, for good
+        ds = gdal.Open(conn)
+        ds.GetRasterBand(1).DeleteNoDataValue()
+        ds = None
+        self.assertEqual(self.band_says(conn)[0], 0.0)
+        # the product's own cannot be dropped; a level takes nothing
+        ds = gdal.Open(conn)
+        with self.assertRaises(RuntimeError) as e:
+            ds.GetRasterBand(1).DeleteNoDataValue()
+        print(e.exception)
+        self.assertIn("product's own", str(e.exception))
+        self.assertIn("gdal_translate -a_nodata none", str(e.exception))
+        self.assertEqual(gdal.GetLastErrorNo(), gdal.CPLE_NotSupported)
+        with self.assertRaises(RuntimeError) as e:
+            ds.GetRasterBand(1).GetOverview(0).SetNoDataValue(3)
+        print(e.exception)
+        self.assertIn("full-resolution band", str(e.exception))
+        self.assertEqual(ds.GetRasterBand(1).GetNoDataValue(), 0.0)
+
+    def test_gdal_edit(self):
+        """gdal_edit.py -ro on a connection string: kept in the DEM's
+        .aux.xml, shown by gdalinfo, copied by gdal_translate. Without -ro
+        the refusal says to use it."""
+        conn = T.conn(self.dem, PRODUCT="svf", DIRECTIONS=4)
+        p = T.run(["gdal_edit.py", "-a_nodata", "-1", conn], ok=False, cwd=self.cwd)
+        self.assertIn("gdal_edit.py -ro", p.stderr)
+        T.run(["gdal_edit.py", "-ro", "-a_nodata", "-1", "-units", "fraction", conn],
+              cwd=self.cwd)
+        self.assertCwdClean()
+        info = T.run(["gdalinfo", conn]).stdout
+        self.assertIn("NoData Value=-1", info)
+        self.assertIn("Unit Type: fraction", info)
+        out = os.path.join(self.tmp.path, "svf.tif")
+        T.run(["gdal_translate", "-q", conn, out])
+        self.assertEqual(self.band_says(out)[:2], (-1.0, "fraction"))
+        # 16 directions, not 4: another entry
+        self.assertEqual(self.band_says(T.conn(self.dem, PRODUCT="svf"))[:2], ("nan", ""))
+
+    def test_atlas(self):
+        """An atlas's band: the user's nodata and colour, kept in the
+        atlas's .aux.xml."""
+        tsa = os.path.join(self.demdir, "a.tsa")
+        T.run(["gdal_translate", "-q", "-of", "TERRASHADE"] + T.oo_args(dict(
+            PRODUCT="farshadow", DATE="2026-12-21", TIMEZONE="-05:00", ATLAS_STEPS=2,
+            FAR_THRESHOLD=4)) + [T.conn(self.dem), tsa])
+        self.assertEqual(self.band_says(tsa), (255.0, "", "Gray"))
+        ds = gdal.Open(tsa)
+        ds.GetRasterBand(1).SetNoDataValue(1)
+        ds.GetRasterBand(1).SetColorInterpretation(gdal.GCI_AlphaBand)
+        ds = None
+        self.assertEqual(self.band_says(tsa), (1.0, "", "Alpha"))
+        ds = gdal.Open(tsa)
+        self.assertEqual(ds.GetRasterBand(2).GetNoDataValue(), 255.0)
+        self.assertTrue(os.path.exists(tsa + ".aux.xml"))
 
 
 if __name__ == "__main__":

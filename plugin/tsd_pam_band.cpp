@@ -1,0 +1,89 @@
+/*
+ * tsd_pam_band.cpp - a band's nodata value, unit and colour: the user's
+ * (through PAM) first, the product's own otherwise (tsd_pam_band.h).
+ *
+ * PAM keeps them in the .aux.xml of the DEM (a product: one <Subdataset>
+ * per DEM and set of options, tsd_dataset_metadata.cpp) or of the atlas, so
+ * a value set on one product never reaches another product, other options
+ * or the DEM itself. PAM cannot keep a cleared unit or colour, nor a
+ * deleted nodata value: clearing one gives back the product's own.
+ */
+#include "tsd_pam_band.h"
+
+#include "tsd_gdal.h"
+
+namespace tsd
+{
+
+double TSPamBand::GetNoDataValue(int *pbSuccess)
+{
+    if (pbSuccess)
+        *pbSuccess = TRUE; // every product has one
+    const GDALRasterBandPamInfo *psPamInfo = UserPam();
+    if (psPamInfo && psPamInfo->bNoDataValueSet)
+        return psPamInfo->dfNoDataValue;
+    return OwnNoData();
+}
+
+const char *TSPamBand::GetUnitType()
+{
+    const GDALRasterBandPamInfo *psPamInfo = UserPam();
+    if (psPamInfo && psPamInfo->pszUnitType)
+        return psPamInfo->pszUnitType;
+    return OwnUnit();
+}
+
+GDALColorInterp TSPamBand::GetColorInterpretation()
+{
+    const GDALRasterBandPamInfo *psPamInfo = UserPam();
+    if (psPamInfo && psPamInfo->eColorInterp != GCI_Undefined)
+        return psPamInfo->eColorInterp;
+    return OwnColor();
+}
+
+/* Whether what the user sets on this band is reported; if not, say why
+ * and where to set it (GDAL's PAM would take it and report nothing). */
+bool TSPamBand::Accepts(const char *pszWhat)
+{
+    const char *pszWhy = NotHere();
+    if (!pszWhy)
+        return true;
+    Fail(CPLE_NotSupported, CPLSPrintf("%s: the %s of band %d cannot be changed here: %s",
+                                       poDS ? poDS->GetDescription() : "", pszWhat, nBand,
+                                       pszWhy));
+    return false;
+}
+
+CPLErr TSPamBand::SetNoDataValue(double dfValue)
+{
+    return Accepts("nodata value") ? GDALPamRasterBand::SetNoDataValue(dfValue) : CE_Failure;
+}
+
+CPLErr TSPamBand::SetUnitType(const char *pszUnit)
+{
+    return Accepts("unit") ? GDALPamRasterBand::SetUnitType(pszUnit) : CE_Failure;
+}
+
+CPLErr TSPamBand::SetColorInterpretation(GDALColorInterp eColor)
+{
+    return Accepts("colour interpretation") ? GDALPamRasterBand::SetColorInterpretation(eColor)
+                                            : CE_Failure;
+}
+
+CPLErr TSPamBand::DeleteNoDataValue()
+{
+    if (!Accepts("nodata value"))
+        return CE_Failure;
+    const GDALRasterBandPamInfo *psPamInfo = GetPamInfo();
+    if (psPamInfo && psPamInfo->bNoDataValueSet)
+        return GDALPamRasterBand::DeleteNoDataValue();
+    Fail(CPLE_NotSupported,
+         CPLSPrintf("%s: band %d's nodata value is the product's own, on the cells it has "
+                    "no value for, and cannot be removed (only one set with SetNoDataValue "
+                    "or gdal_edit.py -a_nodata can); gdal_translate -a_nodata none writes a "
+                    "copy without it",
+                    poDS ? poDS->GetDescription() : "", nBand));
+    return CE_Failure;
+}
+
+} // namespace tsd
