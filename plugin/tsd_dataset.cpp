@@ -5,7 +5,8 @@
  * reader (tsd_dem) and the compute functions (tsd_compute).
  *
  * A dataset computes its whole product once, lazily on the first block read
- * (under a mutex), keeps it in memory as float planes (bytes for the
+ * (under a mutex; again on the next read if the reading caller's progress
+ * callback stopped it), keeps it in memory as float planes (bytes for the
  * products stored as bytes, PRODUCT=farshadow) and copies 256 x 256 blocks
  * out of it. Its overview levels (tsd_overview.cpp) are datasets of this
  * class too, set up by the same Setup at their size.
@@ -24,6 +25,7 @@
 #include "cpl_string.h"
 #include "gdal_priv.h"
 
+#include "tsd_caller_progress.h"
 #include "tsd_connstr.h"
 #include "tsd_dataset.h"
 #include "tsd_dem.h"
@@ -159,16 +161,19 @@ CPLErr TSRasterBand::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXS
                                GDALDataType eBufType, GSpacing nPixelSpace, GSpacing nLineSpace,
                                GDALRasterIOExtraArg *psExtraArg)
 {
+    const CallerProgress oCaller(psExtraArg); // a computation started here reports to it
     CPLErr eErr = CE_None;
-    if (eRWFlag == GF_Read && nBufXSize == nXSize && nBufYSize == nYSize &&
-        eBufType == eDataType && nPixelSpace == GDALGetDataTypeSizeBytes(eDataType) &&
-        nLineSpace % nPixelSpace == 0 &&
-        reinterpret_cast<uintptr_t>(pData) % static_cast<uintptr_t>(nPixelSpace) == 0 &&
-        DirectRead(nXOff, nYOff, nXSize, nYSize, pData, nLineSpace, psExtraArg, &eErr))
-        return eErr;
-    return GDALPamRasterBand::IRasterIO(eRWFlag, nXOff, nYOff, nXSize, nYSize, pData,
-                                        nBufXSize, nBufYSize, eBufType, nPixelSpace,
-                                        nLineSpace, psExtraArg);
+    if (!(eRWFlag == GF_Read && nBufXSize == nXSize && nBufYSize == nYSize &&
+          eBufType == eDataType && nPixelSpace == GDALGetDataTypeSizeBytes(eDataType) &&
+          nLineSpace % nPixelSpace == 0 &&
+          reinterpret_cast<uintptr_t>(pData) % static_cast<uintptr_t>(nPixelSpace) == 0 &&
+          DirectRead(nXOff, nYOff, nXSize, nYSize, pData, nLineSpace, psExtraArg, &eErr)))
+        eErr = GDALPamRasterBand::IRasterIO(eRWFlag, nXOff, nYOff, nXSize, nYSize, pData,
+                                            nBufXSize, nBufYSize, eBufType, nPixelSpace,
+                                            nLineSpace, psExtraArg);
+    if (eErr != CE_None && oCaller.CancelledUnsaid())
+        static_cast<TSDataset *>(poDS)->FailCancelled();
+    return eErr;
 }
 
 /* Cells x0 .. x0+n-1 of a product row (mirrored when flip_x) into a block
@@ -302,17 +307,46 @@ ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
 }
 
 /* Start the progress line of a computation run by psRun (PROGRESS, after
- * TERRASHADE_PROGRESS_AFTER seconds under auto) and hook it to the run. */
+ * TERRASHADE_PROGRESS_AFTER seconds under auto) and hook it to the run,
+ * with the progress callback of the read that started it, if it has one. */
 void TSDataset::StartProgress(tsd_progress *psProgress, const char *pszLabel,
                               tsd_run *psRun) const
 {
     tsd_progress_begin(psProgress, m_sOpts.progress_mode, nullptr, pszLabel,
                        CPLAtof(CPLGetConfigOption("TERRASHADE_PROGRESS_AFTER", "1")));
+    CallerProgress::Hook(psProgress);
     psRun->progress = tsd_progress_report;
     psRun->progress_user = psProgress;
 }
 
-/* Compute the product once; later calls return the same outcome. */
+/* Report a computation the caller's progress callback stopped (nothing
+ * of it is kept, so that the next read computes it again) with its error
+ * number, CPLE_UserInterrupt, as GDAL reports a read its callback stops. */
+void TSDataset::FailCancelled() const
+{
+    CallerProgress::NoteCancelled();
+    Fail(TS_ERR_CANCELLED, CPLSPrintf("computing PRODUCT=%s was cancelled by the caller's "
+                                      "progress callback; a later read computes it again",
+                                      m_psProduct->name));
+}
+
+CPLErr TSDataset::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize, int nYSize,
+                            void *pData, int nBufXSize, int nBufYSize, GDALDataType eBufType,
+                            int nBandCount, int *panBandMap, GSpacing nPixelSpace,
+                            GSpacing nLineSpace, GSpacing nBandSpace,
+                            GDALRasterIOExtraArg *psExtraArg)
+{
+    const CallerProgress oCaller(psExtraArg);
+    const CPLErr eErr = GDALPamDataset::IRasterIO(
+        eRWFlag, nXOff, nYOff, nXSize, nYSize, pData, nBufXSize, nBufYSize, eBufType,
+        nBandCount, panBandMap, nPixelSpace, nLineSpace, nBandSpace, psExtraArg);
+    if (eErr != CE_None && oCaller.CancelledUnsaid())
+        FailCancelled();
+    return eErr;
+}
+
+/* Compute the product once; later calls return the same outcome, except
+ * after the caller's progress callback stopped it. */
 CPLErr TSDataset::EnsureComputed()
 {
     std::lock_guard<std::mutex> oLock(m_oMutex);
@@ -383,6 +417,15 @@ CPLErr TSDataset::EnsureComputed()
             m_pafProduct = nullptr;
             VSIFree(m_pabyProduct);
             m_pabyProduct = nullptr;
+        }
+        if (eStatus == TS_ERR_CANCELLED && sProgress.cancelled)
+        {
+            // not tried: the DEM stays open for the next read, which computes
+            m_bTried = false;
+            m_osError.clear();
+            CPLDebug(DRIVER, "computing the whole product: cancelled by the caller");
+            FailCancelled();
+            return CE_Failure;
         }
         if (m_poDEM)
             GDALClose(m_poDEM);

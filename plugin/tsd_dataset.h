@@ -90,6 +90,7 @@ class TSDataset final : public GDALPamDataset
 
     CPLErr EnsureComputed();
     void StartProgress(tsd_progress *psProgress, const char *pszLabel, tsd_run *psRun) const;
+    void FailCancelled() const;
     bool SetupWindow(int W, int H);
     bool EnsureFarField();
     bool ComputeChunk(int cx, int cy, WindowChunk &c);
@@ -128,6 +129,11 @@ class TSDataset final : public GDALPamDataset
     CPLErr IBuildOverviews(const char *pszResampling, int nOverviews, const int *panOverviewList,
                            int nListBands, const int *panBandList, GDALProgressFunc pfnProgress,
                            void *pProgressData, CSLConstList papszOptions) override;
+    /* sets the caller's progress callback for the computation a read starts */
+    CPLErr IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize, int nYSize,
+                     void *pData, int nBufXSize, int nBufYSize, GDALDataType eBufType,
+                     int nBandCount, int *panBandMap, GSpacing nPixelSpace, GSpacing nLineSpace,
+                     GSpacing nBandSpace, GDALRasterIOExtraArg *psExtraArg) override;
     CPLErr GetGeoTransform(double *padfGT) override;
     const OGRSpatialReference *GetSpatialRef() const override;
     char **GetMetadata(const char *pszDomain = "") override;

@@ -25,8 +25,17 @@ void tsd_progress_begin(tsd_progress *p, tsd_progress_mode mode, FILE *out,
     p->t0 = now_s();
     p->done = 0.0;
     snprintf(p->label, sizeof p->label, "%s", label ? label : "computing");
+    p->caller = NULL;
+    p->caller_user = NULL;
+    p->cancelled = 0;
     if (mode == TSD_PROGRESS_YES)
         tsd_progress_report(0.0, p);
+}
+
+void tsd_progress_set_caller(tsd_progress *p, ts_progress_fn caller, void *user)
+{
+    p->caller = caller;
+    p->caller_user = user;
 }
 
 /* Print ticks up to `upto` (0..TICKS), opening the line first. */
@@ -49,15 +58,18 @@ static void advance(tsd_progress *p, int upto)
 int tsd_progress_report(double done, void *user)
 {
     tsd_progress *p = user;
-    if (!p || p->mode == TSD_PROGRESS_NO)
+    if (!p)
         return 0;
     if (done > p->done)
         p->done = done > 1.0 ? 1.0 : done;
-    if (p->ticks < 0 && p->mode == TSD_PROGRESS_AUTO &&
-        (!isatty(fileno(p->out)) || now_s() - p->t0 < p->after_s))
-        return 0;
-    advance(p, (int)(p->done * TICKS + 1e-9));
-    return 0;
+    int print = p->mode == TSD_PROGRESS_YES ||
+                (p->mode == TSD_PROGRESS_AUTO &&
+                 (p->ticks >= 0 || (isatty(fileno(p->out)) && now_s() - p->t0 >= p->after_s)));
+    if (print)
+        advance(p, (int)(p->done * TICKS + 1e-9));
+    if (p->caller && p->caller(p->done, p->caller_user))
+        p->cancelled = 1;
+    return p->cancelled;
 }
 
 void tsd_progress_end(tsd_progress *p, int ok)
@@ -68,7 +80,7 @@ void tsd_progress_end(tsd_progress *p, int ok)
         advance(p, TICKS);
         fprintf(p->out, " - done in %.1f s.\n", now_s() - p->t0);
     } else {
-        fprintf(p->out, " - failed.\n");
+        fprintf(p->out, p->cancelled ? " - cancelled.\n" : " - failed.\n");
     }
     fflush(p->out);
 }

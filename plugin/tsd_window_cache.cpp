@@ -210,7 +210,8 @@ bool TSDataset::EnsureFarField()
     return true;
 }
 
-/* Compute chunk (cx, cy) into c; false with s.error. */
+/* Compute chunk (cx, cy) into c; false with s.error, or cancelled by the
+ * caller's progress callback (s.error empty). */
 bool TSDataset::ComputeChunk(int cx, int cy, WindowChunk &c)
 {
     WindowState &s = *m_poWindow;
@@ -225,6 +226,7 @@ bool TSDataset::ComputeChunk(int cx, int cy, WindowChunk &c)
     const int aw = std::min(W, gx0 + c.w + p.margin_x) - ax0;
     const int ah = std::min(H, gy0 + c.h + p.margin_y) - ay0;
     char szMsg[1024] = "";
+    bool bCancelled = false; // by the caller's progress callback
     ts_grid sGrid{};
     ts_status eSt =
         tsd_dem_load_window(GDALRasterBand::ToHandle(m_poDEM->GetRasterBand(m_sOpts.band)),
@@ -244,9 +246,10 @@ bool TSDataset::ComputeChunk(int cx, int cy, WindowChunk &c)
     if (eSt == TS_OK)
     {
         // Each chunk is computed inside a block read, where GDAL passes no
-        // progress callback: a line of its own on stderr, as the whole
-        // DEM's (the first chunk also sweeps the far field); numbered in the
-        // grid's order, placed in the raster's columns and rows
+        // progress callback (the RasterIO's caller's, if any, is told too):
+        // a line of its own on stderr, as the whole DEM's (the first chunk
+        // also sweeps the far field); numbered in the grid's order, placed
+        // in the raster's columns and rows
         const int nx = (W + p.tile - 1) / p.tile, ny = (H + p.tile - 1) / p.tile;
         const int rx0 = m_sCells.flip_x ? W - gx0 - c.w : gx0;
         const int ry0 = m_sCells.flip_y ? H - gy0 - c.h : gy0;
@@ -266,6 +269,7 @@ bool TSDataset::ComputeChunk(int cx, int cy, WindowChunk &c)
         const tsd_compute_ctx sCtx{&m_sOpts, &sRun, &sRan, szMsg, sizeof szMsg};
         eSt = tsd_product_compute(&sCtx, &sRegion, pafOut, nullptr);
         tsd_progress_end(&sProgress, eSt == TS_OK);
+        bCancelled = eSt == TS_ERR_CANCELLED && sProgress.cancelled;
         if (eSt == TS_OK && sRan.calls > 0)
         {
             // a chunk's sweep is bounded by its near field, not MAX_DISTANCE
@@ -297,16 +301,16 @@ bool TSDataset::ComputeChunk(int cx, int cy, WindowChunk &c)
     }
     VSIFree(pafOut);
     ts_grid_free(&sGrid);
-    if (eSt != TS_OK)
+    if (eSt != TS_OK && !bCancelled) // a cancelled chunk is computed again when read
     {
         s.status = eSt;
         s.error = szMsg;
-        return false;
     }
-    return true;
+    return eSt == TS_OK;
 }
 
-/* Chunk (cx, cy), from the cache or computed; nullptr with s.error. */
+/* Chunk (cx, cy), from the cache or computed; nullptr with s.error, or
+ * cancelled (s.error empty). */
 const WindowChunk *TSDataset::Chunk(int cx, int cy)
 {
     WindowState &s = *m_poWindow;
@@ -340,7 +344,8 @@ CPLErr TSDataset::WindowBlock(int iPlane, int x0, int y0, int nBW, int nBH, bool
     WindowState &s = *m_poWindow;
     const int W = nRasterXSize, H = nRasterYSize, T = s.plan.tile;
     const float fNaN = std::numeric_limits<float>::quiet_NaN();
-    for (int by = 0; by < nBH && s.error.empty(); by++)
+    bool bCancelled = false;
+    for (int by = 0; by < nBH && s.error.empty() && !bCancelled; by++)
     {
         const int y = y0 + by;
         const int gy = m_sCells.flip_y ? H - 1 - y : y;
@@ -355,7 +360,10 @@ CPLErr TSDataset::WindowBlock(int iPlane, int x0, int y0, int nBW, int nBH, bool
                 if (!c || c->cx != gx / T)
                     c = Chunk(gx / T, gy / T);
                 if (!c)
+                {
+                    bCancelled = s.error.empty();
                     break;
+                }
                 v = c->data[(static_cast<size_t>(iPlane) * c->h + (gy - c->cy * T)) * c->w +
                             (gx - c->cx * T)];
             }
@@ -369,6 +377,12 @@ CPLErr TSDataset::WindowBlock(int iPlane, int x0, int y0, int nBW, int nBH, bool
     if (!s.error.empty())
     {
         Fail(s.status, s.error.c_str());
+        return CE_Failure;
+    }
+    if (bCancelled)
+    {
+        CPLDebug(DRIVER, "computing a chunk: cancelled by the caller");
+        FailCancelled();
         return CE_Failure;
     }
     return CE_None;
@@ -401,11 +415,13 @@ CPLErr TSRasterBand::WindowReadBlock(int nBlockXOff, int nBlockYOff, void *pImag
             continue; // no room in the block cache: read again when asked
         const CPLErr eErr = ds->WindowBlock(i - 1, x0, y0, nBlockXSize, nBlockYSize, bByte,
                                             poBlock->GetDataRef());
-        if (eErr != CE_None)
-            poBlock->MarkClean();
         poBlock->DropLock();
         if (eErr != CE_None)
+        {
+            // out of the cache, not left there unfilled as if read
+            poOther->FlushBlock(nBlockXOff, nBlockYOff, FALSE);
             return CE_Failure;
+        }
     }
     return CE_None;
 }

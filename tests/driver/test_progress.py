@@ -13,16 +13,22 @@ progress callback, so the driver prints its own line to stderr:
 - windowed (TILE_SIZE): a line per chunk, each computed inside a block read:
   "TERRASHADE: computing svf of chunk 2 of 4 (100 x 100 cells from column
   100, row 0): 0...100 - done in 0.1 s.";
-- the result does not depend on the option; a bad value is an error.
+- the result does not depend on the option; a bad value is an error;
+- a read with a progress callback of its own (RasterIO's extra argument:
+  ReadAsArray(callback=...), gdal.Translate's) tells it the fraction
+  computed, and the computation stops when it returns 0: the read fails
+  at once with CPLE_UserInterrupt, nothing of it is kept, and the next
+  read computes the product again (whole DEM, chunk by chunk, block reads).
 """
 import os
 import pty
 import re
 import subprocess
+import time
 import unittest
 
 import tsdriver as T
-from tsdriver import np
+from tsdriver import gdal, np
 
 UTM_GT = (600000.0, 30.0, 0.0, 4000000.0, 0.0, -30.0)
 LINE = re.compile(r"TERRASHADE: computing (\w+) of (\d+) x (\d+) cells: "
@@ -33,17 +39,24 @@ CHUNK_LINE = re.compile(r"TERRASHADE: computing (\w+) of chunk (\d+) of (\d+) "
 DAY = {"DATE": "2026-06-21", "TIMEZONE": "-04:00"}
 
 
-class Progress(unittest.TestCase):
+class FractalCase(unittest.TestCase):
+    """Tests on a SIDE x SIDE fractal DEM (seed SEED) in a temporary
+    directory, cls.dem in cls.dir."""
+    SIDE, SEED = 200, 3
+
     @classmethod
     def setUpClass(cls):
         cls.tmp = T.TempDir()
         cls.dir = cls.tmp.__enter__()
         cls.dem = T.write_tif(os.path.join(cls.dir, "fractal.tif"),
-                              T.fractal_dem(200, seed=3), UTM_GT, 32617)
+                              T.fractal_dem(cls.SIDE, seed=cls.SEED), UTM_GT, 32617)
 
     @classmethod
     def tearDownClass(cls):
         cls.tmp.__exit__(None, None, None)
+
+
+class Progress(FractalCase):
 
     def translate(self, options, dem=None):
         out = os.path.join(self.dir, "out.tif")
@@ -144,6 +157,114 @@ class Progress(unittest.TestCase):
                    os.path.join(self.dir, "bad.tif")], ok=False)
         print(p.stderr.strip())
         self.assertIn("PROGRESS", p.stderr)
+
+
+class Stopper:
+    """A RasterIO progress callback: counts its calls and the computations
+    that began (a call with 0 before GDAL's own first report), and
+    returns 0 (stop) from the call `stop_at` of them on (never if None)."""
+
+    def __init__(self, stop_at=None, starts=False):
+        self.stop_at, self.starts = stop_at, starts
+        self.calls = self.began = 0
+
+    def __call__(self, done, _message, _data):
+        self.calls += 1
+        if done == 0.0:
+            self.began += 1
+        n = self.began if self.starts else self.calls
+        return 0 if self.stop_at is not None and n >= self.stop_at else 1
+
+
+class CallerCancel(FractalCase):
+    """The caller's progress callback stops the computation."""
+    SIDE, SEED = 1024, 5  # svf with 32 directions takes a second or two
+
+    def open(self, **opts):
+        return gdal.OpenEx(T.conn(self.dem), open_options=["%s=%s" % kv for kv in opts.items()])
+
+    def assertCancelled(self, read, errno=gdal.CPLE_UserInterrupt):
+        """read() fails with the driver's cancel (the last error number
+        CPLE_UserInterrupt unless errno is None); returns how long it
+        took."""
+        t = time.monotonic()
+        with self.assertRaises(RuntimeError) as e:
+            read()
+        took = time.monotonic() - t
+        print("cancelled in %.2f s: %s" % (took, e.exception))
+        self.assertIn("was cancelled by the caller's progress callback", str(e.exception))
+        if errno is not None:
+            self.assertEqual(gdal.GetLastErrorNo(), errno)
+        return took
+
+    def test_whole_product(self):
+        svf = dict(PRODUCT="svf", DIRECTIONS=32, PROGRESS="no")
+        ds = self.open(**svf)
+        counting = Stopper()
+        t = time.monotonic()
+        ref = ds.GetRasterBand(1).ReadAsArray(callback=counting)
+        full = time.monotonic() - t
+        print("uncancelled: %.2f s, %d calls of the callback" % (full, counting.calls))
+        self.assertGreaterEqual(counting.calls, 32)  # an azimuth each, and GDAL's
+        ds = None
+        # the straight copy (DirectRead) and a read through the blocks (Float64)
+        for buf_type in (None, gdal.GDT_Float64):
+            with self.subTest(buf_type=buf_type):
+                ds = self.open(**svf)
+                b = ds.GetRasterBand(1)
+                stop = Stopper(stop_at=3)
+                took = self.assertCancelled(
+                    lambda: b.ReadAsArray(buf_type=buf_type, callback=stop))
+                self.assertEqual(stop.calls, 3)  # no call after the stop
+                self.assertLess(took, 0.5 * full)
+                # the next read, without a callback, computes it all again
+                np.testing.assert_array_equal(b.ReadAsArray(), ref)
+                ds = None
+        # block reads (IReadBlock) after a cancel
+        ds = self.open(**svf)
+        b = ds.GetRasterBand(1)
+        self.assertCancelled(lambda: b.ReadAsArray(callback=Stopper(stop_at=2)))
+        block = np.frombuffer(b.ReadBlock(1, 2), dtype=np.float32).reshape(256, 256)
+        np.testing.assert_array_equal(block, ref[512:768, 256:512])
+
+    def test_translate(self):
+        """gdal.Translate hands its callback to the reads: cancelling it
+        stops the computation, and writes no file."""
+        ds = self.open(PRODUCT="svf", DIRECTIONS=16, PROGRESS="no")
+        out = os.path.join(self.dir, "cancelled.tif")
+        # (gdal.Translate resets the error number as it cleans up)
+        self.assertCancelled(lambda: gdal.Translate(out, ds, callback=Stopper(stop_at=3)),
+                             errno=None)
+        self.assertFalse(os.path.exists(out))
+
+    def test_chunks(self):
+        """Chunk by chunk (TILE_SIZE): a chunk cancelled is computed again
+        by the next read, the chunks computed before it are kept; a
+        multi-band product's other bands, filled from the same chunks, keep
+        no block of a cancelled read."""
+        small = T.write_tif(os.path.join(self.dir, "small.tif"),
+                            T.fractal_dem(256, seed=6), UTM_GT, 32617)
+        for opts, stop_at, band in (
+                # the third of four chunks
+                (dict(PRODUCT="svf", DIRECTIONS=8, TILE_SIZE=128), 3, 1),
+                # 16 chunks of 64 cells; a block of band 1 (the whole DEM)
+                # computes them, then so does band 2's, filled from them (the
+                # cache holds 5): stopped in band 2's
+                (dict(PRODUCT="horizon", DIRECTIONS=4, TILE_SIZE=64), 18, 2)):
+            with self.subTest(**opts):
+                oo = ["%s=%s" % kv for kv in dict(opts, PROGRESS="no").items()]
+                fresh = gdal.OpenEx(T.conn(small), open_options=oo)
+                ref = fresh.ReadAsArray()
+                fresh = None
+                ds = gdal.OpenEx(T.conn(small), open_options=oo)
+                stop = Stopper(stop_at=stop_at, starts=True)
+                self.assertCancelled(lambda: ds.GetRasterBand(1).ReadAsArray(callback=stop))
+                print("chunk computations begun: %d" % stop.began)
+                self.assertEqual(stop.began, stop_at)
+                np.testing.assert_array_equal(ds.GetRasterBand(band).ReadAsArray(),
+                                              ref if ref.ndim == 2 else ref[band - 1])
+                np.testing.assert_array_equal(ds.ReadAsArray(), ref)
+                ds = None
 
 
 if __name__ == "__main__":

@@ -84,7 +84,7 @@ class Log(QgsProcessingFeedback):
         super().__init__()
         self.lines = []
         self.warnings = []
-        self.cancel_on_progress = cancel  # the user's Cancel, once something is written
+        self.cancel_on_progress = cancel  # the user's Cancel, once the bar moves
 
     def setProgress(self, progress):
         super().setProgress(progress)
@@ -318,8 +318,9 @@ class Processing(unittest.TestCase):
         self.assertIn("offset", result["bad_time"]["error"])
 
     def test_cancel(self):
-        """Cancel during the write: the algorithm fails with 'cancelled' and
-        leaves no output file."""
+        """Cancel once the bar moves (the driver tells GDAL's copy its
+        progress while it computes, so during the computation): the
+        algorithm fails with 'cancelled' and leaves no output file."""
         r = self.result["cancel_svf"]
         self.assertEqual(r.get("error"), "cancelled", r)
         self.assertFalse(os.path.exists(self.out("cancel_svf")))
