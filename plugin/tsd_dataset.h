@@ -1,8 +1,8 @@
 /*
  * tsd_dataset.h - the classes of a TERRASHADE:<dem> dataset, shared by
- * tsd_dataset.cpp (opening, computing, blocks), tsd_dataset_metadata.cpp
- * (metadata and PAM) and tsd_dataset_warnings.cpp (what a DEM or a sun
- * deserves a word about).
+ * tsd_dataset.cpp (opening, computing), tsd_band.cpp (blocks and reads),
+ * tsd_dataset_metadata.cpp (metadata and PAM) and tsd_dataset_warnings.cpp
+ * (what a DEM or a sun deserves a word about).
  */
 #ifndef TSD_DATASET_H
 #define TSD_DATASET_H
