@@ -165,9 +165,9 @@ def output_format(args):
 
 
 def block_size(tile):
-    """The output's internal tile size: the window size up to 512, else the
-    largest power of two up to 512 that divides it, so that every window
-    covers whole internal tiles."""
+    """The tiled GeoTIFF's internal tile size (DEST, or the one a COG is
+    copied from): the window size up to 512, else the largest power of two
+    up to 512 that divides it, so that every window covers whole tiles."""
     if tile <= 512:
         return tile
     b = 512
@@ -416,14 +416,17 @@ def compute(client, watch, out, source, task_options, tile, quiet, run):
     return len(wins)
 
 
-def finish(partial, fmt, dest, block, creation_options):
+def finish(partial, fmt, dest, creation_options):
     """partial (closed GeoTIFF) -> dest, in fmt, by rename."""
     final = partial
     if fmt == "COG":
         final = dest + ".partial"
+        # The COG driver's own tiles (BLOCKSIZE 512, as gdal_translate -of COG),
+        # not the windows': a copy need not match them, and a COG's tiles are
+        # what its readers fetch, a request each (GDAL warns below 128).
         try:
             gdal.Translate(final, partial, format="COG",
-                           creationOptions=list(creation_options) + ["BLOCKSIZE=%d" % block])
+                           creationOptions=list(creation_options))
         except RuntimeError as e:
             raise Failure("cannot write %s: %s" % (final, e))
         remove(partial)
@@ -483,7 +486,7 @@ def run(args):
                     args.tile_size, args.quiet, run_id)
         out.FlushCache()
         out = None
-        finish(partial, fmt, args.dest, block, args.creation_options)
+        finish(partial, fmt, args.dest, args.creation_options)
     except BaseException:
         out = None
         remove(partial)

@@ -6,6 +6,8 @@ dask.distributed equals gdal_translate of the same source, bit for bit.
   of Float32): every band's bits, the georeferencing, nodata, band
   descriptions and metadata equal gdal_translate's;
 - an existing cluster (--scheduler) writing a COG: the same pixels, COG layout;
+  a COG's tiles are gdal_translate -of COG's, whatever the window size, with
+  no GDAL warning;
 - a worker process that dies on its first task (a test hook in
   terrashade/windows.py, once per run) is replaced, Dask retries the window,
   and the result is still identical;
@@ -309,6 +311,33 @@ class Distributed(unittest.TestCase):
             cluster.close()
         self.assertEqual(gdal.Open(dest).GetMetadata("IMAGE_STRUCTURE").get("LAYOUT"), "COG")
         self.assert_identical(dest, self.reference(HORIZON, "ref_cog.tif"))
+
+    def test_cog_tiles_are_the_cog_drivers(self):
+        """A COG's internal tiles are the COG driver's (512, as gdal_translate
+        -of COG writes them), whatever the window size: the COG is copied
+        from the windows' tiled GeoTIFF, so its tiles need not be theirs. The
+        program gave it the window's tiles, and GDAL warned, even with -q,
+        "Warning 6: '64' is an unexpected value for BLOCKSIZE creation option
+        that should be >= 128." for --tile-size 64 or less, and for sizes
+        whose tiles are small (1040: tiles of 16)."""
+        ref = self.path("ref_tiles.cog.tif")
+        p = T.run(["gdal_translate", "-q", "-of", "COG"] + T.oo_args(SHADE)
+                  + [T.conn(self.dem), ref])
+        self.assertEqual(p.stderr, "")
+        for tile in (64, 1040):
+            with self.subTest(tile=tile):
+                dest = self.path("tiles%d.cog.tif" % tile)
+                p = distributed(["--workers", 1, "--tile-size", tile, "-q"] + T.oo_args(SHADE)
+                                + [T.conn(self.dem), dest])
+                self.assertEqual(p.stderr, "")  # no warning
+                got, want = gdal.Open(dest), gdal.Open(ref)
+                self.assertEqual(got.GetMetadata("IMAGE_STRUCTURE").get("LAYOUT"), "COG")
+                a, b = got.GetRasterBand(1), want.GetRasterBand(1)
+                self.assertEqual(a.GetBlockSize(), [512, 512])
+                self.assertEqual(a.GetBlockSize(), b.GetBlockSize())
+                self.assertEqual(a.GetOverviewCount(), b.GetOverviewCount())
+                got = want = a = b = None
+                self.assert_identical(dest, ref)
 
     def test_existing_cluster_reads_the_dem_of_each_run(self):
         """A worker keeps its dataset open between the tasks of a run, not
