@@ -91,6 +91,9 @@ typedef enum {
 typedef ts_status (*ts_day_plane_fn)(void *user, const ts_grid *grid, double azimuth,
                                      double sun_elevation, float *plane, ts_error *err);
 
+/** ts_day_opts.plane_cache_bytes by default: 2 GiB. */
+#define TS_DAY_PLANE_CACHE_DEFAULT ((size_t)2048 << 20)
+
 /** Options of the day computations. Fill with ts_day_opts_default. */
 typedef struct {
     ts_horizon_opts horizon; /**< curvature, refraction, max_distance, threads;
@@ -112,6 +115,15 @@ typedef struct {
      * values). */
     int table_heights_given;
     double table_height_min, table_height_max;
+    /** A lattice of sites: bytes of horizon planes that ts_sun_hours,
+     * ts_insolation and ts_sun_visibility_steps may keep from one time step
+     * to the next. Where its suns span more than 2 degrees of azimuth (a
+     * DEM spanning many degrees of longitude: up to 361 sweeps a step) a
+     * lattice's planes lie at whole degrees, so the steps share them, and
+     * a day sweeps each once while they fit; those beyond are swept again
+     * at each step that needs them. 0 = keep none.
+     * ts_day_opts_default: TS_DAY_PLANE_CACHE_DEFAULT. */
+    size_t plane_cache_bytes;
     ts_day_plane_fn plane_hook; /**< after each horizon sweep; NULL = none */
     void *plane_hook_user;      /**< passed to plane_hook */
 } ts_day_opts;
@@ -194,8 +206,9 @@ ts_status ts_day_atlas_times(const ts_sun_sites *sites, const ts_day_opts *o,
  * The sun seen from every cell at one instant: vis (width*height, may not
  * be NULL) receives the visible fraction (0..1) of the sun's disk above
  * the cell's horizon toward the sun (ts_horizon_sweep at the sun's grid
- * azimuth; with a lattice, sweeps at azimuths 1 deg apart or less across
- * the cells' range, interpolated linearly), raised to the Earth's horizon
+ * azimuth; with a lattice, sweeps at most 1 deg apart across the cells'
+ * range, at the whole degrees where it is wider than 2 deg, interpolated
+ * linearly), raised to the Earth's horizon
  * when o->earth_horizon; NaN for nodata. az and el (may be NULL) receive
  * each cell's grid azimuth and apparent elevation of the sun. `ref` (may
  * be NULL) receives the sun at the reference site. No sweep is run while
@@ -207,10 +220,21 @@ ts_status ts_sun_visibility(const ts_grid *grid, const ts_sun_sites *sites,
                             ts_error *err);
 
 /**
+ * ts_sun_visibility at n instants, instant k into vis + k * width*height,
+ * with the horizon planes of a lattice kept from one instant to the next
+ * (o->plane_cache_bytes) as ts_sun_hours does: the same values, each
+ * azimuth swept once while its planes fit. Progress (o->horizon.progress)
+ * per instant.
+ */
+ts_status ts_sun_visibility_steps(const ts_grid *grid, const ts_sun_sites *sites,
+                                  const ts_day_opts *o, const double *unix_times, int n,
+                                  float *vis, ts_error *err);
+
+/**
  * The horizon sweeps ts_sun_visibility runs at `unix_time` for `sites`:
  * 1 for one site; for a lattice, enough for its suns' azimuths 1 degree
- * apart or less (none are run while the sun is below every cell's
- * horizon). -1 if the sun cannot be computed or memory runs out.
+ * apart or less (at the whole degrees that bracket them where they span
+ * more than 2; none are run while the sun is below every cell's horizon). -1 if the sun cannot be computed or memory runs out.
  */
 int ts_sun_visibility_sweeps(const ts_sun_sites *sites, const ts_day_opts *o,
                              double unix_time);

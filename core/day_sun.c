@@ -110,6 +110,7 @@ void ts_day_opts_default(ts_day_opts *o)
     o->linke_turbidity = 3.0;
     o->earth_horizon = 1;
     o->sun_hours_rule = TS_SUN_HOURS_VISIBLE;
+    o->plane_cache_bytes = TS_DAY_PLANE_CACHE_DEFAULT;
 }
 
 ts_status ts_sun_sites_validate(const ts_sun_sites *s, ts_error *err)
@@ -211,24 +212,46 @@ double ts_wrap180(double a)
 }
 
 /* SPA at node i. */
-ts_status ts_day_node_sun(const ts_sun_sites *s, const ts_day_opts *o, int i,
-                          double t, ts_sun_sample *out, ts_error *err)
+/* The sun at node i at t; instant: the detail of a node at t (its part
+ * that depends on the instant only), or NULL. */
+static ts_status node_sun(const ts_sun_sites *s, const ts_day_opts *o, int i, double t,
+                          const ts_sun_detail *instant, ts_sun_sample *out,
+                          ts_sun_detail *det, ts_error *err)
 {
     ts_sun_input in = o->sun;
     ts_sun_output sun;
-    ts_sun_detail det;
     in.jd = ts_julian_day_from_unix(t);
     in.longitude = s->longitude[i];
     in.latitude = s->latitude[i];
-    ts_status st = ts_sun_position_detail(&in, &sun, &det, err);
+    ts_status st = instant ? ts_sun_position_from(&in, instant, &sun, det, err)
+                           : ts_sun_position_detail(&in, &sun, det, err);
     if (st != TS_OK)
         return st;
     out->unix_time = t;
     out->azimuth = sun.azimuth;
     out->elevation = sun.elevation;
-    out->true_elevation = det.e0;
+    out->true_elevation = det->e0;
     out->grid_azimuth = ts_wrap360(sun.azimuth + (s->north_azimuth ? s->north_azimuth[i] : 0.0));
-    out->distance_au = det.R;
+    out->distance_au = det->R;
+    return TS_OK;
+}
+
+ts_status ts_day_node_sun(const ts_sun_sites *s, const ts_day_opts *o, int i,
+                          double t, ts_sun_sample *out, ts_error *err)
+{
+    ts_sun_detail det;
+    return node_sun(s, o, i, t, NULL, out, &det, err);
+}
+
+ts_status ts_day_nodes_sun(const ts_sun_sites *s, const ts_day_opts *o, double t,
+                           ts_sun_sample *ns, ts_error *err)
+{
+    ts_sun_detail instant, det;
+    ts_status st;
+    for (int i = 0; i < s->nx * s->ny; i++)
+        if ((st = node_sun(s, o, i, t, i ? &instant : NULL, &ns[i], i ? &det : &instant,
+                           err)) != TS_OK)
+            return st;
     return TS_OK;
 }
 
@@ -259,9 +282,11 @@ ts_status ts_sun_highest_site(const ts_sun_sites *sites, const ts_day_opts *o,
     if (!o || !out)
         return ts_fail(err, TS_ERR_ARG, "ts_sun_highest_site: NULL argument");
     int best = -1;
+    ts_sun_detail instant, det;
     for (int i = 0; i < sites->nx * sites->ny; i++) {
         ts_sun_sample s;
-        if ((st = ts_day_node_sun(sites, o, i, unix_time, &s, err)) != TS_OK)
+        if ((st = node_sun(sites, o, i, unix_time, i ? &instant : NULL, &s,
+                           i ? &det : &instant, err)) != TS_OK)
             return st;
         if (best < 0 || s.elevation > out->elevation)
             best = i, *out = s;

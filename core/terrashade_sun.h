@@ -194,6 +194,17 @@ double ts_sun_refraction(double e0, const ts_sun_input *in);
 ts_status ts_sun_position_detail(const ts_sun_input *in, ts_sun_output *out,
                                  ts_sun_detail *detail, ts_error *err);
 
+/**
+ * ts_sun_position_detail at in's site, its sections 3.1-3.10 (what depends
+ * on the instant only: jd and delta_t) taken from `instant`, the detail of
+ * a call of ts_sun_position_detail at the same instant: the same results,
+ * bit for bit, at the cost of sections 3.11-3.15 alone, to place the sun
+ * at many sites of one instant. An `instant` of another jd or delta_t is
+ * an error.
+ */
+ts_status ts_sun_position_from(const ts_sun_input *in, const ts_sun_detail *instant,
+                               ts_sun_output *out, ts_sun_detail *detail, ts_error *err);
+
 #ifdef __cplusplus
 }
 #endif

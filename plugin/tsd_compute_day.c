@@ -68,17 +68,30 @@ static ts_status done(const tsd_compute_ctx *c, ts_status st, const ts_error *er
     return st == TS_OK ? TS_OK : tsd_fail_core(c->msg, c->msg_size, NULL, err);
 }
 
+/* The sun of a day product, with its day options and sun sites over
+ * region r; NULL (an internal error) if the dataset has no sun. */
+static const tsd_sun *day_setup(const tsd_compute_ctx *c, const tsd_region *r,
+                                ts_day_opts *day, ts_sun_sites *sites)
+{
+    const tsd_sun *sun = day_sun(c);
+    if (sun) {
+        *day = tsd_compute_day_opts(c, sun);
+        *sites = tsd_compute_sun_sites(sun, r->dem);
+    }
+    return sun;
+}
+
 /* sunhours and insolation: one day swept at each step, or a date range
  * (START_DATE) from horizons swept once (core/sun_range.c) */
 TSD_COMPUTE_FN(tsd_compute_sunhours)
 {
     (void)bytes;
-    const tsd_sun *sun = day_sun(c);
+    ts_day_opts day;
+    ts_sun_sites sites;
+    const tsd_sun *sun = day_setup(c, r, &day, &sites);
     ts_error err;
     if (!sun)
         return TS_ERR_INTERNAL;
-    ts_day_opts day = tsd_compute_day_opts(c, sun);
-    ts_sun_sites sites = tsd_compute_sun_sites(sun, r->dem);
     if (sun->is_range)
         return done(c, ts_sun_hours_range(r->dem, &sites, &day, &sun->range, out, &err),
                     &err);
@@ -91,13 +104,13 @@ TSD_COMPUTE_FN(tsd_compute_sunhours)
 TSD_COMPUTE_FN(tsd_compute_insolation)
 {
     (void)bytes;
-    const tsd_sun *sun = day_sun(c);
     size_t cells = (size_t)r->width * r->height;
+    ts_day_opts day;
+    ts_sun_sites sites;
+    const tsd_sun *sun = day_setup(c, r, &day, &sites);
     ts_error err;
     if (!sun)
         return TS_ERR_INTERNAL;
-    ts_day_opts day = tsd_compute_day_opts(c, sun);
-    ts_sun_sites sites = tsd_compute_sun_sites(sun, r->dem);
     if (sun->is_range)
         return done(c,
                     ts_insolation_range(r->dem, &sites, &day, &sun->range, out,
@@ -132,19 +145,6 @@ static ts_status each_step(const tsd_compute_ctx *c, const tsd_region *r, step_f
     return TS_OK;
 }
 
-/* daycycle: the visible fraction of the sun's disk at step k */
-static ts_status visibility_step(const tsd_compute_ctx *c, const tsd_region *r,
-                                 const tsd_sun *sun, int k, size_t offset, float *out,
-                                 uint8_t *bytes, ts_error *err)
-{
-    (void)bytes;
-    ts_day_opts day = tsd_compute_day_opts(c, sun);
-    ts_sun_sites sites = tsd_compute_sun_sites(sun, r->dem);
-    day.horizon.progress = NULL; /* each_step reports the steps */
-    return ts_sun_visibility(r->dem, &sites, &day, sun->times[k], out + offset, NULL,
-                             NULL, NULL, err);
-}
-
 /* farshadow: the far shadows of the sun at step k */
 static ts_status far_shadow_step(const tsd_compute_ctx *c, const tsd_region *r,
                                  const tsd_sun *sun, int k, size_t offset, float *out,
@@ -158,7 +158,17 @@ static ts_status far_shadow_step(const tsd_compute_ctx *c, const tsd_region *r,
 
 TSD_COMPUTE_FN(tsd_compute_daycycle)
 {
-    return each_step(c, r, visibility_step, out, bytes);
+    /* every step at once, so that a lattice's planes serve them all */
+    (void)bytes;
+    ts_day_opts day;
+    ts_sun_sites sites;
+    const tsd_sun *sun = day_setup(c, r, &day, &sites);
+    ts_error err;
+    if (!sun)
+        return TS_ERR_INTERNAL;
+    return done(c, ts_sun_visibility_steps(r->dem, &sites, &day, sun->times, sun->steps, out,
+                                           &err),
+                &err);
 }
 
 TSD_COMPUTE_FN(tsd_compute_farshadow)

@@ -270,7 +270,8 @@ CPLErr TSDataset::EnsureComputed()
 /* Refuse products that cannot fit, with a sentence saying what to do.
  * psSun, the cells and nLevel serve the advice on windows (level 0). */
 static bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *psPlan,
-                        const tsd_sun *psSun, const tsd_cells &sCells, int nLevel)
+                        const tsd_sun *psSun, const tsd_cells &sCells, int nLevel,
+                        double *pdfHeadroom)
 {
     double dfSteady = 0;
     // windowed: the chunk with its margin, the cache and the far field
@@ -290,6 +291,7 @@ static bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window
     CPLDebug(DRIVER, "memory: about %.0f MiB while computing (%.0f MiB kept)%s, limit %.0f MiB",
              dfPeak / 1048576.0, dfSteady / 1048576.0, psPlan ? " by window" : "",
              dfLimit / 1048576.0);
+    *pdfHeadroom = std::max(0.0, dfLimit - dfPeak);
     if (dfPeak <= dfLimit && dfPeak < static_cast<double>(std::numeric_limits<size_t>::max()) / 2)
         return true;
     char szAdvice[512] = "";
@@ -449,10 +451,16 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
         CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szMsg);
     if (m_nLevel == 0)
         WarnShortDistance(dfMinCell);
+    double dfHeadroom = 0;
     if (!SetupWindow(W, H) ||
         !CheckMemory(sOpts, W, H, WindowPlan(m_poWindow), m_bHasSun ? &m_sSun : nullptr,
-                     m_sCells, m_nLevel))
+                     m_sCells, m_nLevel, &dfHeadroom))
         return false;
+    // a lattice's day keeps horizon planes across its steps: in at most
+    // half of what the limit leaves (docs/day-cycle.md)
+    if (m_bHasSun)
+        m_sSun.day.plane_cache_bytes = static_cast<size_t>(
+            std::min(static_cast<double>(m_sSun.day.plane_cache_bytes), dfHeadroom / 2));
     /* a bad TERRASHADE_BACKEND or _SIMD is an error here (without probing OpenCL) */
     m_bUsesBackend = m_psProduct->uses_backend && m_psProduct->uses_backend(&sOpts, psSun);
     if (tsd_backend_check_env(&sOpts, m_bUsesBackend, szMsg, sizeof szMsg) != 0)

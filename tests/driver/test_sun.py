@@ -340,6 +340,29 @@ class Sun(unittest.TestCase):
             self.assertLessEqual(abs(per[row, n // 2] - want) * 60, 5.0)
         self.assertGreater(per[0].mean(), per[-1].mean() + 1.5)
 
+    def test_per_cell_sun_over_the_world(self):
+        """A world DEM of 4-degree cells: the suns' azimuths span the whole
+        circle at every step. The day keeps its horizon planes across the
+        steps (docs/day-cycle.md); with MAX_MEMORY leaving room for a few,
+        the rest swept again at each step, every value is the same."""
+        n_x, n_y = 90, 45
+        yy, xx = np.mgrid[0:n_y, 0:n_x]
+        z = (2000 * (1 + np.sin(xx * 0.7) * np.cos(yy * 0.9))).astype(np.float32)
+        dem = T.write_tif(os.path.join(self.dir, "world.tif"), z,
+                          (-180.0, 4.0, 0, 90.0, 0, -4.0), 4326)
+        for product, band in (("sunhours", 1), ("daycycle", 7)):
+            oo = {"PRODUCT": product, "DATE": "2026-06-21", "TIMEZONE": "Z",
+                  "STEP_MINUTES": "60", "SUN_POSITION": "per_cell"}
+            kept = T.read(T.conn(dem), band, oo)
+            few = T.read(T.conn(dem), band, dict(oo, MAX_MEMORY="1"))
+            self.assertTrue(np.array_equal(kept, few, equal_nan=True), product)
+        # the June solstice: the Arctic has no night, the Antarctic no day
+        self.assertTrue(np.all((kept >= 0) & (kept <= 1)))
+        hours = T.read(T.conn(dem), 1, dict(oo, PRODUCT="sunhours"))
+        self.assertGreater(hours[1].mean(), 20.0)
+        self.assertLess(hours[-2].mean(), 1.0)
+        self.assertTrue(np.all((hours >= 0) & (hours <= 24)))
+
     def test_per_cell_sun_on_coarse_cells_is_each_cells_sun(self):
         """A flat DEM of 3-degree cells from 50 S to 80 S, 0 to 90 E, on
         2026-06-01 (the sun grazes the horizon there): each cell gets the sun
