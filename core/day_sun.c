@@ -211,7 +211,6 @@ double ts_wrap180(double a)
     return a > 180.0 ? a - 360.0 : a;
 }
 
-/* SPA at node i. */
 /* The sun at node i at t; instant: the detail of a node at t (its part
  * that depends on the instant only), or NULL. */
 static ts_status node_sun(const ts_sun_sites *s, const ts_day_opts *o, int i, double t,
@@ -243,14 +242,23 @@ ts_status ts_day_node_sun(const ts_sun_sites *s, const ts_day_opts *o, int i,
     return node_sun(s, o, i, t, NULL, out, &det, err);
 }
 
+/* node_sun of nodes 0, 1, ... in turn at one t: node 0's detail is kept in
+ * *instant, and the nodes after take the instant's part from it. */
+static ts_status node_sun_in_turn(const ts_sun_sites *s, const ts_day_opts *o, int i,
+                                  double t, ts_sun_detail *instant, ts_sun_sample *out,
+                                  ts_error *err)
+{
+    ts_sun_detail det;
+    return node_sun(s, o, i, t, i ? instant : NULL, out, i ? &det : instant, err);
+}
+
 ts_status ts_day_nodes_sun(const ts_sun_sites *s, const ts_day_opts *o, double t,
                            ts_sun_sample *ns, ts_error *err)
 {
-    ts_sun_detail instant, det;
+    ts_sun_detail instant;
     ts_status st;
     for (int i = 0; i < s->nx * s->ny; i++)
-        if ((st = node_sun(s, o, i, t, i ? &instant : NULL, &ns[i], i ? &det : &instant,
-                           err)) != TS_OK)
+        if ((st = node_sun_in_turn(s, o, i, t, &instant, &ns[i], err)) != TS_OK)
             return st;
     return TS_OK;
 }
@@ -282,11 +290,10 @@ ts_status ts_sun_highest_site(const ts_sun_sites *sites, const ts_day_opts *o,
     if (!o || !out)
         return ts_fail(err, TS_ERR_ARG, "ts_sun_highest_site: NULL argument");
     int best = -1;
-    ts_sun_detail instant, det;
+    ts_sun_detail instant;
     for (int i = 0; i < sites->nx * sites->ny; i++) {
         ts_sun_sample s;
-        if ((st = node_sun(sites, o, i, unix_time, i ? &instant : NULL, &s,
-                           i ? &det : &instant, err)) != TS_OK)
+        if ((st = node_sun_in_turn(sites, o, i, unix_time, &instant, &s, err)) != TS_OK)
             return st;
         if (best < 0 || s.elevation > out->elevation)
             best = i, *out = s;

@@ -120,6 +120,16 @@ static inline float cell_vis(double e, float h, float fl)
     return (float)ts_sun_disk_fraction(e, h);
 }
 
+/* Cell i's horizon the fraction f (clamped to 0..1) of the way from plane
+ * pa to plane pb. */
+static inline float plane_between(const float *pa, const float *pb, size_t i, double f)
+{
+    float ff = (float)f;
+    if (ff < 0) ff = 0;
+    if (ff > 1) ff = 1;
+    return pa[i] + ff * (pb[i] - pa[i]);
+}
+
 /* The azimuths of a lattice's suns, as offsets lo..hi from a_ref, and
  * their highest elevation. */
 static void lattice_span(const ts_sun_sample *ns, int nodes, double a_ref, double *lo,
@@ -190,10 +200,7 @@ static ts_status vis_narrow(ts_vis_ctx *c, const ts_horizon_opts *ho, double a_r
             if (b > K - 2) b = K - 2;
             if (b != j - 1)
                 continue;
-            float f = (float)(u - b);
-            if (f < 0) f = 0;
-            if (f > 1) f = 1;
-            float h = c->pa[i] + f * (c->pb[i] - c->pa[i]);
+            float h = plane_between(c->pa, c->pb, i, u - b);
             vis[i] = cell_vis(c->cel[i], h, c->floor ? c->floor[i] : NAN);
         }
         float *t = c->pa;
@@ -212,14 +219,11 @@ int ts_sun_visibility_sweeps(const ts_sun_sites *sites, const ts_day_opts *o,
         return 1;
     ts_sun_sample *ns = malloc((size_t)nodes * sizeof *ns);
     int K = -1;
-    if (ns && ts_day_nodes_sun(sites, o, unix_time, ns, &err) != TS_OK)
-        goto done;
-    if (ns) {
-        double lo, hi, emax;
-        lattice_span(ns, nodes, ns[ts_day_ref_node(sites)].grid_azimuth, &lo, &hi, &emax);
-        K = lattice_sweeps(ns[ts_day_ref_node(sites)].grid_azimuth, lo, hi);
+    if (ns && ts_day_nodes_sun(sites, o, unix_time, ns, &err) == TS_OK) {
+        double lo, hi, emax, a_ref = ns[ts_day_ref_node(sites)].grid_azimuth;
+        lattice_span(ns, nodes, a_ref, &lo, &hi, &emax);
+        K = lattice_sweeps(a_ref, lo, hi);
     }
-done:
     free(ns);
     return K;
 }
@@ -377,12 +381,8 @@ ts_status ts_vis_step(ts_vis_ctx *c, double t, float *vis, float *az, float *el,
             if (b > b1) b = b1;
             if (!all_kept && b != j)
                 continue;
-            float f = (float)(u - b);
-            if (f < 0) f = 0;
-            if (f > 1) f = 1;
-            const float *qa = all_kept ? kept_plane(c, b) : pa,
-                        *qb = all_kept ? kept_plane(c, b + 1) : pb;
-            float h = qa[i] + f * (qb[i] - qa[i]);
+            float h = all_kept ? plane_between(kept_plane(c, b), kept_plane(c, b + 1), i, u - b)
+                               : plane_between(pa, pb, i, u - b);
             vis[i] = cell_vis(c->cel[i], h, c->floor ? c->floor[i] : NAN);
         }
         pa = pb;
