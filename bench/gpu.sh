@@ -7,7 +7,9 @@
 # (writing a private ICD file for it when /etc/OpenCL/vendors has none),
 # selects the NVIDIA device and runs cl_bench: every product's throughput on
 # both backends, the largest |C - OpenCL| per product, and the horizons
-# without the copy of their planes to the host. Prints the machine first.
+# without the copy of their planes to the host; then once more, one repeat,
+# with TERRASHADE_OPENCL_PROFILE=1 for the device time of each kernel.
+# Prints the machine first.
 #
 # Usage: bench/gpu.sh [--quick] [--dry-run] [--size N] [--dirs D] [--repeat R]
 #   --quick    1024² DEM, 16 directions, best of 2 (default 4096², 32, best of 3)
@@ -214,3 +216,7 @@ fi
 # ------------------------------------------------------------------ bench
 say "== cl_bench --size $size --dirs $dirs --repeat $repeat"
 "$BUILD_DIR/cl_bench" --size "$size" --dirs "$dirs" --repeat "$repeat"
+say "== kernel times: TERRASHADE_OPENCL_PROFILE=1 cl_bench --size $size --dirs $dirs --repeat 1"
+say "(each launch waits for its event here, so the throughputs of this run are not the figures)"
+TERRASHADE_OPENCL_PROFILE=1 "$BUILD_DIR/cl_bench" --size "$size" --dirs "$dirs" --repeat 1 2>&1 |
+    sed -n '/TERRASHADE_OPENCL_PROFILE/,$p'

@@ -279,7 +279,8 @@ static ts_cl_dev *make_device(int i, ts_error *err)
     d->ctx = clCreateContext(props, 1, &r->id, NULL, NULL, &e);
     if (e == CL_SUCCESS) {
         call = "clCreateCommandQueue";
-        d->queue = clCreateCommandQueue(d->ctx, r->id, 0, &e);
+        d->queue = clCreateCommandQueue(
+            d->ctx, r->id, ts_cl_profiling() ? CL_QUEUE_PROFILING_ENABLE : 0, &e);
     }
     if (e == CL_SUCCESS) {
         call = "clCreateProgramWithSource";
@@ -296,12 +297,16 @@ static ts_cl_dev *make_device(int i, ts_error *err)
         cl_device_fp_config sp = 0;
         clGetDeviceInfo(r->id, CL_DEVICE_SINGLE_FP_CONFIG, sizeof sp, &sp, NULL);
         /* TS_NEAR_* come with the embedded core/cellmath/cm_near_field.h */
-        snprintf(opts, sizeof opts, "%s%s%s",
+        /* TERRASHADE_OPENCL_BUILD_OPTIONS: kernel variants for tuning (the
+         * TS_* macros the .cl files test with #ifndef) */
+        const char *extra = getenv("TERRASHADE_OPENCL_BUILD_OPTIONS");
+        snprintf(opts, sizeof opts, "%s%s%s %.200s",
                  (major > 1 || (major == 1 && minor >= 2)) ? "-cl-std=CL1.2 " : "",
                  d->info.fp64 ? "-DTS_FP64=1 " : "",
                  (sp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT)
                      ? "-cl-fp32-correctly-rounded-divide-sqrt"
-                     : "");
+                     : "",
+                 extra ? extra : "");
         e = clBuildProgram(d->prog, 1, &r->id, opts, NULL, NULL);
         if (e == CL_SUCCESS && getenv("TERRASHADE_OPENCL_VERBOSE")) {
             char log[4096] = "";

@@ -36,6 +36,14 @@ const char *ts_cl_error_name(cl_int code);
  * TS_ERR_INTERNAL. */
 ts_status ts_cl_status_of(cl_int e);
 
+/* TERRASHADE_OPENCL_PROFILE is set (and not "0"): queues are made with
+ * profiling on and every launch is timed (cl_profile.c). */
+int ts_cl_profiling(void);
+
+/* Wait for a launch's event and add its device time to the total of kernel
+ * `name`; the totals go to stderr at exit. */
+void ts_cl_profile_add(const char *name, cl_event ev);
+
 /* TERRASHADE_OPENCL_MAX_ALLOC in bytes (k, M, G suffixes), 0 when unset. */
 ts_status ts_cl_env_max_alloc(unsigned long long *limit, ts_error *err);
 

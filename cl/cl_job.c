@@ -201,9 +201,15 @@ void ts_cl_job_run(ts_cl_job *j, cl_kernel k, cl_uint dims, const size_t *global
     for (cl_uint i = 0; i < dims; i++)
         if (global[i] == 0)
             return; /* nothing to do */
-    cl_int e = clEnqueueNDRangeKernel(j->d->queue, k, dims, NULL, global, local, 0, NULL, NULL);
+    cl_event ev = NULL;
+    cl_int e = clEnqueueNDRangeKernel(j->d->queue, k, dims, NULL, global, local, 0, NULL,
+                                      ts_cl_profiling() ? &ev : NULL);
     if (e != CL_SUCCESS)
         job_cl_fail(j, e, "clEnqueueNDRangeKernel (%s)", what);
+    if (ev) {
+        ts_cl_profile_add(what, ev);
+        clReleaseEvent(ev);
+    }
 }
 
 void ts_cl_job_write(ts_cl_job *j, cl_mem m, size_t offset, size_t bytes, const void *src,
