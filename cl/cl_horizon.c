@@ -205,8 +205,12 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
     cl_kernel k1 = ts_cl_job_kernel(&J, "ts_sweep_lines");
     cl_kernel k2 = ts_cl_job_kernel(&J, "ts_sweep_finish");
     cl_kernel k3 = ts_cl_job_kernel(&J, "ts_transpose");
+    /* without a cap, the common case first (ts_sweep_fast), the cells it
+     * leaves after it */
+    cl_kernel kf = cap == 0 ? ts_cl_job_kernel(&J, "ts_sweep_fast") : NULL;
     size_t wg1 = ts_cl_job_wg(&J, k1, 64);
     size_t wg2 = ts_cl_job_wg(&J, k2, D->is_cpu ? 256 : 128);
+    size_t wgf = kf ? ts_cl_job_wg(&J, kf, D->is_cpu ? 256 : 128) : 0;
     size_t wg3 = ts_cl_job_wg(&J, k3, 256);
     if (J.st == TS_OK && wg3 < 32)
         ts_cl_job_fail(&J, TS_ERR_INTERNAL,
@@ -265,6 +269,20 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
             ts_cl_job_run(&J, k1, 1, &global, &wg1, "ts_sweep_lines");
         }
         /* pass 2: cells */
+        size_t global2[2] = {ts_cl_round_up(cells, wg2), (size_t)nb}, local2[2] = {wg2, 1};
+        const cl_int marked_only = kf != NULL;
+        if (kf) {
+            ts_cl_job_args(&J, kf, 0,
+                           TS_CL_ARGS(TS_CL_ARG(zb), TS_CL_ARG(ztb), TS_CL_ARG(cW),
+                                      TS_CL_ARG(cH), TS_CL_ARG(ipb), TS_CL_ARG(dpb),
+                                      TS_CL_ARG(frb), TS_CL_ARG(srb)));
+            ts_cl_job_arg_real(&J, kf, 8, c);
+            ts_cl_job_args(&J, kf, 9,
+                           TS_CL_ARGS(TS_CL_ARG(ob), TS_CL_ARG(hib), TS_CL_ARG(lob),
+                                      TS_CL_ARG(cplane)));
+            size_t globalf[2] = {ts_cl_round_up(cells, wgf), (size_t)nb}, localf[2] = {wgf, 1};
+            ts_cl_job_run(&J, kf, 2, globalf, localf, "ts_sweep_fast");
+        }
         ts_cl_job_args(&J, k2, 0,
                        TS_CL_ARGS(TS_CL_ARG(zb), TS_CL_ARG(ztb), TS_CL_ARG(cW), TS_CL_ARG(cH),
                                   TS_CL_ARG(ipb), TS_CL_ARG(dpb), TS_CL_ARG(frb),
@@ -273,8 +291,7 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
         ts_cl_job_arg_real(&J, k2, 9, cap);
         ts_cl_job_args(&J, k2, 10,
                        TS_CL_ARGS(TS_CL_ARG(ob), TS_CL_ARG(hib), TS_CL_ARG(lob),
-                                  TS_CL_ARG(cplane)));
-        size_t global2[2] = {ts_cl_round_up(cells, wg2), (size_t)nb}, local2[2] = {wg2, 1};
+                                  TS_CL_ARG(cplane), TS_CL_ARG(marked_only)));
         ts_cl_job_run(&J, k2, 2, global2, local2, "ts_sweep_finish");
         /* Planes along x back into rows, into the occluder buffer (free
          * now, and twice a plane's size); then read each run of planes

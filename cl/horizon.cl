@@ -16,18 +16,21 @@
  * azimuths in one launch. Each keeps its convex hull in a stack of (d, g)
  * points (and their step indices k) in global memory, interleaved across
  * work-items (entry j of slot s at j * nslots + s) so that neighbouring
- * work-items touch neighbouring memory. For every sample k of the line
- * (cell i below it, cell i + 1 above it) it writes the far-field occluder
- * the hull finds (its step index and distance, as int2 (k, bits of dd)):
+ * work-items touch neighbouring memory (each slot's entries together ran
+ * pass 1 2.8 times slower on an H200: docs/performance.md). For every
+ * sample k of the line (cell i below it, cell i + 1 above it) it writes the
+ * far-field occluder the hull finds (its step index and distance, as int2
+ * (k, bits of dd)):
  *   hi[cell i]     from the height of cell i (the C code's `hi`),
  *   lo[cell i + 1] from the height of cell i + 1 (the C code's cur_lo,
  *                  which the next line reads as its `lo`).
  * The C code hands cur_lo from one line to the next in a loop; here it
  * waits in `lo` for pass 2, so the lines are independent.
  *
- * Pass 2 (ts_sweep_finish): one work-item per cell and azimuth: the far
- * field (the cell's own ray sampled at both occluders and TS_FAR_SPREAD
- * steps beside them; past the distance cap, the exact march of
+ * Pass 2 (ts_sweep_fast, then ts_sweep_finish for the cells it leaves;
+ * ts_sweep_finish alone under a distance cap): one work-item per cell and
+ * azimuth: the far field (the cell's own ray sampled at both occluders and
+ * TS_FAR_SPREAD steps beside them; past the distance cap, the exact march of
  * cm_ray_exact), the exact near field (the float fast path of ts_near_row
  * for interior cells without a distance cap, cm_near_exact in `real`
  * elsewhere and for cells whose fast path met nodata), the larger of the
@@ -198,23 +201,31 @@ cm_near_tables ts_near_tables(__global const int *P, __global const real *Q)
     return q;
 }
 
+/* The piece constants of an azimuth (cm_fast_piece_init) for step L. */
+cm_fast_piece ts_near_piece(__global const int *P, __global const real *Q, int n, float L,
+                            float c)
+{
+    const real pt = Q[TS_CLD_T];
+    return cm_fast_piece_init(P[TS_CLI_PDU + n], P[TS_CLI_PDV + n], fabs(pt) <= RC(1e-12),
+                              Q[TS_CLD_PSA + n], Q[TS_CLD_PSB + n], pt, L, c);
+}
+
 /* The float fast path of near_run (near_field.c) for one interior cell zc
  * at height h, piece by piece as there (cm_fast_piece's slopes), +0 for a
- * -0 as near_merge. *flag: a corner was nodata or infinite (the cell is
- * then redone by cm_near_exact). */
+ * -0 as near_merge. The pieces come from `lp` when `shared` (the work-group
+ * made them once, the same bits), else are made here for step L. *flag: a
+ * corner was nodata or infinite (the cell is then redone by cm_near_exact). */
 float ts_near_fast(__global const float *zc, __global const int *P, __global const real *Q,
-                   long u_stride, long v_stride, float h, float L, float c, int *flag)
+                   __local const cm_fast_piece *lp, int shared, long u_stride, long v_stride,
+                   float h, float L, float c, int *flag)
 {
     float best = -INFINITY, prev = 0.0f;
     int bad = 0;
-    const real pt = Q[TS_CLD_T];
-    const float t = (float)pt;
-    const int flat_v = fabs(pt) <= RC(1e-12);
+    const float t = (float)Q[TS_CLD_T];
     for (int n = 0; n < P[TS_CLI_NPIECES]; n++) {
         __global const float *q0 =
             zc + (long)P[TS_CLI_PDU + n] * u_stride + (long)P[TS_CLI_PDV + n] * v_stride;
-        cm_fast_piece q = cm_fast_piece_init(P[TS_CLI_PDU + n], P[TS_CLI_PDV + n], flat_v,
-                                             Q[TS_CLD_PSA + n], Q[TS_CLD_PSB + n], pt, L, c);
+        const cm_fast_piece q = shared ? lp[n] : ts_near_piece(P, Q, n, L, c);
         const float k[4] = {q0[0], q0[u_stride], q0[v_stride], q0[u_stride + v_stride]};
         const float X = cm_fast_twist(k[0], k[1], k[2], k[3]);
         const float f = cm_fast_cross(q, k[q.e0], k[q.e1], h);
@@ -234,14 +245,66 @@ float ts_near_fast(__global const float *zc, __global const int *P, __global con
     return best + 0.0f;
 }
 
-/* Pass 2: global size (cells rounded up, azimuths in the batch); work-item
- * `cell` is the cell u * V + v of its azimuth's u-major layout. */
+/* One cell of pass 2: where it lies in its azimuth's u-major layout and
+ * what its ray and near field need. */
+typedef struct {
+    long po;         /* its element in the output plane */
+    int v, x, y, k;  /* v across the lines, x and y in the DEM, k the step */
+    float hc;        /* its height */
+    int2 olo;        /* the occluder of the line below it ((-1, 0): none) */
+    real step;       /* metres a step on its row */
+    cm_ray_grid r;
+} ts_finish_cell;
+
+ts_finish_cell ts_finish_setup(__global const float *zr, __global const float *zt,
+                               __global const int *P, __global const real *Q,
+                               __global const float *fr_all, __global const real *sr_all,
+                               __global const int2 *lo, long cell, long plane)
+{
+    ts_finish_cell f;
+    const int xm = P[TS_CLI_XMAJOR], V = P[TS_CLI_V];
+    __global const float *z = xm ? zt : zr; /* u-major heights */
+    f.po = P[TS_CLI_PLANE] * plane + cell;
+    f.hc = z[cell];
+    const int u = (int)(cell / V);
+    f.v = (int)(cell - (long)u * V);
+    f.x = xm ? u : f.v;
+    f.y = xm ? f.v : u;
+    const int u_start = P[TS_CLI_USTART], u_step = P[TS_CLI_USTEP];
+    f.k = (u - u_start) * u_step;
+    const float F = fr_all[P[TS_CLI_FLOFF] + f.k];
+    f.olo = (F > 0.0f && f.v >= 1 && !isnan(f.hc)) ? lo[f.po] : (int2)(-1, 0);
+    const int sroff = P[TS_CLI_SROFF];
+    f.step = sroff >= 0 ? sr_all[sroff + f.y] : Q[TS_CLD_STEPM];
+    const cm_ray_grid r = {z, V, Q[TS_CLD_T], (long)V * u_start, (long)V * u_step, 1};
+    f.r = r;
+    return f;
+}
+
+/* Whether the cell is far enough from the DEM's sides for the float near
+ * field (without a distance cap). */
+int ts_finish_interior(const ts_finish_cell *f, int W, int H, real cap)
+{
+    const int m = TS_NEAR_MARGIN;
+    return cap == 0 && f->y >= m && f->y < H - m && W > 2 * m && f->x >= m && f->x < W - m;
+}
+
+/* A cell that ts_sweep_fast leaves to ts_sweep_finish keeps its occluder
+ * hi as (TS_REST_MARK - hi.x, hi.y), below every step index and -1. */
+#define TS_REST_MARK (-3)
+
+/*
+ * Pass 2 in full: global size (cells rounded up, azimuths in the batch);
+ * work-item `cell` is the cell u * V + v of its azimuth's u-major layout.
+ * marked_only: only the cells ts_sweep_fast marked (the others are done).
+ */
 __kernel void ts_sweep_finish(__global const float *zr, __global const float *zt, const int W,
                               const int H,
                               __global const int *ip, __global const real *dp,
                               __global const float *fr_all, __global const real *sr_all,
                               const real c, const real cap, __global float *out,
-                              __global const int2 *hi, __global const int2 *lo, const long plane)
+                              __global const int2 *hi, __global const int2 *lo, const long plane,
+                              const int marked_only)
 {
     const long cell = get_global_id(0);
     const int a = (int)get_global_id(1);
@@ -250,44 +313,99 @@ __kernel void ts_sweep_finish(__global const float *zr, __global const float *zt
     __global const int *P = ip + a * TS_CLI_N;
     __global const real *Q = dp + a * TS_CLD_N;
     const long po = P[TS_CLI_PLANE] * plane + cell;
-    const int xm = P[TS_CLI_XMAJOR], V = P[TS_CLI_V];
-    __global const float *z = xm ? zt : zr; /* u-major heights */
-    const float hc = z[cell];
-    if (isnan(hc)) {
+    int2 ohi = hi[po];
+    if (marked_only) {
+        if (ohi.x > TS_REST_MARK + 1)
+            return;
+        ohi.x = TS_REST_MARK - ohi.x;
+    }
+    const ts_finish_cell f = ts_finish_setup(zr, zt, P, Q, fr_all, sr_all, lo, cell, plane);
+    if (isnan(f.hc)) {
         out[po] = NAN;
         return;
     }
-    const int u = (int)(cell / V), v = (int)(cell - (long)u * V);
-    const int x = xm ? u : v, y = xm ? v : u;
-    const int u_start = P[TS_CLI_USTART], u_step = P[TS_CLI_USTEP];
-    const long u_stride = (long)V * u_step, v_stride = 1, origin = (long)V * u_start;
-    const int k = (u - u_start) * u_step;
-    const float F = fr_all[P[TS_CLI_FLOFF] + k];
-    const int2 none = (int2)(-1, 0);
-    const int2 ohi = hi[po];
-    const int2 olo = (F > 0.0f && v >= 1) ? lo[po] : none;
-    const int sroff = P[TS_CLI_SROFF];
-    const real step = sroff >= 0 ? sr_all[sroff + y] : Q[TS_CLD_STEPM];
-    const cm_ray_grid r = {z, V, Q[TS_CLD_T], origin, u_stride, v_stride};
     const cm_near_tables nt = ts_near_tables(P, Q);
-    const float farf = ts_far_field(&r, k, v, hc, olo, ohi, step, c, cap);
-    const int m = TS_NEAR_MARGIN;
-    const int interior =
-        cap == 0 && y >= m && y < H - m && W > 2 * m && x >= m && x < W - m;
+    const float farf = ts_far_field(&f.r, f.k, f.v, f.hc, f.olo, ohi, f.step, c, cap);
     float res;
     int left;
-    if (interior) {
+    if (ts_finish_interior(&f, W, H, cap)) {
         int flagged;
-        float nf = ts_near_fast(z + cell, P, Q, u_stride, v_stride, hc, (float)step, (float)c,
-                                &flagged);
+        float nf = ts_near_fast(f.r.z + cell, P, Q, 0, 0, f.r.u_stride, f.r.v_stride, f.hc,
+                                (float)f.step, (float)c, &flagged);
         if (flagged)
-            nf = cm_near_exact(&r, &nt, k, v, hc, step, c, 0, &left);
+            nf = cm_near_exact(&f.r, &nt, f.k, f.v, f.hc, f.step, c, 0, &left);
         res = nf > farf ? nf : farf;
     } else {
-        float nf = cm_near_exact(&r, &nt, k, v, hc, step, c, cap, &left);
+        float nf = cm_near_exact(&f.r, &nt, f.k, f.v, f.hc, f.step, c, cap, &left);
         res = left ? nf : fmax(nf, farf);
     }
     out[po] = ts_atan_deg(res);
+}
+
+/*
+ * Pass 2's common case, without a distance cap: the interior cells whose
+ * near field the float fast path answers and whose far field has its ray
+ * at both occluders; the others it marks (TS_REST_MARK) for
+ * ts_sweep_finish (marked_only), the same computation as one kernel did.
+ * Without the exact near field and the lost ray in it, the kernel holds
+ * fewer registers, so more of it runs at once. Local size (n, 1), one
+ * azimuth a work-group: where the step is the azimuth's own (projected
+ * DEMs) the work-group makes the near-field pieces once in local memory
+ * (made per cell, their double-precision setup took a fifth of pass 2's
+ * time on an H200).
+ */
+__kernel void ts_sweep_fast(__global const float *zr, __global const float *zt, const int W,
+                            const int H,
+                            __global const int *ip, __global const real *dp,
+                            __global const float *fr_all, __global const real *sr_all,
+                            const real c, __global float *out, __global int2 *hi,
+                            __global const int2 *lo, const long plane)
+{
+    __local cm_fast_piece lp[TS_NEAR_MAX_PIECES];
+    const long cell = get_global_id(0);
+    const int a = (int)get_global_id(1);
+    __global const int *P = ip + a * TS_CLI_N;
+    __global const real *Q = dp + a * TS_CLD_N;
+    /* the same for the whole work-group: all of it meets the barrier or none */
+    const int shared = P[TS_CLI_SROFF] < 0;
+    if (shared) {
+        for (int n = (int)get_local_id(0); n < P[TS_CLI_NPIECES]; n += (int)get_local_size(0))
+            lp[n] = ts_near_piece(P, Q, n, (float)Q[TS_CLD_STEPM], (float)c);
+        barrier(CLK_LOCAL_MEM_FENCE);
+    }
+    if (cell >= (long)W * H)
+        return;
+    const ts_finish_cell f = ts_finish_setup(zr, zt, P, Q, fr_all, sr_all, lo, cell, plane);
+    if (isnan(f.hc)) {
+        out[f.po] = NAN;
+        return;
+    }
+    const int2 ohi = hi[f.po];
+    int rest = !ts_finish_interior(&f, W, H, 0);
+    float farf = -INFINITY;
+    for (int cc = 0; cc < 2 && !rest; cc++) {
+        const int2 cand = cc ? ohi : f.olo;
+        if (cand.x < 0 || (cc == 1 && ohi.x == f.olo.x))
+            continue;
+        const int dk = f.k - cand.x;
+        for (int e = -TS_FAR_SPREAD; e <= TS_FAR_SPREAD; e++) {
+            if (dk + e <= TS_NEAR_STEPS)
+                continue;
+            const float s = cm_ray_slope(&f.r, f.k, f.v, f.hc, dk + e,
+                                         as_float(cand.y) + (float)(e * f.step), (float)c);
+            rest |= e == 0 && s == -INFINITY; /* ts_far_field's lost ray */
+            farf = s > farf ? s : farf;
+        }
+    }
+    int flagged = 0;
+    float nf = -INFINITY;
+    if (!rest)
+        nf = ts_near_fast(f.r.z + cell, P, Q, lp, shared, f.r.u_stride, f.r.v_stride, f.hc,
+                          (float)f.step, (float)c, &flagged);
+    if (rest || flagged)
+        hi[f.po] = (int2)(TS_REST_MARK - ohi.x, ohi.y);
+    else
+        out[f.po] = ts_atan_deg(nf > farf ? nf : farf);
 }
 
 /* ------------------------------------------------------------- transpose */
