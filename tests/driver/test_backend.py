@@ -12,7 +12,8 @@ C with a warning when OpenCL was asked for and cannot run, bad values.
   back is silent (CPLDebug); a product computed chunk by chunk
   (TILE_SIZE) warns once and its BACKEND says what its chunks ran;
 - BACKEND=bogus and TERRASHADE_BACKEND=cuda: non-zero exit, clear message;
-- the default (auto) on a CPU OpenCL device runs C and says why.
+- the default (auto) on a CPU OpenCL device runs C and says why;
+- TERRASHADE_OPENCL_PROFILE and TERRASHADE_OPENCL_BUILD_OPTIONS (tuning aids).
 """
 import os
 import sys
@@ -219,6 +220,41 @@ class Backend(unittest.TestCase):
                   TERRASHADE_OPENCL_DEVICE=99, CPL_DEBUG="TERRASHADE")
         self.assertIn("TERRASHADE_OPENCL_DEVICE=99", p.stderr)
         self.assertNotIn("Warning", p.stderr)
+
+    def test_kernel_profile_and_build_options(self):
+        """TERRASHADE_OPENCL_PROFILE=1 prints each kernel's device time at
+        exit and changes no result; TERRASHADE_OPENCL_BUILD_OPTIONS reaches
+        the kernels' build: a macro they test, at its default, changes
+        nothing, and one that breaks the build falls back to C, saying so."""
+        dem = self.dems["synthetic"]
+        ref, out = (os.path.join(self.dir, n) for n in ("prof_ref.tif", "prof.tif"))
+        base = ["gdal_translate", "-q", "-oo", "PRODUCT=horizon", "-oo", "DIRECTIONS=8",
+                "-oo", "BACKEND=opencl", T.conn(dem)]
+        p = T.run(base + [ref], TERRASHADE_OPENCL_PROFILE="0")
+        self.assertNotIn("TERRASHADE_OPENCL_PROFILE", p.stderr)
+        want = gdal.Open(ref)
+        self.assertEqual(want.GetMetadataItem("BACKEND"), "opencl")
+        want = want.ReadAsArray()
+        for env in ({"TERRASHADE_OPENCL_PROFILE": "1"},
+                    {"TERRASHADE_OPENCL_BUILD_OPTIONS": "-DTS_LOST_STEPS=8"}):
+            with self.subTest(env=env):
+                p = T.run(base + [out], **env)
+                print(p.stderr)
+                ds = gdal.Open(out)
+                self.assertEqual(ds.GetMetadataItem("BACKEND"), "opencl")
+                np.testing.assert_array_equal(ds.ReadAsArray(), want)
+                if "TERRASHADE_OPENCL_PROFILE" in env:
+                    self.assertIn("TERRASHADE_OPENCL_PROFILE: device time per kernel",
+                                  p.stderr)
+                    for k in ("ts_sweep_lines", "ts_sweep_fast", "ts_sweep_finish"):
+                        self.assertRegex(p.stderr, r"\n  %s +[1-9]\d* +\d+\.\d{4} " % k)
+        p = T.run(base + [out], TERRASHADE_OPENCL_BUILD_OPTIONS="-DTS_FAR_SPREAD=(")
+        print(p.stderr)
+        self.assertIn("BACKEND=opencl was requested", p.stderr)
+        self.assertIn("OpenCL kernels failed to build", p.stderr)
+        ds = gdal.Open(out)
+        self.assertEqual(ds.GetMetadataItem("BACKEND"), "c")
+        np.testing.assert_allclose(ds.ReadAsArray(), want, atol=1e-3)
 
     def test_bad_values_are_errors(self):
         dem = self.dems["synthetic"]
