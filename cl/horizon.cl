@@ -102,6 +102,10 @@ __kernel void ts_sweep_lines(__global const float *zr, __global const float *zt,
     const int2 none = (int2)(-1, 0);
     real d = 0;
     int n = 0, far = -1;
+    /* the hull's top two points, S[n - 1] and S[n - 2] where they exist,
+     * kept in registers: the pops test them at every sample, and each
+     * load from the stack waits on global memory */
+    real2 top1 = (real2)(0, 0), top2 = (real2)(0, 0);
     for (int k = k0; k <= k1; k++) {
         int i = (int)(b + fl[k]);
         float F = fr[k];
@@ -130,16 +134,20 @@ __kernel void ts_sweep_lines(__global const float *zr, __global const float *zt,
         if (!isnan(hs)) {
             real gs = hs - c * d * d;
             while (n >= 2) {
-                real2 s2 = S[(n - 2) * ns], s1 = S[(n - 1) * ns];
-                if (!((s2.y - gs) * (d - s1.x) >= (s1.y - gs) * (d - s2.x)))
+                if (!((top2.y - gs) * (d - top1.x) >= (top1.y - gs) * (d - top2.x)))
                     break;
                 n--;
+                top1 = top2;
+                if (n >= 2)
+                    top2 = S[(n - 2) * ns];
             }
             if (far > n - 1)
                 far = n - 1;
             while (far + 1 < n && d - S[(far + 1) * ns].x >= near_skip)
                 far++;
-            S[n * ns] = (real2)(d, gs);
+            top2 = top1;
+            top1 = (real2)(d, gs);
+            S[n * ns] = top1;
             SK[n * ns] = k;
             n++;
             pushed = 1;
