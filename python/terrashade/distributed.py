@@ -9,9 +9,11 @@ product's size, bands, types, nodata, georeferencing and metadata, creates
 DEST.partial, submits one task per --tile-size window (each task reads its
 window through the driver on a worker) and writes the windows as they
 complete, through one dataset, then renames DEST.partial to DEST. Any
-failure removes what was written and exits non-zero. See docs/distributed.md.
+failure removes what was written and exits non-zero (3 where the cluster was
+lost during the run). See docs/distributed.md.
 """
 import argparse
+import asyncio
 import contextlib
 import logging
 import os
@@ -35,6 +37,7 @@ gdal.UseExceptions()
 
 PROG = "terrashade.distributed"
 TILE_MIN, TILE_MAX = 16, 65536
+LOST = 3  # exit status: the cluster was lost during the run; run it again
 SIDE_FILES = (".aux.xml", ".ovr", ".msk")  # GDAL's beside a GeoTIFF
 # The driver's inline option segment (plugin/tsd_connstr.c): KEY=VALUE items,
 # an ASCII identifier as KEY with blanks allowed around it, up to the first ':'.
@@ -93,7 +96,9 @@ def parse_args(argv):
     p.add_argument("-co", dest="creation_options", action="append", default=[],
                    metavar="NAME=VALUE", help="a creation option of the output driver")
     p.add_argument("--timeout", type=positive, default=10, metavar="SECONDS",
-                   help="how long to try to reach --scheduler (default 10)")
+                   help="how long to try to reach --scheduler, to wait for its answer "
+                   "during the run, and to wait for a worker when the cluster has none "
+                   "(default 10)")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="no progress bar and no summary line")
     p.add_argument("source", metavar="SOURCE", help="TERRASHADE:[KEY=VALUE,...:]dem.tif")
@@ -205,6 +210,14 @@ def create_like(src, path, block, creation_options):
     return out
 
 
+def dask_logs(level):
+    """Only Dask's logs of level and above reach stderr, as LocalCluster's
+    silence_logs: on its handlers, as Dask's configuration gives its loggers
+    their own levels."""
+    for handler in logging.getLogger("distributed").handlers:
+        handler.setLevel(level)
+
+
 def start_cluster(args):
     """(client, cluster or None, task options to add)."""
     from dask.distributed import Client, LocalCluster
@@ -222,6 +235,7 @@ def start_cluster(args):
         except (OSError, TimeoutError) as e:
             raise Failure("cannot reach the Dask scheduler at %s within %d s: %s"
                           % (args.scheduler, args.timeout, e), code=2)
+        dask_logs(logging.ERROR)  # as the local cluster's: the program says what failed
         # A worker has one task slot per thread, by default one per core.
         return client, None, 1
     workers = args.workers or os.cpu_count() or 1
@@ -232,10 +246,66 @@ def start_cluster(args):
     return Client(cluster), cluster, max(1, (os.cpu_count() or 1) // slots)
 
 
-def check_workers(client):
+class Watch:
+    """Whether the cluster can still finish the run. Dask cancels every
+    future at once when the client's connection to the scheduler closes,
+    but waits for ever on a scheduler that answers nothing (its machine or
+    the network gone) and on a cluster without workers: the run checks the
+    scheduler's answer (within --timeout) and its workers (none for longer
+    than --timeout) whenever a second has passed without a window."""
+
+    EVERY = 1.0  # s between checks
+
+    def __init__(self, client, timeout, dest):
+        self.client, self.timeout, self.dest = client, timeout, dest
+        self.address = client.scheduler.address
+        self.lost = False  # then the client's scheduler calls would hang or fail
+        self.checked = self.workers_seen = time.monotonic()
+
+    def fail(self, what, why, done=None, total=None):
+        self.lost = True
+        # The client's close then cancels its reconnection, which Dask logs with
+        # tracebacks, in part through asyncio's logger (the root's last resort).
+        dask_logs(logging.CRITICAL)
+        logging.getLogger().setLevel(logging.CRITICAL)
+        when = ("during the run, after %d of %d windows" % (done, total) if total
+                else "before the run's windows were submitted")
+        raise Failure("lost %s at %s %s: %s; nothing written to %s: run the command again "
+                      "once the cluster is back (a run starts over)"
+                      % (what, self.address, when, why, self.dest), code=LOST)
+
+    def connected(self, done=None, total=None):
+        if self.client.status != "running":  # "connecting" again, or closed: futures lost
+            self.fail("the Dask scheduler", "its connection closed (the scheduler ended, "
+                      "or its machine or the network went away)", done, total)
+
+    def check(self, done, total):
+        self.connected(done, total)
+        now = time.monotonic()
+        if now - self.checked < self.EVERY:
+            return
+        try:
+            workers = self.client.sync(self.client.scheduler.ncores,
+                                       callback_timeout=self.timeout)
+        except asyncio.TimeoutError:
+            self.fail("the Dask scheduler", "it did not answer for %d s (--timeout)"
+                      % self.timeout, done, total)
+        except OSError as e:  # Dask's CommClosedError too
+            self.connected(done, total)
+            self.fail("the Dask scheduler", "%s: %s" % (type(e).__name__, e), done, total)
+        self.checked = now = time.monotonic()
+        if workers:
+            self.workers_seen = now
+        elif now - self.workers_seen > self.timeout:
+            self.fail("the workers of the Dask cluster", "the scheduler has had none for "
+                      "%d s (--timeout)" % self.timeout, done, total)
+
+
+def check_workers(client, watch):
     try:
         found = client.run(W.probe)
     except Exception as e:
+        watch.connected()
         raise Failure("the Dask workers cannot run terrashade's tasks (%s): install "
                       "the terrashade package on them (make install) or put it on "
                       "their PYTHONPATH" % e)
@@ -249,61 +319,98 @@ def check_workers(client):
     return len(found)
 
 
-def _progress_bar(futures, ready):
-    """Dask's console progress bar over futures; sets ready once the
-    scheduler tracks them (its first draw), or when the bar gives up."""
-    from distributed.diagnostics.progressbar import TextProgressBar
+class ProgressBar:
+    """Dask's console progress bar over futures, on stderr, in a thread of
+    its own; ready is set once the scheduler tracks the futures (its first
+    draw), or when the bar gives up."""
 
-    class Bar(TextProgressBar):
-        def _draw_bar(self, **kwargs):
-            ready.set()
-            super()._draw_bar(**kwargs)
+    def __init__(self, futures):
+        self.ready = threading.Event()
+        self.lock = threading.Lock()  # a draw, or stop()
+        self.drawn = self.stopped = False  # drawn: its line is not ended
+        self.thread = threading.Thread(target=self._run, args=(futures,), daemon=True)
+        self.thread.start()
 
-    try:
-        # dask's console bar writes to stdout; the program's stdout stays clean.
-        with contextlib.redirect_stdout(sys.stderr):
-            Bar(futures, complete=True)
-    finally:
-        ready.set()
+    def _run(self, futures):
+        from distributed.diagnostics.progressbar import TextProgressBar
+        owner = self
+
+        class Bar(TextProgressBar):
+            def _draw_bar(self, **kwargs):
+                owner.ready.set()
+                with owner.lock:
+                    if not owner.stopped:
+                        super()._draw_bar(**kwargs)
+                        owner.drawn = True
+
+            def _draw_stop(self, **kwargs):  # at the end: the line erased
+                with owner.lock:
+                    if not owner.stopped:
+                        super()._draw_stop(**kwargs)
+                        owner.drawn = False
+
+        try:
+            # dask's console bar writes to stdout; the program's stdout stays clean.
+            with contextlib.redirect_stdout(sys.stderr):
+                Bar(futures, complete=True)
+        except Exception:  # its connection lost with the scheduler: the run says so
+            pass
+        finally:
+            self.ready.set()
+
+    def stop(self):
+        """No more drawing; a drawn bar's line is ended, so that the reason
+        the run failed starts a line of its own."""
+        with self.lock:
+            if self.drawn and not self.stopped:
+                sys.stderr.write("\n")
+            self.stopped = True
 
 
-def compute(client, out, source, task_options, tile, quiet, run):
+def compute(client, watch, out, source, task_options, tile, quiet, run):
     from dask.distributed import as_completed
     wins = W.windows(out.RasterXSize, out.RasterYSize, tile)
     futures = [client.submit(W.read_window, source, task_options, w, run, pure=False)
                for w in wins]
     window_of = dict(zip((f.key for f in futures), wins))
-    bar = None
-    ready = threading.Event()  # the bar tracks the futures (or there is none)
-    if quiet:
-        ready.set()
-    else:
-        bar = threading.Thread(target=_progress_bar, args=(futures, ready), daemon=True)
-        bar.start()
+    bar = None if quiet else ProgressBar(futures)
     # Written windows are released so that the workers drop them, but not
     # before the bar's scheduler side has seen every key: it waits for all
     # of them, and a key forgotten first would leave it waiting for ever.
     held = []
+    done = 0
+    pending = as_completed(futures)
     try:
-        for fut in as_completed(futures):
-            try:
-                (xoff, yoff, _, _), a = fut.result()
-            except Exception as e:
-                raise Failure("the window (xoff, yoff, xsize, ysize) = %r of %s "
-                              "failed: %s: %s" % (window_of[fut.key], source,
-                                                  type(e).__name__, e))
-            for i in range(out.RasterCount):
-                out.GetRasterBand(i + 1).WriteArray(a[i], xoff, yoff)
-            held.append(fut)
-            if ready.is_set():
+        while not pending.is_empty():
+            batch = pending.next_batch(block=False)
+            if not batch:  # as as_completed's own wait, but the cluster is watched
+                watch.check(done, len(wins))
+                time.sleep(0.1)
+            for fut in batch:
+                try:
+                    (xoff, yoff, _, _), a = fut.result()
+                except Exception as e:
+                    watch.connected(done, len(wins))  # cancelled with the connection
+                    raise Failure("the window (xoff, yoff, xsize, ysize) = %r of %s "
+                                  "failed: %s: %s" % (window_of[fut.key], source,
+                                                      type(e).__name__, e))
+                for i in range(out.RasterCount):
+                    out.GetRasterBand(i + 1).WriteArray(a[i], xoff, yoff)
+                done += 1
+                held.append(fut)
+            if bar is None or bar.ready.is_set():
                 for f in held:
                     f.release()
                 held.clear()
     except BaseException:
-        client.cancel(futures)
+        if bar is not None:
+            bar.stop()
+        if not watch.lost:  # else nothing to cancel, and no one to tell
+            with contextlib.suppress(Exception):  # why the run failed comes first
+                client.cancel(futures)
         raise
     if bar is not None:
-        bar.join(timeout=5)
+        bar.thread.join(timeout=5)
     for f in held:
         f.release()
     return len(wins)
@@ -360,22 +467,23 @@ def run(args):
         raise Failure("DEST %s is the DEM itself: the product would replace it; write "
                       "it to another file" % args.dest)
     size = (src.RasterXSize, src.RasterYSize, src.RasterCount)
-    out = client = cluster = None
+    out = client = cluster = watch = None
     run_id = uuid.uuid4().hex  # no worker reuses a dataset opened for an earlier run
     t0 = time.time()
     try:  # from the partial's creation on: a Ctrl-C may come at any time
         out = create_like(src, partial, block, [] if fmt == "COG" else args.creation_options)
         src = None
         client, cluster, threads = start_cluster(args)
-        nworkers = check_workers(client)
+        watch = Watch(client, args.timeout, args.dest)
+        nworkers = check_workers(client, watch)
         keys = given_keys(args.source, args.open_options)
         task_options = list(args.open_options)
         if "THREADS" not in keys:
             task_options.append("THREADS=%d" % threads)
         if "PROGRESS" not in keys:
             task_options.append("PROGRESS=no")  # the Dask bar says it
-        n = compute(client, out, absolute_source(args.source), task_options, args.tile_size,
-                    args.quiet, run_id)
+        n = compute(client, watch, out, absolute_source(args.source), task_options,
+                    args.tile_size, args.quiet, run_id)
         out.FlushCache()
         out = None
         finish(partial, fmt, args.dest, args.creation_options)
@@ -386,9 +494,11 @@ def run(args):
         raise
     finally:
         if client is not None:
-            with contextlib.suppress(Exception):  # the workers close this run's datasets
-                client.run(W.forget, run_id)
-            client.close()
+            if client.status == "running" and not (watch and watch.lost):
+                with contextlib.suppress(Exception):  # the workers close this run's datasets
+                    client.run(W.forget, run_id)
+            with contextlib.suppress(Exception):  # bounded; a closing error hides no result
+                client.close(timeout=args.timeout)
         if cluster is not None:
             cluster.close()
     if not args.quiet:

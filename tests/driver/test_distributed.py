@@ -13,11 +13,15 @@ dask.distributed equals gdal_translate of the same source, bit for bit.
   and the result is still identical;
 - a window that fails (no retries allowed) fails the run: exit 1, the
   older DEST untouched, no DEST.partial;
+- an existing cluster lost during the run (its scheduler killed or stopped,
+  its only worker killed): one sentence, exit 3 within seconds, no DEST.partial;
 - bad input (an unreachable scheduler or one that is no address, an
   unwritable destination or one that is a directory, a SOURCE the driver
   refuses, bad tile sizes): a clear message, a non-zero exit and neither
   DEST nor DEST.partial left behind.
 """
+import contextlib
+import json
 import os
 import re
 import signal
@@ -44,6 +48,92 @@ SUNHOURS = {"PRODUCT": "sunhours", "DATE": "2024-12-21", "TIMEZONE": "-05:00",
 def distributed(args, ok=True, cwd=None, **env):
     return T.run(["/usr/bin/python3", "-m", "terrashade.distributed"] + list(args),
                  ok=ok, cwd=cwd, PYTHONPATH=PYTHONPATH, **env)
+
+
+# dask-worker --preload: the worker's windows never finish, so that the run
+# is surely under way when the test takes its cluster away; the first that
+# starts says so by creating the file $TS_TEST_TASK_STARTED.
+STALLED_TASKS = """
+import os, time
+from terrashade import windows
+
+def read_window(*args):
+    open(os.environ["TS_TEST_TASK_STARTED"], "w").close()
+    time.sleep(600)
+
+windows.read_window = read_window
+"""
+
+
+class ExternalCluster:
+    """A context of dask-scheduler and dask-worker processes, each in a
+    session of its own so that a test can kill or stop one of them; every
+    process started here (the program's runs too) is killed at its end,
+    whether the test passed or not."""
+
+    def __init__(self, directory):
+        self.dir = directory
+        self.file = os.path.join(directory, "scheduler.json")
+        self.procs = {}
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        for p in self.procs.values():
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(p.pid, signal.SIGKILL)
+            p.communicate(timeout=30)
+
+    def start(self, name, args, **env):
+        """A process; a run's (name "run...") stderr is piped, the others' logged."""
+        with open(os.path.join(self.dir, name + ".log"), "w") as log:
+            self.procs[name] = subprocess.Popen(
+                [str(a) for a in args], stdout=log, start_new_session=True,
+                stderr=subprocess.PIPE if name.startswith("run") else subprocess.STDOUT,
+                env=T.env(PYTHONPATH=PYTHONPATH, **env))
+        return self.procs[name]
+
+    def run(self, name, args):
+        return self.start(name, ["/usr/bin/python3", "-m", "terrashade.distributed"] + args)
+
+    def start_cluster(self, preload):
+        self.start("scheduler", ["dask-scheduler", "--host", "127.0.0.1", "--port", 0,
+                                 "--no-dashboard", "--scheduler-file", self.file])
+        self.start("worker", ["dask-worker", "--scheduler-file", self.file, "--nthreads", 1,
+                              "--no-nanny", "--no-dashboard", "--preload", preload,
+                              "--local-directory", self.dir],
+                   TS_TEST_TASK_STARTED=os.path.join(self.dir, "started"))
+        self.wait_for(lambda: os.path.exists(self.file) and os.path.getsize(self.file),
+                      "the scheduler's file")
+        with open(self.file) as f:
+            return json.load(f)["address"]
+
+    def wait_for(self, done, what, seconds=60):
+        for _ in range(int(seconds * 20)):
+            if done():
+                return
+            for name, p in self.procs.items():
+                if p.poll() is not None:
+                    raise AssertionError("%s ended (exit %s) before %s:\n%s" % (
+                        name, p.returncode, what,
+                        self.stderr(p) if name.startswith("run") else self.log(name)))
+            time.sleep(0.05)
+        raise AssertionError("no %s within %d s" % (what, seconds))
+
+    @staticmethod
+    def stderr(p, timeout=None):
+        """A run's stderr, read as bytes and decoded: text mode would turn the
+        progress bar's carriage returns into line ends (a blank first line
+        where the bar drew once)."""
+        return p.communicate(timeout=timeout)[1].decode(errors="replace")
+
+    def log(self, name):
+        with open(os.path.join(self.dir, name + ".log")) as f:
+            return f.read()
+
+    def signal(self, name, sig):
+        os.killpg(self.procs[name].pid, sig)
 
 
 def files_open(path):
@@ -344,6 +434,73 @@ class Distributed(unittest.TestCase):
             self.assertEqual(f.read(), "an older result")  # DEST untouched
         os.remove(dest)
         self.assert_nothing_left(dest)
+
+    def test_cluster_lost_during_the_run(self):
+        """The scheduler of an existing cluster killed (its connection
+        closes), stopped (it answers nothing: a machine or network gone), or
+        its only worker killed, while the run waits for windows: one
+        sentence that says what was lost, exit 3 within seconds, the older
+        DEST untouched and no DEST.partial. The program waited for ever on a
+        stopped scheduler or a cluster without workers, and printed Dask's
+        tracebacks (its progress bar's thread) and, ten seconds after the
+        scheduler died, 'OSError: Timed out trying to connect'."""
+        preload = self.path("stalled_tasks.py")
+        with open(preload, "w") as f:
+            f.write(STALLED_TASKS)
+        for lost, sig, said in (
+                ("scheduler", signal.SIGKILL,
+                 "lost the Dask scheduler at {address} during the run, after 0 of 12 windows: "
+                 "its connection closed"),
+                ("scheduler", signal.SIGSTOP,
+                 "lost the Dask scheduler at {address} during the run, after 0 of 12 windows: "
+                 "it did not answer for 2 s (--timeout)"),
+                ("worker", signal.SIGKILL,
+                 "lost the workers of the Dask cluster at {address} during the run, after 0 "
+                 "of 12 windows: the scheduler has had none for 2 s (--timeout)")):
+            directory = self.path("lost_%s_%s" % (lost, sig.name))
+            os.mkdir(directory)
+            with self.subTest(lost=lost, signal=sig.name), ExternalCluster(directory) as cluster:
+                address = cluster.start_cluster(preload)
+                dest = os.path.join(directory, "out.tif")
+                with open(dest, "w") as f:
+                    f.write("an older result")
+                # the first with Dask's progress bar, whose thread printed a traceback
+                quiet = [] if lost == "scheduler" and sig == signal.SIGKILL else ["-q"]
+                p = cluster.run("run", ["--scheduler", address, "--timeout", 2, "--tile-size",
+                                        64] + quiet + T.oo_args(SHADE) + [T.conn(self.dem), dest])
+                cluster.wait_for(lambda: os.path.exists(os.path.join(directory, "started")),
+                                 "a task")
+                t0 = time.time()
+                cluster.signal(lost, sig)
+                err = cluster.stderr(p, 60)  # a hang fails here, not in CI's limit
+                took = time.time() - t0
+                print("%s %s: exit %d after %.1f s" % (lost, sig.name, p.returncode, took))
+                self.assertEqual(p.returncode, 3, err)
+                # one sentence on a line of its own (after the bar's, whose draws
+                # each start with a carriage return), no traceback
+                lines = err.rstrip("\n").split("\n")
+                self.assertTrue(lines[-1].startswith("terrashade.distributed: error: "
+                                                     + said.format(address=address)), err)
+                self.assertEqual([line for line in lines[:-1] if "% Completed" not in line],
+                                 [], err)
+                self.assertIn("; nothing written to %s: run the command again" % dest, err)
+                # at once when its connection closes, else after --timeout (2 s) and
+                # up to a second between checks: generous bounds for a loaded machine
+                self.assertLess(took, 5 if sig == signal.SIGKILL and lost == "scheduler"
+                                else 10)
+                with open(dest) as f:
+                    self.assertEqual(f.read(), "an older result")
+                os.remove(dest)
+                self.assert_nothing_left(dest)
+                if sig == signal.SIGSTOP:  # and at the start: not reached, as when absent
+                    p = cluster.run("run_at_start", ["--scheduler", address, "--timeout", 2,
+                                                     "-q", T.conn(self.dem), dest])
+                    err = cluster.stderr(p, 60)
+                    self.assertEqual(p.returncode, 2, err)
+                    self.assertIn("cannot reach the Dask scheduler at %s within 2 s" % address,
+                                  err)
+                    self.assertNotIn("Traceback", err)
+                    self.assert_nothing_left(dest)
 
     def test_unreachable_scheduler(self):
         with socket.socket() as s:  # a port nobody listens on
