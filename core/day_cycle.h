@@ -240,6 +240,18 @@ int ts_sun_visibility_sweeps(const ts_sun_sites *sites, const ts_day_opts *o,
                              double unix_time);
 
 /**
+ * The distinct horizon planes that the steps at unix_times[0..n) sweep for
+ * `sites` when each step's sweeps run (ts_sun_visibility_sweeps): a
+ * narrow lattice's at its own azimuths, summed over the steps; a wide one's
+ * at whole degrees, which the steps share, each counted once (at most
+ * 360). n for one site. -1 if the sun cannot be computed or memory runs
+ * out. A windowed day's far field keeps one plane for each (the driver's
+ * memory estimate).
+ */
+int ts_sun_visibility_planes(const ts_sun_sites *sites, const ts_day_opts *o,
+                             const double *unix_times, int n);
+
+/**
  * Hours of direct sun over [start, start + length): the sum over uniform
  * steps of step_s seconds of the step's length times, at the middle of the
  * step, 1 if any of the sun's disk is visible (o->sun_hours_rule

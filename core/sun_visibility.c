@@ -210,20 +210,32 @@ static ts_status vis_narrow(ts_vis_ctx *c, const ts_horizon_opts *ho, double a_r
     return TS_OK;
 }
 
+/* The span of a lattice's suns at unix_time (lattice_span), from a_ref,
+ * its reference node's azimuth; ns: room for every node. */
+static ts_status lattice_at(const ts_sun_sites *sites, const ts_day_opts *o, double unix_time,
+                            ts_sun_sample *ns, double *a_ref, double *lo, double *hi)
+{
+    ts_error err;
+    double emax;
+    ts_status st = ts_day_nodes_sun(sites, o, unix_time, ns, &err);
+    if (st != TS_OK)
+        return st;
+    *a_ref = ns[ts_day_ref_node(sites)].grid_azimuth;
+    lattice_span(ns, sites->nx * sites->ny, *a_ref, lo, hi, &emax);
+    return TS_OK;
+}
+
 int ts_sun_visibility_sweeps(const ts_sun_sites *sites, const ts_day_opts *o,
                              double unix_time)
 {
-    ts_error err;
     int nodes = sites->nx * sites->ny;
     if (nodes == 1)
         return 1;
     ts_sun_sample *ns = malloc((size_t)nodes * sizeof *ns);
     int K = -1;
-    if (ns && ts_day_nodes_sun(sites, o, unix_time, ns, &err) == TS_OK) {
-        double lo, hi, emax, a_ref = ns[ts_day_ref_node(sites)].grid_azimuth;
-        lattice_span(ns, nodes, a_ref, &lo, &hi, &emax);
+    double a_ref, lo, hi;
+    if (ns && lattice_at(sites, o, unix_time, ns, &a_ref, &lo, &hi) == TS_OK)
         K = lattice_sweeps(a_ref, lo, hi);
-    }
     free(ns);
     return K;
 }
@@ -233,6 +245,36 @@ static int lattice_slot(long b)
 {
     long s = b % LATTICE_SLOTS;
     return (int)(s < 0 ? s + LATTICE_SLOTS : s);
+}
+
+int ts_sun_visibility_planes(const ts_sun_sites *sites, const ts_day_opts *o,
+                             const double *unix_times, int n)
+{
+    int nodes = sites->nx * sites->ny;
+    if (nodes == 1)
+        return n;
+    ts_sun_sample *ns = malloc((size_t)nodes * sizeof *ns);
+    unsigned char *seen = calloc(LATTICE_SLOTS, 1);
+    int planes = ns && seen ? 0 : -1;
+    for (int k = 0; k < n && planes >= 0; k++) {
+        double a_ref, lo, hi;
+        long b0, b1;
+        if (lattice_at(sites, o, unix_times[k], ns, &a_ref, &lo, &hi) != TS_OK) {
+            planes = -1;
+        } else if (hi - lo <= LATTICE_NARROW) { /* its own azimuths: not shared */
+            planes += lattice_sweeps(a_ref, lo, hi);
+        } else { /* whole steps of azimuth, each swept once a day */
+            lattice_brackets(a_ref + lo, a_ref + hi, &b0, &b1);
+            for (long b = b0; b <= b1 + 1; b++)
+                if (!seen[lattice_slot(b)]) {
+                    seen[lattice_slot(b)] = 1;
+                    planes++;
+                }
+        }
+    }
+    free(seen);
+    free(ns);
+    return planes;
 }
 
 /* The plane at b steps of azimuth if kept, else NULL. */

@@ -64,31 +64,53 @@ static int far_factor(const tsd_options *o, int W, int H, int f_mem, double near
     return f < 1 ? 1 : f;
 }
 
+/* SUN_POSITION=per_cell's lattice thinned to at most THIN x THIN nodes,
+ * its corners and edges among them, for counting its sweeps: its thousands
+ * of nodes, for every step of a day, would hold up the dataset's opening,
+ * and its four corners alone miss a world DEM's spread of azimuths (its
+ * east and west edges meet, so their suns agree). */
+#define THIN 9
+typedef struct {
+    double lon[THIN * THIN], lat[THIN * THIN], north[THIN * THIN];
+    ts_sun_sites sites;
+} thin_lattice;
+
+static void thin_lattice_of(const ts_sun_sites *s, thin_lattice *t)
+{
+    const int mx = s->nx < THIN ? s->nx : THIN, my = s->ny < THIN ? s->ny : THIN;
+    for (int b = 0; b < my; b++)
+        for (int a = 0; a < mx; a++) {
+            int i = mx > 1 ? (int)lround((double)a * (s->nx - 1) / (mx - 1)) : 0;
+            int j = my > 1 ? (int)lround((double)b * (s->ny - 1) / (my - 1)) : 0;
+            t->lon[b * mx + a] = s->longitude[j * s->nx + i];
+            t->lat[b * mx + a] = s->latitude[j * s->nx + i];
+            t->north[b * mx + a] = s->north_azimuth ? s->north_azimuth[j * s->nx + i] : 0.0;
+        }
+    ts_sun_sites thin = {mx, my, s->x0, s->y0,
+                         mx > 1 ? s->dx * (s->nx - 1) / (mx - 1) : s->dx,
+                         my > 1 ? s->dy * (s->ny - 1) / (my - 1) : s->dy,
+                         t->lon, t->lat, t->north};
+    t->sites = thin;
+}
+
 /* The far planes of a sun at `t`: one sweep, or a lattice's several
- * (SUN_POSITION=per_cell), counted from the lattice's four corners (the
- * suns' azimuths vary smoothly over it; its thousands of nodes, for every
- * step of a day, would hold up the dataset's opening); when in doubt, 4. */
+ * (SUN_POSITION=per_cell, counted on the thinned lattice); when in doubt,
+ * 4. */
 static int sun_sweeps(const tsd_sun *sun, double t)
 {
-    const ts_sun_sites *s = &sun->sites;
     if (!tsd_sun_per_cell(sun))
         return 1;
-    double lon[4], lat[4], north[4];
-    for (int k = 0; k < 4; k++) {
-        int i = (k & 1) * (s->nx - 1), j = (k >> 1) * (s->ny - 1);
-        lon[k] = s->longitude[j * s->nx + i];
-        lat[k] = s->latitude[j * s->nx + i];
-        north[k] = s->north_azimuth ? s->north_azimuth[j * s->nx + i] : 0.0;
-    }
-    ts_sun_sites corners = {2, 2, s->x0, s->y0, s->dx * (s->nx - 1), s->dy * (s->ny - 1),
-                            lon, lat, north};
-    int k = ts_sun_visibility_sweeps(&corners, &sun->day, t);
+    thin_lattice thin;
+    thin_lattice_of(&sun->sites, &thin);
+    int k = ts_sun_visibility_sweeps(&thin.sites, &sun->day, t);
     return k > 0 ? k : 4;
 }
 
-/* The far planes of a day product's sun: those of each time step with the
+/* The far planes of a day product's sun: those of the time steps with the
  * sun up at the centre (its upper limb above the lowest Earth horizon any
- * land can see, TSD_DAY_SUN_UP_DEG), or a date range's horizon azimuths. */
+ * land can see, TSD_DAY_SUN_UP_DEG), each plane once (a wide lattice's
+ * whole degrees serve every step: ts_sun_visibility_planes), or a date
+ * range's horizon azimuths. */
 static int day_sweeps(const tsd_options *o, const tsd_sun *sun)
 {
     if (!sun)
@@ -99,20 +121,29 @@ static int day_sweeps(const tsd_options *o, const tsd_sun *sun)
     const int n = ts_day_step_count(sun->day_length, step);
     double *mid = malloc((size_t)n * sizeof *mid), *dur = malloc((size_t)n * sizeof *dur);
     ts_error err;
-    int up = 4 * n; /* when in doubt, every step */
+    int planes = 4 * n; /* when in doubt, every step */
     if (mid && dur && ts_day_uniform_times(sun->day_start, sun->day_length, step, mid, dur,
                                            &err) == TS_OK) {
-        up = 0;
+        int up = 0;
         for (int k = 0; k < n; k++) {
             ts_sun_sample at;
             if (ts_sun_at_site(&sun->sites, &sun->day, mid[k], &at, &err) != TS_OK ||
                 at.elevation + TS_SUN_RADIUS_DEG > TSD_DAY_SUN_UP_DEG)
-                up += sun_sweeps(sun, mid[k]);
+                mid[up++] = mid[k];
+        }
+        if (!tsd_sun_per_cell(sun)) {
+            planes = up;
+        } else {
+            thin_lattice thin;
+            thin_lattice_of(&sun->sites, &thin);
+            int p = ts_sun_visibility_planes(&thin.sites, &sun->day, mid, up);
+            if (p >= 0)
+                planes = p;
         }
     }
     free(mid);
     free(dur);
-    return up;
+    return planes;
 }
 
 /* Why the product or method of o needs the whole DEM (NULL: it does

@@ -174,6 +174,43 @@ class MemoryEstimate(unittest.TestCase):
     def test_windowed_day_estimate_is_an_upper_bound(self):
         self.brackets(WINDOWED_DAY, dict(COMMON, TILE_SIZE=512), estimate_logged, over=2.0)
 
+    def test_world_day_counts_each_far_plane_once(self):
+        """SUN_POSITION=per_cell on a world DEM in windows: the suns' azimuths
+        span the whole circle at every step, swept at whole degrees that the
+        steps share, so the far field keeps at most 360 planes. The estimate
+        counted every step's sweeps (about 2900 planes for 720 x 360 cells at
+        60-minute steps: a far grid of 240 x 120 where the DEM's own fits,
+        252 MiB; 1440 x 720 at 30-minute steps refused under MAX_MEMORY=2000
+        as needing 6616 MiB, where the run takes 1.3-1.7 GB); the corners it
+        counted them on miss a world DEM's spread, since its east and west
+        edges meet. Windowed, the result is the whole DEM's."""
+        d = os.path.dirname(self.out)
+        worlds = {}
+        for nx in (720, 1440):
+            yy, xx = T.np.mgrid[0:nx // 2, 0:nx]
+            z = (2000 * (1 + T.np.sin(xx * 0.07) * T.np.cos(yy * 0.09))).astype(T.np.float32)
+            worlds[nx] = T.write_tif(os.path.join(d, "world%d.tif" % nx), z,
+                                     (-180.0, 360.0 / nx, 0, 90.0, 0, -360.0 / nx), 4326)
+        day = {"PRODUCT": "sunhours", "DATE": "2026-06-21", "TIMEZONE": "Z",
+               "SUN_POSITION": "per_cell", "BACKEND": "c"}
+        oo = dict(day, STEP_MINUTES=60, TILE_SIZE=256, MAX_MEMORY=8000)
+        p = T.run(["gdalinfo"] + T.oo_args(oo) + [T.conn(worlds[720])],
+                  CPL_DEBUG="TERRASHADE")
+        self.assertIn("far grid 720 x 360", p.stderr)
+        m = re.search(r"memory: about (\d+) MiB while computing .*by window", p.stderr)
+        self.assertIsNotNone(m, p.stderr)
+        # 720 x 360 cells of 2 + 360 16-bit planes and a float plane, plus the chunks
+        self.assertLess(int(m.group(1)), 230)
+        # opens (it was refused), its far grid within a quarter of the limit
+        p = T.run(["gdalinfo"] + T.oo_args(dict(day, TILE_SIZE=512, MAX_MEMORY=2000)) +
+                  [T.conn(worlds[1440])], CPL_DEBUG="TERRASHADE")
+        m = re.search(r"memory: about (\d+) MiB while computing .*by window", p.stderr)
+        self.assertIsNotNone(m, p.stderr)
+        self.assertLess(int(m.group(1)), 500)
+        whole = T.read(T.conn(worlds[720]), 1, dict(oo, TILE_SIZE=0))
+        windowed = T.read(T.conn(worlds[720]), 1, oo)
+        T.np.testing.assert_allclose(windowed, whole, atol=0.01)
+
     def test_cache_the_estimate_counts_is_the_cache(self):
         """The estimate counts the chunks the LRU cache keeps: a row of them
         (width / TILE_SIZE + 1) and at least 4. A DEM at most two chunks wide
