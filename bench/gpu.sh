@@ -218,5 +218,12 @@ say "== cl_bench --size $size --dirs $dirs --repeat $repeat"
 "$BUILD_DIR/cl_bench" --size "$size" --dirs "$dirs" --repeat "$repeat"
 say "== kernel times: TERRASHADE_OPENCL_PROFILE=1 cl_bench --size $size --dirs $dirs --repeat 1"
 say "(each launch waits for its event here, so the throughputs of this run are not the figures)"
-TERRASHADE_OPENCL_PROFILE=1 "$BUILD_DIR/cl_bench" --size "$size" --dirs "$dirs" --repeat 1 2>&1 |
-    sed -n '/TERRASHADE_OPENCL_PROFILE/,$p'
+TERRASHADE_OPENCL_PROFILE=1 "$BUILD_DIR/cl_bench" --size "$size" --dirs "$dirs" --repeat 1 \
+    >"$BUILD_DIR/profile" 2>&1 || true
+sed -n '/TERRASHADE_OPENCL_PROFILE/,$p' "$BUILD_DIR/profile"
+# The horizon sweep's own rate (issue 13's GPU goal): its kernels' device
+# time, the transposes included (one of them may be another product's).
+awk -v px="$size" -v dirs="$dirs" '
+    $1 ~ /^ts_(sweep_lines|sweep_fast|sweep_finish|transpose)$/ { t += $3 }
+    END { if (t > 0) printf "horizon sweep, kernels alone: %.1f ms = %.1f Mpx-dir/s\n",
+                          1e3 * t, px * px * dirs / t / 1e6 }' "$BUILD_DIR/profile"
