@@ -300,7 +300,14 @@ static ts_cl_dev *make_device(int i, ts_error *err)
         /* TERRASHADE_OPENCL_BUILD_OPTIONS: kernel variants for tuning (the
          * TS_* macros the .cl files test with #ifndef) */
         const char *extra = getenv("TERRASHADE_OPENCL_BUILD_OPTIONS");
-        snprintf(opts, sizeof opts, "%s%s%s %.200s",
+        if (extra && strlen(extra) > 200) {
+            ts_fail(err, TS_ERR_ARG,
+                    "TERRASHADE_OPENCL_BUILD_OPTIONS is %zu characters long, more than the "
+                    "200 the kernels' build options have room for",
+                    strlen(extra));
+            goto failed;
+        }
+        snprintf(opts, sizeof opts, "%s%s%s %s",
                  (major > 1 || (major == 1 && minor >= 2)) ? "-cl-std=CL1.2 " : "",
                  d->info.fp64 ? "-DTS_FP64=1 " : "",
                  (sp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT)

@@ -3,7 +3,8 @@
  * horizon planes kept from one step to the next (ts_day_opts.
  * plane_cache_bytes) change no value and sweep each azimuth once, and the
  * SPA's part that depends on the instant alone, computed once for every
- * site (ts_sun_position_from), changes no bit. */
+ * site (ts_sun_position_from), changes no bit; the planes a day sweeps are
+ * counted as it sweeps them (ts_sun_visibility_planes). */
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
@@ -189,6 +190,58 @@ START_TEST(test_visibility_steps)
 }
 END_TEST
 
+/* ts_sun_visibility_planes (the windows' memory estimate): a wide
+ * lattice's whole degrees counted once over the day, at most 360 and at
+ * least the sweeps the day runs; a narrow one's own sweeps summed over the
+ * steps (each step's ts_sun_visibility_sweeps); one site, one a step. */
+START_TEST(test_planes_counted)
+{
+    world w;
+    world_init(&w);
+    const size_t n = (size_t)W * H;
+    enum { STEPS = 12 };
+    double t[STEPS];
+    const double start = ts_local_midnight(2026, 6, 21, 0);
+    for (int k = 0; k < STEPS; k++)
+        t[k] = start + (k + 0.5) * 7200;
+    float *all = malloc(STEPS * n * sizeof *all);
+    ts_error err;
+    int summed = 0;
+    for (int k = 0; k < STEPS; k++)
+        summed += ts_sun_visibility_sweeps(&w.s, &w.o, t[k]);
+    w.sweeps = 0;
+    ck_assert(ts_sun_visibility_steps(&w.g, &w.s, &w.o, t, STEPS, all, &err) == TS_OK);
+    const int wide = ts_sun_visibility_planes(&w.s, &w.o, t, STEPS);
+    printf("day lattice, wide: %d planes counted, %d swept, %d summed step by step\n", wide,
+           w.sweeps, summed);
+    ck_assert_int_ge(wide, w.sweeps);
+    ck_assert_int_le(wide, 360);
+    ck_assert_int_gt(summed, 5 * wide);
+
+    /* a lattice 0.4 degrees wide: its sweeps at its own azimuths */
+    for (int i = 0; i < NX * NY; i++) {
+        w.lon[i] = -100.2 + 0.4 * (i % NX) / (NX - 1);
+        w.lat[i] = 40.0 + 0.4 * (i / NX) / (NY - 1);
+    }
+    summed = 0;
+    for (int k = 0; k < STEPS; k++)
+        summed += ts_sun_visibility_sweeps(&w.s, &w.o, t[k]);
+    w.sweeps = 0;
+    ck_assert(ts_sun_visibility_steps(&w.g, &w.s, &w.o, t, STEPS, all, &err) == TS_OK);
+    const int narrow = ts_sun_visibility_planes(&w.s, &w.o, t, STEPS);
+    printf("day lattice, narrow: %d planes counted, %d swept\n", narrow, w.sweeps);
+    ck_assert_int_eq(narrow, summed);
+    ck_assert_int_ge(narrow, w.sweeps);
+
+    ts_sun_sites one = {1, 1, 0.0, 0.0, 1.0, 1.0, w.lon, w.lat, w.north};
+    ck_assert_int_eq(ts_sun_visibility_planes(&one, &w.o, t, STEPS), STEPS);
+    t[3] = NAN; /* the sun cannot be computed */
+    ck_assert_int_eq(ts_sun_visibility_planes(&w.s, &w.o, t, STEPS), -1);
+    free(all);
+    ts_grid_free(&w.g);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("day_lattice");
@@ -197,6 +250,7 @@ int main(void)
     tcase_add_test(tc, test_sun_position_from);
     tcase_add_test(tc, test_planes_kept_over_a_day);
     tcase_add_test(tc, test_visibility_steps);
+    tcase_add_test(tc, test_planes_counted);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

@@ -248,13 +248,17 @@ class Backend(unittest.TestCase):
                                   p.stderr)
                     for k in ("ts_sweep_lines", "ts_sweep_fast", "ts_sweep_finish"):
                         self.assertRegex(p.stderr, r"\n  %s +[1-9]\d* +\d+\.\d{4} " % k)
-        p = T.run(base + [out], TERRASHADE_OPENCL_BUILD_OPTIONS="-DTS_FAR_SPREAD=(")
-        print(p.stderr)
-        self.assertIn("BACKEND=opencl was requested", p.stderr)
-        self.assertIn("OpenCL kernels failed to build", p.stderr)
-        ds = gdal.Open(out)
-        self.assertEqual(ds.GetMetadataItem("BACKEND"), "c")
-        np.testing.assert_allclose(ds.ReadAsArray(), want, atol=1e-3)
+        for bad, said in (("-DTS_FAR_SPREAD=(", "OpenCL kernels failed to build"),
+                          ("-DTS_LOST_STEPS=8 " * 12, "TERRASHADE_OPENCL_BUILD_OPTIONS is 216 "
+                           "characters long, more than the 200")):
+            with self.subTest(bad=bad):
+                p = T.run(base + [out], TERRASHADE_OPENCL_BUILD_OPTIONS=bad)
+                print(p.stderr)
+                self.assertIn("BACKEND=opencl was requested", p.stderr)
+                self.assertIn(said, p.stderr)
+                ds = gdal.Open(out)
+                self.assertEqual(ds.GetMetadataItem("BACKEND"), "c")
+                np.testing.assert_allclose(ds.ReadAsArray(), want, atol=1e-3)
 
     def test_bad_values_are_errors(self):
         dem = self.dems["synthetic"]
