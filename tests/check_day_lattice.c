@@ -59,6 +59,16 @@ static void world_init(world *w)
     w->o.plane_hook_user = &w->sweeps;
 }
 
+enum { STEPS = 12 };
+
+/* STEPS instants 2 hours apart over the day of `midnight`, at the steps'
+ * middles. */
+static void two_hourly(double midnight, double *t)
+{
+    for (int k = 0; k < STEPS; k++)
+        t[k] = midnight + (k + 0.5) * 7200;
+}
+
 static int same_bits(const float *a, const float *b, size_t n)
 {
     return memcmp(a, b, n * sizeof *a) == 0;
@@ -160,11 +170,8 @@ START_TEST(test_visibility_steps)
     world w;
     world_init(&w);
     const size_t n = (size_t)W * H;
-    enum { STEPS = 12 };
     double t[STEPS];
-    const double start = ts_local_midnight(2026, 12, 21, 0);
-    for (int k = 0; k < STEPS; k++)
-        t[k] = start + (k + 0.5) * 7200;
+    two_hourly(ts_local_midnight(2026, 12, 21, 0), t);
     float *all = malloc(STEPS * n * sizeof *all), *one = malloc(n * sizeof *one);
     ts_error err;
     w.sweeps = 0;
@@ -199,11 +206,8 @@ START_TEST(test_planes_counted)
     world w;
     world_init(&w);
     const size_t n = (size_t)W * H;
-    enum { STEPS = 12 };
     double t[STEPS];
-    const double start = ts_local_midnight(2026, 6, 21, 0);
-    for (int k = 0; k < STEPS; k++)
-        t[k] = start + (k + 0.5) * 7200;
+    two_hourly(ts_local_midnight(2026, 6, 21, 0), t);
     float *all = malloc(STEPS * n * sizeof *all);
     ts_error err;
     int summed = 0;
