@@ -169,6 +169,26 @@ __kernel void ts_sweep_lines(__global const float *zr, __global const float *zt,
 #define TS_FAR_SPREAD 0
 #endif
 
+/* The cell's own ray sampled at and beside (TS_FAR_SPREAD steps) a line's
+ * occluder cand: the highest slope; *lost: the ray cannot be sampled at the
+ * occluder itself (the caller's cm_ray_lost, or ts_sweep_finish). */
+float ts_far_at(const cm_ray_grid *r, int k, int i, float h, int2 cand, real step, real c,
+                int *lost)
+{
+    float best = -INFINITY;
+    const int dk = k - cand.x;
+    *lost = 0;
+    for (int e = -TS_FAR_SPREAD; e <= TS_FAR_SPREAD; e++) {
+        if (dk + e <= TS_NEAR_STEPS)
+            continue;
+        float s = cm_ray_slope(r, k, i, h, dk + e, as_float(cand.y) + (float)(e * step),
+                               (float)c);
+        *lost |= e == 0 && s == -INFINITY;
+        best = s > best ? s : best;
+    }
+    return best;
+}
+
 /* far_field: the cell's own ray at and beside the two lines' occluders (at
  * one it cannot be sampled at, the steps up to it: cm_ray_lost); when one
  * lies past the distance cap, the exact ray over the far part of the radius
@@ -182,17 +202,14 @@ float ts_far_field(const cm_ray_grid *r, int k, int i, float h, int2 lo, int2 hi
         int2 cand = cc ? hi : lo;
         if (cand.x < 0 || (cc == 1 && hi.x == lo.x))
             continue;
-        int dk = k - cand.x;
         beyond_cap |= cap > 0 && as_float(cand.y) > cap;
-        for (int e = -TS_FAR_SPREAD; e <= TS_FAR_SPREAD; e++) {
-            if (dk + e <= TS_NEAR_STEPS)
-                continue;
-            float s = cm_ray_slope(r, k, i, h, dk + e, as_float(cand.y) + (float)(e * step),
-                                   (float)c);
-            if (e == 0 && s == -INFINITY) /* the ray cannot be sampled there */
-                s = cm_ray_lost(r, k, i, h, dk, TS_NEAR_STEPS, cap / step, step, c);
-            best = s > best ? s : best;
+        int lost;
+        float s = ts_far_at(r, k, i, h, cand, step, c, &lost);
+        if (lost) { /* the steps up to the occluder instead of the lost sample */
+            float sl = cm_ray_lost(r, k, i, h, k - cand.x, TS_NEAR_STEPS, cap / step, step, c);
+            s = sl > s ? sl : s;
         }
+        best = s > best ? s : best;
     }
     if (!beyond_cap)
         return best;
@@ -395,15 +412,10 @@ __kernel void ts_sweep_fast(__global const float *zr, __global const float *zt, 
         const int2 cand = cc ? ohi : f.olo;
         if (cand.x < 0 || (cc == 1 && ohi.x == f.olo.x))
             continue;
-        const int dk = f.k - cand.x;
-        for (int e = -TS_FAR_SPREAD; e <= TS_FAR_SPREAD; e++) {
-            if (dk + e <= TS_NEAR_STEPS)
-                continue;
-            const float s = cm_ray_slope(&f.r, f.k, f.v, f.hc, dk + e,
-                                         as_float(cand.y) + (float)(e * f.step), (float)c);
-            rest |= e == 0 && s == -INFINITY; /* ts_far_field's lost ray */
-            farf = s > farf ? s : farf;
-        }
+        int lost; /* ts_far_field's cm_ray_lost: left to ts_sweep_finish */
+        const float s = ts_far_at(&f.r, f.k, f.v, f.hc, cand, f.step, c, &lost);
+        rest |= lost;
+        farf = s > farf ? s : farf;
     }
     int flagged = 0;
     float nf = -INFINITY;
