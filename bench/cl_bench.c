@@ -1,7 +1,7 @@
 /*
  * cl_bench: the C and the OpenCL backend side by side, product by product.
  *
- *   cl_bench [--size N] [--dirs D] [--repeat R] [--threads T]
+ *   cl_bench [--size N] [--dirs D] [--repeat R] [--threads T] [--no-streams]
  *   cl_bench --list
  *
  * Generates an N x N fractal DEM (default 1024, fBm value noise, Hurst 0.8,
@@ -22,7 +22,9 @@
  * components, svf, sky light and openness, the three colours), and, for the
  * horizons, the time the device takes to copy the planes to host memory
  * (the same bytes in the same buffer sizes, timed alone), so that the
- * kernels' own rate can be told from the bus's.
+ * kernels' own rate can be told from the bus's. Then, unless --no-streams,
+ * the horizons on OpenCL as the driver's streams sweep them: one azimuth
+ * per call, and 16 per call (the GPU default of TERRASHADE_OPENCL_BATCH).
  */
 #ifdef HAVE_CONFIG_H
 #include <config.h>
@@ -196,9 +198,52 @@ static void run(ctx *c, int p, int cl, float *hout)
         die(NAMES[p], &e);
 }
 
+/* The driver's horizon streams (plugin/tsd_compute.c) on OpenCL: every
+ * azimuth in its own call (ts_cl_horizon_sweep: the DEM uploaded and the
+ * lines of one azimuth launched each time), then in calls of 16
+ * (ts_cl_horizon_sweeps, the GPU default); each plane checked against the
+ * all-at-once planes `want`, which it must equal bit for bit. */
+static void stream_calls(ctx *c, const float *want, int repeat)
+{
+    const int dirs = c->o.directions, per[2] = {1, 16};
+    float *planes = malloc(c->n * 16 * sizeof(float));
+    double az[16];
+    if (!planes) {
+        fprintf(stderr, "cl_bench: out of memory\n");
+        exit(1);
+    }
+    bench_touch_pages(planes, c->n * 16 * sizeof(float));
+    printf("\nhorizons as the driver streams them (OpenCL, best of %d):\n", repeat);
+    for (int v = 0; v < 2; v++) {
+        double best = 1e30;
+        int same = 1;
+        for (int r = 0; r < repeat; r++) {
+            double t = bench_now();
+            for (int k0 = 0; k0 < dirs; k0 += per[v]) {
+                const int n = dirs - k0 < per[v] ? dirs - k0 : per[v];
+                ts_error e;
+                for (int i = 0; i < n; i++)
+                    az[i] = ts_horizon_azimuth(&c->o, k0 + i);
+                ts_status st = n == 1 ? ts_cl_horizon_sweep(&c->g, az[0], &c->o, planes, &e)
+                                      : ts_cl_horizon_sweeps(&c->g, az, n, &c->o, planes, &e);
+                if (st != TS_OK)
+                    die("horizon sweeps", &e);
+                if (r == 0)
+                    same &= !memcmp(planes, want + c->n * k0, c->n * n * sizeof(float));
+            }
+            t = bench_now() - t;
+            best = t < best ? t : best;
+        }
+        printf("  %2d azimuth(s) per call: %.3f s = %.1f Mpx-dir/s; planes %s\n", per[v], best,
+               (double)c->n * dirs / best / 1e6,
+               same ? "bit-identical to all at once" : "DIFFER from all at once");
+    }
+    free(planes);
+}
+
 int main(int argc, char **argv)
 {
-    int size = 1024, dirs = 16, repeat = 3, threads = 0;
+    int size = 1024, dirs = 16, repeat = 3, threads = 0, streams = 1;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--list"))
             return list_devices();
@@ -210,9 +255,12 @@ int main(int argc, char **argv)
             repeat = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc)
             threads = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--no-streams"))
+            streams = 0;
         else {
             fprintf(stderr,
-                    "usage: %s [--size N] [--dirs D] [--repeat R] [--threads T] | --list\n",
+                    "usage: %s [--size N] [--dirs D] [--repeat R] [--threads T] "
+                    "[--no-streams] | --list\n",
                     argv[0]);
             return 2;
         }
@@ -316,6 +364,8 @@ int main(int argc, char **argv)
                work / best[0] / 1e6, work / best[1] / 1e6, best[0] / best[1], diff, best[0],
                best[1]);
     }
+    if (streams)
+        stream_calls(&c, hz_cl, repeat); /* (before the copy below overwrites hz_cl) */
     /* The horizon planes go to host memory: on a GPU that copy can take
      * longer than the kernels. */
     double rb = readback_seconds(hz_cl, c.n * dirs * sizeof(float), c.n * sizeof(float), repeat);

@@ -216,10 +216,10 @@ fi
 # ------------------------------------------------------------------ bench
 say "== cl_bench --size $size --dirs $dirs --repeat $repeat"
 "$BUILD_DIR/cl_bench" --size "$size" --dirs "$dirs" --repeat "$repeat"
-say "== kernel times: TERRASHADE_OPENCL_PROFILE=1 cl_bench --size $size --dirs $dirs --repeat 1"
+say "== kernel times: TERRASHADE_OPENCL_PROFILE=1 cl_bench --size $size --dirs $dirs --repeat 1 --no-streams"
 say "(each launch waits for its event here, so the throughputs of this run are not the figures)"
 TERRASHADE_OPENCL_PROFILE=1 "$BUILD_DIR/cl_bench" --size "$size" --dirs "$dirs" --repeat 1 \
-    >"$BUILD_DIR/profile" 2>&1 || true
+    --no-streams >"$BUILD_DIR/profile" 2>&1 || true
 sed -n '/TERRASHADE_OPENCL_PROFILE/,$p' "$BUILD_DIR/profile"
 # The horizon sweep's own rate (issue 13's GPU goal): its kernels' device
 # time, the transposes included (one of them may be another product's).

@@ -12,6 +12,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "arg_checks.h"
 #include "status_internal.h"
 #include "terrashade_backend.h"
 #include "terrashade_cl.h"
@@ -163,6 +164,25 @@ ts_status ts_backend_horizon_sweep(ts_backend backend, const ts_grid *grid, doub
 {
     DISPATCH(ts_cl_horizon_sweep(grid, azimuth, opts, out, cl_err),
              ts_horizon_sweep(grid, azimuth, opts, out, err));
+}
+
+/* The C side of ts_backend_horizon_sweeps: one sweep after the other. */
+static ts_status c_horizon_sweeps(const ts_grid *grid, const double *azimuths, int n,
+                                  const ts_horizon_opts *opts, float *out, ts_error *err)
+{
+    ts_status st = ts_check_sweeps_args(grid, azimuths, n, opts, out, NULL, err);
+    const size_t cells = st == TS_OK ? (size_t)grid->width * grid->height : 0;
+    for (int a = 0; st == TS_OK && a < n; a++)
+        st = ts_horizon_sweep(grid, azimuths[a], opts, out + (size_t)a * cells, err);
+    return st;
+}
+
+ts_status ts_backend_horizon_sweeps(ts_backend backend, const ts_grid *grid,
+                                    const double *azimuths, int n, const ts_horizon_opts *opts,
+                                    float *out, ts_backend_report *report, ts_error *err)
+{
+    DISPATCH(ts_cl_horizon_sweeps(grid, azimuths, n, opts, out, cl_err),
+             c_horizon_sweeps(grid, azimuths, n, opts, out, err));
 }
 
 ts_status ts_backend_horizon_compute(ts_backend backend, const ts_grid *grid,

@@ -376,6 +376,24 @@ ts_status ts_cl_horizon_sweep(const ts_grid *grid, double azimuth, const ts_hori
     return st == TS_OK ? edge_apply(grid, opts, &azimuth, 1, out, err) : st;
 }
 
+ts_status ts_cl_horizon_sweeps(const ts_grid *grid, const double *azimuths, int n,
+                               const ts_horizon_opts *opts, float *out, ts_error *err)
+{
+    double *az = n > 0 ? malloc((size_t)n * sizeof *az) : NULL;
+    if (n > 0 && !az)
+        return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the azimuth list");
+    ts_status st = ts_check_sweeps_args(grid, azimuths, n, opts, out, az, err);
+    ts_horizon_opts run;
+    if (st == TS_OK)
+        st = uncapped_opts(grid, opts, az, n, &run, err);
+    if (st == TS_OK)
+        st = horizon_run(grid, &run, az, n, out, err);
+    if (st == TS_OK)
+        st = edge_apply(grid, opts, az, n, out, err);
+    free(az);
+    return st;
+}
+
 ts_status ts_cl_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts, float *out,
                                 ts_error *err)
 {

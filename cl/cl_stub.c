@@ -46,6 +46,13 @@ ts_status ts_cl_horizon_sweep(const ts_grid *grid, double azimuth, const ts_hori
     return NOT_BUILT(err);
 }
 
+ts_status ts_cl_horizon_sweeps(const ts_grid *grid, const double *azimuths, int n,
+                               const ts_horizon_opts *opts, float *out, ts_error *err)
+{
+    (void)grid, (void)azimuths, (void)n, (void)opts, (void)out;
+    return NOT_BUILT(err);
+}
+
 ts_status ts_cl_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts, float *out,
                                 ts_error *err)
 {

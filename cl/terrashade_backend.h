@@ -70,6 +70,16 @@ ts_status ts_backend_horizon_sweep(ts_backend backend, const ts_grid *grid,
                                    float *out, ts_backend_report *report,
                                    ts_error *err);
 
+/**
+ * The sweeps of n azimuths in one call, into n planes of width*height
+ * (ts_cl_horizon_sweeps: the DEM uploaded once for all of them); on C,
+ * ts_horizon_sweep for each in turn. Plane a is what
+ * ts_backend_horizon_sweep gives for azimuth a on the same backend.
+ */
+ts_status ts_backend_horizon_sweeps(ts_backend backend, const ts_grid *grid,
+                                    const double *azimuths, int n, const ts_horizon_opts *opts,
+                                    float *out, ts_backend_report *report, ts_error *err);
+
 ts_status ts_backend_horizon_compute(ts_backend backend, const ts_grid *grid,
                                      const ts_horizon_opts *opts, float *out,
                                      ts_backend_report *report, ts_error *err);

@@ -100,6 +100,18 @@ ts_status ts_cl_devices(ts_cl_info *list, int max, int *count, ts_error *err);
 /** The horizon sweep on the device (ts_horizon_sweep_fn): one azimuth. */
 ts_horizon_sweep_fn ts_cl_horizon_sweep;
 
+/**
+ * The horizon sweeps of n azimuths (degrees from north, any value: each is
+ * reduced to [0, 360)) in one call: n planes of width*height into `out`,
+ * plane a that of azimuth a, each the plane ts_cl_horizon_sweep gives for
+ * that azimuth, bit for bit. The DEM is uploaded once and the azimuths'
+ * lines launched together (in batches that fit the device), so that a GPU
+ * gets enough lines to fill it. opts->directions and start_azimuth are
+ * ignored.
+ */
+ts_status ts_cl_horizon_sweeps(const ts_grid *grid, const double *azimuths, int n,
+                               const ts_horizon_opts *opts, float *out, ts_error *err);
+
 /** The horizons on the device (ts_horizon_compute_fn): opts->directions planes. */
 ts_horizon_compute_fn ts_cl_horizon_compute;
 

@@ -59,6 +59,28 @@ ts_status ts_check_sweep_args(const ts_grid *grid, double *azimuth,
     return TS_OK;
 }
 
+ts_status ts_check_sweeps_args(const ts_grid *grid, const double *azimuths, int n,
+                               const ts_horizon_opts *opts, const float *out, double *reduced,
+                               ts_error *err)
+{
+    if (!out || !azimuths)
+        return ts_fail(err, TS_ERR_ARG, "output buffer or azimuth list is NULL");
+    if (n < 1)
+        return ts_fail(err, TS_ERR_ARG, "the azimuth list must have at least one entry, got %d",
+                       n);
+    ts_status st = TS_OK;
+    for (int a = 0; st == TS_OK && a < n; a++) {
+        double az = azimuths[a];
+        st = ts_check_sweep_args(grid, &az, opts, err);
+        if (reduced)
+            reduced[a] = az;
+    }
+    if (st == TS_OK && (double)n * grid->width * grid->height > (double)(SIZE_MAX / sizeof *out))
+        return ts_fail(err, TS_ERR_ARG, "%d planes of %d x %d floats cannot be addressed", n,
+                       grid->width, grid->height);
+    return st;
+}
+
 ts_status ts_check_normals_args(const ts_grid *grid, const float *nx, const float *ny,
                                 const float *nz, ts_error *err)
 {

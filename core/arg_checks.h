@@ -16,6 +16,13 @@ ts_status ts_check_shm_args(const ts_grid *grid, double *azimuth, double elevati
 ts_status ts_check_sweep_args(const ts_grid *grid, double *azimuth,
                               const ts_horizon_opts *opts, ts_error *err);
 
+/* Checks of the backends' sweeps of n azimuths in one call (each as
+ * ts_check_sweep_args checks it; into reduced[0..n-1], in [0, 360), where
+ * reduced is not NULL), and that n planes of output can be addressed. */
+ts_status ts_check_sweeps_args(const ts_grid *grid, const double *azimuths, int n,
+                               const ts_horizon_opts *opts, const float *out, double *reduced,
+                               ts_error *err);
+
 /* Checks of ts_normals' arguments. */
 ts_status ts_check_normals_args(const ts_grid *grid, const float *nx, const float *ny,
                                 const float *nz, ts_error *err);

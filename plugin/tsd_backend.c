@@ -73,12 +73,29 @@ int tsd_backend_check_env(const tsd_options *o, int uses_backend, char *msg, siz
     int cap;
     if (ts_cpu_vectors_parse(getenv("TERRASHADE_SIMD"), &cap, &err) != TS_OK)
         return (tsd_fail_core(msg, n, NULL, &err), -1);
+    if (uses_backend && tsd_backend_batch(msg, n) < 0)
+        return -1;
     if (!uses_backend || o->backend != TSD_BACKEND_AUTO || !env || !*env ||
         ts_backend_parse(env, &b, &err) == TS_OK)
         return 0;
     return (tsd_fail(msg, n, TS_ERR_ARG,
                      "TERRASHADE_BACKEND must be auto, c or opencl, got '%.40s'", env),
             -1);
+}
+
+int tsd_backend_batch(char *msg, size_t n)
+{
+    const char *env = getenv("TERRASHADE_OPENCL_BATCH");
+    if (!env || !*env)
+        return 0;
+    char *end;
+    long v = strtol(env, &end, 10);
+    if (end == env || *end || v < 1 || v > TSD_OPENCL_BATCH_MAX)
+        return (tsd_fail(msg, n, TS_ERR_ARG,
+                         "TERRASHADE_OPENCL_BATCH must be an integer from 1 to %d, got '%.40s'",
+                         TSD_OPENCL_BATCH_MAX, env),
+                -1);
+    return (int)v;
 }
 
 void tsd_backend_summary_text(const tsd_backend_summary *s, char *backend, size_t bn,

@@ -53,8 +53,18 @@ int tsd_backend_predict(const tsd_options *o, tsd_backend_summary *s, char *msg,
  * sentence in msg if TERRASHADE_SIMD is not auto, avx512, avx2 or none
  * (every product runs C code), or, for a product that chooses a backend
  * (uses_backend) with BACKEND=auto, if TERRASHADE_BACKEND is not auto, c or
- * opencl; else 0. */
+ * opencl, or TERRASHADE_OPENCL_BATCH is not 1..TSD_OPENCL_BATCH_MAX (for a
+ * product that chooses a backend); else 0. */
 int tsd_backend_check_env(const tsd_options *o, int uses_backend, char *msg, size_t msg_size);
+
+/** The most azimuths a horizon stream sweeps in one OpenCL call
+ * (TERRASHADE_OPENCL_BATCH): unset or empty 0 (automatic: one on a CPU
+ * device, TSD_OPENCL_BATCH_DEFAULT on a GPU or an accelerator), else an
+ * integer from 1 to TSD_OPENCL_BATCH_MAX; -1 with a sentence in msg for
+ * anything else. */
+#define TSD_OPENCL_BATCH_DEFAULT 16
+#define TSD_OPENCL_BATCH_MAX 256
+int tsd_backend_batch(char *msg, size_t msg_size);
 
 /**
  * The metadata values of a summary: backend "c", "opencl" or "mixed" (some

@@ -7,6 +7,7 @@
 #include "tsd_products.h"
 #include "tsd_pyramid.h"
 #include "tsd_text.h"
+#include "terrashade_cl.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -112,44 +113,71 @@ ts_status tsd_normals_make(const tsd_compute_ctx *c, const ts_grid *g, tsd_norma
     return TS_OK;
 }
 
+/* Azimuths per backend call of a stream of `directions` planes of `cells`:
+ * on OpenCL as many as TERRASHADE_OPENCL_BATCH allows (by default
+ * TSD_OPENCL_BATCH_DEFAULT on a GPU, whose lines of one azimuth fill a few
+ * per cent of it, and one on a CPU device, where larger batches measured
+ * slower) and the run's batch memory holds; on C one, as the sweep's
+ * threads already fill the CPU and each plane is summed as it comes. */
+static int stream_batch(const tsd_compute_ctx *c, size_t cells, int directions)
+{
+    ts_backend_report rep;
+    ts_cl_info info;
+    ts_error err;
+    char msg[256];
+    const double plane = (double)cells * sizeof(float);
+    int most = tsd_backend_batch(msg, sizeof msg); /* (checked at open) */
+    if (most == 1 || directions <= 1 || c->run->batch_bytes < plane ||
+        ts_backend_choose(BK(c), &rep, &err) != TS_OK || rep.used != TS_BACKEND_OPENCL)
+        return 1;
+    if (most <= 0)
+        most = ts_cl_peek(&info, &err) == TS_OK && strcmp(info.type, "CPU")
+                   ? TSD_OPENCL_BATCH_DEFAULT
+                   : 1;
+    const double fit = 1 + c->run->batch_bytes / plane; /* the one plane is counted */
+    const int n = most < directions ? most : directions;
+    return fit < n ? (int)fit : n;
+}
+
 ts_status tsd_compute_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_plane_fn add,
                              void *user)
 {
     size_t cells = (size_t)g->width * g->height;
     ts_horizon_opts h;
     ts_error err;
-    ts_status st;
+    ts_status st = TS_OK;
     tsd_compute_horizon_opts(c, &h);
     if (c->opts->horizon_method == TSD_HORIZON_PYRAMID)
         return tsd_pyramid_stream(c, g, add, user);
-    float *plane = malloc(cells * sizeof(float));
-    if (!plane)
+    const int batch = stream_batch(c, cells, h.directions);
+    float *planes = malloc((size_t)batch * cells * sizeof(float));
+    double az[TSD_OPENCL_BATCH_MAX];
+    if (!planes)
         return oom(c, "a horizon plane");
-    h.progress = NULL; /* reported here, per azimuth */
-    for (int k = 0; k < h.directions; k++) {
-        double az = ts_horizon_azimuth(&h, k);
+    h.progress = NULL; /* reported here, per call */
+    for (int k0 = 0; st == TS_OK && k0 < h.directions; k0 += batch) {
+        const int n = h.directions - k0 < batch ? h.directions - k0 : batch;
         ts_backend_report rep = {0};
-        if ((st = tsd_compute_report(c, (double)k / h.directions)) != TS_OK) {
-            free(plane);
-            return st;
+        for (int i = 0; i < n; i++)
+            az[i] = ts_horizon_azimuth(&h, k0 + i);
+        if ((st = tsd_compute_report(c, (double)k0 / h.directions)) != TS_OK)
+            break;
+        /* the sweeps on the backend; the accumulation is C only */
+        st = n == 1 ? ts_backend_horizon_sweep(BK(c), g, az[0], &h, planes, &rep, &err)
+                    : ts_backend_horizon_sweeps(BK(c), g, az, n, &h, planes, &rep, &err);
+        if (NOTE(c, st, rep) != TS_OK) {
+            st = core_fail(c, &err);
+            break;
         }
-        /* the sweep on the backend; the accumulation is C only */
-        if (NOTE(c, ts_backend_horizon_sweep(BK(c), g, az, &h, plane, &rep, &err), rep) !=
-            TS_OK) {
-            free(plane);
-            return core_fail(c, &err);
-        }
-        if ((st = tsd_compute_far(c, g, az, 0, plane)) != TS_OK) {
-            free(plane);
-            return st;
-        }
-        if (add(user, g, k, az, plane, &err) != TS_OK) {
-            free(plane);
-            return core_fail(c, &err);
+        for (int i = 0; st == TS_OK && i < n; i++) {
+            float *plane = planes + (size_t)i * cells;
+            if ((st = tsd_compute_far(c, g, az[i], 0, plane)) == TS_OK &&
+                add(user, g, k0 + i, az[i], plane, &err) != TS_OK)
+                st = core_fail(c, &err);
         }
     }
-    free(plane);
-    return TS_OK;
+    free(planes);
+    return st;
 }
 
 /* The sky products' accumulator of sky_stream. */

@@ -60,6 +60,9 @@ typedef struct {
      * for the whole DEM */
     double near_distance;
     struct tsd_far_field *far;
+    /* host memory a horizon stream may add for batches of planes, each
+     * batch one OpenCL call (tsd_compute_stream); 0: one plane a call */
+    double batch_bytes;
 } tsd_run;
 
 /** The run state of options `o`, with `sun` (may be NULL) placing the sun

@@ -461,6 +461,9 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     if (m_bHasSun)
         m_sSun.day.plane_cache_bytes = static_cast<size_t>(
             std::min(static_cast<double>(m_sSun.day.plane_cache_bytes), dfHeadroom / 2));
+    // OpenCL sweeps of a horizon stream in batches: in the other half
+    // (docs/opencl.md, "Through the driver")
+    m_sRun.batch_bytes = dfHeadroom / 2;
     /* a bad TERRASHADE_BACKEND or _SIMD is an error here (without probing OpenCL) */
     m_bUsesBackend = m_psProduct->uses_backend && m_psProduct->uses_backend(&sOpts, psSun);
     if (tsd_backend_check_env(&sOpts, m_bUsesBackend, szMsg, sizeof szMsg) != 0)

@@ -206,6 +206,36 @@ START_TEST(test_horizon_sweep)
         snprintf(name, sizeof name, "horizon sweep at %g", az[k]);
         expect_close(name, c, cl, n, TOL_HORIZON);
     }
+    /* every azimuth in one call: each plane what its own call gives, bit for
+     * bit, on both backends (the driver's batches, tsd_compute_stream) */
+    const int na = (int)(sizeof az / sizeof *az);
+    float *all = tdem_floats(n * na);
+    for (int b = 0; b < 2; b++) {
+        ts_backend_report rep;
+        ck_assert_msg(ts_backend_horizon_sweeps(b ? TS_BACKEND_OPENCL : TS_BACKEND_C, &g, az, na,
+                                                &o, all, &rep, &e) == TS_OK,
+                      "%s", e.message);
+        ck_assert_int_eq(rep.used, b ? TS_BACKEND_OPENCL : TS_BACKEND_C);
+        for (int k = 0; k < na; k++) {
+            ck_assert_int_eq(b ? ts_cl_horizon_sweep(&g, az[k], &o, cl, &e)
+                               : ts_horizon_sweep(&g, az[k], &o, cl, &e),
+                             TS_OK);
+            ck_assert_msg(!memcmp(all + (size_t)k * n, cl, n * sizeof *cl),
+                          "%s: azimuth %g swept with the others differs from its own sweep",
+                          b ? "opencl" : "c", az[k]);
+        }
+    }
+    /* a bad list: nothing, NULL, an azimuth that is no number */
+    const double bad[] = {10, NAN};
+    ck_assert_int_eq(ts_cl_horizon_sweeps(&g, az, 0, &o, all, &e), TS_ERR_ARG);
+    ck_assert_ptr_nonnull(strstr(e.message, "at least one entry, got 0"));
+    ck_assert_int_eq(ts_cl_horizon_sweeps(&g, NULL, 1, &o, all, &e), TS_ERR_ARG);
+    ck_assert_int_eq(ts_cl_horizon_sweeps(&g, bad, 2, &o, all, &e), TS_ERR_ARG);
+    ck_assert_int_eq(ts_backend_horizon_sweeps(TS_BACKEND_C, &g, bad, 2, &o, all, NULL, &e),
+                     TS_ERR_ARG);
+    ck_assert_int_eq(ts_backend_horizon_sweeps(TS_BACKEND_C, &g, az, -1, &o, all, NULL, &e),
+                     TS_ERR_ARG);
+    free(all);
     free(c);
     free(cl);
     free_dem(&g, s);

@@ -13,7 +13,9 @@ C with a warning when OpenCL was asked for and cannot run, bad values.
   (TILE_SIZE) warns once and its BACKEND says what its chunks ran;
 - BACKEND=bogus and TERRASHADE_BACKEND=cuda: non-zero exit, clear message;
 - the default (auto) on a CPU OpenCL device runs C and says why;
-- TERRASHADE_OPENCL_PROFILE and TERRASHADE_OPENCL_BUILD_OPTIONS (tuning aids).
+- TERRASHADE_OPENCL_PROFILE and TERRASHADE_OPENCL_BUILD_OPTIONS (tuning aids);
+- TERRASHADE_OPENCL_BATCH: the horizon streams' azimuths per OpenCL call,
+  the same bits at any batch, bounded by MAX_MEMORY's room, bad values.
 """
 import os
 import sys
@@ -259,6 +261,70 @@ class Backend(unittest.TestCase):
                 ds = gdal.Open(out)
                 self.assertEqual(ds.GetMetadataItem("BACKEND"), "c")
                 np.testing.assert_allclose(ds.ReadAsArray(), want, atol=1e-3)
+
+    def test_opencl_batches(self):
+        """The driver's horizon streams (svf, negative openness, envlight)
+        sweep TERRASHADE_OPENCL_BATCH azimuths per OpenCL call, bit for bit
+        what one azimuth a call gives (a last batch shorter); half of what
+        MAX_MEMORY leaves bounds a batch; on a CPU device (PoCL here) the
+        default is one a call; a value out of 1..256 is an error."""
+        import re
+        dem = self.dems["synthetic"]
+        out = os.path.join(self.dir, "batch.tif")
+
+        def run(options, batch, memory=None):
+            args = ["gdal_translate", "-q"] + T.oo_args(dict(options, BACKEND="opencl"))
+            if memory:
+                args += ["-oo", "MAX_MEMORY=%d" % memory]
+            env = {"CPL_DEBUG": "TERRASHADE"}
+            if batch is not None:
+                env["TERRASHADE_OPENCL_BATCH"] = str(batch)
+            p = T.run(args + [T.conn(dem), out], **env)
+            calls = re.search(r"\((\d+) call\(s\): (\d+) OpenCL, 0 C\)", p.stderr)
+            self.assertIsNotNone(calls, p.stderr)
+            self.assertEqual(calls.group(1), calls.group(2))
+            ds = gdal.Open(out)
+            self.assertEqual(ds.GetMetadataItem("BACKEND"), "opencl")
+            return ds.ReadAsArray(), int(calls.group(1))
+
+        for options in ({"PRODUCT": "svf", "DIRECTIONS": 16},
+                        {"PRODUCT": "openness", "OPENNESS": "negative", "DIRECTIONS": 16},
+                        {"PRODUCT": "envlight", "SKY": "uniform", "DIRECTIONS": 16}):
+            with self.subTest(options=options):
+                want, one = run(options, 1)
+                others = one - 16  # the calls besides the sweeps
+                _, default = run(options, None)
+                self.assertEqual(default, one, "a CPU device: one azimuth a call")
+                # a 150 x 133 DEM: planes of 78 KiB; MAX_MEMORY=1 leaves room
+                # for a few more (the estimate, a few planes, from 1 MiB)
+                for batch, memory, calls in ((16, None, 1), (5, None, 4), (7, None, 3),
+                                             (16, 1, None)):
+                    got, n = run(options, batch, memory)
+                    print(options["PRODUCT"], "batch", batch, "MAX_MEMORY", memory, ":",
+                          n - others, "sweep calls")
+                    if calls is not None:
+                        self.assertEqual(n - others, calls)
+                    else:
+                        self.assertGreater(n - others, 1)
+                        self.assertLess(n - others, 16)
+                    np.testing.assert_array_equal(got, want)
+        # a batch that OpenCL cannot take (its buffers over the limit) runs
+        # on C as a whole: C's bits
+        want = compute(dem, {"PRODUCT": "svf", "DIRECTIONS": 16, "BACKEND": "c"})[0][0]
+        p = T.run(["gdal_translate", "-q", "-oo", "PRODUCT=svf", "-oo", "DIRECTIONS=16", "-oo",
+                   "BACKEND=opencl", T.conn(dem), out], TERRASHADE_OPENCL_BATCH="8",
+                  TERRASHADE_OPENCL_MAX_ALLOC="4k")
+        print(p.stderr)
+        self.assertIn("BACKEND=opencl was requested", p.stderr)
+        self.assertIn("TERRASHADE_OPENCL_MAX_ALLOC", p.stderr)
+        ds = gdal.Open(out)
+        np.testing.assert_array_equal(ds.ReadAsArray().astype(np.float64), want)
+        for bad in ("0", "257", "x", "8k"):
+            with self.subTest(bad=bad):
+                p = T.run(["gdal_translate", "-q", "-oo", "PRODUCT=svf", "-oo", "BACKEND=opencl",
+                           T.conn(dem), out], ok=False, TERRASHADE_OPENCL_BATCH=bad)
+                self.assertIn("TERRASHADE_OPENCL_BATCH must be an integer from 1 to 256, "
+                              "got '%s'" % bad, p.stderr)
 
     def test_bad_values_are_errors(self):
         dem = self.dems["synthetic"]
