@@ -113,13 +113,11 @@ ts_status tsd_normals_make(const tsd_compute_ctx *c, const ts_grid *g, tsd_norma
     return TS_OK;
 }
 
-/* Azimuths per backend call of a stream of `directions` planes of `cells`:
- * on OpenCL as many as TERRASHADE_OPENCL_BATCH allows (by default
- * TSD_OPENCL_BATCH_DEFAULT on a GPU, whose lines of one azimuth fill a few
- * per cent of it, and one on a CPU device, where larger batches measured
- * slower) and the run's batch memory holds; on C one, as the sweep's
- * threads already fill the CPU and each plane is summed as it comes. */
-static int stream_batch(const tsd_compute_ctx *c, size_t cells, int directions)
+/* (tsd_compute.h) By default TSD_OPENCL_BATCH_DEFAULT on a GPU, whose lines
+ * of one azimuth fill a few per cent of it, and one on a CPU device, where
+ * larger batches measured slower; on C one, as the sweep's threads already
+ * fill the CPU and each plane is summed as it comes. */
+int tsd_compute_batch(const tsd_compute_ctx *c, size_t cells, int directions)
 {
     ts_backend_report rep;
     ts_cl_info info;
@@ -149,7 +147,7 @@ ts_status tsd_compute_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_pla
     tsd_compute_horizon_opts(c, &h);
     if (c->opts->horizon_method == TSD_HORIZON_PYRAMID)
         return tsd_pyramid_stream(c, g, add, user);
-    const int batch = stream_batch(c, cells, h.directions);
+    const int batch = tsd_compute_batch(c, cells, h.directions);
     float *planes = malloc((size_t)batch * cells * sizeof(float));
     double az[TSD_OPENCL_BATCH_MAX];
     if (!planes)

@@ -139,8 +139,14 @@ void tsd_normals_free(tsd_normals *nm);
 typedef ts_status (*tsd_plane_fn)(void *user, const ts_grid *g, int k, double azimuth,
                                   const float *plane, ts_error *err);
 
-/* Sweep the DIRECTIONS horizon planes one at a time on the backend (with
- * progress per azimuth) and hand each to `add`. */
+/* Azimuths per backend call for `n` horizon planes of `cells` each: on
+ * OpenCL up to TERRASHADE_OPENCL_BATCH (by default 16 on a GPU, 1 on a CPU
+ * device) and as many as c->run->batch_bytes holds beside the first plane;
+ * 1 on C. */
+int tsd_compute_batch(const tsd_compute_ctx *c, size_t cells, int n);
+
+/* Sweep the DIRECTIONS horizon planes on the backend, tsd_compute_batch at
+ * a time (with progress per call), and hand each to `add` in order. */
 ts_status tsd_compute_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_plane_fn add,
                              void *user);
 

@@ -68,12 +68,18 @@ static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
     ts_sh_key_reference(&w, l, az, el, &shade_ref, &share_ref);
     /* the first horizon plane is the output itself (ts_sh_swath_light reads
      * a cell's planes before it writes the cell): one fresh plane fewer, and
-     * its page faults */
+     * its page faults; on a GPU that takes the swath in one call
+     * (tsd_compute_batch), the planes in one block instead, so that one
+     * upload of the DEM and one launch serve them all */
+    const int one_call = o->horizon_method != TSD_HORIZON_PYRAMID && s.n > 1 &&
+                         tsd_compute_batch(c, cells, s.n) >= s.n;
     float **planes = calloc((size_t)s.n, sizeof *planes);
+    /* (without the block's memory, plane by plane as on C) */
+    float *block = one_call && planes ? malloc((size_t)s.n * cells * sizeof(float)) : NULL;
     if (planes)
-        planes[0] = shade ? shade : share;
+        planes[0] = block ? block : shade ? shade : share;
     for (int i = 1; planes && i < s.n; i++)
-        if (!(planes[i] = malloc(cells * sizeof(float)))) {
+        if (!(planes[i] = block ? block + (size_t)i * cells : malloc(cells * sizeof(float)))) {
             for (int j = 1; j < i; j++)
                 free(planes[j]);
             free(planes);
@@ -92,18 +98,26 @@ static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
     h.nonpositive_moot = 1;
     if (o->horizon_method == TSD_HORIZON_PYRAMID)
         st = pyramid_planes(c, g, &s, planes);
-    for (int i = 0; o->horizon_method != TSD_HORIZON_PYRAMID && st == TS_OK && i < s.n; i++) {
+    double az_list[TSD_OPENCL_BATCH_MAX];
+    const int per_call = block ? s.n : 1;
+    for (int i = 0; o->horizon_method != TSD_HORIZON_PYRAMID && st == TS_OK && i < s.n;
+         i += per_call) {
         ts_backend_report rep = {0};
         if ((st = tsd_compute_report(c, (double)i / s.n)) != TS_OK)
             break;
-        st = ts_backend_horizon_sweep(tsd_backend_to_ts(o->backend), g,
-                                      ts_sh_swath_azimuth(&s, i), &h, planes[i], &rep, &err);
+        for (int k = 0; k < per_call; k++)
+            az_list[k] = ts_sh_swath_azimuth(&s, i + k);
+        st = per_call > 1 ? ts_backend_horizon_sweeps(tsd_backend_to_ts(o->backend), g, az_list,
+                                                      per_call, &h, block, &rep, &err)
+                          : ts_backend_horizon_sweep(tsd_backend_to_ts(o->backend), g,
+                                                     az_list[0], &h, planes[i], &rep, &err);
         if (c->backend && rep.backend[0])
             tsd_backend_summary_add(c->backend, &rep);
         if (st != TS_OK)
             st = core_fail(c, &err);
-        else /* a window's: raised to the far field and the DEM's edge */
-            st = tsd_compute_far(c, g, ts_sh_swath_azimuth(&s, i), 0, planes[i]);
+        for (int k = 0; st == TS_OK && k < per_call; k++) /* a window's: raised to the far
+                                                            * field and the DEM's edge */
+            st = tsd_compute_far(c, g, az_list[k], 0, planes[i + k]);
     }
     if (st == TS_OK &&
         (st = ts_sh_swath_light(g, &w, (const float *const *)planes, l, nm ? nm->nx : NULL,
@@ -113,9 +127,10 @@ static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
                                 &err)) != TS_OK)
         st = core_fail(c, &err);
     note_c_part(c, "METHOD=sh");
-    for (int i = 1; i < s.n; i++)
+    for (int i = 1; !block && i < s.n; i++)
         free(planes[i]);
     free(planes);
+    free(block);
     ts_sh_wedges_free(&w);
     return st;
 }

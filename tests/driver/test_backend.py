@@ -264,10 +264,11 @@ class Backend(unittest.TestCase):
 
     def test_opencl_batches(self):
         """The driver's horizon streams (svf, negative openness, envlight)
-        sweep TERRASHADE_OPENCL_BATCH azimuths per OpenCL call, bit for bit
-        what one azimuth a call gives (a last batch shorter); half of what
-        MAX_MEMORY leaves bounds a batch; on a CPU device (PoCL here) the
-        default is one a call; a value out of 1..256 is an error."""
+        sweep TERRASHADE_OPENCL_BATCH azimuths per OpenCL call, and
+        METHOD=sh its swath in one call where the batch holds it, bit for
+        bit what one azimuth a call gives (a last batch shorter); half of
+        what MAX_MEMORY leaves bounds a batch; on a CPU device (PoCL here)
+        the default is one a call; a value out of 1..256 is an error."""
         import re
         dem = self.dems["synthetic"]
         out = os.path.join(self.dir, "batch.tif")
@@ -280,34 +281,42 @@ class Backend(unittest.TestCase):
             if batch is not None:
                 env["TERRASHADE_OPENCL_BATCH"] = str(batch)
             p = T.run(args + [T.conn(dem), out], **env)
-            calls = re.search(r"\((\d+) call\(s\): (\d+) OpenCL, 0 C\)", p.stderr)
+            calls = re.search(r"\((\d+) call\(s\): (\d+) OpenCL, (\d+) C\)", p.stderr)
             self.assertIsNotNone(calls, p.stderr)
-            self.assertEqual(calls.group(1), calls.group(2))
-            ds = gdal.Open(out)
-            self.assertEqual(ds.GetMetadataItem("BACKEND"), "opencl")
-            return ds.ReadAsArray(), int(calls.group(1))
+            # only METHOD=sh's lighting, which has no kernel, runs C: no
+            # sweep fell back
+            self.assertEqual(calls.group(3), "1" if options.get("METHOD") == "sh" else "0")
+            return gdal.Open(out).ReadAsArray(), int(calls.group(2))
 
-        for options in ({"PRODUCT": "svf", "DIRECTIONS": 16},
-                        {"PRODUCT": "openness", "OPENNESS": "negative", "DIRECTIONS": 16},
-                        {"PRODUCT": "envlight", "SKY": "uniform", "DIRECTIONS": 16}):
+        # (options, its sweeps, the sweep calls at batch 16, 5, 7, 2); the
+        # swath of METHOD=sh is swept in one call or one azimuth a call
+        cases = [({"PRODUCT": "svf", "DIRECTIONS": 16}, 16, (1, 4, 3, 8)),
+                 ({"PRODUCT": "openness", "OPENNESS": "negative", "DIRECTIONS": 16}, 16,
+                  (1, 4, 3, 8)),
+                 ({"PRODUCT": "envlight", "SKY": "uniform", "DIRECTIONS": 16}, 16, (1, 4, 3, 8)),
+                 ({"METHOD": "sh", "OUTPUT_TYPE": "Float32"}, 3, (1, 1, 1, 3)),
+                 ({"PRODUCT": "shadow", "METHOD": "sh", "SWATH_DIRECTIONS": 5}, 5,
+                  (1, 1, 1, 5))]
+        for options, sweeps, expect in cases:
             with self.subTest(options=options):
                 want, one = run(options, 1)
-                others = one - 16  # the calls besides the sweeps
+                others = one - sweeps  # the calls besides the sweeps
                 _, default = run(options, None)
                 self.assertEqual(default, one, "a CPU device: one azimuth a call")
+                for batch, calls in zip((16, 5, 7, 2), expect):
+                    got, n = run(options, batch)
+                    print(options, "batch", batch, ":", n - others, "sweep calls")
+                    self.assertEqual(n - others, calls)
+                    np.testing.assert_array_equal(got, want)
+                if options.get("METHOD") == "sh":
+                    continue  # (its wedge tables alone take 8 MiB)
                 # a 150 x 133 DEM: planes of 78 KiB; MAX_MEMORY=1 leaves room
                 # for a few more (the estimate, a few planes, from 1 MiB)
-                for batch, memory, calls in ((16, None, 1), (5, None, 4), (7, None, 3),
-                                             (16, 1, None)):
-                    got, n = run(options, batch, memory)
-                    print(options["PRODUCT"], "batch", batch, "MAX_MEMORY", memory, ":",
-                          n - others, "sweep calls")
-                    if calls is not None:
-                        self.assertEqual(n - others, calls)
-                    else:
-                        self.assertGreater(n - others, 1)
-                        self.assertLess(n - others, 16)
-                    np.testing.assert_array_equal(got, want)
+                got, n = run(options, 16, 1)
+                print(options, "batch 16, MAX_MEMORY=1:", n - others, "sweep calls")
+                self.assertLess(n - others, sweeps)
+                self.assertGreater(n - others, 1)
+                np.testing.assert_array_equal(got, want)
         # a batch that OpenCL cannot take (its buffers over the limit) runs
         # on C as a whole: C's bits
         want = compute(dem, {"PRODUCT": "svf", "DIRECTIONS": 16, "BACKEND": "c"})[0][0]
