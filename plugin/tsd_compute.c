@@ -125,7 +125,11 @@ int tsd_compute_batch(const tsd_compute_ctx *c, size_t cells, int directions)
     char msg[256];
     const double plane = (double)cells * sizeof(float);
     int most = tsd_backend_batch(msg, sizeof msg); /* (checked at open) */
-    if (most == 1 || directions <= 1 || c->run->batch_bytes < plane ||
+    ts_horizon_opts h;
+    tsd_compute_horizon_opts(c, &h);
+    /* a capped sweep (MAX_DISTANCE, a window's near field) may run on C
+     * (TS_CL_CAPPED_SWEEP_REASON): its planes would wait for nothing */
+    if (most == 1 || directions <= 1 || c->run->batch_bytes < plane || h.max_distance > 0 ||
         ts_backend_choose(BK(c), &rep, &err) != TS_OK || rep.used != TS_BACKEND_OPENCL)
         return 1;
     if (most <= 0)

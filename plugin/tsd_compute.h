@@ -142,7 +142,8 @@ typedef ts_status (*tsd_plane_fn)(void *user, const ts_grid *g, int k, double az
 /* Azimuths per backend call for `n` horizon planes of `cells` each: on
  * OpenCL up to TERRASHADE_OPENCL_BATCH (by default 16 on a GPU, 1 on a CPU
  * device) and as many as c->run->batch_bytes holds beside the first plane;
- * 1 on C. */
+ * 1 on C, and for capped sweeps (MAX_DISTANCE, a window's near field),
+ * which the OpenCL kernel leaves to C. */
 int tsd_compute_batch(const tsd_compute_ctx *c, size_t cells, int n);
 
 /* Sweep the DIRECTIONS horizon planes on the backend, tsd_compute_batch at

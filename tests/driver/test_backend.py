@@ -317,6 +317,13 @@ class Backend(unittest.TestCase):
                 self.assertLess(n - others, sweeps)
                 self.assertGreater(n - others, 1)
                 np.testing.assert_array_equal(got, want)
+        # capped sweeps (MAX_DISTANCE here; a window's near field) run on C,
+        # one azimuth a call whatever the batch
+        for batch in ("1", "8"):
+            p = T.run(["gdal_translate", "-q"] + T.oo_args(
+                {"PRODUCT": "svf", "DIRECTIONS": 16, "MAX_DISTANCE": 300, "BACKEND": "opencl"})
+                + [T.conn(dem), out], TERRASHADE_OPENCL_BATCH=batch, CPL_DEBUG="TERRASHADE")
+            self.assertRegex(p.stderr, r"\(17 call\(s\): 1 OpenCL, 16 C\)")
         # a batch that OpenCL cannot take (its buffers over the limit) runs
         # on C as a whole: C's bits
         want = compute(dem, {"PRODUCT": "svf", "DIRECTIONS": 16, "BACKEND": "c"})[0][0]
