@@ -199,9 +199,9 @@ static void run(ctx *c, int p, int cl, float *hout)
 }
 
 /* The driver's horizon streams (plugin/tsd_compute.c) on OpenCL: every
- * azimuth in its own call (ts_cl_horizon_sweep: the DEM uploaded and the
- * lines of one azimuth launched each time), then in calls of 16
- * (ts_cl_horizon_sweeps, the GPU default); each plane checked against the
+ * azimuth in its own call (the DEM uploaded and the lines of one azimuth
+ * launched each time), then in calls of 16 (the GPU default of
+ * ts_cl_horizon_sweeps' batches); each plane checked against the
  * all-at-once planes `want`, which it must equal bit for bit. */
 static void stream_calls(ctx *c, const float *want, int repeat)
 {
@@ -224,9 +224,7 @@ static void stream_calls(ctx *c, const float *want, int repeat)
                 ts_error e;
                 for (int i = 0; i < n; i++)
                     az[i] = ts_horizon_azimuth(&c->o, k0 + i);
-                ts_status st = n == 1 ? ts_cl_horizon_sweep(&c->g, az[0], &c->o, planes, &e)
-                                      : ts_cl_horizon_sweeps(&c->g, az, n, &c->o, planes, &e);
-                if (st != TS_OK)
+                if (ts_cl_horizon_sweeps(&c->g, az, n, &c->o, planes, &e) != TS_OK)
                     die("horizon sweeps", &e);
                 if (r == 0)
                     same &= !memcmp(planes, want + c->n * k0, c->n * n * sizeof(float));

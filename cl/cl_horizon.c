@@ -362,18 +362,26 @@ static ts_status edge_apply(const ts_grid *grid, const ts_horizon_opts *opts, co
     return st;
 }
 
+/* The n planes of azimuths az (checked, in [0, 360)): the kernels, with
+ * the options uncapped where nothing caps, then the world beyond the edge;
+ * the one tail of the three entry points below. */
+static ts_status sweep_azimuths(const ts_grid *grid, const ts_horizon_opts *opts,
+                                const double *az, int n, float *out, ts_error *err)
+{
+    ts_horizon_opts run;
+    ts_status st = uncapped_opts(grid, opts, az, n, &run, err);
+    if (st == TS_OK)
+        st = horizon_run(grid, &run, az, n, out, err);
+    return st == TS_OK ? edge_apply(grid, opts, az, n, out, err) : st;
+}
+
 ts_status ts_cl_horizon_sweep(const ts_grid *grid, double azimuth, const ts_horizon_opts *opts,
                               float *out, ts_error *err)
 {
     if (!out)
         return ts_fail(err, TS_ERR_ARG, "output buffer is NULL");
     ts_status st = ts_check_sweep_args(grid, &azimuth, opts, err);
-    ts_horizon_opts run;
-    if (st == TS_OK)
-        st = uncapped_opts(grid, opts, &azimuth, 1, &run, err);
-    if (st == TS_OK)
-        st = horizon_run(grid, &run, &azimuth, 1, out, err);
-    return st == TS_OK ? edge_apply(grid, opts, &azimuth, 1, out, err) : st;
+    return st == TS_OK ? sweep_azimuths(grid, opts, &azimuth, 1, out, err) : st;
 }
 
 ts_status ts_cl_horizon_sweeps(const ts_grid *grid, const double *azimuths, int n,
@@ -383,13 +391,8 @@ ts_status ts_cl_horizon_sweeps(const ts_grid *grid, const double *azimuths, int 
     if (n > 0 && !az)
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the azimuth list");
     ts_status st = ts_check_sweeps_args(grid, azimuths, n, opts, out, az, err);
-    ts_horizon_opts run;
     if (st == TS_OK)
-        st = uncapped_opts(grid, opts, az, n, &run, err);
-    if (st == TS_OK)
-        st = horizon_run(grid, &run, az, n, out, err);
-    if (st == TS_OK)
-        st = edge_apply(grid, opts, az, n, out, err);
+        st = sweep_azimuths(grid, opts, az, n, out, err);
     free(az);
     return st;
 }
@@ -405,12 +408,7 @@ ts_status ts_cl_horizon_compute(const ts_grid *grid, const ts_horizon_opts *opts
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the azimuth list");
     for (int k = 0; k < opts->directions; k++)
         az[k] = ts_horizon_azimuth(opts, k); /* in [0, 360) */
-    ts_horizon_opts run;
-    st = uncapped_opts(grid, opts, az, opts->directions, &run, err);
-    if (st == TS_OK)
-        st = horizon_run(grid, &run, az, opts->directions, out, err);
-    if (st == TS_OK)
-        st = edge_apply(grid, opts, az, opts->directions, out, err);
+    st = sweep_azimuths(grid, opts, az, opts->directions, out, err);
     free(az);
     return st;
 }

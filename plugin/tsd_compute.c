@@ -165,9 +165,8 @@ ts_status tsd_compute_stream(const tsd_compute_ctx *c, const ts_grid *g, tsd_pla
         if ((st = tsd_compute_report(c, (double)k0 / h.directions)) != TS_OK)
             break;
         /* the sweeps on the backend; the accumulation is C only */
-        st = n == 1 ? ts_backend_horizon_sweep(BK(c), g, az[0], &h, planes, &rep, &err)
-                    : ts_backend_horizon_sweeps(BK(c), g, az, n, &h, planes, &rep, &err);
-        if (NOTE(c, st, rep) != TS_OK) {
+        if (NOTE(c, ts_backend_horizon_sweeps(BK(c), g, az, n, &h, planes, &rep, &err), rep) !=
+            TS_OK) {
             st = core_fail(c, &err);
             break;
         }

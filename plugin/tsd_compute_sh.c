@@ -107,10 +107,9 @@ static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
             break;
         for (int k = 0; k < per_call; k++)
             az_list[k] = ts_sh_swath_azimuth(&s, i + k);
-        st = per_call > 1 ? ts_backend_horizon_sweeps(tsd_backend_to_ts(o->backend), g, az_list,
-                                                      per_call, &h, block, &rep, &err)
-                          : ts_backend_horizon_sweep(tsd_backend_to_ts(o->backend), g,
-                                                     az_list[0], &h, planes[i], &rep, &err);
+        /* (with the block, i is 0 and planes[0] the block) */
+        st = ts_backend_horizon_sweeps(tsd_backend_to_ts(o->backend), g, az_list, per_call, &h,
+                                       planes[i], &rep, &err);
         if (c->backend && rep.backend[0])
             tsd_backend_summary_add(c->backend, &rep);
         if (st != TS_OK)
