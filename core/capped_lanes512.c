@@ -315,6 +315,66 @@ list_samples(const ts_cap_lanes *r, int slot, int s0, int a0, int b0, int g, int
     L->n[q] += __builtin_popcount(take);
 }
 
+/* The tests' terms for threshold T (thr) and lower query height gmin at
+ * query distance d: group_may_hold's right side and sign, list_samples'
+ * threshold and right side. */
+TS_AVX512 static inline __attribute__((always_inline)) void
+threshold_tests(__m512d thr, __m512d gmin, __m512d d, __m512d *rhs, __mmask8 *neg, __m512d *tt,
+                __m512d *rt)
+{
+    *neg = _mm512_cmp_pd_mask(thr, _mm512_setzero_pd(), _CMP_LT_OQ);
+    const __m512d td = _mm512_mul_pd(thr, d);
+    const __m512d size = _mm512_add_pd(_mm512_abs_pd(gmin), _mm512_abs_pd(td));
+    *rhs = _mm512_fnmadd_pd(size, _mm512_set1_pd(1e-12), _mm512_fmadd_pd(thr, d, gmin));
+    /* sample by sample: T = -inf (no threshold) as T = 0 against -inf, so
+     * that every sample passes (a distance of 0 would give NaN), and a slot
+     * without a sample (d NaN) fails */
+    const __mmask8 none = _mm512_cmp_pd_mask(thr, _mm512_set1_pd(-INFINITY), _CMP_EQ_OQ);
+    *tt = _mm512_mask_mov_pd(thr, none, _mm512_setzero_pd());
+    *rt = _mm512_mask_mov_pd(*rhs, none, _mm512_set1_pd(-INFINITY));
+}
+
+/* The threshold raised, where the scan so far has taken a steeper sample
+ * than the one it came from: the steeper, from the higher query point, of
+ * the two queries' answers so far, less the margin (prune_threshold's).
+ * Those answers are samples of the window that the scan has taken, so
+ * the pruning argument holds with either as L. A query's answer is at
+ * height g + bn, its slope from the higher point ghi (bn + (g - ghi)) / bd
+ * to within ~2^-51 (|bn| + |g - ghi|) / bd, which is taken off too: T
+ * stays below L's slope where the difference cancels. */
+TS_AVX512 static inline __attribute__((always_inline)) __m512d
+raised_threshold(const scan512 *a, int q, __m512d thr)
+{
+    const __mmask8 hc = _mm512_cmp_pd_mask(a->gc[q], a->gc[q], _CMP_ORD_Q);
+    const __mmask8 hn = _mm512_cmp_pd_mask(a->gn[q], a->gn[q], _CMP_ORD_Q);
+    const __m512d ninf = _mm512_set1_pd(-INFINITY), slack = _mm512_set1_pd(1e-14);
+    const __m512d ghi = _mm512_max_pd(_mm512_mask_mov_pd(ninf, hc, a->gc[q]),
+                                      _mm512_mask_mov_pd(ninf, hn, a->gn[q]));
+    __m512d s = ninf;
+    for (int x = 0; x < 2; x++) {
+        const __m512d g = x ? a->gn[q] : a->gc[q], bn = x ? a->bnn[q] : a->bnc[q];
+        const __m512d bd = x ? a->bdn[q] : a->bdc[q], up = _mm512_sub_pd(g, ghi);
+        /* -inf where no answer yet (bn = -inf), NaN where no query */
+        const __m512d sx = _mm512_div_pd(
+            _mm512_fnmadd_pd(_mm512_add_pd(_mm512_abs_pd(bn), _mm512_abs_pd(up)), slack,
+                             _mm512_add_pd(bn, up)),
+            bd);
+        s = _mm512_max_pd(s, _mm512_mask_mov_pd(ninf, x ? hn : hc, sx));
+    }
+    const __m512d t = _mm512_fnmadd_pd(_mm512_abs_pd(s), _mm512_set1_pd(PRUNE_MARGIN), s);
+    /* NaN (no answer yet: -inf less its margin) fails the compare */
+    return _mm512_mask_mov_pd(thr, _mm512_cmp_pd_mask(t, thr, _CMP_GT_OQ), t);
+}
+
+/* Lists of at least this many slots are scanned before the next level-1
+ * group's tests, to raise their threshold. */
+#ifndef RAISE_FROM
+#define RAISE_FROM 64
+#endif
+_Static_assert(2 * RAISE_FROM + 2 * TS_CAP_G1 <= LIST_MAX &&
+                   NG * (TS_CAP_G1 / TS_CAP_G0) <= PAIRS_MAX,
+               "the lists and pairs of the level-1 groups scanned at once fit");
+
 /* The pruned scan of steps s_lo..s_hi for the ng groups of lines from g.
  * Each group of lines lists the slots it must scan: those of the level-0
  * groups that the level-1 and level-0 bounds leave (the newest PRUNE_NEAR
@@ -323,22 +383,11 @@ list_samples(const ts_cap_lanes *r, int slot, int s0, int a0, int b0, int g, int
 TS_AVX512 static inline __attribute__((always_inline)) void
 scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 *a)
 {
-    __m512d thr[NG], rhs[NG], tt[NG], rt[NG];
+    __m512d thr[NG], rhs[NG], tt[NG], rt[NG], gmin[NG];
     __mmask8 idle[NG], neg[NG];
     for (int q = 0; q < ng; q++) {
-        __m512d gmin;
-        prune_threshold(r, k, lag_hi, g + 8 * q, a, q, &thr[q], &gmin, &idle[q]);
-        neg[q] = _mm512_cmp_pd_mask(thr[q], _mm512_setzero_pd(), _CMP_LT_OQ);
-        const __m512d td = _mm512_mul_pd(thr[q], a->d[q]);
-        const __m512d size = _mm512_add_pd(_mm512_abs_pd(gmin), _mm512_abs_pd(td));
-        rhs[q] = _mm512_fnmadd_pd(size, _mm512_set1_pd(1e-12),
-                                  _mm512_fmadd_pd(thr[q], a->d[q], gmin));
-        /* sample by sample: T = -inf (no threshold) as T = 0 against -inf,
-         * so that every sample passes (a distance of 0 would give NaN),
-         * and a slot without a sample (d NaN) fails */
-        const __mmask8 none = _mm512_cmp_pd_mask(thr[q], _mm512_set1_pd(-INFINITY), _CMP_EQ_OQ);
-        tt[q] = _mm512_mask_mov_pd(thr[q], none, _mm512_setzero_pd());
-        rt[q] = _mm512_mask_mov_pd(rhs[q], none, _mm512_set1_pd(-INFINITY));
+        prune_threshold(r, k, lag_hi, g + 8 * q, a, q, &thr[q], &gmin[q], &idle[q]);
+        threshold_tests(thr[q], gmin[q], a->d[q], &rhs[q], &neg[q], &tt[q], &rt[q]);
     }
     slot_lists L;
     for (int q = 0; q < NG; q++)
@@ -387,8 +436,9 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
             }
         }
         idx0 = idx0 + count < r->groups[0] ? idx0 + count : idx0 + count - r->groups[0];
-        if (P.n > PAIRS_MAX - NG * 8 || m1 == s_hi / TS_CAP_G1) {
-            /* their samples that a line may take, then the scan of those */
+        if (P.n) {
+            /* their samples that a line may take, then the scan of those,
+             * whose answers may raise the threshold for the newer groups */
             for (int p = 0; p < P.n; p++) {
                 const int q = P.q[p], s0 = P.m0[p] * TS_CAP_G0;
                 const int a0 = s0 > s_lo ? s0 : s_lo,
@@ -396,12 +446,23 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
                 list_samples(r, P.idx[p] * TS_CAP_G0, s0, a0, b0, g, q, tt[q], rt[q], idle[q], &L);
             }
             P.n = 0;
-            int full = 0;
+            int most = 0;
             for (int q = 0; q < ng; q++)
-                full |= L.n[q] > LIST_MAX - PAIRS_MAX * TS_CAP_G0;
-            if (full || m1 == s_hi / TS_CAP_G1)
+                most = L.n[q] > most ? L.n[q] : most;
+            /* long lists, with two level-1 groups or more still to test:
+             * scanned now, so that their answers may raise the threshold
+             * for the newer groups (short ones wait, and the last groups:
+             * a scan per level-1 group costs more than it prunes there) */
+            if (most >= RAISE_FROM && m1 + 2 <= s_hi / TS_CAP_G1) {
                 scan512_lists(r, g, ng, &L, a);
+                for (int q = 0; q < ng; q++) {
+                    thr[q] = raised_threshold(a, q, thr[q]);
+                    threshold_tests(thr[q], gmin[q], a->d[q], &rhs[q], &neg[q], &tt[q], &rt[q]);
+                }
+            }
         }
+        if (m1 == s_hi / TS_CAP_G1)
+            scan512_lists(r, g, ng, &L, a);
     }
 }
 

@@ -259,7 +259,8 @@ static int cl_on(int j, int k)
     return k >= 3 * j && k <= 300 + 7 * j && !(k >= 500 && k <= 507);
 }
 
-static void check_capped_scan(double near, double cap, double c, double jitter, uint32_t seed)
+static void check_capped_scan(double near, double cap, double c, double jitter, uint32_t seed,
+                              int ramp)
 {
     static float hs[CL_STEPS][CL_LINES + 1], hc[CL_STEPS][CL_LINES + 1], hn[CL_STEPS][CL_LINES + 1];
     static double d[CL_STEPS][CL_LINES + 1];
@@ -270,6 +271,11 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
              * 10 m, or of 10 m +- jitter (per-row spacing) */
             const double x = k - 3 * j;
             float h = (float)(2.5 * floor((x * 0.37 + 40.0 * sin(x * 0.013 + j)) / 2.5));
+            /* or a steady climb with centimetres of noise: every sample
+             * behind nearly as steep as the next, so that the pruned scan's
+             * lists grow long and its threshold rises within a scan */
+            if (ramp)
+                h = (float)(x * 0.37 + 0.01 * (cl_rand(&seed) % 8));
             if (cl_rand(&seed) % 61 == 0)
                 h += (float)(cl_rand(&seed) % 300);
             if ((k / 37 + j) % 11 == 0)
@@ -398,18 +404,22 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
 START_TEST(test_capped_scan_pruned)
 {
     const double curved = (1 - TS_DEFAULT_REFRACTION) / (2 * TS_EARTH_RADIUS);
-    check_capped_scan(25.0, 2000.0, 0.0, 0.0, 1);    /* 3..200 lags: pruned */
-    check_capped_scan(25.0, 2000.0, curved, 0.0, 2);
-    check_capped_scan(25.0, 2555.0, 0.0, 0.01, 3);   /* per-row steps, up to 258 lags */
-    check_capped_scan(80.0, 1200.0, curved, 0.01, 4);
-    check_capped_scan(25.0, 500.0, 0.0, 0.0, 5);     /* 50 lags: the whole window */
+    check_capped_scan(25.0, 2000.0, 0.0, 0.0, 1, 0);    /* 3..200 lags: pruned */
+    check_capped_scan(25.0, 2000.0, curved, 0.0, 2, 0);
+    check_capped_scan(25.0, 2555.0, 0.0, 0.01, 3, 0);   /* per-row steps, up to 258 lags */
+    check_capped_scan(80.0, 1200.0, curved, 0.01, 4, 0);
+    check_capped_scan(25.0, 500.0, 0.0, 0.0, 5, 0);     /* 50 lags: the whole window */
     /* 3..500 and 9..3000 lags: the hybrid too (with AVX-512) */
-    check_capped_scan(25.0, 5000.0, 0.0, 0.0, 6);
-    check_capped_scan(25.0, 5000.0, curved, 0.0, 7);
-    check_capped_scan(85.0, 30000.0, curved, 0.0, 8);
+    check_capped_scan(25.0, 5000.0, 0.0, 0.0, 6, 0);
+    check_capped_scan(25.0, 5000.0, curved, 0.0, 7, 0);
+    check_capped_scan(85.0, 30000.0, curved, 0.0, 8, 0);
     /* steps of 9-11 m, windows of 10..333 and 10..555 lags (pruned) */
-    check_capped_scan(105.0, 3000.0, 0.0, 0.1, 9);
-    check_capped_scan(105.0, 5000.0, curved, 0.1, 10);
+    check_capped_scan(105.0, 3000.0, 0.0, 0.1, 9, 0);
+    check_capped_scan(105.0, 5000.0, curved, 0.1, 10, 0);
+    /* long lists: the steady climb, a pruned window and hybrid ones */
+    check_capped_scan(25.0, 2000.0, 0.0, 0.0, 11, 1);
+    check_capped_scan(25.0, 5000.0, curved, 0.0, 12, 1);
+    check_capped_scan(105.0, 5000.0, 0.0, 0.1, 13, 1);
 }
 END_TEST
 
