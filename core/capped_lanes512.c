@@ -401,7 +401,8 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
     group_pairs P;
     P.n = 0;
     int idx1 = s_lo / TS_CAP_G1 % r->groups[1], idx0 = s_lo / TS_CAP_G0 % r->groups[0];
-    for (int m1 = s_lo / TS_CAP_G1; m1 <= s_hi / TS_CAP_G1; m1++) {
+    const int last1 = s_hi / TS_CAP_G1;
+    for (int m1 = s_lo / TS_CAP_G1; m1 <= last1; m1++) {
         const int a1 = m1 * TS_CAP_G1 > s_lo ? m1 * TS_CAP_G1 : s_lo;
         const int b1 =
             m1 * TS_CAP_G1 + TS_CAP_G1 - 1 < s_hi ? m1 * TS_CAP_G1 + TS_CAP_G1 - 1 : s_hi;
@@ -453,7 +454,7 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
              * scanned now, so that their answers may raise the threshold
              * for the newer groups (short ones wait, and the last groups:
              * a scan per level-1 group costs more than it prunes there) */
-            if (most >= RAISE_FROM && m1 + 2 <= s_hi / TS_CAP_G1) {
+            if (most >= RAISE_FROM && m1 + 2 <= last1) {
                 scan512_lists(r, g, ng, &L, a);
                 for (int q = 0; q < ng; q++) {
                     thr[q] = raised_threshold(a, q, thr[q]);
@@ -461,9 +462,8 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
                 }
             }
         }
-        if (m1 == s_hi / TS_CAP_G1)
-            scan512_lists(r, g, ng, &L, a);
     }
+    scan512_lists(r, g, ng, &L, a); /* what is left, the newest groups' */
 }
 
 /* scan_scalar for up to NG groups from g (those below g1), eight lines
