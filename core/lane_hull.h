@@ -75,6 +75,10 @@ void ts_lane_pushes_reset(ts_lane_pushes *p, int lines);
  * then needs another pass of the hull step before the step's last. */
 int ts_lane_delayed_pushes(ts_lane_pushes *p, const double *d_ring, const double *g_ring,
                            size_t slot_stride, int slots, double behind, ts_lane_step *s);
+/* The same line by line (any CPU; what the AVX-512 pushes of
+ * core/lane_pushes.c must equal). */
+int ts_lane_delayed_pushes_scalar(ts_lane_pushes *p, const double *d_ring, const double *g_ring,
+                                  size_t slot_stride, int slots, double behind, ts_lane_step *s);
 
 /* The step, vectorised: eight lines per AVX-512 vector (lane_hull.c) where
  * the CPU has AVX-512 and the hulls fit 32-bit offsets, else four per AVX2

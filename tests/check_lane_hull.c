@@ -9,7 +9,8 @@
  * step's range at every offset of a vector, queries asked or not (hi_from,
  * hi_to, NaN heights), constant steps (the occluder's step from its
  * distance, k_step > 0) and per-row steps (the points' steps stored), and
- * the far-only sweep's delayed pushes. The products' checksums at every
+ * the far-only sweep's delayed pushes (the scalar form's line by line,
+ * the others' as this CPU runs them). The products' checksums at every
  * level (tests/driver/test_cpu_paths.py) test the same end to end. */
 #include <check.h>
 #include <math.h>
@@ -171,8 +172,12 @@ static long run_block(const block_case *bc, long *found)
             if (bc->behind > 0) {
                 ts_lane_step sf = s;
                 for (int more = 1; more;) {
-                    more = ts_lane_delayed_pushes(&st[f].push, ring_d, ring_g, LINES + PAD, SLOTS,
-                                                  bc->behind, &sf);
+                    /* the scalar form with the scalar pushes, the others
+                     * with this CPU's (AVX-512 here and in CI) */
+                    more = (f == SCALAR ? ts_lane_delayed_pushes_scalar
+                                        : ts_lane_delayed_pushes)(&st[f].push, ring_d, ring_g,
+                                                                  LINES + PAD, SLOTS, bc->behind,
+                                                                  &sf);
                     form_step(f, &st[f], &sf);
                 }
             } else {
