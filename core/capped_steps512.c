@@ -107,6 +107,7 @@ TS_AVX512 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
         __mmask8 left = 0;
         for (int q = 0; q < 2; q++) {
             const int *kq = q ? occ->lo_k + j + 1 : occ->hi_k + j;
+            const float *fq = q ? occ->lo_dd + j + 1 : occ->hi_dd + j;
             long long *ko = q ? r->kn : r->kc;
             double *ddo = q ? r->ddn : r->ddc;
             const __m512d gq = _mm512_load_pd((q ? r->qn : r->qc) + j);
@@ -116,16 +117,28 @@ TS_AVX512 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
             const __m512i lag = _mm512_sub_epi64(_mm512_set1_epi64(k), kk);
             __mmask8 ok = _mm512_mask_cmpge_epi64_mask(has, kk, zero);
             ok = _mm512_mask_cmple_epi64_mask(ok, lag, _mm512_set1_epi64(r->lag_hi));
-            /* its slot: (k mod slots - lag) mod slots */
-            __m512i slot = _mm512_sub_epi64(_mm512_set1_epi64(k % r->slots), lag);
-            slot = _mm512_mask_add_epi64(slot, _mm512_cmplt_epi64_mask(slot, zero), slot,
-                                         _mm512_set1_epi64(r->slots));
-            const __m256i at = _mm256_add_epi32(
-                _mm256_mullo_epi32(_mm512_cvtepi64_epi32(slot), _mm256_set1_epi32(r->stride)),
-                lane);
-            const __m512d dd =
-                _mm512_sub_pd(d, _mm512_mask_i32gather_pd(_mm512_set1_pd(NAN), ok, at, r->d, 8));
-            ok = _mm512_mask_cmp_pd_mask(ok, dd, cap, _CMP_LE_OQ);
+            /* A hull point lies at least the near field's distance back; up
+             * to sure_hi lags it is surely within the cap too, and its
+             * distance is the hull's (the same double, rounded to float
+             * there and again by ts_cap_answers512). Beyond, the ring's
+             * distance is tested as the scan tests it. */
+            __m512d dd = _mm512_cvtps_pd(
+                _mm512_castps512_ps256(_mm512_maskz_loadu_ps((__mmask16)ok, fq)));
+            const __mmask8 unsure =
+                _mm512_mask_cmpgt_epi64_mask(ok, lag, _mm512_set1_epi64(r->sure_hi));
+            if (unsure) {
+                /* its slot: (k mod slots - lag) mod slots */
+                __m512i slot = _mm512_sub_epi64(_mm512_set1_epi64(k % r->slots), lag);
+                slot = _mm512_mask_add_epi64(slot, _mm512_cmplt_epi64_mask(slot, zero), slot,
+                                             _mm512_set1_epi64(r->slots));
+                const __m256i at = _mm256_add_epi32(
+                    _mm256_mullo_epi32(_mm512_cvtepi64_epi32(slot), _mm256_set1_epi32(r->stride)),
+                    lane);
+                const __m512d dp =
+                    _mm512_mask_i32gather_pd(_mm512_set1_pd(NAN), unsure, at, r->d, 8);
+                dd = _mm512_mask_sub_pd(dd, unsure, d, dp);
+                ok &= ~unsure | _mm512_mask_cmp_pd_mask(unsure, dd, cap, _CMP_LE_OQ);
+            }
             const __m512i kb = _mm512_mask_mov_epi64(none, has, _mm512_load_epi64(ko + j));
             const __m512d db =
                 _mm512_mask_mov_pd(_mm512_set1_pd(1.0), has, _mm512_load_pd(ddo + j));
