@@ -118,8 +118,6 @@ prune_threshold(const ts_cap_lanes *r, int k, int lag_hi, int j, const scan512 *
 {
     const __m512i zero = _mm512_setzero_si512();
     const __m512d near = _mm512_set1_pd(r->near), cap = _mm512_set1_pd(r->cap);
-    const __m256i lane =
-        _mm256_add_epi32(_mm256_set1_epi32(j), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
     __m512d cd[4], cg[4];
     __mmask8 cok[4];
     for (int i = 0; i < 2; i++) { /* the previous answers */
@@ -128,12 +126,7 @@ prune_threshold(const ts_cap_lanes *r, int k, int lag_hi, int j, const scan512 *
         __mmask8 ok = _mm512_cmpge_epi64_mask(kk, zero);
         ok = _mm512_mask_cmpge_epi64_mask(ok, lag, _mm512_set1_epi64(r->lag_lo));
         ok = _mm512_mask_cmple_epi64_mask(ok, lag, _mm512_set1_epi64(lag_hi));
-        /* its slot: (k mod slots - lag) mod slots */
-        __m512i slot = _mm512_sub_epi64(_mm512_set1_epi64(k % r->slots), lag);
-        slot = _mm512_mask_add_epi64(slot, _mm512_cmplt_epi64_mask(slot, zero), slot,
-                                     _mm512_set1_epi64(r->slots));
-        const __m256i at = _mm256_add_epi32(
-            _mm256_mullo_epi32(_mm512_cvtepi64_epi32(slot), _mm256_set1_epi32(r->stride)), lane);
+        const __m256i at = ts_cap_ring_at512(r, k, lag, j);
         cd[i] = _mm512_mask_i32gather_pd(_mm512_set1_pd(NAN), ok, at, r->d, 8);
         cg[i] = _mm512_mask_i32gather_pd(_mm512_setzero_pd(), ok, at, r->g, 8);
         cok[i] = ok;

@@ -35,6 +35,27 @@ void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0, int g1,
 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
                             const ts_lane_occluders *occ, unsigned char *need);
 
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+
+#include "simd_clones.h"
+
+/* The ring offsets (slot * stride + line) of the samples `lag` steps
+ * before step k of lines j..j + 7, for a gather: the slot is
+ * (k mod slots - lag) mod slots, lag in 0..slots - 1. */
+TS_AVX512 static inline __attribute__((always_inline)) __m256i
+ts_cap_ring_at512(const ts_cap_lanes *r, int k, __m512i lag, int j)
+{
+    __m512i slot = _mm512_sub_epi64(_mm512_set1_epi64(k % r->slots), lag);
+    slot = _mm512_mask_add_epi64(slot, _mm512_cmplt_epi64_mask(slot, _mm512_setzero_si512()),
+                                 slot, _mm512_set1_epi64(r->slots));
+    const __m256i lane =
+        _mm256_add_epi32(_mm256_set1_epi32(j), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    return _mm256_add_epi32(
+        _mm256_mullo_epi32(_mm512_cvtepi64_epi32(slot), _mm256_set1_epi32(r->stride)), lane);
+}
+#endif
+
 /* Empty n groups' entries (no samples: -inf, 0, 0). */
 static inline void ts_cap_groups_empty(double *gmax, double *dlo, double *dhi, size_t n)
 {

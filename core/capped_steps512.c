@@ -101,8 +101,6 @@ TS_AVX512 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
     const __m512d cap = _mm512_set1_pd(r->cap);
     const __m512i zero = _mm512_setzero_si512(), none = _mm512_set1_epi64(-1);
     for (int j = g0; j < g1; j += 8) {
-        const __m256i lane =
-            _mm256_add_epi32(_mm256_set1_epi32(j), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
         const __m512d d = _mm512_load_pd(r->qd + j);
         __mmask8 left = 0;
         for (int q = 0; q < 2; q++) {
@@ -127,13 +125,7 @@ TS_AVX512 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
             const __mmask8 unsure =
                 _mm512_mask_cmpgt_epi64_mask(ok, lag, _mm512_set1_epi64(r->sure_hi));
             if (unsure) {
-                /* its slot: (k mod slots - lag) mod slots */
-                __m512i slot = _mm512_sub_epi64(_mm512_set1_epi64(k % r->slots), lag);
-                slot = _mm512_mask_add_epi64(slot, _mm512_cmplt_epi64_mask(slot, zero), slot,
-                                             _mm512_set1_epi64(r->slots));
-                const __m256i at = _mm256_add_epi32(
-                    _mm256_mullo_epi32(_mm512_cvtepi64_epi32(slot), _mm256_set1_epi32(r->stride)),
-                    lane);
+                const __m256i at = ts_cap_ring_at512(r, k, lag, j);
                 const __m512d dp =
                     _mm512_mask_i32gather_pd(_mm512_set1_pd(NAN), unsure, at, r->d, 8);
                 dd = _mm512_mask_sub_pd(dd, unsure, d, dp);

@@ -1,9 +1,7 @@
 /* A lockstep block's hull step, eight lines per AVX-512 vector; see
  * lane_hull.h. */
 #include <limits.h>
-#include <math.h>
 #include <stddef.h>
-#include <stdlib.h>
 
 #include "lane_hull.h"
 #include "simd_clones.h"

@@ -101,15 +101,16 @@ int ts_lane_delayed_pushes_scalar(ts_lane_pushes *p, const double *d_ring, const
 
 #define AVX512VL __attribute__((target("avx512f,avx512vl")))
 
-/* The ring as the vector pushes read it, and the block's lines j..j + 7. */
+/* The ring as the vector pushes read it (its distances d), and the block's
+ * lines j..j + 7. */
 typedef struct {
-    const double *d, *g;
+    const double *d;
     size_t stride;
     __m256i stride8, lane; /* the stride in every lane; the lines */
     int j, slots;
 } ring8;
 
-/* The doubles of ring (R->d or R->g) at the lanes' slots where m, else src:
+/* The doubles of ring (R->d, or the heights beside it) at the lanes' slots where m, else src:
  * one load where those lanes share a slot (a line keeps its neighbours'
  * pace), else a gather. */
 AVX512VL static inline __m512d ring_read(const ring8 *R, const double *ring, __m256i slot,
@@ -157,7 +158,7 @@ AVX512VL static int delayed_pushes512(ts_lane_pushes *p, const double *d_ring,
     const int k = s->k;
     const __m256i kv = _mm256_set1_epi32(k);
     const __m512d nan = _mm512_set1_pd(NAN), far = _mm512_set1_pd(behind);
-    ring8 R = {d_ring, g_ring, slot_stride, _mm256_set1_epi32((int)slot_stride),
+    ring8 R = {d_ring, slot_stride, _mm256_set1_epi32((int)slot_stride),
                _mm256_setzero_si256(), 0, slots};
     __mmask8 more = 0;
     for (int j = s->j0; j <= s->j1; j += 8) {
