@@ -103,7 +103,8 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
     if (C->far_T > 0)
         ts_lane_pushes_reset(&w->far_push, nl);
     const ts_lane_occluders occ = {w->lo_k, w->hi_k, w->lo_dd, w->hi_dd};
-    const ts_lane_hulls hulls = {w->lane_stacks, G->U + 1, w->lane_n, w->lane_far};
+    const ts_lane_hulls hulls = {w->lane_stacks,  G->U + 1, w->lane_n, w->lane_far,
+                                 w->lane_beside, LOCKSTEP_LINES + 1};
     const ts_lane_lost lost = {&C->ray, C->c, C->cap, w->lost};
     const double c = C->c;
     for (int k = kmin; k <= kmax; k++) {
@@ -177,6 +178,7 @@ static void ws_free(sweep_ws *w)
     free(w->lane_stacks);
     free(w->lane_n);
     free(w->lane_far);
+    free(w->lane_beside);
     free(w->carry);
     free(w->carry_next);
     free(w->lane_f);
@@ -228,6 +230,12 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
             w->lane_stacks =
                 malloc((size_t)(LOCKSTEP_LINES + 1) * (U + 1) * sizeof *w->lane_stacks);
             ok = ok && w->lane_n && w->lane_far && w->lane_stacks;
+            /* the hulls' most read points beside them, where every step
+             * takes AVX-512 (ts_lane_hull_step: its 32-bit offsets fit) */
+            if (ok && ts_cpu_vector_level() == TS_CPU_VECTORS_AVX512 &&
+                (long long)(LOCKSTEP_LINES + 1) * (U + 1) * 6 <= INT_MAX)
+                ok = (w->lane_beside = malloc(TS_BESIDE * (LOCKSTEP_LINES + 1) *
+                                              sizeof(double))) != NULL;
         }
         w->carry = malloc((size_t)U * sizeof *w->carry);
         w->carry_next = malloc((size_t)U * sizeof *w->carry_next);

@@ -41,6 +41,18 @@ AVX512VL static inline __m512d field(const group *G, __mmask8 m, __m256i p, int 
     return _mm512_mask_i32gather_pd(_mm512_setzero_pd(), m, i, G->pd, 8);
 }
 
+/* Array a of the hulls' beside (lane_hull.h) at lines jq.., where m. */
+AVX512VL static inline __m512d beside_load(const ts_lane_hulls *H, int a, int jq, __mmask8 m)
+{
+    return _mm512_maskz_loadu_pd(m, H->beside + (size_t)a * H->beside_n + jq);
+}
+
+AVX512VL static inline void beside_store(const ts_lane_hulls *H, int a, int jq, __mmask8 m,
+                                         __m512d v)
+{
+    _mm512_mask_storeu_pd(H->beside + (size_t)a * H->beside_n + jq, m, v);
+}
+
 AVX512VL static inline __m256 load8f(__mmask8 m, const float *p)
 {
     return _mm512_castps512_ps256(_mm512_maskz_loadu_ps((__mmask16)m, p));
@@ -131,7 +143,7 @@ ALWAYS void advance(int Q, const group *G, const __mmask8 *lanes, __m256i *far,
  * hybrid's hulls, all of whose points lie beyond the near field). */
 ALWAYS void query(int Q, const group *const *G, const __mmask8 *m, const __m256i *far,
                   const __m512d *g, int long_walks, int k_now, double k_step, __m256i *k_out,
-                  __m256 *dd_out)
+                  __m256 *dd_out, const __m512d (*at_far)[4])
 {
     const __m256i zero = _mm256_setzero_si256(), one = _mm256_set1_epi32(1);
     __mmask8 ok[QMAX], active[QMAX];
@@ -141,8 +153,11 @@ ALWAYS void query(int Q, const group *const *G, const __mmask8 *m, const __m256i
         const __mmask8 both = _mm256_mask_cmpge_epi32_mask(m[q] | m[q + 1], far[q], zero);
         const __mmask8 below = _mm256_mask_cmpgt_epi32_mask(both, far[q], zero);
         const __m256i fm = _mm256_sub_epi32(far[q], one);
-        const __m512d df = field(G[q], both, far[q], 0), gf = field(G[q], both, far[q], 1);
-        const __m512d dm = field(G[q], below, fm, 0), gm = field(G[q], below, fm, 1);
+        /* (at_far: far's point and the one under it, known: the top two) */
+        const __m512d df = at_far ? at_far[q / 2][0] : field(G[q], both, far[q], 0);
+        const __m512d gf = at_far ? at_far[q / 2][1] : field(G[q], both, far[q], 1);
+        const __m512d dm = at_far ? at_far[q / 2][2] : field(G[q], below, fm, 0);
+        const __m512d gm = at_far ? at_far[q / 2][3] : field(G[q], below, fm, 1);
         const __m512d d = G[q]->d;
         for (int r = q; r < q + 2; r++) {
             ok[r] = _mm256_mask_cmpge_epi32_mask(m[r], far[r], zero);
@@ -179,17 +194,43 @@ ALWAYS void query(int Q, const group *const *G, const __mmask8 *m, const __m256i
     }
 }
 
+/* walk_down's first pass for the pushes, from the top two points kept
+ * beside the stacks (the same operations): (d1, g1) the top. */
+ALWAYS void first_pop_beside(const ts_lane_hulls *H, int j, const group *const *GP,
+                             const __m512d *gs, __mmask8 *active, __m256i *top, __m512d *d1,
+                             __m512d *g1)
+{
+    const __m256i one = _mm256_set1_epi32(1);
+    for (int q = 0; q < NG; q++) {
+        const int jq = j + 8 * q;
+        const __m512d d = GP[q]->d;
+        const __m512d dm = beside_load(H, TS_BESIDE_SD, jq, active[q]);
+        const __m512d gm = beside_load(H, TS_BESIDE_SG, jq, active[q]);
+        const __m512d lhs = _mm512_mul_pd(_mm512_sub_pd(gm, gs[q]), _mm512_sub_pd(d, d1[q]));
+        const __m512d rhs = _mm512_mul_pd(_mm512_sub_pd(g1[q], gs[q]), _mm512_sub_pd(d, dm));
+        const __mmask8 pop = _mm512_mask_cmp_pd_mask(active[q], lhs, rhs, _CMP_GE_OQ);
+        d1[q] = _mm512_mask_mov_pd(d1[q], pop, dm);
+        g1[q] = _mm512_mask_mov_pd(g1[q], pop, gm);
+        top[q] = _mm256_mask_sub_epi32(top[q], pop, top[q], one);
+        active[q] = _mm256_mask_cmpgt_epi32_mask(pop, top[q], _mm256_setzero_si256());
+    }
+}
+
 /* Groups of eight lines from j on, NG of them at once, those of lanes[q]
- * in group q (a group with none is left alone). */
+ * in group q (a group with none is left alone). With the points beside
+ * (H->beside), the pushes' first compares come from there, and in the
+ * hybrid (far at the top) the queries' first points too. */
 AVX512VL static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, int j,
                                   const __mmask8 *lanes, const ts_lane_occluders *occ)
 {
     const __m512d c = _mm512_set1_pd(s->c), near_skip = _mm512_set1_pd(s->near_skip);
     const __m256i one = _mm256_set1_epi32(1);
+    const int bes = H->beside != NULL;
     group G[NG], P[NG]; /* the lines at their queries' and their pushes' distances */
     const group *GP[NG];
     __m256i idx[NG], m[NG], top[NG], far[NG];
     __m512d cdd[NG], gs[NG], d1[NG], g1[NG];
+    __m512d at_far[NG][4]; /* the hybrid's with bes: far's point and the one under it */
     __mmask8 push[NG], active[NG];
     for (int q = 0; q < NG; q++) {
         const int jq = j + 8 * q;
@@ -217,9 +258,18 @@ AVX512VL static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, 
         /* the top point is m - 1; the walk leaves the new top */
         top[q] = _mm256_sub_epi32(m[q], one);
         active[q] = _mm256_mask_cmpgt_epi32_mask(push[q], top[q], _mm256_setzero_si256());
-        d1[q] = field(&G[q], active[q], top[q], 0);
-        g1[q] = field(&G[q], active[q], top[q], 1);
+        if (bes) { /* (a line with one point keeps it as the new top too) */
+            const __mmask8 some =
+                _mm256_mask_cmpge_epi32_mask(push[q], top[q], _mm256_setzero_si256());
+            d1[q] = beside_load(H, TS_BESIDE_TD, jq, some);
+            g1[q] = beside_load(H, TS_BESIDE_TG, jq, some);
+        } else {
+            d1[q] = field(&G[q], active[q], top[q], 0);
+            g1[q] = field(&G[q], active[q], top[q], 1);
+        }
     }
+    if (bes)
+        first_pop_beside(H, j, GP, gs, active, top, d1, g1);
     walk_down(NG, GP, gs, active, top, d1, g1, 0);
     /* Pops only take from the top, so far is at most the new top; lines
      * with nothing to push keep m = n, where far already is. */
@@ -251,6 +301,27 @@ AVX512VL static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, 
             _mm512_mask_i32scatter_epi32((int *)H->pts, (__mmask16)push[q],
                                          _mm512_castsi256_si512(kat), kp, 4);
         }
+        if (bes) {
+            if (s->push_d) {
+                /* far is the top: the queries' first points are the new
+                 * top and the one it went on, or the kept two (the lines
+                 * without a push) */
+                const __mmask8 keep = lanes[q] & (__mmask8)~push[q];
+                const __m512d kept[4] = {beside_load(H, TS_BESIDE_TD, jq, keep),
+                                         beside_load(H, TS_BESIDE_TG, jq, keep),
+                                         beside_load(H, TS_BESIDE_SD, jq, keep),
+                                         beside_load(H, TS_BESIDE_SG, jq, keep)};
+                at_far[q][0] = _mm512_mask_blend_pd(push[q], kept[0], P[q].d);
+                at_far[q][1] = _mm512_mask_blend_pd(push[q], kept[1], gs[q]);
+                at_far[q][2] = _mm512_mask_blend_pd(push[q], kept[2], d1[q]);
+                at_far[q][3] = _mm512_mask_blend_pd(push[q], kept[3], g1[q]);
+            }
+            /* the new top, and the one it went on (none: garbage, never read) */
+            beside_store(H, TS_BESIDE_SD, jq, push[q], d1[q]);
+            beside_store(H, TS_BESIDE_SG, jq, push[q], g1[q]);
+            beside_store(H, TS_BESIDE_TD, jq, push[q], GP[q]->d);
+            beside_store(H, TS_BESIDE_TG, jq, push[q], gs[q]);
+        }
         store8i(H->n + jq, lanes[q], _mm256_mask_add_epi32(m[q], push[q], m[q], one));
         store8i(H->far + jq, lanes[q], far[q]);
         /* the occluders of the cells below (hi, when asked) and above (lo) */
@@ -266,7 +337,8 @@ AVX512VL static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, 
         qm[2 * q + 1] = _mm512_mask_cmp_pd_mask(lanes[q], hn, hn, _CMP_ORD_Q);
         qg[2 * q + 1] = _mm512_sub_pd(hn, cdd[q]);
     }
-    query(2 * NG, QG, qm, qfar, qg, s->push_d != NULL, s->k, s->k_step, k, dd);
+    query(2 * NG, QG, qm, qfar, qg, s->push_d != NULL, s->k, s->k_step, k, dd,
+          bes && s->push_d ? (const __m512d(*)[4])at_far : NULL);
     for (int q = 0; q < NG; q++) {
         const int jq = j + 8 * q;
         store8i(occ->hi_k + jq, lanes[q], k[2 * q]);

@@ -23,7 +23,17 @@ typedef struct {
     ts_hull_pt *pts;
     int stride;
     int *n, *far;
+    /* NULL, or the points the AVX-512 step reads most, kept beside the
+     * stacks so that it needs no gather for them: TS_BESIDE arrays of
+     * beside_n doubles (line j's at [j] of each). Only that step reads and
+     * keeps them: hulls that have them must take every step there. */
+    double *beside;
+    int beside_n;
 } ts_lane_hulls;
+
+/* The arrays of ts_lane_hulls' beside: the d and g of the top point (T)
+ * and of the one under it (S), each where the stack has it. */
+enum { TS_BESIDE_TD, TS_BESIDE_TG, TS_BESIDE_SD, TS_BESIDE_SG, TS_BESIDE };
 
 /* Step k of lines j0..j1: each line's distance d[j] from its first sample,
  * its height hs[j] (NaN: no sample to push), and the heights hc[j], hn[j]

@@ -1,6 +1,7 @@
 /* The lockstep hull step's three forms (lane_hull.h): the scalar reference
  * (ts_lane_hull_step_scalar), the AVX2 step (ts_lane_hull_step_avx2) and
- * ts_lane_hull_step as this CPU runs it (AVX-512 here and in CI), each on
+ * ts_lane_hull_step as this CPU runs it (AVX-512 here and in CI), with and
+ * without the hulls' most read points kept beside them (AVX-512 only), each on
  * its own copy of the same synthetic block of lines, step by step: every
  * answer (occluder steps and distances) and every hull (sizes, far
  * pointers, points) must be the same bits. The blocks are built to reach
@@ -29,8 +30,9 @@
 #define PAD 16     /* the vector steps' loads beyond the last line */
 #define SLOTS 64   /* the delayed pushes' ring */
 
-enum { SCALAR, AVX2, NATIVE, FORMS };
-static const char *const form_names[FORMS] = {"scalar", "avx2", "ts_lane_hull_step"};
+enum { SCALAR, AVX2, NATIVE, TOPS, FORMS };
+static const char *const form_names[FORMS] = {"scalar", "avx2", "ts_lane_hull_step",
+                                              "ts_lane_hull_step with points beside"};
 
 typedef struct {
     ts_hull_pt *pts;
@@ -38,6 +40,7 @@ typedef struct {
     int hi_k[LINES + PAD], lo_k[LINES + PAD];
     float hi_dd[LINES + PAD], lo_dd[LINES + PAD];
     ts_lane_pushes push;
+    double beside[TS_BESIDE * (LINES + PAD)]; /* the TOPS form's */
 } form_state;
 
 typedef struct {
@@ -47,15 +50,18 @@ typedef struct {
 } block_case;
 
 /* The vector forms where ts_cpu_vector_level allows them (AVX2 at least:
- * ts_lane_hull_step then runs AVX2's or AVX-512's). */
+ * ts_lane_hull_step then runs AVX2's or AVX-512's; the hulls' tops beside
+ * them only with AVX-512, as the sweep keeps them). */
 static int form_available(int f)
 {
-    return f == SCALAR || ts_cpu_vector_level() >= TS_CPU_VECTORS_AVX2;
+    return f == SCALAR || (f == TOPS ? ts_cpu_vector_level() == TS_CPU_VECTORS_AVX512
+                                     : ts_cpu_vector_level() >= TS_CPU_VECTORS_AVX2);
 }
 
 static void form_step(int f, form_state *st, const ts_lane_step *s)
 {
-    const ts_lane_hulls h = {st->pts, STEPS + 1, st->n, st->far};
+    const ts_lane_hulls h = {st->pts, STEPS + 1, st->n, st->far, f == TOPS ? st->beside : NULL,
+                             LINES + PAD};
     const ts_lane_occluders occ = {st->lo_k, st->hi_k, st->lo_dd, st->hi_dd};
     if (f == SCALAR) {
         ts_lane_hull_step_scalar(&h, s, &occ);
