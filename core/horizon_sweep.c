@@ -193,13 +193,15 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
     const int U = C->geom->U, capped = C->cap > 0, need_visit = C->visit != NULL;
     *w = (sweep_ws){0};
     int ok = 1;
+    /* the block's hulls' offsets fit the gathers' 32 bits, as
+     * ts_lane_hull_step's AVX-512 step asks */
+    const int hulls32 = (long long)(LOCKSTEP_LINES + 1) * (U + 1) * 6 <= INT_MAX;
     /* capped lines too where their windows are short enough for the
      * brute force (capped_lanes.h), one by one otherwise */
     w->lockstep = !need_visit && (!capped || ts_cap_lanes_pays(C->lags));
-    /* long windows: in lockstep too where the hybrid pays (and its hulls'
-     * offsets fit the gathers' 32 bits, as ts_lane_hull_step asks) */
-    w->hybrid = !need_visit && capped && !w->lockstep && ts_cap_lanes_hybrid_pays(C->lags) &&
-                (long long)(LOCKSTEP_LINES + 1) * (U + 1) * 6 <= INT_MAX;
+    /* long windows: in lockstep too where the hybrid pays (and hulls32) */
+    w->hybrid =
+        !need_visit && capped && !w->lockstep && ts_cap_lanes_hybrid_pays(C->lags) && hulls32;
     w->lockstep |= w->hybrid;
     if (capped && !w->lockstep) {
         w->raw = malloc((size_t)(U + 1) * sizeof *w->raw);
@@ -231,9 +233,8 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
                 malloc((size_t)(LOCKSTEP_LINES + 1) * (U + 1) * sizeof *w->lane_stacks);
             ok = ok && w->lane_n && w->lane_far && w->lane_stacks;
             /* the hulls' most read points beside them, where every step
-             * takes AVX-512 (ts_lane_hull_step: its 32-bit offsets fit) */
-            if (ok && ts_cpu_vector_level() == TS_CPU_VECTORS_AVX512 &&
-                (long long)(LOCKSTEP_LINES + 1) * (U + 1) * 6 <= INT_MAX)
+             * takes AVX-512 (hulls32) */
+            if (ok && hulls32 && ts_cpu_vector_level() == TS_CPU_VECTORS_AVX512)
                 ok = (w->lane_beside = malloc(TS_BESIDE * (LOCKSTEP_LINES + 1) *
                                               sizeof(double))) != NULL;
         }

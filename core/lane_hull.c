@@ -86,6 +86,22 @@ ALWAYS __mmask8 any_of(int Q, const __mmask8 *active)
     return any;
 }
 
+/* One pass of a walk down a hull, for the lines of mask m (from
+ * distance d at hull height g): point j - 1 (dm, gm) hides point j (dj,
+ * gj) where it pops; there j moves down to it, and the lines stay active
+ * while j > 0. Every walk's compare, so that they all round alike. */
+ALWAYS void pop_pass(__m512d d, __m512d g, __m512d dm, __m512d gm, __mmask8 m, __m512d *dj,
+                     __m512d *gj, __m256i *j, __mmask8 *active)
+{
+    const __m512d lhs = _mm512_mul_pd(_mm512_sub_pd(gm, g), _mm512_sub_pd(d, *dj));
+    const __m512d rhs = _mm512_mul_pd(_mm512_sub_pd(*gj, g), _mm512_sub_pd(d, dm));
+    const __mmask8 pop = _mm512_mask_cmp_pd_mask(m, lhs, rhs, _CMP_GE_OQ);
+    *dj = _mm512_mask_mov_pd(*dj, pop, dm);
+    *gj = _mm512_mask_mov_pd(*gj, pop, gm);
+    *j = _mm256_mask_sub_epi32(*j, pop, *j, _mm256_set1_epi32(1));
+    *active = _mm256_mask_cmpgt_epi32_mask(pop, *j, _mm256_setzero_si256());
+}
+
 /* The walk of hull_push's pops and of stack_query, for Q vectors of lines
  * (those of active[q], of group G[q]) at hull heights g[q]: j[q] moves
  * down while point j - 1 hides point j (dj, gj: point j's fields) as seen
@@ -96,21 +112,14 @@ ALWAYS __mmask8 any_of(int Q, const __mmask8 *active)
 ALWAYS void walk_down(int Q, const group *const *G, const __m512d *g, __mmask8 *active,
                       __m256i *j, __m512d *dj, __m512d *gj, int skip_idle)
 {
-    const __m256i zero = _mm256_setzero_si256(), one = _mm256_set1_epi32(1);
+    const __m256i one = _mm256_set1_epi32(1);
     while (any_of(Q, active))
         for (int q = 0; q < Q; q++) {
             if (skip_idle && !active[q])
                 continue;
-            const __m512d d = G[q]->d;
-            __m256i jm = _mm256_sub_epi32(j[q], one);
-            __m512d dm = field(G[q], active[q], jm, 0), gm = field(G[q], active[q], jm, 1);
-            __m512d lhs = _mm512_mul_pd(_mm512_sub_pd(gm, g[q]), _mm512_sub_pd(d, dj[q]));
-            __m512d rhs = _mm512_mul_pd(_mm512_sub_pd(gj[q], g[q]), _mm512_sub_pd(d, dm));
-            __mmask8 pop = _mm512_mask_cmp_pd_mask(active[q], lhs, rhs, _CMP_GE_OQ);
-            dj[q] = _mm512_mask_mov_pd(dj[q], pop, dm);
-            gj[q] = _mm512_mask_mov_pd(gj[q], pop, gm);
-            j[q] = _mm256_mask_sub_epi32(j[q], pop, j[q], one);
-            active[q] = _mm256_mask_cmpgt_epi32_mask(pop, j[q], zero);
+            const __m256i jm = _mm256_sub_epi32(j[q], one);
+            const __m512d dm = field(G[q], active[q], jm, 0), gm = field(G[q], active[q], jm, 1);
+            pop_pass(G[q]->d, g[q], dm, gm, active[q], &dj[q], &gj[q], &j[q], &active[q]);
         }
 }
 
@@ -161,13 +170,8 @@ ALWAYS void query(int Q, const group *const *G, const __mmask8 *m, const __m256i
         const __m512d d = G[q]->d;
         for (int r = q; r < q + 2; r++) {
             ok[r] = _mm256_mask_cmpge_epi32_mask(m[r], far[r], zero);
-            const __m512d lhs = _mm512_mul_pd(_mm512_sub_pd(gm, g[r]), _mm512_sub_pd(d, df));
-            const __m512d rhs = _mm512_mul_pd(_mm512_sub_pd(gf, g[r]), _mm512_sub_pd(d, dm));
-            const __mmask8 pop = _mm512_mask_cmp_pd_mask(ok[r] & below, lhs, rhs, _CMP_GE_OQ);
-            dj[r] = _mm512_mask_mov_pd(df, pop, dm);
-            gj[r] = _mm512_mask_mov_pd(gf, pop, gm);
-            j[r] = _mm256_mask_sub_epi32(far[r], pop, far[r], one);
-            active[r] = _mm256_mask_cmpgt_epi32_mask(pop, j[r], zero);
+            dj[r] = df, gj[r] = gf, j[r] = far[r];
+            pop_pass(d, g[r], dm, gm, ok[r] & below, &dj[r], &gj[r], &j[r], &active[r]);
         }
     }
     walk_down(Q, G, g, active, j, dj, gj, long_walks);
@@ -200,19 +204,11 @@ ALWAYS void first_pop_beside(const ts_lane_hulls *H, int j, const group *const *
                              const __m512d *gs, __mmask8 *active, __m256i *top, __m512d *d1,
                              __m512d *g1)
 {
-    const __m256i one = _mm256_set1_epi32(1);
     for (int q = 0; q < NG; q++) {
         const int jq = j + 8 * q;
-        const __m512d d = GP[q]->d;
         const __m512d dm = beside_load(H, TS_BESIDE_SD, jq, active[q]);
         const __m512d gm = beside_load(H, TS_BESIDE_SG, jq, active[q]);
-        const __m512d lhs = _mm512_mul_pd(_mm512_sub_pd(gm, gs[q]), _mm512_sub_pd(d, d1[q]));
-        const __m512d rhs = _mm512_mul_pd(_mm512_sub_pd(g1[q], gs[q]), _mm512_sub_pd(d, dm));
-        const __mmask8 pop = _mm512_mask_cmp_pd_mask(active[q], lhs, rhs, _CMP_GE_OQ);
-        d1[q] = _mm512_mask_mov_pd(d1[q], pop, dm);
-        g1[q] = _mm512_mask_mov_pd(g1[q], pop, gm);
-        top[q] = _mm256_mask_sub_epi32(top[q], pop, top[q], one);
-        active[q] = _mm256_mask_cmpgt_epi32_mask(pop, top[q], _mm256_setzero_si256());
+        pop_pass(GP[q]->d, gs[q], dm, gm, active[q], &d1[q], &g1[q], &top[q], &active[q]);
     }
 }
 
