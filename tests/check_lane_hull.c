@@ -1,7 +1,7 @@
-/* The lockstep hull step's three forms (lane_hull.h): the scalar reference
- * (ts_lane_hull_step_scalar), the AVX2 step (ts_lane_hull_step_avx2) and
- * ts_lane_hull_step as this CPU runs it (AVX-512 here and in CI), with and
- * without the hulls' most read points kept beside them (AVX-512 only), each on
+/* The lockstep hull step's four forms (lane_hull.h): the scalar reference
+ * (ts_lane_hull_step_scalar), the AVX2 step (ts_lane_hull_step_avx2),
+ * ts_lane_hull_step as this CPU runs it (AVX-512 here and in CI), and the
+ * same with the hulls' most read points kept beside them (AVX-512 only), each on
  * its own copy of the same synthetic block of lines, step by step: every
  * answer (occluder steps and distances) and every hull (sizes, far
  * pointers, points) must be the same bits. The blocks are built to reach
