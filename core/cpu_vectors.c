@@ -24,13 +24,15 @@ ts_status ts_cpu_vectors_parse(const char *text, int *cap, ts_error *err)
                    "TERRASHADE_SIMD must be auto, avx512, avx2 or none, got '%.40s'", text);
 }
 
-/* The CPU's own level: AVX-512 with its 256-bit forms (every AVX-512 CPU
- * but the Xeon Phi has them), AVX2, or neither. */
+/* The CPU's own level: AVX-512 with its 256-bit forms and byte masks
+ * (avx512vl, avx512bw: every AVX-512 CPU but the Xeon Phi has them), AVX2,
+ * or neither. */
 static int cpu_level(void)
 {
 #if defined(__GNUC__) && defined(__x86_64__)
     __builtin_cpu_init();
-    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl")
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                   __builtin_cpu_supports("avx512bw")
                ? TS_CPU_VECTORS_AVX512
            : __builtin_cpu_supports("avx2") ? TS_CPU_VECTORS_AVX2
                                             : TS_CPU_VECTORS_NONE;

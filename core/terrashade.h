@@ -583,7 +583,7 @@ int ts_cpu_count(void);
 enum {
     TS_CPU_VECTORS_NONE = 0,  /**< the portable C paths */
     TS_CPU_VECTORS_AVX2 = 1,  /**< AVX2 where a path has it, else portable C */
-    TS_CPU_VECTORS_AVX512 = 2 /**< AVX-512 (with AVX-512VL) */
+    TS_CPU_VECTORS_AVX512 = 2 /**< AVX-512 (with AVX-512VL and BW) */
 };
 
 /** The widest hand-written vector code this process runs: the CPU's,
