@@ -218,7 +218,7 @@ typedef struct {
 
 /* Scan the listed slots, each group of lines its own list, in lockstep (the
  * chains of the groups stay independent, so that their latencies overlap),
- * and empty the lists. A shorter list is padded with the ring's spare slot,
+ * and empty the lists. A shorter list goes on with the ring's spare slot,
  * which has no samples (d NaN: never taken). */
 TS_AVX512BW static inline __attribute__((always_inline)) void
 scan512_lists(const ts_cap_lanes *r, int g, int ng, slot_lists *L, scan512 *a)
@@ -229,18 +229,17 @@ scan512_lists(const ts_cap_lanes *r, int g, int ng, slot_lists *L, scan512 *a)
     int n = 0;
     for (int q = 0; q < ng; q++)
         n = L->n[q] > n ? L->n[q] : n;
-    const __m512i spare = _mm512_set1_epi32(r->slots * r->stride);
-    for (int q = 0; q < ng; q++)
-        for (int i = L->n[q]; i < n; i += 16) {
-            _mm512_storeu_si512(L->off[q] + i, spare);
-            _mm512_storeu_si512(L->step[q] + i, _mm512_setzero_si512());
-        }
+    /* (selected, not stored: the stores' loops branch on each list's
+     * length) */
+    const int spare = r->slots * r->stride;
     for (int i = 0; i < n; i++)
         for (int q = 0; q < NG; q++) {
             if (q >= ng)
                 break;
-            const size_t at = (size_t)L->off[q][i] + g + 8 * q;
-            scan512_one(r, q, r->d + at, r->g + at, _mm512_set1_epi64(L->step[q][i]), test, a);
+            const int in = i < L->n[q];
+            const size_t at = (size_t)(in ? L->off[q][i] : spare) + g + 8 * q;
+            const long long step = in ? L->step[q][i] : 0;
+            scan512_one(r, q, r->d + at, r->g + at, _mm512_set1_epi64(step), test, a);
         }
     for (int q = 0; q < ng; q++)
         L->n[q] = 0;
