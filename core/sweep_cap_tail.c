@@ -5,7 +5,49 @@
 
 #include "cap_tail_bound.h"
 #include "near_field.h"
+#include "simd_clones.h"
 #include "sweep_cap_tail.h"
+#include "terrashade.h"
+
+#if defined(__GNUC__) && defined(__x86_64__)
+/* cells_left's first cells, sixteen at a time: those up to the return
+ * value, their count in *n. */
+TS_AVX512 static int cells_left512(const float *zrow, const float *bound, const float *orow,
+                                   int W, int *left, int *n)
+{
+    const __m512i iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    int x = 0, m = 0;
+    for (; x + 16 <= W; x += 16) {
+        const __m512 z = _mm512_loadu_ps(zrow + x);
+        const __mmask16 keep =
+            _mm512_cmp_ps_mask(z, z, _CMP_ORD_Q) &
+            ~_mm512_cmp_ps_mask(_mm512_loadu_ps(bound + x), _mm512_loadu_ps(orow + x), _CMP_LT_OQ);
+        _mm512_storeu_si512(left + m, _mm512_maskz_compress_epi32(
+                                          keep, _mm512_add_epi32(iota, _mm512_set1_epi32(x))));
+        m += __builtin_popcount(keep);
+    }
+    *n = m;
+    return x;
+}
+#endif
+
+/* The cells of a row that the row bound leaves (zrow[x] not nodata and
+ * not bound[x] < orow[x]: a NaN bound leaves it) into left, in order;
+ * their count. Listed without a branch per cell: most are ruled out, in no
+ * pattern a branch predicts. left has room for W + 16. */
+static int cells_left(const float *zrow, const float *bound, const float *orow, int W, int *left)
+{
+    int n = 0, x = 0;
+#if defined(__GNUC__) && defined(__x86_64__)
+    if (ts_cpu_vector_level() == TS_CPU_VECTORS_AVX512)
+        x = cells_left512(zrow, bound, orow, W, left, &n);
+#endif
+    for (; x < W; x++) {
+        left[n] = x;
+        n += (zrow[x] == zrow[x]) & !(bound[x] < orow[x]);
+    }
+    return n;
+}
 
 /* An upper bound of the slope from cell (k, i) at height h to its ray
  * between whole steps j and j + 1: the highest corner of the patches it
@@ -64,16 +106,21 @@ void ts_cap_tail(const ts_line_geom *G, const ts_grid *grid, double cap, double 
     ts_cap_stencil st;
     ts_cap_stencil_init(&st, G, s0, smax, step, c);
     int xa = W, xb = W;
-    float *bound = malloc(2 * (size_t)W * sizeof *bound);
+    /* the row's bounds (and the stencil's scratch), then the cells left */
+    float *bound = malloc(2 * (size_t)W * sizeof *bound + ((size_t)W + 16) * sizeof(int));
+    int *left = NULL, nleft = W;
     if (bound) {
         ts_cap_stencil_range(&st, G, W, y, &xa, &xb);
         for (int x = 0; x < W; x++)
             bound[x] = NAN; /* no row bound: the per-cell path */
         if (xa < xb)
             ts_cap_stencil_row(&st, zrow, xa, xb, bound, bound + W);
+        left = (int *)(bound + 2 * (size_t)W);
+        nleft = cells_left(zrow, bound, orow, W, left);
     }
-    for (int x = 0; x < W; x++) {
-        if (isnan(zrow[x]) || (bound && bound[x] < orow[x]))
+    for (int j = 0; j < nleft; j++) {
+        const int x = left ? left[j] : j;
+        if (isnan(zrow[x]))
             continue;
         int u = G->x_major ? x : y, i = G->x_major ? y : x;
         int k = (u - G->u_start) * G->u_step;
