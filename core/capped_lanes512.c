@@ -210,8 +210,8 @@ groups_needed(const ts_cap_lanes *r, int l, int idx, int g, int ng, const __m512
 }
 
 /* The slots each group of eight lines scans, oldest first: their steps and
- * offsets in the ring (slot * stride). A level-1 group adds at most
- * TS_CAP_G1 to a list; the lists have room for a vector's store beyond. */
+ * offsets in the ring (slot * stride). A level-0 group adds at most
+ * TS_CAP_G0 to a list; the lists have room for a vector's store beyond. */
 #define LIST_MAX 1024
 typedef struct {
     int n[NG];
@@ -248,7 +248,8 @@ scan512_lists(const ts_cap_lanes *r, int g, int ng, slot_lists *L, scan512 *a)
 }
 
 /* Level-0 groups to scan for a group of lines: the group, its entry in
- * the groups' rings, the group of lines. */
+ * the groups' rings, the group of lines; the pairs have room for a
+ * vector's store beyond. */
 #define PAIRS_MAX 64
 typedef struct {
     int n;
@@ -369,14 +370,23 @@ raised_threshold(const scan512 *a, int q, __m512d thr)
     return _mm512_mask_mov_pd(thr, _mm512_cmp_pd_mask(t, thr, _CMP_GT_OQ), t);
 }
 
-/* Lists of at least this many slots are scanned before the next level-1
- * group's tests, to raise their threshold. */
-#ifndef RAISE_FROM
-#define RAISE_FROM 64
-#endif
-_Static_assert(2 * RAISE_FROM + 2 * TS_CAP_G1 <= LIST_MAX &&
-                   NG * (TS_CAP_G1 / TS_CAP_G0) <= PAIRS_MAX,
-               "the lists and pairs of the level-1 groups scanned at once fit");
+_Static_assert(PAIRS_MAX * TS_CAP_G0 <= LIST_MAX && NG * (TS_CAP_G1 / TS_CAP_G0) <= PAIRS_MAX,
+               "the lists of the pairs listed at once fit, and a level-1 group's pairs");
+
+/* The samples of the pairs P that a line may take, appended to the lists
+ * (list_samples); P emptied. */
+TS_AVX512BW static inline __attribute__((always_inline)) void
+list_pairs(const ts_cap_lanes *r, int s_lo, int s_hi, int g, const __m512d *tt, const __m512d *rt,
+           const __mmask8 *idle, group_pairs *P, slot_lists *L)
+{
+    for (int p = 0; p < P->n; p++) {
+        const int q = P->q[p], s0 = P->m0[p] * TS_CAP_G0;
+        const int a0 = s0 > s_lo ? s0 : s_lo,
+                  b0 = s0 + TS_CAP_G0 - 1 < s_hi ? s0 + TS_CAP_G0 - 1 : s_hi;
+        list_samples(r, P->idx[p] * TS_CAP_G0, s0, a0, b0, g, q, tt[q], rt[q], idle[q], L);
+    }
+    P->n = 0;
+}
 
 /* The pruned scan of steps s_lo..s_hi for the ng groups of lines from g.
  * Each group of lines lists the slots it must scan: those of the level-0
@@ -440,33 +450,20 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
             }
         }
         idx0 = idx0 + count < r->groups[0] ? idx0 + count : idx0 + count - r->groups[0];
-        if (P.n) {
-            /* their samples that a line may take, then the scan of those,
-             * whose answers may raise the threshold for the newer groups */
-            for (int p = 0; p < P.n; p++) {
-                const int q = P.q[p], s0 = P.m0[p] * TS_CAP_G0;
-                const int a0 = s0 > s_lo ? s0 : s_lo,
-                          b0 = s0 + TS_CAP_G0 - 1 < s_hi ? s0 + TS_CAP_G0 - 1 : s_hi;
-                list_samples(r, P.idx[p] * TS_CAP_G0, s0, a0, b0, g, q, tt[q], rt[q], idle[q], &L);
-            }
-            P.n = 0;
-            int most = 0;
-            for (int q = 0; q < ng; q++)
-                most = L.n[q] > most ? L.n[q] : most;
-            /* long lists, with two level-1 groups or more still to test:
-             * scanned now, so that their answers may raise the threshold
-             * for the newer groups (short ones wait, and the last groups:
-             * a scan per level-1 group costs more than it prunes there) */
-            if (most >= RAISE_FROM && m1 + 2 <= last1) {
-                scan512_lists(r, g, ng, &L, a);
-                for (int q = 0; q < ng; q++) {
-                    thr[q] = raised_threshold(a, q, thr[q]);
-                    threshold_tests(thr[q], gmin[q], a->d[q], &rhs[q], &neg[q], &tt[q], &rt[q]);
-                }
+        /* The pairs are listed and scanned once, after all the tests, but
+         * where the next level-1 group's could overflow them (long windows):
+         * then their answers raise the threshold for the newer groups. */
+        if (P.n > PAIRS_MAX - NG * (TS_CAP_G1 / TS_CAP_G0) && m1 < last1) {
+            list_pairs(r, s_lo, s_hi, g, tt, rt, idle, &P, &L);
+            scan512_lists(r, g, ng, &L, a);
+            for (int q = 0; q < ng; q++) {
+                thr[q] = raised_threshold(a, q, thr[q]);
+                threshold_tests(thr[q], gmin[q], a->d[q], &rhs[q], &neg[q], &tt[q], &rt[q]);
             }
         }
     }
-    scan512_lists(r, g, ng, &L, a); /* what is left, the newest groups' */
+    list_pairs(r, s_lo, s_hi, g, tt, rt, idle, &P, &L);
+    scan512_lists(r, g, ng, &L, a); /* all, or those since the early scan */
 }
 
 /* scan_scalar for up to NG groups from g (those below g1), eight lines
