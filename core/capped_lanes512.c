@@ -8,10 +8,6 @@
 #include "capped_lanes512.h"
 #include "simd_clones.h"
 
-/* AVX-512 with the byte masks and 128-bit forms (ts_cpu_vector_level asks
- * for them) */
-#define TS_AVX512BW __attribute__((target("avx512f,avx512bw,avx512vl")))
-
 /* groups of eight lines scanned together: independent chains of compares
  * and selects, so that their latencies overlap */
 #define NG TS_CAP_NG
@@ -27,7 +23,7 @@ typedef struct {
 /* One slot of the window for group q of eight lines (its distances pd,
  * heights pg, already at the group's lines; step ks): the operations of
  * scan_scalar; the distance test only where `test`. */
-TS_AVX512BW static inline __attribute__((always_inline)) void
+TS_AVX512 static inline __attribute__((always_inline)) void
 scan512_one(const ts_cap_lanes *r, int q, const double *pd, const double *pg, __m512i ks,
             int test, scan512 *a)
 {
@@ -53,7 +49,7 @@ scan512_one(const ts_cap_lanes *r, int q, const double *pd, const double *pg, __
 
 /* One slot of the window (its distances pd, heights pg, step ks) for ng
  * groups of eight lines. */
-TS_AVX512BW static inline __attribute__((always_inline)) void
+TS_AVX512 static inline __attribute__((always_inline)) void
 scan512_slot(const ts_cap_lanes *r, int ng, const double *pd, const double *pg, __m512i ks,
              int test, scan512 *a)
 {
@@ -66,7 +62,7 @@ scan512_slot(const ts_cap_lanes *r, int ng, const double *pd, const double *pg, 
 
 /* The window's slots of lags lag_from down to lag_to (oldest first), for
  * ng groups of eight lines from line g. */
-TS_AVX512BW static inline __attribute__((always_inline)) void
+TS_AVX512 static inline __attribute__((always_inline)) void
 scan512_lags(const ts_cap_lanes *r, int k, int g, int ng, int lag_from, int lag_to, scan512 *a)
 {
     int slot = (k - lag_from) % r->slots;
@@ -118,7 +114,7 @@ scan512_lags(const ts_cap_lanes *r, int k, int g, int ng, int lag_from, int lag_
  * point) of four samples of the window, each taken only where the scan's
  * own tests put it in the window: the line's previous answers of both
  * queries, and its newest and oldest slot. */
-TS_AVX512BW static inline __attribute__((always_inline)) void
+TS_AVX512 static inline __attribute__((always_inline)) void
 prune_threshold(const ts_cap_lanes *r, int k, int lag_hi, int j, const scan512 *a, int q,
                 __m512d *thr, __m512d *gmin, __mmask8 *idle)
 {
@@ -183,7 +179,7 @@ prune_threshold(const ts_cap_lanes *r, int k, int lag_hi, int j, const scan512 *
  * threshold: unless gmax + T dsel < gmin + T d (above: rhs) or the line
  * has no query, dsel the group's newest distance where T >= 0, its oldest
  * where T < 0 (neg). */
-TS_AVX512BW static inline __attribute__((always_inline)) __mmask8
+TS_AVX512 static inline __attribute__((always_inline)) __mmask8
 group_may_hold(const ts_cap_lanes *r, int l, size_t at, int q, const __m512d *thr,
                const __m512d *rhs, const __mmask8 *neg, const __mmask8 *idle)
 {
@@ -195,7 +191,7 @@ group_may_hold(const ts_cap_lanes *r, int l, size_t at, int q, const __m512d *th
 
 /* The ng groups of lines from g (bit q: group q) for which group idx of
  * level l may hold such a sample on some line (group_may_hold). */
-TS_AVX512BW static inline __attribute__((always_inline)) unsigned
+TS_AVX512 static inline __attribute__((always_inline)) unsigned
 groups_needed(const ts_cap_lanes *r, int l, int idx, int g, int ng, const __m512d *thr,
               const __m512d *rhs, const __mmask8 *neg, const __mmask8 *idle)
 {
@@ -222,7 +218,7 @@ typedef struct {
  * chains of the groups stay independent, so that their latencies overlap),
  * and empty the lists. A shorter list goes on with the ring's spare slot,
  * which has no samples (d NaN: never taken). */
-TS_AVX512BW static inline __attribute__((always_inline)) void
+TS_AVX512 static inline __attribute__((always_inline)) void
 scan512_lists(const ts_cap_lanes *r, int g, int ng, slot_lists *L, scan512 *a)
 {
     /* the distance test, unless every lag of the window is sure (the spare
@@ -270,7 +266,7 @@ _Static_assert(TS_CAP_G0 <= 8 && TS_CAP_G1 / TS_CAP_G0 <= 8,
 /* Which of the count level-0 groups from entry idx0 on (at most the
  * TS_CAP_G1 / TS_CAP_G0 of a level-1 group) group q of lines from g needs
  * (bit i: the i-th), by group_may_hold. */
-TS_AVX512BW static inline __attribute__((always_inline)) unsigned
+TS_AVX512 static inline __attribute__((always_inline)) unsigned
 level0_needed(const ts_cap_lanes *r, int idx0, int count, int g, int q, const __m512d *thr,
               const __m512d *rhs, const __mmask8 *neg, const __mmask8 *idle)
 {
@@ -288,7 +284,7 @@ level0_needed(const ts_cap_lanes *r, int idx0, int count, int g, int q, const __
  * s0 (ring slot slot) whose samples some line of q may take: the group
  * test with the group one sample (gmax = g_p, dsel = d_p), tt and rt the
  * threshold and right side as there. */
-TS_AVX512BW static inline __attribute__((always_inline)) void
+TS_AVX512 static inline __attribute__((always_inline)) void
 list_samples(const ts_cap_lanes *r, int slot, int s0, int a0, int b0, int g, int q, __m512d tt,
              __m512d rt, __mmask8 idle, slot_lists *L)
 {
@@ -322,7 +318,7 @@ list_samples(const ts_cap_lanes *r, int slot, int s0, int a0, int b0, int g, int
 /* The tests' terms for threshold T (thr) and lower query height gmin at
  * query distance d: group_may_hold's right side and sign, list_samples'
  * threshold and right side. */
-TS_AVX512BW static inline __attribute__((always_inline)) void
+TS_AVX512 static inline __attribute__((always_inline)) void
 threshold_tests(__m512d thr, __m512d gmin, __m512d d, __m512d *rhs, __mmask8 *neg, __m512d *tt,
                 __m512d *rt)
 {
@@ -346,7 +342,7 @@ threshold_tests(__m512d thr, __m512d gmin, __m512d d, __m512d *rhs, __mmask8 *ne
  * height g + bn, its slope from the higher point ghi (bn + (g - ghi)) / bd
  * to within ~2^-51 (|bn| + |g - ghi|) / bd, which is taken off too: T
  * stays below L's slope where the difference cancels. */
-TS_AVX512BW static inline __attribute__((always_inline)) __m512d
+TS_AVX512 static inline __attribute__((always_inline)) __m512d
 raised_threshold(const scan512 *a, int q, __m512d thr)
 {
     const __mmask8 hc = _mm512_cmp_pd_mask(a->gc[q], a->gc[q], _CMP_ORD_Q);
@@ -375,7 +371,7 @@ _Static_assert(PAIRS_MAX * TS_CAP_G0 <= LIST_MAX && NG * (TS_CAP_G1 / TS_CAP_G0)
 
 /* The samples of the pairs P that a line may take, appended to the lists
  * (list_samples); P emptied. */
-TS_AVX512BW static inline __attribute__((always_inline)) void
+TS_AVX512 static inline __attribute__((always_inline)) void
 list_pairs(const ts_cap_lanes *r, int s_lo, int s_hi, int g, const __m512d *tt, const __m512d *rt,
            const __mmask8 *idle, group_pairs *P, slot_lists *L)
 {
@@ -393,7 +389,7 @@ list_pairs(const ts_cap_lanes *r, int s_lo, int s_hi, int g, const __m512d *tt, 
  * groups that the level-1 and level-0 bounds leave (the newest PRUNE_NEAR
  * steps untested), and of these the samples that the same bound, taken
  * sample by sample (a group of one: gmax = g_p, dsel = d_p), leaves. */
-TS_AVX512BW static inline __attribute__((always_inline)) void
+TS_AVX512 static inline __attribute__((always_inline)) void
 scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 *a)
 {
     __m512d thr[NG], rhs[NG], tt[NG], rt[NG], gmin[NG];
@@ -470,7 +466,7 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
  * per AVX-512 vector: the same operations per line; with r->prune, only
  * the slots that may change the answer. */
 
-TS_AVX512BW void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1)
+TS_AVX512 void ts_cap_scan512(const ts_cap_lanes *r, int k, int g, int g1)
 {
     const int lag_hi = k < r->lag_hi ? k : r->lag_hi;
     const int ng = (g1 - g) / 8 < NG ? (g1 - g) / 8 : NG;

@@ -22,20 +22,15 @@ typedef struct {
     const int *pk;
 } group;
 
-/* AVX-512 with its 256-bit forms (every AVX-512 CPU but the Xeon Phi has
- * them; ts_cpu_vector_level asks): mask compares and masked adds of the
- * lines' indices, each one instruction on the walks' dependent chains. */
-#define AVX512VL __attribute__((target("avx512f,avx512vl")))
-
 /* 3 x: a shift and an add, where vpmulld takes 10 cycles (on the walks'
  * chains: index, gather, compare, index). */
-AVX512VL static inline __m256i times3(__m256i x)
+TS_AVX512 static inline __m256i times3(__m256i x)
 {
     return _mm256_add_epi32(_mm256_slli_epi32(x, 1), x);
 }
 
 /* Field f (0: d, 1: g) of point p of each line, where m. */
-AVX512VL static inline __m512d field(const group *G, __mmask8 m, __m256i p, int f)
+TS_AVX512 static inline __m512d field(const group *G, __mmask8 m, __m256i p, int f)
 {
     __m256i i = _mm256_add_epi32(times3(_mm256_add_epi32(G->first, p)), _mm256_set1_epi32(f));
     return _mm512_mask_i32gather_pd(_mm512_setzero_pd(), m, i, G->pd, 8);
@@ -46,7 +41,7 @@ AVX512VL static inline __m512d field(const group *G, __mmask8 m, __m256i p, int 
  * values no walk uses: every use is masked): each line's (d, g) pair loaded
  * on its own and the eight transposed, in about half the time of two
  * gathers on the Zen 4 host (session 38). */
-AVX512VL static inline __attribute__((always_inline)) void
+TS_AVX512 static inline __attribute__((always_inline)) void
 fields(const group *G, __mmask8 m, __m256i p, __m512d *d, __m512d *g)
 {
     int at[8] __attribute__((aligned(32)));
@@ -71,7 +66,7 @@ fields(const group *G, __mmask8 m, __m256i p, __m512d *d, __m512d *g)
 
 /* Point p of each line of m set to (d, g), as two scatters would, each
  * line's pair stored on its own (the others' into a spare pair). */
-AVX512VL static inline __attribute__((always_inline)) void
+TS_AVX512 static inline __attribute__((always_inline)) void
 set_fields(const group *G, __mmask8 m, __m256i p, __m512d d, __m512d g)
 {
     int at[8] __attribute__((aligned(32)));
@@ -96,28 +91,28 @@ set_fields(const group *G, __mmask8 m, __m256i p, __m512d d, __m512d g)
 }
 
 /* Array a of the hulls' beside (lane_hull.h) at lines jq.., where m. */
-AVX512VL static inline __m512d beside_load(const ts_lane_hulls *H, int a, int jq, __mmask8 m)
+TS_AVX512 static inline __m512d beside_load(const ts_lane_hulls *H, int a, int jq, __mmask8 m)
 {
     return _mm512_maskz_loadu_pd(m, H->beside + (size_t)a * H->beside_n + jq);
 }
 
-AVX512VL static inline void beside_store(const ts_lane_hulls *H, int a, int jq, __mmask8 m,
+TS_AVX512 static inline void beside_store(const ts_lane_hulls *H, int a, int jq, __mmask8 m,
                                          __m512d v)
 {
     _mm512_mask_storeu_pd(H->beside + (size_t)a * H->beside_n + jq, m, v);
 }
 
-AVX512VL static inline __m256 load8f(__mmask8 m, const float *p)
+TS_AVX512 static inline __m256 load8f(__mmask8 m, const float *p)
 {
     return _mm512_castps512_ps256(_mm512_maskz_loadu_ps((__mmask16)m, p));
 }
 
-AVX512VL static inline __m256i load8i(__mmask8 m, const int *p)
+TS_AVX512 static inline __m256i load8i(__mmask8 m, const int *p)
 {
     return _mm512_castsi512_si256(_mm512_maskz_loadu_epi32((__mmask16)m, p));
 }
 
-AVX512VL static inline void store8i(int *p, __mmask8 m, __m256i v)
+TS_AVX512 static inline void store8i(int *p, __mmask8 m, __m256i v)
 {
     _mm512_mask_storeu_epi32(p, (__mmask16)m, _mm512_castsi256_si512(v));
 }
@@ -126,7 +121,7 @@ AVX512VL static inline void store8i(int *p, __mmask8 m, __m256i v)
  * loop issues the gathers of Q independent vectors (lines, or the two
  * queries of the same lines), so that their latencies overlap; Q is a
  * constant where they are inlined. */
-#define ALWAYS AVX512VL static inline __attribute__((always_inline))
+#define ALWAYS TS_AVX512 static inline __attribute__((always_inline))
 /* vectors of eight lines a step takes at once (4: measured faster than 1,
  * 2 and 8), and at most twice as many walks (two queries per line) */
 #define NG 4
@@ -275,7 +270,7 @@ ALWAYS void first_pop_beside(const ts_lane_hulls *H, int j, const group *const *
  * in group q (a group with none is left alone). With the points beside
  * (H->beside), the pushes' first compares come from there, and in the
  * hybrid (far at the top) the queries' first points too. */
-AVX512VL static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, int j,
+TS_AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s, int j,
                                   const __mmask8 *lanes, const ts_lane_occluders *occ)
 {
     const __m512d c = _mm512_set1_pd(s->c), near_skip = _mm512_set1_pd(s->near_skip);

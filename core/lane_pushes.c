@@ -99,8 +99,6 @@ int ts_lane_delayed_pushes_scalar(ts_lane_pushes *p, const double *d_ring, const
 #if defined(__GNUC__) && defined(__x86_64__)
 #include <immintrin.h>
 
-#define AVX512VL __attribute__((target("avx512f,avx512vl")))
-
 /* The ring as the vector pushes read it (its distances d), and the block's
  * lines j..j + 7. */
 typedef struct {
@@ -113,7 +111,7 @@ typedef struct {
 /* The doubles of ring (R->d, or the heights beside it) at the lanes' slots where m, else src:
  * one load where those lanes share a slot (a line keeps its neighbours'
  * pace), else a gather. */
-AVX512VL static inline __m512d ring_read(const ring8 *R, const double *ring, __m256i slot,
+TS_AVX512 static inline __m512d ring_read(const ring8 *R, const double *ring, __m256i slot,
                                          __mmask8 m, __m512d src)
 {
     const __m256i first = _mm256_set1_epi32(m ? __builtin_ctz(m) : 0);
@@ -125,7 +123,7 @@ AVX512VL static inline __m512d ring_read(const ring8 *R, const double *ring, __m
 }
 
 /* The lanes of m move one step on (q, and slot in the ring). */
-AVX512VL static inline void step_on(const ring8 *R, __mmask8 m, __m256i *q, __m256i *slot)
+TS_AVX512 static inline void step_on(const ring8 *R, __mmask8 m, __m256i *q, __m256i *slot)
 {
     const __m256i one = _mm256_set1_epi32(1);
     *q = _mm256_mask_add_epi32(*q, m, *q, one);
@@ -138,7 +136,7 @@ AVX512VL static inline void step_on(const ring8 *R, __mmask8 m, __m256i *q, __m2
 /* oldest_waiting for the lanes of wait, whose distance at their slot is
  * *dr: each moves past the slots without a sample, before step k, and *dr
  * is the distance at its new slot where that is before k. */
-AVX512VL static inline void oldest_waiting8(const ring8 *R, int k, __mmask8 wait, __m256i *q,
+TS_AVX512 static inline void oldest_waiting8(const ring8 *R, int k, __mmask8 wait, __m256i *q,
                                             __m256i *slot, __m512d *dr)
 {
     __mmask8 skip = _mm512_mask_cmp_pd_mask(wait, *dr, *dr, _CMP_UNORD_Q);
@@ -151,7 +149,7 @@ AVX512VL static inline void oldest_waiting8(const ring8 *R, int k, __mmask8 wait
 }
 
 /* ts_lane_delayed_pushes_scalar, eight lines a vector. */
-AVX512VL static int delayed_pushes512(ts_lane_pushes *p, const double *d_ring,
+TS_AVX512 static int delayed_pushes512(ts_lane_pushes *p, const double *d_ring,
                                       const double *g_ring, size_t slot_stride, int slots,
                                       double behind, const ts_lane_step *s)
 {

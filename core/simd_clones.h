@@ -16,9 +16,11 @@
 #endif
 
 /* TS_AVX512: a function compiled for AVX-512 only (hand-written intrinsics),
- * called only where ts_cpu_vector_level() says the CPU has it. */
+ * called only where ts_cpu_vector_level() says the CPU has it: AVX-512F
+ * with its 128- and 256-bit forms (VL) and byte and word masks (BW), which
+ * that level asks for. */
 #if defined(__GNUC__) && defined(__x86_64__)
-#define TS_AVX512 __attribute__((target("avx512f")))
+#define TS_AVX512 __attribute__((target("avx512f,avx512vl,avx512bw")))
 #include <immintrin.h>
 
 /* The first n of sixteen AVX-512 lanes: none for n <= 0, all for n >= 16
