@@ -68,62 +68,114 @@ TS_AVX512 static void piece_peaks(const cm_fast_piece *q, float t, float L, floa
     }
 }
 
-/* One piece over cells x0 <= x < x1 (cm_fast_piece's float operations),
- * its end's edge corners e0, e1 constants, so that they are registers; the
- * cells whose inner peak the test finds are queued in qx[0] and qx[1],
- * block by block in turn (two shorter chains of counts), nq their counts. */
+/* A piece's constants as vectors (piece_vector's). */
+typedef struct {
+    __m512 tv, one, frac, inv_b, cb, cLL, ka, kbn, xt, invL;
+    __m512i sign, step;
+} piece_vectors;
+
+/* One vector of cells from x (those of lanes) of one piece (cm_fast_piece's
+ * float operations), its end's edge corners e0, e1 and has_sa constants;
+ * a cell whose inner peak the test finds is appended to the queue qx
+ * (*nq cells). */
+TS_AVX512 static inline __attribute__((always_inline)) void
+piece_vector(const piece_vectors *v, const float *const cn[4], const int e0, const int e1,
+             const int has_sa, const float *restrict zrow, int x, __mmask16 lanes,
+             float *restrict best, float *restrict flag, float *restrict prev, int *restrict qx,
+             int *nq)
+{
+    __m512 c[4];
+    for (int i = 0; i < 4; i++)
+        c[i] = _mm512_maskz_loadu_ps(lanes, cn[i] + x);
+    const __m512 h = _mm512_maskz_loadu_ps(lanes, zrow + x);
+    const __m512 X = _mm512_add_ps(_mm512_sub_ps(_mm512_sub_ps(c[3], c[1]), c[2]), c[0]);
+    const __m512 dz = _mm512_add_ps(_mm512_sub_ps(c[e0], h),
+                                    _mm512_mul_ps(_mm512_sub_ps(c[e1], c[e0]), v->frac));
+    const __m512 f = _mm512_sub_ps(_mm512_mul_ps(dz, v->inv_b), v->cb);
+    __m512 m = _mm512_max_ps(f, _mm512_maskz_loadu_ps(lanes, best + x));
+    if (!has_sa) { /* the ray's start */
+        const __m512 A = _mm512_sub_ps(c[1], c[0]), B = _mm512_sub_ps(c[2], c[0]);
+        const __m512 beta = _mm512_castsi512_ps(_mm512_xor_si512(
+            _mm512_castps_si512(_mm512_add_ps(_mm512_add_ps(A, _mm512_mul_ps(B, v->tv)),
+                                              _mm512_mul_ps(X, v->xt))),
+            v->sign));
+        m = _mm512_max_ps(_mm512_mul_ps(beta, v->invL), m);
+    } else {
+        const __m512 g2 = _mm512_sub_ps(_mm512_mul_ps(X, v->tv), v->cLL);
+        const __m512 D = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, prev + x), f);
+        __mmask16 k = _mm512_mask_cmp_ps_mask(lanes, g2, _mm512_setzero_ps(), _CMP_LT_OQ);
+        k = _mm512_mask_cmp_ps_mask(k, D, _mm512_mul_ps(g2, v->ka), _CMP_GT_OQ);
+        k = _mm512_mask_cmp_ps_mask(k, D, _mm512_mul_ps(g2, v->kbn), _CMP_LT_OQ);
+        _mm512_storeu_si512(qx + *nq, _mm512_maskz_compress_epi32(
+                                          k, _mm512_add_epi32(_mm512_set1_epi32(x), v->step)));
+        *nq += __builtin_popcount(k);
+    }
+    _mm512_mask_storeu_ps(best + x, lanes, m);
+    _mm512_mask_storeu_ps(prev + x, lanes, f);
+    const __m512 xx = _mm512_sub_ps(X, X); /* NaN where X is not finite */
+    const __mmask16 bad = _mm512_mask_cmp_ps_mask(lanes, xx, xx, _CMP_UNORD_Q);
+    if (bad) {
+        const __m512 fl = _mm512_maskz_loadu_ps(lanes, flag + x);
+        _mm512_mask_storeu_ps(flag + x, bad, _mm512_add_ps(fl, v->one));
+    }
+}
+
+/* One piece over the vectors of cells from xs (the first one's lanes below
+ * x0 masked off) to x1, has_sa constant: vector i's queued cells go to
+ * qx[i & 1] (two shorter chains of counts). The vectors between the first
+ * and the last are whole, and taken two at a time, so that the counts and
+ * the masks stay out of memory. */
+TS_AVX512 static inline __attribute__((always_inline)) void
+piece_run(const piece_vectors *v, const float *const cn[4], const int e0, const int e1,
+          const int has_sa, const float *restrict zrow, int xs, int x0, int x1,
+          float *restrict best, float *restrict flag, float *restrict prev, int *const qx[2],
+          int nq[2])
+{
+    int n0 = nq[0], n1 = nq[1], x = xs;
+    int *restrict q0 = qx[0], *restrict q1 = qx[1];
+#define PIECE_VECTOR(at, lanes, q, n)                                                          \
+    piece_vector(v, cn, e0, e1, has_sa, zrow, at, lanes, best, flag, prev, q, &n)
+    PIECE_VECTOR(x, ts_first_lanes16(x1 - x) & ~ts_first_lanes16(x0 - x), q0, n0);
+    for (x += 16; x + 32 <= x1; x += 32) {
+        PIECE_VECTOR(x, 0xFFFF, q1, n1);
+        PIECE_VECTOR(x + 16, 0xFFFF, q0, n0);
+    }
+    if (x < x1)
+        PIECE_VECTOR(x, ts_first_lanes16(x1 - x), q1, n1);
+    if (x + 16 < x1)
+        PIECE_VECTOR(x + 16, ts_first_lanes16(x1 - x - 16), q0, n0);
+#undef PIECE_VECTOR
+    nq[0] = n0;
+    nq[1] = n1;
+}
+
+/* One piece over cells x0 <= x < x1 (piece_run, with and without the
+ * ray's start), its end's edge corners e0, e1 constants, so that they are
+ * registers; the cells whose inner peak the test finds are queued in qx[0]
+ * and qx[1], nq their counts. */
 TS_AVX512 static inline __attribute__((always_inline)) void
 piece_cells(const cm_fast_piece *q, const float *const cn[4], const int e0, const int e1,
             float t, const float *restrict zrow, int xs, int x0, int x1, float *restrict best,
             float *restrict flag, float *restrict prev, int *const qx[2], int nq[2])
 {
-    const __m512 tv = _mm512_set1_ps(t), one = _mm512_set1_ps(1.0f);
-    const __m512i sign = _mm512_set1_epi32((int)0x80000000u);
-    const __m512i step = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-    const __m512 frac = _mm512_set1_ps(q->frac), inv_b = _mm512_set1_ps(q->inv_b);
-    const __m512 cb = _mm512_set1_ps(q->cb), cLL = _mm512_set1_ps(q->cLL);
-    const __m512 ka = _mm512_set1_ps(q->ka), kbn = _mm512_set1_ps(q->kbn);
-    const __m512 xt = _mm512_set1_ps(q->a0 * t + q->b0), invL = _mm512_set1_ps(q->invL);
-    const int has_sa = q->has_sa;
-    for (int x = xs; x < x1; x += 16) {
-        const __mmask16 lanes = ts_first_lanes16(x1 - x) & ~ts_first_lanes16(x0 - x);
-        __m512 c[4];
-        for (int i = 0; i < 4; i++)
-            c[i] = _mm512_maskz_loadu_ps(lanes, cn[i] + x);
-        const __m512 h = _mm512_maskz_loadu_ps(lanes, zrow + x);
-        const __m512 X = _mm512_add_ps(_mm512_sub_ps(_mm512_sub_ps(c[3], c[1]), c[2]), c[0]);
-        const __m512 dz = _mm512_add_ps(_mm512_sub_ps(c[e0], h),
-                                        _mm512_mul_ps(_mm512_sub_ps(c[e1], c[e0]), frac));
-        const __m512 f = _mm512_sub_ps(_mm512_mul_ps(dz, inv_b), cb);
-        __m512 m = _mm512_max_ps(f, _mm512_maskz_loadu_ps(lanes, best + x));
-        if (!has_sa) { /* the ray's start */
-            const __m512 A = _mm512_sub_ps(c[1], c[0]), B = _mm512_sub_ps(c[2], c[0]);
-            const __m512 beta = _mm512_castsi512_ps(_mm512_xor_si512(
-                _mm512_castps_si512(
-                    _mm512_add_ps(_mm512_add_ps(A, _mm512_mul_ps(B, tv)), _mm512_mul_ps(X, xt))),
-                sign));
-            m = _mm512_max_ps(_mm512_mul_ps(beta, invL), m);
-        } else {
-            const __m512 g2 = _mm512_sub_ps(_mm512_mul_ps(X, tv), cLL);
-            const __m512 D = _mm512_sub_ps(_mm512_maskz_loadu_ps(lanes, prev + x), f);
-            __mmask16 k = _mm512_mask_cmp_ps_mask(lanes, g2, _mm512_setzero_ps(), _CMP_LT_OQ);
-            k = _mm512_mask_cmp_ps_mask(k, D, _mm512_mul_ps(g2, ka), _CMP_GT_OQ);
-            k = _mm512_mask_cmp_ps_mask(k, D, _mm512_mul_ps(g2, kbn), _CMP_LT_OQ);
-            const int b = ((x - xs) >> 4) & 1;
-            _mm512_storeu_si512(qx[b] + nq[b],
-                                _mm512_maskz_compress_epi32(
-                                    k, _mm512_add_epi32(_mm512_set1_epi32(x), step)));
-            nq[b] += __builtin_popcount(k);
-        }
-        _mm512_mask_storeu_ps(best + x, lanes, m);
-        _mm512_mask_storeu_ps(prev + x, lanes, f);
-        const __m512 xx = _mm512_sub_ps(X, X); /* NaN where X is not finite */
-        const __mmask16 bad = _mm512_mask_cmp_ps_mask(lanes, xx, xx, _CMP_UNORD_Q);
-        if (bad) {
-            const __m512 fl = _mm512_maskz_loadu_ps(lanes, flag + x);
-            _mm512_mask_storeu_ps(flag + x, bad, _mm512_add_ps(fl, one));
-        }
-    }
+    const piece_vectors v = {
+        .tv = _mm512_set1_ps(t),
+        .one = _mm512_set1_ps(1.0f),
+        .frac = _mm512_set1_ps(q->frac),
+        .inv_b = _mm512_set1_ps(q->inv_b),
+        .cb = _mm512_set1_ps(q->cb),
+        .cLL = _mm512_set1_ps(q->cLL),
+        .ka = _mm512_set1_ps(q->ka),
+        .kbn = _mm512_set1_ps(q->kbn),
+        .xt = _mm512_set1_ps(q->a0 * t + q->b0),
+        .invL = _mm512_set1_ps(q->invL),
+        .sign = _mm512_set1_epi32((int)0x80000000u),
+        .step = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15),
+    };
+    if (q->has_sa)
+        piece_run(&v, cn, e0, e1, 1, zrow, xs, x0, x1, best, flag, prev, qx, nq);
+    else
+        piece_run(&v, cn, e0, e1, 0, zrow, xs, x0, x1, best, flag, prev, qx, nq);
 }
 
 TS_AVX512 static void run(const ts_near_plan *p, const float *restrict zrow, int x0, int x1,
