@@ -18,6 +18,44 @@
 #include "capped_lanes512.h"
 
 #if defined(__GNUC__) && defined(__x86_64__)
+#include <math.h>
+
+/* Steps of one length (k_step > 0: each distance is its step's multiple of
+ * k_step, one rounding) make every line's delayed push its sample of step
+ * k - lag, lag the least with lag k_step >= near: the one the general
+ * pushes (ts_lane_delayed_pushes) find there, one a step, and read in
+ * place from the ring (cleared with the block, and its slot of every step
+ * rewritten). 0 where near lies within 1e-6 steps of a whole number of
+ * steps, where rounding might decide, or the ring is too short: then the
+ * general pushes. */
+static int uniform_push_lag(const ts_cap_lanes *r, double k_step)
+{
+    if (!(k_step > 0))
+        return 0;
+    const double x = r->near / k_step, lag = ceil(x);
+    if (!(lag - x >= 1e-6 && x - (lag - 1) >= 1e-6 && lag >= 1 && lag < r->slots))
+        return 0;
+    return (int)lag;
+}
+
+/* The pushes of step k for uniform_push_lag's lag: the ring's slot of step
+ * k - lag (NaN distances where a line has no sample there), none before
+ * step lag. */
+static void ring_pushes(ts_cap_lanes *r, int k, int lag, ts_lane_step *hs)
+{
+    if (k >= lag) {
+        const size_t at = (size_t)((k - lag) % r->slots) * r->stride;
+        hs->push_d = r->d + at;
+        hs->push_g = r->g + at;
+    } else {
+        for (int j = hs->j0; j <= hs->j1; j++)
+            r->push.pd[j] = NAN;
+        hs->push_d = r->push.pd;
+        hs->push_g = r->push.pg;
+    }
+    hs->push_ks = r->push.ks; /* (unread: the hulls' steps follow from k_step) */
+    hs->near_skip = 0.0;
+}
 
 int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_lane_step *s,
                              int nl, const ts_lane_occluders *occ)
@@ -31,10 +69,16 @@ int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_l
      * passes as a line has ready */
     ts_lane_step hs = *s;
     int more, pushed;
-    do {
-        more = ts_lane_delayed_pushes(&r->push, r->d, r->g, r->stride, r->slots, r->near, &hs);
+    const int lag = uniform_push_lag(r, s->k_step);
+    if (lag > 0) {
+        ring_pushes(r, k, lag, &hs);
         pushed = ts_lane_hull_step(h, &hs, occ);
-    } while (pushed && more);
+    } else
+        do {
+            more = ts_lane_delayed_pushes(&r->push, r->d, r->g, r->stride, r->slots, r->near,
+                                          &hs);
+            pushed = ts_lane_hull_step(h, &hs, occ);
+        } while (pushed && more);
     if (!pushed) {
         r->hull_lost = 1;
         return 0;

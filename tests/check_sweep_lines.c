@@ -294,20 +294,26 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
     full.prune = 0;
     ts_cap_lanes_clear(&pruned);
     ts_cap_lanes_clear(&full);
-    int ok_k[3][CL_LINES + 1], hi_k[3][CL_LINES + 1];
-    float ok_dd[3][CL_LINES + 1], hi_dd[3][CL_LINES + 1];
-    long queries = 0, ties = 0, bad = 0, hull_steps = 0, hyb_ties = 0;
-    /* long windows (AVX-512): the hybrid, unbounded hulls first */
+    int ok_k[4][CL_LINES + 1], hi_k[4][CL_LINES + 1];
+    float ok_dd[4][CL_LINES + 1], hi_dd[4][CL_LINES + 1];
+    long queries = 0, ties = 0, bad = 0, hull_steps[2] = {0}, hyb_ties = 0;
+    /* long windows (AVX-512): the hybrid, unbounded hulls first; where the
+     * steps are of one length, twice: with the general delayed pushes
+     * (k_step 0) and as the sweep runs it, the pushes read in place from
+     * the ring and the hulls' steps from their distances (k_step = step:
+     * each d here is (k - 3j) x 10, exact) */
     const int hybrid = ts_cap_lanes_hybrid_pays(lags) && !ts_cap_lanes_pays(lags);
-    ts_cap_lanes hyb = {0};
-    static ts_hull_pt pts[CL_LINES * (CL_STEPS + 1)];
-    int hn_n[CL_LINES + 1] = {0}, hn_far[CL_LINES + 1];
-    const ts_lane_hulls hulls = {pts, CL_STEPS + 1, hn_n, hn_far};
+    const int hybrids = hybrid ? (jitter == 0.0 ? 2 : 1) : 0;
+    ts_cap_lanes hyb[2] = {{0}, {0}};
+    static ts_hull_pt pts[2][CL_LINES * (CL_STEPS + 1)];
+    int hn_n[2][CL_LINES + 1] = {{0}}, hn_far[2][CL_LINES + 1];
+    const ts_lane_hulls hulls[2] = {{pts[0], CL_STEPS + 1, hn_n[0], hn_far[0], NULL, 0},
+                                    {pts[1], CL_STEPS + 1, hn_n[1], hn_far[1], NULL, 0}};
     for (int j = 0; j <= CL_LINES; j++)
-        hn_far[j] = -1;
-    if (hybrid) {
-        ck_assert(ts_cap_lanes_alloc(&hyb, CL_LINES, lags, near, cap));
-        ts_cap_lanes_clear(&hyb);
+        hn_far[0][j] = hn_far[1][j] = -1;
+    for (int u = 0; u < hybrids; u++) {
+        ck_assert(ts_cap_lanes_alloc(&hyb[u], CL_LINES, lags, near, cap));
+        ts_cap_lanes_clear(&hyb[u]);
     }
     for (int k = 0; k < CL_STEPS; k++) {
         int j0 = CL_LINES, j1 = -1;
@@ -326,11 +332,13 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
             const ts_lane_occluders occ = {ok_k[v], hi_k[v], ok_dd[v], hi_dd[v]};
             ts_cap_lanes_step(v ? &full : &pruned, &st, CL_LINES, &occ);
         }
-        if (hybrid) {
-            const ts_lane_occluders occ = {ok_k[2], hi_k[2], ok_dd[2], hi_dd[2]};
-            if (!ts_cap_lanes_hybrid_step(&hyb, &hulls, &st, CL_LINES, &occ))
-                ts_cap_lanes_step(&hyb, &st, CL_LINES, &occ);
-            hull_steps += !hyb.hull_lost;
+        for (int u = 0; u < hybrids; u++) {
+            const ts_lane_occluders occ = {ok_k[2 + u], hi_k[2 + u], ok_dd[2 + u], hi_dd[2 + u]};
+            ts_lane_step su = st;
+            su.k_step = u ? step : 0.0;
+            if (!ts_cap_lanes_hybrid_step(&hyb[u], &hulls[u], &su, CL_LINES, &occ))
+                ts_cap_lanes_step(&hyb[u], &su, CL_LINES, &occ);
+            hull_steps[u] += !hyb[u].hull_lost;
         }
         for (int j = j0; j <= j1; j++)
             for (int q = 0; q < 2; q++) {
@@ -359,11 +367,11 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
                 queries++;
                 ties += nbest > 1;
                 const int jo = q ? j + 1 : j;
-                if (hybrid) {
+                for (int u = 0; u < hybrids; u++) {
                     /* the steepest slope; another equally steep sample's
                      * step (the hull's tie rule) counts as a tie */
-                    const int gk = q ? ok_k[2][jo] : hi_k[2][jo];
-                    const float gdd = q ? ok_dd[2][jo] : hi_dd[2][jo];
+                    const int gk = q ? ok_k[2 + u][jo] : hi_k[2 + u][jo];
+                    const float gdd = q ? ok_dd[2 + u][jo] : hi_dd[2 + u][jo];
                     int good = gk == bk && gdd == (float)bd;
                     if (!good && gk >= 0 && bk >= 0 && cl_on(j, gk) && !isnan(hs[gk][j])) {
                         const double dd = d[k][j] - d[gk][j];
@@ -372,9 +380,9 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
                         hyb_ties += good;
                     }
                     if (!good && bad++ == 0)
-                        printf("step %d line %d query %d (hybrid): step %d dd %.9g, "
-                               "want %ld %.9g\n",
-                               k, j, q, gk, gdd, bk, bd);
+                        printf("step %d line %d query %d (hybrid, k_step %s): step %d dd "
+                               "%.9g, want %ld %.9g\n",
+                               k, j, q, u ? "> 0" : "0", gk, gdd, bk, bd);
                 }
                 for (int v = 0; v < 2; v++) {
                     const int gk = q ? ok_k[v][jo] : hi_k[v][jo];
@@ -391,14 +399,18 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
     printf("capped scan, lags %d..%d, %s, c %g, jitter %g: %ld queries, %ld with tied "
            "steepest, %ld wrong\n", lags[0], lags[1], pruned.prune ? "pruned" : "not pruned",
            c, jitter, queries, ties, bad);
+    for (int u = 0; u < hybrids; u++)
+        printf("  hybrid (k_step %s): hulls on %ld of %d steps\n", u ? "> 0" : "0",
+               hull_steps[u], CL_STEPS);
     if (hybrid)
-        printf("  hybrid: hulls on %ld of %d steps, %ld answers another tied sample\n",
-               hull_steps, CL_STEPS, hyb_ties);
+        printf("  hybrid: %ld answers another tied sample\n", hyb_ties);
     ts_cap_lanes_free(&pruned);
     ts_cap_lanes_free(&full);
-    ts_cap_lanes_free(&hyb);
+    ts_cap_lanes_free(&hyb[0]);
+    ts_cap_lanes_free(&hyb[1]);
     ck_assert_msg(queries > 10000 && bad == 0, "%ld of %ld capped queries wrong", bad, queries);
-    ck_assert(!hybrid || hull_steps > 400);
+    ck_assert(!hybrid || hull_steps[0] > 400);
+    ck_assert(hybrids < 2 || hull_steps[1] > 400);
 }
 
 START_TEST(test_capped_scan_pruned)
