@@ -173,6 +173,29 @@ ALWAYS void walk_down(int Q, const group *const *G, const __m512d *g, __mmask8 *
         }
 }
 
+/* walk_down for the queries' Q vectors in pairs: vectors q and q + 1 (q
+ * even) are the same lines, from the same far, and each pass moves every
+ * walking lane one point down, so that a lane walking in both stands on the
+ * same point in both: one load of each pass's points serves the pair (a
+ * lane walking in one only reads its own). The same compares as walk_down. */
+ALWAYS void walk_pairs(int Q, const group *const *G, const __m512d *g, __mmask8 *active,
+                       __m256i *j, __m512d *dj, __m512d *gj, int skip_idle)
+{
+    const __m256i one = _mm256_set1_epi32(1);
+    while (any_of(Q, active))
+        for (int q = 0; q < Q; q += 2) {
+            const __mmask8 m = active[q] | active[q + 1];
+            if (skip_idle && !m)
+                continue;
+            const __m256i jm =
+                _mm256_sub_epi32(_mm256_mask_blend_epi32(active[q], j[q + 1], j[q]), one);
+            __m512d dm, gm;
+            fields(G[q], m, jm, &dm, &gm);
+            for (int r = q; r < q + 2; r++)
+                pop_pass(G[q]->d, g[r], dm, gm, active[r], &dj[r], &gj[r], &j[r], &active[r]);
+        }
+}
+
 /* far_advance for Q groups: far[q] moves up while its next point (below
  * n[q]) is near_skip behind. */
 ALWAYS void advance(int Q, const group *G, const __mmask8 *lanes, __m256i *far,
@@ -228,7 +251,7 @@ ALWAYS void query(int Q, const group *const *G, const __mmask8 *m, const __m256i
             pop_pass(d, g[r], dm, gm, ok[r] & below, &dj[r], &gj[r], &j[r], &active[r]);
         }
     }
-    walk_down(Q, G, g, active, j, dj, gj, long_walks);
+    walk_pairs(Q, G, g, active, j, dj, gj, long_walks);
     for (int q = 0; q < Q; q++) {
         const __m512d dd = _mm512_sub_pd(G[q]->d, dj[q]);
         if (k_step > 0) {
@@ -294,7 +317,12 @@ TS_AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s,
          * distance where it pushes another point's) */
         GP[q] = &G[q];
         if (s->push_d) {
-            P[q] = G[q];
+            /* (field by field: a copy of the whole struct read back the
+             * stores just made to G[q] with one wider load, which stalls on
+             * store forwarding: ~7 % of this function's samples) */
+            P[q].first = G[q].first;
+            P[q].pd = G[q].pd;
+            P[q].pk = G[q].pk;
             GP[q] = &P[q];
             P[q].d = _mm512_maskz_loadu_pd(lanes[q], s->push_d + jq);
             push[q] = _mm512_mask_cmp_pd_mask(lanes[q], P[q].d, P[q].d, _CMP_ORD_Q);
