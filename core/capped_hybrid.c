@@ -57,8 +57,8 @@ static void ring_pushes(ts_cap_lanes *r, int k, int lag, ts_lane_step *hs)
     hs->near_skip = 0.0;
 }
 
-int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_lane_step *s,
-                             int nl, const ts_lane_occluders *occ)
+int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, ts_lane_step *s, int nl,
+                             const ts_lane_occluders *occ)
 {
     const int k = s->k, j0 = s->j0, j1 = s->j1;
     if (r->hull_lost || j0 > j1 || r->stride > TS_CAP_MAX_LINES) {
@@ -67,17 +67,17 @@ int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_l
     }
     /* the ring's samples the near field's distance behind, in as many
      * passes as a line has ready */
-    ts_lane_step hs = *s;
+    /* (in s itself: a copy of s, read back right after the caller's stores
+     * to it with wider loads, stalled on store forwarding) */
     int more, pushed;
     const int lag = uniform_push_lag(r, s->k_step);
     if (lag > 0) {
-        ring_pushes(r, k, lag, &hs);
-        pushed = ts_lane_hull_step(h, &hs, occ);
+        ring_pushes(r, k, lag, s);
+        pushed = ts_lane_hull_step(h, s, occ);
     } else
         do {
-            more = ts_lane_delayed_pushes(&r->push, r->d, r->g, r->stride, r->slots, r->near,
-                                          &hs);
-            pushed = ts_lane_hull_step(h, &hs, occ);
+            more = ts_lane_delayed_pushes(&r->push, r->d, r->g, r->stride, r->slots, r->near, s);
+            pushed = ts_lane_hull_step(h, s, occ);
         } while (pushed && more);
     if (!pushed) {
         r->hull_lost = 1;
@@ -109,8 +109,8 @@ int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_l
 
 #else
 
-int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_lane_step *s,
-                             int nl, const ts_lane_occluders *occ)
+int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, ts_lane_step *s, int nl,
+                             const ts_lane_occluders *occ)
 {
     (void)r;
     (void)h;

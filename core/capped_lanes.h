@@ -105,10 +105,12 @@ int ts_cap_lanes_hybrid_pays(const int lags[4]);
  * once its line is the near field's distance past it (r->push: every
  * sample beyond the near field, none within). The answers differ from
  * ts_cap_lanes_step's only between equally steep samples (up to
- * rounding). Returns 0, having done nothing, where the CPU has no
+ * rounding). Sets s's pushes (push_d, push_g, push_ks; near_skip 0) for
+ * the hulls. Returns 0, having answered nothing, where the CPU has no
  * AVX-512, the block too many lines, or the hulls missed a step
- * (hull_lost): the caller then runs ts_cap_lanes_step. */
-int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, const ts_lane_step *s,
-                             int nl, const ts_lane_occluders *occ);
+ * (hull_lost): the caller then runs ts_cap_lanes_step (which reads none
+ * of those fields). */
+int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, ts_lane_step *s, int nl,
+                             const ts_lane_occluders *occ);
 
 #endif

@@ -149,14 +149,16 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
             else if (!hybrid && !ts_lane_hull_step(&hulls, &step, &occ))
                 ts_lane_hull_step_scalar(&hulls, &step, &occ);
         }
-        if (j1 == nl - 1)
-            next[k] = (occluder){w->lo_k[nl], w->lo_dd[nl]};
         const int jw = prime && j0 == 0 ? 1 : j0;
         float *o = C->out + C->o_origin + (ptrdiff_t)k * C->o_u_stride +
                    (i0 + jw) * C->o_v_stride; /* cell (k, i0 + jw) */
         /* (far-only: every occluder lies beyond the threshold) */
         ts_lane_far_field(G, C->grid->z, (float)c, C->far_T > 0 ? 0 : TS_NEAR_STEPS, k, (int)i0,
                           jw, j1, w->hc, &occ, &lost, w->slope, o, C->o_v_stride);
+        /* the carry, read after the far field: right after the hull step's
+         * vector stores to it, the load stalled on store forwarding */
+        if (j1 == nl - 1)
+            next[k] = (occluder){w->lo_k[nl], w->lo_dd[nl]};
     }
     w->carry_next = w->carry;
     w->carry = next;
