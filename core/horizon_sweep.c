@@ -32,6 +32,7 @@
 #include <limits.h>
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "arg_checks.h"
 #include "cellmath/cm_fastmath.h"
@@ -46,6 +47,16 @@
 
 /* Step k of lines j0..j1 of a block (rows i0 + j): each line's distance
  * from its first sample, as ts_line_sample_at advances it. */
+/* A block's per-line arrays on whole cache lines, each row of them too
+ * (LANE_ROW entries): the lockstep passes' vector loads and stores of eight
+ * or sixteen lines from line 0 then split no line. */
+#define LANE_ROW ((LOCKSTEP_LINES + 2 + 15) / 16 * 16)
+
+static void *alloc_lines(size_t bytes)
+{
+    return aligned_alloc(64, (bytes + 63) / 64 * 64);
+}
+
 static void lane_distances(const sweep_ctx *C, sweep_ws *w, int k, int i0, int j0, int j1)
 {
     const ts_line_geom *G = C->geom;
@@ -104,7 +115,7 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         ts_lane_pushes_reset(&w->far_push, nl);
     const ts_lane_occluders occ = {w->lo_k, w->hi_k, w->lo_dd, w->hi_dd};
     const ts_lane_hulls hulls = {w->lane_stacks,  G->U + 1, w->lane_n, w->lane_far,
-                                 w->lane_beside, LOCKSTEP_LINES + 1};
+                                 w->lane_beside, LANE_ROW};
     const ts_lane_lost lost = {&C->ray, C->c, C->cap, w->lost};
     const double c = C->c;
     for (int k = kmin; k <= kmax; k++) {
@@ -229,26 +240,27 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
         if (capped)
             ok = ts_cap_lanes_alloc(&w->capl, LOCKSTEP_LINES + 1, C->lags, C->near_skip, C->cap);
         if (!capped || w->hybrid) {
-            w->lane_n = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_n);
-            w->lane_far = malloc((LOCKSTEP_LINES + 1) * sizeof *w->lane_far);
+            w->lane_n = alloc_lines(LANE_ROW * sizeof *w->lane_n);
+            w->lane_far = alloc_lines(LANE_ROW * sizeof *w->lane_far);
             w->lane_stacks =
                 malloc((size_t)(LOCKSTEP_LINES + 1) * (U + 1) * sizeof *w->lane_stacks);
             ok = ok && w->lane_n && w->lane_far && w->lane_stacks;
             /* the hulls' most read points beside them, where every step
              * takes AVX-512 (hulls32) */
             if (ok && hulls32 && ts_cpu_vector_level() == TS_CPU_VECTORS_AVX512)
-                ok = (w->lane_beside = malloc(TS_BESIDE * (LOCKSTEP_LINES + 1) *
-                                              sizeof(double))) != NULL;
+                ok = (w->lane_beside = alloc_lines(TS_BESIDE * LANE_ROW * sizeof(double))) !=
+                     NULL;
         }
         w->carry = malloc((size_t)U * sizeof *w->carry);
         w->carry_next = malloc((size_t)U * sizeof *w->carry_next);
         /* a block has up to LOCKSTEP_LINES + 1 lines (with the primed one) */
-        const size_t row = LOCKSTEP_LINES + 2;
-        w->lane_f = malloc(6 * row * sizeof *w->lane_f);
-        w->lane_i = calloc(4 * row, sizeof *w->lane_i); /* the lost flags start clear */
-        w->lane_d = malloc(row * sizeof *w->lane_d);
+        const size_t row = LANE_ROW;
+        w->lane_f = alloc_lines(6 * row * sizeof *w->lane_f);
+        w->lane_i = alloc_lines(4 * row * sizeof *w->lane_i);
+        w->lane_d = alloc_lines(row * sizeof *w->lane_d);
         ok = ok && w->carry && w->carry_next && w->lane_f && w->lane_i && w->lane_d;
         if (ok) {
+            memset(w->lane_i, 0, 4 * row * sizeof *w->lane_i); /* the lost flags start clear */
             w->hc = w->lane_f;
             w->hn = w->lane_f + row;
             w->hs = w->lane_f + 2 * row;

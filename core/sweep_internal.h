@@ -68,7 +68,7 @@ typedef struct {
     /* unbounded sweep: the lines of a block, swept in lockstep */
     hull_pt *lane_stacks; /* line j's hull at lane_stacks + j * (U + 1) */
     int *lane_n, *lane_far; /* its size, its top-most point beyond the near field */
-    double *lane_beside;    /* NULL, or TS_BESIDE x (LOCKSTEP_LINES + 1): ts_lane_hulls' */
+    double *lane_beside;    /* NULL, or TS_BESIDE rows of LANE_ROW: ts_lane_hulls' */
     occluder *carry, *carry_next; /* far-side occluders from the line before */
     /* the block's current step, by line (one entry more than lines) */
     float *lane_f;      /* holds: */
