@@ -84,7 +84,7 @@ int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, ts_lane_st
         return 0;
     }
     double *rd, *rg;
-    ts_cap_ring_slot(r, k, nl, &rd, &rg);
+    ts_cap_ring_slot(r, k, nl, j0, j1, &rd, &rg); /* (j0..j1: ts_cap_answers512) */
     const int g0 = j0 / 8 * 8, g1 = (j1 + 8) / 8 * 8;
     ts_cap_queries512(r, s, g0, g1);
     /* the hull's answers, where they are the window's; the groups of eight

@@ -263,12 +263,15 @@ static void scan_groups(const ts_cap_lanes *r, int k, int g0, int g1)
 }
 #endif
 
-void ts_cap_ring_slot(ts_cap_lanes *r, int k, int nl, double **rd, double **rg)
+void ts_cap_ring_slot(ts_cap_lanes *r, int k, int nl, int j0, int j1, double **rd, double **rg)
 {
     const size_t at = (size_t)(k % r->slots) * r->stride;
     *rd = r->d + at;
     *rg = r->g + at;
-    for (int j = 0; j < nl; j++)
+    const int lo = j0 < nl ? j0 : nl, hi = j1 + 1 > 0 ? j1 + 1 : 0;
+    for (int j = 0; j < lo; j++)
+        (*rd)[j] = NAN;
+    for (int j = hi > lo ? hi : lo; j < nl; j++)
         (*rd)[j] = NAN;
 }
 
@@ -278,7 +281,7 @@ void ts_cap_lanes_step(ts_cap_lanes *r, const ts_lane_step *s, int nl,
     const int k = s->k, j0 = s->j0, j1 = s->j1;
     const double c = s->c;
     double *rd, *rg;
-    ts_cap_ring_slot(r, k, nl, &rd, &rg);
+    ts_cap_ring_slot(r, k, nl, j0, j1, &rd, &rg); /* (j0..j1 written below) */
     r->hull_lost = 1; /* (a step a hybrid's hulls did not take) */
     if (j0 <= j1) {
         const int g0 = j0 / 8 * 8, g1 = (j1 + 8) / 8 * 8;

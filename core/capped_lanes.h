@@ -85,9 +85,10 @@ void ts_cap_lanes_clear(ts_cap_lanes *r);
 void ts_cap_lanes_step(ts_cap_lanes *r, const ts_lane_step *s, int nl,
                        const ts_lane_occluders *occ);
 
-/* Step k's slot of the ring (rd, rg) for the step's samples, emptied first
- * (d NaN: no sample) for lines 0..nl-1. */
-void ts_cap_ring_slot(ts_cap_lanes *r, int k, int nl, double **rd, double **rg);
+/* Step k's slot of the ring (rd, rg) for the step's samples, emptied
+ * (d NaN: no sample) for the lines of 0..nl-1 outside j0..j1 (all where
+ * j0 > j1): the caller writes every line of j0..j1. */
+void ts_cap_ring_slot(ts_cap_lanes *r, int k, int nl, int j0, int j1, double **rd, double **rg);
 
 /* Lines a block may have for ts_cap_lanes_hybrid_step. */
 #define TS_CAP_MAX_LINES 256
