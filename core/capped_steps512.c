@@ -42,10 +42,8 @@ TS_AVX512 void ts_cap_queries512(ts_cap_lanes *r, const ts_lane_step *s, int g0,
         hi = _mm512_mask_cmple_epi64_mask(hi, idx, _mm512_set1_epi64(s->hi_to));
         const __m512d d = _mm512_maskz_loadu_pd(on, s->d + j);
         const __m512d cdd = _mm512_mul_pd(_mm512_mul_pd(c, d), d);
-        const __m512d hc =
-            _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_maskz_loadu_ps(hi, s->hc + j)));
-        const __m512d hn =
-            _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_maskz_loadu_ps(on, s->hn + j)));
+        const __m512d hc = _mm512_cvtps_pd(_mm256_maskz_loadu_ps(hi, s->hc + j));
+        const __m512d hn = _mm512_cvtps_pd(_mm256_maskz_loadu_ps(on, s->hn + j));
         _mm512_store_pd(r->qd + j, d);
         _mm512_store_pd(r->qc + j, _mm512_mask_sub_pd(nan, hi, hc, cdd));
         _mm512_store_pd(r->qn + j, _mm512_mask_sub_pd(nan, on, hn, cdd));
@@ -73,14 +71,12 @@ TS_AVX512 void ts_cap_answers512(ts_cap_lanes *r, const ts_lane_step *s, int g0,
         on = _mm512_mask_cmple_epi64_mask(on, idx, _mm512_set1_epi64(s->j1));
         _mm512_mask_cvtepi64_storeu_epi32(occ->hi_k + j, on, _mm512_load_epi64(r->kc + j));
         _mm512_mask_cvtepi64_storeu_epi32(occ->lo_k + j + 1, on, _mm512_load_epi64(r->kn + j));
-        _mm512_mask_storeu_ps(occ->hi_dd + j, on,
-                              _mm512_castps256_ps512(_mm512_cvtpd_ps(_mm512_load_pd(r->ddc + j))));
-        _mm512_mask_storeu_ps(occ->lo_dd + j + 1, on,
-                              _mm512_castps256_ps512(_mm512_cvtpd_ps(_mm512_load_pd(r->ddn + j))));
+        /* (256-bit stores: see lane_hull.c's store8i) */
+        _mm256_mask_storeu_ps(occ->hi_dd + j, on, _mm512_cvtpd_ps(_mm512_load_pd(r->ddc + j)));
+        _mm256_mask_storeu_ps(occ->lo_dd + j + 1, on, _mm512_cvtpd_ps(_mm512_load_pd(r->ddn + j)));
         /* the step's own samples enter the ring after its queries */
         const __m512d d = _mm512_maskz_loadu_pd(on, s->d + j);
-        const __m512d hs =
-            _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_maskz_loadu_ps(on, s->hs + j)));
+        const __m512d hs = _mm512_cvtps_pd(_mm256_maskz_loadu_ps(on, s->hs + j));
         const __mmask8 has = _mm512_cmp_pd_mask(hs, hs, _CMP_ORD_Q);
         const __m512d g = _mm512_sub_pd(hs, _mm512_mul_pd(_mm512_mul_pd(c, d), d));
         _mm512_mask_store_pd(rd + j, on, _mm512_mask_mov_pd(nan, has, d));
@@ -110,8 +106,7 @@ TS_AVX512 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
             double *ddo = q ? r->ddn : r->ddc;
             const __m512d gq = _mm512_load_pd((q ? r->qn : r->qc) + j);
             const __mmask8 has = _mm512_cmp_pd_mask(gq, gq, _CMP_ORD_Q);
-            const __m512i kk = _mm512_cvtepi32_epi64(
-                _mm512_castsi512_si256(_mm512_maskz_loadu_epi32((__mmask16)has, kq)));
+            const __m512i kk = _mm512_cvtepi32_epi64(_mm256_maskz_loadu_epi32(has, kq));
             const __m512i lag = _mm512_sub_epi64(_mm512_set1_epi64(k), kk);
             __mmask8 ok = _mm512_mask_cmpge_epi64_mask(has, kk, zero);
             ok = _mm512_mask_cmple_epi64_mask(ok, lag, _mm512_set1_epi64(r->lag_hi));
@@ -120,8 +115,7 @@ TS_AVX512 void ts_cap_hull_answers512(ts_cap_lanes *r, int k, int g0, int g1,
              * distance is the hull's (the same double, rounded to float
              * there and again by ts_cap_answers512). Beyond, the ring's
              * distance is tested as the scan tests it. */
-            __m512d dd = _mm512_cvtps_pd(
-                _mm512_castps512_ps256(_mm512_maskz_loadu_ps((__mmask16)ok, fq)));
+            __m512d dd = _mm512_cvtps_pd(_mm256_maskz_loadu_ps(ok, fq));
             const __mmask8 unsure =
                 _mm512_mask_cmpgt_epi64_mask(ok, lag, _mm512_set1_epi64(r->sure_hi));
             if (unsure) {

@@ -68,13 +68,10 @@ static void lane_distances(const sweep_ctx *C, sweep_ws *w, int k, int i0, int j
             if (k > k0[j])
                 dist[j] += G->step_row[row];
         }
-    } else if (G->anchored) {
-        const double d = (double)(k + G->k_anchor) * G->step_m; /* as on the whole DEM */
-        for (int j = j0; j <= j1; j++)
-            dist[j] = d;
+    } else if (G->anchored) { /* as on the whole DEM */
+        ts_lane_distances(k + G->k_anchor, NULL, G->step_m, j0, j1, dist);
     } else {
-        for (int j = j0; j <= j1; j++)
-            dist[j] = (double)(k - k0[j]) * G->step_m;
+        ts_lane_distances(k, k0, G->step_m, j0, j1, dist);
     }
 }
 

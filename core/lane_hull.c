@@ -102,19 +102,22 @@ TS_AVX512 static inline void beside_store(const ts_lane_hulls *H, int a, int jq,
     _mm512_mask_storeu_pd(H->beside + (size_t)a * H->beside_n + jq, m, v);
 }
 
+/* Eight lines' floats and ints: 256-bit masked loads and stores (a
+ * 512-bit one with half its mask clear still spans, and may split, a
+ * 64-byte range) */
 TS_AVX512 static inline __m256 load8f(__mmask8 m, const float *p)
 {
-    return _mm512_castps512_ps256(_mm512_maskz_loadu_ps((__mmask16)m, p));
+    return _mm256_maskz_loadu_ps(m, p);
 }
 
 TS_AVX512 static inline __m256i load8i(__mmask8 m, const int *p)
 {
-    return _mm512_castsi512_si256(_mm512_maskz_loadu_epi32((__mmask16)m, p));
+    return _mm256_maskz_loadu_epi32(m, p);
 }
 
 TS_AVX512 static inline void store8i(int *p, __mmask8 m, __m256i v)
 {
-    _mm512_mask_storeu_epi32(p, (__mmask16)m, _mm512_castsi256_si512(v));
+    _mm256_mask_storeu_epi32(p, m, v);
 }
 
 /* The loops below walk several hulls' stacks at once: each pass of a
@@ -418,11 +421,9 @@ TS_AVX512 static void hull_groups(const ts_lane_hulls *H, const ts_lane_step *s,
     for (int q = 0; q < NG; q++) {
         const int jq = j + 8 * q;
         store8i(occ->hi_k + jq, lanes[q], k[2 * q]);
-        _mm512_mask_storeu_ps(occ->hi_dd + jq, (__mmask16)lanes[q],
-                              _mm512_castps256_ps512(dd[2 * q]));
+        _mm256_mask_storeu_ps(occ->hi_dd + jq, lanes[q], dd[2 * q]);
         store8i(occ->lo_k + jq + 1, lanes[q], k[2 * q + 1]);
-        _mm512_mask_storeu_ps(occ->lo_dd + jq + 1, (__mmask16)lanes[q],
-                              _mm512_castps256_ps512(dd[2 * q + 1]));
+        _mm256_mask_storeu_ps(occ->lo_dd + jq + 1, lanes[q], dd[2 * q + 1]);
     }
 }
 

@@ -97,6 +97,32 @@ void ts_lane_sample(const ts_line_geom *G, const float *z, int k, int i0, int j0
     sample_any(zk, vs, F, j0, j1, jn, hc, hn, hs);
 }
 
+#if defined(__GNUC__) && defined(__x86_64__)
+TS_AVX512 static void distances_avx512(int k, const int *k0, double step, int j0, int j1,
+                                       double *dist)
+{
+    const __m512d st = _mm512_set1_pd(step);
+    const __m256i kv = _mm256_set1_epi32(k);
+    for (int j = j0 / 8 * 8; j <= j1; j += 8) {
+        const __m256i n = k0 ? _mm256_sub_epi32(kv, _mm256_loadu_si256((const __m256i *)(k0 + j)))
+                             : kv;
+        _mm512_storeu_pd(dist + j, _mm512_mul_pd(_mm512_cvtepi32_pd(n), st));
+    }
+}
+#endif
+
+void ts_lane_distances(int k, const int *k0, double step, int j0, int j1, double *dist)
+{
+#if defined(__GNUC__) && defined(__x86_64__)
+    if (ts_cpu_vector_level() == TS_CPU_VECTORS_AVX512) {
+        distances_avx512(k, k0, step, j0, j1, dist);
+        return;
+    }
+#endif
+    for (int j = j0; j <= j1; j++)
+        dist[j] = (double)(k0 ? k - k0[j] : k) * step;
+}
+
 /* The grid's layout as the direction sees it (passed by pointer: a copy
  * by value, made with wider loads right after its fields' stores, stalled
  * on store forwarding, ~1.4 % of a bounded sweep's samples). */

@@ -22,6 +22,15 @@
 void ts_lane_sample(const ts_line_geom *G, const float *z, int k, int i0, int j0, int j1,
                     float *hc, float *hn, float *hs);
 
+/* Step k's distances of lines j0..j1 on steps of one length: dist[j] =
+ * (k - k0[j]) x step, one rounding each (k0 NULL: k x step for all). With
+ * AVX-512 they are written eight lines a store from line j0 / 8 x 8 up to
+ * the vector holding j1, the lines around j0..j1 taking values of no use
+ * (dist and k0 must have room up to line j1 / 8 x 8 + 7), so that the
+ * passes' loads of the same eight lines read one whole store back, which
+ * the CPU forwards (four 16-byte stores, it could not). */
+void ts_lane_distances(int k, const int *k0, double step, int j0, int j1, double *dist);
+
 /* Far-field occluders of a step's cells, per line j: their steps (< 0:
  * none) and distances from the cell, from the line below (lo) and the
  * cell's own line (hi). */
