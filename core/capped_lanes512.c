@@ -408,7 +408,9 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
      * lines) in step order; the groups' entries kept in step (no division
      * per group) */
     group_pairs P;
-    P.n = 0;
+    /* (the pairs' count in a register: the lists' stores may alias P.n in
+     * the compiler's view, which then reloaded it after each) */
+    int pn = 0;
     int idx1 = s_lo / TS_CAP_G1 % r->groups[1], idx0 = s_lo / TS_CAP_G0 % r->groups[0];
     const int last1 = s_hi / TS_CAP_G1;
     for (int m1 = s_lo / TS_CAP_G1; m1 <= last1; m1++) {
@@ -438,19 +440,21 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
                 const __mmask16 need0 =
                     (__mmask16)((level0_needed(r, idx0, count, g, q, thr, rhs, neg, idle) | near) &
                                 ((1u << count) - 1));
-                _mm512_storeu_si512(P.m0 + P.n, _mm512_maskz_compress_epi32(need0, m0s));
-                _mm512_storeu_si512(P.idx + P.n, _mm512_maskz_compress_epi32(need0, idxs));
-                _mm512_storeu_si512(P.q + P.n,
+                _mm512_storeu_si512(P.m0 + pn, _mm512_maskz_compress_epi32(need0, m0s));
+                _mm512_storeu_si512(P.idx + pn, _mm512_maskz_compress_epi32(need0, idxs));
+                _mm512_storeu_si512(P.q + pn,
                                     _mm512_maskz_compress_epi32(need0, _mm512_set1_epi32(q)));
-                P.n += __builtin_popcount(need0);
+                pn += __builtin_popcount(need0);
             }
         }
         idx0 = idx0 + count < r->groups[0] ? idx0 + count : idx0 + count - r->groups[0];
         /* The pairs are listed and scanned once, after all the tests, but
          * where the next level-1 group's could overflow them (long windows):
          * then their answers raise the threshold for the newer groups. */
-        if (P.n > PAIRS_MAX - NG * (TS_CAP_G1 / TS_CAP_G0) && m1 < last1) {
+        if (pn > PAIRS_MAX - NG * (TS_CAP_G1 / TS_CAP_G0) && m1 < last1) {
+            P.n = pn;
             list_pairs(r, s_lo, s_hi, g, tt, rt, idle, &P, &L);
+            pn = 0;
             scan512_lists(r, g, ng, &L, a);
             for (int q = 0; q < ng; q++) {
                 thr[q] = raised_threshold(a, q, thr[q]);
@@ -458,6 +462,7 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
             }
         }
     }
+    P.n = pn;
     list_pairs(r, s_lo, s_hi, g, tt, rt, idle, &P, &L);
     scan512_lists(r, g, ng, &L, a); /* all, or those since the early scan */
 }
