@@ -66,9 +66,9 @@ int ts_cap_lanes_hybrid_step(ts_cap_lanes *r, const ts_lane_hulls *h, ts_lane_st
         return 0;
     }
     /* the ring's samples the near field's distance behind, in as many
-     * passes as a line has ready */
-    /* (in s itself: a copy of s, read back right after the caller's stores
-     * to it with wider loads, stalled on store forwarding) */
+     * passes as a line has ready, set in s itself (a copy of s, read back
+     * with wider loads right after the caller's stores, stalled on store
+     * forwarding) */
     int more, pushed;
     const int lag = uniform_push_lag(r, s->k_step);
     if (lag > 0) {

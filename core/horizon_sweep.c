@@ -45,8 +45,6 @@
 #include "sweep_far.h"
 #include "sweep_internal.h"
 
-/* Step k of lines j0..j1 of a block (rows i0 + j): each line's distance
- * from its first sample, as ts_line_sample_at advances it. */
 /* A block's per-line arrays on whole cache lines, each row of them too
  * (LANE_ROW entries): the lockstep passes' vector loads and stores of eight
  * or sixteen lines from line 0 then split no line. */
@@ -57,6 +55,8 @@ static void *alloc_lines(size_t bytes)
     return aligned_alloc(64, (bytes + 63) / 64 * 64);
 }
 
+/* Step k of lines j0..j1 of a block (rows i0 + j): each line's distance
+ * from its first sample, as ts_line_sample_at advances it. */
 static void lane_distances(const sweep_ctx *C, sweep_ws *w, int k, int i0, int j0, int j1)
 {
     const ts_line_geom *G = C->geom;
