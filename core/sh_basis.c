@@ -39,7 +39,6 @@ void ts_sh_rotation_set(ts_sh_rotation *r, double az_start)
             /* c' = c cos - s sin, s' = c sin + s cos (ts_sh_rotate_z) */
             int k = l * (l + 1) + m, am = m < 0 ? -m : m;
             r->p[k] = (float)cos(am * angle);
-            r->perm[k] = l * (l + 1) - m;
             r->q[k] = (float)(m > 0 ? -sin(am * angle) : m < 0 ? sin(am * angle) : 0);
         }
 }

@@ -33,10 +33,6 @@
 
 #define N TS_SH_COEFFS
 
-/* perm of every rotation about z: m -> -m within each band
- * (ts_sh_rotation_set: perm[k] = l (l + 1) - m). */
-static const int BAND_MIRROR[N] = {0, 3, 2, 1, 8, 7, 6, 5, 4, 15, 14, 13, 12, 11, 10, 9};
-
 /* One wedge's rotation in the two-accumulator form. */
 typedef struct {
     float p[N], q_mirrored[N];
@@ -68,7 +64,7 @@ static void slot_rotation_set(slot_rotation *s, double az_start)
     ts_sh_rotation_set(&r, az_start);
     for (int k = 0; k < N; k++) {
         s->p[k] = r.p[k];
-        s->q_mirrored[k] = r.q[BAND_MIRROR[k]];
+        s->q_mirrored[k] = r.q[TS_SH_BAND_MIRROR[k]];
     }
 }
 
@@ -186,7 +182,7 @@ static void swath_cells(const swath_ctx *C, size_t c0, size_t c1, const float *n
             add_boundary(w->fall, P[n - 1][c], &C->rot[n], a1, a2);
         }
         for (int k = 0; k < N; k++)
-            v[k] = a1[k] + a2[BAND_MIRROR[k]];
+            v[k] = a1[k] + a2[TS_SH_BAND_MIRROR[k]];
         if (C->share) {
             float p[N];
             for (int k = 0; k < N; k++)
@@ -398,7 +394,7 @@ static void fold_rows(void *ctx, int worker, long a0, long a1)
             const float *t = src + e * N;
             double u[N], share = 0;
             for (int k = 0; k < N; k++) { /* the rotation, as add_interior's */
-                u[k] = (double)t[k] * r->p[k] + (double)t[r->perm[k]] * r->q[k];
+                u[k] = (double)t[k] * r->p[k] + (double)t[TS_SH_BAND_MIRROR[k]] * r->q[k];
                 share += J->l[k] * u[k];
             }
             if (C->fold_share)

@@ -258,7 +258,7 @@ static void wedge_rows(void *ctx, int worker, long y0, long y1)
 static ts_status add_wedge(const ts_sh_visibility *v, const float *table, double az_start,
                            const float *a, const float *b, ts_error *err)
 {
-    wedge_ctx C = {v, a, b, table, {{0}, {0}, {0}}};
+    wedge_ctx C = {v, a, b, table, {{0}, {0}}};
     ts_sh_rotation_set(&C.rot, az_start);
     return ts_parallel_for(ts_thread_count(v->w->threads, v->grid->height), v->grid->height,
                            wedge_rows,
