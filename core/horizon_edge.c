@@ -4,6 +4,7 @@
 #include <stdint.h>
 
 #include "day_cycle.h"
+#include "disk_fraction.h"
 #include "horizon_edge.h"
 #include "parallel.h"
 #include "simd_clones.h"
@@ -192,15 +193,26 @@ static void sun_rows(void *ctx, int worker, long begin, long end)
 {
     (void)worker;
     const ts_edge_job *j = ctx;
+    /* From a height >= 0 (c >= 0) the edge's raise stays <= 0 deg
+     * (edge_tangent's t <= 0) and so does the Earth's floor: where the sun
+     * clears 0 deg, such a cell keeps vis (the fraction 1), without the
+     * edge's atan nor the floor's acos (most cells, by day). */
+    const int clears0 = j->opts->edge == TS_EDGE_HORIZON && j->c >= 0 &&
+                        ts_sun_disk_clears(j->sun_elevation, 0.0);
     for (long y = begin; y < end; y++) {
         float *vis = j->plane + (size_t)y * j->grid->width;
         for (int x = 0; x < j->grid->width; x++) {
-            if (isnan(vis[x]))
+            if (isnan(vis[x]) || (clears0 && ts_grid_at(j->grid, x, (int)y) >= 0))
                 continue;
             float h = edge_raise(j, x, (int)y, -90.0f);
+            /* the Earth's floor raises h to at most max(h, 0): where the sun
+             * clears that, the fraction is 1 whatever the floor (u only
+             * grows as h falls), so no acos */
+            if (h == h && ts_sun_disk_clears(j->sun_elevation, h > 0 ? h : 0.0f))
+                continue;
             if (j->opts->edge == TS_EDGE_HORIZON)
                 h = earth_floor(j->opts, ts_grid_at(j->grid, x, (int)y), h);
-            vis[x] = isnan(h) ? NAN : vis[x] * (float)ts_sun_disk_fraction(j->sun_elevation, h);
+            vis[x] = isnan(h) ? NAN : vis[x] * (float)ts_sun_disk_fraction_inl(j->sun_elevation, h);
         }
     }
 }

@@ -11,6 +11,7 @@
 
 #include "day_cycle.h"
 #include "day_cycle_internal.h"
+#include "disk_fraction.h"
 #include "status_internal.h"
 
 #define DEG2RAD (M_PI / 180.0)
@@ -117,7 +118,7 @@ static inline float cell_vis(double e, float h, float fl)
         return NAN;
     if (!isnan(fl) && fl > h)
         h = fl;
-    return (float)ts_sun_disk_fraction(e, h);
+    return (float)ts_sun_disk_fraction_inl(e, h);
 }
 
 /* Cell i's horizon the fraction f (clamped to 0..1) of the way from plane

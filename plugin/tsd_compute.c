@@ -8,6 +8,7 @@
 #include "tsd_pyramid.h"
 #include "tsd_text.h"
 #include "terrashade_cl.h"
+#include "disk_fraction.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -429,8 +430,8 @@ TSD_COMPUTE_FN(tsd_compute_shadow)
         return st;
     for (size_t i = 0; i < cells; i++)
         if (out[i] == out[i])
-            out[i] = (float)ts_disk_fraction(c->run->sun_elevation, out[i],
-                                             c->opts->light_radius);
+            out[i] = (float)ts_disk_fraction_inl(c->run->sun_elevation, out[i],
+                                                 c->opts->light_radius);
     return TS_OK;
 }
 

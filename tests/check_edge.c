@@ -200,33 +200,43 @@ START_TEST(test_edge_sun)
     tdem_create(&g, 30, 20, 30.0, 30.0);
     tdem_fractal(&g, 9, 300.0);
     g.z[45] = NAN;
+    /* cells near sea level and below it, whose Earth's floor is within a
+     * sun radius of 0 deg: suns there keep a part of the disk hidden */
+    g.z[200] = 0.5f, g.z[201] = 2.0f, g.z[202] = -3.0f, g.z[203] = 0.0f;
     const size_t n = 30 * 20;
     float *vis = tdem_floats(n), *plane = tdem_floats(n);
     const ts_edge_mode modes[] = {TS_EDGE_OPEN, TS_EDGE_HORIZON, TS_EDGE_NODATA};
-    for (int m = 0; m < 3; m++) {
-        ts_horizon_opts o = opts_edge(modes[m], 1, m == 2 ? 100.0 : 0.0);
-        for (size_t i = 0; i < n; i++) {
-            vis[i] = isnan(g.z[i]) ? NAN : 0.75f;
-            plane[i] = isnan(g.z[i]) ? NAN : -90.0f;
-        }
-        ck_assert_int_eq(ts_horizon_edge_sun(&g, 250.0, -0.2, &o, vis, &e), TS_OK);
-        ck_assert_int_eq(ts_horizon_edge_apply(&g, 250.0, &o, plane, &e), TS_OK);
-        ck_assert_int_eq(ts_horizon_earth_floor(&g, &o, plane, &e), TS_OK);
-        int lit = 0;
-        for (size_t i = 0; i < n; i++) {
-            if (isnan(plane[i])) {
-                ck_assert(isnan(vis[i]));
-                continue;
+    /* suns below, within and above a radius (0.2666 deg) of the horizontal */
+    const double suns[] = {-0.2, 0.1, 0.2, 0.25, 0.3, 1.0};
+    for (int m = 0; m < 3; m++)
+        for (int k = 0; k < (int)(sizeof suns / sizeof *suns); k++) {
+            ts_horizon_opts o = opts_edge(modes[m], 1, m == 2 ? 100.0 : 0.0);
+            for (size_t i = 0; i < n; i++) {
+                vis[i] = isnan(g.z[i]) ? NAN : 0.75f;
+                plane[i] = isnan(g.z[i]) ? NAN : -90.0f;
             }
-            float want = modes[m] == TS_EDGE_OPEN
-                             ? 0.75f
-                             : 0.75f * (float)ts_sun_disk_fraction(-0.2, plane[i]);
-            ck_assert_float_eq(vis[i], want);
-            lit += vis[i] > 0;
+            ck_assert_int_eq(ts_horizon_edge_sun(&g, 250.0, suns[k], &o, vis, &e), TS_OK);
+            ck_assert_int_eq(ts_horizon_edge_apply(&g, 250.0, &o, plane, &e), TS_OK);
+            ck_assert_int_eq(ts_horizon_earth_floor(&g, &o, plane, &e), TS_OK);
+            int lit = 0, part = 0;
+            for (size_t i = 0; i < n; i++) {
+                if (isnan(plane[i])) {
+                    ck_assert(isnan(vis[i]));
+                    continue;
+                }
+                float want = modes[m] == TS_EDGE_OPEN
+                                 ? 0.75f
+                                 : 0.75f * (float)ts_sun_disk_fraction(suns[k], plane[i]);
+                ck_assert_float_eq(vis[i], want);
+                lit += vis[i] > 0;
+                part += vis[i] > 0 && vis[i] < 0.75f;
+            }
+            /* a sun at -0.2 deg: above the dip of cells 100..400 m high */
+            ck_assert_int_gt(lit, 0);
+            /* at 0.1-0.25 deg the low cells see a part of the disk */
+            if (modes[m] == TS_EDGE_HORIZON && suns[k] > 0 && suns[k] < 0.26)
+                ck_assert_int_gt(part, 0);
         }
-        /* a sun at -0.2 deg: above the dip of cells 100..400 m high */
-        ck_assert_int_gt(lit, 0);
-    }
     ts_horizon_opts o = opts_edge(TS_EDGE_HORIZON, 1, 0);
     ck_assert_int_eq(ts_horizon_edge_sun(&g, 250.0, 91.0, &o, vis, &e), TS_ERR_ARG);
     free(vis);
