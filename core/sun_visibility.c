@@ -12,6 +12,7 @@
 #include "day_cycle.h"
 #include "day_cycle_internal.h"
 #include "disk_fraction.h"
+#include "simd_clones.h"
 #include "status_internal.h"
 
 #define DEG2RAD (M_PI / 180.0)
@@ -121,6 +122,30 @@ static inline float cell_vis(double e, float h, float fl)
     return (float)ts_sun_disk_fraction_inl(e, h);
 }
 
+/* vis[i] = cell_vis(e, pa[i], floor[i]) for the cells i < n (floor NULL: no
+ * floor; cel: each cell's own e): the whole disk's cases in a loop that
+ * vectorises, by cell_vis' double arithmetic, then the cells of a partly
+ * hidden disk (and nodata) by cell_vis itself (one division a cell, where
+ * a loop calling out could not vectorise: ~15 % of a day's sunhours). */
+TS_SIMD_CLONES
+static void vis_cells(double e, const float *restrict cel, const float *restrict pa,
+                      const float *restrict floor, size_t n, float *restrict vis)
+{
+    int partial = 0;
+    for (size_t i = 0; i < n; i++) {
+        const float h = pa[i], fl = floor ? floor[i] : NAN;
+        const float hf = fl > h ? fl : h; /* a NaN h stays NaN */
+        const double u = ((cel ? (double)cel[i] : e) - hf) / TS_SUN_RADIUS_DEG;
+        const int whole = (u >= 1.0) | (u <= -1.0);
+        vis[i] = whole ? (u >= 1.0 ? 1.0f : 0.0f) : NAN;
+        partial |= !whole;
+    }
+    if (partial)
+        for (size_t i = 0; i < n; i++)
+            if (vis[i] != vis[i])
+                vis[i] = cell_vis(cel ? cel[i] : e, pa[i], floor ? floor[i] : NAN);
+}
+
 /* Cell i's horizon the fraction f (clamped to 0..1) of the way from plane
  * pa to plane pb. */
 static inline float plane_between(const float *pa, const float *pb, size_t i, double f)
@@ -186,8 +211,7 @@ static ts_status vis_narrow(ts_vis_ctx *c, const ts_horizon_opts *ho, double a_r
     if ((st = ts_day_sweep(c->g, a_ref + lo, ho, c->o, NAN, c->pa, err)) != TS_OK)
         return st;
     if (K == 1) {
-        for (size_t i = 0; i < c->cells; i++)
-            vis[i] = cell_vis(c->cel[i], c->pa[i], c->floor ? c->floor[i] : NAN);
+        vis_cells(0.0, c->cel, c->pa, c->floor, c->cells, vis);
         return TS_OK;
     }
     for (int j = 1; j < K; j++) {
@@ -346,8 +370,7 @@ ts_status ts_vis_step(ts_vis_ctx *c, double t, float *vis, float *az, float *el,
         }
         if ((st = ts_day_sweep(g, a, &ho, c->o, e, c->pa, err)) != TS_OK)
             return st;
-        for (size_t i = 0; i < c->cells; i++)
-            vis[i] = cell_vis(e, c->pa[i], c->floor ? c->floor[i] : NAN);
+        vis_cells(e, NULL, c->pa, c->floor, c->cells, vis);
         return TS_OK;
     }
 
