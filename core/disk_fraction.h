@@ -10,10 +10,17 @@
 
 #include "terrashade.h"
 
+/* ts_disk_fraction's u: the light's centre above the horizon, in radii
+ * (one subtraction and one division, rounded as every user of it must). */
+static inline double ts_disk_u(double light_elevation, double horizon, double radius)
+{
+    return (light_elevation - horizon) / radius;
+}
+
 static inline double ts_disk_fraction_inl(double light_elevation, double horizon, double radius)
 {
     if (radius > 0) { /* else NaN, by the call */
-        const double u = (light_elevation - horizon) / radius;
+        const double u = ts_disk_u(light_elevation, horizon, radius);
         if (u >= 1.0)
             return 1.0;
         if (u <= -1.0)
@@ -32,7 +39,7 @@ static inline double ts_sun_disk_fraction_inl(double sun_elevation, double horiz
  * rounding included). A NaN gives 0. */
 static inline int ts_sun_disk_clears(double sun_elevation, double horizon)
 {
-    return (sun_elevation - horizon) / TS_SUN_RADIUS_DEG >= 1.0;
+    return ts_disk_u(sun_elevation, horizon, TS_SUN_RADIUS_DEG) >= 1.0;
 }
 
 #endif

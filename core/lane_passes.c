@@ -71,11 +71,12 @@ TS_AVX512 static void sample_avx512(const float *zk, int vs, float F, int j0, in
 /* For CPUs with AVX2 and no AVX-512 (most desktops and laptops). */
 #define AVX2 __attribute__((target("avx2")))
 
-/* The first n floats (ints) at p, the rest 0, and the store of a vector's
- * first n: whole vectors where n >= 8, else through a buffer. (Not masked
- * loads and stores: QEMU's emulation, which the tests run the AVX2 paths
- * on, reads all eight elements, beyond an array's end.) */
-AVX2 static inline __m256 load_first8f(const float *p, int n)
+/* The first n floats at p, the rest 0, and the store of a vector's first
+ * n: whole vectors where n >= 8, else through a buffer (ints through the
+ * same, as bits). (Not masked loads and stores: QEMU's emulation, which
+ * the tests run the AVX2 paths on, reads all eight elements, beyond an
+ * array's end.) */
+AVX2 static inline __m256 load_first8f(const void *p, int n)
 {
     if (n >= 8)
         return _mm256_loadu_ps(p);
@@ -85,17 +86,7 @@ AVX2 static inline __m256 load_first8f(const float *p, int n)
     return _mm256_loadu_ps(b);
 }
 
-AVX2 static inline __m256i load_first8i(const int *p, int n)
-{
-    if (n >= 8)
-        return _mm256_loadu_si256((const __m256i *)p);
-    int b[8] = {0};
-    if (n > 0)
-        memcpy(b, p, (size_t)n * sizeof *b);
-    return _mm256_loadu_si256((const __m256i *)b);
-}
-
-AVX2 static inline void store_first8f(float *p, int n, __m256 v)
+AVX2 static inline void store_first8f(void *p, int n, __m256 v)
 {
     if (n >= 8) {
         _mm256_storeu_ps(p, v);
@@ -103,17 +94,6 @@ AVX2 static inline void store_first8f(float *p, int n, __m256 v)
     }
     float b[8];
     _mm256_storeu_ps(b, v);
-    memcpy(p, b, (size_t)n * sizeof *b);
-}
-
-AVX2 static inline void store_first8i(int *p, int n, __m256i v)
-{
-    if (n >= 8) {
-        _mm256_storeu_si256((__m256i *)p, v);
-        return;
-    }
-    int b[8];
-    _mm256_storeu_si256((__m256i *)b, v);
     memcpy(p, b, (size_t)n * sizeof *b);
 }
 
@@ -444,8 +424,8 @@ AVX2 static int far_run32_avx2(FAR_PARAMS, float *restrict out)
         const __m256i lanes = _mm256_cmpgt_epi32(_mm256_set1_epi32(n), step);
         const __m256 h = load_first8f(hc + j, n);
         const __m256i i = _mm256_add_epi32(_mm256_set1_epi32(i0 + j), step);
-        const __m256i kl = load_first8i(lo_k + j, n);
-        const __m256i khi = load_first8i(hi_k + j, n);
+        const __m256i kl = _mm256_castps_si256(load_first8f(lo_k + j, n));
+        const __m256i khi = _mm256_castps_si256(load_first8f(hi_k + j, n));
         const __m256i kh = _mm256_or_si256(khi, _mm256_cmpeq_epi32(khi, kl)); /* the same step */
         __m256 best = _mm256_set1_ps(-INFINITY);
         __m256i lost_l, lost_h;
@@ -459,7 +439,7 @@ AVX2 static int far_run32_avx2(FAR_PARAMS, float *restrict out)
             /* rare: at the DEM's edges and nodata */
             const __m256i flags = _mm256_or_si256(_mm256_and_si256(lost_l, _mm256_set1_epi32(1)),
                                                   _mm256_and_si256(lost_h, _mm256_set1_epi32(2)));
-            store_first8i(lost + j, n, flags);
+            store_first8f(lost + j, n, _mm256_castsi256_ps(flags));
             any = 1;
         }
         const __m256 nan = _mm256_cmp_ps(h, h, _CMP_UNORD_Q);
@@ -521,24 +501,21 @@ void ts_lane_far_field(const ts_line_geom *G, const float *z, float cf, int near
         return;
     }
 #endif
+    int direct = 0; /* the slopes written straight into out */
 #if HAVE_FAR_AVX2
     if (span <= INT_MAX && ts_cpu_vector_level() == TS_CPU_VECTORS_AVX2) {
+        direct = ostride == 1;
         any = far_run32_avx2(&R, G->ray_o, G->ray_f, z, cf, k, i0, j0, j1, hc, occ->lo_k,
                              occ->lo_dd, occ->hi_k, occ->hi_dd, slope, lost->flags,
-                             ostride == 1 ? out : NULL);
-        if (ostride != 1)
-            for (int j = j0; j <= j1; j++)
-                out[(j - j0) * ostride] = slope[j];
-        if (any)
-            far_lost(G, near, k, i0, j0, j1, hc, occ, lost, out, ostride);
-        return;
-    }
+                             direct ? out : NULL);
+    } else
 #endif
-    any = (span > INT_MAX ? far_run64 : far_run32)(&R, G->ray_o, G->ray_f, z, cf, k, i0, j0, j1,
-                                                   hc, occ->lo_k, occ->lo_dd, occ->hi_k,
-                                                   occ->hi_dd, slope, lost->flags);
-    for (int j = j0; j <= j1; j++)
-        out[(j - j0) * ostride] = slope[j];
+        any = (span > INT_MAX ? far_run64 : far_run32)(&R, G->ray_o, G->ray_f, z, cf, k, i0,
+                                                       j0, j1, hc, occ->lo_k, occ->lo_dd,
+                                                       occ->hi_k, occ->hi_dd, slope, lost->flags);
+    if (!direct)
+        for (int j = j0; j <= j1; j++)
+            out[(j - j0) * ostride] = slope[j];
     if (any)
         far_lost(G, near, k, i0, j0, j1, hc, occ, lost, out, ostride);
 }

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "arg_checks.h"
+#include "disk_fraction.h"
 #include "cellmath/cm_sun.h"
 #include "horn_row.h"
 #include "parallel.h"
@@ -19,7 +20,7 @@ double ts_disk_fraction(double light_elevation, double horizon, double radius)
 {
     if (isnan(light_elevation) || isnan(horizon) || !(radius > 0))
         return NAN;
-    double u = (light_elevation - horizon) / radius;
+    double u = ts_disk_u(light_elevation, horizon, radius);
     if (u >= 1.0)
         return 1.0;
     if (u <= -1.0)

@@ -135,7 +135,7 @@ static void vis_cells(double e, const float *restrict cel, const float *restrict
     for (size_t i = 0; i < n; i++) {
         const float h = pa[i], fl = floor ? floor[i] : NAN;
         const float hf = fl > h ? fl : h; /* a NaN h stays NaN */
-        const double u = ((cel ? (double)cel[i] : e) - hf) / TS_SUN_RADIUS_DEG;
+        const double u = ts_disk_u(cel ? (double)cel[i] : e, hf, TS_SUN_RADIUS_DEG);
         const int whole = (u >= 1.0) | (u <= -1.0);
         vis[i] = whole ? (u >= 1.0 ? 1.0f : 0.0f) : NAN;
         partial |= !whole;
