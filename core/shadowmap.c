@@ -4,13 +4,21 @@
  * thread a band of the map's rows, so no two threads write one texel), take
  * each tile's largest depth, then filter every cell against the map. The
  * formulas are those of the OpenCL kernels (core/cellmath/cm_shadowmap.h),
- * so both render the same map.
+ * so both render the same map. The filter remembers each receiver's fan
+ * depth per texel: its blocker search and its taps read the same texels
+ * around the receiver two to three times over, six triangle tests each.
  */
 #include <math.h>
 #include <stdlib.h>
 
+/* The filter reads each receiver's fan depths through its memo (below). */
+struct ts_sm_recv_s;
+static float sm_fan_depth(const struct ts_sm_recv_s *r, float x, float y);
+#define TS_SM_FAN_DEPTH sm_fan_depth
+
 #include "cellmath/cm_shadowmap.h"
 #include "parallel.h"
+#include "shadowmap_raster.h"
 #include "status_internal.h"
 #include "terrashade_shadowmap.h"
 
@@ -21,6 +29,91 @@ typedef struct {
     int *map;            /* f->width * f->height keys */
     float *out;
 } sm_job;
+
+/* Most texels of a receiver's box that its memo keeps (a box is the fan's
+ * extent: a few texels across, up to a few hundred tall under a low light;
+ * a taller one is read without the memo). */
+#define SM_MEMO_MAX 4096
+
+/* One thread's memo of the current receiver's fan depths, and its fan's
+ * triangles set up once: the operations of ts_sm_fan_depth, in its order,
+ * so that every depth has the same bits. */
+typedef struct {
+    unsigned *stamp; /* SM_MEMO_MAX: gen where depth[] holds this receiver's */
+    float *depth;
+    unsigned gen;
+    int a0, b0, na, nb; /* the box's texel centres: columns a0.., rows b0.. */
+    int nt;             /* valid triangles: corners p, q of the fan */
+    float au[6], av[6], bu[6], bv[6], det[6], dp[6], dq[6];
+} sm_memo;
+
+/* Start the memo on receiver r (r->memo = m). */
+static void sm_memo_start(sm_memo *m, ts_sm_recv *r)
+{
+    r->memo = m;
+    if (++m->gen == 0) { /* wrapped: every stamp is stale */
+        for (int k = 0; k < SM_MEMO_MAX; k++)
+            m->stamp[k] = 0;
+        m->gen = 1;
+    }
+    m->nt = 0;
+    for (int t = 0; t < 6; t++) {
+        if (!((r->tri >> t) & 1))
+            continue;
+        int p = t + 1, q = t == 5 ? 1 : t + 2, n = m->nt;
+        m->au[n] = r->fu[p] - r->fu[0], m->av[n] = r->fv[p] - r->fv[0];
+        m->bu[n] = r->fu[q] - r->fu[0], m->bv[n] = r->fv[q] - r->fv[0];
+        m->det[n] = m->au[n] * m->bv[n] - m->bu[n] * m->av[n];
+        if (!(m->det[n] > 1e-12f || m->det[n] < -1e-12f)) /* seen edge-on */
+            continue;
+        m->dp[n] = r->fd[p] - r->fd[0];
+        m->dq[n] = r->fd[q] - r->fd[0];
+        m->nt++;
+    }
+    double a0 = ceil(r->box[0]), a1 = floor(r->box[1]);
+    double b0 = ceil(r->box[2]), b1 = floor(r->box[3]);
+    double na = a1 - a0 + 1, nb = b1 - b0 + 1;
+    m->na = m->nb = 0;
+    if (na > 0 && nb > 0 && na * nb <= SM_MEMO_MAX) {
+        m->a0 = (int)a0, m->b0 = (int)b0;
+        m->na = (int)na, m->nb = (int)nb;
+    }
+}
+
+static float sm_fan_solve(const sm_memo *m, const ts_sm_recv *r, float x, float y)
+{
+    float best = -INFINITY, px = x - r->fu[0], py = y - r->fv[0];
+    for (int n = 0; n < m->nt; n++) {
+        float n1 = px * m->bv[n] - m->bu[n] * py, n2 = m->au[n] * py - px * m->av[n];
+        if (m->det[n] > 0.0f ? (n1 < 0.0f || n2 < 0.0f) : (n1 > 0.0f || n2 > 0.0f))
+            continue;
+        float l1 = n1 / m->det[n], l2 = n2 / m->det[n];
+        if (!(l1 >= 0.0f && l2 >= 0.0f && l1 + l2 <= 1.0f))
+            continue;
+        float d = r->fd[0] + l1 * m->dp[n] + l2 * m->dq[n];
+        best = d > best ? d : best;
+    }
+    return best;
+}
+
+/* ts_sm_fan_depth through the receiver's memo (its own where it has none). */
+static float sm_fan_depth(const ts_sm_recv *r, float x, float y)
+{
+    sm_memo *m = r->memo;
+    if (!m)
+        return ts_sm_fan_depth(r, x, y);
+    if (!(x >= r->box[0] && x <= r->box[1] && y >= r->box[2] && y <= r->box[3]))
+        return -INFINITY;
+    const int a = (int)x - m->a0, b = (int)y - m->b0;
+    if (a < 0 || b < 0 || a >= m->na || b >= m->nb || (float)(int)x != x || (float)(int)y != y)
+        return sm_fan_solve(m, r, x, y); /* no memo for this box, or not a texel centre */
+    const int k = b * m->na + a;
+    if (m->stamp[k] != m->gen) {
+        m->depth[k] = sm_fan_solve(m, r, x, y);
+        m->stamp[k] = m->gen;
+    }
+    return m->depth[k];
+}
 
 static void project_rows(void *ctx, int worker, long begin, long end)
 {
@@ -42,19 +135,11 @@ static void render_band(void *ctx, int worker, long begin, long end)
 {
     (void)worker;
     const sm_job *J = ctx;
-    const int W = J->g->width, H = J->g->height, mw = J->f->width;
+    const int mw = J->f->width;
     for (long i = begin * mw; i < end * mw; i++)
         J->map[i] = TS_SM_EMPTY;
-    for (int y = 0; y + 1 < H; y++)
-        for (int x = 0; x + 1 < W; x++) {
-            long i = (long)y * W + x;
-            float a = J->pv[i], b = J->pv[i + 1], c = J->pv[i + W], d = J->pv[i + W + 1];
-            float lo = fminf(fminf(a, b), fminf(c, d)), hi = fmaxf(fmaxf(a, b), fmaxf(c, d));
-            if (hi < (float)begin - 1.0f || lo > (float)end) /* NaN: in, then skipped */
-                continue;
-            ts_sm_quad(J->f->params, J->map, mw, J->f->height, (int)begin, (int)end, J->pu,
-                       J->pv, J->pd, W, x, y);
-        }
+    ts_sm_render_band(J->f->params, J->map, mw, (int)begin, (int)end, J->pu, J->pv, J->pd,
+                      J->g->width, J->g->height);
 }
 
 /* The tiles' largest keys, after the map: tile rows [begin, end). */
@@ -73,11 +158,25 @@ static void filter_rows(void *ctx, int worker, long begin, long end)
 {
     (void)worker;
     const sm_job *J = ctx;
+    const ts_shadowmap_frame *f = J->f;
     const int W = J->g->width, H = J->g->height;
+    sm_memo m = {.stamp = calloc(SM_MEMO_MAX, sizeof(unsigned)),
+                 .depth = malloc(SM_MEMO_MAX * sizeof(float))};
+    sm_memo *use = m.stamp && m.depth ? &m : NULL; /* no memory: ts_sm_fan_depth */
     for (long y = begin; y < end; y++)
-        for (int x = 0; x < W; x++)
-            J->out[y * W + x] = ts_sm_cell_at(J->f->params, J->map, J->f->width, J->f->height,
-                                              J->pu, J->pv, J->pd, W, H, x, (int)y);
+        for (int x = 0; x < W; x++) {
+            ts_sm_recv r;
+            float near = ts_sm_recv_make(f->params, J->pu, J->pv, J->pd, W, H, x, (int)y, &r);
+            if (near > 0.0f) { /* as ts_sm_cell_at */
+                if (use)
+                    sm_memo_start(use, &r);
+                float lit = ts_sm_cell(f->params, J->map, f->width, f->height, &r);
+                near = near < lit ? near : lit;
+            }
+            J->out[y * W + x] = near;
+        }
+    free(m.stamp);
+    free(m.depth);
 }
 
 ts_status ts_shadowmap_compute(const ts_grid *grid, double azimuth, double elevation,

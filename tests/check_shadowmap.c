@@ -5,6 +5,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "cellmath/cm_shadowmap.h"
+#include "shadowmap_raster.h"
 #include "terrashade.h"
 #include "terrashade_shadowmap.h"
 #include "test_expect.h"
@@ -223,6 +225,61 @@ START_TEST(test_bad_input)
 }
 END_TEST
 
+/* The C backend's rasteriser (vectors at this CPU's level: make check runs
+ * it again under TERRASHADE_SIMD=avx2 and none, tests/driver/test_cpu_paths.py)
+ * against the portable one of the OpenCL kernel, ts_sm_quad: the same keys
+ * in every texel, on a mesh of triangles from one texel to ~40 wide and up
+ * to ~60 tall, some edge-on or with a nodata corner, whole and in bands. */
+START_TEST(test_raster_same_keys)
+{
+    enum { W = 48, H = 40, MW = 520, MH = 200 };
+    static float pu[W * H], pv[W * H], pd[W * H];
+    static int fast[MW * MH], ref[MW * MH];
+    float P[TS_SMP_COUNT] = {0};
+    P[TS_SMP_BIAS] = 0.01f;
+    P[TS_SMP_SLOPE_CAP] = 8.0f;
+    unsigned seed = 12345;
+    for (int y = 0; y < H; y++) {
+        float u = 2.0f;
+        for (int x = 0; x < W; x++) {
+            int i = y * W + x;
+            seed = seed * 1103515245u + 12345u;
+            float r1 = (float)((seed >> 8) & 0xffff) / 65536.0f;
+            seed = seed * 1103515245u + 12345u;
+            float r2 = (float)((seed >> 8) & 0xffff) / 65536.0f;
+            /* columns 0.3 to 20 texels apart, rows jumping by up to 60 */
+            pu[i] = u + 0.7f * r1 + (y % 5 == 0 ? 0.0f : 0.3f * r2);
+            u += 0.3f + 4.0f * (float)((x + y) % 6);
+            pv[i] = 30.0f + 3.0f * y + 60.0f * r2 * (x % 3 == 0) + 5.0f * r1;
+            pd[i] = 100.0f * r1 - 50.0f * r2;
+            if (x == 7 && y == 9)
+                pd[i] = NAN;
+            if (y == 20) /* a row seen edge-on against the one above where x < 8 */
+                pv[i] = x < 8 ? pv[i - W] : pv[i];
+        }
+    }
+    const int bands[][2] = {{0, MH}, {0, 37}, {37, 38}, {38, 120}, {120, MH}};
+    long covered = 0;
+    for (int k = 0; k < 5; k++) {
+        const int vlo = bands[k][0], vhi = bands[k][1];
+        for (int i = 0; i < MW * MH; i++)
+            fast[i] = ref[i] = TS_SM_EMPTY;
+        ts_sm_render_band(P, fast, MW, vlo, vhi, pu, pv, pd, W, H);
+        for (int y = 0; y + 1 < H; y++)
+            for (int x = 0; x + 1 < W; x++)
+                ts_sm_quad(P, ref, MW, MH, vlo, vhi, pu, pv, pd, W, x, y);
+        for (int i = 0; i < MW * MH; i++) {
+            ck_assert_msg(fast[i] == ref[i], "band [%d, %d) texel (%d, %d): key %d, not %d",
+                          vlo, vhi, i % MW, i / MW, fast[i], ref[i]);
+            covered += k == 0 && ref[i] != TS_SM_EMPTY;
+        }
+    }
+    printf("rasteriser (%s): the portable loop's keys in all %d texels, %ld covered\n",
+           ts_cpu_vectors_name(ts_cpu_vector_level()), MW * MH, covered);
+    ck_assert_int_gt(covered, MW * MH * 2 / 5);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("shadowmap");
@@ -233,6 +290,7 @@ int main(void)
     tcase_add_test(t, test_plane_and_pillar);
     tcase_add_test(t, test_nodata_threads);
     tcase_add_test(t, test_bad_input);
+    tcase_add_test(t, test_raster_same_keys);
     suite_add_tcase(s, t);
     return test_run_suite(s);
 }

@@ -119,53 +119,89 @@ CM_FN float ts_sm_clampf(float x, float lo, float hi)
     return x < lo ? lo : x > hi ? hi : x;
 }
 
+/* A triangle set up for rasterising: its corners (texel coordinates, and
+ * the first one's depth), depth slopes per texel, offset, the sign of its
+ * area, and the texel centres its box holds, clipped to the map and band. */
+typedef struct {
+    float u0, v0, d0, u1, v1, u2, v2;
+    float gu, gv, off, sg;
+    int a0, a1, b0, b1;
+} ts_sm_tri;
+
 /*
- * Render one triangle (texel coordinates and depths of its corners) into
- * the map of mw x mh texels, rows [vlo, vhi) only (the C backend's band).
- * A texel whose centre lies inside the triangle or on its edge keeps the
- * larger of its key and that of the triangle's depth there less the
- * slope-scaled offset bias + min(max |depth slope|, cap). Triangles with a
- * NaN corner (nodata) or no area (seen edge-on) are skipped.
+ * Set up one triangle (texel coordinates and depths of its corners) for the
+ * map of mw texels a row, rows [vlo, vhi) only (the C backend's band): its
+ * depth's slopes and slope-scaled offset bias + min(max |depth slope|, cap),
+ * and its box of texel centres. 0 where it is skipped: a NaN corner
+ * (nodata) or no area (seen edge-on).
  */
-CM_FN void ts_sm_triangle(CM_GLOBAL const float *P, CM_GLOBAL int *map, int mw, int mh,
-                          int vlo, int vhi, float u0, float v0, float d0, float u1, float v1,
-                          float d1, float u2, float v2, float d2)
+CM_FN int ts_sm_tri_setup(CM_GLOBAL const float *P, int mw, int vlo, int vhi, float u0,
+                          float v0, float d0, float u1, float v1, float d1, float u2, float v2,
+                          float d2, ts_sm_tri *t)
 {
     float area = (u1 - u0) * (v2 - v0) - (u2 - u0) * (v1 - v0);
     if (!(area > 1e-12f || area < -1e-12f)) /* also NaN */
-        return;
+        return 0;
     if (isnan(d0 + d1 + d2))
-        return;
+        return 0;
     float gu = ((d1 - d0) * (v2 - v0) - (d2 - d0) * (v1 - v0)) / area;
     float gv = ((d2 - d0) * (u1 - u0) - (d1 - d0) * (u2 - u0)) / area;
     float slope = CM_FABSF(gu) > CM_FABSF(gv) ? CM_FABSF(gu) : CM_FABSF(gv);
     float cap = P[TS_SMP_SLOPE_CAP];
-    float off = P[TS_SMP_BIAS] + 0.75f * (slope < cap ? slope : cap);
+    t->off = P[TS_SMP_BIAS] + 0.75f * (slope < cap ? slope : cap);
     float umin = u0 < u1 ? (u0 < u2 ? u0 : u2) : (u1 < u2 ? u1 : u2);
     float umax = u0 > u1 ? (u0 > u2 ? u0 : u2) : (u1 > u2 ? u1 : u2);
     float vmin = v0 < v1 ? (v0 < v2 ? v0 : v2) : (v1 < v2 ? v1 : v2);
     float vmax = v0 > v1 ? (v0 > v2 ? v0 : v2) : (v1 > v2 ? v1 : v2);
     int a0 = (int)ceil(umin), a1 = (int)floor(umax);
     int b0 = (int)ceil(vmin), b1 = (int)floor(vmax);
-    a0 = a0 < 0 ? 0 : a0;
-    a1 = a1 > mw - 1 ? mw - 1 : a1;
-    b0 = b0 < vlo ? vlo : b0;
-    b1 = b1 > vhi - 1 ? vhi - 1 : b1;
-    float sg = area > 0.0f ? 1.0f : -1.0f;
-    for (int b = b0; b <= b1; b++) {
-        float fb = (float)b;
-        for (int a = a0; a <= a1; a++) {
-            float fa = (float)a;
-            float e0 = ((u1 - u0) * (fb - v0) - (v1 - v0) * (fa - u0)) * sg;
-            float e1 = ((u2 - u1) * (fb - v1) - (v2 - v1) * (fa - u1)) * sg;
-            float e2 = ((u0 - u2) * (fb - v2) - (v0 - v2) * (fa - u2)) * sg;
-            if (e0 < 0.0f || e1 < 0.0f || e2 < 0.0f)
+    t->a0 = a0 < 0 ? 0 : a0;
+    t->a1 = a1 > mw - 1 ? mw - 1 : a1;
+    t->b0 = b0 < vlo ? vlo : b0;
+    t->b1 = b1 > vhi - 1 ? vhi - 1 : b1;
+    t->sg = area > 0.0f ? 1.0f : -1.0f;
+    t->u0 = u0, t->v0 = v0, t->d0 = d0, t->u1 = u1, t->v1 = v1, t->u2 = u2, t->v2 = v2;
+    t->gu = gu, t->gv = gv;
+    return t->a0 <= t->a1 && t->b0 <= t->b1;
+}
+
+/* Whether texel centre (fa, fb) lies inside the triangle or on its edge. */
+CM_FN int ts_sm_tri_covers(const ts_sm_tri *t, float fa, float fb)
+{
+    float e0 = ((t->u1 - t->u0) * (fb - t->v0) - (t->v1 - t->v0) * (fa - t->u0)) * t->sg;
+    float e1 = ((t->u2 - t->u1) * (fb - t->v1) - (t->v2 - t->v1) * (fa - t->u1)) * t->sg;
+    float e2 = ((t->u0 - t->u2) * (fb - t->v2) - (t->v0 - t->v2) * (fa - t->u2)) * t->sg;
+    return !(e0 < 0.0f || e1 < 0.0f || e2 < 0.0f);
+}
+
+/* The key the triangle leaves at texel centre (fa, fb). */
+CM_FN int ts_sm_tri_key(const ts_sm_tri *t, float fa, float fb)
+{
+    return ts_sm_key(t->d0 + t->gu * (fa - t->u0) + t->gv * (fb - t->v0) - t->off);
+}
+
+/*
+ * Render one triangle (texel coordinates and depths of its corners) into
+ * the map of mw x mh texels, rows [vlo, vhi) only (the C backend's band).
+ * A texel whose centre lies inside the triangle or on its edge keeps the
+ * larger of its key and that of the triangle's depth there less the
+ * slope-scaled offset (ts_sm_tri_setup).
+ */
+CM_FN void ts_sm_triangle(CM_GLOBAL const float *P, CM_GLOBAL int *map, int mw, int mh,
+                          int vlo, int vhi, float u0, float v0, float d0, float u1, float v1,
+                          float d1, float u2, float v2, float d2)
+{
+    ts_sm_tri t;
+    if (!ts_sm_tri_setup(P, mw, vlo, vhi, u0, v0, d0, u1, v1, d1, u2, v2, d2, &t))
+        return;
+    for (int b = t.b0; b <= t.b1; b++)
+        for (int a = t.a0; a <= t.a1; a++) {
+            if (!ts_sm_tri_covers(&t, (float)a, (float)b))
                 continue;
-            int key = ts_sm_key(d0 + gu * (fa - u0) + gv * (fb - v0) - off);
+            int key = ts_sm_tri_key(&t, (float)a, (float)b);
             TS_SM_KEEP_MAX(&map[(long)b * mw + a], key);
             TS_SM_KEEP_TILE(map, mw, mh, a, b, key);
         }
-    }
 }
 
 /* The largest key of tile (tx, ty) of the map (C: after rendering). */
@@ -190,13 +226,16 @@ CM_FN int ts_sm_fetch(CM_GLOBAL const int *map, int mw, int mh, int a, int b)
  * corners of its own triangles, the fan of the mesh around it (fu[1..6]:
  * its neighbours E, SE, S, W, NW, N; triangle t joins corners t + 1 and
  * t + 2, t = 5 corners 6 and 1; bit t of tri: all three corners valid). */
-typedef struct {
+typedef struct ts_sm_recv_s {
     float fu[7], fv[7], fd[7];
     int tri;
     float box[4]; /* the corners' u and v range, padded: no triangle reaches out of it */
+#ifndef __OPENCL_C_VERSION__
+    void *memo; /* C: the fan depths its filter has found (core/shadowmap.c), or NULL */
+#endif
 } ts_sm_recv;
 
-/* The receiver's box (ts_sm_recv_depth's quick reject): the range of its
+/* The receiver's box (ts_sm_fan_depth's quick reject): the range of its
  * seven points, padded by far more than the barycentric test's rounding, so
  * that a texel out of it is out of every triangle by that test too. */
 CM_FN void ts_sm_recv_box(ts_sm_recv *r)
@@ -212,14 +251,10 @@ CM_FN void ts_sm_recv_box(ts_sm_recv *r)
     r->box[0] = u0 - pad, r->box[1] = u1 + pad, r->box[2] = v0 - pad, r->box[3] = v1 + pad;
 }
 
-/* The receiver's depth at texel (x, y): its own surface where a triangle of
- * its fan covers the texel (the nearest the light of those that do), else
- * its plane (depth slopes gu, gv). A tap compares the map with the
- * receiver's surface, not its plane, where it can: the plane of a concave
- * receiver (a valley floor) runs below its own fan, which then shadowed it
- * through the map (under a light at 90 degrees, which nothing can hide,
- * cells lost up to 0.61 of it). */
-CM_FN float ts_sm_recv_depth(const ts_sm_recv *r, float gu, float gv, float x, float y)
+/* The depth of the receiver's own surface at texel (x, y): the nearest the
+ * light of its fan's triangles that cover the texel, -INFINITY where none
+ * does (ts_sm_recv_depth). */
+CM_FN float ts_sm_fan_depth(const ts_sm_recv *r, float x, float y)
 {
     float best = -INFINITY, px = x - r->fu[0], py = y - r->fv[0];
     const int in_box = x >= r->box[0] && x <= r->box[1] && y >= r->box[2] && y <= r->box[3];
@@ -242,7 +277,27 @@ CM_FN float ts_sm_recv_depth(const ts_sm_recv *r, float gu, float gv, float x, f
         float d = r->fd[0] + l1 * (r->fd[p] - r->fd[0]) + l2 * (r->fd[q] - r->fd[0]);
         best = d > best ? d : best;
     }
-    return best > -INFINITY ? best : r->fd[0] + gu * px + gv * py;
+    return best;
+}
+
+/* What the taps and the blocker search read the fan's depth with at a
+ * texel centre (integer x, y): the C backend's filter remembers each
+ * texel's (core/shadowmap.c), the same values. */
+#ifndef TS_SM_FAN_DEPTH
+#define TS_SM_FAN_DEPTH ts_sm_fan_depth
+#endif
+
+/* The receiver's depth at texel (x, y): its own surface where a triangle of
+ * its fan covers the texel (the nearest the light of those that do), else
+ * its plane (depth slopes gu, gv). A tap compares the map with the
+ * receiver's surface, not its plane, where it can: the plane of a concave
+ * receiver (a valley floor) runs below its own fan, which then shadowed it
+ * through the map (under a light at 90 degrees, which nothing can hide,
+ * cells lost up to 0.61 of it). */
+CM_FN float ts_sm_recv_depth(const ts_sm_recv *r, float gu, float gv, float x, float y)
+{
+    float best = TS_SM_FAN_DEPTH(r, x, y);
+    return best > -INFINITY ? best : r->fd[0] + gu * (x - r->fu[0]) + gv * (y - r->fv[0]);
 }
 
 /* Lit share of one tap at (tu, tv): the comparisons at the four texels
@@ -352,13 +407,22 @@ CM_FN float ts_sm_pcf_auto(CM_GLOBAL const float *P, CM_GLOBAL const int *map, i
     nu = nu > TS_SM_SEARCH_TAPS ? TS_SM_SEARCH_TAPS : nu;
     nv = nv > TS_SM_SEARCH_TAPS ? TS_SM_SEARCH_TAPS : nv;
     float sum = 0.0f;
-    int blockers = 0;
+    int blockers = 0, last_b = 0;
+    /* taps less than a texel apart round to the same texel: a repeated row
+     * of taps, or a tap repeating the one before it, adds nothing to the
+     * least D or to whether there is a blocker, and is skipped */
     for (int j = 0; j < nv; j++) {
         float tv = v + (nv > 1 ? ((float)j / (float)(nv - 1) * 2.0f - 1.0f) * hv : 0.0f);
-        int b = (int)floor(tv + 0.5f);
+        int b = (int)floor(tv + 0.5f), last_a = 0;
+        if (j > 0 && b == last_b)
+            continue;
+        last_b = b;
         for (int i = 0; i < nu; i++) {
             float tu = u + (nu > 1 ? ((float)i / (float)(nu - 1) * 2.0f - 1.0f) * hu : 0.0f);
             int a = (int)floor(tu + 0.5f);
+            if (i > 0 && a == last_a)
+                continue;
+            last_a = a;
             float d = ts_sm_recv_depth(r, gu, gv, (float)a, (float)b);
             int k = ts_sm_fetch(map, mw, mh, a, b);
             if (!(k > ts_sm_key(d)))
@@ -469,16 +533,23 @@ CM_FN float ts_sm_near(CM_GLOBAL const float *P, CM_GLOBAL const float *pu,
     return lit;
 }
 
-/* ts_sm_cell for cell (x, y) of the projected vertices pu, pv, pd. */
-CM_FN float ts_sm_cell_at(CM_GLOBAL const float *P, CM_GLOBAL const int *map, int mw, int mh,
-                          CM_GLOBAL const float *pu, CM_GLOBAL const float *pv,
-                          CM_GLOBAL const float *pd, int W, int H, int x, int y)
+/* The receiver at cell (x, y) of the projected vertices pu, pv, pd, into r,
+ * and its near field's lit share (ts_sm_near), which is what the cell gets
+ * where that is not above 0: NaN for nodata, 0 in its own shadow (r then
+ * unset). */
+CM_FN float ts_sm_recv_make(CM_GLOBAL const float *P, CM_GLOBAL const float *pu,
+                            CM_GLOBAL const float *pv, CM_GLOBAL const float *pd, int W, int H,
+                            int x, int y, ts_sm_recv *r)
 {
     long i = (long)y * W + x;
     long ring[8];
     const int rx[8] = {0, 1, 1, 1, 0, -1, -1, -1}, ry[8] = {-1, -1, 0, 1, 1, 1, 0, -1};
     for (int k = 0; k < 8; k++)
         ring[k] = ts_sm_neighbour(pd, W, H, i, x + rx[k], y + ry[k]);
+    r->fu[0] = pu[i];
+    r->fv[0] = pv[i];
+    r->fd[0] = pd[i];
+    r->tri = 0;
     if (isnan(pd[i]))
         return pd[i];
     float near = ts_sm_near(P, pu, pv, pd, i, ring);
@@ -486,19 +557,29 @@ CM_FN float ts_sm_cell_at(CM_GLOBAL const float *P, CM_GLOBAL const int *map, in
         return 0.0f;
     /* the fan: E, SE, S, W, NW, N (the mesh's diagonals run NW-SE) */
     const int fan[6] = {2, 3, 4, 6, 7, 0};
-    ts_sm_recv r;
-    r.fu[0] = pu[i];
-    r.fv[0] = pv[i];
-    r.fd[0] = pd[i];
-    r.tri = 0;
     for (int k = 0; k < 6; k++) {
         long j = ring[fan[k]];
-        r.fu[k + 1] = pu[j];
-        r.fv[k + 1] = pv[j];
-        r.fd[k + 1] = pd[j];
-        r.tri |= (j != i && ring[fan[(k + 1) % 6]] != i) << k;
+        r->fu[k + 1] = pu[j];
+        r->fv[k + 1] = pv[j];
+        r->fd[k + 1] = pd[j];
+        r->tri |= (j != i && ring[fan[(k + 1) % 6]] != i) << k;
     }
-    ts_sm_recv_box(&r);
+    ts_sm_recv_box(r);
+#ifndef __OPENCL_C_VERSION__
+    r->memo = 0;
+#endif
+    return near;
+}
+
+/* ts_sm_cell for cell (x, y) of the projected vertices pu, pv, pd. */
+CM_FN float ts_sm_cell_at(CM_GLOBAL const float *P, CM_GLOBAL const int *map, int mw, int mh,
+                          CM_GLOBAL const float *pu, CM_GLOBAL const float *pv,
+                          CM_GLOBAL const float *pd, int W, int H, int x, int y)
+{
+    ts_sm_recv r;
+    float near = ts_sm_recv_make(P, pu, pv, pd, W, H, x, y, &r);
+    if (!(near > 0.0f))
+        return near;
     float lit = ts_sm_cell(P, map, mw, mh, &r);
     return near < lit ? near : lit;
 }

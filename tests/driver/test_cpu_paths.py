@@ -99,6 +99,15 @@ class PortableOracles(unittest.TestCase):
             summary = [line for line in p.stdout.splitlines() if "Checks:" in line]
             print("TERRASHADE_SIMD=none %s: %s" % (suite, summary[-1] if summary else "?"))
 
+    def test_shadowmap_raster_every_level(self):
+        # check_shadowmap holds the C rasteriser to the portable loop's keys
+        for simd in ("avx2", "none"):
+            p = T.run([os.path.join(T.BUILDDIR, "tests", "check_shadowmap")],
+                      TERRASHADE_SIMD=simd, CK_DEFAULT_TIMEOUT="600")
+            line = [x for x in p.stdout.splitlines() if x.startswith("rasteriser")]
+            self.assertEqual(len(line), 1, p.stdout)
+            print("TERRASHADE_SIMD=%s check_shadowmap: %s" % (simd, line[0]))
+
 
 class EmulatedCpus(unittest.TestCase):
     @classmethod
