@@ -36,15 +36,13 @@ typedef struct {
 #define SM_MEMO_MAX 4096
 
 /* One thread's memo of the current receiver's fan depths, and its fan's
- * triangles set up once: the operations of ts_sm_fan_depth, in its order,
- * so that every depth has the same bits. */
+ * triangles set up once (ts_sm_fan_depth sets them up at every call). */
 typedef struct {
     unsigned *stamp; /* SM_MEMO_MAX: gen where depth[] holds this receiver's */
     float *depth;
     unsigned gen;
     int a0, b0, na, nb; /* the box's texel centres: columns a0.., rows b0.. */
-    int nt;             /* valid triangles: corners p, q of the fan */
-    float au[6], av[6], bu[6], bv[6], det[6], dp[6], dq[6];
+    ts_sm_fan fan;
 } sm_memo;
 
 /* Start the memo on receiver r (r->memo = m). */
@@ -56,20 +54,7 @@ static void sm_memo_start(sm_memo *m, ts_sm_recv *r)
             m->stamp[k] = 0;
         m->gen = 1;
     }
-    m->nt = 0;
-    for (int t = 0; t < 6; t++) {
-        if (!((r->tri >> t) & 1))
-            continue;
-        int p = t + 1, q = t == 5 ? 1 : t + 2, n = m->nt;
-        m->au[n] = r->fu[p] - r->fu[0], m->av[n] = r->fv[p] - r->fv[0];
-        m->bu[n] = r->fu[q] - r->fu[0], m->bv[n] = r->fv[q] - r->fv[0];
-        m->det[n] = m->au[n] * m->bv[n] - m->bu[n] * m->av[n];
-        if (!(m->det[n] > 1e-12f || m->det[n] < -1e-12f)) /* seen edge-on */
-            continue;
-        m->dp[n] = r->fd[p] - r->fd[0];
-        m->dq[n] = r->fd[q] - r->fd[0];
-        m->nt++;
-    }
+    ts_sm_fan_setup(r, &m->fan);
     double a0 = ceil(r->box[0]), a1 = floor(r->box[1]);
     double b0 = ceil(r->box[2]), b1 = floor(r->box[3]);
     double na = a1 - a0 + 1, nb = b1 - b0 + 1;
@@ -80,36 +65,20 @@ static void sm_memo_start(sm_memo *m, ts_sm_recv *r)
     }
 }
 
-static float sm_fan_solve(const sm_memo *m, const ts_sm_recv *r, float x, float y)
-{
-    float best = -INFINITY, px = x - r->fu[0], py = y - r->fv[0];
-    for (int n = 0; n < m->nt; n++) {
-        float n1 = px * m->bv[n] - m->bu[n] * py, n2 = m->au[n] * py - px * m->av[n];
-        if (m->det[n] > 0.0f ? (n1 < 0.0f || n2 < 0.0f) : (n1 > 0.0f || n2 > 0.0f))
-            continue;
-        float l1 = n1 / m->det[n], l2 = n2 / m->det[n];
-        if (!(l1 >= 0.0f && l2 >= 0.0f && l1 + l2 <= 1.0f))
-            continue;
-        float d = r->fd[0] + l1 * m->dp[n] + l2 * m->dq[n];
-        best = d > best ? d : best;
-    }
-    return best;
-}
-
 /* ts_sm_fan_depth through the receiver's memo (its own where it has none). */
 static float sm_fan_depth(const ts_sm_recv *r, float x, float y)
 {
     sm_memo *m = r->memo;
     if (!m)
         return ts_sm_fan_depth(r, x, y);
-    if (!(x >= r->box[0] && x <= r->box[1] && y >= r->box[2] && y <= r->box[3]))
+    if (!ts_sm_in_box(r, x, y))
         return -INFINITY;
     const int a = (int)x - m->a0, b = (int)y - m->b0;
     if (a < 0 || b < 0 || a >= m->na || b >= m->nb || (float)(int)x != x || (float)(int)y != y)
-        return sm_fan_solve(m, r, x, y); /* no memo for this box, or not a texel centre */
+        return ts_sm_fan_solve(&m->fan, r, x, y); /* no memo for this box, or not a texel centre */
     const int k = b * m->na + a;
     if (m->stamp[k] != m->gen) {
-        m->depth[k] = sm_fan_solve(m, r, x, y);
+        m->depth[k] = ts_sm_fan_solve(&m->fan, r, x, y);
         m->stamp[k] = m->gen;
     }
     return m->depth[k];

@@ -235,7 +235,7 @@ typedef struct ts_sm_recv_s {
 #endif
 } ts_sm_recv;
 
-/* The receiver's box (ts_sm_fan_depth's quick reject): the range of its
+/* The receiver's box (ts_sm_in_box: the fan's quick reject): the range of its
  * seven points, padded by far more than the barycentric test's rounding, so
  * that a texel out of it is out of every triangle by that test too. */
 CM_FN void ts_sm_recv_box(ts_sm_recv *r)
@@ -251,33 +251,68 @@ CM_FN void ts_sm_recv_box(ts_sm_recv *r)
     r->box[0] = u0 - pad, r->box[1] = u1 + pad, r->box[2] = v0 - pad, r->box[3] = v1 + pad;
 }
 
+/* The receiver's fan's triangles that have all three corners and an area
+ * (not seen edge-on), in the fan's order: corners p, q as offsets from the
+ * receiver (au, av; bu, bv), the determinant, and the depths' offsets. */
+typedef struct {
+    int nt;
+    float au[6], av[6], bu[6], bv[6], det[6], dp[6], dq[6];
+} ts_sm_fan;
+
+CM_FN void ts_sm_fan_setup(const ts_sm_recv *r, ts_sm_fan *f)
+{
+    f->nt = 0;
+    for (int t = 0; t < 6; t++) {
+        if (!((r->tri >> t) & 1))
+            continue;
+        int p = t + 1, q = t == 5 ? 1 : t + 2, n = f->nt;
+        f->au[n] = r->fu[p] - r->fu[0], f->av[n] = r->fv[p] - r->fv[0];
+        f->bu[n] = r->fu[q] - r->fu[0], f->bv[n] = r->fv[q] - r->fv[0];
+        f->det[n] = f->au[n] * f->bv[n] - f->bu[n] * f->av[n];
+        if (!(f->det[n] > 1e-12f || f->det[n] < -1e-12f)) /* seen edge-on */
+            continue;
+        f->dp[n] = r->fd[p] - r->fd[0];
+        f->dq[n] = r->fd[q] - r->fd[0];
+        f->nt++;
+    }
+}
+
+/* The nearest the light of the fan's triangles that cover texel (x, y),
+ * -INFINITY where none does. */
+CM_FN float ts_sm_fan_solve(const ts_sm_fan *f, const ts_sm_recv *r, float x, float y)
+{
+    float best = -INFINITY, px = x - r->fu[0], py = y - r->fv[0];
+    for (int n = 0; n < f->nt; n++) {
+        float n1 = px * f->bv[n] - f->bu[n] * py, n2 = f->au[n] * py - px * f->av[n];
+        /* the signs first: the divisions only where both can be >= 0 */
+        if (f->det[n] > 0.0f ? (n1 < 0.0f || n2 < 0.0f) : (n1 > 0.0f || n2 > 0.0f))
+            continue;
+        float l1 = n1 / f->det[n], l2 = n2 / f->det[n];
+        if (!(l1 >= 0.0f && l2 >= 0.0f && l1 + l2 <= 1.0f))
+            continue;
+        float d = r->fd[0] + l1 * f->dp[n] + l2 * f->dq[n];
+        best = d > best ? d : best;
+    }
+    return best;
+}
+
+/* Whether texel (x, y) lies in the receiver's box (out of it, no triangle
+ * of its fan covers it). */
+CM_FN int ts_sm_in_box(const ts_sm_recv *r, float x, float y)
+{
+    return x >= r->box[0] && x <= r->box[1] && y >= r->box[2] && y <= r->box[3];
+}
+
 /* The depth of the receiver's own surface at texel (x, y): the nearest the
  * light of its fan's triangles that cover the texel, -INFINITY where none
  * does (ts_sm_recv_depth). */
 CM_FN float ts_sm_fan_depth(const ts_sm_recv *r, float x, float y)
 {
-    float best = -INFINITY, px = x - r->fu[0], py = y - r->fv[0];
-    const int in_box = x >= r->box[0] && x <= r->box[1] && y >= r->box[2] && y <= r->box[3];
-    for (int t = 0; t < 6 * in_box; t++) {
-        if (!((r->tri >> t) & 1))
-            continue;
-        int p = t + 1, q = t == 5 ? 1 : t + 2;
-        float au = r->fu[p] - r->fu[0], av = r->fv[p] - r->fv[0];
-        float bu = r->fu[q] - r->fu[0], bv = r->fv[q] - r->fv[0];
-        float det = au * bv - bu * av;
-        if (!(det > 1e-12f || det < -1e-12f)) /* seen edge-on */
-            continue;
-        float n1 = px * bv - bu * py, n2 = au * py - px * av;
-        /* the signs first: the divisions only where both can be >= 0 */
-        if (det > 0.0f ? (n1 < 0.0f || n2 < 0.0f) : (n1 > 0.0f || n2 > 0.0f))
-            continue;
-        float l1 = n1 / det, l2 = n2 / det;
-        if (!(l1 >= 0.0f && l2 >= 0.0f && l1 + l2 <= 1.0f))
-            continue;
-        float d = r->fd[0] + l1 * (r->fd[p] - r->fd[0]) + l2 * (r->fd[q] - r->fd[0]);
-        best = d > best ? d : best;
-    }
-    return best;
+    if (!ts_sm_in_box(r, x, y))
+        return -INFINITY;
+    ts_sm_fan f;
+    ts_sm_fan_setup(r, &f);
+    return ts_sm_fan_solve(&f, r, x, y);
 }
 
 /* What the taps and the blocker search read the fan's depth with at a
