@@ -240,8 +240,8 @@ ts_status ts_horizon_edge_apply(const ts_grid *grid, double azimuth,
     if (opts->edge == TS_EDGE_OPEN)
         return ts_ok(err);
     ts_edge_job j = edge_job_of(grid, azimuth, opts, plane, 0.0);
-    return ts_parallel_for(ts_thread_count(opts->threads, grid->height), grid->height,
-                           edge_rows, &j, err);
+    return ts_parallel_for_ranges(ts_thread_count(opts->threads, grid->height), grid->height,
+                                  TS_ROWS_GRAIN, edge_rows, &j, err);
 }
 
 ts_status ts_horizon_edge_sun(const ts_grid *grid, double azimuth, double elevation,
@@ -256,8 +256,8 @@ ts_status ts_horizon_edge_sun(const ts_grid *grid, double azimuth, double elevat
     if (opts->edge == TS_EDGE_OPEN)
         return ts_ok(err);
     ts_edge_job j = edge_job_of(grid, azimuth, opts, vis, elevation);
-    return ts_parallel_for(ts_thread_count(opts->threads, grid->height), grid->height,
-                           sun_rows, &j, err);
+    return ts_parallel_for_ranges(ts_thread_count(opts->threads, grid->height), grid->height,
+                                  TS_ROWS_GRAIN, sun_rows, &j, err);
 }
 
 ts_status ts_horizon_earth_floor(const ts_grid *grid, const ts_horizon_opts *opts,

@@ -277,30 +277,54 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
            (!need_visit || (w->vx && w->vy && w->vh && w->vs && w->vd));
 }
 
+/* Lines [b0 + begin, b0 + end) in workspace w, as a fresh workspace would
+ * take them: nothing carried from lines w took before (the line before
+ * begin is primed instead). */
+static void sweep_lines(const sweep_ctx *C, sweep_ws *w, long begin, long end)
+{
+    const occluder none = {-1, 0.0f};
+    if (w->lockstep) {
+        for (int k = 0; k < C->geom->U; k++)
+            w->carry[k] = none;
+        long b = C->b0 + begin, bend = C->b0 + end;
+        for (int prime = begin > 0; b < bend; prime = 0) {
+            int nl = bend - b < LOCKSTEP_LINES ? (int)(bend - b) : LOCKSTEP_LINES;
+            sweep_block(C, w, b - prime, nl + prime, prime);
+            b += nl;
+        }
+        return;
+    }
+    w->lo.prev_k0 = 1;
+    w->lo.prev_k1 = 0;
+    if (begin > 0)
+        ts_sweep_process_line(C, w, C->b0 + begin - 1, 0);
+    for (long b = C->b0 + begin; b < C->b0 + end; b++)
+        ts_sweep_process_line(C, w, b, 1);
+}
+
 void ts_sweep_range(void *ctx, int worker, long begin, long end)
 {
     (void)worker;
     const sweep_ctx *C = ctx;
     sweep_ws w;
-    if (!ws_init(&w, C)) {
-        ws_free(&w);
+    if (ws_init(&w, C))
+        sweep_lines(C, &w, begin, end);
+    else
         __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
-        return;
-    }
-    if (w.lockstep) {
-        long b = C->b0 + begin, bend = C->b0 + end;
-        for (int prime = begin > 0; b < bend; prime = 0) {
-            int nl = bend - b < LOCKSTEP_LINES ? (int)(bend - b) : LOCKSTEP_LINES;
-            sweep_block(C, &w, b - prime, nl + prime, prime);
-            b += nl;
-        }
-        ws_free(&w);
-        return;
-    }
-    if (begin > 0)
-        ts_sweep_process_line(C, &w, C->b0 + begin - 1, 0);
-    for (long b = C->b0 + begin; b < C->b0 + end; b++)
-        ts_sweep_process_line(C, &w, b, 1);
+    ws_free(&w);
+}
+
+void ts_sweep_ranges(void *ctx, int worker, ts_range_queue *q)
+{
+    (void)worker;
+    const sweep_ctx *C = ctx;
+    sweep_ws w;
+    long begin, end;
+    if (ws_init(&w, C))
+        while (ts_range_next(q, &begin, &end))
+            sweep_lines(C, &w, begin, end);
+    else
+        __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
     ws_free(&w);
 }
 
@@ -404,13 +428,15 @@ ts_status ts_horizon_sweep(const ts_grid *grid, double azimuth,
     C.alloc_failed = &failed;
     C.edge_rows = ts_edge_rows_init(&C.edge, grid, azimuth, opts, out);
     long lines = geom.b_hi - geom.b_lo + 1;
-    /* One chunk per thread: each chunk re-primes one line. */
-    int threads = ts_thread_count(opts->threads, lines);
+    /* Ranges taken as the threads get to them (a core slowed by another
+     * process, or rougher terrain, takes fewer); each range re-primes one
+     * line, so they are whole lockstep blocks. */
     if (!C.near_only)
-        st = ts_parallel_for(threads, lines, ts_sweep_range, &C, err);
+        st = ts_parallel_ranges(ts_thread_count(opts->threads, lines), lines, LOCKSTEP_LINES,
+                                ts_sweep_ranges, &C, err);
     if (st == TS_OK && !failed)
-        st = ts_parallel_for(ts_thread_count(opts->threads, grid->height), grid->height,
-                             finish_rows, &C, err);
+        st = ts_parallel_for_ranges(ts_thread_count(opts->threads, grid->height), grid->height,
+                                    TS_ROWS_GRAIN, finish_rows, &C, err);
     ts_line_geom_free(&geom);
     if (st != TS_OK)
         return st;

@@ -76,8 +76,8 @@ ts_status ts_normals_threads(const ts_grid *grid, int threads, float *nx, float 
     if (st != TS_OK)
         return st;
     normals_ctx C = {grid, nx, ny, nz};
-    return ts_parallel_for(ts_thread_count(threads, grid->height), grid->height, normals_rows,
-                           &C, err);
+    return ts_parallel_for_ranges(ts_thread_count(threads, grid->height), grid->height,
+                                  TS_ROWS_GRAIN, normals_rows, &C, err);
 }
 
 ts_status ts_normals(const ts_grid *grid, float *nx, float *ny, float *nz, ts_error *err)

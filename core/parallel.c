@@ -83,3 +83,92 @@ ts_status ts_parallel_for(int threads, long items, ts_range_fn fn, void *ctx,
     free(tids);
     return ts_ok(err);
 }
+
+struct ts_range_queue {
+    atomic_long next;
+    long items, grain;
+    int threads;
+};
+
+int ts_range_next(ts_range_queue *q, long *begin, long *end)
+{
+    long at = atomic_load_explicit(&q->next, memory_order_relaxed), n;
+    do {
+        if (at >= q->items)
+            return 0;
+        const long left = q->items - at;
+        /* guided: half of what is left, split among the threads, in
+         * whole grains */
+        n = (left / (2L * q->threads) + q->grain - 1) / q->grain * q->grain;
+        n = n < q->grain ? q->grain : n;
+        n = n > left ? left : n;
+    } while (!atomic_compare_exchange_weak_explicit(&q->next, &at, at + n, memory_order_relaxed,
+                                                    memory_order_relaxed));
+    *begin = at;
+    *end = at + n;
+    return 1;
+}
+
+typedef struct {
+    ts_ranges_fn fn;
+    void *ctx;
+    int worker;
+    ts_range_queue *q;
+} ranges_worker;
+
+static void *run_ranges(void *arg)
+{
+    ranges_worker *r = arg;
+    r->fn(r->ctx, r->worker, r->q);
+    return NULL;
+}
+
+ts_status ts_parallel_ranges(int threads, long items, long grain, ts_ranges_fn fn, void *ctx,
+                             ts_error *err)
+{
+    if (items <= 0)
+        return ts_ok(err);
+    ts_range_queue q;
+    atomic_init(&q.next, 0);
+    q.items = items;
+    q.grain = grain < 1 ? 1 : grain;
+    const long most = (items + q.grain - 1) / q.grain; /* ranges there can be */
+    q.threads = threads < 1 ? 1 : threads > most ? (int)most : threads;
+    ranges_worker *w = q.threads > 1 ? malloc((size_t)q.threads * sizeof *w) : NULL;
+    pthread_t *tids = q.threads > 1 ? malloc((size_t)q.threads * sizeof *tids) : NULL;
+    int started = 1;
+    if (w && tids)
+        for (int t = 1; t < q.threads; t++) {
+            w[t] = (ranges_worker){fn, ctx, t, &q};
+            if (pthread_create(&tids[t], NULL, run_ranges, &w[t]) != 0)
+                break;
+            started++;
+        }
+    /* (no thread made: the calling one takes every range) */
+    fn(ctx, 0, &q);
+    for (int t = 1; t < started; t++)
+        pthread_join(tids[t], NULL);
+    free(w);
+    free(tids);
+    return ts_ok(err);
+}
+
+typedef struct {
+    ts_range_fn fn;
+    void *ctx;
+} range_fn_each;
+
+static void each_range(void *ctx, int worker, ts_range_queue *q)
+{
+    const range_fn_each *e = ctx;
+    long begin, end;
+    while (ts_range_next(q, &begin, &end))
+        e->fn(e->ctx, worker, begin, end);
+}
+
+ts_status ts_parallel_for_ranges(int threads, long items, long grain, ts_range_fn fn, void *ctx,
+                                 ts_error *err)
+{
+    range_fn_each e = {fn, ctx};
+    return ts_parallel_ranges(threads, items, grain, each_range, &e, err);
+}

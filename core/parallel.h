@@ -18,4 +18,37 @@ int ts_thread_count(int requested, long items);
 ts_status ts_parallel_for(int threads, long items, ts_range_fn fn, void *ctx,
                           ts_error *err);
 
+/* The ranges of ts_parallel_ranges: what is left of [0, items). */
+typedef struct ts_range_queue ts_range_queue;
+
+/* Take the next range of q into [*begin, *end): a share of what is left
+ * (half of it split among the threads), a multiple of the grain but the
+ * last, at least the grain; 0 when nothing is left. */
+int ts_range_next(ts_range_queue *q, long *begin, long *end);
+
+/* Work on the ranges a worker takes from q (ts_range_next, until it says
+ * none is left). */
+typedef void (*ts_ranges_fn)(void *ctx, int worker, ts_range_queue *q);
+
+/* Run fn on `threads` threads (the first the calling one), each taking
+ * ranges of [0, items) until none is left: sizes that shrink as the work
+ * runs out, so that a thread on a slower core (or a harder part of the
+ * work) takes less, and the threads end together. Every item lies in
+ * exactly one range; which thread takes it, and in how many pieces, is
+ * not fixed, so fn's results must not depend on that (nor on the ranges
+ * running together: they need not). If a thread cannot be made, fewer
+ * threads take the ranges. */
+ts_status ts_parallel_ranges(int threads, long items, long grain, ts_ranges_fn fn, void *ctx,
+                             ts_error *err);
+
+/* ts_parallel_ranges for a ts_range_fn: fn once for each range a worker
+ * takes, in turn (so fn must accept any sub-range, and several on one
+ * worker). For work item by item (rows), where a split in fixed halves
+ * would wait on the slower core. */
+/* Rows a range of ts_parallel_for_ranges holds at least, for work row by
+ * row. */
+#define TS_ROWS_GRAIN 8
+ts_status ts_parallel_for_ranges(int threads, long items, long grain, ts_range_fn fn, void *ctx,
+                                 ts_error *err);
+
 #endif

@@ -115,8 +115,8 @@ ts_status ts_sky_accumulate_model(const ts_grid *grid, const float *nx, const fl
     C.width = (size_t)grid->width;
     ts_sky_plane_init(&C.p, nx, ny, nz, plane, azimuth, directions, svf_model, svf_acc, sky_acc,
                       openness_acc);
-    return ts_parallel_for(ts_thread_count(threads, grid->height), grid->height, sky_rows, &C,
-                           err);
+    return ts_parallel_for_ranges(ts_thread_count(threads, grid->height), grid->height,
+                                  TS_ROWS_GRAIN, sky_rows, &C, err);
 }
 
 ts_status ts_sky_finish(const ts_grid *grid, int directions, float *svf_acc, float *sky_acc,

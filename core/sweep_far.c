@@ -84,7 +84,8 @@ ts_status ts_sweep_far_lanes(const ts_grid *grid, double azimuth, double thresho
     C.out = out;
     C.alloc_failed = &failed;
     const long lines = geom.b_hi - geom.b_lo + 1;
-    st = ts_parallel_for(ts_thread_count(opts->threads, lines), lines, ts_sweep_range, &C, err);
+    st = ts_parallel_ranges(ts_thread_count(opts->threads, lines), lines, LOCKSTEP_LINES,
+                            ts_sweep_ranges, &C, err);
     ts_line_geom_free(&geom);
     if (st == TS_OK && failed)
         st = ts_fail(err, TS_ERR_NOMEM, "cannot allocate the far-field sweep workspace");

@@ -5,12 +5,15 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "oracle.h"
 #include "terrashade.h"
 #include "test_grid.h"
 #include "test_run.h"
 #include "test_stats.h"
+
+#include "parallel.h"
 
 /* Axis and non-axis azimuths: the sweep's line geometry differs for each. */
 static const double AZ[] = {0, 33.7, 45, 90, 137, 180, 222.2, 300};
@@ -297,10 +300,11 @@ START_TEST(test_compute_matches_sweep)
 }
 END_TEST
 
-/* Horizons with `threads` workers, 16 directions. */
-static float *horizons(const ts_grid *g, int threads)
+/* Horizons with `threads` workers, 16 directions, up to max_distance
+ * metres (0: unbounded). */
+static float *horizons(const ts_grid *g, int threads, double max_distance)
 {
-    ts_horizon_opts o = opts_with(1, 0);
+    ts_horizon_opts o = opts_with(1, max_distance);
     o.threads = threads;
     o.start_azimuth = 3.3;
     float *out = tdem_floats((size_t)g->width * (size_t)g->height * 16);
@@ -309,15 +313,16 @@ static float *horizons(const ts_grid *g, int threads)
     return out;
 }
 
-static void check_threads(const ts_grid *g, const char *label)
+static void check_threads(const ts_grid *g, const char *label, double max_distance)
 {
     size_t bytes = (size_t)g->width * (size_t)g->height * 16 * sizeof(float);
-    float *one = horizons(g, 1);
-    int counts[] = {2, 3, 0};
-    for (int i = 0; i < 3; i++) {
-        float *many = horizons(g, counts[i]);
+    float *one = horizons(g, 1, max_distance);
+    int counts[] = {2, 3, 7, 0};
+    for (int i = 0; i < 4; i++) {
+        float *many = horizons(g, counts[i], max_distance);
         ck_assert_msg(memcmp(one, many, bytes) == 0,
-                      "%s: threads=%d differs from threads=1", label, counts[i]);
+                      "%s, max distance %g m: threads=%d differs from threads=1", label,
+                      max_distance, counts[i]);
         free(many);
     }
     free(one);
@@ -328,11 +333,81 @@ START_TEST(test_threads_bit_identical)
     ts_grid g;
     tdem_create(&g, 157, 131, 10.0, 12.0);
     tdem_sharp(&g, 3);
-    check_threads(&g, "sharp 157x131");
+    check_threads(&g, "sharp 157x131", 0);
     ts_grid_free(&g);
     tdem_load(&g, "jacksboro");
-    check_threads(&g, "jacksboro");
+    check_threads(&g, "jacksboro", 0);
     ts_grid_free(&g);
+    /* long enough for each thread to take several ranges of lines and
+     * rows; bounded: the brute-force window, the pruned scan, the hybrid */
+    tdem_create(&g, 700, 520, 10.0, 10.0);
+    tdem_fbm(&g, 77, 0.8, 1500.0);
+    const double caps[] = {0, 600, 2000, 4000};
+    for (int i = 0; i < 4; i++)
+        check_threads(&g, "fractal 700x520", caps[i]);
+    ts_grid_free(&g);
+}
+END_TEST
+
+/* ts_parallel_ranges: which items each range held, and each worker's */
+typedef struct {
+    long grain, items;
+    int *seen;         /* per item: times taken */
+    long per_worker[8]; /* items taken */
+    int bad_size;      /* a range off the grain (not the last) */
+    int slow_worker;   /* -1: none; else it sleeps per item */
+} ranges_probe;
+
+static void probe_ranges(void *ctx, int worker, ts_range_queue *q)
+{
+    ranges_probe *p = ctx;
+    long b, e;
+    while (ts_range_next(q, &b, &e)) {
+        if (e <= b || (e != p->items && (e - b) % p->grain != 0))
+            __atomic_store_n(&p->bad_size, 1, __ATOMIC_RELAXED);
+        for (long i = b; i < e; i++) {
+            __atomic_add_fetch(&p->seen[i], 1, __ATOMIC_RELAXED);
+            if (worker == p->slow_worker) {
+                struct timespec ms5 = {0, 5000000};
+                nanosleep(&ms5, NULL);
+            }
+        }
+        __atomic_add_fetch(&p->per_worker[worker], e - b, __ATOMIC_RELAXED);
+    }
+}
+
+START_TEST(test_parallel_ranges)
+{
+    const long items[] = {0, 1, 5, 63, 64, 65, 1000, 4099};
+    const long grains[] = {1, 8, 64};
+    const int threads[] = {1, 2, 3, 8};
+    for (int a = 0; a < 8; a++)
+        for (int b = 0; b < 3; b++)
+            for (int c = 0; c < 4; c++) {
+                ranges_probe p = {grains[b], items[a], calloc((size_t)items[a] + 1, sizeof(int)),
+                                  {0}, 0, -1};
+                ts_error err;
+                ck_assert(ts_parallel_ranges(threads[c], items[a], grains[b], probe_ranges, &p,
+                                             &err) == TS_OK);
+                long total = 0;
+                for (long i = 0; i < items[a]; i++)
+                    ck_assert_msg(p.seen[i] == 1,
+                                  "items %ld grain %ld threads %d: item %ld taken %d times",
+                                  items[a], grains[b], threads[c], i, p.seen[i]);
+                for (int w = 0; w < 8; w++)
+                    total += p.per_worker[w];
+                ck_assert_int_eq(total, items[a]);
+                ck_assert_msg(!p.bad_size, "items %ld grain %ld threads %d: a range off the grain",
+                              items[a], grains[b], threads[c]);
+                free(p.seen);
+            }
+    /* A worker that takes 5 ms an item leaves most of them to the other
+     * (a split in halves would give each 32) */
+    ranges_probe p = {1, 64, calloc(65, sizeof(int)), {0}, 0, 1};
+    ts_error err;
+    ck_assert(ts_parallel_ranges(2, 64, 1, probe_ranges, &p, &err) == TS_OK);
+    ck_assert_msg(p.per_worker[0] >= 40, "the fast worker took %ld of 64 items", p.per_worker[0]);
+    free(p.seen);
 }
 END_TEST
 
@@ -441,6 +516,7 @@ int main(void)
     tcase_add_test(tc, test_far_field_at_edges_and_holes);
     tcase_add_test(tc, test_compute_matches_sweep);
     tcase_add_test(tc, test_threads_bit_identical);
+    tcase_add_test(tc, test_parallel_ranges);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }
