@@ -130,7 +130,8 @@ ts_status ts_env_light_accumulate(const ts_env_light_request *req, ts_error *err
                    table->lp + ts_env_table_sector_floats(table) * req->k, sa, ca,
                    table->normal_steps, table->horizon_steps, req->r, req->g, req->b};
     const int rows = req->grid->height;
-    return ts_parallel_for(ts_thread_count(req->threads, rows), rows, light_rows, &C, err);
+    return ts_parallel_for_ranges(ts_thread_count(req->threads, rows), rows, TS_ROWS_GRAIN,
+                                  light_rows, &C, err);
 }
 
 ts_status ts_env_light_finish(const ts_grid *grid, float *r, float *g, float *b, ts_error *err)

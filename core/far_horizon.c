@@ -57,8 +57,8 @@ static ts_status far_sweep(const ts_grid *grid, double azimuth, double threshold
         return st;
     degrees_ctx C = {grid, out};
     if (degrees)
-        st = ts_parallel_for(ts_thread_count(o.threads, grid->height), grid->height, to_degrees,
-                             &C, err);
+        st = ts_parallel_for_ranges(ts_thread_count(o.threads, grid->height), grid->height,
+                                    TS_ROWS_GRAIN, to_degrees, &C, err);
     return st == TS_OK ? ts_ok(err) : st;
 }
 

@@ -210,7 +210,8 @@ static int reconstruct(ts_pyramid *P, const coarse *lv, int j, int threads, ts_e
     for (int x = 0; x < W; x++)
         ts_pyr_taps((x + 0.5) / lv->s - 0.5, lv->w, 0, idx + 4 * (size_t)x, w + 4 * (size_t)x);
     recon_ctx rc = {lv, P->level[j].hu, W, idx, w};
-    ts_parallel_for(ts_thread_count(threads, lv->h), lv->h, reconstruct_rows, &rc, err);
+    ts_parallel_for_ranges(ts_thread_count(threads, lv->h), lv->h, TS_ROWS_GRAIN, reconstruct_rows,
+                           &rc, err);
     free(idx);
     free(w);
     return 1;
@@ -272,7 +273,8 @@ ts_status ts_pyramid_build(const ts_grid *grid, const ts_pyramid_opts *opts, int
             nx[i] = ts_pyr_taps((i + 0.5) * ratio - 0.5, prev.w, 1, cx + 4 * (size_t)i,
                                 cw + 4 * (size_t)i);
         decimate_ctx dc = {&prev, &cur, nx, cx, cw};
-        ts_parallel_for(ts_thread_count(threads, cur.h), cur.h, decimate_rows, &dc, err);
+        ts_parallel_for_ranges(ts_thread_count(threads, cur.h), cur.h, TS_ROWS_GRAIN,
+                               decimate_rows, &dc, err);
         P->level[j] = (ts_pyr_level){s, cur.h, NULL};
         ok = reconstruct(P, &cur, j, threads, err);
         prev = cur;

@@ -108,8 +108,8 @@ ts_status ts_sh_shade(const ts_grid *grid, const double m[TS_SH_COEFFS][TS_SH_CO
         return ts_fail(err, TS_ERR_ARG, "the light and the normals must not be NULL");
     shade_ctx C = {grid, {{0}}, nx, ny, nz, vis, NULL, scale, out};
     ts_sh_fold_cosine(m, C.mh);
-    return ts_parallel_for(ts_thread_count(threads, grid->height), grid->height, shade_rows, &C,
-                           err);
+    return ts_parallel_for_ranges(ts_thread_count(threads, grid->height), grid->height,
+                                  TS_ROWS_GRAIN, shade_rows, &C, err);
 }
 
 static void share_rows(void *ctx, int worker, long y0, long y1)
@@ -136,8 +136,8 @@ ts_status ts_sh_visible_share(const ts_grid *grid, const double l[TS_SH_COEFFS],
     if (!l)
         return ts_fail(err, TS_ERR_ARG, "the light must not be NULL");
     shade_ctx C = {grid, {{0}}, NULL, NULL, NULL, vis, l, scale, out};
-    return ts_parallel_for(ts_thread_count(threads, grid->height), grid->height, share_rows, &C,
-                           err);
+    return ts_parallel_for_ranges(ts_thread_count(threads, grid->height), grid->height,
+                                  TS_ROWS_GRAIN, share_rows, &C, err);
 }
 
 void ts_sh_key_reference(const ts_sh_wedges *w, const double l[TS_SH_COEFFS],

@@ -452,9 +452,8 @@ static ts_status fold_tables(swath_ctx *C, const double *az_start, ts_error *err
             for (int k = 0; k < N; k++)
                 J.mh[j][k] = C->mh[j][k];
         }
-        st = ts_parallel_for(ts_thread_count(C->w->threads, (long)slots * S), (long)slots * S,
-                             fold_rows,
-                             &J, err);
+        st = ts_parallel_for_ranges(ts_thread_count(C->w->threads, (long)slots * S),
+                                    (long)slots * S, 1, fold_rows, &J, err);
     }
     if (!ok || st != TS_OK)
         fold_free(C, slots);
@@ -518,7 +517,7 @@ ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
         !(C.rows_n = malloc((size_t)threads * 3 * grid->width * sizeof(float))))
         st = ts_fail(err, TS_ERR_NOMEM, "out of memory for rows of normals");
     if (st == TS_OK)
-        st = ts_parallel_for(threads, grid->height, swath_rows, &C, err);
+        st = ts_parallel_for_ranges(threads, grid->height, TS_ROWS_GRAIN, swath_rows, &C, err);
     free(C.rows_n);
     fold_free(&C, slot_count(s));
     free(rot);
