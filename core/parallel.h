@@ -41,13 +41,14 @@ typedef void (*ts_ranges_fn)(void *ctx, int worker, ts_range_queue *q);
 ts_status ts_parallel_ranges(int threads, long items, long grain, ts_ranges_fn fn, void *ctx,
                              ts_error *err);
 
+/* The grain of ts_parallel_for_ranges for work row by row: rows a range
+ * holds at least. */
+#define TS_ROWS_GRAIN 8
+
 /* ts_parallel_ranges for a ts_range_fn: fn once for each range a worker
  * takes, in turn (so fn must accept any sub-range, and several on one
  * worker). For work item by item (rows), where a split in fixed halves
  * would wait on the slower core. */
-/* Rows a range of ts_parallel_for_ranges holds at least, for work row by
- * row. */
-#define TS_ROWS_GRAIN 8
 ts_status ts_parallel_for_ranges(int threads, long items, long grain, ts_range_fn fn, void *ctx,
                                  ts_error *err);
 

@@ -260,9 +260,8 @@ static ts_status add_wedge(const ts_sh_visibility *v, const float *table, double
 {
     wedge_ctx C = {v, a, b, table, {{0}, {0}}};
     ts_sh_rotation_set(&C.rot, az_start);
-    return ts_parallel_for(ts_thread_count(v->w->threads, v->grid->height), v->grid->height,
-                           wedge_rows,
-                           &C, err);
+    return ts_parallel_for_ranges(ts_thread_count(v->w->threads, v->grid->height),
+                                  v->grid->height, TS_ROWS_GRAIN, wedge_rows, &C, err);
 }
 
 ts_status ts_sh_visibility_init(ts_sh_visibility *v, const ts_grid *grid,
