@@ -302,18 +302,6 @@ static void sweep_lines(const sweep_ctx *C, sweep_ws *w, long begin, long end)
         ts_sweep_process_line(C, w, b, 1);
 }
 
-void ts_sweep_range(void *ctx, int worker, long begin, long end)
-{
-    (void)worker;
-    const sweep_ctx *C = ctx;
-    sweep_ws w;
-    if (ws_init(&w, C))
-        sweep_lines(C, &w, begin, end);
-    else
-        __atomic_store_n(C->alloc_failed, 1, __ATOMIC_RELAXED);
-    ws_free(&w);
-}
-
 void ts_sweep_ranges(void *ctx, int worker, ts_range_queue *q)
 {
     (void)worker;
@@ -469,7 +457,12 @@ ts_status ts_horizon_sweep_lines(const ts_grid *grid, double azimuth,
     C.visit = visit;
     C.user = user;
     C.alloc_failed = &failed;
-    ts_sweep_range(&C, 0, 0, geom.b_hi - geom.b_lo + 1);
+    sweep_ws w; /* one thread: the visitor sees the lines in order */
+    if (ws_init(&w, &C))
+        sweep_lines(&C, &w, 0, geom.b_hi - geom.b_lo + 1);
+    else
+        failed = 1;
+    ws_free(&w);
     free(scratch);
     ts_line_geom_free(&geom);
     if (failed)

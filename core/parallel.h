@@ -41,9 +41,10 @@ typedef void (*ts_ranges_fn)(void *ctx, int worker, ts_range_queue *q);
 ts_status ts_parallel_ranges(int threads, long items, long grain, ts_ranges_fn fn, void *ctx,
                              ts_error *err);
 
-/* The grain of ts_parallel_for_ranges for work row by row: rows a range
- * holds at least. */
+/* The grains of ts_parallel_for_ranges for work row by row (rows a range
+ * holds at least) and cell by cell (cells). */
 #define TS_ROWS_GRAIN 8
+#define TS_CELLS_GRAIN 4096
 
 /* ts_parallel_ranges for a ts_range_fn: fn once for each range a worker
  * takes, in turn (so fn must accept any sub-range, and several on one

@@ -30,7 +30,6 @@
 #ifndef CHUNK
 #define CHUNK 1024 /* columns: the rows of every level a chunk reads stay in L2 */
 #endif
-#define ROW_BLOCK 32 /* rows whose per-level entries are filled at a time */
 
 /* What sample j of the cells of one row shares: the level rows at the
  * samples' row (the vertical taps), the cells' own row on the level, and
@@ -414,7 +413,7 @@ void ts_pyr_rows_range(void *ctx, int worker, long y0, long y1)
     float *own = ts_pyr_alloc(2 * 3 * P * sizeof *own);
     double *tpp = ts_pyr_alloc(3 * P * sizeof *tpp);
     int *jd = ts_pyr_alloc((size_t)2 * n * P * sizeof *jd);
-    row_level *rl = malloc((size_t)n * ROW_BLOCK * levels * sizeof *rl);
+    row_level *rl = malloc((size_t)n * TS_PYR_ROW_BLOCK * levels * sizeof *rl);
     /* without planes (only the sky sums wanted), each grid row of a pair
      * and azimuth is written to a row of scratch, summed, then reused */
     const int planes = B->az[0].out != NULL;
@@ -436,8 +435,8 @@ void ts_pyr_rows_range(void *ctx, int worker, long y0, long y1)
             w[i][a] = (row_ws){f, f + P, f + 2 * P, f + 3 * P, f + 4 * P, f + 5 * P, tpp,
                                jd + ((size_t)i * n + a) * P, NULL, 1, 0, NULL};
         }
-    for (long yb = y0; yb < y1; yb += ROW_BLOCK) {
-        long ye = yb + ROW_BLOCK < y1 ? yb + ROW_BLOCK : y1;
+    for (long yb = y0; yb < y1; yb += TS_PYR_ROW_BLOCK) {
+        long ye = yb + TS_PYR_ROW_BLOCK < y1 ? yb + TS_PYR_ROW_BLOCK : y1;
         for (int a = 0; a < n; a++) {
             /* an earlier azimuth with the same vy reads the same level rows */
             const int b = B->same_vy[a];
@@ -446,10 +445,10 @@ void ts_pyr_rows_range(void *ctx, int worker, long y0, long y1)
                     const level_az *L = &B->az[a].lv[j], *Lb = &B->az[b].lv[j];
                     size_t at = (size_t)(y - yb) * levels + j;
                     const row_level *same = b < a && Lb->lev == L->lev && Lb->s == L->s
-                                                ? &rl[(size_t)b * ROW_BLOCK * levels + at]
+                                                ? &rl[(size_t)b * TS_PYR_ROW_BLOCK * levels + at]
                                                 : NULL;
                     row_level_fill(&B->az[a], (int)y, L->lev, L->s, a == 0, same,
-                                   &rl[(size_t)a * ROW_BLOCK * levels + at]);
+                                   &rl[(size_t)a * TS_PYR_ROW_BLOCK * levels + at]);
                 }
         }
         /* a chunk of columns down the rows, two rows at a time, then the
@@ -468,7 +467,7 @@ void ts_pyr_rows_range(void *ctx, int worker, long y0, long y1)
                     for (int a = 0; a < n; a++) {
                         w[i][a].out = planes ? B->az[a].out + (size_t)(y + i) * W
                                              : scratch + ((size_t)i * n + a) * P;
-                        g[i].rl[a] = &rl[((size_t)a * ROW_BLOCK + (y + i - yb)) * levels];
+                        g[i].rl[a] = &rl[((size_t)a * TS_PYR_ROW_BLOCK + (y + i - yb)) * levels];
                     }
                 }
                 batch_rows(B, g, rows, c0, c1);

@@ -89,6 +89,6 @@ ts_status ts_range_evaluate(const ts_range_bucket *b, int threads, ts_error *err
     if (b->count < 1)
         return TS_OK;
     long cells = (long)b->cells;
-    return ts_parallel_for_ranges(ts_thread_count(threads, (cells >> 14) + 1), cells, 1L << 12,
-                                  eval_range, (void *)b, err);
+    return ts_parallel_for_ranges(ts_thread_count(threads, (cells >> 14) + 1), cells,
+                                  TS_CELLS_GRAIN, eval_range, (void *)b, err);
 }

@@ -155,14 +155,12 @@ static inline int hull_push(hull_pt *S, int *n, int *far, double d, double gs, i
  * thread's first is only primed); with a visitor, hands it the samples. */
 void ts_sweep_process_line(const sweep_ctx *C, sweep_ws *w, long b, int write);
 
-/* The sweep's set-up and checks (every entry point's), and its lines
- * [b0 + begin, b0 + end) of a worker (a ts_range_fn: the line before is
- * primed, then each is written), or of every range a worker takes (a
- * ts_ranges_fn, one workspace for them all, each range as ts_sweep_range
- * takes it) (horizon_sweep.c). */
+/* The sweep's set-up and checks (every entry point's), and its lines of
+ * every range [begin, end) a worker takes (a ts_ranges_fn: lines [b0 +
+ * begin, b0 + end), the line before each range primed, then each written;
+ * one workspace for them all) (horizon_sweep.c). */
 ts_status ts_sweep_setup(const ts_grid *grid, double azimuth, const ts_horizon_opts *opts,
                          ts_line_geom *geom, sweep_ctx *C, ts_error *err);
-void ts_sweep_range(void *ctx, int worker, long begin, long end);
 void ts_sweep_ranges(void *ctx, int worker, ts_range_queue *q);
 
 /* The far-only sweep's parts of a lockstep block (sweep_far.c): its

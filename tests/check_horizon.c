@@ -8,12 +8,11 @@
 #include <time.h>
 
 #include "oracle.h"
+#include "parallel.h"
 #include "terrashade.h"
 #include "test_grid.h"
 #include "test_run.h"
 #include "test_stats.h"
-
-#include "parallel.h"
 
 /* Axis and non-axis azimuths: the sweep's line geometry differs for each. */
 static const double AZ[] = {0, 33.7, 45, 90, 137, 180, 222.2, 300};
