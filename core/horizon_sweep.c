@@ -221,8 +221,6 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
     w->stack = malloc((size_t)(U + 1) * sizeof *w->stack);
     w->lo.prev = malloc((size_t)U * sizeof(occluder));
     w->lo.cur = malloc((size_t)U * sizeof(occluder));
-    w->lo.prev_k0 = 1;
-    w->lo.prev_k1 = 0;
     if (need_visit) {
         w->vx = malloc((size_t)U * sizeof(float));
         w->vy = malloc((size_t)U * sizeof(float));
@@ -231,7 +229,6 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
         w->vd = malloc((size_t)U * sizeof(double));
     }
     if (w->lockstep) {
-        const occluder none = {-1, 0.0f};
         /* capped lines keep windows (rings) instead of hulls, the hybrid's
          * both */
         if (capped)
@@ -269,17 +266,16 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
             w->lane_k0 = w->lane_i + 2 * row;
             w->lost = w->lane_i + 3 * row;
         }
-        for (int k = 0; ok && k < U; k++)
-            w->carry[k] = none;
         ok = ok && (C->far_T == 0 || ts_far_ws_init(w, C));
     }
     return ok && w->stack && w->lo.prev && w->lo.cur &&
            (!need_visit || (w->vx && w->vy && w->vh && w->vs && w->vd));
 }
 
-/* Lines [b0 + begin, b0 + end) in workspace w, as a fresh workspace would
- * take them: nothing carried from lines w took before (the line before
- * begin is primed instead). */
+/* Lines [b0 + begin, b0 + end) in workspace w (ws_init's), as a fresh
+ * workspace would take them: nothing carried from lines w took before (the
+ * line before begin is primed instead); the carries are set here, not by
+ * ws_init. */
 static void sweep_lines(const sweep_ctx *C, sweep_ws *w, long begin, long end)
 {
     const occluder none = {-1, 0.0f};

@@ -115,8 +115,7 @@ static ts_status horizons_run(const ts_pyramid *pyr, int count, const double *az
             B.share |= b < a;
         }
         st = ts_parallel_for_ranges(ts_thread_count(opts->threads, g->height), g->height,
-                                    TS_PYR_ROW_BLOCK,
-                                    ts_pyr_rows_range, &B, err);
+                                    TS_PYR_ROW_BLOCK, ts_pyr_rows_range, &B, err);
     }
     for (int i = 0; i < k; i++) {
         free(C[i].step);

@@ -65,11 +65,14 @@ typedef struct {
     const ts_sky_plane *sky;
 } batch_ctx;
 
+/* Rows whose per-level entries ts_pyr_rows_range fills at a time (so the
+ * grain of its ranges). */
+#define TS_PYR_ROW_BLOCK 32
+
 /* The rows [y0, y1) of the batch ctx (a batch_ctx) for
  * ts_parallel_for_ranges: every azimuth's horizons, then each row span's
  * edge and sky terms (core/pyramid_horizon.c), TS_PYR_ROW_BLOCK rows at a
- * time (so the ranges' grain). */
-#define TS_PYR_ROW_BLOCK 32 /* rows whose per-level entries are filled at a time */
+ * time. */
 void ts_pyr_rows_range(void *ctx, int worker, long y0, long y1);
 
 /* Per-thread rows of state, one entry per cell of the grid row. */

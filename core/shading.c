@@ -140,7 +140,8 @@ static ts_status shade_direct(const ts_direct_request *req, int horn, ts_error *
         failed = 0;
     direct_horn_ctx C = {direct_ctx_of(req, &p), req->grid, &failed};
     if (!horn)
-        return ts_parallel_for_ranges(threads, (long)plane, TS_CELLS_GRAIN, direct_range, &C.d, err);
+        return ts_parallel_for_ranges(threads, (long)plane, TS_CELLS_GRAIN, direct_range, &C.d,
+                                      err);
     st = ts_parallel_for_ranges(threads, req->grid->height, TS_ROWS_GRAIN, direct_horn_rows, &C,
                                 err);
     if (st == TS_OK && failed)
