@@ -36,6 +36,13 @@ ts_edge_mode tsd_options_edge(const tsd_options *o)
     if (!tsd_product_takes(tsd_product_of(o), tsd_option_find("EDGE")) || o->edge < 0 ||
         o->edge > 2)
         return TS_EDGE_OPEN;
+    /* Negative openness sweeps the negated DEM. Ground beyond the edge at
+     * sea level or higher bounds a horizon from below, not a negated one:
+     * taken as the negated sea-level plane, it stood as a wall above every
+     * negated height, so that a plane at 2000 m read 59 deg in its middle.
+     * It sees the DEM alone there (docs/driver.md, openness). */
+    if (modes[o->edge] == TS_EDGE_HORIZON && tsd_sweeps_negated_dem(o))
+        return TS_EDGE_OPEN;
     return modes[o->edge];
 }
 

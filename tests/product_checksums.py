@@ -72,6 +72,8 @@ EDGE_VARIANTS = {
     "svf_edge": {"DIRECTIONS": "16"},
     "openness_edge": {"DIRECTIONS": "16"},
     "openness_edgenodata": {"DIRECTIONS": "16", "MAX_DISTANCE": "3000", "EDGE": "nodata"},
+    # (the negated DEM's rays see the DEM alone: openness_negative's sums)
+    "openness_negedge": {"DIRECTIONS": "16", "OPENNESS": "negative"},
     "sky_edge": {"DIRECTIONS": "16", "CURVATURE": "NO"},
     "sunhours_edge": dict(DAY),
     "insolation_edge": dict(DAY, LINKE_TURBIDITY="4"),

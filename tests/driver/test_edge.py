@@ -5,6 +5,8 @@
   shadow, exact and shm; SUN_ELEVATION=-90 lights nothing;
 - a flat DEM at 1000 m: openness 90 deg within the dip with horizon, up to
   about 152 at the edges with open, nodata on the edge band with nodata;
+  negative openness the same with horizon as with open, a plane 90 at any
+  height and a pit more;
   the horizon of an edge cell looking out is the analytic dip, and 0 without
   curvature;
 - the day products: nodata at the edges with EDGE=nodata, no sun below the
@@ -85,6 +87,8 @@ class Edge(unittest.TestCase):
                 self.assertEqual(self.lit(self.flat, SUN_ELEVATION=dip(1000) - 0.3, **o), 0)
                 if method == "exact":
                     self.assertEqual(self.lit(self.flat, SUN_ELEVATION=-0.1, **o), 1600)
+                if method == "shm":  # (MAX_DISTANCE is refused there: test_options)
+                    continue
                 o = dict(o, SUN_ELEVATION=-2, MAX_DISTANCE=60)
                 before = self.lit(self.rough, EDGE="open", **o)
                 print("  %s, sun at -2 deg, MAX_DISTANCE=60: %d lit with EDGE=open"
@@ -108,6 +112,41 @@ class Edge(unittest.TestCase):
         band[3:-3, 3:-3] = False
         np.testing.assert_array_equal(np.isnan(nodata), band)
         np.testing.assert_allclose(nodata[~band], 90.0, atol=1e-3)
+
+    def test_negative_openness_does_not_depend_on_height(self):
+        """Negative openness sweeps the negated DEM; the negated sea-level
+        plane beyond the edge once stood as a wall above it (a plane at
+        2000 m read 59.4 deg in its middle, a pit 3000 m deep was capped at
+        90). With EDGE=horizon it sees the DEM alone, as EDGE=open: a plane
+        reads 90 wherever a ray has terrain, whatever its height, with
+        either horizon method, and a pit more than 90 (114.5 deg at the
+        bottom of this one, exact; the pyramid's coarse levels see little of
+        the plane beyond the rim: 90.5)."""
+        d = self.tmp.path
+        o = dict(PRODUCT="openness", OPENNESS="negative", DIRECTIONS=16)
+        y, x = np.mgrid[0:40, 0:40]
+        r = np.hypot(x - 20, y - 20)
+        for method in ("exact", "pyramid"):
+            m = dict(o, HORIZON_METHOD=method)
+            for height in (0, 1000, 2000):
+                flat = T.write_tif(os.path.join(d, "flat_%d.tif" % height),
+                                   np.full((40, 40), height, np.float32), GT, 32617)
+                a = T.read(T.conn(flat), 1, m)
+                with self.subTest(method=method, height=height):
+                    np.testing.assert_allclose(a[1:-1, 1:-1], 90.0, atol=1e-3)
+                    np.testing.assert_array_equal(
+                        a, T.read(T.conn(flat), 1, dict(m, EDGE="open")))
+            # a conical pit 300 m deep and 300 m across in a plane at 2000 m:
+            # walls of 45 deg around its bottom
+            z = (2000 - 300 * np.clip(1 - r / 10, 0, 1)).astype(np.float32)
+            pit = T.write_tif(os.path.join(d, "pit.tif"), z, GT, 32617)
+            a = T.read(T.conn(pit), 1, m)
+            print("  negative openness (%s): plane 90 at 0, 1000 and 2000 m; pit bottom %.2f"
+                  % (method, a[20, 20]))
+            with self.subTest(method=method, pit=True):
+                if method == "exact":  # (the rim's plane, 600 m off at the edge: 26.6 deg up)
+                    self.assertGreater(a[20, 20], 110.0)
+                np.testing.assert_array_equal(a, T.read(T.conn(pit), 1, dict(m, EDGE="open")))
 
     def test_dip_of_an_edge_cell(self):
         o = dict(PRODUCT="horizon", DIRECTIONS=4)

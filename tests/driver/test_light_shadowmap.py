@@ -133,6 +133,13 @@ BAD = [
     (["SHADOWMAP_SCALE=4", "METHOD=shm"], "SHADOWMAP_SCALE applies to METHOD=shadowmap only"),
     (["METHOD=shadowmap", "MAX_DISTANCE=1000"],
      "MAX_DISTANCE does not apply to METHOD=shadowmap"),
+    # METHOD=shm's shadows once ignored MAX_DISTANCE, and the other methods
+    # PENUMBRA_DEPTH, without a word
+    (["METHOD=shm", "MAX_DISTANCE=1000"], "MAX_DISTANCE does not apply to METHOD=shm"),
+    (["METHOD=shm", "MAX_DISTANCE=1000", "PRODUCT=shadow"],
+     "MAX_DISTANCE does not apply to METHOD=shm"),
+    (["PENUMBRA_DEPTH=500"], "PENUMBRA_DEPTH applies to METHOD=shm only"),
+    (["PENUMBRA_DEPTH=500", "METHOD=sh"], "PENUMBRA_DEPTH applies to METHOD=shm only"),
     # one sentence, the open interval, below, at and above it
     (["LIGHT_RADIUS=0"], "LIGHT_RADIUS must be greater than 0 and less than 45 degrees, got 0"),
     (["LIGHT_RADIUS=-1"], "LIGHT_RADIUS must be greater than 0 and less than 45 degrees, got -1"),
