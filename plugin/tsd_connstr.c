@@ -110,18 +110,18 @@ ts_status tsd_connstr_parse(const char *name, tsd_connstr *out, char *msg,
 
 /* Was the last inline item key=value cut at a ':' of its value, leaving
  * dem? A time (TIMEZONE, DATETIME) whose value ends in the hours or minutes,
- * the DEM starting with the next two digits, then a ':', an offset, Z or
- * nothing; or SKY=cie, the DEM starting with the sky type's digits, then a
- * ':' or nothing. (strchr finds the '\0' too.) */
+ * the DEM starting with the next two digits, then a ':', an offset, Z, a ','
+ * (more items) or nothing; or SKY=cie, the DEM starting with the sky type's
+ * digits, then a ':', a ',' or nothing. (strchr finds the '\0' too.) */
 static int cut_at_colon(const char *key, int key_len, const char *value, const char *dem)
 {
     size_t n = strlen(value), digits = strspn(dem, "0123456789");
     if (key_len == 3 && !strncasecmp(key, "SKY", 3))
-        return !strcasecmp(value, "cie") && digits > 0 && strchr(":", dem[digits]);
+        return !strcasecmp(value, "cie") && digits > 0 && strchr(":,", dem[digits]);
     if (key_len != 8 || (strncasecmp(key, "TIMEZONE", 8) && strncasecmp(key, "DATETIME", 8)))
         return 0;
     return n > 0 && isdigit((unsigned char)value[n - 1]) && digits >= 2 &&
-           strchr(":+-Z", dem[2]);
+           strchr(":+-Z,", dem[2]);
 }
 
 void tsd_connstr_cut_colon_hint(const tsd_connstr *c, char *hint, size_t hint_size)
@@ -143,6 +143,39 @@ void tsd_connstr_cut_colon_hint(const tsd_connstr *c, char *hint, size_t hint_si
              "inline (TIMEZONE=-0500, DATETIME=2026-06-21T073000+0200, SKY=cie9) or give "
              "the option as an open option (-oo)",
              key_len, last, value, c->dem);
+}
+
+void tsd_connstr_segment_hint(const tsd_connstr *c, char *hint, size_t hint_size)
+{
+    hint[0] = '\0';
+    if (!c->dem || (c->options && c->options[0]))
+        return;
+    const char *colon = strchr(c->dem, ':');
+    const char *eq = strchr(c->dem, '=');
+    if (!colon || !eq || eq > colon)
+        return;
+    /* the first item of the would-be segment that is not KEY=VALUE */
+    const size_t len = (size_t)(colon - c->dem);
+    size_t start = 0;
+    for (size_t i = 0; i <= len; i++) {
+        if (i < len && c->dem[i] != ',')
+            continue;
+        if (!is_item(c->dem + start, i - start)) {
+            if (i == start)
+                snprintf(hint, hint_size,
+                         "; if '%.*s' was meant as inline options, it has an empty item (a "
+                         "doubled or trailing ','): every item between the commas must be "
+                         "KEY=VALUE",
+                         (int)len, c->dem);
+            else
+                snprintf(hint, hint_size,
+                         "; if '%.*s' was meant as inline options, its item '%.*s' is not "
+                         "KEY=VALUE, as every item between the commas must be",
+                         (int)len, c->dem, (int)(i - start), c->dem + start);
+            return;
+        }
+        start = i + 1;
+    }
 }
 
 const char *tsd_connstr_add_hint(char *msg, size_t msg_size, const char *hint)

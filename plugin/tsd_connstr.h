@@ -42,9 +42,16 @@ ts_status tsd_connstr_parse(const char *name, tsd_connstr *out, char *msg,
 /** Into hint ("" if not so): a sentence, starting "; ", for a connection
  * string whose last inline option is TIMEZONE, DATETIME or SKY cut at its
  * ':' (TIMEZONE=-05:00, DATETIME=...T07:30:00, SKY=cie:9), which leaves the
- * DEM's name starting with digits and ':' ("00:dem.tif"). The caller
- * appends it to the failure that follows (tsd_connstr_add_hint). */
+ * DEM's name starting with digits and ':' or ',' ("00:dem.tif",
+ * "00,PRODUCT=sunhours:dem.tif"). The caller appends it to the failure that
+ * follows (tsd_connstr_add_hint). */
 void tsd_connstr_cut_colon_hint(const tsd_connstr *c, char *hint, size_t hint_size);
+
+/** Into hint ("" if not so): a sentence, starting "; ", for a DEM name that
+ * looks like inline options that did not parse ("PRODUCT=svf,:dem.tif": an
+ * item before the first ':' that is not KEY=VALUE, e.g. the empty one of a
+ * doubled or trailing comma), naming the item; for the failure to open it. */
+void tsd_connstr_segment_hint(const tsd_connstr *c, char *hint, size_t hint_size);
 
 /** msg with hint appended (msg's final '.' dropped, so the sentence goes on);
  * msg unchanged if hint is "". Returns msg. */

@@ -341,6 +341,8 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     const std::string osDEM = sConn.dem;
     char szCut[512]; /* "" unless an inline value was cut at its ':' */
     tsd_connstr_cut_colon_hint(&sConn, szCut, sizeof szCut);
+    char szSegment[512]; /* "" unless the DEM's name looks like inline options */
+    tsd_connstr_segment_hint(&sConn, szSegment, sizeof szSegment);
     tsd_connstr_free(&sConn);
 
     auto poDS = std::unique_ptr<TSDataset>(new TSDataset());
@@ -354,7 +356,8 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     if (!poDEM)
     {
         snprintf(szMsg, sizeof szMsg, "cannot open the DEM '%s' as a raster", osDEM.c_str());
-        return FailOpen(CPLE_OpenFailed, tsd_connstr_add_hint(szMsg, sizeof szMsg, szCut));
+        tsd_connstr_add_hint(szMsg, sizeof szMsg, szCut);
+        return FailOpen(CPLE_OpenFailed, tsd_connstr_add_hint(szMsg, sizeof szMsg, szSegment));
     }
     poDS->m_poDEM = poDEM;
     poDS->m_osDEM = osDEM;

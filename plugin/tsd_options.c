@@ -81,7 +81,14 @@ static int parse_number(const opt_def *d, const char *v, double *out, char *msg,
             REFUSE("%s must be a whole number, got '%s'", d->name, v);
         *out = (double)l;
     } else {
-        double x = strtod(v, &end);
+        /* decimal only: strtod also reads C's hexadecimal floats (0x10 = 16) */
+        const char *digits = v;
+        while (isspace((unsigned char)*digits))
+            digits++;
+        digits += *digits == '+' || *digits == '-';
+        if (digits[0] == '0' && (digits[1] == 'x' || digits[1] == 'X'))
+            end = (char *)v;
+        double x = end == v ? 0.0 : strtod(v, &end);
         if ((end == v || *end || !isfinite(x)) && d->kind == K_FLOAT_AUTO)
             REFUSE("%s must be %s or a number, got '%s'", d->name, d->values, v);
         if (end == v || *end || !isfinite(x))
@@ -93,12 +100,15 @@ static int parse_number(const opt_def *d, const char *v, double *out, char *msg,
     int high = d->has_max && !(x <= d->max);
     if (!low && !high)
         return 0;
+    /* whole numbers' limits in full (%g wrote 1 << 20 as 1.04858e+06) */
+    char lo[32], hi[32];
+    snprintf(lo, sizeof lo, d->kind == K_INT ? "%.0f" : "%g", d->min);
+    snprintf(hi, sizeof hi, d->kind == K_INT ? "%.0f" : "%g", d->max);
     if (d->min_exclusive)
-        REFUSE("%s must be greater than %g and at most %g, got %s", d->name, d->min, d->max,
-               v);
+        REFUSE("%s must be greater than %s and at most %s, got %s", d->name, lo, hi, v);
     if (!d->has_max)
-        REFUSE("%s must be at least %g, got %s", d->name, d->min, v);
-    REFUSE("%s must be between %g and %g, got %s", d->name, d->min, d->max, v);
+        REFUSE("%s must be at least %s, got %s", d->name, lo, v);
+    REFUSE("%s must be between %s and %s, got %s", d->name, lo, hi, v);
 }
 
 static int parse_bool(const char *v, int *out)

@@ -62,6 +62,28 @@ CASES = [
     ("inline DATETIME with ':'", "TERRASHADE:datetime=2026-06-21T07:30:00+02:00:" + DEM, [],
      "expected the time as hh:mm or hh:mm:ss; the inline options end at the first ':', "
      "so datetime ends at '2026-06-21T07'"),
+    # ... with more items after it: the first check to fail (TIMEZONE without
+    # DATE, which the DEM's name swallowed) said nothing of the ':' (session 46)
+    ("inline TIMEZONE with ':', not last",
+     "TERRASHADE:TIMEZONE=-05:00,PRODUCT=sunhours,DATE=2026-06-21:" + DEM, [],
+     "TIMEZONE applies with DATE (or DATETIME) to the day products only; the inline "
+     "options end at the first ':', so TIMEZONE ends at '-05' and the rest, "
+     "'00,PRODUCT=sunhours,DATE=2026-06-21:%s', was taken as the DEM's name" % DEM),
+    ("inline SKY with ':', not last", "TERRASHADE:SKY=cie:9,PRODUCT=envlight:" + DEM, [],
+     "so SKY ends at 'cie' and the rest, '9,PRODUCT=envlight:%s'" % DEM),
+    # inline options that do not parse are the DEM's name: say which item
+    ("inline options, a trailing comma", "TERRASHADE:PRODUCT=svf,:" + DEM, [],
+     "cannot open the DEM 'PRODUCT=svf,:%s' as a raster; if 'PRODUCT=svf,' was meant as "
+     "inline options, it has an empty item (a doubled or trailing ',')" % DEM),
+    ("inline options, an item without '='", "TERRASHADE:PRODUCT=svf,DIRECTIONS:" + DEM, [],
+     "if 'PRODUCT=svf,DIRECTIONS' was meant as inline options, its item 'DIRECTIONS' is "
+     "not KEY=VALUE"),
+    # numbers: decimal only (strtod read 0x10 as 16), whole numbers' limits in
+    # full (%g wrote 1 << 20 as 1.04858e+06)
+    ("hexadecimal number", T.conn(DEM), ["SUN_ELEVATION=0x10"],
+     "SUN_ELEVATION must be a number, got '0x10'"),
+    ("whole number's limit", T.conn(DEM), ["TILE_SIZE=1048577"],
+     "TILE_SIZE must be between 0 and 1048576, got 1048577"),
     ("inline SKY with ':'", "TERRASHADE:PRODUCT=envlight,SKY=cie:9:" + DEM, [],
      "got 'cie'; the inline options end at the first ':', so SKY ends at 'cie' and the "
      "rest, '9:%s', was taken as the DEM's name: write times and skies without ':' "
