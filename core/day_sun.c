@@ -77,9 +77,9 @@ ts_status ts_parse_utc_offset(const char *s, int *minutes, ts_error *err)
     }
     if (!ok)
         return ts_fail(err, TS_ERR_ARG,
-                       "Cannot read '%.64s' as an offset from UTC: expected Z or "
-                       "+hh:mm / -hh:mm, e.g. +02:00 (named time zones are not "
-                       "supported: give the offset that applies on the day).", s);
+                       "Cannot read '%.64s' as an offset from UTC: expected Z (or UTC), "
+                       "+hh:mm, -hh:mm, +hhmm or +hh, e.g. +02:00 (named time zones are "
+                       "not supported: give the offset that applies on the day).", s);
     if (h > 23 || m > 59)
         return ts_fail(err, TS_ERR_ARG,
                        "The offset from UTC '%.64s' is out of range (at most "

@@ -128,7 +128,7 @@ const opt_def TSD_OPTION_ROWS[] = {
      NULL,
      "Chunks (TILE_SIZE): metres within which occluders come from the "
      "full-resolution DEM, exactly; farther ones from a coarser grid "
-     "(the DEM's overviews or a decimated read). 0 = 128 cells, or 32 cells of "
+     "(the DEM's overviews or an averaged read). 0 = 128 cells, or 32 cells of "
      "the far grid where that is longer (a DEM of more than 2048 x 2048 far cells)"},
     {"DATETIME", K_TEXT, FIELD(datetime), "", 0, 0, 0, 0, NULL, 1, P, LISTED,
      check_datetime,
@@ -149,7 +149,8 @@ const opt_def TSD_OPTION_ROWS[] = {
      "START_DATE"},
     {"TIMEZONE", K_TEXT, FIELD(timezone), "", 0, 0, 0, 0, NULL, 1, P, LISTED,
      check_timezone,
-     "Fixed offset from UTC of the local day: Z, +hh:mm, -hh:mm, +hhmm; "
+     "Fixed offset from UTC of the local day: Z or UTC, +hh:mm, -hh:mm, +hhmm, "
+     "+hh; "
      "needed with DATE; with DATETIME it defaults to DATETIME's offset"},
     {"STEP_MINUTES", K_INT, FIELD(step_minutes), "5", 1, 240, 0, 1, NULL, 1, P, LISTED,
      NULL,

@@ -56,8 +56,8 @@ void GDALRegister_TERRASHADE()
     poDriver->SetMetadataItem(GDAL_DMD_LONGNAME,
                               "terrashade: shaded relief with cast shadows, "
                               "horizons, sky-view factor");
-    poDriver->SetMetadataItem(GDAL_DMD_HELPTOPIC,
-                              "https://example.invalid/terrashade/docs/driver.md");
+    /* (relative, as GDAL's own drivers' topics are: the source tree's) */
+    poDriver->SetMetadataItem(GDAL_DMD_HELPTOPIC, "docs/driver.md");
     poDriver->SetMetadataItem(GDAL_DCAP_VIRTUALIO, "YES");
     poDriver->SetMetadataItem(GDAL_DCAP_CREATECOPY, "YES");
     poDriver->SetMetadataItem(GDAL_DMD_EXTENSION, "tsa");

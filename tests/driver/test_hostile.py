@@ -216,11 +216,11 @@ class Hostile(unittest.TestCase):
                        ("+99", "is out of range (at most 23:59)"),
                        ("Europe/Zurich", "named time zones are not supported"),
                        ("CET", "named time zones are not supported"),
-                       ("+2", "expected Z or +hh:mm"),
-                       ("+02:0", "expected Z or +hh:mm"),
-                       ("02:00", "expected Z or +hh:mm"),
-                       ("UTC+2", "expected Z or +hh:mm"),
-                       ("-", "expected Z or +hh:mm")):
+                       ("+2", "expected Z (or UTC), +hh:mm"),
+                       ("+02:0", "expected Z (or UTC), +hh:mm"),
+                       ("02:00", "expected Z (or UTC), +hh:mm"),
+                       ("UTC+2", "expected Z (or UTC), +hh:mm"),
+                       ("-", "expected Z (or UTC), +hh:mm")):
             head = ("The offset from UTC '%s'" if "range" in why else
                     "Cannot read '%s' as an offset from UTC") % v
             cases.append(("TIMEZONE=" + v, ["gdalinfo", "-nomd"] + day +
