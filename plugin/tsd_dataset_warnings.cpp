@@ -85,9 +85,19 @@ void WarnHeightUnit(const tsd_cells &sCells, const OGRSpatialReference &oSRS,
 /* A MAX_DISTANCE shorter than the DEM's cells (dfCell: its smallest side)
  * holds no terrain: no shadow, no horizon above the cell's own slope. Most
  * often a distance meant in cells (RVT's radius is in pixels) or
- * kilometres. */
+ * kilometres. And METHOD=shm's shadow height map follows every occluder to
+ * the DEM's edge: MAX_DISTANCE bounds its sky term and EDGE=nodata's reach
+ * only (it shadowed a cell from 150 m away at MAX_DISTANCE=10 m, without a
+ * word, until session 46). */
 void TSDataset::WarnShortDistance(double dfCell)
 {
+    if (m_sOpts.max_distance > 0 && m_sOpts.method == TSD_METHOD_SHM &&
+        tsd_product_takes(m_psProduct, tsd_option_find("METHOD")))
+        CPLError(CE_Warning, CPLE_AppDefined,
+                 "TERRASHADE: METHOD=shm casts shadows from every occluder up to the DEM's "
+                 "edge: MAX_DISTANCE=%g m bounds only its sky term (SKY_WEIGHT) and the "
+                 "reach of EDGE=nodata. METHOD=exact casts them from within MAX_DISTANCE",
+                 m_sOpts.max_distance);
     if (!(m_sOpts.max_distance > 0 && m_sOpts.max_distance < dfCell) ||
         !tsd_product_takes(m_psProduct, tsd_option_find("MAX_DISTANCE")))
         return;

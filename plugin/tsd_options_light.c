@@ -1,6 +1,8 @@
 /* The light's options: LIGHT_RADIUS (the disk of the exact method, and of
  * METHOD=shadowmap's auto filter), METHOD=shm's and METHOD=shadowmap's own
- * options, and the combinations where they make no sense. */
+ * options, and the combinations where they make no sense. (METHOD=shm with
+ * MAX_DISTANCE bounds its sky term and EDGE=nodata's reach, not its
+ * shadows: a warning, TSDataset::WarnShortDistance.) */
 #include "tsd_options_light.h"
 
 #include <math.h>
@@ -31,9 +33,6 @@ int tsd_options_check_light(const tsd_options *o, char *msg, size_t n)
     if (o->method != TSD_METHOD_SHM && o->penumbra_depth != d.penumbra_depth)
         REFUSE("PENUMBRA_DEPTH applies to METHOD=shm only (the other methods soften the "
                "shadows by LIGHT_RADIUS)");
-    if (o->method == TSD_METHOD_SHM && o->max_distance > 0)
-        REFUSE("MAX_DISTANCE does not apply to METHOD=shm (its shadow height map follows every "
-               "occluder to the DEM's edge); use METHOD=exact");
     if (!shadowmap && o->shadowmap_scale != d.shadowmap_scale)
         REFUSE("SHADOWMAP_SCALE applies to METHOD=shadowmap only");
     if (!shadowmap && !isnan(o->pcf_kernel))

@@ -87,8 +87,6 @@ class Edge(unittest.TestCase):
                 self.assertEqual(self.lit(self.flat, SUN_ELEVATION=dip(1000) - 0.3, **o), 0)
                 if method == "exact":
                     self.assertEqual(self.lit(self.flat, SUN_ELEVATION=-0.1, **o), 1600)
-                if method == "shm":  # (MAX_DISTANCE is refused there: test_options)
-                    continue
                 o = dict(o, SUN_ELEVATION=-2, MAX_DISTANCE=60)
                 before = self.lit(self.rough, EDGE="open", **o)
                 print("  %s, sun at -2 deg, MAX_DISTANCE=60: %d lit with EDGE=open"

@@ -133,11 +133,7 @@ BAD = [
     (["SHADOWMAP_SCALE=4", "METHOD=shm"], "SHADOWMAP_SCALE applies to METHOD=shadowmap only"),
     (["METHOD=shadowmap", "MAX_DISTANCE=1000"],
      "MAX_DISTANCE does not apply to METHOD=shadowmap"),
-    # METHOD=shm's shadows once ignored MAX_DISTANCE, and the other methods
-    # PENUMBRA_DEPTH, without a word
-    (["METHOD=shm", "MAX_DISTANCE=1000"], "MAX_DISTANCE does not apply to METHOD=shm"),
-    (["METHOD=shm", "MAX_DISTANCE=1000", "PRODUCT=shadow"],
-     "MAX_DISTANCE does not apply to METHOD=shm"),
+    # the other methods once ignored PENUMBRA_DEPTH without a word
     (["PENUMBRA_DEPTH=500"], "PENUMBRA_DEPTH applies to METHOD=shm only"),
     (["PENUMBRA_DEPTH=500", "METHOD=sh"], "PENUMBRA_DEPTH applies to METHOD=shm only"),
     # one sentence, the open interval, below, at and above it
@@ -159,6 +155,20 @@ class BadInput(unittest.TestCase):
                 gdal.OpenEx(T.conn(T.LUX), gdal.OF_RASTER, open_options=oo)
             print("%-50s -> %s" % (" ".join(oo), cm.exception))
             self.assertIn(text, str(cm.exception))
+
+    def test_shm_says_what_max_distance_bounds(self):
+        """METHOD=shm's shadows follow every occluder to the DEM's edge:
+        MAX_DISTANCE bounds its sky term and EDGE=nodata's reach only, and
+        the dataset says so (it once took the option without a word)."""
+        with T.TempDir() as d:
+            out = os.path.join(d, "o.tif")
+            for oo, said in ((["METHOD=shm", "MAX_DISTANCE=200"], True),
+                             (["METHOD=shm"], False), (["MAX_DISTANCE=200"], False)):
+                with self.subTest(oo=oo):
+                    p = T.run(["gdal_translate", "-q"] + sum((["-oo", o] for o in oo), [])
+                              + [T.conn(T.LUX), out])
+                    self.assertEqual("MAX_DISTANCE=200 m bounds only its sky term" in p.stderr,
+                                     said, p.stderr)
 
     def test_low_light(self):
         """The light at or below the horizon is refused at open (gdalinfo, a
