@@ -124,18 +124,35 @@ def given_keys(source, open_options):
     return {item.split("=", 1)[0].strip().upper() for item in items}
 
 
+def absolute_path(text):
+    """text (a name, quoted or not) made absolute if it is a relative path
+    that exists here; None if it is not one."""
+    quoted = len(text) > 1 and text[0] == text[-1] == '"'
+    path = text[1:-1] if quoted else text
+    if not path or os.path.isabs(path) or path.startswith("/vsi") or not os.path.exists(path):
+        return None
+    path = os.path.abspath(path)
+    return '"%s"' % path if quoted else path
+
+
 def absolute_source(source):
     """SOURCE with a relative DEM path that exists here made absolute: each
     worker would resolve it in its own working directory (an existing
     cluster's workers do not share the client's), and read another file of
-    that name, or none."""
+    that name, or none. Also the file inside another driver's name
+    (GTIFF_DIR:1:dem.tif, NETCDF:"dem.nc":z, GPKG:dem.gpkg:table): the
+    parts between its ':' that are relative paths existing here."""
     head, dem = split_source(source)
-    quoted = len(dem) > 1 and dem[0] == dem[-1] == '"'
-    path = dem[1:-1] if quoted else dem
-    if not path or os.path.isabs(path) or path.startswith("/vsi") or not os.path.exists(path):
+    whole = absolute_path(dem)
+    if whole is not None:
+        return "TERRASHADE:" + head + whole
+    if os.path.exists(dem):  # (an absolute or virtual path, or nothing to do)
         return source
-    path = os.path.abspath(path)
-    return "TERRASHADE:" + head + ('"%s"' % path if quoted else path)
+    parts = dem.split(":")
+    fixed = [absolute_path(p) or p for p in parts]
+    if len(parts) < 2 or fixed == parts:
+        return source
+    return "TERRASHADE:" + head + ":".join(fixed)
 
 
 def open_source(source, open_options):
@@ -239,8 +256,12 @@ def start_cluster(args):
         # A worker has one task slot per thread, by default one per core.
         return client, None, 1
     workers = args.workers or os.cpu_count() or 1
+    # on this machine's loopback only, with its HTTP servers on free ports:
+    # dashboard_address=None still served the scheduler's on 0.0.0.0:8787,
+    # reachable from other machines, and warned where that port was taken
     cluster = LocalCluster(n_workers=workers, threads_per_worker=args.threads_per_worker,
-                           processes=True, dashboard_address=None,
+                           processes=True, host="127.0.0.1", dashboard_address="127.0.0.1:0",
+                           worker_dashboard_address="127.0.0.1:0",
                            silence_logs=logging.ERROR)
     slots = workers * args.threads_per_worker
     return Client(cluster), cluster, max(1, (os.cpu_count() or 1) // slots)
@@ -302,6 +323,16 @@ class Watch:
 
 
 def check_workers(client, watch):
+    """The workers' count, once every one can run the tasks; waits up to
+    --timeout for a first worker (a cluster's may still be starting)."""
+    try:
+        if not client.scheduler_info().get("workers"):
+            client.wait_for_workers(1, timeout=watch.timeout)
+    except (asyncio.TimeoutError, TimeoutError):
+        watch.connected()
+        raise Failure("the Dask cluster at %s has no workers (none joined within %d s, "
+                      "--timeout): start them (dask-worker %s)"
+                      % (watch.address, watch.timeout, watch.address), code=2)
     try:
         found = client.run(W.probe)
     except Exception as e:
@@ -310,7 +341,7 @@ def check_workers(client, watch):
                       "the terrashade package on them (make install) or put it on "
                       "their PYTHONPATH" % e)
     if not found:
-        raise Failure("the Dask cluster has no workers")
+        raise Failure("the Dask cluster at %s has no workers" % watch.address, code=2)
     missing = [w for w, r in found.items() if not r["driver"]]
     if missing:
         raise Failure("GDAL on worker(s) %s cannot find the TERRASHADE driver: set "

@@ -396,18 +396,46 @@ class Distributed(unittest.TestCase):
         cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                dashboard_address=None, scheduler_port=0)
         svf = {"PRODUCT": "svf", "DIRECTIONS": 4}
+        # the file inside another driver's name too (session 46: it failed,
+        # 'cannot open the DEM GTIFF_DIR:1:rel.tif', on such a cluster)
+        sources = {"relative.tif": "TERRASHADE:rel.tif",
+                   "relative_dir.tif": "TERRASHADE:GTIFF_DIR:1:rel.tif"}
         try:
             with Client(cluster) as client:  # the workers' working directory
                 client.run(os.chdir, worker_dir)
-            dest = self.path("relative.tif")
-            distributed(["--scheduler", cluster.scheduler_address, "--tile-size", 64, "-q"]
-                        + T.oo_args(svf) + ["TERRASHADE:rel.tif", dest], cwd=client_dir)
+            for name, source in sources.items():
+                distributed(["--scheduler", cluster.scheduler_address, "--tile-size", 64,
+                             "-q"] + T.oo_args(svf) + [source, self.path(name)],
+                            cwd=client_dir)
         finally:
             cluster.close()
-        ref = self.path("ref_relative.tif")  # gdal_translate where the client runs
-        T.run(["gdal_translate", "-q"] + T.oo_args(svf) + ["TERRASHADE:rel.tif", ref],
-              cwd=client_dir)
-        self.assert_identical(dest, ref)
+        for name, source in sources.items():
+            ref = self.path("ref_" + name)  # gdal_translate where the client runs
+            T.run(["gdal_translate", "-q"] + T.oo_args(svf) + [source, ref], cwd=client_dir)
+            self.assert_identical(self.path(name), ref)
+
+    def test_cluster_without_workers(self):
+        """A cluster with no worker at the start: the run waits --timeout for
+        one to join (they may still be starting), then says so, exit 2
+        (session 46: it failed at once, exit 1, whatever --timeout said)."""
+        with ExternalCluster(self.path("")) as c:
+            c.start("scheduler", ["dask-scheduler", "--host", "127.0.0.1", "--port", 0,
+                                  "--no-dashboard", "--scheduler-file", c.file])
+            c.wait_for(lambda: os.path.exists(c.file) and os.path.getsize(c.file),
+                       "the scheduler's file")
+            with open(c.file) as f:
+                address = json.load(f)["address"]
+            dest = self.path("no_workers.tif")
+            start = time.monotonic()
+            p = distributed(["--scheduler", address, "--timeout", 2, "-q",
+                             T.conn(self.dem), dest], ok=False)
+            took = time.monotonic() - start
+            print("  no workers: exit %d after %.1f s: %s"
+                  % (p.returncode, took, p.stderr.strip()))
+            self.assertEqual(p.returncode, 2)
+            self.assertIn("has no workers (none joined within 2 s, --timeout)", p.stderr)
+            self.assertGreaterEqual(took, 2.0)
+            self.assert_nothing_left(dest)
 
     def test_killed_worker_is_retried(self):
         flag = self.path("crashed")
