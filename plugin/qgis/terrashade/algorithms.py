@@ -126,13 +126,33 @@ def number_text(value):
     return text[:-2] if text.endswith(".0") else text
 
 
+def connection(dem):
+    """TERRASHADE:dem, the name quoted where the driver would read its start
+    as inline options (a file 'a=b:c.tif': '=' before a ':'), as the driver
+    asks (docs/driver.md); any other name as it is."""
+    colon, eq = dem.find(":"), dem.find("=")
+    if colon > 0 and 0 <= eq < colon and not dem.startswith('"'):
+        dem = '"%s"' % dem
+    return "%s:%s" % (DRIVER, dem)
+
+
+def output_format(out):
+    """(GDAL driver, creation options) of the output file out."""
+    ext = os.path.splitext(out)[1].lstrip(".")
+    fmt = (QgsRasterFileWriter.driverForExtension(ext) if ext else "") or "GTiff"
+    creation = ["COMPRESS=DEFLATE", "TILED=YES", "BIGTIFF=IF_SAFER"] if fmt == "GTiff" else []
+    return fmt, creation
+
+
 def command_line(dem, options, out):
-    """The gdal_translate command that does the same."""
-    args = ["gdal_translate"]
+    """The gdal_translate command that writes the same file."""
+    fmt, creation = output_format(out)
+    args = ["gdal_translate", "-of", fmt]
+    for c in creation:
+        args += ["-co", c]
     for k, v in options.items():
-        if k != "PROGRESS":
-            args += ["-oo", "%s=%s" % (k, v)]
-    return " ".join(shlex.quote(a) for a in args + ["%s:%s" % (DRIVER, dem), out])
+        args += ["-oo", "%s=%s" % (k, v)]
+    return " ".join(shlex.quote(a) for a in args + [connection(dem), out])
 
 
 class Warnings:
@@ -177,14 +197,11 @@ def gdal_call(function, *args, **kwargs):
 
 
 def write(dem, options, out, feedback):
-    ds, message = gdal_call(gdal.OpenEx, "%s:%s" % (DRIVER, dem), gdal.OF_RASTER,
+    ds, message = gdal_call(gdal.OpenEx, connection(dem), gdal.OF_RASTER,
                             open_options=["%s=%s" % kv for kv in options.items()])
     if ds is None:
         raise QgsProcessingException(message or "cannot open %s" % dem)
-    ext = os.path.splitext(out)[1].lstrip(".")
-    fmt = QgsRasterFileWriter.driverForExtension(ext) if ext else ""
-    fmt = fmt or "GTiff"
-    creation = ["COMPRESS=DEFLATE", "TILED=YES", "BIGTIFF=IF_SAFER"] if fmt == "GTiff" else []
+    fmt, creation = output_format(out)
 
     def progress(done, _message, _data):
         if feedback is not None:

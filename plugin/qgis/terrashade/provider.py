@@ -1,4 +1,6 @@
 """The terrashade Processing provider: one algorithm per product of the driver."""
+import sys
+
 from qgis.core import Qgis, QgsMessageLog, QgsProcessingProvider
 
 from .algorithms import make_algorithms
@@ -28,6 +30,9 @@ class TerrashadeProvider(QgsProcessingProvider):
         except DriverError as e:  # QGIS starts anyway; the log says what to do
             self.problem = str(e)
             QgsMessageLog.logMessage(self.problem, "terrashade", Qgis.Warning)
+            # and stderr, which qgis_process shows (it prints no log): else
+            # it said only 'Algorithm terrashade:shade not found!'
+            print("terrashade: " + self.problem, file=sys.stderr)
             return
         self.problem = ""
         for alg in algorithms:
