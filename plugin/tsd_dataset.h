@@ -95,7 +95,9 @@ class TSDataset final : public GDALPamDataset
     bool EnsureFarField();
     bool ComputeChunk(int cx, int cy, WindowChunk &c);
     const WindowChunk *Chunk(int cx, int cy);
-    CPLErr WindowBlock(int iPlane, int x0, int y0, int nBW, int nBH, bool bByte, void *pImage);
+    // the block at (x0, y0) of nPlanes planes (piPlane[k] into ppImage[k])
+    CPLErr WindowBlock(int nPlanes, const int *piPlane, void *const *ppImage, int x0, int y0,
+                       int nBW, int nBH, bool bByte);
     bool Setup(const char *pszConnection, int W, int H);
     void WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfLon, double dfLat);
     void WarnShortDistance(double dfMinCell);

@@ -341,6 +341,30 @@ class Windows(unittest.TestCase):
         np.testing.assert_array_equal(win == -90, whole == -90)
         self.assertLess(d.max(), 15.0)
 
+    def test_bands_one_after_another_compute_each_chunk_once(self):
+        """A reader that takes the bands one after the other (a Python loop
+        of ReadAsArray) computes each chunk once, also where a block spans
+        more chunks than the cache keeps (TILE_SIZE=64 under 256-cell
+        blocks: 265 computations for 25 chunks until session 46), and gets
+        the bits of a whole-dataset read."""
+        code = """
+import sys
+from osgeo import gdal
+import numpy as np
+ds = gdal.OpenEx("TERRASHADE:" + sys.argv[1], gdal.OF_RASTER,
+                 open_options=["PRODUCT=horizon", "DIRECTIONS=8", "TILE_SIZE=64"])
+a = np.stack([ds.GetRasterBand(b).ReadAsArray() for b in range(1, ds.RasterCount + 1)])
+np.save(sys.argv[2], a)
+"""
+        out = os.path.join(self.tmp, "bands.npy")
+        p = T.run(["/usr/bin/python3", "-c", code, self.dem, out], CPL_DEBUG="TERRASHADE")
+        computed = p.stderr.count("computed chunk (")
+        chunks = ((520 + 63) // 64) * ((600 + 63) // 64)
+        print("  band by band: %d chunk computations for %d chunks" % (computed, chunks))
+        self.assertEqual(computed, chunks)
+        np.testing.assert_array_equal(
+            np.load(out), product(self.dem, PRODUCT="horizon", DIRECTIONS=8, TILE_SIZE=64))
+
     def test_small_dem_whole(self):
         """A DEM within one tile is computed whole: TILE_SIZE changes nothing."""
         a = product(T.LUX, PRODUCT="horizon", DIRECTIONS=4, TILE_SIZE=0)
