@@ -155,6 +155,30 @@ def absolute_source(source):
     return "TERRASHADE:" + head + ":".join(fixed)
 
 
+class Said:
+    """The driver's warnings said on stderr, each once: the client's open of
+    SOURCE, then the tasks' (windows.read_window returns them), as GDAL's
+    own handler words them."""
+
+    def __init__(self):
+        self.seen = set()
+
+    def say(self, messages, bar=None):
+        new = [m for m in messages if m not in self.seen]
+        if not new:
+            return
+        self.seen.update(new)
+        if bar is not None:
+            bar.interrupt()
+        for number, message in new:
+            sys.stderr.write("Warning %d: %s\n" % (number, message))
+        if bar is not None:
+            bar.resume()
+
+
+SAID = Said()
+
+
 def open_source(source, open_options):
     if not source.upper().startswith("TERRASHADE:"):
         raise Failure("SOURCE must be a TERRASHADE connection string "
@@ -162,11 +186,16 @@ def open_source(source, open_options):
     if gdal.GetDriverByName("TERRASHADE") is None:
         raise Failure("GDAL cannot find the TERRASHADE driver: set GDAL_DRIVER_PATH "
                       "to the directory of gdal_TERRASHADE.so, or make install")
+    said = W.Warnings()
+    gdal.PushErrorHandler(said)
     try:
         return gdal.OpenEx(source, gdal.OF_RASTER | gdal.OF_READONLY,
                            open_options=open_options)
     except RuntimeError as e:
         raise Failure("cannot open %s: %s" % (source, e))
+    finally:
+        gdal.PopErrorHandler()
+        SAID.say(said.messages)
 
 
 def output_format(args):
@@ -389,6 +418,16 @@ class ProgressBar:
         finally:
             self.ready.set()
 
+    def interrupt(self):
+        """Until resume(): no drawing, and a drawn bar's line ended, so that
+        a message starts a line of its own (the next draw redraws it)."""
+        self.lock.acquire()
+        if self.drawn and not self.stopped:
+            sys.stderr.write("\n")
+
+    def resume(self):
+        self.lock.release()
+
     def stop(self):
         """No more drawing; a drawn bar's line is ended, so that the reason
         the run failed starts a line of its own."""
@@ -419,7 +458,8 @@ def compute(client, watch, out, source, task_options, tile, quiet, run):
                 time.sleep(0.1)
             for fut in batch:
                 try:
-                    (xoff, yoff, _, _), a = fut.result()
+                    (xoff, yoff, _, _), a, warned = fut.result()
+                    SAID.say(warned, bar)
                 except Exception as e:
                     watch.connected(done, len(wins))  # cancelled with the connection
                     raise Failure("the window (xoff, yoff, xsize, ysize) = %r of %s "

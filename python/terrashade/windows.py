@@ -71,18 +71,40 @@ def _maybe_crash():
     os._exit(17)
 
 
+class Warnings:
+    """GDAL's warnings while it is pushed (gdal.PushErrorHandler, this
+    thread's), each once, in order; errors still raise (gdal.UseExceptions
+    takes them from the last error, which the handler does not clear)."""
+
+    def __init__(self):
+        self.messages = []
+
+    def __call__(self, level, number, message):
+        if level == gdal.CE_Warning and (number, message) not in self.messages:
+            self.messages.append((number, message))
+
+
 def read_window(source, open_options, window, run):
-    """The product's pixels in window (xoff, yoff, xsize, ysize) as an array
-    of shape (bands, ysize, xsize), read through the driver; run names the
-    run (its tasks share a worker thread's dataset)."""
+    """(window, the product's pixels in window (xoff, yoff, xsize, ysize) as
+    an array of shape (bands, ysize, xsize), the driver's warnings as
+    (number, message) pairs), read through the driver; run names the run
+    (its tasks share a worker thread's dataset). The warnings go back to the
+    client, which says each once: printed here, every worker of a local
+    cluster repeated the client's on the same terminal, and an existing
+    cluster's went to the workers' logs."""
     _maybe_crash()
-    ds = _dataset(source, open_options, run)
-    xoff, yoff, xsize, ysize = window
-    a = ds.ReadAsArray(xoff, yoff, xsize, ysize)
+    said = Warnings()
+    gdal.PushErrorHandler(said)
+    try:
+        ds = _dataset(source, open_options, run)
+        xoff, yoff, xsize, ysize = window
+        a = ds.ReadAsArray(xoff, yoff, xsize, ysize)
+    finally:
+        gdal.PopErrorHandler()
     if a is None:
         raise RuntimeError("reading window %r of %s failed: %s"
                            % (window, source, gdal.GetLastErrorMsg()))
-    return window, a.reshape((ds.RasterCount, ysize, xsize))
+    return window, a.reshape((ds.RasterCount, ysize, xsize)), said.messages
 
 
 def probe():

@@ -224,6 +224,20 @@ class Distributed(unittest.TestCase):
                 self.assertEqual(gdal.Open(dest).GetRasterBand(1).GetBlockSize(), [64, 64])
                 self.assert_identical(dest, self.reference(options, "ref_%s.tif" % name))
 
+    def test_warnings_said_once(self):
+        """The driver's warnings are said once, by the client: each worker
+        process of a local cluster printed its own copy on the same terminal
+        (three with two workers, -q or not, until session 46)."""
+        options = {"PRODUCT": "svf", "DIRECTIONS": 4, "MAX_DISTANCE": 1}
+        for quiet in ([], ["-q"]):
+            with self.subTest(quiet=quiet):
+                dest = self.path("warned.tif")
+                p = distributed(["--workers", 2, "--tile-size", 64] + quiet
+                                + T.oo_args(options) + [T.conn(self.dem), dest])
+                said = "Warning 1: TERRASHADE: MAX_DISTANCE=1 m is shorter than the DEM's cells"
+                self.assertEqual(p.stderr.count(said), 1, p.stderr)
+                self.assert_identical(dest, self.reference(options, "ref_warned.tif"))
+
     def test_inline_options_as_the_driver_reads_them(self):
         """THREADS and PROGRESS given inline are left to the user, also where
         the driver's parser allows blanks around a key: the program added
