@@ -13,6 +13,7 @@
 #
 # Usage: bench/gpu.sh [--quick] [--dry-run] [--size N] [--dirs D] [--repeat R]
 #   --quick    1024² DEM, 16 directions, best of 2 (default 4096², 32, best of 3)
+#   --dirs D   a multiple of 8 (cl_bench's batches of azimuths)
 #   --dry-run  without an NVIDIA device, run on the default OpenCL device
 #              (PoCL on a CPU), to test the script itself
 # Environment: CC (default cc), JOBS (parallel compiles, default nproc),
