@@ -7,9 +7,13 @@
 #include <cstdlib>
 #include <string>
 
+#include <algorithm>
+#include <cstring>
+
 #include "cpl_conv.h"
 #include "cpl_string.h"
 #include "cpl_vsi.h"
+#include "ogr_spatialref.h"
 
 #include "shadow_atlas.h"
 #include "tsd_atlas_check.h"
@@ -83,6 +87,101 @@ std::string AtlasAsDEM(const std::string &osDEM, bool bGiven)
                       "DEM=...", osDEM.c_str(), bGiven ? "" : " (the atlas's SOURCE_DEM)");
 }
 
+std::string AtlasSourceDEM(const char *pszAtlas, const std::string &osDEM)
+{
+    if (osDEM.empty() || !CPLIsFilenameRelative(osDEM.c_str()))
+        return osDEM;
+    const std::string osNear = CPLFormFilename(CPLGetPath(pszAtlas), osDEM.c_str(), nullptr);
+    VSIStatBufL sStat;
+    return VSIStatL(osNear.c_str(), &sStat) == 0 ? osNear : osDEM;
+}
+
+/* target (absolute) as a path relative to the folder base (absolute),
+ * with ../ where it lies outside (CPLExtractRelativePath gives up there). */
+static std::string RelativeTo(const std::string &osBase, const std::string &osTarget)
+{
+    const CPLStringList aosB(CSLTokenizeString2(osBase.c_str(), "/", 0));
+    const CPLStringList aosT(CSLTokenizeString2(osTarget.c_str(), "/", 0));
+    int n = 0;
+    while (n < aosB.size() && n < aosT.size() - 1 && strcmp(aosB[n], aosT[n]) == 0)
+        n++;
+    std::string osRel;
+    for (int i = n; i < aosB.size(); i++)
+        osRel += "../";
+    for (int i = n; i < aosT.size(); i++)
+        osRel += std::string(aosT[i]) + (i + 1 < aosT.size() ? "/" : "");
+    return osRel;
+}
+
+std::string AtlasSourceDEMToWrite(const char *pszAtlas, const std::string &osDEM)
+{
+    VSIStatBufL sStat; // (a name of another driver, GTIFF_DIR:1:x.tif, is no file)
+    if (osDEM.empty() || !CPLIsFilenameRelative(osDEM.c_str()) ||
+        VSIStatL(osDEM.c_str(), &sStat) != 0)
+        return osDEM;
+    char *pszCwd = CPLGetCurrentDir();
+    if (!pszCwd)
+        return osDEM;
+    const std::string osCwd = pszCwd;
+    CPLFree(pszCwd);
+    const std::string osAbsDEM = CPLFormFilename(osCwd.c_str(), osDEM.c_str(), nullptr);
+    const std::string osAtlasDir =
+        CPLIsFilenameRelative(pszAtlas)
+            ? std::string(CPLFormFilename(osCwd.c_str(), CPLGetPath(pszAtlas), nullptr))
+            : std::string(CPLGetPath(pszAtlas));
+    // (a Windows path, or one through ./ or ../, would need more: absolute)
+    if (osAbsDEM.find("/./") != std::string::npos || osAbsDEM.find("/../") != std::string::npos ||
+        osAtlasDir.find("/./") != std::string::npos ||
+        osAtlasDir.find("/../") != std::string::npos || osAbsDEM[0] != '/' ||
+        osAtlasDir.empty() || osAtlasDir[0] != '/')
+        return osAbsDEM;
+    return RelativeTo(osAtlasDir, osAbsDEM);
+}
+
+std::string CheckAtlasDEM(GDALDataset *poDEM, const std::string &osDEM, bool bGiven, int W,
+                          int H, bool bHasGT, const double *padfGT,
+                          const OGRSpatialReference *poSRS)
+{
+    const char *pszWhich = bGiven ? "" : " (the atlas's SOURCE_DEM)";
+    if (poDEM->GetRasterXSize() != W || poDEM->GetRasterYSize() != H)
+        return CPLSPrintf("SHADOWS=all: the DEM '%s'%s (%d x %d) does not match the %d x %d "
+                          "atlas", osDEM.c_str(), pszWhich, poDEM->GetRasterXSize(),
+                          poDEM->GetRasterYSize(), W, H);
+    double adfGT[6];
+    if (bHasGT && poDEM->GetGeoTransform(adfGT) == CE_None)
+    {
+        // the same cells on the ground, rows and columns in either order (a
+        // product of a south-up DEM is north-up)
+        const double dx = std::fabs(padfGT[1]), dy = std::fabs(padfGT[5]);
+        const double ax[2] = {adfGT[0], adfGT[0] + W * adfGT[1]};
+        const double ay[2] = {adfGT[3], adfGT[3] + H * adfGT[5]};
+        const double bx[2] = {padfGT[0], padfGT[0] + W * padfGT[1]};
+        const double by[2] = {padfGT[3], padfGT[3] + H * padfGT[5]};
+        const double tol = 1e-6;
+        const bool bSame =
+            adfGT[2] == 0 && adfGT[4] == 0 &&
+            std::fabs(std::fabs(adfGT[1]) - dx) <= tol * dx &&
+            std::fabs(std::fabs(adfGT[5]) - dy) <= tol * dy &&
+            std::fabs(std::min(ax[0], ax[1]) - std::min(bx[0], bx[1])) <= tol * dx * W &&
+            std::fabs(std::min(ay[0], ay[1]) - std::min(by[0], by[1])) <= tol * dy * H;
+        if (!bSame)
+            return CPLSPrintf("SHADOWS=all: the DEM '%s'%s does not lie where the atlas does "
+                              "(its geotransform %.10g, %.10g, %.10g, %.10g, %.10g, %.10g "
+                              "against the atlas's %.10g, %.10g, %.10g, %.10g, %.10g, %.10g): "
+                              "name the DEM the atlas was made from with DEM=...",
+                              osDEM.c_str(), pszWhich, adfGT[0], adfGT[1], adfGT[2], adfGT[3],
+                              adfGT[4], adfGT[5], padfGT[0], padfGT[1], padfGT[2], padfGT[3],
+                              padfGT[4], padfGT[5]);
+    }
+    const OGRSpatialReference *poDEMSRS = poDEM->GetSpatialRef();
+    if (poSRS && !poSRS->IsEmpty() && poDEMSRS && !poDEMSRS->IsEmpty() &&
+        !poSRS->IsSame(poDEMSRS))
+        return CPLSPrintf("SHADOWS=all: the DEM '%s'%s is in another CRS (%s) than the "
+                          "atlas (%s): name the DEM the atlas was made from with DEM=...",
+                          osDEM.c_str(), pszWhich, poDEMSRS->GetName(), poSRS->GetName());
+    return std::string();
+}
+
 std::string CheckAtlasSource(GDALDataset *poSrcDS)
 {
     const int nBands = poSrcDS->GetRasterCount();
@@ -94,6 +193,11 @@ std::string CheckAtlasSource(GDALDataset *poSrcDS)
                               "binary far-shadow maps of PRODUCT=farshadow", b,
                               GDALGetDataTypeName(eType));
     }
+    const char *pszShadows = poSrcDS->GetMetadataItem("SHADOWS");
+    if (pszShadows && EQUAL(pszShadows, "all"))
+        return "the source holds far and near shadows (an atlas opened with SHADOWS=all, or "
+               "a copy of one): an atlas stores the far shadows alone; write it from the "
+               "atlas opened without SHADOWS=all, or from PRODUCT=farshadow";
     tsd_options sSrcOpts;
     const CPLStringList aosSrcMeta(CSLDuplicate(poSrcDS->GetMetadata()));
     const std::string osCause = CheckAtlasMetadata(aosSrcMeta, nBands, &sSrcOpts);

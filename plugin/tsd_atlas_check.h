@@ -38,6 +38,24 @@ bool IsAtlasFile(const char *pszName);
  * open option DEM, else the atlas's SOURCE_DEM). */
 std::string AtlasAsDEM(const std::string &osDEM, bool bGiven);
 
+/** The atlas's SOURCE_DEM as the atlas at pszAtlas names it: a relative
+ * path is the atlas's folder's (as a VRT's sources are) where a file is
+ * there, else as it is. */
+std::string AtlasSourceDEM(const char *pszAtlas, const std::string &osDEM);
+
+/** The SOURCE_DEM to write into the atlas at pszAtlas: a relative path of
+ * a file (the writer's working directory's) made relative to the atlas's
+ * folder, so that the two can move together; anything else as it is. */
+std::string AtlasSourceDEMToWrite(const char *pszAtlas, const std::string &osDEM);
+
+/** "" if poDEM (named osDEM, bGiven: by DEM=) can be the DEM of a W x H
+ * atlas with that geotransform (if bHasGT) and CRS (if not null): the
+ * same size, the same cells on the ground (extent and cell size, whatever
+ * the rows' order) and the same CRS; else why not, a sentence. */
+std::string CheckAtlasDEM(GDALDataset *poDEM, const std::string &osDEM, bool bGiven, int W,
+                          int H, bool bHasGT, const double *padfGT,
+                          const OGRSpatialReference *poSRS);
+
 } // namespace tsd
 
 #endif

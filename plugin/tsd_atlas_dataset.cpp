@@ -346,8 +346,13 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
     poDS->m_bAll = bAll;
     poDS->m_nThreads = nThreads;
     poDS->m_bDEMGiven = !osDEM.empty();
+    if (poDS->m_bDEMGiven && !bAll) // (it was taken without a word)
+        return FailOpen(TS_ERR_ARG, "DEM applies with SHADOWS=all only, which recomputes the "
+                                    "near shadows from it; SHADOWS=far reads the atlas alone");
     poDS->m_osDEM = !osDEM.empty() ? osDEM
-                                   : poDS->m_aosMeta.FetchNameValueDef("SOURCE_DEM", "");
+                                   : AtlasSourceDEM(poOpenInfo->pszFilename,
+                                                    poDS->m_aosMeta.FetchNameValueDef(
+                                                        "SOURCE_DEM", ""));
     if (bAll && poDS->m_osDEM.empty())
         return FailOpen(TS_ERR_ARG,
                           "SHADOWS=all recomputes the near shadows from the DEM, but the "
@@ -376,6 +381,26 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
                 poDS->GDALDataset::SetMetadataItem(pszKey, pszValue);
         }
         CPLFree(pszKey);
+    }
+    if (bAll)
+    {
+        // the DEM at open, not at the first read (a QGIS layer opened and
+        // then failed block by block), and the same ground as the atlas (a
+        // copy moved or reprojected, of the same size, was taken)
+        std::unique_ptr<GDALDataset> poDEM(GDALDataset::Open(
+            poDS->m_osDEM.c_str(), GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR));
+        if (!poDEM)
+            return FailOpen(CPLE_OpenFailed,
+                            CPLSPrintf("SHADOWS=all cannot open the DEM '%s'%s (give it with "
+                                       "the open option DEM=...)", poDS->m_osDEM.c_str(),
+                                       poDS->m_bDEMGiven ? "" : " (the atlas's SOURCE_DEM)"));
+        const std::string osWhy = CheckAtlasDEM(
+            poDEM.get(), poDS->m_osDEM, poDS->m_bDEMGiven, psInfo->width, psInfo->height,
+            poDS->m_bHasGT, poDS->m_adfGT, poDS->m_oSRS.IsEmpty() ? nullptr : &poDS->m_oSRS);
+        if (!osWhy.empty())
+            return FailOpen(TS_ERR_ARG, osWhy.c_str());
+        // what a copy holds: far and near shadows (CheckAtlasSource refuses it)
+        poDS->GDALDataset::SetMetadataItem("SHADOWS", "all");
     }
     for (int k = 0; k < psInfo->steps; k++)
     {
@@ -473,6 +498,8 @@ GDALDataset *TSAtlasDataset::CreateCopy(const char *pszFilename, GDALDataset *po
     for (char **p = poSrcDS->GetMetadata(); p && *p; p++)
     {
         std::string osLine = *p;
+        if (STARTS_WITH_CI(osLine.c_str(), "SOURCE_DEM=")) // as the atlas's folder names it
+            osLine = "SOURCE_DEM=" + AtlasSourceDEMToWrite(pszFilename, osLine.substr(11));
         std::replace(osLine.begin(), osLine.end(), '\n', ' ');
         std::replace(osLine.begin(), osLine.end(), '\r', ' ');
         if (!STARTS_WITH_CI(osLine.c_str(), "SRS_WKT="))

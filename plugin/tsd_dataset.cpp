@@ -25,6 +25,7 @@
 #include "cpl_string.h"
 #include "gdal_priv.h"
 
+#include "tsd_atlas_check.h"
 #include "tsd_caller_progress.h"
 #include "tsd_connstr.h"
 #include "tsd_dataset.h"
@@ -352,6 +353,12 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
         return FailOpen(TS_ERR_ARG, tsd_connstr_add_hint(szMsg, sizeof szMsg, szCut));
     poDS->m_psProduct = tsd_product_of(&sOpts);
 
+    if (IsAtlasFile(osDEM.c_str())) // (its 0/1 maps were taken as heights)
+        return FailOpen(TS_ERR_ARG,
+                        CPLSPrintf("the DEM '%s' is a far-shadow atlas (.tsa), not a DEM: open "
+                                   "it as it is (%s, its far shadows; -oo SHADOWS=all with "
+                                   "the near ones), or name the DEM it was made from",
+                                   osDEM.c_str(), osDEM.c_str()));
     GDALDataset *poDEM = OpenDEM(osDEM.c_str());
     if (!poDEM)
     {

@@ -13,6 +13,7 @@
 """
 import datetime
 import os
+import shutil
 import struct
 import unittest
 import zlib
@@ -353,6 +354,72 @@ class Atlas(unittest.TestCase):
         path = self.write("self.tsa", forge(data, "\n".join(text) + "\n"))
         self.refused(path, "(the atlas's SOURCE_DEM) is a far-shadow atlas (.tsa), not a DEM",
                      ["SHADOWS=all"])
+
+    def test_relative_source_dem_is_the_atlas_folders(self):
+        """An atlas written from a relative DEM records it relative to the
+        atlas's folder, and reads it from there: opened from another folder,
+        where a file of the DEM's name held other terrain, SHADOWS=all read
+        that one without a word (session 46)."""
+        here = os.getcwd()
+        work = os.path.join(self.dir, "rel")
+        os.makedirs(os.path.join(work, "atlases"), exist_ok=True)
+        os.makedirs(os.path.join(work, "elsewhere"), exist_ok=True)
+        shutil.copy(T.JACKSBORO, os.path.join(work, "dem.tif"))
+        # a decoy of the same name and size, flat, where the reader runs
+        T.run(["gdal_translate", "-q", "-scale", "0", "5000", "0", "0", "-ot", "Float32",
+               T.JACKSBORO, os.path.join(work, "elsewhere", "dem.tif")])
+        try:
+            os.chdir(work)
+            T.run(["gdal_translate", "-q", "-of", "TERRASHADE"] + sum(
+                (["-oo", o] for o in oo(DAY)), []) + ["TERRASHADE:dem.tif",
+                                                       os.path.join("atlases", "day.tsa")])
+            self.assertEqual(gdal.Open("atlases/day.tsa").GetMetadataItem("SOURCE_DEM"),
+                             "../dem.tif")
+            os.chdir(os.path.join(work, "elsewhere"))
+            ds = gdal.OpenEx("../atlases/day.tsa", open_options=["SHADOWS=all"])
+            got = ds.GetRasterBand(16).ReadAsArray()
+            ds = None
+        finally:
+            os.chdir(here)
+        ref = gdal.OpenEx(self.tsa, open_options=["SHADOWS=all"])  # (kept while read)
+        np.testing.assert_array_equal(got, ref.GetRasterBand(16).ReadAsArray())
+
+    def test_shadows_all_dem_checked_at_open(self):
+        """SHADOWS=all checks its DEM when the atlas opens (a QGIS layer
+        opened, then failed block by block): there, of the atlas's size, on
+        the same ground and in the same CRS; DEM= only with SHADOWS=all; a
+        copy of far and near shadows is no atlas source."""
+        moved = os.path.join(self.dir, "moved.tif")
+        T.run(["gdal_translate", "-q", "-a_ullr", "-84", "36.5", "-83.6", "36.2",
+               T.JACKSBORO, moved])
+        other_crs = os.path.join(self.dir, "other_crs.tif")
+        T.run(["gdal_translate", "-q", "-a_srs", "EPSG:4269", T.JACKSBORO, other_crs])
+        for options, sentence in (
+                (["SHADOWS=all", "DEM=" + moved], "does not lie where the atlas does"),
+                (["SHADOWS=all", "DEM=" + other_crs], "is in another CRS"),
+                (["SHADOWS=all", "DEM=/nonexistent/dem.tif"],
+                 "SHADOWS=all cannot open the DEM '/nonexistent/dem.tif'"),
+                (["DEM=" + T.JACKSBORO], "DEM applies with SHADOWS=all only")):
+            with self.subTest(options=options):
+                with self.assertRaises(RuntimeError) as e:
+                    gdal.OpenEx(self.tsa, open_options=options)
+                print("%-40s -> %s" % (options[-1][-24:], e.exception))
+                self.assertIn(sentence, str(e.exception))
+        all_tif = os.path.join(self.dir, "all.tif")
+        T.run(["gdal_translate", "-q", "-oo", "SHADOWS=all", self.tsa, all_tif])
+        self.assertEqual(gdal.Open(all_tif).GetMetadataItem("SHADOWS"), "all")
+        p = T.run(["gdal_translate", "-of", "TERRASHADE", all_tif,
+                   os.path.join(self.dir, "from_all.tsa")], ok=False)
+        self.assertIn("the source holds far and near shadows", p.stderr)
+
+    def test_atlas_is_no_dem_of_a_product(self):
+        """TERRASHADE:day.tsa computed a product from the atlas's 0/1 maps
+        as heights; refused, as DEM=day.tsa is."""
+        for conn in (T.conn(self.tsa), "TERRASHADE:PRODUCT=svf:" + self.tsa):
+            with self.subTest(conn=conn):
+                with self.assertRaises(RuntimeError) as e:
+                    gdal.OpenEx(conn, gdal.OF_RASTER)
+                self.assertIn("is a far-shadow atlas (.tsa), not a DEM", str(e.exception))
 
     def test_shadows_all_refuses_what_are_not_heights(self):
         """SHADOWS=all reads its DEM as a product's open does: a complex or
