@@ -64,26 +64,23 @@ const tsd_window_plan *WindowPlan(const WindowState *p)
     return p ? &p->plan : nullptr;
 }
 
-/* The overview of `hBand` that GDAL would read for a W' = w grid (the
- * smallest not smaller), compared over a sample with the average of the
- * full-resolution cells under it. false with the error set. */
-static bool OverviewsAgree(GDALRasterBand *poBand, int w, const std::string &osDEM)
+/* How far the n x n overview cells from (ox, oy) of poOvr lie from the
+ * full-resolution cells of poBand under them: the mean |difference| from
+ * their average and from the cell -r nearest takes (what -r average and -r
+ * nearest build), and the tolerance (2 % of the averages' range, at least
+ * 0.5). false where nothing could be compared (or read: the reads that
+ * follow will say). */
+struct OverviewSample
 {
-    GDALRasterBand *poOvr = nullptr;
-    for (int i = 0; i < poBand->GetOverviewCount(); i++)
-    {
-        GDALRasterBand *p = poBand->GetOverview(i);
-        if (p && p->GetXSize() >= w && (!poOvr || p->GetXSize() < poOvr->GetXSize()))
-            poOvr = p;
-    }
-    if (!poOvr)
-        return true;
+    double dfAverage, dfNearest, dfTol;
+};
+
+static bool SampleOverview(GDALRasterBand *poBand, GDALRasterBand *poOvr, int ox, int oy, int n,
+                           OverviewSample *psOut)
+{
     const int W = poBand->GetXSize(), H = poBand->GetYSize();
-    const int ow = poOvr->GetXSize(), oh = poOvr->GetYSize();
-    const double rx = static_cast<double>(W) / ow, ry = static_cast<double>(H) / oh;
-    // a centred sample of at most 32 x 32 overview cells and 2048 x 2048 DEM cells
-    const int n = std::max(1, std::min({32, ow, oh, static_cast<int>(2048 / std::max(rx, ry))}));
-    const int ox = (ow - n) / 2, oy = (oh - n) / 2;
+    const double rx = static_cast<double>(W) / poOvr->GetXSize();
+    const double ry = static_cast<double>(H) / poOvr->GetYSize();
     const int fx = static_cast<int>(ox * rx), fy = static_cast<int>(oy * ry);
     const int fw = std::min(W - fx, static_cast<int>(std::ceil(n * rx)));
     const int fh = std::min(H - fy, static_cast<int>(std::ceil(n * ry)));
@@ -92,10 +89,11 @@ static bool OverviewsAgree(GDALRasterBand *poBand, int w, const std::string &osD
                         nullptr) != CE_None ||
         poBand->RasterIO(GF_Read, fx, fy, fw, fh, afFull.data(), fw, fh, GDT_Float32, 0, 0,
                          nullptr) != CE_None)
-        return true; // unreadable here: the reads that follow will say
+        return false;
     int bHasNoData = FALSE;
     const double dfNoData = tsd_dem_nodata(GDALRasterBand::ToHandle(poBand), &bHasNoData);
-    double dfSum = 0, dfMin = INFINITY, dfMax = -INFINITY;
+    auto valid = [&](double v) { return std::isfinite(v) && !(bHasNoData && v == dfNoData); };
+    double dfAvg = 0, dfNear = 0, dfMin = INFINITY, dfMax = -INFINITY;
     int nCompared = 0;
     for (int j = 0; j < n; j++)
         for (int i = 0; i < n; i++)
@@ -111,30 +109,69 @@ static bool OverviewsAgree(GDALRasterBand *poBand, int w, const std::string &osD
                 for (int x = x0; x < x1; x++)
                 {
                     const float v = afFull[static_cast<size_t>(y) * fw + x];
-                    if (std::isfinite(v) && !(bHasNoData && v == dfNoData))
+                    if (valid(v))
                         s += v, c++;
                 }
-            if (c == 0 || !std::isfinite(o) || (bHasNoData && o == dfNoData))
+            // (the cell -r nearest takes: GDAL 3.6's round((i) r), the first)
+            const int cx = std::min(fw - 1, static_cast<int>((ox + i) * rx + 0.5) - fx);
+            const int cy = std::min(fh - 1, static_cast<int>((oy + j) * ry + 0.5) - fy);
+            const float fCentre = afFull[static_cast<size_t>(cy) * fw + cx];
+            if (c == 0 || !valid(o))
                 continue;
-            dfSum += std::fabs(o - s / c);
+            dfAvg += std::fabs(o - s / c);
+            dfNear += valid(fCentre) ? std::fabs(o - fCentre) : std::fabs(o - s / c);
             dfMin = std::min(dfMin, s / c);
             dfMax = std::max(dfMax, s / c);
             nCompared++;
         }
     if (nCompared == 0)
+        return false;
+    *psOut = {dfAvg / nCompared, dfNear / nCompared, std::max(0.5, 0.02 * (dfMax - dfMin))};
+    return true;
+}
+
+/* The overview of `hBand` that GDAL would read for a W' = w grid (the
+ * smallest not smaller), compared with the full-resolution cells under it
+ * over nine samples across the DEM (corners, edges' middles, centre), so
+ * that one stale tile of a mosaic is seen (a centred sample alone missed
+ * it). false with the error set. */
+static bool OverviewsAgree(GDALRasterBand *poBand, int w, const std::string &osDEM)
+{
+    GDALRasterBand *poOvr = nullptr;
+    for (int i = 0; i < poBand->GetOverviewCount(); i++)
+    {
+        GDALRasterBand *p = poBand->GetOverview(i);
+        if (p && p->GetXSize() >= w && (!poOvr || p->GetXSize() < poOvr->GetXSize()))
+            poOvr = p;
+    }
+    if (!poOvr)
         return true;
-    const double dfMean = dfSum / nCompared;
-    const double dfTol = std::max(0.5, 0.02 * (dfMax - dfMin));
-    if (dfMean <= dfTol)
-        return true;
-    Fail(TS_ERR_ARG,
-         CPLSPrintf("the DEM '%s' has overviews that disagree with it: its %d x %d overview "
-                    "differs from the average of the full-resolution cells under it by %.3g "
-                    "on average over a %d x %d sample (tolerance %.3g); the far field of "
-                    "TILE_SIZE would come from it. Rebuild the overviews (gdaladdo -r "
-                    "average) or remove them (gdaladdo -clean), or set TILE_SIZE=0",
-                    osDEM.c_str(), ow, oh, dfMean, n, n, dfTol));
-    return false;
+    const int ow = poOvr->GetXSize(), oh = poOvr->GetYSize();
+    const double r = std::max(static_cast<double>(poBand->GetXSize()) / ow,
+                              static_cast<double>(poBand->GetYSize()) / oh);
+    // samples of at most 32 x 32 overview cells and 1024 x 1024 DEM cells
+    const int n = std::max(1, std::min({32, ow, oh, static_cast<int>(1024 / r)}));
+    for (int sy = 0; sy < 3; sy++)
+        for (int sx = 0; sx < 3; sx++)
+        {
+            const int ox = (ow - n) * sx / 2, oy = (oh - n) * sy / 2;
+            OverviewSample sS;
+            if (!SampleOverview(poBand, poOvr, ox, oy, n, &sS) ||
+                std::min(sS.dfAverage, sS.dfNearest) <= sS.dfTol)
+                continue;
+            Fail(TS_ERR_ARG,
+                 CPLSPrintf("the DEM '%s' has overviews that disagree with it: its %d x %d "
+                            "overview differs from the full-resolution cells under it by %.3g "
+                            "on average (from their average; %.3g from the cells -r nearest takes) "
+                            "over the %d x %d overview cells from column %d, row %d "
+                            "(tolerance %.3g); the far field of TILE_SIZE would come from "
+                            "it. Rebuild the overviews (gdaladdo -r average) or remove them "
+                            "(gdaladdo -clean), or set TILE_SIZE=0",
+                            osDEM.c_str(), ow, oh, sS.dfAverage, sS.dfNearest, n, n, ox, oy,
+                            sS.dfTol));
+            return false;
+        }
+    return true;
 }
 
 /* Plan the chunks of a W x H product (level 0 only); false with the
