@@ -137,6 +137,12 @@ void TSDataset::SetupMetadata()
             static_cast<TSRasterBand *>(poBand)->SetColor(
                 GDALGetColorInterpretationByName(sInfo.color));
     }
+    // chunk by chunk, the far grid's size: MAX_MEMORY (three quarters of the
+    // machine's memory by default) can make it coarser, and the far field
+    // with it, where the options alone say nothing (docs/windows.md)
+    if (const tsd_window_plan *psPlan = WindowPlan(m_poWindow))
+        GDALDataset::SetMetadataItem("FAR_GRID",
+                                     CPLSPrintf("%d x %d", psPlan->far_w, psPlan->far_h));
     SetupEnvironmentMetadata();
     if (m_bHasSun)
         SetupSunMetadata();

@@ -365,6 +365,21 @@ np.save(sys.argv[2], a)
         np.testing.assert_array_equal(
             np.load(out), product(self.dem, PRODUCT="horizon", DIRECTIONS=8, TILE_SIZE=64))
 
+    def test_far_grid_in_the_metadata(self):
+        """The far grid's size, which MAX_MEMORY can coarsen where the
+        options are otherwise the same, is in the metadata (FAR_GRID); a
+        product computed whole has none."""
+        def far_grid(**options):
+            ds = gdal.OpenEx(T.conn(self.dem), gdal.OF_RASTER,
+                             open_options=["%s=%s" % kv for kv in options.items()])
+            return ds.GetMetadataItem("FAR_GRID")
+        svf = dict(PRODUCT="svf", DIRECTIONS=32, TILE_SIZE=128)
+        self.assertEqual(far_grid(**svf), "600 x 520")
+        coarse = far_grid(MAX_MEMORY=64, **svf)  # (a third: test_overviews_disagree)
+        print("  FAR_GRID: 600 x 520, with MAX_MEMORY=64 %s" % coarse)
+        self.assertNotEqual(coarse, "600 x 520")
+        self.assertIsNone(far_grid(PRODUCT="svf", DIRECTIONS=32, TILE_SIZE=0))
+
     def test_small_dem_whole(self):
         """A DEM within one tile is computed whole: TILE_SIZE changes nothing."""
         a = product(T.LUX, PRODUCT="horizon", DIRECTIONS=4, TILE_SIZE=0)
