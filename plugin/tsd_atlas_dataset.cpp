@@ -90,6 +90,17 @@ class TSAtlasDataset final : public GDALPamDataset
     {
         return m_oSRS.IsEmpty() ? nullptr : &m_oSRS;
     }
+    /* gdaladdo: GDAL's own refusal ("BuildOverviews() not supported") was
+     * no TERRASHADE sentence and said nothing of what to do */
+    CPLErr IBuildOverviews(const char *, int, const int *, int, const int *, GDALProgressFunc,
+                           void *, CSLConstList) override
+    {
+        Fail(CPLE_NotSupported,
+             CPLSPrintf("%s: a far-shadow atlas is read-only and holds no overviews; copy it "
+                        "(gdal_translate day.tsa day.tif) and run gdaladdo on the copy",
+                        GetDescription()));
+        return CE_Failure;
+    }
 };
 
 /* Its nodata value and colour are the atlas's unless the user set them

@@ -460,7 +460,7 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
                                   sizeof szMsg))
         CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szMsg);
     if (m_nLevel == 0)
-        WarnShortDistance(dfMinCell);
+        WarnShortDistance(dfMinCell, W, H);
     double dfHeadroom = 0;
     if (!SetupWindow(W, H) ||
         !CheckMemory(sOpts, W, H, WindowPlan(m_poWindow), m_bHasSun ? &m_sSun : nullptr,

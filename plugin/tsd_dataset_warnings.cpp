@@ -2,6 +2,7 @@
  * user meant: refusals at open (a band that is not heights) and warnings
  * (no geotransform, heights of unknown unit on a grid in feet, a
  * MAX_DISTANCE shorter than a cell, a DEM too wide for one sun). */
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -89,8 +90,19 @@ void WarnHeightUnit(const tsd_cells &sCells, const OGRSpatialReference &oSRS,
  * the DEM's edge: MAX_DISTANCE bounds its sky term and EDGE=nodata's reach
  * only (it shadowed a cell from 150 m away at MAX_DISTANCE=10 m, without a
  * word, until session 46). */
-void TSDataset::WarnShortDistance(double dfCell)
+void TSDataset::WarnShortDistance(double dfCell, int W, int H)
 {
+    // PRODUCT=farshadow: a FAR_THRESHOLD as long as the DEM's longer side
+    // (the default 512 on a smaller DEM) leaves the maps empty, but for
+    // the diagonals' last cells (all 158 maps of jacksboro's day)
+    if (tsd_product_takes(m_psProduct, tsd_option_find("FAR_THRESHOLD")) &&
+        m_sOpts.far_threshold >= std::max(W, H))
+        CPLError(CE_Warning, CPLE_AppDefined,
+                 "TERRASHADE: FAR_THRESHOLD=%d cells is as long as the DEM's longer side "
+                 "(%d x %d cells) or longer: few occluders if any lie that far from a cell, "
+                 "so the maps are empty or nearly. Give a shorter one (e.g. "
+                 "FAR_THRESHOLD=%d)",
+                 m_sOpts.far_threshold, W, H, std::max(1, std::max(W, H) / 8));
     if (m_sOpts.max_distance > 0 && m_sOpts.method == TSD_METHOD_SHM &&
         tsd_product_takes(m_psProduct, tsd_option_find("METHOD")))
         CPLError(CE_Warning, CPLE_AppDefined,

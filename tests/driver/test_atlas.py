@@ -412,6 +412,21 @@ class Atlas(unittest.TestCase):
                    os.path.join(self.dir, "from_all.tsa")], ok=False)
         self.assertIn("the source holds far and near shadows", p.stderr)
 
+    def test_gdaladdo_and_a_threshold_longer_than_the_dem(self):
+        """gdaladdo on an atlas gets a TERRASHADE sentence (GDAL's own said
+        'BuildOverviews() not supported'); a FAR_THRESHOLD as long as the
+        DEM's longer side (the default 512 on jacksboro) warns that the maps
+        are empty, as all 158 of a day's were, without a word."""
+        p = T.run(["gdaladdo", self.tsa, "2"], ok=False)
+        self.assertIn("TERRASHADE: %s: a far-shadow atlas is read-only" % self.tsa, p.stderr)
+        day = dict(DAY)
+        day.pop("FAR_THRESHOLD", None)
+        p = T.run(["gdalinfo"] + sum((["-oo", o] for o in oo(day)), []) + [T.conn(T.JACKSBORO)])
+        self.assertIn("FAR_THRESHOLD=512 cells is as long as the DEM's longer side (403 x 344 "
+                      "cells) or longer", p.stderr)
+        p = T.run(["gdalinfo"] + sum((["-oo", o] for o in oo(DAY)), []) + [T.conn(T.JACKSBORO)])
+        self.assertNotIn("FAR_THRESHOLD", p.stderr)
+
     def test_atlas_is_no_dem_of_a_product(self):
         """TERRASHADE:day.tsa computed a product from the atlas's 0/1 maps
         as heights; refused, as DEM=day.tsa is."""

@@ -415,7 +415,7 @@ class Sun(unittest.TestCase):
                            (dict(instant, METHOD="shm"), "SUN_POSITION=per_cell"),
                            (dict(instant, METHOD="shadowmap"), "Crop the DEM"),
                            (dict(instant, LIGHT_RADIUS=1), "Crop the DEM"),
-                           (dict(instant, PRODUCT="farshadow"), "Crop the DEM")):
+                           (dict(instant, PRODUCT="farshadow", FAR_THRESHOLD=8), "Crop the DEM")):
             p = T.run(["gdal_translate", "-q"] + T.oo_args(oo) + [T.conn(wide), out])
             # from the centre (8 E, 48 N) to the farthest corner cell's centre
             self.assertIn("the DEM reaches %.1f degrees of arc from its centre" % reach,
