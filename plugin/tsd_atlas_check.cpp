@@ -87,17 +87,32 @@ std::string AtlasAsDEM(const std::string &osDEM, bool bGiven)
                       "DEM=...", osDEM.c_str(), bGiven ? "" : " (the atlas's SOURCE_DEM)");
 }
 
+/* The physical absolute path of an existing file or folder (symbolic
+ * links, . and .. resolved), or "" (none, or a GDAL virtual path). */
+static std::string Physical(const std::string &osPath)
+{
+    if (osPath.empty() || STARTS_WITH(osPath.c_str(), "/vsi"))
+        return std::string();
+    char *pszReal = realpath(osPath.c_str(), nullptr);
+    const std::string osReal = pszReal ? pszReal : "";
+    free(pszReal);
+    return osReal;
+}
+
 std::string AtlasSourceDEM(const char *pszAtlas, const std::string &osDEM)
 {
     if (osDEM.empty() || !CPLIsFilenameRelative(osDEM.c_str()))
         return osDEM;
-    const std::string osNear = CPLFormFilename(CPLGetPath(pszAtlas), osDEM.c_str(), nullptr);
-    VSIStatBufL sStat;
-    return VSIStatL(osNear.c_str(), &sStat) == 0 ? osNear : osDEM;
+    // the atlas's folder's, as a path from here (absolute: also what its
+    // metadata shows, so that a copy of it elsewhere still finds the DEM)
+    const std::string osNear =
+        Physical(CPLFormFilename(CPLGetPath(pszAtlas), osDEM.c_str(), nullptr));
+    return osNear.empty() ? osDEM : osNear;
 }
 
-/* target (absolute) as a path relative to the folder base (absolute),
- * with ../ where it lies outside (CPLExtractRelativePath gives up there). */
+/* target as a path relative to the folder base (both physical and
+ * absolute), with ../ where it lies outside (CPLExtractRelativePath gives
+ * up there). */
 static std::string RelativeTo(const std::string &osBase, const std::string &osTarget)
 {
     const CPLStringList aosB(CSLTokenizeString2(osBase.c_str(), "/", 0));
@@ -115,27 +130,19 @@ static std::string RelativeTo(const std::string &osBase, const std::string &osTa
 
 std::string AtlasSourceDEMToWrite(const char *pszAtlas, const std::string &osDEM)
 {
-    VSIStatBufL sStat; // (a name of another driver, GTIFF_DIR:1:x.tif, is no file)
-    if (osDEM.empty() || !CPLIsFilenameRelative(osDEM.c_str()) ||
-        VSIStatL(osDEM.c_str(), &sStat) != 0)
+    // (a name of another driver, GTIFF_DIR:1:x.tif, or a virtual path: as
+    // it is; an absolute path given: as it is)
+    if (osDEM.empty() || !CPLIsFilenameRelative(osDEM.c_str()))
         return osDEM;
-    char *pszCwd = CPLGetCurrentDir();
-    if (!pszCwd)
+    const std::string osDEMReal = Physical(osDEM);
+    if (osDEMReal.empty())
         return osDEM;
-    const std::string osCwd = pszCwd;
-    CPLFree(pszCwd);
-    const std::string osAbsDEM = CPLFormFilename(osCwd.c_str(), osDEM.c_str(), nullptr);
-    const std::string osAtlasDir =
-        CPLIsFilenameRelative(pszAtlas)
-            ? std::string(CPLFormFilename(osCwd.c_str(), CPLGetPath(pszAtlas), nullptr))
-            : std::string(CPLGetPath(pszAtlas));
-    // (a Windows path, or one through ./ or ../, would need more: absolute)
-    if (osAbsDEM.find("/./") != std::string::npos || osAbsDEM.find("/../") != std::string::npos ||
-        osAtlasDir.find("/./") != std::string::npos ||
-        osAtlasDir.find("/../") != std::string::npos || osAbsDEM[0] != '/' ||
-        osAtlasDir.empty() || osAtlasDir[0] != '/')
-        return osAbsDEM;
-    return RelativeTo(osAtlasDir, osAbsDEM);
+    // the atlas's folder exists (the atlas is written into it); physical
+    // paths both, so that links, . and .. count as the file system has them
+    const std::string osDirReal = Physical(CPLGetPath(pszAtlas)[0] ? CPLGetPath(pszAtlas) : ".");
+    if (osDirReal.empty() || osDirReal[0] != '/' || osDEMReal[0] != '/')
+        return osDEMReal; // (an atlas on /vsimem/, /vsis3/...: the DEM's absolute path)
+    return RelativeTo(osDirReal, osDEMReal);
 }
 
 std::string CheckAtlasDEM(GDALDataset *poDEM, const std::string &osDEM, bool bGiven, int W,
@@ -150,20 +157,18 @@ std::string CheckAtlasDEM(GDALDataset *poDEM, const std::string &osDEM, bool bGi
     double adfGT[6];
     if (bHasGT && poDEM->GetGeoTransform(adfGT) == CE_None)
     {
-        // the same cells on the ground, rows and columns in either order (a
-        // product of a south-up DEM is north-up)
+        // the same geotransform: a product keeps its DEM's, rows' order
+        // included (a flipped copy would lay the near shadows the other way
+        // up), within a millionth of a cell (rotation terms as
+        // tsd_cells_compute accepts them)
         const double dx = std::fabs(padfGT[1]), dy = std::fabs(padfGT[5]);
-        const double ax[2] = {adfGT[0], adfGT[0] + W * adfGT[1]};
-        const double ay[2] = {adfGT[3], adfGT[3] + H * adfGT[5]};
-        const double bx[2] = {padfGT[0], padfGT[0] + W * padfGT[1]};
-        const double by[2] = {padfGT[3], padfGT[3] + H * padfGT[5]};
         const double tol = 1e-6;
-        const bool bSame =
-            adfGT[2] == 0 && adfGT[4] == 0 &&
-            std::fabs(std::fabs(adfGT[1]) - dx) <= tol * dx &&
-            std::fabs(std::fabs(adfGT[5]) - dy) <= tol * dy &&
-            std::fabs(std::min(ax[0], ax[1]) - std::min(bx[0], bx[1])) <= tol * dx * W &&
-            std::fabs(std::min(ay[0], ay[1]) - std::min(by[0], by[1])) <= tol * dy * H;
+        const bool bSame = std::fabs(adfGT[0] - padfGT[0]) <= tol * dx &&
+                           std::fabs(adfGT[3] - padfGT[3]) <= tol * dy &&
+                           std::fabs(adfGT[1] - padfGT[1]) <= tol * dx &&
+                           std::fabs(adfGT[5] - padfGT[5]) <= tol * dy &&
+                           std::fabs(adfGT[2] - padfGT[2]) <= tol * dx &&
+                           std::fabs(adfGT[4] - padfGT[4]) <= tol * dy;
         if (!bSame)
             return CPLSPrintf("SHADOWS=all: the DEM '%s'%s does not lie where the atlas does "
                               "(its geotransform %.10g, %.10g, %.10g, %.10g, %.10g, %.10g "

@@ -39,19 +39,21 @@ bool IsAtlasFile(const char *pszName);
 std::string AtlasAsDEM(const std::string &osDEM, bool bGiven);
 
 /** The atlas's SOURCE_DEM as the atlas at pszAtlas names it: a relative
- * path is the atlas's folder's (as a VRT's sources are) where a file is
- * there, else as it is. */
+ * path is the atlas's folder's (as a VRT's sources are), given back as the
+ * physical absolute path of the file there, else as it is. */
 std::string AtlasSourceDEM(const char *pszAtlas, const std::string &osDEM);
 
 /** The SOURCE_DEM to write into the atlas at pszAtlas: a relative path of
  * a file (the writer's working directory's) made relative to the atlas's
- * folder, so that the two can move together; anything else as it is. */
+ * folder (physical paths both), so that the two can move together, or
+ * absolute where the atlas is on a GDAL virtual file system; anything else
+ * as it is. */
 std::string AtlasSourceDEMToWrite(const char *pszAtlas, const std::string &osDEM);
 
 /** "" if poDEM (named osDEM, bGiven: by DEM=) can be the DEM of a W x H
  * atlas with that geotransform (if bHasGT) and CRS (if not null): the
- * same size, the same cells on the ground (extent and cell size, whatever
- * the rows' order) and the same CRS; else why not, a sentence. */
+ * same size, the same geotransform (within a millionth of a cell) and the
+ * same CRS; else why not, a sentence. */
 std::string CheckAtlasDEM(GDALDataset *poDEM, const std::string &osDEM, bool bGiven, int W,
                           int H, bool bHasGT, const double *padfGT,
                           const OGRSpatialReference *poSRS);

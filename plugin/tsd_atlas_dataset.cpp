@@ -393,6 +393,10 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
         }
         CPLFree(pszKey);
     }
+    // a relative SOURCE_DEM found beside the atlas: its path from here, so
+    // that a copy of the atlas written elsewhere names the same file
+    if (!poDS->m_bDEMGiven && !poDS->m_osDEM.empty())
+        poDS->GDALDataset::SetMetadataItem("SOURCE_DEM", poDS->m_osDEM.c_str());
     if (bAll)
     {
         // the DEM at open, not at the first read (a QGIS layer opened and

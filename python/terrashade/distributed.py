@@ -158,22 +158,30 @@ def absolute_source(source):
 class Said:
     """The driver's warnings said on stderr, each once: the client's open of
     SOURCE, then the tasks' (windows.read_window returns them), as GDAL's
-    own handler words them."""
+    own handler words them. The tasks open SOURCE with its DEM's path made
+    absolute (absolute_source): their warnings that name it are the same
+    ones once it is named as SOURCE does (same_dem: (theirs, SOURCE's))."""
 
     def __init__(self):
         self.seen = set()
+        self.same_dem = None
 
     def say(self, messages, bar=None):
+        if self.same_dem and self.same_dem[0] != self.same_dem[1]:
+            messages = [(n, m.replace(self.same_dem[0], self.same_dem[1]))
+                        for n, m in messages]
         new = [m for m in messages if m not in self.seen]
         if not new:
             return
         self.seen.update(new)
         if bar is not None:
             bar.interrupt()
-        for number, message in new:
-            sys.stderr.write("Warning %d: %s\n" % (number, message))
-        if bar is not None:
-            bar.resume()
+        try:
+            for number, message in new:
+                sys.stderr.write("Warning %d: %s\n" % (number, message))
+        finally:  # (a broken pipe, Ctrl-C: the bar's stop() must not wait for ever)
+            if bar is not None:
+                bar.resume()
 
 
 SAID = Said()
@@ -459,12 +467,12 @@ def compute(client, watch, out, source, task_options, tile, quiet, run):
             for fut in batch:
                 try:
                     (xoff, yoff, _, _), a, warned = fut.result()
-                    SAID.say(warned, bar)
                 except Exception as e:
                     watch.connected(done, len(wins))  # cancelled with the connection
                     raise Failure("the window (xoff, yoff, xsize, ysize) = %r of %s "
                                   "failed: %s: %s" % (window_of[fut.key], source,
                                                       type(e).__name__, e))
+                SAID.say(warned, bar)  # (its own errors are not the window's)
                 for i in range(out.RasterCount):
                     out.GetRasterBand(i + 1).WriteArray(a[i], xoff, yoff)
                 done += 1
@@ -553,8 +561,10 @@ def run(args):
             task_options.append("THREADS=%d" % threads)
         if "PROGRESS" not in keys:
             task_options.append("PROGRESS=no")  # the Dask bar says it
-        n = compute(client, watch, out, absolute_source(args.source), task_options,
-                    args.tile_size, args.quiet, run_id)
+        tasks_source = absolute_source(args.source)
+        SAID.same_dem = (split_source(tasks_source)[1], split_source(args.source)[1])
+        n = compute(client, watch, out, tasks_source, task_options, args.tile_size,
+                    args.quiet, run_id)
         out.FlushCache()
         out = None
         finish(partial, fmt, args.dest, args.creation_options)

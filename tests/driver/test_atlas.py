@@ -373,8 +373,11 @@ class Atlas(unittest.TestCase):
             T.run(["gdal_translate", "-q", "-of", "TERRASHADE"] + sum(
                 (["-oo", o] for o in oo(DAY)), []) + ["TERRASHADE:dem.tif",
                                                        os.path.join("atlases", "day.tsa")])
+            with open("atlases/day.tsa", "rb") as f:  # the metadata text as stored
+                self.assertIn(b"\nSOURCE_DEM=../dem.tif\n", f.read())
+            # as opened: where that is from here, so that a copy elsewhere finds it
             self.assertEqual(gdal.Open("atlases/day.tsa").GetMetadataItem("SOURCE_DEM"),
-                             "../dem.tif")
+                             os.path.realpath("dem.tif"))
             os.chdir(os.path.join(work, "elsewhere"))
             ds = gdal.OpenEx("../atlases/day.tsa", open_options=["SHADOWS=all"])
             got = ds.GetRasterBand(16).ReadAsArray()
