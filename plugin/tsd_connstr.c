@@ -29,20 +29,29 @@ static int is_item(const char *s, size_t len)
     return i < len && s[i] == '=';
 }
 
-/* Does s[0..len) consist of comma-separated KEY=VALUE items? */
-static int is_option_segment(const char *s, size_t len)
+/* The first of the comma-separated items of s[0..len) that is not
+ * KEY=VALUE: 1 with its offset and length, 0 where every one is. */
+static int bad_item(const char *s, size_t len, size_t *at, size_t *n)
 {
-    if (len == 0)
-        return 0;
     size_t start = 0;
     for (size_t i = 0; i <= len; i++) {
         if (i == len || s[i] == ',') {
-            if (!is_item(s + start, i - start))
-                return 0;
+            if (!is_item(s + start, i - start)) {
+                *at = start;
+                *n = i - start;
+                return 1;
+            }
             start = i + 1;
         }
     }
-    return 1;
+    return 0;
+}
+
+/* Does s[0..len) consist of comma-separated KEY=VALUE items? */
+static int is_option_segment(const char *s, size_t len)
+{
+    size_t at, n;
+    return len > 0 && !bad_item(s, len, &at, &n);
 }
 
 static char *dup_range(const char *s, size_t len)
@@ -156,26 +165,19 @@ void tsd_connstr_segment_hint(const tsd_connstr *c, char *hint, size_t hint_size
         return;
     /* the first item of the would-be segment that is not KEY=VALUE */
     const size_t len = (size_t)(colon - c->dem);
-    size_t start = 0;
-    for (size_t i = 0; i <= len; i++) {
-        if (i < len && c->dem[i] != ',')
-            continue;
-        if (!is_item(c->dem + start, i - start)) {
-            if (i == start)
-                snprintf(hint, hint_size,
-                         "; if '%.*s' was meant as inline options, it has an empty item (a "
-                         "doubled or trailing ','): every item between the commas must be "
-                         "KEY=VALUE",
-                         (int)len, c->dem);
-            else
-                snprintf(hint, hint_size,
-                         "; if '%.*s' was meant as inline options, its item '%.*s' is not "
-                         "KEY=VALUE, as every item between the commas must be",
-                         (int)len, c->dem, (int)(i - start), c->dem + start);
-            return;
-        }
-        start = i + 1;
-    }
+    size_t at, n;
+    if (!bad_item(c->dem, len, &at, &n))
+        return;
+    if (n == 0)
+        snprintf(hint, hint_size,
+                 "; if '%.*s' was meant as inline options, it has an empty item (a doubled or "
+                 "trailing ','): every item between the commas must be KEY=VALUE",
+                 (int)len, c->dem);
+    else
+        snprintf(hint, hint_size,
+                 "; if '%.*s' was meant as inline options, its item '%.*s' is not KEY=VALUE, "
+                 "as every item between the commas must be",
+                 (int)len, c->dem, (int)n, c->dem + at);
 }
 
 const char *tsd_connstr_add_hint(char *msg, size_t msg_size, const char *hint)
