@@ -3,12 +3,11 @@
  * its metadata validated as the options of PRODUCT=farshadow, the source of
  * a new atlas, a DEM that is not an atlas.
  */
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <string>
-
-#include <algorithm>
 #include <cstring>
+#include <string>
 
 #include "cpl_conv.h"
 #include "cpl_string.h"

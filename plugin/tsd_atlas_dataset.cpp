@@ -67,6 +67,8 @@ class TSAtlasDataset final : public GDALPamDataset
     std::string m_osError{};            // why SHADOWS=all failed
     CPLErrorNum m_nErr = CPLE_AppDefined; // and its error number
     GByte *m_pabyNear = nullptr; // near-shadow bits, raster order, one plane per map
+    GDALDataset *m_poDEM = nullptr; // SHADOWS=all: the DEM, opened and checked at open,
+                                    // until EnsureNear has read it
 
     CPLErr EnsureNear();
 
@@ -134,6 +136,8 @@ TSAtlasDataset::~TSAtlasDataset()
     TSAtlasDataset::FlushCache(true);
     ts_atlas_free(m_psAtlas);
     VSIFree(m_pabyNear);
+    if (m_poDEM)
+        GDALClose(m_poDEM);
 }
 
 CPLErr TSAtlasBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
@@ -179,7 +183,7 @@ CPLErr TSAtlasDataset::EnsureNear()
         const ts_atlas_info *psInfo = ts_atlas_get_info(m_psAtlas);
         const int W = psInfo->width, H = psInfo->height;
         char szMsg[1024] = "";
-        GDALDataset *poDEM = nullptr;
+        GDALDataset *poDEM = m_poDEM; // (opened, its size and ground checked, at open)
         tsd_cells sCells{};
         ts_grid sGrid{};
         bool bGrid = false;
@@ -197,17 +201,8 @@ CPLErr TSAtlasDataset::EnsureNear()
         if (!(std::isfinite(psInfo->threshold_m) && psInfo->threshold_m > 0))
             m_osError = "SHADOWS=all needs the atlas's far threshold in "
                         "metres, which this atlas does not record";
-        else if (!(poDEM = GDALDataset::Open(m_osDEM.c_str(),
-                                             GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR)))
-            m_osError = CPLSPrintf("SHADOWS=all cannot open the DEM '%s' "
-                                   "(give it with the open option DEM=...)",
-                                   m_osDEM.c_str());
         else if (dynamic_cast<TSAtlasDataset *>(poDEM))
             m_osError = AtlasAsDEM(m_osDEM, m_bDEMGiven);
-        else if (poDEM->GetRasterXSize() != W || poDEM->GetRasterYSize() != H)
-            m_osError = CPLSPrintf("SHADOWS=all: the DEM '%s' (%d x %d) does "
-                                   "not match the %d x %d atlas", m_osDEM.c_str(),
-                                   poDEM->GetRasterXSize(), poDEM->GetRasterYSize(), W, H);
         else if (nBandDEM > poDEM->GetRasterCount())
             m_osError = CPLSPrintf("SHADOWS=all: the atlas's metadata says BAND=%d, but the "
                                    "DEM '%s' has %d band(s)", nBandDEM, m_osDEM.c_str(),
@@ -279,8 +274,9 @@ CPLErr TSAtlasDataset::EnsureNear()
         if (bGrid)
             ts_grid_free(&sGrid);
         tsd_cells_free(&sCells);
-        if (poDEM)
-            GDALClose(poDEM);
+        if (m_poDEM) // read: its handle is not kept
+            GDALClose(m_poDEM);
+        m_poDEM = nullptr;
         if (!m_osError.empty())
         {
             VSIFree(m_pabyNear);
@@ -402,15 +398,15 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
         // the DEM at open, not at the first read (a QGIS layer opened and
         // then failed block by block), and the same ground as the atlas (a
         // copy moved or reprojected, of the same size, was taken)
-        std::unique_ptr<GDALDataset> poDEM(GDALDataset::Open(
-            poDS->m_osDEM.c_str(), GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR));
-        if (!poDEM)
+        poDS->m_poDEM =
+            GDALDataset::Open(poDS->m_osDEM.c_str(), GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR);
+        if (!poDS->m_poDEM)
             return FailOpen(CPLE_OpenFailed,
                             CPLSPrintf("SHADOWS=all cannot open the DEM '%s'%s (give it with "
                                        "the open option DEM=...)", poDS->m_osDEM.c_str(),
                                        poDS->m_bDEMGiven ? "" : " (the atlas's SOURCE_DEM)"));
         const std::string osWhy = CheckAtlasDEM(
-            poDEM.get(), poDS->m_osDEM, poDS->m_bDEMGiven, psInfo->width, psInfo->height,
+            poDS->m_poDEM, poDS->m_osDEM, poDS->m_bDEMGiven, psInfo->width, psInfo->height,
             poDS->m_bHasGT, poDS->m_adfGT, poDS->m_oSRS.IsEmpty() ? nullptr : &poDS->m_oSRS);
         if (!osWhy.empty())
             return FailOpen(TS_ERR_ARG, osWhy.c_str());
