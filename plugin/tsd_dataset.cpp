@@ -353,12 +353,6 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
         return FailOpen(TS_ERR_ARG, tsd_connstr_add_hint(szMsg, sizeof szMsg, szCut));
     poDS->m_psProduct = tsd_product_of(&sOpts);
 
-    if (IsAtlasFile(osDEM.c_str())) // (its 0/1 maps were taken as heights)
-        return FailOpen(TS_ERR_ARG,
-                        CPLSPrintf("the DEM '%s' is a far-shadow atlas (.tsa), not a DEM: open "
-                                   "it as it is (%s, its far shadows; -oo SHADOWS=all with "
-                                   "the near ones), or name the DEM it was made from",
-                                   osDEM.c_str(), osDEM.c_str()));
     GDALDataset *poDEM = OpenDEM(osDEM.c_str());
     if (!poDEM)
     {
@@ -368,6 +362,15 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     }
     poDS->m_poDEM = poDEM;
     poDS->m_osDEM = osDEM;
+    // an atlas, which this driver opens (its 0/1 maps were taken as heights);
+    // its file read only then, not for every DEM
+    if (poDEM->GetDriver() && EQUAL(poDEM->GetDriver()->GetDescription(), DRIVER) &&
+        IsAtlasFile(osDEM.c_str()))
+        return FailOpen(TS_ERR_ARG,
+                        CPLSPrintf("the DEM '%s' is a far-shadow atlas (.tsa), not a DEM: open "
+                                   "it as it is (%s, its far shadows; -oo SHADOWS=all with "
+                                   "the near ones), or name the DEM it was made from",
+                                   osDEM.c_str(), osDEM.c_str()));
     if (sOpts.band > poDEM->GetRasterCount())
         return FailOpen(TS_ERR_ARG,
                              CPLSPrintf("BAND=%d, but the DEM '%s' has %d band(s)",
@@ -460,7 +463,7 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
                                   sizeof szMsg))
         CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szMsg);
     if (m_nLevel == 0)
-        WarnShortDistance(dfMinCell, W, H);
+        WarnDistances(dfMinCell, W, H);
     double dfHeadroom = 0;
     if (!SetupWindow(W, H) ||
         !CheckMemory(sOpts, W, H, WindowPlan(m_poWindow), m_bHasSun ? &m_sSun : nullptr,
