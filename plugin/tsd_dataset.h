@@ -100,7 +100,7 @@ class TSDataset final : public GDALPamDataset
                        int nBW, int nBH, bool bByte);
     bool Setup(const char *pszConnection, int W, int H);
     void WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfLon, double dfLat);
-    void WarnShortDistance(double dfMinCell, int W, int H);
+    void WarnDistances(double dfMinCell, int W, int H);
     static GDALDataset *OpenDEM(const char *pszDEM);
     ts_status LoadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg);
     void StartReadAhead();

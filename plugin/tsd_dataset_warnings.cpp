@@ -83,14 +83,15 @@ void WarnHeightUnit(const tsd_cells &sCells, const OGRSpatialReference &oSRS,
              osDEM.c_str());
 }
 
-/* A MAX_DISTANCE shorter than the DEM's cells (dfCell: its smallest side)
+/* Distances that likely do not say what was meant. A MAX_DISTANCE shorter
+ * than the DEM's cells (dfCell: its smallest side)
  * holds no terrain: no shadow, no horizon above the cell's own slope. Most
  * often a distance meant in cells (RVT's radius is in pixels) or
  * kilometres. And METHOD=shm's shadow height map follows every occluder to
  * the DEM's edge: MAX_DISTANCE bounds its sky term and EDGE=nodata's reach
  * only (it shadowed a cell from 150 m away at MAX_DISTANCE=10 m, without a
  * word, until session 46). */
-void TSDataset::WarnShortDistance(double dfCell, int W, int H)
+void TSDataset::WarnDistances(double dfCell, int W, int H)
 {
     // PRODUCT=farshadow: a FAR_THRESHOLD as long as the DEM's longer side
     // (the default 512 on a smaller DEM) leaves the maps empty, but for

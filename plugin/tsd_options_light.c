@@ -2,7 +2,7 @@
  * METHOD=shadowmap's auto filter), METHOD=shm's and METHOD=shadowmap's own
  * options, and the combinations where they make no sense. (METHOD=shm with
  * MAX_DISTANCE bounds its sky term and EDGE=nodata's reach, not its
- * shadows: a warning, TSDataset::WarnShortDistance.) */
+ * shadows: a warning, TSDataset::WarnDistances.) */
 #include "tsd_options_light.h"
 
 #include <math.h>
