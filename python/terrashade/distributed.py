@@ -174,14 +174,9 @@ class Said:
         if not new:
             return
         self.seen.update(new)
-        if bar is not None:
-            bar.interrupt()
-        try:
+        with bar.paused() if bar is not None else contextlib.nullcontext():
             for number, message in new:
                 sys.stderr.write("Warning %d: %s\n" % (number, message))
-        finally:  # (a broken pipe, Ctrl-C: the bar's stop() must not wait for ever)
-            if bar is not None:
-                bar.resume()
 
 
 SAID = Said()
@@ -426,15 +421,16 @@ class ProgressBar:
         finally:
             self.ready.set()
 
-    def interrupt(self):
-        """Until resume(): no drawing, and a drawn bar's line ended, so that
-        a message starts a line of its own (the next draw redraws it)."""
-        self.lock.acquire()
-        if self.drawn and not self.stopped:
-            sys.stderr.write("\n")
-
-    def resume(self):
-        self.lock.release()
+    @contextlib.contextmanager
+    def paused(self):
+        """Within it: no drawing, and a drawn bar's line ended, so that a
+        message starts a line of its own (the next draw redraws it). The
+        lock is released however the block ends (a broken pipe, Ctrl-C:
+        stop() must not wait for ever)."""
+        with self.lock:
+            if self.drawn and not self.stopped:
+                sys.stderr.write("\n")
+            yield
 
     def stop(self):
         """No more drawing; a drawn bar's line is ended, so that the reason
