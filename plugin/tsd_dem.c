@@ -2,6 +2,7 @@
 #include "tsd_dem.h"
 
 #include "tsd_dem_check.h"
+#include "tsd_dem_valid.h"
 #include "tsd_text.h"
 
 #include <math.h>
@@ -221,9 +222,11 @@ static ts_status checked_and_flipped(GDALRasterBandH band, const tsd_dem_convers
     return TS_OK;
 }
 
-ts_status tsd_dem_load_window(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
-                              int x0, int y0, int w, int h, ts_grid *grid, char *msg,
-                              size_t n)
+/* The loads read heights and mask from `src` (tsd_dem_valid_band of
+ * `band`), and take everything else from `band`. */
+static ts_status load_window(GDALRasterBandH band, GDALRasterBandH src, const tsd_cells *cells,
+                             double z_factor, int x0, int y0, int w, int h, ts_grid *grid,
+                             char *msg, size_t n)
 {
     const int W = GDALGetRasterBandXSize(band), H = GDALGetRasterBandYSize(band);
     ts_status st = grid_of(cells, w, h, y0, grid, msg, n);
@@ -232,14 +235,13 @@ ts_status tsd_dem_load_window(GDALRasterBandH band, const tsd_cells *cells, doub
     const tsd_dem_conversion c = conversion_of(band, z_factor);
     /* the grid's window in the band's own orientation */
     const int rx = cells->flip_x ? W - x0 - w : x0, ry = cells->flip_y ? H - y0 - h : y0;
-    GDALRasterBandH mask =
-        GDALGetMaskFlags(band) == GMF_ALL_VALID ? NULL : GDALGetMaskBand(band);
+    GDALRasterBandH mask = GDALGetMaskFlags(src) == GMF_ALL_VALID ? NULL : GDALGetMaskBand(src);
     unsigned char *m = mask ? malloc((size_t)w * h) : NULL;
     if (mask && !m) {
         ts_grid_free(grid);
         return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory reading the DEM's mask");
     }
-    if (GDALRasterIO(band, GF_Read, rx, ry, w, h, grid->z, w, h, GDT_Float32, 0,
+    if (GDALRasterIO(src, GF_Read, rx, ry, w, h, grid->z, w, h, GDT_Float32, 0,
                      (int)(grid->stride * sizeof(float))) != CE_None ||
         (mask && GDALRasterIO(mask, GF_Read, rx, ry, w, h, m, w, h, GDT_Byte, 0, w) != CE_None))
         return read_failed(grid, m, msg, n);
@@ -252,17 +254,17 @@ ts_status tsd_dem_load_window(GDALRasterBandH band, const tsd_cells *cells, doub
     return checked_and_flipped(band, &c, cells, grid, &seen, &p, msg, n);
 }
 
-ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
-                                 double z_factor, int w, int h, ts_grid *grid, char *msg,
-                                 size_t n)
+static ts_status load_resampled(GDALRasterBandH band, GDALRasterBandH src,
+                                const tsd_cells *cells, double z_factor, int w, int h,
+                                ts_grid *grid, char *msg, size_t n)
 {
     ts_status st = grid_of(cells, w, h, 0, grid, msg, n);
     if (st != TS_OK)
         return st;
     const tsd_dem_conversion c = conversion_of(band, z_factor);
 
-    int all_valid = GDALGetMaskFlags(band) == GMF_ALL_VALID || nodata_in_values(band, w, h);
-    GDALRasterBandH mask = all_valid ? NULL : GDALGetMaskBand(band);
+    int all_valid = GDALGetMaskFlags(src) == GMF_ALL_VALID || nodata_in_values(src, w, h);
+    GDALRasterBandH mask = all_valid ? NULL : GDALGetMaskBand(src);
     unsigned char *m = NULL;
     /* resampled: one request for the whole grid, as gdal_translate -outsize
      * makes for a level of this size (where a request's edge falls changes
@@ -277,7 +279,7 @@ ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
     for (int y0 = 0; y0 < h; y0 += strip) {
         int rows = h - y0 < strip ? h - y0 : strip;
         float *z = grid->z + (ptrdiff_t)y0 * grid->stride;
-        if (read_rows(band, y0, rows, w, h, z, grid->stride, GDT_Float32) != CE_None ||
+        if (read_rows(src, y0, rows, w, h, z, grid->stride, GDT_Float32) != CE_None ||
             (mask && read_rows(mask, y0, rows, w, h, m, w, GDT_Byte) != CE_None))
             return read_failed(grid, m, msg, n);
         for (int y = 0; y < rows; y++)
@@ -288,6 +290,30 @@ ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
     const tsd_dem_placement p = {0, 0, (double)GDALGetRasterBandXSize(band) / w,
                                  (double)GDALGetRasterBandYSize(band) / h};
     return checked_and_flipped(band, &c, cells, grid, &seen, &p, msg, n);
+}
+
+ts_status tsd_dem_load_window(GDALRasterBandH band, const tsd_cells *cells, double z_factor,
+                              int x0, int y0, int w, int h, ts_grid *grid, char *msg,
+                              size_t n)
+{
+    GDALRasterBandH src = tsd_dem_valid_band(band);
+    if (!src)
+        return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory reading the DEM's mask");
+    ts_status st = load_window(band, src, cells, z_factor, x0, y0, w, h, grid, msg, n);
+    tsd_dem_valid_release(band, src);
+    return st;
+}
+
+ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
+                                 double z_factor, int w, int h, ts_grid *grid, char *msg,
+                                 size_t n)
+{
+    GDALRasterBandH src = tsd_dem_valid_band(band);
+    if (!src)
+        return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory reading the DEM's mask");
+    ts_status st = load_resampled(band, src, cells, z_factor, w, h, grid, msg, n);
+    tsd_dem_valid_release(band, src);
+    return st;
 }
 
 /* Metres per unit of a unit's name (GDAL's band unit types, PROJ's and

@@ -1,7 +1,8 @@
 /*
  * tsd_dem.h - read a DEM band through GDAL's C API into a core grid:
- * float metres, NaN where the band's mask (nodata, alpha, mask band) says
- * invalid, scale/offset and Z_FACTOR applied, flipped to row 0 = north.
+ * float metres, NaN where any validity the DEM declares (nodata, mask
+ * band, alpha: tsd_dem_valid.h) says invalid, scale/offset and Z_FACTOR
+ * applied, flipped to row 0 = north.
  * Every load refuses what no terrain holds (tsd_dem_check.h: heights beyond
  * the Earth's, cliffs between neighbours, most often an undeclared nodata
  * value) with TS_ERR_ARG and a sentence naming the cell and the remedy.
@@ -33,7 +34,8 @@ ts_status tsd_dem_load(GDALRasterBandH band, const tsd_cells *cells, double z_fa
 
 /** The same at w x h cells (an overview level): each coarse cell is the
  * average of the valid cells under it (GDAL's average resampling through
- * RasterIO, which uses the band's own overviews where it has them); a
+ * RasterIO, which uses the band's own overviews where it has them, but
+ * not where tsd_dem_valid_band adds to GDAL's mask); a
  * coarse cell none of whose cells is valid is NaN. `cells` are those of
  * the w x h grid. At the band's own size, tsd_dem_load. */
 ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,

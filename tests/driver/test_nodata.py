@@ -113,6 +113,86 @@ class Nodata(unittest.TestCase):
                         self.assertLessEqual(p.stderr.count("Warning"), warnings, p.stderr)
                         np.testing.assert_array_equal(T.read(out, 1), expected)
 
+    def test_every_validity_the_dem_declares(self):
+        """A nodata value beside a mask band, an alpha band beside a nodata
+        value, and a Float32 or Int16 alpha band (gdalwarp -dstalpha), none
+        of which GDAL's one mask combines: every invalid cell is nodata, as
+        on the same DEM with NaN there (whole and windowed), and an
+        overview level has no wall where the voids' zeros would stand."""
+        z = T.fractal_dem(120, seed=3) + 500
+        hole_nd, hole_m = np.zeros(z.shape, bool), np.zeros(z.shape, bool)
+        hole_nd[20:30, 30:40] = True
+        hole_m[70:80, 5:15] = True
+        gdal.SetConfigOption("GDAL_TIFF_INTERNAL_MASK", "YES")
+        try:
+            with T.TempDir() as tmp:
+                def dem(name, dtype, alpha_type=None, internal_mask=False):
+                    """z with nodata 0 in hole_nd, and 1 in hole_m, which
+                    the mask band or the alpha band marks."""
+                    path = os.path.join(tmp, name)
+                    bands = 2 if alpha_type else 1
+                    ds = gdal.GetDriverByName("GTiff").Create(
+                        path, z.shape[1], z.shape[0], bands, dtype)
+                    ds.SetGeoTransform(GT)
+                    ds.SetProjection(gdal.Open(ref).GetProjection())
+                    rb = ds.GetRasterBand(1)
+                    rb.WriteArray(np.where(hole_nd, 0, np.where(hole_m, 1, np.round(z))))
+                    rb.SetNoDataValue(0)
+                    if alpha_type:
+                        ab = ds.GetRasterBand(2)
+                        ab.SetColorInterpretation(gdal.GCI_AlphaBand)
+                        ab.WriteArray(np.where(hole_m, 0, 255))
+                    if internal_mask:
+                        ds.CreateMaskBand(gdal.GMF_PER_DATASET)
+                        rb.GetMaskBand().WriteArray(np.where(hole_m, 0, 255).astype(np.uint8))
+                    ds = None
+                    return path
+                ref = T.write_tif(os.path.join(tmp, "ref.tif"),
+                                  np.where(hole_nd | hole_m, np.nan, np.round(z)), GT, 32617)
+                cases = {
+                    "nodata and a mask band": dem("m.tif", gdal.GDT_Float32,
+                                                  internal_mask=True),
+                    "nodata and a Byte alpha": dem("a8.tif", gdal.GDT_Byte, gdal.GDT_Byte),
+                    "nodata and a Float32 alpha": dem("af.tif", gdal.GDT_Float32,
+                                                      gdal.GDT_Float32),
+                    "nodata and an Int16 alpha": dem("ai.tif", gdal.GDT_Int16, gdal.GDT_Int16),
+                }
+                for name, path in cases.items():
+                    if "Byte" in name:  # heights within a Byte: the reference too
+                        zb = np.where(hole_nd | hole_m, np.nan, np.clip(np.round(z), 0, 255))
+                        ref_p = T.write_tif(os.path.join(tmp, "ref8.tif"), zb, GT, 32617)
+                    else:
+                        ref_p = ref
+                    for tile in (0, 64):
+                        with self.subTest(case=name, tile=tile):
+                            opts = dict(PRODUCT="svf", DIRECTIONS=8, TILE_SIZE=tile)
+                            got = T.read(T.conn(path, **opts), 1)
+                            want = T.read(T.conn(ref_p, **opts), 1)
+                            np.testing.assert_array_equal(np.isnan(got), hole_nd | hole_m)
+                            np.testing.assert_array_equal(got, want)
+                # a warped DEM's alpha collar is nodata at every level, as
+                # the same warp's NaN collar is
+                big = T.write_tif(os.path.join(tmp, "big.tif"), T.fractal_dem(600) + 800,
+                                  GT, 32617)
+                alpha, nan = os.path.join(tmp, "alpha.tif"), os.path.join(tmp, "nan.tif")
+                gdal.Warp(alpha, big, dstSRS="EPSG:32615", dstAlpha=True)
+                gdal.Warp(nan, big, dstSRS="EPSG:32615", dstNodata=float("nan"))
+                wds = gdal.Open(alpha)
+                collar = wds.GetRasterBand(2).ReadAsArray() == 0
+                self.assertTrue(collar.any())
+                da = gdal.OpenEx(T.conn(alpha), open_options=["PRODUCT=svf", "DIRECTIONS=8"])
+                dn = gdal.OpenEx(T.conn(nan), open_options=["PRODUCT=svf", "DIRECTIONS=8"])
+                ra, rn = da.GetRasterBand(1), dn.GetRasterBand(1)
+                np.testing.assert_array_equal(np.isnan(ra.ReadAsArray()), collar)
+                self.assertGreater(ra.GetOverviewCount(), 0)
+                for i in range(ra.GetOverviewCount()):
+                    a, n = ra.GetOverview(i).ReadAsArray(), rn.GetOverview(i).ReadAsArray()
+                    print("level %d: alpha %d NaN, NaN collar %d NaN, max |diff| %.3g" % (
+                        i + 1, np.isnan(a).sum(), np.isnan(n).sum(), np.nanmax(abs(a - n))))
+                    np.testing.assert_allclose(a, n, atol=1e-4)
+        finally:
+            gdal.SetConfigOption("GDAL_TIFF_INTERNAL_MASK", None)
+
     def test_all_nodata(self):
         with T.TempDir() as tmp:
             dem = T.write_tif(os.path.join(tmp, "empty.tif"),
