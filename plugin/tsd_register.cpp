@@ -6,8 +6,10 @@
  * connection strings to a product of a DEM (tsd_dataset.cpp), files with
  * the atlas magic to a far-shadow atlas (tsd_atlas_dataset.cpp).
  */
+#include <cerrno>
 #include <cstdlib>
 
+#include "cpl_string.h"
 #include "gdal_priv.h"
 
 #include "tsd_connstr.h"
@@ -30,6 +32,64 @@ GDALDataset *OpenAny(GDALOpenInfo *poOpenInfo)
     if (!tsd::IdentifyAtlas(poOpenInfo))
         return nullptr;
     return tsd::OpenAtlas(poOpenInfo);
+}
+
+/* Delete, rename and copy. A connection string names a product computed
+ * from a DEM, not a file; GDAL's default (the files of the opened dataset,
+ * which are the DEM's for the auxiliary file's sake) would delete, move or
+ * copy the DEM itself, even through QuietDelete when a write is pointed at
+ * a connection string. So they are refused; an atlas is a file of its own,
+ * handled as GDAL's default handles it. */
+bool IsConnection(const char *pszName)
+{
+    return STARTS_WITH_CI(pszName, TSD_PREFIX);
+}
+
+CPLErr RefuseConnection(const char *pszWhat, const char *pszName)
+{
+    CPLError(CE_Failure, CPLE_NotSupported,
+             "TERRASHADE: cannot %s '%s': a connection string names a product computed "
+             "from a DEM, not a file of its own; the DEM is left as it is (%s it by its "
+             "own name if that is what you mean)",
+             pszWhat, pszName, pszWhat);
+    return CE_Failure;
+}
+
+CPLErr DeleteAny(const char *pszName)
+{
+    if (IsConnection(pszName))
+        return RefuseConnection("delete", pszName);
+    const char *const apszDrivers[] = {tsd::DRIVER, nullptr};
+    GDALDatasetH hDS = GDALOpenEx(pszName, GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR, apszDrivers,
+                                  nullptr, nullptr);
+    if (!hDS)
+        return CE_Failure;
+    char **papszFiles = GDALGetFileList(hDS);
+    GDALClose(hDS);
+    CPLErr eErr = CE_None;
+    for (int i = 0; papszFiles && papszFiles[i]; i++)
+        if (VSIUnlink(papszFiles[i]) != 0)
+        {
+            CPLError(CE_Failure, CPLE_AppDefined, "TERRASHADE: cannot delete '%s': %s",
+                     papszFiles[i], VSIStrerror(errno));
+            eErr = CE_Failure;
+        }
+    CSLDestroy(papszFiles);
+    return eErr;
+}
+
+CPLErr RenameAny(const char *pszNewName, const char *pszOldName)
+{
+    if (IsConnection(pszOldName) || IsConnection(pszNewName))
+        return RefuseConnection("rename", IsConnection(pszOldName) ? pszOldName : pszNewName);
+    return GDALDriver::DefaultRename(pszNewName, pszOldName);
+}
+
+CPLErr CopyFilesAny(const char *pszNewName, const char *pszOldName)
+{
+    if (IsConnection(pszOldName) || IsConnection(pszNewName))
+        return RefuseConnection("copy", IsConnection(pszOldName) ? pszOldName : pszNewName);
+    return GDALDriver::DefaultCopyFiles(pszNewName, pszOldName);
 }
 
 /* Set a driver item to a malloc'ed string (NULL: out of memory, not set). */
@@ -68,5 +128,8 @@ void GDALRegister_TERRASHADE()
     poDriver->pfnIdentify = IdentifyAny;
     poDriver->pfnOpen = OpenAny;
     poDriver->pfnCreateCopy = tsd::CreateAtlasCopy;
+    poDriver->pfnDelete = DeleteAny;
+    poDriver->pfnRename = RenameAny;
+    poDriver->pfnCopyFiles = CopyFilesAny;
     GetGDALDriverManager()->RegisterDriver(poDriver);
 }

@@ -2,6 +2,7 @@
 through gdal_translate, gdalinfo and Python."""
 import os
 import re
+import shutil
 import tempfile
 import unittest
 
@@ -161,6 +162,52 @@ class Errors(unittest.TestCase):
         with self.assertRaises(RuntimeError) as e:
             gdal.Open(T.conn(DEM), gdal.GA_Update)
         self.assertIn("read-only", str(e.exception))
+
+    def test_connection_strings_are_not_files(self):
+        """Delete, rename and copy of a connection string, and writes aimed
+        at one (GDAL deletes what a write would overwrite), are refused and
+        leave the DEM and its .aux.xml alone; an atlas is still a file."""
+        with T.TempDir() as tmp:
+            dem = os.path.join(tmp, "dem.tif")
+            shutil.copy(T.JACKSBORO, dem)
+            T.run(["gdalinfo", "-stats", dem])  # writes dem.tif.aux.xml
+            src = shutil.copy(T.JACKSBORO, os.path.join(tmp, "src.tif"))
+            files = {f: open(f, "rb").read() for f in (dem, dem + ".aux.xml")}
+
+            def untouched():
+                for f, data in files.items():
+                    self.assertTrue(os.path.exists(f), f)
+                    with open(f, "rb") as h:
+                        self.assertEqual(h.read(), data, f)
+
+            name = "TERRASHADE:" + dem
+            for verb, cmd in (("delete", ["gdalmanage", "delete", name]),
+                              ("rename", ["gdalmanage", "rename", name,
+                                          os.path.join(tmp, "moved.tif")]),
+                              ("copy", ["gdalmanage", "copy", name,
+                                        os.path.join(tmp, "copied.tif")]),
+                              ("delete", ["gdal_translate", "-q", src, name]),
+                              ("delete", ["gdal_translate", "-q", src,
+                                          "TERRASHADE:PRODUCT=svf:" + dem])):
+                with self.subTest(cmd=cmd):
+                    # (gdalmanage says the error but exits 0)
+                    p = T.run(cmd, ok=None if cmd[0] == "gdalmanage" else False, cwd=tmp)
+                    self.assertIn("cannot %s '" % verb, p.stderr)
+                    self.assertIn("the DEM is left as it is", p.stderr)
+                    untouched()
+            with self.assertRaises(RuntimeError):
+                gdal.GetDriverByName("TERRASHADE").Delete(name)
+            untouched()
+            # an atlas is deleted as a file, and overwritten
+            tsa = os.path.join(tmp, "day.tsa")
+            far = ["-oo", "PRODUCT=farshadow", "-oo", "DATE=2026-06-21",
+                   "-oo", "TIMEZONE=-06:00", "-oo", "STEP_MINUTES=120"]
+            for _ in range(2):
+                T.run(["gdal_translate", "-q", "-of", "TERRASHADE"] + far + [name, tsa])
+                self.assertEqual(gdal.IdentifyDriver(tsa).ShortName, "TERRASHADE")
+            T.run(["gdalmanage", "delete", tsa])
+            self.assertFalse(os.path.exists(tsa))
+            untouched()
 
     def test_memory_limit_is_a_clear_error(self):
         """A product too large for the limit: refused at open, not a crash."""

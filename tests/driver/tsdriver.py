@@ -48,7 +48,8 @@ def env(**extra):
 
 
 def run(args, ok=True, cwd=None, **extra_env):
-    """Run a command; check its exit status is 0 (ok=True) or not 0.
+    """Run a command; check its exit status is 0 (ok=True) or not 0
+    (ok=False), or either (ok=None: gdalmanage exits 0 on errors).
 
     Returns the CompletedProcess with .stdout/.stderr as text. A process
     killed by a signal (a crash) always fails the test."""
@@ -59,7 +60,7 @@ def run(args, ok=True, cwd=None, **extra_env):
         raise AssertionError("crashed with signal %d:\n%s" % (-p.returncode, out))
     if ok and p.returncode != 0:
         raise AssertionError("failed (exit %d):\n%s" % (p.returncode, out))
-    if not ok and p.returncode == 0:
+    if ok is False and p.returncode == 0:
         raise AssertionError("succeeded but should have failed:\n%s" % out)
     return p
 
