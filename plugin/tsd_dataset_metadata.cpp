@@ -8,6 +8,8 @@
 #include <cstring>
 #include <string>
 
+#include <vector>
+
 #include "cpl_conv.h"
 #include "cpl_string.h"
 
@@ -87,7 +89,7 @@ bool TSDataset::ReportBackend(bool bMayWarn)
 
 void TSDataset::SetupMetadata()
 {
-    char szValue[128];
+    char szValue[TSD_PATH_MAX]; // ENV_MAP's whole path
     const int nBands = GetRasterCount();
     for (int i = 0; i < tsd_options_count(); i++)
     {
@@ -233,7 +235,7 @@ void TSDataset::SetupPam(const char *pszConnection)
 {
     SetDescription(pszConnection);
     char **papszFiles = m_poDEM->GetFileList();
-    char szCanon[1024];
+    std::vector<char> achCanon(4 * TSD_PATH_MAX); // ENV_MAP's whole path and the rest
     // The key names the sun used (placed by DATETIME, if given), as it
     // always has, so that earlier .aux.xml entries are found again.
     tsd_options sKey = m_sOpts;
@@ -241,9 +243,9 @@ void TSDataset::SetupPam(const char *pszConnection)
     sKey.sun_elevation = m_sRun.sun_elevation;
     sKey.step_minutes = tsd_options_step_minutes(&m_sOpts); // a range's 30 when not given
     if (papszFiles && papszFiles[0] &&
-        tsd_options_canonical(&sKey, szCanon, sizeof szCanon) == 0)
+        tsd_options_canonical(&sKey, achCanon.data(), achCanon.size()) == 0)
     {
-        std::string osSub = std::string(DRIVER) + ":" + szCanon;
+        std::string osSub = std::string(DRIVER) + ":" + achCanon.data();
         if (m_osDEM != papszFiles[0])
             osSub += ":" + m_osDEM;
         SetPhysicalFilename(papszFiles[0]);

@@ -206,7 +206,8 @@ const char *tsd_option_default(int i);
 
 /**
  * The value of option i in `o` written to buf ("315", "YES", "shade"...;
- * OUTPUT_TYPE: the type written, Byte or Float32). Returns the option's
+ * OUTPUT_TYPE: the type written, Byte or Float32), cut to buf_size (a
+ * path option's whole value needs TSD_PATH_MAX). Returns the option's
  * name, NULL past the end.
  */
 const char *tsd_options_value(const tsd_options *o, int i, char *buf,
@@ -221,7 +222,10 @@ char *tsd_options_xml(void);
 /**
  * A canonical, comma-separated "KEY=VALUE,..." string of all the options
  * that change the product's pixels (not THREADS, MAX_MEMORY or BACKEND), in table
- * order. Returns 0, or -1 if buf is too small.
+ * order, every value whole (the key of a product's auxiliary-file entry:
+ * two ENV_MAP paths alike in their first hundred characters are two
+ * keys); 4 * TSD_PATH_MAX bytes always suffice. Returns 0, or -1 if buf is
+ * too small.
  */
 int tsd_options_canonical(const tsd_options *o, char *buf, size_t buf_size);
 

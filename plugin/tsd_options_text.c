@@ -86,7 +86,7 @@ int tsd_options_canonical(const tsd_options *o, char *buf, size_t n)
     size_t used = 0;
     buf[0] = '\0';
     for (int i = 0; i < TSD_OPTION_COUNT; i++) {
-        char value[64];
+        char value[TSD_PATH_MAX]; /* a path's whole length: the key must tell maps apart */
         if (!TSD_OPTION_ROWS[i].affects_pixels)
             continue;
         const char *name = tsd_options_value(o, i, value, sizeof value);

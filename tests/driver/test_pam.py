@@ -151,6 +151,32 @@ class Pam(unittest.TestCase):
         # 16 directions, not 4: another entry
         self.assertEqual(self.band_says(T.conn(self.dem, PRODUCT="svf"))[:2], ("nan", ""))
 
+    def test_long_env_map_paths_are_two_entries(self):
+        """Two ENV_MAP paths alike in their first 120 characters: two
+        entries, each with its own statistics and nodata, and the whole
+        path in the key and the metadata."""
+        maps = os.path.join(self.tmp.path, "environment-maps-" + "x" * 100)
+        os.makedirs(maps)
+        paths = [shutil.copy(os.path.join(T.DATA, "envmaps", f), maps)
+                 for f in ("city.exr", "forest.exr")]
+        conns = [T.conn(self.dem, PRODUCT="envlight", ENV_MAP=p) for p in paths]
+        means = []
+        for c in conns:
+            T.run(["gdalinfo", "-stats", c], cwd=self.cwd)
+            ds = gdal.Open(c)
+            means.append(float(ds.GetRasterBand(1).GetMetadataItem("STATISTICS_MEAN")))
+            self.assertEqual(ds.GetMetadataItem("ENV_MAP"), paths[len(means) - 1])
+            ds = None
+        print("envlight means (city, forest):", means)
+        self.assertNotAlmostEqual(means[0], means[1], 3)
+        T.run(["gdal_edit.py", "-ro", "-a_nodata", "-1", conns[0]], cwd=self.cwd)
+        self.assertEqual(self.band_says(conns[0])[0], -1.0)
+        self.assertEqual(self.band_says(conns[1])[0], "nan")
+        subs = [s.get("name") for s in
+                ET.parse(self.dem + ".aux.xml").getroot().iter("Subdataset")]
+        for p in paths:
+            self.assertTrue(any("ENV_MAP=" + p in s for s in subs), (p, subs))
+
     def test_atlas(self):
         """An atlas's band: the user's nodata and colour, kept in the
         atlas's .aux.xml."""

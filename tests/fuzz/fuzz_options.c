@@ -44,9 +44,9 @@ static void check_applied(const tsd_options *o)
             fuzz_require(isfinite(x), "an accepted number is not finite");
     }
     fuzz_require(tsd_options_band_count(o) >= 1, "an accepted product has no band");
-    char canon[4096];
+    static char canon[4 * TSD_PATH_MAX];
     fuzz_require(tsd_options_canonical(o, canon, sizeof canon) == 0,
-                 "the canonical string does not fit 4096 bytes");
+                 "the canonical string does not fit 4 * TSD_PATH_MAX bytes");
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
