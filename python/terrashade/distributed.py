@@ -33,8 +33,6 @@ except ImportError as _e:  # a Python without GDAL's bindings: a sentence, not a
 
 from terrashade import windows as W  # noqa: E402 (after the check above)
 
-gdal.UseExceptions()
-
 PROG = "terrashade.distributed"
 TILE_MIN, TILE_MAX = 16, 65536
 LOST = 3  # exit status: the cluster was lost during the run; run it again
@@ -163,6 +161,10 @@ class Said:
     ones once it is named as SOURCE does (same_dem: (theirs, SOURCE's))."""
 
     def __init__(self):
+        self.reset()
+
+    def reset(self):
+        """A new run says its warnings again."""
         self.seen = set()
         self.same_dem = None
 
@@ -597,11 +599,16 @@ def _terminate(_signum, _frame):
 
 
 def main(argv=None):
+    """The command; returns its exit status. From a script too: GDAL's
+    exceptions and the SIGTERM handler are the caller's again after it."""
     args = parse_args(argv)
+    SAID.reset()
+    previous = None
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, _terminate)
+        previous = signal.signal(signal.SIGTERM, _terminate)
     try:
-        run(args)
+        with W.gdal_exceptions():
+            run(args)
     except Failure as e:
         print("%s: error: %s" % (PROG, e), file=sys.stderr)
         return e.code
@@ -614,6 +621,9 @@ def main(argv=None):
         print("%s: %s; nothing written to %s" % (
             PROG, "terminated" if terminated else "interrupted", args.dest), file=sys.stderr)
         return 128 + (signal.SIGTERM if terminated else signal.SIGINT)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
     return 0
 
 

@@ -5,12 +5,11 @@ TERRASHADE plugin there (GDAL_DRIVER_PATH or the installed plugin), not
 dask. Functions are sent to workers by reference, so the workers import
 terrashade (installed by `make install`, or on PYTHONPATH).
 """
+import contextlib
 import os
 import threading
 
 from osgeo import gdal
-
-gdal.UseExceptions()
 
 # One open dataset per worker thread: GDAL datasets are not thread-safe, and
 # keeping the dataset open lets a worker's later windows reuse what the
@@ -44,6 +43,8 @@ def _dataset(source, open_options, run):
         _open.pop(me, None)
     del held  # the previous one closes before the next opens: bounded memory
     ds = gdal.OpenEx(source, gdal.OF_RASTER | gdal.OF_READONLY, open_options=list(open_options))
+    if ds is None:  # (with GDAL's exceptions off; on, OpenEx raised)
+        raise RuntimeError("cannot open %s: %s" % (source, gdal.GetLastErrorMsg()))
     with _open_lock:
         _open[me] = (key, ds)
     return ds
@@ -71,10 +72,25 @@ def _maybe_crash():
     os._exit(17)
 
 
+@contextlib.contextmanager
+def gdal_exceptions():
+    """GDAL's exceptions on within, the caller's setting back after: the
+    package's own calls raise, and a script that imports it keeps its
+    mode (this module's functions work in either)."""
+    was = gdal.GetUseExceptions()
+    gdal.UseExceptions()
+    try:
+        yield
+    finally:
+        if not was:
+            gdal.DontUseExceptions()
+
+
 class Warnings:
     """GDAL's warnings while it is pushed (gdal.PushErrorHandler, this
-    thread's), each once, in order; errors still raise (gdal.UseExceptions
-    takes them from the last error, which the handler does not clear)."""
+    thread's), each once, in order; errors still raise where GDAL's
+    exceptions are on (they come from the last error, which the handler
+    does not clear), else the caller tests what GDAL returned."""
 
     def __init__(self):
         self.messages = []

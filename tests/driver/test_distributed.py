@@ -28,6 +28,7 @@ import signal
 import socket
 import subprocess
 import sys
+import textwrap
 import time
 import unittest
 
@@ -237,6 +238,60 @@ class Distributed(unittest.TestCase):
                 said = "Warning 1: TERRASHADE: MAX_DISTANCE=1 m is shorter than the DEM's cells"
                 self.assertEqual(p.stderr.count(said), 1, p.stderr)
                 self.assert_identical(dest, self.reference(options, "ref_warned.tif"))
+
+    def test_a_script_keeps_its_own_settings(self):
+        """From a script: importing the package leaves GDAL's exceptions as
+        they were (it turned them on for the whole process), main() run
+        twice says its warnings each time (the second said none) and gives
+        SIGTERM back to the script's handler, and read_window works with
+        exceptions off."""
+        script = self.path("script.py")
+        with open(script, "w") as f:
+            f.write(textwrap.dedent('''\
+                import signal, sys
+                from osgeo import gdal
+                gdal.DontUseExceptions()
+                from terrashade import distributed as D, windows as W
+
+
+                def main():  # (the workers import this file: spawn)
+                    print("exceptions after import:", gdal.GetUseExceptions())
+                    mine = lambda *_: None
+                    signal.signal(signal.SIGTERM, mine)
+                    for k in range(2):
+                        rc = D.main(["--workers", "1", "--tile-size", "64", "-q", "-oo",
+                                     "MAX_DISTANCE=1", "TERRASHADE:PRODUCT=svf,DIRECTIONS=4:"
+                                     + sys.argv[1], sys.argv[2] + str(k) + ".tif"])
+                        print("run", k, "rc", rc, file=sys.stderr)
+                    print("exceptions after main:", gdal.GetUseExceptions())
+                    print("SIGTERM is mine:", signal.getsignal(signal.SIGTERM) is mine)
+                    w, a, said = W.read_window("TERRASHADE:PRODUCT=svf,DIRECTIONS=4:"
+                                               + sys.argv[1], ["MAX_DISTANCE=1"],
+                                               (0, 0, 8, 8), "r")
+                    print("window", a.shape, len(said))
+                    try:
+                        W.read_window("TERRASHADE:" + sys.argv[1] + ".missing", [], (0, 0, 8, 8), "r")
+                    except RuntimeError as e:
+                        print("missing DEM raised:", "cannot open" in str(e))
+
+
+                if __name__ == "__main__":
+                    main()
+                '''))
+        p = T.run(["/usr/bin/python3", script, self.dem, self.path("script_out")],
+                  PYTHONPATH=PYTHONPATH)
+        print(p.stdout)
+        self.assertIn("exceptions after import: 0", p.stdout)
+        self.assertIn("exceptions after main: 0", p.stdout)
+        self.assertIn("SIGTERM is mine: True", p.stdout)
+        self.assertIn("window (1, 8, 8) 1", p.stdout)
+        self.assertIn("missing DEM raised: True", p.stdout)
+        said = "Warning 1: TERRASHADE: MAX_DISTANCE=1 m is shorter than the DEM's cells"
+        self.assertEqual(p.stderr.count(said), 2, p.stderr)
+        self.assertIn("run 1 rc 0", p.stderr)
+        for k in range(2):
+            self.assert_identical(self.path("script_out%d.tif" % k), self.reference(
+                {"PRODUCT": "svf", "DIRECTIONS": 4, "MAX_DISTANCE": 1}, "ref_script.tif"))
 
     def test_inline_options_as_the_driver_reads_them(self):
         """THREADS and PROGRESS given inline are left to the user, also where
