@@ -325,7 +325,7 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
                              "with gdal_translate instead (gdal_edit.py -ro sets a "
                              "product's nodata value, unit or statistics in the DEM's "
                              ".aux.xml)");
-    char szMsg[1024] = "";
+    char szMsg[4096] = ""; // the option list, and hints that quote the name
     tsd_connstr sConn;
     const ts_status eParsed =
         tsd_connstr_parse(poOpenInfo->pszFilename, &sConn, szMsg, sizeof szMsg);
@@ -344,13 +344,26 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     tsd_connstr_cut_colon_hint(&sConn, szCut, sizeof szCut);
     char szSegment[512]; /* "" unless the DEM's name looks like inline options */
     tsd_connstr_segment_hint(&sConn, szSegment, sizeof szSegment);
+    /* "" unless the whole name after the prefix is a file: a DEM whose
+     * name starts like KEY=VALUE:, not quoted, read as inline options */
+    char szWhole[2048] = "";
+    const char *pszWhole = poOpenInfo->pszFilename + strlen(TSD_PREFIX);
+    VSIStatBufL sStat;
+    if (sConn.options && sConn.options[0] && VSIStatL(pszWhole, &sStat) == 0)
+        snprintf(szWhole, sizeof szWhole,
+                 "; '%s' is a file: if it is the DEM, quote its name (TERRASHADE:\"%s\"), "
+                 "as a DEM's name that starts like KEY=VALUE: must be",
+                 pszWhole, pszWhole);
     tsd_connstr_free(&sConn);
 
     auto poDS = std::unique_ptr<TSDataset>(new TSDataset());
     tsd_options &sOpts = poDS->m_sOpts;
     tsd_options_defaults(&sOpts);
     if (tsd_options_apply(&sOpts, aosOptions.List(), szMsg, sizeof szMsg) != 0)
-        return FailOpen(TS_ERR_ARG, tsd_connstr_add_hint(szMsg, sizeof szMsg, szCut));
+    {
+        tsd_connstr_add_hint(szMsg, sizeof szMsg, szCut);
+        return FailOpen(TS_ERR_ARG, tsd_connstr_add_hint(szMsg, sizeof szMsg, szWhole));
+    }
     poDS->m_psProduct = tsd_product_of(&sOpts);
 
     GDALDataset *poDEM = OpenDEM(osDEM.c_str());

@@ -119,6 +119,21 @@ class Errors(unittest.TestCase):
                     gdal.OpenEx(connection, gdal.OF_RASTER, open_options=oo)
                 self.assertIn(text, str(e.exception))
 
+    def test_unquoted_name_like_options_hint(self):
+        """A DEM named like inline options, not quoted: the error says the
+        whole name is a file and how to quote it; where no such file exists
+        it says nothing of the kind; the quoted name opens."""
+        with T.TempDir() as tmp:
+            shutil.copy(DEM, os.path.join(tmp, "a=b:c.tif"))
+            p = T.run(["gdalinfo", "TERRASHADE:a=b:c.tif"], ok=False, cwd=tmp)
+            self.assertIn("unknown option 'a'", p.stderr)
+            self.assertIn("'a=b:c.tif' is a file: if it is the DEM, quote its name "
+                          "(TERRASHADE:\"a=b:c.tif\")", p.stderr)
+            p = T.run(["gdalinfo", "TERRASHADE:a=b:d.tif"], ok=False, cwd=tmp)
+            self.assertIn("unknown option 'a'", p.stderr)
+            self.assertNotIn("is a file", p.stderr)
+            T.run(["gdalinfo", 'TERRASHADE:"a=b:c.tif"'], cwd=tmp)
+
     def test_inline_colon_hint_only_for_a_cut_value(self):
         """The hint of a value cut at its ':' is for TIMEZONE, DATETIME and
         SKY only, and the spellings it suggests open: SKY=cie9 inline is
