@@ -208,6 +208,21 @@ ts_status tsd_dem_check(GDALRasterBandH band, const tsd_dem_conversion *c, const
                         const tsd_dem_seen *seen, double spacing, const tsd_dem_placement *p,
                         char *msg, size_t n)
 {
+    /* before the heights: a NaN scale leaves none to test */
+    const double scale = GDALGetRasterScale(band, NULL), offset = GDALGetRasterOffset(band, NULL);
+    if (!isfinite(scale) || scale == 0 || !isfinite(offset)) {
+        GDALDatasetH ds = GDALGetBandDataset(band);
+        const char *path = ds ? GDALGetDescription(ds) : "";
+        return tsd_fail(msg, n, TS_ERR_ARG,
+                        "the DEM '%s' gives band %d a scale of %g and an offset of %g: %s. "
+                        "Set them to what the values mean (gdal_edit.py -scale 1 -offset 0 "
+                        "%s, if they are metres)",
+                        path, GDALGetBandNumber(band), scale, offset,
+                        isfinite(scale) && isfinite(offset)
+                            ? "every height would be the offset, a flat plane"
+                            : "no height would be a number",
+                        path);
+    }
     if (seen->lo_key > seen->hi_key)
         return TS_OK; /* no valid height */
     double low, high;

@@ -94,15 +94,24 @@ class ImpossibleHeights(unittest.TestCase):
                 T.run(["gdal_translate", "-q", "-ot", "Float32", dem, copy])
                 out = T.read(T.conn(copy, PRODUCT="svf", DIRECTIONS=4), 1)
                 self.assertFalse(np.isnan(out).any())
-        # a scale that does not tell the void from other values (0: every
-        # height is the offset) names no void
-        flat = self.dem("scale0.tif", np.arange(96 * 96).reshape(96, 96), dtype=gdal.GDT_Int16)
-        ds = gdal.Open(flat, gdal.GA_Update)
-        ds.GetRasterBand(1).SetScale(0)
-        ds.GetRasterBand(1).SetOffset(100)
-        ds = None
-        np.testing.assert_allclose(T.read(T.conn(flat, PRODUCT="svf", DIRECTIONS=4), 1), 1.0,
-                                   atol=1e-6)
+        # a scale of 0 (every height the offset: a flat product, said by
+        # nothing) and a scale or offset that is no number (no height at
+        # all: an empty product) are errors, not a void
+        for scale, offset, says in ((0, 100, "every height would be the offset, a flat plane"),
+                                    (float("nan"), 0, "no height would be a number"),
+                                    (0.01, float("inf"), "no height would be a number")):
+            with self.subTest(scale=scale, offset=offset):
+                flat = self.dem("scale.tif", np.arange(96 * 96).reshape(96, 96),
+                                dtype=gdal.GDT_Int16)
+                ds = gdal.Open(flat, gdal.GA_Update)
+                ds.GetRasterBand(1).SetScale(scale)
+                ds.GetRasterBand(1).SetOffset(offset)
+                ds = None
+                for extra in ({"TILE_SIZE": 0}, {"TILE_SIZE": 64}):
+                    err = failure(T.conn(flat, PRODUCT="svf", DIRECTIONS=4, **extra))
+                    self.assertIn("gives band 1 a scale of %g and an offset of %g: %s"
+                                  % (scale, offset, says), err)
+                    self.assertIn("gdal_edit.py -scale 1 -offset 0", err)
         # an overview level (a 600 x 600 DEM has one of 300 x 300): a coarse
         # cell all of whose cells are the void
         big = np.round(T.fractal_dem(600, seed=4, relief=300.0) / 0.01)
