@@ -12,11 +12,12 @@
 #include "gdal_priv.h"
 
 #include "terrashade.h"
+#include "tsd_window.h"
 
 namespace tsd
 {
 
-constexpr int BLOCK = 256;
+constexpr int BLOCK = TSD_BLOCK_SIDE;
 /** Overview levels stop at the first one whose longer side is at most
  * this many cells (as gdaladdo's default). */
 constexpr int OVERVIEW_MIN_SIDE = 256;

@@ -128,8 +128,9 @@ const opt_def TSD_OPTION_ROWS[] = {
      NULL,
      "Chunks (TILE_SIZE): metres within which occluders come from the "
      "full-resolution DEM, exactly; farther ones from a coarser grid "
-     "(the DEM's overviews or an averaged read). 0 = 128 cells, or 32 cells of "
-     "the far grid where that is longer (a DEM of more than 2048 x 2048 far cells)"},
+     "(the DEM's overviews or an averaged read). 0 = 128 cells (of a cell's "
+     "longer side), or 32 cells of the far grid where that is longer (a DEM of "
+     "more than 2048 x 2048 far cells)"},
     {"DATETIME", K_TEXT, FIELD(datetime), "", 0, 0, 0, 0, NULL, 1, P, LISTED,
      check_datetime,
      "Place the sun by date and time (SPA) instead of SUN_AZIMUTH and "

@@ -22,9 +22,11 @@ static int is(const tsd_product_def *d, const char *a, const char *b)
     return strcmp(d->name, a) == 0 || (b && strcmp(d->name, b) == 0);
 }
 
-static int ceil_cells(double metres, double cell)
+/* (double: a distance of 1e8 m on 1 cm cells, or near a pole's cells of
+ * micrometres, is more cells than an int holds) */
+static double ceil_cells(double metres, double cell)
 {
-    return (int)ceil(metres / cell - 1e-9);
+    return ceil(metres / cell - 1e-9);
 }
 
 /* Bytes the far field keeps per cell of its grid: the heights, two float
@@ -184,7 +186,10 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
         int cells = TSD_NEAR_AUTO_CELLS > TSD_FAR_CELLS_PER_NEAR * f_mem
                         ? TSD_NEAR_AUTO_CELLS
                         : TSD_FAR_CELLS_PER_NEAR * f_mem;
-        near = cells * cell;
+        /* in cells' longer sides: 128 cells every way (at 80 degrees N a
+         * degree DEM's east-west cells are a sixth of its north-south
+         * ones, and 128 of them were 22 rows, up to 5 degrees off) */
+        near = cells * (cells_min_x > cell_y ? cells_min_x : cell_y);
     }
     /* MAX_DISTANCE: the near field is all there is, exact to it */
     p->far = o->max_distance == 0;
@@ -206,12 +211,19 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
     double mx = ceil_cells(p->near_m, cells_min_x) + 2.0, my = ceil_cells(p->near_m, cell_y) + 2.0;
     p->margin_x = mx < W ? (int)mx : W;
     p->margin_y = my < H ? (int)my : H;
+    p->dem_w = W;
+    p->dem_h = H;
     p->windowed = 1;
-    /* a cache that holds a row of chunks (GDAL reads blocks row by row),
-     * and at least 4, so that a read that straddles a chunk corner keeps
-     * its four */
-    p->cache_chunks = (W + p->tile - 1) / p->tile + 1;
-    p->cache_chunks = p->cache_chunks < 4 ? 4 : p->cache_chunks;
+    /* a cache that holds the chunks a row of blocks spans (GDAL reads
+     * blocks row by row, and a copy under a small block cache reads each
+     * band's row in turn: a row of 128-cell chunks under 256-cell blocks
+     * kept by halves was computed again for every band, 3430 computations
+     * of 25 chunks), and at least 4, so that a read that straddles a chunk
+     * corner keeps its four */
+    const int B = TSD_BLOCK_SIDE, T = p->tile;
+    const long long rows = B % T == 0 ? B / T : T % B == 0 ? 1 : B / T + 2;
+    const long long row = ((long long)W + T - 1) / T;
+    p->cache_chunks = (int)(row * rows + 1 < 4 ? 4 : row * rows + 1);
     if (p->far) {
         /* the sweeps of a chunk: the sun's (METHOD=sh: its swath's; a
          * day's: one per step at most, a date range's HORIZON_DIRECTIONS),
@@ -229,8 +241,8 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
                             ? sun_planes
                             : o->directions + sun_planes;
         int f = far_factor(o, W, H, f_mem, near / cell, p->far_planes);
-        p->far_w = (W + f - 1) / f;
-        p->far_h = (H + f - 1) / f;
+        p->far_w = (int)(((long long)W + f - 1) / f);
+        p->far_h = (int)(((long long)H + f - 1) / f);
         p->far_own = f == 1;
     }
     return 0;
@@ -297,13 +309,28 @@ void tsd_window_advice(const tsd_options *o, const tsd_sun *sun, int W, int H,
         snprintf(out, n, "; it is computed on the whole DEM (%s)", why);
 }
 
+/* The cells of a chunk's side (at most the tile, at most the DEM's side)
+ * and of the window it is computed on (its margins, within the DEM). */
+static int chunk_side(int tile, int dem)
+{
+    return tile < dem ? tile : dem;
+}
+
+static int window_side(int tile, int margin, int dem)
+{
+    const long long w = (long long)chunk_side(tile, dem) + 2LL * margin;
+    return w < dem ? (int)w : dem;
+}
+
 double tsd_window_peak_bytes(const tsd_options *o, const tsd_window_plan *p, double *steady)
 {
-    const int W = p->tile + 2 * p->margin_x, H = p->tile + 2 * p->margin_y;
+    const int W = window_side(p->tile, p->margin_x, p->dem_w);
+    const int H = window_side(p->tile, p->margin_y, p->dem_h);
     double kept_one = 0;
     double computing = tsd_product_peak_bytes(o, W, H, &kept_one);
     /* the chunk cropped out of it, and the cache */
-    double chunk = (double)p->tile * p->tile * sizeof(float) * tsd_options_band_count(o);
+    double chunk = (double)chunk_side(p->tile, p->dem_w) * chunk_side(p->tile, p->dem_h) *
+                   sizeof(float) * tsd_options_band_count(o);
     double far = (double)p->far_w * p->far_h * far_bytes_per_cell(p->far_planes, p->far_own);
     double kept = chunk * p->cache_chunks + far;
     if (steady)

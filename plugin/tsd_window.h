@@ -23,6 +23,9 @@ extern "C" {
 
 /** Smallest TILE_SIZE (0 = the whole DEM at once). */
 #define TSD_TILE_MIN 64
+/** The side of the blocks GDAL reads a product by (tsd_gdal.h's BLOCK):
+ * the chunk cache keeps what a row of them spans. */
+#define TSD_BLOCK_SIDE 256
 /** NEAR_DISTANCE=0 (automatic): this many cells of the DEM, or
  * TSD_FAR_CELLS_PER_NEAR cells of the far grid if that is longer. */
 #define TSD_NEAR_AUTO_CELLS 128
@@ -67,6 +70,7 @@ typedef struct {
     int far_own;           /* the far grid is the DEM itself (16-bit angle planes) */
     int far_planes;        /* far-field azimuths kept (the sweeps of a chunk) */
     int cache_chunks;      /* chunks the LRU cache keeps */
+    int dem_w, dem_h;      /* the DEM's size (a chunk and its margins lie within it) */
 } tsd_window_plan;
 
 /**

@@ -9,6 +9,7 @@ near field within NEAR_DISTANCE and one far-field grid per dataset.
   are refused with a sentence.
 """
 import os
+import re
 import shutil
 import unittest
 
@@ -400,6 +401,60 @@ np.save(sys.argv[2], a)
         self.refused({"NEAR_DISTANCE": 2e6}, ["NEAR_DISTANCE"])
         self.refused({"TILE_SIZE": 128, "NEAR_DISTANCE": 300},
                      ["NEAR_DISTANCE=300 m is", "cells of this DEM", "at least 16 cells"])
+
+    def test_plan_sizes(self):
+        """A window's margin of more cells than an int holds (MAX_DISTANCE
+        1e8 m on 1 cm cells) is the DEM's, not negative (which read outside
+        the DEM and passed the memory check at 0 MiB); a DEM narrower than
+        a tile is planned at its own height (a 9216 x 300 strip's horizons,
+        12.8 GiB by square chunks, refused under MAX_MEMORY=4000); a block
+        cache too small for a row of blocks of every band (GDAL then copies
+        band by band, and each band computes its chunks again) gives the
+        same bits."""
+        cm = T.write_tif(os.path.join(self.tmp, "cm.tif"), T.fractal_dem(128, seed=2) / 1e4,
+                         (500000, 0.01, 0, 4000000, 0, -0.01), 32617)
+        o = dict(PRODUCT="svf", DIRECTIONS=8, MAX_DISTANCE=1e8)
+        p = T.run(["gdalinfo", "-oo", "TILE_SIZE=64"] + T.oo_args(o) + [T.conn(cm)],
+                  CPL_DEBUG="TERRASHADE")
+        self.assertIn("(margin 128 x 128 cells)", p.stderr)
+        np.testing.assert_array_equal(product(cm, TILE_SIZE=64, **o), product(cm, TILE_SIZE=0, **o))
+        strip = os.path.join(self.tmp, "strip.vrt")
+        with open(strip, "w") as f:
+            f.write('<VRTDataset rasterXSize="9216" rasterYSize="300"><SRS>EPSG:32617</SRS>'
+                    '<GeoTransform>500000, 10, 0, 4000000, 0, -10</GeoTransform>'
+                    '<VRTRasterBand dataType="Float32" band="1"/></VRTDataset>')
+        p = T.run(["gdalinfo", "-oo", "PRODUCT=horizon", "-oo", "DIRECTIONS=32",
+                   "-oo", "MAX_MEMORY=4000", T.conn(strip)], CPL_DEBUG="TERRASHADE")
+        mib = int(re.search(r"memory: about (\d+) MiB while computing", p.stderr).group(1))
+        print("  9216 x 300 strip, 32 horizons: about %d MiB by window" % mib)
+        self.assertLess(mib, 4000)
+        o = dict(PRODUCT="horizon", DIRECTIONS=4, TILE_SIZE=256)
+        outs = []
+        for cache in ("1", "256"):
+            outs.append(os.path.join(self.tmp, "cache%s.tif" % cache))
+            T.run(["gdal_translate", "-q"] + T.oo_args(o) + [T.conn(self.dem), outs[-1]],
+                  GDAL_CACHEMAX=cache)
+        np.testing.assert_array_equal(T.read(outs[0]), T.read(outs[1]))
+        np.testing.assert_array_equal(T.read(outs[0]), product(self.dem, **o))
+
+    def test_high_latitude_near_field(self):
+        """jacksboro moved to 80 N, where its east-west cells are a sixth of
+        its north-south ones: the automatic near field is 128 of the longer
+        cells (it was 128 of the shorter, 22 rows, and 225 horizons were
+        more than 1 degree off, up to 5.3)."""
+        dem = os.path.join(self.tmp, "j80.tif")
+        T.run(["gdal_translate", "-q", "-a_ullr", "10", "80", "10.3358", "79.7133333",
+               T.JACKSBORO, dem])
+        o = dict(PRODUCT="horizon", DIRECTIONS=16)
+        p = T.run(["gdalinfo", "-oo", "TILE_SIZE=64"] + T.oo_args(o) + [T.conn(dem)],
+                  CPL_DEBUG="TERRASHADE")
+        margin = re.search(r"\(margin (\d+) x (\d+) cells\)", p.stderr)
+        print("  80 N: margin %s x %s cells" % margin.groups())
+        self.assertGreaterEqual(int(margin.group(2)), 128)
+        d = np.abs(product(dem, TILE_SIZE=64, **o) - product(dem, TILE_SIZE=0, **o))
+        print("  80 N: %d horizons more than 1 degree off, max %.2f" % ((d > 1).sum(), d.max()))
+        self.assertLess((d > 1).sum(), 40)
+        self.assertLess(d.max(), 3.0)
 
     def test_near_distance_refusal_names_a_distance_that_is_accepted(self):
         """Cells of 30.02 m: 16 cells are 480.32 m. The refusal of 480 m once
