@@ -81,9 +81,13 @@ typedef struct {
     const ts_grid_origin *origin; /* a window of a larger DEM, or NULL */
 } ts_grid;
 
+/** A grid's longest side, cells. */
+#define TS_MAX_SIDE (1 << 20)
+
 /**
- * Allocate a width x height grid with stride = width, heights set to 0 and
- * constant cell sizes. Free it with ts_grid_free.
+ * Allocate a width x height grid (each side 1 .. TS_MAX_SIDE) with stride =
+ * width, heights set to 0 and constant cell sizes. Free it with
+ * ts_grid_free.
  */
 ts_status ts_grid_create(ts_grid *grid, int width, int height, double cell_x,
                          double cell_y, ts_error *err);

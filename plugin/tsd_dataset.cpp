@@ -274,6 +274,21 @@ static bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window
                         const tsd_sun *psSun, const tsd_cells &sCells, int nLevel,
                         double *pdfHeadroom)
 {
+    if (!psPlan && (W > TS_MAX_SIDE || H > TS_MAX_SIDE))
+    {
+        // (found here, not at the first read, where it said no more than the core's limit)
+        char szAdvice[512] = "";
+        if (nLevel == 0)
+            tsd_window_advice(&sOpts, psSun, W, H, tsd_cells_min_x(&sCells, H),
+                              sCells.cell_y, std::numeric_limits<double>::max(), szAdvice,
+                              sizeof szAdvice);
+        Fail(TS_ERR_ARG, CPLSPrintf("PRODUCT=%s computes this %d x %d DEM whole, and a DEM "
+                                    "computed whole has at most %d cells a side%s; crop or "
+                                    "downsample the DEM",
+                                    tsd_options_product_name(&sOpts), W, H, TS_MAX_SIDE,
+                                    szAdvice));
+        return false;
+    }
     double dfSteady = 0;
     // windowed: the chunk with its margin, the cache and the far field
     const double dfPeak = psPlan ? tsd_window_peak_bytes(&sOpts, psPlan, &dfSteady)

@@ -410,7 +410,8 @@ np.save(sys.argv[2], a)
         12.8 GiB by square chunks, refused under MAX_MEMORY=4000); a block
         cache too small for a row of blocks of every band (GDAL then copies
         band by band, and each band computes its chunks again) gives the
-        same bits."""
+        same bits. A DEM longer than a grid computed whole is refused at
+        open, where windows would do."""
         cm = T.write_tif(os.path.join(self.tmp, "cm.tif"), T.fractal_dem(128, seed=2) / 1e4,
                          (500000, 0.01, 0, 4000000, 0, -0.01), 32617)
         o = dict(PRODUCT="svf", DIRECTIONS=8, MAX_DISTANCE=1e8)
@@ -428,6 +429,18 @@ np.save(sys.argv[2], a)
         mib = int(re.search(r"memory: about (\d+) MiB while computing", p.stderr).group(1))
         print("  9216 x 300 strip, 32 horizons: about %d MiB by window" % mib)
         self.assertLess(mib, 4000)
+        # longer than a grid computed whole: said at open, with the windows
+        # that do it (the first read said only the core's limit)
+        long = os.path.join(self.tmp, "long.vrt")
+        with open(long, "w") as f:
+            f.write('<VRTDataset rasterXSize="2097152" rasterYSize="64"><SRS>EPSG:32617</SRS>'
+                    '<GeoTransform>500000, 10, 0, 4000000, 0, -10</GeoTransform>'
+                    '<VRTRasterBand dataType="Float32" band="1"/></VRTDataset>')
+        p = T.run(["gdalinfo", "-oo", "TILE_SIZE=0", T.conn(long)], ok=False)
+        self.assertIn("computes this 2097152 x 64 DEM whole, and a DEM computed whole has at "
+                      "most 1048576 cells a side; TILE_SIZE=4096 computes it window by window",
+                      p.stderr)
+        T.run(["gdalinfo", T.conn(long)])
         o = dict(PRODUCT="horizon", DIRECTIONS=4, TILE_SIZE=256)
         outs = []
         for cache in ("1", "256"):
