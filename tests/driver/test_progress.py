@@ -237,6 +237,34 @@ class CallerCancel(FractalCase):
                              errno=None)
         self.assertFalse(os.path.exists(out))
 
+    def test_date_range_positions(self):
+        """A date range's sun positions, found before its sweeps, report
+        progress after each sampled day and take a cancel there (ten years
+        at 1-minute steps were 16 s of silence, and a cancel waited for
+        them); the bar only moves forward."""
+        tiny = T.write_tif(os.path.join(self.dir, "tiny.tif"), T.fractal_dem(16, seed=7),
+                           UTM_GT, 32617)
+        for product in ("sunhours", "insolation"):
+            with self.subTest(product=product):
+                oo = ["PRODUCT=" + product, "START_DATE=2026-01-01", "END_DATE=2026-12-31",
+                      "TIMEZONE=-05:00", "STEP_MINUTES=10", "DAY_INTERVAL=1", "PROGRESS=no",
+                      "HORIZON_DIRECTIONS=4"]  # (the sweeps: a few reports)
+                seen = []
+                ds = gdal.OpenEx(T.conn(tiny), open_options=oo)
+                ds.GetRasterBand(1).ReadAsArray(
+                    callback=lambda done, _m, _d: seen.append(done) or 1)
+                ds = None
+                # (on 16 x 16 cells the sweeps are nothing beside 52 560 positions)
+                early = [d for d in seen if 0 < d < 0.9]
+                print("%s: %d reports, %d of them below 0.9" % (product, len(seen), len(early)))
+                self.assertGreater(len(early), 50)  # (the driver passes on each 1 %)
+                self.assertEqual(seen, sorted(seen))
+                ds = gdal.OpenEx(T.conn(tiny), open_options=oo)
+                stop = Stopper(stop_at=3)
+                self.assertCancelled(lambda: ds.GetRasterBand(1).ReadAsArray(callback=stop))
+                self.assertEqual(stop.calls, 3)
+                ds = None
+
     def test_chunks(self):
         """Chunk by chunk (TILE_SIZE): a chunk cancelled is computed again
         by the next read, the chunks computed before it are kept; a
