@@ -236,6 +236,19 @@ ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
                             double scale_shade, float *shade, double scale_share, float *share,
                             ts_error *err);
 
+/**
+ * ts_sh_swath_light reporting its progress through report's callback
+ * (report->progress, may be NULL: none) from `from` to `to`, about 32
+ * times, and stopping with TS_ERR_CANCELLED where the callback asks; the
+ * same cells.
+ */
+ts_status ts_sh_swath_light_reported(const ts_grid *grid, const ts_sh_wedges *w,
+                                     const float *const *planes, const double l[TS_SH_COEFFS],
+                                     const float *nx, const float *ny, const float *nz,
+                                     double scale_shade, float *shade, double scale_share,
+                                     float *share, const ts_horizon_opts *report, double from,
+                                     double to, ts_error *err);
+
 /* ---------------------------------------------------------- key light */
 
 /**

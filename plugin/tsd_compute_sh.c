@@ -45,6 +45,10 @@ static ts_status pyramid_planes(const tsd_compute_ctx *c, const ts_grid *g,
     return st;
 }
 
+/* The progress bar's part for the sweeps; the SH pass has the rest (from
+ * a tenth of a run at SWATH_DIRECTIONS=3 to half at thousands). */
+#define SWEEPS_SHARE 0.75
+
 /* The key light of METHOD=sh: its swath's SWATH_DIRECTIONS horizons (sweeps
  * on the backend, or the pyramid's with HORIZON_METHOD=pyramid), all kept,
  * the first in the output, then one pass of ts_sh_swath_light into shade
@@ -103,7 +107,7 @@ static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
     for (int i = 0; o->horizon_method != TSD_HORIZON_PYRAMID && st == TS_OK && i < s.n;
          i += per_call) {
         ts_backend_report rep = {0};
-        if ((st = tsd_compute_report(c, (double)i / s.n)) != TS_OK)
+        if ((st = tsd_compute_report(c, SWEEPS_SHARE * i / s.n)) != TS_OK)
             break;
         for (int k = 0; k < per_call; k++)
             az_list[k] = ts_sh_swath_azimuth(&s, i + k);
@@ -118,12 +122,14 @@ static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
                                                             * field and the DEM's edge */
             st = tsd_compute_far(c, g, az_list[k], 0, planes[i + k]);
     }
+    ts_horizon_opts report; /* the SH pass's share of the bar, and a cancel */
+    tsd_compute_horizon_opts(c, &report);
     if (st == TS_OK &&
-        (st = ts_sh_swath_light(g, &w, (const float *const *)planes, l, nm ? nm->nx : NULL,
-                                nm ? nm->ny : NULL, nm ? nm->nz : NULL,
-                                above > 0 && shade_ref > 0 ? above / shade_ref : 0, shade,
-                                above > 0 && share_ref > 0 ? above / share_ref : 0, share,
-                                &err)) != TS_OK)
+        (st = ts_sh_swath_light_reported(
+             g, &w, (const float *const *)planes, l, nm ? nm->nx : NULL, nm ? nm->ny : NULL,
+             nm ? nm->nz : NULL, above > 0 && shade_ref > 0 ? above / shade_ref : 0, shade,
+             above > 0 && share_ref > 0 ? above / share_ref : 0, share, &report, SWEEPS_SHARE,
+             1.0, &err)) != TS_OK)
         st = core_fail(c, &err);
     note_c_part(c, "METHOD=sh");
     for (int i = 1; !block && i < s.n; i++)

@@ -276,35 +276,21 @@ START_TEST(test_no_writes_outside)
 END_TEST
 
 /* Progress: reported from 0 to 1, never backwards, once per azimuth and
- * at the end; a non-zero answer stops the computation. */
-typedef struct {
-    int calls, stop_at;
-    double last, first;
-} progress_log;
-
-static int log_progress(double done, void *user)
-{
-    progress_log *l = user;
-    if (l->calls == 0)
-        l->first = done;
-    ck_assert_msg(done >= l->last && done <= 1.0, "progress %g after %g", done, l->last);
-    l->last = done;
-    return ++l->calls == l->stop_at;
-}
+ * at the end; a non-zero answer stops the computation (tprog_log). */
 
 START_TEST(test_progress_and_cancel)
 {
     ts_horizon_opts o = dflt();
     o.directions = 8;
-    progress_log l = {0, -1, 0, -1};
-    o.progress = log_progress;
+    tprog l = {0, -1, 0, -1};
+    o.progress = tprog_log;
     o.progress_user = &l;
     ts_error e;
     ck_assert(ts_horizon_compute(&G, &o, hor, &e) == TS_OK);
     ck_assert_int_eq(l.calls, 9);
     ck_assert(l.first == 0.0 && l.last == 1.0);
     /* stop at the third report: cancelled, with a message */
-    l = (progress_log){0, 3, 0, -1};
+    l = (tprog){0, 3, 0, -1};
     ck_assert(ts_horizon_compute(&G, &o, hor, &e) == TS_ERR_CANCELLED);
     ck_assert_int_eq(l.calls, 3);
     ck_assert(e.code == TS_ERR_CANCELLED && strstr(e.message, "cancelled"));

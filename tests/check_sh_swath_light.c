@@ -237,6 +237,35 @@ END_TEST
  * row's from the grid as ts_normals does: bit for bit the same shade and
  * share, on the folded path (a large grid, a key's swath) and the general
  * one (a small grid), with one and two threads, nodata in the DEM. */
+/* A W x H fbm grid with a hole at (W / 3, H / 2), its normals, a key
+ * light's swath (135 deg, 25 deg, radius 2) and made-up horizon planes. */
+static void swath_inputs(int W, int H, ts_grid *g, float **nx, float **ny, float **nz,
+                         ts_sh_swath *sw, double l[N], float *planes[3])
+{
+    const size_t cells = (size_t)W * H;
+    ts_error err;
+    tdem_create(g, W, H, 10, 10);
+    tdem_fbm(g, 7, 0.8, 400);
+    g->z[(size_t)(H / 2) * g->stride + W / 3] = NAN;
+    *nx = tdem_floats(cells), *ny = tdem_floats(cells), *nz = tdem_floats(cells);
+    ck_assert(ts_normals(g, *nx, *ny, *nz, &err) == TS_OK);
+    key_of(135, 25, 2, sw, l);
+    for (int k = 0; k < sw->n; k++) {
+        planes[k] = tdem_floats(cells);
+        for (size_t c = 0; c < cells; c++)
+            planes[k][c] = (float)(20 + 25 * sin(0.029 * (double)c + k));
+    }
+}
+
+static void swath_inputs_free(ts_grid *g, float *nx, float *ny, float *nz,
+                              const ts_sh_swath *sw, float *planes[3])
+{
+    for (int k = 0; k < sw->n; k++)
+        free(planes[k]);
+    free(nx), free(ny), free(nz);
+    ts_grid_free(g);
+}
+
 START_TEST(swath_light_row_normals)
 {
     const int sizes[2][2] = {{400, 340}, {37, 23}};
@@ -245,20 +274,10 @@ START_TEST(swath_light_row_normals)
         const size_t cells = (size_t)W * H;
         ts_grid g;
         ts_error err;
-        tdem_create(&g, W, H, 10, 10);
-        tdem_fbm(&g, 7, 0.8, 400);
-        g.z[(size_t)(H / 2) * g.stride + W / 3] = NAN;
-        float *nx = tdem_floats(cells), *ny = tdem_floats(cells), *nz = tdem_floats(cells);
-        ck_assert(ts_normals(&g, nx, ny, nz, &err) == TS_OK);
+        float *nx, *ny, *nz, *planes[3];
         ts_sh_swath sw;
         double l[N];
-        key_of(135, 25, 2, &sw, l);
-        float *planes[3];
-        for (int k = 0; k < sw.n; k++) {
-            planes[k] = tdem_floats(cells);
-            for (size_t c = 0; c < cells; c++)
-                planes[k][c] = (float)(20 + 25 * sin(0.029 * (double)c + k));
-        }
+        swath_inputs(W, H, &g, &nx, &ny, &nz, &sw, l, planes);
         for (int threads = 1; threads <= 2; threads++) {
             ts_sh_wedges w;
             ck_assert(ts_sh_wedges_build(&sw, threads, &w, &err) == TS_OK);
@@ -282,11 +301,56 @@ START_TEST(swath_light_row_normals)
             free(shade), free(share), free(shade_rows), free(share_rows);
             ts_sh_wedges_free(&w);
         }
-        for (int k = 0; k < sw.n; k++)
-            free(planes[k]);
-        free(nx), free(ny), free(nz);
-        ts_grid_free(&g);
+        swath_inputs_free(&g, nx, ny, nz, &sw, planes);
     }
+}
+END_TEST
+
+/* ts_sh_swath_light_reported: the cells of ts_sh_swath_light bit for bit,
+ * about 33 reports from `from` to below `to`, in order, at 1 and 2
+ * threads, with the normals' planes and made row by row (the rows in
+ * batches between reports); a callback that stops ends it with
+ * TS_ERR_CANCELLED and no report after. */
+START_TEST(swath_light_reported)
+{
+    const int W = 300, H = 211;
+    const size_t cells = (size_t)W * H;
+    ts_grid g;
+    ts_error err;
+    float *nx, *ny, *nz, *planes[3];
+    ts_sh_swath sw;
+    double l[N];
+    swath_inputs(W, H, &g, &nx, &ny, &nz, &sw, l, planes);
+    for (int threads = 1; threads <= 2; threads++)
+        for (int rows = 0; rows < 2; rows++) {
+            ts_sh_wedges w;
+            ck_assert(ts_sh_wedges_build(&sw, threads, &w, &err) == TS_OK);
+            float *shade = tdem_floats(cells), *got = tdem_floats(cells);
+            const float *n[3] = {rows ? NULL : nx, rows ? NULL : ny, rows ? NULL : nz};
+            ck_assert(ts_sh_swath_light(&g, &w, (const float *const *)planes, l, n[0], n[1],
+                                        n[2], 1.5, shade, 0, NULL, &err) == TS_OK);
+            ts_horizon_opts h;
+            ts_horizon_opts_default(&h);
+            tprog r = {0, -1, 0, -1};
+            h.progress = tprog_log;
+            h.progress_user = &r;
+            ck_assert_msg(ts_sh_swath_light_reported(&g, &w, (const float *const *)planes, l,
+                                                     n[0], n[1], n[2], 1.5, got, 0, NULL, &h,
+                                                     0.75, 1.0, &err) == TS_OK,
+                          "%s", err.message);
+            ck_assert(memcmp(shade, got, cells * sizeof(float)) == 0);
+            ck_assert_int_eq(r.calls, 33); /* before the tables, and before each batch */
+            ck_assert(r.first == 0.75 && r.last < 1.0 && r.last > 0.99);
+            tprog stop = {0, 5, 0, -1};
+            h.progress_user = &stop;
+            ck_assert(ts_sh_swath_light_reported(&g, &w, (const float *const *)planes, l, n[0],
+                                                 n[1], n[2], 1.5, got, 0, NULL, &h, 0.75, 1.0,
+                                                 &err) == TS_ERR_CANCELLED);
+            ck_assert_int_eq(stop.calls, 5);
+            free(shade), free(got);
+            ts_sh_wedges_free(&w);
+        }
+    swath_inputs_free(&g, nx, ny, nz, &sw, planes);
 }
 END_TEST
 
@@ -342,6 +406,7 @@ static Suite *suite(void)
     tcase_add_test(tc, swath_light_folded);
     tcase_add_test(tc, swath_light_window_path);
     tcase_add_test(tc, swath_light_row_normals);
+    tcase_add_test(tc, swath_light_reported);
     tcase_add_test(tc, block_shade_avx512);
     suite_add_tcase(s, tc);
     return s;

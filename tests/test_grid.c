@@ -25,3 +25,13 @@ void tdem_load(ts_grid *g, const char *name)
     char msg[4200];
     ck_assert_msg(tdem_read(g, name, NULL, NULL, msg, sizeof msg) == 0, "%s", msg);
 }
+
+int tprog_log(double done, void *user)
+{
+    tprog *l = user;
+    if (l->calls == 0)
+        l->first = done;
+    ck_assert_msg(done >= l->last && done <= 1.0, "progress %g after %g", done, l->last);
+    l->last = done;
+    return ++l->calls == l->stop_at;
+}

@@ -20,4 +20,15 @@ void tdem_load(ts_grid *g, const char *name);
 /* Allocate n floats (aborts the test on failure); free with free(). */
 float *tdem_floats(size_t n);
 
+/* A progress callback's log: tprog_log (a ts_progress_fn, user: a tprog)
+ * counts the calls and keeps the first and last fraction, fails the test
+ * where a fraction goes back or passes 1, and asks to stop (returns 1) at
+ * call stop_at (-1: never). Start it as {0, stop_at, 0, -1}. */
+typedef struct {
+    int calls, stop_at;
+    double last, first;
+} tprog;
+
+int tprog_log(double done, void *user);
+
 #endif

@@ -265,6 +265,37 @@ class CallerCancel(FractalCase):
                 self.assertEqual(stop.calls, 3)
                 ds = None
 
+    def test_sh_pass(self):
+        """METHOD=sh's SH pass after its sweeps (half the run with a swath
+        of thousands, until session 47 without a report or a cancel)
+        reports from 0.75 to 1 and stops where the callback asks; the bar
+        only moves forward, and a cancelled product is computed whole by
+        the next read."""
+        small = T.write_tif(os.path.join(self.dir, "sh128.tif"), T.fractal_dem(128, seed=8),
+                            UTM_GT, 32617)
+        oo = ["PRODUCT=shade", "METHOD=sh", "SWATH_DIRECTIONS=360", "PROGRESS=no"]
+        seen, at = [], []
+        ds = gdal.OpenEx(T.conn(small), open_options=oo)
+        t0 = time.monotonic()
+        ref = ds.GetRasterBand(1).ReadAsArray(
+            callback=lambda d, _m, _u: seen.append(d) or at.append(time.monotonic()) or 1)
+        ds = None
+        gaps = np.diff([t0] + at)
+        print("METHOD=sh: %d reports in %.2f s, the longest gap %.2f s (at %.2f)"
+              % (len(seen), at[-1] - t0, gaps.max(), seen[int(gaps.argmax())]))
+        self.assertEqual(seen, sorted(seen))  # (check_sh_swath_light counts the pass's own)
+        calls = []
+
+        def stop_in_sh_pass(done, _m, _u):
+            calls.append(done)
+            return 0 if done > 0.8 else 1
+        ds = gdal.OpenEx(T.conn(small), open_options=oo)
+        self.assertCancelled(lambda: ds.GetRasterBand(1).ReadAsArray(callback=stop_in_sh_pass))
+        self.assertGreater(calls[-1], 0.8)
+        self.assertEqual(len([d for d in calls if d > 0.8]), 1)  # none after the stop
+        np.testing.assert_array_equal(ds.GetRasterBand(1).ReadAsArray(), ref)
+        ds = None
+
     def test_chunks(self):
         """Chunk by chunk (TILE_SIZE): a chunk cancelled is computed again
         by the next read, the chunks computed before it are kept; a
