@@ -21,6 +21,8 @@ void ts_shadowmap_opts_default(ts_shadowmap_opts *opts)
     opts->kernel = TS_SHADOWMAP_AUTO;
     opts->light_radius = TS_SUN_RADIUS_DEG;
     opts->threads = 0;
+    opts->progress = NULL;
+    opts->progress_user = NULL;
 }
 
 ts_status ts_shadowmap_opts_validate(const ts_shadowmap_opts *opts, ts_error *err)

@@ -39,9 +39,14 @@ typedef struct {
     double light_radius; /**< the light's angular radius, degrees, 0 < r < 45
                               (what auto's kernel follows) */
     int threads;         /**< worker threads; 0 = number of cores */
+    ts_progress_fn progress; /**< the C backend reports 0..1 in the map's
+                                  rows and the cells' (and stops with
+                                  TS_ERR_CANCELLED where it asks); NULL: none */
+    void *progress_user;     /**< passed to progress */
 } ts_shadowmap_opts;
 
-/** Defaults: scale 2, auto kernel, the sun's radius, all cores. */
+/** Defaults: scale 2, auto kernel, the sun's radius, all cores, no
+ * progress. */
 void ts_shadowmap_opts_default(ts_shadowmap_opts *opts);
 
 /** Check the options; the message names the offending field. */

@@ -258,6 +258,8 @@ static ts_status shadowmap_visibility(const tsd_compute_ctx *c, const ts_grid *g
     so.kernel = isnan(c->opts->pcf_kernel) ? TS_SHADOWMAP_AUTO : c->opts->pcf_kernel;
     so.light_radius = c->opts->light_radius;
     so.threads = c->opts->threads;
+    so.progress = c->run->progress;
+    so.progress_user = c->run->progress_user;
     if (NOTE(c, ts_backend_shadowmap_compute(BK(c), g, c->run->sun_azimuth,
                                              c->run->sun_elevation, &so, vis, &rep, &err),
              rep) != TS_OK)

@@ -166,7 +166,8 @@ START_TEST(test_plane_and_pillar)
 }
 END_TEST
 
-/* Nodata stays NaN and casts nothing; threads do not change a bit. */
+/* Nodata stays NaN and casts nothing; threads, and the passes reported
+ * in batches, do not change a bit. */
 START_TEST(test_nodata_threads)
 {
     ts_grid g;
@@ -182,12 +183,24 @@ START_TEST(test_nodata_threads)
     ts_error err;
     o.threads = 1;
     ck_assert_int_eq(ts_shadowmap_compute(&g, 200, 25, &o, a, &err), TS_OK);
-    o.threads = 3;
-    ck_assert_int_eq(ts_shadowmap_compute(&g, 200, 25, &o, b, &err), TS_OK);
-    for (size_t i = 0; i < n; i++) {
-        ck_assert(isnan(a[i]) == isnan(g.z[(i / g.width) * g.stride + i % g.width]));
-        ck_assert(a[i] == b[i] || (isnan(a[i]) && isnan(b[i])));
+    for (int reported = 0; reported < 2; reported++) {
+        /* reported: the passes in batches with a report before each, in
+         * order (tprog_log), 32 of them; a stop at the fifth ends it */
+        tprog log = {0, -1, 0, -1};
+        o.threads = 3;
+        o.progress = reported ? tprog_log : NULL;
+        o.progress_user = &log;
+        ck_assert_int_eq(ts_shadowmap_compute(&g, 200, 25, &o, b, &err), TS_OK);
+        ck_assert_int_eq(log.calls, reported ? 32 : 0);
+        for (size_t i = 0; i < n; i++) {
+            ck_assert(isnan(a[i]) == isnan(g.z[(i / g.width) * g.stride + i % g.width]));
+            ck_assert(a[i] == b[i] || (isnan(a[i]) && isnan(b[i])));
+        }
     }
+    tprog stop = {0, 5, 0, -1};
+    o.progress_user = &stop;
+    ck_assert_int_eq(ts_shadowmap_compute(&g, 200, 25, &o, b, &err), TS_ERR_CANCELLED);
+    ck_assert_int_eq(stop.calls, 5);
     free(a);
     free(b);
     ts_grid_free(&g);
