@@ -6,9 +6,6 @@
 
 #include "status_internal.h"
 
-/* Largest grid side we accept: keeps width*height*directions in size_t and
- * every index in ptrdiff_t, and turns absurd sizes into a clear error. */
-
 ts_status ts_grid_create(ts_grid *grid, int width, int height, double cell_x,
                          double cell_y, ts_error *err)
 {

@@ -172,3 +172,36 @@ ts_status ts_parallel_for_ranges(int threads, long items, long grain, ts_range_f
     range_fn_each e = {fn, ctx};
     return ts_parallel_ranges(threads, items, grain, each_range, &e, err);
 }
+
+/* One batch of ts_parallel_reported: fn over base + [begin, end). */
+typedef struct {
+    ts_range_fn fn;
+    void *ctx;
+    long base;
+} batch_of;
+
+static void batch_range(void *ctx, int worker, long begin, long end)
+{
+    const batch_of *b = ctx;
+    b->fn(b->ctx, worker, b->base + begin, b->base + end);
+}
+
+ts_status ts_parallel_reported(int threads, long items, long grain, ts_range_fn fn, void *ctx,
+                               const ts_horizon_opts *report, double from, double to,
+                               int batches, ts_error *err)
+{
+    if (!report || !report->progress)
+        batches = 1;
+    ts_status st = TS_OK;
+    for (int k = 0; st == TS_OK && k < batches; k++) {
+        batch_of b = {fn, ctx, items * k / batches};
+        const long n = items * (k + 1) / batches - b.base;
+        if (batches > 1 && (st = ts_progress(report, from + (to - from) * k / batches, err)) !=
+                               TS_OK)
+            break;
+        if (n > 0)
+            st = grain > 0 ? ts_parallel_for_ranges(threads, n, grain, batch_range, &b, err)
+                           : ts_parallel_for(threads, n, batch_range, &b, err);
+    }
+    return st;
+}

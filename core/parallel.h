@@ -53,4 +53,16 @@ ts_status ts_parallel_ranges(int threads, long items, long grain, ts_ranges_fn f
 ts_status ts_parallel_for_ranges(int threads, long items, long grain, ts_range_fn fn, void *ctx,
                                  ts_error *err);
 
+/* A long pass that reports its progress and takes a cancel: fn over [0,
+ * items) in `batches` batches, with ts_progress(report) before each, from
+ * `from` to below `to` (a stop ends it with TS_ERR_CANCELLED); where report
+ * has no callback, one batch and no report. Each batch runs by
+ * ts_parallel_for_ranges with `grain`, or with grain 0 by ts_parallel_for
+ * (fixed shares: for work each call of which has a fixed cost). fn's
+ * results must not depend on the batches, as they must not on the
+ * threads' shares. */
+ts_status ts_parallel_reported(int threads, long items, long grain, ts_range_fn fn, void *ctx,
+                               const ts_horizon_opts *report, double from, double to,
+                               int batches, ts_error *err);
+
 #endif

@@ -461,40 +461,10 @@ static ts_status fold_tables(swath_ctx *C, const double *az_start, ts_error *err
     return st;
 }
 
-/* swath_rows over rows base + [y0, y1): a batch of rows between reports */
-typedef struct {
-    swath_ctx *C;
-    long base;
-} row_batch;
-
-static void batch_rows(void *ctx, int worker, long y0, long y1)
-{
-    const row_batch *b = ctx;
-    swath_rows(b->C, worker, b->base + y0, b->base + y1);
-}
-
-/* The rows in SWATH_BATCHES batches, reporting from `from` to `to` before
- * each (where report has a callback: the pass of a swath of thousands of
- * samples is half a METHOD=sh run); a row's cells do not depend on the
- * batches, as they do not on the threads' ranges. */
+/* The rows in SWATH_BATCHES batches between reports, where the caller
+ * wants them (the pass of a swath of thousands of samples is half a
+ * METHOD=sh run). */
 #define SWATH_BATCHES 32
-static ts_status all_rows(swath_ctx *C, int threads, const ts_horizon_opts *report,
-                          double from, double to, ts_error *err)
-{
-    const long H = C->g->height;
-    if (!report || !report->progress)
-        return ts_parallel_for_ranges(threads, H, TS_ROWS_GRAIN, swath_rows, C, err);
-    ts_status st = TS_OK;
-    for (int b = 0; st == TS_OK && b < SWATH_BATCHES; b++) {
-        row_batch rb = {C, H * b / SWATH_BATCHES};
-        const long end = H * (b + 1) / SWATH_BATCHES;
-        if ((st = ts_progress(report, from + (to - from) * b / SWATH_BATCHES, err)) == TS_OK &&
-            end > rb.base)
-            st = ts_parallel_for_ranges(threads, end - rb.base, TS_ROWS_GRAIN, batch_rows, &rb,
-                                        err);
-    }
-    return st;
-}
 
 ts_status ts_sh_swath_light(const ts_grid *grid, const ts_sh_wedges *w,
                             const float *const *planes, const double l[TS_SH_COEFFS],
@@ -565,7 +535,8 @@ ts_status ts_sh_swath_light_reported(const ts_grid *grid, const ts_sh_wedges *w,
         !(C.rows_n = malloc((size_t)threads * 3 * grid->width * sizeof(float))))
         st = ts_fail(err, TS_ERR_NOMEM, "out of memory for rows of normals");
     if (st == TS_OK)
-        st = all_rows(&C, threads, report, from, to, err);
+        st = ts_parallel_reported(threads, grid->height, TS_ROWS_GRAIN, swath_rows, &C, report,
+                                  from, to, SWATH_BATCHES, err);
     free(C.rows_n);
     fold_free(&C, slot_count(s));
     free(rot);

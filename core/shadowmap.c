@@ -148,45 +148,10 @@ static void filter_rows(void *ctx, int worker, long begin, long end)
     free(m.depth);
 }
 
-/* A pass over [0, n) in SM_BATCHES batches, reporting from `from` to `to`
- * before each where opts has a callback (at a 0.5 degree sun the map's
- * rendering and the cells' filter took 3.7 s of a 1024^2 DEM, 18 s of a
- * 2048^2 one, without a report or a cancel); a texel's or a cell's value
- * does not depend on the batches, as it does not on the threads' shares. */
+/* The map's rows and the cells' rows in SM_BATCHES batches between
+ * reports, where the caller wants them (at a 0.5 degree sun rendering and
+ * filtering took 3.7 s of a 1024^2 DEM, 18 s of a 2048^2 one). */
 #define SM_BATCHES 16
-typedef struct {
-    ts_range_fn fn;
-    void *ctx;
-    long base;
-} sm_batch;
-
-static void batch_range(void *ctx, int worker, long begin, long end)
-{
-    const sm_batch *b = ctx;
-    b->fn(b->ctx, worker, b->base + begin, b->base + end);
-}
-
-static ts_status reported_pass(const ts_shadowmap_opts *opts, long n, ts_range_fn fn,
-                               void *ctx, double from, double to, ts_error *err)
-{
-    const int threads = ts_thread_count(opts->threads, n);
-    if (!opts->progress)
-        return ts_parallel_for(threads, n, fn, ctx, err);
-    ts_horizon_opts report;
-    ts_horizon_opts_default(&report);
-    report.progress = opts->progress;
-    report.progress_user = opts->progress_user;
-    ts_status st = TS_OK;
-    for (int b = 0; st == TS_OK && b < SM_BATCHES; b++) {
-        sm_batch sb = {fn, ctx, n * b / SM_BATCHES};
-        const long end = n * (b + 1) / SM_BATCHES;
-        if ((st = ts_progress(&report, from + (to - from) * b / SM_BATCHES, err)) == TS_OK &&
-            end > sb.base)
-            st = ts_parallel_for(ts_thread_count(opts->threads, end - sb.base), end - sb.base,
-                                 batch_range, &sb, err);
-    }
-    return st;
-}
 
 ts_status ts_shadowmap_compute(const ts_grid *grid, double azimuth, double elevation,
                                const ts_shadowmap_opts *opts, float *visibility, ts_error *err)
@@ -203,18 +168,24 @@ ts_status ts_shadowmap_compute(const ts_grid *grid, double azimuth, double eleva
         st = ts_fail(err, TS_ERR_NOMEM, "out of memory for a %d x %d shadow map", f.width,
                      f.height);
     const int threads = opts->threads;
+    ts_horizon_opts report; /* (what ts_parallel_reported reports through) */
+    ts_horizon_opts_default(&report);
+    report.progress = opts->progress;
+    report.progress_user = opts->progress_user;
     if (st == TS_OK)
         st = ts_parallel_for(ts_thread_count(threads, grid->height), grid->height,
                              project_rows, &J, err);
     /* (the bar: rendering a little more than half, the filter the rest, as
      * measured at a low sun) */
     if (st == TS_OK)
-        st = reported_pass(opts, f.height, render_band, &J, 0.0, 0.55, err);
+        st = ts_parallel_reported(ts_thread_count(threads, f.height), f.height, 0, render_band,
+                                  &J, &report, 0.0, 0.55, SM_BATCHES, err);
     const long th = (f.height + TS_SM_TILE - 1) / TS_SM_TILE;
     if (st == TS_OK)
         st = ts_parallel_for(ts_thread_count(threads, th), th, tile_rows, &J, err);
     if (st == TS_OK)
-        st = reported_pass(opts, grid->height, filter_rows, &J, 0.55, 1.0, err);
+        st = ts_parallel_reported(ts_thread_count(threads, grid->height), grid->height, 0,
+                                  filter_rows, &J, &report, 0.55, 1.0, SM_BATCHES, err);
     free(J.pu);
     free(J.pv);
     free(J.pd);

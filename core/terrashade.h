@@ -81,7 +81,8 @@ typedef struct {
     const ts_grid_origin *origin; /* a window of a larger DEM, or NULL */
 } ts_grid;
 
-/** A grid's longest side, cells. */
+/** A grid's longest side, cells: keeps width*height*directions in size_t
+ * and every index in ptrdiff_t, and turns absurd sizes into a clear error. */
 #define TS_MAX_SIDE (1 << 20)
 
 /**

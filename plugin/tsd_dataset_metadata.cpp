@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstring>
 #include <string>
-
 #include <vector>
 
 #include "cpl_conv.h"
