@@ -50,5 +50,6 @@ C_TESTS=$(cd "$TOP" && ls tests/check_*.c tests/cl/check_*.c | sed 's/\.c$//' | 
 # only the check programs and what they link, not the GDAL plugin
 make -j"$JOBS" $C_TESTS
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+    LSAN_OPTIONS=suppressions="$TOP/tests/lsan.supp" \
     make check-TESTS TESTS="$C_TESTS"
 [ "$KEEP" = 1 ] || rm -rf "$B"
