@@ -349,7 +349,7 @@ static void finish_rows(void *ctx, int worker, long y0, long y1)
         int interior = scratch && uncut && y >= m && y < H - m && W > 2 * m;
         int xa = interior ? m : W, xb = interior ? W - m : W;
         if (interior)
-            ts_near_row(&C->near, G, grid->z, zrow, (int)y, xa, xb, step, C->c, orow, scratch);
+            ts_near_row(&C->near, zrow, xa, xb, step, C->c, orow, scratch);
         if (scratch)
             ts_near_edges(&C->near, G, grid->z, zrow, (int)y, xa, xb, W, step, C->c, C->cap,
                           orow, scratch);

@@ -150,6 +150,150 @@ static void near_run(const ts_near_plan *p, const float *restrict zrow, int x0, 
     }
 }
 
+/* Piece n's slope at cells e0 <= e < e1 (corners c00[e] .. c11[e], height
+ * hz[e]), folded into best[e]: what cm_near_piece gives, with the same
+ * double operations, in a loop the compiler vectorises. voids = 0: for
+ * corners without nodata, the cells with a nodata corner (where
+ * cm_near_piece takes its other branch) counted in flag[e]; voids = 1:
+ * both branches, each cell's own selected, where a ray crosses nodata
+ * (speckled voids flag most cells of a row, and the scalar near field made
+ * such a DEM's sweep 7x dearer). An end's slope (he - h) / (s L) - c s L
+ * has the form of the polynomial's at s, so the one division takes either
+ * numerator. */
+static inline __attribute__((always_inline)) void
+exact_piece(const ts_near_plan *p, int n, const float *restrict c00, const float *restrict c10,
+            const float *restrict c01, const float *restrict c11, const float *restrict hz,
+            int e0, int e1, double smax, double L, double c, int voids, double *restrict best,
+            float *restrict flag)
+{
+    const int flat_v = fabs(p->t) <= 1e-12; /* along a grid line: 01, 11 weigh nothing */
+    const double t = flat_v ? 0 : p->t;
+    const double a0 = -p->piece_du[n], b0 = flat_v ? 0 : -p->piece_dv[n];
+    const double sa = p->piece_sa[n], sb = p->piece_sb[n] < smax ? p->piece_sb[n] : smax;
+    const int has_sa = sa > 0;
+    /* a nodata patch's ends on grid lines (cm_edge_height's weights) */
+    double wa[4], wb[4];
+    cm_edge_weights(a0 - sa, b0 - t * sa, wa);
+    cm_edge_weights(a0 - sb, b0 - t * sb, wb);
+    const double ca = c * sa * L, cb = c * sb * L, la = sa * L, lb = sb * L;
+    for (int e = e0; e < e1; e++) {
+        const float h0 = c00[e], h1 = c10[e], h2 = c01[e], h3 = c11[e];
+        const float A = h1 - h0, B = h2 - h0, X = h3 - h1 - h2 + h0;
+        const int nodata = (h0 != h0) | (h1 != h1) | (h2 != h2) | (h3 != h3);
+        double alpha, beta, gamma;
+        cm_patch_poly(h0, A, B, X, a0, b0, t, &alpha, &beta, &gamma);
+        const double P = alpha - hz[e];
+        double m;
+        if (!voids) {
+            m = cm_piece_max(P, beta, gamma, sa, sb, L, c);
+            flag[e] += nodata ? 1.0f : 0.0f;
+        } else {
+            /* cm_edge_height's sums, from 0 (a skipped corner adds +0,
+             * which leaves a sum that is never -0 as it is) */
+            double ea = 0.0, eb = 0.0;
+            ea += wa[0] > 0 ? wa[0] * h0 : 0.0;
+            ea += wa[1] > 0 ? wa[1] * h1 : 0.0;
+            ea += wa[2] > 0 ? wa[2] * h2 : 0.0;
+            ea += wa[3] > 0 ? wa[3] * h3 : 0.0;
+            eb += wb[0] > 0 ? wb[0] * h0 : 0.0;
+            eb += wb[1] > 0 ? wb[1] * h1 : 0.0;
+            eb += wb[2] > 0 ? wb[2] * h2 : 0.0;
+            eb += wb[3] > 0 ? wb[3] * h3 : 0.0;
+            const double na = nodata ? ea - hz[e] : P + beta * sa + gamma * sa * sa;
+            const double nb = nodata ? eb - hz[e] : P + beta * sb + gamma * sb * sb;
+            const double fa = has_sa ? na / la - ca : beta / L, fb = nb / lb - cb;
+            /* cm_near_piece's nodata branch: the valid ends' largest */
+            double me = has_sa && fa > -INFINITY ? fa : -INFINITY;
+            me = fb > me ? fb : me;
+            m = nodata ? me : cm_piece_max_ends(P, beta, gamma, sa, sb, L, c, fa, fb);
+        }
+        best[e] = m > best[e] ? m : best[e];
+    }
+}
+
+/* Piece n's corners 00, 10, 01, 11 from a cell, as element offsets (a
+ * ray along a grid line: 01 and 11 are 00 and 10, which alone weigh). */
+static void piece_corners(const ts_near_plan *p, int n, ptrdiff_t off[4])
+{
+    const int flat_v = fabs(p->t) <= 1e-12;
+    for (int j = 0; j < 4; j++)
+        off[j] = p->piece_off[n][flat_v ? j & 1 : j];
+}
+
+/* cm_near_exact over cells x0 <= x < x1 of a row whose pieces before
+ * n_end are on the grid: those pieces before smax steps (with sb cut
+ * there), each by exact_piece (voids as there; flag[x] is left 0 with
+ * voids). best: doubles. */
+static inline __attribute__((always_inline)) void
+exact_cells(const ts_near_plan *p, const float *restrict zrow, int x0, int x1, int n_end,
+            double smax, double L, double c, int voids, double *restrict best,
+            float *restrict flag)
+{
+    for (int x = x0; x < x1; x++) {
+        best[x] = -INFINITY;
+        flag[x] = 0.0f;
+    }
+    for (int n = 0; n < n_end && p->piece_sa[n] < smax; n++) {
+        ptrdiff_t o[4];
+        piece_corners(p, n, o);
+        exact_piece(p, n, zrow + o[0], zrow + o[1], zrow + o[2], zrow + o[3], zrow, x0, x1, smax,
+                    L, c, voids, best, flag);
+    }
+}
+
+TS_SIMD_CLONES
+static void exact_run(const ts_near_plan *p, const float *restrict zrow, int x0, int x1,
+                      int n_end, double smax, double L, double c, double *restrict best,
+                      float *restrict flag)
+{
+    exact_cells(p, zrow, x0, x1, n_end, smax, L, c, 0, best, flag);
+}
+
+TS_SIMD_CLONES
+static void exact_run_voids(const ts_near_plan *p, const float *restrict zrow, int x0, int x1,
+                            int n_end, double smax, double L, double c, double *restrict best,
+                            float *restrict flag)
+{
+    exact_cells(p, zrow, x0, x1, n_end, smax, L, c, 1, best, flag);
+}
+
+/* Cells of a list that exact_list_voids takes at a time. */
+#define LIST_CHUNK 128
+/* Where more than this share of a row's cells is listed, exact_run_voids
+ * takes the whole row (its unlisted cells' answers dropped) rather than
+ * gather the listed ones: svf of a 1024^2 DEM took 7 % less time so at 10 %
+ * voids (nearly every cell listed), and 1.5x more at 1 %. */
+#define LIST_MOST 0.8
+
+/* exact_run_voids over the listed cells qx[0..nq) of an interior row (no
+ * cap), best[e] for cell qx[e]: each piece's corners gathered into rows of
+ * their own, LIST_CHUNK cells at a time, for the vector loop. */
+TS_SIMD_CLONES
+static void exact_list_voids(const ts_near_plan *p, const float *restrict zrow,
+                             const int *restrict qx, int nq, double L, double c,
+                             double *restrict best)
+{
+    float cn[4][LIST_CHUNK], hz[LIST_CHUNK], flag[LIST_CHUNK];
+    for (int e0 = 0; e0 < nq; e0 += LIST_CHUNK) {
+        const int ne = nq - e0 < LIST_CHUNK ? nq - e0 : LIST_CHUNK;
+        const int *restrict x = qx + e0;
+        double *restrict b = best + e0;
+        for (int e = 0; e < ne; e++) {
+            hz[e] = zrow[x[e]];
+            b[e] = -INFINITY;
+        }
+        for (int n = 0; n < p->npieces; n++) {
+            ptrdiff_t o[4];
+            piece_corners(p, n, o);
+            for (int j = 0; j < 4; j++)
+                for (int e = 0; e < ne; e++)
+                    cn[j][e] = zrow[x[e] + o[j]];
+            exact_piece(p, n, cn[0], cn[1], cn[2], cn[3], hz, 0, ne, INFINITY, L, c, 1, b,
+                        flag);
+        }
+    }
+}
+
 /* out[x] = max(best[x], out[x]) over the cells with a height and no flag,
  * branch-free; returns whether any cell is flagged. */
 TS_SIMD_CLONES
@@ -166,9 +310,8 @@ static int near_merge(const float *restrict zrow, const float *restrict best,
     return flagged;
 }
 
-void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
-                 const float *zrow, int y, int x0, int x1, double step, double c,
-                 float *out, float *scratch)
+void ts_near_row(const ts_near_plan *p, const float *zrow, int x0, int x1, double step,
+                 double c, float *out, float *scratch)
 {
     /* best in zrow's phase on 64-byte lines (ts_near_run_avx512's aligned
      * vectors) */
@@ -181,50 +324,28 @@ void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
                  (unsigned char *)(queue + 2 * (size_t)x1), (int *)(queue + x1));
     if (!near_merge(zrow, best, flag, x0, x1, out))
         return;
-    /* cells whose near field touches nodata: the scalar near field */
+    /* cells whose near field touches nodata: ts_near_field's arithmetic,
+     * vectorised over the list of them, in the queue's room
+     * (TS_NEAR_ROW_SCRATCH leaves 5 x1 floats there): a double, a flag and
+     * an int a cell */
+    double *exact = (double *)(scratch + ((phase + 2 * (size_t)x1 + 1) & ~(size_t)1));
+    float *unused = (float *)(exact + x1);
+    int *qx = (int *)(unused + x1), nq = 0;
     for (int x = x0; x < x1; x++) {
-        if (flag[x] == 0.0f || isnan(zrow[x]))
-            continue;
-        int u = g->x_major ? x : y, v = g->x_major ? y : x;
-        int left;
-        float nf = ts_near_field(p, g, z, (u - g->u_start) * g->u_step, v, zrow[x], step, c,
-                                 0.0, &left);
+        qx[nq] = x;
+        nq += flag[x] != 0.0f && zrow[x] == zrow[x];
+    }
+    if (nq > LIST_MOST * (x1 - x0)) { /* most of the row: no gathers */
+        exact_run_voids(p, zrow, x0, x1, p->npieces, INFINITY, step, c, exact, unused);
+        for (int e = 0; e < nq; e++)
+            exact[e] = exact[qx[e]];
+    } else {
+        exact_list_voids(p, zrow, qx, nq, step, c, exact);
+    }
+    for (int e = 0; e < nq; e++) {
+        const int x = qx[e];
+        const float nf = (float)exact[e];
         out[x] = nf > out[x] ? nf : out[x];
-    }
-}
-
-/* cm_near_exact over cells x0 <= x < x1 of a row whose pieces before
- * n_end are on the grid: those pieces before smax steps (with sb cut
- * there), each by cm_near_piece's arithmetic for corners without nodata,
- * in loops the compiler vectorises; cells with a nodata corner (where
- * cm_near_piece takes its other branch) are flagged. best: doubles. */
-TS_SIMD_CLONES
-static void exact_run(const ts_near_plan *p, const float *restrict zrow, int x0, int x1,
-                      int n_end, double smax, double L, double c, double *restrict best,
-                      float *restrict flag)
-{
-    for (int x = x0; x < x1; x++) {
-        best[x] = -INFINITY;
-        flag[x] = 0.0f;
-    }
-    const int flat_v = fabs(p->t) <= 1e-12; /* along a grid line: 01, 11 weigh nothing */
-    const double t = flat_v ? 0 : p->t;
-    for (int n = 0; n < n_end && p->piece_sa[n] < smax; n++) {
-        const float *restrict c00 = zrow + p->piece_off[n][0];
-        const float *restrict c10 = zrow + p->piece_off[n][1];
-        const float *restrict c01 = flat_v ? c00 : zrow + p->piece_off[n][2];
-        const float *restrict c11 = flat_v ? c10 : zrow + p->piece_off[n][3];
-        const double a0 = -p->piece_du[n], b0 = flat_v ? 0 : -p->piece_dv[n];
-        const double sa = p->piece_sa[n], sb = p->piece_sb[n] < smax ? p->piece_sb[n] : smax;
-        for (int x = x0; x < x1; x++) {
-            const float h0 = c00[x], h1 = c10[x], h2 = c01[x], h3 = c11[x];
-            const float A = h1 - h0, B = h2 - h0, X = h3 - h1 - h2 + h0;
-            double alpha, beta, gamma;
-            cm_patch_poly(h0, A, B, X, a0, b0, t, &alpha, &beta, &gamma);
-            const double m = cm_piece_max(alpha - zrow[x], beta, gamma, sa, sb, L, c);
-            best[x] = m > best[x] ? m : best[x];
-            flag[x] += ((h0 != h0) | (h1 != h1) | (h2 != h2) | (h3 != h3)) ? 1.0f : 0.0f;
-        }
     }
 }
 
@@ -300,12 +421,16 @@ void ts_near_edges(const ts_near_plan *p, const ts_line_geom *g, const float *z,
             }
         }
         exact_run(p, zrow, x, x1, n_end, smax, step, c, best, flag);
+        int flagged = 0;
+        for (int xf = x; xf < x1; xf++)
+            flagged |= flag[xf] != 0.0f;
+        if (flagged) /* a nodata corner: the run again, both branches */
+            exact_run_voids(p, zrow, x, x1, n_end, smax, step, c, best, flag);
         for (; x < x1; x++) {
             if (isnan(zrow[x]))
                 continue;
-            int left = left_all; /* near_cell's too: 0 on the grid */
-            float nf = flag[x] == 0.0f ? (float)best[x]
-                                       : near_cell(p, g, z, zrow, y, x, step, c, cap, &left);
+            const int left = left_all; /* near_cell's too: 0 on the grid */
+            const float nf = (float)best[x];
             out[x] = left ? nf : fmaxf(nf, out[x]);
         }
     }

@@ -47,26 +47,27 @@ float ts_ray_exact(const ts_line_geom *g, const float *z, int k, int i, float h,
                    double s_to, double step, double c);
 
 /*
- * Near field of the interior cells x0 <= x < x1 of one grid row, all with
- * the same metres per step. zrow points at the row's first height;
- * out[x] receives max(out[x], near field) (the far field is already there).
- * Cells whose near field touches nodata are redone by ts_near_field.
+ * Near field of the interior cells x0 <= x < x1 of one grid row (their
+ * pieces all on the grid), all with the same metres per step. zrow points
+ * at the row's first height; out[x] receives max(out[x], near field) (the
+ * far field is already there). Cells whose near field touches nodata or
+ * an infinity are redone with ts_near_field's double arithmetic,
+ * vectorised over runs of them; the same bits as ts_near_field.
  * scratch: TS_NEAR_ROW_SCRATCH(x1) floats.
  */
 #define TS_NEAR_ROW_SCRATCH(x1) (7 * (size_t)(x1) + 160)
-void ts_near_row(const ts_near_plan *p, const ts_line_geom *g, const float *z,
-                 const float *zrow, int y, int x0, int x1, double step, double c,
-                 float *out, float *scratch);
+void ts_near_row(const ts_near_plan *p, const float *zrow, int x0, int x1, double step,
+                 double c, float *out, float *scratch);
 
 /*
  * Near field of the cells of row y outside [xa, xb) (the interior that
  * ts_near_row does), cap as ts_near_field: out[x] = the near field where
  * the ray leaves the grid inside it, else max(out[x], near field). Cells
- * that touch no nodata take the vectorised form of ts_near_field's double
- * arithmetic in runs: of cells whose pieces all lie on the grid, and of at
- * least 8 cells whose rays leave the grid at the same piece (the pieces
- * before it); the others take ts_near_field itself; the same bits either
- * way. scratch: 3 W floats (TS_NEAR_ROW_SCRATCH(W) is more).
+ * take the vectorised form of ts_near_field's double arithmetic in runs:
+ * of cells whose pieces all lie on the grid, and of at least 8 cells whose
+ * rays leave the grid at the same piece (the pieces before it); the others
+ * take ts_near_field itself; the same bits either way. scratch: 3 W floats
+ * (TS_NEAR_ROW_SCRATCH(W) is more).
  */
 void ts_near_edges(const ts_near_plan *p, const ts_line_geom *g, const float *z,
                    const float *zrow, int y, int xa, int xb, int W, double step, double c,

@@ -39,23 +39,34 @@ typedef struct {
     const CM_GLOBAL cm_real *sa, *sb;
 } cm_near_tables;
 
-/* Bilinear height at (a, b) of a patch (corners 00, 10, 01, 11) from the
- * corners that weigh something there; NaN if one of those is nodata. */
-CM_FN cm_real cm_edge_height(float h0, float h1, float h2, float h3, cm_real a, cm_real b)
+/* The bilinear weights at (a, b) of a patch's corners 00, 10, 01, 11, a and
+ * b within a hair of 0 or 1 snapped to it. */
+CM_FN void cm_edge_weights(cm_real a, cm_real b, cm_real w[4])
 {
     const cm_real eps = CM_R(1e-9);
     a = a < eps ? 0 : a > 1 - eps ? 1 : a;
     b = b < eps ? 0 : b > 1 - eps ? 1 : b;
-    const cm_real w0 = (1 - a) * (1 - b), w1 = a * (1 - b), w2 = (1 - a) * b, w3 = a * b;
+    w[0] = (1 - a) * (1 - b);
+    w[1] = a * (1 - b);
+    w[2] = (1 - a) * b;
+    w[3] = a * b;
+}
+
+/* Bilinear height at (a, b) of a patch (corners 00, 10, 01, 11) from the
+ * corners that weigh something there; NaN if one of those is nodata. */
+CM_FN cm_real cm_edge_height(float h0, float h1, float h2, float h3, cm_real a, cm_real b)
+{
+    cm_real w[4];
+    cm_edge_weights(a, b, w);
     cm_real sum = 0;
-    if (w0 > 0)
-        sum += w0 * h0; /* a NaN corner makes the sum NaN */
-    if (w1 > 0)
-        sum += w1 * h1;
-    if (w2 > 0)
-        sum += w2 * h2;
-    if (w3 > 0)
-        sum += w3 * h3;
+    if (w[0] > 0)
+        sum += w[0] * h0; /* a NaN corner makes the sum NaN */
+    if (w[1] > 0)
+        sum += w[1] * h1;
+    if (w[2] > 0)
+        sum += w[2] * h2;
+    if (w[3] > 0)
+        sum += w[3] * h3;
     return sum;
 }
 
@@ -67,12 +78,10 @@ CM_FN cm_real cm_slope_at(cm_real P, cm_real beta, cm_real gamma, cm_real s, cm_
     return (P + beta * s + gamma * s * s) / (s * L) - c * s * L;
 }
 
-/* Largest slope over s in [sa, sb]; at sa = 0 the limit beta / L. */
-CM_FN cm_real cm_piece_max(cm_real P, cm_real beta, cm_real gamma, cm_real sa, cm_real sb,
-                           cm_real L, cm_real c)
+/* cm_piece_max given its ends' slopes fa (at sa) and fb (at sb). */
+CM_FN cm_real cm_piece_max_ends(cm_real P, cm_real beta, cm_real gamma, cm_real sa, cm_real sb,
+                                cm_real L, cm_real c, cm_real fa, cm_real fb)
 {
-    cm_real fb = cm_slope_at(P, beta, gamma, sb, L, c);
-    cm_real fa = sa > 0 ? cm_slope_at(P, beta, gamma, sa, L, c) : beta / L;
     cm_real m = fa > fb ? fa : fb;
     cm_real g2 = gamma - c * L * L;
     if (sa > 0 && P < 0 && g2 < 0) {
@@ -83,6 +92,15 @@ CM_FN cm_real cm_piece_max(cm_real P, cm_real beta, cm_real gamma, cm_real sa, c
         }
     }
     return m;
+}
+
+/* Largest slope over s in [sa, sb]; at sa = 0 the limit beta / L. */
+CM_FN cm_real cm_piece_max(cm_real P, cm_real beta, cm_real gamma, cm_real sa, cm_real sb,
+                           cm_real L, cm_real c)
+{
+    cm_real fb = cm_slope_at(P, beta, gamma, sb, L, c);
+    cm_real fa = sa > 0 ? cm_slope_at(P, beta, gamma, sa, L, c) : beta / L;
+    return cm_piece_max_ends(P, beta, gamma, sa, sb, L, c, fa, fb);
 }
 
 /* h(s) = alpha + beta s + gamma s^2 along the ray in a patch with corner
