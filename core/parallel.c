@@ -1,4 +1,8 @@
-/* Parallel-for on POSIX threads; no pool, no global state. */
+/* Parallel-for on POSIX threads; no pool, no global state. Each thread
+ * takes its creator's locale (uselocale), so that a caller that holds the
+ * "C" locale while the process has the user's (the GDAL driver, whose
+ * numbers must read and print with a '.') has it in its workers too. */
+#include <locale.h>
 #include <pthread.h>
 #include <sched.h>
 #include <stdatomic.h>
@@ -30,11 +34,14 @@ typedef struct {
     int worker;
     long begin, end;
     atomic_int *state;
+    locale_t locale; /* the creator's */
 } chunk;
 
 static void *run_chunk(void *arg)
 {
     chunk *c = arg;
+    if (c->worker > 0)
+        uselocale(c->locale);
     int s;
     while ((s = atomic_load_explicit(c->state, memory_order_acquire)) == WAIT)
         sched_yield();
@@ -63,8 +70,10 @@ ts_status ts_parallel_for(int threads, long items, ts_range_fn fn, void *ctx,
     }
     atomic_int state;
     atomic_init(&state, WAIT);
+    const locale_t loc = uselocale((locale_t)0);
     for (int t = 0; t < threads; t++)
-        chunks[t] = (chunk){fn, ctx, t, items * t / threads, items * (t + 1) / threads, &state};
+        chunks[t] = (chunk){fn, ctx, t, items * t / threads, items * (t + 1) / threads, &state,
+                            loc};
     int started = 1;
     for (int t = 1; t < threads; t++) {
         if (pthread_create(&tids[t], NULL, run_chunk, &chunks[t]) != 0)
@@ -114,11 +123,13 @@ typedef struct {
     void *ctx;
     int worker;
     ts_range_queue *q;
+    locale_t locale; /* the creator's */
 } ranges_worker;
 
 static void *run_ranges(void *arg)
 {
     ranges_worker *r = arg;
+    uselocale(r->locale);
     r->fn(r->ctx, r->worker, r->q);
     return NULL;
 }
@@ -137,9 +148,10 @@ ts_status ts_parallel_ranges(int threads, long items, long grain, ts_ranges_fn f
     ranges_worker *w = q.threads > 1 ? malloc((size_t)q.threads * sizeof *w) : NULL;
     pthread_t *tids = q.threads > 1 ? malloc((size_t)q.threads * sizeof *tids) : NULL;
     int started = 1;
+    const locale_t loc = uselocale((locale_t)0);
     if (w && tids)
         for (int t = 1; t < q.threads; t++) {
-            w[t] = (ranges_worker){fn, ctx, t, &q};
+            w[t] = (ranges_worker){fn, ctx, t, &q, loc};
             if (pthread_create(&tids[t], NULL, run_ranges, &w[t]) != 0)
                 break;
             started++;

@@ -29,6 +29,7 @@
 #include "tsd_geodesy.h"
 #include "tsd_options.h"
 #include "tsd_pam_band.h"
+#include "tsd_locale.h"
 
 namespace tsd
 {
@@ -142,6 +143,7 @@ TSAtlasDataset::~TSAtlasDataset()
 
 CPLErr TSAtlasBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
 {
+    tsd::CLocale oC; /* tsd_locale.h */
     TSAtlasDataset *ds = static_cast<TSAtlasDataset *>(poDS);
     if (ds->m_bAll && ds->EnsureNear() != CE_None)
         return CE_Failure;

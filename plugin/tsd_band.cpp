@@ -15,6 +15,7 @@
 #include "tsd_caller_progress.h"
 #include "tsd_dataset.h"
 #include "tsd_gdal.h"
+#include "tsd_locale.h"
 
 namespace tsd
 {
@@ -61,6 +62,7 @@ const char *TSRasterBand::NotHere() const
 
 CPLErr TSRasterBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
 {
+    tsd::CLocale oC; /* tsd_locale.h */
     TSDataset *ds = static_cast<TSDataset *>(poDS);
     if (ds->m_poWindow) // chunk by chunk (tsd_window_cache.cpp)
         return WindowReadBlock(nBlockXOff, nBlockYOff, pImage);
@@ -143,6 +145,7 @@ CPLErr TSRasterBand::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXS
                                GDALDataType eBufType, GSpacing nPixelSpace, GSpacing nLineSpace,
                                GDALRasterIOExtraArg *psExtraArg)
 {
+    tsd::CLocale oC; /* tsd_locale.h */
     const CallerProgress oCaller(psExtraArg); // a computation started here reports to it
     CPLErr eErr = CE_None;
     if (!(eRWFlag == GF_Read && nBufXSize == nXSize && nBufYSize == nYSize &&

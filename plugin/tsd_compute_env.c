@@ -30,9 +30,8 @@ int tsd_exposure_parse(const char *text, double *stops)
 {
     if (!text[0] || strcasecmp(text, "auto") == 0)
         return 1;
-    char *end = NULL;
-    double x = strtod(text, &end);
-    if (end == text || *end || !isfinite(x) || fabs(x) > TSD_EXPOSURE_MAX)
+    double x;
+    if (tsd_parse_decimal(text, &x) != 0 || fabs(x) > TSD_EXPOSURE_MAX)
         return -1;
     *stops = x;
     return 0;

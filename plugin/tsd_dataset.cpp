@@ -32,6 +32,7 @@
 #include "tsd_dem.h"
 #include "tsd_gdal.h"
 #include "tsd_window.h"
+#include "tsd_locale.h"
 
 namespace tsd
 {
@@ -88,6 +89,7 @@ void TSDataset::StartReadAhead()
         m_oReadAhead = std::thread(
             [this]
             {
+                tsd::CLocale oC; /* its messages' numbers (tsd_locale.h) */
                 char szMsg[1024] = "";
                 m_eReadStatus = LoadDEM(&m_sReadGrid, szMsg, sizeof szMsg);
                 m_osReadMsg = szMsg;
@@ -160,6 +162,7 @@ CPLErr TSDataset::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize
                             GSpacing nLineSpace, GSpacing nBandSpace,
                             GDALRasterIOExtraArg *psExtraArg)
 {
+    tsd::CLocale oC; /* tsd_locale.h */
     const CallerProgress oCaller(psExtraArg);
     const CPLErr eErr = GDALPamDataset::IRasterIO(
         eRWFlag, nXOff, nYOff, nXSize, nYSize, pData, nBufXSize, nBufYSize, eBufType,

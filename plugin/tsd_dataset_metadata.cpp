@@ -14,6 +14,7 @@
 
 #include "tsd_dataset.h"
 #include "tsd_gdal.h"
+#include "tsd_locale.h"
 
 namespace tsd
 {
@@ -37,6 +38,7 @@ void TSDataset::EnsureBackendMetadata()
 
 char **TSDataset::GetMetadata(const char *pszDomain)
 {
+    tsd::CLocale oC; /* tsd_locale.h */
     if (!pszDomain || !*pszDomain)
         EnsureBackendMetadata();
     return GDALPamDataset::GetMetadata(pszDomain);
@@ -44,6 +46,7 @@ char **TSDataset::GetMetadata(const char *pszDomain)
 
 const char *TSDataset::GetMetadataItem(const char *pszName, const char *pszDomain)
 {
+    tsd::CLocale oC; /* tsd_locale.h */
     if ((!pszDomain || !*pszDomain) && pszName && STARTS_WITH_CI(pszName, "BACKEND"))
         EnsureBackendMetadata();
     return GDALPamDataset::GetMetadataItem(pszName, pszDomain);

@@ -242,7 +242,7 @@ const opt_def TSD_OPTION_ROWS[] = {
     {"EXPOSURE", K_TEXT, FIELD(exposure), "", 0, 0, 0, 0, NULL, 1, P, LISTED,
      check_exposure,
      "envlight with OUTPUT_TYPE=Byte: stops by which the light is scaled (x "
-     "2^EXPOSURE) before the sRGB curve; empty or AUTO: the brightest "
+     "2^EXPOSURE) before the sRGB curve; AUTO (the default): the brightest "
      "unshadowed surface of any slope and aspect maps to 255"},
 
     {"ENV_METHOD", K_SELECT, FIELD(env_method), "table", 0, 0, 0, 0, "table|sh", 1, P,
@@ -399,9 +399,8 @@ static int check_tile_size(const char *v, char *msg, size_t n)
  * it (not a number: the kind's check says so). */
 static int check_light_radius(const char *v, char *msg, size_t n)
 {
-    char *end;
-    double r = strtod(v, &end);
-    if (end == v || *end || !isfinite(r) || (r > 0 && r < TS_LIGHT_RADIUS_MAX))
+    double r;
+    if (tsd_parse_decimal(v, &r) != 0 || (r > 0 && r < TS_LIGHT_RADIUS_MAX))
         return 0;
     tsd_fail(msg, n, TS_ERR_ARG, "LIGHT_RADIUS must be greater than 0 and less than %g "
              "degrees, got %s", TS_LIGHT_RADIUS_MAX, v);

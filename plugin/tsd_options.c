@@ -77,23 +77,14 @@ static int parse_number(const opt_def *d, const char *v, double *out, char *msg,
     errno = 0;
     if (d->kind == K_INT) {
         long l = strtol(v, &end, 10);
-        if (end == v || *end || errno)
+        if (end == v || *end)
             REFUSE("%s must be a whole number, got '%s'", d->name, v);
-        *out = (double)l;
-    } else {
-        /* decimal only: strtod also reads C's hexadecimal floats (0x10 = 16) */
-        const char *digits = v;
-        while (isspace((unsigned char)*digits))
-            digits++;
-        digits += *digits == '+' || *digits == '-';
-        if (digits[0] == '0' && (digits[1] == 'x' || digits[1] == 'X'))
-            end = (char *)v;
-        double x = end == v ? 0.0 : strtod(v, &end);
-        if ((end == v || *end || !isfinite(x)) && d->kind == K_FLOAT_AUTO)
+        /* a whole number too long for a long: past the range below */
+        *out = errno == ERANGE ? (l < 0 ? -INFINITY : INFINITY) : (double)l;
+    } else if (tsd_parse_decimal(v, out) != 0) {
+        if (d->kind == K_FLOAT_AUTO)
             REFUSE("%s must be %s or a number, got '%s'", d->name, d->values, v);
-        if (end == v || *end || !isfinite(x))
-            REFUSE("%s must be a number, got '%s'", d->name, v);
-        *out = x;
+        REFUSE("%s must be a number, got '%s'", d->name, v);
     }
     double x = *out;
     int low = d->min_exclusive ? !(x > d->min) : !(x >= d->min);
@@ -188,7 +179,9 @@ void tsd_options_defaults(tsd_options *o)
 }
 
 /* Copy s without surrounding blanks into buf; returns buf. */
-static char *trim(const char *s, size_t len, char *buf, size_t n)
+/* s[0..len) without surrounding spaces into buf of n bytes; returns its
+ * length, n or more where it did not fit (buf then holds its start). */
+static size_t trim(const char *s, size_t len, char *buf, size_t n)
 {
     while (len && isspace((unsigned char)*s)) {
         s++;
@@ -196,11 +189,36 @@ static char *trim(const char *s, size_t len, char *buf, size_t n)
     }
     while (len && isspace((unsigned char)s[len - 1]))
         len--;
+    const size_t full = len;
     if (len >= n)
         len = n - 1;
     memcpy(buf, s, len);
     buf[len] = '\0';
-    return buf;
+    return full;
+}
+
+/* Whether two spellings of option id's value mean the same: as numbers,
+ * booleans or choices they read as, else as text (case aside). */
+static int same_value(int id, const char *a, const char *b)
+{
+    const opt_def *d = &TSD_OPTION_ROWS[id];
+    double x, y;
+    int p, q;
+    switch (d->kind) {
+    case K_FLOAT:
+    case K_FLOAT_AUTO:
+    case K_INT:
+        if (tsd_parse_decimal(a, &x) == 0 && tsd_parse_decimal(b, &y) == 0)
+            return x == y;
+        break;
+    case K_BOOL:
+        if (parse_bool(a, &p) == 0 && parse_bool(b, &q) == 0)
+            return p == q;
+        break;
+    default:
+        break;
+    }
+    return strcasecmp(a, b) == 0;
 }
 
 /* The names of the options of `scope`, "A, B, C"; for an atlas "A, B and
@@ -239,7 +257,7 @@ static int apply_scope(tsd_options *o, const char *const *kv, int scope, char *m
             REFUSE("%s '%s' is not of the form KEY=VALUE",
                    scope == TSD_SCOPE_ATLAS ? "open option" : "option", item);
         trim(item, (size_t)(eq - item), key, sizeof key);
-        trim(eq + 1, strlen(eq + 1), value, sizeof value);
+        const size_t nvalue = trim(eq + 1, strlen(eq + 1), value, sizeof value);
         int id = tsd_option_find(key);
         if (id >= 0 && !(TSD_OPTION_ROWS[id].scope & scope) && scope == TSD_SCOPE_PRODUCT)
             REFUSE("%s is an open option of far-shadow atlas files (.tsa), not of "
@@ -251,10 +269,13 @@ static int apply_scope(tsd_options *o, const char *const *kv, int scope, char *m
             REFUSE("unknown option '%s'; the options are %s (see gdalinfo "
                    "--format TERRASHADE)", key, names);
         }
+        if (nvalue >= sizeof value)
+            REFUSE("%s is too long (%zu characters; at most %zu)", TSD_OPTION_ROWS[id].name,
+                   nvalue, sizeof value - 1);
         if (seen[id]) {
             const char *e = strchr(seen[id], '=');
             trim(e + 1, strlen(e + 1), before, sizeof before);
-            if (strcasecmp(before, value) != 0)
+            if (!same_value(id, before, value))
                 REFUSE("%s is given twice, as %s and as %s", TSD_OPTION_ROWS[id].name, before,
                        value);
         }

@@ -16,6 +16,7 @@
 
 #include "tsd_dataset.h"
 #include "tsd_gdal.h"
+#include "tsd_locale.h"
 
 namespace tsd
 {
@@ -98,11 +99,13 @@ CPLErr TSDataset::IBuildOverviews(const char *, int, const int *, int, const int
 
 int TSRasterBand::GetOverviewCount()
 {
+    tsd::CLocale oC; /* tsd_locale.h */
     return static_cast<TSDataset *>(poDS)->m_nOverviews;
 }
 
 GDALRasterBand *TSRasterBand::GetOverview(int i)
 {
+    tsd::CLocale oC; /* tsd_locale.h */
     TSDataset *poOvr = static_cast<TSDataset *>(poDS)->Overview(i);
     return poOvr ? poOvr->GetRasterBand(nBand) : nullptr;
 }

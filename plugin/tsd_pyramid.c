@@ -32,8 +32,9 @@ int tsd_options_check_pyramid(const tsd_options *o, char *msg, size_t n)
     /* as SVF_MODEL: a value that would do nothing is a mistake; the
      * default given explicitly is not */
     if (o->horizon_method != TSD_HORIZON_PYRAMID) {
-        double k0 = atof(tsd_option_default(tsd_option_find("PYRAMID_LEVEL_STEP")));
-        double o0 = atof(tsd_option_default(tsd_option_find("PYRAMID_OFFSET")));
+        double k0 = 0, o0 = 0; /* (the table's defaults are numbers) */
+        tsd_parse_decimal(tsd_option_default(tsd_option_find("PYRAMID_LEVEL_STEP")), &k0);
+        tsd_parse_decimal(tsd_option_default(tsd_option_find("PYRAMID_OFFSET")), &o0);
         const char *which = o->pyramid_offset != o0         ? "PYRAMID_OFFSET"
                             : o->pyramid_level_step != k0 ? "PYRAMID_LEVEL_STEP"
                                                           : NULL;

@@ -14,6 +14,7 @@
 
 #include "tsd_connstr.h"
 #include "tsd_gdal.h"
+#include "tsd_locale.h"
 #include "tsd_options.h"
 #include "tsd_products.h"
 
@@ -22,11 +23,13 @@ namespace
 
 int IdentifyAny(GDALOpenInfo *poOpenInfo)
 {
+    tsd::CLocale oC;
     return tsd::IdentifyProduct(poOpenInfo) || tsd::IdentifyAtlas(poOpenInfo);
 }
 
 GDALDataset *OpenAny(GDALOpenInfo *poOpenInfo)
 {
+    tsd::CLocale oC;
     if (tsd::IdentifyProduct(poOpenInfo))
         return tsd::OpenProduct(poOpenInfo);
     if (!tsd::IdentifyAtlas(poOpenInfo))
@@ -57,6 +60,7 @@ CPLErr RefuseConnection(const char *pszWhat, const char *pszName)
 
 CPLErr DeleteAny(const char *pszName)
 {
+    tsd::CLocale oC;
     if (IsConnection(pszName))
         return RefuseConnection("delete", pszName);
     const char *const apszDrivers[] = {tsd::DRIVER, nullptr};
@@ -80,6 +84,7 @@ CPLErr DeleteAny(const char *pszName)
 
 CPLErr RenameAny(const char *pszNewName, const char *pszOldName)
 {
+    tsd::CLocale oC;
     if (IsConnection(pszOldName) || IsConnection(pszNewName))
         return RefuseConnection("rename", IsConnection(pszOldName) ? pszOldName : pszNewName);
     return GDALDriver::DefaultRename(pszNewName, pszOldName);
@@ -87,9 +92,19 @@ CPLErr RenameAny(const char *pszNewName, const char *pszOldName)
 
 CPLErr CopyFilesAny(const char *pszNewName, const char *pszOldName)
 {
+    tsd::CLocale oC;
     if (IsConnection(pszOldName) || IsConnection(pszNewName))
         return RefuseConnection("copy", IsConnection(pszOldName) ? pszOldName : pszNewName);
     return GDALDriver::DefaultCopyFiles(pszNewName, pszOldName);
+}
+
+GDALDataset *CreateCopyAny(const char *pszFilename, GDALDataset *poSrcDS, int bStrict,
+                           char **papszOptions, GDALProgressFunc pfnProgress,
+                           void *pProgressData)
+{
+    tsd::CLocale oC;
+    return tsd::CreateAtlasCopy(pszFilename, poSrcDS, bStrict, papszOptions, pfnProgress,
+                                pProgressData);
 }
 
 /* Set a driver item to a malloc'ed string (NULL: out of memory, not set). */
@@ -110,6 +125,7 @@ void GDALRegister_TERRASHADE()
         return;
     if (GDALGetDriverByName(tsd::DRIVER) != nullptr)
         return;
+    tsd::CLocale oC; /* the option list's numbers */
     GDALDriver *poDriver = new GDALDriver();
     poDriver->SetDescription(tsd::DRIVER);
     poDriver->SetMetadataItem(GDAL_DCAP_RASTER, "YES");
@@ -127,7 +143,7 @@ void GDALRegister_TERRASHADE()
     SetOwnedItem(poDriver, "TERRASHADE_PRODUCTS", tsd_products_xml());
     poDriver->pfnIdentify = IdentifyAny;
     poDriver->pfnOpen = OpenAny;
-    poDriver->pfnCreateCopy = tsd::CreateAtlasCopy;
+    poDriver->pfnCreateCopy = CreateCopyAny;
     poDriver->pfnDelete = DeleteAny;
     poDriver->pfnRename = RenameAny;
     poDriver->pfnCopyFiles = CopyFilesAny;

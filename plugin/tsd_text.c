@@ -1,6 +1,10 @@
-/* Failing with a sentence, and a growing string; see tsd_text.h. */
+/* Failing with a sentence, reading a number, and a growing string; see
+ * tsd_text.h. */
 #include "tsd_text.h"
 
+#include <ctype.h>
+#include <math.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,6 +26,43 @@ ts_status tsd_fail_core(char *msg, size_t n, const char *what, const ts_error *e
     if (what)
         return tsd_fail(msg, n, err->code, "%s: %s", what, text);
     return tsd_fail(msg, n, err->code, "%s", text);
+}
+
+static locale_t c_locale;
+static pthread_once_t c_locale_once = PTHREAD_ONCE_INIT;
+
+static void make_c_locale(void)
+{
+    c_locale = newlocale(LC_ALL_MASK, "C", (locale_t)0);
+}
+
+locale_t tsd_c_locale(void)
+{
+    pthread_once(&c_locale_once, make_c_locale);
+    return c_locale;
+}
+
+int tsd_parse_decimal(const char *text, double *x)
+{
+    const char *digits = text;
+    while (isspace((unsigned char)*digits))
+        digits++;
+    digits += *digits == '+' || *digits == '-';
+    if (!isdigit((unsigned char)digits[0]) && digits[0] != '.')
+        return -1; /* (strtod also reads "inf" and "nan") */
+    if (digits[0] == '0' && (digits[1] == 'x' || digits[1] == 'X'))
+        return -1;
+    const locale_t c = tsd_c_locale();
+    char *end;
+    const double v = c ? strtod_l(text, &end, c) : strtod(text, &end);
+    if (end == text || !isfinite(v)) /* (an underflow reads as its rounding) */
+        return -1;
+    while (isspace((unsigned char)*end))
+        end++;
+    if (*end)
+        return -1;
+    *x = v;
+    return 0;
 }
 
 void tsd_strbuf_add(tsd_strbuf *b, const char *fmt, ...)

@@ -1,11 +1,13 @@
 /*
  * tsd_text.h - text helpers of the plugin's C side: the one way to fail
- * with a sentence (tsd_fail), and a growing string for the XML lists the
- * driver publishes. Plain C, no GDAL.
+ * with a sentence (tsd_fail), the one way to read a number
+ * (tsd_parse_decimal), and a growing string for the XML lists the driver
+ * publishes. Plain C, no GDAL.
  */
 #ifndef TSD_TEXT_H
 #define TSD_TEXT_H
 
+#include <locale.h>
 #include <stddef.h>
 
 #include "terrashade.h"
@@ -28,6 +30,21 @@ ts_status tsd_fail(char *msg, size_t msg_size, ts_status code, const char *fmt, 
 
 /** tsd_fail with a core error: "what: message" (what may be NULL), its code. */
 ts_status tsd_fail_core(char *msg, size_t msg_size, const char *what, const ts_error *err);
+
+/**
+ * The "C" locale, made once for the process (NULL: out of memory). The
+ * driver holds it on its thread while it runs (tsd_locale.h); the parser
+ * below takes it whatever the thread holds.
+ */
+locale_t tsd_c_locale(void);
+
+/**
+ * Read a decimal number: the whole of text but surrounding spaces, with a
+ * '.' whatever the process's locale; C's hexadecimal floats (0x10),
+ * infinities, NaN and overflow are refused (an underflow reads as what it
+ * rounds to). 0 with *x set, else -1.
+ */
+int tsd_parse_decimal(const char *text, double *x);
 
 /** A growing string; zero it before use, free(s) after. */
 typedef struct {
