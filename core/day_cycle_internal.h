@@ -40,6 +40,7 @@ typedef struct {
     float *pa, *pb;     /* horizon planes */
     float *cel, *caz;   /* lattice: per-cell elevation and azimuth offset */
     ts_sun_sample *ns;  /* per-node sun */
+    double *noff;       /* per-node azimuth from the reference's, unwrapped */
     /* lattice: planes at azimuth s * LATTICE_AZ_STEP kept from earlier
      * steps (NULL: not kept), and how many more may be */
     float **kept;

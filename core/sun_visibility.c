@@ -48,6 +48,7 @@ void ts_vis_free(ts_vis_ctx *c)
     free(c->cel);
     free(c->caz);
     free(c->ns);
+    free(c->noff);
     memset(c, 0, sizeof *c);
 }
 
@@ -75,13 +76,14 @@ ts_status ts_vis_init(ts_vis_ctx *c, const ts_grid *g, const ts_sun_sites *s,
     c->cel = lattice ? malloc(c->cells * sizeof(float)) : NULL;
     c->caz = lattice ? malloc(c->cells * sizeof(float)) : NULL;
     c->ns = malloc((size_t)c->nodes * sizeof *c->ns);
+    c->noff = malloc((size_t)c->nodes * sizeof *c->noff);
     c->floor = o->earth_horizon ? malloc(c->cells * sizeof(float)) : NULL;
     c->kept = lattice ? calloc(LATTICE_SLOTS, sizeof *c->kept) : NULL;
     if (keep && lattice) {
         size_t planes = o->plane_cache_bytes / (c->cells * sizeof(float));
         c->room = planes < (size_t)LATTICE_SLOTS ? (int)planes : LATTICE_SLOTS;
     }
-    if (!c->pa || !c->ns || (lattice && (!c->pb || !c->cel || !c->caz || !c->kept)) ||
+    if (!c->pa || !c->ns || !c->noff || (lattice && (!c->pb || !c->cel || !c->caz || !c->kept)) ||
         (o->earth_horizon && !c->floor)) {
         ts_vis_free(c);
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the sun's work planes");
@@ -158,17 +160,27 @@ static inline float plane_between(const float *pa, const float *pb, size_t i, do
 
 /* The azimuths of a lattice's suns, as offsets lo..hi from a_ref, and
  * their highest elevation. */
-static void lattice_span(const ts_sun_sample *ns, int nodes, double a_ref, double *lo,
-                         double *hi, double *emax)
+static void lattice_span(const ts_sun_sample *ns, int nx, int ny, double a_ref, double *off,
+                         double *lo, double *hi, double *emax)
 {
     *lo = INFINITY;
     *hi = *emax = -INFINITY;
-    for (int i = 0; i < nodes; i++) {
-        double d = ts_wrap180(ns[i].grid_azimuth - a_ref);
-        *lo = fmin(*lo, d);
-        *hi = fmax(*hi, d);
-        *emax = fmax(*emax, ns[i].elevation);
-    }
+    for (int j = 0; j < ny; j++)
+        for (int i = 0; i < nx; i++) {
+            /* from a_ref, but as its neighbour (left, or above for a row's
+             * first) continues: wrapped each from a_ref alone, two nodes on
+             * either side of a_ref + 180 were averaged the long way round,
+             * and a band of cells took a sun from the opposite side */
+            const int k = j * nx + i, p = i > 0 ? k - 1 : j > 0 ? k - nx : -1;
+            double d = ts_wrap180(ns[k].grid_azimuth - a_ref);
+            if (p >= 0)
+                d += 360.0 * round((off[p] + ts_wrap180(ns[k].grid_azimuth -
+                                                        ns[p].grid_azimuth) - d) / 360.0);
+            off[k] = d;
+            *lo = fmin(*lo, d);
+            *hi = fmax(*hi, d);
+            *emax = fmax(*emax, ns[k].elevation);
+        }
 }
 
 /* The brackets b0..b1 of whole LATTICE_AZ_STEPs (bracket b: between the
@@ -236,9 +248,10 @@ static ts_status vis_narrow(ts_vis_ctx *c, const ts_horizon_opts *ho, double a_r
 }
 
 /* The span of a lattice's suns at unix_time (lattice_span), from a_ref,
- * its reference node's azimuth; ns: room for every node. */
+ * its reference node's azimuth; ns and off: room for every node. */
 static ts_status lattice_at(const ts_sun_sites *sites, const ts_day_opts *o, double unix_time,
-                            ts_sun_sample *ns, double *a_ref, double *lo, double *hi)
+                            ts_sun_sample *ns, double *off, double *a_ref, double *lo,
+                            double *hi)
 {
     ts_error err;
     double emax;
@@ -246,7 +259,7 @@ static ts_status lattice_at(const ts_sun_sites *sites, const ts_day_opts *o, dou
     if (st != TS_OK)
         return st;
     *a_ref = ns[ts_day_ref_node(sites)].grid_azimuth;
-    lattice_span(ns, sites->nx * sites->ny, *a_ref, lo, hi, &emax);
+    lattice_span(ns, sites->nx, sites->ny, *a_ref, off, lo, hi, &emax);
     return TS_OK;
 }
 
@@ -257,11 +270,13 @@ int ts_sun_visibility_sweeps(const ts_sun_sites *sites, const ts_day_opts *o,
     if (nodes == 1)
         return 1;
     ts_sun_sample *ns = malloc((size_t)nodes * sizeof *ns);
+    double *off = malloc((size_t)nodes * sizeof *off);
     int K = -1;
     double a_ref, lo, hi;
-    if (ns && lattice_at(sites, o, unix_time, ns, &a_ref, &lo, &hi) == TS_OK)
+    if (ns && off && lattice_at(sites, o, unix_time, ns, off, &a_ref, &lo, &hi) == TS_OK)
         K = lattice_sweeps(a_ref, lo, hi);
     free(ns);
+    free(off);
     return K;
 }
 
@@ -279,12 +294,13 @@ int ts_sun_visibility_planes(const ts_sun_sites *sites, const ts_day_opts *o,
     if (nodes == 1)
         return n;
     ts_sun_sample *ns = malloc((size_t)nodes * sizeof *ns);
+    double *off = malloc((size_t)nodes * sizeof *off);
     unsigned char *seen = calloc(LATTICE_SLOTS, 1);
-    int planes = ns && seen ? 0 : -1;
+    int planes = ns && off && seen ? 0 : -1;
     for (int k = 0; k < n && planes >= 0; k++) {
         double a_ref, lo, hi;
         long b0, b1;
-        if (lattice_at(sites, o, unix_times[k], ns, &a_ref, &lo, &hi) != TS_OK) {
+        if (lattice_at(sites, o, unix_times[k], ns, off, &a_ref, &lo, &hi) != TS_OK) {
             planes = -1;
         } else if (hi - lo <= LATTICE_NARROW) { /* its own azimuths: not shared */
             planes += lattice_sweeps(a_ref, lo, hi);
@@ -299,6 +315,7 @@ int ts_sun_visibility_planes(const ts_sun_sites *sites, const ts_day_opts *o,
     }
     free(seen);
     free(ns);
+    free(off);
     return planes;
 }
 
@@ -376,7 +393,7 @@ ts_status ts_vis_step(ts_vis_ctx *c, double t, float *vis, float *az, float *el,
 
     /* Lattice: azimuths as offsets from the reference node's. */
     double a_ref = r->grid_azimuth, lo, hi, emax;
-    lattice_span(c->ns, c->nodes, a_ref, &lo, &hi, &emax);
+    lattice_span(c->ns, s->nx, s->ny, a_ref, c->noff, &lo, &hi, &emax);
     for (int y = 0; y < H; y++) {
         int j;
         double fy;
@@ -395,10 +412,9 @@ ts_status ts_vis_step(ts_vis_ctx *c, double t, float *vis, float *az, float *el,
             double e0 = w00 * n00->true_elevation + w10 * n10->true_elevation +
                         w01 * n01->true_elevation + w11 * n11->true_elevation;
             double e = e0 + ts_sun_refraction(e0, &c->o->sun);
-            double d = w00 * ts_wrap180(n00->grid_azimuth - a_ref) +
-                       w10 * ts_wrap180(n10->grid_azimuth - a_ref) +
-                       w01 * ts_wrap180(n01->grid_azimuth - a_ref) +
-                       w11 * ts_wrap180(n11->grid_azimuth - a_ref);
+            const double *off = c->noff;
+            double d = w00 * off[j * s->nx + i] + w10 * off[j * s->nx + i1] +
+                       w01 * off[j1 * s->nx + i] + w11 * off[j1 * s->nx + i1];
             size_t k = (size_t)y * W + x;
             c->cel[k] = (float)e;
             c->caz[k] = (float)d;
