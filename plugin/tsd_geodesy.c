@@ -20,8 +20,10 @@ static int grid_registered(const double gt[6], int width, int height, double cro
 {
     double top = gt[3], bottom = gt[3] + height * gt[5], cell = fabs(gt[5]);
     double dlon = fabs(gt[1]), x1 = gt[0] + width * gt[1];
-    int north = top > 90 + 1e-9 && top - 0.5 * cell <= 90 + 1e-9;
-    int south = bottom < -90 - 1e-9 && bottom + 0.5 * cell >= -90 - 1e-9;
+    /* a row centred on a pole reaches half a cell past it; a hair past is
+     * rounding (geographic() takes it), a few tenths of a cell something else */
+    int north = top - 90 >= 0.25 * cell && top - 0.5 * cell <= 90 + 1e-9;
+    int south = -90 - bottom >= 0.25 * cell && bottom + 0.5 * cell >= -90 - 1e-9;
     int meridian = width * dlon > 360 + 1e-9 && (width - 1) * dlon <= 360 + 1e-9;
     crop[0] = fmin(gt[0], x1);
     crop[1] = north ? top - cell : top;
@@ -54,11 +56,24 @@ static ts_status geographic(const double gt[6], int width, int height, double a,
                     "longitude): %s, as in a grid-registered grid; crop those cells off, e.g. "
                     "gdal_translate -projwin %.10g %.10g %.10g %.10g dem.tif cropped.tif",
                     bottom, top, width * dlon, what, crop[0], crop[1], crop[2], crop[3]);
-    if (fabs(top) > 90 + 1e-9 || fabs(bottom) > 90 + 1e-9)
+    /* past a pole by a thousandth of a cell or less: rounding of the
+     * geotransform (90 + 1e-13), taken as the pole */
+    const double hair = fmax(1e-9, 1e-3 * fabs(gt[5]));
+    if (fabs(top) > 90 + hair || fabs(bottom) > 90 + hair) {
+        const double past = fmax(fabs(top), fabs(bottom)) - 90;
+        if (past < fabs(gt[5]))
+            return tsd_fail(msg, n, TS_ERR_ARG,
+                            "the DEM reaches %.6g degrees (%.2f of a cell) past the pole "
+                            "(latitudes %.10g to %.10g): its geotransform's origin or pixel "
+                            "size is off; set them right (gdal_edit.py -a_ullr or -tr)",
+                            past, past / fabs(gt[5]), bottom, top);
         return tsd_fail(msg, n, TS_ERR_ARG,
                     "the DEM reaches beyond the poles (latitudes %g to %g); its "
                     "geotransform is not in degrees of a geographic CRS",
                     bottom, top);
+    }
+    top = fmin(top, 90);
+    bottom = fmax(bottom, -90);
     if (width * dlon > 360 + 1e-9)
         return tsd_fail(msg, n, TS_ERR_ARG,
                     "the DEM spans %g degrees of longitude (cell %g degrees), "
@@ -88,47 +103,98 @@ static ts_status geographic(const double gt[6], int width, int height, double a,
 }
 
 /* tsd_geodesy.h */
-int tsd_lonlat_transforms(OGRSpatialReferenceH srs, OGRCoordinateTransformationH *fwd,
-                          OGRCoordinateTransformationH *inv)
+void tsd_geographic_units(OGRSpatialReferenceH srs, double *unit_deg, double *pm_deg)
 {
-    *fwd = NULL;
-    if (inv)
-        *inv = NULL;
-    OGRSpatialReferenceH geo = OSRCloneGeogCS(srs);
+    const double rad = OSRGetAngularUnits(srs, NULL); /* radians per unit */
+    *unit_deg = rad > 0 ? rad * 180.0 / M_PI : 1.0;
+    const double pm = OSRGetPrimeMeridian(srs, NULL); /* degrees */
+    *pm_deg = isfinite(pm) ? pm : 0.0;
+}
+
+/* tsd_geodesy.h */
+int tsd_lonlat_open(OGRSpatialReferenceH srs, int with_inv, tsd_lonlat *t)
+{
+    memset(t, 0, sizeof *t);
+    OGRSpatialReferenceH geo = NULL;
+    if (OSRIsDerivedGeographic(srs)) {
+        /* a rotated pole: OSRCloneGeogCS keeps the rotation, so its base is
+         * built here, on its ellipsoid, in degrees from Greenwich */
+        OGRErr e1 = OGRERR_NONE, e2 = OGRERR_NONE;
+        const double a = OSRGetSemiMajor(srs, &e1), invf = OSRGetInvFlattening(srs, &e2);
+        geo = OSRNewSpatialReference(NULL);
+        if (geo && (e1 != OGRERR_NONE || e2 != OGRERR_NONE ||
+                    OSRSetGeogCS(geo, "base of a rotated pole", "unknown", "unknown", a, invf,
+                                 "Greenwich", 0.0, "degree", M_PI / 180) != OGRERR_NONE)) {
+            OSRDestroySpatialReference(geo);
+            geo = NULL;
+        }
+    } else {
+        geo = OSRCloneGeogCS(srs);
+    }
     if (!geo)
         return 0;
+    tsd_geographic_units(geo, &t->unit_deg, &t->pm_deg);
     OSRSetAxisMappingStrategy(geo, OAMS_TRADITIONAL_GIS_ORDER);
     OGRSpatialReferenceH src = OSRClone(srs);
     OSRSetAxisMappingStrategy(src, OAMS_TRADITIONAL_GIS_ORDER);
-    *fwd = OCTNewCoordinateTransformation(src, geo);
-    if (inv)
-        *inv = OCTNewCoordinateTransformation(geo, src);
+    t->fwd = OCTNewCoordinateTransformation(src, geo);
+    if (with_inv)
+        t->inv = OCTNewCoordinateTransformation(geo, src);
     OSRDestroySpatialReference(src);
     OSRDestroySpatialReference(geo); /* the transforms hold their own */
-    if (*fwd && (!inv || *inv))
+    if (t->fwd && (!with_inv || t->inv))
         return 1;
-    if (*fwd)
-        OCTDestroyCoordinateTransformation(*fwd);
-    if (inv && *inv)
-        OCTDestroyCoordinateTransformation(*inv);
-    *fwd = NULL;
-    if (inv)
-        *inv = NULL;
+    tsd_lonlat_close(t);
     return 0;
+}
+
+int tsd_lonlat_to(const tsd_lonlat *t, int n, double *x, double *y, int *ok)
+{
+    double *z = calloc(n > 0 ? (size_t)n : 1, sizeof *z);
+    if (!z)
+        return 0;
+    const int all = OCTTransformEx(t->fwd, n, x, y, z, ok) != 0;
+    free(z);
+    for (int i = 0; i < n; i++) {
+        x[i] = x[i] * t->unit_deg + t->pm_deg;
+        y[i] *= t->unit_deg;
+    }
+    return all;
+}
+
+int tsd_lonlat_from(const tsd_lonlat *t, int n, double *x, double *y, int *ok)
+{
+    double *z = calloc(n > 0 ? (size_t)n : 1, sizeof *z);
+    if (!z)
+        return 0;
+    for (int i = 0; i < n; i++) {
+        x[i] = (x[i] - t->pm_deg) / t->unit_deg;
+        y[i] /= t->unit_deg;
+    }
+    const int all = OCTTransformEx(t->inv, n, x, y, z, ok) != 0;
+    free(z);
+    return all;
+}
+
+void tsd_lonlat_close(tsd_lonlat *t)
+{
+    if (t->fwd)
+        OCTDestroyCoordinateTransformation(t->fwd);
+    if (t->inv)
+        OCTDestroyCoordinateTransformation(t->inv);
+    t->fwd = t->inv = NULL;
 }
 
 /* Lengths on the ground of a projected DEM: its CRS to longitude and
  * latitude and the ellipsoid's geodesics. */
 typedef struct {
-    OGRCoordinateTransformationH fwd;
+    tsd_lonlat ll;
     struct geod_geodesic g;
 } ground_ctx;
 
 static void ground_close(ground_ctx *t)
 {
-    if (t->fwd)
-        OCTDestroyCoordinateTransformation(t->fwd);
-    t->fwd = NULL;
+    tsd_lonlat_close(&t->ll);
 }
 
 static int ground_open(ground_ctx *t, OGRSpatialReferenceH srs)
@@ -140,7 +206,7 @@ static int ground_open(ground_ctx *t, OGRSpatialReferenceH srs)
         return 0;
     geod_init(&t->g, a, invf != 0 ? 1.0 / invf : 0.0);
     CPLPushErrorHandler(CPLQuietErrorHandler); /* a failure is ours to word */
-    const int ok = tsd_lonlat_transforms(srs, &t->fwd, NULL);
+    const int ok = tsd_lonlat_open(srs, 0, &t->ll);
     CPLPopErrorHandler();
     return ok;
 }
@@ -152,8 +218,7 @@ static int ground_lengths(const ground_ctx *t, const double gt[6], int n, const 
                           const double *y0, const double *x1, const double *y1, double *len)
 {
     double *X = malloc((size_t)2 * n * sizeof *X), *Y = malloc((size_t)2 * n * sizeof *Y);
-    double *Z = calloc((size_t)2 * n, sizeof *Z);
-    int *ok = malloc((size_t)2 * n * sizeof *ok), good = X && Y && Z && ok;
+    int *ok = malloc((size_t)2 * n * sizeof *ok), good = X && Y && ok;
     for (int i = 0; good && i < n; i++) {
         X[2 * i] = gt[0] + x0[i] * gt[1];
         Y[2 * i] = gt[3] + y0[i] * gt[5];
@@ -162,7 +227,7 @@ static int ground_lengths(const ground_ctx *t, const double gt[6], int n, const 
     }
     if (good) {
         CPLPushErrorHandler(CPLQuietErrorHandler);
-        good = OCTTransformEx(t->fwd, 2 * n, X, Y, Z, ok) != 0;
+        good = tsd_lonlat_to(&t->ll, 2 * n, X, Y, ok);
         CPLPopErrorHandler();
     }
     for (int i = 0; good && i < n; i++) {
@@ -178,7 +243,6 @@ static int ground_lengths(const ground_ctx *t, const double gt[6], int n, const 
     }
     free(X);
     free(Y);
-    free(Z);
     free(ok);
     return good;
 }

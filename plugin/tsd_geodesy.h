@@ -71,12 +71,35 @@ void tsd_cells_free(tsd_cells *c);
  * rows (cell_x where the rows do not differ), metres. */
 double tsd_cells_min_x(const tsd_cells *c, int height);
 
-/** A projected CRS's transform to its own geographic CRS (fwd) and back
- * (inv, where asked; may be NULL), both in longitude-latitude order; 1, or
- * 0 with neither left where PROJ has none. Destroy with
- * OCTDestroyCoordinateTransformation. */
-int tsd_lonlat_transforms(OGRSpatialReferenceH srs, OGRCoordinateTransformationH *fwd,
-                          OGRCoordinateTransformationH *inv);
+/**
+ * A CRS's points as longitude and latitude in degrees east of Greenwich,
+ * and back. PROJ transforms to the CRS's own geographic CRS, which may
+ * count in grads or from another prime meridian (NTF (Paris), EPSG:27572
+ * and 4807, in grads from Paris; MGI (Ferro)); the conversion to degrees
+ * from Greenwich is applied here (once missing: the Lambert II DEMs' cells
+ * were 10 % off and their sun 5 degrees away).
+ */
+typedef struct {
+    OGRCoordinateTransformationH fwd, inv; /* to the geographic CRS and back */
+    double unit_deg;                       /* degrees per angular unit of it */
+    double pm_deg;                         /* its prime meridian east of Greenwich */
+} tsd_lonlat;
+
+/** Open t for srs (a projected or derived geographic CRS), inv only where
+ * asked; 1, or 0 with nothing to close where PROJ has no transform. */
+int tsd_lonlat_open(OGRSpatialReferenceH srs, int with_inv, tsd_lonlat *t);
+
+/** n points in place, the CRS to degrees (tsd_lonlat_to) or back
+ * (tsd_lonlat_from, t opened with_inv), longitude first; ok[i] (may be
+ * NULL) whether point i went; returns whether they all did. */
+int tsd_lonlat_to(const tsd_lonlat *t, int n, double *x, double *y, int *ok);
+int tsd_lonlat_from(const tsd_lonlat *t, int n, double *x, double *y, int *ok);
+
+void tsd_lonlat_close(tsd_lonlat *t);
+
+/** A geographic CRS's angular unit in degrees and its prime meridian in
+ * degrees east of Greenwich. */
+void tsd_geographic_units(OGRSpatialReferenceH srs, double *unit_deg, double *pm_deg);
 
 /**
  * Where the sun is seen from, in the core grid's frame (row 0 north, after

@@ -85,9 +85,8 @@ static int grow_sites(const tsd_sites *s, int width, int height, int *nx, int *n
 
 /* The longitude, latitude and grid azimuth of true north of s's nodes. */
 static ts_status sites_fill(const double gt[6], int width, int height, int geographic,
-                            double deg, OGRCoordinateTransformationH fwd,
-                            OGRCoordinateTransformationH inv, const tsd_cells *cells,
-                            tsd_sites *s, char *msg, size_t n)
+                            int rotated, double deg, double pm, const tsd_lonlat *ll,
+                            const tsd_cells *cells, tsd_sites *s, char *msg, size_t n)
 {
     size_t nodes = (size_t)s->nx * s->ny;
     s->lon = malloc(nodes * sizeof *s->lon);
@@ -106,11 +105,11 @@ static ts_status sites_fill(const double gt[6], int width, int height, int geogr
             double Y = gt[3] + px * gt[4] + py * gt[5];
             double lon, lat, north = 0.0;
             if (geographic) {
-                lon = X * deg;
+                lon = X * deg + pm;
                 lat = Y * deg;
             } else {
-                double x = X, y = Y, z = 0;
-                if (!OCTTransform(fwd, 1, &x, &y, &z) || !isfinite(x) || !isfinite(y)) {
+                double x = X, y = Y;
+                if (!tsd_lonlat_to(ll, 1, &x, &y, NULL) || !isfinite(x) || !isfinite(y)) {
                     rc = tsd_fail(msg, n, TS_ERR_ARG,
                                   "PROJ cannot find the longitude and latitude of "
                                   "the DEM's point (%.10g, %.10g), so the sun's position "
@@ -121,14 +120,16 @@ static ts_status sites_fill(const double gt[6], int width, int height, int geogr
                 lat = y;
                 /* grid azimuth of true north: a small step north, back */
                 double step = lat + 1e-4 <= 90.0 ? 1e-4 : -1e-4;
-                double x2 = lon, y2 = lat + step, z2 = 0;
-                if (!OCTTransform(inv, 1, &x2, &y2, &z2) || !isfinite(x2) || !isfinite(y2)) {
+                double x2 = lon, y2 = lat + step;
+                if (!tsd_lonlat_from(ll, 1, &x2, &y2, NULL) || !isfinite(x2) || !isfinite(y2)) {
                     rc = tsd_fail(msg, n, TS_ERR_ARG,
                                   "PROJ cannot transform a point north of (%.8g, "
                                   "%.8g) back into the DEM's CRS", lon, lat);
                     break;
                 }
                 double dx = (x2 - X) * (step > 0 ? 1 : -1), dy = (y2 - Y) * (step > 0 ? 1 : -1);
+                if (rotated) /* degrees of a rotated pole: east-west ones shrink */
+                    dx *= cos(Y * deg * M_PI / 180.0);
                 north = atan2(dx, dy) * 180.0 / M_PI;
             }
             if (!isfinite(lat) || lat < -90.0 - 1e-9 || lat > 90.0 + 1e-9) {
@@ -156,16 +157,22 @@ ts_status tsd_sites_compute(const double gt[6], int width, int height,
         return tsd_fail(msg, n, TS_ERR_ARG, "the DEM has no CRS, so the sun's position over it is "
                     "unknown: give it a CRS (gdal_edit.py -a_srs) or use "
                     "SUN_AZIMUTH and SUN_ELEVATION");
-    int geographic = OSRIsGeographic(srs);
-    if (!geographic && !OSRIsProjected(srs))
+    /* a rotated pole (a derived geographic CRS: CORDEX's, COSMO's) counts
+     * in degrees that are not longitudes and latitudes: through PROJ, as a
+     * projection */
+    const int derived = OSRIsDerivedGeographic(srs);
+    const int geographic = OSRIsGeographic(srs) && !derived;
+    if (!geographic && !derived && !OSRIsProjected(srs))
         return tsd_fail(msg, n, TS_ERR_ARG, "the DEM's CRS is neither geographic nor projected (a "
                     "local or engineering CRS), so its longitudes and latitudes are "
                     "unknown; use SUN_AZIMUTH and SUN_ELEVATION instead");
-    OGRCoordinateTransformationH fwd = NULL, inv = NULL;
-    if (!geographic && !tsd_lonlat_transforms(srs, &fwd, &inv))
+    tsd_lonlat ll = {0};
+    if (!geographic && !tsd_lonlat_open(srs, 1, &ll))
         return tsd_fail(msg, n, TS_ERR_ARG, "PROJ cannot transform the DEM's CRS to longitude and "
                     "latitude, so the sun's position over it is unknown");
-    double deg = geographic ? OSRGetAngularUnits(srs, NULL) * 180.0 / M_PI : 1.0;
+    double deg = 1.0, pm = 0.0; /* a geographic CRS's unit and prime meridian */
+    if (geographic || derived)
+        tsd_geographic_units(srs, &deg, &pm);
     int nx = per_cell ? site_nodes(width, 1) : 1, ny = per_cell ? site_nodes(height, 1) : 1;
     ts_status rc;
     /* a finer lattice where the first one's nodes lie too far apart (the
@@ -174,13 +181,12 @@ ts_status tsd_sites_compute(const double gt[6], int width, int height,
         s->nx = nx;
         s->ny = ny;
         site_grid(s, width, height);
-        rc = sites_fill(gt, width, height, geographic, deg, fwd, inv, cells, s, msg, n);
+        rc = sites_fill(gt, width, height, geographic, derived, deg, pm, &ll, cells, s, msg, n);
         if (rc != TS_OK || !per_cell || pass == 3 || !grow_sites(s, width, height, &nx, &ny))
             break;
         tsd_sites_free(s);
     }
-    if (fwd) OCTDestroyCoordinateTransformation(fwd);
-    if (inv) OCTDestroyCoordinateTransformation(inv);
+    tsd_lonlat_close(&ll);
     if (rc != TS_OK)
         tsd_sites_free(s);
     return rc;

@@ -1,0 +1,176 @@
+"""The sun over DEMs in unusual frames (docs/driver.md, "Georeferencing").
+
+- A CRS whose geographic CRS counts in grads or from another prime meridian
+  (NTF (Paris): Lambert II, EPSG:27572, in grads from Paris; MGI (Ferro),
+  EPSG:4805) puts the sun over the same place, and gives the same cell
+  sizes, as EPSG:4326 or Lambert 93 there: its longitudes and latitudes
+  were once taken as degrees from Greenwich (cells 10 % off, the sun 5
+  degrees away, or a site 17 degrees of longitude off).
+- A rotated pole (PROJ's ob_tran, CORDEX's and COSMO's grids) is a frame,
+  not longitudes and latitudes: the sun is found at the real place and
+  turned into the grid's azimuth, as in a projection.
+- SUN_POSITION=per_cell where the sun's azimuth across the DEM turns
+  through the direction opposite the centre's: each cell's sun is
+  interpolated between its own lattice nodes, which were once each wrapped
+  from the centre's azimuth, so that two nodes on either side were
+  averaged the long way round (a band of cells lit from the wrong side).
+"""
+import math
+import unittest
+
+import tsdriver as T
+from tsdriver import gdal, np, osr
+
+DT = "2026-06-21T12:00:00Z"
+
+
+def md(name, oo):
+    ds = gdal.OpenEx(name, gdal.OF_RASTER, open_options=["%s=%s" % kv for kv in oo.items()])
+    return ds.GetMetadata()
+
+
+def to_crs(epsg_or_proj, lon, lat):
+    """(lon, lat) in degrees of WGS 84 to the CRS's (x, y)."""
+    wgs, s = osr.SpatialReference(), osr.SpatialReference()
+    wgs.ImportFromEPSG(4326)
+    if isinstance(epsg_or_proj, int):
+        s.ImportFromEPSG(epsg_or_proj)
+    else:
+        s.SetFromUserInput(epsg_or_proj)
+    for r in (wgs, s):
+        r.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+    x, y, _ = osr.CoordinateTransformation(wgs, s).TransformPoint(lon, lat)
+    return x, y
+
+
+class SunFrames(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = T.TempDir()
+        cls.dir = cls.tmp.__enter__()
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.__exit__(None, None, None)
+
+    def dem(self, name, crs, x0, y0, cell, n=41, slope=0.0):
+        """n x n cells centred on (x0, y0) of the CRS, rising toward grid
+        north by `slope` of the cells' own size a row."""
+        rows = np.arange(n, dtype=np.float64)[:, None] * np.ones((1, n))
+        z = 500 + slope * (n - rows) * abs(cell[1])
+        gt = (x0 - cell[0] * n / 2, cell[0], 0, y0 + cell[1] * n / 2, 0, -cell[1])
+        return T.write_tif("%s/%s.tif" % (self.dir, name), z.astype(np.float32), gt, crs)
+
+    def sun(self, path):
+        m = md(T.conn(path), {"PRODUCT": "shade", "DATETIME": DT})
+        return {k: float(m[k]) for k in ("SUN_SITE_LONGITUDE", "SUN_SITE_LATITUDE",
+                                         "SUN_AZIMUTH_TRUE", "SUN_AZIMUTH", "SUN_ELEVATION",
+                                         "MERIDIAN_CONVERGENCE")}
+
+    def test_grads_and_other_prime_meridians(self):
+        lon, lat = 2.5, 48.6  # near Paris
+        ref = self.sun(self.dem("wgs84", 4326, lon, lat, (0.0005, 0.0005)))
+        cases = {27572: (50.0, 50.0), 2154: (50.0, 50.0), 4807: (0.0005, 0.0005),
+                 4805: (0.0005, 0.0005)}
+        for crs, cell in cases.items():
+            x, y = to_crs(crs, lon, lat)
+            s = self.sun(self.dem("c%d" % crs, crs, x, y, cell))
+            print("EPSG:%d: site %.5f %.5f, sun %.3f / %.3f (EPSG:4326: %.5f %.5f, %.3f / %.3f)"
+                  % (crs, s["SUN_SITE_LONGITUDE"], s["SUN_SITE_LATITUDE"],
+                     s["SUN_AZIMUTH_TRUE"], s["SUN_ELEVATION"], ref["SUN_SITE_LONGITUDE"],
+                     ref["SUN_SITE_LATITUDE"], ref["SUN_AZIMUTH_TRUE"], ref["SUN_ELEVATION"]))
+            # datum shifts (NTF, MGI against WGS 84) are ~100 m: 0.002 degrees
+            self.assertAlmostEqual(s["SUN_SITE_LONGITUDE"], lon, delta=0.003, msg=crs)
+            self.assertAlmostEqual(s["SUN_SITE_LATITUDE"], lat, delta=0.003, msg=crs)
+            self.assertAlmostEqual(s["SUN_AZIMUTH_TRUE"], ref["SUN_AZIMUTH_TRUE"], delta=0.01)
+            self.assertAlmostEqual(s["SUN_ELEVATION"], ref["SUN_ELEVATION"], delta=0.01)
+
+    def test_cells_of_a_grads_projection(self):
+        """A plane rising 0.2 of a cell a cell toward grid north: its horizon
+        north is atan(0.2 k), k the projection's scale there (1.0004 in
+        Lambert II, 0.9997 in Lambert 93); it read 10.2 degrees in Lambert
+        II, its cells taken 10 % too long."""
+        lon, lat = 2.337229, 48.6
+        for crs, k in ((27572, 1.0004), (2154, 0.9997)):
+            x, y = to_crs(crs, lon, lat)
+            path = self.dem("plane%d" % crs, crs, x, y, (50.0, 50.0), slope=0.2)
+            ds = gdal.OpenEx(T.conn(path), gdal.OF_RASTER, open_options=[
+                "PRODUCT=horizon", "DIRECTIONS=4", "CURVATURE=NO", "EDGE=open"])
+            h = ds.GetRasterBand(1).ReadAsArray()[20, 20]
+            print("EPSG:%d: horizon north %.4f, expected %.4f" % (
+                crs, h, math.degrees(math.atan(0.2 * k))))
+            self.assertAlmostEqual(h, math.degrees(math.atan(0.2 * k)), delta=0.01)
+
+    def test_rotated_pole(self):
+        rot = ("+proj=ob_tran +o_proj=longlat +o_lon_p=0 +o_lat_p=39.25 +lon_0=18 "
+               "+datum=WGS84 +no_defs")
+        rx, ry = -25.0, 20.0  # rotated coordinates: about 37.4 W, 61.2 N
+        s = osr.SpatialReference()
+        s.SetFromUserInput(rot)
+        wgs = osr.SpatialReference()
+        wgs.ImportFromEPSG(4326)
+        for r in (s, wgs):
+            r.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+        ct = osr.CoordinateTransformation(s, wgs)
+        lon, lat, _ = ct.TransformPoint(rx, ry)
+        # grid north's true direction: a step north in the rotated grid
+        lon2, lat2, _ = ct.TransformPoint(rx, ry + 1e-4)
+        dx = (lon2 - lon) * math.cos(math.radians(lat))
+        grid_north_true = math.degrees(math.atan2(dx, lat2 - lat))
+        got = self.sun(self.dem("rotated", rot, rx, ry, (0.01, 0.01), n=21))
+        ref = self.sun(self.dem("rotref", 4326, lon, lat, (0.001, 0.001), n=21))
+        print("rotated pole: site %.4f %.4f (real %.4f %.4f), sun true %.3f (%.3f), "
+              "grid %.3f, convergence %.3f (grid north at true %.3f)" % (
+                  got["SUN_SITE_LONGITUDE"], got["SUN_SITE_LATITUDE"], lon, lat,
+                  got["SUN_AZIMUTH_TRUE"], ref["SUN_AZIMUTH_TRUE"], got["SUN_AZIMUTH"],
+                  got["MERIDIAN_CONVERGENCE"], grid_north_true))
+        self.assertAlmostEqual(got["SUN_SITE_LONGITUDE"], lon, delta=1e-3)
+        self.assertAlmostEqual(got["SUN_SITE_LATITUDE"], lat, delta=1e-3)
+        self.assertAlmostEqual(got["SUN_AZIMUTH_TRUE"], ref["SUN_AZIMUTH_TRUE"], delta=0.01)
+        self.assertAlmostEqual(got["SUN_ELEVATION"], ref["SUN_ELEVATION"], delta=0.01)
+        # the sun's grid azimuth: its true one from grid north's direction
+        self.assertAlmostEqual(got["SUN_AZIMUTH"],
+                               (got["SUN_AZIMUTH_TRUE"] - grid_north_true) % 360, delta=0.1)
+
+    def test_per_cell_sun_through_the_opposite_azimuth(self):
+        """A band around the world at 60 N rising north (0.09), 1 degree cells:
+        at 03:00 UTC the sun's azimuth at 162.5 E is opposite the centre's
+        (0.5 E). Each cell's shade there against that of a 3-column DEM of
+        its own, whose sun is its centre's."""
+        nx, ny, dy = 360, 60, 0.01
+        z = (100 + 100.0 * (ny - np.arange(ny)))[:, None] * np.ones((1, nx))
+        gt = (-180.0, 1.0, 0, 60.0, 0, -dy)
+        band = T.write_tif(self.dir + "/band.tif", z.astype(np.float32), gt, 4326)
+        opts = ["PRODUCT=shade", "OUTPUT_TYPE=Float32", "DATETIME=2026-06-21T03:00:00Z",
+                "EDGE=open"]
+        ds = gdal.OpenEx(T.conn(band), gdal.OF_RASTER, open_options=opts +
+                         ["SUN_POSITION=per_cell"])
+        row = ds.GetRasterBand(1).ReadAsArray()[ny // 2]
+        worst = 0.0
+        for col in range(338, 348):  # 158.5 .. 167.5 E
+            own = T.write_tif(self.dir + "/col%d.tif" % col,
+                              z[:, col - 1:col + 2].astype(np.float32),
+                              (-180.0 + col - 1, 1.0, 0, 60.0, 0, -dy), 4326)
+            d2 = gdal.OpenEx(T.conn(own), gdal.OF_RASTER, open_options=opts)
+            ref = d2.GetRasterBand(1).ReadAsArray()[ny // 2, 1]
+            worst = max(worst, abs(float(row[col]) - float(ref)))
+            print("%.1f E: per cell %.5f, its own sun %.5f" % (col - 179.5, row[col], ref))
+        self.assertLess(worst, 0.002)
+
+    def test_a_pole_by_rounding(self):
+        """A polar cap whose top is the pole give or take rounding (90 + 1e-13)
+        opens; one 0.6 of a cell past it is off by more than rounding and
+        not grid-registered (a row centred on the pole: half a cell), and
+        the message says so (it once said 'cannot compute the north-south
+        cell size' and 'not in degrees of a geographic CRS')."""
+        z = np.zeros((50, 72), np.float32)
+        for top, ok in ((90 + 1e-13, True), (90.000001, True), (90.03, False)):
+            path = T.write_tif(self.dir + "/cap.tif", z, (-180.0, 5.0, 0, top, 0, -0.05), 4326)
+            r = T.run(["gdal_translate", "-q", "-oo", "PRODUCT=svf", "-oo", "DIRECTIONS=4",
+                       T.conn(path), self.dir + "/cap_svf.tif"], ok=ok)
+            if not ok:
+                self.assertIn("0.60 of a cell) past the pole", r.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
