@@ -58,9 +58,7 @@ def flat_dem(path, lat, lon, n=32, cell=0.0005, z=0.0):
     return T.write_tif(path, np.full((n, n), z, np.float32), gt, 4326)
 
 
-def md(path, oo):
-    ds = gdal.OpenEx(path, gdal.OF_RASTER, open_options=["%s=%s" % kv for kv in oo.items()])
-    return ds.GetMetadata()
+md = T.metadata
 
 
 class Sun(unittest.TestCase):

@@ -24,9 +24,7 @@ from tsdriver import gdal, np, osr
 DT = "2026-06-21T12:00:00Z"
 
 
-def md(name, oo):
-    ds = gdal.OpenEx(name, gdal.OF_RASTER, open_options=["%s=%s" % kv for kv in oo.items()])
-    return ds.GetMetadata()
+md = T.metadata
 
 
 def to_crs(epsg_or_proj, lon, lat):

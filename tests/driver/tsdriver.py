@@ -111,6 +111,14 @@ def read(path, band=None, options=None):
     return arrays[0] if band else np.array(arrays)
 
 
+def metadata(path, options=None):
+    """The dataset's metadata (default domain), opened with these TERRASHADE
+    open options."""
+    oo = ["%s=%s" % kv for kv in (options or {}).items()]
+    ds = gdal.OpenEx(path, gdal.OF_RASTER, open_options=oo)
+    return ds.GetMetadata()
+
+
 def read_dem(path, band=1):
     """The DEM as the driver sees it: float32 metres, NaN where masked."""
     ds = gdal.Open(path)
