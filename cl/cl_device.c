@@ -173,12 +173,19 @@ ts_status ts_cl_env_max_alloc(unsigned long long *limit, ts_error *err)
         mul = 1024.0 * 1024, end++;
     else if (*end == 'g' || *end == 'G')
         mul = 1024.0 * 1024 * 1024, end++;
-    if (end == s || *end || errno || !(v >= 1) || !isfinite(v))
+    const char *digits = s;
+    while (isspace((unsigned char)*digits))
+        digits++;
+    const int hex = digits[0] == '0' && (digits[1] == 'x' || digits[1] == 'X');
+    const double bytes = v * mul; /* 0.5M is half a megabyte */
+    /* below 2^63: beyond, the conversion to a count of bytes is undefined */
+    if (end == s || *end || errno || hex || !isfinite(bytes) || !(bytes >= 1) ||
+        !(bytes < 9.2e18))
         return ts_fail(err, TS_ERR_ARG,
-                    "TERRASHADE_OPENCL_MAX_ALLOC must be a number of bytes (k, M, G suffixes "
-                    "allowed), got '%.60s'",
+                    "TERRASHADE_OPENCL_MAX_ALLOC must be a number of bytes from 1 to 8E "
+                    "(decimal, k, M, G suffixes allowed), got '%.60s'",
                     s);
-    *limit = (unsigned long long)(v * mul);
+    *limit = (unsigned long long)bytes;
     return TS_OK;
 }
 

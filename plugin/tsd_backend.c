@@ -1,6 +1,8 @@
 /* What the backend dispatcher ran for a product; see tsd_backend.h. */
 #include "tsd_backend.h"
 
+#include "terrashade_cl.h"
+
 #include "tsd_text.h"
 
 #include <stdio.h>
@@ -53,15 +55,52 @@ void tsd_backend_summary_merge(tsd_backend_summary *s, const tsd_backend_summary
     take_reason(s, add->reason, add->fell_back);
 }
 
+void tsd_backend_note_c(tsd_backend_summary *s, ts_backend requested, const char *why)
+{
+    ts_backend_report r;
+    ts_error err;
+    if (!s || ts_backend_choose(TS_BACKEND_C, &r, &err) != TS_OK)
+        return;
+    r.requested = requested;
+    snprintf(r.reason, sizeof r.reason, "%s", why);
+    tsd_backend_summary_add(s, &r);
+}
+
+const char *tsd_backend_c_step(const tsd_options *o, int *all)
+{
+    const char *p = tsd_options_product_name(o);
+    const int horizon = !strcmp(p, "horizon"), shadow = !strcmp(p, "shadow");
+    *all = 0;
+    if (o->horizon_method == TSD_HORIZON_PYRAMID) {
+        *all = horizon;
+        return TSD_PYRAMID_C_REASON;
+    }
+    if (o->max_distance > 0 && o->method == TSD_METHOD_EXACT) {
+        *all = horizon || shadow;
+        return TS_CL_CAPPED_SWEEP_REASON;
+    }
+    if (o->sun_position == TSD_SUN_PER_CELL) {
+        *all = shadow;
+        return TSD_PER_CELL_C_REASON;
+    }
+    return NULL;
+}
+
 int tsd_backend_predict(const tsd_options *o, tsd_backend_summary *s, char *msg,
                         size_t n)
 {
     ts_backend_report r;
     ts_error err;
     memset(s, 0, sizeof *s);
-    if (ts_backend_choose(tsd_backend_to_ts(o->backend), &r, &err) != TS_OK)
+    const ts_backend requested = tsd_backend_to_ts(o->backend);
+    if (ts_backend_choose(requested, &r, &err) != TS_OK) /* (a bad TERRASHADE_BACKEND) */
         return (tsd_fail_core(msg, n, NULL, &err), -1);
-    tsd_backend_summary_add(s, &r);
+    int all;
+    const char *why = tsd_backend_c_step(o, &all);
+    if (!all)
+        tsd_backend_summary_add(s, &r);
+    if (why) /* (after the choice: its failure's reason would come first) */
+        tsd_backend_note_c(s, r.requested, why);
     return 0;
 }
 

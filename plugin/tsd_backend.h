@@ -41,10 +41,29 @@ void tsd_backend_summary_add(tsd_backend_summary *s, const ts_backend_report *r)
  * chunks computed so far), as if its calls had been added one by one. */
 void tsd_backend_summary_merge(tsd_backend_summary *s, const tsd_backend_summary *add);
 
+/** The reasons of the steps that run in C whatever the backend (with
+ * TS_CL_CAPPED_SWEEP_REASON, MAX_DISTANCE's): the same before computing
+ * (tsd_backend_predict) as after. */
+#define TSD_PYRAMID_C_REASON                                                               \
+    "HORIZON_METHOD=pyramid runs on the C backend (there is no OpenCL pyramid)"
+#define TSD_PER_CELL_C_REASON "SUN_POSITION=per_cell: the per-cell sun runs in C only"
+
+/** Add a step that runs in C whatever the backend (it has no OpenCL
+ * path), why: the reason the metadata and the BACKEND=opencl warning give.
+ * requested: the options' backend. */
+void tsd_backend_note_c(tsd_backend_summary *s, ts_backend requested, const char *why);
+
+/** Why a heavy step of this product runs in C with these options whatever
+ * the backend (MAX_DISTANCE's capped sweeps, the pyramid's horizons, the
+ * per-cell sun), or NULL; *all: every heavy step does (a horizon product,
+ * a shadow), else the product is mixed where OpenCL runs. */
+const char *tsd_backend_c_step(const tsd_options *o, int *all);
+
 /**
  * Predict, without computing, the summary of the product's calls
- * (ts_backend_choose: probes the OpenCL device). 0, or -1 with a sentence
- * in msg (a bad TERRASHADE_BACKEND).
+ * (ts_backend_choose: probes the OpenCL device), with the C step of
+ * tsd_backend_c_step. 0, or -1 with a sentence in msg (a bad
+ * TERRASHADE_BACKEND).
  */
 int tsd_backend_predict(const tsd_options *o, tsd_backend_summary *s, char *msg,
                         size_t msg_size);

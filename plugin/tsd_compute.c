@@ -327,6 +327,8 @@ static ts_status sun_per_cell(const tsd_compute_ctx *c, const ts_grid *g, float 
     if (ts_sun_visibility(g, &sites, &d, sun->instant, vis, az, el, NULL, &err) !=
         TS_OK)
         return core_fail(c, &err);
+    /* (its sweeps are the core's own, not the dispatcher's: said here) */
+    tsd_backend_note_c(c->backend, BK(c), TSD_PER_CELL_C_REASON);
     return TS_OK;
 }
 

@@ -16,19 +16,16 @@ static ts_status core_fail(const tsd_compute_ctx *c, const ts_error *err)
     return tsd_fail_core(c->msg, c->msg_size, NULL, err);
 }
 
-/* The SH part runs in C: say so in the backend summary when the sweeps'
- * backend was not chosen as C (as the other C-only steps do). */
+/* A step of the SH methods that runs in C, noted after the product's other
+ * calls (tsd_backend_note_c). */
 static void note_c_part(const tsd_compute_ctx *c, const char *what)
 {
-    ts_backend_report r;
-    ts_error err;
-    if (!c->backend || !c->backend->calls || c->backend->requested == TS_BACKEND_C ||
-        ts_backend_choose(TS_BACKEND_C, &r, &err) != TS_OK)
+    char why[160];
+    if (!c->backend || !c->backend->calls || c->backend->requested == TS_BACKEND_C)
         return;
-    r.requested = c->backend->requested;
-    snprintf(r.reason, sizeof r.reason,
-             "%s: the SH visibility and lighting have no OpenCL kernel and run in C", what);
-    tsd_backend_summary_add(c->backend, &r);
+    snprintf(why, sizeof why, "%s: the SH visibility and lighting have no OpenCL kernel and "
+             "run in C", what);
+    tsd_backend_note_c(c->backend, c->backend->requested, why);
 }
 
 /* HORIZON_METHOD=pyramid: the swath's horizons from the pyramid (B-spline). */

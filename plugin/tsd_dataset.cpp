@@ -512,6 +512,15 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     m_bUsesBackend = m_psProduct->uses_backend && m_psProduct->uses_backend(&sOpts, psSun);
     if (tsd_backend_check_env(&sOpts, m_bUsesBackend, szMsg, sizeof szMsg) != 0)
         return Fail(TS_ERR_ARG, szMsg), false;
+    /* asked for where nothing could run on it (the day products): said at
+     * open, as the C steps of the others are said when they run (shadow's
+     * per-cell sun among them) */
+    if (!m_bUsesBackend && sOpts.backend == TSD_BACKEND_OPENCL && m_nLevel == 0 &&
+        sOpts.sun_position != TSD_SUN_PER_CELL)
+        CPLError(CE_Warning, CPLE_AppDefined,
+                 "TERRASHADE: BACKEND=opencl was requested, but PRODUCT=%s runs on the C "
+                 "backend only",
+                 m_psProduct->name);
 
     nRasterXSize = W;
     nRasterYSize = H;

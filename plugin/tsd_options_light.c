@@ -40,6 +40,10 @@ int tsd_options_check_light(const tsd_options *o, char *msg, size_t n)
     if (shadowmap && o->sun_position == TSD_SUN_PER_CELL)
         REFUSE("METHOD=shadowmap renders one depth map for one light direction: it needs "
                "SUN_POSITION=center");
+    /* (once taken without a word: shade went exact, shadow kept the centre's sun) */
+    if (o->method == TSD_METHOD_SHM && o->sun_position == TSD_SUN_PER_CELL)
+        REFUSE("METHOD=shm builds its shadow height maps for one sun direction: it needs "
+               "SUN_POSITION=center (METHOD=exact takes a sun per cell)");
     /* said at open (gdalinfo, a QGIS layer), not on the first read; DATETIME's
      * sun is checked once it is computed (tsd_sun_setup) */
     if (shadowmap && !tsd_options_sun_from_time(o) && !(o->sun_elevation > 0))

@@ -86,8 +86,7 @@ static ts_status note_backend(const tsd_compute_ctx *c)
         r.fell_back = 1;
         snprintf(r.backend, sizeof r.backend, "c");
         snprintf(r.device, sizeof r.device, "%s", cpu.device);
-        snprintf(r.reason, sizeof r.reason,
-                 "HORIZON_METHOD=pyramid runs on the C backend (there is no OpenCL pyramid)");
+        snprintf(r.reason, sizeof r.reason, "%s", TSD_PYRAMID_C_REASON);
     }
     if (c->backend)
         tsd_backend_summary_add(c->backend, &r);

@@ -388,9 +388,18 @@ START_TEST(test_too_large)
                      TS_OK);
     ck_assert_int_eq(r.fell_back, 1);
     ck_assert(memcmp(h, sc.h, sc.n * 4 * sizeof *h) == 0);
-    setenv("TERRASHADE_OPENCL_MAX_ALLOC", "lots", 1);
-    ck_assert_int_ne(ts_cl_normals(&sc.g, h, h + sc.n, h + 2 * sc.n, &e), TS_OK);
-    ck_assert_ptr_nonnull(strstr(e.message, "TERRASHADE_OPENCL_MAX_ALLOC"));
+    /* not a size: refused; a fraction of a unit is a size; 2^64 bytes and
+     * more overflowed the count (undefined) */
+    const char *bad[] = {"lots", "0x1000", "17179869184G", "0.5", "-1k"};
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        setenv("TERRASHADE_OPENCL_MAX_ALLOC", bad[i], 1);
+        ck_assert_int_ne(ts_cl_normals(&sc.g, h, h + sc.n, h + 2 * sc.n, &e), TS_OK);
+        ck_assert_msg(strstr(e.message, "TERRASHADE_OPENCL_MAX_ALLOC"), "%s: %s", bad[i],
+                      e.message);
+    }
+    setenv("TERRASHADE_OPENCL_MAX_ALLOC", "0.5M", 1); /* once refused, as below 1 */
+    ck_assert_msg(ts_cl_normals(&sc.g, h, h + sc.n, h + 2 * sc.n, &e) == TS_OK, "0.5M: %s",
+                  e.message);
     free(h);
     scene_free(&sc, &SHAPES[4]);
     clear_env();

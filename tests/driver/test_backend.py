@@ -177,14 +177,16 @@ class Backend(unittest.TestCase):
         print(p.stdout, p.stderr)
         self.assertIn("BACKEND=c\n", p.stdout)
         self.assertEqual(p.stderr.count("BACKEND=opencl was requested"), 1)
-        # OpenCL runs the normals, C the capped sweeps: predicted opencl,
-        # computed mixed (it stayed opencl); a chunk's sweep is capped by
-        # its near field, MAX_DISTANCE's by MAX_DISTANCE
-        for extra, why in [({}, "bounded by its near field of 11837 m (TILE_SIZE=256"),
-                           ({"MAX_DISTANCE": 500}, "a MAX_DISTANCE sweep runs on the C")]:
+        # OpenCL runs the normals, C the capped sweeps: computed mixed (it
+        # stayed opencl); a chunk's sweep is capped by its near field, which
+        # the prediction does not foresee (opencl), MAX_DISTANCE's by
+        # MAX_DISTANCE, which it does (mixed)
+        for extra, why, predicted in [
+                ({}, "bounded by its near field of 11837 m (TILE_SIZE=256", "opencl"),
+                ({"MAX_DISTANCE": 500}, "a MAX_DISTANCE sweep runs on the C", "mixed")]:
             _, before, after, _ = compute(dem, dict(options, BACKEND="opencl", **extra))
             print(before, after)
-            self.assertEqual(before["BACKEND"], "opencl")
+            self.assertEqual(before["BACKEND"], predicted)
             self.assertEqual(after["BACKEND"], "mixed")
             self.assertIn(why, after["BACKEND_FALLBACK_REASON"])
 
@@ -384,6 +386,43 @@ class Backend(unittest.TestCase):
             "PRODUCT=sunhours", "DATE=2026-06-21", "TIMEZONE=-05:00", "STEP_MINUTES=60"])
         ds.GetRasterBand(1).Checksum()
         self.assertEqual(backend_md(ds), {})
+
+    def test_c_steps_are_said_before_computing(self):
+        """Steps with no OpenCL path for their options run in C whatever the
+        backend: BACKEND=opencl says so before computing (gdal_translate
+        copies the metadata then), as after, and warns. The items once held
+        'opencl' without a reason for a horizon capped by MAX_DISTANCE,
+        which ran wholly in C, and the per-cell sun of shade ran in C
+        without being counted at all."""
+        dem = self.dems["jacksboro"]
+        cases = [
+            ({"PRODUCT": "horizon", "DIRECTIONS": 4, "MAX_DISTANCE": 300}, "c",
+             "a MAX_DISTANCE sweep runs on the C backend"),
+            ({"PRODUCT": "horizon", "DIRECTIONS": 4, "HORIZON_METHOD": "pyramid"}, "c",
+             "HORIZON_METHOD=pyramid"),
+            ({"PRODUCT": "svf", "DIRECTIONS": 8, "MAX_DISTANCE": 300}, "mixed",
+             "a MAX_DISTANCE sweep runs on the C backend"),
+            ({"PRODUCT": "shade", "SUN_POSITION": "per_cell",
+              "DATETIME": "2026-06-21T12:00:00-05:00"}, "mixed", "SUN_POSITION=per_cell"),
+        ]
+        out = os.path.join(self.dir, "c_steps.tif")
+        for options, backend, reason in cases:
+            with self.subTest(options=options):
+                _, before, after, _ = compute(dem, dict(options, BACKEND="opencl"))
+                p = T.run(["gdal_translate", "-q"] + T.oo_args(dict(options, BACKEND="opencl"))
+                          + [T.conn(dem), out])
+                written = backend_md(gdal.Open(out))
+                print(options, before, after, written)
+                for md in (before, after, written):
+                    self.assertEqual(md["BACKEND"], backend)
+                    self.assertIn(reason, md["BACKEND_FALLBACK_REASON"])
+                self.assertIn("ran on the C backend instead: " + reason, p.stderr)
+        # a day product has no OpenCL step at all: said at open (once silent)
+        p = T.run(["gdal_translate", "-q"] + T.oo_args({
+            "PRODUCT": "sunhours", "DATE": "2026-06-21", "TIMEZONE": "Z", "STEP_MINUTES": 60,
+            "BACKEND": "opencl"}) + [T.conn(dem), out])
+        self.assertIn("BACKEND=opencl was requested, but PRODUCT=sunhours runs on the C "
+                      "backend only", p.stderr)
 
 
 if __name__ == "__main__":

@@ -410,7 +410,7 @@ class Sun(unittest.TestCase):
         self.assertAlmostEqual(reach, 9.5, delta=0.3)
         for oo, advice in ((day, "SUN_POSITION=per_cell computes the sun across the DEM"),
                            (instant, "SUN_POSITION=per_cell"),
-                           (dict(instant, METHOD="shm"), "SUN_POSITION=per_cell"),
+                           (dict(instant, METHOD="shm"), "Crop the DEM"),
                            (dict(instant, METHOD="shadowmap"), "Crop the DEM"),
                            (dict(instant, LIGHT_RADIUS=1), "Crop the DEM"),
                            (dict(instant, PRODUCT="farshadow", FAR_THRESHOLD=8), "Crop the DEM")):
@@ -555,6 +555,11 @@ class Sun(unittest.TestCase):
             (J, ["PRODUCT=sunhours", "OUTPUT_TYPE=Byte"] + day, "in hours"),
             (J, ["PRODUCT=farshadow", "SUN_POSITION=per_cell"] + day, "SUN_POSITION=center"),
             (J, ["PRODUCT=shadow", "SUN_POSITION=per_cell"], "needs the sun from DATETIME"),
+            # once taken without a word (shade went exact, shadow took the centre's sun)
+            (J, ["PRODUCT=shade", "METHOD=shm", "SUN_POSITION=per_cell",
+                 "DATETIME=2026-06-21T07:30Z"], "METHOD=shm builds its shadow height maps"),
+            (J, ["PRODUCT=shadow", "METHOD=shm", "SUN_POSITION=per_cell",
+                 "DATETIME=2026-06-21T07:30Z"], "needs SUN_POSITION=center"),
             (J, ["PRODUCT=sunhours", "PRESSURE=0"] + day, "PRESSURE must be between 300 and 1100"),
             (J, ["PRODUCT=sunhours", "TEMPERATURE=-300"] + day, "TEMPERATURE must be"),
             (J, ["PRODUCT=sunhours", "DELTA_T=9000"] + day, "DELTA_T must be between"),
