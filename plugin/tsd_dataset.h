@@ -7,6 +7,7 @@
 #ifndef TSD_DATASET_H
 #define TSD_DATASET_H
 
+#include <atomic>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -63,6 +64,29 @@ class TSDataset final : public GDALPamDataset
     bool m_bHasGT = true;
     OGRSpatialReference m_oSRS{};
     std::mutex m_oMutex{};
+    /* the thread computing under m_oMutex (EnsureComputed, WindowBlock):
+     * a read of the dataset from its own progress callback, on that thread,
+     * would wait for itself (or take a block GDAL's cache holds unfilled) */
+    std::atomic<std::thread::id> m_oComputer{};
+    bool ReadInsideOwnComputation() const;
+    /* the calling thread marked as m_oComputer while it holds m_oMutex */
+    class ComputingHere
+    {
+        std::atomic<std::thread::id> &m_roComputer;
+
+      public:
+        explicit ComputingHere(std::atomic<std::thread::id> &roComputer)
+            : m_roComputer(roComputer)
+        {
+            m_roComputer.store(std::this_thread::get_id());
+        }
+        ~ComputingHere()
+        {
+            m_roComputer.store(std::thread::id());
+        }
+        ComputingHere(const ComputingHere &) = delete;
+        ComputingHere &operator=(const ComputingHere &) = delete;
+    };
     bool m_bTried = false;
     std::string m_osError{};      // why computing failed
     ts_status m_eStatus = TS_OK;  // and its status
@@ -113,6 +137,7 @@ class TSDataset final : public GDALPamDataset
     void SetupSunMetadata();
     void SetupMetadata();
     void SetupPam(const char *pszConnection);
+    bool m_bLegacyPam = false; // BuildPamFilename: the DEM's own .aux.xml (SetupPam)
     bool SetupEnvironment();
     void SetupEnvironmentMetadata();
 
@@ -140,6 +165,13 @@ class TSDataset final : public GDALPamDataset
     const OGRSpatialReference *GetSpatialRef() const override;
     char **GetMetadata(const char *pszDomain = "") override;
     const char *GetMetadataItem(const char *pszName, const char *pszDomain = "") override;
+
+  protected:
+    /* the products' own .aux.xml, <DEM>.terrashade.aux.xml, one save or load
+     * at a time in the process (tsd_dataset_metadata.cpp, SetupPam) */
+    const char *BuildPamFilename() override;
+    CPLErr TrySaveXML() override;
+    CPLErr TryLoadXML(char **papszSiblingFiles = nullptr) override;
 };
 
 /** A band of it: one plane of the product. Its nodata value, unit and

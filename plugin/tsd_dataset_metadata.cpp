@@ -6,6 +6,7 @@
  */
 #include <cmath>
 #include <cstring>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -233,6 +234,55 @@ void TSDataset::SetupSunMetadata()
 
 /* Auxiliary metadata (statistics...) goes next to the DEM's file, in a
  * subdataset entry per set of options, never into the current directory. */
+/* The products of a DEM keep their entries (statistics, the user's nodata,
+ * unit and colour) in a file of their own beside it, <DEM>.terrashade.aux.xml,
+ * not in the DEM's own .aux.xml, which they once shared: GDAL rewrites such
+ * a file whole (it reads it, then truncates and writes it), so processes
+ * saving statistics of several products at once lost each other's entries
+ * and the DEM's own, georeferencing included (a PNG's, kept there). Saves
+ * and loads are one at a time in this process; processes can still lose
+ * each other's product entries, never the DEM's (docs/driver.md, PAM). */
+const char *TSDataset::BuildPamFilename()
+{
+    if (!psPam)
+        return nullptr;
+    if (psPam->pszPamFilename)
+        return psPam->pszPamFilename;
+    const char *pszBase = GDALPamDataset::BuildPamFilename(); // <DEM>.aux.xml, or a proxy's
+    if (!pszBase || m_bLegacyPam)
+        return pszBase;
+    std::string os(pszBase);
+    const std::string osAux = ".aux.xml";
+    if (os.size() > osAux.size() && EQUAL(os.c_str() + os.size() - osAux.size(), osAux.c_str()))
+    {
+        os.insert(os.size() - osAux.size(), ".terrashade");
+        CPLFree(psPam->pszPamFilename);
+        psPam->pszPamFilename = CPLStrdup(os.c_str());
+    }
+    return psPam->pszPamFilename;
+}
+
+namespace
+{
+std::mutex &PamFileMutex()
+{
+    static std::mutex oMutex;
+    return oMutex;
+}
+} // namespace
+
+CPLErr TSDataset::TrySaveXML()
+{
+    std::lock_guard<std::mutex> oLock(PamFileMutex());
+    return GDALPamDataset::TrySaveXML();
+}
+
+CPLErr TSDataset::TryLoadXML(char **papszSiblingFiles)
+{
+    std::lock_guard<std::mutex> oLock(PamFileMutex());
+    return GDALPamDataset::TryLoadXML(papszSiblingFiles);
+}
+
 void TSDataset::SetupPam(const char *pszConnection)
 {
     SetDescription(pszConnection);
@@ -252,7 +302,22 @@ void TSDataset::SetupPam(const char *pszConnection)
             osSub += ":" + m_osDEM;
         SetPhysicalFilename(papszFiles[0]);
         SetSubdatasetName(osSub.c_str());
+        VSIStatBufL sStat;
+        const char *pszOwn = BuildPamFilename();
+        const bool bOwnFile = pszOwn && VSIStatL(pszOwn, &sStat) == 0;
         TryLoadXML();
+        if (!bOwnFile) // an entry from before session 48, in the DEM's own file
+        {
+            CPLFree(psPam->pszPamFilename);
+            psPam->pszPamFilename = nullptr;
+            m_bLegacyPam = true;
+            CPLPushErrorHandler(CPLQuietErrorHandler);
+            TryLoadXML();
+            CPLPopErrorHandler();
+            m_bLegacyPam = false;
+            CPLFree(psPam->pszPamFilename);
+            psPam->pszPamFilename = nullptr; // the next save: the products' own file
+        }
     }
     else
     {

@@ -1,6 +1,10 @@
-"""PAM (.aux.xml) goes next to the DEM, one entry per set of options, never
-into the current directory; a nodata value, unit or colour the user sets
-there is what the band reports, on that product and options only."""
+"""PAM goes next to the DEM, into the products' own <DEM>.terrashade.aux.xml
+(not the DEM's .aux.xml), one entry per set of options, never into the
+current directory; a nodata value, unit or colour the user sets there is
+what the band reports, on that product and options only. Entries written
+into the DEM's own .aux.xml before are still read. Threads saving several
+products' statistics at once keep every entry, and processes doing so never
+touch the DEM's own file (its georeferencing, for a PNG DEM)."""
 import math
 import os
 import shutil
@@ -8,7 +12,7 @@ import unittest
 import xml.etree.ElementTree as ET
 
 import tsdriver as T
-from tsdriver import gdal, np
+from tsdriver import gdal, np, osr
 
 
 class Pam(unittest.TestCase):
@@ -37,7 +41,8 @@ class Pam(unittest.TestCase):
                     p = T.run(["gdalinfo", "-stats", conn], cwd=self.cwd)
                     self.assertIn("STATISTICS_MEAN", p.stdout)
                     self.assertCwdClean()
-        aux = self.dem + ".aux.xml"
+        aux = self.dem + ".terrashade.aux.xml"
+        self.assertFalse(os.path.exists(self.dem + ".aux.xml"), os.listdir(self.demdir))
         self.assertTrue(os.path.exists(aux), os.listdir(self.demdir))
         subs = [s.get("name") for s in ET.parse(aux).getroot().iter("Subdataset")]
         print("subdatasets in %s: %s" % (os.path.basename(aux), subs))
@@ -60,7 +65,7 @@ class Pam(unittest.TestCase):
         finally:
             os.chdir(old)
         self.assertCwdClean()
-        self.assertTrue(os.path.exists(self.dem + ".aux.xml"))
+        self.assertTrue(os.path.exists(self.dem + ".terrashade.aux.xml"))
 
     def test_dem_without_a_file(self):
         """A /vsimem DEM: no .aux.xml anywhere, no error."""
@@ -173,7 +178,7 @@ class Pam(unittest.TestCase):
         self.assertEqual(self.band_says(conns[0])[0], -1.0)
         self.assertEqual(self.band_says(conns[1])[0], "nan")
         subs = [s.get("name") for s in
-                ET.parse(self.dem + ".aux.xml").getroot().iter("Subdataset")]
+                ET.parse(self.dem + ".terrashade.aux.xml").getroot().iter("Subdataset")]
         for p in paths:
             self.assertTrue(any("ENV_MAP=" + p in s for s in subs), (p, subs))
 
@@ -193,6 +198,69 @@ class Pam(unittest.TestCase):
         ds = gdal.Open(tsa)
         self.assertEqual(ds.GetRasterBand(2).GetNoDataValue(), 255.0)
         self.assertTrue(os.path.exists(tsa + ".aux.xml"))
+
+    def test_an_entry_in_the_dems_own_file_is_still_read(self):
+        """Before session 48 the entries went into the DEM's .aux.xml: a
+        nodata value set there is still what the band reports, and the
+        next save goes to the products' own file."""
+        conn = T.conn(self.dem, PRODUCT="svf", DIRECTIONS=4)
+        T.run(["gdal_edit.py", "-ro", "-a_nodata", "-1", conn], cwd=self.cwd)
+        own = self.dem + ".terrashade.aux.xml"
+        os.rename(own, self.dem + ".aux.xml")  # where it was written then
+        self.assertEqual(self.band_says(conn)[0], -1.0)
+        T.run(["gdal_edit.py", "-ro", "-units", "x", conn], cwd=self.cwd)
+        self.assertTrue(os.path.exists(own))
+        self.assertEqual(self.band_says(conn)[:2], (-1.0, "x"))
+
+    def test_many_products_at_once(self):
+        """Statistics of 8 products saved at once: by 4 threads of one
+        process every entry is kept (GDAL rewrites an .aux.xml whole, and
+        they lost each other's: 3 to 8 of 32 were left); by 4 processes the
+        DEM's own .aux.xml, which holds a PNG's georeferencing, is never
+        touched (it was wiped in 2 to 5 runs of 12)."""
+        import threading
+        products = [dict(PRODUCT="shadow", SUN_ELEVATION=5 + 5 * i) for i in range(8)]
+        errors = []
+
+        def stats(items):
+            try:
+                for oo in items:
+                    ds = gdal.Open(T.conn(self.dem, **oo))
+                    ds.GetRasterBand(1).ComputeStatistics(False)
+                    ds = None
+            except Exception as e:  # noqa: BLE001 - reported below
+                errors.append(e)
+        threads = [threading.Thread(target=stats, args=(products[i::4],)) for i in range(4)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        self.assertEqual(errors, [])
+        subs = [s.get("name") for s in
+                ET.parse(self.dem + ".terrashade.aux.xml").getroot().iter("Subdataset")]
+        print("entries after 4 threads:", len(subs))
+        self.assertEqual(len(subs), 8, subs)
+        # a PNG DEM, its georeferencing in its own .aux.xml
+        png = os.path.join(self.demdir, "dem.png")
+        z = T.fractal_dem(96, seed=3, relief=200.0)
+        src = gdal.GetDriverByName("MEM").Create("", 96, 96, 1, gdal.GDT_UInt16)
+        src.GetRasterBand(1).WriteArray((z - z.min()).astype(np.uint16))
+        src.SetGeoTransform((500000.0, 10.0, 0, 4000000.0, 0, -10.0))
+        utm = osr.SpatialReference()
+        utm.ImportFromEPSG(32617)
+        src.SetProjection(utm.ExportToWkt())
+        gdal.GetDriverByName("PNG").CreateCopy(png, src)
+        src = None
+        own = open(png + ".aux.xml", "rb").read()
+        import subprocess
+        procs = [subprocess.Popen(["gdalinfo", "-stats", T.conn(png, **oo)],
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                  env=T.env()) for oo in products]
+        for p in procs:
+            p.wait(timeout=300)
+            self.assertEqual(p.returncode, 0, p.stderr.read())
+        self.assertEqual(open(png + ".aux.xml", "rb").read(), own)
+        self.assertTrue(os.path.exists(png + ".terrashade.aux.xml"))
 
 
 if __name__ == "__main__":
