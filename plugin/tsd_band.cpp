@@ -146,6 +146,8 @@ CPLErr TSRasterBand::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXS
                                GDALRasterIOExtraArg *psExtraArg)
 {
     tsd::CLocale oC; /* tsd_locale.h */
+    if (static_cast<TSDataset *>(poDS)->ReadInsideOwnComputation())
+        return CE_Failure; // (before GDAL's block cache, which may hold the block unfilled)
     const CallerProgress oCaller(psExtraArg); // a computation started here reports to it
     CPLErr eErr = CE_None;
     if (!(eRWFlag == GF_Read && nBufXSize == nXSize && nBufYSize == nYSize &&

@@ -156,6 +156,18 @@ void TSDataset::FailCancelled() const
                                       m_psProduct->name));
 }
 
+bool TSDataset::ReadInsideOwnComputation() const
+{
+    if (m_oComputer.load() != std::this_thread::get_id())
+        return false;
+    CPLError(CE_Failure, CPLE_AppDefined,
+             "TERRASHADE: '%s' was read from inside its own computation (from its progress "
+             "callback, on the thread computing it), which would wait for itself: read it "
+             "once the read that computes it has returned",
+             GetDescription());
+    return true;
+}
+
 CPLErr TSDataset::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize, int nYSize,
                             void *pData, int nBufXSize, int nBufYSize, GDALDataType eBufType,
                             int nBandCount, int *panBandMap, GSpacing nPixelSpace,
@@ -163,6 +175,8 @@ CPLErr TSDataset::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize
                             GDALRasterIOExtraArg *psExtraArg)
 {
     tsd::CLocale oC; /* tsd_locale.h */
+    if (ReadInsideOwnComputation())
+        return CE_Failure;
     const CallerProgress oCaller(psExtraArg);
     const CPLErr eErr = GDALPamDataset::IRasterIO(
         eRWFlag, nXOff, nYOff, nXSize, nYSize, pData, nBufXSize, nBufYSize, eBufType,
@@ -176,7 +190,10 @@ CPLErr TSDataset::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize
  * after the caller's progress callback stopped it. */
 CPLErr TSDataset::EnsureComputed()
 {
+    if (ReadInsideOwnComputation())
+        return CE_Failure;
     std::lock_guard<std::mutex> oLock(m_oMutex);
+    const ComputingHere oHere(m_oComputer);
     if (!m_bTried)
     {
         m_bTried = true;

@@ -377,7 +377,10 @@ const WindowChunk *TSDataset::Chunk(int cx, int cy)
 CPLErr TSDataset::WindowBlock(int nPlanes, const int *piPlane, void *const *ppImage, int x0,
                               int y0, int nBW, int nBH, bool bByte)
 {
+    if (ReadInsideOwnComputation())
+        return CE_Failure;
     std::lock_guard<std::mutex> oLock(m_oMutex);
+    const ComputingHere oHere(m_oComputer);
     WindowState &s = *m_poWindow;
     const int W = nRasterXSize, H = nRasterYSize, T = s.plan.tile;
     const float fNaN = std::numeric_limits<float>::quiet_NaN();

@@ -348,5 +348,45 @@ class CallerCancel(FractalCase):
                 ds = None
 
 
+class ReadFromItsOwnCallback(FractalCase):
+    """A progress callback that reads the dataset being computed, on the
+    computing thread (a GUI drawing a preview): that read fails with a
+    sentence, and the outer read, and later ones, give the product. It hung
+    the process for good (the whole product, an overview level, a day
+    product) or, windowed, returned GDAL's unfilled block (garbage)."""
+    SIDE, SEED = 600, 3  # an overview level
+
+    def test_whole_overview_windowed_day(self):
+        cases = [(dict(PRODUCT="svf", DIRECTIONS=8), None),
+                 (dict(PRODUCT="svf", DIRECTIONS=8), 0),
+                 (dict(PRODUCT="svf", DIRECTIONS=8, TILE_SIZE=128), None),
+                 (dict(PRODUCT="sunhours", STEP_MINUTES=60, **DAY), None)]
+        for opts, level in cases:
+            with self.subTest(opts=opts, level=level):
+                oo = ["%s=%s" % kv for kv in dict(opts, PROGRESS="no").items()]
+
+                def band(ds):
+                    b = ds.GetRasterBand(1)
+                    return b if level is None else b.GetOverview(level)
+                ref_ds = gdal.OpenEx(T.conn(self.dem), open_options=oo)
+                ref = band(ref_ds).ReadAsArray()
+                ds = gdal.OpenEx(T.conn(self.dem), open_options=oo)
+                inner = []
+
+                def cb(_done, _msg, _data):
+                    if not inner:
+                        try:
+                            inner.append(band(ds).ReadAsArray(0, 0, 16, 16))
+                        except RuntimeError as e:
+                            inner.append(str(e))
+                    return 1
+                out = band(ds).ReadAsArray(callback=cb)
+                print(opts, level, inner[0] if isinstance(inner[0], str) else "an array")
+                self.assertIsInstance(inner[0], str)
+                self.assertIn("was read from inside its own computation", inner[0])
+                np.testing.assert_array_equal(out, ref)
+                np.testing.assert_array_equal(band(ds).ReadAsArray(), ref)
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)
