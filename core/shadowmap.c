@@ -177,9 +177,15 @@ ts_status ts_shadowmap_compute(const ts_grid *grid, double azimuth, double eleva
                              project_rows, &J, err);
     /* (the bar: rendering a little more than half, the filter the rest, as
      * measured at a low sun) */
+    /* each band of the map scans every quad of the DEM: no more bands than
+     * cores (THREADS=64 on two made the render 10x dearer, the same bits) */
+    const int cores = ts_cpu_count();
     if (st == TS_OK)
-        st = ts_parallel_reported(ts_thread_count(threads, f.height), f.height, 0, render_band,
-                                  &J, &report, 0.0, 0.55, SM_BATCHES, err);
+        st = ts_parallel_reported(ts_thread_count(threads > 0 && threads < cores ? threads
+                                                                                : cores,
+                                                  f.height),
+                                  f.height, 0, render_band, &J, &report, 0.0, 0.55, SM_BATCHES,
+                                  err);
     const long th = (f.height + TS_SM_TILE - 1) / TS_SM_TILE;
     if (st == TS_OK)
         st = ts_parallel_for(ts_thread_count(threads, th), th, tile_rows, &J, err);
