@@ -205,6 +205,25 @@ ts_status tsd_sun_setup(const tsd_options *o, tsd_sites *sites, double min_cell_
     return TS_OK;
 }
 
+int tsd_sun_zone_warning(const tsd_sun *s, const tsd_options *o, char *warning, size_t n)
+{
+    if (isfinite(s->instant) || !(s->day_length > 0) || o->datetime[0])
+        return 0;
+    const double lon = s->sites_owned.lon[0], solar = lon * 4.0; /* minutes east of UTC */
+    const double apart = remainder(s->offset_minutes - solar, 1440.0);
+    if (!(fabs(apart) > 240.0))
+        return 0;
+    const long sm = lround(solar), so = labs(sm);
+    snprintf(warning, n,
+             "TIMEZONE's offset (%+03d:%02d) is %.1f hours from the mean solar time at the "
+             "DEM's centre (longitude %.1f: UTC%c%02ld:%02ld), farther than any time zone: "
+             "its day's midnight falls in daylight, and the sun's hours are split between "
+             "two dates. Is it the site's offset?",
+             s->offset_minutes / 60, abs(s->offset_minutes) % 60, fabs(apart) / 60.0, lon,
+             sm < 0 ? '-' : '+', so / 60, so % 60);
+    return 1;
+}
+
 int tsd_sun_night_warning(const tsd_sun *s, const tsd_options *o, char *warning, size_t n)
 {
     const char *product = tsd_product_of(o)->name;

@@ -75,6 +75,15 @@ int tsd_sun_per_cell(const tsd_sun *sun);
 int tsd_sun_night_warning(const tsd_sun *s, const tsd_options *o, char *warning,
                           size_t warning_size);
 
+/** 1 with a sentence in `warning` when a day product's day (DATE or
+ * START_DATE with TIMEZONE, not DATETIME) is of an offset more than 4 hours
+ * from the mean solar time at the DEM's centre (modulo a day): no civil
+ * time zone is that far from its sun (western China's, the farthest, ~3
+ * h), so its local midnight falls in daylight and the day's light is
+ * split between two calendar days. 0 otherwise. */
+int tsd_sun_zone_warning(const tsd_sun *s, const tsd_options *o, char *warning,
+                         size_t warning_size);
+
 /** ISO 8601 local time with its offset, whole seconds:
  * 2026-06-21T07:30:00+02:00 (or ...Z for offset 0). */
 void tsd_format_time(double unix_time, int offset_minutes, char *buf, size_t n);

@@ -145,6 +145,23 @@ class Sun(unittest.TestCase):
                           "night): no time of that day lights the DEM", err)
             self.assertNotIn("check DATETIME's offset", err)
 
+    def test_a_day_of_a_far_offset_warns(self):
+        """A day product's TIMEZONE more than 4 hours from the mean solar time
+        at the DEM's centre (modulo a day) puts its midnight in daylight:
+        a warning, which no real zone gets (-05:00 and -04:00 at jacksboro,
+        84.2 W; +14:00 at 157 W is 0.5 hours from it)."""
+        out = os.path.join(self.dir, "zone.tif")
+        day = ["-oo", "PRODUCT=sunhours", "-oo", "DATE=2026-06-21", "-oo", "STEP_MINUTES=60"]
+        for tz, warns in (("+07:00", True), ("Z", True), ("-05:00", False),
+                          ("-04:00", False)):
+            p = T.run(["gdal_translate", "-q"] + day + ["-oo", "TIMEZONE=" + tz,
+                                                        T.conn(T.JACKSBORO), out])
+            self.assertEqual("hours from the mean solar time" in p.stderr, warns, (tz, p.stderr))
+        line = flat_dem(os.path.join(self.dir, "line.tif"), 1.9, -157.4)
+        p = T.run(["gdal_translate", "-q"] + day + ["-oo", "TIMEZONE=+14:00", T.conn(line),
+                                                    out])
+        self.assertNotIn("hours from the mean solar time", p.stderr)
+
     def test_a_per_cell_night_is_night_at_every_site(self):
         """A 20 x 20 degree DEM at dusk, per cell: the sun has set in the east
         (6.4 degrees down at the lattice's middle node) but not in the west,
