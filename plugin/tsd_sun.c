@@ -209,7 +209,9 @@ int tsd_sun_zone_warning(const tsd_sun *s, const tsd_options *o, char *warning, 
 {
     if (isfinite(s->instant) || !(s->day_length > 0) || o->datetime[0])
         return 0;
-    const double lon = s->sites_owned.lon[0], solar = lon * 4.0; /* minutes east of UTC */
+    const tsd_sites *st = &s->sites_owned; /* the centre: the middle node of a lattice */
+    const double lon = st->lon[(size_t)(st->ny / 2) * st->nx + st->nx / 2];
+    const double solar = lon * 4.0; /* minutes east of UTC */
     const double apart = remainder(s->offset_minutes - solar, 1440.0);
     if (!(fabs(apart) > 240.0))
         return 0;
