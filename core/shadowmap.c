@@ -28,6 +28,7 @@ typedef struct {
     float *pu, *pv, *pd; /* projected vertices, width*height each */
     int *map;            /* f->width * f->height keys */
     float *out;
+    float *seg_lo, *seg_hi; /* ts_sm_seg_bounds of every mesh row (NULL: none) */
 } sm_job;
 
 /* Most texels of a receiver's box that its memo keeps (a box is the fan's
@@ -99,6 +100,14 @@ static void project_rows(void *ctx, int worker, long begin, long end)
     }
 }
 
+/* The segments' bounds of mesh rows [begin, end). */
+static void seg_rows(void *ctx, int worker, long begin, long end)
+{
+    (void)worker;
+    const sm_job *J = ctx;
+    ts_sm_seg_bounds(J->pv, J->g->width, (int)begin, (int)end, J->seg_lo, J->seg_hi);
+}
+
 /* Render every quad that reaches map rows [begin, end). */
 static void render_band(void *ctx, int worker, long begin, long end)
 {
@@ -107,8 +116,8 @@ static void render_band(void *ctx, int worker, long begin, long end)
     const int mw = J->f->width;
     for (long i = begin * mw; i < end * mw; i++)
         J->map[i] = TS_SM_EMPTY;
-    ts_sm_render_band(J->f->params, J->map, mw, (int)begin, (int)end, J->pu, J->pv, J->pd,
-                      J->g->width, J->g->height);
+    ts_sm_render_band_segs(J->f->params, J->map, mw, (int)begin, (int)end, J->pu, J->pv, J->pd,
+                           J->g->width, J->g->height, J->seg_lo, J->seg_hi);
 }
 
 /* The tiles' largest keys, after the map: tile rows [begin, end). */
@@ -163,7 +172,20 @@ ts_status ts_shadowmap_compute(const ts_grid *grid, double azimuth, double eleva
     const size_t cells = (size_t)grid->width * grid->height;
     sm_job J = {grid, &f, malloc(cells * sizeof(float)), malloc(cells * sizeof(float)),
                 malloc(cells * sizeof(float)),
-                malloc(ts_shadowmap_keys(&f) * sizeof(int)), visibility};
+                malloc(ts_shadowmap_keys(&f) * sizeof(int)), visibility, NULL, NULL};
+    /* a few floats a row: without them (no memory) each band scans every quad */
+    const size_t nseg = grid->height > 1 && grid->width > 1
+                            ? (size_t)(grid->height - 1) * TS_SM_SEGS(grid->width)
+                            : 0;
+    if (nseg) {
+        J.seg_lo = malloc(nseg * sizeof(float));
+        J.seg_hi = malloc(nseg * sizeof(float));
+        if (!J.seg_lo || !J.seg_hi) {
+            free(J.seg_lo);
+            free(J.seg_hi);
+            J.seg_lo = J.seg_hi = NULL;
+        }
+    }
     if (!J.pu || !J.pv || !J.pd || !J.map)
         st = ts_fail(err, TS_ERR_NOMEM, "out of memory for a %d x %d shadow map", f.width,
                      f.height);
@@ -175,6 +197,9 @@ ts_status ts_shadowmap_compute(const ts_grid *grid, double azimuth, double eleva
     if (st == TS_OK)
         st = ts_parallel_for(ts_thread_count(threads, grid->height), grid->height,
                              project_rows, &J, err);
+    if (st == TS_OK && J.seg_lo)
+        st = ts_parallel_for(ts_thread_count(threads, grid->height - 1), grid->height - 1,
+                             seg_rows, &J, err);
     /* (the bar: rendering a little more than half, the filter the rest, as
      * measured at a low sun) */
     /* each band of the map scans every quad of the DEM: no more bands than
@@ -196,5 +221,7 @@ ts_status ts_shadowmap_compute(const ts_grid *grid, double azimuth, double eleva
     free(J.pv);
     free(J.pd);
     free(J.map);
+    free(J.seg_lo);
+    free(J.seg_hi);
     return st == TS_OK ? ts_ok(err) : st;
 }

@@ -169,14 +169,48 @@ AVX2 static void raster_avx2(const ts_sm_tri *t, const lane_start *s, int *map, 
 #define HAVE_RASTER_X86 0
 #endif
 
+void ts_sm_seg_bounds(const float *pv, int W, int y0, int y1, float *lo, float *hi)
+{
+    const int segs = TS_SM_SEGS(W);
+    for (int y = y0; y < y1; y++)
+        for (int s = 0; s < segs; s++) {
+            const int xe = (s + 1) * TS_SM_SEG < W - 1 ? (s + 1) * TS_SM_SEG : W - 1;
+            float a = NAN, b = NAN;
+            for (int x = s * TS_SM_SEG; x <= xe; x++) /* the quads' vertex columns */
+                for (int r = 0; r < 2; r++) {
+                    const float v = pv[(long)(y + r) * W + x];
+                    a = fminf(a, v);
+                    b = fmaxf(b, v);
+                }
+            lo[(long)y * segs + s] = a;
+            hi[(long)y * segs + s] = b;
+        }
+}
+
 void ts_sm_render_band(const float *P, int *map, int mw, int vlo, int vhi, const float *pu,
                        const float *pv, const float *pd, int W, int H)
+{
+    ts_sm_render_band_segs(P, map, mw, vlo, vhi, pu, pv, pd, W, H, NULL, NULL);
+}
+
+void ts_sm_render_band_segs(const float *P, int *map, int mw, int vlo, int vhi,
+                            const float *pu, const float *pv, const float *pd, int W, int H,
+                            const float *slo, const float *shi)
 {
     lane_start s;
     lane_start_make(&s);
     const int level = HAVE_RASTER_X86 ? ts_cpu_vector_level() : TS_CPU_VECTORS_NONE;
+    const int segs = TS_SM_SEGS(W);
     for (int y = 0; y + 1 < H; y++)
         for (int x = 0; x + 1 < W; x++) {
+            if (slo && x % TS_SM_SEG == 0) {
+                /* the segment's bounds, the quads' own test: NaN bounds are in */
+                const long k = (long)y * segs + x / TS_SM_SEG;
+                if (shi[k] < (float)vlo - 1.0f || slo[k] > (float)vhi) {
+                    x += TS_SM_SEG - 1;
+                    continue;
+                }
+            }
             const long i = (long)y * W + x, c[4] = {i, i + 1, i + W + 1, i + W};
             float lo = fminf(fminf(pv[c[0]], pv[c[1]]), fminf(pv[c[2]], pv[c[3]]));
             float hi = fmaxf(fmaxf(pv[c[0]], pv[c[1]]), fmaxf(pv[c[2]], pv[c[3]]));
