@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cpl_conv.h"
+#include "cpl_minixml.h"
 #include "cpl_string.h"
 
 #include "tsd_dataset.h"
@@ -26,6 +27,10 @@ namespace tsd
  * costs no OpenCL initialisation. */
 void TSDataset::EnsureBackendMetadata()
 {
+    // asked for from the progress callback of this dataset's own computation,
+    // which holds the mutex: computing says what ran
+    if (m_oComputer.load() == std::this_thread::get_id())
+        return;
     std::lock_guard<std::mutex> oLock(m_oMutex);
     if (!m_bUsesBackend || m_bBackendKnown || m_bTried)
         return;
@@ -264,23 +269,44 @@ const char *TSDataset::BuildPamFilename()
 
 namespace
 {
-std::mutex &PamFileMutex()
+/* recursive: GDAL's save calls TrySaveXML again, virtually, to write into
+ * GDAL_PAM_PROXY_DIR where the file next to the DEM cannot be written */
+std::recursive_mutex &PamFileMutex()
 {
-    static std::mutex oMutex;
+    static std::recursive_mutex oMutex;
     return oMutex;
 }
 } // namespace
 
 CPLErr TSDataset::TrySaveXML()
 {
-    std::lock_guard<std::mutex> oLock(PamFileMutex());
+    std::lock_guard<std::recursive_mutex> oLock(PamFileMutex());
     return GDALPamDataset::TrySaveXML();
 }
 
 CPLErr TSDataset::TryLoadXML(char **papszSiblingFiles)
 {
-    std::lock_guard<std::mutex> oLock(PamFileMutex());
+    std::lock_guard<std::recursive_mutex> oLock(PamFileMutex());
     return GDALPamDataset::TryLoadXML(papszSiblingFiles);
+}
+
+/* Whether the .aux.xml at pszPath holds a <Subdataset> named pszName (under
+ * the PAM file mutex: a save may be under way in another thread). */
+static bool HasPamEntry(const char *pszPath, const char *pszName)
+{
+    VSIStatBufL sStat;
+    if (!*pszPath || VSIStatL(pszPath, &sStat) != 0)
+        return false;
+    std::lock_guard<std::recursive_mutex> oLock(PamFileMutex());
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLXMLNode *psTree = CPLParseXMLFile(pszPath);
+    CPLPopErrorHandler();
+    bool bFound = false;
+    for (CPLXMLNode *ps = psTree ? psTree->psChild : nullptr; ps && !bFound; ps = ps->psNext)
+        bFound = ps->eType == CXT_Element && EQUAL(ps->pszValue, "Subdataset") &&
+                 EQUAL(CPLGetXMLValue(ps, "name", ""), pszName);
+    CPLDestroyXMLNode(psTree);
+    return bFound;
 }
 
 void TSDataset::SetupPam(const char *pszConnection)
@@ -302,29 +328,36 @@ void TSDataset::SetupPam(const char *pszConnection)
             osSub += ":" + m_osDEM;
         SetPhysicalFilename(papszFiles[0]);
         SetSubdatasetName(osSub.c_str());
-        VSIStatBufL sStat;
+        bool bLegacy = false;
         const char *pszOwn = BuildPamFilename();
-        const bool bOwnFile = pszOwn && VSIStatL(pszOwn, &sStat) == 0;
+        const std::string osOwn = pszOwn ? pszOwn : "";
         TryLoadXML();
-        if (!bOwnFile) // an entry from before session 48, in the DEM's own file
+        if (!HasPamEntry(osOwn.c_str(), osSub.c_str())) // one from before session 48?
         {
             CPLFree(psPam->pszPamFilename);
             psPam->pszPamFilename = nullptr;
             m_bLegacyPam = true;
-            CPLPushErrorHandler(CPLQuietErrorHandler);
-            TryLoadXML();
-            CPLPopErrorHandler();
+            const char *pszOld = BuildPamFilename(); // the DEM's own
+            if (pszOld && HasPamEntry(pszOld, osSub.c_str()))
+            {
+                CPLPushErrorHandler(CPLQuietErrorHandler);
+                bLegacy = TryLoadXML() == CE_None;
+                CPLPopErrorHandler();
+            }
             m_bLegacyPam = false;
             CPLFree(psPam->pszPamFilename);
             psPam->pszPamFilename = nullptr; // the next save: the products' own file
         }
+        // a legacy entry moves to the products' file when the dataset closes,
+        // so that another product's first save there does not hide it
+        nPamFlags = bLegacy ? nPamFlags | GPF_DIRTY : nPamFlags & ~GPF_DIRTY;
     }
     else
     {
         nPamFlags |= GPF_DISABLED; // no file to put it next to
+        nPamFlags &= ~GPF_DIRTY;
     }
     CSLDestroy(papszFiles);
-    nPamFlags &= ~GPF_DIRTY;
 }
 
 } // namespace tsd

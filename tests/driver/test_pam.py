@@ -207,9 +207,14 @@ class Pam(unittest.TestCase):
         T.run(["gdal_edit.py", "-ro", "-a_nodata", "-1", conn], cwd=self.cwd)
         own = self.dem + ".terrashade.aux.xml"
         os.rename(own, self.dem + ".aux.xml")  # where it was written then
+        # another product's first save makes the products' file, without it
+        T.run(["gdalinfo", "-stats", T.conn(self.dem, PRODUCT="shadow")], cwd=self.cwd)
+        self.assertTrue(os.path.exists(own))
+        self.assertEqual(self.band_says(conn)[0], -1.0)
+        # and it moved there when that dataset closed
+        os.remove(self.dem + ".aux.xml")
         self.assertEqual(self.band_says(conn)[0], -1.0)
         T.run(["gdal_edit.py", "-ro", "-units", "x", conn], cwd=self.cwd)
-        self.assertTrue(os.path.exists(own))
         self.assertEqual(self.band_says(conn)[:2], (-1.0, "x"))
 
     def test_many_products_at_once(self):
