@@ -163,6 +163,34 @@ CPLErr TSRasterBand::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXS
     return eErr;
 }
 
+CPLErr TSRasterBand::ComputeStatistics(int bApproxOK, double *pdfMin, double *pdfMax,
+                                       double *pdfMean, double *pdfStdDev,
+                                       GDALProgressFunc pfnProgress, void *pProgressData)
+{
+    if (static_cast<TSDataset *>(poDS)->ReadInsideOwnComputation())
+        return CE_Failure;
+    return GDALPamRasterBand::ComputeStatistics(bApproxOK, pdfMin, pdfMax, pdfMean, pdfStdDev,
+                                                pfnProgress, pProgressData);
+}
+
+CPLErr TSRasterBand::ComputeRasterMinMax(int bApproxOK, double *adfMinMax)
+{
+    if (static_cast<TSDataset *>(poDS)->ReadInsideOwnComputation())
+        return CE_Failure;
+    return GDALPamRasterBand::ComputeRasterMinMax(bApproxOK, adfMinMax);
+}
+
+CPLErr TSRasterBand::GetHistogram(double dfMin, double dfMax, int nBuckets,
+                                  GUIntBig *panHistogram, int bIncludeOutOfRange, int bApproxOK,
+                                  GDALProgressFunc pfnProgress, void *pProgressData)
+{
+    if (static_cast<TSDataset *>(poDS)->ReadInsideOwnComputation())
+        return CE_Failure;
+    return GDALPamRasterBand::GetHistogram(dfMin, dfMax, nBuckets, panHistogram,
+                                           bIncludeOutOfRange, bApproxOK, pfnProgress,
+                                           pProgressData);
+}
+
 /* Cells x0 .. x0+n-1 of a product row (mirrored when flip_x) into a block
  * row, as bytes (tsd_to_byte) or floats; the rest of the block row is
  * nodata. */

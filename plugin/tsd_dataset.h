@@ -200,6 +200,16 @@ class TSRasterBand final : public TSPamBand
 
   public:
     TSRasterBand(TSDataset *poDSIn, int nBandIn, GDALDataType eType);
+    /* GDAL's statistics read blocks straight from its cache, where the block
+     * being computed sits unfilled: refused from the computation's own
+     * progress callback (TSDataset::ReadInsideOwnComputation), as reads are */
+    CPLErr ComputeStatistics(int bApproxOK, double *pdfMin, double *pdfMax, double *pdfMean,
+                             double *pdfStdDev, GDALProgressFunc pfnProgress,
+                             void *pProgressData) override;
+    CPLErr ComputeRasterMinMax(int bApproxOK, double *adfMinMax) override;
+    CPLErr GetHistogram(double dfMin, double dfMax, int nBuckets, GUIntBig *panHistogram,
+                        int bIncludeOutOfRange, int bApproxOK, GDALProgressFunc pfnProgress,
+                        void *pProgressData) override;
 
     CPLErr IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage) override;
     CPLErr IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize, int nYSize,
