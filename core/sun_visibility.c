@@ -392,7 +392,7 @@ ts_status ts_vis_step(ts_vis_ctx *c, double t, float *vis, float *az, float *el,
     }
 
     /* Lattice: azimuths as offsets from the reference node's. */
-    double a_ref = r->grid_azimuth, lo, hi, emax;
+    double a_ref = r->grid_azimuth, lo, hi, emax, clo = INFINITY, chi = -INFINITY;
     lattice_span(c->ns, s->nx, s->ny, a_ref, c->noff, &lo, &hi, &emax);
     for (int y = 0; y < H; y++) {
         int j;
@@ -412,9 +412,19 @@ ts_status ts_vis_step(ts_vis_ctx *c, double t, float *vis, float *az, float *el,
             double e0 = w00 * n00->true_elevation + w10 * n10->true_elevation +
                         w01 * n01->true_elevation + w11 * n11->true_elevation;
             double e = e0 + ts_sun_refraction(e0, &c->o->sun);
-            const double *off = c->noff;
-            double d = w00 * off[j * s->nx + i] + w10 * off[j * s->nx + i1] +
-                       w01 * off[j1 * s->nx + i] + w11 * off[j1 * s->nx + i1];
+            /* around the subsolar (or antisolar) point the azimuths turn a
+             * whole circle, and the lattice's unwrapping leaves a seam: a
+             * node across it lies ~360 from its quad's first, which it
+             * continues here */
+            const double *off = c->noff, o00 = off[j * s->nx + i];
+            double o10 = off[j * s->nx + i1], o01 = off[j1 * s->nx + i],
+                   o11 = off[j1 * s->nx + i1];
+            o10 = fabs(o10 - o00) > 180.0 ? o00 + ts_wrap180(o10 - o00) : o10;
+            o01 = fabs(o01 - o00) > 180.0 ? o00 + ts_wrap180(o01 - o00) : o01;
+            o11 = fabs(o11 - o00) > 180.0 ? o00 + ts_wrap180(o11 - o00) : o11;
+            double d = w00 * o00 + w10 * o10 + w01 * o01 + w11 * o11;
+            clo = fmin(clo, d);
+            chi = fmax(chi, d);
             size_t k = (size_t)y * W + x;
             c->cel[k] = (float)e;
             c->caz[k] = (float)d;
@@ -422,6 +432,8 @@ ts_status ts_vis_step(ts_vis_ctx *c, double t, float *vis, float *az, float *el,
             if (az) az[k] = (float)ts_wrap360(a_ref + d);
         }
     }
+    lo = fmin(lo, clo); /* (the cells' own span: wider only across a seam) */
+    hi = fmax(hi, chi);
     if (emax + rad <= c->floor_min) {
         *dark = 1;
         for (int y = 0; y < H; y++)

@@ -155,6 +155,36 @@ class SunFrames(unittest.TestCase):
             print("%.1f E: per cell %.5f, its own sun %.5f" % (col - 179.5, row[col], ref))
         self.assertLess(worst, 0.002)
 
+    def test_per_cell_sun_around_the_subsolar_point(self):
+        """A world DEM at noon UTC on the June solstice holds the subsolar
+        point (0, 23.4 N), around which the sun's azimuth turns a whole
+        circle, so that no unwrapping of the lattice's azimuths is free of
+        a seam. Cells beside it (here from the subsolar point east, rows
+        22.5 and 23.5 N) took azimuths averaged across it: shade 0.096
+        where its own sun gives 0.63. Each against a 3 x 3 DEM of its own."""
+        lat = 89.5 - np.arange(180)
+        # rising 0.3 to the east (heights in units of 2 km, Z_FACTOR)
+        z = np.arange(360)[None, :] * 111000.0 * np.cos(np.radians(lat))[:, None] * 0.3 / 2000
+        world = T.write_tif(self.dir + "/world.tif", z.astype(np.float32),
+                            (-180.0, 1.0, 0, 90.0, 0, -1.0), 4326)
+        opts = ["PRODUCT=shade", "OUTPUT_TYPE=Float32", "DATETIME=2026-06-21T12:00:00Z",
+                "SKY_WEIGHT=0", "CURVATURE=NO", "EDGE=open", "Z_FACTOR=2000"]
+        ds = gdal.OpenEx(T.conn(world), gdal.OF_RASTER,
+                         open_options=opts + ["SUN_POSITION=per_cell"])
+        a = ds.GetRasterBand(1).ReadAsArray()
+        worst = 0.0
+        for lon in (40.5, 60.5, 80.5):
+            for la in (24.5, 23.5, 22.5, 21.5):
+                x, y = int(lon + 179.5), int(89.5 - la)
+                own = T.write_tif(self.dir + "/own.tif", z[y - 1:y + 2, x - 1:x + 2].astype(
+                    np.float32), (lon - 1.5, 1.0, 0, la + 1.5, 0, -1.0), 4326)
+                d2 = gdal.OpenEx(T.conn(own), gdal.OF_RASTER, open_options=opts)
+                ref = float(d2.GetRasterBand(1).ReadAsArray()[1, 1])
+                d2 = None
+                worst = max(worst, abs(float(a[y, x]) - ref))
+                print("%.1f E %.1f N: per cell %.4f, its own sun %.4f" % (lon, la, a[y, x], ref))
+        self.assertLess(worst, 0.01)
+
     def test_a_pole_by_rounding(self):
         """A polar cap whose top is the pole give or take rounding (90 + 1e-13)
         opens; one 0.6 of a cell past it is off by more than rounding and
