@@ -176,7 +176,10 @@ ts_status ts_cl_env_max_alloc(unsigned long long *limit, ts_error *err)
     const char *digits = s;
     while (isspace((unsigned char)*digits))
         digits++;
+    digits += *digits == '+' || *digits == '-';
     const int hex = digits[0] == '0' && (digits[1] == 'x' || digits[1] == 'X');
+    while (isspace((unsigned char)*end)) /* trailing spaces, as leading ones */
+        end++;
     const double bytes = v * mul; /* 0.5M is half a megabyte */
     /* below 2^63: beyond, the conversion to a count of bytes is undefined */
     if (end == s || *end || errno || hex || !isfinite(bytes) || !(bytes >= 1) ||

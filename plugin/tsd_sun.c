@@ -216,12 +216,13 @@ int tsd_sun_zone_warning(const tsd_sun *s, const tsd_options *o, char *warning, 
     if (!(fabs(apart) > 240.0))
         return 0;
     const long sm = lround(solar), so = labs(sm);
+    const int om = abs(s->offset_minutes);
     snprintf(warning, n,
-             "TIMEZONE's offset (%+03d:%02d) is %.1f hours from the mean solar time at the "
+             "TIMEZONE's offset (%c%02d:%02d) is %.1f hours from the mean solar time at the "
              "DEM's centre (longitude %.1f: UTC%c%02ld:%02ld), farther than any time zone: "
              "its day's midnight falls in daylight, and the sun's hours are split between "
              "two dates. Is it the site's offset?",
-             s->offset_minutes / 60, abs(s->offset_minutes) % 60, fabs(apart) / 60.0, lon,
+             s->offset_minutes < 0 ? '-' : '+', om / 60, om % 60, fabs(apart) / 60.0, lon,
              sm < 0 ? '-' : '+', so / 60, so % 60);
     return 1;
 }

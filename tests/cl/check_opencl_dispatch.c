@@ -390,14 +390,14 @@ START_TEST(test_too_large)
     ck_assert(memcmp(h, sc.h, sc.n * 4 * sizeof *h) == 0);
     /* not a size: refused; a fraction of a unit is a size; 2^64 bytes and
      * more overflowed the count (undefined) */
-    const char *bad[] = {"lots", "0x1000", "17179869184G", "0.5", "-1k"};
+    const char *bad[] = {"lots", "0x1000", "+0x10M", "17179869184G", "0.5", "-1k", "  "};
     for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
         setenv("TERRASHADE_OPENCL_MAX_ALLOC", bad[i], 1);
         ck_assert_int_ne(ts_cl_normals(&sc.g, h, h + sc.n, h + 2 * sc.n, &e), TS_OK);
         ck_assert_msg(strstr(e.message, "TERRASHADE_OPENCL_MAX_ALLOC"), "%s: %s", bad[i],
                       e.message);
     }
-    setenv("TERRASHADE_OPENCL_MAX_ALLOC", "0.5M", 1); /* once refused, as below 1 */
+    setenv("TERRASHADE_OPENCL_MAX_ALLOC", "0.5M ", 1); /* once refused: below 1, a space */
     ck_assert_msg(ts_cl_normals(&sc.g, h, h + sc.n, h + 2 * sc.n, &e) == TS_OK, "0.5M: %s",
                   e.message);
     free(h);

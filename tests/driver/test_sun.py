@@ -161,6 +161,16 @@ class Sun(unittest.TestCase):
         p = T.run(["gdal_translate", "-q"] + day + ["-oo", "TIMEZONE=+14:00", T.conn(line),
                                                     out])
         self.assertNotIn("hours from the mean solar time", p.stderr)
+        # the centre's solar time, not a lattice corner's (150 degrees of
+        # longitude: the western corner's is 5.6 hours from -05:00)
+        wide = T.write_tif(os.path.join(self.dir, "wide150.tif"), np.zeros((40, 150), np.float32),
+                           (-160.0, 1.0, 0, 40.0, 0, -1.0), 4326)
+        p = T.run(["gdal_translate", "-q"] + day + ["-oo", "TIMEZONE=-05:00", "-oo",
+                                                    "SUN_POSITION=per_cell", T.conn(wide), out])
+        self.assertNotIn("hours from the mean solar time", p.stderr)
+        p = T.run(["gdal_translate", "-q"] + day + ["-oo", "TIMEZONE=-00:30", T.conn(line),
+                                                    out])
+        self.assertIn("TIMEZONE's offset (-00:30)", p.stderr)
 
     def test_a_per_cell_night_is_night_at_every_site(self):
         """A 20 x 20 degree DEM at dusk, per cell: the sun has set in the east
