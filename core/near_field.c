@@ -188,17 +188,9 @@ exact_piece(const ts_near_plan *p, int n, const float *restrict c00, const float
             m = cm_piece_max(P, beta, gamma, sa, sb, L, c);
             flag[e] += nodata ? 1.0f : 0.0f;
         } else {
-            /* cm_edge_height's sums, from 0 (a skipped corner adds +0,
-             * which leaves a sum that is never -0 as it is) */
-            double ea = 0.0, eb = 0.0;
-            ea += wa[0] > 0 ? wa[0] * h0 : 0.0;
-            ea += wa[1] > 0 ? wa[1] * h1 : 0.0;
-            ea += wa[2] > 0 ? wa[2] * h2 : 0.0;
-            ea += wa[3] > 0 ? wa[3] * h3 : 0.0;
-            eb += wb[0] > 0 ? wb[0] * h0 : 0.0;
-            eb += wb[1] > 0 ? wb[1] * h1 : 0.0;
-            eb += wb[2] > 0 ? wb[2] * h2 : 0.0;
-            eb += wb[3] > 0 ? wb[3] * h3 : 0.0;
+            /* cm_edge_height's sums */
+            const double ea = cm_edge_sum(wa, h0, h1, h2, h3);
+            const double eb = cm_edge_sum(wb, h0, h1, h2, h3);
             const double na = nodata ? ea - hz[e] : P + beta * sa + gamma * sa * sa;
             const double nb = nodata ? eb - hz[e] : P + beta * sb + gamma * sb * sb;
             const double fa = has_sa ? na / la - ca : beta / L, fb = nb / lb - cb;

@@ -52,22 +52,28 @@ CM_FN void cm_edge_weights(cm_real a, cm_real b, cm_real w[4])
     w[3] = a * b;
 }
 
+/* The height of corners h0..h3 under weights w (cm_edge_weights) from the
+ * corners that weigh something, summed from 0 in order; NaN if one of those
+ * is nodata. A corner that weighs nothing adds +0, which leaves the sum (never
+ * -0) as it is: a select, not a branch, so that vector loops take it too
+ * (core/near_field.c). */
+CM_FN cm_real cm_edge_sum(const cm_real w[4], float h0, float h1, float h2, float h3)
+{
+    cm_real sum = 0;
+    sum += w[0] > 0 ? w[0] * h0 : CM_R(0.0); /* a NaN corner makes the sum NaN */
+    sum += w[1] > 0 ? w[1] * h1 : CM_R(0.0);
+    sum += w[2] > 0 ? w[2] * h2 : CM_R(0.0);
+    sum += w[3] > 0 ? w[3] * h3 : CM_R(0.0);
+    return sum;
+}
+
 /* Bilinear height at (a, b) of a patch (corners 00, 10, 01, 11) from the
  * corners that weigh something there; NaN if one of those is nodata. */
 CM_FN cm_real cm_edge_height(float h0, float h1, float h2, float h3, cm_real a, cm_real b)
 {
     cm_real w[4];
     cm_edge_weights(a, b, w);
-    cm_real sum = 0;
-    if (w[0] > 0)
-        sum += w[0] * h0; /* a NaN corner makes the sum NaN */
-    if (w[1] > 0)
-        sum += w[1] * h1;
-    if (w[2] > 0)
-        sum += w[2] * h2;
-    if (w[3] > 0)
-        sum += w[3] * h3;
-    return sum;
+    return cm_edge_sum(w, h0, h1, h2, h3);
 }
 
 /* Slope (with the curvature term -c d) to h(s) = h0 + P + beta s +
