@@ -12,6 +12,14 @@
 #include <string.h>
 
 
+/* An offset from UTC in minutes (within a day) as +hh:mm or -hh:mm. */
+#define OFFSET_TEXT 24
+static void offset_text(int minutes, char buf[OFFSET_TEXT])
+{
+    snprintf(buf, OFFSET_TEXT, "%c%02d:%02d", minutes < 0 ? '-' : '+', abs(minutes) / 60,
+             abs(minutes) % 60);
+}
+
 void tsd_format_time(double t, int offset, char *buf, size_t n)
 {
     if (!isfinite(t)) {
@@ -33,12 +41,11 @@ void tsd_format_time(double t, int offset, char *buf, size_t n)
     long long m = mp < 10 ? mp + 3 : mp - 9;
     if (m <= 2)
         y++;
-    char off[16];
+    char off[OFFSET_TEXT];
     if (offset == 0)
         snprintf(off, sizeof off, "Z");
     else
-        snprintf(off, sizeof off, "%c%02d:%02d", offset < 0 ? '-' : '+', abs(offset) / 60,
-                 abs(offset) % 60);
+        offset_text(offset, off);
     snprintf(buf, n, "%04lld-%02lld-%02lldT%02lld:%02lld:%02lld%s", y, m, d, sec / 3600,
              sec / 60 % 60, sec % 60, off);
 }
@@ -215,15 +222,15 @@ int tsd_sun_zone_warning(const tsd_sun *s, const tsd_options *o, char *warning, 
     const double apart = remainder(s->offset_minutes - solar, 1440.0);
     if (!(fabs(apart) > 240.0))
         return 0;
-    const long sm = lround(solar), so = labs(sm);
-    const int om = abs(s->offset_minutes);
+    char given[OFFSET_TEXT], sun[OFFSET_TEXT];
+    offset_text(s->offset_minutes, given);
+    offset_text((int)lround(solar), sun);
     snprintf(warning, n,
-             "TIMEZONE's offset (%c%02d:%02d) is %.1f hours from the mean solar time at the "
-             "DEM's centre (longitude %.1f: UTC%c%02ld:%02ld), farther than any time zone: "
-             "its day's midnight falls in daylight, and the sun's hours are split between "
-             "two dates. Is it the site's offset?",
-             s->offset_minutes < 0 ? '-' : '+', om / 60, om % 60, fabs(apart) / 60.0, lon,
-             sm < 0 ? '-' : '+', so / 60, so % 60);
+             "TIMEZONE's offset (%s) is %.1f hours from the mean solar time at the DEM's "
+             "centre (longitude %.1f: UTC%s), farther than any time zone: its day's midnight "
+             "falls in daylight, and the sun's hours are split between two dates. Is it the "
+             "site's offset?",
+             given, fabs(apart) / 60.0, lon, sun);
     return 1;
 }
 
@@ -266,14 +273,16 @@ int tsd_sun_night_warning(const tsd_sun *s, const tsd_options *o, char *warning,
     /* mean solar time at the site: UTC plus 4 minutes per degree east */
     const double lon = s->sites_owned.lon[node];
     const long solar = lround(fmod(fmod(s->instant / 60.0 + lon * 4.0, 1440.0) + 1440.0, 1440.0));
-    const long offset = lround(lon * 4.0);
-    char when[64], given[32];
+    char when[64], given[48], at[OFFSET_TEXT];
     tsd_format_time(s->instant, s->offset_minutes, when, sizeof when);
-    if (s->offset_minutes == 0)
+    offset_text((int)lround(lon * 4.0), at);
+    if (s->offset_minutes == 0) {
         snprintf(given, sizeof given, "Z is UTC itself");
-    else
-        snprintf(given, sizeof given, "given as %c%02d:%02d", s->offset_minutes < 0 ? '-' : '+',
-                 abs(s->offset_minutes) / 60, abs(s->offset_minutes) % 60);
+    } else {
+        char off[OFFSET_TEXT];
+        offset_text(s->offset_minutes, off);
+        snprintf(given, sizeof given, "given as %s", off);
+    }
     int len = snprintf(warning, n,
                        "DATETIME=%s puts the sun's centre %.1f degrees below the horizon at %s "
                        "(mean solar time %02ld:%02ld there): it is night, no terrain sees the "
@@ -291,7 +300,7 @@ int tsd_sun_night_warning(const tsd_sun *s, const tsd_options *o, char *warning,
     else
         snprintf(warning + len, n - (size_t)len,
                  "If that is not the time meant, check DATETIME's offset from UTC (%s; mean "
-                 "solar time at longitude %.1f is UTC%c%02ld:%02ld)",
-                 given, lon, offset < 0 ? '-' : '+', labs(offset) / 60, labs(offset) % 60);
+                 "solar time at longitude %.1f is UTC%s)",
+                 given, lon, at);
     return 1;
 }
