@@ -11,7 +11,8 @@
 # no return came back: water, dark roofs), then times whole gdal_translate
 # processes of
 #   PRODUCT=svf DIRECTIONS=32
-#   PRODUCT=sunhours DATE=2026-06-21 TIMEZONE=Z   (one day, default steps)
+#   PRODUCT=sunhours DATE=2026-06-21 TIMEZONE=-05:00   (one day, default steps;
+#                                  the DEM lies at 81 W)
 # on each, in REPEATS rounds that each run every command once, and prints
 # the best wall time of each and its ratio to the DEM without voids. A cell
 # whose near field touches nodata is solved in double precision (the
@@ -65,7 +66,7 @@ cmd() {
     [ "$f" = 0 ] || src="$WORK/voids_$(bench_key "$f").tif"
     case $product in
     svf) opts="-oo PRODUCT=svf -oo DIRECTIONS=32" ;;
-    *) opts="-oo PRODUCT=sunhours -oo DATE=2026-06-21 -oo TIMEZONE=Z" ;;
+    *) opts="-oo PRODUCT=sunhours -oo DATE=2026-06-21 -oo TIMEZONE=-05:00" ;;
     esac
     echo "gdal_translate -q $opts 'TERRASHADE:$src' '$WORK/out.tif'"
 }
