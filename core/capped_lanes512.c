@@ -99,6 +99,16 @@ scan512_lags(const ts_cap_lanes *r, int k, int g, int ng, int lag_from, int lag_
  * fused multiply-add), against a right side lowered by 1e-12 of its terms'
  * size, far above those roundings. The scan's rounded (g_p - g) / (d - d_p)
  * is then below T + 2^-51 |T|, far inside the margin.
+ *
+ * Ties. Where T is 0 (L level with the higher query point, as on exactly
+ * flat ground without curvature, where every sample ties) the margin is
+ * 0 and no group passes that test. But where the window's oldest sample,
+ * which the scan takes first, is at least as high as both query points,
+ * the chain's numerator is >= 0 from there on, so a later sample p with
+ * g_p <= g (numerator <= 0; the signs of the subtraction and the products
+ * are exact) is never taken: a group whose gmax <= gmin can be left out
+ * exactly, and the oldest slot is scanned before the pruned ones
+ * (threshold_tests' tie lanes, scan512_pruned).
  */
 #define PRUNE_MARGIN 1e-9
 /* The newest lags are scanned without a test: their groups seldom prune
@@ -109,14 +119,16 @@ scan512_lags(const ts_cap_lanes *r, int k, int g, int ng, int lag_from, int lag_
 #endif
 
 /* For the eight lines from j: the prune threshold T (-inf: none known;
- * +inf: no query), the lower of the two query heights (+inf: no query) and
- * the lines without a query. T is the steepest (for the higher query
- * point) of four samples of the window, each taken only where the scan's
- * own tests put it in the window: the line's previous answers of both
- * queries, and its newest and oldest slot. */
+ * +inf: no query), the lower of the two query heights (+inf: no query),
+ * the lines without a query and the tie lines (those whose oldest slot is
+ * in the window and at least as high as both query points). T is the
+ * steepest (for the higher query point) of four samples of the window,
+ * each taken only where the scan's own tests put it in the window: the
+ * line's previous answers of both queries, and its newest and oldest
+ * slot. */
 TS_AVX512 static inline __attribute__((always_inline)) void
 prune_threshold(const ts_cap_lanes *r, int k, int lag_hi, int j, const scan512 *a, int q,
-                __m512d *thr, __m512d *gmin, __mmask8 *idle)
+                __m512d *thr, __m512d *gmin, __mmask8 *idle, __mmask8 *tie)
 {
     const __m512i zero = _mm512_setzero_si512();
     const __m512d near = _mm512_set1_pd(r->near), cap = _mm512_set1_pd(r->cap);
@@ -150,10 +162,13 @@ prune_threshold(const ts_cap_lanes *r, int k, int lag_hi, int j, const scan512 *
     const __m512d gn = _mm512_mask_mov_pd(_mm512_set1_pd(-INFINITY), hn, a->gn[q]);
     const __m512d ghi = _mm512_max_pd(gc, gn);
     __m512d bn = _mm512_set1_pd(-INFINITY), bd = _mm512_set1_pd(1.0);
+    *tie = 0;
     for (int c = 0; c < 4; c++) {
         const __m512d dd = _mm512_sub_pd(a->d[q], cd[c]), n = _mm512_sub_pd(cg[c], ghi);
         __mmask8 ok = _mm512_mask_cmp_pd_mask(cok[c], dd, near, _CMP_GE_OQ);
         ok = _mm512_mask_cmp_pd_mask(ok, dd, cap, _CMP_LE_OQ);
+        if (c == 2) /* the oldest slot, in the window, not below the queries */
+            *tie = _mm512_mask_cmp_pd_mask(ok, cg[c], ghi, _CMP_GE_OQ);
         ok = _mm512_mask_cmp_pd_mask(ok, _mm512_mul_pd(n, bd), _mm512_mul_pd(bn, dd), _CMP_GT_OQ);
         bn = _mm512_mask_mov_pd(bn, ok, n);
         bd = _mm512_mask_mov_pd(bd, ok, dd);
@@ -315,17 +330,33 @@ list_samples(const ts_cap_lanes *r, int slot, int s0, int a0, int b0, int g, int
     L->n[q] += __builtin_popcount(take);
 }
 
+/* The smallest double above x (x finite; -0 as +0). */
+TS_AVX512 static inline __attribute__((always_inline)) __m512d next_up(__m512d x)
+{
+    const __m512d z = _mm512_add_pd(x, _mm512_setzero_pd()); /* -0 + 0 = +0 */
+    const __m512i b = _mm512_castpd_si512(z);
+    const __mmask8 negative = _mm512_cmp_pd_mask(z, _mm512_setzero_pd(), _CMP_LT_OQ);
+    return _mm512_castsi512_pd(_mm512_mask_sub_epi64(_mm512_add_epi64(b, _mm512_set1_epi64(1)),
+                                                     negative, b, _mm512_set1_epi64(1)));
+}
+
 /* The tests' terms for threshold T (thr) and lower query height gmin at
  * query distance d: group_may_hold's right side and sign, list_samples'
- * threshold and right side. */
+ * threshold and right side. On the tie lines (prune_threshold) where T is
+ * 0, the right side is the next double above gmin, so that the tests
+ * leave out exactly the groups and samples with g_p <= gmin (the pruning
+ * comment's ties). */
 TS_AVX512 static inline __attribute__((always_inline)) void
-threshold_tests(__m512d thr, __m512d gmin, __m512d d, __m512d *rhs, __mmask8 *neg, __m512d *tt,
-                __m512d *rt)
+threshold_tests(__m512d thr, __m512d gmin, __m512d d, __mmask8 tie, __m512d *rhs, __mmask8 *neg,
+                __m512d *tt, __m512d *rt)
 {
     *neg = _mm512_cmp_pd_mask(thr, _mm512_setzero_pd(), _CMP_LT_OQ);
     const __m512d td = _mm512_mul_pd(thr, d);
     const __m512d size = _mm512_add_pd(_mm512_abs_pd(gmin), _mm512_abs_pd(td));
     *rhs = _mm512_fnmadd_pd(size, _mm512_set1_pd(1e-12), _mm512_fmadd_pd(thr, d, gmin));
+    /* (gmin is finite on a tie line: it has a query) */
+    const __mmask8 level = _mm512_mask_cmp_pd_mask(tie, thr, _mm512_setzero_pd(), _CMP_EQ_OQ);
+    *rhs = _mm512_mask_mov_pd(*rhs, level, next_up(gmin));
     /* sample by sample: T = -inf (no threshold) as T = 0 against -inf, so
      * that every sample passes (a distance of 0 would give NaN), and a slot
      * without a sample (d NaN) fails */
@@ -393,16 +424,21 @@ TS_AVX512 static inline __attribute__((always_inline)) void
 scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 *a)
 {
     __m512d thr[NG], rhs[NG], tt[NG], rt[NG], gmin[NG];
-    __mmask8 idle[NG], neg[NG];
+    __mmask8 idle[NG], neg[NG], tie[NG];
     for (int q = 0; q < ng; q++) {
-        prune_threshold(r, k, lag_hi, g + 8 * q, a, q, &thr[q], &gmin[q], &idle[q]);
-        threshold_tests(thr[q], gmin[q], a->d[q], &rhs[q], &neg[q], &tt[q], &rt[q]);
+        prune_threshold(r, k, lag_hi, g + 8 * q, a, q, &thr[q], &gmin[q], &idle[q], &tie[q]);
+        threshold_tests(thr[q], gmin[q], a->d[q], tie[q], &rhs[q], &neg[q], &tt[q], &rt[q]);
     }
+    /* the oldest slot first, whatever the tests say (the tie lines' pruning
+     * rests on it), then the pruned ones after it */
+    scan512_lags(r, k, g, ng, lag_hi, lag_hi, a);
+    if (lag_hi - 1 < r->lag_lo)
+        return;
     slot_lists L;
     for (int q = 0; q < NG; q++)
         L.n[q] = 0;
     const unsigned all = (1u << ng) - 1;
-    const int s_lo = k - lag_hi, s_hi = k - r->lag_lo, s_near = s_hi - PRUNE_NEAR + 1;
+    const int s_lo = k - lag_hi + 1, s_hi = k - r->lag_lo, s_near = s_hi - PRUNE_NEAR + 1;
     const __m512i iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 0, 0, 0, 0, 0, 0, 0, 0);
     /* the level-0 groups each group of lines needs, (group, its entry,
      * lines) in step order; the groups' entries kept in step (no division
@@ -458,7 +494,8 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
             scan512_lists(r, g, ng, &L, a);
             for (int q = 0; q < ng; q++) {
                 thr[q] = raised_threshold(a, q, thr[q]);
-                threshold_tests(thr[q], gmin[q], a->d[q], &rhs[q], &neg[q], &tt[q], &rt[q]);
+                threshold_tests(thr[q], gmin[q], a->d[q], tie[q], &rhs[q], &neg[q], &tt[q],
+                                &rt[q]);
             }
         }
     }

@@ -259,6 +259,7 @@ static int cl_on(int j, int k)
     return k >= 3 * j && k <= 300 + 7 * j && !(k >= 500 && k <= 507);
 }
 
+/* ramp: 0 terraces, 1 a steady climb, 2 level plateaus */
 static void check_capped_scan(double near, double cap, double c, double jitter, uint32_t seed,
                               int ramp)
 {
@@ -274,8 +275,13 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
             /* or a steady climb with centimetres of noise: every sample
              * behind nearly as steep as the next, so that the pruned scan's
              * lists grow long and its threshold rises within a scan */
-            if (ramp)
+            if (ramp == 1)
                 h = (float)(x * 0.37 + 0.01 * (cl_rand(&seed) % 8));
+            /* or long level plateaus (flat ground without curvature, where
+             * every sample of a window ties with the query points: the
+             * pruned scan's tie lines), a step of 5 m every 150 */
+            if (ramp == 2)
+                h = (float)(5.0 * floor((x + 40.0 * j) / 150.0));
             if (cl_rand(&seed) % 61 == 0)
                 h += (float)(cl_rand(&seed) % 300);
             if ((k / 37 + j) % 11 == 0)
@@ -283,6 +289,8 @@ static void check_capped_scan(double near, double cap, double c, double jitter, 
             hs[k][j] = h;
             hc[k][j] = cl_rand(&seed) % 17 == 0 ? NAN : h - (float)(cl_rand(&seed) % 5) * 2.5f;
             hn[k][j] = h + (float)(cl_rand(&seed) % 3) * 2.5f;
+            if (ramp == 2 && cl_rand(&seed) % 5 != 0) /* mostly level with the ground */
+                hc[k][j] = hn[k][j] = h;
             d[k][j] = k == 3 * j ? 0.0 : (k > 0 ? d[k - 1][j] : 0.0) +
                                          step * (1.0 + jitter * sin(k * 0.7));
         }
@@ -432,6 +440,11 @@ START_TEST(test_capped_scan_pruned)
     check_capped_scan(25.0, 2000.0, 0.0, 0.0, 11, 1);
     check_capped_scan(25.0, 5000.0, curved, 0.0, 12, 1);
     check_capped_scan(105.0, 5000.0, 0.0, 0.1, 13, 1);
+    /* level plateaus: windows of ties, pruned and hybrid */
+    check_capped_scan(25.0, 2000.0, 0.0, 0.0, 14, 2);
+    check_capped_scan(25.0, 1000.0, 0.0, 0.0, 15, 2);
+    check_capped_scan(25.0, 5000.0, 0.0, 0.0, 16, 2);
+    check_capped_scan(105.0, 3000.0, 0.0, 0.1, 17, 2);
 }
 END_TEST
 
