@@ -429,10 +429,13 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
         return FailOpen(TS_ERR_ARG, osNotHeights.c_str());
     // Z_FACTOR=AUTO becomes the factor of the DEM's vertical unit here, so
     // that the metadata and the auxiliary-file key say the number used
-    char szZWhy[256];
+    char szZWhy[256], szUnitNote[512];
     int bUnitSaid = 0;
-    sOpts.z_factor = tsd_dem_z_factor(GDALRasterBand::ToHandle(poDEM->GetRasterBand(sOpts.band)),
-                                      sOpts.z_factor, &bUnitSaid, szZWhy, sizeof szZWhy);
+    GDALRasterBandH hHeights = GDALRasterBand::ToHandle(poDEM->GetRasterBand(sOpts.band));
+    const bool bUnitNote = std::isnan(sOpts.z_factor) &&
+                           tsd_dem_unit_note(hHeights, szUnitNote, sizeof szUnitNote);
+    sOpts.z_factor = tsd_dem_z_factor(hHeights, sOpts.z_factor, &bUnitSaid, szZWhy,
+                                      sizeof szZWhy);
     const int W = poDEM->GetRasterXSize(), H = poDEM->GetRasterYSize();
     if (poDEM->GetGeoTransform(poDS->m_adfGT) != CE_None)
     {
@@ -446,7 +449,9 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
         poDS->m_oSRS = *poSRS;
     if (!poDS->Setup(poOpenInfo->pszFilename, W, H))
         return nullptr;
-    if (!bUnitSaid)
+    if (bUnitNote)
+        CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szUnitNote);
+    else if (!bUnitSaid)
         WarnHeightUnit(poDS->m_sCells, poDS->m_oSRS, osDEM);
     // not through PAM: it is derived, like the rest of the metadata
     poDS->GDALDataset::SetMetadataItem("Z_FACTOR_SOURCE", szZWhy);

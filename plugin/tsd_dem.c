@@ -5,6 +5,7 @@
 #include "tsd_dem_valid.h"
 #include "tsd_text.h"
 
+#include <ctype.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -316,12 +317,43 @@ ts_status tsd_dem_load_resampled(GDALRasterBandH band, const tsd_cells *cells,
     return st;
 }
 
+/* A unit's name as metres_per_unit compares it: lower case, '_', '-' and
+ * runs of spaces as one space, '.' and parentheses dropped, and a trailing
+ * datum word (asl, amsl, msl, navd88, ...: "ft asl", "m (NAVD88)") cut. */
+static void unit_key(const char *unit, char *key, size_t n)
+{
+    static const char *const datum_words[] = {"asl",    "amsl",    "msl",   "above sea level",
+                                              "navd88", "ngvd29",  "egm96", "egm2008",
+                                              "height", "elevation"};
+    size_t k = 0;
+    for (const char *c = unit; *c && k + 1 < n; c++) {
+        char ch = (char)tolower((unsigned char)*c);
+        if (ch == '.' || ch == '(' || ch == ')')
+            continue;
+        if (ch == '_' || ch == '-' || isspace((unsigned char)ch))
+            ch = ' ';
+        if (ch == ' ' && (k == 0 || key[k - 1] == ' '))
+            continue;
+        key[k++] = ch;
+    }
+    while (k > 0 && key[k - 1] == ' ')
+        k--;
+    key[k] = '\0';
+    for (size_t i = 0; i < sizeof datum_words / sizeof datum_words[0]; i++) {
+        const size_t w = strlen(datum_words[i]);
+        if (k > w + 1 && key[k - w - 1] == ' ' && strcmp(key + k - w, datum_words[i]) == 0) {
+            key[k - w - 1] = '\0';
+            return;
+        }
+    }
+}
+
 /* Metres per unit of a unit's name (GDAL's band unit types, PROJ's and
- * GeoTIFF's names), or 0 if not known. */
+ * GeoTIFF's names, and their common spellings), or 0 if not known. */
 static double metres_per_unit(const char *unit)
 {
     static const struct {
-        const char *name;
+        const char *name; /* as unit_key writes it */
         double metres;
     } units[] = {
         {"m", 1.0}, {"metre", 1.0}, {"meter", 1.0},
@@ -330,17 +362,23 @@ static double metres_per_unit(const char *unit)
         {"mm", 0.001}, {"millimetre", 0.001}, {"millimeter", 0.001},
         {"km", 1000.0}, {"kilometre", 1000.0}, {"kilometer", 1000.0},
         {"ft", 0.3048}, {"foot", 0.3048}, {"feet", 0.3048}, {"international foot", 0.3048},
-        {"US survey foot", 1200.0 / 3937.0}, {"US survey feet", 1200.0 / 3937.0},
-        {"ftUS", 1200.0 / 3937.0}, {"us-ft", 1200.0 / 3937.0}, {"foot_us", 1200.0 / 3937.0},
+        {"international feet", 0.3048}, {"intl ft", 0.3048}, {"ft intl", 0.3048},
+        {"us survey foot", 1200.0 / 3937.0}, {"us survey feet", 1200.0 / 3937.0},
+        {"survey foot", 1200.0 / 3937.0}, {"survey feet", 1200.0 / 3937.0},
+        {"us foot", 1200.0 / 3937.0}, {"us feet", 1200.0 / 3937.0},
+        {"ftus", 1200.0 / 3937.0}, {"ft us", 1200.0 / 3937.0}, {"us ft", 1200.0 / 3937.0},
+        {"usft", 1200.0 / 3937.0}, {"foot us", 1200.0 / 3937.0},
     };
+    char key[64];
+    unit_key(unit, key, sizeof key);
     /* a plural's trailing s aside (metres, centimeters; not "ms" or "cms") */
-    size_t len = strlen(unit);
+    size_t len = strlen(key);
     for (int plural = 0; plural < 2; plural++)
         for (size_t i = 0; i < sizeof units / sizeof units[0]; i++) {
             size_t k = strlen(units[i].name);
-            if (plural ? k > 2 && len == k + 1 && (unit[k] == 's' || unit[k] == 'S') &&
-                             strncasecmp(unit, units[i].name, k) == 0
-                       : strcasecmp(unit, units[i].name) == 0)
+            if (plural ? k > 2 && len == k + 1 && key[k] == 's' &&
+                             strncmp(key, units[i].name, k) == 0
+                       : strcmp(key, units[i].name) == 0)
                 return units[i].metres;
         }
     return 0.0;
@@ -376,6 +414,41 @@ static int metadata_unit(GDALRasterBandH band, double *metres, char *why, size_t
     }
     snprintf(why, n, "no vertical unit in the CRS or the band: heights taken as metres");
     return 0;
+}
+
+int tsd_dem_unit_note(GDALRasterBandH band, char *note, size_t n)
+{
+    const char *unit = GDALGetRasterUnitType(band);
+    if (!unit || !unit[0])
+        return 0;
+    const double band_m = metres_per_unit(unit);
+    double crs_m = 0;
+    char crs_name[96] = "";
+    GDALDatasetH ds = GDALGetBandDataset(band);
+    OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
+    if (srs && (OSRIsCompound(srs) || OSRIsVertical(srs))) {
+        char *name = NULL;
+        const double m = OSRGetTargetLinearUnits(srs, "VERT_CS", &name);
+        if (m > 0 && isfinite(m)) {
+            crs_m = m;
+            snprintf(crs_name, sizeof crs_name, "%s", name ? name : "?");
+        }
+    }
+    if (crs_m > 0 && band_m > 0 && fabs(band_m / crs_m - 1) > 1e-9) {
+        snprintf(note, n, "the DEM's CRS gives its heights in %s, its band in '%s': the "
+                          "CRS's unit is used (Z_FACTOR=%.10g). If the heights are in %s, "
+                          "give Z_FACTOR=%.10g",
+                 crs_name, unit, crs_m, unit, band_m);
+        return 1;
+    }
+    if (crs_m > 0 || band_m > 0)
+        return 0;
+    snprintf(note, n, "the DEM's band gives its heights' unit as '%s', which is not a length "
+                      "terrashade knows: they are taken as metres. Give Z_FACTOR, the metres "
+                      "of one unit (0.3048 for feet, 0.3048006096 for US survey feet), or "
+                      "1 if they are metres",
+             unit);
+    return 1;
 }
 
 double tsd_dem_z_factor(GDALRasterBandH band, double requested, int *said, char *why,

@@ -74,6 +74,16 @@ int tsd_dem_steepness_warning(GDALRasterBandH band, const tsd_cells *cells, doub
 double tsd_dem_z_factor(GDALRasterBandH band, double requested, int *said, char *why,
                         size_t why_size);
 
+/**
+ * A sentence for Z_FACTOR=AUTO's users when `band`'s metadata says its
+ * heights' unit in a way that may not be what was meant: a band unit type
+ * that is not a length terrashade knows ("ft asl" and the like are known;
+ * "dam" or "hm" are not), so the heights are taken as metres; or a
+ * compound CRS whose vertical unit differs from the band's unit type (the
+ * CRS's is used). Returns 1 with the sentence in `note`, else 0.
+ */
+int tsd_dem_unit_note(GDALRasterBandH band, char *note, size_t note_size);
+
 #ifdef __cplusplus
 }
 #endif

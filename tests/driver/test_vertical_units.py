@@ -87,6 +87,61 @@ class VerticalUnits(unittest.TestCase):
                 want = T.read(T.conn(m), band=1, options=OPTIONS)
                 np.testing.assert_allclose(got, want, atol=1e-5)
 
+    def test_band_unit_spellings(self):
+        """The spellings of feet and metres that DEMs carry (underscores,
+        hyphens, case, plurals, a datum word after the unit): the same factor
+        as the plain name, said in the metadata as the band spells it."""
+        for unit, factor in (("usft", FT_US), ("ft_US", FT_US), ("us_survey_foot", FT_US),
+                             ("US Survey Feet", FT_US), ("survey foot", FT_US),
+                             ("U.S. survey foot", FT_US), ("ft asl", 0.3048),
+                             ("Feet (NAVD88)", 0.3048),
+                             ("m AMSL", 1.0), ("Meters", 1.0), ("metre-height", 1.0)):
+            with self.subTest(unit=unit):
+                path = os.path.join(self.dir, "spelled.tif")
+                T.write_tif(path, self.z, NC_GT, 2264)
+                ds = gdal.Open(path, gdal.GA_Update)
+                ds.GetRasterBand(1).SetUnitType(unit)
+                ds = None
+                ds = opened(path)
+                self.assertEqual(ds.GetMetadataItem("Z_FACTOR"), "%.10g" % factor)
+                self.assertEqual(ds.GetMetadataItem("Z_FACTOR_SOURCE"), "band unit " + unit)
+                ds = None
+                self.assertNotIn("Warning", T.open_stderr(path))
+
+    def test_unknown_band_unit_warns(self):
+        """A band unit that is not a length terrashade knows: metres, with a
+        warning that names it and the factors to give (until session 49 the
+        heights were taken as metres without a word)."""
+        path = os.path.join(self.dir, "unknown.tif")
+        T.write_tif(path, self.z, NC_GT, 32617)
+        ds = gdal.Open(path, gdal.GA_Update)
+        ds.GetRasterBand(1).SetUnitType("dam")
+        ds = None
+        err = T.open_stderr(path)
+        self.assertIn("Warning 1: TERRASHADE: the DEM's band gives its heights' unit as 'dam', "
+                      "which is not a length terrashade knows: they are taken as metres. Give "
+                      "Z_FACTOR, the metres of one unit (0.3048 for feet, 0.3048006096 for US "
+                      "survey feet), or 1 if they are metres", err)
+        self.assertEqual(err.count("Warning"), 1)
+        self.assertNotIn("heights' unit", T.open_stderr(path, Z_FACTOR="10"))
+
+    def test_crs_and_band_disagree_warns(self):
+        """A compound CRS in US survey feet and a band unit of metres: the CRS
+        wins, as documented, and a warning says so with the other factor."""
+        path = T.write_tif(os.path.join(self.dir, "conflict.tif"), self.z, NC_GT,
+                           "EPSG:2264+6360")
+        ds = gdal.Open(path, gdal.GA_Update)
+        ds.GetRasterBand(1).SetUnitType("m")
+        ds = None
+        ds = opened(path)
+        self.assertEqual(ds.GetMetadataItem("Z_FACTOR"), "%.10g" % FT_US)
+        ds = None
+        err = T.open_stderr(path)
+        self.assertIn("the DEM's CRS gives its heights in US survey foot, its band in 'm': the "
+                      "CRS's unit is used (Z_FACTOR=0.3048006096). If the heights are in m, "
+                      "give Z_FACTOR=1", err)
+        self.assertNotIn("Warning", T.open_stderr(self.ftus))
+
     def test_no_unit_is_metres(self):
         self.check(self.plain, 1.0,
                    "no vertical unit in the CRS or the band: heights taken as metres",
