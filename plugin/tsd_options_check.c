@@ -10,6 +10,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 const char *tsd_options_product_name(const tsd_options *o)
 {
@@ -165,6 +166,28 @@ static int check_environment(const tsd_options *o, char *msg, size_t n)
     return 0;
 }
 
+/* The fewest DIRECTIONS of an integral over the sky (svf, openness, sky,
+ * envlight, the sky terms of shade and insolation): with 1 to 3 azimuths
+ * the sum is no integral (an 80 degree open plane read svf 0.005 or 0.17
+ * with one, by START_AZIMUTH); 4, along the grid's axes, is the least that
+ * sees every side. */
+#define INTEGRAL_DIRECTIONS_MIN 4
+
+static int check_integral_directions(const tsd_options *o, char *msg, size_t n)
+{
+    const tsd_product_def *p = tsd_product_of(o);
+    const int per_band = p->bands_option && strcmp(p->bands_option, "DIRECTIONS") == 0;
+    const int weighted = tsd_product_takes(p, tsd_option_find("SKY_WEIGHT"));
+    if (!tsd_product_takes(p, tsd_option_find("DIRECTIONS")) || per_band ||
+        (weighted && !(o->sky_weight > 0)) || o->directions >= INTEGRAL_DIRECTIONS_MIN)
+        return 0;
+    /* shade's SKY_WEIGHT term and insolation's diffuse light are sky terms */
+    REFUSE("DIRECTIONS=%d is too few for PRODUCT=%s: its %s is an integral over the sky's "
+           "azimuths; give at least %d (16 by default; 32 or more on steep ground)",
+           o->directions, p->name, weighted || p->daily ? "sky term" : "value",
+           INTEGRAL_DIRECTIONS_MIN);
+}
+
 /* The SH options: ENV_METHOD, METHOD=sh's key light. */
 static int check_sh(const tsd_options *o, char *msg, size_t n)
 {
@@ -266,7 +289,8 @@ int tsd_options_check(const tsd_options *o, char *msg, size_t n)
                     "start at FAR_THRESHOLD cells and have no end)", pn);
     if (o->sun_position == TSD_SUN_PER_CELL && !from_time)
         REFUSE("SUN_POSITION=per_cell needs the sun from DATETIME or DATE");
-    if (tsd_options_check_pyramid(o, msg, n) != 0 || check_sh(o, msg, n) != 0)
+    if (check_integral_directions(o, msg, n) != 0 || tsd_options_check_pyramid(o, msg, n) != 0 ||
+        check_sh(o, msg, n) != 0)
         return -1;
     return check_environment(o, msg, n);
 }

@@ -28,6 +28,18 @@ CASES = [
      "DIRECTIONS must be a whole number, got '2.5'"),
     ("too many directions", T.conn(DEM), ["DIRECTIONS=100000"],
      "DIRECTIONS must be between 1 and 3600"),
+    # an integral over the sky from 1 to 3 azimuths (svf 0.005 on an open
+    # 80 degree plane); the horizon product takes any count
+    ("svf of one direction", T.conn(DEM), ["PRODUCT=svf", "DIRECTIONS=1"],
+     "DIRECTIONS=1 is too few for PRODUCT=svf: its value is an integral over the sky's "
+     "azimuths; give at least 4 (16 by default; 32 or more on steep ground)"),
+    ("openness of three directions", T.conn(DEM), ["PRODUCT=openness", "DIRECTIONS=3"],
+     "DIRECTIONS=3 is too few for PRODUCT=openness"),
+    ("shade's sky term of two directions", T.conn(DEM), ["SKY_WEIGHT=0.3", "DIRECTIONS=2"],
+     "DIRECTIONS=2 is too few for PRODUCT=shade: its sky term is an integral"),
+    ("insolation's sky term of two directions", T.conn(DEM),
+     ["PRODUCT=insolation", "DATE=2026-06-21", "TIMEZONE=Z", "DIRECTIONS=2"],
+     "DIRECTIONS=2 is too few for PRODUCT=insolation: its sky term"),
     ("zero z factor", T.conn(DEM), ["Z_FACTOR=0"],
      "Z_FACTOR must be greater than 0"),
     ("bad product", T.conn(DEM), ["PRODUCT=hillshade"],
