@@ -30,6 +30,7 @@
 #include "tsd_connstr.h"
 #include "tsd_dataset.h"
 #include "tsd_dem.h"
+#include "tsd_dem_check.h"
 #include "tsd_gdal.h"
 #include "tsd_window.h"
 #include "tsd_locale.h"
@@ -225,6 +226,8 @@ CPLErr TSDataset::EnsureComputed()
                 std::chrono::steady_clock::now() - tStart;
             CPLDebug(DRIVER, "read the DEM in %.3f s%s", dfRead.count(),
                      bAhead ? " (waited for the read ahead)" : "");
+            if (m_nLevel == 0)
+                WarnBelowSea(&sGrid);
             if (m_psProduct->byte == TSD_BYTE_ALWAYS)
                 m_pabyProduct = static_cast<GByte *>(VSI_MALLOC2_VERBOSE(nCells, nBands));
             else
@@ -457,6 +460,18 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     poDS->GDALDataset::SetMetadataItem("Z_FACTOR_SOURCE", szZWhy);
     poDS->m_nOverviews = OverviewCount(poDS->m_psProduct, W, H);
     return poDS.release();
+}
+
+/* EDGE=horizon's sea level beyond the edges above heights of grid g
+ * (tsd_grid_below_sea_warning): once per dataset. */
+void TSDataset::WarnBelowSea(const ts_grid *g)
+{
+    char szWarning[512];
+    if (m_bBelowSeaWarned || tsd_options_edge(&m_sOpts) != TS_EDGE_HORIZON ||
+        !tsd_grid_below_sea_warning(g, szWarning, sizeof szWarning) ||
+        m_bBelowSeaWarned.exchange(true))
+        return;
+    CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szWarning);
 }
 
 /* Everything that follows from the georeferencing (m_adfGT, m_bHasGT,

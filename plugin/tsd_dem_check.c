@@ -301,3 +301,30 @@ int tsd_dem_steepness_warning(GDALRasterBandH band, const tsd_cells *cells, doub
              cells->cell_x, cells->cell_y, question);
     return 1;
 }
+
+/* Below this lowest height EDGE=horizon's sea level at the DEM's edges
+ * stands as a wall worth a word: -1 m is a few degrees of horizon within
+ * ten metres of the edge, and keeps coastal DEMs whose sea reads a few
+ * decimetres below 0 quiet. */
+#define BELOW_SEA_WARN_M (-1.0)
+
+int tsd_grid_below_sea_warning(const ts_grid *g, char *warning, size_t n)
+{
+    float lowest = INFINITY;
+    for (int y = 0; y < g->height; y++) {
+        const float *row = g->z + (ptrdiff_t)y * g->stride;
+        for (int x = 0; x < g->width; x++)
+            lowest = row[x] < lowest ? row[x] : lowest; /* NaN fails the compare */
+    }
+    if (!(lowest < BELOW_SEA_WARN_M))
+        return 0;
+    snprintf(warning, n,
+             "the DEM's heights reach %.1f m, below sea level: with EDGE=horizon (the "
+             "default) the ground beyond the DEM's edges is the sea-level sphere, which "
+             "stands as a wall above them, so that they are shaded and their sky closed as "
+             "in a pit (sea floor, depressions such as the Dead Sea, ellipsoidal heights "
+             "where the geoid lies below the ellipsoid). Give EDGE=open (nothing beyond the "
+             "edges) or EDGE=nodata",
+             lowest);
+    return 1;
+}

@@ -80,6 +80,14 @@ ts_status tsd_dem_check(GDALRasterBandH band, const tsd_dem_conversion *c, const
                         const tsd_dem_seen *seen, double spacing, const tsd_dem_placement *p,
                         char *msg, size_t msg_size);
 
+/**
+ * A sentence for EDGE=horizon's users when the grid `g` holds valid heights
+ * more than a metre below sea level: that mode puts the sea-level sphere
+ * beyond the DEM's edges, a wall above them. Returns 1 with the sentence in
+ * `warning`, else 0. (A pass over the grid's heights.)
+ */
+int tsd_grid_below_sea_warning(const ts_grid *g, char *warning, size_t warning_size);
+
 #ifdef __cplusplus
 }
 #endif

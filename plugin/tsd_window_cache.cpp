@@ -242,6 +242,7 @@ bool TSDataset::EnsureFarField()
         s.error = std::string("the far-field grid: ") + szMsg;
         return false;
     }
+    WarnBelowSea(&sCoarse);
     tsd_far_field_init(&s.far, &sCoarse, W, H, s.plan.near_m, &m_sOpts);
     s.farReady = true;
     return true;
@@ -271,6 +272,8 @@ bool TSDataset::ComputeChunk(int cx, int cy, WindowChunk &c)
                             szMsg, sizeof szMsg);
     const ts_grid_origin sOrigin{ax0, ay0, s.refCellX, W, H};
     sGrid.origin = &sOrigin;
+    if (eSt == TS_OK)
+        WarnBelowSea(&sGrid);
     const int nBands = tsd_options_band_count(&m_sOpts);
     const size_t nCells = static_cast<size_t>(aw) * ah;
     float *pafOut = nullptr;

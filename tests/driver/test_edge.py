@@ -214,6 +214,31 @@ class Edge(unittest.TestCase):
                     if not np.isnan(c).all():
                         self.assertLessEqual(np.nanmax(np.abs(c - cl)), 1e-3)
 
+    def test_below_sea_level_warns(self):
+        """Heights below sea level under EDGE=horizon (the default): the
+        sea-level sphere beyond the edges stands as a wall above them (a
+        plane at -4000 m was all in shadow at a 10 degree sun, svf 0.03), so
+        the first read warns once, whole or chunk by chunk; EDGE=open lights
+        the plane, and a sea a few decimetres below 0 says nothing."""
+        deep = T.write_tif(os.path.join(self.tmp.path, "deep.tif"),
+                           np.full((160, 160), -4000, np.float32), GT, 32617)
+        shallow = T.write_tif(os.path.join(self.tmp.path, "shallow.tif"),
+                              np.full((40, 40), -0.4, np.float32), GT, 32617)
+        want = ("Warning 1: TERRASHADE: the DEM's heights reach -4000.0 m, below sea level: "
+                "with EDGE=horizon (the default) the ground beyond the DEM's edges is the "
+                "sea-level sphere, which stands as a wall above them")
+        for oo in ({}, {"TILE_SIZE": 64}, {"PRODUCT": "svf"}):
+            with self.subTest(**oo):
+                err = T.translate_stderr(deep, **oo)
+                self.assertIn(want, err)
+                self.assertEqual(err.count("below sea level"), 1)
+        self.assertEqual(self.lit(deep, PRODUCT="shadow", SUN_ELEVATION=10), 0)
+        self.assertEqual(self.lit(deep, PRODUCT="shadow", SUN_ELEVATION=10, EDGE="open"),
+                         160 * 160)
+        for dem, oo in ((deep, {"EDGE": "open"}), (deep, {"EDGE": "nodata"}), (shallow, {})):
+            with self.subTest(dem=os.path.basename(dem), **oo):
+                self.assertNotIn("below sea level", T.translate_stderr(dem, **oo))
+
     def test_bad_values(self):
         p = T.run(["gdalinfo", T.conn(self.flat, PRODUCT="svf", EDGE="foo")], ok=False)
         self.assertIn("EDGE must be one of horizon, open, nodata, got 'foo'", p.stderr)

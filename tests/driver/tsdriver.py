@@ -86,6 +86,13 @@ def open_stderr(dem, **options):
     return run(["gdalinfo", "-nomd"] + oo_args(options) + [conn(dem)]).stderr
 
 
+def translate_stderr(dem, **options):
+    """What `gdal_translate -oo KEY=VALUE ... TERRASHADE:dem` (into memory)
+    says on stderr: the warnings of the computation too; it must succeed."""
+    return run(["gdal_translate", "-q"] + oo_args(options)
+               + [conn(dem), "/vsimem/translate_stderr.tif"]).stderr
+
+
 def translate(dem, out, options=None, inline=None, extra=()):
     """gdal_translate TERRASHADE:... out.tif with -oo options; returns out."""
     run(["gdal_translate", "-q", "-of", "GTiff"] + oo_args(options or {})
