@@ -85,7 +85,7 @@ void WarnHeightUnit(const tsd_cells &sCells, const OGRSpatialReference &oSRS,
 
 /* Distances that likely do not say what was meant. A MAX_DISTANCE shorter
  * than the DEM's cells (dfCell: its smallest side)
- * holds no terrain: no shadow, no horizon above the cell's own slope. Most
+ * holds no other cell: no shadow or horizon but the cell's own slope. Most
  * often a distance meant in cells (RVT's radius is in pixels) or
  * kilometres. And METHOD=shm's shadow height map follows every occluder to
  * the DEM's edge: MAX_DISTANCE bounds its sky term and EDGE=nodata's reach
@@ -116,8 +116,8 @@ void TSDataset::WarnDistances(double dfCell, int W, int H)
         return;
     CPLError(CE_Warning, CPLE_AppDefined,
              "TERRASHADE: MAX_DISTANCE=%g m is shorter than the DEM's cells (%.4g m): no "
-             "terrain lies within it, so nothing casts a shadow or raises a horizon. It is "
-             "in metres: %g cells are %.4g m",
+             "other cell lies within it, so only the slope of a cell's own surface there "
+             "casts a shadow or raises a horizon. It is in metres: %g cells are %.4g m",
              m_sOpts.max_distance, dfCell, m_sOpts.max_distance,
              m_sOpts.max_distance * dfCell);
 }

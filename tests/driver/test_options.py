@@ -125,16 +125,19 @@ class Options(unittest.TestCase):
 
     def test_max_distance_shorter_than_a_cell_warns(self):
         """MAX_DISTANCE=10 on 30 m cells (10 cells meant, as RVT's radius is in
-        pixels?) holds no terrain: a warning that says so and what 10 cells
-        are; none at 30 m and beyond, nor for a product without it."""
+        pixels?) holds no other cell: a warning that says so and what 10 cells
+        are; none at 30 m and beyond, nor for a product without it. (Until
+        session 49 it said that nothing casts a shadow there, where the
+        cell's own slope still does.)"""
         def warned(**oo):
             err = T.open_stderr(self.dem, **oo)
             return "MAX_DISTANCE" in err and err
         err = warned(PRODUCT="svf", MAX_DISTANCE=10)
         print(err.strip())
         self.assertIn("Warning 1: TERRASHADE: MAX_DISTANCE=10 m is shorter than the DEM's "
-                      "cells (30 m): no terrain lies within it, so nothing casts a shadow or "
-                      "raises a horizon. It is in metres: 10 cells are 300 m", err)
+                      "cells (30 m): no other cell lies within it, so only the slope of a "
+                      "cell's own surface there casts a shadow or raises a horizon. It is in "
+                      "metres: 10 cells are 300 m", err)
         self.assertTrue(warned(PRODUCT="shadow", MAX_DISTANCE=10))
         self.assertFalse(warned(PRODUCT="svf", MAX_DISTANCE=30))
         self.assertFalse(warned(PRODUCT="svf"))
