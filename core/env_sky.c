@@ -103,6 +103,16 @@ ts_status ts_sky_parse(const char *name, ts_sky_kind *kind, int *cie_type, ts_er
                    "from 1 to 15, got '%s'", name);
 }
 
+int ts_sky_follows_sun(ts_sky_kind kind, int cie_type)
+{
+    if (kind == TS_SKY_CLEAR)
+        return 1;
+    if (kind != TS_SKY_CIE || cie_type < 1 || cie_type > 15)
+        return 0;
+    const double *p = CIE_PARAMS[cie_type - 1];
+    return p[2] != 0 || p[4] != 0; /* an indicatrix that is not 1 */
+}
+
 /* Relative radiance of one sky direction (unit vector d, z up). */
 typedef struct {
     ts_sky_kind kind;

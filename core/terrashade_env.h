@@ -202,6 +202,13 @@ double ts_cie_sky_relative(int type, double zenith_deg, double sun_distance_deg,
 ts_status ts_sky_parse(const char *name, ts_sky_kind *kind, int *cie_type, ts_error *err);
 
 /**
+ * 1 if the sky's radiance depends on where the sun is (clear, and the CIE
+ * types with a circumsolar indicatrix: all but 1, 3 and 5), else 0
+ * (uniform, overcast, CIE types 1, 3, 5).
+ */
+int ts_sky_follows_sun(ts_sky_kind kind, int cie_type);
+
+/**
  * A standard sky as an environment on a width x height lat-long grid
  * (ts_env_sphere_grid; 0 x 0 = TS_SKY_DEFAULT_WIDTH x HEIGHT), grey
  * (R = G = B). Normalised so that the horizontal diffuse irradiance is pi

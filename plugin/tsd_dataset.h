@@ -126,6 +126,7 @@ class TSDataset final : public GDALPamDataset
     void WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfLon, double dfLat);
     void WarnDistances(double dfMinCell, int W, int H);
     void WarnBelowSea(const ts_grid *g);
+    void WarnSkyAtNight() const;
     std::atomic<bool> m_bBelowSeaWarned{false}; // WarnBelowSea: once per dataset
     static GDALDataset *OpenDEM(const char *pszDEM);
     ts_status LoadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg);

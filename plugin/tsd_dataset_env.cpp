@@ -106,9 +106,32 @@ bool TSDataset::SetupEnvironment()
         return false;
     }
     m_sRun.env = &m_sEnv;
+    WarnSkyAtNight();
     CPLDebug(DRIVER, "environment: %zu texels, flat plane E/pi %g %g %g, peak %g",
              m_sEnv.env.count, m_sEnv.flat[0], m_sEnv.flat[1], m_sEnv.flat[2], m_sEnv.peak);
     return true;
+}
+
+/* A standard sky that follows the sun, with the sun below the horizon: the
+ * CIE defines its skies for a sun above it; the formula goes on there (a
+ * dusk sky's distribution), normalised as every sky to an open plane's 1,
+ * so it lights the terrain as by day. Said, not refused: a day's series of
+ * shade through dusk keeps going. */
+void TSDataset::WarnSkyAtNight() const
+{
+    ts_sky_kind eKind;
+    int nType = 0;
+    if (!m_sOpts.sky[0] || m_sRun.sun_elevation >= 0 ||
+        ts_sky_parse(m_sOpts.sky, &eKind, &nType, nullptr) != TS_OK ||
+        !ts_sky_follows_sun(eKind, nType))
+        return;
+    CPLError(CE_Warning, CPLE_AppDefined,
+             "TERRASHADE: SKY=%s with the sun %.1f degrees below the horizon: the CIE "
+             "standard skies are defined for a sun above it. Their formula is continued "
+             "there (a dusk sky's distribution of light) and normalised, as every sky, so "
+             "that an open flat plane gets 1: it lights the terrain as by day, not as a "
+             "night sky. SKY=uniform or overcast do not follow the sun",
+             m_sOpts.sky, -m_sRun.sun_elevation);
 }
 
 /* The map (its full path, layout, channels, size), the light of an open

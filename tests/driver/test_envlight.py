@@ -250,6 +250,23 @@ class EnvLight(unittest.TestCase):
             ENV_MAP=SUNSET, PROGRESS="no"))
         self.assertTrue(np.allclose(s, 1.0, atol=1e-4), (np.nanmin(s), np.nanmax(s)))
 
+    def test_sun_following_sky_at_night_warns(self):
+        """SKY=clear (or a CIE type with a circumsolar region) with the sun
+        below the horizon: the standard defines it for a sun above; the
+        formula goes on, normalised, so a warning says it lights as by day.
+        None for the skies that do not follow the sun, nor by day."""
+        warned = "the CIE standard skies are defined for a sun above it"
+        for sky, elevation, warns in (("clear", -90, True), ("cie:7", -5, True),
+                                      ("cie:1", -90, False), ("overcast", -90, False),
+                                      ("uniform", -90, False), ("clear", 10, False)):
+            with self.subTest(sky=sky, elevation=elevation):
+                err = T.open_stderr(T.JACKSBORO, PRODUCT="envlight", SKY=sky,
+                                    SUN_ELEVATION=elevation)
+                self.assertEqual(warned in err, warns, err)
+        err = T.open_stderr(T.JACKSBORO, PRODUCT="envlight", SKY="clear", SUN_ELEVATION=-90)
+        self.assertIn("Warning 1: TERRASHADE: SKY=clear with the sun 90.0 degrees below the "
+                      "horizon: the CIE standard skies are defined for a sun above it.", err)
+
     def test_bad_input(self):
         truncated = self.path("truncated.exr")
         with open(SUNSET, "rb") as f:
