@@ -278,7 +278,8 @@ static ts_status env_light_cl(ts_backend_env_light *state, const ts_env_light_re
         ts_cl_env_light_close(state->cl);
         state->cl = NULL;
         state->failed = 1;
-        snprintf(state->reason, sizeof state->reason, "%s", err->message);
+        snprintf(state->reason, sizeof state->reason, "%s",
+                 err ? err->message : ts_status_name(st));
     }
     return st;
 }

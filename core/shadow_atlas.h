@@ -124,6 +124,7 @@ ts_status ts_atlas_writer_add(ts_atlas_writer *w, const uint8_t *plane,
 ts_status ts_atlas_writer_finish(ts_atlas_writer *w, const ts_atlas_info *info,
                                  uint8_t **bytes, size_t *size, ts_error *err);
 
+/** Free a writer, finished or not (NULL: nothing). */
 void ts_atlas_writer_free(ts_atlas_writer *w);
 
 /**
@@ -153,6 +154,8 @@ typedef struct ts_atlas ts_atlas;
 ts_status ts_atlas_open(const uint8_t *bytes, size_t size, ts_atlas **out,
                         ts_error *err);
 
+/** The atlas's header (size, steps, georeferencing, metadata text); owned
+ * by the atlas, valid until ts_atlas_free. */
 const ts_atlas_info *ts_atlas_get_info(const ts_atlas *a);
 
 /** The record of map `step` (0-based), or NULL. */
@@ -165,6 +168,7 @@ const ts_atlas_step *ts_atlas_get_step(const ts_atlas *a, int step);
 ts_status ts_atlas_read(const ts_atlas *a, int step, int x0, int y0, int w,
                         int h, uint8_t *out, ptrdiff_t stride, ts_error *err);
 
+/** Free an opened atlas (NULL: nothing). */
 void ts_atlas_free(ts_atlas *a);
 
 #ifdef __cplusplus

@@ -37,7 +37,9 @@ typedef enum {
     TS_ERR_CANCELLED /**< the progress callback asked to stop */
 } ts_status;
 
-/** Error detail: the code and one sentence for the user. */
+/** Error detail: the code and one sentence for the user. Every function
+ * that takes a `ts_error *err` accepts NULL there (the status is returned
+ * either way). */
 typedef struct {
     ts_status code;
     char message[256];
@@ -48,13 +50,6 @@ const char *ts_status_name(ts_status code);
 
 /* ------------------------------------------------------------------ grid */
 
-/**
- * A DEM grid. Heights are float metres with NaN for nodata, stored row by
- * row, `stride` floats from the start of one row to the next (stride >=
- * width). Cell sizes are in metres. For a geographic grid the east-west cell
- * size shrinks with latitude: set `cell_x_row` to `height` per-row values
- * (row 0 first); NULL means every row has `cell_x`.
- */
 /**
  * Where a grid lies in a larger DEM when it is a window of it (ts_grid's
  * `origin`): horizon sweeps then place their lines and measure distances
@@ -69,16 +64,23 @@ typedef struct {
                                       edge lies (ts_horizon_edge_apply) */
 } ts_grid_origin;
 
+/**
+ * A DEM grid. Heights are float metres with NaN for nodata, stored row by
+ * row, `stride` floats from the start of one row to the next (stride >=
+ * width). Cell sizes are in metres. For a geographic grid the east-west cell
+ * size shrinks with latitude: set `cell_x_row` to `height` per-row values
+ * (row 0 first); NULL means every row has `cell_x`. Row 0 is north.
+ */
 typedef struct {
-    int width;
-    int height;
-    ptrdiff_t stride;
-    float *z;
-    double cell_x;
-    double cell_y;
-    double *cell_x_row;
-    int owns_memory; /* set by ts_grid_create; ts_grid_free frees only then */
-    const ts_grid_origin *origin; /* a window of a larger DEM, or NULL */
+    int width;          /**< cells per row */
+    int height;         /**< rows */
+    ptrdiff_t stride;   /**< floats from one row's start to the next's */
+    float *z;           /**< heights, metres; NaN: nodata */
+    double cell_x;      /**< east-west cell size, metres */
+    double cell_y;      /**< north-south cell size, metres */
+    double *cell_x_row; /**< per-row east-west sizes (height values), or NULL */
+    int owns_memory; /**< set by ts_grid_create; ts_grid_free frees only then */
+    const ts_grid_origin *origin; /**< a window of a larger DEM, or NULL */
 } ts_grid;
 
 /** A grid's longest side, cells: keeps width*height*directions in size_t
@@ -438,6 +440,9 @@ ts_status ts_sky_accumulate(const ts_grid *grid, const float *nx,
                             const float *plane, double azimuth, int directions,
                             float *svf_acc, float *sky_acc,
                             float *openness_acc, ts_error *err);
+/** Turn the accumulators of `directions` ts_sky_accumulate calls into the
+ * terms themselves, in place (svf and sky 0..1, openness degrees); the same
+ * NULLs as there. */
 ts_status ts_sky_finish(const ts_grid *grid, int directions, float *svf_acc,
                         float *sky_acc, float *openness_acc, ts_error *err);
 

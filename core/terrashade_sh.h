@@ -158,6 +158,7 @@ typedef struct {
  *  ts_sh_wedges_free. */
 ts_status ts_sh_wedges_build(const ts_sh_swath *s, int threads, ts_sh_wedges *w,
                              ts_error *err);
+/** Free the tables (zeroed: freeing twice is harmless). */
 void ts_sh_wedges_free(ts_sh_wedges *w);
 
 /** The visibility of swath s with the same horizon, omega_deg, in every
@@ -188,11 +189,17 @@ typedef struct {
     float *prev;     /**< the last plane */
 } ts_sh_visibility;
 
+/** Start the visibility of `grid` for the swath of `w` (both kept by
+ * pointer: they must outlive v): vis zeroed, plane 0 expected next. Free
+ * with ts_sh_visibility_free. */
 ts_status ts_sh_visibility_init(ts_sh_visibility *v, const ts_grid *grid,
                                 const ts_sh_wedges *w, ts_error *err);
 /** Add plane k (horizon angles in degrees at ts_sh_swath_azimuth(k)). */
 ts_status ts_sh_visibility_add(ts_sh_visibility *v, int k, const float *plane, ts_error *err);
+/** After every plane: the wedges that need the last one; vis then holds
+ * each cell's visibility. An error if a plane is missing. */
 ts_status ts_sh_visibility_finish(ts_sh_visibility *v, ts_error *err);
+/** Free vis and the plane copies (zeroed: freeing twice is harmless). */
 void ts_sh_visibility_free(ts_sh_visibility *v);
 
 /* ------------------------------------------------------------ shading */
