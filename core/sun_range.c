@@ -30,7 +30,7 @@ void ts_date_range_default(ts_date_range *r)
 
 static int date_ok(int y, int m, int d)
 {
-    return y >= 1 && y <= 9999 && m >= 1 && m <= 12 && d >= 1 && d <= ts_days_in_month(y, m);
+    return y >= 0 && y <= 9999 && m >= 1 && m <= 12 && d >= 1 && d <= ts_days_in_month(y, m);
 }
 
 ts_status ts_date_range_check(const ts_date_range *r, int *days, int *sampled, ts_error *err)
@@ -39,10 +39,10 @@ ts_status ts_date_range_check(const ts_date_range *r, int *days, int *sampled, t
         return ts_fail(err, TS_ERR_ARG, "the date range is NULL");
     if (!date_ok(r->first_year, r->first_month, r->first_day))
         return ts_fail(err, TS_ERR_ARG, "the first day of the range, %04d-%02d-%02d, is not a "
-                       "date (years 1 to 9999)", r->first_year, r->first_month, r->first_day);
+                       "date (years 0 to 9999)", r->first_year, r->first_month, r->first_day);
     if (!date_ok(r->last_year, r->last_month, r->last_day))
         return ts_fail(err, TS_ERR_ARG, "the last day of the range, %04d-%02d-%02d, is not a "
-                       "date (years 1 to 9999)", r->last_year, r->last_month, r->last_day);
+                       "date (years 0 to 9999)", r->last_year, r->last_month, r->last_day);
     long long n = ts_days_from_civil(r->last_year, r->last_month, r->last_day) -
                   ts_days_from_civil(r->first_year, r->first_month, r->first_day) + 1;
     if (n < 1)

@@ -106,8 +106,12 @@ void TSDataset::SetupMetadata()
         // validated against them (tsd_atlas_check.cpp)
         const bool bApplies = tsd_option_applies(i) == TSD_APPLIES_SELECTOR ||
                               tsd_product_takes(m_psProduct, i);
+        // a date range's own settings say nothing of one day
+        const bool bRangeOnly =
+            EQUAL(pszName, "DAY_INTERVAL") || EQUAL(pszName, "HORIZON_DIRECTIONS");
         if (!bApplies || EQUAL(pszName, "THREADS") || EQUAL(pszName, "MAX_MEMORY") ||
-            EQUAL(pszName, "BACKEND") || !szValue[0])
+            EQUAL(pszName, "BACKEND") || !szValue[0] ||
+            (bRangeOnly && !tsd_options_is_range(&m_sOpts)))
             continue; // BACKEND: what ran (SetupBackendMetadata)
         GDALDataset::SetMetadataItem(pszName, szValue);
     }

@@ -168,12 +168,17 @@ ts_status tsd_sun_setup(const tsd_options *o, tsd_sites *sites, double min_cell_
         s->day_start = ts_local_day_start(s->instant, s->offset_minutes);
     }
     s->day_length = 86400.0 * (s->is_range ? s->range_days : 1);
-    /* the SPA's range of years, checked once here (at both ends of a range) */
+    /* the SPA's range of years, checked once here: at both ends of a day
+     * product's day or range (a day ending past it failed on the first read,
+     * after the open) */
     ts_sun_sample probe;
-    if (ts_sun_at_site(&s->sites, &s->day, s->day_start, &probe, &err) != TS_OK ||
-        (s->is_range && ts_sun_at_site(&s->sites, &s->day, s->day_start + s->day_length,
-                                       &probe, &err) != TS_OK))
-        return tsd_fail_core(msg, n, "cannot compute the sun's position", &err);
+    const char *first = s->is_range ? "START_DATE" : o->date[0] ? "DATE" : "DATETIME";
+    if (ts_sun_at_site(&s->sites, &s->day, s->day_start, &probe, &err) != TS_OK)
+        return tsd_fail_core(msg, n, first, &err);
+    if ((s->is_range || p->daily) &&
+        ts_sun_at_site(&s->sites, &s->day, s->day_start + s->day_length, &probe, &err) !=
+            TS_OK)
+        return tsd_fail_core(msg, n, s->is_range ? "END_DATE (the range's end)" : first, &err);
 
     if (p->steps != TSD_STEPS_NONE) {
         int steps = tsd_options_band_count(o);
@@ -212,25 +217,65 @@ ts_status tsd_sun_setup(const tsd_options *o, tsd_sites *sites, double min_cell_
     return TS_OK;
 }
 
+/* The civil offsets from UTC in use: -12:00 (Baker Island) to +14:00 (Line
+ * Islands). Beyond, a day's offset is likely a sign or a typo, which the
+ * solar-time test below, modulo a day, does not see (+21:00 for -03:00
+ * named the day before). */
+#define CIVIL_OFFSET_WEST_MIN (-12 * 60)
+#define CIVIL_OFFSET_EAST_MIN (14 * 60)
+
 int tsd_sun_zone_warning(const tsd_sun *s, const tsd_options *o, char *warning, size_t n)
 {
-    if (isfinite(s->instant) || !(s->day_length > 0) || o->datetime[0])
+    /* the day products' day: from DATE and TIMEZONE, a range's, or DATETIME's
+     * own offset */
+    if (!tsd_product_of(o)->daily || !(s->day_length > 0))
         return 0;
+    const char *whose = o->datetime[0] ? "DATETIME's" : "TIMEZONE's";
+    char given[OFFSET_TEXT], sun[OFFSET_TEXT];
+    offset_text(s->offset_minutes, given);
+    if (s->offset_minutes < CIVIL_OFFSET_WEST_MIN || s->offset_minutes > CIVIL_OFFSET_EAST_MIN) {
+        snprintf(warning, n,
+                 "%s offset (%s) is beyond every civil time zone (-12:00 to +14:00): the "
+                 "day it names starts %s from UTC's midnight, on another date than the "
+                 "site's. Is its sign right?",
+                 whose, given, given);
+        return 1;
+    }
     const tsd_sites *st = &s->sites_owned; /* the centre: the middle node of a lattice */
     const double lon = st->lon[(size_t)(st->ny / 2) * st->nx + st->nx / 2];
     const double solar = lon * 4.0; /* minutes east of UTC */
     const double apart = remainder(s->offset_minutes - solar, 1440.0);
     if (!(fabs(apart) > 240.0))
         return 0;
-    char given[OFFSET_TEXT], sun[OFFSET_TEXT];
-    offset_text(s->offset_minutes, given);
     offset_text((int)lround(solar), sun);
     snprintf(warning, n,
-             "TIMEZONE's offset (%s) is %.1f hours from the mean solar time at the DEM's "
-             "centre (longitude %.1f: UTC%s), farther than any time zone: its day's midnight "
-             "falls in daylight, and the sun's hours are split between two dates. Is it the "
-             "site's offset?",
-             given, fabs(apart) / 60.0, lon, sun);
+             "%s offset (%s) is %.1f hours from the mean solar time at the DEM's centre "
+             "(longitude %.1f: UTC%s), farther than any time zone: its day's midnight falls "
+             "%.1f hours from the site's, where the sun may be up, and a day's sun may be "
+             "split between two dates. Is it the site's offset?",
+             whose, given, fabs(apart) / 60.0, lon, sun, fabs(apart) / 60.0);
+    return 1;
+}
+
+/* The longest DAY_INTERVAL that keeps a range's total within about a
+ * percent: midpoint samples of the seasons' curve err by ~I^2/24 of its
+ * curvature, ~1 % of a block's sun at 46.5 N at 61 days, 3 % at 91. */
+#define RANGE_INTERVAL_WARN_DAYS 61
+
+int tsd_sun_range_warning(const tsd_sun *s, const tsd_options *o, char *warning, size_t n)
+{
+    /* a block's days: the interval, or the whole range where it is shorter */
+    if (!s->is_range || o->day_interval <= RANGE_INTERVAL_WARN_DAYS ||
+        s->range_days <= RANGE_INTERVAL_WARN_DAYS)
+        return 0;
+    snprintf(warning, n,
+             "DAY_INTERVAL=%d computes one day of every %d of the range (%d days, %d "
+             "computed) and counts it for the others: the sun's days change with the "
+             "seasons across such a block, so the total can be off by percents (one day "
+             "for a whole year read 30 %% more sun hours at 46.5 N than every 14 days). "
+             "At most %d (14 by default) keeps it within about a percent",
+             o->day_interval, o->day_interval, s->range_days, s->range_sampled,
+             RANGE_INTERVAL_WARN_DAYS);
     return 1;
 }
 

@@ -75,6 +75,15 @@ int tsd_sun_per_cell(const tsd_sun *sun);
 int tsd_sun_night_warning(const tsd_sun *s, const tsd_options *o, char *warning,
                           size_t warning_size);
 
+/**
+ * A sentence when a date range's DAY_INTERVAL is so long that one computed
+ * day counts for a stretch of the seasons (blocks of more than 61 days,
+ * over a range that long): the total can then be off by percents (one day
+ * for a whole year read 30 % more sun hours at 46.5 N than every 14 days).
+ * Returns 1 with it in `warning`, else 0.
+ */
+int tsd_sun_range_warning(const tsd_sun *s, const tsd_options *o, char *warning, size_t n);
+
 /** 1 with a sentence in `warning` when a day product's day (DATE or
  * START_DATE with TIMEZONE, not DATETIME) is of an offset more than 4 hours
  * from the mean solar time at the DEM's centre (modulo a day): no civil

@@ -171,6 +171,20 @@ class Sun(unittest.TestCase):
         p = T.run(["gdal_translate", "-q"] + day + ["-oo", "TIMEZONE=-00:30", T.conn(line),
                                                     out])
         self.assertIn("TIMEZONE's offset (-00:30)", p.stderr)
+        # the day of a DATETIME: its own offset (no warning until session 49)
+        p = T.run(["gdal_translate", "-q", "-oo", "PRODUCT=sunhours", "-oo", "STEP_MINUTES=60",
+                   "-oo", "DATETIME=2026-06-21T17:00:00Z", T.conn(T.JACKSBORO), out])
+        self.assertIn("DATETIME's offset (+00:00) is 5.6 hours from the mean solar time", p.stderr)
+        # beyond every civil zone: +21:00 for -03:00 names the day before,
+        # which modulo a day is 0 hours from Brasilia's solar time
+        bra = flat_dem(os.path.join(self.dir, "bra.tif"), -15.8, -47.9)
+        for tz in ("+21:00", "-23:59", "+14:30"):
+            p = T.run(["gdal_translate", "-q"] + day + ["-oo", "TIMEZONE=" + tz, T.conn(bra),
+                                                        out])
+            self.assertIn("TIMEZONE's offset (%s) is beyond every civil time zone (-12:00 to "
+                          "+14:00)" % tz, p.stderr)
+        p = T.run(["gdal_translate", "-q"] + day + ["-oo", "TIMEZONE=-03:00", T.conn(bra), out])
+        self.assertNotIn("TIMEZONE's offset", p.stderr)
 
     def test_a_per_cell_night_is_night_at_every_site(self):
         """A 20 x 20 degree DEM at dusk, per cell: the sun has set in the east

@@ -167,6 +167,10 @@ class Year(unittest.TestCase):
         md = meta(T.conn(self.dem), day)
         self.assertEqual(md["STEP_MINUTES"], "5")
         self.assertNotIn("RANGE_DAYS", md)
+        # nor a range's own settings (until session 49: DAY_INTERVAL=14 and
+        # HORIZON_DIRECTIONS=64 on one day)
+        self.assertNotIn("DAY_INTERVAL", md)
+        self.assertNotIn("HORIZON_DIRECTIONS", md)
         self.assertEqual(md["DAY_END"], "2026-03-21T00:00:00-05:00")
         c = self.product({"PRODUCT": "sunhours", "START_DATE": "2026-03-20",
                           "TIMEZONE": "-05:00", "STEP_MINUTES": 5}, band=1)
@@ -175,6 +179,22 @@ class Year(unittest.TestCase):
               "the mean %.2f h" % (100 * mean_rel, max_abs, m))
         self.assertLessEqual(mean_rel, 0.004)
         self.assertLessEqual(max_abs, 1.0)
+
+    def test_long_interval_warns(self):
+        """A DAY_INTERVAL over 61 days over a range that long: one computed
+        day stands for a stretch of the seasons, so a warning (a year at 365
+        read 30 % more sun hours at Bern than at 14); none at the default,
+        nor over a month, whatever the interval."""
+        year = ["PRODUCT=sunhours", "START_DATE=2026-01-01", "END_DATE=2026-12-31",
+                "TIMEZONE=-05:00"]
+        for interval, warns in ((91, True), (365, True), (61, False), (14, False)):
+            p = T.run(["gdalinfo"] + [a for o in year + ["DAY_INTERVAL=%d" % interval]
+                                      for a in ("-oo", o)] + [T.conn(self.dem)])
+            self.assertEqual("computes one day of every" in p.stderr, warns, p.stderr)
+        p = T.run(["gdalinfo", "-oo", "PRODUCT=sunhours", "-oo", "START_DATE=2026-06-01",
+                   "-oo", "END_DATE=2026-06-30", "-oo", "TIMEZONE=-05:00", "-oo",
+                   "DAY_INTERVAL=100", T.conn(self.dem)])
+        self.assertNotIn("computes one day of every", p.stderr)
 
     def test_bad_input(self):
         zone = ["TIMEZONE=-05:00"]
@@ -225,6 +245,23 @@ class Year(unittest.TestCase):
                 self.assertIn("TERRASHADE", p.stderr)
             if os.path.exists(out):
                 os.remove(out)
+        # the sun's years (-2000 to 6000) at both ends of the day or range, at
+        # open: a day ending past them opened, then failed on the first read
+        for oo, text in ((["PRODUCT=sunhours", "DATE=6000-12-31", "TIMEZONE=-01:00"],
+                          "DATE: The date (Julian day"),
+                         (["PRODUCT=insolation", "DATE=6001-01-01", "TIMEZONE=+01:00"],
+                          "DATE: The date (Julian day"),
+                         (["PRODUCT=sunhours", "START_DATE=6000-12-01", "END_DATE=6001-01-05",
+                           "TIMEZONE=Z"], "END_DATE (the range's end): The date")):
+            with self.subTest(oo=oo):
+                p = T.run(["gdalinfo"] + [a for o in oo for a in ("-oo", o)] +
+                          [T.conn(self.dem)], ok=False)
+                self.assertIn(text, p.stderr)
+                self.assertIn("must lie between the years -2000 and 6000", p.stderr)
+        # year 0 is a year of the range as of DATE (refused until session 49)
+        md = meta(T.conn(self.dem), {"PRODUCT": "sunhours", "START_DATE": "0000-01-01",
+                                     "END_DATE": "0000-01-10", "TIMEZONE": "Z"})
+        self.assertEqual(md["RANGE_DAYS"], "10")
         # a DEM without a geotransform: the sentence names START_DATE
         nogt = os.path.join(self.dir, "nogt.tif")
         ds = gdal.GetDriverByName("GTiff").Create(nogt, 8, 8, 1, gdal.GDT_Float32)
