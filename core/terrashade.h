@@ -1,5 +1,6 @@
 /*
- * terrashade.h - public API of libterrashade, the terrain shading core.
+ * terrashade.h - the API of libterrashade, the terrain shading core (used by
+ * the plugin, the benches and the tests within the build; not installed).
  *
  * The core knows nothing of GDAL or OpenCL. It works on a DEM grid of float
  * heights in metres (NaN = nodata) with cell sizes in metres, and returns
