@@ -226,8 +226,7 @@ CPLErr TSDataset::EnsureComputed()
                 std::chrono::steady_clock::now() - tStart;
             CPLDebug(DRIVER, "read the DEM in %.3f s%s", dfRead.count(),
                      bAhead ? " (waited for the read ahead)" : "");
-            if (m_nLevel == 0)
-                WarnBelowSea(&sGrid);
+            WarnBelowSea(&sGrid);
             if (m_psProduct->byte == TSD_BYTE_ALWAYS)
                 m_pabyProduct = static_cast<GByte *>(VSI_MALLOC2_VERBOSE(nCells, nBands));
             else
@@ -463,13 +462,14 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
 }
 
 /* EDGE=horizon's sea level beyond the edges above heights of grid g
- * (tsd_grid_below_sea_warning): once per dataset. */
+ * (tsd_grid_below_sea_warning): once per DEM, whichever level computes
+ * first (QGIS zoomed out reads only an overview). */
 void TSDataset::WarnBelowSea(const ts_grid *g)
 {
     char szWarning[512];
-    if (m_bBelowSeaWarned || tsd_options_edge(&m_sOpts) != TS_EDGE_HORIZON ||
-        !tsd_grid_below_sea_warning(g, szWarning, sizeof szWarning) ||
-        m_bBelowSeaWarned.exchange(true))
+    std::atomic<bool> &bWarned = (m_poBase ? m_poBase : this)->m_bBelowSeaWarned;
+    if (bWarned || tsd_options_edge(&m_sOpts) != TS_EDGE_HORIZON ||
+        !tsd_grid_below_sea_warning(g, szWarning, sizeof szWarning) || bWarned.exchange(true))
         return;
     CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szWarning);
 }

@@ -121,7 +121,7 @@ void TSDataset::WarnSkyAtNight() const
 {
     ts_sky_kind eKind;
     int nType = 0;
-    if (!m_sOpts.sky[0] || m_sRun.sun_elevation >= 0 ||
+    if (m_nLevel != 0 || !m_sOpts.sky[0] || m_sRun.sun_elevation >= 0 ||
         ts_sky_parse(m_sOpts.sky, &eKind, &nType, nullptr) != TS_OK ||
         !ts_sky_follows_sun(eKind, nType))
         return;

@@ -367,7 +367,9 @@ static double metres_per_unit(const char *unit)
         {"survey foot", 1200.0 / 3937.0}, {"survey feet", 1200.0 / 3937.0},
         {"us foot", 1200.0 / 3937.0}, {"us feet", 1200.0 / 3937.0},
         {"ftus", 1200.0 / 3937.0}, {"ft us", 1200.0 / 3937.0}, {"us ft", 1200.0 / 3937.0},
-        {"usft", 1200.0 / 3937.0}, {"foot us", 1200.0 / 3937.0},
+        {"usft", 1200.0 / 3937.0}, {"foot us", 1200.0 / 3937.0}, {"feet us", 1200.0 / 3937.0},
+        {"foot us survey", 1200.0 / 3937.0}, {"feet us survey", 1200.0 / 3937.0},
+        {"masl", 1.0}, {"mamsl", 1.0}, {"ftasl", 0.3048}, {"ftamsl", 0.3048},
     };
     char key[64];
     unit_key(unit, key, sizeof key);
@@ -435,15 +437,15 @@ int tsd_dem_unit_note(GDALRasterBandH band, char *note, size_t n)
         }
     }
     if (crs_m > 0 && band_m > 0 && fabs(band_m / crs_m - 1) > 1e-9) {
-        snprintf(note, n, "the DEM's CRS gives its heights in %s, its band in '%s': the "
-                          "CRS's unit is used (Z_FACTOR=%.10g). If the heights are in %s, "
+        snprintf(note, n, "the DEM's CRS gives its heights in %s, its band in '%.60s': the "
+                          "CRS's unit is used (Z_FACTOR=%.10g). If the heights are in %.60s, "
                           "give Z_FACTOR=%.10g",
                  crs_name, unit, crs_m, unit, band_m);
         return 1;
     }
     if (crs_m > 0 || band_m > 0)
         return 0;
-    snprintf(note, n, "the DEM's band gives its heights' unit as '%s', which is not a length "
+    snprintf(note, n, "the DEM's band gives its heights' unit as '%.60s', which is not a length "
                       "terrashade knows: they are taken as metres. Give Z_FACTOR, the metres "
                       "of one unit (0.3048 for feet, 0.3048006096 for US survey feet), or "
                       "1 if they are metres",

@@ -168,16 +168,17 @@ ts_status tsd_sun_setup(const tsd_options *o, tsd_sites *sites, double min_cell_
         s->day_start = ts_local_day_start(s->instant, s->offset_minutes);
     }
     s->day_length = 86400.0 * (s->is_range ? s->range_days : 1);
-    /* the SPA's range of years, checked once here: at both ends of a day
-     * product's day or range (a day ending past it failed on the first read,
-     * after the open) */
+    /* the SPA's range of years, checked once here: at both ends of the day
+     * or range (a day ending past it failed on the first read, after the
+     * open). The end less a second: the steps sample their middles, half a
+     * step (30 s at least) before it, and a day ending at the limit itself
+     * computes */
     ts_sun_sample probe;
     const char *first = s->is_range ? "START_DATE" : o->date[0] ? "DATE" : "DATETIME";
     if (ts_sun_at_site(&s->sites, &s->day, s->day_start, &probe, &err) != TS_OK)
         return tsd_fail_core(msg, n, first, &err);
-    if ((s->is_range || p->daily) &&
-        ts_sun_at_site(&s->sites, &s->day, s->day_start + s->day_length, &probe, &err) !=
-            TS_OK)
+    if (ts_sun_at_site(&s->sites, &s->day, s->day_start + s->day_length - 1.0, &probe, &err) !=
+        TS_OK)
         return tsd_fail_core(msg, n, s->is_range ? "END_DATE (the range's end)" : first, &err);
 
     if (p->steps != TSD_STEPS_NONE) {

@@ -85,11 +85,13 @@ int tsd_sun_night_warning(const tsd_sun *s, const tsd_options *o, char *warning,
 int tsd_sun_range_warning(const tsd_sun *s, const tsd_options *o, char *warning, size_t n);
 
 /** 1 with a sentence in `warning` when a day product's day (DATE or
- * START_DATE with TIMEZONE, not DATETIME) is of an offset more than 4 hours
- * from the mean solar time at the DEM's centre (modulo a day): no civil
- * time zone is that far from its sun (western China's, the farthest, ~3
- * h), so its local midnight falls in daylight and the day's light is
- * split between two calendar days. 0 otherwise. */
+ * START_DATE with TIMEZONE, or DATETIME with its own offset) is of an
+ * offset beyond every civil time zone (-12:00 to +14:00: likely a sign's
+ * typo, which names another date), or more than 4 hours from the mean
+ * solar time at the DEM's centre (modulo a day): no civil time zone is that
+ * far from its sun (western China's, the farthest, ~3 h), so its local
+ * midnight may fall in daylight and a day's light be split between two
+ * calendar days. 0 otherwise. */
 int tsd_sun_zone_warning(const tsd_sun *s, const tsd_options *o, char *warning,
                          size_t warning_size);
 

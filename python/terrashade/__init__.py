@@ -3,4 +3,4 @@
 terrashade.distributed runs a product over a large DEM as window tasks on
 dask.distributed (python3 -m terrashade.distributed --help).
 """
-__version__ = "0.1.0"
+__version__ = "0.2.0"

@@ -95,7 +95,9 @@ class VerticalUnits(unittest.TestCase):
                              ("US Survey Feet", FT_US), ("survey foot", FT_US),
                              ("U.S. survey foot", FT_US), ("ft asl", 0.3048),
                              ("Feet (NAVD88)", 0.3048),
-                             ("m AMSL", 1.0), ("Meters", 1.0), ("metre-height", 1.0)):
+                             ("m AMSL", 1.0), ("Meters", 1.0), ("metre-height", 1.0),
+                             ("feet US", FT_US), ("foot (US survey)", FT_US),
+                             ("m.a.s.l.", 1.0)):
             with self.subTest(unit=unit):
                 path = os.path.join(self.dir, "spelled.tif")
                 T.write_tif(path, self.z, NC_GT, 2264)

@@ -258,6 +258,11 @@ class Year(unittest.TestCase):
                           [T.conn(self.dem)], ok=False)
                 self.assertIn(text, p.stderr)
                 self.assertIn("must lie between the years -2000 and 6000", p.stderr)
+        # a day that ends at the limit itself computes (its steps sample their
+        # middles, before it)
+        md = meta(T.conn(self.dem), {"PRODUCT": "sunhours", "DATE": "6000-12-31",
+                                     "TIMEZONE": "Z", "STEP_MINUTES": 60})
+        self.assertEqual(md["DAY_END"], "6001-01-01T00:00:00Z")
         # year 0 is a year of the range as of DATE (refused until session 49)
         md = meta(T.conn(self.dem), {"PRODUCT": "sunhours", "START_DATE": "0000-01-01",
                                      "END_DATE": "0000-01-10", "TIMEZONE": "Z"})
