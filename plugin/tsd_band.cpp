@@ -148,6 +148,7 @@ CPLErr TSRasterBand::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXS
     tsd::CLocale oC; /* tsd_locale.h */
     if (static_cast<TSDataset *>(poDS)->ReadInsideOwnComputation())
         return CE_Failure; // (before GDAL's block cache, which may hold the block unfilled)
+    const auto oReads = static_cast<TSDataset *>(poDS)->LockReads();
     const CallerProgress oCaller(psExtraArg); // a computation started here reports to it
     CPLErr eErr = CE_None;
     if (!(eRWFlag == GF_Read && nBufXSize == nXSize && nBufYSize == nYSize &&
@@ -169,6 +170,7 @@ CPLErr TSRasterBand::ComputeStatistics(int bApproxOK, double *pdfMin, double *pd
 {
     if (static_cast<TSDataset *>(poDS)->ReadInsideOwnComputation())
         return CE_Failure;
+    const auto oReads = static_cast<TSDataset *>(poDS)->LockReads();
     return GDALPamRasterBand::ComputeStatistics(bApproxOK, pdfMin, pdfMax, pdfMean, pdfStdDev,
                                                 pfnProgress, pProgressData);
 }
@@ -177,6 +179,7 @@ CPLErr TSRasterBand::ComputeRasterMinMax(int bApproxOK, double *adfMinMax)
 {
     if (static_cast<TSDataset *>(poDS)->ReadInsideOwnComputation())
         return CE_Failure;
+    const auto oReads = static_cast<TSDataset *>(poDS)->LockReads();
     return GDALPamRasterBand::ComputeRasterMinMax(bApproxOK, adfMinMax);
 }
 
@@ -186,6 +189,7 @@ CPLErr TSRasterBand::GetHistogram(double dfMin, double dfMax, int nBuckets,
 {
     if (static_cast<TSDataset *>(poDS)->ReadInsideOwnComputation())
         return CE_Failure;
+    const auto oReads = static_cast<TSDataset *>(poDS)->LockReads();
     return GDALPamRasterBand::GetHistogram(dfMin, dfMax, nBuckets, panHistogram,
                                            bIncludeOutOfRange, bApproxOK, pfnProgress,
                                            pProgressData);

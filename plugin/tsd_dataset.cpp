@@ -178,6 +178,7 @@ CPLErr TSDataset::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize
     tsd::CLocale oC; /* tsd_locale.h */
     if (ReadInsideOwnComputation())
         return CE_Failure;
+    const auto oReads = LockReads();
     const CallerProgress oCaller(psExtraArg);
     const CPLErr eErr = GDALPamDataset::IRasterIO(
         eRWFlag, nXOff, nYOff, nXSize, nYSize, pData, nBufXSize, nBufYSize, eBufType,

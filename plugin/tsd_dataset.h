@@ -64,6 +64,15 @@ class TSDataset final : public GDALPamDataset
     bool m_bHasGT = true;
     OGRSpatialReference m_oSRS{};
     std::mutex m_oMutex{};
+    /* one reader at a time through GDAL's block cache (IRasterIO, the
+     * statistics): GDAL 3.6 files a block in the band's cache before
+     * IReadBlock fills it, so that a second thread reading the same block
+     * took it unfilled (zeros, garbage) while the first computed it */
+    std::recursive_mutex m_oReadMutex{};
+    std::unique_lock<std::recursive_mutex> LockReads()
+    {
+        return std::unique_lock<std::recursive_mutex>(m_oReadMutex);
+    }
     /* the thread computing under m_oMutex (EnsureComputed, WindowBlock):
      * a read of the dataset from its own progress callback, on that thread,
      * would wait for itself (or take a block GDAL's cache holds unfilled) */
