@@ -27,21 +27,18 @@ def read_all(name, options):
     return out
 
 
-def in_two_threads(name, options):
-    """Both threads open their own dataset, then read it at once."""
-    start = threading.Barrier(2)
+def at_once(task):
+    """task(i, start) in two threads i = 0, 1; each calls start() (a barrier)
+    just before the read to time; their results."""
+    barrier = threading.Barrier(2)
     results, errors = [None, None], []
 
     def work(i):
         try:
-            ds = gdal.OpenEx(name, gdal.OF_RASTER, open_options=options)
-            start.wait(timeout=60)
-            results[i] = np.stack([ds.GetRasterBand(b).ReadAsArray()
-                                   for b in range(1, ds.RasterCount + 1)])
-            ds = None
+            results[i] = task(i, lambda: barrier.wait(timeout=60))
         except Exception as e:  # reported by the main thread
             errors.append(e)
-            start.abort()
+            barrier.abort()
 
     threads = [threading.Thread(target=work, args=(i,)) for i in range(2)]
     for t in threads:
@@ -51,29 +48,26 @@ def in_two_threads(name, options):
     if errors:
         raise errors[0]
     return results
+
+
+def in_two_threads(name, options):
+    """Both threads open their own dataset, then read it at once."""
+    def task(i, start):
+        ds = gdal.OpenEx(name, gdal.OF_RASTER, open_options=options)
+        start()
+        out = np.stack([ds.GetRasterBand(b).ReadAsArray()
+                        for b in range(1, ds.RasterCount + 1)])
+        ds = None
+        return out
+    return at_once(task)
 
 
 def shared_by_two_threads(ds, windows):
     """Two threads read windows of band 1 of the same dataset at once."""
-    start = threading.Barrier(2)
-    results, errors = [None, None], []
-
-    def work(i):
-        try:
-            start.wait(timeout=60)
-            results[i] = ds.GetRasterBand(1).ReadAsArray(*windows[i])
-        except Exception as e:  # reported by the main thread
-            errors.append(e)
-            start.abort()
-
-    threads = [threading.Thread(target=work, args=(i,)) for i in range(2)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join(timeout=300)
-    if errors:
-        raise errors[0]
-    return results
+    def task(i, start):
+        start()
+        return ds.GetRasterBand(1).ReadAsArray(*windows[i])
+    return at_once(task)
 
 
 class Threads(unittest.TestCase):
