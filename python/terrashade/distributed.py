@@ -167,6 +167,7 @@ class Said:
         """A new run says its warnings again."""
         self.seen = set()
         self.same_dem = None
+        self.final = None  # (device, inode) of the file renamed to DEST (finish)
 
     def say(self, messages, bar=None):
         if self.same_dem and self.same_dem[0] != self.same_dem[1]:
@@ -513,6 +514,8 @@ def finish(partial, fmt, dest, creation_options):
     for side in SIDE_FILES:
         with contextlib.suppress(FileNotFoundError):
             os.remove(dest + side)
+    st = os.stat(final)
+    SAID.final = (st.st_dev, st.st_ino)  # an interrupt from here on: written()
     os.replace(final, dest)
     if os.path.exists(final + ".aux.xml"):
         os.replace(final + ".aux.xml", dest + ".aux.xml")
@@ -589,6 +592,18 @@ def run(args):
               file=sys.stderr)
 
 
+def written(dest):
+    """Whether DEST is the file finish() renamed to it: an interrupt may
+    come between any two steps, the rename's own included."""
+    if SAID.final is None:
+        return False
+    try:
+        st = os.stat(dest)
+    except OSError:
+        return False
+    return (st.st_dev, st.st_ino) == SAID.final
+
+
 class Terminated(KeyboardInterrupt):
     """SIGTERM (timeout, Slurm, systemd, Kubernetes...), cleaned up as Ctrl-C;
     Python's default ends the program at once and left DEST.partial behind."""
@@ -618,8 +633,12 @@ def main(argv=None):
         return 1
     except KeyboardInterrupt as e:
         terminated = isinstance(e, Terminated)
-        print("%s: %s; nothing written to %s" % (
-            PROG, "terminated" if terminated else "interrupted", args.dest), file=sys.stderr)
+        what = "terminated" if terminated else "interrupted"
+        if written(args.dest):  # while the cluster closed, DEST being complete
+            print("%s: %s while closing the cluster; %s was written in full" % (
+                PROG, what, args.dest), file=sys.stderr)
+        else:
+            print("%s: %s; nothing written to %s" % (PROG, what, args.dest), file=sys.stderr)
         return 128 + (signal.SIGTERM if terminated else signal.SIGINT)
     finally:
         if previous is not None:

@@ -707,6 +707,38 @@ class Distributed(unittest.TestCase):
                 os.remove(dest)
                 self.assert_nothing_left(dest)
 
+    def test_interrupt_after_dest_is_written(self):
+        """Ctrl-C once DEST is in place, while the cluster closes (~0.6 s):
+        DEST is the whole new product, and the message says so (until
+        session 49 it said 'nothing written' over the new DEST). The signal
+        goes as soon as DEST is replaced; a run that ends first exits 0."""
+        dest = self.path("late.tif")
+        with open(dest, "w") as f:
+            f.write("an older result")
+        before = os.stat(dest).st_ino
+        p = subprocess.Popen(
+            ["/usr/bin/python3", "-m", "terrashade.distributed", "--workers", "1",
+             "--tile-size", "64", "-q"] + T.oo_args(HORIZON) + [T.conn(self.dem), dest],
+            stderr=subprocess.PIPE, text=True, start_new_session=True,
+            env=T.env(PYTHONPATH=PYTHONPATH),
+            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+        for _ in range(60000):
+            if p.poll() is not None or os.stat(dest).st_ino != before:
+                break
+            time.sleep(0.002)
+        if p.poll() is None:
+            p.send_signal(signal.SIGINT)
+        err = p.communicate(timeout=120)[1]
+        print("exit %d: %s" % (p.returncode, err.strip()))
+        self.assertIn(p.returncode, (0, 130), err)
+        self.assertNotIn("nothing written", err)
+        if p.returncode == 130:
+            self.assertIn("terrashade.distributed: interrupted while closing the cluster; "
+                          "%s was written in full" % dest, err)
+        ds = gdal.Open(dest)
+        self.assertEqual((ds.RasterXSize, ds.RasterYSize), (200, 150))
+        ds = None
+
     def test_python_without_gdal(self):
         """A Python that cannot import osgeo (python3 first on PATH is often
         not the system one): a sentence and exit 1, even for --help."""
