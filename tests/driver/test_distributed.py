@@ -674,6 +674,16 @@ class Distributed(unittest.TestCase):
             self.assertEqual(f.read(), before)
         self.assertFalse(os.path.exists(dest + ".partial"))
 
+    def start_signalled_run(self, dest):
+        """A run of the horizon product into dest, to be signalled: in its own
+        session (the shell's job control may ignore SIGINT)."""
+        return subprocess.Popen(
+            ["/usr/bin/python3", "-m", "terrashade.distributed", "--workers", "1",
+             "--tile-size", "64", "-q"] + T.oo_args(HORIZON) + [T.conn(self.dem), dest],
+            stderr=subprocess.PIPE, text=True, start_new_session=True,
+            env=T.env(PYTHONPATH=PYTHONPATH),
+            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+
     def test_interrupted_run_leaves_nothing(self):
         """Ctrl-C (SIGINT) and SIGTERM (what timeout, Slurm, systemd or
         Kubernetes send) during a run: the partial file is removed, an older
@@ -685,13 +695,7 @@ class Distributed(unittest.TestCase):
             with self.subTest(said):
                 with open(dest, "w") as f:
                     f.write("an older result")
-                # in its own session: the shell's job control may ignore SIGINT
-                p = subprocess.Popen(
-                    ["/usr/bin/python3", "-m", "terrashade.distributed", "--workers", "1",
-                     "--tile-size", "64", "-q"] + T.oo_args(HORIZON) + [T.conn(self.dem), dest],
-                    stderr=subprocess.PIPE, text=True, start_new_session=True,
-                    env=T.env(PYTHONPATH=PYTHONPATH),
-                    preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+                p = self.start_signalled_run(dest)
                 for _ in range(600):  # created before the cluster starts
                     if os.path.exists(dest + ".partial") or p.poll() is not None:
                         break
@@ -716,12 +720,7 @@ class Distributed(unittest.TestCase):
         with open(dest, "w") as f:
             f.write("an older result")
         before = os.stat(dest).st_ino
-        p = subprocess.Popen(
-            ["/usr/bin/python3", "-m", "terrashade.distributed", "--workers", "1",
-             "--tile-size", "64", "-q"] + T.oo_args(HORIZON) + [T.conn(self.dem), dest],
-            stderr=subprocess.PIPE, text=True, start_new_session=True,
-            env=T.env(PYTHONPATH=PYTHONPATH),
-            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+        p = self.start_signalled_run(dest)
         for _ in range(60000):
             if p.poll() is not None or os.stat(dest).st_ino != before:
                 break
