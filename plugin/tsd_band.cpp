@@ -149,7 +149,9 @@ CPLErr TSRasterBand::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXS
     if (static_cast<TSDataset *>(poDS)->ReadInsideOwnComputation())
         return CE_Failure; // (before GDAL's block cache, which may hold the block unfilled)
     const auto oReads = static_cast<TSDataset *>(poDS)->LockReads();
-    const CallerProgress oCaller(psExtraArg); // a computation started here reports to it
+    CallerProgress oCaller(psExtraArg, nXOff, nYOff, nXSize, nYSize); // a computation
+                                                                     // started here reports to it
+    psExtraArg = oCaller.Arg(psExtraArg);
     CPLErr eErr = CE_None;
     if (!(eRWFlag == GF_Read && nBufXSize == nXSize && nBufYSize == nYSize &&
           eBufType == eDataType && nPixelSpace == GDALGetDataTypeSizeBytes(eDataType) &&

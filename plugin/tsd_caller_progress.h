@@ -16,23 +16,44 @@ namespace tsd
 {
 
 /** For its lifetime, a RasterIO with a progress callback on this thread:
- * set by the datasets' and bands' IRasterIO; an inner RasterIO without
- * one keeps the outer's. */
+ * set by the datasets' and bands' IRasterIO, with the window read (raster
+ * cells); an inner RasterIO without one keeps the outer's. The callback
+ * sees one fraction of the read that never goes back: GDAL's own reports
+ * (through Arg()) and the computations' (Hook), each computation's 0..1
+ * spread over its share of what is left of the read (a chunk: the part of
+ * the window it covers), never below what the callback was told. */
 class CallerProgress
 {
     const GDALRasterIOExtraArg *m_psPrev;
     int m_nCancelledBefore; // NoteCancelled's count at the start
+    GDALRasterIOExtraArg m_sArg{}; // the caller's, with Track as its callback
+    const GDALRasterIOExtraArg *m_psUser = nullptr; // the caller's own, if hooked
+    double m_dfSeen = 0;           // the most the callback was told in this read
+    int m_anWindow[4] = {0, 0, 0, 0};
+    const CallerProgress *m_poPrevRead;
+
+    static int CPL_STDCALL Track(double dfDone, const char *pszMsg, void *pData);
+    double Share(const int *panCells) const; // of the window, 1 without cells
 
   public:
-    explicit CallerProgress(const GDALRasterIOExtraArg *psExtraArg);
+    CallerProgress(const GDALRasterIOExtraArg *psExtraArg, int nXOff, int nYOff, int nXSize,
+                   int nYSize);
     ~CallerProgress();
     CallerProgress(const CallerProgress &) = delete;
     CallerProgress &operator=(const CallerProgress &) = delete;
 
+    /** What to pass on to GDAL's RasterIO in place of psExtraArg: the same,
+     * with the callback tracked. */
+    GDALRasterIOExtraArg *Arg(GDALRasterIOExtraArg *psExtraArg)
+    {
+        return m_psUser ? &m_sArg : psExtraArg;
+    }
+
     /** Hook the callback of the read under way on this thread, if any,
      * to psProgress: told the fraction computed, it stops the computation
-     * by returning FALSE. */
-    static void Hook(tsd_progress *psProgress);
+     * by returning FALSE. panCells (x, y, width, height in raster cells;
+     * NULL: the whole read) is what the computation covers. */
+    static void Hook(tsd_progress *psProgress, const int *panCells = nullptr);
 
     /** Count a computation that the callback stopped on this thread. */
     static void NoteCancelled();

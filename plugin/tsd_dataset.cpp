@@ -135,13 +135,14 @@ ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
 
 /* Start the progress line of a computation run by psRun (PROGRESS, after
  * TERRASHADE_PROGRESS_AFTER seconds under auto) and hook it to the run,
- * with the progress callback of the read that started it, if it has one. */
+ * with the progress callback of the read that started it, if it has one
+ * (panCells: the raster cells a chunk covers; NULL: the whole read). */
 void TSDataset::StartProgress(tsd_progress *psProgress, const char *pszLabel,
-                              tsd_run *psRun) const
+                              tsd_run *psRun, const int *panCells) const
 {
     tsd_progress_begin(psProgress, m_sOpts.progress_mode, nullptr, pszLabel,
                        CPLAtof(CPLGetConfigOption("TERRASHADE_PROGRESS_AFTER", "1")));
-    CallerProgress::Hook(psProgress);
+    CallerProgress::Hook(psProgress, panCells);
     psRun->progress = tsd_progress_report;
     psRun->progress_user = psProgress;
 }
@@ -179,7 +180,8 @@ CPLErr TSDataset::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize
     if (ReadInsideOwnComputation())
         return CE_Failure;
     const auto oReads = LockReads();
-    const CallerProgress oCaller(psExtraArg);
+    CallerProgress oCaller(psExtraArg, nXOff, nYOff, nXSize, nYSize);
+    psExtraArg = oCaller.Arg(psExtraArg);
     const CPLErr eErr = GDALPamDataset::IRasterIO(
         eRWFlag, nXOff, nYOff, nXSize, nYSize, pData, nBufXSize, nBufYSize, eBufType,
         nBandCount, panBandMap, nPixelSpace, nLineSpace, nBandSpace, psExtraArg);

@@ -122,7 +122,8 @@ class TSDataset final : public GDALPamDataset
     std::string m_osReadMsg{};
 
     CPLErr EnsureComputed();
-    void StartProgress(tsd_progress *psProgress, const char *pszLabel, tsd_run *psRun) const;
+    void StartProgress(tsd_progress *psProgress, const char *pszLabel, tsd_run *psRun,
+                       const int *panCells = nullptr) const;
     void FailCancelled() const;
     bool SetupWindow(int W, int H);
     bool EnsureFarField();

@@ -295,12 +295,13 @@ bool TSDataset::ComputeChunk(int cx, int cy, WindowChunk &c)
         const int ry0 = m_sCells.flip_y ? H - gy0 - c.h : gy0;
         tsd_progress sProgress;
         tsd_run sRun = m_sRun;
+        const int anCells[4] = {rx0, ry0, c.w, c.h};
         StartProgress(&sProgress,
                       CPLSPrintf("computing %s of chunk %d of %d (%d x %d cells from column "
                                  "%d, row %d)",
                                  m_psProduct->name, cy * nx + cx + 1, nx * ny, c.w, c.h, rx0,
                                  ry0),
-                      &sRun);
+                      &sRun, anCells);
         sRun.near_distance = p.near_m;
         sRun.far = p.far ? &s.far : nullptr;
         tsd_backend_summary sRan{};

@@ -160,20 +160,20 @@ class Progress(FractalCase):
 
 
 class Stopper:
-    """A RasterIO progress callback: counts its calls and the computations
-    that began (a call with 0 before GDAL's own first report), and
-    returns 0 (stop) from the call `stop_at` of them on (never if None)."""
+    """A RasterIO progress callback: keeps what it was told, and returns 0
+    (stop) from its call `stop_at` on, or from the first that says
+    `stop_from` or more (never if both are None)."""
 
-    def __init__(self, stop_at=None, starts=False):
-        self.stop_at, self.starts = stop_at, starts
-        self.calls = self.began = 0
+    def __init__(self, stop_at=None, stop_from=None):
+        self.stop_at, self.stop_from = stop_at, stop_from
+        self.calls, self.told = 0, []
 
     def __call__(self, done, _message, _data):
         self.calls += 1
-        if done == 0.0:
-            self.began += 1
-        n = self.began if self.starts else self.calls
-        return 0 if self.stop_at is not None and n >= self.stop_at else 1
+        self.told.append(done)
+        if self.stop_from is not None:
+            return 0 if done >= self.stop_from else 1
+        return 0 if self.stop_at is not None and self.calls >= self.stop_at else 1
 
 
 class CallerCancel(FractalCase):
@@ -317,6 +317,32 @@ class CallerCancel(FractalCase):
         np.testing.assert_array_equal(ds.GetRasterBand(1).ReadAsArray(), ref)
         ds = None
 
+    def test_windowed_progress_never_goes_back(self):
+        """A windowed read's callback, told by GDAL's blocks and by each
+        chunk's computation, hears one fraction that never goes back and
+        ends at 1 (until session 49 it went back to 0 at each chunk: 18
+        times in a ReadAsArray, 12 in a gdal.Translate), whole and in a
+        window across chunks."""
+        small = T.write_tif(os.path.join(self.dir, "mono.tif"),
+                            T.fractal_dem(256, seed=7), UTM_GT, 32617)
+        oo = ["PRODUCT=svf", "DIRECTIONS=8", "TILE_SIZE=64", "PROGRESS=no"]
+        reads = (("ReadAsArray", lambda ds, cb: ds.GetRasterBand(1).ReadAsArray(callback=cb)),
+                 ("a window", lambda ds, cb: ds.GetRasterBand(1).ReadAsArray(
+                     40, 40, 150, 100, callback=cb)),
+                 ("gdal.Translate", lambda ds, cb: gdal.Translate(
+                     os.path.join(self.dir, "mono_out.tif"), ds, callback=cb)))
+        for name, read in reads:
+            with self.subTest(read=name):
+                ds = gdal.OpenEx(T.conn(small), open_options=oo)
+                told = Stopper()
+                read(ds, told)
+                ds = None
+                print("%s: %d calls, from %.3f to %.3f" % (name, told.calls, told.told[0],
+                                                           told.told[-1]))
+                self.assertGreater(told.calls, 10)
+                self.assertEqual(told.told, sorted(told.told))
+                self.assertEqual(told.told[-1], 1.0)
+
     def test_chunks(self):
         """Chunk by chunk (TILE_SIZE): a chunk cancelled is computed again
         by the next read, the chunks computed before it are kept; a
@@ -324,24 +350,27 @@ class CallerCancel(FractalCase):
         no block of a cancelled read."""
         small = T.write_tif(os.path.join(self.dir, "small.tif"),
                             T.fractal_dem(256, seed=6), UTM_GT, 32617)
-        for opts, stop_at, band in (
+        # the read's fraction goes 1/n a chunk, and on (until session 49 each
+        # chunk told 0 to 1 again): stopped where the chunk stop_at begins
+        for opts, stop_at, chunks, band in (
                 # the third of four chunks
-                (dict(PRODUCT="svf", DIRECTIONS=8, TILE_SIZE=128), 3, 1),
+                (dict(PRODUCT="svf", DIRECTIONS=8, TILE_SIZE=128), 3, 4, 1),
                 # 16 chunks of 64 cells; a block of band 1 (the whole DEM)
                 # computes them, filling the other bands' blocks in the same
                 # pass (the cache holds 5): stopped at the tenth, band 2's
                 # block half filled, which must not stay in GDAL's cache
-                (dict(PRODUCT="horizon", DIRECTIONS=4, TILE_SIZE=64), 10, 2)):
+                (dict(PRODUCT="horizon", DIRECTIONS=4, TILE_SIZE=64), 10, 16, 2)):
             with self.subTest(**opts):
                 oo = ["%s=%s" % kv for kv in dict(opts, PROGRESS="no").items()]
                 fresh = gdal.OpenEx(T.conn(small), open_options=oo)
                 ref = fresh.ReadAsArray()
                 fresh = None
                 ds = gdal.OpenEx(T.conn(small), open_options=oo)
-                stop = Stopper(stop_at=stop_at, starts=True)
+                stop = Stopper(stop_from=(stop_at - 1) / chunks)
                 self.assertCancelled(lambda: ds.GetRasterBand(1).ReadAsArray(callback=stop))
-                print("chunk computations begun: %d" % stop.began)
-                self.assertEqual(stop.began, stop_at)
+                print("stopped at %.4f, after %d calls" % (stop.told[-1], stop.calls))
+                self.assertEqual(stop.told, sorted(stop.told))
+                self.assertAlmostEqual(stop.told[-1], (stop_at - 1) / chunks, places=12)
                 np.testing.assert_array_equal(ds.GetRasterBand(band).ReadAsArray(),
                                               ref if ref.ndim == 2 else ref[band - 1])
                 np.testing.assert_array_equal(ds.ReadAsArray(), ref)
