@@ -165,7 +165,9 @@ BAD = [
     ("bad_time", "terrashade:shade", {"INPUT": J, "DATETIME": "2026-12-21T09:00"}),
 ]
 # the user cancels once the progress bar moves (Log in CHILD, by the name)
-CANCEL = [("cancel_svf", "terrashade:svf", {"INPUT": J, "DIRECTIONS": 8})]
+CANCEL = [("cancel_svf", "terrashade:svf", {"INPUT": J, "DIRECTIONS": 8}),
+          # several bands: GDAL's failed copy left OUTPUT.aux.xml behind
+          ("cancel_horizon", "terrashade:horizon", {"INPUT": J, "DIRECTIONS": 8})]
 
 
 def qgis_env(home):
@@ -331,9 +333,12 @@ class Processing(unittest.TestCase):
         """Cancel once the bar moves (the driver tells GDAL's copy its
         progress while it computes, so during the computation): the
         algorithm fails with 'cancelled' and leaves no output file."""
-        r = self.result["cancel_svf"]
-        self.assertEqual(r.get("error"), "cancelled", r)
-        self.assertFalse(os.path.exists(self.out("cancel_svf")))
+        for name, _alg, _params in CANCEL:
+            with self.subTest(name):
+                r = self.result[name]
+                self.assertEqual(r.get("error"), "cancelled", r)
+                self.assertFalse(os.path.exists(self.out(name)))
+                self.assertFalse(os.path.exists(self.out(name) + ".aux.xml"))
 
     def test_with_gdal_exceptions(self):
         """gdal.UseExceptions() is global to osgeo.gdal, so another plugin or

@@ -9,6 +9,7 @@ into open options, opens TERRASHADE:<dem> through GDAL and writes the result
 with gdal.Translate, so it gives exactly what `gdal_translate -oo ...
 TERRASHADE:dem out.tif` gives. Only presentation is written here.
 """
+import contextlib
 import os
 import shlex
 import sys
@@ -213,6 +214,12 @@ def write(dem, options, out, feedback):
         format=fmt, creationOptions=creation, callback=progress))
     ds = None
     if res is None:
+        # GDAL's failed copy of a multi-band product deletes the raster but
+        # leaves its PAM sidecar (band descriptions): no output file means
+        # none of it
+        if not os.path.exists(out):
+            with contextlib.suppress(OSError):
+                os.remove(out + ".aux.xml")
         if feedback is not None and feedback.isCanceled():
             raise QgsProcessingException("cancelled")
         raise QgsProcessingException(message or "gdal.Translate failed")
