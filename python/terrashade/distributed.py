@@ -270,6 +270,27 @@ def dask_logs(level):
         handler.setLevel(level)
 
 
+@contextlib.contextmanager
+def interrupts_held():
+    """Ctrl-C and SIGTERM held while a cluster starts, raised once it has
+    (at the end of the with block, after the caller holds the cluster to
+    close): a LocalCluster cut short in its start was left for Dask's exit
+    handler, which printed its tracebacks."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    got = []
+    previous = {s: signal.signal(s, lambda signum, _frame: got.append(signum))
+                for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+    if got:
+        raise Terminated() if got[0] == signal.SIGTERM else KeyboardInterrupt()
+
+
 def start_cluster(args):
     """(client, cluster or None, task options to add)."""
     from dask.distributed import Client, LocalCluster
@@ -553,7 +574,8 @@ def run(args):
     try:  # from the partial's creation on: a Ctrl-C may come at any time
         out = create_like(src, partial, block, [] if fmt == "COG" else args.creation_options)
         src = None
-        client, cluster, threads = start_cluster(args)
+        with interrupts_held():
+            client, cluster, threads = start_cluster(args)
         watch = Watch(client, args.timeout, args.dest)
         nworkers = check_workers(client, watch)
         keys = given_keys(args.source, args.open_options)
