@@ -429,16 +429,24 @@ scan512_pruned(const ts_cap_lanes *r, int k, int lag_hi, int g, int ng, scan512 
         prune_threshold(r, k, lag_hi, g + 8 * q, a, q, &thr[q], &gmin[q], &idle[q], &tie[q]);
         threshold_tests(thr[q], gmin[q], a->d[q], tie[q], &rhs[q], &neg[q], &tt[q], &rt[q]);
     }
-    /* the oldest slot first, whatever the tests say (the tie lines' pruning
-     * rests on it), then the pruned ones after it */
-    scan512_lags(r, k, g, ng, lag_hi, lag_hi, a);
-    if (lag_hi - 1 < r->lag_lo)
-        return;
+    /* Where a tie line's threshold is level, the oldest slot first, whatever
+     * the tests say (its pruning rests on it), then the pruned ones after
+     * it. (A tie line's threshold is never below 0, its oldest sample's
+     * slope being a candidate: it is level from the start or never.) */
+    __mmask8 level = 0;
+    for (int q = 0; q < ng; q++)
+        level |= _mm512_mask_cmp_pd_mask(tie[q], thr[q], _mm512_setzero_pd(), _CMP_EQ_OQ);
+    int first_lag = lag_hi;
+    if (level) {
+        scan512_lags(r, k, g, ng, lag_hi, lag_hi, a);
+        if (--first_lag < r->lag_lo)
+            return;
+    }
     slot_lists L;
     for (int q = 0; q < NG; q++)
         L.n[q] = 0;
     const unsigned all = (1u << ng) - 1;
-    const int s_lo = k - lag_hi + 1, s_hi = k - r->lag_lo, s_near = s_hi - PRUNE_NEAR + 1;
+    const int s_lo = k - first_lag, s_hi = k - r->lag_lo, s_near = s_hi - PRUNE_NEAR + 1;
     const __m512i iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 0, 0, 0, 0, 0, 0, 0, 0);
     /* the level-0 groups each group of lines needs, (group, its entry,
      * lines) in step order; the groups' entries kept in step (no division
