@@ -134,7 +134,8 @@ bool TSRasterBand::DirectRead(int nXOff, int nYOff, int nXSize, int nYSize, void
     if (psExtraArg && psExtraArg->pfnProgress &&
         !psExtraArg->pfnProgress(1.0, "", psExtraArg->pProgressData))
     {
-        CPLError(CE_Failure, CPLE_UserInterrupt, "User terminated");
+        CPLError(CE_Failure, CPLE_UserInterrupt,
+                 "TERRASHADE: the read was cancelled by the caller's progress callback");
         *peErr = CE_Failure;
     }
     return true;

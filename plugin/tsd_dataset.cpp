@@ -363,8 +363,8 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
         return FailOpen(CPLE_NotSupported,
                              "TERRASHADE datasets are read-only; write the product "
                              "with gdal_translate instead (gdal_edit.py -ro sets a "
-                             "product's nodata value, unit or statistics in the DEM's "
-                             ".aux.xml)");
+                             "product's nodata value, unit or statistics in "
+                             "<DEM>.terrashade.aux.xml)");
     char szMsg[4096] = ""; // the option list, and hints that quote the name
     tsd_connstr sConn;
     const ts_status eParsed =
@@ -503,10 +503,11 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
                        CPLE_AppDefined,
                        CPLSPrintf("%s needs a georeferenced DEM, but '%s' has no %s: the "
                                   "sun's position over it is unknown. Give it one "
-                                  "(gdal_edit.py -a_srs / -a_ullr) or use SUN_AZIMUTH "
-                                  "and SUN_ELEVATION",
-                                  pszWhat, m_osDEM.c_str(),
-                                  !m_bHasGT ? "geotransform" : "CRS")), false;
+                                  "(gdal_edit.py -a_srs / -a_ullr)%s",
+                                  pszWhat, m_osDEM.c_str(), !m_bHasGT ? "geotransform" : "CRS",
+                                  m_psProduct->daily ? ""
+                                                     : " or use SUN_AZIMUTH and SUN_ELEVATION")),
+                   false;
         tsd_sites sSites;
         eSt = tsd_sites_compute(m_adfGT, W, H, hSRS, &m_sCells,
                                 sOpts.sun_position == TSD_SUN_PER_CELL, &sSites, szMsg,

@@ -104,14 +104,19 @@ void TSDataset::WarnDistances(double dfCell, int W, int H)
                  "so the maps are empty or nearly. Give a shorter one (e.g. "
                  "FAR_THRESHOLD=%d)",
                  m_sOpts.far_threshold, W, H, std::max(1, std::max(W, H) / 8));
-    if (m_sOpts.max_distance > 0 && m_sOpts.method == TSD_METHOD_SHM &&
-        tsd_product_takes(m_psProduct, tsd_option_find("METHOD")))
+    const bool bShm = m_sOpts.max_distance > 0 && m_sOpts.method == TSD_METHOD_SHM &&
+                      tsd_product_takes(m_psProduct, tsd_option_find("METHOD"));
+    if (bShm)
         CPLError(CE_Warning, CPLE_AppDefined,
                  "TERRASHADE: METHOD=shm casts shadows from every occluder up to the DEM's "
-                 "edge: MAX_DISTANCE=%g m bounds only its sky term (SKY_WEIGHT) and the "
-                 "reach of EDGE=nodata. METHOD=exact casts them from within MAX_DISTANCE",
-                 m_sOpts.max_distance);
-    if (!(m_sOpts.max_distance > 0 && m_sOpts.max_distance < dfCell) ||
+                 "edge: MAX_DISTANCE=%g m bounds only %sthe reach of EDGE=nodata. "
+                 "METHOD=exact casts them from within MAX_DISTANCE",
+                 m_sOpts.max_distance,
+                 tsd_product_takes(m_psProduct, tsd_option_find("SKY_WEIGHT"))
+                     ? "its sky term (SKY_WEIGHT) and "
+                     : "");
+    // (under METHOD=shm the distance does not bound the shadows: said above)
+    if (bShm || !(m_sOpts.max_distance > 0 && m_sOpts.max_distance < dfCell) ||
         !tsd_product_takes(m_psProduct, tsd_option_find("MAX_DISTANCE")))
         return;
     CPLError(CE_Warning, CPLE_AppDefined,

@@ -64,7 +64,7 @@ static void remedies(GDALRasterBandH band, const tsd_dem_conversion *c, int full
     GDALDatasetH ds = GDALGetBandDataset(band);
     const char *path = ds ? GDALGetDescription(ds) : "";
     const double raw = ((double)z - c->offset) / c->scale; /* as the band holds it */
-    char declare[160] = "";
+    char declare[TSD_PATH_MAX + 160] = ""; /* the DEM's name, whole */
     if (full && isfinite(raw))
         snprintf(declare, sizeof declare, " (gdal_edit.py -a_nodata %.9g %s)", raw, path);
     snprintf(out, n,
@@ -91,7 +91,7 @@ static ts_status height_error(GDALRasterBandH band, const tsd_dem_conversion *c,
         }
     }
     const int full = p->sx == 1 && p->sy == 1; /* else a coarse cell: an average */
-    char todo[320];
+    char todo[TSD_PATH_MAX + 320];
     remedies(band, c, full, z, todo, sizeof todo);
     GDALDatasetH ds = GDALGetBandDataset(band);
     return tsd_fail(msg, n, TS_ERR_ARG,
@@ -128,7 +128,7 @@ static ts_status cliff_error(GDALRasterBandH band, const tsd_dem_conversion *c,
     else if (gx + 2 < g->width && row[gx + 2] == b)
         v = b;
     const int full = p->sx == 1 && p->sy == 1;
-    char todo[320];
+    char todo[TSD_PATH_MAX + 320];
     remedies(band, c, full, v, todo, sizeof todo);
     GDALDatasetH ds = GDALGetBandDataset(band);
     return tsd_fail(msg, n, TS_ERR_ARG,

@@ -205,7 +205,8 @@ static int check_sh(const tsd_options *o, char *msg, size_t n)
     const int o_swath = tsd_option_find("SWATH_DIRECTIONS");
     if (o->swath_directions != atoi(tsd_option_default(o_swath)) && o->method != TSD_METHOD_SH)
         REFUSE("SWATH_DIRECTIONS=%d sets the horizon sweeps of METHOD=sh's key light; "
-               "give METHOD=sh with it", o->swath_directions);
+               "give METHOD=sh with it (PRODUCT=shade and PRODUCT=shadow)",
+               o->swath_directions);
     if (o->method == TSD_METHOD_SH && o->sun_position == TSD_SUN_PER_CELL)
         REFUSE("METHOD=sh lights with one key light, the sun at the DEM's centre: "
                "SUN_POSITION=per_cell needs METHOD=exact");
@@ -287,6 +288,12 @@ int tsd_options_check(const tsd_options *o, char *msg, size_t n)
     if (o->max_distance > 0 && !tsd_product_takes(p, tsd_option_find("MAX_DISTANCE")))
         REFUSE("MAX_DISTANCE does not apply to PRODUCT=%s (its far shadows "
                     "start at FAR_THRESHOLD cells and have no end)", pn);
+    if (o->sun_position == TSD_SUN_PER_CELL &&
+        !tsd_product_takes(p, tsd_option_find("SUN_POSITION"))) {
+        tsd_products_taking(tsd_option_find("SUN_POSITION"), "PRODUCT=", ", ", list,
+                            sizeof list);
+        REFUSE("SUN_POSITION=per_cell applies to %s, not to PRODUCT=%s", list, pn);
+    }
     if (o->sun_position == TSD_SUN_PER_CELL && !from_time)
         REFUSE("SUN_POSITION=per_cell needs the sun from DATETIME or DATE");
     if (check_integral_directions(o, msg, n) != 0 || tsd_options_check_pyramid(o, msg, n) != 0 ||

@@ -31,12 +31,14 @@ int tsd_options_check_light(const tsd_options *o, char *msg, size_t n)
         REFUSE("LIGHT_RADIUS applies with SUN_POSITION=center: the per-cell sun is the sun's "
                "own disk");
     if (o->method != TSD_METHOD_SHM && o->penumbra_depth != d.penumbra_depth)
-        REFUSE("PENUMBRA_DEPTH applies to METHOD=shm only (the other methods soften the "
-               "shadows by LIGHT_RADIUS)");
+        REFUSE("PENUMBRA_DEPTH applies to METHOD=shm only, of PRODUCT=shade and "
+               "PRODUCT=shadow (the other methods soften the shadows by LIGHT_RADIUS)");
     if (!shadowmap && o->shadowmap_scale != d.shadowmap_scale)
-        REFUSE("SHADOWMAP_SCALE applies to METHOD=shadowmap only");
+        REFUSE("SHADOWMAP_SCALE applies to METHOD=shadowmap only, of PRODUCT=shade and "
+               "PRODUCT=shadow");
     if (!shadowmap && !isnan(o->pcf_kernel))
-        REFUSE("PCF_KERNEL applies to METHOD=shadowmap only");
+        REFUSE("PCF_KERNEL applies to METHOD=shadowmap only, of PRODUCT=shade and "
+               "PRODUCT=shadow");
     if (shadowmap && o->sun_position == TSD_SUN_PER_CELL)
         REFUSE("METHOD=shadowmap renders one depth map for one light direction: it needs "
                "SUN_POSITION=center");

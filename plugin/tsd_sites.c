@@ -155,8 +155,8 @@ ts_status tsd_sites_compute(const double gt[6], int width, int height,
     memset(s, 0, sizeof *s);
     if (!srs)
         return tsd_fail(msg, n, TS_ERR_ARG, "the DEM has no CRS, so the sun's position over it is "
-                    "unknown: give it a CRS (gdal_edit.py -a_srs) or use "
-                    "SUN_AZIMUTH and SUN_ELEVATION");
+                    "unknown: give it a CRS (gdal_edit.py -a_srs) or, for shade and "
+                    "shadow, use SUN_AZIMUTH and SUN_ELEVATION");
     /* a rotated pole (a derived geographic CRS: CORDEX's, COSMO's) counts
      * in degrees that are not longitudes and latitudes: through PROJ, as a
      * projection */
@@ -165,7 +165,8 @@ ts_status tsd_sites_compute(const double gt[6], int width, int height,
     if (!geographic && !derived && !OSRIsProjected(srs))
         return tsd_fail(msg, n, TS_ERR_ARG, "the DEM's CRS is neither geographic nor projected (a "
                     "local or engineering CRS), so its longitudes and latitudes are "
-                    "unknown; use SUN_AZIMUTH and SUN_ELEVATION instead");
+                    "unknown: give it a geographic or projected CRS (gdal_edit.py -a_srs) or, "
+                    "for shade and shadow, use SUN_AZIMUTH and SUN_ELEVATION instead");
     tsd_lonlat ll = {0};
     if (!geographic && !tsd_lonlat_open(srs, 1, &ll))
         return tsd_fail(msg, n, TS_ERR_ARG, "PROJ cannot transform the DEM's CRS to longitude and "

@@ -231,15 +231,17 @@ int tsd_sun_zone_warning(const tsd_sun *s, const tsd_options *o, char *warning, 
      * own offset */
     if (!tsd_product_of(o)->daily || !(s->day_length > 0))
         return 0;
-    const char *whose = o->datetime[0] ? "DATETIME's" : "TIMEZONE's";
+    /* TIMEZONE, where given, sets the day's offset over DATETIME's own */
+    const char *whose = o->timezone[0] ? "TIMEZONE's" : "DATETIME's";
     char given[OFFSET_TEXT], sun[OFFSET_TEXT];
     offset_text(s->offset_minutes, given);
     if (s->offset_minutes < CIVIL_OFFSET_WEST_MIN || s->offset_minutes > CIVIL_OFFSET_EAST_MIN) {
         snprintf(warning, n,
                  "%s offset (%s) is beyond every civil time zone (-12:00 to +14:00): the "
-                 "day it names starts %s from UTC's midnight, on another date than the "
-                 "site's. Is its sign right?",
-                 whose, given, given);
+                 "day it names starts %.4g hours %s UTC's midnight of that date, so that its "
+                 "sun is another date's than the site's. Is its sign right?",
+                 whose, given, abs(s->offset_minutes) / 60.0,
+                 s->offset_minutes > 0 ? "before" : "after");
         return 1;
     }
     const tsd_sites *st = &s->sites_owned; /* the centre: the middle node of a lattice */

@@ -40,6 +40,17 @@ CASES = [
     ("insolation's sky term of two directions", T.conn(DEM),
      ["PRODUCT=insolation", "DATE=2026-06-21", "TIMEZONE=Z", "DIRECTIONS=2"],
      "DIRECTIONS=2 is too few for PRODUCT=insolation: its sky term"),
+    # a per-cell sun for a product without a sun (it said: needs DATETIME or
+    # DATE, which svf refuses) or that takes the centre's (envlight took it
+    # without a word)
+    ("per-cell sun for svf", T.conn(DEM), ["PRODUCT=svf", "SUN_POSITION=per_cell"],
+     "SUN_POSITION=per_cell applies to PRODUCT=shade, PRODUCT=shadow, PRODUCT=sunhours, "
+     "PRODUCT=insolation, PRODUCT=daycycle, not to PRODUCT=svf"),
+    ("per-cell sun for envlight", T.conn(DEM),
+     ["PRODUCT=envlight", "SKY=clear", "DATETIME=2026-06-21T12:00-05:00",
+      "SUN_POSITION=per_cell"], "not to PRODUCT=envlight"),
+    ("a shadow-map option for svf", T.conn(DEM), ["PRODUCT=svf", "PCF_KERNEL=3"],
+     "PCF_KERNEL applies to METHOD=shadowmap only, of PRODUCT=shade and PRODUCT=shadow"),
     ("zero z factor", T.conn(DEM), ["Z_FACTOR=0"],
      "Z_FACTOR must be greater than 0"),
     ("bad product", T.conn(DEM), ["PRODUCT=hillshade"],

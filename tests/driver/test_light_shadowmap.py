@@ -169,6 +169,12 @@ class BadInput(unittest.TestCase):
                               + [T.conn(T.LUX), out])
                     self.assertEqual("MAX_DISTANCE=200 m bounds only its sky term" in p.stderr,
                                      said, p.stderr)
+            # shadow has no sky term; and a distance under a cell says
+            # nothing of the cell's own slope there, shm ignoring it
+            p = T.run(["gdal_translate", "-q", "-oo", "PRODUCT=shadow", "-oo", "METHOD=shm",
+                       "-oo", "MAX_DISTANCE=5", T.conn(T.LUX), out])
+            self.assertIn("MAX_DISTANCE=5 m bounds only the reach of EDGE=nodata", p.stderr)
+            self.assertNotIn("shorter than the DEM's cells", p.stderr)
 
     def test_low_light(self):
         """The light at or below the horizon is refused at open (gdalinfo, a

@@ -175,6 +175,20 @@ class Sun(unittest.TestCase):
         p = T.run(["gdal_translate", "-q", "-oo", "PRODUCT=sunhours", "-oo", "STEP_MINUTES=60",
                    "-oo", "DATETIME=2026-06-21T17:00:00Z", T.conn(T.JACKSBORO), out])
         self.assertIn("DATETIME's offset (+00:00) is 5.6 hours from the mean solar time", p.stderr)
+        # TIMEZONE given with it sets the day: named as the one at fault
+        p = T.run(["gdal_translate", "-q", "-oo", "PRODUCT=sunhours", "-oo", "STEP_MINUTES=60",
+                   "-oo", "DATETIME=2026-06-21T12:00:00-05:00", "-oo", "TIMEZONE=+10:00",
+                   T.conn(T.JACKSBORO), out])
+        self.assertIn("TIMEZONE's offset (+10:00) is", p.stderr)
+        # a day product without georeferencing is not told to give the sun
+        # by hand, which it refuses
+        nogt = os.path.join(self.dir, "nogt.tif")
+        ds = gdal.GetDriverByName("GTiff").Create(nogt, 8, 8, 1, gdal.GDT_Float32)
+        ds = None
+        p = T.run(["gdalinfo", "-oo", "PRODUCT=sunhours", "-oo", "DATE=2026-06-21", "-oo",
+                   "TIMEZONE=Z", T.conn(nogt)], ok=False)
+        self.assertIn("DATE needs a georeferenced DEM", p.stderr)
+        self.assertNotIn("SUN_AZIMUTH", p.stderr)
         # beyond every civil zone: +21:00 for -03:00 names the day before,
         # which modulo a day is 0 hours from Brasilia's solar time
         bra = flat_dem(os.path.join(self.dir, "bra.tif"), -15.8, -47.9)
