@@ -170,7 +170,8 @@ const opt_def TSD_OPTION_ROWS[] = {
     {"PRESSURE", K_FLOAT, FIELD(pressure), "1013.25", 300, 1100, 0, 1, NULL, 1, P, LISTED,
      NULL,
      "Mean air pressure at the DEM, hPa (atmospheric refraction of the sun); "
-     "300 (above Everest's summit) to 1100 (the highest recorded at sea level)"},
+     "300 (above Everest's summit) to 1100 (above 1084, the highest recorded at "
+     "sea level)"},
     {"TEMPERATURE", K_FLOAT, FIELD(temperature), "15", -90, 60, 0, 1, NULL, 1, P,
      LISTED, NULL,
      "Mean air temperature at the DEM, degrees Celsius (atmospheric "

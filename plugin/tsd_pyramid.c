@@ -22,8 +22,8 @@ int tsd_options_check_pyramid(const tsd_options *o, char *msg, size_t n)
             o->method == TSD_METHOD_SH)
             continue;
         tsd_products_taking(id, "PRODUCT=", " and ", list, sizeof list);
-        REFUSE("%s applies to the products that use horizons (%s; shade: its sky term), "
-               "not to PRODUCT=%s%s",
+        REFUSE("%s applies to the products whose horizons the pyramid can give (%s; shade: "
+               "its sky term), not to PRODUCT=%s%s",
                own[i], list, p->name,
                tsd_product_takes(p, tsd_option_find("METHOD"))
                    ? ", whose shadows METHOD chooses (with METHOD=sh from horizons)"
