@@ -160,7 +160,8 @@ static int set_option(tsd_options *o, int id, const char *v, char *msg, size_t n
         return 0;
     case K_TEXT:
         if (strlen(v) >= d->size) {
-            REFUSE("%s is too long (%zu characters)", d->name, strlen(v));
+            REFUSE("%s is too long (%zu characters; at most %zu)", d->name, strlen(v),
+                   d->size - 1);
         }
         if (d->validate && d->validate(v, msg, n) != 0)
             return -1;
