@@ -7,14 +7,13 @@ namespace tsd
 {
 
 /* Per thread: readers on several threads (one dataset each) have their
- * own callbacks. */
-static thread_local const GDALRasterIOExtraArg *tl_psCaller = nullptr;
-static thread_local CallerProgress *tl_poRead = nullptr; // whose m_sArg tl_psCaller is
+ * own callbacks; the innermost read with one, its callback tracked. */
+static thread_local CallerProgress *tl_poRead = nullptr;
 static thread_local int tl_nCancelled = 0;
 
 CallerProgress::CallerProgress(const GDALRasterIOExtraArg *psExtraArg, int nXOff, int nYOff,
                                int nXSize, int nYSize)
-    : m_psPrev(tl_psCaller), m_nCancelledBefore(tl_nCancelled), m_poPrevRead(tl_poRead)
+    : m_nCancelledBefore(tl_nCancelled), m_poPrevRead(tl_poRead)
 {
     if (!psExtraArg || !psExtraArg->pfnProgress)
         return;
@@ -26,14 +25,12 @@ CallerProgress::CallerProgress(const GDALRasterIOExtraArg *psExtraArg, int nXOff
     m_anWindow[1] = nYOff;
     m_anWindow[2] = nXSize;
     m_anWindow[3] = nYSize;
-    tl_psCaller = &m_sArg;
     tl_poRead = this;
 }
 
 CallerProgress::~CallerProgress()
 {
-    tl_psCaller = m_psPrev;
-    tl_poRead = const_cast<CallerProgress *>(m_poPrevRead);
+    tl_poRead = m_poPrevRead;
 }
 
 int CPL_STDCALL CallerProgress::Track(double dfDone, const char *pszMsg, void *pData)
@@ -76,12 +73,12 @@ double CallerProgress::Share(const int *panCells) const
 
 void CallerProgress::Hook(tsd_progress *psProgress, const int *panCells)
 {
-    if (!tl_psCaller || !tl_poRead)
-        return;
     const CallerProgress *poRead = tl_poRead;
+    if (!poRead)
+        return;
     const double dfFrom = poRead->m_dfSeen;
     /* a chunk: as much of the read as GDAL's blocks of it will say */
-    tl_sComputation = {tl_psCaller, dfFrom, std::min(1.0 - dfFrom, poRead->Share(panCells))};
+    tl_sComputation = {&poRead->m_sArg, dfFrom, std::min(1.0 - dfFrom, poRead->Share(panCells))};
     tsd_progress_set_caller(psProgress, CallerStops, &tl_sComputation);
 }
 

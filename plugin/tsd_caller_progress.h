@@ -24,13 +24,12 @@ namespace tsd
  * the window it covers), never below what the callback was told. */
 class CallerProgress
 {
-    const GDALRasterIOExtraArg *m_psPrev;
     int m_nCancelledBefore; // NoteCancelled's count at the start
     GDALRasterIOExtraArg m_sArg{}; // the caller's, with Track as its callback
     const GDALRasterIOExtraArg *m_psUser = nullptr; // the caller's own, if hooked
     double m_dfSeen = 0;           // the most the callback was told in this read
     int m_anWindow[4] = {0, 0, 0, 0};
-    const CallerProgress *m_poPrevRead;
+    CallerProgress *m_poPrevRead; // the outer read with a callback, if any
 
     static int CPL_STDCALL Track(double dfDone, const char *pszMsg, void *pData);
     double Share(const int *panCells) const; // of the window, 1 without cells
