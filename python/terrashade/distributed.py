@@ -167,7 +167,6 @@ class Said:
         """A new run says its warnings again."""
         self.seen = set()
         self.same_dem = None
-        self.final = None  # (device, inode) of the file renamed to DEST (finish)
 
     def say(self, messages, bar=None):
         if self.same_dem and self.same_dem[0] != self.same_dem[1]:
@@ -515,6 +514,10 @@ def compute(client, watch, out, source, task_options, tile, quiet, run):
     return len(wins)
 
 
+# (device, inode) of the file finish() renames to DEST, once it is about to
+RENAMED = []
+
+
 def finish(partial, fmt, dest, creation_options):
     """partial (closed GeoTIFF) -> dest, in fmt, by rename."""
     final = partial
@@ -536,7 +539,7 @@ def finish(partial, fmt, dest, creation_options):
         with contextlib.suppress(FileNotFoundError):
             os.remove(dest + side)
     st = os.stat(final)
-    SAID.final = (st.st_dev, st.st_ino)  # an interrupt from here on: written()
+    RENAMED[:] = [(st.st_dev, st.st_ino)]  # an interrupt from here on: written()
     os.replace(final, dest)
     if os.path.exists(final + ".aux.xml"):
         os.replace(final + ".aux.xml", dest + ".aux.xml")
@@ -617,13 +620,13 @@ def run(args):
 def written(dest):
     """Whether DEST is the file finish() renamed to it: an interrupt may
     come between any two steps, the rename's own included."""
-    if SAID.final is None:
+    if not RENAMED:
         return False
     try:
         st = os.stat(dest)
     except OSError:
         return False
-    return (st.st_dev, st.st_ino) == SAID.final
+    return (st.st_dev, st.st_ino) == RENAMED[0]
 
 
 class Terminated(KeyboardInterrupt):
@@ -640,6 +643,7 @@ def main(argv=None):
     exceptions and the SIGTERM handler are the caller's again after it."""
     args = parse_args(argv)
     SAID.reset()
+    RENAMED.clear()
     previous = None
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGTERM, _terminate)
