@@ -147,9 +147,9 @@ CPLErr TSRasterBand::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXS
                                GDALRasterIOExtraArg *psExtraArg)
 {
     tsd::CLocale oC; /* tsd_locale.h */
-    if (static_cast<TSDataset *>(poDS)->ReadInsideOwnComputation())
+    const TSDataset::ReadTurn oTurn(*static_cast<TSDataset *>(poDS));
+    if (oTurn.Refused())
         return CE_Failure; // (before GDAL's block cache, which may hold the block unfilled)
-    const auto oReads = static_cast<TSDataset *>(poDS)->LockReads();
     CallerProgress oCaller(psExtraArg, nXOff, nYOff, nXSize, nYSize); // a computation
                                                                      // started here reports to it
     psExtraArg = oCaller.Arg(psExtraArg);
@@ -171,18 +171,18 @@ CPLErr TSRasterBand::ComputeStatistics(int bApproxOK, double *pdfMin, double *pd
                                        double *pdfMean, double *pdfStdDev,
                                        GDALProgressFunc pfnProgress, void *pProgressData)
 {
-    if (static_cast<TSDataset *>(poDS)->ReadInsideOwnComputation())
+    const TSDataset::ReadTurn oTurn(*static_cast<TSDataset *>(poDS));
+    if (oTurn.Refused())
         return CE_Failure;
-    const auto oReads = static_cast<TSDataset *>(poDS)->LockReads();
     return GDALPamRasterBand::ComputeStatistics(bApproxOK, pdfMin, pdfMax, pdfMean, pdfStdDev,
                                                 pfnProgress, pProgressData);
 }
 
 CPLErr TSRasterBand::ComputeRasterMinMax(int bApproxOK, double *adfMinMax)
 {
-    if (static_cast<TSDataset *>(poDS)->ReadInsideOwnComputation())
+    const TSDataset::ReadTurn oTurn(*static_cast<TSDataset *>(poDS));
+    if (oTurn.Refused())
         return CE_Failure;
-    const auto oReads = static_cast<TSDataset *>(poDS)->LockReads();
     return GDALPamRasterBand::ComputeRasterMinMax(bApproxOK, adfMinMax);
 }
 
@@ -190,9 +190,9 @@ CPLErr TSRasterBand::GetHistogram(double dfMin, double dfMax, int nBuckets,
                                   GUIntBig *panHistogram, int bIncludeOutOfRange, int bApproxOK,
                                   GDALProgressFunc pfnProgress, void *pProgressData)
 {
-    if (static_cast<TSDataset *>(poDS)->ReadInsideOwnComputation())
+    const TSDataset::ReadTurn oTurn(*static_cast<TSDataset *>(poDS));
+    if (oTurn.Refused())
         return CE_Failure;
-    const auto oReads = static_cast<TSDataset *>(poDS)->LockReads();
     return GDALPamRasterBand::GetHistogram(dfMin, dfMax, nBuckets, panHistogram,
                                            bIncludeOutOfRange, bApproxOK, pfnProgress,
                                            pProgressData);

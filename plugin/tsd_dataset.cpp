@@ -177,9 +177,9 @@ CPLErr TSDataset::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize
                             GDALRasterIOExtraArg *psExtraArg)
 {
     tsd::CLocale oC; /* tsd_locale.h */
-    if (ReadInsideOwnComputation())
+    const ReadTurn oTurn(*this);
+    if (oTurn.Refused())
         return CE_Failure;
-    const auto oReads = LockReads();
     CallerProgress oCaller(psExtraArg, nXOff, nYOff, nXSize, nYSize);
     psExtraArg = oCaller.Arg(psExtraArg);
     const CPLErr eErr = GDALPamDataset::IRasterIO(

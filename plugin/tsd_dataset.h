@@ -69,15 +69,31 @@ class TSDataset final : public GDALPamDataset
      * IReadBlock fills it, so that a second thread reading the same block
      * took it unfilled (zeros, garbage) while the first computed it */
     std::recursive_mutex m_oReadMutex{};
-    std::unique_lock<std::recursive_mutex> LockReads()
-    {
-        return std::unique_lock<std::recursive_mutex>(m_oReadMutex);
-    }
     /* the thread computing under m_oMutex (EnsureComputed, WindowBlock):
      * a read of the dataset from its own progress callback, on that thread,
      * would wait for itself (or take a block GDAL's cache holds unfilled) */
     std::atomic<std::thread::id> m_oComputer{};
     bool ReadInsideOwnComputation() const;
+
+  public:
+    /* A read's turn (IRasterIO, the statistics): refused, with the error
+     * said, from inside the dataset's own computation; else the read lock
+     * held for the turn's life */
+    class ReadTurn
+    {
+        std::unique_lock<std::recursive_mutex> m_oLock{};
+        bool m_bRefused;
+
+      public:
+        explicit ReadTurn(TSDataset &oDS) : m_bRefused(oDS.ReadInsideOwnComputation())
+        {
+            if (!m_bRefused)
+                m_oLock = std::unique_lock<std::recursive_mutex>(oDS.m_oReadMutex);
+        }
+        bool Refused() const { return m_bRefused; }
+    };
+
+  private:
     /* the calling thread marked as m_oComputer while it holds m_oMutex */
     class ComputingHere
     {
