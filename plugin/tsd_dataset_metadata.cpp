@@ -4,8 +4,12 @@
  * and when the sun was placed, the backend that ran (asked for lazily, so
  * that opening costs no OpenCL initialisation), and PAM next to the DEM.
  */
+#include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -249,8 +253,8 @@ void TSDataset::SetupSunMetadata()
  * a file whole (it reads it, then truncates and writes it), so processes
  * saving statistics of several products at once lost each other's entries
  * and the DEM's own, georeferencing included (a PNG's, kept there). Saves
- * and loads are one at a time in this process; processes can still lose
- * each other's product entries, never the DEM's (docs/driver.md, PAM). */
+ * and loads take turns, between threads and between processes
+ * (PamFileTurn; docs/driver.md, PAM). */
 const char *TSDataset::BuildPamFilename()
 {
     if (!psPam)
@@ -280,28 +284,89 @@ std::recursive_mutex &PamFileMutex()
     static std::recursive_mutex oMutex;
     return oMutex;
 }
+
+/* How long a save or load waits for another process's turn on the same
+ * DEM's file before it goes ahead without one (a save takes milliseconds;
+ * a holder stuck on a network file system must not hang this one). */
+constexpr int PAM_LOCK_WAIT_MS = 30000;
+
+/* One turn on the products' auxiliary file of a DEM: this process's
+ * threads one at a time (PamFileMutex), and processes too, by an advisory
+ * lock (flock) on the DEM's own file, which every product of that DEM
+ * shares and which is never written: GDAL rewrites an .aux.xml whole
+ * (reads, truncates, writes), so processes saving statistics of several
+ * products at once lost each other's entries. Saves lock exclusively,
+ * loads shared (a load never reads a half-written file). Nested turns of
+ * the same thread (the proxy directory's save) take no second lock. No
+ * lock where the DEM is not a local file (/vsimem/, a network file system
+ * that refuses it) or after PAM_LOCK_WAIT_MS: then as before. */
+class PamFileTurn
+{
+    std::lock_guard<std::recursive_mutex> m_oThreads{PamFileMutex()};
+    int m_fd = -1;
+    static int &Depth()
+    {
+        static int nDepth = 0; // guarded by PamFileMutex
+        return nDepth;
+    }
+
+  public:
+    PamFileTurn(const char *pszDEM, bool bWrite)
+    {
+        if (Depth()++ > 0 || !pszDEM || !*pszDEM || STARTS_WITH(pszDEM, "/vsi"))
+            return;
+        m_fd = open(pszDEM, O_RDONLY | O_CLOEXEC);
+        if (m_fd < 0)
+            return;
+        for (int nWaited = 0;; nWaited += 5)
+        {
+            if (flock(m_fd, (bWrite ? LOCK_EX : LOCK_SH) | LOCK_NB) == 0)
+                return;
+            if (errno != EWOULDBLOCK && errno != EINTR)
+                break; // no locks here (some network file systems)
+            if (nWaited >= PAM_LOCK_WAIT_MS)
+            {
+                CPLDebug("TERRASHADE", "no turn on the auxiliary file of %s after %d ms: "
+                         "going ahead without one", pszDEM, nWaited);
+                break;
+            }
+            usleep(5000);
+        }
+        close(m_fd);
+        m_fd = -1;
+    }
+    ~PamFileTurn()
+    {
+        Depth()--;
+        if (m_fd >= 0)
+            close(m_fd); // (releases the lock)
+    }
+    PamFileTurn(const PamFileTurn &) = delete;
+    PamFileTurn &operator=(const PamFileTurn &) = delete;
+};
 } // namespace
 
 CPLErr TSDataset::TrySaveXML()
 {
-    std::lock_guard<std::recursive_mutex> oLock(PamFileMutex());
+    const PamFileTurn oTurn(GetPhysicalFilename(), true);
     return GDALPamDataset::TrySaveXML();
 }
 
 CPLErr TSDataset::TryLoadXML(char **papszSiblingFiles)
 {
-    std::lock_guard<std::recursive_mutex> oLock(PamFileMutex());
+    const PamFileTurn oTurn(GetPhysicalFilename(), false);
     return GDALPamDataset::TryLoadXML(papszSiblingFiles);
 }
 
-/* Whether the .aux.xml at pszPath holds a <Subdataset> named pszName (under
- * the PAM file mutex: a save may be under way in another thread). */
-static bool HasPamEntry(const char *pszPath, const char *pszName)
+/* Whether the .aux.xml at pszPath holds a <Subdataset> named pszName (in
+ * a turn on DEM pszDEM's auxiliary file: a save may be under way in another
+ * thread or process). */
+static bool HasPamEntry(const char *pszPath, const char *pszName, const char *pszDEM)
 {
     VSIStatBufL sStat;
     if (!*pszPath || VSIStatL(pszPath, &sStat) != 0)
         return false;
-    std::lock_guard<std::recursive_mutex> oLock(PamFileMutex());
+    const PamFileTurn oTurn(pszDEM, false);
     CPLPushErrorHandler(CPLQuietErrorHandler);
     CPLXMLNode *psTree = CPLParseXMLFile(pszPath);
     CPLPopErrorHandler();
@@ -336,13 +401,13 @@ void TSDataset::SetupPam(const char *pszConnection)
         const char *pszOwn = BuildPamFilename();
         const std::string osOwn = pszOwn ? pszOwn : "";
         TryLoadXML();
-        if (!HasPamEntry(osOwn.c_str(), osSub.c_str())) // one from before session 48?
+        if (!HasPamEntry(osOwn.c_str(), osSub.c_str(), papszFiles[0])) // one from before session 48?
         {
             CPLFree(psPam->pszPamFilename);
             psPam->pszPamFilename = nullptr;
             m_bLegacyPam = true;
             const char *pszOld = BuildPamFilename(); // the DEM's own
-            if (pszOld && HasPamEntry(pszOld, osSub.c_str()))
+            if (pszOld && HasPamEntry(pszOld, osSub.c_str(), papszFiles[0]))
             {
                 CPLPushErrorHandler(CPLQuietErrorHandler);
                 bLegacy = TryLoadXML() == CE_None;
