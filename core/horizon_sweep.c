@@ -113,7 +113,7 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
     const ts_lane_occluders occ = {w->lo_k, w->hi_k, w->lo_dd, w->hi_dd};
     const ts_lane_hulls hulls = {w->lane_stacks,  G->U + 1, w->lane_n, w->lane_far,
                                  w->lane_beside, LANE_ROW};
-    const ts_lane_lost lost = {&C->ray, C->c, C->cap, w->lost};
+    const ts_lane_lost lost = {&C->ray, C->c, C->cap, C->far_T, w->lost};
     const double c = C->c;
     for (int k = kmin; k <= kmax; k++) {
         /* The lines on the grid at step k: rows i0 + j in [0, V - 1]. */
@@ -160,7 +160,8 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         const int jw = prime && j0 == 0 ? 1 : j0;
         float *o = C->out + C->o_origin + (ptrdiff_t)k * C->o_u_stride +
                    (i0 + jw) * C->o_v_stride; /* cell (k, i0 + jw) */
-        /* (far-only: every occluder lies beyond the threshold) */
+        /* (far-only: every occluder lies beyond the threshold, and so do
+         * the lost rays' steps, lost.from) */
         ts_lane_far_field(G, C->grid->z, (float)c, C->far_T > 0 ? 0 : TS_NEAR_STEPS, k, (int)i0,
                           jw, j1, w->hc, &occ, &lost, w->slope, o, C->o_v_stride);
         /* the carry, read after the far field: right after the hull step's

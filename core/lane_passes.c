@@ -455,8 +455,10 @@ AVX2 static int far_run32_avx2(FAR_PARAMS, float *restrict out)
 
 /* Cells j0..j1 whose lost flags are set (FAR_LOOP's), clearing them: each
  * flagged occluder's slope by cm_ray_lost raises the cell's far field at
- * out[(j - j0) * ostride], unless near is 0 (the far-only sweep keeps its
- * threshold). */
+ * out[(j - j0) * ostride], from the ray's steps beyond the near field's
+ * `near`, or, in the far-only sweep, beyond lost->from metres (its
+ * threshold: without them, a cell whose ray left the DEM before the lines'
+ * occluders lost that terrain, up to 8 deg near the DEM's edges). */
 static void far_lost(const ts_line_geom *G, int near, int k, int i0, int j0, int j1,
                      const float *hc, const ts_lane_occluders *occ, const ts_lane_lost *lost,
                      float *out, ptrdiff_t ostride)
@@ -464,17 +466,21 @@ static void far_lost(const ts_line_geom *G, int near, int k, int i0, int j0, int
     for (int j = j0; j <= j1; j++) {
         const int f = lost->flags[j];
         lost->flags[j] = 0; /* the AVX-512 pass writes only vectors with a flag */
-        if (!f || near == 0 || hc[j] != hc[j])
+        if (!f || hc[j] != hc[j])
             continue;
         const int i = i0 + j;
         const double step = ts_line_cell_step(G, k, i);
+        /* far-only: the steps from the first at least lost->from away, s0,
+         * and no part of a step before it */
+        const int s0 = lost->from > 0 ? (int)ceil(lost->from / step) : near + 1;
+        const int piece_from = lost->from > 0 ? s0 : near;
         float *o = out + (j - j0) * ostride;
         for (int e = 0; e < 2; e++) {
             if (!(f >> e & 1))
                 continue;
             const int kc = e ? occ->hi_k[j] : occ->lo_k[j];
-            const float s = cm_ray_lost(lost->ray, k, i, hc[j], k - kc, near, lost->cap / step,
-                                        step, lost->c);
+            const float s = cm_ray_lost_from(lost->ray, k, i, hc[j], k - kc, s0 - 1, piece_from,
+                                             lost->cap / step, step, lost->c);
             *o = s > *o ? s : *o;
         }
     }

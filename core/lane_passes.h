@@ -43,10 +43,12 @@ typedef struct {
  * the grid or on nodata there; cm_ray_lost samples the ray's steps up to
  * it): the grid as the rays see it, the curvature coefficient and the
  * distance cap (metres, 0 = none) in double, as the near field takes them,
- * and scratch of j1 + 1 ints, clear between calls. */
+ * the far-only sweep's threshold (metres; 0 = the near field's steps
+ * instead: the ray's steps count from the first at least this far), and
+ * scratch of j1 + 1 ints, clear between calls. */
 typedef struct {
     const cm_ray_grid *ray;
-    double c, cap;
+    double c, cap, from;
     int *flags;
 } ts_lane_lost;
 
@@ -54,9 +56,10 @@ typedef struct {
  * hc[j] into out[(j - j0) * ostride]: the larger of the cell's own ray sampled at
  * the two occluders (the second skipped when it is the first's step;
  * either skipped within the near field, at most `near` steps back; at one
- * the ray cannot be sampled at, cm_ray_lost unless near is 0, the far-only
- * sweep's), -inf when none counts, NaN where hc is nodata; cf is the
- * curvature coefficient; slope: scratch of j1 + 1 floats. */
+ * the ray cannot be sampled at, cm_ray_lost beyond the near field, or
+ * beyond lost->from metres in the far-only sweep, whose near is 0), -inf
+ * when none counts, NaN where hc is nodata; cf is the curvature
+ * coefficient; slope: scratch of j1 + 1 floats. */
 void ts_lane_far_field(const ts_line_geom *G, const float *z, float cf, int near, int k, int i0,
                        int j0, int j1, const float *hc, const ts_lane_occluders *occ,
                        const ts_lane_lost *lost, float *slope, float *out, ptrdiff_t ostride);

@@ -313,12 +313,15 @@ CM_FN float cm_ray_slope(const cm_ray_grid *r, int k, int i, float h, int dk, fl
  * but on nodata, at the TS_LOST_STEPS whole steps beyond it (a hole's far
  * side, where the lines found their terrain: a cell looking across a
  * nodata block saw nothing, -90, where the terrain stood 16-25 deg up);
- * beyond `near` steps and within s_cap steps (0 = none); -inf if none
- * counts. A few steps, not the whole ray, so that a DEM whose edge holds
- * every line's occluder costs a few steps a cell.
+ * beyond `near` steps (the part of a step from `piece_from` at least) and
+ * within s_cap steps (0 = none); -inf if none counts. A few steps, not the
+ * whole ray, so that a DEM whose edge holds every line's occluder costs a
+ * few steps a cell. (cm_ray_lost: the part of a step from the near field's
+ * last, near; the far-only sweep's from its first far step, near + 1, so
+ * that nothing nearer than its threshold counts.)
  */
-CM_FN float cm_ray_lost(const cm_ray_grid *r, int k, int i, float h, int dk, int near,
-                        cm_real s_cap, cm_real step, cm_real c)
+CM_FN float cm_ray_lost_from(const cm_ray_grid *r, int k, int i, float h, int dk, int near,
+                             int piece_from, cm_real s_cap, cm_real step, cm_real c)
 {
     /* where the ray ends: the grid's start along u (k steps back), where
      * v = i - t s leaves [0, V - 1], or the cap */
@@ -338,7 +341,7 @@ CM_FN float cm_ray_lost(const cm_ray_grid *r, int k, int i, float h, int dk, int
         best = v > best ? v : best;
     }
     if (exit > hi && exit < last) { /* the ray leaves the grid (or the cap) within a step */
-        cm_real from = hi > near ? (cm_real)hi : (cm_real)near;
+        cm_real from = hi > piece_from ? (cm_real)hi : (cm_real)piece_from;
         float v = exit > from ? cm_ray_exact(r, k, i, h, from, exit, step, c) : -INFINITY;
         best = v > best ? v : best;
     }
@@ -352,6 +355,12 @@ CM_FN float cm_ray_lost(const cm_ray_grid *r, int k, int i, float h, int dk, int
         best = v > best ? v : best;
     }
     return best;
+}
+
+CM_FN float cm_ray_lost(const cm_ray_grid *r, int k, int i, float h, int dk, int near,
+                        cm_real s_cap, cm_real step, cm_real c)
+{
+    return cm_ray_lost_from(r, k, i, h, dk, near, near, s_cap, step, c);
 }
 
 /*
