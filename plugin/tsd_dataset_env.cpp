@@ -6,6 +6,7 @@
  * decoded by the core's OpenEXR reader. And its metadata.
  */
 #include <cerrno>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -23,13 +24,20 @@ namespace tsd
  * (TS_ENV_MAX_PIXELS of float RGBA, uncompressed, is 1 GiB). */
 constexpr vsi_l_offset MAX_MAP_BYTES = static_cast<vsi_l_offset>(2) << 30;
 
+/* The first four bytes of every OpenEXR file (its magic number, 20000630
+ * little-endian). */
+constexpr GByte EXR_MAGIC[4] = {0x76, 0x2f, 0x31, 0x01};
+
 /* The bytes of the file at pszPath (any GDAL path) into oBytes; false with
- * a sentence in osError. */
+ * a sentence in osError. What does not start as an OpenEXR file does is
+ * refused after four bytes, and a file larger than MAX_MAP_BYTES before
+ * it is read where its size is known (else after MAX_MAP_BYTES). */
 static bool ReadWholeFile(const char *pszPath, std::vector<GByte> &oBytes,
                           std::string &osError)
 {
     VSIStatBufL sStat;
-    if (VSIStatExL(pszPath, &sStat, VSI_STAT_EXISTS_FLAG | VSI_STAT_NATURE_FLAG) != 0)
+    if (VSIStatExL(pszPath, &sStat, VSI_STAT_EXISTS_FLAG | VSI_STAT_NATURE_FLAG |
+                                        VSI_STAT_SIZE_FLAG) != 0)
     {
         osError = CPLSPrintf("cannot open ENV_MAP '%s': no such file", pszPath);
         return false;
@@ -39,29 +47,38 @@ static bool ReadWholeFile(const char *pszPath, std::vector<GByte> &oBytes,
         osError = CPLSPrintf("ENV_MAP '%s' is a directory, not an OpenEXR file", pszPath);
         return false;
     }
+    const std::string osTooLarge =
+        CPLSPrintf("ENV_MAP '%s' is larger than %d GiB: not an environment map this driver "
+                   "reads",
+                   pszPath, static_cast<int>(MAX_MAP_BYTES >> 30));
+    if (VSI_ISREG(sStat.st_mode) && static_cast<vsi_l_offset>(sStat.st_size) > MAX_MAP_BYTES)
+    {
+        osError = osTooLarge;
+        return false;
+    }
     VSILFILE *fp = VSIFOpenL(pszPath, "rb");
     if (!fp)
     {
         osError = CPLSPrintf("cannot open ENV_MAP '%s': %s", pszPath, VSIStrerror(errno));
         return false;
     }
-    // read to the end, whatever the size the file system reports
+    // read to the end, whatever the size the file system reports: until a
+    // read gives nothing (GDAL 3.6's /vsizip/ and /vsigzip/ give short reads
+    // without their end-of-file flag)
     constexpr size_t CHUNK = 1 << 20;
     size_t nUsed = 0;
     bool bOk = true;
     for (;;)
     {
-        if (nUsed + CHUNK > MAX_MAP_BYTES)
+        if (nUsed >= MAX_MAP_BYTES)
         {
-            osError = CPLSPrintf("ENV_MAP '%s' is larger than %d GiB: not an environment "
-                                 "map this driver reads",
-                                 pszPath, static_cast<int>(MAX_MAP_BYTES >> 30));
+            osError = osTooLarge;
             bOk = false;
             break;
         }
         try
         {
-            oBytes.resize(nUsed + CHUNK);
+            oBytes.resize(nUsed + (nUsed ? CHUNK : sizeof EXR_MAGIC));
         }
         catch (const std::bad_alloc &)
         {
@@ -69,19 +86,31 @@ static bool ReadWholeFile(const char *pszPath, std::vector<GByte> &oBytes,
             bOk = false;
             break;
         }
-        const size_t nGot = VSIFReadL(oBytes.data() + nUsed, 1, CHUNK, fp);
+        const size_t nWant = oBytes.size() - nUsed;
+        const size_t nGot = VSIFReadL(oBytes.data() + nUsed, 1, nWant, fp);
         nUsed += nGot;
-        if (nGot < CHUNK)
-        {
-            if (!VSIFEofL(fp))
-            {
-                osError = CPLSPrintf("cannot read ENV_MAP '%s'", pszPath);
-                bOk = false;
-            }
+        if (nUsed <= sizeof EXR_MAGIC && nGot < nWant)
+            break; // (shorter than the magic number: refused below)
+        if (nUsed == sizeof EXR_MAGIC && memcmp(oBytes.data(), EXR_MAGIC, sizeof EXR_MAGIC))
             break;
-        }
+        if (nGot == 0)
+            break;
     }
     VSIFCloseL(fp);
+    if (bOk && (nUsed < sizeof EXR_MAGIC || memcmp(oBytes.data(), EXR_MAGIC, sizeof EXR_MAGIC)))
+    {
+        osError = CPLSPrintf("ENV_MAP '%s' is not an OpenEXR file: it does not start with "
+                             "OpenEXR's magic number (76 2f 31 01)",
+                             pszPath);
+        bOk = false;
+    }
+    else if (bOk && VSI_ISREG(sStat.st_mode) &&
+             nUsed < static_cast<vsi_l_offset>(sStat.st_size))
+    {
+        osError = CPLSPrintf("cannot read ENV_MAP '%s': %zu of its %llu bytes read", pszPath,
+                             nUsed, static_cast<unsigned long long>(sStat.st_size));
+        bOk = false;
+    }
     oBytes.resize(bOk ? nUsed : 0);
     return bOk;
 }
