@@ -10,6 +10,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import unittest
 
 BUILDDIR = os.path.abspath(os.environ.get("TS_BUILDDIR", os.getcwd()))
 SRCDIR = os.path.abspath(
@@ -176,6 +177,12 @@ def fractal_dem(n, seed=1, relief=300.0):
     return z.astype(np.float32)
 
 
+def flat_dem(path, lat, lon, n=32, cell=0.0005, z=0.0):
+    """A flat n x n DEM in EPSG:4326 centred at (lat, lon)."""
+    gt = (lon - n * cell / 2, cell, 0, lat + n * cell / 2, 0, -cell)
+    return write_tif(path, np.full((n, n), z, np.float32), gt, 4326)
+
+
 _UTM = {}
 
 
@@ -199,6 +206,17 @@ class TempDir:
 
     def __exit__(self, *exc):
         shutil.rmtree(self.path, ignore_errors=True)
+
+
+class TempDirCase(unittest.TestCase):
+    """A test class whose tests share a TempDir, self.dir, removed once the
+    last of them has run."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = TempDir()
+        cls.dir = cls.tmp.__enter__()
+        cls.addClassCleanup(cls.tmp.__exit__, None, None, None)
 
 
 def describe(name, a, b):

@@ -1,0 +1,165 @@
+"""terrashade.distributed: the Dask cluster: started (Ctrl-C and SIGTERM
+held until it has) or reached, its workers checked, and watched during the
+run; SIGTERM cleaned up as Ctrl-C."""
+import asyncio
+import contextlib
+import logging
+import os
+import signal
+import threading
+import time
+
+from terrashade import windows as W
+from terrashade._distributed_report import LOST, Failure
+
+def dask_logs(level):
+    """Only Dask's logs of level and above reach stderr, as LocalCluster's
+    silence_logs: on its handlers, as Dask's configuration gives its loggers
+    their own levels."""
+    for handler in logging.getLogger("distributed").handlers:
+        handler.setLevel(level)
+
+
+def start_cluster(args):
+    """(client, cluster or None, task options to add)."""
+    from dask.distributed import Client, LocalCluster
+    if args.scheduler:
+        try:
+            client = Client(args.scheduler, timeout="%ds" % args.timeout)
+        except ValueError as e:  # not an address: no port, an unknown scheme...
+            raise Failure("--scheduler %s is not a Dask scheduler address such as "
+                          "tcp://host:8786 (%s)" % (args.scheduler, e), code=2)
+        except TypeError as e:  # tls:// without Dask's TLS settings (no SSL context)
+            raise Failure("--scheduler %s needs Dask's TLS settings: the CA, certificate and "
+                          "key in the Dask configuration (distributed.comm.tls.*, e.g. "
+                          "DASK_DISTRIBUTED__COMM__TLS__CA_FILE and __CLIENT__CERT/__KEY) "
+                          "(%s)" % (args.scheduler, e), code=2)
+        except (OSError, TimeoutError) as e:
+            raise Failure("cannot reach the Dask scheduler at %s within %d s: %s"
+                          % (args.scheduler, args.timeout, e), code=2)
+        dask_logs(logging.ERROR)  # as the local cluster's: the program says what failed
+        # A worker has one task slot per thread, by default one per core.
+        return client, None, 1
+    workers = args.workers or os.cpu_count() or 1
+    # on this machine's loopback only, with its HTTP servers on free ports:
+    # dashboard_address=None still served the scheduler's on 0.0.0.0:8787,
+    # reachable from other machines, and warned where that port was taken
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=args.threads_per_worker,
+                           processes=True, host="127.0.0.1", dashboard_address="127.0.0.1:0",
+                           worker_dashboard_address="127.0.0.1:0",
+                           silence_logs=logging.ERROR)
+    slots = workers * args.threads_per_worker
+    return Client(cluster), cluster, max(1, (os.cpu_count() or 1) // slots)
+
+
+class Watch:
+    """Whether the cluster can still finish the run. Dask cancels every
+    future at once when the client's connection to the scheduler closes,
+    but waits for ever on a scheduler that answers nothing (its machine or
+    the network gone) and on a cluster without workers: the run checks the
+    scheduler's answer (within --timeout) and its workers (none for longer
+    than --timeout) whenever a second has passed without a window."""
+
+    EVERY = 1.0  # s between checks
+
+    def __init__(self, client, timeout, dest):
+        self.client, self.timeout, self.dest = client, timeout, dest
+        self.address = client.scheduler.address
+        self.lost = False  # then the client's scheduler calls would hang or fail
+        self.checked = self.workers_seen = time.monotonic()
+
+    def fail(self, what, why, done=None, total=None):
+        self.lost = True
+        # The client's close then cancels its reconnection, which Dask logs with
+        # tracebacks, in part through asyncio's logger (the root's last resort).
+        dask_logs(logging.CRITICAL)
+        logging.getLogger().setLevel(logging.CRITICAL)
+        when = ("during the run, after %d of %d windows" % (done, total) if total
+                else "before the run's windows were submitted")
+        raise Failure("lost %s at %s %s: %s; nothing written to %s: run the command again "
+                      "once the cluster is back (a run starts over)"
+                      % (what, self.address, when, why, self.dest), code=LOST)
+
+    def connected(self, done=None, total=None):
+        if self.client.status != "running":  # "connecting" again, or closed: futures lost
+            self.fail("the Dask scheduler", "its connection closed (the scheduler ended, "
+                      "or its machine or the network went away)", done, total)
+
+    def check(self, done, total):
+        self.connected(done, total)
+        now = time.monotonic()
+        if now - self.checked < self.EVERY:
+            return
+        try:
+            workers = self.client.sync(self.client.scheduler.ncores,
+                                       callback_timeout=self.timeout)
+        except asyncio.TimeoutError:
+            self.fail("the Dask scheduler", "it did not answer for %d s (--timeout)"
+                      % self.timeout, done, total)
+        except OSError as e:  # Dask's CommClosedError too
+            self.connected(done, total)
+            self.fail("the Dask scheduler", "%s: %s" % (type(e).__name__, e), done, total)
+        self.checked = now = time.monotonic()
+        if workers:
+            self.workers_seen = now
+        elif now - self.workers_seen > self.timeout:
+            self.fail("the workers of the Dask cluster", "the scheduler has had none for "
+                      "%d s (--timeout)" % self.timeout, done, total)
+
+
+def check_workers(client, watch):
+    """The workers' count, once every one can run the tasks; waits up to
+    --timeout for a first worker (a cluster's may still be starting)."""
+    try:
+        if not client.scheduler_info().get("workers"):
+            client.wait_for_workers(1, timeout=watch.timeout)
+    except (asyncio.TimeoutError, TimeoutError):
+        watch.connected()
+        raise Failure("the Dask cluster at %s has no workers (none joined within %d s, "
+                      "--timeout): start them (dask-worker %s)"
+                      % (watch.address, watch.timeout, watch.address), code=2)
+    try:
+        found = client.run(W.probe)
+    except Exception as e:
+        watch.connected()
+        raise Failure("the Dask workers cannot run terrashade's tasks (%s): install "
+                      "the terrashade package on them (make install) or put it on "
+                      "their PYTHONPATH" % e)
+    if not found:
+        raise Failure("the Dask cluster at %s has no workers" % watch.address, code=2)
+    missing = [w for w, r in found.items() if not r["driver"]]
+    if missing:
+        raise Failure("GDAL on worker(s) %s cannot find the TERRASHADE driver: set "
+                      "GDAL_DRIVER_PATH there (now %r) or install the plugin"
+                      % (", ".join(missing), found[missing[0]]["GDAL_DRIVER_PATH"]))
+    return len(found)
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (timeout, Slurm, systemd, Kubernetes...), cleaned up as Ctrl-C;
+    Python's default ends the program at once and left DEST.partial behind."""
+
+
+def _terminate(_signum, _frame):
+    raise Terminated()
+
+
+@contextlib.contextmanager
+def interrupts_held():
+    """Ctrl-C and SIGTERM held while a cluster starts, raised once it has
+    (at the end of the with block, after the caller holds the cluster to
+    close): a LocalCluster cut short in its start was left for Dask's exit
+    handler, which printed its tracebacks."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    got = []
+    previous = {s: signal.signal(s, lambda signum, _frame: got.append(signum))
+                for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+    if got:
+        raise Terminated() if got[0] == signal.SIGTERM else KeyboardInterrupt()

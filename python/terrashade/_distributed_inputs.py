@@ -1,0 +1,141 @@
+"""terrashade.distributed: the run's inputs: the command line, parsed and
+checked, and SOURCE, the TERRASHADE connection string (its options, its
+DEM's path as the workers must read it, and the client's open)."""
+import argparse
+import os
+import re
+
+from osgeo import gdal
+
+from terrashade import windows as W
+from terrashade._distributed_report import SAID, Failure
+
+PROG = "terrashade.distributed"
+TILE_MIN, TILE_MAX = 16, 65536
+
+
+def tile_size(text):
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError("must be a whole number, got %r" % text)
+    if n < TILE_MIN or n > TILE_MAX or n % 16:
+        raise argparse.ArgumentTypeError(
+            "must be a multiple of 16 between %d and %d (GeoTIFF tiles are "
+            "multiples of 16), got %d" % (TILE_MIN, TILE_MAX, n))
+    return n
+
+
+def positive(text):
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise argparse.ArgumentTypeError("must be a whole number >= 1, got %r" % text)
+    return n
+
+
+def parse_args(argv):
+    p = argparse.ArgumentParser(
+        prog=PROG, description="Compute a TERRASHADE product window by window "
+        "on dask.distributed and write it as a tiled GeoTIFF or COG.")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", metavar="ADDRESS",
+                       help="an existing Dask scheduler (tcp://host:8786); every "
+                       "worker must read the DEM by the same path and find the plugin")
+    where.add_argument("--workers", type=positive, metavar="N",
+                       help="worker processes of the local cluster (default: one per core)")
+    p.add_argument("--threads-per-worker", type=positive, default=1, metavar="N",
+                   help="threads of each local worker (default 1)")
+    p.add_argument("--tile-size", type=tile_size, default=1024, metavar="N",
+                   help="window size in cells, a multiple of 16 (default 1024)")
+    p.add_argument("-oo", dest="open_options", action="append", default=[],
+                   metavar="KEY=VALUE", help="an open option of the driver (repeatable)")
+    p.add_argument("--format", choices=["GTiff", "COG"],
+                   help="output format (default: COG for *.cog.tif, else GTiff)")
+    p.add_argument("-co", dest="creation_options", action="append", default=[],
+                   metavar="NAME=VALUE", help="a creation option of the output driver")
+    p.add_argument("--timeout", type=positive, default=10, metavar="SECONDS",
+                   help="how long to try to reach --scheduler, to wait for its answer "
+                   "during the run, and to wait for a worker when the cluster has none "
+                   "(default 10)")
+    p.add_argument("-q", "--quiet", action="store_true",
+                   help="no progress bar and no summary line")
+    p.add_argument("source", metavar="SOURCE", help="TERRASHADE:[KEY=VALUE,...:]dem.tif")
+    p.add_argument("dest", metavar="DEST", help="output .tif (GeoTIFF) or .cog.tif (COG)")
+    args = p.parse_args(argv)
+    for oo in args.open_options:
+        if not re.match(r"^[A-Za-z_]\w*=", oo):
+            p.error("-oo takes KEY=VALUE, got %r" % oo)
+    return args
+
+
+# The driver's inline option segment (plugin/tsd_connstr.c): KEY=VALUE items,
+# an ASCII identifier as KEY with blanks allowed around it, up to the first ':'.
+_ITEM = r" *[A-Za-z_][A-Za-z0-9_]* *=[^,:]*"
+INLINE = re.compile(r"^(%s(?:,%s)*):" % (_ITEM, _ITEM))
+
+
+def split_source(source):
+    """SOURCE's inline option segment with its ':' ("" if none) and the DEM."""
+    rest = source[len("TERRASHADE:"):]
+    m = INLINE.match(rest)
+    return (rest[:m.end()], rest[m.end():]) if m else ("", rest)
+
+
+def given_keys(source, open_options):
+    """Upper-case names of the options given inline in SOURCE or by -oo."""
+    inline = split_source(source)[0]
+    items = list(open_options) + (inline[:-1].split(",") if inline else [])
+    return {item.split("=", 1)[0].strip().upper() for item in items}
+
+
+def absolute_path(text):
+    """text (a name, quoted or not) made absolute if it is a relative path
+    that exists here; None if it is not one."""
+    quoted = len(text) > 1 and text[0] == text[-1] == '"'
+    path = text[1:-1] if quoted else text
+    if not path or os.path.isabs(path) or path.startswith("/vsi") or not os.path.exists(path):
+        return None
+    path = os.path.abspath(path)
+    return '"%s"' % path if quoted else path
+
+
+def absolute_source(source):
+    """SOURCE with a relative DEM path that exists here made absolute: each
+    worker would resolve it in its own working directory (an existing
+    cluster's workers do not share the client's), and read another file of
+    that name, or none. Also the file inside another driver's name
+    (GTIFF_DIR:1:dem.tif, NETCDF:"dem.nc":z, GPKG:dem.gpkg:table): the
+    parts between its ':' that are relative paths existing here."""
+    head, dem = split_source(source)
+    whole = absolute_path(dem)
+    if whole is not None:
+        return "TERRASHADE:" + head + whole
+    if os.path.exists(dem):  # (an absolute or virtual path, or nothing to do)
+        return source
+    parts = dem.split(":")
+    fixed = [absolute_path(p) or p for p in parts]
+    if len(parts) < 2 or fixed == parts:
+        return source
+    return "TERRASHADE:" + head + ":".join(fixed)
+
+
+def open_source(source, open_options):
+    if not source.upper().startswith("TERRASHADE:"):
+        raise Failure("SOURCE must be a TERRASHADE connection string "
+                      "(TERRASHADE:[KEY=VALUE,...:]dem.tif), got %r" % source)
+    if gdal.GetDriverByName("TERRASHADE") is None:
+        raise Failure("GDAL cannot find the TERRASHADE driver: set GDAL_DRIVER_PATH "
+                      "to the directory of gdal_TERRASHADE.so, or make install")
+    said = W.Warnings()
+    gdal.PushErrorHandler(said)
+    try:
+        return gdal.OpenEx(source, gdal.OF_RASTER | gdal.OF_READONLY,
+                           open_options=open_options)
+    except RuntimeError as e:
+        raise Failure("cannot open %s: %s" % (source, e))
+    finally:
+        gdal.PopErrorHandler()
+        SAID.say(said.messages)

@@ -1,0 +1,93 @@
+"""terrashade.distributed interrupted: Ctrl-C (SIGINT) or SIGTERM during a
+run removes the partial file and leaves an older DEST as it was (exit 130 or
+143); once DEST is in place, it is the whole new product and the message
+says so.
+"""
+import os
+import signal
+import subprocess
+import time
+import unittest
+
+import tsdistributed as TD
+import tsdriver as T
+from tsdistributed import HORIZON, PYTHONPATH
+from tsdriver import gdal
+
+
+class DistributedInterrupts(TD.DistributedCase):
+    def start_signalled_run(self, dest):
+        """A run of the horizon product into dest, to be signalled: in its own
+        session (the shell's job control may ignore SIGINT)."""
+        return subprocess.Popen(
+            ["/usr/bin/python3", "-m", "terrashade.distributed", "--workers", "1",
+             "--tile-size", "64", "-q"] + T.oo_args(HORIZON) + [T.conn(self.dem), dest],
+            stderr=subprocess.PIPE, text=True, start_new_session=True,
+            env=T.env(PYTHONPATH=PYTHONPATH),
+            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+
+    def test_interrupted_run_leaves_nothing(self):
+        """Ctrl-C (SIGINT) and SIGTERM (what timeout, Slurm, systemd or
+        Kubernetes send) during a run: the partial file is removed, an older
+        DEST stays as it was, exit 130 or 143. SIGTERM ended the program on
+        the spot and left DEST.partial behind. At once, and 0.4 and 0.8 s
+        into the cluster's start (a cluster cut short there was left to
+        Dask's exit handler, which printed tracebacks)."""
+        dest = self.path("interrupted.tif")
+        for sig, code, said, delay in ((signal.SIGINT, 130, "interrupted", 0.0),
+                                       (signal.SIGTERM, 143, "terminated", 0.0),
+                                       (signal.SIGINT, 130, "interrupted", 0.4),
+                                       (signal.SIGINT, 130, "interrupted", 0.8)):
+            with self.subTest(said, delay=delay):
+                with open(dest, "w") as f:
+                    f.write("an older result")
+                p = self.start_signalled_run(dest)
+                for _ in range(600):  # created before the cluster starts
+                    if os.path.exists(dest + ".partial") or p.poll() is not None:
+                        break
+                    time.sleep(0.05)
+                time.sleep(delay)
+                self.assertIsNone(p.poll(), "the run ended before the signal")
+                p.send_signal(sig)
+                err = p.communicate(timeout=120)[1]
+                self.assertEqual(p.returncode, code, err)
+                self.assertIn("terrashade.distributed: %s; nothing written to %s"
+                              % (said, dest), err)
+                # while the cluster starts: it is closed, not left to Dask's
+                # exit handler (its tracebacks until session 49)
+                self.assertNotIn("Traceback", err)
+                with open(dest) as f:
+                    self.assertEqual(f.read(), "an older result")
+                os.remove(dest)
+                self.assert_nothing_left(dest)
+
+    def test_interrupt_after_dest_is_written(self):
+        """Ctrl-C once DEST is in place, while the cluster closes (~0.6 s):
+        DEST is the whole new product, and the message says so (until
+        session 49 it said 'nothing written' over the new DEST). The signal
+        goes as soon as DEST is replaced; a run that ends first exits 0."""
+        dest = self.path("late.tif")
+        with open(dest, "w") as f:
+            f.write("an older result")
+        before = os.stat(dest).st_ino
+        p = self.start_signalled_run(dest)
+        for _ in range(60000):
+            if p.poll() is not None or os.stat(dest).st_ino != before:
+                break
+            time.sleep(0.002)
+        if p.poll() is None:
+            p.send_signal(signal.SIGINT)
+        err = p.communicate(timeout=120)[1]
+        print("exit %d: %s" % (p.returncode, err.strip()))
+        self.assertIn(p.returncode, (0, 130), err)
+        self.assertNotIn("nothing written", err)
+        if p.returncode == 130:
+            self.assertIn("terrashade.distributed: interrupted while closing the cluster; "
+                          "%s was written in full" % dest, err)
+        ds = gdal.Open(dest)
+        self.assertEqual((ds.RasterXSize, ds.RasterYSize), (200, 150))
+        ds = None
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
