@@ -32,6 +32,7 @@
 #include "tsd_dem.h"
 #include "tsd_dem_check.h"
 #include "tsd_gdal.h"
+#include "tsd_source_stamp.h"
 #include "tsd_window.h"
 #include "tsd_locale.h"
 
@@ -219,6 +220,12 @@ CPLErr TSDataset::EnsureComputed()
         ts_grid sGrid;
         const bool bAhead = m_oReadAhead.joinable();
         eStatus = ReadDEM(&sGrid, szMsg, sizeof szMsg);
+        if (eStatus == TS_OK && !DEMUnchanged()) // (read, maybe, half before, half after)
+        {
+            ts_grid_free(&sGrid);
+            eStatus = TS_ERR_ARG;
+            snprintf(szMsg, sizeof szMsg, "%s", SourcesChangedError(m_osDEM, m_nLevel).c_str());
+        }
         if (eStatus != TS_OK)
         {
             m_osError = szMsg;

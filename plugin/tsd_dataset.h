@@ -167,6 +167,13 @@ class TSDataset final : public GDALPamDataset
     void SetupMetadata();
     void SetupPam(const char *pszConnection);
     bool m_bLegacyPam = false; // BuildPamFilename: the DEM's own .aux.xml (SetupPam)
+    /* the DEM's file (level 0; empty: none, a MEM DEM) and the stamps of
+     * its contents, and of ENV_MAP's, when the dataset opened
+     * (tsd_source_stamp.h): a product is not computed from a DEM changed
+     * since, and PAM's statistics of other contents are dropped */
+    std::string m_osDEMFile{}, m_osDEMStamp{}, m_osPamStamp{};
+    bool DEMUnchanged() const;
+    void DropStalePamStatistics();
     bool SetupEnvironment();
     void SetupEnvironmentMetadata();
 

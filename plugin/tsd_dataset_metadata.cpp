@@ -21,6 +21,7 @@
 #include "tsd_dataset.h"
 #include "tsd_gdal.h"
 #include "tsd_locale.h"
+#include "tsd_source_stamp.h"
 
 namespace tsd
 {
@@ -290,6 +291,11 @@ std::recursive_mutex &PamFileMutex()
  * a holder stuck on a network file system must not hang this one). */
 constexpr int PAM_LOCK_WAIT_MS = 30000;
 
+/* Where an entry keeps the stamp of the contents its statistics are of:
+ * band 1's metadata item, in a domain of its own. */
+constexpr const char *PAM_STAMP_ITEM = "SOURCE_FILES";
+constexpr const char *PAM_STAMP_DOMAIN = "TERRASHADE_PAM";
+
 /* One turn on the products' auxiliary file of a DEM: this process's
  * threads one at a time (PamFileMutex), and processes too, by an advisory
  * lock (flock) on the DEM's own file, which every product of that DEM
@@ -349,6 +355,9 @@ class PamFileTurn
 CPLErr TSDataset::TrySaveXML()
 {
     const PamFileTurn oTurn(GetPhysicalFilename(), true);
+    // the contents the entry's statistics are of (DropStalePamStatistics)
+    if (!m_osPamStamp.empty() && nBands > 0)
+        GetRasterBand(1)->SetMetadataItem(PAM_STAMP_ITEM, m_osPamStamp.c_str(), PAM_STAMP_DOMAIN);
     return GDALPamDataset::TrySaveXML();
 }
 
@@ -376,6 +385,36 @@ static bool HasPamEntry(const char *pszPath, const char *pszName, const char *ps
                  EQUAL(CPLGetXMLValue(ps, "name", ""), pszName);
     CPLDestroyXMLNode(psTree);
     return bFound;
+}
+
+/* Statistics and histograms saved for other contents of the DEM or of
+ * ENV_MAP (regenerated under the same name: GDAL drops the DEM's own
+ * .aux.xml then, not the products'), or by a version that kept no stamp,
+ * are dropped: they were reported, and copied into gdal_translate's
+ * output and QGIS's stretch, as this product's. What the user set stays.
+ * The entry is saved without them when the dataset closes. */
+void TSDataset::DropStalePamStatistics()
+{
+    if (nBands < 1)
+        return;
+    const char *pszSaved = GetRasterBand(1)->GetMetadataItem(PAM_STAMP_ITEM, PAM_STAMP_DOMAIN);
+    if (pszSaved && m_osPamStamp == pszSaved)
+        return;
+    bool bDropped = false;
+    for (int i = 1; i <= nBands; i++)
+        bDropped = static_cast<TSRasterBand *>(GetRasterBand(i))->DropSavedStatistics() ||
+                   bDropped;
+    if (bDropped)
+        CPLDebug(DRIVER, "%s: statistics saved for other contents of its files dropped "
+                 "(saved for '%s', now '%s')",
+                 GetDescription(), pszSaved ? pszSaved : "(no stamp)", m_osPamStamp.c_str());
+}
+
+bool TSDataset::DEMUnchanged() const
+{
+    const TSDataset *poLevel0 = m_poBase ? m_poBase : this;
+    return poLevel0->m_osDEMFile.empty() ||
+           SourceStamp(poLevel0->m_osDEMFile.c_str(), nullptr) == poLevel0->m_osDEMStamp;
 }
 
 void TSDataset::SetupPam(const char *pszConnection)
@@ -420,6 +459,10 @@ void TSDataset::SetupPam(const char *pszConnection)
         // a legacy entry moves to the products' file when the dataset closes,
         // so that another product's first save there does not hide it
         nPamFlags = bLegacy ? nPamFlags | GPF_DIRTY : nPamFlags & ~GPF_DIRTY;
+        m_osDEMFile = papszFiles[0];
+        m_osDEMStamp = SourceStamp(m_osDEMFile.c_str(), nullptr);
+        m_osPamStamp = SourceStamp(m_osDEMFile.c_str(), m_sOpts.env_map);
+        DropStalePamStatistics();
     }
     else
     {

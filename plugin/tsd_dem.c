@@ -172,13 +172,22 @@ static void to_metres(float *restrict r, const unsigned char *restrict mr, int w
     seen->step_bits = step;
 }
 
-static ts_status read_failed(ts_grid *grid, unsigned char *m, char *msg, size_t n)
+/* GDAL's reason, or, where it gave none (GDAL 3.6's direct reads of a
+ * truncated GeoTIFF fail without one), what to try: the DEM named. */
+static ts_status read_failed(GDALRasterBandH band, ts_grid *grid, unsigned char *m, char *msg,
+                             size_t n)
 {
     const char *last = CPLGetLastErrorMsg();
+    GDALDatasetH ds = GDALGetBandDataset(band);
+    const char *name = ds ? GDALGetDescription(ds) : "";
     free(m);
     ts_grid_free(grid);
-    return tsd_fail(msg, n, TS_ERR_INTERNAL, "cannot read the DEM%s%s",
-                    last && *last ? ": " : "", last ? last : "");
+    if (last && *last)
+        return tsd_fail(msg, n, TS_ERR_INTERNAL, "cannot read the DEM '%s': %s", name, last);
+    return tsd_fail(msg, n, TS_ERR_INTERNAL,
+                    "cannot read the DEM '%s' (GDAL gave no reason: is the file truncated or "
+                    "damaged? `gdalinfo -checksum` reads it whole)",
+                    name);
 }
 
 /* A w x h grid of the cells' sizes, row spacing from row `row0` on. */
@@ -245,7 +254,7 @@ static ts_status load_window(GDALRasterBandH band, GDALRasterBandH src, const ts
     if (GDALRasterIO(src, GF_Read, rx, ry, w, h, grid->z, w, h, GDT_Float32, 0,
                      (int)(grid->stride * sizeof(float))) != CE_None ||
         (mask && GDALRasterIO(mask, GF_Read, rx, ry, w, h, m, w, h, GDT_Byte, 0, w) != CE_None))
-        return read_failed(grid, m, msg, n);
+        return read_failed(src, grid, m, msg, n);
     tsd_dem_seen seen = TSD_DEM_SEEN_NONE;
     for (int y = 0; y < h; y++)
         to_metres(grid->z + (ptrdiff_t)y * grid->stride, m ? m + (size_t)y * w : NULL, w,
@@ -282,7 +291,7 @@ static ts_status load_resampled(GDALRasterBandH band, GDALRasterBandH src,
         float *z = grid->z + (ptrdiff_t)y0 * grid->stride;
         if (read_rows(src, y0, rows, w, h, z, grid->stride, GDT_Float32) != CE_None ||
             (mask && read_rows(mask, y0, rows, w, h, m, w, GDT_Byte) != CE_None))
-            return read_failed(grid, m, msg, n);
+            return read_failed(src, grid, m, msg, n);
         for (int y = 0; y < rows; y++)
             to_metres(z + (ptrdiff_t)y * grid->stride, m ? m + (size_t)y * w : NULL, w,
                       c.scale, c.offset, &seen);

@@ -10,6 +10,10 @@
  */
 #include "tsd_pam_band.h"
 
+#include "cpl_minixml.h"
+#include "cpl_string.h"
+
+
 #include "tsd_gdal.h"
 
 namespace tsd
@@ -84,6 +88,32 @@ CPLErr TSPamBand::DeleteNoDataValue()
                     "copy without it",
                     poDS ? poDS->GetDescription() : "", nBand));
     return CE_Failure;
+}
+
+bool TSPamBand::DropSavedStatistics()
+{
+    bool bDropped = false;
+    char **papszMD = CSLDuplicate(GDALPamRasterBand::GetMetadata());
+    for (char **ppsz = papszMD; ppsz && *ppsz; ppsz++)
+    {
+        char *pszKey = nullptr;
+        CPLParseNameValue(*ppsz, &pszKey);
+        if (pszKey && STARTS_WITH_CI(pszKey, "STATISTICS_"))
+        {
+            GDALPamRasterBand::SetMetadataItem(pszKey, nullptr); // (marks PAM dirty)
+            bDropped = true;
+        }
+        CPLFree(pszKey);
+    }
+    CSLDestroy(papszMD);
+    if (psPam && psPam->psSavedHistograms)
+    {
+        CPLDestroyXMLNode(psPam->psSavedHistograms);
+        psPam->psSavedHistograms = nullptr;
+        MarkPamDirty();
+        bDropped = true;
+    }
+    return bDropped;
 }
 
 } // namespace tsd

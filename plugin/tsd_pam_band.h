@@ -51,6 +51,10 @@ class TSPamBand : public GDALPamRasterBand
     CPLErr SetColorInterpretation(GDALColorInterp eColor) override;
     /* drops a value the user set; the product's own cannot be dropped */
     CPLErr DeleteNoDataValue() override;
+    /* drops the statistics and histograms PAM holds (saved for contents
+     * the product's files no longer have), keeping what the user set;
+     * whether there were any */
+    bool DropSavedStatistics();
 };
 
 } // namespace tsd

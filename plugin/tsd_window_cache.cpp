@@ -21,6 +21,7 @@
 
 #include "terrashade_cl.h"
 #include "tsd_dataset.h"
+#include "tsd_source_stamp.h"
 #include "tsd_dem.h"
 #include "tsd_gdal.h"
 #include "tsd_window.h"
@@ -369,6 +370,12 @@ const WindowChunk *TSDataset::Chunk(int cx, int cy)
     const auto tStart = std::chrono::steady_clock::now();
     if (!ComputeChunk(cx, cy, c))
         return nullptr;
+    if (!DEMUnchanged()) // (its chunks and far grid would mix two DEMs)
+    {
+        s.status = TS_ERR_ARG;
+        s.error = SourcesChangedError(m_osDEM, m_nLevel);
+        return nullptr;
+    }
     const std::chrono::duration<double> dfSec = std::chrono::steady_clock::now() - tStart;
     CPLDebug(DRIVER, "computed chunk (%d, %d) of %d x %d cells in %.3f s", cx, cy, c.w, c.h,
              dfSec.count());

@@ -1,0 +1,131 @@
+"""The files a product is made of, changed on disk (a DEM regenerated
+under the same name, a replaced ENV_MAP, a DEM rewritten while a dataset
+on it stays open, as in a QGIS session left open):
+- statistics saved for their former contents are not reported (nor copied
+  into gdal_translate's output or QGIS's stretch) as the new product's;
+  what the user set stays;
+- a dataset opened before the DEM changed refuses to compute from it
+  (whole, by chunks, an overview level), naming the cause, instead of
+  mixing the two DEMs; opened again, it computes the new one;
+- a DEM cut short is named in the error, with what to try."""
+import os
+import unittest
+
+import tsdriver as T
+from exr_write import write_exr
+from tsdriver import gdal, np
+
+
+def write_dem(path, seed, n=96):
+    T.write_tif(path, T.fractal_dem(n, seed=seed, relief=200.0),
+                (500000, 10, 0, 4000000, 0, -10), 32617)
+
+
+def saved_mean(path, **oo):
+    """gdalinfo -stats of TERRASHADE:path: its band's STATISTICS_MEAN."""
+    out = T.run(["gdalinfo", "-stats", T.conn(path, **oo)]).stdout
+    return float(out.split("STATISTICS_MEAN=")[1].split()[0])
+
+
+def true_mean(path, **oo):
+    ds = gdal.OpenEx(T.conn(path), open_options=["%s=%s" % kv for kv in oo.items()])
+    return float(np.nanmean(ds.GetRasterBand(1).ReadAsArray()))
+
+
+class ChangedFiles(T.TempDirCase):
+    def test_statistics_of_a_regenerated_dem(self):
+        """Until session 50 the statistics saved in <DEM>.terrashade.aux.xml
+        outlived a DEM regenerated under its name (GDAL drops the DEM's own
+        .aux.xml then, not the products'): 0.797 for svf's mean where it
+        was 0.509. A nodata value the user set stays."""
+        dem = os.path.join(self.dir, "regen.tif")
+        write_dem(dem, 1)
+        first = saved_mean(dem, PRODUCT="svf")
+        T.run(["gdal_edit.py", "-ro", "-a_nodata", "-1", T.conn(dem, PRODUCT="svf")])
+        os.remove(dem)
+        write_dem(dem, 2)
+        again = saved_mean(dem, PRODUCT="svf")
+        want = true_mean(dem, PRODUCT="svf")
+        print("svf's mean: first DEM %.6f, regenerated %.6f, reported %.6f"
+              % (first, want, again))
+        self.assertGreater(abs(first - want), 1e-3)
+        self.assertAlmostEqual(again, want, places=5)
+        ds = gdal.Open(T.conn(dem, PRODUCT="svf"))
+        self.assertEqual(ds.GetRasterBand(1).GetNoDataValue(), -1.0)
+        ds = None
+        # the same contents: the saved statistics stand (no recomputation)
+        self.assertEqual(saved_mean(dem, PRODUCT="svf"), again)
+
+    def test_statistics_of_a_replaced_env_map(self):
+        dem = os.path.join(self.dir, "env.tif")
+        write_dem(dem, 3)
+        light = os.path.join(self.dir, "light.exr")
+        write_exr(light, np.ones((16, 32, 3)))
+        first = saved_mean(dem, PRODUCT="envlight", ENV_MAP=light)
+        write_exr(light, np.full((16, 32, 3), 3.0))
+        again = saved_mean(dem, PRODUCT="envlight", ENV_MAP=light)
+        print("envlight's mean under a map of 1, then of 3: %.6f, %.6f" % (first, again))
+        self.assertAlmostEqual(again, 3 * first, places=4)
+
+    def rewrite(self, dem, seed, n):
+        """The DEM's heights rewritten in place (the same file)."""
+        ds = gdal.Open(dem, gdal.GA_Update)
+        ds.GetRasterBand(1).WriteArray(T.fractal_dem(n, seed=seed, relief=200.0))
+        ds = None
+
+    def test_a_dem_changed_under_an_open_dataset(self):
+        for name, oo in (("whole", {}), ("by chunks", dict(TILE_SIZE=64)),
+                         ("overview level 1", {})):
+            with self.subTest(name):
+                dem = os.path.join(self.dir, "open_%d.tif" % len(name))
+                n = 600 if name.startswith("overview") else 96  # (levels down to ~256)
+                write_dem(dem, 4, n)
+                ds = gdal.OpenEx(T.conn(dem), open_options=[
+                    "PRODUCT=svf"] + ["%s=%s" % kv for kv in oo.items()])
+                band = ds.GetRasterBand(1)
+                if name.startswith("overview"):
+                    band = band.GetOverview(0)
+                    self.assertIsNotNone(band)
+                self.rewrite(dem, 5, n)
+                with self.assertRaises(RuntimeError) as cm:
+                    band.ReadAsArray()
+                print("%s: %s" % (name, cm.exception))
+                self.assertIn("changed on disk since this dataset was opened", str(cm.exception))
+                self.assertIn("open it again", str(cm.exception))
+                band = ds = None
+                # opened again: the new DEM's product
+                again = true_mean(dem, PRODUCT="svf", **oo)
+                fresh = os.path.join(self.dir, "fresh_%d.tif" % len(name))
+                gdal.Translate(fresh, dem)
+                self.assertEqual(again, true_mean(fresh, PRODUCT="svf", **oo))
+
+    def test_an_unchanged_dem_computes_after_a_while(self):
+        """Reading it (its .aux.xml written beside it) does not count as a
+        change: a dataset computes, closes and opens again as before."""
+        dem = os.path.join(self.dir, "same.tif")
+        write_dem(dem, 6)
+        ds = gdal.OpenEx(T.conn(dem), open_options=["PRODUCT=svf", "TILE_SIZE=64"])
+        T.run(["gdalinfo", "-stats", dem])  # the DEM's own statistics saved
+        a = ds.GetRasterBand(1).ReadAsArray()
+        self.assertTrue(np.isfinite(a).all())
+        ds = None
+
+    def test_a_dem_cut_short(self):
+        """A GeoTIFF cut short (a copy interrupted): GDAL 3.6's direct read
+        fails without a reason, and the error said only "cannot read the
+        DEM"; it names the DEM and what to try, whole and by chunks."""
+        dem = os.path.join(self.dir, "whole.tif")
+        write_dem(dem, 7, 512)
+        cut = os.path.join(self.dir, "cut.tif")
+        with open(dem, "rb") as f, open(cut, "wb") as g:
+            g.write(f.read()[:150000])
+        for oo in (dict(PRODUCT="svf", TILE_SIZE=0), dict(PRODUCT="svf", TILE_SIZE=128)):
+            p = T.run(["gdal_translate", "-q"] + T.oo_args(oo)
+                      + [T.conn(cut), os.path.join(self.dir, "out.tif")], ok=False)
+            print(p.stderr.strip().splitlines()[-1])
+            self.assertIn("cannot read the DEM '%s'" % cut, p.stderr)
+            self.assertIn("gdalinfo -checksum", p.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
