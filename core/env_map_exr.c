@@ -82,10 +82,33 @@ static const char *lib_message(const exr_source *s, exr_result_t rv)
     return s->lib_msg[0] ? s->lib_msg : exr_get_default_error_message(rv);
 }
 
-/* The channels used: R, G, B into slots 0..2, or Y into slot 0 (grey). */
+/* The channels used: R, G, B into slots 0..2, or Y into slot 0 (grey);
+ * chroma: grey from a luminance/chroma file (RY and BY left). */
 typedef struct {
-    int grey;
+    int grey, chroma;
 } channel_plan;
+
+/* Channel name `name` appended to the list in listed[size] (", " between),
+ * its bytes other than printable ASCII as '?' (a name cut within a UTF-8
+ * character made the whole error unreadable to Python), at most 24 of
+ * them, and "..." where the list is full. */
+static void list_channel(char *listed, size_t size, const char *name)
+{
+    size_t used = strlen(listed);
+    if (used + 32 >= size) {
+        if (used + 4 < size && (used < 3 || strcmp(listed + used - 3, "...") != 0))
+            snprintf(listed + used, size - used, "...");
+        return;
+    }
+    if (used)
+        used += (size_t)snprintf(listed + used, size - used, ", ");
+    size_t k = 0;
+    for (; name[k] && k < 24; k++)
+        listed[used + k] = name[k] >= 0x20 && name[k] < 0x7f ? name[k] : '?';
+    listed[used + k] = '\0';
+    if (name[k])
+        snprintf(listed + used + k, size - used - k, "...");
+}
 
 static int slot_of(const channel_plan *plan, const char *channel)
 {
@@ -107,20 +130,18 @@ static ts_status plan_channels(exr_context_t ctx, const exr_source *src, channel
     const exr_attr_chlist_t *chl = NULL;
     if (exr_get_channels(ctx, 0, &chl) != EXR_ERR_SUCCESS || !chl)
         return ts_fail(err, TS_ERR_ARG, "environment map '%s' has no channel list", src->name);
-    int found[4] = {0, 0, 0, 0}; /* R, G, B, Y */
-    static const char *const names[4] = {"R", "G", "B", "Y"};
-    char listed[96] = "";
+    int found[6] = {0, 0, 0, 0, 0, 0}; /* R, G, B, Y, and chroma RY, BY */
+    static const char *const names[6] = {"R", "G", "B", "Y", "RY", "BY"};
+    char listed[256] = "";
     for (int c = 0; c < chl->num_channels; c++) {
         const exr_attr_chlist_entry_t *e = &chl->entries[c];
-        size_t used = strlen(listed);
-        if (used + 8 < sizeof listed)
-            snprintf(listed + used, sizeof listed - used, "%s%.6s", used ? ", " : "",
-                     e->name.str);
-        for (int k = 0; k < 4; k++)
+        list_channel(listed, sizeof listed, e->name.str);
+        for (int k = 0; k < 6; k++)
             if (strcmp(e->name.str, names[k]) == 0)
                 found[k] = (e->x_sampling == 1 && e->y_sampling == 1) ? 1 : -1;
     }
     plan->grey = !(found[0] == 1 && found[1] == 1 && found[2] == 1);
+    plan->chroma = plan->grey && found[4] && found[5];
     if (!plan->grey || found[3] == 1)
         return TS_OK;
     return ts_fail(err, TS_ERR_ARG,
@@ -285,6 +306,7 @@ static ts_status read_part0(exr_context_t ctx, exr_source *src, double rotation_
     if (info) { /* the header is all that was asked for */
         info->cube = layout == ENV_CUBE;
         info->grey = plan.grey;
+        info->chroma = plan.chroma;
         info->width = (int)w;
         info->height = (int)h;
         return TS_OK;

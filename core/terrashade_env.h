@@ -144,6 +144,8 @@ ts_status ts_env_load_exr_memory(const void *buf, size_t size, const char *name,
 typedef struct {
     int cube;          /**< 1: cube faces, 0: lat-long */
     int grey;          /**< 1: grey from Y, 0: colour from R, G, B */
+    int chroma;        /**< 1: grey from Y of a luminance/chroma file (it has RY and
+                            BY, OpenEXR's YC colour): its colour is not read */
     int width, height; /**< of the data window, pixels */
 } ts_env_map_info;
 

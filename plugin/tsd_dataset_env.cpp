@@ -136,6 +136,12 @@ bool TSDataset::SetupEnvironment()
     }
     m_sRun.env = &m_sEnv;
     WarnSkyAtNight();
+    if (m_nLevel == 0 && m_sEnv.has_map && m_sEnv.map.chroma)
+        CPLError(CE_Warning, CPLE_AppDefined,
+                 "TERRASHADE: ENV_MAP '%s' stores its colour as luminance and chroma (Y, RY, "
+                 "BY: OpenEXR's YC images): only its luminance Y is read, so its light is "
+                 "grey. Save it with R, G and B channels for a coloured light",
+                 m_sOpts.env_map);
     CPLDebug(DRIVER, "environment: %zu texels, flat plane E/pi %g %g %g, peak %g",
              m_sEnv.env.count, m_sEnv.flat[0], m_sEnv.flat[1], m_sEnv.flat[2], m_sEnv.peak);
     return true;

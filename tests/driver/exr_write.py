@@ -15,14 +15,17 @@ def _attr(name, kind, payload):
         + payload
 
 
-def write_exr(path, rgb, envmap=None):
+def write_exr(path, rgb, envmap=None, names=("R", "G", "B")):
     """rgb: height x width x 3 floats, row 0 at the top (a lat-long map's
-    zenith). envmap: None, "latlong" or "cube"."""
+    zenith). envmap: None, "latlong" or "cube". names: the three planes'
+    channel names (UTF-8), R, G, B by default."""
     rgb = np.ascontiguousarray(rgb, dtype="<f4")
     h, w = rgb.shape[:2]
+    # channels are listed (and stored) in the order of their names' bytes
+    order = sorted(range(3), key=lambda i: names[i].encode())
     chans = b""
-    for c in "BGR":  # channels are listed (and stored) in name order
-        chans += c.encode() + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1)  # FLOAT
+    for i in order:
+        chans += names[i].encode() + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1)  # FLOAT
     chans += b"\0"
     box = struct.pack("<iiii", 0, 0, w - 1, h - 1)
     header = b"".join([
@@ -46,6 +49,6 @@ def write_exr(path, rgb, envmap=None):
         f.write(struct.pack("<%dQ" % h, *offsets))
         for y in range(h):
             f.write(struct.pack("<ii", y, line_bytes))
-            for c in (2, 1, 0):  # B, G, R
-                f.write(rgb[y, :, c].tobytes())
+            for i in order:
+                f.write(rgb[y, :, i].tobytes())
     return path

@@ -203,6 +203,29 @@ class EnvLight(unittest.TestCase):
         self.assertIn("is not an OpenEXR file", err)
         self.assertLess(time.time() - t0, 5.0)
 
+    def test_channels_it_cannot_use(self):
+        """A luminance/chroma map (Y, RY, BY) is read as grey from Y, with a
+        warning (it was silent); the channels of a map without R, G, B or Y
+        are listed whole, their bytes beyond ASCII as '?' (names cut to six
+        bytes within a UTF-8 character left Python's error empty)."""
+        self.flat_dem()
+        yc = write_exr(self.path("yc.exr"), np.dstack([np.full((16, 32), v) for v in
+                                                       (2.0, 0.3, -0.2)]),
+                       names=("Y", "RY", "BY"))
+        p = T.run(["gdal_translate", "-q", "-oo", "PRODUCT=envlight", "-oo", "ENV_MAP=" + yc,
+                   T.conn(self.path("flat.tif")), self.path("yc.tif")])
+        print(p.stderr.strip())
+        self.assertIn("stores its colour as luminance and chroma", p.stderr)
+        self.assertEqual(T.metadata(self.path("yc.tif"))["ENV_MAP_CHANNELS"], "Y")
+        named = write_exr(self.path("named.exr"), np.ones((16, 32, 3)),
+                          names=("diffuse.R", "diffuse.G", "\u65e5\u672c\u8a9e.B"))
+        with self.assertRaises(RuntimeError) as cm:
+            gdal.OpenEx(T.conn(self.path("flat.tif")),
+                        open_options=["PRODUCT=envlight", "ENV_MAP=" + named])
+        print(cm.exception)
+        self.assertIn("(it has: diffuse.G, diffuse.R, ?????????.B)",
+                      str(cm.exception))
+
     def flat_dem(self):
         path = self.path("flat.tif")
         if not os.path.exists(path):
