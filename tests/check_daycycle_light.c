@@ -145,6 +145,38 @@ START_TEST(test_esra)
 }
 END_TEST
 
+/* ESRA off the zenith, worked by hand from Rigollier et al. (2000): the
+ * diffuse angular function Fd(h) = A0 + A1 sin h + A2 sin^2 h at two
+ * elevations, and the beam at 1 deg, where air mass > 20 takes Kasten's
+ * (1996) Rayleigh thickness 1 / (10.4 + 0.718 m). Sea level, TL = 3, 1 AU. */
+START_TEST(test_esra_low_sun)
+{
+    ts_clear_sky c;
+    /* Trd = -0.015843 + 0.030543*3 + 0.0003797*9 = 0.0792033
+     * A0 = 0.26463 - 0.061581*3 + 0.0031408*9 = 0.1081542 (A0 Trd > 0.002)
+     * A1 = 2.0402 + 0.018945*3 - 0.011161*9 = 1.996586
+     * A2 = -1.3025 + 0.039231*3 + 0.0085079*9 = -1.1082359
+     * sin h = 0.5 (h = 30): Fd = 0.1081542 + 0.998293 - 0.2770590 = 0.8293882,
+     *   D = 1367 * 0.0792033 * 0.8293882 = 89.7986 W/m2
+     * sin h = 0.2 (h = 11.536959): Fd = 0.1081542 + 0.3993172 - 0.0443294
+     *   = 0.4631420, D = 1367 * 0.0792033 * 0.4631420 = 50.1448 W/m2 */
+    ts_clear_sky_esra(30.0, 0.0, 3.0, 1.0, &c);
+    printf("ESRA, TL 3: diffuse %.4f W/m2 at sin h 0.5", c.diffuse_horizontal);
+    CK_NEAR(c.diffuse_horizontal, 89.7986, 0.001, "diffuse, sin h 0.5");
+    ts_clear_sky_esra(asin(0.2) * 180 / M_PI, 0.0, 3.0, 1.0, &c);
+    printf(", %.4f W/m2 at sin h 0.2", c.diffuse_horizontal);
+    CK_NEAR(c.diffuse_horizontal, 50.1448, 0.001, "diffuse, sin h 0.2");
+    /* h = 1: m = 1 / (sin 1 + 0.50572 * 7.07995^-1.6364)
+     *        = 1 / (0.0174524 + 0.0205551) = 26.3106 (> 20),
+     * dR = 1 / (10.4 + 0.718 * 26.3106) = 1 / 29.2910 = 0.0341402,
+     * Bn = 1367 exp(-0.8662 * 3 * 26.3106 * 0.0341402) = 1367 exp(-2.334187)
+     *    = 132.448 W/m2 */
+    ts_clear_sky_esra(1.0, 0.0, 3.0, 1.0, &c);
+    printf("; beam normal %.3f W/m2 at 1 deg\n", c.beam_normal);
+    CK_NEAR(c.beam_normal, 132.448, 0.005, "beam normal, 1 deg");
+}
+END_TEST
+
 /* The insolation of a flat open plane is the clear-sky global horizontal
  * irradiation, summed step by step here independently. */
 START_TEST(test_insolation_flat)
@@ -263,6 +295,7 @@ static Suite *suite(void)
     tcase_add_test(tc, test_shadows_cut_sun_hours);
     tcase_add_test(tc, test_grid_north);
     tcase_add_test(tc, test_esra);
+    tcase_add_test(tc, test_esra_low_sun);
     tcase_add_test(tc, test_insolation_flat);
     tcase_add_test(tc, test_insolation_slopes);
     tcase_add_test(tc, test_insolation_lattice);

@@ -1,9 +1,10 @@
 /* Order-4 SH light and visibility (core/sh_*.c): projection and
- * reconstruction of analytic functions, rotation about z against the
- * projection of the rotated function, the triple product against
- * brute-force quadrature, the wedge tables against a direct sum over the
- * sphere, the visibility of flat ground, the key light, and bad input. The
- * visibility and the light of grids are in check_sh_swath_light.c. */
+ * reconstruction of analytic functions, a cap against quadrature, rotation
+ * about z against the projection of the rotated function, the triple
+ * product against brute-force quadrature, the wedge tables against a
+ * direct sum over the sphere, the visibility of flat ground, the key light,
+ * and bad input. The visibility and the light of grids are in
+ * check_sh_swath_light.c. */
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
@@ -124,6 +125,41 @@ START_TEST(cap_unit_power)
     ts_sh_cap(d, 1e-4, c);
     for (int i = 0; i < N; i++)
         ck_assert(fabs(c[i] - y[i]) < 1e-8);
+}
+END_TEST
+
+/* A uniform 30-degree cap of unit power around a tilted direction d,
+ * projected by quadrature in the cap's own frame (midpoint in cos of the
+ * angle from d, 64 azimuths: exact for band 3), against ts_sh_cap: every
+ * band's coefficients, band 3's zonal mean (5c^2 - 1)(1 + c)/8 among them. */
+START_TEST(cap_projected)
+{
+    double d[3] = {0.3, -0.4, sqrt(1 - 0.25)}, c[N], q[N] = {0};
+    const double r = 30 * PI / 180, cr = cos(r), power = 1 / (2 * PI * (1 - cr));
+    /* e1, e2: a frame around d */
+    double e1[3] = {d[2], 0, -d[0]}, l1 = hypot(d[0], d[2]);
+    e1[0] /= l1, e1[2] /= l1;
+    double e2[3] = {d[1] * e1[2] - d[2] * e1[1], d[2] * e1[0] - d[0] * e1[2],
+                    d[0] * e1[1] - d[1] * e1[0]};
+    const int NU = 4000, NP = 64;
+    const double du = (1 - cr) / NU, dp = 2 * PI / NP;
+    for (int a = 0; a < NU; a++)
+        for (int b = 0; b < NP; b++) {
+            double u = cr + (a + 0.5) * du, v = sqrt(1 - u * u), p = (b + 0.5) * dp, w[3], y[N];
+            for (int k = 0; k < 3; k++)
+                w[k] = u * d[k] + v * (cos(p) * e1[k] + sin(p) * e2[k]);
+            ts_sh_eval(w, y);
+            for (int i = 0; i < N; i++)
+                q[i] += power * y[i] * du * dp;
+        }
+    ts_sh_cap(d, 30, c);
+    double worst = 0;
+    for (int i = 0; i < N; i++) {
+        ck_assert_msg(fabs(c[i] - q[i]) < 1e-7, "coefficient %d: %.9f, quadrature %.9f", i,
+                      c[i], q[i]);
+        worst = fmax(worst, fabs(c[i] - q[i]));
+    }
+    printf("30-degree cap: max |coefficient - quadrature| %.2e\n", worst);
 }
 END_TEST
 
@@ -305,6 +341,7 @@ static Suite *suite(void)
     tcase_set_timeout(tc, 120);
     tcase_add_test(tc, projection_roundtrip);
     tcase_add_test(tc, cap_unit_power);
+    tcase_add_test(tc, cap_projected);
     tcase_add_test(tc, rotation_about_z);
     tcase_add_test(tc, triple_product_brute_force);
     tcase_add_test(tc, wedges_brute_force);

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "terrashade.h"
+#include "test_expect.h"
 #include "test_grid.h"
 #include "test_run.h"
 
@@ -173,6 +174,47 @@ static void sky_terms(const ts_grid *g, const lit *L, float *svf, float *sky, fl
                                 svf, sky, op};
     ck_assert_msg(ts_sky_terms(&req, &err) == TS_OK, "%s", err.message);
 }
+
+/* A geographic grid (0.01 deg cells, rows from 66 N to 62 N: each row its own
+ * east-west width) holding a surface that rises 0.08 m per metre east: every
+ * row has the east component -0.08 / sqrt(1.0064) of the normal and, lit
+ * from due west at 45 deg (N.L does not read the north component, which the
+ * converging columns tilt a little), N.L = 1.08 sin 45 / sqrt(1.0064) =
+ * 0.761243 (interior cells). */
+START_TEST(test_normals_geographic_rows)
+{
+    const int W = 24, H = 400;
+    const double cy = 0.01 * 111320.0, s = 0.08;
+    ts_grid g;
+    ts_error err;
+    double cx[400];
+    tdem_create(&g, W, H, cy, cy);
+    for (int y = 0; y < H; y++) {
+        cx[y] = cy * cos((66.0 - (y + 0.5) * 0.01) * DEG);
+        for (int x = 0; x < W; x++)
+            g.z[y * g.stride + x] = (float)(s * (x + 0.5) * cx[y]);
+    }
+    ck_assert(ts_grid_set_row_spacing(&g, cx, &err) == TS_OK);
+    lit L = light_setup_dirs(&g, 8);
+    float *out = tdem_floats(L.n);
+    direct(&g, &L, 270.0, 45.0, out);
+    const double len = sqrt(1 + s * s), want = (s + 1) * sin(45 * DEG) / len;
+    double worst = 0;
+    for (int y = 1; y < H - 1; y++)
+        for (int x = 1; x < W - 1; x++) {
+            size_t k = (size_t)y * W + x;
+            CK_NEAR(L.nx[k], -s / len, 2e-5, "geographic nx");
+            CK_NEAR(out[k], want, 5e-5, "geographic N.L, sun west at 45");
+            worst = fmax(worst, fabs(out[k] - want));
+        }
+    printf("geographic rows 66-62 N, plane rising 0.08 east: N.L %.6f (row 1) %.6f "
+           "(row %d), want %.6f, max |diff| %.2g\n", out[W + W / 2],
+           out[(size_t)(H - 2) * W + W / 2], H - 2, want, worst);
+    free(out);
+    light_free(&L);
+    ts_grid_free(&g);
+}
+END_TEST
 
 START_TEST(test_direct_flat)
 {
@@ -436,6 +478,7 @@ int main(void)
     tcase_add_test(tc, test_sun_disk_fraction);
     tcase_add_test(tc, test_normals_horn);
     tcase_add_test(tc, test_normals_signs);
+    tcase_add_test(tc, test_normals_geographic_rows);
     tcase_add_test(tc, test_direct_flat);
     tcase_add_test(tc, test_direct_tilted);
     tcase_add_test(tc, test_direct_horn_same_bits);

@@ -1,5 +1,6 @@
 /* The sky-view factor models (radiative, solid angle) and openness of the
- * sky terms, against their closed forms. */
+ * sky terms, against their closed forms; one swath of the radiative terms
+ * against quadrature. */
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
@@ -10,6 +11,7 @@
 #include "test_grid.h"
 #include "test_run.h"
 
+static const double PI_D = 3.14159265358979323846;
 static const double DEG = 3.14159265358979323846 / 180.0;
 
 /* Per-direction horizons of the cells, one row per cell: a mix of negative,
@@ -192,6 +194,53 @@ START_TEST(test_cone)
 }
 END_TEST
 
+/* (1/pi) of the integral of n.w sin(theta) over the swath of azimuths
+ * [a0, a1] (degrees from north) from the zenith down to theta1 (Timonen &
+ * Westerholm 2010, eq. 4, c = 1): midpoint rule, w = (east, north, up). */
+static double swath_quadrature(const double n[3], double a0, double a1, double theta1)
+{
+    const int NA = 256, NT = 2000;
+    double s = 0, da = (a1 - a0) * DEG / NA, dt = theta1 / NT;
+    for (int i = 0; i < NA; i++) {
+        double az = a0 * DEG + (i + 0.5) * da;
+        for (int j = 0; j < NT; j++) {
+            double t = (j + 0.5) * dt, st = sin(t);
+            s += (n[0] * st * sin(az) + n[1] * st * cos(az) + n[2] * cos(t)) * st;
+        }
+    }
+    return s * da * dt / PI_D;
+}
+
+/* One swath of 4 (azimuth 90, so [45, 135]) at two cells tilted 30 deg,
+ * towards azimuth 110 (horizon 20) and away, towards 290 (horizon 40): the
+ * horizon bounds the sky above the tangent plane across the whole swath,
+ * so the radiative svf and sky terms are eq. 4 over the swath exactly
+ * (with the swath weight sin(pi/n)/pi of the normal's tilt). */
+START_TEST(test_swath_quadrature)
+{
+    ts_grid g;
+    ts_error e;
+    ck_assert(ts_grid_create(&g, 2, 1, 10, 10, &e) == TS_OK);
+    const double tilt = 30 * DEG, face[2] = {110 * DEG, 290 * DEG};
+    float nx[2], ny[2], nz[2], hor[2] = {20, 40}, svf[2] = {0}, sky[2] = {0};
+    for (int i = 0; i < 2; i++) {
+        nx[i] = (float)(sin(tilt) * sin(face[i]));
+        ny[i] = (float)(sin(tilt) * cos(face[i]));
+        nz[i] = (float)cos(tilt);
+    }
+    ck_assert(ts_sky_accumulate(&g, nx, ny, nz, hor, 90.0, 4, svf, sky, NULL, &e) == TS_OK);
+    for (int i = 0; i < 2; i++) {
+        double n[3] = {nx[i], ny[i], nz[i]};
+        double want = swath_quadrature(n, 45, 135, (90 - hor[i]) * DEG);
+        printf("swath [45, 135], normal tilted 30 towards %.0f, horizon %.0f: svf term %.6f, "
+               "sky term %.6f, quadrature %.6f\n", face[i] / DEG, hor[i], svf[i], sky[i], want);
+        ck_assert_msg(fabs(svf[i] - want) < 1e-5, "svf term %.7f, want %.7f", svf[i], want);
+        ck_assert_msg(fabs(sky[i] - want) < 1e-5, "sky term %.7f, want %.7f", sky[i], want);
+    }
+    ts_grid_free(&g);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("sky_models");
@@ -202,6 +251,7 @@ int main(void)
     tcase_add_test(tc, test_accumulating_form_and_nodata);
     tcase_add_test(tc, test_bad_model);
     tcase_add_test(tc, test_cone);
+    tcase_add_test(tc, test_swath_quadrature);
     suite_add_tcase(s, tc);
     return test_run_suite(s);
 }

@@ -154,6 +154,27 @@ class Options(unittest.TestCase):
                     self.assertAlmostEqual(got["radiative"], 1 - np.sin(np.radians(b)) ** 2,
                                            delta=1e-4)
 
+    def test_negative_without_curvature(self):
+        """OPENNESS=negative sweeps the negated DEM without the curvature
+        correction (docs/driver.md): with the default CURVATURE it is the
+        positive openness of -z with CURVATURE=NO EDGE=open, on a DEM wide
+        enough (15 km) for the correction to show if it were applied."""
+        y, x = np.mgrid[0:512, 0:512].astype(float)
+        z = 800 + 300 * np.sin(x / 37.0) * np.cos(y / 53.0) + 150 * np.sin((x + 2 * y) / 91.0)
+        gt = (500000, 30.0, 0, 4000000, 0, -30.0)
+        with T.TempDir() as d:
+            pos = T.write_tif(os.path.join(d, "z.tif"), z.astype(np.float32), gt, 32617)
+            neg = T.write_tif(os.path.join(d, "negz.tif"), (-z).astype(np.float32), gt, 32617)
+            on = T.read(T.conn(pos), band=1, options={"PRODUCT": "openness", "DIRECTIONS": 16,
+                                                      "OPENNESS": "negative"})
+            ref = T.read(T.conn(neg), band=1, options={"PRODUCT": "openness", "DIRECTIONS": 16,
+                                                       "CURVATURE": "NO", "EDGE": "open"})
+        diff = np.abs(on - ref)
+        print("negative openness vs positive openness of -z without curvature: max |diff| "
+              "%.3g deg, mean %.3g" % (diff.max(), diff.mean()))
+        self.assertFalse(np.isnan(diff).any())
+        self.assertLess(diff.max(), 1e-5)
+
     def test_bad_values(self):
         for opt, value, sentence in (
                 ("SVF_MODEL", "zaksek", "SVF_MODEL must be one of radiative, solid_angle, "
