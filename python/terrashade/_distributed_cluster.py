@@ -6,11 +6,14 @@ import contextlib
 import logging
 import os
 import signal
+import sys
 import threading
 import time
 
 from terrashade import windows as W
+from terrashade._distributed_inputs import PROG
 from terrashade._distributed_report import LOST, Failure
+
 
 def dask_logs(level):
     """Only Dask's logs of level and above reach stderr, as LocalCluster's
@@ -149,13 +152,23 @@ def interrupts_held():
     """Ctrl-C and SIGTERM held while a cluster starts, raised once it has
     (at the end of the with block, after the caller holds the cluster to
     close): a LocalCluster cut short in its start was left for Dask's exit
-    handler, which printed its tracebacks."""
+    handler, which printed its tracebacks. A second signal is raised at
+    once: the start may never end (below)."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     got = []
-    previous = {s: signal.signal(s, lambda signum, _frame: got.append(signum))
-                for s in (signal.SIGINT, signal.SIGTERM)}
+
+    def held(signum, _frame):
+        # a second one: the user insists (a start can wait for ever on
+        # workers that a Ctrl-C sent to the whole process group ended)
+        if got:
+            raise Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
+        got.append(signum)
+        print("%s: %s while the Dask cluster starts: stopping once it has (again "
+              "to stop at once)" % (PROG, "terminated" if signum == signal.SIGTERM
+                                    else "interrupted"), file=sys.stderr, flush=True)
+    previous = {s: signal.signal(s, held) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
         yield
     finally:

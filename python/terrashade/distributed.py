@@ -119,6 +119,8 @@ def run(args):
             client, cluster, threads = start_cluster(args)
         watch = Watch(client, args.timeout, args.dest)
         nworkers = check_workers(client, watch)
+        if cluster is not None:  # its workers: a Ctrl-C is this process's to handle
+            client.run(W.ignore_interrupts)
         keys = given_keys(args.source, args.open_options)
         task_options = list(args.open_options)
         if "THREADS" not in keys:

@@ -128,3 +128,16 @@ def probe():
     drv = gdal.GetDriverByName("TERRASHADE")
     return {"driver": drv is not None, "gdal": gdal.__version__,
             "GDAL_DRIVER_PATH": os.environ.get("GDAL_DRIVER_PATH", "")}
+
+
+def ignore_interrupts():
+    """On a worker of the run's own local cluster: Ctrl-C ignored. A Ctrl-C
+    at the terminal signals the whole process group; the run's process
+    closes its workers, while each printed its own KeyboardInterrupt
+    tracebacks. Run on the worker's event loop, its main thread."""
+    import signal
+    try:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except ValueError:  # not the main thread: Ctrl-C stays as it was
+        return False
+    return True

@@ -61,6 +61,41 @@ class DistributedInterrupts(TD.DistributedCase):
                 os.remove(dest)
                 self.assert_nothing_left(dest)
 
+    def test_ctrl_c_at_the_terminal(self):
+        """Ctrl-C at the terminal signals the whole process group, the
+        cluster's workers too: the run stops as for its own Ctrl-C, and the
+        workers print nothing (each printed its KeyboardInterrupt
+        tracebacks until session 50). The signal goes once the workers have
+        started, while they compute."""
+        dem = self.path("big.tif")
+        T.write_tif(dem, T.fractal_dem(600, seed=5, relief=300.0),
+                    (500000, 10, 0, 4000000, 0, -10), 32617)
+        dest = self.path("group.tif")
+        p = subprocess.Popen(
+            ["/usr/bin/python3", "-m", "terrashade.distributed", "--workers", "2",
+             "--tile-size", "64", "-q", "-oo", "PRODUCT=horizon", "-oo", "DIRECTIONS=128",
+             T.conn(dem), dest],
+            stderr=subprocess.PIPE, text=True, start_new_session=True,
+            env=T.env(PYTHONPATH=PYTHONPATH),
+            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+        workers = []
+        for _ in range(1200):  # the workers' processes, then their first windows
+            workers = [w for w in subprocess.run(["pgrep", "-P", str(p.pid), "-f", "spawn_main"],
+                                                 capture_output=True, text=True).stdout.split()]
+            if len(workers) == 2 or p.poll() is not None:
+                break
+            time.sleep(0.05)
+        time.sleep(3.0)
+        self.assertIsNone(p.poll(), "the run ended before the signal")
+        os.killpg(p.pid, signal.SIGINT)
+        err = p.communicate(timeout=120)[1]
+        print("exit %d: %s" % (p.returncode, err.strip()))
+        self.assertEqual(p.returncode, 130, err)
+        self.assertIn("terrashade.distributed: interrupted; nothing written to %s" % dest, err)
+        self.assertNotIn("Traceback", err)
+        self.assertNotIn("KeyboardInterrupt", err)
+        self.assert_nothing_left(dest)
+
     def test_interrupt_after_dest_is_written(self):
         """Ctrl-C once DEST is in place, while the cluster closes (~0.6 s):
         DEST is the whole new product, and the message says so (until
