@@ -545,7 +545,10 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
                                   sizeof szMsg))
         CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szMsg);
     if (m_nLevel == 0)
+    {
         WarnDistances(dfMinCell, W, H);
+        WarnSweepTurn(H);
+    }
     double dfHeadroom = 0;
     if (!SetupWindow(W, H) ||
         !CheckMemory(sOpts, W, H, WindowPlan(m_poWindow), m_bHasSun ? &m_sSun : nullptr,

@@ -151,6 +151,7 @@ class TSDataset final : public GDALPamDataset
     bool Setup(const char *pszConnection, int W, int H);
     void WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfLon, double dfLat);
     void WarnDistances(double dfMinCell, int W, int H);
+    void WarnSweepTurn(int H);
     void WarnBelowSea(const ts_grid *g);
     void WarnSkyAtNight() const;
     std::atomic<bool> m_bBelowSeaWarned{false}; // WarnBelowSea: once per dataset

@@ -167,4 +167,41 @@ void TSDataset::WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfL
                  dfTurn, dfReach, pszDo);
 }
 
+/* Degrees by which a sweep's ground azimuth may turn on a geographic DEM's
+ * rows before it is said. */
+static const double SWEEP_TURN_WARN_DEG = 0.5;
+
+/* A geographic DEM's sweeps keep their direction in cells, set at its
+ * central row (core/line_geometry.c): on a row whose cells are k times as
+ * wide, azimuth a is swept as atan(k tan a), turned by up to
+ * atan(|k - 1| / (2 sqrt k)) (at tan a = 1 / sqrt k). Said where that
+ * passes SWEEP_TURN_WARN_DEG on its northern or southern rows, with what
+ * to do (METHOD=shadowmap takes each row's own width: not said). */
+void TSDataset::WarnSweepTurn(int H)
+{
+    if (!m_sCells.cell_x_row || H < 3 || m_sOpts.method == TSD_METHOD_SHADOWMAP)
+        return;
+    const double dfCentre = m_sCells.cell_x_row[H / 2];
+    double dfTurn = 0;
+    for (const int y : {0, H - 1})
+    {
+        const double k = m_sCells.cell_x_row[y] / dfCentre;
+        if (k > 0)
+            dfTurn = std::max(dfTurn, atan(fabs(k - 1) / (2 * sqrt(k))) * 180 / M_PI);
+    }
+    if (!(dfTurn > SWEEP_TURN_WARN_DEG))
+        return;
+    CPLError(CE_Warning, CPLE_AppDefined,
+             "TERRASHADE: the DEM's rows span so many degrees of latitude that its cells' "
+             "widths change by %.0f %%: its sweeps keep their direction in cells, taken "
+             "at its central row, so that on its northern and southern rows an azimuth is "
+             "swept up to %.1f degrees turned toward or away from the meridian (at azimuths "
+             "near 45 degrees; none at 0, 90, 180, 270). Horizons and cast shadows there turn "
+             "as much; sky-view factor, openness and the day's integrals, which average "
+             "over azimuths, change less. Cut the DEM into bands of latitude, or reproject "
+             "it to a projected CRS (gdalwarp -t_srs, e.g. a UTM zone)",
+             100 * fabs(m_sCells.cell_x_row[0] - m_sCells.cell_x_row[H - 1]) / dfCentre,
+             dfTurn);
+}
+
 } // namespace tsd

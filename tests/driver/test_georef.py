@@ -138,6 +138,28 @@ class Georef(unittest.TestCase):
                     nodata=-32768)
         return path
 
+    def test_tall_geographic_dem_warns_of_turned_sweeps(self):
+        """A geographic DEM from 65 to 70 N: its sweeps keep their direction
+        in cells, taken at its central row, so that on its northern and
+        southern rows azimuth 45 is swept as 41.8 and 47.8 (session 50's
+        audit measured that on planes and peaks of known azimuth); the open
+        says so, giving the turn, atan(|k - 1| / (2 sqrt k)) with k the
+        rows' cos of latitude over the centre's. Not on jacksboro (0.1
+        degrees tall), nor with METHOD=shadowmap, which takes each row's
+        own width."""
+        tall = os.path.join(self.dir, "tall.tif")
+        T.write_tif(tall, np.zeros((1000, 40), np.float32), (10.0, 0.005, 0, 70.0, 0, -0.005),
+                    4326)
+        k = [math.cos(math.radians(lat)) / math.cos(math.radians(70.0 - 500.5 * 0.005))
+             for lat in (70.0 - 0.0025, 65.0 + 0.0025)]
+        turn = max(math.degrees(math.atan(abs(x - 1) / (2 * math.sqrt(x)))) for x in k)
+        self.assertAlmostEqual(turn, 3.2, delta=0.05)
+        said = T.open_stderr(tall, PRODUCT="horizon")
+        print(said.strip())
+        self.assertIn("an azimuth is swept up to %.1f degrees turned" % turn, said)
+        self.assertNotIn("swept up to", T.open_stderr(tall, PRODUCT="shade", METHOD="shadowmap"))
+        self.assertNotIn("swept up to", T.open_stderr(T.JACKSBORO, PRODUCT="horizon"))
+
     def test_feet_and_us_survey_feet(self):
         ref = T.read(T.conn(self.utm, PRODUCT="shadow", SUN_ELEVATION=10))
         for unit, factor in (("ft", FT), ("us-ft", US_FT)):
