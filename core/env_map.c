@@ -190,8 +190,9 @@ static ts_status add_pixel(const env_image *img, int x, int y, const pixel_part 
     for (int c = 0; c < 3; c++)
         if (!isfinite(px[c]))
             return ts_fail(err, TS_ERR_ARG,
-                           "environment map '%s': pixel (%d, %d) is %s; NaN and infinite "
-                           "values are refused (negative ones are clamped to 0)",
+                           "environment map '%s': pixel (%d, %d) (column, row, from the "
+                           "top left of its data window) is %s; NaN and infinite values are "
+                           "refused (negative ones are clamped to 0)",
                            name, x, y, isnan(px[c]) ? "NaN" : "infinite");
     pixel_geom g;
     if (img->layout == ENV_CUBE)

@@ -144,9 +144,13 @@ static ts_status plan_channels(exr_context_t ctx, const exr_source *src, channel
     plan->chroma = plan->grey && found[4] && found[5];
     if (!plan->grey || found[3] == 1)
         return TS_OK;
+    int parts = 1;
+    exr_get_count(ctx, &parts);
     return ts_fail(err, TS_ERR_ARG,
                    "environment map '%s' has no usable channel: it needs R, G and B, or Y, "
-                   "not subsampled (it has: %s)", src->name, listed[0] ? listed : "none");
+                   "not subsampled (%s has: %s)", src->name,
+                   parts > 1 ? "its first part, the one read," : "it",
+                   listed[0] ? listed : "none");
 }
 
 /* The layout from the envmap attribute, else from the aspect ratio. */
