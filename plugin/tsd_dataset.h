@@ -168,11 +168,12 @@ class TSDataset final : public GDALPamDataset
     void SetupMetadata();
     void SetupPam(const char *pszConnection);
     bool m_bLegacyPam = false; // BuildPamFilename: the DEM's own .aux.xml (SetupPam)
-    /* the DEM's file (level 0; empty: none, a MEM DEM) and the stamps of
-     * its contents, and of ENV_MAP's, when the dataset opened
+    /* the DEM's files (level 0; none: a MEM DEM) and the stamps of their
+     * contents, and of ENV_MAP's with them, when the dataset opened
      * (tsd_source_stamp.h): a product is not computed from a DEM changed
      * since, and PAM's statistics of other contents are dropped */
-    std::string m_osDEMFile{}, m_osDEMStamp{}, m_osPamStamp{};
+    std::vector<std::string> m_aosDEMFiles{};
+    std::string m_osDEMStamp{}, m_osPamStamp{};
     bool DEMUnchanged() const;
     void DropStalePamStatistics();
     bool SetupEnvironment();

@@ -70,7 +70,7 @@ static bool ReadWholeFile(const char *pszPath, std::vector<GByte> &oBytes,
     bool bOk = true;
     for (;;)
     {
-        if (nUsed >= MAX_MAP_BYTES)
+        if (nUsed > MAX_MAP_BYTES) // (a file of exactly MAX_MAP_BYTES reads whole)
         {
             osError = osTooLarge;
             bOk = false;

@@ -298,14 +298,17 @@ constexpr const char *PAM_STAMP_DOMAIN = "TERRASHADE_PAM";
 
 /* One turn on the products' auxiliary file of a DEM: this process's
  * threads one at a time (PamFileMutex), and processes too, by an advisory
- * lock (flock) on the DEM's own file, which every product of that DEM
+ * lock (flock) on the DEM's directory, which every product of that DEM
  * shares and which is never written: GDAL rewrites an .aux.xml whole
  * (reads, truncates, writes), so processes saving statistics of several
- * products at once lost each other's entries. Saves lock exclusively,
- * loads shared (a load never reads a half-written file). Nested turns of
- * the same thread (the proxy directory's save) take no second lock. No
- * lock where the DEM is not a local file (/vsimem/, a network file system
- * that refuses it) or after PAM_LOCK_WAIT_MS: then as before. */
+ * products at once lost each other's entries. (Not on the DEM's file: its
+ * open and close here would drop the POSIX locks this process holds on it,
+ * SQLite's in a GeoPackage DEM.) Saves lock exclusively, loads shared (a
+ * load never reads a half-written file). Nested turns of the same thread
+ * (the proxy directory's save) take no second lock. No lock where the DEM
+ * is not a local file (/vsimem/), where the file system refuses it (NFS's
+ * emulation of flock on a directory) or after PAM_LOCK_WAIT_MS: then as
+ * before. */
 class PamFileTurn
 {
     std::lock_guard<std::recursive_mutex> m_oThreads{PamFileMutex()};
@@ -321,7 +324,8 @@ class PamFileTurn
     {
         if (Depth()++ > 0 || !pszDEM || !*pszDEM || STARTS_WITH(pszDEM, "/vsi"))
             return;
-        m_fd = open(pszDEM, O_RDONLY | O_CLOEXEC);
+        const std::string osDir = CPLGetPath(pszDEM);
+        m_fd = open(osDir.empty() ? "." : osDir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
         if (m_fd < 0)
             return;
         for (int nWaited = 0;; nWaited += 5)
@@ -413,8 +417,7 @@ void TSDataset::DropStalePamStatistics()
 bool TSDataset::DEMUnchanged() const
 {
     const TSDataset *poLevel0 = m_poBase ? m_poBase : this;
-    return poLevel0->m_osDEMFile.empty() ||
-           SourceStamp(poLevel0->m_osDEMFile.c_str(), nullptr) == poLevel0->m_osDEMStamp;
+    return SourceStamp(poLevel0->m_aosDEMFiles) == poLevel0->m_osDEMStamp;
 }
 
 void TSDataset::SetupPam(const char *pszConnection)
@@ -459,9 +462,9 @@ void TSDataset::SetupPam(const char *pszConnection)
         // a legacy entry moves to the products' file when the dataset closes,
         // so that another product's first save there does not hide it
         nPamFlags = bLegacy ? nPamFlags | GPF_DIRTY : nPamFlags & ~GPF_DIRTY;
-        m_osDEMFile = papszFiles[0];
-        m_osDEMStamp = SourceStamp(m_osDEMFile.c_str(), nullptr);
-        m_osPamStamp = SourceStamp(m_osDEMFile.c_str(), m_sOpts.env_map);
+        m_aosDEMFiles = SourceFiles(papszFiles, nullptr);
+        m_osDEMStamp = SourceStamp(m_aosDEMFiles);
+        m_osPamStamp = SourceStamp(SourceFiles(papszFiles, m_sOpts.env_map));
         DropStalePamStatistics();
     }
     else

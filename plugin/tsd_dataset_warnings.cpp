@@ -182,26 +182,27 @@ void TSDataset::WarnSweepTurn(int H)
     if (!m_sCells.cell_x_row || H < 3 || m_sOpts.method == TSD_METHOD_SHADOWMAP)
         return;
     const double dfCentre = m_sCells.cell_x_row[H / 2];
-    double dfTurn = 0;
+    double dfTurn = 0, dfChange = 0;
     for (const int y : {0, H - 1})
     {
         const double k = m_sCells.cell_x_row[y] / dfCentre;
         if (k > 0)
             dfTurn = std::max(dfTurn, atan(fabs(k - 1) / (2 * sqrt(k))) * 180 / M_PI);
+        dfChange = std::max(dfChange, fabs(k - 1));
     }
     if (!(dfTurn > SWEEP_TURN_WARN_DEG))
         return;
     CPLError(CE_Warning, CPLE_AppDefined,
              "TERRASHADE: the DEM's rows span so many degrees of latitude that its cells' "
-             "widths change by %.0f %%: its sweeps keep their direction in cells, taken "
-             "at its central row, so that on its northern and southern rows an azimuth is "
+             "widths differ from its central row's by up to %.0f %%: its sweeps keep their "
+             "direction in cells, taken there, so that on its northern and southern rows an "
+             "azimuth is "
              "swept up to %.1f degrees turned toward or away from the meridian (at azimuths "
              "near 45 degrees; none at 0, 90, 180, 270). Horizons and cast shadows there turn "
              "as much; sky-view factor, openness and the day's integrals, which average "
              "over azimuths, change less. Cut the DEM into bands of latitude, or reproject "
              "it to a projected CRS (gdalwarp -t_srs, e.g. a UTM zone)",
-             100 * fabs(m_sCells.cell_x_row[0] - m_sCells.cell_x_row[H - 1]) / dfCentre,
-             dfTurn);
+             100 * dfChange, dfTurn);
 }
 
 } // namespace tsd

@@ -1,9 +1,10 @@
 /*
- * tsd_source_stamp.cpp - the stamp of the DEM's and ENV_MAP's files
+ * tsd_source_stamp.cpp - the stamp of the files a product is made of
  * (tsd_source_stamp.h).
  */
 #include "tsd_source_stamp.h"
 
+#include <cstdint>
 #include <sys/stat.h>
 
 #include "cpl_conv.h"
@@ -13,44 +14,72 @@
 namespace tsd
 {
 
-/* One file's part of the stamp. */
-static std::string FileStamp(const char *pszPath)
+std::vector<std::string> SourceFiles(char **papszDEMFiles, const char *pszEnvMap)
 {
-    if (!STARTS_WITH(pszPath, "/vsi"))
+    std::vector<std::string> aos;
+    const auto Add = [&aos](const char *pszPath)
+    {
+        if (STARTS_WITH(pszPath, "/vsi") || CPLIsFilenameRelative(pszPath) == FALSE)
+            aos.emplace_back(pszPath);
+        else
+        {
+            char *pszCwd = CPLGetCurrentDir();
+            aos.emplace_back(pszCwd ? CPLFormFilename(pszCwd, pszPath, nullptr) : pszPath);
+            CPLFree(pszCwd);
+        }
+    };
+    for (char **ppsz = papszDEMFiles; ppsz && *ppsz; ppsz++)
+    {
+        const size_t n = strlen(*ppsz);
+        if (!(n >= 8 && EQUAL(*ppsz + n - 8, ".aux.xml")))
+            Add(*ppsz);
+    }
+    if (pszEnvMap && *pszEnvMap)
+        Add(pszEnvMap);
+    return aos;
+}
+
+/* One file's part of the stamp. */
+static std::string FileStamp(const std::string &osPath)
+{
+    if (!STARTS_WITH(osPath.c_str(), "/vsi"))
     {
         struct stat sSt;
-        if (stat(pszPath, &sSt) != 0)
+        if (stat(osPath.c_str(), &sSt) != 0)
             return "missing";
-        return CPLSPrintf("%lld bytes, modified %lld.%09ld, changed %lld.%09ld, inode %llu",
+        return CPLSPrintf("%llu:%llu:%lld:%lld.%09ld", static_cast<unsigned long long>(sSt.st_dev),
+                          static_cast<unsigned long long>(sSt.st_ino),
                           static_cast<long long>(sSt.st_size),
-                          static_cast<long long>(sSt.st_mtim.tv_sec), sSt.st_mtim.tv_nsec,
-                          static_cast<long long>(sSt.st_ctim.tv_sec), sSt.st_ctim.tv_nsec,
-                          static_cast<unsigned long long>(sSt.st_ino));
+                          static_cast<long long>(sSt.st_mtim.tv_sec), sSt.st_mtim.tv_nsec);
     }
     VSIStatBufL sSt;
-    if (VSIStatExL(pszPath, &sSt, VSI_STAT_EXISTS_FLAG | VSI_STAT_SIZE_FLAG) != 0)
+    if (VSIStatExL(osPath.c_str(), &sSt, VSI_STAT_EXISTS_FLAG | VSI_STAT_SIZE_FLAG) != 0)
         return "missing";
-    return CPLSPrintf("%llu bytes, modified %lld", static_cast<unsigned long long>(sSt.st_size),
+    return CPLSPrintf("%llu:%lld", static_cast<unsigned long long>(sSt.st_size),
                       static_cast<long long>(sSt.st_mtime));
 }
 
-std::string SourceStamp(const char *pszDEMFile, const char *pszEnvMap)
+std::string SourceStamp(const std::vector<std::string> &aosFiles)
 {
-    std::string os;
-    if (pszDEMFile && *pszDEMFile)
-        os = std::string("DEM: ") + FileStamp(pszDEMFile);
-    if (pszEnvMap && *pszEnvMap)
-        os += std::string(os.empty() ? "" : "; ") + "ENV_MAP: " + FileStamp(pszEnvMap);
-    return os;
+    if (aosFiles.empty())
+        return "";
+    // FNV-1a over each file's stamp, not its path: the same file named
+    // another way (relative, through a link) is the same contents
+    uint64_t h = 14695981039346656037ULL;
+    for (const std::string &osPath : aosFiles)
+        for (const char c : FileStamp(osPath) + '\n')
+            h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ULL;
+    return CPLSPrintf("%zu file%s, %016llx", aosFiles.size(), aosFiles.size() == 1 ? "" : "s",
+                      static_cast<unsigned long long>(h));
 }
 
 std::string SourcesChangedError(const std::string &osDEM, int nLevel)
 {
     const std::string osWhat =
         nLevel ? std::string(CPLSPrintf("overview level %d", nLevel)) : "the product";
-    return CPLSPrintf("the DEM '%s' changed on disk since this dataset was opened, so that "
-                      "%s would mix its former and its new contents: open it again (in QGIS, "
-                      "remove the layer and add it again)",
+    return CPLSPrintf("the DEM '%s' (or a file it is read from) changed on disk since this "
+                      "dataset was opened, so that %s would mix its former and its new "
+                      "contents: open it again (in QGIS, remove the layer and add it again)",
                       osDEM.c_str(), osWhat.c_str());
 }
 

@@ -100,15 +100,47 @@ class ChangedFiles(T.TempDirCase):
                 self.assertEqual(again, true_mean(fresh, PRODUCT="svf", **oo))
 
     def test_an_unchanged_dem_computes_after_a_while(self):
-        """Reading it (its .aux.xml written beside it) does not count as a
-        change: a dataset computes, closes and opens again as before."""
+        """What does not change the DEM's contents does not count: reading
+        it (its .aux.xml written beside it), a chmod, a hard link to it (a
+        backup's), and a chdir after opening it by a relative path (each
+        refused it during session 50, before the stamp left the change time
+        out and kept absolute paths)."""
         dem = os.path.join(self.dir, "same.tif")
         write_dem(dem, 6)
-        ds = gdal.OpenEx(T.conn(dem), open_options=["PRODUCT=svf", "TILE_SIZE=64"])
-        T.run(["gdalinfo", "-stats", dem])  # the DEM's own statistics saved
-        a = ds.GetRasterBand(1).ReadAsArray()
+        cwd = os.getcwd()
+        os.chdir(self.dir)
+        try:
+            ds = gdal.OpenEx(T.conn("same.tif"), open_options=["PRODUCT=svf", "TILE_SIZE=64"])
+            T.run(["gdalinfo", "-stats", dem])  # the DEM's own statistics saved
+            os.chmod(dem, 0o640)
+            os.link(dem, os.path.join(self.dir, "backup.tif"))
+            os.chdir("/")
+            a = ds.GetRasterBand(1).ReadAsArray()
+        finally:
+            os.chdir(cwd)
         self.assertTrue(np.isfinite(a).all())
         ds = None
+
+    def test_a_vrt_whose_source_is_regenerated(self):
+        """A VRT DEM's sources are its files too: statistics saved before
+        its source was regenerated are dropped (the VRT itself did not
+        change), and a dataset open across the change refuses."""
+        src = os.path.join(self.dir, "src.tif")
+        vrt = os.path.join(self.dir, "dem.vrt")
+        write_dem(src, 8)
+        gdal.BuildVRT(vrt, [src])
+        first = saved_mean(vrt, PRODUCT="svf")
+        ds = gdal.OpenEx(T.conn(vrt), open_options=["PRODUCT=svf"])
+        os.remove(src)
+        write_dem(src, 9)
+        with self.assertRaises(RuntimeError) as cm:
+            ds.GetRasterBand(1).ReadAsArray()
+        self.assertIn("changed on disk", str(cm.exception))
+        ds = None
+        again, want = saved_mean(vrt, PRODUCT="svf"), true_mean(vrt, PRODUCT="svf")
+        print("VRT svf mean: before %.6f, after %.6f, reported %.6f" % (first, want, again))
+        self.assertGreater(abs(first - want), 1e-3)
+        self.assertAlmostEqual(again, want, places=5)
 
     def test_a_dem_cut_short(self):
         """A GeoTIFF cut short (a copy interrupted): GDAL 3.6's direct read

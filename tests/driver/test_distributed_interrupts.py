@@ -96,6 +96,34 @@ class DistributedInterrupts(TD.DistributedCase):
         self.assertNotIn("KeyboardInterrupt", err)
         self.assert_nothing_left(dest)
 
+    def test_signals_held_while_the_cluster_starts(self):
+        """While the cluster starts, one Ctrl-C or SIGTERM is held, said,
+        and raised once the start is over; a second is raised at once (a
+        start can wait for ever on a worker that the first one ended)."""
+        import io
+        from contextlib import redirect_stderr
+        from terrashade._distributed_cluster import Terminated, interrupts_held
+        for sig, exc in ((signal.SIGINT, KeyboardInterrupt), (signal.SIGTERM, Terminated)):
+            with self.subTest(sig=sig):
+                said, reached = io.StringIO(), []
+                with redirect_stderr(said), self.assertRaises(exc):
+                    with interrupts_held():
+                        os.kill(os.getpid(), sig)
+                        time.sleep(0.05)
+                        reached.append("after the first")
+                self.assertEqual(reached, ["after the first"])
+                self.assertIn("while the Dask cluster starts: stopping once it has", said.getvalue())
+                with redirect_stderr(io.StringIO()), self.assertRaises(exc):
+                    with interrupts_held():
+                        os.kill(os.getpid(), sig)
+                        time.sleep(0.05)
+                        os.kill(os.getpid(), sig)
+                        time.sleep(0.05)
+                        reached.append("after the second")
+                self.assertEqual(reached, ["after the first"])
+        # the handlers are given back
+        self.assertIs(signal.getsignal(signal.SIGINT), signal.default_int_handler)
+
     def test_interrupt_after_dest_is_written(self):
         """Ctrl-C once DEST is in place, while the cluster closes (~0.6 s):
         DEST is the whole new product, and the message says so (until
