@@ -65,10 +65,14 @@ static double mean_abs_diff(const ts_grid *g, const float *a, const float *b)
     return sum / (double)n;
 }
 
-/* Measured: 135/10 97.17 %, 315/30 99.87 % (docs/methods.md). */
+/* Measured: 135/10 97.18 %, 315/30 99.87 % (docs/methods.md); held to
+ * within 0.03 of a percent (the bits are the same on every backend and
+ * vector level): a slope bias four times its own left 97.00 % at 135/10,
+ * which a floor of 97 % passed (session 50's mutation audit). */
 START_TEST(test_jacksboro_agreement)
 {
-    static const struct { double az, el; } LIGHTS[] = {{135, 10}, {315, 30}};
+    static const struct { double az, el, floor; } LIGHTS[] = {{135, 10, 0.9715},
+                                                              {315, 30, 0.9984}};
     ts_grid g;
     tdem_load(&g, "jacksboro");
     const size_t n = (size_t)g.width * g.height;
@@ -80,7 +84,7 @@ START_TEST(test_jacksboro_agreement)
         printf("jacksboro %g/%g: shadow map agrees with the exact shadow on %.2f %% of the "
                "cells\n",
                LIGHTS[k].az, LIGHTS[k].el, 100 * a);
-        ck_assert_msg(a >= 0.97, "agreement %.4f < 0.97", a);
+        ck_assert_msg(a >= LIGHTS[k].floor, "agreement %.5f < %.4f", a, LIGHTS[k].floor);
     }
     free(ex);
     free(sm);
