@@ -62,11 +62,22 @@ static bool ReadWholeFile(const char *pszPath, std::vector<GByte> &oBytes,
         osError = CPLSPrintf("cannot open ENV_MAP '%s': %s", pszPath, VSIStrerror(errno));
         return false;
     }
+    // what does not start as OpenEXR does is refused after four bytes
+    GByte abyMagic[sizeof EXR_MAGIC];
+    if (VSIFReadL(abyMagic, 1, sizeof abyMagic, fp) != sizeof abyMagic ||
+        memcmp(abyMagic, EXR_MAGIC, sizeof EXR_MAGIC) != 0)
+    {
+        VSIFCloseL(fp);
+        osError = CPLSPrintf("ENV_MAP '%s' is not an OpenEXR file: it does not start with "
+                             "OpenEXR's magic number (76 2f 31 01)",
+                             pszPath);
+        return false;
+    }
     // read to the end, whatever the size the file system reports: until a
     // read gives nothing (GDAL 3.6's /vsizip/ and /vsigzip/ give short reads
     // without their end-of-file flag)
     constexpr size_t CHUNK = 1 << 20;
-    size_t nUsed = 0;
+    size_t nUsed = sizeof EXR_MAGIC;
     bool bOk = true;
     for (;;)
     {
@@ -78,7 +89,7 @@ static bool ReadWholeFile(const char *pszPath, std::vector<GByte> &oBytes,
         }
         try
         {
-            oBytes.resize(nUsed + (nUsed ? CHUNK : sizeof EXR_MAGIC));
+            oBytes.resize(nUsed + CHUNK);
         }
         catch (const std::bad_alloc &)
         {
@@ -86,26 +97,15 @@ static bool ReadWholeFile(const char *pszPath, std::vector<GByte> &oBytes,
             bOk = false;
             break;
         }
-        const size_t nWant = oBytes.size() - nUsed;
-        const size_t nGot = VSIFReadL(oBytes.data() + nUsed, 1, nWant, fp);
+        if (nUsed == sizeof EXR_MAGIC)
+            memcpy(oBytes.data(), abyMagic, sizeof abyMagic);
+        const size_t nGot = VSIFReadL(oBytes.data() + nUsed, 1, CHUNK, fp);
         nUsed += nGot;
-        if (nUsed <= sizeof EXR_MAGIC && nGot < nWant)
-            break; // (shorter than the magic number: refused below)
-        if (nUsed == sizeof EXR_MAGIC && memcmp(oBytes.data(), EXR_MAGIC, sizeof EXR_MAGIC))
-            break;
         if (nGot == 0)
             break;
     }
     VSIFCloseL(fp);
-    if (bOk && (nUsed < sizeof EXR_MAGIC || memcmp(oBytes.data(), EXR_MAGIC, sizeof EXR_MAGIC)))
-    {
-        osError = CPLSPrintf("ENV_MAP '%s' is not an OpenEXR file: it does not start with "
-                             "OpenEXR's magic number (76 2f 31 01)",
-                             pszPath);
-        bOk = false;
-    }
-    else if (bOk && VSI_ISREG(sStat.st_mode) &&
-             nUsed < static_cast<vsi_l_offset>(sStat.st_size))
+    if (bOk && VSI_ISREG(sStat.st_mode) && nUsed < static_cast<vsi_l_offset>(sStat.st_size))
     {
         osError = CPLSPrintf("cannot read ENV_MAP '%s': %zu of its %llu bytes read", pszPath,
                              nUsed, static_cast<unsigned long long>(sStat.st_size));

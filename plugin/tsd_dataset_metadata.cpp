@@ -464,7 +464,10 @@ void TSDataset::SetupPam(const char *pszConnection)
         nPamFlags = bLegacy ? nPamFlags | GPF_DIRTY : nPamFlags & ~GPF_DIRTY;
         m_aosDEMFiles = SourceFiles(papszFiles, nullptr);
         m_osDEMStamp = SourceStamp(m_aosDEMFiles);
-        m_osPamStamp = SourceStamp(SourceFiles(papszFiles, m_sOpts.env_map));
+        // the DEM's stamp, and ENV_MAP's beside it (the DEM's files stated once)
+        m_osPamStamp = m_sOpts.env_map[0] ? m_osDEMStamp + "; ENV_MAP: " +
+                                                SourceStamp(SourceFiles(nullptr, m_sOpts.env_map))
+                                          : m_osDEMStamp;
         DropStalePamStatistics();
     }
     else

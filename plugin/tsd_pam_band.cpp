@@ -13,7 +13,6 @@
 #include "cpl_minixml.h"
 #include "cpl_string.h"
 
-
 #include "tsd_gdal.h"
 
 namespace tsd

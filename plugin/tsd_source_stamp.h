@@ -15,9 +15,9 @@ namespace tsd
 {
 
 /* The files to stamp: the DEM's file list (GDALDataset::GetFileList, NULL
- * ended) but its .aux.xml files, which GDAL rewrites as it reads, and
- * ENV_MAP (null or empty: none), each made absolute against the current
- * directory, so that a later chdir does not lose them. */
+ * ended; NULL: none) but its .aux.xml files, which GDAL rewrites as it
+ * reads, and ENV_MAP (null or empty: none), each made absolute against the
+ * current directory, so that a later chdir does not lose them. */
 std::vector<std::string> SourceFiles(char **papszDEMFiles, const char *pszEnvMap);
 
 /* A short stamp of those files' contents: a 64-bit digest, in hex, of each
