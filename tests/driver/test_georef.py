@@ -93,15 +93,7 @@ class Georef(unittest.TestCase):
         """
         ds = gdal.Open(self.utm)
         gt, W, H = ds.GetGeoTransform(), ds.RasterXSize, ds.RasterYSize
-        wgs, utm = osr.SpatialReference(), osr.SpatialReference()
-        wgs.ImportFromEPSG(4326)
-        utm.ImportFromEPSG(32617)
-        for s in (wgs, utm):
-            s.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
-        ct = osr.CoordinateTransformation(wgs, utm)
-        x0, y0, _ = ct.TransformPoint(-84.2458, 36.5896)
-        x1, y1, _ = ct.TransformPoint(-84.2458, 36.6896)
-        north = math.degrees(math.atan2(x1 - x0, y1 - y0))
+        north = T.utm17_grid_north(-84.2458, 36.5896, 0.1)
         print("grid azimuth of true north: %.3f deg" % north)
         for el, az in ((5, 135), (10, 135), (10, 315)):
             geo = T.translate(T.JACKSBORO, os.path.join(self.dir, "geo.tif"), {

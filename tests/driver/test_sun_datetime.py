@@ -13,7 +13,7 @@ import os
 import unittest
 
 import tsdriver as T
-from tsdriver import flat_dem, gdal, np, osr
+from tsdriver import flat_dem, gdal, np
 
 
 md = T.metadata
@@ -211,15 +211,7 @@ class SunDatetime(T.TempDirCase):
         mu = md(T.conn(utm), {"PRODUCT": "shadow", "DATETIME": dt})
         mg = md(T.conn(T.JACKSBORO), {"PRODUCT": "shadow", "DATETIME": dt})
         lat, lon = float(mu["SUN_SITE_LATITUDE"]), float(mu["SUN_SITE_LONGITUDE"])
-        wgs, u = osr.SpatialReference(), osr.SpatialReference()
-        wgs.ImportFromEPSG(4326)
-        u.ImportFromEPSG(32617)
-        for s in (wgs, u):
-            s.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
-        ct = osr.CoordinateTransformation(wgs, u)
-        x0, y0, _ = ct.TransformPoint(lon, lat)
-        x1, y1, _ = ct.TransformPoint(lon, lat + 0.01)
-        north = math.degrees(math.atan2(x1 - x0, y1 - y0))
+        north = T.utm17_grid_north(lon, lat, 0.01)
         conv = float(mu["MERIDIAN_CONVERGENCE"])
         print("UTM: convergence %.4f deg (osr: %.4f, (lon + 81) sin(lat): %.4f); sun true "
               "%s, grid %s; geographic DEM: %s" % (

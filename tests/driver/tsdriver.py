@@ -5,6 +5,7 @@ them there and exports $srcdir). They use the plugin in place:
 GDAL_DRIVER_PATH = <builddir>/plugin/.libs, set here before osgeo is
 imported, and passed on to every GDAL tool they run.
 """
+import math
 import os
 import shutil
 import subprocess
@@ -195,6 +196,21 @@ def jacksboro_utm(tmp):
              "-r", "bilinear", "-ot", "Float32", "-dstnodata", "-32768",
              JACKSBORO, out])
     return out
+
+
+def utm17_grid_north(lon, lat, dlat):
+    """The azimuth (degrees clockwise from UTM 17N's grid north) of true
+    north at (lon, lat): the grid bearing from there to dlat degrees
+    north."""
+    wgs, utm = osr.SpatialReference(), osr.SpatialReference()
+    wgs.ImportFromEPSG(4326)
+    utm.ImportFromEPSG(32617)
+    for s in (wgs, utm):
+        s.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+    ct = osr.CoordinateTransformation(wgs, utm)
+    x0, y0, _ = ct.TransformPoint(lon, lat)
+    x1, y1, _ = ct.TransformPoint(lon, lat + dlat)
+    return math.degrees(math.atan2(x1 - x0, y1 - y0))
 
 
 class TempDir:
