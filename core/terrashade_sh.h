@@ -94,6 +94,14 @@ ts_status ts_sh_project_env(const ts_env *env, double out[3][TS_SH_COEFFS], ts_e
 void ts_sh_key_light(double azimuth, double elevation, double radius_deg,
                      double out[TS_SH_COEFFS]);
 
+/**
+ * The least radius (degrees) of a key light's disk: a smaller LIGHT_RADIUS
+ * is taken as this. Order 4 cannot tell a disk of 0.01 degrees from a point
+ * (its bands differ by ~1e-7), and a swath 1e-38 degrees wide made wedge
+ * tables of float zeros and denormals: shades of 1 or NaN.
+ */
+#define TS_SH_KEY_RADIUS_MIN 0.01
+
 /** Fraction (0..1) of a disk of angular radius r centred at elevation e
  *  above the horizontal (the planar-disk chord area, as the exact shade's). */
 double ts_sh_disk_above(double elevation, double radius_deg);

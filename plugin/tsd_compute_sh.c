@@ -54,7 +54,9 @@ static ts_status key_light(const tsd_compute_ctx *c, const ts_grid *g, const tsd
                            float *shade, float *share)
 {
     const tsd_options *o = c->opts;
-    const double az = c->run->sun_azimuth, el = c->run->sun_elevation, r = o->light_radius;
+    const double az = c->run->sun_azimuth, el = c->run->sun_elevation,
+                 r = o->light_radius > TS_SH_KEY_RADIUS_MIN ? o->light_radius
+                                                            : TS_SH_KEY_RADIUS_MIN;
     const size_t cells = (size_t)g->width * g->height;
     ts_sh_swath s;
     ts_sh_wedges w;
