@@ -2,7 +2,9 @@
 #include "tsd_option_table.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "day_cycle.h"
 #include "terrashade_env.h"
@@ -378,6 +380,45 @@ static int check_exposure(const char *v, char *msg, size_t n)
                          "EXPOSURE must be AUTO or a number of stops between %g and %g, "
                          "got '%s'", -TSD_EXPOSURE_MAX, TSD_EXPOSURE_MAX, v),
                 -1);
+    return 0;
+}
+
+int tsd_option_meaning(int id, const char *v, char *out, size_t n)
+{
+    const char *name = id >= 0 && id < TSD_OPTION_COUNT ? TSD_OPTION_ROWS[id].name : "";
+    ts_error err;
+    int a, b, c;
+    if (strcmp(name, "SKY") == 0) {
+        ts_sky_kind kind;
+        if (ts_sky_parse(v, &kind, &a, &err) != TS_OK)
+            return -1;
+        snprintf(out, n, "%d:%d", (int)kind, a);
+    } else if (strcmp(name, "TIMEZONE") == 0) {
+        if (ts_parse_utc_offset(v, &a, &err) != TS_OK)
+            return -1;
+        snprintf(out, n, "%d", a);
+    } else if (strcmp(name, "DATETIME") == 0) {
+        char norm[TSD_TEXT_MAX * 2];
+        double t;
+        tsd_datetime_normalise(v, norm, sizeof norm);
+        /* the instant and its offset: the offset names a day product's day */
+        if (ts_parse_iso8601(norm, &t, &a, &err) != TS_OK)
+            return -1;
+        snprintf(out, n, "%.17g %d", t, a);
+    } else if (strcmp(name, "DATE") == 0 || strcmp(name, "START_DATE") == 0 ||
+               strcmp(name, "END_DATE") == 0) {
+        if (ts_parse_date(v, &a, &b, &c, &err) != TS_OK)
+            return -1;
+        snprintf(out, n, "%d-%d-%d", a, b, c);
+    } else if (strcmp(name, "EXPOSURE") == 0) {
+        double stops;
+        int autoexp = tsd_exposure_parse(v, &stops);
+        if (autoexp < 0)
+            return -1;
+        snprintf(out, n, autoexp ? "auto" : "%.17g", stops);
+    } else {
+        return -1;
+    }
     return 0;
 }
 

@@ -40,6 +40,12 @@ typedef struct {
 extern const opt_def TSD_OPTION_ROWS[];
 extern const int TSD_OPTION_COUNT;
 
+/** What a text option's value means, written so that two spellings of
+ *  one meaning write the same (SKY=cie9 and cie:9; TIMEZONE=-0500 and
+ *  -05:00; DATETIME's basic and extended forms; EXPOSURE=1 and 1.0): 0, or
+ *  -1 where option id has no such reading or v does not parse. */
+int tsd_option_meaning(int id, const char *v, char *out, size_t n);
+
 /** The i-th value of a '|'-list into buf ("" past the end); returns buf. */
 const char *tsd_select_value(const char *values, int index, char *buf, size_t n);
 

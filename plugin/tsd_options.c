@@ -199,7 +199,8 @@ static size_t trim(const char *s, size_t len, char *buf, size_t n)
 }
 
 /* Whether two spellings of option id's value mean the same: as numbers,
- * booleans or choices they read as, else as text (case aside). */
+ * booleans, choices or the text options' readings (tsd_option_meaning),
+ * else as text (case aside). */
 static int same_value(int id, const char *a, const char *b)
 {
     const opt_def *d = &TSD_OPTION_ROWS[id];
@@ -216,8 +217,13 @@ static int same_value(int id, const char *a, const char *b)
         if (parse_bool(a, &p) == 0 && parse_bool(b, &q) == 0)
             return p == q;
         break;
-    default:
+    default: {
+        char ma[128], mb[128];
+        if (tsd_option_meaning(id, a, ma, sizeof ma) == 0 &&
+            tsd_option_meaning(id, b, mb, sizeof mb) == 0)
+            return strcmp(ma, mb) == 0;
         break;
+    }
     }
     return strcasecmp(a, b) == 0;
 }

@@ -2,6 +2,7 @@
 #include "tsd_options.h"
 
 #include "day_cycle.h"
+#include "tsd_compute_env.h"
 #include "tsd_options_light.h"
 #include "tsd_products.h"
 #include "tsd_pyramid.h"
@@ -160,7 +161,9 @@ static int check_environment(const tsd_options *o, char *msg, size_t n)
         REFUSE("ENV_HORIZON_STEPS must be odd (3, 5, ..., 181: a node at 0 degrees, the "
                "horizon of open flat ground, which else reads too little light), got %d",
                o->env_horizon_steps);
-    if (o->exposure[0] && !tsd_options_output_byte(o))
+    /* (EXPOSURE=AUTO, the default, is no mistake) */
+    double stops;
+    if (tsd_exposure_parse(o->exposure, &stops) == 0 && !tsd_options_output_byte(o))
         REFUSE("EXPOSURE applies to OUTPUT_TYPE=Byte (the display image); Float32 "
                "keeps the light's own values");
     return 0;

@@ -328,6 +328,41 @@ class Hostile(unittest.TestCase):
         once = T.read(T.conn(DEM, PRODUCT="svf", DIRECTIONS=4))
         np.testing.assert_array_equal(twice, once)
 
+    def test_other_spellings_of_one_value_are_once(self):
+        # the text options were compared as text: SKY=cie9 inline (no colons
+        # there) and -oo SKY=cie:9, QGIS's spelling, were "given twice"
+        day = ["-oo", "PRODUCT=sunhours", "-oo", "DATE=2026-06-21"]
+        same = [
+            ("SKY", ["-oo", "PRODUCT=envlight", "-oo", "SKY=cie:9"], "SKY=cie9"),
+            ("TIMEZONE", day + ["-oo", "TIMEZONE=-05:00"], "TIMEZONE=-0500"),
+            ("TIMEZONE Z", day + ["-oo", "TIMEZONE=Z"], "TIMEZONE=+0000"),
+            ("DATETIME", ["-oo", "DATETIME=2026-06-21T14:00:00-05:00"],
+             "DATETIME=20260621T1400-0500"),
+            ("EXPOSURE", ["-oo", "PRODUCT=envlight", "-oo", "SKY=uniform", "-oo",
+                          "OUTPUT_TYPE=Byte", "-oo", "EXPOSURE=1"], "EXPOSURE=1.0"),
+            # AUTO, the declared default, is no mistake with Float32
+            ("EXPOSURE=AUTO, Float32", ["-oo", "PRODUCT=envlight", "-oo", "SKY=uniform",
+                                        "-oo", "EXPOSURE=AUTO"], "OUTPUT_TYPE=Float32"),
+        ]
+        results = run_cases([(n, ["gdalinfo", "-nomd"] + a + ["TERRASHADE:%s:%s" % (i, DEM)],
+                              True) for n, a, i in same])
+        for name, _, _ in same:
+            with self.subTest(name):
+                Hostile.count += 1
+                if isinstance(results[name], AssertionError):
+                    raise results[name]
+        other = [
+            ("SKY", ["-oo", "PRODUCT=envlight", "-oo", "SKY=cie:8"], "SKY=cie9",
+             "SKY is given twice, as cie9 and as cie:8"),
+            ("DATETIME", ["-oo", "DATETIME=2026-06-21T14:00:00-04:00"],
+             "DATETIME=20260621T1400-0500", "DATETIME is given twice"),
+            # the same instant in another offset names another local day
+            ("DATETIME offset", ["-oo", "DATETIME=2026-06-21T19:00:00Z"],
+             "DATETIME=20260621T1400-0500", "DATETIME is given twice"),
+        ]
+        self.check_failures([(n, ["gdalinfo", "-nomd"] + a + ["TERRASHADE:%s:%s" % (i, DEM)],
+                              t) for n, a, i, t in other])
+
     # --------------------------------------------------- georeferencing
 
     def test_odd_georeferencing_is_refused(self):
