@@ -237,6 +237,7 @@ CPLErr TSDataset::EnsureComputed()
             CPLDebug(DRIVER, "read the DEM in %.3f s%s", dfRead.count(),
                      bAhead ? " (waited for the read ahead)" : "");
             WarnBelowSea(&sGrid);
+            WarnVoids(&sGrid);
             if (m_psProduct->byte == TSD_BYTE_ALWAYS)
                 m_pabyProduct = static_cast<GByte *>(VSI_MALLOC2_VERBOSE(nCells, nBands));
             else
@@ -484,6 +485,22 @@ void TSDataset::WarnBelowSea(const ts_grid *g)
     CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szWarning);
 }
 
+/* Voids wider than MAX_DISTANCE (tsd_grid_voids_warning), from the whole
+ * DEM's grid (or an overview level's) or a chunk's (a run of voids cut by
+ * the chunk's edge is at least as wide as it shows): once per DEM. A reprojected
+ * DEM's collar, or a lake left nodata, put openness of up to 150 degrees
+ * along its border, unsaid (EDGE=horizon and nodata did not apply there). */
+void TSDataset::WarnVoids(const ts_grid *g)
+{
+    char szWarning[768];
+    std::atomic<bool> &bWarned = (m_poBase ? m_poBase : this)->m_bVoidsWarned;
+    if (bWarned || !tsd_product_takes(m_psProduct, tsd_option_find("MAX_DISTANCE")) ||
+        !tsd_grid_voids_warning(g, m_sOpts.max_distance, szWarning, sizeof szWarning) ||
+        bWarned.exchange(true))
+        return;
+    CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szWarning);
+}
+
 /* Everything that follows from the georeferencing (m_adfGT, m_bHasGT,
  * m_oSRS) of a W x H grid and the options: the cells, the sun, the memory
  * check, the bands, the metadata and (level 0) PAM. Shared by the DEM's
@@ -546,6 +563,7 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
         CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szMsg);
     if (m_nLevel == 0)
     {
+        WarnUnusedOptions();
         WarnDistances(dfMinCell, W, H);
         WarnSweepTurn(H);
     }

@@ -152,9 +152,12 @@ class TSDataset final : public GDALPamDataset
     void WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfLon, double dfLat);
     void WarnDistances(double dfMinCell, int W, int H);
     void WarnSweepTurn(int H);
+    void WarnUnusedOptions();
     void WarnBelowSea(const ts_grid *g);
+    void WarnVoids(const ts_grid *g);
     void WarnSkyAtNight() const;
     std::atomic<bool> m_bBelowSeaWarned{false}; // WarnBelowSea: once per dataset
+    std::atomic<bool> m_bVoidsWarned{false};   // WarnVoids: once per dataset
     static GDALDataset *OpenDEM(const char *pszDEM);
     ts_status LoadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg);
     void StartReadAhead();

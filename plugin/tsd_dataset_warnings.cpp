@@ -127,6 +127,20 @@ void TSDataset::WarnDistances(double dfCell, int W, int H)
              m_sOpts.max_distance * dfCell);
 }
 
+/* An option given for a product that does not use it does nothing: said,
+ * where an audit found eleven such silent for svf alone (SUN_AZIMUTH,
+ * STEP_MINUTES, FAR_THRESHOLD...) and farshadow's TILE_SIZE, beside
+ * options refused for the same reason (tsd_options_check). */
+void TSDataset::WarnUnusedOptions()
+{
+    char szList[1024];
+    const int nUnused = tsd_options_unused(&m_sOpts, m_psProduct, szList, sizeof szList);
+    if (nUnused > 0)
+        CPLError(CE_Warning, CPLE_AppDefined,
+                 "TERRASHADE: PRODUCT=%s does not use %s: given, %s nothing here",
+                 m_psProduct->name, szList, nUnused > 1 ? "they do" : "it does");
+}
+
 /* Degrees of arc from the DEM's centre beyond which SUN_POSITION=center warns. */
 static const double SUN_REACH_WARN_DEG = 1.0;
 

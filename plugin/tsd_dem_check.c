@@ -328,3 +328,69 @@ int tsd_grid_below_sea_warning(const ts_grid *g, char *warning, size_t n)
              lowest);
     return 1;
 }
+
+/* The longest run of voids among n cells step apart that has valid cells
+ * on one side at least (all voids: none), in cells; its first index. */
+static int longest_voids(const float *z, ptrdiff_t step, int n, int *first)
+{
+    int best = 0, run = 0, seen_valid = 0;
+    for (int k = 0; k <= n; k++) {
+        if (k < n && isnan(z[k * step])) {
+            run++;
+            continue;
+        }
+        /* a run ended by a valid cell, or by the edge after valid ones */
+        if (run > best && (k < n || seen_valid))
+            best = run, *first = k - run;
+        seen_valid |= k < n;
+        run = 0;
+    }
+    return best;
+}
+
+int tsd_grid_voids_warning(const ts_grid *g, double max_distance, char *warning, size_t n)
+{
+    const int W = g->width, H = g->height;
+    double widest = 0;
+    int row = 0, line = 0, from = 0, len = 0;
+    for (int y = 0; y < H; y++) {
+        int first = 0;
+        const int k = longest_voids(g->z + (ptrdiff_t)y * g->stride, 1, W, &first);
+        if (k * ts_grid_cell_x(g, y) > widest)
+            widest = k * ts_grid_cell_x(g, y), row = 1, line = y, from = first, len = k;
+    }
+    for (int x = 0; x < W; x++) {
+        int first = 0;
+        const int k = longest_voids(g->z + x, g->stride, H, &first);
+        if (k * g->cell_y > widest)
+            widest = k * g->cell_y, row = 0, line = x, from = first, len = k;
+    }
+    if (!(max_distance > 0 && widest > max_distance))
+        return 0;
+    /* in the whole DEM's cells where g is a window of it, where a run cut
+     * by the window's edge is at least as wide as it shows */
+    const ts_grid_origin *o = g->origin;
+    const int ox = o ? o->x0 : 0, oy = o ? o->y0 : 0;
+    const int full = row ? (o ? o->full_width : W) : (o ? o->full_height : H);
+    const int cut = (from == 0 && (row ? ox : oy) > 0) ||
+                    (from + len == (row ? W : H) && from + len + (row ? ox : oy) < full);
+    line += row ? oy : ox;
+    from += row ? ox : oy;
+    const int edge = from == 0 || from + len == full;
+    snprintf(warning, n,
+             "the DEM has nodata %s %s%.0f m across (%s %d, cells %d to %d), wider than "
+             "MAX_DISTANCE=%g m: a ray that meets no valid cell within MAX_DISTANCE has no "
+             "horizon (-90 degrees), so the cells along such voids look down into them: "
+             "openness up to 150 degrees, svf and sky a little higher there%s. Fill the "
+             "voids (gdal_fillnodata.py)%s, or give no MAX_DISTANCE (rays then cross the "
+             "voids to the terrain beyond)",
+             edge ? "along its edge (a collar, as from gdalwarp)" : "voids",
+             cut ? "at least " : "", widest,
+             row ? "row" : "column", line, from, from + len - 1, max_distance,
+             edge ? "; EDGE applies at the grid's edge, not at the data's, so EDGE=horizon "
+                    "does not raise them and EDGE=nodata leaves them valid"
+                  : "",
+             edge ? ", crop the collar (gdalwarp -crop_to_cutline, gdal_translate -projwin)"
+                  : "");
+    return 1;
+}

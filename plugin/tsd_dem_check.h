@@ -88,6 +88,18 @@ ts_status tsd_dem_check(GDALRasterBandH band, const tsd_dem_conversion *c, const
  */
 int tsd_grid_below_sea_warning(const ts_grid *g, char *warning, size_t warning_size);
 
+/**
+ * A sentence for a MAX_DISTANCE of `max_distance` metres shorter than the
+ * widest run of nodata cells along a row or column of the grid `g` (the
+ * DEM's or a window of it) that has valid cells beside it: a
+ * collar from the grid's edge (a reprojected or clipped DEM) or an inner
+ * void (lidar's water). A ray that meets no valid cell within the distance
+ * has no horizon (-90 degrees), so cells along such voids look down into
+ * them. Returns 1 with the sentence, else 0.
+ */
+int tsd_grid_voids_warning(const ts_grid *g, double max_distance, char *warning,
+                           size_t warning_size);
+
 #ifdef __cplusplus
 }
 #endif

@@ -249,6 +249,27 @@ void tsd_products_taking(int option, const char *prefix, const char *last, char 
     }
 }
 
+int tsd_options_unused(const tsd_options *o, const tsd_product_def *p, char *buf, size_t n)
+{
+    int count = 0;
+    size_t used = 0;
+    char list[256];
+    buf[0] = '\0';
+    for (int i = 0; i < tsd_options_count(); i++) {
+        if (!(o->given >> i & 1) || !(tsd_option_scope(i) & TSD_SCOPE_PRODUCT) ||
+            tsd_option_applies(i) != TSD_APPLIES_LISTED || tsd_product_takes(p, i))
+            continue;
+        tsd_products_taking(i, "", " and ", list, sizeof list);
+        /* "SUN_AZIMUTH (an option of shade, shadow and envlight)" */
+        if (used < n)
+            used += (size_t)snprintf(buf + used, n - used, "%s%s (an option of %s)",
+                                     count ? ", " : "",
+                                     tsd_option_name(i), list);
+        count++;
+    }
+    return count;
+}
+
 /* Horizon planes a HORIZON_METHOD=pyramid run holds at once: none where it
  * sums the sky terms row by row (svf, sky, openness, shade's uniform sky);
  * METHOD=sh's swath, or a batch of DIRECTIONS, where it hands out planes. */

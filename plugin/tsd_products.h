@@ -94,6 +94,13 @@ void tsd_products_taking(int option, const char *prefix, const char *last, char 
                          size_t n);
 
 /**
+ * The options given in o (tsd_options_given) that product p does not
+ * take, each with the products that do: "SUN_AZIMUTH (an option of shade,
+ * shadow and envlight), STEP_MINUTES (...)" into buf; returns how many.
+ */
+int tsd_options_unused(const tsd_options *o, const tsd_product_def *p, char *buf, size_t n);
+
+/**
  * Peak memory in bytes while computing a width x height product, the DEM
  * grid included; `steady` (may be NULL) receives what stays afterwards
  * (the product, as float planes, or byte planes). Doubles, so that nothing

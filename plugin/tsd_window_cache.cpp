@@ -274,7 +274,10 @@ bool TSDataset::ComputeChunk(int cx, int cy, WindowChunk &c)
     const ts_grid_origin sOrigin{ax0, ay0, s.refCellX, W, H};
     sGrid.origin = &sOrigin;
     if (eSt == TS_OK)
+    {
         WarnBelowSea(&sGrid);
+        WarnVoids(&sGrid); // (in the DEM's cells: not from the coarse far grid)
+    }
     const int nBands = tsd_options_band_count(&m_sOpts);
     const size_t nCells = static_cast<size_t>(aw) * ah;
     float *pafOut = nullptr;

@@ -231,6 +231,44 @@ class Nodata(unittest.TestCase):
             self.assertAlmostEqual(T.read(T.conn(geo, OUTPUT_TYPE="Float32"), 1)[0, 0],
                                    np.sin(np.radians(45)), 5)
 
+    def test_voids_wider_than_max_distance_are_said(self):
+        """A ray that meets no valid cell within MAX_DISTANCE has no horizon
+        (-90): the cells along a nodata collar (gdalwarp's) or a lake left
+        nodata, wider than the distance, read openness up to ~135-150
+        degrees, unsaid until session 51. Now a warning names the void,
+        whole and windowed, once; none without MAX_DISTANCE or where the
+        voids are narrower than it."""
+        z = T.fractal_dem(160, seed=5) + 400
+        collar = z.copy()
+        collar[:, :40] = np.nan          # 40 cells = 1200 m from the west edge
+        lake = z.copy()
+        lake[60:100, 70:110] = np.nan    # 40 x 40 cells inside
+        with T.TempDir() as tmp:
+            dems = {n: T.write_tif(os.path.join(tmp, n + ".tif"), a, GT, 32617)
+                    for n, a in (("collar", collar), ("lake", lake))}
+            said = {"collar": ("nodata along its edge (a collar", "1200 m across",
+                               "EDGE=horizon does not raise them"),
+                    "lake": ("nodata voids ", "m across")}
+            for name, dem in dems.items():
+                for window in ({}, {"TILE_SIZE": 64, "NEAR_DISTANCE": 900}):
+                    with self.subTest(name=name, window=window):
+                        err = T.translate_stderr(dem, PRODUCT="openness", MAX_DISTANCE=600,
+                                                 DIRECTIONS=8, **window)
+                        self.assertEqual(err.count("wider than MAX_DISTANCE=600 m"), 1, err)
+                        for text in said[name]:
+                            self.assertIn(text, err)
+                        if not window:  # (a chunk may see part of the void)
+                            self.assertIn("1200 m across" if name == "collar" else
+                                          "1200 m across (row 60, cells 70 to 109)", err)
+                        # the effect it warns of: open sky into the void
+                        o = T.read(T.conn(dem, PRODUCT="openness", MAX_DISTANCE=600,
+                                          DIRECTIONS=8, **window), 1)
+                        self.assertGreater(np.nanmax(o), 120)
+                        for quiet in (dict(MAX_DISTANCE=1500), {}):
+                            err = T.translate_stderr(dem, PRODUCT="openness", DIRECTIONS=8,
+                                                     **dict(window, **quiet))
+                            self.assertNotIn("MAX_DISTANCE", err)
+
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)

@@ -142,6 +142,26 @@ class Options(unittest.TestCase):
         self.assertFalse(warned(PRODUCT="svf", MAX_DISTANCE=30))
         self.assertFalse(warned(PRODUCT="svf"))
 
+    def test_options_a_product_does_not_use_warn(self):
+        """An option that does nothing for the product (SUN_AZIMUTH for svf,
+        TILE_SIZE for farshadow: eleven were silent for svf alone) opens with
+        one warning that names each and the products that use it; the
+        options a product uses, and those of every product, say nothing."""
+        err = T.open_stderr(self.dem, PRODUCT="svf", SUN_AZIMUTH=100, STEP_MINUTES=10)
+        self.assertIn("Warning 1: TERRASHADE: PRODUCT=svf does not use SUN_AZIMUTH (an "
+                      "option of shade, shadow and envlight), STEP_MINUTES (an option of "
+                      "sunhours, insolation and daycycle): given, they do nothing here", err)
+        self.assertEqual(err.count("does not use"), 1)
+        err = T.open_stderr(self.dem, PRODUCT="farshadow", DATE="2026-06-21", TIMEZONE="Z",
+                            TILE_SIZE=128)
+        self.assertIn("PRODUCT=farshadow does not use TILE_SIZE (an option of shade, ", err)
+        self.assertIn("given, it does nothing here", err)
+        for oo in (dict(PRODUCT="svf", DIRECTIONS=8, MAX_DISTANCE=500, THREADS=1),
+                   dict(PRODUCT="shade", SUN_AZIMUTH=100, TILE_SIZE=128, Z_FACTOR=2),
+                   dict(PRODUCT="sunhours", DATE="2026-06-21", TIMEZONE="Z",
+                        STEP_MINUTES=10)):
+            self.assertNotIn("does not use", T.open_stderr(self.dem, **oo), oo)
+
     def test_curvature_and_refraction(self):
         """On a big flat-topped DEM the Earth's curvature lowers far horizons;
         refraction k = 1 cancels it."""
