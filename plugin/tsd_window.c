@@ -174,9 +174,13 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
         p->why_whole = "TILE_SIZE=0";
     else if (W <= o->tile_size && H <= o->tile_size)
         p->why_whole = "the DEM fits in one tile";
+    const int fits = p->why_whole != NULL && o->tile_size != 0;
     if (!p->why_whole)
         p->why_whole = whole_by_method(o, d);
-    if (p->why_whole)
+    /* a DEM within one tile still has its NEAR_DISTANCE checked, so that
+     * whether it is refused does not depend on the DEM's size (a script
+     * that ran on a small DEM failed on a larger one) */
+    if (p->why_whole && !(fits && o->near_distance > 0 && !whole_by_method(o, d)))
         return 0;
     double cell = cells_min_x < cell_y ? cells_min_x : cell_y;
     /* the far grid's coarsening that keeps it within TSD_FAR_MAX_CELLS */
@@ -207,6 +211,8 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
                      : TSD_FAR_CELLS_PER_NEAR * f_mem);
         return -1;
     }
+    if (p->why_whole) /* (the check above alone) */
+        return 0;
     /* the sweep samples a cell's neighbours too: two cells more */
     double mx = ceil_cells(p->near_m, cells_min_x) + 2.0, my = ceil_cells(p->near_m, cell_y) + 2.0;
     p->margin_x = mx < W ? (int)mx : W;

@@ -242,6 +242,11 @@ def main():
                               PROGRESS="no")
                     if group is not EDGE_VARIANTS and product in edge_products:
                         oo["EDGE"] = "open"  # the record from before EDGE
+                    if dem_name == "lux" and name == "svf_tiled":
+                        # 2000 m is 3.4 of lux's cells, refused since session
+                        # 51 where lux fits in one tile (the whole DEM, the
+                        # same pixels without it)
+                        del oo["NEAR_DISTANCE"]
                     ds = gdal.OpenEx("TERRASHADE:" + dem,
                                      open_options=["%s=%s" % kv for kv in oo.items()])
                     a = read_all(ds)

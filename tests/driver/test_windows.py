@@ -401,6 +401,14 @@ np.save(sys.argv[2], a)
         self.refused({"NEAR_DISTANCE": 2e6}, ["NEAR_DISTANCE"])
         self.refused({"TILE_SIZE": 128, "NEAR_DISTANCE": 300},
                      ["NEAR_DISTANCE=300 m is", "cells of this DEM", "at least 16 cells"])
+        # also where the DEM fits in one tile (jacksboro, 403 x 344, under the
+        # default 4096), so that a script that runs on a small DEM runs on a
+        # larger one: it was accepted there, and refused on a larger DEM
+        self.refused({"NEAR_DISTANCE": 300}, ["NEAR_DISTANCE=300 m is", "at least 16 cells"])
+        T.run(["gdalinfo", "-oo", "NEAR_DISTANCE=300", "-oo", "MAX_DISTANCE=300",
+               T.conn(T.JACKSBORO)])
+        T.run(["gdalinfo", "-oo", "NEAR_DISTANCE=300", "-oo", "TILE_SIZE=0",
+               T.conn(T.JACKSBORO)])
 
     def test_plan_sizes(self):
         """A window's margin of more cells than an int holds (MAX_DISTANCE
