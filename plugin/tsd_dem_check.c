@@ -56,17 +56,25 @@ static int height_limits(GDALRasterBandH band, const tsd_dem_conversion *c, doub
     return earth;
 }
 
-/* The remedies' sentence: declare `z` (a grid height) as nodata when the
- * grid holds the DEM's own values, or set a unit. */
+static float raw_metres(double raw, const tsd_dem_conversion *c);
+
+/* The remedies' sentence: declare `z` (a grid height, of the band's cell
+ * col, row) as nodata when the grid holds the DEM's own values, or set a
+ * unit. The value declared is the band's own, read again: z, a float, holds
+ * 24 bits, so that an Int32 void -2147483648 was named -2.14748365e+09,
+ * which declared did not match it. */
 static void remedies(GDALRasterBandH band, const tsd_dem_conversion *c, int full, float z,
-                     char *out, size_t n)
+                     int col, int row, char *out, size_t n)
 {
     GDALDatasetH ds = GDALGetBandDataset(band);
     const char *path = ds ? GDALGetDescription(ds) : "";
-    const double raw = ((double)z - c->offset) / c->scale; /* as the band holds it */
+    double raw = ((double)z - c->offset) / c->scale, cell; /* as the band holds it */
+    if (full && GDALRasterIO(band, GF_Read, col, row, 1, 1, &cell, 1, 1, GDT_Float64, 0, 0) ==
+                    CE_None && raw_metres(cell, c) == z)
+        raw = cell;
     char declare[TSD_PATH_MAX + 160] = ""; /* the DEM's name, whole */
     if (full && isfinite(raw))
-        snprintf(declare, sizeof declare, " (gdal_edit.py -a_nodata %.9g %s)", raw, path);
+        snprintf(declare, sizeof declare, " (gdal_edit.py -a_nodata %.17g %s)", raw, path);
     snprintf(out, n,
              "A nodata value the DEM does not declare? Declare it%s and those cells are "
              "nodata. Heights in another unit? Set the band's unit (gdal_edit.py -units ft) "
@@ -92,7 +100,7 @@ static ts_status height_error(GDALRasterBandH band, const tsd_dem_conversion *c,
     }
     const int full = p->sx == 1 && p->sy == 1; /* else a coarse cell: an average */
     char todo[TSD_PATH_MAX + 320];
-    remedies(band, c, full, z, todo, sizeof todo);
+    remedies(band, c, full, z, p->x0 + gx, p->y0 + gy, todo, sizeof todo);
     GDALDatasetH ds = GDALGetBandDataset(band);
     return tsd_fail(msg, n, TS_ERR_ARG,
                     "the DEM '%s' holds a height no terrain has: %.6g m%s in band %d %s "
@@ -129,7 +137,7 @@ static ts_status cliff_error(GDALRasterBandH band, const tsd_dem_conversion *c,
         v = b;
     const int full = p->sx == 1 && p->sy == 1;
     char todo[TSD_PATH_MAX + 320];
-    remedies(band, c, full, v, todo, sizeof todo);
+    remedies(band, c, full, v, p->x0 + gx + (v == a ? 0 : 1), p->y0 + gy, todo, sizeof todo);
     GDALDatasetH ds = GDALGetBandDataset(band);
     return tsd_fail(msg, n, TS_ERR_ARG,
                     "the DEM '%s' holds a cliff no terrain has: %.6g m beside %.6g m%s in "

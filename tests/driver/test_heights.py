@@ -124,6 +124,25 @@ class ImpossibleHeights(unittest.TestCase):
         self.assertIn("holds -32768, the value Int16 DEMs leave in their voids, in band 1 "
                       "near column 334, row 402", err)
 
+    def test_32_bit_voids_are_named_exactly(self):
+        """The value the remedy declares is the band's own: an Int32 void
+        -2147483648 was named from its float height, -2.14748365e+09, which
+        declared (gdal_edit.py) matched no cell, and the error came back;
+        so did UInt32's 4294967295 and an Int32 -99999999 (-100000000). The
+        remedy as given makes them nodata."""
+        for dtype, void in ((gdal.GDT_Int32, -2147483648), (gdal.GDT_UInt32, 4294967295),
+                            (gdal.GDT_Int32, -99999999)):
+            name = "%s_%d.tif" % (gdal.GetDataTypeName(dtype), void)
+            z = np.round(self.z).astype(np.float64)  # (float32 holds 24 bits)
+            z[40:52, 30:47] = void
+            with self.subTest(dem=name):
+                dem = self.dem(name, z, dtype=dtype)
+                err = failure(T.conn(dem, PRODUCT="svf", DIRECTIONS=4))
+                self.assertIn("gdal_edit.py -a_nodata %d %s" % (void, dem), err)
+                T.run(["gdal_edit.py", "-a_nodata", str(void), dem])
+                out = T.read(T.conn(dem, PRODUCT="svf", DIRECTIONS=4), 1)
+                np.testing.assert_array_equal(np.isnan(out), z == void)
+
     def test_declared_it_is_nodata(self):
         """The remedy the error gives works: the void is nodata in the output."""
         z = self.with_void(-32768)
@@ -141,7 +160,7 @@ class ImpossibleHeights(unittest.TestCase):
                 err = failure(T.conn(dem, TILE_SIZE=0))
                 self.assertIn("holds a height no terrain has: %.6g m in band 1 at column 30, "
                               "row 40" % np.float32(value), err)
-                self.assertIn("-a_nodata %.9g" % np.float32(value), err)
+                self.assertIn("-a_nodata %.17g " % np.float32(value), err)
             with self.subTest(value=value, path="windows"):
                 err = failure(T.conn(dem, TILE_SIZE=64))
                 self.assertIn("holds a height no terrain has", err)
