@@ -104,6 +104,15 @@ void TSDataset::WarnDistances(double dfCell, int W, int H)
                  "so the maps are empty or nearly. Give a shorter one (e.g. "
                  "FAR_THRESHOLD=%d)",
                  m_sOpts.far_threshold, W, H, std::max(1, std::max(W, H) / 8));
+    // every ray leaves the DEM somewhere: an all-nodata product, which
+    // gdalinfo -stats then calls "no valid pixels" (an audit)
+    // (METHOD=shadowmap refuses EDGE=nodata)
+    if (tsd_options_edge(&m_sOpts) == TS_EDGE_NODATA && !(m_sOpts.max_distance > 0))
+        CPLError(CE_Warning, CPLE_AppDefined,
+                 "TERRASHADE: EDGE=nodata without MAX_DISTANCE makes every cell nodata: it "
+                 "leaves out the cells whose rays leave the DEM within MAX_DISTANCE, and "
+                 "unbounded every ray leaves it. Give MAX_DISTANCE (e.g. the reach of the "
+                 "terrain that matters), or EDGE=horizon or open");
     const bool bShm = m_sOpts.max_distance > 0 && m_sOpts.method == TSD_METHOD_SHM &&
                       tsd_product_takes(m_psProduct, tsd_option_find("METHOD"));
     if (bShm)

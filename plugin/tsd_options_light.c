@@ -54,5 +54,10 @@ int tsd_options_check_light(const tsd_options *o, char *msg, size_t n)
     if (shadowmap && o->max_distance > 0)
         REFUSE("MAX_DISTANCE does not apply to METHOD=shadowmap (its depth map holds the "
                "whole DEM); use METHOD=exact");
+    /* it left every cell valid, where unbounded EDGE=nodata blanks them all */
+    if (shadowmap && tsd_options_edge(o) == TS_EDGE_NODATA)
+        REFUSE("EDGE=nodata does not apply to METHOD=shadowmap (it leaves out the cells "
+               "whose rays leave the DEM within MAX_DISTANCE, which METHOD=shadowmap does "
+               "not take); use METHOD=exact with MAX_DISTANCE, or EDGE=horizon or open");
     return 0;
 }

@@ -247,6 +247,20 @@ class Edge(unittest.TestCase):
         self.assertIn("EDGE applies to", p.stderr)
         self.assertIn("not to PRODUCT=farshadow", p.stderr)
 
+    def test_unbounded_nodata_warns_and_shadowmap_refuses_it(self):
+        """EDGE=nodata without MAX_DISTANCE blanks every cell (every ray
+        leaves the DEM): a warning says so, where gdalinfo -stats only said
+        "no valid pixels"; none with MAX_DISTANCE. METHOD=shadowmap, which
+        takes no MAX_DISTANCE, left every cell valid under it: refused."""
+        err = T.translate_stderr(self.flat, PRODUCT="svf", EDGE="nodata")
+        self.assertIn("EDGE=nodata without MAX_DISTANCE makes every cell nodata", err)
+        self.assertTrue(np.isnan(T.read(T.conn(self.flat), 1,
+                                        dict(PRODUCT="svf", EDGE="nodata"))).all())
+        self.assertNotIn("EDGE=nodata", T.translate_stderr(self.flat, PRODUCT="svf",
+                                                           EDGE="nodata", MAX_DISTANCE=100))
+        p = T.run(["gdalinfo", T.conn(self.flat, METHOD="shadowmap", EDGE="nodata")], ok=False)
+        self.assertIn("EDGE=nodata does not apply to METHOD=shadowmap", p.stderr)
+
     def test_metadata_lists_edge_where_it_applies(self):
         import xml.etree.ElementTree as ET
         xml = gdal.GetDriverByName("TERRASHADE").GetMetadataItem("TERRASHADE_PRODUCTS")
