@@ -92,8 +92,9 @@ ts_status ts_sky_parse(const char *name, ts_sky_kind *kind, int *cie_type, ts_er
         /* cie:N, or cieN where a ':' cannot go (an inline connection string) */
         const char *num = name + 3 + (name[3] == ':');
         char *end;
-        long n = strtol(num, &end, 10);
-        if (end != num && *end == '\0' && n >= 1 && n <= 15) {
+        /* digits only: strtol took 'cie: 9' and 'cie:+9' too */
+        long n = *num >= '0' && *num <= '9' ? strtol(num, &end, 10) : 0;
+        if (n && *end == '\0' && n >= 1 && n <= 15) {
             *kind = TS_SKY_CIE;
             *cie_type = (int)n;
             return ts_ok(err);

@@ -9,6 +9,7 @@
  */
 #include <math.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #include "status_internal.h"
 #include "terrashade_sun.h"
@@ -84,6 +85,29 @@ void ts_sun_input_default(ts_sun_input *in)
     in->atmos_refraction = TS_SUN_DEFAULT_ATMOS_REFRACTION;
 }
 
+/* Julian day jd as "YYYY-MM-DD hh:mm UTC" (the inverse of
+ * ts_days_from_civil, H. Hinnant's civil_from_days). */
+static void utc_text(double jd, char *out, size_t n)
+{
+    if (!(fabs(jd) < 1e11)) { /* beyond any calendar date a long long holds */
+        snprintf(out, n, "far outside the years -2000 to 6000");
+        return;
+    }
+    /* to the nearest minute (a day's end, 05:00, read 04:59) */
+    const double all = floor((jd - TS_JD_UNIX_EPOCH) * 1440.0 + 0.5);
+    const double days = floor(all / 1440.0);
+    const int minutes = (int)(all - days * 1440.0);
+    long long z = (long long)days + 719468;
+    const long long era = (z >= 0 ? z : z - 146096) / 146097;
+    const long long doe = z - era * 146097;
+    const long long yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
+    const long long doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    const long long mp = (5 * doy + 2) / 153;
+    const int d = (int)(doy - (153 * mp + 2) / 5 + 1), m = (int)(mp < 10 ? mp + 3 : mp - 9);
+    snprintf(out, n, "%lld-%02d-%02d %02d:%02d UTC", yoe + era * 400 + (m <= 2), m, d,
+             minutes / 60, minutes % 60);
+}
+
 ts_status ts_sun_input_validate(const ts_sun_input *in, ts_error *err)
 {
     if (!in)
@@ -109,11 +133,16 @@ ts_status ts_sun_input_validate(const ts_sun_input *in, ts_error *err)
     /* The paper's range of validity: years -2000 to 6000. */
     double jd_min = (double)ts_days_from_civil(-2000, 1, 1) + TS_JD_UNIX_EPOCH;
     double jd_max = (double)ts_days_from_civil(6001, 1, 1) + TS_JD_UNIX_EPOCH;
-    if (in->jd < jd_min || in->jd >= jd_max)
+    if (in->jd < jd_min || in->jd >= jd_max) {
+        /* the instant in UTC: a local day of 6000-12-31 west of Greenwich
+         * ends in 6001, which a Julian day alone did not show */
+        char when[64];
+        utc_text(in->jd, when, sizeof when);
         return ts_fail(err, TS_ERR_ARG,
-                       "The date (Julian day %.6f) must lie between the years -2000 "
-                       "and 6000, where the solar position algorithm is valid.",
-                       in->jd);
+                       "The instant %s (Julian day %.6f) must lie between the years -2000 "
+                       "and 6000 (UTC), where the solar position algorithm is valid.",
+                       when, in->jd);
+    }
     if (in->longitude < -180.0 || in->longitude > 180.0)
         return ts_fail(err, TS_ERR_ARG,
                        "Longitude must be between -180 and 180 degrees (east "

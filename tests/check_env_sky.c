@@ -201,9 +201,10 @@ START_TEST(test_sky_parse)
     ck_assert(ts_sky_parse("cie9", &kind, &type, &err) == TS_OK && kind == TS_SKY_CIE &&
               type == 9);
     ck_assert(ts_sky_parse("CIE12", &kind, &type, &err) == TS_OK && type == 12);
+    /* (strtol took a blank or a sign: 'cie: 9', 'cie:+9', 'cie -3') */
     const char *bad[] = {"cie:0", "cie:16", "cie:", "cie:3x", "sunny", "", "cie", "cie0",
-                         "cie16", "cie::3"};
-    for (int i = 0; i < 10; i++) {
+                         "cie16", "cie::3", "cie: 9", "cie:+9", "cie -3", "cie:-1"};
+    for (int i = 0; i < (int)(sizeof bad / sizeof bad[0]); i++) {
         ck_assert(ts_sky_parse(bad[i], &kind, &type, &err) == TS_ERR_ARG);
         ck_assert(err.message[0] != 0);
     }

@@ -247,12 +247,14 @@ class Year(unittest.TestCase):
                 os.remove(out)
         # the sun's years (-2000 to 6000) at both ends of the day or range, at
         # open: a day ending past them opened, then failed on the first read
+        # (the instant in UTC named: a day of 6000-12-31 west of Greenwich
+        # ends in 6001, which the Julian day alone did not show)
         for oo, text in ((["PRODUCT=sunhours", "DATE=6000-12-31", "TIMEZONE=-01:00"],
-                          "DATE: The date (Julian day"),
+                          "DATE: The instant 6001-01-01 01:00 UTC (Julian day"),
                          (["PRODUCT=insolation", "DATE=6001-01-01", "TIMEZONE=+01:00"],
-                          "DATE: The date (Julian day"),
+                          "DATE: The instant 6001-01-01 23:00 UTC (Julian day"),
                          (["PRODUCT=sunhours", "START_DATE=6000-12-01", "END_DATE=6001-01-05",
-                           "TIMEZONE=Z"], "END_DATE (the range's end): The date")):
+                           "TIMEZONE=Z"], "END_DATE (the range's end): The instant 6001-01-06")):
             with self.subTest(oo=oo):
                 p = T.run(["gdalinfo"] + [a for o in oo for a in ("-oo", o)] +
                           [T.conn(self.dem)], ok=False)
