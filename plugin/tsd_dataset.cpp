@@ -493,9 +493,13 @@ void TSDataset::WarnBelowSea(const ts_grid *g)
 void TSDataset::WarnVoids(const ts_grid *g)
 {
     char szWarning[768];
-    std::atomic<bool> &bWarned = (m_poBase ? m_poBase : this)->m_bVoidsWarned;
+    TSDataset *poBase = m_poBase ? m_poBase : this; // (an overview level's cells: in its)
+    std::atomic<bool> &bWarned = poBase->m_bVoidsWarned;
     if (bWarned || !tsd_product_takes(m_psProduct, tsd_option_find("MAX_DISTANCE")) ||
-        !tsd_grid_voids_warning(g, m_sOpts.max_distance, szWarning, sizeof szWarning) ||
+        !tsd_grid_voids_warning(g, m_sOpts.max_distance,
+                                static_cast<double>(poBase->nRasterXSize) / nRasterXSize,
+                                static_cast<double>(poBase->nRasterYSize) / nRasterYSize,
+                                szWarning, sizeof szWarning) ||
         bWarned.exchange(true))
         return;
     CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szWarning);

@@ -356,7 +356,8 @@ static int longest_voids(const float *z, ptrdiff_t step, int n, int *first)
     return best;
 }
 
-int tsd_grid_voids_warning(const ts_grid *g, double max_distance, char *warning, size_t n)
+int tsd_grid_voids_warning(const ts_grid *g, double max_distance, double per_x, double per_y,
+                           char *warning, size_t n)
 {
     const int W = g->width, H = g->height;
     double widest = 0;
@@ -385,6 +386,12 @@ int tsd_grid_voids_warning(const ts_grid *g, double max_distance, char *warning,
     line += row ? oy : ox;
     from += row ? ox : oy;
     const int edge = from == 0 || from + len == full;
+    /* an overview level's cells, in the DEM's */
+    const double along = row ? per_x : per_y, across = row ? per_y : per_x;
+    line = (int)(line * across);
+    const int last = (int)((from + len) * along) - 1;
+    from = (int)(from * along);
+    len = last - from + 1;
     snprintf(warning, n,
              "the DEM has nodata %s %s%.0f m across (%s %d, cells %d to %d), wider than "
              "MAX_DISTANCE=%g m: a ray that meets no valid cell within MAX_DISTANCE has no "

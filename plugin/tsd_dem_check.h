@@ -95,10 +95,12 @@ int tsd_grid_below_sea_warning(const ts_grid *g, char *warning, size_t warning_s
  * collar from the grid's edge (a reprojected or clipped DEM) or an inner
  * void (lidar's water). A ray that meets no valid cell within the distance
  * has no horizon (-90 degrees), so cells along such voids look down into
- * them. Returns 1 with the sentence, else 0.
+ * them. The sentence names the void's row or column in the DEM's cells,
+ * per_x and per_y of them to a cell of g (an overview level's: 2, 4...).
+ * Returns 1 with the sentence, else 0.
  */
-int tsd_grid_voids_warning(const ts_grid *g, double max_distance, char *warning,
-                           size_t warning_size);
+int tsd_grid_voids_warning(const ts_grid *g, double max_distance, double per_x, double per_y,
+                           char *warning, size_t warning_size);
 
 #ifdef __cplusplus
 }
