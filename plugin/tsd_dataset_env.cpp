@@ -188,7 +188,8 @@ void TSDataset::SetupEnvironmentMetadata()
         "ENV_FLAT_LIGHT", CPLSPrintf("%.6g,%.6g,%.6g", e.flat[0], e.flat[1], e.flat[2]));
     if (m_psProduct->compute == tsd_compute_envlight && tsd_options_output_byte(&m_sOpts))
     {
-        GDALDataset::SetMetadataItem("EXPOSURE", CPLSPrintf("%.6g", e.exposure));
+        // (+ 0.0: an automatic exposure of a peak of 1 is -log2(1) = -0)
+        GDALDataset::SetMetadataItem("EXPOSURE", CPLSPrintf("%.6g", e.exposure + 0.0));
         GDALDataset::SetMetadataItem("EXPOSURE_RULE",
                                      e.exposure_auto ? "auto: the brightest unshadowed "
                                                        "surface maps to 255"

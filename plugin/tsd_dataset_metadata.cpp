@@ -104,9 +104,22 @@ void TSDataset::SetupMetadata()
 {
     char szValue[TSD_PATH_MAX]; // ENV_MAP's whole path
     const int nBands = GetRasterCount();
+    // envlight under ENV_MAP, or a sky without a sun (uniform, overcast):
+    // no sun lights it, so its options record none (SUN_AZIMUTH=315 read
+    // as the light's direction)
+    ts_sky_kind eSky;
+    int nCie = 0;
+    const bool bSunless =
+        m_psProduct->compute == tsd_compute_envlight &&
+        (m_sOpts.env_map[0] || (ts_sky_parse(m_sOpts.sky, &eSky, &nCie, nullptr) == TS_OK &&
+                                !ts_sky_follows_sun(eSky, nCie)));
     for (int i = 0; i < tsd_options_count(); i++)
     {
         const char *pszName = tsd_options_value(&m_sOpts, i, szValue, sizeof szValue);
+        if (bSunless && (EQUAL(pszName, "SUN_AZIMUTH") || EQUAL(pszName, "SUN_ELEVATION") ||
+                         EQUAL(pszName, "DELTA_T") || EQUAL(pszName, "PRESSURE") ||
+                         EQUAL(pszName, "TEMPERATURE")))
+            continue;
         // only the options of this product: an atlas copied from it is
         // validated against them (tsd_atlas_check.cpp)
         const bool bApplies = tsd_option_applies(i) == TSD_APPLIES_SELECTOR ||
@@ -435,6 +448,12 @@ void TSDataset::SetupPam(const char *pszConnection)
         tsd_options_canonical(&sKey, achCanon.data(), achCanon.size()) == 0)
     {
         std::string osSub = std::string(DRIVER) + ":" + achCanon.data();
+        // chunks and the far grid change pixels where the options alone do
+        // not say (TILE_SIZE=256 against the whole DEM, a MAX_MEMORY that
+        // coarsens the far grid): they shared one entry's statistics
+        if (const tsd_window_plan *psPlan = WindowPlan(m_poWindow))
+            osSub += CPLSPrintf(",WINDOWS=%d/%.17g/%dx%d", psPlan->tile, psPlan->near_m,
+                                psPlan->far_w, psPlan->far_h);
         if (m_osDEM != papszFiles[0])
             osSub += ":" + m_osDEM;
         SetPhysicalFilename(papszFiles[0]);
@@ -459,6 +478,13 @@ void TSDataset::SetupPam(const char *pszConnection)
             CPLFree(psPam->pszPamFilename);
             psPam->pszPamFilename = nullptr; // the next save: the products' own file
         }
+        // what the entry holds of the driver's own descriptions and metadata
+        // (saved beside the statistics, GDAL's PAM keeps them all) is of the
+        // DEM and options when it was saved: computed again over it, so that
+        // a regenerated DEM's day does not keep the old site's times and sun
+        // (an atlas then stored them, and its near shadows took that sun),
+        // nor SOURCE_DEM another directory's name; what the user set stays
+        SetupMetadata();
         // a legacy entry moves to the products' file when the dataset closes,
         // so that another product's first save there does not hide it
         nPamFlags = bLegacy ? nPamFlags | GPF_DIRTY : nPamFlags & ~GPF_DIRTY;

@@ -56,6 +56,65 @@ class ChangedFiles(T.TempDirCase):
         # the same contents: the saved statistics stand (no recomputation)
         self.assertEqual(saved_mean(dem, PRODUCT="svf"), again)
 
+    def test_metadata_of_a_regenerated_dem_is_its_own(self):
+        """GDAL's PAM saves a band's descriptions and metadata beside its
+        statistics, and loaded them over what the driver computed: after one
+        gdalinfo -stats, a day product of a DEM regenerated at another
+        latitude kept the old site's times and sun (an atlas then stored
+        them, and its near shadows took that sun), an svf's SOURCE_CRS_KIND
+        stayed projected for a geographic DEM, and SOURCE_DEM kept the name
+        it was first opened by. What the user set stays."""
+        dem = os.path.join(self.dir, "site.tif")
+        z = T.fractal_dem(64, seed=3, relief=200.0)
+
+        def at(lat):
+            if os.path.exists(dem):
+                os.remove(dem)
+            T.write_tif(dem, z, (10.0, 0.001, 0, lat, 0, -0.001), 4326)
+
+        day = dict(PRODUCT="daycycle", DATE="2026-06-21", TIMEZONE="+0100",
+                   STEP_MINUTES=120)
+
+        def band2():
+            ds = gdal.OpenEx(T.conn(dem), open_options=["%s=%s" % kv for kv in day.items()])
+            b = ds.GetRasterBand(2)
+            return b.GetDescription(), b.GetMetadataItem("SUN_ELEVATION")
+
+        at(45.0)
+        fresh45 = band2()
+        T.run(["gdalinfo", "-stats", "-hist", T.conn(dem, **day)])
+        T.run(["gdal_edit.py", "-ro", "-a_nodata", "-1", T.conn(dem, PRODUCT="svf")])
+        T.run(["gdalinfo", "-stats", "-hist", T.conn(dem, PRODUCT="svf")])
+        at(62.0)
+        got = band2()
+        os.rename(dem + ".terrashade.aux.xml", dem + ".aside")
+        fresh62 = band2()
+        os.rename(dem + ".aside", dem + ".terrashade.aux.xml")
+        print("daycycle band 2 at 45 N %s, at 62 N %s, reported %s" % (fresh45, fresh62, got))
+        self.assertNotEqual(fresh45, fresh62)
+        self.assertEqual(got, fresh62)
+        # SOURCE_DEM by the path it is opened with now, and the user's nodata
+        ds = gdal.OpenEx(T.conn(os.path.abspath(dem)), open_options=["PRODUCT=svf"])
+        self.assertEqual(ds.GetMetadataItem("SOURCE_DEM"), os.path.abspath(dem))
+        self.assertEqual(ds.GetMetadataItem("SOURCE_CRS_KIND"), "geographic")
+        self.assertEqual(ds.GetRasterBand(1).GetNoDataValue(), -1.0)
+        ds = None
+
+    def test_windows_have_their_own_statistics(self):
+        """TILE_SIZE and MAX_MEMORY change pixels (chunks, a coarser far
+        grid) where the options in the entry's key said nothing: TILE_SIZE=0
+        and 256 shared one entry's statistics. The chunks and the far grid
+        are in the key now."""
+        dem = os.path.join(self.dir, "tiles.tif")
+        write_dem(dem, 4, n=600)
+        whole = saved_mean(dem, PRODUCT="svf", TILE_SIZE=0)
+        tiled = saved_mean(dem, PRODUCT="svf", TILE_SIZE=128)
+        want = true_mean(dem, PRODUCT="svf", TILE_SIZE=128)
+        print("svf's mean: whole %.7f, TILE_SIZE=128 %.7f (computed %.7f)"
+              % (whole, tiled, want))
+        self.assertNotEqual(whole, want)
+        self.assertAlmostEqual(tiled, want, places=6)
+
     def test_statistics_of_a_replaced_env_map(self):
         dem = os.path.join(self.dir, "env.tif")
         write_dem(dem, 3)

@@ -274,9 +274,19 @@ class EnvLight(unittest.TestCase):
         self.assertEqual(md["ENV_MAP_LAYOUT"], "cube")
         self.assertEqual(md["ENV_MAP_SIZE"], "128 x 768")
         self.assertEqual(md["ENV_ROTATION"], "30")
+        # a map, or a sky without a sun, is lit by no sun: none recorded
+        # (SUN_AZIMUTH=315 read as the light's direction)
+        self.assertNotIn("SUN_AZIMUTH", md)
+        self.assertNotIn("PRESSURE", md)
         ds = gdal.OpenEx(T.conn(T.JACKSBORO), open_options=[
             "PRODUCT=envlight", "SKY=cie:7", "SUN_AZIMUTH=100", "SUN_ELEVATION=20"])
         self.assertEqual(ds.GetMetadataItem("SKY"), "cie:7")
+        self.assertEqual(ds.GetMetadataItem("SUN_AZIMUTH"), "100")
+        ds = None
+        ds = gdal.OpenEx(T.conn(T.JACKSBORO), open_options=[
+            "PRODUCT=envlight", "SKY=overcast", "OUTPUT_TYPE=Byte"])
+        self.assertIsNone(ds.GetMetadataItem("SUN_AZIMUTH"))
+        self.assertEqual(ds.GetMetadataItem("EXPOSURE"), "0")  # not -0
         ds = None
 
     def test_shade_sky_term_from_a_sky(self):
