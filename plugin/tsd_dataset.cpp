@@ -344,7 +344,16 @@ static bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window
     if (dfPeak <= dfLimit && dfPeak < static_cast<double>(std::numeric_limits<size_t>::max()) / 2)
         return true;
     char szAdvice[512] = "";
-    if (nLevel == 0)
+    // a small DEM's chunks with their margins can need more than the whole
+    // DEM at once: say so, where the advice named no TILE_SIZE at all
+    double dfWholeSteady = 0;
+    const double dfWhole = tsd_product_peak_bytes(&sOpts, W, H, &dfWholeSteady);
+    if (psPlan && W <= TS_MAX_SIDE && H <= TS_MAX_SIDE && dfWhole <= dfLimit)
+        snprintf(szAdvice, sizeof szAdvice,
+                 "; TILE_SIZE=0 computes it whole in about %.0f MiB (its chunks with their "
+                 "margins need more)",
+                 dfWhole / 1048576.0);
+    else if (nLevel == 0)
         tsd_window_advice(&sOpts, psSun, W, H, tsd_cells_min_x(&sCells, H), sCells.cell_y,
                           dfLimit, szAdvice, sizeof szAdvice);
     // fewer bands need less where an option sets their count (svf streams its DIRECTIONS)

@@ -401,6 +401,10 @@ np.save(sys.argv[2], a)
         self.refused({"NEAR_DISTANCE": 2e6}, ["NEAR_DISTANCE"])
         self.refused({"TILE_SIZE": 128, "NEAR_DISTANCE": 300},
                      ["NEAR_DISTANCE=300 m is", "cells of this DEM", "at least 16 cells"])
+        # a small DEM's chunks with their margins need more than the whole
+        # DEM: the refusal says that TILE_SIZE=0 fits (it named no TILE_SIZE)
+        self.refused({"PRODUCT": "horizon", "DIRECTIONS": 8, "MAX_MEMORY": 6, "TILE_SIZE": 64},
+                     ["more than the limit of 6 MiB", "TILE_SIZE=0 computes it whole in about"])
         # also where the DEM fits in one tile (jacksboro, 403 x 344, under the
         # default 4096), so that a script that runs on a small DEM runs on a
         # larger one: it was accepted there, and refused on a larger DEM
