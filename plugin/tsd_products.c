@@ -249,6 +249,20 @@ void tsd_products_taking(int option, const char *prefix, const char *last, char 
     }
 }
 
+/* Why option `name`, which p takes, does nothing beside o's other options
+ * (NULL: it does something). */
+static const char *moot_beside(const tsd_options *o, const tsd_product_def *p, const char *name)
+{
+    if ((!strcmp(name, "PRESSURE") || !strcmp(name, "TEMPERATURE") ||
+         !strcmp(name, "DELTA_T")) &&
+        !tsd_options_sun_from_time(o))
+        return "it refracts and places a sun computed from DATETIME";
+    if ((!strcmp(name, "DIRECTIONS") || !strcmp(name, "START_AZIMUTH")) &&
+        tsd_product_takes(p, tsd_option_find("SKY_WEIGHT")) && !(o->sky_weight > 0))
+        return "of the sky term, which SKY_WEIGHT=0 leaves out";
+    return NULL;
+}
+
 int tsd_options_unused(const tsd_options *o, const tsd_product_def *p, char *buf, size_t n)
 {
     int count = 0;
@@ -257,14 +271,18 @@ int tsd_options_unused(const tsd_options *o, const tsd_product_def *p, char *buf
     buf[0] = '\0';
     for (int i = 0; i < tsd_options_count(); i++) {
         if (!(o->given >> i & 1) || !(tsd_option_scope(i) & TSD_SCOPE_PRODUCT) ||
-            tsd_option_applies(i) != TSD_APPLIES_LISTED || tsd_product_takes(p, i))
+            tsd_option_applies(i) != TSD_APPLIES_LISTED)
             continue;
-        tsd_products_taking(i, "", " and ", list, sizeof list);
+        const char *moot = tsd_product_takes(p, i) ? moot_beside(o, p, tsd_option_name(i)) : NULL;
+        if (tsd_product_takes(p, i) && !moot)
+            continue;
         /* "SUN_AZIMUTH (an option of shade, shadow and envlight)" */
+        if (!moot)
+            tsd_products_taking(i, "", " and ", list, sizeof list);
         if (used < n)
-            used += (size_t)snprintf(buf + used, n - used, "%s%s (an option of %s)",
-                                     count ? ", " : "",
-                                     tsd_option_name(i), list);
+            used += (size_t)snprintf(buf + used, n - used, "%s%s (%s%s)", count ? ", " : "",
+                                     tsd_option_name(i), moot ? "" : "an option of ",
+                                     moot ? moot : list);
         count++;
     }
     return count;

@@ -156,7 +156,14 @@ class Options(unittest.TestCase):
                             TILE_SIZE=128)
         self.assertIn("PRODUCT=farshadow does not use TILE_SIZE (an option of shade, ", err)
         self.assertIn("given, it does nothing here", err)
+        # options of the product that its other options leave without work
+        err = T.open_stderr(self.dem, PRODUCT="shade", PRESSURE=900, DIRECTIONS=32)
+        self.assertIn("PRODUCT=shade does not use DIRECTIONS (of the sky term, which "
+                      "SKY_WEIGHT=0 leaves out), PRESSURE (it refracts and places a sun "
+                      "computed from DATETIME): given, they do nothing here", err)
         for oo in (dict(PRODUCT="svf", DIRECTIONS=8, MAX_DISTANCE=500, THREADS=1),
+                   dict(PRODUCT="shade", PRESSURE=900, DIRECTIONS=32, SKY_WEIGHT=0.3,
+                        DATETIME="2026-06-21T12:00:00Z"),
                    dict(PRODUCT="shade", SUN_AZIMUTH=100, TILE_SIZE=128, Z_FACTOR=2),
                    dict(PRODUCT="sunhours", DATE="2026-06-21", TIMEZONE="Z",
                         STEP_MINUTES=10)):
