@@ -109,6 +109,29 @@ for name, alg, params in json.loads(sys.argv[2]):
         result[name] = {"output": out["OUTPUT"], "log": fb.lines, "warnings": fb.warnings}
     except QgsProcessingException as e:
         result[name] = {"error": str(e), "warnings": fb.warnings}
+# outputs loaded into a project: the algorithm sets the post-processor that
+# draws a layer of several bands (not a colour image) as its first band in grey
+from qgis.core import QgsProcessingContext, QgsProject, QgsRasterLayer
+result["renderers"] = {}
+for name in ("horizon", "range_default", "envlight", "svf"):
+    if "output" not in result.get(name, {}):
+        continue
+    alg = [a for n, a, _ in json.loads(sys.argv[2]) if n == name][0]
+    params = dict([p for n, _, p in json.loads(sys.argv[2]) if n == name][0])
+    params["OUTPUT"] = params["OUTPUT"][:-4] + "_loaded.tif"
+    context = QgsProcessingContext()
+    context.addLayerToLoadOnCompletion(params["OUTPUT"], QgsProcessingContext.LayerDetails(
+        name, QgsProject.instance(), name))
+    processing.run(alg, params, context=context, feedback=Log())
+    post = context.layerToLoadOnCompletionDetails(params["OUTPUT"]).postProcessor()
+    layer = QgsRasterLayer(params["OUTPUT"], name)
+    before = layer.renderer().type()
+    if post is not None:
+        post.postProcessLayer(layer, context, Log())
+    r = layer.renderer()
+    result["renderers"][name] = [before, r.type(), post is not None] + (
+        [r.grayBand(), r.contrastEnhancement().minimumValue(),
+         r.contrastEnhancement().maximumValue()] if r.type() == "singlebandgray" else [])
 plugin.unload()
 result["unloaded"] = reg.providerById("terrashade") is None
 print("RESULT " + json.dumps(result))
@@ -328,6 +351,24 @@ class Processing(unittest.TestCase):
         # a time without an offset: the driver's sentence
         self.assertIn("TERRASHADE", result["bad_time"].get("error", ""))
         self.assertIn("offset", result["bad_time"]["error"])
+
+    def test_loaded_outputs_of_several_bands_show_their_first_band(self):
+        """QGIS draws a raster of three bands or more as red, green and blue
+        from bands 1-3: horizon's first three azimuths, insolation's global,
+        beam and diffuse made a colour picture of unrelated quantities. An
+        output loaded into the project shows its first band in grey,
+        stretched to its range; envlight's red, green and blue stay colour."""
+        r = self.result["renderers"]
+        print(r)
+        for name in ("horizon", "range_default"):
+            before, after, posted, band, lo, hi = r[name]
+            self.assertTrue(posted)
+            self.assertEqual((before, after, band), ("multibandcolor", "singlebandgray", 1))
+            a = T.read(self.result[name]["output"], 1)
+            self.assertAlmostEqual(lo, float(np.nanmin(a)), places=3)
+            self.assertAlmostEqual(hi, float(np.nanmax(a)), places=3)
+        self.assertEqual(r["envlight"][:2], ["multibandcolor", "multibandcolor"])
+        self.assertEqual(r["svf"][:2], ["singlebandgray", "singlebandgray"])
 
     def test_cancel(self):
         """Cancel once the bar moves (the driver tells GDAL's copy its

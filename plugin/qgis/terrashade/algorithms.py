@@ -15,13 +15,15 @@ import shlex
 import sys
 
 from osgeo import gdal
-from qgis.core import (QgsProcessingAlgorithm, QgsProcessingException,
+from qgis.core import (QgsContrastEnhancement, QgsProcessingAlgorithm, QgsProcessingException,
+                       QgsProcessingLayerPostProcessorInterface,
                        QgsProcessingParameterBoolean, QgsProcessingParameterDefinition,
                        QgsProcessingParameterEnum, QgsProcessingParameterFile,
                        QgsProcessingParameterNumber,
                        QgsProcessingParameterRasterDestination,
                        QgsProcessingParameterRasterLayer, QgsProcessingParameterString,
-                       QgsRasterFileWriter)
+                       QgsRaster, QgsRasterBandStats, QgsRasterFileWriter,
+                       QgsSingleBandGrayRenderer)
 
 from .driver_tables import DRIVER, is_yes, read_driver, single_raster
 
@@ -323,7 +325,46 @@ class TerrashadeAlgorithm(QgsProcessingAlgorithm):
         feedback.pushInfo("Computing %s on the whole DEM first; the progress bar moves "
                           "while the result is written." % self.product.name)
         translate(dem, opts, out, feedback)
+        if context.willLoadLayerOnCompletion(out):
+            context.layerToLoadOnCompletionDetails(out).setPostProcessor(
+                FirstBandGray.create())
         return {"OUTPUT": out}
+
+
+class FirstBandGray(QgsProcessingLayerPostProcessorInterface):
+    """Shows a loaded output of several bands that are not a colour image
+    (horizon's azimuths, insolation's global, beam and diffuse) as its first
+    band in grey, stretched from its minimum to its maximum: QGIS draws any
+    raster of three bands or more as red, green and blue from bands 1-3,
+    which made a picture of three unrelated quantities. envlight's red,
+    green and blue bands keep QGIS's colour rendering."""
+
+    def postProcessLayer(self, layer, context, feedback):  # noqa: N802
+        provider = layer.dataProvider() if layer is not None else None
+        if provider is None or provider.bandCount() < 2:
+            return
+        if provider.colorInterpretation(1) == QgsRaster.RedBand:  # a colour image
+            return
+        stats = provider.bandStatistics(1, QgsRasterBandStats.Min | QgsRasterBandStats.Max)
+        renderer = QgsSingleBandGrayRenderer(provider, 1)
+        contrast = QgsContrastEnhancement(provider.dataType(1))
+        contrast.setContrastEnhancementAlgorithm(
+            QgsContrastEnhancement.StretchToMinimumMaximum)
+        if stats.maximumValue > stats.minimumValue:
+            contrast.setMinimumValue(stats.minimumValue)
+            contrast.setMaximumValue(stats.maximumValue)
+        renderer.setContrastEnhancement(contrast)
+        layer.setRenderer(renderer)
+        layer.triggerRepaint()
+
+    # QGIS deletes a post-processor once it has run, and keeps no Python
+    # reference to it: one for each run, kept here until the next
+    instance = None
+
+    @staticmethod
+    def create():
+        FirstBandGray.instance = FirstBandGray()
+        return FirstBandGray.instance
 
 
 def make_algorithms():
