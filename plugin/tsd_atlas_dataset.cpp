@@ -6,6 +6,7 @@
  * driver's option table (tsd_options.h).
  */
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -537,15 +538,39 @@ GDALDataset *TSAtlasDataset::CreateCopy(const char *pszFilename, GDALDataset *po
     size_t nSize = 0;
     if (ts_atlas_writer_finish(psW, &sInfo, &pabyFile, &nSize, &sErr) != TS_OK)
         return FailOpen(sErr.code, sErr.message);
+    // Only a regular file (or a new one) is written, and only what this
+    // call opened is removed on failure: it unlinked whatever the path named
+    // when the write failed, so that /dev/full itself, a symlink, or another
+    // user's write-protected file in an unwritable folder went (an audit)
+    VSIStatBufL sStat;
+    if (VSIStatL(pszFilename, &sStat) == 0 && !VSI_ISREG(sStat.st_mode))
+    {
+        free(pabyFile);
+        return FailOpen(CPLE_FileIO,
+                        CPLSPrintf("cannot write the atlas '%s': it exists and is not a "
+                                   "regular file (a folder, a device, a pipe); an atlas is "
+                                   "a file of its own",
+                                   pszFilename));
+    }
+    errno = 0;
     VSILFILE *fp = VSIFOpenL(pszFilename, "wb");
+    int nErrno = errno;
     bool bOK = fp && VSIFWriteL(pabyFile, 1, nSize, fp) == nSize;
-    if (fp && VSIFCloseL(fp) != 0)
+    if (fp && !bOK)
+        nErrno = errno;
+    if (fp && VSIFCloseL(fp) != 0 && bOK)
+    {
         bOK = false;
+        nErrno = errno;
+    }
     free(pabyFile);
     if (!bOK)
     {
-        VSIUnlink(pszFilename);
-        return FailOpen(CPLE_FileIO, CPLSPrintf("cannot write the atlas '%s'", pszFilename));
+        if (fp) // its contents are this call's, cut short
+            VSIUnlink(pszFilename);
+        return FailOpen(CPLE_FileIO,
+                        CPLSPrintf("cannot write the atlas '%s'%s%s", pszFilename,
+                                   nErrno ? ": " : "", nErrno ? VSIStrerror(nErrno) : ""));
     }
     CPLDebug(DRIVER, "wrote the atlas %s: %d maps of %d x %d, %zu bytes (%.4f bits per cell)",
              pszFilename, nBands, W, H, nSize, nSize * 8.0 / nCells);

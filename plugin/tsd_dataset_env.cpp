@@ -47,6 +47,15 @@ static bool ReadWholeFile(const char *pszPath, std::vector<GByte> &oBytes,
         osError = CPLSPrintf("ENV_MAP '%s' is a directory, not an OpenEXR file", pszPath);
         return false;
     }
+    // a pipe's open waits for a writer, forever (an audit), and a device
+    // may too (a terminal): a map is a file
+    if (!STARTS_WITH(pszPath, "/vsi") && !VSI_ISREG(sStat.st_mode))
+    {
+        osError = CPLSPrintf("ENV_MAP '%s' is not a regular file (a pipe, a device...), not "
+                             "an OpenEXR file",
+                             pszPath);
+        return false;
+    }
     const std::string osTooLarge =
         CPLSPrintf("ENV_MAP '%s' is larger than %d GiB: not an environment map this driver "
                    "reads",

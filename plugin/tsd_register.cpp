@@ -58,18 +58,50 @@ CPLErr RefuseConnection(const char *pszWhat, const char *pszName)
     return CE_Failure;
 }
 
+/* The files of the atlas pszName: those it lists where it opens, else,
+ * where it has the atlas magic but does not open (a damaged or truncated
+ * one: the very file a user wants gone, which could be neither deleted nor
+ * renamed), itself and its .aux.xml; NULL with the open's error. */
+char **AtlasFiles(const char *pszName)
+{
+    const char *const apszDrivers[] = {tsd::DRIVER, nullptr};
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    GDALDatasetH hDS =
+        GDALOpenEx(pszName, GDAL_OF_RASTER, apszDrivers, nullptr, nullptr);
+    CPLPopErrorHandler();
+    if (hDS)
+    {
+        char **papszFiles = GDALGetFileList(hDS);
+        GDALClose(hDS);
+        return papszFiles;
+    }
+    GDALOpenInfo oInfo(pszName, GA_ReadOnly);
+    if (!tsd::IdentifyAtlas(&oInfo))
+    {
+        // not an atlas at all: the open's own error
+        GDALClose(GDALOpenEx(pszName, GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR, apszDrivers,
+                             nullptr, nullptr));
+        return nullptr;
+    }
+    CPLErrorReset(); // (the quiet open's error is no failure of the caller's)
+    CPLDebug(tsd::DRIVER, "%s: a damaged atlas, handled as its file", pszName);
+    CPLStringList aosFiles;
+    aosFiles.AddString(pszName);
+    VSIStatBufL sStat;
+    const std::string osAux = std::string(pszName) + ".aux.xml";
+    if (VSIStatL(osAux.c_str(), &sStat) == 0)
+        aosFiles.AddString(osAux.c_str());
+    return aosFiles.StealList();
+}
+
 CPLErr DeleteAny(const char *pszName)
 {
     tsd::CLocale oC;
     if (IsConnection(pszName))
         return RefuseConnection("delete", pszName);
-    const char *const apszDrivers[] = {tsd::DRIVER, nullptr};
-    GDALDatasetH hDS = GDALOpenEx(pszName, GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR, apszDrivers,
-                                  nullptr, nullptr);
-    if (!hDS)
+    char **papszFiles = AtlasFiles(pszName);
+    if (!papszFiles)
         return CE_Failure;
-    char **papszFiles = GDALGetFileList(hDS);
-    GDALClose(hDS);
     CPLErr eErr = CE_None;
     for (int i = 0; papszFiles && papszFiles[i]; i++)
         if (VSIUnlink(papszFiles[i]) != 0)
@@ -87,7 +119,23 @@ CPLErr RenameAny(const char *pszNewName, const char *pszOldName)
     tsd::CLocale oC;
     if (IsConnection(pszOldName) || IsConnection(pszNewName))
         return RefuseConnection("rename", IsConnection(pszOldName) ? pszOldName : pszNewName);
-    return GDALDriver::DefaultRename(pszNewName, pszOldName);
+    // as GDAL's DefaultRename, from AtlasFiles (a damaged atlas too)
+    char **papszOld = AtlasFiles(pszOldName);
+    if (!papszOld)
+        return CE_Failure;
+    char **papszNew = CPLCorrespondingPaths(pszOldName, pszNewName, papszOld);
+    CPLErr eErr = papszNew ? CE_None : CE_Failure;
+    for (int i = 0; papszNew && papszOld[i]; i++)
+        if (CPLMoveFile(papszNew[i], papszOld[i]) != 0)
+        {
+            CPLError(CE_Failure, CPLE_AppDefined, "TERRASHADE: cannot rename '%s' to '%s': %s",
+                     papszOld[i], papszNew[i], VSIStrerror(errno));
+            eErr = CE_Failure;
+            break;
+        }
+    CSLDestroy(papszOld);
+    CSLDestroy(papszNew);
+    return eErr;
 }
 
 CPLErr CopyFilesAny(const char *pszNewName, const char *pszOldName)

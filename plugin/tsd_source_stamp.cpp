@@ -5,6 +5,7 @@
 #include "tsd_source_stamp.h"
 
 #include <cstdint>
+#include <cstring>
 #include <sys/stat.h>
 
 #include "cpl_conv.h"
@@ -52,6 +53,11 @@ static std::string FileStamp(const std::string &osPath)
                           static_cast<long long>(sSt.st_size),
                           static_cast<long long>(sSt.st_mtim.tv_sec), sSt.st_mtim.tv_nsec);
     }
+    // /vsigzip/'s stat gives the time 0 once GDAL caches the file's
+    // handle, so that every /vsigzip/ DEM read as changed after its open:
+    // the compressed file's own stamp instead
+    if (STARTS_WITH(osPath.c_str(), "/vsigzip/"))
+        return "gz " + FileStamp(osPath.substr(strlen("/vsigzip/")));
     VSIStatBufL sSt;
     if (VSIStatExL(osPath.c_str(), &sSt, VSI_STAT_EXISTS_FLAG | VSI_STAT_SIZE_FLAG) != 0)
         return "missing";

@@ -264,6 +264,51 @@ class Atlas(unittest.TestCase):
         self.assertIn(sentence, str(e.exception))
         return str(e.exception)
 
+    def test_writes_and_deletes_only_its_own_files(self):
+        """A failed write removed whatever the path named (as root /dev/full
+        itself, a symlink, a write-protected file of another user): now a
+        path that is not a regular file is refused and left as it is, and
+        only a file this write opened is removed, the reason said. A damaged
+        atlas, which did not open, could be neither deleted nor renamed."""
+        d = os.path.join(self.dir, "own")
+        os.mkdir(d)
+        # (a pipe hangs in GDAL's own look at the destination, as for GTiff)
+        folder, link = os.path.join(d, "folder.tsa"), os.path.join(d, "link.tsa")
+        os.mkdir(folder)
+        os.symlink(os.path.join(d, "missing", "x.tsa"), link)
+        for path, text in ((folder, "it exists and is not a regular file"),
+                           (link, "No such file or directory")):
+            p = T.run(["gdal_translate", "-q", "-of", "TERRASHADE", self.tsa, path], ok=False)
+            self.assertIn("cannot write the atlas '%s': %s" % (path, text), p.stderr)
+            self.assertTrue(os.path.lexists(path), path)
+        self.assertTrue(os.path.islink(link))
+        # a damaged atlas (its header's CRC) is deleted and renamed as a file
+        with open(self.tsa, "rb") as f:
+            data = bytearray(f.read())
+        data[20] ^= 0xFF
+        drv = gdal.GetDriverByName("TERRASHADE")
+        for op in ("rename", "delete"):
+            bad = os.path.join(d, "bad_%s.tsa" % op)
+            with open(bad, "wb") as f:
+                f.write(data)
+            with open(bad + ".aux.xml", "w") as f:
+                f.write("<PAMDataset/>")
+            if op == "delete":
+                self.assertEqual(drv.Delete(bad), gdal.CE_None)
+                self.assertFalse(os.path.exists(bad) or os.path.exists(bad + ".aux.xml"))
+            else:
+                new = os.path.join(d, "renamed.tsa")
+                self.assertEqual(drv.Rename(new, bad), gdal.CE_None)
+                self.assertTrue(os.path.exists(new) and os.path.exists(new + ".aux.xml"))
+                self.assertFalse(os.path.exists(bad))
+        # a file that is no atlas is not touched
+        plain = os.path.join(d, "plain.tsa")
+        with open(plain, "w") as f:
+            f.write("my notes")
+        with self.assertRaises(RuntimeError):
+            drv.Delete(plain)
+        self.assertTrue(os.path.exists(plain))
+
     def test_metadata_validated_like_options(self):
         """Each value of the metadata text goes through the option table; the
         message gives the real cause."""

@@ -115,6 +115,27 @@ class ChangedFiles(T.TempDirCase):
         self.assertNotEqual(whole, want)
         self.assertAlmostEqual(tiled, want, places=6)
 
+    def test_a_gzipped_dem_is_not_changed_by_reading_it(self):
+        """/vsigzip/'s stat gives the time 0 once GDAL caches the file: every
+        product of a /vsigzip/ DEM was refused as 'changed on disk' at its
+        first read. Stamped by the .gz file itself, it computes, and a .gz
+        rewritten under an open dataset is still caught."""
+        import gzip
+        import shutil
+        dem = os.path.join(self.dir, "gz.tif")
+        write_dem(dem, 6)
+        with open(dem, "rb") as f, gzip.open(dem + ".gz", "wb") as g:
+            shutil.copyfileobj(f, g)
+        gz = "/vsigzip/" + dem + ".gz"
+        np.testing.assert_array_equal(T.read(T.conn(gz, PRODUCT="svf")),
+                                      T.read(T.conn(dem, PRODUCT="svf")))
+        ds = gdal.OpenEx(T.conn(gz), open_options=["PRODUCT=svf"])
+        os.utime(dem + ".gz", (1, 1))
+        with self.assertRaises(RuntimeError) as e:
+            ds.GetRasterBand(1).ReadAsArray()
+        self.assertIn("changed on disk", str(e.exception))
+        ds = None
+
     def test_statistics_of_a_replaced_env_map(self):
         dem = os.path.join(self.dir, "env.tif")
         write_dem(dem, 3)

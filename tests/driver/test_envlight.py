@@ -261,6 +261,17 @@ class EnvLight(unittest.TestCase):
         want = np.floor(1 + 254 * srgb(fl * 2 ** 0.5) + 0.5)
         self.assertLessEqual(np.nanmax(np.abs(by - want)), 1)
 
+    def test_a_map_that_is_no_file_is_refused_at_once(self):
+        """An ENV_MAP that is a pipe waited forever in its open for a
+        writer; a device could too: refused, as a folder is."""
+        pipe = self.path("pipe.exr")
+        os.mkfifo(pipe)
+        for m in (pipe, "/dev/zero"):
+            p = T.run(["timeout", "60", "gdalinfo", T.conn(T.JACKSBORO, PRODUCT="envlight"),
+                       "-oo", "ENV_MAP=" + m], ok=False)
+            self.assertEqual(p.returncode, 1, p.stderr)
+            self.assertIn("ENV_MAP '%s' is not a regular file" % m, p.stderr)
+
     def test_bands_and_metadata(self):
         ds = gdal.OpenEx(T.conn(T.JACKSBORO), open_options=[
             "PRODUCT=envlight", "ENV_MAP=" + SUNSET_CUBE, "ENV_ROTATION=30"])
