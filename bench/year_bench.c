@@ -35,6 +35,45 @@ static void die(const char *what, const ts_error *e)
     exit(1);
 }
 
+static void usage(FILE *to)
+{
+    fprintf(to,
+            "usage: year_bench [--size N] [--cell M] [--year Y] [--interval D]\n"
+            "                  [--step MIN] [--dirs D1,D2,...] [--day YYYY-MM-DD]\n"
+            "                  [--lat L] [--lon L] [--threads T] [--no-insolation]\n"
+            "  --size N          the N x N fBm DEM, 16..65536 (default 4096)\n"
+            "  --cell M          its cells in metres (default 30)\n"
+            "  --year Y          the year (default 2026)\n"
+            "  --interval D      one day every D days of it (default %d)\n"
+            "  --step MIN        minutes between sun positions (default %g)\n"
+            "  --dirs D1,D2,...  horizon directions of the year's runs, one run each\n"
+            "                    (default %d)\n"
+            "  --day YYYY-MM-DD  the day of per-step sweeps (default 2026-03-20)\n"
+            "  --lat L, --lon L  where the DEM lies, UTC+1 (default 46.5, 7.9)\n"
+            "  --threads T       worker threads (default 0: every core)\n"
+            "  --no-insolation   hours of sun only, no insolation\n",
+            TS_RANGE_DAY_INTERVAL, TS_RANGE_STEP_MINUTES, TS_RANGE_HORIZON_DIRECTIONS);
+}
+
+static void usage_error(const char *what, const char *opt)
+{
+    fprintf(stderr, "year_bench: %s%s\n", what, opt ? opt : "");
+    usage(stderr);
+    exit(2);
+}
+
+/* Whether `a` is one of the options that take a value. */
+static int takes_value(const char *a)
+{
+    static const char *const opts[] = {"--size", "--cell",  "--year", "--interval",
+                                       "--step", "--dirs",  "--day",  "--lat",
+                                       "--lon",  "--threads"};
+    for (size_t k = 0; k < sizeof opts / sizeof *opts; k++)
+        if (!strcmp(a, opts[k]))
+            return 1;
+    return 0;
+}
+
 static void print_load(const char *when)
 {
     double l[3] = {0, 0, 0};
@@ -90,12 +129,18 @@ int main(int argc, char **argv)
     const char *dirs = NULL, *day = "2026-03-20";
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            usage(stdout);
+            return 0;
+        }
         if (!strcmp(a, "--no-insolation")) {
             insol = 0;
             continue;
         }
+        if (!takes_value(a))
+            usage_error("unknown option ", a);
         if (!v)
-            die("each option but --no-insolation takes a value (see the source's head)", NULL);
+            usage_error("a value is missing after ", a);
         i++;
         if (!strcmp(a, "--size")) size = atoi(v);
         else if (!strcmp(a, "--cell")) cell = atof(v);
@@ -107,7 +152,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--lat")) lat = atof(v);
         else if (!strcmp(a, "--lon")) lon = atof(v);
         else if (!strcmp(a, "--threads")) threads = atoi(v);
-        else die("unknown option (see the source's head)", NULL);
+        else usage_error("unknown option ", a); /* not reached: takes_value */
     }
     if (size < 16 || size > 65536 || !(cell > 0))
         die("--size must be 16..65536 and --cell positive", NULL);

@@ -171,11 +171,20 @@ ts_status ts_atlas_open(const uint8_t *b, size_t n, ts_atlas **out, ts_error *er
              in = get64(b + 152);
     uint64_t sn = (uint64_t)steps * TS_ATLAS_STEP_SIZE;
     uint64_t secs[4][2] = {{so, sn}, {to, tn}, {dof, dn}, {io, in}};
-    for (int i = 0; i < 4; i++)
+    uint64_t end = hsize;
+    for (int i = 0; i < 4; i++) {
         if (secs[i][0] < hsize || secs[i][0] > n || secs[i][1] > n - secs[i][0])
             BAD("the atlas is truncated: a section at byte %llu of %llu bytes lies "
                 "beyond the end of the %zu-byte file",
                 (unsigned long long)secs[i][0], (unsigned long long)secs[i][1], n);
+        end = secs[i][0] + secs[i][1] > end ? secs[i][0] + secs[i][1] : end;
+    }
+    /* every byte under a checksum: bytes after the last section are none
+     * of the atlas's (appended data, a copy cut into another file) */
+    if (end < n)
+        BAD("the atlas is damaged: %llu bytes follow its last section, which ends at byte "
+            "%llu of the %zu-byte file", (unsigned long long)(n - end),
+            (unsigned long long)end, n);
     if (lzma_crc32(b + to, (size_t)tn, lzma_crc32(b + so, (size_t)sn, 0)) != get32(b + 164))
         BAD("the atlas's step table or metadata text is damaged (CRC32 mismatch)");
     a->info.width = (int)W;

@@ -230,7 +230,9 @@ class Atlas(unittest.TestCase):
         cases = [("truncated", data[:len(data) // 2], "truncated"),
                  ("header", data[:20] + bytes([data[20] ^ 1]) + data[21:], "damaged"),
                  ("index", data[:-40] + bytes([data[-40] ^ 0x20]) + data[-39:], "damaged"),
-                 ("version", data[:8] + bytes([9]) + data[9:], "version 9")]
+                 ("version", data[:8] + bytes([9]) + data[9:], "version 9"),
+                 # bytes after the last section, under no checksum, were read
+                 ("appended", data + bytes(100), "100 bytes follow its last section")]
         for name, blob, text in cases:
             with self.subTest(name):
                 path = os.path.join(self.dir, name + ".tsa")
