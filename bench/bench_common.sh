@@ -6,7 +6,8 @@
 # Takes the plugin from $BUILDDIR/plugin/.libs (BUILDDIR defaults to the
 # current directory) when it has gdal_TERRASHADE.so, else from wherever GDAL
 # finds it; stops with a sentence if GDAL cannot find the driver. Then makes
-# the scratch directory $WORK, removed on exit.
+# the scratch directory $WORK, removed on exit; on an interrupt (INT, TERM)
+# it is removed and the script exits (130, 143).
 
 PYTHON=${PYTHON:-/usr/bin/python3}
 BUILDDIR=${BUILDDIR:-$(pwd)}
@@ -22,7 +23,11 @@ bench_setup() {
         exit 1
     fi
     WORK=$(mktemp -d "${TMPDIR:-/tmp}/$1.XXXXXX")
-    trap 'rm -rf "$WORK"' EXIT INT TERM
+    trap 'rm -rf "$WORK"' EXIT
+    # interrupted: the work directory goes, and so does the script (the
+    # commands after it would only fail on the missing files)
+    trap 'rm -rf "$WORK"; trap - EXIT; exit 130' INT
+    trap 'rm -rf "$WORK"; trap - EXIT; exit 143' TERM
 }
 
 # bench_machine: the machine in one line (CPUs, model, load, GDAL) and

@@ -1,3 +1,4 @@
+#!/usr/bin/python3
 """The benchmarks' DEM: an N x N spectral fractal GeoTIFF (bench/*.sh).
 
 Usage: fractal_tif.py N PATH [BETA [CELL [RELIEF]]]
@@ -10,12 +11,24 @@ horizon above 60 degrees); BETA = 1.8 is fBm of Hurst exponent 0.8 (power
 f^-(2H + 2)), the character of bench/ts_bench's tdem_fbm and of real relief.
 """
 import sys
+
+
+def usage():
+    sys.stderr.write("usage: fractal_tif.py N PATH [BETA [CELL [RELIEF]]]\n")
+    sys.exit(2)
+
+
+if len(sys.argv) < 3 or len(sys.argv) > 6:
+    usage()
+try:
+    n, path = int(sys.argv[1]), sys.argv[2]
+    beta = float(sys.argv[3]) if len(sys.argv) > 3 else 1.1
+    cell = float(sys.argv[4]) if len(sys.argv) > 4 else 10.0
+    relief = float(sys.argv[5]) if len(sys.argv) > 5 else 1400.0
+except ValueError:
+    usage()
 import numpy as np
 from osgeo import gdal, osr
-n, path = int(sys.argv[1]), sys.argv[2]
-beta = float(sys.argv[3]) if len(sys.argv) > 3 else 1.1
-cell = float(sys.argv[4]) if len(sys.argv) > 4 else 10.0
-relief = float(sys.argv[5]) if len(sys.argv) > 5 else 1400.0
 if n < 2 or not cell > 0 or not relief > 0:
     sys.exit("fractal_tif.py: N must be >= 2, CELL and RELIEF > 0")
 rng = np.random.default_rng(42)

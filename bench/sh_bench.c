@@ -179,20 +179,20 @@ static void bench_key(const ts_grid *g, int swath, const float *nx, const float 
 int main(int argc, char **argv)
 {
     int size = 4096, dirs = 32, swath = 3, bad = 0;
-    for (int i = 1; i + 1 < argc; i += 2) {
-        if (!strcmp(argv[i], "--size"))
+    for (int i = 1; i < argc && !bad; i += 2) {
+        if (strcmp(argv[i], "--size") && strcmp(argv[i], "--dirs") && strcmp(argv[i], "--swath")) {
+            fprintf(stderr, "%s: unknown option %s\n", argv[0], argv[i]);
+            bad = 1;
+        } else if (i + 1 == argc)
+            bad = 1; /* its value is missing */
+        else if (!strcmp(argv[i], "--size"))
             size = atoi(argv[i + 1]);
         else if (!strcmp(argv[i], "--dirs"))
             dirs = atoi(argv[i + 1]);
         else if (!strcmp(argv[i], "--swath"))
             swath = atoi(argv[i + 1]);
-        else {
-            fprintf(stderr, "%s: unknown option %s\n", argv[0], argv[i]);
-            bad = 1;
-            break;
-        }
     }
-    if (bad || argc % 2 == 0 || size < 2 || dirs < 1 || swath < 1) {
+    if (bad || size < 2 || dirs < 1 || swath < 1) {
         fprintf(stderr, "usage: %s [--size N >= 2] [--dirs D >= 1] [--swath S >= 1]\n",
                 argv[0]);
         return 2;

@@ -332,8 +332,13 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
     }
     const ts_status eSt = ts_atlas_open(pabyFile, static_cast<size_t>(nSize), &psAtlas, &sErr);
     VSIFree(pabyFile);
+    // a file that does not read as an atlas: FileIO, as docs/driver.md's
+    // errors say (the core's argument error read as a bad option, 5)
     if (eSt != TS_OK)
-        return FailOpen(eSt, CPLSPrintf("'%s': %s", poOpenInfo->pszFilename, sErr.message));
+        return eSt == TS_ERR_NOMEM
+                   ? FailOpen(eSt, CPLSPrintf("'%s': %s", poOpenInfo->pszFilename, sErr.message))
+                   : FailOpen(CPLE_FileIO,
+                              CPLSPrintf("'%s': %s", poOpenInfo->pszFilename, sErr.message));
     auto poDS = std::unique_ptr<TSAtlasDataset>(new TSAtlasDataset());
     poDS->m_psAtlas = psAtlas;
     const ts_atlas_info *psInfo = ts_atlas_get_info(psAtlas);
