@@ -57,17 +57,29 @@ build baseline "$one"
 cmd="ts_bench --size $SIZE --dirs $DIRS --max-distance $DISTANCES --repeat 1"
 echo "== machine: $(nproc) CPU(s), $(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n 1)"
 echo "== $cmd, $REPEAT rounds (best of each)"
+# the times of an earlier run that did not finish would join this table
+rm -f "$BUILD_DIR"/times.* "$BUILD_DIR"/out
 r=1
 while [ "$r" -le "$REPEAT" ]; do
     for b in shipped:auto avx2:avx2 baseline:none; do
         name=${b%%:*}
+        # ts_bench's own message (stderr) says why it failed
         TERRASHADE_SIMD=${b#*:} "$BUILD_DIR/$name/ts_bench" --size "$SIZE" --dirs "$DIRS" \
-            --max-distance "$DISTANCES" --repeat 1 |
-            sed -n "s/^horizon .*max distance *\([0-9]*\) m: \([0-9.]*\) s.*/$name \1 \2/p" \
-                >>"$BUILD_DIR/times.$r"
+            --max-distance "$DISTANCES" --repeat 1 >"$BUILD_DIR/out" || {
+            echo "cpu_levels.sh: the $name build's $cmd failed (exit $?)" >&2
+            exit 1
+        }
+        # distances as ts_bench prints them (%g: 960, 95.5, 1e+06)
+        sed -n "s/^horizon .*max distance *\([0-9][0-9.e+]*\) m: \([0-9.]*\) s.*/$name \1 \2/p" \
+            "$BUILD_DIR/out" >>"$BUILD_DIR/times.$r"
     done
     r=$((r + 1))
 done
+[ -s "$BUILD_DIR/times.1" ] || {
+    echo "cpu_levels.sh: no horizon times in ts_bench's output:" >&2
+    cat "$BUILD_DIR/out" >&2
+    exit 1
+}
 cat "$BUILD_DIR"/times.* | awk -v dirs="$DIRS" -v size="$SIZE" '
     { k = $1 " " $2; if (!(k in best) || $3 < best[k]) best[k] = $3;
       if (!($1 in seen)) { seen[$1] = 1; order[++n] = $1 }
@@ -87,4 +99,4 @@ cat "$BUILD_DIR"/times.* | awk -v dirs="$DIRS" -v size="$SIZE" '
         }
         printf "(x: the time against the shipped build at the same distance)\n";
     }'
-rm -f "$BUILD_DIR"/times.*
+rm -f "$BUILD_DIR"/times.* "$BUILD_DIR"/out

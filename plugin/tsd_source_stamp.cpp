@@ -83,6 +83,11 @@ std::string SourcesChangedError(const std::string &osDEM, int nLevel)
 {
     const std::string osWhat =
         nLevel ? std::string(CPLSPrintf("overview level %d", nLevel)) : "the product";
+    VSIStatBufL sStat;
+    if (VSIStatL(osDEM.c_str(), &sStat) != 0)
+        return CPLSPrintf("the DEM '%s' was deleted or moved since this dataset was opened, "
+                          "so that %s cannot be computed from it",
+                          osDEM.c_str(), osWhat.c_str());
     return CPLSPrintf("the DEM '%s' (or a file it is read from) changed on disk since this "
                       "dataset was opened, so that %s would mix its former and its new "
                       "contents: open it again (in QGIS, remove the layer and add it again)",

@@ -136,6 +136,19 @@ class ChangedFiles(T.TempDirCase):
         self.assertIn("changed on disk", str(e.exception))
         ds = None
 
+    def test_a_deleted_dem_is_said_deleted(self):
+        """A DEM deleted under an open dataset was said to have 'changed on
+        disk'; it says deleted or moved now."""
+        dem = os.path.join(self.dir, "gone.tif")
+        write_dem(dem, 7)
+        ds = gdal.OpenEx(T.conn(dem), open_options=["PRODUCT=svf"])
+        os.remove(dem)
+        with self.assertRaises(RuntimeError) as e:
+            ds.GetRasterBand(1).ReadAsArray()
+        self.assertIn("the DEM '%s' was deleted or moved since this dataset was opened" % dem,
+                      str(e.exception))
+        ds = None
+
     def test_statistics_of_a_replaced_env_map(self):
         dem = os.path.join(self.dir, "env.tif")
         write_dem(dem, 3)
