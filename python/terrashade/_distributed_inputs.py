@@ -122,6 +122,24 @@ def absolute_source(source):
     return "TERRASHADE:" + head + ":".join(fixed)
 
 
+def absolute_env_map(source, open_options):
+    """(SOURCE, open options) with a relative ENV_MAP that exists here made
+    absolute, inline or given by -oo: as the DEM, each worker read it in its
+    own working directory, another map of that name (the pixels a forest's
+    under the client's sunset's metadata), or none."""
+    def fix(item):
+        key, sep, value = item.partition("=")
+        if key.strip().upper() != "ENV_MAP" or not sep:
+            return item
+        whole = absolute_path(value.strip())
+        return item if whole is None else key + "=" + whole
+    head, dem = split_source(source)
+    if head:
+        head = ",".join(fix(i) for i in head[:-1].split(",")) + ":"
+        source = "TERRASHADE:" + head + dem
+    return source, [fix(i) for i in open_options]
+
+
 def open_source(source, open_options):
     if not source.upper().startswith("TERRASHADE:"):
         raise Failure("SOURCE must be a TERRASHADE connection string "

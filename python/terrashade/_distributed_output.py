@@ -1,6 +1,7 @@
 """terrashade.distributed: DEST, the output file: its format and tiles, the
 partial file written first, and its rename into place."""
 import contextlib
+import glob
 import os
 
 from osgeo import gdal
@@ -72,11 +73,36 @@ def create_like(src, path, block, creation_options):
 RENAMED = []
 
 
-def finish(partial, fmt, dest, creation_options):
-    """partial (closed GeoTIFF) -> dest, in fmt, by rename."""
+def partial_names(dest):
+    """The run's own partial files: the GeoTIFF its windows are written
+    into, and the file renamed to DEST (the same, or its COG copy). Named by
+    the process, so that two runs writing one DEST at once never share a
+    file (they shared DEST.partial: the one still running wrote into the
+    file the other had renamed to DEST, and left garbage there). A partial
+    left by a run that was killed (its process gone) is removed."""
+    tag = ".%d" % os.getpid()
+    for stale in glob.glob(glob.escape(dest) + ".*.partial") + [dest + ".partial"]:
+        pid = stale[len(dest) + 1:].split(".")[0]
+        if pid.isdigit() and int(pid) != os.getpid():
+            try:
+                os.kill(int(pid), 0)
+                continue  # a run still at work: its own file
+            except ProcessLookupError:
+                pass
+            except PermissionError:
+                continue
+        elif not stale.endswith(dest + ".partial"):
+            continue
+        remove(stale)
+    return dest + tag + ".tiles.partial", dest + tag + ".partial"
+
+
+def finish(partial, fmt, dest, creation_options, cog_partial):
+    """partial (closed GeoTIFF) -> dest, in fmt, by rename (a COG through
+    its copy cog_partial)."""
     final = partial
     if fmt == "COG":
-        final = dest + ".partial"
+        final = cog_partial
         # The COG driver's own tiles (BLOCKSIZE 512, as gdal_translate -of COG),
         # not the windows': a copy need not match them, and a COG's tiles are
         # what its readers fetch, a request each (GDAL warns below 128).
@@ -86,15 +112,16 @@ def finish(partial, fmt, dest, creation_options):
         except RuntimeError as e:
             raise Failure("cannot write %s: %s" % (final, e))
         remove(partial)
-    # An older DEST's side files described the old product and would be read
-    # back for the new one (statistics, histograms, overviews, mask), as
-    # gdal_translate's overwrite deletes them.
-    for side in SIDE_FILES:
-        with contextlib.suppress(FileNotFoundError):
-            os.remove(dest + side)
     st = os.stat(final)
     RENAMED[:] = [(st.st_dev, st.st_ino)]  # an interrupt from here on: written()
     os.replace(final, dest)
+    # An older DEST's side files described the old product and would be read
+    # back for the new one (statistics, histograms, overviews, mask), as
+    # gdal_translate's overwrite deletes them; once DEST is the new one, so
+    # that a failed rename leaves the old DEST whole, side files too.
+    for side in SIDE_FILES:
+        with contextlib.suppress(FileNotFoundError):
+            os.remove(dest + side)
     if os.path.exists(final + ".aux.xml"):
         os.replace(final + ".aux.xml", dest + ".aux.xml")
 

@@ -34,10 +34,11 @@ from terrashade import windows as W  # noqa: E402
 from terrashade._distributed_report import (  # noqa: E402,F401
     LOST, SAID, Failure, ProgressBar, Said)
 from terrashade._distributed_inputs import (  # noqa: E402,F401
-    INLINE, PROG, TILE_MAX, TILE_MIN, _ITEM, absolute_path, absolute_source, given_keys,
-    open_source, parse_args, positive, split_source, tile_size)
+    INLINE, PROG, TILE_MAX, TILE_MIN, _ITEM, absolute_env_map, absolute_path, absolute_source,
+    given_keys, open_source, parse_args, positive, split_source, tile_size)
 from terrashade._distributed_output import (  # noqa: E402,F401
-    RENAMED, SIDE_FILES, block_size, create_like, finish, output_format, remove, written)
+    RENAMED, SIDE_FILES, block_size, create_like, finish, output_format, partial_names, remove,
+    written)
 from terrashade._distributed_cluster import (  # noqa: E402,F401
     Terminated, Watch, _terminate, check_workers, dask_logs, interrupts_held, start_cluster)
 
@@ -66,9 +67,13 @@ def compute(client, watch, out, source, task_options, tile, quiet, run):
                     (xoff, yoff, _, _), a, warned = fut.result()
                 except Exception as e:
                     watch.connected(done, len(wins))  # cancelled with the connection
+                    # a DEM (or ENV_MAP) a worker cannot open: say where it ran
+                    where = (" (on a Dask worker, which must reach the DEM and ENV_MAP by "
+                             "the same path as this machine: a shared file system, not "
+                             "/vsimem/)" if "cannot open" in str(e) else "")
                     raise Failure("the window (xoff, yoff, xsize, ysize) = %r of %s "
-                                  "failed: %s: %s" % (window_of[fut.key], source,
-                                                      type(e).__name__, e))
+                                  "failed: %s: %s%s" % (window_of[fut.key], source,
+                                                        type(e).__name__, e, where))
                 SAID.say(warned, bar)  # (its own errors are not the window's)
                 for i in range(out.RasterCount):
                     out.GetRasterBand(i + 1).WriteArray(a[i], xoff, yoff)
@@ -103,7 +108,8 @@ def run(args):
         raise Failure("cannot write %s: it is a directory; DEST names the output file"
                       % args.dest)
     block = block_size(args.tile_size)
-    partial = args.dest + (".tiles.partial" if fmt == "COG" else ".partial")
+    tiles_partial, dest_partial = partial_names(args.dest)
+    partial = tiles_partial if fmt == "COG" else dest_partial
     dem = src.GetMetadataItem("SOURCE_DEM") or ""
     if os.path.exists(dem) and os.path.exists(args.dest) and os.path.samefile(dem, args.dest):
         raise Failure("DEST %s is the DEM itself: the product would replace it; write "
@@ -122,7 +128,7 @@ def run(args):
         if cluster is not None:  # its workers: a Ctrl-C is this process's to handle
             client.run(W.ignore_interrupts)
         keys = given_keys(args.source, args.open_options)
-        task_options = list(args.open_options)
+        args.source, task_options = absolute_env_map(args.source, args.open_options)
         if "THREADS" not in keys:
             task_options.append("THREADS=%d" % threads)
         if "PROGRESS" not in keys:
@@ -133,17 +139,24 @@ def run(args):
                     args.quiet, run_id)
         out.FlushCache()
         out = None
-        finish(partial, fmt, args.dest, args.creation_options)
+        finish(partial, fmt, args.dest, args.creation_options, dest_partial)
     except BaseException:
         out = None
         remove(partial)
-        remove(args.dest + ".partial")
+        remove(dest_partial)
         raise
     finally:
         if client is not None:
             if client.status == "running" and not (watch and watch.lost):
-                with contextlib.suppress(Exception):  # the workers close this run's datasets
-                    client.run(W.forget, run_id)
+                # the workers close this run's datasets, within --timeout: a
+                # worker that stopped answering (a stopped process) held an
+                # interrupted run for Dask's 30 s connect timeout
+                def forget():
+                    with contextlib.suppress(Exception):
+                        client.run(W.forget, run_id)
+                t = threading.Thread(target=forget, daemon=True)
+                t.start()
+                t.join(args.timeout)
             with contextlib.suppress(Exception):  # bounded; a closing error hides no result
                 client.close(timeout=args.timeout)
         if cluster is not None:

@@ -7,6 +7,7 @@ terrashade (installed by `make install`, or on PYTHONPATH).
 """
 import contextlib
 import os
+import socket
 import threading
 
 from osgeo import gdal
@@ -42,6 +43,12 @@ def _dataset(source, open_options, run):
             return held[1]
         _open.pop(me, None)
     del held  # the previous one closes before the next opens: bounded memory
+    if gdal.GetDriverByName("TERRASHADE") is None:
+        # a worker that joined after the start's check (probe): GDAL's open
+        # then failed with no message at all
+        raise RuntimeError("GDAL on the worker at %s cannot find the TERRASHADE driver: set "
+                           "GDAL_DRIVER_PATH there (now %r) or install the plugin"
+                           % (socket.gethostname(), os.environ.get("GDAL_DRIVER_PATH", "")))
     ds = gdal.OpenEx(source, gdal.OF_RASTER | gdal.OF_READONLY, open_options=list(open_options))
     if ds is None:  # (with GDAL's exceptions off; on, OpenEx raised)
         raise RuntimeError("cannot open %s: %s" % (source, gdal.GetLastErrorMsg()))

@@ -51,7 +51,7 @@ class Distributed(TD.DistributedCase):
                 self.assertIn("from 12 windows of 64 on 2 workers", p.stderr)
                 self.assertIn("Completed", p.stderr)  # the Dask progress bar
                 self.assertEqual(p.stdout, "")
-                self.assertFalse(os.path.exists(dest + ".partial"))
+                self.assertEqual(TD.partials(dest), [])
                 self.assertEqual(gdal.Open(dest).GetRasterBand(1).GetBlockSize(), [64, 64])
                 self.assert_identical(dest, self.reference(options, "ref_%s.tif" % name))
 
@@ -124,6 +124,26 @@ class Distributed(TD.DistributedCase):
         for k in range(2):
             self.assert_identical(self.path("script_out%d.tif" % k), self.reference(
                 {"PRODUCT": "svf", "DIRECTIONS": 4, "MAX_DISTANCE": 1}, "ref_script.tif"))
+
+    def test_relative_env_map_is_made_absolute(self):
+        """As the DEM: a relative ENV_MAP, inline or by -oo, was read in each
+        worker's working directory (on an existing cluster another map of
+        that name: a forest's light under the sunset's metadata)."""
+        from terrashade import distributed as D
+        here = os.getcwd()
+        os.chdir(self.dir)
+        try:
+            with open("env.exr", "wb") as f:
+                f.write(b"v/1\x01")
+            whole = os.path.join(os.path.realpath(self.dir), "env.exr")
+            src, oo = D.absolute_env_map("TERRASHADE:PRODUCT=envlight,env_map=env.exr:dem.tif",
+                                         ["ENV_MAP=env.exr", "DIRECTIONS=8", "env_map = gone.exr"])
+            self.assertEqual(src, "TERRASHADE:PRODUCT=envlight,env_map=%s:dem.tif" % whole)
+            self.assertEqual(oo, ["ENV_MAP=" + whole, "DIRECTIONS=8", "env_map = gone.exr"])
+            self.assertEqual(D.absolute_env_map("TERRASHADE:dem.tif", ["ENV_MAP=/abs.exr"]),
+                             ("TERRASHADE:dem.tif", ["ENV_MAP=/abs.exr"]))
+        finally:
+            os.chdir(here)
 
     def test_inline_options_as_the_driver_reads_them(self):
         """THREADS and PROGRESS given inline are left to the user, also where

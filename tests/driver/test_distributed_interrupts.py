@@ -43,7 +43,7 @@ class DistributedInterrupts(TD.DistributedCase):
                     f.write("an older result")
                 p = self.start_signalled_run(dest)
                 for _ in range(600):  # created before the cluster starts
-                    if os.path.exists(dest + ".partial") or p.poll() is not None:
+                    if TD.partials(dest) or p.poll() is not None:
                         break
                     time.sleep(0.05)
                 time.sleep(delay)

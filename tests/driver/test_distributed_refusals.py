@@ -22,23 +22,47 @@ class DistributedRefusals(TD.DistributedCase):
             self.assertIn("cannot write %s: it is a directory" % dest, p.stderr)
             self.assertNotIn("Traceback", p.stderr)
             self.assertEqual(os.listdir(dest), [])
-            self.assertFalse(os.path.exists(dest + ".partial"))
+            self.assertEqual(TD.partials(dest), [])
         finally:
             os.rmdir(dest)
 
-    def test_partial_name_is_a_directory(self):
-        """DEST.partial taken by a directory: GDAL's reason, not the cleanup's
-        IsADirectoryError, and the directory is left alone."""
-        dest = self.path("taken.tif")
-        os.mkdir(dest + ".partial")
+    def test_partials_are_the_runs_own(self):
+        """Two runs writing one DEST at once shared DEST.partial: the one
+        still running wrote into the file the other had renamed to DEST
+        (garbage there, after a success). Each run's partial is named by its
+        process now: another live process's is left alone, a killed run's
+        (its process gone) and the former name's are removed, and a
+        directory by the former name is no obstacle."""
+        dest = self.path("own.tif")
+        dead = 4194305  # beyond Linux's largest pid: no process has it
+        live = os.path.join(self.dir, "own.tif.1.partial")  # init's: alive
+        stale = [dest + ".%d.partial" % dead, dest + ".partial"]
+        for f in [live] + stale:
+            with open(f, "w") as fh:
+                fh.write("not ours")
+        os.mkdir(dest + ".tiles.partial")
         try:
-            p = distributed(["--workers", 1, T.conn(self.dem), dest], ok=False)
-            self.assertEqual(p.returncode, 1, p.stderr)
-            self.assertIn("cannot write %s.partial: " % dest, p.stderr)
-            self.assertTrue(os.path.isdir(dest + ".partial"))
-            self.assertFalse(os.path.exists(dest))
+            distributed(["--workers", 1, "--tile-size", 64, "-q", T.conn(self.dem), dest])
+            self.assert_identical(dest, self.reference({}, "ref_own.tif"))
+            self.assertTrue(os.path.exists(live))
+            for f in stale:
+                self.assertFalse(os.path.exists(f), f)
+            self.assertEqual([f for f in os.listdir(self.dir)
+                              if f.startswith("own.tif") and f.endswith(".partial")
+                              and f != "own.tif.1.partial" and f != "own.tif.tiles.partial"], [])
         finally:
-            os.rmdir(dest + ".partial")
+            os.remove(live)
+            os.rmdir(dest + ".tiles.partial")
+
+    def test_a_worker_without_the_plugin_names_it(self):
+        """A worker that joins after the start's check, without the plugin:
+        GDAL's open failed with no message ('cannot open ...: ')."""
+        p = T.run(["/usr/bin/python3", "-c",
+                   "from terrashade import windows as W\n"
+                   "W.read_window(%r, [], (0, 0, 8, 8), 'r')" % T.conn(self.dem)],
+                  ok=False, PYTHONPATH=PYTHONPATH, GDAL_DRIVER_PATH="/nonexistent")
+        self.assertIn("cannot find the TERRASHADE driver: set GDAL_DRIVER_PATH there "
+                      "(now '/nonexistent')", p.stderr)
 
     def test_destination_is_the_dem(self):
         """DEST naming the DEM (here by another path) is refused before any
@@ -52,7 +76,7 @@ class DistributedRefusals(TD.DistributedCase):
         self.assertNotIn("Traceback", p.stderr)
         with open(self.dem, "rb") as f:
             self.assertEqual(f.read(), before)
-        self.assertFalse(os.path.exists(dest + ".partial"))
+        self.assertEqual(TD.partials(dest), [])
 
     def test_python_without_gdal(self):
         """A Python that cannot import osgeo (python3 first on PATH is often
@@ -74,7 +98,7 @@ class DistributedRefusals(TD.DistributedCase):
         missing_dir = self.path("no/such/dir/out.tif")
         cases = [
             ("unwritable destination", [T.conn(self.dem)],
-             "cannot write %s.partial" % missing_dir, missing_dir),
+             "cannot write %s." % missing_dir, missing_dir),
             ("driver refuses SOURCE", ["-oo", "PRODUCT=hillshade", T.conn(self.dem)],
              "PRODUCT must be one of", None),
             ("missing DEM", [T.conn(self.path("nodem.tif"))],

@@ -3,6 +3,7 @@ not a test itself): the package on sys.path, here and in the worker processes
 that a test's own cluster spawns; the program's run; a DEM for each test
 class, with gdal_translate's product of it to compare with, bit for bit.
 """
+import glob
 import os
 import sys
 
@@ -23,6 +24,12 @@ SUNHOURS = {"PRODUCT": "sunhours", "DATE": "2024-12-21", "TIMEZONE": "-05:00",
 def distributed(args, ok=True, cwd=None, **env):
     return T.run(["/usr/bin/python3", "-m", "terrashade.distributed"] + list(args),
                  ok=ok, cwd=cwd, PYTHONPATH=PYTHONPATH, **env)
+
+
+def partials(dest):
+    """The partial files of runs writing DEST: DEST.<pid>.partial and
+    DEST.<pid>.tiles.partial (and DEST.partial, their name until session 51)."""
+    return glob.glob(glob.escape(dest) + ".*partial")
 
 
 def bits(a):
@@ -70,5 +77,5 @@ class DistributedCase(T.TempDirCase):
             gdal.GetDataTypeName(a.GetRasterBand(1).DataType)))
 
     def assert_nothing_left(self, dest):
-        for p in (dest, dest + ".partial", dest + ".tiles.partial"):
+        for p in [dest] + partials(dest):
             self.assertFalse(os.path.exists(p), "%s was left behind" % p)
