@@ -25,9 +25,18 @@ SRCDIR=$(cd "$(dirname "$0")/.." && pwd)
 GDAL_DRIVER_PATH="$BUILDDIR/plugin/.libs"
 PYTHONPATH="$SRCDIR/python"
 export GDAL_DRIVER_PATH PYTHONPATH
+# terrashade.distributed runs on Dask: checked before the DEM is made
+if ! why=$("$PYTHON" -c 'import dask, distributed' 2>&1); then
+    echo "distributed_bench: needs dask and distributed, which $PYTHON cannot import" \
+         "(Debian/Ubuntu: apt-get install python3-distributed; or pip install" \
+         "'dask[distributed]'): $(printf '%s\n' "$why" | tail -n 1)" >&2
+    exit 1
+fi
 
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/distributed_bench.XXXXXX")
-trap 'rm -rf "$WORK"' EXIT INT TERM
+trap 'rm -rf "$WORK"' EXIT
+trap 'rm -rf "$WORK"; trap - EXIT; exit 130' INT
+trap 'rm -rf "$WORK"; trap - EXIT; exit 143' TERM
 DEM="$WORK/fractal_${SIZE}.tif"
 # tsdriver.py stops with a message if the plugin was not built here
 TS_BUILDDIR="$BUILDDIR" "$PYTHON" - "$SIZE" "$DEM" "$SRCDIR/tests/driver" <<'EOF'

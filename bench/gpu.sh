@@ -26,14 +26,15 @@
 set -eu
 
 size=4096 dirs=32 repeat=3 dry=0
+usage() { echo "usage: $0 [--quick] [--dry-run] [--size N] [--dirs D] [--repeat R]" >&2; exit 2; }
 while [ $# -gt 0 ]; do
     case $1 in
     --quick) size=1024 dirs=16 repeat=2 ;;
     --dry-run) dry=1 ;;
-    --size) size=$2; shift ;;
-    --dirs) dirs=$2; shift ;;
-    --repeat) repeat=$2; shift ;;
-    *) echo "usage: $0 [--quick] [--dry-run] [--size N] [--dirs D] [--repeat R]" >&2; exit 2 ;;
+    --size) [ $# -ge 2 ] || usage; size=$2; shift ;;
+    --dirs) [ $# -ge 2 ] || usage; dirs=$2; shift ;;
+    --repeat) [ $# -ge 2 ] || usage; repeat=$2; shift ;;
+    *) usage ;;
     esac
     shift
 done
@@ -135,6 +136,10 @@ else
         say "NVIDIA ICD file: wrote a private one, $BUILD_DIR/icd/nvidia.icd -> $nv_lib"
     else
         say "NVIDIA OpenCL driver: none found (no nvidia .icd file, no libnvidia-opencl.so.1)"
+        # nothing to build for: stop before the build's minute
+        [ "$dry" = 1 ] || fail "no NVIDIA OpenCL driver on this machine (driver installed?
+NVIDIA_OPENCL_LIB names libnvidia-opencl.so.1 where it is elsewhere); --dry-run runs on
+another device"
     fi
 fi
 if command -v clinfo >/dev/null 2>&1; then
@@ -219,9 +224,14 @@ say "== cl_bench --size $size --dirs $dirs --repeat $repeat"
 "$BUILD_DIR/cl_bench" --size "$size" --dirs "$dirs" --repeat "$repeat"
 say "== kernel times: TERRASHADE_OPENCL_PROFILE=1 cl_bench --size $size --dirs $dirs --repeat 1 --no-streams"
 say "(each launch waits for its event here, so the throughputs of this run are not the figures)"
-TERRASHADE_OPENCL_PROFILE=1 "$BUILD_DIR/cl_bench" --size "$size" --dirs "$dirs" --repeat 1 \
-    --no-streams >"$BUILD_DIR/profile" 2>&1 || true
-sed -n '/TERRASHADE_OPENCL_PROFILE/,$p' "$BUILD_DIR/profile"
+# the kernel times are on stderr (at exit), the table again on stdout: only the former
+if TERRASHADE_OPENCL_PROFILE=1 "$BUILD_DIR/cl_bench" --size "$size" --dirs "$dirs" --repeat 1 \
+    --no-streams >"$BUILD_DIR/profile.out" 2>"$BUILD_DIR/profile"; then
+    sed -n '/TERRASHADE_OPENCL_PROFILE/,$p' "$BUILD_DIR/profile"
+else
+    say "(the profile run failed:)"
+    cat "$BUILD_DIR/profile"
+fi
 # The horizon sweep's own rate (issue 13's GPU goal): its kernels' device
 # time, the transposes included (one of them may be another product's).
 awk -v px="$size" -v dirs="$dirs" '

@@ -19,6 +19,21 @@ set -eu
 SIZE=${1:-4096}
 REPEATS=${2:-2}
 . "$(dirname "$0")/bench_common.sh"
+# what the run needs, checked before the minutes of its agreement phase
+missing=
+for c in gdaldem gdal_translate gdalinfo; do
+    command -v "$c" >/dev/null 2>&1 || missing="$missing $c,"
+done
+[ -x /usr/bin/time ] || missing="$missing /usr/bin/time (GNU time),"
+"$PYTHON" -c 'import numpy; from osgeo import gdal' >/dev/null 2>&1 ||
+    missing="$missing $PYTHON with numpy and osgeo,"
+for f in jacksboro lux_elev; do
+    [ -f "$(dirname "$0")/../tests/data/$f.tif" ] || missing="$missing tests/data/$f.tif,"
+done
+if [ -n "$missing" ]; then
+    echo "shadow_methods_bench: needs${missing%,}: not found" >&2
+    exit 1
+fi
 bench_setup shadow_methods_bench
 DEM="$WORK/fractal_${SIZE}.tif"
 FBM="$WORK/fbm_${SIZE}.tif"

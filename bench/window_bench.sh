@@ -7,7 +7,9 @@
 #       (defaults: "4096 16384", -oo PRODUCT=shade -oo BACKEND=c)
 #
 # For each SIZE: a SIZE x SIZE fractal DEM (bench/fractal_tif.py: 10 m cells,
-# EPSG:32617; 16384 and above as a VRT mosaic of the 4096 one, no disk cost),
+# EPSG:32617; made once at the largest SIZE up to 4096, the smaller ones cut
+# from it; above 4096, multiples of 4096 as a VRT mosaic of the 4096 one, no
+# disk cost),
 # then, timed with /usr/bin/time (wall seconds, peak resident MiB):
 #   window  gdal_translate -srcwin 0 0 256 256 OPTIONS [-oo TILE_SIZE=T] TERRASHADE:dem out
 #   whole   gdal_translate OPTIONS [-oo TILE_SIZE=T] TERRASHADE:dem out   (Mcells/s)
@@ -15,7 +17,8 @@
 # with TILE_SIZE=512; then how far the whole product with TILE_SIZE=2048
 # is from TILE_SIZE=0's (median, p99 and max |difference| over the largest
 # value, share within 1 %). TILE_SIZE=0 on a
-# DEM larger than the memory limit is refused, and printed so.
+# DEM larger than the memory limit is refused, and printed so; any other
+# failure stops the script with the command's error and exit status 1.
 #
 # The plugin is taken from $BUILDDIR/plugin/.libs (BUILDDIR defaults to the
 # current directory) or from wherever GDAL finds it. Needs /usr/bin/python3
@@ -28,14 +31,30 @@ if [ $# -eq 0 ]; then
     set -- -oo PRODUCT=shade -oo BACKEND=c
 fi
 HERE=$(cd "$(dirname "$0")" && pwd)
+# the DEM made: the largest SIZE, or 4096 when a SIZE is a mosaic of it
+base=0
+for n in $SIZES; do
+    case $n in
+    *[!0-9]* | "" | 0*)
+        echo "window_bench: SIZES must be positive integers, got '$n'" >&2
+        exit 2 ;;
+    esac
+    if [ "$n" -gt 4096 ] && [ $((n % 4096)) -ne 0 ]; then
+        echo "window_bench: a SIZE above 4096 must be a multiple of 4096 (a mosaic), got $n" >&2
+        exit 2
+    fi
+    [ "$n" -le "$base" ] || base=$n
+done
+[ "$base" -gt 0 ] || { echo "window_bench: no SIZES" >&2; exit 2; }
+[ "$base" -le 4096 ] || base=4096
 . "$(dirname "$0")/bench_common.sh"
 bench_setup window_bench
-"$PYTHON" "$HERE/fractal_tif.py" 4096 "$WORK/dem_4096.tif"
+"$PYTHON" "$HERE/fractal_tif.py" "$base" "$WORK/dem_$base.tif"
 
-dem_of() { # the DEM of size $1: the 4096 one, or a mosaic of it
-    if [ "$1" -le 4096 ]; then
-        [ "$1" -eq 4096 ] || gdal_translate -q -srcwin 0 0 "$1" "$1" \
-            "$WORK/dem_4096.tif" "$WORK/dem_$1.tif"
+dem_of() { # the DEM of size $1: the one made, cut from it, or a mosaic of it
+    if [ "$1" -le "$base" ]; then
+        [ "$1" -eq "$base" ] || gdal_translate -q -srcwin 0 0 "$1" "$1" \
+            "$WORK/dem_$base.tif" "$WORK/dem_$1.tif"
     else
         "$PYTHON" - "$1" "$WORK" <<'PY'
 import sys
@@ -68,7 +87,16 @@ timed() { # label cells command...: one line of seconds, MiB, Mcells/s
         awk -v l="$label" -v s="$sec" -v k="$kb" -v c="$cells" 'BEGIN {
             printf "%-40s %8.2f s %8.0f MiB %8.1f Mcells/s\n", l, s, k / 1024, c / s / 1e6 }'
     else
-        printf "%-40s refused: %s\n" "$label" "$(grep -m1 ERROR "$WORK/err" | cut -c1-160)"
+        rc=$?
+        # the driver's refusal for memory (MAX_MEMORY, or three quarters of
+        # the physical memory) is a result; anything else is a failure
+        if grep -q 'needs about [0-9]* MiB.*MAX_MEMORY' "$WORK/err"; then
+            printf "%-40s refused: %s\n" "$label" "$(grep -m1 ERROR "$WORK/err" | cut -c1-160)"
+        else
+            echo "window_bench: $label failed (exit $rc): $*" >&2
+            cat "$WORK/err" >&2
+            exit 1
+        fi
     fi
 }
 
