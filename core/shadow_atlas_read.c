@@ -180,11 +180,16 @@ ts_status ts_atlas_open(const uint8_t *b, size_t n, ts_atlas **out, ts_error *er
         end = secs[i][0] + secs[i][1] > end ? secs[i][0] + secs[i][1] : end;
     }
     /* every byte under a checksum: bytes after the last section are none
-     * of the atlas's (appended data, a copy cut into another file) */
+     * of the atlas's (appended data, a copy cut into another file), and the
+     * sections follow each other without gaps or overlaps */
     if (end < n)
         BAD("the atlas is damaged: %llu bytes follow its last section, which ends at byte "
             "%llu of the %zu-byte file", (unsigned long long)(n - end),
             (unsigned long long)end, n);
+    if ((uint64_t)hsize + sn + tn + dn + in != n)
+        BAD("the atlas is damaged: its header and sections hold %llu bytes of the %zu-byte "
+            "file (gaps or overlaps between them)",
+            (unsigned long long)((uint64_t)hsize + sn + tn + dn + in), n);
     if (lzma_crc32(b + to, (size_t)tn, lzma_crc32(b + so, (size_t)sn, 0)) != get32(b + 164))
         BAD("the atlas's step table or metadata text is damaged (CRC32 mismatch)");
     a->info.width = (int)W;

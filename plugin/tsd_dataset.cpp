@@ -224,7 +224,9 @@ CPLErr TSDataset::EnsureComputed()
         {
             ts_grid_free(&sGrid);
             eStatus = TS_ERR_ARG;
-            snprintf(szMsg, sizeof szMsg, "%s", SourcesChangedError(m_osDEM, m_nLevel).c_str());
+            snprintf(szMsg, sizeof szMsg, "%s", SourcesChangedError(m_osDEM, m_nLevel,
+                                         (m_poBase ? m_poBase : this)->m_aosDEMFiles)
+                         .c_str());
         }
         if (eStatus != TS_OK)
         {

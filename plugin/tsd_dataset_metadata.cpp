@@ -451,18 +451,31 @@ void TSDataset::SetupPam(const char *pszConnection)
         // chunks and the far grid change pixels where the options alone do
         // not say (TILE_SIZE=256 against the whole DEM, a MAX_MEMORY that
         // coarsens the far grid): they shared one entry's statistics
+        const std::string osDEMPart = m_osDEM != papszFiles[0] ? ":" + m_osDEM : "";
+        const std::string osUnwindowed = osSub + osDEMPart; // the key until session 51
         if (const tsd_window_plan *psPlan = WindowPlan(m_poWindow))
             osSub += CPLSPrintf(",WINDOWS=%d/%.17g/%dx%d", psPlan->tile, psPlan->near_m,
                                 psPlan->far_w, psPlan->far_h);
-        if (m_osDEM != papszFiles[0])
-            osSub += ":" + m_osDEM;
+        osSub += osDEMPart;
         SetPhysicalFilename(papszFiles[0]);
         SetSubdatasetName(osSub.c_str());
         bool bLegacy = false;
         const char *pszOwn = BuildPamFilename();
         const std::string osOwn = pszOwn ? pszOwn : "";
         TryLoadXML();
-        if (!HasPamEntry(osOwn.c_str(), osSub.c_str(), papszFiles[0])) // one from before session 48?
+        // a windowed product's entry saved under the key without its chunks
+        // (before session 51): what the user set comes over; its statistics,
+        // maybe of other pixels (the whole DEM's), do not
+        if (osUnwindowed != osSub && !HasPamEntry(osOwn.c_str(), osSub.c_str(), papszFiles[0]) &&
+            HasPamEntry(osOwn.c_str(), osUnwindowed.c_str(), papszFiles[0]))
+        {
+            SetSubdatasetName(osUnwindowed.c_str());
+            bLegacy = TryLoadXML() == CE_None;
+            SetSubdatasetName(osSub.c_str());
+            for (int i = 1; i <= nBands; i++)
+                static_cast<TSRasterBand *>(GetRasterBand(i))->DropSavedStatistics();
+        }
+        else if (!HasPamEntry(osOwn.c_str(), osSub.c_str(), papszFiles[0])) // before session 48?
         {
             CPLFree(psPam->pszPamFilename);
             psPam->pszPamFilename = nullptr;

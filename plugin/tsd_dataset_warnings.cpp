@@ -109,7 +109,8 @@ void TSDataset::WarnDistances(double dfCell, int W, int H)
     // (METHOD=shadowmap refuses EDGE=nodata)
     if (tsd_options_edge(&m_sOpts) == TS_EDGE_NODATA && !(m_sOpts.max_distance > 0))
         CPLError(CE_Warning, CPLE_AppDefined,
-                 "TERRASHADE: EDGE=nodata without MAX_DISTANCE makes every cell nodata: it "
+                 "TERRASHADE: EDGE=nodata without MAX_DISTANCE makes nodata every cell that "
+                 "casts a ray (all of them, but a day's steps with the sun down): it "
                  "leaves out the cells whose rays leave the DEM within MAX_DISTANCE, and "
                  "unbounded every ray leaves it. Give MAX_DISTANCE (e.g. the reach of the "
                  "terrain that matters), or EDGE=horizon or open");

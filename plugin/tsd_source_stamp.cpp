@@ -79,15 +79,18 @@ std::string SourceStamp(const std::vector<std::string> &aosFiles)
                       static_cast<unsigned long long>(h));
 }
 
-std::string SourcesChangedError(const std::string &osDEM, int nLevel)
+std::string SourcesChangedError(const std::string &osDEM, int nLevel,
+                                const std::vector<std::string> &aosFiles)
 {
     const std::string osWhat =
         nLevel ? std::string(CPLSPrintf("overview level %d", nLevel)) : "the product";
+    // by its files: the DEM's name may be a driver's (GTIFF_DIR:1:dem.tif)
     VSIStatBufL sStat;
-    if (VSIStatL(osDEM.c_str(), &sStat) != 0)
-        return CPLSPrintf("the DEM '%s' was deleted or moved since this dataset was opened, "
-                          "so that %s cannot be computed from it",
-                          osDEM.c_str(), osWhat.c_str());
+    for (const std::string &osFile : aosFiles)
+        if (VSIStatL(osFile.c_str(), &sStat) != 0)
+            return CPLSPrintf("the DEM '%s' (its file '%s') was deleted or moved since this "
+                              "dataset was opened, so that %s cannot be computed from it",
+                              osDEM.c_str(), osFile.c_str(), osWhat.c_str());
     return CPLSPrintf("the DEM '%s' (or a file it is read from) changed on disk since this "
                       "dataset was opened, so that %s would mix its former and its new "
                       "contents: open it again (in QGIS, remove the layer and add it again)",

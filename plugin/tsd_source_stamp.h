@@ -29,10 +29,11 @@ std::vector<std::string> SourceFiles(char **papszDEMFiles, const char *pszEnvMap
  * files were not seen to change. Empty for no files. */
 std::string SourceStamp(const std::vector<std::string> &aosFiles);
 
-/* The sentence refusing to compute from pszDEM after its files changed on
- * disk since the dataset opened (nLevel: the overview level, 0 = full
- * resolution). */
-std::string SourcesChangedError(const std::string &osDEM, int nLevel);
+/* The sentence refusing to compute from pszDEM after its files (aosFiles,
+ * SourceFiles') changed on disk since the dataset opened, or one of them
+ * went (nLevel: the overview level, 0 = full resolution). */
+std::string SourcesChangedError(const std::string &osDEM, int nLevel,
+                                const std::vector<std::string> &aosFiles);
 
 } // namespace tsd
 

@@ -183,7 +183,13 @@ bool TSDataset::SetupWindow(int W, int H)
     const double dfMinX = tsd_cells_min_x(&m_sCells, H);
     poState->refCellX = m_sCells.cell_x_row ? m_sCells.cell_x_row[H / 2] : m_sCells.cell_x;
     char szMsg[512];
-    if (tsd_window_plan_make(&m_sOpts, m_bHasSun ? &m_sSun : nullptr, W, H, dfMinX, m_sCells.cell_y,
+    // an overview level is computed whole (below): NEAR_DISTANCE, checked
+    // against the DEM's cells at level 0, is none of its business (its
+    // coarser cells made a valid one "too few cells" when zoomed out)
+    tsd_options sOpts = m_sOpts;
+    if (m_nLevel > 0)
+        sOpts.near_distance = 0;
+    if (tsd_window_plan_make(&sOpts, m_bHasSun ? &m_sSun : nullptr, W, H, dfMinX, m_sCells.cell_y,
                              &poState->plan, szMsg, sizeof szMsg) != 0)
         return Fail(TS_ERR_ARG, szMsg), false;
     if (m_nLevel > 0 && poState->plan.windowed)
@@ -376,7 +382,8 @@ const WindowChunk *TSDataset::Chunk(int cx, int cy)
     if (!DEMUnchanged()) // (its chunks and far grid would mix two DEMs)
     {
         s.status = TS_ERR_ARG;
-        s.error = SourcesChangedError(m_osDEM, m_nLevel);
+        s.error = SourcesChangedError(m_osDEM, m_nLevel,
+                                      (m_poBase ? m_poBase : this)->m_aosDEMFiles);
         return nullptr;
     }
     const std::chrono::duration<double> dfSec = std::chrono::steady_clock::now() - tStart;

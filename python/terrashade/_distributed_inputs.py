@@ -126,18 +126,24 @@ def absolute_env_map(source, open_options):
     """(SOURCE, open options) with a relative ENV_MAP that exists here made
     absolute, inline or given by -oo: as the DEM, each worker read it in its
     own working directory, another map of that name (the pixels a forest's
-    under the client's sunset's metadata), or none."""
-    def fix(item):
+    under the client's sunset's metadata), or none. An inline one moves to
+    the open options: its absolute path may hold the ':' or ',' that end an
+    inline value."""
+    def whole(item):
         key, sep, value = item.partition("=")
         if key.strip().upper() != "ENV_MAP" or not sep:
-            return item
-        whole = absolute_path(value.strip())
-        return item if whole is None else key + "=" + whole
+            return None
+        path = absolute_path(value.strip())
+        return None if path is None else "ENV_MAP=" + path.strip('"')
+    options = [whole(i) or i for i in open_options]
     head, dem = split_source(source)
     if head:
-        head = ",".join(fix(i) for i in head[:-1].split(",")) + ":"
-        source = "TERRASHADE:" + head + dem
-    return source, [fix(i) for i in open_options]
+        items = head[:-1].split(",")
+        moved = [whole(i) for i in items]
+        kept = [i for i, m in zip(items, moved) if m is None]
+        options += [m for m in moved if m is not None]
+        source = "TERRASHADE:" + (",".join(kept) + ":" if kept else "") + dem
+    return source, options
 
 
 def open_source(source, open_options):

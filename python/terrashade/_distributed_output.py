@@ -1,8 +1,9 @@
 """terrashade.distributed: DEST, the output file: its format and tiles, the
 partial file written first, and its rename into place."""
 import contextlib
-import glob
 import os
+import socket
+import uuid
 
 from osgeo import gdal
 
@@ -76,24 +77,15 @@ RENAMED = []
 def partial_names(dest):
     """The run's own partial files: the GeoTIFF its windows are written
     into, and the file renamed to DEST (the same, or its COG copy). Named by
-    the process, so that two runs writing one DEST at once never share a
-    file (they shared DEST.partial: the one still running wrote into the
-    file the other had renamed to DEST, and left garbage there). A partial
-    left by a run that was killed (its process gone) is removed."""
-    tag = ".%d" % os.getpid()
-    for stale in glob.glob(glob.escape(dest) + ".*.partial") + [dest + ".partial"]:
-        pid = stale[len(dest) + 1:].split(".")[0]
-        if pid.isdigit() and int(pid) != os.getpid():
-            try:
-                os.kill(int(pid), 0)
-                continue  # a run still at work: its own file
-            except ProcessLookupError:
-                pass
-            except PermissionError:
-                continue
-        elif not stale.endswith(dest + ".partial"):
-            continue
-        remove(stale)
+    the machine, the process and a random part, so that two runs writing
+    one DEST at once never share a file (they shared DEST.partial: the one
+    still running wrote into the file the other had renamed to DEST, and
+    left garbage there), also runs on other hosts or in containers, whose
+    process numbers repeat. Another run's partial is never removed: that it
+    is stale cannot be told from here (a run killed with SIGKILL leaves its
+    own behind, to delete by hand)."""
+    host = "".join(c if c.isalnum() or c in "-_" else "_" for c in socket.gethostname())
+    tag = ".%s-%d-%s" % (host or "host", os.getpid(), uuid.uuid4().hex[:8])
     return dest + tag + ".tiles.partial", dest + tag + ".partial"
 
 

@@ -53,6 +53,18 @@ def forge(data, text=None, step=None, version=None):
     return bytes(h) + bytes(steps) + new_text + rest
 
 
+def gap(data, k):
+    """The atlas with k garbage bytes after its header, its sections'
+    offsets moved past them and its header's CRC made again."""
+    import struct
+    import zlib
+    head = bytearray(data[:168])
+    for off in (104, 112, 128, 144):  # steps, text, dictionary, index offsets
+        struct.pack_into("<Q", head, off, struct.unpack_from("<Q", head, off)[0] + k)
+    struct.pack_into("<I", head, 160, zlib.crc32(bytes(head[:160])))
+    return bytes(head) + bytes([0x5A] * k) + data[168:]
+
+
 def band_metadata(ds):
     return [(ds.GetRasterBand(b).GetDescription(), ds.GetRasterBand(b).GetMetadata())
             for b in range(1, ds.RasterCount + 1)]
@@ -232,7 +244,10 @@ class Atlas(unittest.TestCase):
                  ("index", data[:-40] + bytes([data[-40] ^ 0x20]) + data[-39:], "damaged"),
                  ("version", data[:8] + bytes([9]) + data[9:], "version 9"),
                  # bytes after the last section, under no checksum, were read
-                 ("appended", data + bytes(100), "100 bytes follow its last section")]
+                 ("appended", data + bytes(100), "100 bytes follow its last section"),
+                 # 128 bytes between the header and the first section, the
+                 # offsets moved and the header's CRC made again: no checksum
+                 ("gap", gap(data, 128), "gaps or overlaps between them")]
         for name, blob, text in cases:
             with self.subTest(name):
                 path = os.path.join(self.dir, name + ".tsa")

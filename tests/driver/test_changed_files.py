@@ -145,9 +145,46 @@ class ChangedFiles(T.TempDirCase):
         os.remove(dem)
         with self.assertRaises(RuntimeError) as e:
             ds.GetRasterBand(1).ReadAsArray()
-        self.assertIn("the DEM '%s' was deleted or moved since this dataset was opened" % dem,
+        self.assertIn("the DEM '%s' (its file '%s') was deleted or moved since this dataset "
+                      "was opened" % (dem, dem),
                       str(e.exception))
         ds = None
+        # a DEM named through another driver, rewritten: changed, not deleted
+        # (its name is no file: it read as deleted)
+        write_dem(dem, 7)
+        ds = gdal.OpenEx(T.conn("GTIFF_DIR:1:" + dem), open_options=["PRODUCT=svf"])
+        write_dem(dem, 8)
+        with self.assertRaises(RuntimeError) as e:
+            ds.GetRasterBand(1).ReadAsArray()
+        self.assertIn("changed on disk", str(e.exception))
+        ds = None
+
+    def test_a_windowed_entry_from_before_its_key_had_the_chunks(self):
+        """Session 51 put the chunks and far grid in a windowed product's
+        key: an entry saved under the key without them keeps what the user
+        set (nodata, unit), not its statistics, which may be the whole
+        DEM's pixels'."""
+        import re
+        dem = os.path.join(self.dir, "oldkey.tif")
+        write_dem(dem, 9, n=200)
+        oo = ["PRODUCT=svf", "TILE_SIZE=64", "DIRECTIONS=4"]
+        ds = gdal.OpenEx(T.conn(dem), open_options=oo)
+        b = ds.GetRasterBand(1)
+        b.SetNoDataValue(-7)
+        b.SetUnitType("myunit")
+        b.ComputeStatistics(False)
+        b = ds = None
+        aux = dem + ".terrashade.aux.xml"
+        with open(aux) as f:
+            text = f.read()
+        self.assertIn(",WINDOWS=", text)
+        with open(aux, "w") as f:
+            f.write(re.sub(r",WINDOWS=[^\":<]*", "", text))
+        ds = gdal.OpenEx(T.conn(dem), open_options=oo)
+        b = ds.GetRasterBand(1)
+        self.assertEqual((b.GetNoDataValue(), b.GetUnitType()), (-7.0, "myunit"))
+        self.assertIsNone(b.GetMetadataItem("STATISTICS_MEAN"))
+        b = ds = None
 
     def test_statistics_of_a_replaced_env_map(self):
         dem = os.path.join(self.dir, "env.tif")

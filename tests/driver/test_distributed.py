@@ -137,9 +137,14 @@ class Distributed(TD.DistributedCase):
                 f.write(b"v/1\x01")
             whole = os.path.join(os.path.realpath(self.dir), "env.exr")
             src, oo = D.absolute_env_map("TERRASHADE:PRODUCT=envlight,env_map=env.exr:dem.tif",
-                                         ["ENV_MAP=env.exr", "DIRECTIONS=8", "env_map = gone.exr"])
-            self.assertEqual(src, "TERRASHADE:PRODUCT=envlight,env_map=%s:dem.tif" % whole)
-            self.assertEqual(oo, ["ENV_MAP=" + whole, "DIRECTIONS=8", "env_map = gone.exr"])
+                                         ["DIRECTIONS=8", "env_map = gone.exr"])
+            # (inline, moved to the open options: an absolute path may hold
+            # the ':' or ',' that end an inline value)
+            self.assertEqual(src, "TERRASHADE:PRODUCT=envlight:dem.tif")
+            self.assertEqual(oo, ["DIRECTIONS=8", "env_map = gone.exr", "ENV_MAP=" + whole])
+            self.assertEqual(D.absolute_env_map("TERRASHADE:ENV_MAP=env.exr:dem.tif",
+                                                ["ENV_MAP=env.exr"]),
+                             ("TERRASHADE:dem.tif", ["ENV_MAP=" + whole, "ENV_MAP=" + whole]))
             self.assertEqual(D.absolute_env_map("TERRASHADE:dem.tif", ["ENV_MAP=/abs.exr"]),
                              ("TERRASHADE:dem.tif", ["ENV_MAP=/abs.exr"]))
         finally:

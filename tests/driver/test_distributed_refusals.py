@@ -30,29 +30,25 @@ class DistributedRefusals(TD.DistributedCase):
         """Two runs writing one DEST at once shared DEST.partial: the one
         still running wrote into the file the other had renamed to DEST
         (garbage there, after a success). Each run's partial is named by its
-        process now: another live process's is left alone, a killed run's
-        (its process gone) and the former name's are removed, and a
-        directory by the former name is no obstacle."""
+        machine, process and a random part now, and another's is never
+        touched (on another host or in a container its process number says
+        nothing here)."""
+        from terrashade._distributed_output import partial_names
         dest = self.path("own.tif")
-        dead = 4194305  # beyond Linux's largest pid: no process has it
-        live = os.path.join(self.dir, "own.tif.1.partial")  # init's: alive
-        stale = [dest + ".%d.partial" % dead, dest + ".partial"]
-        for f in [live] + stale:
+        a, b = partial_names(dest), partial_names(dest)
+        self.assertNotEqual(a, b)
+        self.assertTrue(a[1].startswith(dest + ".") and a[1].endswith(".partial"))
+        others = [dest + ".partial", dest + ".otherhost-1-0123abcd.partial"]
+        for f in others:
             with open(f, "w") as fh:
                 fh.write("not ours")
-        os.mkdir(dest + ".tiles.partial")
         try:
             distributed(["--workers", 1, "--tile-size", 64, "-q", T.conn(self.dem), dest])
             self.assert_identical(dest, self.reference({}, "ref_own.tif"))
-            self.assertTrue(os.path.exists(live))
-            for f in stale:
-                self.assertFalse(os.path.exists(f), f)
-            self.assertEqual([f for f in os.listdir(self.dir)
-                              if f.startswith("own.tif") and f.endswith(".partial")
-                              and f != "own.tif.1.partial" and f != "own.tif.tiles.partial"], [])
+            self.assertEqual(sorted(TD.partials(dest)), sorted(others))
         finally:
-            os.remove(live)
-            os.rmdir(dest + ".tiles.partial")
+            for f in others:
+                os.remove(f)
 
     def test_a_worker_without_the_plugin_names_it(self):
         """A worker that joins after the start's check, without the plugin:

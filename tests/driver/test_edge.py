@@ -253,7 +253,8 @@ class Edge(unittest.TestCase):
         "no valid pixels"; none with MAX_DISTANCE. METHOD=shadowmap, which
         takes no MAX_DISTANCE, left every cell valid under it: refused."""
         err = T.translate_stderr(self.flat, PRODUCT="svf", EDGE="nodata")
-        self.assertIn("EDGE=nodata without MAX_DISTANCE makes every cell nodata", err)
+        self.assertIn("EDGE=nodata without MAX_DISTANCE makes nodata every cell that casts "
+                      "a ray", err)
         self.assertTrue(np.isnan(T.read(T.conn(self.flat), 1,
                                         dict(PRODUCT="svf", EDGE="nodata"))).all())
         self.assertNotIn("EDGE=nodata", T.translate_stderr(self.flat, PRODUCT="svf",

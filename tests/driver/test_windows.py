@@ -411,6 +411,12 @@ np.save(sys.argv[2], a)
         self.refused({"NEAR_DISTANCE": 300}, ["NEAR_DISTANCE=300 m is", "at least 16 cells"])
         T.run(["gdalinfo", "-oo", "NEAR_DISTANCE=300", "-oo", "MAX_DISTANCE=300",
                T.conn(T.JACKSBORO)])
+        # ... but not at an overview level (computed whole), whose coarser
+        # cells made 1200 m, 16.1 of jacksboro's cells, too few when zoomed out
+        p = T.run(["gdal_translate", "-q", "-outsize", "50%", "50%", "-oo",
+                   "NEAR_DISTANCE=1200", "-oo", "PRODUCT=svf", "-oo", "DIRECTIONS=4",
+                   T.conn(T.JACKSBORO), os.path.join(self.tmp, "ovr.tif")])
+        self.assertNotIn("ERROR", p.stderr)
         T.run(["gdalinfo", "-oo", "NEAR_DISTANCE=300", "-oo", "TILE_SIZE=0",
                T.conn(T.JACKSBORO)])
 
