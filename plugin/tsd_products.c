@@ -2,6 +2,7 @@
 #include "tsd_products.h"
 
 #include "simd_clones.h"
+#include "terrashade_env.h"
 #include "terrashade_sh.h"
 #include "tsd_pyramid.h"
 #include "tsd_text.h"
@@ -253,6 +254,16 @@ void tsd_products_taking(int option, const char *prefix, const char *last, char 
  * (NULL: it does something). */
 static const char *moot_beside(const tsd_options *o, const tsd_product_def *p, const char *name)
 {
+    /* envlight under a sky without a sun (uniform, overcast): nothing of
+     * the sun's (ENV_MAP with a sun is refused, tsd_options_check) */
+    ts_sky_kind kind;
+    int cie = 0;
+    if (tsd_product_takes(p, tsd_option_find("EXPOSURE")) && o->sky[0] &&
+        ts_sky_parse(o->sky, &kind, &cie, NULL) == TS_OK && !ts_sky_follows_sun(kind, cie) &&
+        (!strcmp(name, "SUN_AZIMUTH") || !strcmp(name, "SUN_ELEVATION") ||
+         !strcmp(name, "DATETIME") || !strcmp(name, "PRESSURE") ||
+         !strcmp(name, "TEMPERATURE") || !strcmp(name, "DELTA_T")))
+        return "the sun's, and SKY=uniform or overcast has none";
     if ((!strcmp(name, "PRESSURE") || !strcmp(name, "TEMPERATURE") ||
          !strcmp(name, "DELTA_T")) &&
         !tsd_options_sun_from_time(o))

@@ -161,7 +161,12 @@ class Options(unittest.TestCase):
         self.assertIn("PRODUCT=shade does not use DIRECTIONS (of the sky term, which "
                       "SKY_WEIGHT=0 leaves out), PRESSURE (it refracts and places a sun "
                       "computed from DATETIME): given, they do nothing here", err)
+        # envlight under a sky without a sun: its options of the sun
+        err = T.open_stderr(self.dem, PRODUCT="envlight", SKY="overcast", SUN_AZIMUTH=100)
+        self.assertIn("PRODUCT=envlight does not use SUN_AZIMUTH (the sun's, and "
+                      "SKY=uniform or overcast has none)", err)
         for oo in (dict(PRODUCT="svf", DIRECTIONS=8, MAX_DISTANCE=500, THREADS=1),
+                   dict(PRODUCT="envlight", SKY="clear", SUN_AZIMUTH=100),
                    dict(PRODUCT="shade", PRESSURE=900, DIRECTIONS=32, SKY_WEIGHT=0.3,
                         DATETIME="2026-06-21T12:00:00Z"),
                    dict(PRODUCT="shade", SUN_AZIMUTH=100, TILE_SIZE=128, Z_FACTOR=2),
