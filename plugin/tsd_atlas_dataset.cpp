@@ -335,10 +335,10 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
     // a file that does not read as an atlas: FileIO, as docs/driver.md's
     // errors say (the core's argument error read as a bad option, 5)
     if (eSt != TS_OK)
-        return eSt == TS_ERR_NOMEM
-                   ? FailOpen(eSt, CPLSPrintf("'%s': %s", poOpenInfo->pszFilename, sErr.message))
-                   : FailOpen(CPLE_FileIO,
-                              CPLSPrintf("'%s': %s", poOpenInfo->pszFilename, sErr.message));
+    {
+        const char *pszMsg = CPLSPrintf("'%s': %s", poOpenInfo->pszFilename, sErr.message);
+        return eSt == TS_ERR_NOMEM ? FailOpen(eSt, pszMsg) : FailOpen(CPLE_FileIO, pszMsg);
+    }
     auto poDS = std::unique_ptr<TSAtlasDataset>(new TSAtlasDataset());
     poDS->m_psAtlas = psAtlas;
     const ts_atlas_info *psInfo = ts_atlas_get_info(psAtlas);

@@ -26,6 +26,14 @@ int tsd_options_env(const tsd_options *o)
     return o->env_map[0] || o->sky[0];
 }
 
+int tsd_environment_sunless(const tsd_options *o)
+{
+    ts_sky_kind kind;
+    int cie = 0;
+    return o->env_map[0] || (o->sky[0] && ts_sky_parse(o->sky, &kind, &cie, NULL) == TS_OK &&
+                             !ts_sky_follows_sun(kind, cie));
+}
+
 int tsd_exposure_parse(const char *text, double *stops)
 {
     if (!text[0] || strcasecmp(text, "auto") == 0)

@@ -45,6 +45,10 @@ struct tsd_environment {
 /* 1 if the options light with an environment (ENV_MAP or SKY given). */
 int tsd_options_env(const tsd_options *o);
 
+/* 1 if that environment places no sun: ENV_MAP (the map is the light), or
+ * a SKY that does not follow one (uniform, overcast). */
+int tsd_environment_sunless(const tsd_options *o);
+
 /* EXPOSURE's text: 1 for automatic ("" or AUTO), 0 with *stops set, -1 if
  * it is neither (or out of +-TSD_EXPOSURE_MAX). */
 int tsd_exposure_parse(const char *text, double *stops);

@@ -614,11 +614,11 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     const GDALDataType eType = tsd_options_output_byte(&sOpts) ? GDT_Byte : GDT_Float32;
     for (int i = 1; i <= tsd_options_band_count(&sOpts); i++)
         SetBand(i, new TSRasterBand(this, i, eType));
-    SetupMetadata();
     if (m_nLevel == 0)
-        SetupPam(pszConnection);
+        SetupPam(pszConnection); // the metadata too, over what a saved entry holds
     else
     {
+        SetupMetadata();
         SetDescription(pszConnection);
         nPamFlags |= GPF_DISABLED; // a level's statistics are its parent's business
     }

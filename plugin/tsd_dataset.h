@@ -169,7 +169,7 @@ class TSDataset final : public GDALPamDataset
     bool ReportBackend(bool bMayWarn = true);
     void SetupSunMetadata();
     void SetupMetadata();
-    void SetupPam(const char *pszConnection);
+    void SetupPam(const char *pszConnection); // level 0: PAM, then SetupMetadata over it
     bool m_bLegacyPam = false; // BuildPamFilename: the DEM's own .aux.xml (SetupPam)
     /* the DEM's files (level 0; none: a MEM DEM) and the stamps of their
      * contents, and of ENV_MAP's with them, when the dataset opened

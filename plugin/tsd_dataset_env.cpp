@@ -163,11 +163,9 @@ bool TSDataset::SetupEnvironment()
  * shade through dusk keeps going. */
 void TSDataset::WarnSkyAtNight() const
 {
-    ts_sky_kind eKind;
-    int nType = 0;
+    // (SKY was checked at open, and excludes ENV_MAP)
     if (m_nLevel != 0 || !m_sOpts.sky[0] || m_sRun.sun_elevation >= 0 ||
-        ts_sky_parse(m_sOpts.sky, &eKind, &nType, nullptr) != TS_OK ||
-        !ts_sky_follows_sun(eKind, nType))
+        tsd_environment_sunless(&m_sOpts))
         return;
     CPLError(CE_Warning, CPLE_AppDefined,
              "TERRASHADE: SKY=%s with the sun %.1f degrees below the horizon: the CIE "

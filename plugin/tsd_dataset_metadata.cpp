@@ -107,12 +107,8 @@ void TSDataset::SetupMetadata()
     // envlight under ENV_MAP, or a sky without a sun (uniform, overcast):
     // no sun lights it, so its options record none (SUN_AZIMUTH=315 read
     // as the light's direction)
-    ts_sky_kind eSky;
-    int nCie = 0;
     const bool bSunless =
-        m_psProduct->compute == tsd_compute_envlight &&
-        (m_sOpts.env_map[0] || (ts_sky_parse(m_sOpts.sky, &eSky, &nCie, nullptr) == TS_OK &&
-                                !ts_sky_follows_sun(eSky, nCie)));
+        m_psProduct->compute == tsd_compute_envlight && tsd_environment_sunless(&m_sOpts);
     for (int i = 0; i < tsd_options_count(); i++)
     {
         const char *pszName = tsd_options_value(&m_sOpts, i, szValue, sizeof szValue);
@@ -511,6 +507,7 @@ void TSDataset::SetupPam(const char *pszConnection)
     }
     else
     {
+        SetupMetadata();
         nPamFlags |= GPF_DISABLED; // no file to put it next to
         nPamFlags &= ~GPF_DIRTY;
     }

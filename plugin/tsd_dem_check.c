@@ -359,6 +359,8 @@ static int longest_voids(const float *z, ptrdiff_t step, int n, int *first)
 int tsd_grid_voids_warning(const ts_grid *g, double max_distance, double per_x, double per_y,
                            char *warning, size_t n)
 {
+    if (!(max_distance > 0)) /* unbounded rays cross every void: no pass over the grid */
+        return 0;
     const int W = g->width, H = g->height;
     double widest = 0;
     int row = 0, line = 0, from = 0, len = 0;
@@ -374,7 +376,7 @@ int tsd_grid_voids_warning(const ts_grid *g, double max_distance, double per_x, 
         if (k * g->cell_y > widest)
             widest = k * g->cell_y, row = 0, line = x, from = first, len = k;
     }
-    if (!(max_distance > 0 && widest > max_distance))
+    if (!(widest > max_distance))
         return 0;
     /* in the whole DEM's cells where g is a window of it, where a run cut
      * by the window's edge is at least as wide as it shows */

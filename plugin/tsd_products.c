@@ -2,8 +2,8 @@
 #include "tsd_products.h"
 
 #include "simd_clones.h"
-#include "terrashade_env.h"
 #include "terrashade_sh.h"
+#include "tsd_compute_env.h"
 #include "tsd_pyramid.h"
 #include "tsd_text.h"
 
@@ -256,10 +256,7 @@ static const char *moot_beside(const tsd_options *o, const tsd_product_def *p, c
 {
     /* envlight under a sky without a sun (uniform, overcast): nothing of
      * the sun's (ENV_MAP with a sun is refused, tsd_options_check) */
-    ts_sky_kind kind;
-    int cie = 0;
-    if (tsd_product_takes(p, tsd_option_find("EXPOSURE")) && o->sky[0] &&
-        ts_sky_parse(o->sky, &kind, &cie, NULL) == TS_OK && !ts_sky_follows_sun(kind, cie) &&
+    if (tsd_product_takes(p, tsd_option_find("EXPOSURE")) && tsd_environment_sunless(o) &&
         (!strcmp(name, "SUN_AZIMUTH") || !strcmp(name, "SUN_ELEVATION") ||
          !strcmp(name, "DATETIME") || !strcmp(name, "PRESSURE") ||
          !strcmp(name, "TEMPERATURE") || !strcmp(name, "DELTA_T")))
