@@ -2,6 +2,7 @@
 #include "tsd_option_table.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,15 +20,17 @@
 #define ALL TSD_APPLIES_ALL
 #define LISTED TSD_APPLIES_LISTED
 
-static int check_datetime(const char *v, char *msg, size_t n);
-static int check_date(const char *v, char *msg, size_t n);
-static int check_start_date(const char *v, char *msg, size_t n);
-static int check_end_date(const char *v, char *msg, size_t n);
-static int check_timezone(const char *v, char *msg, size_t n);
-static int check_sky(const char *v, char *msg, size_t n);
-static int check_exposure(const char *v, char *msg, size_t n);
-static int check_tile_size(const char *v, char *msg, size_t n);
-static int check_light_radius(const char *v, char *msg, size_t n);
+/* a text option's reading (opt_read_fn): its check and its meaning */
+#define READER(f) static int f(const char *v, char *meaning, size_t mn, char *msg, size_t n)
+READER(check_datetime);
+READER(check_date);
+READER(check_start_date);
+READER(check_end_date);
+READER(check_timezone);
+READER(check_sky);
+READER(check_exposure);
+READER(check_tile_size);
+READER(check_light_radius);
 
 const opt_def TSD_OPTION_ROWS[] = {
     {"PRODUCT", K_PRODUCT, FIELD(product), "shade", 0, 0, 0, 0, NULL, 1, P,
@@ -317,115 +320,118 @@ _Static_assert(sizeof(tsd_method) == sizeof(int) && sizeof(tsd_output_type) == s
                    sizeof(tsd_env_method) == sizeof(int),
                "enum options are int-sized");
 
-static int check_datetime(const char *v, char *msg, size_t n)
+/* Writes a reading's meaning where one is asked for. */
+static void say_meaning(char *meaning, size_t mn, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static void say_meaning(char *meaning, size_t mn, const char *fmt, ...)
+{
+    if (!meaning || mn == 0)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(meaning, mn, fmt, ap);
+    va_end(ap);
+}
+
+/* DATETIME: the instant and its offset (the offset names a day product's
+ * day), so that the basic and extended forms mean the same. */
+READER(check_datetime)
 {
     char norm[TSD_TEXT_MAX * 2];
     double t;
+    int offset;
     ts_error err;
     tsd_datetime_normalise(v, norm, sizeof norm);
-    if (ts_parse_iso8601(norm, &t, NULL, &err) != TS_OK)
+    if (ts_parse_iso8601(norm, &t, &offset, &err) != TS_OK)
         return (tsd_fail_core(msg, n, "DATETIME", &err), -1);
+    say_meaning(meaning, mn, "%.17g %d", t, offset);
     return 0;
 }
 
 /* A date option's value, its name in the sentence. */
-static int check_named_date(const char *name, const char *v, char *msg, size_t n)
+static int read_named_date(const char *name, const char *v, char *meaning, size_t mn,
+                           char *msg, size_t n)
 {
     int y, m, d;
     ts_error err;
     if (ts_parse_date(v, &y, &m, &d, &err) != TS_OK)
         return (tsd_fail_core(msg, n, name, &err), -1);
+    say_meaning(meaning, mn, "%d-%d-%d", y, m, d);
     return 0;
 }
 
-static int check_date(const char *v, char *msg, size_t n)
+READER(check_date)
 {
-    return check_named_date("DATE", v, msg, n);
+    return read_named_date("DATE", v, meaning, mn, msg, n);
 }
 
-static int check_start_date(const char *v, char *msg, size_t n)
+READER(check_start_date)
 {
-    return check_named_date("START_DATE", v, msg, n);
+    return read_named_date("START_DATE", v, meaning, mn, msg, n);
 }
 
-static int check_end_date(const char *v, char *msg, size_t n)
+READER(check_end_date)
 {
-    return check_named_date("END_DATE", v, msg, n);
+    return read_named_date("END_DATE", v, meaning, mn, msg, n);
 }
 
-static int check_timezone(const char *v, char *msg, size_t n)
+/* TIMEZONE: minutes east of UTC (-0500 and -05:00 alike). */
+READER(check_timezone)
 {
     int off;
     ts_error err;
     if (ts_parse_utc_offset(v, &off, &err) != TS_OK)
         return (tsd_fail_core(msg, n, "TIMEZONE", &err), -1);
+    say_meaning(meaning, mn, "%d", off);
     return 0;
 }
 
-static int check_sky(const char *v, char *msg, size_t n)
+/* SKY: its kind and CIE type (cie9 and cie:9 alike). */
+READER(check_sky)
 {
     ts_sky_kind kind;
     int type;
     ts_error err;
     if (ts_sky_parse(v, &kind, &type, &err) != TS_OK) /* its sentence names SKY */
         return (tsd_fail_core(msg, n, NULL, &err), -1);
+    say_meaning(meaning, mn, "%d:%d", (int)kind, type);
     return 0;
 }
 
-static int check_exposure(const char *v, char *msg, size_t n)
+/* EXPOSURE: AUTO or the stops as a number (1 and 1.0 alike). */
+READER(check_exposure)
 {
     double stops;
-    if (tsd_exposure_parse(v, &stops) < 0)
+    int autoexp = tsd_exposure_parse(v, &stops);
+    if (autoexp < 0)
         return (tsd_fail(msg, n, TS_ERR_ARG,
                          "EXPOSURE must be AUTO or a number of stops between %g and %g, "
                          "got '%s'", -TSD_EXPOSURE_MAX, TSD_EXPOSURE_MAX, v),
                 -1);
+    if (autoexp)
+        say_meaning(meaning, mn, "auto");
+    else
+        say_meaning(meaning, mn, "%.17g", stops);
     return 0;
 }
 
 int tsd_option_meaning(int id, const char *v, char *out, size_t n)
 {
-    const char *name = id >= 0 && id < TSD_OPTION_COUNT ? TSD_OPTION_ROWS[id].name : "";
-    ts_error err;
-    int a, b, c;
-    if (strcmp(name, "SKY") == 0) {
-        ts_sky_kind kind;
-        if (ts_sky_parse(v, &kind, &a, &err) != TS_OK)
-            return -1;
-        snprintf(out, n, "%d:%d", (int)kind, a);
-    } else if (strcmp(name, "TIMEZONE") == 0) {
-        if (ts_parse_utc_offset(v, &a, &err) != TS_OK)
-            return -1;
-        snprintf(out, n, "%d", a);
-    } else if (strcmp(name, "DATETIME") == 0) {
-        char norm[TSD_TEXT_MAX * 2];
-        double t;
-        tsd_datetime_normalise(v, norm, sizeof norm);
-        /* the instant and its offset: the offset names a day product's day */
-        if (ts_parse_iso8601(norm, &t, &a, &err) != TS_OK)
-            return -1;
-        snprintf(out, n, "%.17g %d", t, a);
-    } else if (strcmp(name, "DATE") == 0 || strcmp(name, "START_DATE") == 0 ||
-               strcmp(name, "END_DATE") == 0) {
-        if (ts_parse_date(v, &a, &b, &c, &err) != TS_OK)
-            return -1;
-        snprintf(out, n, "%d-%d-%d", a, b, c);
-    } else if (strcmp(name, "EXPOSURE") == 0) {
-        double stops;
-        int autoexp = tsd_exposure_parse(v, &stops);
-        if (autoexp < 0)
-            return -1;
-        snprintf(out, n, autoexp ? "auto" : "%.17g", stops);
-    } else {
+    char msg[256];
+    if (id < 0 || id >= TSD_OPTION_COUNT || TSD_OPTION_ROWS[id].kind != K_TEXT ||
+        !TSD_OPTION_ROWS[id].read || n == 0)
         return -1;
-    }
+    out[0] = '\0';
+    if (TSD_OPTION_ROWS[id].read(v, out, n, msg, sizeof msg) != 0 || !out[0])
+        return -1;
     return 0;
 }
 
 /* TILE_SIZE: 0, or a chunk no smaller than TSD_TILE_MIN (its margin would
  * cost more than the chunk). */
-static int check_tile_size(const char *v, char *msg, size_t n)
+READER(check_tile_size)
 {
+    (void)meaning, (void)mn; /* a number: compared as one */
     char *end;
     long t = strtol(v, &end, 10);
     if (*end == '\0' && t > 0 && t < TSD_TILE_MIN) {
@@ -439,8 +445,9 @@ static int check_tile_size(const char *v, char *msg, size_t n)
 /* LIGHT_RADIUS: the open interval (0, 45), whose upper end the table's
  * inclusive bounds cannot say; one sentence for a value below, at or above
  * it (not a number: the kind's check says so). */
-static int check_light_radius(const char *v, char *msg, size_t n)
+READER(check_light_radius)
 {
+    (void)meaning, (void)mn; /* a number: compared as one */
     double r;
     if (tsd_parse_decimal(v, &r) != 0 || (r > 0 && r < TS_LIGHT_RADIUS_MAX))
         return 0;

@@ -17,8 +17,11 @@
  * the word in `values` (e.g. AUTO: decided from the data), NAN. */
 typedef enum { K_SELECT, K_FLOAT, K_INT, K_BOOL, K_TEXT, K_PRODUCT, K_FLOAT_AUTO } opt_kind;
 
-/* A check of a text option's value beyond its kind: 0, or -1 with msg. */
-typedef int (*opt_validate_fn)(const char *value, char *msg, size_t n);
+/* A reading of an option's value beyond its kind's check: 0, or -1 with
+ * msg. A text option's reading also writes what the value means into
+ * `meaning` (when not NULL), the same for two spellings of one meaning; a
+ * number's leaves it alone (numbers are compared as numbers). */
+typedef int (*opt_read_fn)(const char *value, char *meaning, size_t mn, char *msg, size_t n);
 
 typedef struct {
     const char *name;
@@ -32,7 +35,7 @@ typedef struct {
     int affects_pixels;    /* part of the canonical string */
     int scope;             /* TSD_SCOPE_* */
     tsd_applies applies;
-    opt_validate_fn validate; /* NULL = the kind's check only */
+    opt_read_fn read;      /* NULL = the kind's check only */
     const char *desc;
 } opt_def;
 

@@ -149,7 +149,7 @@ static int set_option(tsd_options *o, int id, const char *v, char *msg, size_t n
     case K_FLOAT:
     case K_INT:
         /* the row's own check first: it may word the range better (LIGHT_RADIUS) */
-        if ((d->validate && d->validate(v, msg, n) != 0) || parse_number(d, v, &x, msg, n) != 0)
+        if ((d->read && d->read(v, NULL, 0, msg, n) != 0) || parse_number(d, v, &x, msg, n) != 0)
             return -1;
         if (d->kind == K_INT) {
             k = (int)x;
@@ -163,7 +163,7 @@ static int set_option(tsd_options *o, int id, const char *v, char *msg, size_t n
             REFUSE("%s is too long (%zu characters; at most %zu)", d->name, strlen(v),
                    d->size - 1);
         }
-        if (d->validate && d->validate(v, msg, n) != 0)
+        if (d->read && d->read(v, NULL, 0, msg, n) != 0)
             return -1;
         snprintf(field, d->size, "%s", v);
         return 0;
