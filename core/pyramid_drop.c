@@ -169,14 +169,14 @@ static void finish_last(row_ws *w, int bspline, int a, int b, const float *restr
     const float *restrict m = w->m;
     const int *restrict jd = w->jd;
     if (!bspline) {
-#pragma GCC ivdep
+TS_PYR_IVDEP
         for (int x = a; x <= b; x++) {
             float mm = A[x] > m[x] ? A[x] : m[x];
             out[x] = mm > -INFINITY ? ts_atan_deg(mm) : -90.0f;
         }
         return;
     }
-#pragma GCC ivdep
+TS_PYR_IVDEP
     for (int x = a; x <= b; x++) {
         int c = jd[x];
         float v = A[x], p2 = s2[x], mm = m[x];
@@ -235,7 +235,7 @@ void ts_pyr_drop_cells(const hz_ctx *C, row_ws *w, int y, int a, int b, double t
         read_ends(C, ON_DEM, y, a, b, tpp, A);
     }
     if (C->bspline) {
-#pragma GCC ivdep
+TS_PYR_IVDEP
         for (int x = a; x <= b; x++)
             A[x] = ts_atan_deg(A[x]); /* atan(NaN) is NaN */
     }

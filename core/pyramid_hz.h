@@ -21,6 +21,17 @@
 #define TS_PYR_FMA_CLONES
 #endif
 
+/* "This loop's iterations do not depend on each other" (the rows it
+ * reads and writes do not overlap): gcc's ivdep, clang's assume_safety,
+ * so that a clang build (the fuzzers) neither warns nor loses it. */
+#if defined(__clang__)
+#define TS_PYR_IVDEP _Pragma("clang loop vectorize(assume_safety)")
+#elif defined(__GNUC__)
+#define TS_PYR_IVDEP _Pragma("GCC ivdep")
+#else
+#define TS_PYR_IVDEP
+#endif
+
 /* What sample j of every cell shares for one azimuth: its offset in
  * cells, split into a whole column ix and a fraction fx, the columns
  * [xa, xb] whose sample is on the grid, and the level it reads. */

@@ -29,7 +29,7 @@ combine_span(const float *const r[4], const float w[4], int taps, int x0, int x1
     const float *r0 = r[0];
     const float w0 = w[0];
     if (taps == 1) {
-#pragma GCC ivdep
+TS_PYR_IVDEP
         for (int x = x0; x <= x1; x++)
             dst[x] = r0[x];
         return;
@@ -37,14 +37,14 @@ combine_span(const float *const r[4], const float w[4], int taps, int x0, int x1
     const float *r1 = r[1];
     const float w1 = w[1];
     if (taps == 2) {
-#pragma GCC ivdep
+TS_PYR_IVDEP
         for (int x = x0; x <= x1; x++)
             dst[x] = fmaf(w1, r1[x], w0 * r0[x]);
         return;
     }
     const float *r2 = r[2], *r3 = r[3];
     const float w2 = w[2], w3 = w[3];
-#pragma GCC ivdep
+TS_PYR_IVDEP
     for (int x = x0; x <= x1; x++)
         dst[x] = fmaf(w3, r3[x], fmaf(w2, r2[x], fmaf(w1, r1[x], w0 * r0[x])));
 }
@@ -98,19 +98,19 @@ void ts_pyr_push_run(row_ws *w, int bspline, int c, int x0, int x1, const float 
     float *restrict s0 = w->s0, *restrict s1 = w->s1, *restrict s2 = w->s2;
     float *restrict m = w->m;
     if (!bspline) {
-#pragma GCC ivdep
+TS_PYR_IVDEP
         for (int x = x0; x <= x1; x++)
             m[x] = a_in[x] > m[x] ? a_in[x] : m[x];
         return;
     }
     if (c == 0) {
-#pragma GCC ivdep
+TS_PYR_IVDEP
         for (int x = x0; x <= x1; x++)
             s2[x] = a_in[x];
         return;
     }
     if (c == 1) {
-#pragma GCC ivdep
+TS_PYR_IVDEP
         for (int x = x0; x <= x1; x++) {
             float a = a_in[x] == a_in[x] ? a_in[x] : s2[x];
             s0[x] = 2.0f * s2[x] - a; /* w_{-1}: knot 0 is w_0 */
@@ -120,7 +120,7 @@ void ts_pyr_push_run(row_ws *w, int bspline, int c, int x0, int x1, const float 
         }
         return;
     }
-#pragma GCC ivdep
+TS_PYR_IVDEP
     for (int x = x0; x <= x1; x++)
         spline_step(s0, s1, s2, m, x, a_in[x]);
 }
@@ -139,7 +139,7 @@ level_span(row_ws *w, const float *restrict T, int ix, float fx, const float *re
     const float gx = 1.0f - fx;
     const float *restrict Ta = T + ix; /* T[x + ix] defeats the vectoriser */
     if (bspline && c >= 2) {
-#pragma GCC ivdep
+TS_PYR_IVDEP
         for (int x = x0; x <= x1; x++) {
             float h = fmaf(fx, Ta[x + 1], gx * Ta[x]);
             spline_step(s0, s1, s2, m, x, ts_atan_deg(fmaf(h - R[x], inv_d, -cd)));
@@ -147,7 +147,7 @@ level_span(row_ws *w, const float *restrict T, int ix, float fx, const float *re
         return 1;
     }
     if (!bspline) { /* the maximum of the tangents; one arctangent at the end */
-#pragma GCC ivdep
+TS_PYR_IVDEP
         for (int x = x0; x <= x1; x++) {
             float h = fmaf(fx, Ta[x + 1], gx * Ta[x]);
             float t = fmaf(h - R[x], inv_d, -cd);
@@ -155,7 +155,7 @@ level_span(row_ws *w, const float *restrict T, int ix, float fx, const float *re
         }
         return 1;
     }
-#pragma GCC ivdep
+TS_PYR_IVDEP
     for (int x = x0; x <= x1; x++) {
         float h = fmaf(fx, Ta[x + 1], gx * Ta[x]);
         A[x] = ts_atan_deg(fmaf(h - R[x], inv_d, -cd));
@@ -179,22 +179,22 @@ void ts_pyr_finish_run(row_ws *w, int bspline, int count, int x0, int x1, float 
 {
     float *restrict s1 = w->s1, *restrict s2 = w->s2, *restrict m = w->m;
     if (!bspline) {
-#pragma GCC ivdep
+TS_PYR_IVDEP
         for (int x = x0; x <= x1; x++)
             out[x] = m[x] > -INFINITY ? ts_atan_deg(m[x]) : -90.0f;
         return;
     }
     if (count >= 2) { /* w_M = 2 w_{M-1} - w_{M-2}: knot M-1 is w_{M-1} */
-#pragma GCC ivdep
+TS_PYR_IVDEP
         for (int x = x0; x <= x1; x++)
             w->A[x] = 2.0f * s2[x] - s1[x];
         ts_pyr_push_run(w, 1, count, x0, x1, w->A);
     } else {
-#pragma GCC ivdep
+TS_PYR_IVDEP
         for (int x = x0; x <= x1; x++)
             m[x] = s2[x] > m[x] ? s2[x] : m[x];
     }
-#pragma GCC ivdep
+TS_PYR_IVDEP
     /* no spline value where nodata left fewer than three samples: the last */
     for (int x = x0; x <= x1; x++) {
         float r = m[x] > -INFINITY ? m[x] : s2[x];
