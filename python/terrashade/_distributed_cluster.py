@@ -44,15 +44,63 @@ def start_cluster(args):
         # A worker has one task slot per thread, by default one per core.
         return client, None, 1
     workers = args.workers or os.cpu_count() or 1
-    # on this machine's loopback only, with its HTTP servers on free ports:
-    # dashboard_address=None still served the scheduler's on 0.0.0.0:8787,
-    # reachable from other machines, and warned where that port was taken
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=args.threads_per_worker,
-                           processes=True, host="127.0.0.1", dashboard_address="127.0.0.1:0",
-                           worker_dashboard_address="127.0.0.1:0",
-                           silence_logs=logging.ERROR)
+    runner = loop_without_ctrl_c()
+    try:
+        # on this machine's loopback only, with its HTTP servers on free ports:
+        # dashboard_address=None still served the scheduler's on 0.0.0.0:8787,
+        # reachable from other machines, and warned where that port was taken
+        cluster = OwnCluster(LocalCluster(
+            n_workers=workers, threads_per_worker=args.threads_per_worker, processes=True,
+            host="127.0.0.1", dashboard_address="127.0.0.1:0",
+            worker_dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR,
+            loop=runner.loop), runner)
+    except BaseException:
+        runner.stop()
+        raise
     slots = workers * args.threads_per_worker
-    return Client(cluster), cluster, max(1, (os.cpu_count() or 1) // slots)
+    try:
+        client = Client(cluster.cluster)
+    except BaseException:
+        cluster.close()
+        raise
+    return client, cluster, max(1, (os.cpu_count() or 1) // slots)
+
+
+def loop_without_ctrl_c():
+    """A running IO loop for the run's local cluster, its thread started with
+    SIGINT and SIGTERM blocked. The cluster's worker processes are started
+    from threads of that thread and keep its signal mask through fork and
+    exec, so a Ctrl-C at the terminal, or a SIGTERM to the whole process
+    group (systemd's or Slurm's stop), never reaches them: one during their
+    start left them half started or gone and the cluster's start waiting for
+    ever. This process's main thread still gets both (interrupts_held) and
+    closes the cluster, which stops its workers by message (and SIGKILL
+    where one does not answer), not by signal."""
+    from distributed.utils import LoopRunner
+    from multiprocessing import resource_tracker
+    # started first: started by a spawn in the loop's thread, it would end
+    # with SIG_UNBLOCK there (CPython's launcher), the mask lost
+    resource_tracker.ensure_running()
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+    try:
+        runner = LoopRunner(asynchronous=False)
+        runner.start()
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+    return runner
+
+
+class OwnCluster:
+    """The run's LocalCluster and the loop it runs on: closed together."""
+
+    def __init__(self, cluster, runner):
+        self.cluster, self.runner = cluster, runner
+
+    def close(self):
+        try:
+            self.cluster.close()
+        finally:
+            self.runner.stop()
 
 
 class Watch:

@@ -61,16 +61,15 @@ class DistributedInterrupts(TD.DistributedCase):
                 os.remove(dest)
                 self.assert_nothing_left(dest)
 
-    def test_ctrl_c_at_the_terminal(self):
-        """Ctrl-C at the terminal signals the whole process group, the
-        cluster's workers too: the run stops as for its own Ctrl-C, and the
-        workers print nothing (each printed its KeyboardInterrupt
-        tracebacks until session 50). The signal goes once the workers have
-        started, while they compute."""
+    def ctrl_c_to_the_group(self, dest, after, sig=signal.SIGINT):
+        """A run of 2 workers into dest, signalled as Ctrl-C at the terminal
+        signals it (SIGINT to the whole process group; or sig, as systemd's
+        or Slurm's stop sends SIGTERM), `after` seconds once both worker
+        processes exist: its exit status and stderr."""
         dem = self.path("big.tif")
-        T.write_tif(dem, T.fractal_dem(600, seed=5, relief=300.0),
-                    (500000, 10, 0, 4000000, 0, -10), 32617)
-        dest = self.path("group.tif")
+        if not os.path.exists(dem):
+            T.write_tif(dem, T.fractal_dem(600, seed=5, relief=300.0),
+                        (500000, 10, 0, 4000000, 0, -10), 32617)
         p = subprocess.Popen(
             ["/usr/bin/python3", "-m", "terrashade.distributed", "--workers", "2",
              "--tile-size", "64", "-q", "-oo", "PRODUCT=horizon", "-oo", "DIRECTIONS=128",
@@ -79,22 +78,59 @@ class DistributedInterrupts(TD.DistributedCase):
             env=T.env(PYTHONPATH=PYTHONPATH),
             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
         workers = []
-        for _ in range(1200):  # the workers' processes, then their first windows
+        for _ in range(1200):  # the workers' processes
             workers = [w for w in subprocess.run(["pgrep", "-P", str(p.pid), "-f", "spawn_main"],
                                                  capture_output=True, text=True).stdout.split()]
             if len(workers) == 2 or p.poll() is not None:
                 break
             time.sleep(0.05)
-        time.sleep(3.0)
+        time.sleep(after)
         self.assertIsNone(p.poll(), "the run ended before the signal")
-        os.killpg(p.pid, signal.SIGINT)
-        err = p.communicate(timeout=120)[1]
+        os.killpg(p.pid, sig)
+        try:
+            err = p.communicate(timeout=120)[1]
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.communicate()
+            self.fail("the run did not end within 120 s of a %s to its group %.1f s "
+                      "after its workers' processes started" % (sig.name, after))
         print("exit %d: %s" % (p.returncode, err.strip()))
-        self.assertEqual(p.returncode, 130, err)
+        return p.returncode, err
+
+    def test_ctrl_c_at_the_terminal(self):
+        """Ctrl-C at the terminal signals the whole process group, the
+        cluster's workers too: the run stops as for its own Ctrl-C, and the
+        workers print nothing (each printed its KeyboardInterrupt
+        tracebacks until session 50). The signal goes once the workers have
+        started, while they compute."""
+        dest = self.path("group.tif")
+        code, err = self.ctrl_c_to_the_group(dest, 3.0)
+        self.assertEqual(code, 130, err)
         self.assertIn("terrashade.distributed: interrupted; nothing written to %s" % dest, err)
         self.assertNotIn("Traceback", err)
         self.assertNotIn("KeyboardInterrupt", err)
         self.assert_nothing_left(dest)
+
+    def test_ctrl_c_at_the_terminal_while_workers_start(self):
+        """The same Ctrl-C at the terminal while the worker processes start,
+        and a SIGTERM to the whole group (systemd's and Slurm's stop): it
+        reached them before they ignore it, ended some half started, and
+        the cluster's start waited for them for ever (a run hung until a
+        second signal; session 52). The workers are started with SIGINT and
+        SIGTERM blocked now; the run stops once the start is over."""
+        dest = self.path("starting.tif")
+        for sig, code, said, after in ((signal.SIGINT, 130, "interrupted", 0.0),
+                                       (signal.SIGINT, 130, "interrupted", 0.3),
+                                       (signal.SIGTERM, 143, "terminated", 0.3)):
+            with self.subTest(said, after=after):
+                code_got, err = self.ctrl_c_to_the_group(dest, after, sig)
+                self.assertEqual(code_got, code, err)
+                self.assertIn("%s while the Dask cluster starts" % said, err)
+                self.assertIn("terrashade.distributed: %s; nothing written to %s"
+                              % (said, dest), err)
+                self.assertNotIn("Traceback", err)
+                self.assertNotIn("KeyboardInterrupt", err)
+                self.assert_nothing_left(dest)
 
     def test_signals_held_while_the_cluster_starts(self):
         """While the cluster starts, one Ctrl-C or SIGTERM is held, said,
