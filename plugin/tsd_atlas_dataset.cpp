@@ -24,6 +24,7 @@
 
 #include "shadow_atlas.h"
 #include "tsd_atlas_check.h"
+#include "tsd_atlas_dataset.h"
 #include "tsd_dataset.h"
 #include "tsd_dem.h"
 #include "tsd_gdal.h"
@@ -48,90 +49,7 @@ static CPLStringList AtlasMetadata(const char *pszText)
     return aosOut;
 }
 
-class TSAtlasBand;
-
-class TSAtlasDataset final : public GDALPamDataset
-{
-    friend class TSAtlasBand;
-
-    ts_atlas *m_psAtlas = nullptr;
-    OGRSpatialReference m_oSRS{};
-    double m_adfGT[6] = {0, 1, 0, 0, 0, 1};
-    bool m_bHasGT = false;
-    bool m_bAll = false; // SHADOWS=all: far | near, near recomputed from the DEM
-    std::string m_osDEM{};
-    int m_nThreads = 0;
-    bool m_bDEMGiven = false;           // DEM= given, not the SOURCE_DEM
-    CPLStringList m_aosMeta{};
-    tsd_options m_sMetaOpts{};          // the metadata, validated as options
-    std::mutex m_oMutex{};
-    bool m_bTried = false;
-    std::string m_osError{};            // why SHADOWS=all failed
-    CPLErrorNum m_nErr = CPLE_AppDefined; // and its error number
-    GByte *m_pabyNear = nullptr; // near-shadow bits, raster order, one plane per map
-    GDALDataset *m_poDEM = nullptr; // SHADOWS=all: the DEM, opened and checked at open,
-                                    // until EnsureNear has read it
-
-    CPLErr EnsureNear();
-
-  public:
-    TSAtlasDataset() = default;
-    ~TSAtlasDataset() override;
-
-    static GDALDataset *Open(GDALOpenInfo *poOpenInfo);
-    static GDALDataset *CreateCopy(const char *pszFilename, GDALDataset *poSrcDS,
-                                   int bStrict, char **papszOptions,
-                                   GDALProgressFunc pfnProgress, void *pProgressData);
-
-    CPLErr GetGeoTransform(double *padfGT) override
-    {
-        if (!m_bHasGT)
-            return GDALPamDataset::GetGeoTransform(padfGT);
-        memcpy(padfGT, m_adfGT, sizeof m_adfGT);
-        return CE_None;
-    }
-    const OGRSpatialReference *GetSpatialRef() const override
-    {
-        return m_oSRS.IsEmpty() ? nullptr : &m_oSRS;
-    }
-    /* gdaladdo: GDAL's own refusal ("BuildOverviews() not supported") was
-     * no TERRASHADE sentence and said nothing of what to do */
-    CPLErr IBuildOverviews(const char *, int, const int *, int, const int *, GDALProgressFunc,
-                           void *, CSLConstList) override
-    {
-        Fail(CPLE_NotSupported,
-             CPLSPrintf("%s: a far-shadow atlas is read-only and holds no overviews; copy it "
-                        "(gdal_translate day.tsa day.tif) and run gdaladdo on the copy",
-                        GetDescription()));
-        return CE_Failure;
-    }
-};
-
-/* Its nodata value and colour are the atlas's unless the user set them
- * (tsd_pam_band.h). */
-class TSAtlasBand final : public TSPamBand
-{
-    int m_nStep;
-
-  protected:
-    double OwnNoData() const override
-    {
-        // as PRODUCT=farshadow, whether or not the maps have nodata cells
-        return TS_ATLAS_NODATA;
-    }
-
-  public:
-    TSAtlasBand(TSAtlasDataset *poDSIn, int nBandIn) : m_nStep(nBandIn - 1)
-    {
-        poDS = poDSIn;
-        nBand = nBandIn;
-        eDataType = GDT_Byte;
-        nBlockXSize = std::min(BLOCK, poDSIn->GetRasterXSize());
-        nBlockYSize = std::min(BLOCK, poDSIn->GetRasterYSize());
-    }
-
-    CPLErr IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage) override;
-};
+} // namespace
 
 TSAtlasDataset::~TSAtlasDataset()
 {
@@ -140,38 +58,6 @@ TSAtlasDataset::~TSAtlasDataset()
     VSIFree(m_pabyNear);
     if (m_poDEM)
         GDALClose(m_poDEM);
-}
-
-CPLErr TSAtlasBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
-{
-    tsd::CLocale oC; /* tsd_locale.h */
-    TSAtlasDataset *ds = static_cast<TSAtlasDataset *>(poDS);
-    if (ds->m_bAll && ds->EnsureNear() != CE_None)
-        return CE_Failure;
-    const int W = nRasterXSize, H = nRasterYSize;
-    const int x0 = nBlockXOff * nBlockXSize, y0 = nBlockYOff * nBlockYSize;
-    const int w = std::min(nBlockXSize, W - x0), h = std::min(nBlockYSize, H - y0);
-    GByte *pabyOut = static_cast<GByte *>(pImage);
-    memset(pabyOut, TS_ATLAS_NODATA, static_cast<size_t>(nBlockXSize) * nBlockYSize);
-    ts_error sErr;
-    if (ts_atlas_read(ds->m_psAtlas, m_nStep, x0, y0, w, h, pabyOut, nBlockXSize, &sErr) !=
-        TS_OK)
-    {
-        Fail(sErr.code, sErr.message);
-        return CE_Failure;
-    }
-    if (ds->m_bAll)
-    {
-        const GByte *near = ds->m_pabyNear + static_cast<size_t>(m_nStep) * W * H;
-        for (int y = 0; y < h; y++)
-            for (int x = 0; x < w; x++)
-            {
-                GByte &v = pabyOut[static_cast<size_t>(y) * nBlockXSize + x];
-                if (v != TS_ATLAS_NODATA)
-                    v |= near[static_cast<size_t>(y0 + y) * W + x0 + x];
-            }
-    }
-    return CE_None;
 }
 
 /* SHADOWS=all: near shadows (occluders within the far threshold) of every
@@ -583,8 +469,6 @@ GDALDataset *TSAtlasDataset::CreateCopy(const char *pszFilename, GDALDataset *po
     GDALOpenInfo oOpenInfo(pszFilename, GA_ReadOnly);
     return TSAtlasDataset::Open(&oOpenInfo);
 }
-
-} // namespace
 
 int IdentifyAtlas(GDALOpenInfo *poOpenInfo)
 {

@@ -147,8 +147,8 @@ CPLErr TSRasterBand::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXS
                                GDALRasterIOExtraArg *psExtraArg)
 {
     tsd::CLocale oC; /* tsd_locale.h */
-    const TSDataset::ReadTurn oTurn(*static_cast<TSDataset *>(poDS));
-    if (oTurn.Refused())
+    std::unique_lock<std::recursive_mutex> oTurn;
+    if (!TakeReadTurn(oTurn))
         return CE_Failure; // (before GDAL's block cache, which may hold the block unfilled)
     CallerProgress oCaller(psExtraArg, nXOff, nYOff, nXSize, nYSize); // a computation
                                                                      // started here reports to it
@@ -167,35 +167,13 @@ CPLErr TSRasterBand::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXS
     return eErr;
 }
 
-CPLErr TSRasterBand::ComputeStatistics(int bApproxOK, double *pdfMin, double *pdfMax,
-                                       double *pdfMean, double *pdfStdDev,
-                                       GDALProgressFunc pfnProgress, void *pProgressData)
+bool TSRasterBand::TakeReadTurn(std::unique_lock<std::recursive_mutex> &oTurn)
 {
-    const TSDataset::ReadTurn oTurn(*static_cast<TSDataset *>(poDS));
-    if (oTurn.Refused())
-        return CE_Failure;
-    return GDALPamRasterBand::ComputeStatistics(bApproxOK, pdfMin, pdfMax, pdfMean, pdfStdDev,
-                                                pfnProgress, pProgressData);
-}
-
-CPLErr TSRasterBand::ComputeRasterMinMax(int bApproxOK, double *adfMinMax)
-{
-    const TSDataset::ReadTurn oTurn(*static_cast<TSDataset *>(poDS));
-    if (oTurn.Refused())
-        return CE_Failure;
-    return GDALPamRasterBand::ComputeRasterMinMax(bApproxOK, adfMinMax);
-}
-
-CPLErr TSRasterBand::GetHistogram(double dfMin, double dfMax, int nBuckets,
-                                  GUIntBig *panHistogram, int bIncludeOutOfRange, int bApproxOK,
-                                  GDALProgressFunc pfnProgress, void *pProgressData)
-{
-    const TSDataset::ReadTurn oTurn(*static_cast<TSDataset *>(poDS));
-    if (oTurn.Refused())
-        return CE_Failure;
-    return GDALPamRasterBand::GetHistogram(dfMin, dfMax, nBuckets, panHistogram,
-                                           bIncludeOutOfRange, bApproxOK, pfnProgress,
-                                           pProgressData);
+    TSDataset *ds = static_cast<TSDataset *>(poDS);
+    if (ds->ReadInsideOwnComputation())
+        return false;
+    oTurn = std::unique_lock<std::recursive_mutex>(ds->m_oReadMutex);
+    return true;
 }
 
 /* Cells x0 .. x0+n-1 of a product row (mirrored when flip_x) into a block

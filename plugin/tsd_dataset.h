@@ -22,7 +22,7 @@
 #include "tsd_compute_env.h"
 #include "tsd_geodesy.h"
 #include "tsd_options.h"
-#include "tsd_pam_band.h"
+#include "tsd_turn_band.h"
 #include "tsd_products.h"
 #include "tsd_progress.h"
 #include "tsd_sun.h"
@@ -217,7 +217,7 @@ class TSDataset final : public GDALPamDataset
 
 /** A band of it: one plane of the product. Its nodata value, unit and
  * colour are the product's unless the user set them (tsd_pam_band.h). */
-class TSRasterBand final : public TSPamBand
+class TSRasterBand final : public TSTurnBand
 {
     int m_nPlane;
     GDALColorInterp m_eColor = GCI_GrayIndex;
@@ -238,20 +238,13 @@ class TSRasterBand final : public TSPamBand
     }
     const GDALRasterBandPamInfo *UserPam() override;
     const char *NotHere() const override;
+    /* as the dataset's ReadTurn: refused from the computation's own progress
+     * callback (TSDataset::ReadInsideOwnComputation), where GDAL's cache
+     * holds the block being computed unfilled */
+    bool TakeReadTurn(std::unique_lock<std::recursive_mutex> &oTurn) override;
 
   public:
     TSRasterBand(TSDataset *poDSIn, int nBandIn, GDALDataType eType);
-    /* GDAL's statistics read blocks straight from its cache, where the block
-     * being computed sits unfilled: refused from the computation's own
-     * progress callback (TSDataset::ReadInsideOwnComputation), as reads are */
-    CPLErr ComputeStatistics(int bApproxOK, double *pdfMin, double *pdfMax, double *pdfMean,
-                             double *pdfStdDev, GDALProgressFunc pfnProgress,
-                             void *pProgressData) override;
-    CPLErr ComputeRasterMinMax(int bApproxOK, double *adfMinMax) override;
-    CPLErr GetHistogram(double dfMin, double dfMax, int nBuckets, GUIntBig *panHistogram,
-                        int bIncludeOutOfRange, int bApproxOK, GDALProgressFunc pfnProgress,
-                        void *pProgressData) override;
-
     CPLErr IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage) override;
     CPLErr IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize, int nYSize,
                      void *pData, int nBufXSize, int nBufYSize, GDALDataType eBufType,

@@ -122,6 +122,32 @@ class Threads(unittest.TestCase):
                "-oo", "FAR_THRESHOLD=8", "-oo", "PROGRESS=no", T.conn(self.dem), atlas])
         self.same_in_threads(atlas, ["SHADOWS=all"])
 
+    def test_atlas_one_dataset_shared_reads_take_turns(self):
+        """One atlas read whole by two threads at once, fresh each trial:
+        both get the single thread's pixels. Until session 52 an atlas's
+        reads did not take turns as a product's do, and 4 of 20 such reads
+        came back with blocks unfilled (nodata among the 0/1 maps; with
+        SHADOWS=all impossible values such as 2, 4, 7)."""
+        dem = T.write_tif(os.path.join(self.dir, "dem256.tif"), T.fractal_dem(256, seed=3),
+                          UTM_GT, 32617)
+        atlas = os.path.join(self.dir, "shared.tsa")
+        T.run(["gdal_translate", "-q", "-of", "TERRASHADE", "-oo", "PRODUCT=farshadow",
+               "-oo", "DATE=2026-06-21", "-oo", "TIMEZONE=-04:00", "-oo", "ATLAS_STEPS=12",
+               "-oo", "FAR_THRESHOLD=16", "-oo", "PROGRESS=no", T.conn(dem), atlas])
+        for options in ([], ["SHADOWS=all"]):
+            single = read_all(atlas, options)
+            for trial in range(2 * TRIALS):
+                ds = gdal.OpenEx(atlas, gdal.OF_RASTER, open_options=options)
+
+                def task(i, start):
+                    start()
+                    return ds.ReadAsArray()
+                got = at_once(task)
+                ds = None
+                for i in range(2):
+                    with self.subTest(options=options, trial=trial, thread=i):
+                        np.testing.assert_array_equal(got[i], single)
+
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)
