@@ -197,6 +197,11 @@ ts_status ts_atlas_open(const uint8_t *b, size_t n, ts_atlas **out, ts_error *er
     a->info.steps = (int)steps;
     a->info.threshold_cells = (int)(get32(b + 44) > INT32_MAX ? 0 : get32(b + 44));
     a->info.threshold_m = getf64(b + 48);
+    /* bits and fields a version-2 writer leaves 0: set, the file is not one
+     * (a later version changes the version number, refused above) */
+    if (flags & ~3u)
+        BAD("the atlas's header is damaged: it sets flag bits 0x%x, which version %u "
+            "does not define", flags & ~3u, version);
     a->info.has_geotransform = flags & 1;
     a->info.has_nodata = (flags & 2) != 0;
     for (int i = 0; i < 6; i++)
@@ -237,6 +242,9 @@ ts_status ts_atlas_open(const uint8_t *b, size_t n, ts_atlas **out, ts_error *er
         a->steps[s].grid_azimuth = getf64(r + 16);
         a->steps[s].elevation = getf64(r + 24);
         a->steps[s].utc_offset_minutes = (int32_t)get32(r + 32);
+        if (get32(r + 36) != 0)
+            BAD("the atlas's step table is invalid: map %u's reserved field is %u, not 0",
+                s + 1, get32(r + 36));
     }
     if ((st = ts_atlas_check_steps(a->steps, (int)steps, "the atlas's step table is invalid",
                                    err)) != TS_OK)

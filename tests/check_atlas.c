@@ -221,8 +221,8 @@ static void put_le(uint8_t *p, uint64_t v, int bytes)
 static void forge_step(uint8_t *file, int k, int at, double value, int32_t offset)
 {
     uint8_t *r = file + TS_ATLAS_HEADER_SIZE + (size_t)k * TS_ATLAS_STEP_SIZE;
-    if (at == 32) {
-        put_le(r + 32, (uint32_t)offset, 4);
+    if (at == 32 || at == 36) { /* the offset, the reserved field */
+        put_le(r + at, (uint32_t)offset, 4);
     } else {
         uint64_t u;
         memcpy(&u, &value, 8);
@@ -258,6 +258,7 @@ START_TEST(test_bad_step_tables)
         {2, 16, -1.0, 0, "-1 grid) lies outside 0 to 360"},
         {0, 32, 0, 5000, "offset from UTC (5000 minutes)"},
         {0, 32, 0, INT32_MIN, "lies outside -23:59 to +23:59"},
+        {1, 36, 0, 9, "map 2's reserved field is 9, not 0"},
     };
     ts_error err;
     ts_atlas *a;
@@ -280,9 +281,17 @@ START_TEST(test_bad_step_tables)
         }
         free(file);
     }
-    /* the metadata text changed without its CRC */
+    /* a flag bit version 2 does not define, under a valid header CRC */
     size_t size;
     uint8_t *file = small_atlas(&size);
+    file[34] |= 0x10; /* bit 20 of the flags at byte 32 */
+    put_le(file + 160, lzma_crc32(file, 160, 0), 4);
+    EXPECT_ARG(ts_atlas_open(file, size, &a, &err), &err);
+    ck_assert_msg(strstr(err.message, "sets flag bits 0x100000, which version 2 does not "
+                                      "define"), "%s", err.message);
+    free(file);
+    /* the metadata text changed without its CRC */
+    file = small_atlas(&size);
     uint8_t *text = memchr(file, '=', size);
     ck_assert(text != NULL);
     text[1] = 'x';
