@@ -4,6 +4,7 @@ run; SIGTERM cleaned up as Ctrl-C."""
 import asyncio
 import contextlib
 import logging
+import multiprocessing
 import os
 import signal
 import sys
@@ -45,6 +46,7 @@ def start_cluster(args):
         return client, None, 1
     workers = args.workers or os.cpu_count() or 1
     runner = loop_without_ctrl_c()
+    children = {p.pid for p in multiprocessing.active_children()}
     try:
         # on this machine's loopback only, with its HTTP servers on free ports:
         # dashboard_address=None still served the scheduler's on 0.0.0.0:8787,
@@ -55,6 +57,9 @@ def start_cluster(args):
             worker_dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR,
             loop=runner.loop), runner)
     except BaseException:
+        # a start cut short (a second Ctrl-C): its workers, still blocking
+        # SIGTERM, would hold the exit handlers' terminate() and join()
+        kill_pids(p.pid for p in multiprocessing.active_children() if p.pid not in children)
         runner.stop()
         raise
     slots = workers * args.threads_per_worker
@@ -71,11 +76,13 @@ def loop_without_ctrl_c():
     SIGINT and SIGTERM blocked. The cluster's worker processes are started
     from threads of that thread and keep its signal mask through fork and
     exec, so a Ctrl-C at the terminal, or a SIGTERM to the whole process
-    group (systemd's or Slurm's stop), never reaches them: one during their
-    start left them half started or gone and the cluster's start waiting for
-    ever. This process's main thread still gets both (interrupts_held) and
-    closes the cluster, which stops its workers by message (and SIGKILL
-    where one does not answer), not by signal."""
+    group (systemd's or Slurm's stop), does not reach them while they
+    start: one then left them half started or gone and the cluster's start
+    waiting for ever. This process's main thread still gets both
+    (interrupts_held) and closes the cluster. Once started, the workers
+    ignore SIGINT and take SIGTERM again (windows.ignore_interrupts); a
+    worker the run's interrupt kept from that is killed where the close
+    fails (OwnCluster.close)."""
     from distributed.utils import LoopRunner
     from multiprocessing import resource_tracker
     # started first: started by a spawn in the loop's thread, it would end
@@ -99,8 +106,27 @@ class OwnCluster:
     def close(self):
         try:
             self.cluster.close()
+        except BaseException:
+            # its workers may still block SIGTERM (stopped during their
+            # start): the exit handlers' terminate() and join() would wait
+            # for them for ever
+            self.kill_workers()
+            raise
         finally:
             self.runner.stop()
+
+    def kill_workers(self):
+        kill_pids(getattr(getattr(getattr(nanny, "process", None), "process", None), "pid",
+                          None)
+                  for nanny in list(getattr(self.cluster, "workers", {}).values()))
+
+
+def kill_pids(pids):
+    """SIGKILL to each of these processes (None: none)."""
+    for pid in pids:
+        if pid:
+            with contextlib.suppress(OSError):
+                os.kill(pid, signal.SIGKILL)
 
 
 class Watch:

@@ -138,13 +138,18 @@ def probe():
 
 
 def ignore_interrupts():
-    """On a worker of the run's own local cluster: Ctrl-C ignored. A Ctrl-C
-    at the terminal signals the whole process group; the run's process
-    closes its workers, while each printed its own KeyboardInterrupt
-    tracebacks. Run on the worker's event loop, its main thread."""
+    """On a worker of the run's own local cluster, once it has started:
+    Ctrl-C ignored, SIGTERM ending it again. A Ctrl-C at the terminal
+    signals the whole process group; the run's process closes its workers,
+    while each printed its own KeyboardInterrupt tracebacks. The worker was
+    started with both blocked (_distributed_cluster.loop_without_ctrl_c);
+    SIGTERM is unblocked here, so that Dask's and multiprocessing's
+    terminate() end it where the cluster's close does not. Run on the
+    worker's event loop, its main thread."""
     import signal
     try:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     except ValueError:  # not the main thread: Ctrl-C stays as it was
         return False
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
     return True

@@ -61,11 +61,12 @@ class DistributedInterrupts(TD.DistributedCase):
                 os.remove(dest)
                 self.assert_nothing_left(dest)
 
-    def ctrl_c_to_the_group(self, dest, after, sig=signal.SIGINT):
+    def ctrl_c_to_the_group(self, dest, after, sig=signal.SIGINT, again=None):
         """A run of 2 workers into dest, signalled as Ctrl-C at the terminal
         signals it (SIGINT to the whole process group; or sig, as systemd's
         or Slurm's stop sends SIGTERM), `after` seconds once both worker
-        processes exist: its exit status and stderr."""
+        processes exist, and `again` seconds later a second time: its exit
+        status and stderr. No worker process outlives it."""
         dem = self.path("big.tif")
         if not os.path.exists(dem):
             T.write_tif(dem, T.fractal_dem(600, seed=5, relief=300.0),
@@ -87,6 +88,12 @@ class DistributedInterrupts(TD.DistributedCase):
         time.sleep(after)
         self.assertIsNone(p.poll(), "the run ended before the signal")
         os.killpg(p.pid, sig)
+        if again is not None:
+            time.sleep(again)
+            try:
+                os.killpg(p.pid, sig)
+            except ProcessLookupError:  # (the group is gone)
+                pass
         try:
             err = p.communicate(timeout=120)[1]
         except subprocess.TimeoutExpired:
@@ -95,6 +102,12 @@ class DistributedInterrupts(TD.DistributedCase):
             self.fail("the run did not end within 120 s of a %s to its group %.1f s "
                       "after its workers' processes started" % (sig.name, after))
         print("exit %d: %s" % (p.returncode, err.strip()))
+        for _ in range(100):  # the workers end with the run (or within 5 s)
+            alive = [w for w in workers if os.path.exists("/proc/%s" % w)]
+            if not alive:
+                break
+            time.sleep(0.05)
+        self.assertEqual(alive, [], "worker processes left running")
         return p.returncode, err
 
     def test_ctrl_c_at_the_terminal(self):
@@ -131,6 +144,16 @@ class DistributedInterrupts(TD.DistributedCase):
                 self.assertNotIn("Traceback", err)
                 self.assertNotIn("KeyboardInterrupt", err)
                 self.assert_nothing_left(dest)
+
+    def test_second_ctrl_c_while_workers_start(self):
+        """A second Ctrl-C while the workers start stops the run without
+        waiting for the start: exit 130 within seconds, and the workers cut
+        short (still blocking SIGTERM, which the exit handlers' terminate()
+        sends) are killed, not waited for."""
+        dest = self.path("twice.tif")
+        code, err = self.ctrl_c_to_the_group(dest, 0.0, again=0.2)
+        self.assertEqual(code, 130, err)
+        self.assert_nothing_left(dest)
 
     def test_signals_held_while_the_cluster_starts(self):
         """While the cluster starts, one Ctrl-C or SIGTERM is held, said,
