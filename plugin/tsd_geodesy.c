@@ -83,6 +83,11 @@ static ts_status geographic(const double gt[6], int width, int height, double a,
     if (!c->cell_x_row)
         return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory for %d rows", height);
     double lon0 = gt[0] + 0.5 * width * gt[1];
+    /* an origin many turns round (lon 1e13 and beyond): lon0 + dlon would
+     * round to lon0, the parallels' widths to nothing (an svf of cliffs);
+     * the same meridian within a turn, exactly (remainder is exact) */
+    if (fabs(lon0) > 360)
+        lon0 = remainder(lon0, 360.0);
     for (int y = 0; y < height; y++) {
         double lat = gt[3] + (y + 0.5) * gt[5];
         double s12 = 0;

@@ -6,6 +6,7 @@
 #include "tsd_products.h"
 #include "tsd_text.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -60,7 +61,10 @@ static int far_factor(const tsd_options *o, int W, int H, int f_mem, double near
         (double)W * H * far_bytes_per_cell(planes, 1) <= budget)
         return 1;
     int f_budget = (int)ceil(sqrt((double)W * H * far_bytes_per_cell(planes, 0) / budget));
-    int f_near = (int)floor(near_cells / TSD_FAR_CELLS_PER_NEAR);
+    /* in double first: a near field of ~7e10 cells and more (NEAR_DISTANCE
+     * on fine cells at a pole) overflowed int, and the budget was lost */
+    double q_near = floor(near_cells / TSD_FAR_CELLS_PER_NEAR);
+    int f_near = q_near < INT_MAX ? (int)q_near : INT_MAX;
     int f = f_budget < f_near ? f_budget : f_near;
     f = f > f_mem ? f : f_mem;
     return f < 1 ? 1 : f;

@@ -72,6 +72,26 @@ class Georef(unittest.TestCase):
         self.assertAlmostEqual(float(md["CELL_SIZE_X"]), 74.6, 0)
         self.assertAlmostEqual(float(md["CELL_SIZE_Y"]), 92.5, 0)
 
+    def test_origin_many_turns_round_measures_the_same_cells(self):
+        """A geographic DEM whose longitudes lie many turns round (origin at
+        lon 1e300, or 1e13) has the cells and the products of the same DEM
+        within a turn: lon0 + dlon rounded to lon0, and until session 52
+        the parallels had no width (an svf of cliffs, min 2e-6 against
+        0.997, and a warning blaming Z_FACTOR)."""
+        heights = T.fractal_dem(64, seed=4, relief=30.0)
+        out = {}
+        for lon in (10.0, 1e13, 1e300):
+            dem = T.write_tif(os.path.join(self.dir, "lon%g.tif" % lon), heights,
+                              (lon, 0.001, 0, 45.0, 0, -0.001), 4326)
+            ds = gdal.Open(T.conn(dem))
+            self.assertAlmostEqual(float(ds.GetMetadataItem("CELL_SIZE_X")), 78.8, 0)
+            ds = None
+            out[lon] = T.read(T.translate(dem, os.path.join(self.dir, "svf%g.tif" % lon),
+                                          {"PRODUCT": "svf", "DIRECTIONS": "8"}))
+        for lon in (1e13, 1e300):
+            with self.subTest(lon=lon):
+                np.testing.assert_allclose(out[lon], out[10.0], atol=1e-6)
+
     def test_geographic_and_utm_shadows_match(self):
         """jacksboro in degrees and warped to UTM 17N give the same shadows.
 

@@ -211,6 +211,25 @@ class MemoryEstimate(unittest.TestCase):
         windowed = T.read(T.conn(worlds[720]), 1, oo)
         T.np.testing.assert_allclose(windowed, whole, atol=0.01)
 
+    def test_huge_near_field_keeps_the_far_grid_in_budget(self):
+        """A near field of more than ~7e10 cells (NEAR_DISTANCE on cells of
+        a nanometre here; on fine cells at a pole in practice) overflowed
+        int in the far grid's factor, which then kept the DEM's own cells
+        and was refused under a MAX_MEMORY that fits (until session 52):
+        the far grid is the one a short NEAR_DISTANCE gives."""
+        d = os.path.dirname(self.out)
+        dem = T.write_tif(os.path.join(d, "nano.tif"), T.fractal_dem(1024, relief=1e-7),
+                          (500000.0, 1e-9, 0.0, 4000000.0, 0.0, -1e-9), 32617)
+        grids = []
+        for near in ("60", "1e6"):
+            p = T.run(["gdalinfo"] + T.oo_args({"TILE_SIZE": 64, "NEAR_DISTANCE": near,
+                                                "MAX_MEMORY": 16, "CELL_SIZES": "grid"}) +
+                      [T.conn(dem)], CPL_DEBUG="TERRASHADE")
+            m = re.search(r"far grid (\d+ x \d+)", p.stderr)
+            self.assertIsNotNone(m, p.stderr)
+            grids.append(m.group(1))
+        self.assertEqual(grids[1], grids[0])
+
     def test_cache_the_estimate_counts_is_the_cache(self):
         """The estimate counts the chunks the LRU cache keeps: a row of them
         (width / TILE_SIZE + 1) and at least 4. A DEM at most two chunks wide
