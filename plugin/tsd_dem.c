@@ -172,6 +172,21 @@ static void to_metres(float *restrict r, const unsigned char *restrict mr, int w
     seen->step_bits = step;
 }
 
+/* The cells a read took, read again as doubles (tsd_dem_beyond_float). */
+typedef struct {
+    GDALRasterBandH band;
+    int x, y, w, rows, h; /* h > 0: rows y .. of the band resampled to h rows */
+} reread_ctx;
+
+static CPLErr reread_doubles(void *ctx, double *buf)
+{
+    const reread_ctx *r = ctx;
+    if (r->h > 0)
+        return read_rows(r->band, r->y, r->rows, r->w, r->h, buf, (size_t)r->w, GDT_Float64);
+    return GDALRasterIO(r->band, GF_Read, r->x, r->y, r->w, r->rows, buf, r->w, r->rows,
+                        GDT_Float64, 0, 0);
+}
+
 /* GDAL's reason, or, where it gave none (GDAL 3.6's direct reads of a
  * truncated GeoTIFF fail without one), what to try: the DEM named. */
 static ts_status read_failed(GDALRasterBandH band, ts_grid *grid, unsigned char *m, char *msg,
@@ -255,6 +270,13 @@ static ts_status load_window(GDALRasterBandH band, GDALRasterBandH src, const ts
                      (int)(grid->stride * sizeof(float))) != CE_None ||
         (mask && GDALRasterIO(mask, GF_Read, rx, ry, w, h, m, w, h, GDT_Byte, 0, w) != CE_None))
         return read_failed(src, grid, m, msg, n);
+    reread_ctx again = {src, rx, ry, w, h, 0};
+    if ((st = tsd_dem_beyond_float(band, grid->z, grid->stride, m, w, h, reread_doubles,
+                                   &again, rx, ry, 1, 1, msg, n)) != TS_OK) {
+        free(m);
+        ts_grid_free(grid);
+        return st;
+    }
     tsd_dem_seen seen = TSD_DEM_SEEN_NONE;
     for (int y = 0; y < h; y++)
         to_metres(grid->z + (ptrdiff_t)y * grid->stride, m ? m + (size_t)y * w : NULL, w,
@@ -292,6 +314,15 @@ static ts_status load_resampled(GDALRasterBandH band, GDALRasterBandH src,
         if (read_rows(src, y0, rows, w, h, z, grid->stride, GDT_Float32) != CE_None ||
             (mask && read_rows(mask, y0, rows, w, h, m, w, GDT_Byte) != CE_None))
             return read_failed(src, grid, m, msg, n);
+        const double sx = (double)GDALGetRasterBandXSize(band) / w,
+                     sy = (double)GDALGetRasterBandYSize(band) / h;
+        reread_ctx again = {src, 0, y0, w, rows, h};
+        if ((st = tsd_dem_beyond_float(band, z, grid->stride, m, w, rows, reread_doubles,
+                                       &again, 0, (int)(sy * y0), sx, sy, msg, n)) != TS_OK) {
+            free(m);
+            ts_grid_free(grid);
+            return st;
+        }
         for (int y = 0; y < rows; y++)
             to_metres(z + (ptrdiff_t)y * grid->stride, m ? m + (size_t)y * w : NULL, w,
                       c.scale, c.offset, &seen);

@@ -6,6 +6,7 @@
 #include "tsd_dem.h"
 #include "tsd_text.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -210,6 +211,48 @@ static ts_status void_error(GDALRasterBandH band, const tsd_dem_conversion *c, c
         }
     }
     return TS_OK;
+}
+
+ts_status tsd_dem_beyond_float(GDALRasterBandH band, const float *z, ptrdiff_t stride,
+                               const unsigned char *m, int w, int rows,
+                               tsd_dem_reread_fn reread, void *ctx, int x0, int y0, double sx,
+                               double sy, char *msg, size_t n)
+{
+    if (GDALGetRasterDataType(band) != GDT_Float64)
+        return TS_OK;
+    int any = 0;
+    for (int y = 0; y < rows && !any; y++)
+        for (int x = 0; x < w; x++)
+            any |= isinf(z[(ptrdiff_t)y * stride + x]);
+    if (!any)
+        return TS_OK;
+    double *d = malloc((size_t)w * rows * sizeof *d);
+    if (!d)
+        return tsd_fail(msg, n, TS_ERR_NOMEM, "out of memory reading the DEM's heights");
+    ts_status st = TS_OK;
+    if (reread(ctx, d) != CE_None) {
+        free(d);
+        return TS_OK; /* as read first: the infinities stay nodata */
+    }
+    int has_nodata = 0;
+    const double nodata = GDALGetRasterNoDataValue(band, &has_nodata);
+    for (size_t i = 0; i < (size_t)w * rows; i++)
+        if (isfinite(d[i]) && fabs(d[i]) > FLT_MAX && !(m && !m[i]) &&
+            !(has_nodata && d[i] == nodata)) {
+            GDALDatasetH ds = GDALGetBandDataset(band);
+            const int full = sx == 1 && sy == 1;
+            st = tsd_fail(msg, n, TS_ERR_ARG,
+                          "the DEM '%s' holds a height no terrain has: %.6g%s in band %d %s "
+                          "column %d, row %d, beyond the range of 32-bit floats (%.6g). Is "
+                          "it a DEM? Declare its voids nodata (gdal_edit.py -a_nodata)",
+                          ds ? GDALGetDescription(ds) : "", d[i], full ? "" : " (averaged)",
+                          GDALGetBandNumber(band), full ? "at" : "near",
+                          x0 + (int)(sx * (double)(i % (size_t)w)),
+                          y0 + (int)(sy * (double)(i / (size_t)w)), (double)FLT_MAX);
+            break;
+        }
+    free(d);
+    return st;
 }
 
 ts_status tsd_dem_check(GDALRasterBandH band, const tsd_dem_conversion *c, const ts_grid *g,

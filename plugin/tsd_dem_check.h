@@ -25,6 +25,21 @@ extern "C" {
 #define TSD_EARTH_LOWEST_M (-12000.0)
 #define TSD_EARTH_HIGHEST_M 9000.0
 
+/** A Float64 band's heights beyond the float range read as +-inf in a
+ * Float32 read, which the conversion takes for nodata, as an infinite
+ * height in the file: where `rows` rows of w cells so read (z, stride)
+ * hold an infinity, the same cells read as doubles by `reread` (into a
+ * w x rows buffer; CE_None on success) tell them apart. TS_OK, or the
+ * first finite height beyond the float range refused as no terrain's, at
+ * band cell (x0 + sx * gx, y0 + sy * gy). Cells the mask m (w a row; NULL:
+ * none) says invalid, and the band's nodata value (-DBL_MAX is common),
+ * are voids, not heights. */
+typedef CPLErr (*tsd_dem_reread_fn)(void *ctx, double *buf);
+ts_status tsd_dem_beyond_float(GDALRasterBandH band, const float *z, ptrdiff_t stride,
+                               const unsigned char *m, int w, int rows,
+                               tsd_dem_reread_fn reread, void *ctx, int x0, int y0, double sx,
+                               double sy, char *msg, size_t n);
+
 /** How a band's values become the grid's heights. */
 typedef struct {
     double scale, offset; /**< value * scale + offset: the band's own, times z_factor */

@@ -174,6 +174,29 @@ class ImpossibleHeights(unittest.TestCase):
                               r"column 332, row 400")
         self.assertNotIn("-a_nodata", err)  # an average is not the DEM's value
 
+    def test_float64_beyond_the_float_range(self):
+        """A Float64 DEM's heights beyond the float range (1e39, 1e300)
+        read as infinities, which are nodata: they were silently nodata
+        (all of a 1e100 DEM, exit 0) until session 52; refused now as 1e30
+        is, whole and windowed. (An overview level's average is GDAL's,
+        which leaves such cells out as it does infinities.) Declared
+        nodata -DBL_MAX, common in Float64 rasters, stays nodata."""
+        z64 = self.z.astype(np.float64)
+        for value in (1e39, 1e300):
+            z = z64.copy()
+            z[40:52, 30:47] = value
+            dem = self.dem("f64_%g.tif" % value, z, dtype=gdal.GDT_Float64)
+            for path, extra in (("whole", {"TILE_SIZE": 0}), ("windows", {"TILE_SIZE": 64})):
+                with self.subTest(value=value, path=path):
+                    err = failure(T.conn(dem, **extra))
+                    self.assertIn("holds a height no terrain has: %.6g in band 1 at column 30, "
+                                  "row 40, beyond the range of 32-bit floats" % value, err)
+        z = z64.copy()
+        z[40:52, 30:47] = -1.7976931348623157e308
+        dem = self.dem("f64nd.tif", z, nodata=-1.7976931348623157e308, dtype=gdal.GDT_Float64)
+        out = T.read(T.conn(dem, PRODUCT="svf", DIRECTIONS=8), 1)
+        np.testing.assert_array_equal(np.isnan(out), z == -1.7976931348623157e308)
+
     def test_the_deepest_and_highest_terrain_are_accepted(self):
         """The Challenger Deep (-10 935 m) and Everest (8 849 m) are terrain:
         a DEM of 1 km cells that climbs from one to the other (206 m between
