@@ -24,6 +24,9 @@ extern "C" {
  * place the plugin writes it (the option table's default string is made
  * from it by TSD_XSTR). */
 #define TSD_REFRACTION_DEFAULT 0.13
+/** The shortest MAX_DISTANCE but 0 (metres): shorter, the rounding of
+ * 32-bit heights swamps a cell's own slope (tsd_option_table.c). */
+#define TSD_MAX_DISTANCE_MIN 0.5
 #define TSD_STR(x) #x
 #define TSD_XSTR(x) TSD_STR(x)
 

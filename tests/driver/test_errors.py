@@ -53,6 +53,10 @@ CASES = [
      "PCF_KERNEL applies to METHOD=shadowmap only, of PRODUCT=shade and PRODUCT=shadow"),
     ("zero z factor", T.conn(DEM), ["Z_FACTOR=0"],
      "Z_FACTOR must be greater than 0"),
+    # shorter, float heights' rounding raised horizons to 82 degrees
+    # (session 52: a micrometre on gentle ground)
+    ("a micrometre's reach", T.conn(DEM), ["PRODUCT=horizon", "MAX_DISTANCE=1e-6"],
+     "MAX_DISTANCE must be 0 (unbounded) or at least 0.5 m, got 1e-6"),
     ("bad product", T.conn(DEM), ["PRODUCT=hillshade"],
      "PRODUCT must be one of shade, shadow, horizon, svf, openness, sky, sunhours, "
      "insolation, daycycle, farshadow, envlight, got 'hillshade'"),
