@@ -436,13 +436,24 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     poDS->m_osDEM = osDEM;
     // an atlas, which this driver opens (its 0/1 maps were taken as heights);
     // its file read only then, not for every DEM
-    if (poDEM->GetDriver() && EQUAL(poDEM->GetDriver()->GetDescription(), DRIVER) &&
-        IsAtlasFile(osDEM.c_str()))
+    const bool bOurs = poDEM->GetDriver() && EQUAL(poDEM->GetDriver()->GetDescription(), DRIVER);
+    if (bOurs && IsAtlasFile(osDEM.c_str()))
         return FailOpen(TS_ERR_ARG,
                         CPLSPrintf("the DEM '%s' is a far-shadow atlas (.tsa), not a DEM: open "
                                    "it as it is (%s, its far shadows; -oo SHADOWS=all with "
                                    "the near ones), or name the DEM it was made from",
                                    osDEM.c_str(), osDEM.c_str()));
+    // a product of this driver (TERRASHADE:TERRASHADE:dem.tif): its shading
+    // was taken as heights, silently
+    if (bOurs)
+    {
+        const char *pszSource = poDEM->GetMetadataItem("SOURCE_DEM");
+        return FailOpen(TS_ERR_ARG,
+                        CPLSPrintf("the DEM '%s' is a TERRASHADE product, not a DEM: name the "
+                                   "DEM itself%s%s%s",
+                                   osDEM.c_str(), pszSource ? " (" : "",
+                                   pszSource ? pszSource : "", pszSource ? ")" : ""));
+    }
     if (sOpts.band > poDEM->GetRasterCount())
         return FailOpen(TS_ERR_ARG,
                              CPLSPrintf("BAND=%d, but the DEM '%s' has %d band(s)",

@@ -53,6 +53,9 @@ CASES = [
      "PCF_KERNEL applies to METHOD=shadowmap only, of PRODUCT=shade and PRODUCT=shadow"),
     ("zero z factor", T.conn(DEM), ["Z_FACTOR=0"],
      "Z_FACTOR must be greater than 0"),
+    # its shading was taken as heights, silently (until session 52)
+    ("a product as the DEM", "TERRASHADE:" + T.conn(DEM), [],
+     "is a TERRASHADE product, not a DEM: name the DEM itself"),
     # shorter, float heights' rounding raised horizons to 82 degrees
     # (session 52: a micrometre on gentle ground)
     ("a micrometre's reach", T.conn(DEM), ["PRODUCT=horizon", "MAX_DISTANCE=1e-6"],
