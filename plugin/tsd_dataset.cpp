@@ -543,6 +543,19 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     if (eSt != TS_OK)
         return Fail(eSt, szMsg), false;
     const double dfMinCell = std::min(m_sCells.cell_y, tsd_cells_min_x(&m_sCells, H));
+    if (m_nLevel == 0 && sOpts.max_distance > 0 &&
+        sOpts.max_distance < std::min(TSD_MAX_DISTANCE_MIN, dfMinCell) &&
+        tsd_product_takes(m_psProduct, tsd_option_find("MAX_DISTANCE")))
+        return Fail(TS_ERR_ARG,
+                    CPLSPrintf("MAX_DISTANCE=%g m is shorter than both %g m and the DEM's "
+                               "cells (%.4g m): within a cell's own surface a horizon is a "
+                               "height difference over the distance, which the rounding of "
+                               "the heights (32-bit floats) swamps. Give 0 (unbounded) or at "
+                               "least %g m; it is in metres (RVT's radius is in cells: times "
+                               "the cell size)",
+                               sOpts.max_distance, TSD_MAX_DISTANCE_MIN, dfMinCell,
+                               std::min(TSD_MAX_DISTANCE_MIN, dfMinCell))),
+               false;
     if (tsd_options_sun_from_time(&sOpts))
     {
         const char *pszWhat = sOpts.datetime[0]     ? "DATETIME"

@@ -220,10 +220,11 @@ ts_status tsd_dem_beyond_float(GDALRasterBandH band, const float *z, ptrdiff_t s
 {
     if (GDALGetRasterDataType(band) != GDT_Float64)
         return TS_OK;
-    int any = 0;
+    int any = 0; /* an infinity where the mask says valid: voids (-DBL_MAX
+                  * declared nodata reads as -inf) cost no second read */
     for (int y = 0; y < rows && !any; y++)
         for (int x = 0; x < w; x++)
-            any |= isinf(z[(ptrdiff_t)y * stride + x]);
+            any |= isinf(z[(ptrdiff_t)y * stride + x]) && !(m && !m[(size_t)y * w + x]);
     if (!any)
         return TS_OK;
     double *d = malloc((size_t)w * rows * sizeof *d);
@@ -241,14 +242,19 @@ ts_status tsd_dem_beyond_float(GDALRasterBandH band, const float *z, ptrdiff_t s
             !(has_nodata && d[i] == nodata)) {
             GDALDatasetH ds = GDALGetBandDataset(band);
             const int full = sx == 1 && sy == 1;
+            const char *path = ds ? GDALGetDescription(ds) : "";
+            char declare[TSD_PATH_MAX + 160] = ""; /* the value whole, as remedies() */
+            if (full)
+                snprintf(declare, sizeof declare, " (gdal_edit.py -a_nodata %.17g %s)", d[i],
+                         path);
             st = tsd_fail(msg, n, TS_ERR_ARG,
-                          "the DEM '%s' holds a height no terrain has: %.6g%s in band %d %s "
-                          "column %d, row %d, beyond the range of 32-bit floats (%.6g). Is "
-                          "it a DEM? Declare its voids nodata (gdal_edit.py -a_nodata)",
-                          ds ? GDALGetDescription(ds) : "", d[i], full ? "" : " (averaged)",
-                          GDALGetBandNumber(band), full ? "at" : "near",
-                          x0 + (int)(sx * (double)(i % (size_t)w)),
-                          y0 + (int)(sy * (double)(i / (size_t)w)), (double)FLT_MAX);
+                          "the DEM '%s' holds a value no terrain's height is: %.6g%s in band "
+                          "%d %s column %d, row %d, beyond the range of 32-bit floats "
+                          "(%.6g). A nodata value the DEM does not declare? Declare it%s and "
+                          "those cells are nodata",
+                          path, d[i], full ? "" : " (averaged)", GDALGetBandNumber(band),
+                          full ? "at" : "near", x0 + (int)(sx * (double)(i % (size_t)w)),
+                          y0 + (int)(sy * (double)(i / (size_t)w)), (double)FLT_MAX, declare);
             break;
         }
     free(d);

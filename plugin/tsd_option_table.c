@@ -31,7 +31,6 @@ READER(check_sky);
 READER(check_exposure);
 READER(check_tile_size);
 READER(check_light_radius);
-READER(check_max_distance);
 
 const opt_def TSD_OPTION_ROWS[] = {
     {"PRODUCT", K_PRODUCT, FIELD(product), "shade", 0, 0, 0, 0, NULL, 1, P,
@@ -97,9 +96,9 @@ const opt_def TSD_OPTION_ROWS[] = {
      "DEM departs from 1 by more than 1 % (Web Mercator beyond ~8 degrees of "
      "latitude), else grid"},
     {"MAX_DISTANCE", K_FLOAT, FIELD(max_distance), "0", 0, 1e8, 0, 1, NULL, 1, P, LISTED,
-     check_max_distance,
+     NULL,
      "Largest distance in metres at which terrain can cast a shadow or "
-     "raise the horizon; 0 = unbounded, else at least " TSD_XSTR(TSD_MAX_DISTANCE_MIN) " m"},
+     "raise the horizon; 0 = unbounded"},
     {"CURVATURE", K_BOOL, FIELD(curvature), "YES", 0, 0, 0, 0, NULL, 1, P, ALL, NULL,
      "Take Earth curvature (with refraction) into account"},
     {"REFRACTION", K_FLOAT, FIELD(refraction), TSD_XSTR(TSD_REFRACTION_DEFAULT), 0, 1, 0, 1,
@@ -457,21 +456,3 @@ READER(check_light_radius)
     return -1;
 }
 
-/* MAX_DISTANCE: 0, or no shorter than TSD_MAX_DISTANCE_MIN. Within a
- * cell's own surface the horizon is a height difference over the distance;
- * the heights are 32-bit floats, rounded to ~1e-7 of themselves, so that
- * a micrometre raised horizons to 82 degrees on gentle ground (and the
- * pyramid's fell to -90); at 0.5 m, on heights of 8000 m, a horizon is
- * at most 0.04 degrees above the one at 1 m, where it can only be lower. */
-READER(check_max_distance)
-{
-    (void)meaning, (void)mn; /* a number: compared as one */
-    double r;
-    if (tsd_parse_decimal(v, &r) != 0 || !(r > 0 && r < TSD_MAX_DISTANCE_MIN))
-        return 0;
-    tsd_fail(msg, n, TS_ERR_ARG, "MAX_DISTANCE must be 0 (unbounded) or at least %g m, got "
-             "%s: within a cell's own surface a horizon is a height difference over the "
-             "distance, and heights are 32-bit floats. It is in metres (RVT's radius is in "
-             "cells: times the cell size)", TSD_MAX_DISTANCE_MIN, v);
-    return -1;
-}

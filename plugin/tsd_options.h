@@ -24,8 +24,12 @@ extern "C" {
  * place the plugin writes it (the option table's default string is made
  * from it by TSD_XSTR). */
 #define TSD_REFRACTION_DEFAULT 0.13
-/** The shortest MAX_DISTANCE but 0 (metres): shorter, the rounding of
- * 32-bit heights swamps a cell's own slope (tsd_option_table.c). */
+/** The shortest MAX_DISTANCE but 0 (metres) where it is also shorter than
+ * the DEM's cells: within a cell's own surface a horizon is a height
+ * difference over the distance, which the rounding of 32-bit heights
+ * swamps (a micrometre raised horizons to 82 degrees on gentle ground; at
+ * 0.5 m, on heights of 8000 m, a horizon is at most 0.04 degrees above the
+ * one at 1 m, where it can only be lower). TSDataset::Setup refuses it. */
 #define TSD_MAX_DISTANCE_MIN 0.5
 #define TSD_STR(x) #x
 #define TSD_XSTR(x) TSD_STR(x)

@@ -59,7 +59,7 @@ CASES = [
     # shorter, float heights' rounding raised horizons to 82 degrees
     # (session 52: a micrometre on gentle ground)
     ("a micrometre's reach", T.conn(DEM), ["PRODUCT=horizon", "MAX_DISTANCE=1e-6"],
-     "MAX_DISTANCE must be 0 (unbounded) or at least 0.5 m, got 1e-6"),
+     "MAX_DISTANCE=1e-06 m is shorter than both 0.5 m and the DEM's cells"),
     ("bad product", T.conn(DEM), ["PRODUCT=hillshade"],
      "PRODUCT must be one of shade, shadow, horizon, svf, openness, sky, sunhours, "
      "insolation, daycycle, farshadow, envlight, got 'hillshade'"),

@@ -189,8 +189,11 @@ class ImpossibleHeights(unittest.TestCase):
             for path, extra in (("whole", {"TILE_SIZE": 0}), ("windows", {"TILE_SIZE": 64})):
                 with self.subTest(value=value, path=path):
                     err = failure(T.conn(dem, **extra))
-                    self.assertIn("holds a height no terrain has: %.6g in band 1 at column 30, "
-                                  "row 40, beyond the range of 32-bit floats" % value, err)
+                    self.assertIn("holds a value no terrain's height is: %.6g in band 1 at "
+                                  "column 30, row 40, beyond the range of 32-bit floats"
+                                  % value, err)
+                    if path == "whole":  # the value to declare, whole
+                        self.assertIn("gdal_edit.py -a_nodata %.17g " % value, err)
         z = z64.copy()
         z[40:52, 30:47] = -1.7976931348623157e308
         dem = self.dem("f64nd.tif", z, nodata=-1.7976931348623157e308, dtype=gdal.GDT_Float64)
