@@ -169,11 +169,7 @@ CPLErr TSRasterBand::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXS
 
 bool TSRasterBand::TakeReadTurn(std::unique_lock<std::recursive_mutex> &oTurn)
 {
-    TSDataset *ds = static_cast<TSDataset *>(poDS);
-    if (ds->ReadInsideOwnComputation())
-        return false;
-    oTurn = std::unique_lock<std::recursive_mutex>(ds->m_oReadMutex);
-    return true;
+    return static_cast<TSDataset *>(poDS)->TakeReadTurn(oTurn);
 }
 
 /* Cells x0 .. x0+n-1 of a product row (mirrored when flip_x) into a block

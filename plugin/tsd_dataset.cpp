@@ -171,6 +171,14 @@ bool TSDataset::ReadInsideOwnComputation() const
     return true;
 }
 
+bool TSDataset::TakeReadTurn(std::unique_lock<std::recursive_mutex> &oTurn)
+{
+    if (ReadInsideOwnComputation())
+        return false;
+    oTurn = std::unique_lock<std::recursive_mutex>(m_oReadMutex);
+    return true;
+}
+
 CPLErr TSDataset::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize, int nYSize,
                             void *pData, int nBufXSize, int nBufYSize, GDALDataType eBufType,
                             int nBandCount, int *panBandMap, GSpacing nPixelSpace,
@@ -178,8 +186,8 @@ CPLErr TSDataset::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize
                             GDALRasterIOExtraArg *psExtraArg)
 {
     tsd::CLocale oC; /* tsd_locale.h */
-    const ReadTurn oTurn(*this);
-    if (oTurn.Refused())
+    std::unique_lock<std::recursive_mutex> oTurn;
+    if (!TakeReadTurn(oTurn))
         return CE_Failure;
     CallerProgress oCaller(psExtraArg, nXOff, nYOff, nXSize, nYSize);
     psExtraArg = oCaller.Arg(psExtraArg);

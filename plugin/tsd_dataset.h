@@ -76,22 +76,10 @@ class TSDataset final : public GDALPamDataset
     bool ReadInsideOwnComputation() const;
 
   public:
-    /* A read's turn (IRasterIO, the statistics): refused, with the error
-     * said, from inside the dataset's own computation; else the read lock
-     * held for the turn's life */
-    class ReadTurn
-    {
-        std::unique_lock<std::recursive_mutex> m_oLock{};
-        bool m_bRefused;
-
-      public:
-        explicit ReadTurn(TSDataset &oDS) : m_bRefused(oDS.ReadInsideOwnComputation())
-        {
-            if (!m_bRefused)
-                m_oLock = std::unique_lock<std::recursive_mutex>(oDS.m_oReadMutex);
-        }
-        bool Refused() const { return m_bRefused; }
-    };
+    /* A read's turn (IRasterIO, the statistics; of the dataset or its
+     * bands): false, with the error said, from inside the dataset's own
+     * computation; else true with oTurn holding the read lock */
+    bool TakeReadTurn(std::unique_lock<std::recursive_mutex> &oTurn);
 
   private:
     /* the calling thread marked as m_oComputer while it holds m_oMutex */
@@ -238,9 +226,9 @@ class TSRasterBand final : public TSTurnBand
     }
     const GDALRasterBandPamInfo *UserPam() override;
     const char *NotHere() const override;
-    /* as the dataset's ReadTurn: refused from the computation's own progress
-     * callback (TSDataset::ReadInsideOwnComputation), where GDAL's cache
-     * holds the block being computed unfilled */
+    /* the dataset's (TSDataset::TakeReadTurn): refused from the computation's
+     * own progress callback, where GDAL's cache holds the block being
+     * computed unfilled */
     bool TakeReadTurn(std::unique_lock<std::recursive_mutex> &oTurn) override;
 
   public:
