@@ -59,6 +59,15 @@ static int height_limits(GDALRasterBandH band, const tsd_dem_conversion *c, doub
 
 static float raw_metres(double raw, const tsd_dem_conversion *c);
 
+/* " (gdal_edit.py -a_nodata RAW PATH)": the raw value whole and the DEM's
+ * name, where it is the file's own cell (full) and finite; else "". */
+static void declare_command(const char *path, double raw, int full, char *out, size_t n)
+{
+    out[0] = '\0';
+    if (full && isfinite(raw))
+        snprintf(out, n, " (gdal_edit.py -a_nodata %.17g %s)", raw, path);
+}
+
 /* The remedies' sentence: declare `z` (a grid height, of the band's cell
  * col, row) as nodata when the grid holds the DEM's own values, or set a
  * unit. The value declared is the band's own, read again: z, a float, holds
@@ -73,9 +82,8 @@ static void remedies(GDALRasterBandH band, const tsd_dem_conversion *c, int full
     if (full && GDALRasterIO(band, GF_Read, col, row, 1, 1, &cell, 1, 1, GDT_Float64, 0, 0) ==
                     CE_None && raw_metres(cell, c) == z)
         raw = cell;
-    char declare[TSD_PATH_MAX + 160] = ""; /* the DEM's name, whole */
-    if (full && isfinite(raw))
-        snprintf(declare, sizeof declare, " (gdal_edit.py -a_nodata %.17g %s)", raw, path);
+    char declare[TSD_PATH_MAX + 160];
+    declare_command(path, raw, full, declare, sizeof declare);
     snprintf(out, n,
              "A nodata value the DEM does not declare? Declare it%s and those cells are "
              "nodata. Heights in another unit? Set the band's unit (gdal_edit.py -units ft) "
@@ -243,10 +251,8 @@ ts_status tsd_dem_beyond_float(GDALRasterBandH band, const float *z, ptrdiff_t s
             GDALDatasetH ds = GDALGetBandDataset(band);
             const int full = sx == 1 && sy == 1;
             const char *path = ds ? GDALGetDescription(ds) : "";
-            char declare[TSD_PATH_MAX + 160] = ""; /* the value whole, as remedies() */
-            if (full)
-                snprintf(declare, sizeof declare, " (gdal_edit.py -a_nodata %.17g %s)", d[i],
-                         path);
+            char declare[TSD_PATH_MAX + 160];
+            declare_command(path, d[i], full, declare, sizeof declare);
             st = tsd_fail(msg, n, TS_ERR_ARG,
                           "the DEM '%s' holds a value no terrain's height is: %.6g%s in band "
                           "%d %s column %d, row %d, beyond the range of 32-bit floats "
