@@ -46,7 +46,7 @@ def start_cluster(args):
         return client, None, 1
     workers = args.workers or os.cpu_count() or 1
     runner = loop_without_ctrl_c()
-    children = {p.pid for p in multiprocessing.active_children()}
+    before = {p.pid for p in multiprocessing.active_children()}
     try:
         # on this machine's loopback only, with its HTTP servers on free ports:
         # dashboard_address=None still served the scheduler's on 0.0.0.0:8787,
@@ -55,11 +55,11 @@ def start_cluster(args):
             n_workers=workers, threads_per_worker=args.threads_per_worker, processes=True,
             host="127.0.0.1", dashboard_address="127.0.0.1:0",
             worker_dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR,
-            loop=runner.loop), runner)
+            loop=runner.loop), runner, before)
     except BaseException:
         # a start cut short (a second Ctrl-C): its workers, still blocking
         # SIGTERM, would hold the exit handlers' terminate() and join()
-        kill_pids(p.pid for p in multiprocessing.active_children() if p.pid not in children)
+        kill_children_since(before)
         runner.stop()
         raise
     slots = workers * args.threads_per_worker
@@ -98,10 +98,11 @@ def loop_without_ctrl_c():
 
 
 class OwnCluster:
-    """The run's LocalCluster and the loop it runs on: closed together."""
+    """The run's LocalCluster and the loop it runs on: closed together. Its
+    workers are this process's children started since `before` (their pids)."""
 
-    def __init__(self, cluster, runner):
-        self.cluster, self.runner = cluster, runner
+    def __init__(self, cluster, runner, before):
+        self.cluster, self.runner, self.before = cluster, runner, before
 
     def close(self):
         try:
@@ -110,23 +111,19 @@ class OwnCluster:
             # its workers may still block SIGTERM (stopped during their
             # start): the exit handlers' terminate() and join() would wait
             # for them for ever
-            self.kill_workers()
+            kill_children_since(self.before)
             raise
         finally:
             self.runner.stop()
 
-    def kill_workers(self):
-        kill_pids(getattr(getattr(getattr(nanny, "process", None), "process", None), "pid",
-                          None)
-                  for nanny in list(getattr(self.cluster, "workers", {}).values()))
 
-
-def kill_pids(pids):
-    """SIGKILL to each of these processes (None: none)."""
-    for pid in pids:
-        if pid:
+def kill_children_since(before):
+    """SIGKILL to this process's children (multiprocessing's: the local
+    cluster's workers, restarted ones too) whose pids are not in before."""
+    for p in multiprocessing.active_children():
+        if p.pid and p.pid not in before:
             with contextlib.suppress(OSError):
-                os.kill(pid, signal.SIGKILL)
+                os.kill(p.pid, signal.SIGKILL)
 
 
 class Watch:
