@@ -3,6 +3,7 @@
 #include "tsd_text.h"
 
 #include <ctype.h>
+#include <float.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdarg.h>
@@ -42,6 +43,18 @@ locale_t tsd_c_locale(void)
     return c_locale;
 }
 
+/* Whether the digits before the exponent hold one that is not 0: a value
+ * so small that strtod rounds it to 0 (1e-400) keeps its sign of being
+ * positive, so that MAX_DISTANCE=1e-400 is refused as too short instead of
+ * read as 0, "unbounded". */
+static int nonzero_mantissa(const char *digits, const char *end)
+{
+    for (; digits < end && *digits != 'e' && *digits != 'E'; digits++)
+        if (*digits >= '1' && *digits <= '9')
+            return 1;
+    return 0;
+}
+
 int tsd_parse_decimal(const char *text, double *x)
 {
     const char *digits = text;
@@ -55,13 +68,14 @@ int tsd_parse_decimal(const char *text, double *x)
     const locale_t c = tsd_c_locale();
     char *end;
     const double v = c ? strtod_l(text, &end, c) : strtod(text, &end);
-    if (end == text || !isfinite(v)) /* (an underflow reads as its rounding) */
+    if (end == text || !isfinite(v))
         return -1;
-    while (isspace((unsigned char)*end))
-        end++;
-    if (*end)
+    const char *tail = end;
+    while (isspace((unsigned char)*tail))
+        tail++;
+    if (*tail)
         return -1;
-    *x = v;
+    *x = v == 0 && nonzero_mantissa(digits, end) ? copysign(DBL_TRUE_MIN, v) : v;
     return 0;
 }
 

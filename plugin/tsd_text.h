@@ -41,8 +41,9 @@ locale_t tsd_c_locale(void);
 /**
  * Read a decimal number: the whole of text but surrounding spaces, with a
  * '.' whatever the process's locale; C's hexadecimal floats (0x10),
- * infinities, NaN and overflow are refused (an underflow reads as what it
- * rounds to). 0 with *x set, else -1.
+ * infinities, NaN and overflow are refused; an underflow reads as what it
+ * rounds to, but never as 0 where a digit is not 0 (1e-400 reads as the
+ * least double of its sign). 0 with *x set, else -1.
  */
 int tsd_parse_decimal(const char *text, double *x);
 

@@ -60,6 +60,10 @@ CASES = [
     # (session 52: a micrometre on gentle ground)
     ("a micrometre's reach", T.conn(DEM), ["PRODUCT=horizon", "MAX_DISTANCE=1e-6"],
      "MAX_DISTANCE=1e-06 m is shorter than both 0.5 m and the DEM's cells"),
+    # below the doubles' range: strtod rounds it to 0, which read as
+    # "unbounded" (until session 53)
+    ("a reach below the doubles", T.conn(DEM), ["PRODUCT=horizon", "MAX_DISTANCE=1e-400"],
+     "m is shorter than both 0.5 m and the DEM's cells"),
     ("bad product", T.conn(DEM), ["PRODUCT=hillshade"],
      "PRODUCT must be one of shade, shadow, horizon, svf, openness, sky, sunhours, "
      "insolation, daycycle, farshadow, envlight, got 'hillshade'"),
