@@ -46,7 +46,7 @@ struct tsd_environment {
 int tsd_options_env(const tsd_options *o);
 
 /* 1 if that environment places no sun: ENV_MAP (the map is the light), or
- * a SKY that does not follow one (uniform, overcast). */
+ * a SKY that does not follow one (uniform, overcast, cie:1, cie:3, cie:5). */
 int tsd_environment_sunless(const tsd_options *o);
 
 /* EXPOSURE's text: 1 for automatic ("" or AUTO), 0 with *stops set, -1 if

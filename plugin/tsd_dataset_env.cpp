@@ -172,7 +172,7 @@ void TSDataset::WarnSkyAtNight() const
              "standard skies are defined for a sun above it. Their formula is continued "
              "there (a dusk sky's distribution of light) and normalised, as every sky, so "
              "that an open flat plane gets 1: it lights the terrain as by day, not as a "
-             "night sky. SKY=uniform or overcast do not follow the sun",
+             "night sky. SKY=uniform, overcast, cie:1, cie:3 and cie:5 do not follow the sun",
              m_sOpts.sky, -m_sRun.sun_elevation);
 }
 

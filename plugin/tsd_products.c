@@ -251,16 +251,21 @@ void tsd_products_taking(int option, const char *prefix, const char *last, char 
 }
 
 /* Why option `name`, which p takes, does nothing beside o's other options
- * (NULL: it does something). */
-static const char *moot_beside(const tsd_options *o, const tsd_product_def *p, const char *name)
+ * (NULL: it does something); the sentence may be written in why[n]. */
+static const char *moot_beside(const tsd_options *o, const tsd_product_def *p, const char *name,
+                               char *why, size_t n)
 {
-    /* envlight under a sky without a sun (uniform, overcast): nothing of
-     * the sun's (ENV_MAP with a sun is refused, tsd_options_check) */
+    /* envlight under a sky without a sun (uniform, overcast, cie:1, 3, 5):
+     * nothing of the sun's (ENV_MAP with a sun is refused,
+     * tsd_options_check); the sky named as the user gave it */
     if (tsd_product_takes(p, tsd_option_find("EXPOSURE")) && tsd_environment_sunless(o) &&
         (!strcmp(name, "SUN_AZIMUTH") || !strcmp(name, "SUN_ELEVATION") ||
          !strcmp(name, "DATETIME") || !strcmp(name, "PRESSURE") ||
-         !strcmp(name, "TEMPERATURE") || !strcmp(name, "DELTA_T")))
-        return "the sun's, and SKY=uniform or overcast has none";
+         !strcmp(name, "TEMPERATURE") || !strcmp(name, "DELTA_T"))) {
+        snprintf(why, n, "the sun's, and %s%s has none", o->sky[0] ? "SKY=" : "ENV_MAP",
+                 o->sky[0] ? o->sky : "");
+        return why;
+    }
     if ((!strcmp(name, "PRESSURE") || !strcmp(name, "TEMPERATURE") ||
          !strcmp(name, "DELTA_T")) &&
         !tsd_options_sun_from_time(o))
@@ -281,7 +286,10 @@ int tsd_options_unused(const tsd_options *o, const tsd_product_def *p, char *buf
         if (!(o->given >> i & 1) || !(tsd_option_scope(i) & TSD_SCOPE_PRODUCT) ||
             tsd_option_applies(i) != TSD_APPLIES_LISTED)
             continue;
-        const char *moot = tsd_product_takes(p, i) ? moot_beside(o, p, tsd_option_name(i)) : NULL;
+        char why[TSD_TEXT_MAX + 64];
+        const char *moot = tsd_product_takes(p, i)
+                               ? moot_beside(o, p, tsd_option_name(i), why, sizeof why)
+                               : NULL;
         if (tsd_product_takes(p, i) && !moot)
             continue;
         /* "SUN_AZIMUTH (an option of shade, shadow and envlight)" */

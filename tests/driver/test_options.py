@@ -164,7 +164,12 @@ class Options(unittest.TestCase):
         # envlight under a sky without a sun: its options of the sun
         err = T.open_stderr(self.dem, PRODUCT="envlight", SKY="overcast", SUN_AZIMUTH=100)
         self.assertIn("PRODUCT=envlight does not use SUN_AZIMUTH (the sun's, and "
-                      "SKY=uniform or overcast has none)", err)
+                      "SKY=overcast has none)", err)
+        # a CIE type without a sun's term is named as given (it said
+        # "SKY=uniform or overcast has none", until session 53)
+        err = T.open_stderr(self.dem, PRODUCT="envlight", SKY="cie:3", SUN_AZIMUTH=100)
+        self.assertIn("PRODUCT=envlight does not use SUN_AZIMUTH (the sun's, and "
+                      "SKY=cie:3 has none)", err)
         for oo in (dict(PRODUCT="svf", DIRECTIONS=8, MAX_DISTANCE=500, THREADS=1),
                    dict(PRODUCT="envlight", SKY="clear", SUN_AZIMUTH=100),
                    dict(PRODUCT="shade", PRESSURE=900, DIRECTIONS=32, SKY_WEIGHT=0.3,
