@@ -275,9 +275,9 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
             ts_cl_job_args(&J, kf, 0,
                            TS_CL_ARGS(TS_CL_ARG(zb), TS_CL_ARG(ztb), TS_CL_ARG(cW),
                                       TS_CL_ARG(cH), TS_CL_ARG(ipb), TS_CL_ARG(dpb),
-                                      TS_CL_ARG(frb), TS_CL_ARG(srb)));
-            ts_cl_job_arg_real(&J, kf, 8, c);
-            ts_cl_job_args(&J, kf, 9,
+                                      TS_CL_ARG(flb), TS_CL_ARG(frb), TS_CL_ARG(srb)));
+            ts_cl_job_arg_real(&J, kf, 9, c);
+            ts_cl_job_args(&J, kf, 10,
                            TS_CL_ARGS(TS_CL_ARG(ob), TS_CL_ARG(hib), TS_CL_ARG(lob),
                                       TS_CL_ARG(cplane)));
             size_t globalf[2] = {ts_cl_round_up(cells, wgf), (size_t)nb}, localf[2] = {wgf, 1};
@@ -285,11 +285,11 @@ static ts_status horizon_run(const ts_grid *grid, const ts_horizon_opts *opts, c
         }
         ts_cl_job_args(&J, k2, 0,
                        TS_CL_ARGS(TS_CL_ARG(zb), TS_CL_ARG(ztb), TS_CL_ARG(cW), TS_CL_ARG(cH),
-                                  TS_CL_ARG(ipb), TS_CL_ARG(dpb), TS_CL_ARG(frb),
-                                  TS_CL_ARG(srb)));
-        ts_cl_job_arg_real(&J, k2, 8, c);
-        ts_cl_job_arg_real(&J, k2, 9, cap);
-        ts_cl_job_args(&J, k2, 10,
+                                  TS_CL_ARG(ipb), TS_CL_ARG(dpb), TS_CL_ARG(flb),
+                                  TS_CL_ARG(frb), TS_CL_ARG(srb)));
+        ts_cl_job_arg_real(&J, k2, 9, c);
+        ts_cl_job_arg_real(&J, k2, 10, cap);
+        ts_cl_job_args(&J, k2, 11,
                        TS_CL_ARGS(TS_CL_ARG(ob), TS_CL_ARG(hib), TS_CL_ARG(lob),
                                   TS_CL_ARG(cplane), TS_CL_ARG(marked_only)));
         ts_cl_job_run(&J, k2, 2, global2, local2, "ts_sweep_finish");

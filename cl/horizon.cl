@@ -155,9 +155,27 @@ __kernel void ts_sweep_lines(__global const float *zr, __global const float *zt,
         if (!pushed)
             while (far + 1 < n && d - S[(far + 1) * ns].x >= near_skip)
                 far++;
-        oh[p] = (!isnan(hc) && inside) ? ts_hull_query(S, SK, ns, far, d, hc, c) : none;
+        /* (also off the grid, between the last row and the one beyond:
+         * its hull may hold the terrain toward the occluders) */
+        oh[p] = !isnan(hc) ? ts_hull_query(S, SK, ns, far, d, hc, c) : none;
         if (has_next)
             ol[p + v_stride] = isnan(hn) ? none : ts_hull_query(S, SK, ns, far, d, hn, c);
+    }
+    /* A line that leaves the grid across row 0 goes on one row before it,
+     * queries only: it answers row 0's cells for the far side, as the C
+     * sweep's row_before (core/horizon_sweep.c) */
+    const int kl = cm_line_k_leaving(fl, U, t >= 0, b, k1);
+    for (int k = k1 + 1; k <= kl; k++) {
+        if (sroff >= 0)
+            d += sr_all[sroff + (xm ? 0 : u_start + k * u_step)]; /* (row -1: row 0's) */
+        else
+            d = (real)(k - k0) * step_m;
+        while (far + 1 < n && d - S[(far + 1) * ns].x >= near_skip)
+            far++;
+        const long p0 = origin + (long)k * u_stride; /* row 0 */
+        const float hn = fr[k] > 0.0f ? z[p0] : NAN;
+        if (fr[k] > 0.0f)
+            ol[p0] = isnan(hn) ? none : ts_hull_query(S, SK, ns, far, d, hn, c);
     }
 }
 
@@ -283,8 +301,9 @@ typedef struct {
 
 ts_finish_cell ts_finish_setup(__global const float *zr, __global const float *zt,
                                __global const int *P, __global const real *Q,
-                               __global const float *fr_all, __global const real *sr_all,
-                               __global const int2 *lo, long cell, long plane)
+                               __global const int *fl_all, __global const float *fr_all,
+                               __global const real *sr_all, __global const int2 *lo, long cell,
+                               long plane)
 {
     ts_finish_cell f;
     const int xm = P[TS_CLI_XMAJOR], V = P[TS_CLI_V];
@@ -298,7 +317,15 @@ ts_finish_cell ts_finish_setup(__global const float *zr, __global const float *z
     const int u_start = P[TS_CLI_USTART], u_step = P[TS_CLI_USTEP];
     f.k = (u - u_start) * u_step;
     const float F = fr_all[P[TS_CLI_FLOFF] + f.k];
-    f.olo = (F > 0.0f && f.v >= 1 && !isnan(f.hc)) ? lo[f.po] : (int2)(-1, 0);
+    /* row 0's far side: the line one row before it, where it has left
+     * the grid (ts_sweep_lines' last steps; none elsewhere, unwritten) */
+    int below = f.v >= 1;
+    if (!below && Q[TS_CLD_T] < 0) {
+        __global const int *fl = fl_all + P[TS_CLI_FLOFF];
+        int k0, k1;
+        below = cm_line_k_range(fl, P[TS_CLI_U], V, 0, -1 - (long)fl[f.k], &k0, &k1);
+    }
+    f.olo = (F > 0.0f && below && !isnan(f.hc)) ? lo[f.po] : (int2)(-1, 0);
     const int sroff = P[TS_CLI_SROFF];
     f.step = sroff >= 0 ? sr_all[sroff + f.y] : Q[TS_CLD_STEPM];
     const cm_ray_grid r = {z, V, Q[TS_CLD_T], (long)V * u_start, (long)V * u_step, 1};
@@ -326,8 +353,9 @@ int ts_finish_interior(const ts_finish_cell *f, int W, int H, real cap)
 __kernel void ts_sweep_finish(__global const float *zr, __global const float *zt, const int W,
                               const int H,
                               __global const int *ip, __global const real *dp,
-                              __global const float *fr_all, __global const real *sr_all,
-                              const real c, const real cap, __global float *out,
+                              __global const int *fl_all, __global const float *fr_all,
+                              __global const real *sr_all, const real c, const real cap,
+                              __global float *out,
                               __global const int2 *hi, __global const int2 *lo, const long plane,
                               const int marked_only)
 {
@@ -344,7 +372,7 @@ __kernel void ts_sweep_finish(__global const float *zr, __global const float *zt
             return;
         ohi.x = TS_REST_MARK - ohi.x;
     }
-    const ts_finish_cell f = ts_finish_setup(zr, zt, P, Q, fr_all, sr_all, lo, cell, plane);
+    const ts_finish_cell f = ts_finish_setup(zr, zt, P, Q, fl_all, fr_all, sr_all, lo, cell, plane);
     if (isnan(f.hc)) {
         out[po] = NAN;
         return;
@@ -382,8 +410,9 @@ __kernel void ts_sweep_finish(__global const float *zr, __global const float *zt
 __kernel void ts_sweep_fast(__global const float *zr, __global const float *zt, const int W,
                             const int H,
                             __global const int *ip, __global const real *dp,
-                            __global const float *fr_all, __global const real *sr_all,
-                            const real c, __global float *out, __global int2 *hi,
+                            __global const int *fl_all, __global const float *fr_all,
+                            __global const real *sr_all, const real c, __global float *out,
+                            __global int2 *hi,
                             __global const int2 *lo, const long plane)
 {
     __local cm_fast_piece lp[TS_NEAR_MAX_PIECES];
@@ -400,7 +429,7 @@ __kernel void ts_sweep_fast(__global const float *zr, __global const float *zt, 
     }
     if (cell >= (long)W * H)
         return;
-    const ts_finish_cell f = ts_finish_setup(zr, zt, P, Q, fr_all, sr_all, lo, cell, plane);
+    const ts_finish_cell f = ts_finish_setup(zr, zt, P, Q, fl_all, fr_all, sr_all, lo, cell, plane);
     if (isnan(f.hc)) {
         out[f.po] = NAN;
         return;

@@ -57,6 +57,19 @@ static void *alloc_lines(size_t bytes)
 
 /* Step k of lines j0..j1 of a block (rows i0 + j): each line's distance
  * from its first sample, as ts_line_sample_at advances it. */
+/* The block's line one row before the grid's first at step k, where it
+ * has left the grid across row 0 (lane_k1): its hull holds the terrain it
+ * crossed on the grid toward the occluders, so that, between rows -1 and 0
+ * (a fraction), it answers row 0's cell for the far side, as the line
+ * before every other cell does (without it, row 0 took its far field from
+ * one line, up to 13-34 degrees low across oblique cliffs). It takes every
+ * such step, so that its distance goes on; -1: none. */
+static int row_before(const sweep_ws *w, int k, long i0, int nl)
+{
+    const long j = -i0 - 1;
+    return j >= 0 && j < nl && w->lane_k1[j] >= 0 && k > w->lane_k1[j] ? (int)j : -1;
+}
+
 static void lane_distances(const sweep_ctx *C, sweep_ws *w, int k, int i0, int j0, int j1)
 {
     const ts_line_geom *G = C->geom;
@@ -64,7 +77,8 @@ static void lane_distances(const sweep_ctx *C, sweep_ws *w, int k, int i0, int j
     const int *restrict k0 = w->lane_k0;
     if (G->step_row) {
         for (int j = j0; j <= j1; j++) {
-            int row = G->x_major ? i0 + j : G->u_start + k * G->u_step;
+            /* (row -1, a line just left the grid: row 0's steps) */
+            int row = G->x_major ? (i0 + j < 0 ? 0 : i0 + j) : G->u_start + k * G->u_step;
             if (k > k0[j])
                 dist[j] += G->step_row[row];
         }
@@ -92,6 +106,7 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
     int kmin = G->U, kmax = -1;
     for (int j = 0; j < nl; j++) {
         int k0, k1;
+        w->lane_k1[j] = -1; /* no steps on the grid: none off it either */
         if (!ts_line_k_range(G, bs + j, &k0, &k1))
             continue;
         if (C->cap == 0 || w->hybrid) {
@@ -99,9 +114,12 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
             w->lane_far[j] = -1;
         }
         w->lane_k0[j] = k0;
+        w->lane_k1[j] = k1;
         w->lane_d[j] = 0.0;
         kmin = k0 < kmin ? k0 : kmin;
-        kmax = k1 > kmax ? k1 : kmax;
+        /* (and the steps where it has left across row 0, row_before) */
+        const int kl = ts_line_k_leaving(G, bs + j, k1);
+        kmax = kl > kmax ? kl : kmax;
     }
     occluder *next = w->carry_next;
     for (int k = 0; k < G->U; k++)
@@ -120,22 +138,35 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
         const long i0 = bs + G->fl[k];
         const int j0 = i0 < 0 ? (int)-i0 : 0;
         const int j1 = G->V - 1 - i0 < nl - 1 ? (int)(G->V - 1 - i0) : nl - 1;
-        if (j0 > j1) {
+        const int jq = row_before(w, k, i0, nl);
+        if (j0 > j1 && jq < 0) {
             if (C->far_T > 0) /* no samples: its slot is empty */
                 ts_far_store(C, w, k, nl, 0, -1);
             if (C->cap > 0) /* no samples: the rings forget this step */
                 ts_cap_lanes_step(&w->capl, &(ts_lane_step){.k = k, .j0 = 1, .j1 = 0}, nl, NULL);
             continue;
         }
-        ts_lane_sample(G, C->grid->z, k, (int)i0, j0, j1, w->hc, w->hn, w->hs);
-        lane_distances(C, w, k, (int)i0, j0, j1);
+        /* the lines stepped: those on the grid, and the one before row 0
+         * that answers row 0's cell (queries only) */
+        const int js = jq >= 0 ? jq : j0;
+        if (j0 <= j1)
+            ts_lane_sample(G, C->grid->z, k, (int)i0, j0, j1, w->hc, w->hn, w->hs);
+        if (jq >= 0) { /* after the sampling, whose vectors may write lane jq */
+            w->hc[jq] = w->hs[jq] = NAN;
+            w->hn[jq] = G->fr[k] > 0.0f ? C->grid->z[G->origin + (ptrdiff_t)k * G->u_stride]
+                                        : NAN; /* on row -1: row 0 is on the next line */
+        }
+        lane_distances(C, w, k, (int)i0, js, j1);
         /* lo_k[j]: the far-side occluder of line j's cell, found by the
          * line before (none where that line is off the grid). */
         const occluder lo0 = j0 == 0 ? w->carry[k] : none;
-        w->lo_k[j0] = lo0.k;
-        w->lo_dd[j0] = lo0.dd;
-        const int last_inside = G->fr[k] == 0.0f ? j1 : G->V - 2 - (int)i0;
-        ts_lane_step step = {k, j0, j1, prime, last_inside, w->lane_d, w->hs, w->hc,
+        w->lo_k[js] = lo0.k;
+        w->lo_dd[js] = lo0.dd;
+        /* Every line asks for its own cell's occluder, the one between the
+         * last row and the one beyond too: off the grid at this step, it
+         * may have been on it toward the occluders (the last row's cells
+         * took their far field from one line, degrees low) */
+        ts_lane_step step = {k, js, j1, prime, j1, w->lane_d, w->hs, w->hc,
                              w->hn, c, C->near_skip, NULL, NULL, NULL, 0.0};
         if (!G->step_row) /* lane_distances' products (ts_far_store keeps them) */
             step.k_step = G->step_m;
@@ -143,7 +174,7 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
             /* far-only: the hulls take the samples far_T behind, one per
              * line and pass (the passes' queries are the same: the last
              * stands) */
-            ts_far_store(C, w, k, nl, j0, j1);
+            ts_far_store(C, w, k, nl, js, j1);
             for (int more = 1; more;) {
                 more = ts_far_pushes(C, w, &step);
                 if (!ts_lane_hull_step(&hulls, &step, &occ))
@@ -162,8 +193,9 @@ static void sweep_block(const sweep_ctx *C, sweep_ws *w, long bs, int nl, int pr
                    (i0 + jw) * C->o_v_stride; /* cell (k, i0 + jw) */
         /* (far-only: every occluder lies beyond the threshold, and so do
          * the lost rays' steps, lost.from) */
-        ts_lane_far_field(G, C->grid->z, (float)c, C->far_T > 0 ? 0 : TS_NEAR_STEPS, k, (int)i0,
-                          jw, j1, w->hc, &occ, &lost, w->slope, o, C->o_v_stride);
+        if (jw <= j1)
+            ts_lane_far_field(G, C->grid->z, (float)c, C->far_T > 0 ? 0 : TS_NEAR_STEPS, k,
+                              (int)i0, jw, j1, w->hc, &occ, &lost, w->slope, o, C->o_v_stride);
         /* the carry, read after the far field: right after the hull step's
          * vector stores to it, the load stalled on store forwarding */
         if (j1 == nl - 1)
@@ -251,11 +283,11 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
         /* a block has up to LOCKSTEP_LINES + 1 lines (with the primed one) */
         const size_t row = LANE_ROW;
         w->lane_f = alloc_lines(6 * row * sizeof *w->lane_f);
-        w->lane_i = alloc_lines(4 * row * sizeof *w->lane_i);
+        w->lane_i = alloc_lines(5 * row * sizeof *w->lane_i);
         w->lane_d = alloc_lines(row * sizeof *w->lane_d);
         ok = ok && w->carry && w->carry_next && w->lane_f && w->lane_i && w->lane_d;
         if (ok) {
-            memset(w->lane_i, 0, 4 * row * sizeof *w->lane_i); /* the lost flags start clear */
+            memset(w->lane_i, 0, 5 * row * sizeof *w->lane_i); /* the lost flags start clear */
             w->hc = w->lane_f;
             w->hn = w->lane_f + row;
             w->hs = w->lane_f + 2 * row;
@@ -266,6 +298,7 @@ static int ws_init(sweep_ws *w, const sweep_ctx *C)
             w->hi_k = w->lane_i + row;
             w->lane_k0 = w->lane_i + 2 * row;
             w->lost = w->lane_i + 3 * row;
+            w->lane_k1 = w->lane_i + 4 * row;
         }
         ok = ok && (C->far_T == 0 || ts_far_ws_init(w, C));
     }

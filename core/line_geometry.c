@@ -148,6 +148,11 @@ int ts_line_k_range(const ts_line_geom *g, long b, int *k0, int *k1)
     return cm_line_k_range(g->fl, g->U, g->V, g->t >= 0, b, k0, k1);
 }
 
+int ts_line_k_leaving(const ts_line_geom *g, long b, int k1)
+{
+    return cm_line_k_leaving(g->fl, g->U, g->t >= 0, b, k1);
+}
+
 void ts_line_out_strides(const ts_line_geom *g, int width, ptrdiff_t *origin,
                          ptrdiff_t *u_stride, ptrdiff_t *v_stride)
 {

@@ -59,6 +59,11 @@ void ts_line_geom_step_range(const ts_line_geom *g, int height, double *shortest
  * [0, V-1]; returns 0 if the line misses the grid. */
 int ts_line_k_range(const ts_line_geom *g, long b, int *k0, int *k1);
 
+/* The last step k >= k1 at which line b's lower row b + fl[k] is at least
+ * -1: where a line that leaves the grid across its first row still
+ * answers the far-side queries of row 0's cells (cm_line_k_leaving). */
+int ts_line_k_leaving(const ts_line_geom *g, long b, int k1);
+
 /* A sweep's results per step of the line before the current one (the far
  * side of the cells between them) and of the current line. */
 typedef struct {

@@ -78,6 +78,7 @@ typedef struct {
     int *lane_i;        /* holds: */
     int *lo_k, *hi_k;   /* far-field occluders; lo_k[j]: from line j - 1 */
     int *lane_k0;       /* each line's first step */
+    int *lane_k1;       /* and last on the grid (-1: none) */
     int *lost;          /* the far field's lost flags (ts_lane_lost) */
     double *lane_d;     /* and the distance of its current sample from it */
     ts_cap_lanes capl;  /* capped lines in lockstep: their windows */

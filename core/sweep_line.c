@@ -99,7 +99,7 @@ void ts_sweep_process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
         }
         ts_line_sample ls;
         ts_line_sample_at(G, z, b, k, k0, 0.0f, &d, &ls);
-        const int i = ls.i, has_next = ls.has_next, inside = ls.inside;
+        const int i = ls.i, has_next = ls.has_next;
         const float F = ls.F, hc = ls.hc, hn = ls.hn, hs = ls.hs;
 
         int pushed = 0;
@@ -131,7 +131,10 @@ void ts_sweep_process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
         if (write) {
             float s_out = NAN;
             if (!isnan(hc)) {
-                occluder hi = inside ? hull_query(C, w, far, d, hc, w->finger[0]) : none;
+                /* (also off the grid, between the last row and the one
+                 * beyond: its hull may hold the terrain toward the
+                 * occluders, as horizon_sweep.c) */
+                occluder hi = hull_query(C, w, far, d, hc, w->finger[0]);
                 occluder lo = (F > 0.0f && k >= pk0 && k <= pk1) ? prev_lo[k] : none;
                 s_out = far_field(C, k, i, hc, lo, hi, ts_line_cell_step(G, k, i));
             }
@@ -147,6 +150,26 @@ void ts_sweep_process_line(const sweep_ctx *C, sweep_ws *w, long b, int write)
             w->vs[nv] = isnan(hs) ? NAN : slope;
             nv++;
         }
+    }
+    /* A line that leaves the grid across row 0 goes on one row before it,
+     * queries only: it answers row 0's cells for the far side, as the
+     * lockstep blocks' row_before (horizon_sweep.c) */
+    const int kl = ts_line_k_leaving(G, b, k1);
+    w->lo.prev_k1 = kl;
+    for (int k = k1 + 1; k <= kl; k++) {
+        if (G->step_row) /* (row -1: row 0's steps) */
+            d += G->step_row[G->x_major ? 0 : G->u_start + k * G->u_step];
+        else if (G->anchored)
+            d = (double)(k + G->k_anchor) * G->step_m;
+        else
+            d = (double)(k - k0) * G->step_m;
+        if (C->cap > 0)
+            ts_window_hull_slide(&w->win, w->raw, w->raw_n, d, C->near_skip, C->cap);
+        else
+            far = far_advance(w->stack, w->n, far, d, C->near_skip);
+        const float hn = G->fr[k] > 0.0f ? z[G->origin + (ptrdiff_t)k * G->u_stride] : NAN;
+        cur_lo[k] = !isnan(hn) ? hull_query(C, w, far, d, hn, w->finger[1])
+                               : (occluder){-1, 0.0f};
     }
     if (w->vs && nv > 0)
         C->visit(C->user, nv, w->vx, w->vy, w->vh, w->vd, w->vs);

@@ -49,4 +49,18 @@ CM_FN int cm_line_k_range(const CM_GLOBAL int *fl, int U, int V, int ascending, 
     return 1;
 }
 
+/* The last step of line b (its steps on the grid ending at k1) whose row
+ * b + fl[k] is at least -1: a descending line (t < 0) goes on one row
+ * before the grid's first after it leaves, where its cell on row 0 asks
+ * it for the far side's occluder (it holds the terrain the line crossed
+ * on the grid, toward the occluders); k1 for an ascending line, whose row
+ * -1 comes before its samples. */
+CM_FN int cm_line_k_leaving(const CM_GLOBAL int *fl, int U, int ascending, long b, int k1)
+{
+    if (ascending)
+        return k1;
+    const int z = cm_first_k(fl, U, 0, -b - 1, 0) - 1; /* last fl >= -b - 1 */
+    return z > k1 ? z : k1;
+}
+
 #endif
