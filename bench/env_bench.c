@@ -135,7 +135,7 @@ int main(int argc, char **argv)
     int dirs = 64, limit = 0, map_w = 1024, map_h = 512;
     ts_env_table_opts to;
     ts_env_table_opts_default(&to);
-    for (int i = 1; i < argc; i++) {
+    for (int i = 1; i < argc; i += 2) { /* an option and its value */
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!v)
             goto usage;
@@ -153,7 +153,6 @@ int main(int argc, char **argv)
             to.horizon_steps = atoi(v);
         else
             goto usage;
-        i++;
     }
     if (dirs < 1 || limit < 0) {
         fprintf(stderr, "env_bench: --dirs must be >= 1 and --limit >= 0\n");
