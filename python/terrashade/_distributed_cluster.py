@@ -46,7 +46,9 @@ def start_cluster(args):
         return client, None, 1
     workers = args.workers or os.cpu_count() or 1
     runner = loop_without_ctrl_c()
-    before = {p.pid for p in multiprocessing.active_children()}
+    before = children()
+    from distributed.deploy.spec import SpecCluster
+    clusters_before = set(SpecCluster._instances)
     try:
         # on this machine's loopback only, with its HTTP servers on free ports:
         # dashboard_address=None still served the scheduler's on 0.0.0.0:8787,
@@ -58,9 +60,18 @@ def start_cluster(args):
             loop=runner.loop), runner, before)
     except BaseException:
         # a start cut short (a second Ctrl-C): its workers, still blocking
-        # SIGTERM, would hold the exit handlers' terminate() and join()
-        kill_children_since(before)
+        # SIGTERM, would hold the exit handlers' terminate() and join().
+        # The IO loop is stopped first, so that their nannies do not
+        # restart them (they did, and the new ones woke to a parent gone and
+        # printed tracebacks): the half-started cluster holds the loop too.
+        # Dask's exit handler is kept from that cluster (it asserted on its
+        # workers' state).
+        for c in set(SpecCluster._instances) - clusters_before:
+            with contextlib.suppress(Exception):
+                c._loop_runner.stop()
+            SpecCluster._instances.discard(c)
         runner.stop()
+        kill_children_since(before)
         raise
     slots = workers * args.threads_per_worker
     try:
@@ -117,13 +128,33 @@ class OwnCluster:
             self.runner.stop()
 
 
+def children():
+    """The pids of this process's children: multiprocessing's, and on Linux
+    every one /proc lists (also one that multiprocessing has started but
+    not yet registered)."""
+    pids = {p.pid for p in multiprocessing.active_children() if p.pid}
+    me = os.getpid()
+    with contextlib.suppress(OSError):
+        for entry in os.listdir("/proc"):
+            if not entry.isdigit():
+                continue
+            try:
+                with open("/proc/%s/stat" % entry) as f:
+                    stat = f.read()
+                # the field after the command name, which may hold ")"
+                if int(stat.rsplit(")", 1)[1].split()[1]) == me:
+                    pids.add(int(entry))
+            except (OSError, ValueError, IndexError):
+                continue
+    return pids
+
+
 def kill_children_since(before):
-    """SIGKILL to this process's children (multiprocessing's: the local
-    cluster's workers, restarted ones too) whose pids are not in before."""
-    for p in multiprocessing.active_children():
-        if p.pid and p.pid not in before:
-            with contextlib.suppress(OSError):
-                os.kill(p.pid, signal.SIGKILL)
+    """SIGKILL to this process's children (the local cluster's workers,
+    restarted ones too) whose pids are not in before."""
+    for pid in children() - before:
+        with contextlib.suppress(OSError):
+            os.kill(pid, signal.SIGKILL)
 
 
 class Watch:
@@ -239,7 +270,11 @@ def interrupts_held():
         print("%s: %s while the Dask cluster starts: stopping once it has (again "
               "to stop at once)" % (PROG, "terminated" if signum == signal.SIGTERM
                                     else "interrupted"), file=sys.stderr, flush=True)
-    previous = {s: signal.signal(s, held) for s in (signal.SIGINT, signal.SIGTERM)}
+    # (a signal the process ignores stays ignored: a run started in the
+    # background of a script, `... &`, has SIGINT ignored and must not stop
+    # at a Ctrl-C to the terminal's process group)
+    previous = {s: signal.signal(s, held) for s in (signal.SIGINT, signal.SIGTERM)
+                if signal.getsignal(s) is not signal.SIG_IGN}
     try:
         yield
     finally:

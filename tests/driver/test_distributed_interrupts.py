@@ -154,6 +154,10 @@ class DistributedInterrupts(TD.DistributedCase):
         code, err = self.ctrl_c_to_the_group(dest, 0.0, again=0.2)
         self.assertEqual(code, 130, err)
         self.assert_nothing_left(dest)
+        # no traceback: Dask's exit handler asserted on the half-started
+        # cluster's workers, and workers spawned after the kill woke to a
+        # parent gone (session 53)
+        self.assertNotIn("Traceback", err)
 
     def test_signals_held_while_the_cluster_starts(self):
         """While the cluster starts, one Ctrl-C or SIGTERM is held, said,
@@ -162,6 +166,10 @@ class DistributedInterrupts(TD.DistributedCase):
         import io
         from contextlib import redirect_stderr
         from terrashade._distributed_cluster import Terminated, interrupts_held
+        # Python's own handler, whatever the runner gave (a suite started in
+        # the background of a script has SIGINT ignored: session 53)
+        before = signal.signal(signal.SIGINT, signal.default_int_handler)
+        self.addCleanup(signal.signal, signal.SIGINT, before)
         for sig, exc in ((signal.SIGINT, KeyboardInterrupt), (signal.SIGTERM, Terminated)):
             with self.subTest(sig=sig):
                 said, reached = io.StringIO(), []
@@ -182,6 +190,22 @@ class DistributedInterrupts(TD.DistributedCase):
                 self.assertEqual(reached, ["after the first"])
         # the handlers are given back
         self.assertIs(signal.getsignal(signal.SIGINT), signal.default_int_handler)
+
+    def test_an_ignored_signal_stays_ignored(self):
+        """A run started in the background of a script (`... &`) has SIGINT
+        ignored: a Ctrl-C to the terminal's process group must not stop it
+        while its cluster starts (interrupts_held took SIGINT over, and such
+        a run ended with exit 130, until session 53)."""
+        from terrashade._distributed_cluster import interrupts_held
+        before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        self.addCleanup(signal.signal, signal.SIGINT, before)
+        reached = []
+        with interrupts_held():
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.05)
+            reached.append("after the signal")
+        self.assertEqual(reached, ["after the signal"])
+        self.assertIs(signal.getsignal(signal.SIGINT), signal.SIG_IGN)
 
     def test_interrupt_after_dest_is_written(self):
         """Ctrl-C once DEST is in place, while the cluster closes (~0.6 s):
