@@ -95,7 +95,8 @@ class PortableOracles(unittest.TestCase):
         for suite in ("check_horizon", "check_sweep_lines", "check_analytic", "check_edge",
                       "check_shadow", "check_sh", "check_sh_swath_light"):
             p = T.run([os.path.join(T.BUILDDIR, "tests", suite)],
-                      TERRASHADE_SIMD="none", CK_DEFAULT_TIMEOUT="600")
+                      TERRASHADE_SIMD="none", CK_DEFAULT_TIMEOUT="600",
+                      CK_TIMEOUT_MULTIPLIER="3")
             summary = [line for line in p.stdout.splitlines() if "Checks:" in line]
             print("TERRASHADE_SIMD=none %s: %s" % (suite, summary[-1] if summary else "?"))
 
@@ -103,7 +104,8 @@ class PortableOracles(unittest.TestCase):
         # check_shadowmap holds the C rasteriser to the portable loop's keys
         for simd in ("avx2", "none"):
             p = T.run([os.path.join(T.BUILDDIR, "tests", "check_shadowmap")],
-                      TERRASHADE_SIMD=simd, CK_DEFAULT_TIMEOUT="600")
+                      TERRASHADE_SIMD=simd, CK_DEFAULT_TIMEOUT="600",
+                      CK_TIMEOUT_MULTIPLIER="3")
             line = [x for x in p.stdout.splitlines() if x.startswith("rasteriser")]
             self.assertEqual(len(line), 1, p.stdout)
             print("TERRASHADE_SIMD=%s check_shadowmap: %s" % (simd, line[0]))

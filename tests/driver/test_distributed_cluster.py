@@ -81,7 +81,13 @@ class ExternalCluster:
         self.wait_for(lambda: os.path.exists(self.file) and os.path.getsize(self.file),
                       "the scheduler's file")
         with open(self.file) as f:
-            return json.load(f)["address"]
+            address = json.load(f)["address"]
+        # the worker joined: the runs below wait only --timeout 2 s for one,
+        # and a dask-worker's start took longer on a loaded machine
+        from dask.distributed import Client
+        with Client(address, timeout="60s") as client:
+            client.wait_for_workers(1, timeout=60)
+        return address
 
     def wait_for(self, done, what, seconds=60):
         for _ in range(int(seconds * 20)):
