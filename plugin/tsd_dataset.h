@@ -112,9 +112,10 @@ class TSDataset final : public GDALPamDataset
      * DEM reopened by name when it computes) */
     int m_nLevel = 0;
     TSDataset *m_poBase = nullptr; // level 0, which owns a level k > 0 (its PAM is level 0's)
-    int m_nOverviews = 0;   // levels offered (level 0 only)
+    int m_nOverviews = 0;   // levels by size (level 0 only), before MakeOverviews
     std::mutex m_oOvrMutex{};
-    std::vector<std::unique_ptr<TSDataset>> m_apoOverviews{}; // made on first use
+    bool m_bOverviewsMade = false; // MakeOverviews ran
+    std::vector<std::unique_ptr<TSDataset>> m_apoOverviews{}; // the levels offered
     bool m_bUsesBackend = false;
     bool m_bBackendKnown = false;     // m_sBackend filled (predicted or ran)
     tsd_backend_summary m_sBackend{}; // predicted, then what ran
@@ -151,6 +152,8 @@ class TSDataset final : public GDALPamDataset
     void StartReadAhead();
     ts_status ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg);
     TSDataset *Overview(int i);
+    int OverviewsOffered();
+    void MakeOverviews();
     TSDataset *MakeOverview(int nLevel);
     void EnsureBackendMetadata();
     void SetupBackendMetadata();

@@ -68,17 +68,61 @@ TSDataset *TSDataset::MakeOverview(int nLevel)
     return poOvr.release();
 }
 
-/* Overview i (level i + 1), made on first use. */
+/* Every level set up at once, on first use (a set-up reads no heights),
+ * and the ones whose set-up fails left out, with one warning: a level is
+ * computed whole, and one over MAX_MEMORY (a 65536² DEM's level 1 is
+ * 32768² cells) was offered and then gave GDAL a NULL band, on which
+ * gdalwarp crashed and -of COG failed. The levels offered are the others,
+ * in order. Under m_oOvrMutex. */
+void TSDataset::MakeOverviews()
+{
+    if (m_bOverviewsMade)
+        return;
+    m_bOverviewsMade = true;
+    std::string osLeftOut, osWhy;
+    for (int k = 1; k <= m_nOverviews; k++)
+    {
+        CPLErrorReset();
+        CPLPushErrorHandler(CPLQuietErrorHandler);
+        TSDataset *poOvr = MakeOverview(k);
+        const std::string osMsg = CPLGetLastErrorMsg();
+        CPLPopErrorHandler();
+        if (poOvr)
+        {
+            m_apoOverviews.emplace_back(poOvr);
+            continue;
+        }
+        const int nFactor = 1 << k;
+        osLeftOut += CPLSPrintf("%s%d (%d x %d)", osLeftOut.empty() ? "" : ", ", k,
+                                (nRasterXSize + nFactor - 1) / nFactor,
+                                (nRasterYSize + nFactor - 1) / nFactor);
+        if (osWhy.empty()) // (without its "TERRASHADE: ")
+            osWhy = osMsg.compare(0, 12, "TERRASHADE: ") == 0 ? osMsg.substr(12) : osMsg;
+    }
+    if (!osLeftOut.empty())
+        CPLError(CE_Warning, CPLE_AppDefined,
+                 "TERRASHADE: %s: overview level(s) %s not offered, of %d: a level is computed "
+                 "whole, and %s. GDAL's tools read the levels offered or the full resolution "
+                 "instead; gdal_translate -of COG copies the levels offered only (-co "
+                 "OVERVIEWS=IGNORE_EXISTING makes every level from the full resolution)",
+                 GetDescription(), osLeftOut.c_str(), m_nOverviews, osWhy.c_str());
+}
+
+/* The levels offered (MakeOverviews). */
+int TSDataset::OverviewsOffered()
+{
+    std::lock_guard<std::mutex> oLock(m_oOvrMutex);
+    MakeOverviews();
+    return static_cast<int>(m_apoOverviews.size());
+}
+
+/* Overview i: the i-th level offered. */
 TSDataset *TSDataset::Overview(int i)
 {
-    if (i < 0 || i >= m_nOverviews)
-        return nullptr;
     std::lock_guard<std::mutex> oLock(m_oOvrMutex);
-    if (m_apoOverviews.empty())
-        m_apoOverviews.resize(m_nOverviews);
-    if (!m_apoOverviews[i])
-        m_apoOverviews[i].reset(MakeOverview(i + 1));
-    return m_apoOverviews[i].get();
+    MakeOverviews();
+    return i >= 0 && i < static_cast<int>(m_apoOverviews.size()) ? m_apoOverviews[i].get()
+                                                                   : nullptr;
 }
 
 /* gdaladdo on a TERRASHADE:<dem> source: its levels are its own (each the
@@ -100,7 +144,7 @@ CPLErr TSDataset::IBuildOverviews(const char *, int, const int *, int, const int
 int TSRasterBand::GetOverviewCount()
 {
     tsd::CLocale oC; /* tsd_locale.h */
-    return static_cast<TSDataset *>(poDS)->m_nOverviews;
+    return static_cast<TSDataset *>(poDS)->OverviewsOffered();
 }
 
 GDALRasterBand *TSRasterBand::GetOverview(int i)

@@ -227,6 +227,39 @@ class Overviews(unittest.TestCase):
                     self.assertFalse(np.array_equal(o, drv, equal_nan=True))
 
 
+    def test_level_over_max_memory_left_out(self):
+        """A level is computed whole: one over MAX_MEMORY, where the full
+        resolution is windowed and fits, is not offered, with one warning
+        that names it and what -of COG does (it was offered, then given to
+        GDAL as a NULL band: gdalwarp -ts crashed with SIGSEGV, -of COG failed;
+        session 53, a 65536² DEM's svf with the default MAX_MEMORY)."""
+        dem = T.write_tif(os.path.join(self.tmp, "flat_2048.tif"),
+                          np.zeros((2048, 2048), np.float32), GT, 32632)
+        # full resolution in 128² chunks: ~17 MiB; level 1 (1024², whole): ~24 MiB
+        oo = dict(PRODUCT="svf", DIRECTIONS=4, MAX_MEMORY=20, TILE_SIZE=128)
+        args = sum([["-oo", "%s=%s" % kv] for kv in oo.items()], [])
+        p = T.run(["gdalinfo"] + args + [T.conn(dem)])
+        self.assertIn("Overviews: 512x512, 256x256\n", p.stdout)
+        said = [line for line in p.stderr.splitlines() if "not offered" in line]
+        self.assertEqual(len(said), 1, p.stderr)
+        for words in ("overview level(s) 1 (1024 x 1024) not offered, of 3: a level is "
+                      "computed whole, and PRODUCT=svf", "more than the limit of 20 MiB "
+                      "(MAX_MEMORY)", "-of COG copies the levels offered only",
+                      "OVERVIEWS=IGNORE_EXISTING"):
+            self.assertIn(words, said[0])
+        ds = open_ds(dem, **oo)
+        self.assertIsNone(ds.GetRasterBand(1).GetOverview(2))
+        ds = None
+        out = os.path.join(self.tmp, "warped_1024.tif")
+        T.run(["gdalwarp", "-q", "-overwrite", "-ts", "1024", "1024"] + args
+              + [T.conn(dem), out])  # (exit 0: it crashed)
+        cog = os.path.join(self.tmp, "levels.cog.tif")
+        T.run(["gdal_translate", "-q", "-of", "COG"] + args + [T.conn(dem), cog])
+        ds = gdal.Open(cog)
+        self.assertEqual([ds.GetRasterBand(1).GetOverview(i).XSize
+                          for i in range(ds.GetRasterBand(1).GetOverviewCount())], [512, 256])
+        ds = None
+
     def test_gdaladdo_refused_with_what_to_do(self):
         """gdaladdo on a TERRASHADE source: the product's levels are its own
         and the dataset is read-only, so there is nothing to build; GDAL's
