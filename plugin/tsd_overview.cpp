@@ -80,6 +80,10 @@ void TSDataset::MakeOverviews()
         return;
     m_bOverviewsMade = true;
     std::string osLeftOut, osWhy;
+    /* the caller's last error, which the set-ups' resets would wipe */
+    const CPLErr eLastType = CPLGetLastErrorType();
+    const CPLErrorNum nLastNo = CPLGetLastErrorNo();
+    const std::string osLastMsg = CPLGetLastErrorMsg();
     for (int k = 1; k <= m_nOverviews; k++)
     {
         CPLErrorReset();
@@ -99,13 +103,15 @@ void TSDataset::MakeOverviews()
         if (osWhy.empty()) // (without its "TERRASHADE: ")
             osWhy = osMsg.compare(0, 12, "TERRASHADE: ") == 0 ? osMsg.substr(12) : osMsg;
     }
+    CPLErrorSetState(eLastType, nLastNo, osLastMsg.c_str());
     if (!osLeftOut.empty())
         CPLError(CE_Warning, CPLE_AppDefined,
-                 "TERRASHADE: %s: overview level(s) %s not offered, of %d: a level is computed "
-                 "whole, and %s. GDAL's tools read the levels offered or the full resolution "
-                 "instead; gdal_translate -of COG copies the levels offered only (-co "
-                 "OVERVIEWS=IGNORE_EXISTING makes every level from the full resolution)",
-                 GetDescription(), osLeftOut.c_str(), m_nOverviews, osWhy.c_str());
+                 "TERRASHADE: overview level(s) %s of the product of %s not offered, of %d: a "
+                 "level is computed whole, and %s. GDAL's tools read the levels offered or the "
+                 "full resolution instead; gdal_translate -of COG copies the levels offered "
+                 "only (-co OVERVIEWS=IGNORE_EXISTING makes every level from the full "
+                 "resolution)",
+                 osLeftOut.c_str(), m_osDEM.c_str(), m_nOverviews, osWhy.c_str());
 }
 
 /* The levels offered (MakeOverviews). */

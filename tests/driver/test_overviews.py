@@ -242,14 +242,27 @@ class Overviews(unittest.TestCase):
         self.assertIn("Overviews: 512x512, 256x256\n", p.stdout)
         said = [line for line in p.stderr.splitlines() if "not offered" in line]
         self.assertEqual(len(said), 1, p.stderr)
-        for words in ("overview level(s) 1 (1024 x 1024) not offered, of 3: a level is "
-                      "computed whole, and PRODUCT=svf", "more than the limit of 20 MiB "
+        for words in ("overview level(s) 1 (1024 x 1024) of the product of %s not offered, "
+                      "of 3: a level is computed whole, and PRODUCT=svf" % dem,
+                      "more than the limit of 20 MiB "
                       "(MAX_MEMORY)", "-of COG copies the levels offered only",
                       "OVERVIEWS=IGNORE_EXISTING"):
             self.assertIn(words, said[0])
         ds = open_ds(dem, **oo)
         self.assertIsNone(ds.GetRasterBand(1).GetOverview(2))
         ds = None
+        # the caller's pending error is kept through the levels' set-ups
+        # (where every level is offered: a warning would be the last)
+        # (in a process without GDAL's Python exceptions: raised, an error is
+        # no error pending)
+        child = ("from osgeo import gdal\n"
+                 "ds = gdal.OpenEx(%r, open_options=['PRODUCT=svf', 'DIRECTIONS=4'])\n"
+                 "band = ds.GetRasterBand(1)\n"
+                 "gdal.PushErrorHandler('CPLQuietErrorHandler')\n"
+                 "gdal.Error(gdal.CE_Failure, gdal.CPLE_AppDefined, \"the caller's own\")\n"
+                 "print(band.GetOverviewCount(), gdal.GetLastErrorMsg())\n" % T.conn(dem))
+        p = T.run(["/usr/bin/python3", "-c", child])
+        self.assertEqual(p.stdout.strip(), "3 the caller's own")
         out = os.path.join(self.tmp, "warped_1024.tif")
         T.run(["gdalwarp", "-q", "-overwrite", "-ts", "1024", "1024"] + args
               + [T.conn(dem), out])  # (exit 0: it crashed)
