@@ -129,9 +129,10 @@ class OwnCluster:
 
 
 def children():
-    """The pids of this process's children: multiprocessing's, and on Linux
-    every one /proc lists (also one that multiprocessing has started but
-    not yet registered)."""
+    """The pids of this process's multiprocessing children: those it has
+    registered, and on Linux those /proc lists as its children running
+    multiprocessing's spawn (one started but not yet registered), not a
+    script's other subprocesses."""
     pids = {p.pid for p in multiprocessing.active_children() if p.pid}
     me = os.getpid()
     with contextlib.suppress(OSError):
@@ -142,8 +143,11 @@ def children():
                 with open("/proc/%s/stat" % entry) as f:
                     stat = f.read()
                 # the field after the command name, which may hold ")"
-                if int(stat.rsplit(")", 1)[1].split()[1]) == me:
-                    pids.add(int(entry))
+                if int(stat.rsplit(")", 1)[1].split()[1]) != me:
+                    continue
+                with open("/proc/%s/cmdline" % entry, "rb") as f:
+                    if b"multiprocessing" in f.read():
+                        pids.add(int(entry))
             except (OSError, ValueError, IndexError):
                 continue
     return pids

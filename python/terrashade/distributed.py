@@ -177,7 +177,9 @@ def main(argv=None):
     SAID.reset()
     RENAMED.clear()
     previous = None
-    if threading.current_thread() is threading.main_thread():
+    # (an ignored SIGTERM stays ignored, as SIGINT: interrupts_held)
+    if threading.current_thread() is threading.main_thread() and \
+            signal.getsignal(signal.SIGTERM) is not signal.SIG_IGN:
         previous = signal.signal(signal.SIGTERM, _terminate)
     try:
         with W.gdal_exceptions():

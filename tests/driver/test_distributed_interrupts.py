@@ -196,16 +196,27 @@ class DistributedInterrupts(TD.DistributedCase):
         ignored: a Ctrl-C to the terminal's process group must not stop it
         while its cluster starts (interrupts_held took SIGINT over, and such
         a run ended with exit 130, until session 53)."""
+        from unittest import mock
+        import terrashade.distributed as D
         from terrashade._distributed_cluster import interrupts_held
-        before = signal.signal(signal.SIGINT, signal.SIG_IGN)
-        self.addCleanup(signal.signal, signal.SIGINT, before)
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            before = signal.signal(sig, signal.SIG_IGN)
+            self.addCleanup(signal.signal, sig, before)
         reached = []
         with interrupts_held():
-            os.kill(os.getpid(), signal.SIGINT)
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                os.kill(os.getpid(), sig)
             time.sleep(0.05)
-            reached.append("after the signal")
-        self.assertEqual(reached, ["after the signal"])
-        self.assertIs(signal.getsignal(signal.SIGINT), signal.SIG_IGN)
+            reached.append("after the signals")
+        self.assertEqual(reached, ["after the signals"])
+        # the run itself keeps SIGTERM ignored too (main() took it over)
+        seen = []
+        with mock.patch.object(D, "run", lambda args: seen.append(
+                signal.getsignal(signal.SIGTERM))):
+            self.assertEqual(D.main(["TERRASHADE:" + T.JACKSBORO, self.path("x.tif")]), 0)
+        self.assertEqual(seen, [signal.SIG_IGN])
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            self.assertIs(signal.getsignal(sig), signal.SIG_IGN)
 
     def test_interrupt_after_dest_is_written(self):
         """Ctrl-C once DEST is in place, while the cluster closes (~0.6 s):
