@@ -115,7 +115,8 @@ class TSDataset final : public GDALPamDataset
     int m_nOverviews = 0;   // levels by size (level 0 only), before MakeOverviews
     std::mutex m_oOvrMutex{};
     bool m_bOverviewsMade = false; // MakeOverviews ran
-    std::vector<std::unique_ptr<TSDataset>> m_apoOverviews{}; // the levels offered
+    std::vector<int> m_anOffered{};   // the levels offered (their set-up succeeds)
+    std::vector<std::unique_ptr<TSDataset>> m_apoOverviews{}; // each made on first use
     bool m_bUsesBackend = false;
     bool m_bBackendKnown = false;     // m_sBackend filled (predicted or ran)
     tsd_backend_summary m_sBackend{}; // predicted, then what ran

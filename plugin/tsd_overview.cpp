@@ -68,12 +68,15 @@ TSDataset *TSDataset::MakeOverview(int nLevel)
     return poOvr.release();
 }
 
-/* Every level set up at once, on first use (a set-up reads no heights),
- * and the ones whose set-up fails left out, with one warning: a level is
- * computed whole, and one over MAX_MEMORY (a 65536² DEM's level 1 is
- * 32768² cells) was offered and then gave GDAL a NULL band, on which
+/* Every level's set-up tried at once, on first use (a set-up reads no
+ * heights), and the ones whose set-up fails left out, with one warning: a
+ * level is computed whole, and one over MAX_MEMORY (a 65536² DEM's level
+ * 1 is 32768² cells) was offered and then gave GDAL a NULL band, on which
  * gdalwarp crashed and -of COG failed. The levels offered are the others,
- * in order. Under m_oOvrMutex. */
+ * in order, each made again when it is first asked for (kept from here,
+ * every level held its own environment light's tables: gdal_translate,
+ * which lists the levels, grew by 10-14 MiB under SKY=overcast). Under
+ * m_oOvrMutex. */
 void TSDataset::MakeOverviews()
 {
     if (m_bOverviewsMade)
@@ -88,12 +91,12 @@ void TSDataset::MakeOverviews()
     {
         CPLErrorReset();
         CPLPushErrorHandler(CPLQuietErrorHandler);
-        TSDataset *poOvr = MakeOverview(k);
+        std::unique_ptr<TSDataset> poOvr(MakeOverview(k));
         const std::string osMsg = CPLGetLastErrorMsg();
         CPLPopErrorHandler();
         if (poOvr)
         {
-            m_apoOverviews.emplace_back(poOvr);
+            m_anOffered.push_back(k);
             continue;
         }
         const int nFactor = 1 << k;
@@ -103,6 +106,7 @@ void TSDataset::MakeOverviews()
         if (osWhy.empty()) // (without its "TERRASHADE: ")
             osWhy = osMsg.compare(0, 12, "TERRASHADE: ") == 0 ? osMsg.substr(12) : osMsg;
     }
+    m_apoOverviews.resize(m_anOffered.size());
     CPLErrorSetState(eLastType, nLastNo, osLastMsg.c_str());
     if (!osLeftOut.empty())
         CPLError(CE_Warning, CPLE_AppDefined,
@@ -119,16 +123,19 @@ int TSDataset::OverviewsOffered()
 {
     std::lock_guard<std::mutex> oLock(m_oOvrMutex);
     MakeOverviews();
-    return static_cast<int>(m_apoOverviews.size());
+    return static_cast<int>(m_anOffered.size());
 }
 
-/* Overview i: the i-th level offered. */
+/* Overview i: the i-th level offered, made on first use. */
 TSDataset *TSDataset::Overview(int i)
 {
     std::lock_guard<std::mutex> oLock(m_oOvrMutex);
     MakeOverviews();
-    return i >= 0 && i < static_cast<int>(m_apoOverviews.size()) ? m_apoOverviews[i].get()
-                                                                   : nullptr;
+    if (i < 0 || i >= static_cast<int>(m_anOffered.size()))
+        return nullptr;
+    if (!m_apoOverviews[i])
+        m_apoOverviews[i].reset(MakeOverview(m_anOffered[i]));
+    return m_apoOverviews[i].get();
 }
 
 /* gdaladdo on a TERRASHADE:<dem> source: its levels are its own (each the
