@@ -173,9 +173,8 @@ __kernel void ts_sweep_lines(__global const float *zr, __global const float *zt,
         while (far + 1 < n && d - S[(far + 1) * ns].x >= near_skip)
             far++;
         const long p0 = origin + (long)k * u_stride; /* row 0 */
-        const float hn = fr[k] > 0.0f ? z[p0] : NAN;
-        if (fr[k] > 0.0f)
-            ol[p0] = isnan(hn) ? none : ts_hull_query(S, SK, ns, far, d, hn, c);
+        if (fr[k] > 0.0f) /* (on row -1, row 0 is on the next line) */
+            ol[p0] = isnan(z[p0]) ? none : ts_hull_query(S, SK, ns, far, d, z[p0], c);
     }
 }
 

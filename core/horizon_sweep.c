@@ -55,8 +55,6 @@ static void *alloc_lines(size_t bytes)
     return aligned_alloc(64, (bytes + 63) / 64 * 64);
 }
 
-/* Step k of lines j0..j1 of a block (rows i0 + j): each line's distance
- * from its first sample, as ts_line_sample_at advances it. */
 /* The block's line one row before the grid's first at step k, where it
  * has left the grid across row 0 (lane_k1): its hull holds the terrain it
  * crossed on the grid toward the occluders, so that, between rows -1 and 0
@@ -70,6 +68,8 @@ static int row_before(const sweep_ws *w, int k, long i0, int nl)
     return j >= 0 && j < nl && w->lane_k1[j] >= 0 && k > w->lane_k1[j] ? (int)j : -1;
 }
 
+/* Step k of lines j0..j1 of a block (rows i0 + j): each line's distance
+ * from its first sample, as ts_line_sample_at advances it. */
 static void lane_distances(const sweep_ctx *C, sweep_ws *w, int k, int i0, int j0, int j1)
 {
     const ts_line_geom *G = C->geom;
