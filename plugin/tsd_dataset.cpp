@@ -4,12 +4,16 @@
  * (tsd_products), the geodesy (tsd_geodesy), the sun (tsd_sun), the DEM
  * reader (tsd_dem) and the compute functions (tsd_compute).
  *
- * A dataset computes its whole product once, lazily on the first block read
- * (under a mutex; again on the next read if the reading caller's progress
- * callback stopped it), keeps it in memory as float planes (bytes for the
- * products stored as bytes, PRODUCT=farshadow), out of which its bands
- * (tsd_band.cpp) copy 256 x 256 blocks. Its overview levels (tsd_overview.cpp) are datasets of this
- * class too, set up by the same Setup at their size.
+ * A dataset computed whole (TILE_SIZE=0, a DEM within one tile, or a method
+ * that is not windowed: tsd_window_plan_make) computes its
+ * product once, lazily on the first block read (under a mutex; again on the
+ * next read if the reading caller's progress callback stopped it), keeps it
+ * in memory as float planes (bytes for the products stored as bytes,
+ * PRODUCT=farshadow), out of which its bands (tsd_band.cpp) copy 256 x 256
+ * blocks; a windowed one computes the chunks around the blocks read
+ * (tsd_window_cache.cpp). Its overview levels (tsd_overview.cpp) are datasets
+ * of this class too, set up by the same Setup at their size. The memory
+ * check is tsd_dataset_memory.cpp's, the warnings tsd_dataset_warnings.cpp's.
  */
 #include <algorithm>
 #include <chrono>
@@ -30,7 +34,6 @@
 #include "tsd_connstr.h"
 #include "tsd_dataset.h"
 #include "tsd_dem.h"
-#include "tsd_dem_check.h"
 #include "tsd_gdal.h"
 #include "tsd_source_stamp.h"
 #include "tsd_window.h"
@@ -311,77 +314,6 @@ CPLErr TSDataset::EnsureComputed()
     return CE_None;
 }
 
-/* Refuse products that cannot fit, with a sentence saying what to do.
- * psSun, the cells and nLevel serve the advice on windows (level 0). */
-static bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *psPlan,
-                        const tsd_sun *psSun, const tsd_cells &sCells, int nLevel,
-                        double *pdfHeadroom)
-{
-    if (!psPlan && (W > TS_MAX_SIDE || H > TS_MAX_SIDE))
-    {
-        // (found here, not at the first read, where it said no more than the core's limit)
-        char szAdvice[512] = "";
-        if (nLevel == 0)
-            tsd_window_advice(&sOpts, psSun, W, H, tsd_cells_min_x(&sCells, H),
-                              sCells.cell_y, std::numeric_limits<double>::max(), szAdvice,
-                              sizeof szAdvice);
-        Fail(TS_ERR_ARG, CPLSPrintf("PRODUCT=%s computes this %d x %d DEM whole, and a DEM "
-                                    "computed whole has at most %d cells a side%s; crop or "
-                                    "downsample the DEM",
-                                    tsd_options_product_name(&sOpts), W, H, TS_MAX_SIDE,
-                                    szAdvice));
-        return false;
-    }
-    double dfSteady = 0;
-    // windowed: the chunk with its margin, the cache and the far field
-    const double dfPeak = psPlan ? tsd_window_peak_bytes(&sOpts, psPlan, &dfSteady)
-                                 : tsd_product_peak_bytes(&sOpts, W, H, &dfSteady);
-    double dfLimit = 0;
-    const char *pszWhy = "MAX_MEMORY";
-    if (sOpts.max_memory_mb > 0)
-        dfLimit = sOpts.max_memory_mb * 1048576.0;
-    else
-    {
-        dfLimit = 0.75 * static_cast<double>(CPLGetUsablePhysicalRAM());
-        pszWhy = "three quarters of the physical memory; set MAX_MEMORY to change";
-        if (dfLimit <= 0)
-            dfLimit = static_cast<double>(std::numeric_limits<size_t>::max()) / 2;
-    }
-    CPLDebug(DRIVER, "memory: about %.0f MiB while computing (%.0f MiB kept)%s, limit %.0f MiB",
-             dfPeak / 1048576.0, dfSteady / 1048576.0, psPlan ? " by window" : "",
-             dfLimit / 1048576.0);
-    *pdfHeadroom = std::max(0.0, dfLimit - dfPeak);
-    if (dfPeak <= dfLimit && dfPeak < static_cast<double>(std::numeric_limits<size_t>::max()) / 2)
-        return true;
-    char szAdvice[512] = "";
-    // a small DEM's chunks with their margins can need more than the whole
-    // DEM at once: say so, where the advice named no TILE_SIZE at all
-    double dfWholeSteady = 0;
-    const double dfWhole = tsd_product_peak_bytes(&sOpts, W, H, &dfWholeSteady);
-    if (psPlan && W <= TS_MAX_SIDE && H <= TS_MAX_SIDE && dfWhole <= dfLimit)
-        snprintf(szAdvice, sizeof szAdvice,
-                 "; TILE_SIZE=0 computes it whole in about %.0f MiB (its chunks with their "
-                 "margins need more)",
-                 dfWhole / 1048576.0);
-    else if (nLevel == 0)
-        tsd_window_advice(&sOpts, psSun, W, H, tsd_cells_min_x(&sCells, H), sCells.cell_y,
-                          dfLimit, szAdvice, sizeof szAdvice);
-    // fewer bands need less where an option sets their count (svf streams its DIRECTIONS)
-    const char *pszBands = tsd_product_of(&sOpts)->bands_option;
-    const std::string osFewer = !pszBands ? ""
-                                : EQUAL(pszBands, "STEP_MINUTES") ? "use a longer STEP_MINUTES, "
-                                : std::string("use fewer ") + pszBands + ", ";
-    Fail(TS_ERR_NOMEM,
-         CPLSPrintf("PRODUCT=%s with %d band(s) on this %d x %d DEM needs "
-                    "about %.0f MiB while computing (%.0f MiB kept), more than the "
-                    "limit of %.0f MiB (%s)%s; crop or downsample the DEM, %sor raise "
-                    "MAX_MEMORY", tsd_options_product_name(&sOpts),
-                    tsd_options_band_count(&sOpts), W, H, dfPeak / 1048576.0,
-                    dfSteady / 1048576.0, dfLimit / 1048576.0, pszWhy, szAdvice,
-                    osFewer.c_str()));
-    return false;
-}
-
 GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
 {
     if (!tsd_connstr_matches(poOpenInfo->pszFilename))
@@ -500,39 +432,6 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     poDS->GDALDataset::SetMetadataItem("Z_FACTOR_SOURCE", szZWhy);
     poDS->m_nOverviews = OverviewCount(poDS->m_psProduct, W, H);
     return poDS.release();
-}
-
-/* EDGE=horizon's sea level beyond the edges above heights of grid g
- * (tsd_grid_below_sea_warning): once per DEM, whichever level computes
- * first (QGIS zoomed out reads only an overview). */
-void TSDataset::WarnBelowSea(const ts_grid *g)
-{
-    char szWarning[512];
-    std::atomic<bool> &bWarned = (m_poBase ? m_poBase : this)->m_bBelowSeaWarned;
-    if (bWarned || tsd_options_edge(&m_sOpts) != TS_EDGE_HORIZON ||
-        !tsd_grid_below_sea_warning(g, szWarning, sizeof szWarning) || bWarned.exchange(true))
-        return;
-    CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szWarning);
-}
-
-/* Voids wider than MAX_DISTANCE (tsd_grid_voids_warning), from the whole
- * DEM's grid (or an overview level's) or a chunk's (a run of voids cut by
- * the chunk's edge is at least as wide as it shows): once per DEM. A reprojected
- * DEM's collar, or a lake left nodata, put openness of up to 150 degrees
- * along its border, unsaid (EDGE=horizon and nodata did not apply there). */
-void TSDataset::WarnVoids(const ts_grid *g)
-{
-    char szWarning[768];
-    TSDataset *poBase = m_poBase ? m_poBase : this; // (an overview level's cells: in its)
-    std::atomic<bool> &bWarned = poBase->m_bVoidsWarned;
-    if (bWarned || !tsd_product_takes(m_psProduct, tsd_option_find("MAX_DISTANCE")) ||
-        !tsd_grid_voids_warning(g, m_sOpts.max_distance,
-                                static_cast<double>(poBase->nRasterXSize) / nRasterXSize,
-                                static_cast<double>(poBase->nRasterYSize) / nRasterYSize,
-                                szWarning, sizeof szWarning) ||
-        bWarned.exchange(true))
-        return;
-    CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szWarning);
 }
 
 /* Everything that follows from the georeferencing (m_adfGT, m_bHasGT,

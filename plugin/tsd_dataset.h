@@ -48,6 +48,13 @@ void WarnNoGeoTransform(GDALDataset *poDEM, const std::string &osDEM);
  * take them in the grid's unit. */
 void WarnHeightUnit(const tsd_cells &sCells, const OGRSpatialReference &oSRS,
                     const std::string &osDEM);
+/* tsd_dataset_memory.cpp: whether a W x H product of sOpts (whole, or by
+ * psPlan's windows) fits MAX_MEMORY; if not, fails with a sentence saying
+ * what to do (psSun, sCells and nLevel serve the advice on windows, at
+ * level 0). *pdfHeadroom: the bytes left under the limit. */
+bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *psPlan,
+                 const tsd_sun *psSun, const tsd_cells &sCells, int nLevel,
+                 double *pdfHeadroom);
 
 /** A TERRASHADE:<dem> dataset: one product of a DEM. */
 class TSDataset final : public GDALPamDataset

@@ -10,6 +10,7 @@
 #include "cpl_string.h"
 
 #include "tsd_dataset.h"
+#include "tsd_dem_check.h"
 
 namespace tsd
 {
@@ -227,6 +228,39 @@ void TSDataset::WarnSweepTurn(int H)
              "over azimuths, change less. Cut the DEM into bands of latitude, or reproject "
              "it to a projected CRS (gdalwarp -t_srs, e.g. a UTM zone)",
              100 * dfChange, dfTurn);
+}
+
+/* EDGE=horizon's sea level beyond the edges above heights of grid g
+ * (tsd_grid_below_sea_warning): once per DEM, whichever level computes
+ * first (QGIS zoomed out reads only an overview). */
+void TSDataset::WarnBelowSea(const ts_grid *g)
+{
+    char szWarning[512];
+    std::atomic<bool> &bWarned = (m_poBase ? m_poBase : this)->m_bBelowSeaWarned;
+    if (bWarned || tsd_options_edge(&m_sOpts) != TS_EDGE_HORIZON ||
+        !tsd_grid_below_sea_warning(g, szWarning, sizeof szWarning) || bWarned.exchange(true))
+        return;
+    CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szWarning);
+}
+
+/* Voids wider than MAX_DISTANCE (tsd_grid_voids_warning), from the whole
+ * DEM's grid (or an overview level's) or a chunk's (a run of voids cut by
+ * the chunk's edge is at least as wide as it shows): once per DEM. A reprojected
+ * DEM's collar, or a lake left nodata, put openness of up to 150 degrees
+ * along its border, unsaid (EDGE=horizon and nodata did not apply there). */
+void TSDataset::WarnVoids(const ts_grid *g)
+{
+    char szWarning[768];
+    TSDataset *poBase = m_poBase ? m_poBase : this; // (an overview level's cells: in its)
+    std::atomic<bool> &bWarned = poBase->m_bVoidsWarned;
+    if (bWarned || !tsd_product_takes(m_psProduct, tsd_option_find("MAX_DISTANCE")) ||
+        !tsd_grid_voids_warning(g, m_sOpts.max_distance,
+                                static_cast<double>(poBase->nRasterXSize) / nRasterXSize,
+                                static_cast<double>(poBase->nRasterYSize) / nRasterYSize,
+                                szWarning, sizeof szWarning) ||
+        bWarned.exchange(true))
+        return;
+    CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szWarning);
 }
 
 } // namespace tsd
