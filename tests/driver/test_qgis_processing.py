@@ -19,11 +19,14 @@
 QGIS runs in child processes (as in test_qgis.py) with HOME in a temporary
 folder, so no user profile is read or written.
 """
+import atexit
 import json
 import os
 import shlex
+import shutil
 import subprocess
 import sys
+import tempfile
 import unittest
 import xml.etree.ElementTree as ET
 
@@ -139,7 +142,11 @@ sys.stdout.flush()
 os._exit(0)
 """
 
-J = T.JACKSBORO
+# QGIS writes the statistics it computes beside the raster it reads
+# (jacksboro.tif.aux.xml): it reads a copy, so the source tree stays clean
+_J_DIR = tempfile.mkdtemp(prefix="tsqp-")
+atexit.register(shutil.rmtree, _J_DIR, True)
+J = shutil.copy(T.JACKSBORO, _J_DIR)
 DAY = {"DATE": "2026-12-21", "TIMEZONE": "-05:00", "STEP_MINUTES": 30}
 RANGE = {"START_DATE": "2026-06-01", "END_DATE": "2026-06-03", "DAY_INTERVAL": 2,
          "TIMEZONE": "-05:00"}
@@ -439,21 +446,21 @@ class Processing(unittest.TestCase):
         p = subprocess.run([qp, "list"], capture_output=True, text=True, timeout=300, env=env)
         self.assertIn("terrashade:sunhours", p.stdout, p.stderr)
         out = self.out("qp_svf")
-        p = subprocess.run([qp, "run", "terrashade:svf", "--", "INPUT=" + T.JACKSBORO,
+        p = subprocess.run([qp, "run", "terrashade:svf", "--", "INPUT=" + J,
                             "DIRECTIONS=8", "OUTPUT=" + out], capture_output=True, text=True,
                            timeout=300, env=env)
         print(p.stdout[-600:])
         self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
-        ref = T.read(T.translate(T.JACKSBORO, self.out("qp_ref"),
+        ref = T.read(T.translate(J, self.out("qp_ref"),
                                  {"PRODUCT": "svf", "DIRECTIONS": 8}))
         np.testing.assert_array_equal(T.read(out), ref)
-        p = subprocess.run([qp, "run", "terrashade:sunhours", "--", "INPUT=" + T.JACKSBORO,
+        p = subprocess.run([qp, "run", "terrashade:sunhours", "--", "INPUT=" + J,
                             "OUTPUT=" + self.out("qp_bad")], capture_output=True, text=True,
                            timeout=300, env=env)
         print((p.stdout + p.stderr)[-400:])
         self.assertNotEqual(p.returncode, 0)
         self.assertIn("DATE", p.stdout + p.stderr)
-        p = subprocess.run([qp, "run", "terrashade:sunhours", "--", "INPUT=" + T.JACKSBORO,
+        p = subprocess.run([qp, "run", "terrashade:sunhours", "--", "INPUT=" + J,
                             "DATE=2026-02-30", "TIMEZONE=Z", "OUTPUT=" + self.out("qp_bad")],
                            capture_output=True, text=True, timeout=300, env=env)
         print((p.stdout + p.stderr)[-400:])
