@@ -49,7 +49,7 @@ if alg is None:
 dialog = AlgorithmDialog(alg.create(), False, None)
 dialog.setParameters({"INPUT": layer, "DATE": "2026-12-21", "TIMEZONE": "-05:00",
                       "STEP_MINUTES": 10})
-dialog.resize(900, 560)
+dialog.resize(1000, 720)
 dialog.show()
 app.processEvents()
 ok = dialog.grab().save(OUT)
