@@ -337,6 +337,7 @@ static void level_heights(const batch_ctx *B, grid_row *g, int j, int c0, int c1
     g->Rj = g->R0;
     if (lo <= hi && B->az[0].lv[j].lev > 0) {
         ts_pyr_combine_rows(g->rl[0][j].r, g->rl[0][j].wr, 4, lo, hi, g->R);
+        ts_pyr_fill_nodata(g->R, g->R0, lo, hi);
         g->Rj = g->R;
     }
     if (B->share)

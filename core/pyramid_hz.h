@@ -130,6 +130,9 @@ void ts_pyr_clear_max(row_ws *w, int x0, int x1);
 /* Whether z[x0..x1] holds nodata (NaN). */
 int ts_pyr_has_nodata(const float *z, int x0, int x1);
 
+/* R[x] = R0[x] where R[x] is nodata (NaN), for x in [x0, x1]. */
+void ts_pyr_fill_nodata(float *restrict R, const float *restrict R0, int x0, int x1);
+
 /* Add sample number c (value a_in[x]) to the spline (or the maximum). */
 void ts_pyr_push_run(row_ws *w, int bspline, int c, int x0, int x1, const float *restrict a_in);
 

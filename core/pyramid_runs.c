@@ -78,6 +78,17 @@ int ts_pyr_has_nodata(const float *z, int x0, int x1)
     return holes;
 }
 
+/* A cell beside a void has no height of its own on a coarse level (its
+ * footprint there is mostly void): it takes its DEM height, so that its
+ * samples there still count (they all repeated its first: a cell two
+ * cells from a 20-row void read -0.9 degrees across it against 24). */
+TS_SIMD_CLONES
+void ts_pyr_fill_nodata(float *restrict R, const float *restrict R0, int x0, int x1)
+{
+    for (int x = x0; x <= x1; x++)
+        R[x] = R[x] == R[x] ? R[x] : R0[x];
+}
+
 /* spline_push on the state of cell x. */
 static inline void spline_step(float *restrict s0, float *restrict s1, float *restrict s2,
                                float *restrict m, int x, float a)
