@@ -36,7 +36,8 @@ static int height_limits(GDALRasterBandH band, const tsd_dem_conversion *c, doub
     GDALDatasetH ds = GDALGetBandDataset(band);
     OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
     OGRErr err = OGRERR_FAILURE;
-    double a = srs ? OSRGetSemiMajor(srs, &err) : 0;
+    /* a local CRS has no ellipsoid: PROJ said so as an ERROR, four times */
+    double a = srs && !OSRIsLocal(srs) ? OSRGetSemiMajor(srs, &err) : 0;
     const int earth = !(err == OGRERR_NONE && a > 0 && fabs(a - TS_EARTH_RADIUS) > 100000.0);
     if (!earth) {
         *low = -a;

@@ -205,6 +205,8 @@ static void ground_close(ground_ctx *t)
 static int ground_open(ground_ctx *t, OGRSpatialReferenceH srs)
 {
     memset(t, 0, sizeof *t);
+    if (OSRIsLocal(srs)) /* no ellipsoid (PROJ said so as an ERROR) */
+        return 0;
     OGRErr e1 = OGRERR_NONE, e2 = OGRERR_NONE;
     double a = OSRGetSemiMajor(srs, &e1), invf = OSRGetInvFlattening(srs, &e2);
     if (e1 != OGRERR_NONE || e2 != OGRERR_NONE || !(a > 0) || !(invf >= 0))

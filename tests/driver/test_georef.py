@@ -222,6 +222,22 @@ class Georef(unittest.TestCase):
         self.assertIn("has no CRS", p.stderr)
         np.testing.assert_array_equal(T.read(T.conn(bare)), T.read(T.conn(utm)))
 
+    def test_local_crs_in_metres(self):
+        """An engineering (local) CRS in metres: its cells are metres, as a
+        projected CRS's, and nothing is said of an ellipsoid it does not
+        have (PROJ's 'CRS has no geodetic CRS' came out as four ERROR
+        lines, with exit 0; session 54's audit)."""
+        z = T.fractal_dem(64, seed=5)
+        gt = (0, 30, 0, 0, 0, -30)
+        local = T.write_tif(os.path.join(self.dir, "local.tif"), z, gt,
+                            'LOCAL_CS["site grid",LOCAL_DATUM["site",0],'
+                            'UNIT["metre",1],AXIS["E",EAST],AXIS["N",NORTH]]')
+        utm = T.write_tif(os.path.join(self.dir, "l_utm.tif"), z, gt, 32617)
+        out = os.path.join(self.dir, "local_shade.tif")
+        p = T.run(["gdal_translate", "-q", T.conn(local), out])
+        self.assertNotIn("ERROR", p.stderr)
+        np.testing.assert_array_equal(T.read(out), T.read(T.conn(utm)))
+
     def test_no_geotransform_means_1_m_cells_north_up(self):
         z = T.fractal_dem(64, seed=6)
         path = os.path.join(self.dir, "nogt.tif")
