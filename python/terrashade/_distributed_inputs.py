@@ -108,7 +108,9 @@ def absolute_source(source):
     cluster's workers do not share the client's), and read another file of
     that name, or none. Also the file inside another driver's name
     (GTIFF_DIR:1:dem.tif, NETCDF:"dem.nc":z, GPKG:dem.gpkg:table): the
-    parts between its ':' that are relative paths existing here."""
+    parts between its ':' that are relative paths existing here, but the
+    driver's name and a number (a file or folder named GTIFF_DIR or 1 here
+    is not what those parts mean)."""
     head, dem = split_source(source)
     whole = absolute_path(dem)
     if whole is not None:
@@ -116,7 +118,7 @@ def absolute_source(source):
     if os.path.exists(dem):  # (an absolute or virtual path, or nothing to do)
         return source
     parts = dem.split(":")
-    fixed = [absolute_path(p) or p for p in parts]
+    fixed = parts[:1] + [p if p.isdigit() else absolute_path(p) or p for p in parts[1:]]
     if len(parts) < 2 or fixed == parts:
         return source
     return "TERRASHADE:" + head + ":".join(fixed)

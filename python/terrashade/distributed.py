@@ -107,6 +107,11 @@ def run(args):
     if os.path.isdir(args.dest):
         raise Failure("cannot write %s: it is a directory; DEST names the output file"
                       % args.dest)
+    if os.path.exists(args.dest) and not os.path.isfile(args.dest):
+        # the result is renamed into place: it would replace a pipe or a
+        # device (/dev/null, run as root) with a file
+        raise Failure("cannot write %s: it is not a regular file (a pipe, a device...); "
+                      "DEST names the output file" % args.dest)
     block = block_size(args.tile_size)
     tiles_partial, dest_partial = partial_names(args.dest)
     partial = tiles_partial if fmt == "COG" else dest_partial

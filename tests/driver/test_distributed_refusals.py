@@ -12,19 +12,55 @@ from tsdistributed import PYTHONPATH, distributed
 
 
 class DistributedRefusals(TD.DistributedCase):
+    def refused_before_work(self, dest, text):
+        """A run to dest exits 1 with text, before any work: no partial."""
+        p = distributed(["--workers", 1, T.conn(self.dem), dest], ok=False)
+        self.assertEqual(p.returncode, 1, p.stderr)
+        self.assertIn("cannot write %s: %s" % (dest, text), p.stderr)
+        self.assertNotIn("Traceback", p.stderr)
+        self.assertEqual(TD.partials(dest), [])
+
     def test_destination_is_a_directory(self):
         """Refused before any work, not when the finished result is renamed."""
         dest = self.path("adir.tif")
         os.mkdir(dest)
         try:
-            p = distributed(["--workers", 1, T.conn(self.dem), dest], ok=False)
-            self.assertEqual(p.returncode, 1, p.stderr)
-            self.assertIn("cannot write %s: it is a directory" % dest, p.stderr)
-            self.assertNotIn("Traceback", p.stderr)
+            self.refused_before_work(dest, "it is a directory")
             self.assertEqual(os.listdir(dest), [])
-            self.assertEqual(TD.partials(dest), [])
         finally:
             os.rmdir(dest)
+
+    def test_destination_is_a_pipe(self):
+        """A pipe (or a device) as DEST was replaced by a regular file, with
+        exit 0: the result is renamed into place (session 54's audit; as root,
+        /dev/null). Refused before any work; the pipe stays a pipe."""
+        import stat
+        dest = self.path("fifo.tif")
+        os.mkfifo(dest)
+        try:
+            self.refused_before_work(dest, "it is not a regular file")
+            self.assertTrue(stat.S_ISFIFO(os.stat(dest).st_mode))
+        finally:
+            os.remove(dest)
+
+    def test_driver_prefix_parts_kept(self):
+        """In another driver's name only the parts that are paths are made
+        absolute: with a file named GTIFF_DIR and a folder named 1 in the
+        working directory, GTIFF_DIR:1:dem.tif became
+        /cwd/GTIFF_DIR:/cwd/1:/cwd/dem.tif, and the run failed."""
+        from terrashade._distributed_inputs import absolute_source
+        here = os.getcwd()
+        work = self.path("prefix_parts")
+        os.mkdir(work)
+        try:
+            os.chdir(work)
+            open("GTIFF_DIR", "w").close()
+            os.mkdir("1")
+            open("dem.tif", "w").close()
+            self.assertEqual(absolute_source("TERRASHADE:GTIFF_DIR:1:dem.tif"),
+                             "TERRASHADE:GTIFF_DIR:1:" + os.path.join(work, "dem.tif"))
+        finally:
+            os.chdir(here)
 
     def test_partials_are_the_runs_own(self):
         """Two runs writing one DEST at once shared DEST.partial: the one
