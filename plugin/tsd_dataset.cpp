@@ -127,7 +127,7 @@ ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
         return m_eReadStatus;
     }
     if (!m_poDEM) // an overview level: the DEM again, read at its size
-        m_poDEM = OpenDEM(m_osDEM.c_str());
+        m_poDEM = OpenDEM(m_osDEMPath.c_str());
     if (!m_poDEM)
     {
         snprintf(pszMsg, nMsg, "cannot open the DEM '%s' again for overview level %d",
@@ -374,6 +374,7 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     }
     poDS->m_poDEM = poDEM;
     poDS->m_osDEM = osDEM;
+    poDS->m_osDEMPath = AbsolutePath(osDEM.c_str()); // (a chdir before a level's read)
     // an atlas, which this driver opens (its 0/1 maps were taken as heights);
     // its file read only then, not for every DEM
     const bool bOurs = poDEM->GetDriver() && EQUAL(poDEM->GetDriver()->GetDescription(), DRIVER);

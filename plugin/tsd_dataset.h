@@ -63,6 +63,7 @@ class TSDataset final : public GDALPamDataset
 
     GDALDataset *m_poDEM = nullptr; // open until the product is computed
     std::string m_osDEM;
+    std::string m_osDEMPath; // m_osDEM made absolute at open: what an overview level reopens
     tsd_options m_sOpts{};                  // what the user said
     const tsd_product_def *m_psProduct = nullptr; // its row of the product table
     tsd_run m_sRun{};                       // the sun used (progress: while computing)
@@ -128,6 +129,10 @@ class TSDataset final : public GDALPamDataset
     bool m_bBackendKnown = false;     // m_sBackend filled (predicted or ran)
     tsd_backend_summary m_sBackend{}; // predicted, then what ran
     tsd_environment m_sEnv{};         // ENV_MAP or SKY (tsd_dataset_env.cpp)
+    // ENV_MAP's bytes, read once when the dataset opens and shared with its
+    // overview levels: a level made later reads no file (a map deleted or
+    // replaced meanwhile gave GDAL a NULL level, or lit it with another map)
+    std::shared_ptr<const std::vector<GByte>> m_poEnvMap{};
     WindowState *m_poWindow = nullptr; // computed chunk by chunk (tsd_window_cache.cpp), or null
     std::thread m_oReadAhead{};  // the DEM read while OpenCL is probed (StartReadAhead)
     ts_grid m_sReadGrid{};       // what it read, for ReadDEM

@@ -2,11 +2,13 @@
  * tsd_dataset_env.cpp - the environment of a TERRASHADE:<dem> dataset
  * (ENV_MAP or SKY, tsd_compute_env.h), set up when the dataset opens so that
  * a bad map fails the open with its sentence: ENV_MAP is read through GDAL's
- * VSI into memory (so /vsimem/, /vsicurl/, /vsizip/... paths work) and
- * decoded by the core's OpenEXR reader. And its metadata.
+ * VSI into memory (so /vsimem/, /vsicurl/, /vsizip/... paths work), once,
+ * its bytes kept for the overview levels, and decoded by the core's OpenEXR
+ * reader. And its metadata.
  */
 #include <cerrno>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -128,16 +130,23 @@ bool TSDataset::SetupEnvironment()
 {
     if (!tsd_options_env(&m_sOpts))
         return true;
-    std::vector<GByte> oMap;
-    std::string osError;
-    if (m_sOpts.env_map[0] && !ReadWholeFile(m_sOpts.env_map, oMap, osError))
+    if (m_sOpts.env_map[0] && m_poBase)
+        m_poEnvMap = m_poBase->m_poEnvMap; // the bytes the dataset read at open
+    else if (m_sOpts.env_map[0])
     {
-        Fail(CPLE_OpenFailed, osError.c_str());
-        return false;
+        auto poMap = std::make_shared<std::vector<GByte>>();
+        std::string osError;
+        if (!ReadWholeFile(m_sOpts.env_map, *poMap, osError))
+        {
+            Fail(CPLE_OpenFailed, osError.c_str());
+            return false;
+        }
+        m_poEnvMap = std::move(poMap);
     }
     char szMsg[1024] = "";
-    const ts_status eSt = tsd_environment_setup(&m_sOpts, &m_sRun, oMap.data(), oMap.size(),
-                                                &m_sEnv, szMsg, sizeof szMsg);
+    const ts_status eSt =
+        tsd_environment_setup(&m_sOpts, &m_sRun, m_poEnvMap ? m_poEnvMap->data() : nullptr,
+                              m_poEnvMap ? m_poEnvMap->size() : 0, &m_sEnv, szMsg, sizeof szMsg);
     if (eSt != TS_OK)
     {
         Fail(eSt, szMsg);

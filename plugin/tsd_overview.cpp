@@ -50,6 +50,7 @@ TSDataset *TSDataset::MakeOverview(int nLevel)
     poOvr->m_nLevel = nLevel;
     poOvr->m_poBase = this;
     poOvr->m_osDEM = m_osDEM;
+    poOvr->m_osDEMPath = m_osDEMPath;
     poOvr->m_sOpts = m_sOpts;
     // measured as the DEM's own cells were (CELL_SIZES=auto decided once)
     poOvr->m_sOpts.cell_sizes = tsd_cells_mode(&m_sCells);

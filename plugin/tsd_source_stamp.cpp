@@ -15,20 +15,35 @@
 namespace tsd
 {
 
+std::string AbsolutePath(const char *pszPath)
+{
+    static const char *const apszArchives[] = {"/vsizip/", "/vsigzip/", "/vsitar/"};
+    std::string osPrefix;
+    const char *pszRest = pszPath;
+    for (const char *pszArchive : apszArchives)
+        if (STARTS_WITH(pszPath, pszArchive))
+        {
+            osPrefix = pszArchive;
+            pszRest = pszPath + strlen(pszArchive);
+            break;
+        }
+    VSIStatBufL sStat;
+    // ("{...}": an archive's name in braces; a name that is no file here:
+    // a driver's prefix, GTIFF_DIR:1:dem.tif, left alone)
+    if (!*pszRest || *pszRest == '{' || STARTS_WITH(pszRest, "/vsi") ||
+        !CPLIsFilenameRelative(pszRest) || VSIStatL(pszPath, &sStat) != 0)
+        return pszPath;
+    char *pszCwd = CPLGetCurrentDir();
+    // (not CPLFormFilename: its buffer holds 2048 characters)
+    std::string osAbs = pszCwd ? osPrefix + pszCwd + "/" + pszRest : std::string(pszPath);
+    CPLFree(pszCwd);
+    return osAbs;
+}
+
 std::vector<std::string> SourceFiles(char **papszDEMFiles, const char *pszEnvMap)
 {
     std::vector<std::string> aos;
-    const auto Add = [&aos](const char *pszPath)
-    {
-        if (STARTS_WITH(pszPath, "/vsi") || CPLIsFilenameRelative(pszPath) == FALSE)
-            aos.emplace_back(pszPath);
-        else
-        {
-            char *pszCwd = CPLGetCurrentDir();
-            aos.emplace_back(pszCwd ? CPLFormFilename(pszCwd, pszPath, nullptr) : pszPath);
-            CPLFree(pszCwd);
-        }
-    };
+    const auto Add = [&aos](const char *pszPath) { aos.emplace_back(AbsolutePath(pszPath)); };
     for (char **ppsz = papszDEMFiles; ppsz && *ppsz; ppsz++)
     {
         const size_t n = strlen(*ppsz);

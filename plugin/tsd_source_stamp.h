@@ -14,6 +14,12 @@
 namespace tsd
 {
 
+/* pszPath made absolute against the current directory where it names a
+ * file by a relative name, plainly or inside /vsizip/, /vsigzip/ or
+ * /vsitar/ (what a later chdir would lose: an overview level reopens the
+ * DEM by it); anything else (a driver's prefix, /vsimem/, a URL) as it is. */
+std::string AbsolutePath(const char *pszPath);
+
 /* The files to stamp: the DEM's file list (GDALDataset::GetFileList, NULL
  * ended; NULL: none) but its .aux.xml files, which GDAL rewrites as it
  * reads, and ENV_MAP (null or empty: none), each made absolute against the

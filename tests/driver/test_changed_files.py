@@ -8,8 +8,10 @@ on it stays open, as in a QGIS session left open):
   (whole, by chunks, an overview level), naming the cause, instead of
   mixing the two DEMs; opened again, it computes the new one;
 - a DEM cut short is named in the error, with what to try."""
+import gzip
 import os
 import unittest
+import zipfile
 
 import tsdriver as T
 from exr_write import write_exr
@@ -250,6 +252,34 @@ class ChangedFiles(T.TempDirCase):
             os.chdir(cwd)
         self.assertTrue(np.isfinite(a).all())
         ds = None
+
+    def test_chdir_archives_and_levels(self):
+        """A chdir after opening the DEM by a relative name inside /vsizip/
+        or /vsigzip/, or opening an overview level of a relative DEM: the
+        stamp took the archive's relative name against the new directory
+        ('deleted or moved since this dataset was opened'), and a level
+        reopened the DEM by its relative name ('cannot open the DEM again';
+        session 54's audit). Both are made absolute when the dataset opens."""
+        dem = os.path.join(self.dir, "arch.tif")
+        write_dem(dem, 9, n=300)
+        with zipfile.ZipFile(os.path.join(self.dir, "arch.zip"), "w") as z:
+            z.write(dem, "arch.tif")
+        with open(dem, "rb") as f, gzip.open(dem + ".gz", "wb") as g:
+            g.write(f.read())
+        cwd = os.getcwd()
+        for name in ("/vsizip/arch.zip/arch.tif", "/vsigzip/arch.tif.gz", "arch.tif"):
+            os.chdir(self.dir)
+            try:
+                ds = gdal.OpenEx(T.conn(name), open_options=["PRODUCT=svf", "DIRECTIONS=4"])
+                os.chdir("/")
+                full = ds.GetRasterBand(1).ReadAsArray()
+                level = ds.GetRasterBand(1).GetOverview(0).ReadAsArray()
+            finally:
+                os.chdir(cwd)
+            self.assertTrue(np.isfinite(full).all(), name)
+            self.assertEqual(level.shape, (150, 150), name)
+            self.assertTrue(np.isfinite(level).all(), name)
+            ds = None
 
     def test_a_vrt_whose_source_is_regenerated(self):
         """A VRT DEM's sources are its files too: statistics saved before

@@ -273,6 +273,45 @@ class Overviews(unittest.TestCase):
                           for i in range(ds.GetRasterBand(1).GetOverviewCount())], [512, 256])
         ds = None
 
+    def test_env_map_read_once(self):
+        """ENV_MAP is read once, when the dataset opens, and its levels use
+        those bytes: a map deleted after the levels were listed gave GDAL a
+        NULL level (gdalwarp crashed with SIGSEGV), and a map replaced meanwhile
+        lit the levels with the new map and the full resolution with the old
+        (session 54's audit)."""
+        maps = os.path.join(self.tmp, "maps")
+        os.makedirs(maps, exist_ok=True)
+        sunset = os.path.join(T.DATA, "envmaps", "sunset.exr")
+        city = os.path.join(T.DATA, "envmaps", "city.exr")
+        oo = dict(PRODUCT="envlight", DIRECTIONS=4, OUTPUT_TYPE="Float32")
+        ref = open_ds(self.dem, ENV_MAP=sunset, **oo)
+        want = read_overview(ref, 0)
+        ref = None
+        for change in ("delete", "replace"):
+            m = T.shutil.copy(sunset, os.path.join(maps, change + ".exr"))
+            ds = open_ds(self.dem, ENV_MAP=m, **oo)
+            self.assertEqual(ds.GetRasterBand(1).GetOverviewCount(), 2)
+            if change == "delete":
+                os.remove(m)
+            else:
+                T.shutil.copy(city, m)
+            band = ds.GetRasterBand(1)
+            self.assertIsNotNone(band.GetOverview(0), change)
+            np.testing.assert_array_equal(read_overview(ds, 0), want, change)
+            ds = None
+        # the same in gdalwarp, which lists the levels, then reads one
+        m = T.shutil.copy(sunset, os.path.join(maps, "warp.exr"))
+        child = ("import os\nfrom osgeo import gdal\n"
+                 "ds = gdal.OpenEx(%r, open_options=%r)\n"
+                 "ds.GetRasterBand(1).GetOverviewCount()\n"
+                 "os.remove(%r)\n"
+                 "out = gdal.Warp('/vsimem/w.tif', ds, width=150, height=130)\n"
+                 "print(out.GetRasterBand(1).Checksum())\n"
+                 % (T.conn(self.dem), ["ENV_MAP=" + m] + ["%s=%s" % kv for kv in oo.items()],
+                    m))
+        p = T.run(["/usr/bin/python3", "-c", child])  # (it crashed: exit 139)
+        self.assertTrue(p.stdout.strip().isdigit(), p.stdout + p.stderr)
+
     def test_gdaladdo_refused_with_what_to_do(self):
         """gdaladdo on a TERRASHADE source: the product's levels are its own
         and the dataset is read-only, so there is nothing to build; GDAL's
