@@ -395,6 +395,15 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
                                    osDEM.c_str(), pszSource ? " (" : "",
                                    pszSource ? pszSource : "", pszSource ? ")" : ""));
     }
+    // a product written to a file (or a VRT of one) keeps its metadata: a
+    // known PRODUCT with its SOURCE_DEM is a product, whatever its driver
+    const char *pszCopyOf = poDEM->GetMetadataItem("SOURCE_DEM");
+    const char *pszCopyProduct = poDEM->GetMetadataItem("PRODUCT");
+    if (!bOurs && pszCopyOf && pszCopyProduct && tsd_product_find(pszCopyProduct) >= 0)
+        return FailOpen(TS_ERR_ARG,
+                        CPLSPrintf("the DEM '%s' is a written TERRASHADE product (PRODUCT=%s "
+                                   "of %s, in its metadata), not a DEM: name the DEM itself",
+                                   osDEM.c_str(), pszCopyProduct, pszCopyOf));
     if (sOpts.band > poDEM->GetRasterCount())
         return FailOpen(TS_ERR_ARG,
                              CPLSPrintf("BAND=%d, but the DEM '%s' has %d band(s)",

@@ -153,6 +153,27 @@ class Errors(unittest.TestCase):
                     gdal.OpenEx(connection, gdal.OF_RASTER, open_options=oo)
                 self.assertIn(text, str(e.exception))
 
+    def test_written_product_refused_as_dem(self):
+        """A product written to a file, or a VRT of one, keeps its metadata
+        (PRODUCT, SOURCE_DEM): as a DEM its shading was taken as heights,
+        with exit 0 (session 54's audit; the TERRASHADE: string itself was
+        refused since session 52)."""
+        with T.TempDir() as tmp:
+            tif = os.path.join(tmp, "shade.tif")
+            vrt = os.path.join(tmp, "shade.vrt")
+            T.run(["gdal_translate", "-q", T.conn(DEM), tif])
+            T.run(["gdal_translate", "-q", "-of", "VRT", tif, vrt])
+            for path in (tif, vrt):
+                p = T.run(["gdalinfo", "-checksum", T.conn(path)], ok=False)
+                self.assertNotEqual(p.returncode, 0, path)
+                self.assertIn("the DEM '%s' is a written TERRASHADE product (PRODUCT=shade of "
+                              "%s, in its metadata), not a DEM: name the DEM itself"
+                              % (path, DEM), p.stderr)
+            # the DEM itself, written by another tool, is no product
+            copy = os.path.join(tmp, "copy.tif")
+            T.run(["gdal_translate", "-q", DEM, copy])
+            T.run(["gdalinfo", "-checksum", T.conn(copy)])
+
     def test_unquoted_name_like_options_hint(self):
         """A DEM named like inline options, not quoted: the error says the
         whole name is a file and how to quote it; where no such file exists
