@@ -453,7 +453,8 @@ void TSDataset::SetupPam(const char *pszConnection)
             osSub += CPLSPrintf(",WINDOWS=%d/%.17g/%dx%d", psPlan->tile, psPlan->near_m,
                                 psPlan->far_w, psPlan->far_h);
         osSub += osDEMPart;
-        SetPhysicalFilename(papszFiles[0]);
+        // (absolute: a chdir before the save put the file in the new directory)
+        SetPhysicalFilename(AbsolutePath(papszFiles[0]).c_str());
         SetSubdatasetName(osSub.c_str());
         bool bLegacy = false;
         const char *pszOwn = BuildPamFilename();

@@ -67,6 +67,22 @@ class Pam(unittest.TestCase):
         self.assertCwdClean()
         self.assertTrue(os.path.exists(self.dem + ".terrashade.aux.xml"))
 
+    def test_chdir_before_the_save(self):
+        """A DEM opened by a relative name, then a chdir before the dataset
+        closes: the statistics go beside the DEM, not into the new current
+        directory (they did until session 54)."""
+        old = os.getcwd()
+        os.chdir(self.demdir)
+        try:
+            ds = gdal.Open(T.conn("jacksboro.tif", PRODUCT="svf", DIRECTIONS=4))
+            ds.GetRasterBand(1).ComputeStatistics(False)
+            os.chdir(self.cwd)
+            ds = None
+        finally:
+            os.chdir(old)
+        self.assertCwdClean()
+        self.assertTrue(os.path.exists(self.dem + ".terrashade.aux.xml"))
+
     def test_dem_without_a_file(self):
         """A /vsimem DEM: no .aux.xml anywhere, no error."""
         with open(T.LUX, "rb") as f:
