@@ -21,7 +21,7 @@ import time
 import uuid
 
 try:
-    from osgeo import gdal  # noqa: F401 (the check; the modules below use it)
+    from osgeo import gdal  # (the check; the modules below use it too)
 except ImportError as _e:  # a Python without GDAL's bindings: a sentence, not a traceback
     sys.exit("terrashade.distributed: error: this Python (%s) cannot import GDAL's "
              "bindings (%s); run it with one that can, e.g. /usr/bin/python3 with "
@@ -97,6 +97,16 @@ def compute(client, watch, out, source, task_options, tile, quiet, run):
     return len(wins)
 
 
+def dem_files(dem):
+    """The local files GDAL reads for the DEM (a VRT's sources among them)."""
+    try:
+        ds = gdal.OpenEx(dem, gdal.OF_RASTER)
+    except RuntimeError:
+        return []
+    files = (ds.GetFileList() or []) if ds is not None else []
+    return [f for f in files if not f.startswith("/vsi") and os.path.exists(f)]
+
+
 def run(args):
     src = open_source(args.source, args.open_options)
     fmt = output_format(args)
@@ -119,6 +129,10 @@ def run(args):
     if os.path.exists(dem) and os.path.exists(args.dest) and os.path.samefile(dem, args.dest):
         raise Failure("DEST %s is the DEM itself: the product would replace it; write "
                       "it to another file" % args.dest)
+    for part in dem_files(dem):  # a VRT's sources: replaced the same way (exit 0)
+        if os.path.exists(args.dest) and os.path.samefile(part, args.dest):
+            raise Failure("DEST %s is a file of the DEM %s: the product would replace it; "
+                          "write it to another file" % (args.dest, dem))
     size = (src.RasterXSize, src.RasterYSize, src.RasterCount)
     out = client = cluster = watch = None
     run_id = uuid.uuid4().hex  # no worker reuses a dataset opened for an earlier run

@@ -8,15 +8,17 @@ import unittest
 
 import tsdistributed as TD
 import tsdriver as T
+from tsdriver import gdal
 from tsdistributed import PYTHONPATH, distributed
 
 
 class DistributedRefusals(TD.DistributedCase):
-    def refused_before_work(self, dest, text):
-        """A run to dest exits 1 with text, before any work: no partial."""
-        p = distributed(["--workers", 1, T.conn(self.dem), dest], ok=False)
+    def refused_before_work(self, dest, text, source=None, said=None):
+        """A run to dest exits 1 with 'cannot write dest: text' (or said),
+        before any work: no partial."""
+        p = distributed(["--workers", 1, source or T.conn(self.dem), dest], ok=False)
         self.assertEqual(p.returncode, 1, p.stderr)
-        self.assertIn("cannot write %s: %s" % (dest, text), p.stderr)
+        self.assertIn(said or "cannot write %s: %s" % (dest, text), p.stderr)
         self.assertNotIn("Traceback", p.stderr)
         self.assertEqual(TD.partials(dest), [])
 
@@ -109,6 +111,21 @@ class DistributedRefusals(TD.DistributedCase):
         with open(self.dem, "rb") as f:
             self.assertEqual(f.read(), before)
         self.assertEqual(TD.partials(dest), [])
+
+    def test_destination_is_a_source_of_a_vrt_dem(self):
+        """DEST naming a source of the VRT that SOURCE reads: the DEM's
+        heights were replaced by the product, with exit 0 (session 54's
+        paths audit)."""
+        src = self.path("vrt_src.tif")
+        T.shutil.copy(self.dem, src)
+        vrt = self.path("via.vrt")
+        gdal.BuildVRT(vrt, [src])
+        with open(src, "rb") as f:
+            before = f.read()
+        self.refused_before_work(src, None, source=T.conn(vrt),
+                                 said="DEST %s is a file of the DEM %s" % (src, vrt))
+        with open(src, "rb") as f:
+            self.assertEqual(f.read(), before)
 
     def test_python_without_gdal(self):
         """A Python that cannot import osgeo (python3 first on PATH is often
