@@ -91,11 +91,25 @@ def given_keys(source, open_options):
     return {item.split("=", 1)[0].strip().upper() for item in items}
 
 
+ARCHIVES = ("/vsizip/", "/vsigzip/", "/vsitar/")
+
+
 def absolute_path(text):
     """text (a name, quoted or not) made absolute if it is a relative path
-    that exists here; None if it is not one."""
+    that exists here, plainly or inside /vsizip/, /vsigzip/ or /vsitar/
+    (the archive's path; as the driver does for its overview levels); None
+    if it is not one."""
     quoted = len(text) > 1 and text[0] == text[-1] == '"'
     path = text[1:-1] if quoted else text
+    prefix = next((a for a in ARCHIVES if path.startswith(a)), "")
+    rest = path[len(prefix):]
+    if prefix:  # the archive: the longest leading part that is a file here
+        cut = [i for i in range(len(rest), 0, -1)
+               if (i == len(rest) or rest[i] == "/") and os.path.isfile(rest[:i])]
+        if not cut or os.path.isabs(rest):
+            return None
+        path = prefix + os.path.abspath(rest[:cut[0]]) + rest[cut[0]:]
+        return '"%s"' % path if quoted else path
     if not path or os.path.isabs(path) or path.startswith("/vsi") or not os.path.exists(path):
         return None
     path = os.path.abspath(path)
@@ -108,9 +122,9 @@ def absolute_source(source):
     cluster's workers do not share the client's), and read another file of
     that name, or none. Also the file inside another driver's name
     (GTIFF_DIR:1:dem.tif, NETCDF:"dem.nc":z, GPKG:dem.gpkg:table): the
-    parts between its ':' that are relative paths existing here, but the
-    driver's name and a number (a file or folder named GTIFF_DIR or 1 here
-    is not what those parts mean)."""
+    first part between its ':' that is a relative path existing here, but
+    not the driver's name nor a number, nor what follows the file (a file or
+    folder named GTIFF_DIR, 1 or z here is not what those parts mean)."""
     head, dem = split_source(source)
     whole = absolute_path(dem)
     if whole is not None:
@@ -118,7 +132,11 @@ def absolute_source(source):
     if os.path.exists(dem):  # (an absolute or virtual path, or nothing to do)
         return source
     parts = dem.split(":")
-    fixed = parts[:1] + [p if p.isdigit() else absolute_path(p) or p for p in parts[1:]]
+    fixed, found = parts[:1], False
+    for p in parts[1:]:  # the file: the first part that is one (not what follows it)
+        whole = None if found or p.isdigit() else absolute_path(p)
+        found = found or whole is not None
+        fixed.append(whole or p)
     if len(parts) < 2 or fixed == parts:
         return source
     return "TERRASHADE:" + head + ":".join(fixed)

@@ -46,21 +46,28 @@ class DistributedRefusals(TD.DistributedCase):
             os.remove(dest)
 
     def test_driver_prefix_parts_kept(self):
-        """In another driver's name only the parts that are paths are made
-        absolute: with a file named GTIFF_DIR and a folder named 1 in the
-        working directory, GTIFF_DIR:1:dem.tif became
-        /cwd/GTIFF_DIR:/cwd/1:/cwd/dem.tif, and the run failed."""
+        """In another driver's name only the file's part is made absolute:
+        with a file named GTIFF_DIR and a folder named 1 in the working
+        directory, GTIFF_DIR:1:dem.tif became /cwd/GTIFF_DIR:/cwd/1:/cwd/dem.tif,
+        and the run failed; NETCDF:"dem.tif":z took a file z's path. An
+        archive's relative path in /vsizip/ was left relative (session 54)."""
         from terrashade._distributed_inputs import absolute_source
         here = os.getcwd()
         work = self.path("prefix_parts")
         os.mkdir(work)
         try:
             os.chdir(work)
-            open("GTIFF_DIR", "w").close()
+            for name in ("GTIFF_DIR", "dem.tif", "z", "a.zip"):
+                open(name, "w").close()
             os.mkdir("1")
-            open("dem.tif", "w").close()
             self.assertEqual(absolute_source("TERRASHADE:GTIFF_DIR:1:dem.tif"),
                              "TERRASHADE:GTIFF_DIR:1:" + os.path.join(work, "dem.tif"))
+            # nor what follows the file (a variable named as a file here)
+            self.assertEqual(absolute_source('TERRASHADE:NETCDF:"dem.tif":z'),
+                             'TERRASHADE:NETCDF:"%s":z' % os.path.join(work, "dem.tif"))
+            # an archive's relative path, as the driver's levels take it
+            self.assertEqual(absolute_source("TERRASHADE:/vsizip/a.zip/dem.tif"),
+                             "TERRASHADE:/vsizip/%s/dem.tif" % os.path.join(work, "a.zip"))
         finally:
             os.chdir(here)
 
