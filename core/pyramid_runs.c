@@ -80,8 +80,10 @@ int ts_pyr_has_nodata(const float *z, int x0, int x1)
 
 /* A cell beside a void has no height of its own on a coarse level (its
  * footprint there is mostly void): it takes its DEM height, so that its
- * samples there still count (they all repeated its first: a cell two
- * cells from a 20-row void read -0.9 degrees across it against 24). */
+ * samples there still count (each was dropped: beside a 40 x 50 void on
+ * jacksboro, 17.5 % of the cell-directions read over 5 degrees low, 13.4 %
+ * with this, 11.6 % away from it; samples touching the void stay no
+ * occluder, methods.md). */
 TS_SIMD_CLONES
 void ts_pyr_fill_nodata(float *restrict R, const float *restrict R0, int x0, int x1)
 {

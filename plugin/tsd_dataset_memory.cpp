@@ -17,8 +17,8 @@ namespace tsd
 /* Refuse products that cannot fit, with a sentence saying what to do.
  * psSun, the cells and nLevel serve the advice on windows (level 0). */
 bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *psPlan,
-                        const tsd_sun *psSun, const tsd_cells &sCells, int nLevel,
-                        double *pdfHeadroom)
+                 const tsd_sun *psSun, const tsd_cells &sCells, int nLevel,
+                 double *pdfHeadroom)
 {
     if (!psPlan && (W > TS_MAX_SIDE || H > TS_MAX_SIDE))
     {
