@@ -299,6 +299,10 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
                             CPLSPrintf("SHADOWS=all cannot open the DEM '%s'%s (give it with "
                                        "the open option DEM=...)", poDS->m_osDEM.c_str(),
                                        poDS->m_bDEMGiven ? "" : " (the atlas's SOURCE_DEM)"));
+        // a product as the DEM: its shading was taken as the near field's heights
+        const std::string osProduct = ProductAsDEM(poDS->m_poDEM, poDS->m_osDEM);
+        if (!osProduct.empty())
+            return FailOpen(TS_ERR_ARG, osProduct.c_str());
         const std::string osWhy = CheckAtlasDEM(
             poDS->m_poDEM, poDS->m_osDEM, poDS->m_bDEMGiven, psInfo->width, psInfo->height,
             poDS->m_bHasGT, poDS->m_adfGT, poDS->m_oSRS.IsEmpty() ? nullptr : &poDS->m_oSRS);

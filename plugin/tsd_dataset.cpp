@@ -44,6 +44,7 @@ namespace tsd
 
 TSDataset::~TSDataset()
 {
+    m_apoOverviews.clear(); // first: a level may light with this dataset's ENV_MAP
     if (m_oReadAhead.joinable()) // before the DEM closes
         m_oReadAhead.join();
     ts_grid_free(&m_sReadGrid);
@@ -127,12 +128,33 @@ ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
         return m_eReadStatus;
     }
     if (!m_poDEM) // an overview level: the DEM again, read at its size
-        m_poDEM = OpenDEM(m_osDEMPath.c_str());
-    if (!m_poDEM)
     {
-        snprintf(pszMsg, nMsg, "cannot open the DEM '%s' again for overview level %d",
-                 m_osDEM.c_str(), m_nLevel);
-        return TS_ERR_INTERNAL;
+        m_poDEM = OpenDEM(m_osDEMPath.c_str());
+        if (!m_poDEM)
+        {
+            snprintf(pszMsg, nMsg, "cannot open the DEM '%s' again for overview level %d",
+                     m_osDEM.c_str(), m_nLevel);
+            return TS_ERR_INTERNAL;
+        }
+        // the same files as at open: a name that stays relative to the working
+        // directory (GTIFF_DIR:1:dem.tif, vrt://dem.tif, a VRT's source) named
+        // another directory's DEM after a chdir, read without a word
+        const std::vector<std::string> &aosOpen = (m_poBase ? m_poBase : this)->m_aosDEMFiles;
+        char **papszFiles = m_poDEM->GetFileList();
+        const bool bSame = aosOpen.empty() || SourceFiles(papszFiles, nullptr) == aosOpen;
+        CSLDestroy(papszFiles);
+        if (!bSame)
+        {
+            GDALClose(m_poDEM);
+            m_poDEM = nullptr;
+            snprintf(pszMsg, nMsg,
+                     "the DEM '%s' names other files now than when this dataset was opened "
+                     "(a name relative to the working directory, which changed?), so overview "
+                     "level %d is not computed from them: open the DEM again, or by an "
+                     "absolute name",
+                     m_osDEM.c_str(), m_nLevel);
+            return TS_ERR_ARG;
+        }
     }
     return LoadDEM(psGrid, pszMsg, nMsg);
 }
@@ -384,26 +406,9 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
                                    "it as it is (%s, its far shadows; -oo SHADOWS=all with "
                                    "the near ones), or name the DEM it was made from",
                                    osDEM.c_str(), osDEM.c_str()));
-    // a product of this driver (TERRASHADE:TERRASHADE:dem.tif): its shading
-    // was taken as heights, silently
-    if (bOurs)
-    {
-        const char *pszSource = poDEM->GetMetadataItem("SOURCE_DEM");
-        return FailOpen(TS_ERR_ARG,
-                        CPLSPrintf("the DEM '%s' is a TERRASHADE product, not a DEM: name the "
-                                   "DEM itself%s%s%s",
-                                   osDEM.c_str(), pszSource ? " (" : "",
-                                   pszSource ? pszSource : "", pszSource ? ")" : ""));
-    }
-    // a product written to a file (or a VRT of one) keeps its metadata: a
-    // known PRODUCT with its SOURCE_DEM is a product, whatever its driver
-    const char *pszCopyOf = poDEM->GetMetadataItem("SOURCE_DEM");
-    const char *pszCopyProduct = poDEM->GetMetadataItem("PRODUCT");
-    if (!bOurs && pszCopyOf && pszCopyProduct && tsd_product_find(pszCopyProduct) >= 0)
-        return FailOpen(TS_ERR_ARG,
-                        CPLSPrintf("the DEM '%s' is a written TERRASHADE product (PRODUCT=%s "
-                                   "of %s, in its metadata), not a DEM: name the DEM itself",
-                                   osDEM.c_str(), pszCopyProduct, pszCopyOf));
+    const std::string osProduct = ProductAsDEM(poDEM, osDEM);
+    if (!osProduct.empty())
+        return FailOpen(TS_ERR_ARG, osProduct.c_str());
     if (sOpts.band > poDEM->GetRasterCount())
         return FailOpen(TS_ERR_ARG,
                              CPLSPrintf("BAND=%d, but the DEM '%s' has %d band(s)",

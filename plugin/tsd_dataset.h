@@ -42,6 +42,11 @@ const tsd_window_plan *WindowPlan(const WindowState *p);
  * a palette), else empty; the warning of a DEM without a geotransform
  * (1 m cells), which names its control points or RPCs. */
 std::string NotHeights(GDALDataset *poDEM, int nBand, const std::string &osDEM);
+/* tsd_dataset_warnings.cpp: the sentence refusing the DEM poDEM (named
+ * osDEM) when it is a product of this driver, open through it or written to
+ * a file or a VRT that keeps its metadata (PRODUCT and SOURCE_DEM), else
+ * empty (the DEM of a product and of an atlas's SHADOWS=all alike). */
+std::string ProductAsDEM(GDALDataset *poDEM, const std::string &osDEM);
 void WarnNoGeoTransform(GDALDataset *poDEM, const std::string &osDEM);
 /* The warning of heights taken as metres for want of a unit on a grid in
  * another unit (US state planes in feet), with the Z_FACTOR that would
@@ -128,11 +133,7 @@ class TSDataset final : public GDALPamDataset
     bool m_bUsesBackend = false;
     bool m_bBackendKnown = false;     // m_sBackend filled (predicted or ran)
     tsd_backend_summary m_sBackend{}; // predicted, then what ran
-    tsd_environment m_sEnv{};         // ENV_MAP or SKY (tsd_dataset_env.cpp)
-    // ENV_MAP's bytes, read once when the dataset opens and shared with its
-    // overview levels: a level made later reads no file (a map deleted or
-    // replaced meanwhile gave GDAL a NULL level, or lit it with another map)
-    std::shared_ptr<const std::vector<GByte>> m_poEnvMap{};
+    tsd_environment m_sEnv{};         // ENV_MAP or SKY (tsd_dataset_env.cpp); a level's ENV_MAP: its dataset's
     WindowState *m_poWindow = nullptr; // computed chunk by chunk (tsd_window_cache.cpp), or null
     std::thread m_oReadAhead{};  // the DEM read while OpenCL is probed (StartReadAhead)
     ts_grid m_sReadGrid{};       // what it read, for ReadDEM

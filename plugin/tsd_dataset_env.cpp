@@ -2,13 +2,12 @@
  * tsd_dataset_env.cpp - the environment of a TERRASHADE:<dem> dataset
  * (ENV_MAP or SKY, tsd_compute_env.h), set up when the dataset opens so that
  * a bad map fails the open with its sentence: ENV_MAP is read through GDAL's
- * VSI into memory (so /vsimem/, /vsicurl/, /vsizip/... paths work), once,
- * its bytes kept for the overview levels, and decoded by the core's OpenEXR
- * reader. And its metadata.
+ * VSI into memory (so /vsimem/, /vsicurl/, /vsizip/... paths work), once
+ * (the overview levels light with the dataset's), and decoded by the core's
+ * OpenEXR reader. And its metadata.
  */
 #include <cerrno>
 #include <cstring>
-#include <memory>
 #include <string>
 #include <vector>
 
@@ -130,23 +129,25 @@ bool TSDataset::SetupEnvironment()
 {
     if (!tsd_options_env(&m_sOpts))
         return true;
+    // an overview level lights with the dataset's own ENV_MAP, read and
+    // decoded at open (the map's light depends on the options only): a level
+    // made later read the file again, and a map deleted meanwhile gave GDAL a
+    // NULL level (gdalwarp crashed), a replaced one another light
     if (m_sOpts.env_map[0] && m_poBase)
-        m_poEnvMap = m_poBase->m_poEnvMap; // the bytes the dataset read at open
-    else if (m_sOpts.env_map[0])
     {
-        auto poMap = std::make_shared<std::vector<GByte>>();
-        std::string osError;
-        if (!ReadWholeFile(m_sOpts.env_map, *poMap, osError))
-        {
-            Fail(CPLE_OpenFailed, osError.c_str());
-            return false;
-        }
-        m_poEnvMap = std::move(poMap);
+        m_sRun.env = &m_poBase->m_sEnv;
+        return true;
+    }
+    std::vector<GByte> oMap;
+    std::string osError;
+    if (m_sOpts.env_map[0] && !ReadWholeFile(m_sOpts.env_map, oMap, osError))
+    {
+        Fail(CPLE_OpenFailed, osError.c_str());
+        return false;
     }
     char szMsg[1024] = "";
-    const ts_status eSt =
-        tsd_environment_setup(&m_sOpts, &m_sRun, m_poEnvMap ? m_poEnvMap->data() : nullptr,
-                              m_poEnvMap ? m_poEnvMap->size() : 0, &m_sEnv, szMsg, sizeof szMsg);
+    const ts_status eSt = tsd_environment_setup(&m_sOpts, &m_sRun, oMap.data(), oMap.size(),
+                                                &m_sEnv, szMsg, sizeof szMsg);
     if (eSt != TS_OK)
     {
         Fail(eSt, szMsg);
@@ -191,7 +192,7 @@ void TSDataset::SetupEnvironmentMetadata()
 {
     if (!m_sRun.env)
         return;
-    const tsd_environment &e = m_sEnv;
+    const tsd_environment &e = *m_sRun.env; // (a level's: its dataset's)
     if (e.has_map)
     {
         GDALDataset::SetMetadataItem("ENV_MAP", m_sOpts.env_map); // not truncated

@@ -11,9 +11,30 @@
 
 #include "tsd_dataset.h"
 #include "tsd_dem_check.h"
+#include "tsd_gdal.h"
 
 namespace tsd
 {
+
+std::string ProductAsDEM(GDALDataset *poDEM, const std::string &osDEM)
+{
+    // a product of this driver (TERRASHADE:TERRASHADE:dem.tif): its shading
+    // was taken as heights, silently
+    const char *pszSource = poDEM->GetMetadataItem("SOURCE_DEM");
+    if (poDEM->GetDriver() && EQUAL(poDEM->GetDriver()->GetDescription(), DRIVER))
+        return CPLSPrintf("the DEM '%s' is a TERRASHADE product, not a DEM: name the DEM "
+                          "itself%s%s%s",
+                          osDEM.c_str(), pszSource ? " (" : "", pszSource ? pszSource : "",
+                          pszSource ? ")" : "");
+    // a product written to a file (or a VRT of one) keeps its metadata: a
+    // known PRODUCT with its SOURCE_DEM is a product, whatever its driver
+    const char *pszProduct = poDEM->GetMetadataItem("PRODUCT");
+    if (pszSource && pszProduct && tsd_product_find(pszProduct) >= 0)
+        return CPLSPrintf("the DEM '%s' is a written TERRASHADE product (PRODUCT=%s of %s, in "
+                          "its metadata), not a DEM: name the DEM itself",
+                          osDEM.c_str(), pszProduct, pszSource);
+    return std::string();
+}
 
 std::string NotHeights(GDALDataset *poDEM, int nBand, const std::string &osDEM)
 {

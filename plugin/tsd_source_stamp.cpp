@@ -27,11 +27,15 @@ std::string AbsolutePath(const char *pszPath)
             pszRest = pszPath + strlen(pszArchive);
             break;
         }
+    // an archive's name in braces, /vsizip/{a.zip}/dem.tif: its name inside
+    const bool bBraces = !osPrefix.empty() && *pszRest == '{' && strchr(pszRest, '}');
+    if (bBraces)
+        osPrefix += '{', pszRest++;
     VSIStatBufL sStat;
-    // ("{...}": an archive's name in braces; a name that is no file here:
-    // a driver's prefix, GTIFF_DIR:1:dem.tif, left alone)
-    if (!*pszRest || *pszRest == '{' || STARTS_WITH(pszRest, "/vsi") ||
-        !CPLIsFilenameRelative(pszRest) || VSIStatL(pszPath, &sStat) != 0)
+    // (a name that is no file here: a driver's prefix, GTIFF_DIR:1:dem.tif,
+    // left alone; the reopened levels check their files, ReadDEM)
+    if (!*pszRest || STARTS_WITH(pszRest, "/vsi") || !CPLIsFilenameRelative(pszRest) ||
+        VSIStatL(pszPath, &sStat) != 0)
         return pszPath;
     char *pszCwd = CPLGetCurrentDir();
     // (not CPLFormFilename: its buffer holds 2048 characters)

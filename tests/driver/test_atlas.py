@@ -516,6 +516,21 @@ class Atlas(unittest.TestCase):
                 self.refused(self.tsa, "SHADOWS=all: band 1 of '%s' %s" % (dem, sentence),
                              ["SHADOWS=all", "DEM=" + dem])
 
+    def test_shadows_all_refuses_a_product_as_its_dem(self):
+        """DEM= a product, live or written to a file: its shading was taken
+        as the near shadows' heights, with exit 0 (session 54's review)."""
+        shade = os.path.join(self.dir, "shade_as_dem.tif")
+        T.run(["gdal_translate", "-q", T.conn(T.JACKSBORO), shade])
+        for dem, sentence in (
+                (shade, "the DEM '%s' is a written TERRASHADE product (PRODUCT=shade of %s"
+                 % (shade, T.JACKSBORO)),
+                (T.conn(T.JACKSBORO), "the DEM '%s' is a TERRASHADE product, not a DEM"
+                 % T.conn(T.JACKSBORO))):
+            with self.subTest(dem=dem):
+                with self.assertRaises(RuntimeError) as e:
+                    gdal.OpenEx(self.tsa, open_options=["SHADOWS=all", "DEM=" + dem])
+                self.assertIn(sentence, str(e.exception))
+
     def test_createcopy_refuses_other_sources(self):
         out = os.path.join(self.dir, "refused.tsa")
         # complex bands

@@ -281,6 +281,44 @@ class ChangedFiles(T.TempDirCase):
             self.assertTrue(np.isfinite(level).all(), name)
             ds = None
 
+    def test_chdir_names_that_stay_relative(self):
+        """Names that stay relative to the working directory (another
+        driver's name, vrt://): after a chdir an overview level reopened
+        the name there, and read another directory's DEM of that name
+        without a word (session 54's review). It is refused, saying why.
+        A plain name starting with '{', and an archive's name in braces,
+        are made absolute at open."""
+        here, there = os.path.join(self.dir, "here"), os.path.join(self.dir, "there")
+        os.makedirs(here, exist_ok=True)
+        os.makedirs(there, exist_ok=True)
+        write_dem(os.path.join(here, "dem.tif"), 11, n=300)
+        write_dem(os.path.join(there, "dem.tif"), 12, n=300)
+        T.shutil.copy(os.path.join(here, "dem.tif"), os.path.join(here, "{site}.tif"))
+        with zipfile.ZipFile(os.path.join(here, "b.zip"), "w") as z:
+            z.write(os.path.join(here, "dem.tif"), "dem.tif")
+        cwd = os.getcwd()
+        for name, ok in (("GTIFF_DIR:1:dem.tif", False), ("vrt://dem.tif?bands=1", False),
+                         ("{site}.tif", True), ("/vsizip/{b.zip}/dem.tif", True)):
+            with self.subTest(name=name):
+                os.chdir(here)
+                try:
+                    ds = gdal.OpenEx(T.conn(name), open_options=["PRODUCT=svf", "DIRECTIONS=4"])
+                    os.chdir(there)
+                    full = ds.GetRasterBand(1).ReadAsArray()
+                    if ok:
+                        level = ds.GetRasterBand(1).GetOverview(0).ReadAsArray()
+                    else:
+                        with self.assertRaises(RuntimeError) as e:
+                            ds.GetRasterBand(1).GetOverview(0).ReadAsArray()
+                        self.assertIn("names other files now than when this dataset was "
+                                      "opened", str(e.exception))
+                finally:
+                    os.chdir(cwd)
+                self.assertTrue(np.isfinite(full).all())
+                if ok:
+                    self.assertTrue(np.isfinite(level).all())
+                ds = None
+
     def test_a_vrt_whose_source_is_regenerated(self):
         """A VRT DEM's sources are its files too: statistics saved before
         its source was regenerated are dropped (the VRT itself did not
