@@ -114,6 +114,7 @@ class TSDataset final : public GDALPamDataset
         ComputingHere &operator=(const ComputingHere &) = delete;
     };
     bool m_bTried = false;
+    bool m_bSavingCopy = false; // TrySaveXML writing its copy (tsd_dataset_metadata.cpp)
     std::string m_osError{};      // why computing failed
     ts_status m_eStatus = TS_OK;  // and its status
     float *m_pafProduct = nullptr;

@@ -365,13 +365,78 @@ class PamFileTurn
 };
 } // namespace
 
+/* A copy of the file at osPath (if there is one) at osCopy: 1 done (or no
+ * file), 0 the copy cannot be made there at all (a folder not writable),
+ * -1 it was begun and failed (a full disk), removed. */
+static int CopyForSave(const std::string &osPath, const std::string &osCopy)
+{
+    GByte *pabyOld = nullptr;
+    vsi_l_offset nOld = 0;
+    VSIStatBufL sStat;
+    const bool bOld = VSIStatL(osPath.c_str(), &sStat) == 0;
+    if (bOld && !VSIIngestFile(nullptr, osPath.c_str(), &pabyOld, &nOld, 64 << 20))
+        return 0;
+    VSILFILE *fp = VSIFOpenL(osCopy.c_str(), "wb");
+    if (!fp)
+    {
+        VSIFree(pabyOld);
+        return 0;
+    }
+    const bool bOk = VSIFWriteL(pabyOld ? pabyOld : reinterpret_cast<GByte *>(&nOld), 1,
+                                static_cast<size_t>(nOld), fp) == nOld;
+    VSIFree(pabyOld);
+    if (VSIFCloseL(fp) == 0 && bOk)
+        return 1;
+    VSIUnlink(osCopy.c_str());
+    return -1;
+}
+
 CPLErr TSDataset::TrySaveXML()
 {
     const PamFileTurn oTurn(GetPhysicalFilename(), true);
     // the contents the entry's statistics are of (DropStalePamStatistics)
     if (!m_osPamStamp.empty() && nBands > 0)
         GetRasterBand(1)->SetMetadataItem(PAM_STAMP_ITEM, m_osPamStamp.c_str(), PAM_STAMP_DOMAIN);
-    return GDALPamDataset::TrySaveXML();
+    const char *pszPam = psPam ? BuildPamFilename() : nullptr;
+    if (m_bSavingCopy || !pszPam || STARTS_WITH(pszPam, "/vsi"))
+        return GDALPamDataset::TrySaveXML(); // (GDAL's retry in its proxy folder, nested)
+    // GDAL rewrites the file in place: reads it, truncates it, writes it. A
+    // write that failed (a full disk) left it cut short, and every product's
+    // entries in it were lost, the nodata and units users set among them. The
+    // save goes to a copy, renamed over the file once written whole.
+    const std::string osPam = pszPam;
+    const std::string osCopy = osPam + CPLSPrintf(".%d.saving", static_cast<int>(getpid()));
+    const int nCopy = CopyForSave(osPam, osCopy);
+    if (nCopy == 0)
+        return GDALPamDataset::TrySaveXML(); // (no copy beside it: in place, as GDAL does)
+    if (nCopy < 0)
+    {
+        CPLError(CE_Warning, CPLE_FileIO,
+                 "TERRASHADE: unable to save auxiliary information in %s: a copy of it could "
+                 "not be written beside it (is the disk full?); the file is left as it was",
+                 osPam.c_str());
+        return CE_Warning;
+    }
+    CPLFree(psPam->pszPamFilename);
+    psPam->pszPamFilename = CPLStrdup(osCopy.c_str());
+    m_bSavingCopy = true;
+    CPLErr eErr = GDALPamDataset::TrySaveXML();
+    m_bSavingCopy = false;
+    const bool bToCopy = psPam->pszPamFilename && osCopy == psPam->pszPamFilename;
+    if (bToCopy) // (else GDAL moved it to its proxy folder)
+    {
+        CPLFree(psPam->pszPamFilename);
+        psPam->pszPamFilename = CPLStrdup(osPam.c_str());
+    }
+    if (bToCopy && eErr == CE_None && VSIRename(osCopy.c_str(), osPam.c_str()) != 0)
+    {
+        CPLError(CE_Warning, CPLE_FileIO,
+                 "TERRASHADE: unable to save auxiliary information in %s: %s", osPam.c_str(),
+                 VSIStrerror(errno));
+        eErr = CE_Warning;
+    }
+    VSIUnlink(osCopy.c_str()); // (gone after the rename)
+    return eErr;
 }
 
 CPLErr TSDataset::TryLoadXML(char **papszSiblingFiles)

@@ -172,6 +172,33 @@ class Pam(unittest.TestCase):
         # 16 directions, not 4: another entry
         self.assertEqual(self.band_says(T.conn(self.dem, PRODUCT="svf"))[:2], ("nan", ""))
 
+    def test_a_failed_save_keeps_the_file(self):
+        """A save that fails (a full disk; here a file-size limit) leaves the
+        products' file as it was: GDAL rewrote it in place, and a write cut
+        short left it truncated, every product's entries lost, the nodata
+        and unit a user set among them (session 54's audit). The save goes
+        to a copy, renamed over the file once whole."""
+        conn = T.conn(self.dem, PRODUCT="svf", DIRECTIONS=4)
+        T.run(["gdal_edit.py", "-ro", "-a_nodata", "7", "-units", "furlong", conn])
+        T.run(["gdalinfo", "-stats", T.conn(self.dem)])
+        aux = self.dem + ".terrashade.aux.xml"
+        with open(aux, "rb") as f:
+            before = f.read()
+        # a limit above the file's size: the copy is written, GDAL's save of
+        # one more entry into it is cut short
+        limit = len(before) + 200
+        child = ("import os, resource, signal\n"
+                 "signal.signal(signal.SIGXFSZ, signal.SIG_IGN)\n"
+                 "resource.setrlimit(resource.RLIMIT_FSIZE, (%d, %d))\n"
+                 "os.execvp('gdalinfo', ['gdalinfo', '-stats', '-oo', 'PRODUCT=openness', %r])\n"
+                 % (limit, limit, T.conn(self.dem)))
+        p = T.run(["/usr/bin/python3", "-c", child])  # (a warning: the product was shown)
+        self.assertIn("nable to save auxiliary information", p.stderr)
+        with open(aux, "rb") as f:
+            self.assertEqual(f.read(), before)
+        self.assertEqual(self.band_says(conn)[:2], (7.0, "furlong"))
+        self.assertEqual([n for n in os.listdir(self.demdir) if n.endswith(".saving")], [])
+
     def test_long_env_map_paths_are_two_entries(self):
         """Two ENV_MAP paths alike in their first 120 characters: two
         entries, each with its own statistics and nodata, and the whole
