@@ -136,23 +136,32 @@ ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
                      m_osDEM.c_str(), m_nLevel);
             return TS_ERR_INTERNAL;
         }
-        // the same files as at open: a name that stays relative to the working
-        // directory (GTIFF_DIR:1:dem.tif, vrt://dem.tif, a VRT's source) named
-        // another directory's DEM after a chdir, read without a word
-        const std::vector<std::string> &aosOpen = (m_poBase ? m_poBase : this)->m_aosDEMFiles;
+        // the files of the open among its files (a name that stays relative
+        // to the working directory, GTIFF_DIR:1:dem.tif, vrt://dem.tif, named
+        // another directory's DEM after a chdir, read without a word); files
+        // added since (an .ovr of gdaladdo) are the DEM's, as GDAL reads them
+        const TSDataset *poLevel0 = m_poBase ? m_poBase : this;
         char **papszFiles = m_poDEM->GetFileList();
-        const bool bSame = aosOpen.empty() || SourceFiles(papszFiles, nullptr) == aosOpen;
+        const std::vector<std::string> aosNow = SourceFiles(papszFiles, nullptr);
         CSLDestroy(papszFiles);
-        if (!bSame)
+        const std::string *posGone = nullptr;
+        for (const std::string &osFile : poLevel0->m_aosDEMFiles)
+            if (!posGone && std::find(aosNow.begin(), aosNow.end(), osFile) == aosNow.end())
+                posGone = &osFile;
+        if (posGone && DEMUnchanged()) // (a file deleted or changed: said by the caller)
         {
             GDALClose(m_poDEM);
             m_poDEM = nullptr;
+            const bool bRelative = m_osDEMPath.empty() || m_osDEMPath[0] != '/';
             snprintf(pszMsg, nMsg,
-                     "the DEM '%s' names other files now than when this dataset was opened "
-                     "(a name relative to the working directory, which changed?), so overview "
-                     "level %d is not computed from them: open the DEM again, or by an "
-                     "absolute name",
-                     m_osDEM.c_str(), m_nLevel);
+                     "the DEM '%s' opens other files now than when this dataset was opened "
+                     "('%s' is not among them%s), so overview level %d is not computed from "
+                     "it: open the DEM again",
+                     m_osDEM.c_str(), posGone->c_str(),
+                     bRelative ? "; its name is relative to the working directory, which "
+                                 "changed?"
+                               : "",
+                     m_nLevel);
             return TS_ERR_ARG;
         }
     }
@@ -263,7 +272,7 @@ CPLErr TSDataset::EnsureComputed()
         }
         if (eStatus != TS_OK)
         {
-            m_osError = szMsg;
+            m_osError = KeptFailure(eStatus, szMsg);
         }
         else
         {
@@ -281,7 +290,7 @@ CPLErr TSDataset::EnsureComputed()
             if (!m_pafProduct && !m_pabyProduct)
             {
                 eStatus = TS_ERR_NOMEM;
-                m_osError = "out of memory for the product";
+                m_osError = KeptFailure(eStatus, "out of memory for the product");
             }
             else
             {
@@ -291,7 +300,7 @@ CPLErr TSDataset::EnsureComputed()
                 const tsd_compute_ctx sCtx{&m_sOpts, &sRun, &sRan, szMsg, sizeof szMsg};
                 eStatus = tsd_product_compute(&sCtx, &sRegion, m_pafProduct, m_pabyProduct);
                 if (eStatus != TS_OK)
-                    m_osError = szMsg;
+                    m_osError = KeptFailure(eStatus, szMsg);
                 else if (sRan.calls > 0)
                 {
                     m_sBackend = sRan;

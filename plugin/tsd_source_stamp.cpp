@@ -28,7 +28,9 @@ std::string AbsolutePath(const char *pszPath)
             break;
         }
     // an archive's name in braces, /vsizip/{a.zip}/dem.tif: its name inside
-    const bool bBraces = !osPrefix.empty() && *pszRest == '{' && strchr(pszRest, '}');
+    // (not /vsigzip/'s: it has no such form, and {g}.tif.gz is a name)
+    const bool bBraces = !osPrefix.empty() && osPrefix != "/vsigzip/" && *pszRest == '{' &&
+                         strchr(pszRest, '}');
     if (bBraces)
         osPrefix += '{', pszRest++;
     VSIStatBufL sStat;

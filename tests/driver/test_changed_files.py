@@ -297,8 +297,12 @@ class ChangedFiles(T.TempDirCase):
         with zipfile.ZipFile(os.path.join(here, "b.zip"), "w") as z:
             z.write(os.path.join(here, "dem.tif"), "dem.tif")
         cwd = os.getcwd()
+        with open(os.path.join(here, "dem.tif"), "rb") as f, \
+                gzip.open(os.path.join(here, "{g}.tif.gz"), "wb") as g:
+            g.write(f.read())
         for name, ok in (("GTIFF_DIR:1:dem.tif", False), ("vrt://dem.tif?bands=1", False),
-                         ("{site}.tif", True), ("/vsizip/{b.zip}/dem.tif", True)):
+                         ("{site}.tif", True), ("/vsizip/{b.zip}/dem.tif", True),
+                         ("/vsigzip/{g}.tif.gz", True)):
             with self.subTest(name=name):
                 os.chdir(here)
                 try:
@@ -310,14 +314,28 @@ class ChangedFiles(T.TempDirCase):
                     else:
                         with self.assertRaises(RuntimeError) as e:
                             ds.GetRasterBand(1).GetOverview(0).ReadAsArray()
-                        self.assertIn("names other files now than when this dataset was "
+                        self.assertIn("opens other files now than when this dataset was "
                                       "opened", str(e.exception))
+                        self.assertIn("relative to the working directory", str(e.exception))
                 finally:
                     os.chdir(cwd)
                 self.assertTrue(np.isfinite(full).all())
                 if ok:
                     self.assertTrue(np.isfinite(level).all())
                 ds = None
+
+    def test_overviews_added_after_open(self):
+        """gdaladdo -ro on the DEM while a product of it is open (QGIS building
+        pyramids): the level reads, the .ovr being the DEM's own; the check
+        of a level's files (session 54) refused it for a while, blaming a
+        change of directory."""
+        dem = os.path.join(self.dir, "ovr_later.tif")
+        write_dem(dem, 13, n=300)
+        ds = gdal.OpenEx(T.conn(dem), open_options=["PRODUCT=svf", "DIRECTIONS=4"])
+        T.run(["gdaladdo", "-q", "-ro", "-r", "average", dem, "2"])
+        level = ds.GetRasterBand(1).GetOverview(0).ReadAsArray()
+        self.assertTrue(np.isfinite(level).all())
+        ds = None
 
     def test_a_vrt_whose_source_is_regenerated(self):
         """A VRT DEM's sources are its files too: statistics saved before
