@@ -103,6 +103,13 @@ def absolute_path(text):
     path = text[1:-1] if quoted else text
     prefix = next((a for a in ARCHIVES if path.startswith(a)), "")
     rest = path[len(prefix):]
+    braced = prefix in ("/vsizip/", "/vsitar/") and rest.startswith("{") and "}" in rest
+    if braced:  # /vsizip/{a.zip}/dem.tif: the archive's name in braces
+        name, after = rest[1:].split("}", 1)
+        if not name or os.path.isabs(name) or not os.path.isfile(name):
+            return None
+        path = prefix + "{" + os.path.abspath(name) + "}" + after
+        return '"%s"' % path if quoted else path
     if prefix:  # the archive: the longest leading part that is a file here
         cut = [i for i in range(len(rest), 0, -1)
                if (i == len(rest) or rest[i] == "/") and os.path.isfile(rest[:i])]

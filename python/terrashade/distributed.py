@@ -133,6 +133,11 @@ def run(args):
         if os.path.exists(args.dest) and os.path.samefile(part, args.dest):
             raise Failure("DEST %s is a file of the DEM %s: the product would replace it; "
                           "write it to another file" % (args.dest, dem))
+    env_map = src.GetMetadataItem("ENV_MAP") or ""
+    if os.path.exists(env_map) and os.path.exists(args.dest) and \
+            os.path.samefile(env_map, args.dest):
+        raise Failure("DEST %s is the ENV_MAP of SOURCE: the product would replace it; "
+                      "write it to another file" % args.dest)
     size = (src.RasterXSize, src.RasterYSize, src.RasterCount)
     out = client = cluster = watch = None
     run_id = uuid.uuid4().hex  # no worker reuses a dataset opened for an earlier run

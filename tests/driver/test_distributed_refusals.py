@@ -68,6 +68,8 @@ class DistributedRefusals(TD.DistributedCase):
             # an archive's relative path, as the driver's levels take it
             self.assertEqual(absolute_source("TERRASHADE:/vsizip/a.zip/dem.tif"),
                              "TERRASHADE:/vsizip/%s/dem.tif" % os.path.join(work, "a.zip"))
+            self.assertEqual(absolute_source("TERRASHADE:/vsizip/{a.zip}/dem.tif"),
+                             "TERRASHADE:/vsizip/{%s}/dem.tif" % os.path.join(work, "a.zip"))
         finally:
             os.chdir(here)
 
