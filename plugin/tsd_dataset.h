@@ -61,6 +61,16 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
                  const tsd_sun *psSun, const tsd_cells &sCells, int nLevel,
                  double *pdfHeadroom);
 
+/* A failure that a dataset keeps, its later reads repeating it: out of
+ * memory (or of file descriptors for a level's DEM) may pass, and the
+ * sentence says that the dataset must be opened again to retry. */
+inline std::string KeptFailure(ts_status eSt, const std::string &osMsg)
+{
+    return eSt == TS_ERR_NOMEM || eSt == TS_ERR_INTERNAL
+               ? osMsg + " (this dataset keeps the failure: open it again to retry)"
+               : osMsg;
+}
+
 /** A TERRASHADE:<dem> dataset: one product of a DEM. */
 class TSDataset final : public GDALPamDataset
 {

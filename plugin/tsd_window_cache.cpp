@@ -246,7 +246,7 @@ bool TSDataset::EnsureFarField()
     if (eSt != TS_OK)
     {
         s.status = eSt;
-        s.error = std::string("the far-field grid: ") + szMsg;
+        s.error = KeptFailure(eSt, std::string("the far-field grid: ") + szMsg);
         return false;
     }
     WarnBelowSea(&sCoarse);
@@ -355,7 +355,7 @@ bool TSDataset::ComputeChunk(int cx, int cy, WindowChunk &c)
     if (eSt != TS_OK && !bCancelled) // a cancelled chunk is computed again when read
     {
         s.status = eSt;
-        s.error = szMsg;
+        s.error = KeptFailure(eSt, szMsg);
     }
     return eSt == TS_OK;
 }

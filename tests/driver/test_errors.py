@@ -174,6 +174,37 @@ class Errors(unittest.TestCase):
             T.run(["gdal_translate", "-q", DEM, copy])
             T.run(["gdalinfo", "-checksum", T.conn(copy)])
 
+    def test_out_of_memory_says_to_reopen(self):
+        """A dataset keeps a failure for its life, its later reads repeating
+        it: out of memory may pass (a moment of pressure under QGIS), so the
+        sentence says to open the dataset again (session 54's audit: it
+        said nothing, and a layer stayed broken)."""
+        with T.TempDir() as tmp:
+            dem = T.write_tif(os.path.join(tmp, "big.tif"), T.fractal_dem(1024, seed=3),
+                              (500000, 10, 0, 4000000, 0, -10), 32617)
+            child = (
+                "import resource\nfrom osgeo import gdal\ngdal.UseExceptions()\n"
+                "ds = gdal.OpenEx(%r, open_options=['PRODUCT=svf', 'TILE_SIZE=0', "
+                "'BACKEND=c'])\nband = ds.GetRasterBand(1)\n"
+                "vm = [int(l.split()[1]) * 1024 for l in open('/proc/self/status') "
+                "if l.startswith('VmSize')][0]\n"
+                "soft, hard = resource.getrlimit(resource.RLIMIT_AS)\n"
+                "resource.setrlimit(resource.RLIMIT_AS, (vm + (8 << 20), hard))\n"
+                "try:\n    band.ReadRaster(0, 0, 16, 16)\nexcept RuntimeError as e:\n"
+                "    print('FIRST', e)\n"
+                "resource.setrlimit(resource.RLIMIT_AS, (soft, hard))\n"
+                "try:\n    band.ReadRaster(0, 0, 16, 16)\nexcept RuntimeError as e:\n"
+                "    print('AGAIN', e)\n"
+                "ds = None\nds = gdal.OpenEx(%r, open_options=['PRODUCT=svf', 'TILE_SIZE=0', "
+                "'BACKEND=c'])\nds.GetRasterBand(1).ReadRaster(0, 0, 16, 16)\n"
+                "print('REOPENED')\n" % (T.conn(dem), T.conn(dem)))
+            p = T.run(["/usr/bin/python3", "-c", child], MALLOC_ARENA_MAX=2)
+            print(p.stdout)
+            lines = dict(line.split(" ", 1) for line in p.stdout.splitlines() if " " in line)
+            self.assertIn("open it again to retry", lines.get("FIRST", ""))
+            self.assertIn("open it again to retry", lines.get("AGAIN", ""))
+            self.assertIn("REOPENED", p.stdout)
+
     def test_unquoted_name_like_options_hint(self):
         """A DEM named like inline options, not quoted: the error says the
         whole name is a file and how to quote it; where no such file exists
