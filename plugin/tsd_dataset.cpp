@@ -130,10 +130,18 @@ ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
     if (!m_poDEM) // an overview level: the DEM again, read at its size
     {
         m_poDEM = OpenDEM(m_osDEMPath.c_str());
-        if (!m_poDEM)
+        // (GTIFF_DIR:1:/data/dem.tif and vrt:///data/dem.tif are absolute)
+        const std::string osName =
+            STARTS_WITH(m_osDEMPath.c_str(), "vrt://") ? m_osDEMPath.substr(6) : m_osDEMPath;
+        const bool bRelative =
+            osName.empty() || (osName[0] != '/' && osName.find(":/") == std::string::npos);
+        const char *pszRelative = bRelative ? "; its name is relative to the working directory, "
+                                              "which changed?"
+                                            : "";
+        if (!m_poDEM) // (out of file descriptors, moved, a chdir...)
         {
-            snprintf(pszMsg, nMsg, "cannot open the DEM '%s' again for overview level %d",
-                     m_osDEM.c_str(), m_nLevel);
+            snprintf(pszMsg, nMsg, "cannot open the DEM '%s' again for overview level %d%s%s",
+                     m_osDEM.c_str(), m_nLevel, pszRelative, KEPT_FAILURE);
             return TS_ERR_INTERNAL;
         }
         // the files of the open among its files (a name that stays relative
@@ -152,16 +160,11 @@ ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
         {
             GDALClose(m_poDEM);
             m_poDEM = nullptr;
-            const bool bRelative = m_osDEMPath.empty() || m_osDEMPath[0] != '/';
             snprintf(pszMsg, nMsg,
                      "the DEM '%s' opens other files now than when this dataset was opened "
                      "('%s' is not among them%s), so overview level %d is not computed from "
                      "it: open the DEM again",
-                     m_osDEM.c_str(), posGone->c_str(),
-                     bRelative ? "; its name is relative to the working directory, which "
-                                 "changed?"
-                               : "",
-                     m_nLevel);
+                     m_osDEM.c_str(), posGone->c_str(), pszRelative, m_nLevel);
             return TS_ERR_ARG;
         }
     }

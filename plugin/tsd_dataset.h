@@ -61,14 +61,15 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
                  const tsd_sun *psSun, const tsd_cells &sCells, int nLevel,
                  double *pdfHeadroom);
 
-/* A failure that a dataset keeps, its later reads repeating it: out of
- * memory (or of file descriptors for a level's DEM) may pass, and the
- * sentence says that the dataset must be opened again to retry. */
+/* What a failure that may pass adds to its sentence: a dataset keeps its
+ * failures, its later reads repeating them. */
+constexpr const char *KEPT_FAILURE = " (this dataset keeps the failure: open it again to retry)";
+
+/* A failure that a dataset keeps: out of memory may pass, and the sentence
+ * says that the dataset must be opened again to retry. */
 inline std::string KeptFailure(ts_status eSt, const std::string &osMsg)
 {
-    return eSt == TS_ERR_NOMEM || eSt == TS_ERR_INTERNAL
-               ? osMsg + " (this dataset keeps the failure: open it again to retry)"
-               : osMsg;
+    return eSt == TS_ERR_NOMEM ? osMsg + KEPT_FAILURE : osMsg;
 }
 
 /** A TERRASHADE:<dem> dataset: one product of a DEM. */
@@ -124,7 +125,7 @@ class TSDataset final : public GDALPamDataset
         ComputingHere &operator=(const ComputingHere &) = delete;
     };
     bool m_bTried = false;
-    bool m_bSavingCopy = false; // TrySaveXML writing its copy (tsd_dataset_metadata.cpp)
+    bool m_bSavingOver = false; // in TrySaveXML's call of GDAL's (tsd_dataset_metadata.cpp)
     std::string m_osError{};      // why computing failed
     ts_status m_eStatus = TS_OK;  // and its status
     float *m_pafProduct = nullptr;

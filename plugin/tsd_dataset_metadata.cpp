@@ -365,30 +365,33 @@ class PamFileTurn
 };
 } // namespace
 
-/* A copy of the file at osPath (if there is one) at osCopy: 1 done (or no
- * file), 0 the copy cannot be made there at all (a folder not writable),
- * -1 it was begun and failed (a full disk), removed. */
-static int CopyForSave(const std::string &osPath, const std::string &osCopy)
+/* The bytes of the file at osPath, for RestoreAfterFailedSave: false where
+ * there is none (or it cannot be read, quietly: GDAL's save says why). */
+static bool ReadForRestore(const std::string &osPath, std::vector<GByte> &oBytes)
 {
+    VSIStatBufL sStat;
+    if (VSIStatL(osPath.c_str(), &sStat) != 0)
+        return false;
     GByte *pabyOld = nullptr;
     vsi_l_offset nOld = 0;
-    VSIStatBufL sStat;
-    const bool bOld = VSIStatL(osPath.c_str(), &sStat) == 0;
-    if (bOld && !VSIIngestFile(nullptr, osPath.c_str(), &pabyOld, &nOld, 64 << 20))
-        return 0;
-    VSILFILE *fp = VSIFOpenL(osCopy.c_str(), "wb");
-    if (!fp)
-    {
-        VSIFree(pabyOld);
-        return 0;
-    }
-    const bool bOk = VSIFWriteL(pabyOld ? pabyOld : reinterpret_cast<GByte *>(&nOld), 1,
-                                static_cast<size_t>(nOld), fp) == nOld;
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    const bool bRead = VSIIngestFile(nullptr, osPath.c_str(), &pabyOld, &nOld, 64 << 20) != 0;
+    CPLPopErrorHandler();
+    if (bRead)
+        oBytes.assign(pabyOld, pabyOld + nOld);
     VSIFree(pabyOld);
-    if (VSIFCloseL(fp) == 0 && bOk)
-        return 1;
-    VSIUnlink(osCopy.c_str());
-    return -1;
+    return bRead;
+}
+
+/* Put the bytes back in the file at osPath, in place (the same file: a
+ * link, its owner and mode kept). */
+static bool RestoreAfterFailedSave(const std::string &osPath, const std::vector<GByte> &oBytes)
+{
+    VSILFILE *fp = VSIFOpenL(osPath.c_str(), "wb");
+    if (!fp)
+        return false;
+    const bool bOk = VSIFWriteL(oBytes.data(), 1, oBytes.size(), fp) == oBytes.size();
+    return VSIFCloseL(fp) == 0 && bOk;
 }
 
 CPLErr TSDataset::TrySaveXML()
@@ -397,45 +400,36 @@ CPLErr TSDataset::TrySaveXML()
     // the contents the entry's statistics are of (DropStalePamStatistics)
     if (!m_osPamStamp.empty() && nBands > 0)
         GetRasterBand(1)->SetMetadataItem(PAM_STAMP_ITEM, m_osPamStamp.c_str(), PAM_STAMP_DOMAIN);
-    const char *pszPam = psPam ? BuildPamFilename() : nullptr;
-    if (m_bSavingCopy || !pszPam || STARTS_WITH(pszPam, "/vsi"))
+    const char *pszPam = psPam && !(nPamFlags & GPF_DISABLED) ? BuildPamFilename() : nullptr;
+    if (m_bSavingOver || !pszPam)
         return GDALPamDataset::TrySaveXML(); // (GDAL's retry in its proxy folder, nested)
     // GDAL rewrites the file in place: reads it, truncates it, writes it. A
-    // write that failed (a full disk) left it cut short, and every product's
-    // entries in it were lost, the nodata and units users set among them. The
-    // save goes to a copy, renamed over the file once written whole.
+    // write cut short (a full disk) left it truncated, every product's
+    // entries lost, the nodata and units users set among them: the former
+    // bytes are put back, and the dataset is marked clean, so that its close
+    // does not try again (GDAL's destructor saves in place, unguarded).
     const std::string osPam = pszPam;
-    const std::string osCopy = osPam + CPLSPrintf(".%d.saving", static_cast<int>(getpid()));
-    const int nCopy = CopyForSave(osPam, osCopy);
-    if (nCopy == 0)
-        return GDALPamDataset::TrySaveXML(); // (no copy beside it: in place, as GDAL does)
-    if (nCopy < 0)
-    {
+    std::vector<GByte> oOld;
+    const bool bOld = ReadForRestore(osPam, oOld);
+    m_bSavingOver = true;
+    const CPLErr eErr = GDALPamDataset::TrySaveXML();
+    m_bSavingOver = false;
+    // failed, or moved to GDAL's proxy folder after a failed write here
+    const bool bMoved = !psPam->pszPamFilename || osPam != psPam->pszPamFilename;
+    if (eErr == CE_None && !bMoved)
+        return eErr;
+    std::vector<GByte> oNow;
+    VSIStatBufL sStat;
+    if (bOld && (!ReadForRestore(osPam, oNow) || oNow != oOld) &&
+        !RestoreAfterFailedSave(osPam, oOld))
         CPLError(CE_Warning, CPLE_FileIO,
-                 "TERRASHADE: unable to save auxiliary information in %s: a copy of it could "
-                 "not be written beside it (is the disk full?); the file is left as it was",
+                 "TERRASHADE: %s could not be written back as it was after the failed save: "
+                 "its entries may be lost",
                  osPam.c_str());
-        return CE_Warning;
-    }
-    CPLFree(psPam->pszPamFilename);
-    psPam->pszPamFilename = CPLStrdup(osCopy.c_str());
-    m_bSavingCopy = true;
-    CPLErr eErr = GDALPamDataset::TrySaveXML();
-    m_bSavingCopy = false;
-    const bool bToCopy = psPam->pszPamFilename && osCopy == psPam->pszPamFilename;
-    if (bToCopy) // (else GDAL moved it to its proxy folder)
-    {
-        CPLFree(psPam->pszPamFilename);
-        psPam->pszPamFilename = CPLStrdup(osPam.c_str());
-    }
-    if (bToCopy && eErr == CE_None && VSIRename(osCopy.c_str(), osPam.c_str()) != 0)
-    {
-        CPLError(CE_Warning, CPLE_FileIO,
-                 "TERRASHADE: unable to save auxiliary information in %s: %s", osPam.c_str(),
-                 VSIStrerror(errno));
-        eErr = CE_Warning;
-    }
-    VSIUnlink(osCopy.c_str()); // (gone after the rename)
+    else if (!bOld && VSIStatL(osPam.c_str(), &sStat) == 0)
+        VSIUnlink(osPam.c_str()); // (a file begun, cut short)
+    if (eErr != CE_None)
+        nPamFlags &= ~GPF_DIRTY;
     return eErr;
 }
 

@@ -176,8 +176,13 @@ class Pam(unittest.TestCase):
         """A save that fails (a full disk; here a file-size limit) leaves the
         products' file as it was: GDAL rewrote it in place, and a write cut
         short left it truncated, every product's entries lost, the nodata
-        and unit a user set among them (session 54's audit). The save goes
-        to a copy, renamed over the file once whole."""
+        and unit a user set among them (session 54's audit). The former
+        bytes are written back, in place, and the dataset's close does not
+        try again. A save changes the file, not what it is: a symbolic link
+        stays one, and nothing is written where GDAL saves nothing
+        (GDAL_PAM_ENABLED=NO: a first version of this fix, which saved to a
+        copy renamed over the file, left an empty file there, and replaced
+        links)."""
         conn = T.conn(self.dem, PRODUCT="svf", DIRECTIONS=4)
         T.run(["gdal_edit.py", "-ro", "-a_nodata", "7", "-units", "furlong", conn])
         T.run(["gdalinfo", "-stats", T.conn(self.dem)])
@@ -197,7 +202,19 @@ class Pam(unittest.TestCase):
         with open(aux, "rb") as f:
             self.assertEqual(f.read(), before)
         self.assertEqual(self.band_says(conn)[:2], (7.0, "furlong"))
-        self.assertEqual([n for n in os.listdir(self.demdir) if n.endswith(".saving")], [])
+        self.assertIn("Unable to save auxiliary information in %s" % aux, p.stderr)
+        # a link stays a link, its target saved into
+        store = os.path.join(self.tmp.path, "store.xml")
+        shutil.move(aux, store)
+        os.symlink(store, aux)
+        T.run(["gdalinfo", "-stats", T.conn(self.dem, PRODUCT="sky", DIRECTIONS=4)])
+        self.assertTrue(os.path.islink(aux))
+        with open(store) as f:
+            self.assertIn("PRODUCT=sky", f.read())
+        # nothing written where GDAL saves nothing
+        os.remove(aux)
+        T.run(["gdalinfo", "-stats", conn], GDAL_PAM_ENABLED="NO")
+        self.assertEqual(sorted(os.listdir(self.demdir)), ["jacksboro.tif"])
 
     def test_long_env_map_paths_are_two_entries(self):
         """Two ENV_MAP paths alike in their first 120 characters: two
