@@ -14,6 +14,11 @@
 
 int ts_cpu_count(void)
 {
+    /* the CPUs this process may run on (taskset, a container's cpuset):
+     * all the online ones ran twice the threads under taskset -c 0 */
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0)
+        return CPU_COUNT(&set);
     long n = sysconf(_SC_NPROCESSORS_ONLN);
     return n < 1 ? 1 : (int)n;
 }

@@ -587,7 +587,8 @@ ts_status ts_pyramid_horizon_compute(const ts_grid *grid, const ts_pyramid_opts 
 
 /* ----------------------------------------------------------------- misc */
 
-/** Number of online CPU cores (>= 1). */
+/** Number of CPU cores this process may run on (its affinity mask: taskset,
+ * a container's cpuset; else the online ones; >= 1). */
 int ts_cpu_count(void);
 
 /** Levels of the hand-written vector code (ts_cpu_vector_level). */

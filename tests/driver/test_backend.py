@@ -105,6 +105,23 @@ class Backend(unittest.TestCase):
         self.assertEqual([v.text for v in o], ["auto", "opencl", "c"])
         self.assertIn("TERRASHADE_BACKEND", o.get("description"))
 
+    def test_c_backend_counts_the_cores_it_may_use(self):
+        """THREADS=0 (the default) runs a thread per core this process may
+        use: under taskset -c 0 one, not every online core (session 54's
+        audit), as BACKEND_DEVICE says; the pixels are the same."""
+        mine = sorted(os.sched_getaffinity(0))
+        outs = []
+        for cpus in (str(mine[0]), ",".join(map(str, mine))):
+            out = os.path.join(self.dir, "cores_%d.tif" % len(outs))
+            T.run(["taskset", "-c", cpus, "gdal_translate", "-q", "-oo", "PRODUCT=svf",
+                   "-oo", "BACKEND=c", T.conn(T.LUX), out])
+            outs.append(out)
+        device = gdal.Open(outs[0]).GetMetadataItem("BACKEND_DEVICE")
+        self.assertIn("CPU, 1 cores", device)
+        device = gdal.Open(outs[1]).GetMetadataItem("BACKEND_DEVICE")
+        self.assertIn("CPU, %d cores" % len(mine), device)
+        np.testing.assert_array_equal(T.read(outs[0]), T.read(outs[1]))
+
     def test_c_and_opencl_agree(self):
         for dem_name, dem in self.dems.items():
             for name, options, tol in PRODUCTS:
