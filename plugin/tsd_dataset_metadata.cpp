@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <mutex>
 #include <string>
@@ -409,8 +410,14 @@ CPLErr TSDataset::TrySaveXML()
     // bytes are put back, and the dataset is marked clean, so that its close
     // does not try again (GDAL's destructor saves in place, unguarded).
     const std::string osPam = pszPam;
+    VSIStatBufL sStatBefore;
     std::vector<GByte> oOld;
     const bool bOld = ReadForRestore(osPam, oOld);
+    // a file (or a link, even dangling) there that could not be read whole is
+    // never removed below: only a file this save began is
+    struct stat sLink;
+    const bool bThere = bOld || VSIStatL(osPam.c_str(), &sStatBefore) == 0 ||
+                        (!STARTS_WITH(pszPam, "/vsi") && lstat(pszPam, &sLink) == 0);
     m_bSavingOver = true;
     const CPLErr eErr = GDALPamDataset::TrySaveXML();
     m_bSavingOver = false;
@@ -419,14 +426,13 @@ CPLErr TSDataset::TrySaveXML()
     if (eErr == CE_None && !bMoved)
         return eErr;
     std::vector<GByte> oNow;
-    VSIStatBufL sStat;
     if (bOld && (!ReadForRestore(osPam, oNow) || oNow != oOld) &&
         !RestoreAfterFailedSave(osPam, oOld))
         CPLError(CE_Warning, CPLE_FileIO,
                  "TERRASHADE: %s could not be written back as it was after the failed save: "
                  "its entries may be lost",
                  osPam.c_str());
-    else if (!bOld && VSIStatL(osPam.c_str(), &sStat) == 0)
+    else if (!bThere && VSIStatL(osPam.c_str(), &sStatBefore) == 0)
         VSIUnlink(osPam.c_str()); // (a file begun, cut short)
     if (eErr != CE_None)
         nPamFlags &= ~GPF_DIRTY;

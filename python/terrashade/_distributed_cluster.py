@@ -24,6 +24,15 @@ def dask_logs(level):
         handler.setLevel(level)
 
 
+def cores():
+    """The cores this process may run on (taskset, a container's cpuset), as
+    the driver's THREADS=0 takes them: os.cpu_count() counts every online one."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
 def start_cluster(args):
     """(client, cluster or None, task options to add)."""
     from dask.distributed import Client, LocalCluster
@@ -44,7 +53,7 @@ def start_cluster(args):
         dask_logs(logging.ERROR)  # as the local cluster's: the program says what failed
         # A worker has one task slot per thread, by default one per core.
         return client, None, 1
-    workers = args.workers or os.cpu_count() or 1
+    workers = args.workers or cores()
     runner = loop_without_ctrl_c()
     before = children()
     from distributed.deploy.spec import SpecCluster
@@ -79,7 +88,7 @@ def start_cluster(args):
     except BaseException:
         cluster.close()
         raise
-    return client, cluster, max(1, (os.cpu_count() or 1) // slots)
+    return client, cluster, max(1, cores() // slots)
 
 
 def loop_without_ctrl_c():
