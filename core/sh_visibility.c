@@ -7,6 +7,7 @@
  * end (a 1D table) whose horizon rises to fully blocked at the swath's edge.
  */
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -31,8 +32,9 @@ static double clamp_omega(double w)
  * Q_i(omega) = integral from omega to pi/2 of A_i(theta) cos(theta) d theta: Q
  * is tabulated once (Gauss, exact for these trigonometric polynomials to
  * rounding) with its derivative -A_i(omega) cos(omega), and read by cubic
- * Hermite interpolation (error below 1e-8 at QN nodes;
- * on the stack, 66 KB).
+ * Hermite interpolation (error below 1e-8 at QN nodes). The table (66 KB)
+ * depends on nothing, so it is built once per process and shared: on the
+ * stack it took METHOD=sh past a 96 KB stack (ulimit -s, a host's thread).
  */
 #define QN 257
 
@@ -61,8 +63,12 @@ static void theta_part(double theta, double a[TS_SH_COEFFS])
     }
 }
 
-static void q_build(q_table *t)
+static q_table q_shared;
+static pthread_once_t q_once = PTHREAD_ONCE_INIT;
+
+static void q_build(void)
 {
+    q_table *t = &q_shared;
     double gx[NQ], gw[NQ], a[TS_SH_COEFFS];
     ts_sh_gauss(NQ, gx, gw);
     for (int n = 0; n < QN; n++) {
@@ -78,6 +84,12 @@ static void q_build(q_table *t)
         for (int i = 0; i < TS_SH_COEFFS; i++)
             t->dq[n][i] = -a[i] * cos(omega);
     }
+}
+
+static const q_table *q_get(void)
+{
+    pthread_once(&q_once, q_build);
+    return &q_shared;
 }
 
 static void q_eval(const q_table *t, double omega, double out[TS_SH_COEFFS])
@@ -141,11 +153,9 @@ static void wedge_from_q(const q_table *t, const phi_nodes *n, double omega_a, d
 void ts_sh_wedge_project(double extent_deg, double omega_a, double omega_b,
                          double out[TS_SH_COEFFS])
 {
-    q_table t;
     phi_nodes n;
-    q_build(&t);
     phi_nodes_build(extent_deg, &n);
-    wedge_from_q(&t, &n, omega_a, omega_b, out);
+    wedge_from_q(q_get(), &n, omega_a, omega_b, out);
 }
 
 static double node_omega(int a)
@@ -163,23 +173,22 @@ static void build_rows(void *ctx, int worker, long a0, long a1)
     (void)worker;
     const build_ctx *C = ctx;
     double v[TS_SH_COEFFS];
-    q_table t;
+    const q_table *t = q_get();
     phi_nodes whole, half;
-    q_build(&t);
     phi_nodes_build(C->s->step, &whole);
     phi_nodes_build(C->s->step / 2, &half);
     for (long a = a0; a < a1; a++) {
         for (int b = 0; b < N_STEPS; b++) {
-            wedge_from_q(&t, &whole, node_omega((int)a), node_omega(b), v);
+            wedge_from_q(t, &whole, node_omega((int)a), node_omega(b), v);
             for (int k = 0; k < TS_SH_COEFFS; k++)
                 C->w->interior[((size_t)a * N_STEPS + b) * TS_SH_COEFFS + k] = (float)v[k];
         }
         if (!C->w->rise)
             continue;
-        wedge_from_q(&t, &half, node_omega((int)a), 90, v);
+        wedge_from_q(t, &half, node_omega((int)a), 90, v);
         for (int k = 0; k < TS_SH_COEFFS; k++)
             C->w->rise[a * TS_SH_COEFFS + k] = (float)v[k];
-        wedge_from_q(&t, &half, 90, node_omega((int)a), v);
+        wedge_from_q(t, &half, 90, node_omega((int)a), v);
         for (int k = 0; k < TS_SH_COEFFS; k++)
             C->w->fall[a * TS_SH_COEFFS + k] = (float)v[k];
     }
