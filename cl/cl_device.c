@@ -16,6 +16,7 @@
 #include <errno.h>
 #include <math.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -94,6 +95,8 @@ static pthread_once_t g_list_once = PTHREAD_ONCE_INIT;
 static pthread_mutex_t g_lock = PTHREAD_MUTEX_INITIALIZER;
 static ts_cl_dev *g_dev[TS_CL_MAX_DEVICES];
 static ts_error g_dev_fail[TS_CL_MAX_DEVICES]; /* code != OK: making it failed */
+
+static atomic_int g_discovered; /* discover() has run: no thread needed */
 
 static void discover(void)
 {
@@ -247,9 +250,39 @@ bad:
                 s);
 }
 
+static void *discover_once(void *unused)
+{
+    (void)unused;
+    pthread_once(&g_list_once, discover);
+    atomic_store_explicit(&g_discovered, 1, memory_order_release);
+    return NULL;
+}
+
+/* fn(arg) on a thread of its own with a stack of 8 MiB, or on the caller's
+ * where no such thread can be made. The OpenCL drivers' own calls need deep
+ * stacks that a host's thread may not have: PoCL's probe of the CPU and its
+ * clang building the kernels overflowed a stack of 64 KB (ulimit -s 64,
+ * SIGSEGV in pocl_cpuinfo_detect_device_info, in clang::Sema). */
+static void on_a_big_stack(void *(*fn)(void *), void *arg)
+{
+    pthread_attr_t attr;
+    pthread_t tid;
+    int made = 0;
+    if (pthread_attr_init(&attr) == 0) {
+        made = pthread_attr_setstacksize(&attr, (size_t)8 << 20) == 0 &&
+               pthread_create(&tid, &attr, fn, arg) == 0;
+        pthread_attr_destroy(&attr);
+    }
+    if (made)
+        pthread_join(tid, NULL);
+    else
+        fn(arg);
+}
+
 static ts_status list_ready(ts_error *err)
 {
-    pthread_once(&g_list_once, discover);
+    if (!atomic_load_explicit(&g_discovered, memory_order_acquire))
+        on_a_big_stack(discover_once, NULL);
     if (g_list.err != CL_SUCCESS) {
         if (g_list.err == -1001 || (g_list.err == CL_DEVICE_NOT_FOUND && g_list.ndev == 0))
             return ts_fail(err, TS_ERR_INTERNAL,
@@ -367,6 +400,19 @@ failed:
     return NULL;
 }
 
+typedef struct {
+    int index;
+    ts_cl_dev *made;
+    ts_error err;
+} make_call;
+
+static void *make_device_call(void *arg)
+{
+    make_call *c = arg;
+    c->made = make_device(c->index, &c->err);
+    return NULL;
+}
+
 ts_status ts_cl_device(ts_cl_dev **dev, ts_error *err)
 {
     *dev = NULL;
@@ -378,10 +424,12 @@ ts_status ts_cl_device(ts_cl_dev **dev, ts_error *err)
         return st;
     pthread_mutex_lock(&g_lock);
     if (!g_dev[i] && g_dev_fail[i].code == TS_OK) {
-        ts_error e = {0};
-        g_dev[i] = make_device(i, &e);
+        make_call c = {i, NULL, {0}};
+        on_a_big_stack(make_device_call, &c);
+        g_dev[i] = c.made;
         if (!g_dev[i])
-            g_dev_fail[i] = e.code != TS_OK ? e : (ts_error){TS_ERR_INTERNAL, "OpenCL failure"};
+            g_dev_fail[i] =
+                c.err.code != TS_OK ? c.err : (ts_error){TS_ERR_INTERNAL, "OpenCL failure"};
     }
     ts_cl_dev *d = g_dev[i];
     ts_error f = g_dev_fail[i];

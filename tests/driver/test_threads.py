@@ -7,8 +7,15 @@ recommended, but its reads take turns (GDAL 3.6's block cache of a dataset
 is not thread-safe: until session 49 the second thread got a windowed
 chunk's block unfilled, zeros and garbage), so they too get the single
 thread's pixels.
+
+A host's thread may have a small stack (Python's threading.stack_size, a
+JVM's -Xss, ulimit -s for a tool's main thread): the driver's work and the
+OpenCL drivers' probe run in 64 KiB (until session 55 METHOD=sh took 150 KB
+of the caller's stack and PoCL's probe of the CPU overflowed it, SIGSEGV).
 """
 import os
+import resource
+import subprocess
 import threading
 import unittest
 
@@ -70,17 +77,23 @@ def shared_by_two_threads(ds, windows):
     return at_once(task)
 
 
-class Threads(unittest.TestCase):
+class WithADem(unittest.TestCase):
+    """A 96² fractal DEM of seed SEED in a temporary directory."""
+    SEED = 5
+
     @classmethod
     def setUpClass(cls):
         cls.tmp = T.TempDir()
         cls.dir = cls.tmp.__enter__()
-        cls.dem = T.write_tif(os.path.join(cls.dir, "dem.tif"), T.fractal_dem(96, seed=5),
-                              UTM_GT, 32617)
+        cls.dem = T.write_tif(os.path.join(cls.dir, "dem.tif"),
+                              T.fractal_dem(96, seed=cls.SEED), UTM_GT, 32617)
 
     @classmethod
     def tearDownClass(cls):
         cls.tmp.__exit__(None, None, None)
+
+
+class Threads(WithADem):
 
     def same_in_threads(self, name, options):
         single = read_all(name, options)
@@ -147,6 +160,59 @@ class Threads(unittest.TestCase):
                 for i in range(2):
                     with self.subTest(options=options, trial=trial, thread=i):
                         np.testing.assert_array_equal(got[i], single)
+
+
+SMALL_STACK = 64 << 10
+SMALL_STACK_OPTIONS = (["PRODUCT=svf", "DIRECTIONS=8"],  # BACKEND=auto: OpenCL's probe
+                       ["PRODUCT=shade", "METHOD=sh"],
+                       ["PRODUCT=envlight", "DIRECTIONS=8",
+                        "ENV_MAP=" + os.path.join(T.DATA, "envmaps", "forest.exr")])
+
+IN_A_SMALL_THREAD = """
+import sys, threading
+from osgeo import gdal
+gdal.UseExceptions()
+out = {}
+def work():
+    ds = gdal.OpenEx(sys.argv[1], gdal.OF_RASTER, open_options=sys.argv[3:])
+    out['sum'] = repr(float(ds.GetRasterBand(1).ReadAsArray().astype('float64').sum()))
+    ds = None
+threading.stack_size(int(sys.argv[2]))
+t = threading.Thread(target=work)
+t.start()
+t.join()
+print(out['sum'])
+"""
+
+
+class SmallStacks(WithADem):
+    SEED = 6
+
+    def test_a_python_thread_of_64_kib(self):
+        """Each product read on a thread of 64 KiB sums as on the main
+        thread (a crash fails T.run)."""
+        for options in SMALL_STACK_OPTIONS:
+            with self.subTest(options=options):
+                want = float(read_all(T.conn(self.dem), options)[0].astype(np.float64).sum())
+                p = T.run(["/usr/bin/python3", "-c", IN_A_SMALL_THREAD, T.conn(self.dem),
+                           SMALL_STACK] + options)
+                self.assertEqual(float(p.stdout.split()[-1]), want)
+
+    def test_gdal_translate_under_ulimit_s_64(self):
+        """gdal_translate with a 64 KiB stack (ulimit -s 64) writes the
+        product it writes with the usual 8 MiB."""
+        def small_stack():
+            resource.setrlimit(resource.RLIMIT_STACK, (SMALL_STACK, SMALL_STACK))
+        for options in SMALL_STACK_OPTIONS:
+            with self.subTest(options=options):
+                want = read_all(T.conn(self.dem), options)
+                out = os.path.join(self.dir, "small.tif")
+                args = ["gdal_translate", "-q"] + T.oo_args(
+                    dict(o.split("=", 1) for o in options)) + [T.conn(self.dem), out]
+                p = subprocess.run(args, env=T.env(), capture_output=True, text=True,
+                               preexec_fn=small_stack, timeout=600)
+                self.assertEqual(p.returncode, 0, p.stderr)
+                np.testing.assert_array_equal(read_all(out, []), want)
 
 
 if __name__ == "__main__":
