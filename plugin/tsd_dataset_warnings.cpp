@@ -16,6 +16,50 @@
 namespace tsd
 {
 
+/* A product written by this driver: a known PRODUCT with its SOURCE_DEM in
+ * its metadata. */
+static bool HoldsAProduct(GDALDataset *poDS, std::string *posWhat)
+{
+    const char *pszSource = poDS->GetMetadataItem("SOURCE_DEM");
+    const char *pszProduct = poDS->GetMetadataItem("PRODUCT");
+    if (!(pszSource && pszProduct && tsd_product_find(pszProduct) >= 0))
+        return false;
+    *posWhat = CPLSPrintf("PRODUCT=%s of %s", pszProduct, pszSource);
+    return true;
+}
+
+/* A mosaic (gdalbuildvrt) keeps no metadata of its sources: the first few
+ * of its files say whether it mosaics products. A few only, each opened,
+ * so that a VRT of ten thousand tiles opens as fast as it did. */
+static std::string ProductInMosaic(GDALDataset *poDEM, const std::string &osDEM)
+{
+    if (!poDEM->GetDriver() || !EQUAL(poDEM->GetDriver()->GetDescription(), "VRT"))
+        return std::string();
+    const CPLStringList aosFiles(poDEM->GetFileList());
+    std::string osFound;
+    int nOpened = 0;
+    for (int i = 0; i < aosFiles.size() && nOpened < 4 && osFound.empty(); i++)
+    {
+        const char *pszFile = aosFiles[i];
+        const char *pszExt = CPLGetExtension(pszFile);
+        if (EQUAL(pszExt, "vrt") || EQUAL(pszExt, "xml") || EQUAL(pszExt, "ovr") ||
+            EQUAL(pszFile, poDEM->GetDescription()))
+            continue;
+        nOpened++;
+        GDALDataset *poSrc = GDALDataset::Open(pszFile, GDAL_OF_RASTER);
+        std::string osWhat;
+        if (poSrc && HoldsAProduct(poSrc, &osWhat))
+            osFound = CPLSPrintf("the DEM '%s' mosaics TERRASHADE products (its source '%s' "
+                                 "is %s, in its metadata), not heights: mosaic the DEMs "
+                                 "themselves",
+                                 osDEM.c_str(), pszFile, osWhat.c_str());
+        if (poSrc)
+            poSrc->ReleaseRef();
+    }
+    CPLErrorReset();
+    return osFound;
+}
+
 std::string ProductAsDEM(GDALDataset *poDEM, const std::string &osDEM)
 {
     // a product of this driver (TERRASHADE:TERRASHADE:dem.tif): its shading
@@ -28,12 +72,12 @@ std::string ProductAsDEM(GDALDataset *poDEM, const std::string &osDEM)
                           pszSource ? ")" : "");
     // a product written to a file (or a VRT of one) keeps its metadata: a
     // known PRODUCT with its SOURCE_DEM is a product, whatever its driver
-    const char *pszProduct = poDEM->GetMetadataItem("PRODUCT");
-    if (pszSource && pszProduct && tsd_product_find(pszProduct) >= 0)
-        return CPLSPrintf("the DEM '%s' is a written TERRASHADE product (PRODUCT=%s of %s, in "
-                          "its metadata), not a DEM: name the DEM itself",
-                          osDEM.c_str(), pszProduct, pszSource);
-    return std::string();
+    std::string osWhat;
+    if (HoldsAProduct(poDEM, &osWhat))
+        return CPLSPrintf("the DEM '%s' is a written TERRASHADE product (%s, in its "
+                          "metadata), not a DEM: name the DEM itself",
+                          osDEM.c_str(), osWhat.c_str());
+    return ProductInMosaic(poDEM, osDEM);
 }
 
 std::string NotHeights(GDALDataset *poDEM, int nBand, const std::string &osDEM)

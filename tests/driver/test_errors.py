@@ -174,6 +174,34 @@ class Errors(unittest.TestCase):
             T.run(["gdal_translate", "-q", DEM, copy])
             T.run(["gdalinfo", "-checksum", T.conn(copy)])
 
+    def test_mosaic_of_products_refused_as_dem(self):
+        """A gdalbuildvrt mosaic keeps no metadata of its sources: a mosaic
+        of products was shaded as heights, exit 0 (until session 55); its
+        sources say what it is. A mosaic of DEMs is a DEM."""
+        with T.TempDir() as tmp:
+            halves, shades = [], []
+            for i, srcwin in enumerate((["0", "0", "200", "344"], ["200", "0", "203", "344"])):
+                half = os.path.join(tmp, "half%d.tif" % i)
+                T.run(["gdal_translate", "-q", "-srcwin"] + srcwin + [DEM, half])
+                shade = os.path.join(tmp, "shade%d.tif" % i)
+                T.run(["gdal_translate", "-q", "-oo", "PRODUCT=svf", T.conn(half), shade])
+                halves.append(half)
+                shades.append(shade)
+            mosaic = os.path.join(tmp, "mosaic.vrt")
+            T.run(["gdalbuildvrt", "-q", mosaic] + shades)
+            for name in (mosaic, "vrt://" + mosaic + "?bands=1"):
+                p = T.run(["gdalinfo", "-checksum", T.conn(name)], ok=False)
+                self.assertIn("the DEM '%s' mosaics TERRASHADE products (its source '%s' is "
+                              "PRODUCT=svf of %s, in its metadata), not heights: mosaic the "
+                              "DEMs themselves" % (name, shades[0], halves[0]), p.stderr)
+            p = T.run(["gdal_translate", "-q", "-of", "TERRASHADE", "-oo", "PRODUCT=farshadow",
+                       "-oo", "DATE=2026-06-21", "-oo", "TIMEZONE=-06:00",
+                       T.conn(mosaic), os.path.join(tmp, "day.tsa")], ok=False)
+            self.assertIn("mosaics TERRASHADE products", p.stderr)
+            dems = os.path.join(tmp, "dems.vrt")
+            T.run(["gdalbuildvrt", "-q", dems] + halves)
+            T.run(["gdalinfo", "-checksum", T.conn(dems)])
+
     def test_out_of_memory_says_to_reopen(self):
         """A dataset keeps a failure for its life, its later reads repeating
         it: out of memory may pass (a moment of pressure under QGIS), so the
