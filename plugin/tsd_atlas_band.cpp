@@ -9,14 +9,14 @@
 #include <mutex>
 
 #include "tsd_atlas_dataset.h"
-#include "tsd_locale.h"
+#include "tsd_entry_state.h"
 
 namespace tsd
 {
 
 CPLErr TSAtlasBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
 {
-    tsd::CLocale oC; /* tsd_locale.h */
+    tsd::EntryState oEntry; /* tsd_entry_state.h */
     TSAtlasDataset *ds = static_cast<TSAtlasDataset *>(poDS);
     if (ds->m_bAll && ds->EnsureNear() != CE_None)
         return CE_Failure;

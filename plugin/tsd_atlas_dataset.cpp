@@ -31,7 +31,7 @@
 #include "tsd_geodesy.h"
 #include "tsd_options.h"
 #include "tsd_pam_band.h"
-#include "tsd_locale.h"
+#include "tsd_entry_state.h"
 
 namespace tsd
 {
@@ -58,6 +58,19 @@ TSAtlasDataset::~TSAtlasDataset()
     VSIFree(m_pabyNear);
     if (m_poDEM)
         GDALClose(m_poDEM);
+}
+
+int TSAtlasDataset::CloseDependentDatasets()
+{
+    int bDropped = GDALPamDataset::CloseDependentDatasets();
+    if (m_poDEM)
+    {
+        GDALClose(m_poDEM);
+        m_poDEM = nullptr;
+        m_bDEMReleased = true;
+        bDropped = TRUE;
+    }
+    return bDropped;
 }
 
 /* SHADOWS=all: near shadows (occluders within the far threshold) of every
@@ -87,7 +100,12 @@ CPLErr TSAtlasDataset::EnsureNear()
         sH.max_distance = psInfo->threshold_m;
         double adfGT[6];
         std::string osNotHeights;
-        if (!(std::isfinite(psInfo->threshold_m) && psInfo->threshold_m > 0))
+        if (m_bDEMReleased)
+            m_osError = CPLSPrintf("SHADOWS=all: the DEM '%s' was closed by GDAL's driver "
+                                   "manager (GDALDestroyDriverManager) before the atlas was "
+                                   "read",
+                                   m_osDEM.c_str());
+        else if (!(std::isfinite(psInfo->threshold_m) && psInfo->threshold_m > 0))
             m_osError = "SHADOWS=all needs the atlas's far threshold in "
                         "metres, which this atlas does not record";
         else if (dynamic_cast<TSAtlasDataset *>(poDEM))

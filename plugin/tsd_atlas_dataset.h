@@ -51,11 +51,17 @@ class TSAtlasDataset final : public GDALPamDataset
     GDALDataset *m_poDEM = nullptr; // SHADOWS=all: the DEM, opened and checked at open,
                                     // until EnsureNear has read it
 
+    bool m_bDEMReleased = false; // closed by CloseDependentDatasets before EnsureNear
+
     CPLErr EnsureNear();
 
   public:
     TSAtlasDataset() = default;
     ~TSAtlasDataset() override;
+
+    /* GDALDestroyDriverManager: SHADOWS=all's DEM closed here, as a
+     * product's (TSDataset::CloseDependentDatasets) */
+    int CloseDependentDatasets() override;
 
     CPLErr IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize, int nYSize,
                      void *pData, int nBufXSize, int nBufYSize, GDALDataType eBufType,

@@ -15,7 +15,7 @@
 #include "tsd_caller_progress.h"
 #include "tsd_dataset.h"
 #include "tsd_gdal.h"
-#include "tsd_locale.h"
+#include "tsd_entry_state.h"
 
 namespace tsd
 {
@@ -62,7 +62,7 @@ const char *TSRasterBand::NotHere() const
 
 CPLErr TSRasterBand::IReadBlock(int nBlockXOff, int nBlockYOff, void *pImage)
 {
-    tsd::CLocale oC; /* tsd_locale.h */
+    tsd::EntryState oEntry; /* tsd_entry_state.h */
     TSDataset *ds = static_cast<TSDataset *>(poDS);
     if (ds->m_poWindow) // chunk by chunk (tsd_window_cache.cpp)
         return WindowReadBlock(nBlockXOff, nBlockYOff, pImage);
@@ -146,7 +146,7 @@ CPLErr TSRasterBand::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXS
                                GDALDataType eBufType, GSpacing nPixelSpace, GSpacing nLineSpace,
                                GDALRasterIOExtraArg *psExtraArg)
 {
-    tsd::CLocale oC; /* tsd_locale.h */
+    tsd::EntryState oEntry; /* tsd_entry_state.h */
     std::unique_lock<std::recursive_mutex> oTurn;
     if (!TakeReadTurn(oTurn))
         return CE_Failure; // (before GDAL's block cache, which may hold the block unfilled)

@@ -37,7 +37,7 @@
 #include "tsd_gdal.h"
 #include "tsd_source_stamp.h"
 #include "tsd_window.h"
-#include "tsd_locale.h"
+#include "tsd_entry_state.h"
 
 namespace tsd
 {
@@ -57,6 +57,39 @@ TSDataset::~TSDataset()
     tsd_environment_free(&m_sEnv);
     VSIFree(m_pafProduct);
     VSIFree(m_pabyProduct);
+}
+
+/* GDALDestroyDriverManager (QGIS's exit, a C host's end) closes every
+ * dataset still open in any order, after asking each to let go of those it
+ * holds: the DEM and each overview level's DEM are closed here, where this
+ * dataset's destructor closed them again after GDAL had (SIGSEGV). A read
+ * after this fails with DEMReleasedError. */
+int TSDataset::CloseDependentDatasets()
+{
+    int bDropped = GDALPamDataset::CloseDependentDatasets();
+    if (m_oReadAhead.joinable())
+        m_oReadAhead.join();
+    for (std::unique_ptr<TSDataset> &poLevel : m_apoOverviews)
+        if (poLevel)
+        {
+            poLevel.reset();
+            bDropped = TRUE;
+        }
+    if (m_poDEM)
+    {
+        GDALClose(m_poDEM);
+        m_poDEM = nullptr;
+        bDropped = TRUE;
+    }
+    m_bDEMReleased = true;
+    return bDropped;
+}
+
+std::string TSDataset::DEMReleasedError() const
+{
+    return CPLSPrintf("the DEM '%s' was closed by GDAL's driver manager "
+                      "(GDALDestroyDriverManager) before the product was read",
+                      m_osDEM.c_str());
 }
 
 CPLErr TSDataset::GetGeoTransform(double *padfGT)
@@ -95,7 +128,7 @@ void TSDataset::StartReadAhead()
         m_oReadAhead = std::thread(
             [this]
             {
-                tsd::CLocale oC; /* its messages' numbers (tsd_locale.h) */
+                tsd::EntryState oEntry; /* its messages' numbers (tsd_entry_state.h) */
                 char szMsg[1024] = "";
                 m_eReadStatus = LoadDEM(&m_sReadGrid, szMsg, sizeof szMsg);
                 m_osReadMsg = szMsg;
@@ -126,6 +159,11 @@ ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
         m_sReadGrid = ts_grid{};
         snprintf(pszMsg, nMsg, "%s", m_osReadMsg.c_str());
         return m_eReadStatus;
+    }
+    if (m_bDEMReleased && !m_poDEM)
+    {
+        snprintf(pszMsg, nMsg, "%s", DEMReleasedError().c_str());
+        return TS_ERR_INTERNAL;
     }
     if (!m_poDEM) // an overview level: the DEM again, read at its size
     {
@@ -222,7 +260,7 @@ CPLErr TSDataset::IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize
                             GSpacing nLineSpace, GSpacing nBandSpace,
                             GDALRasterIOExtraArg *psExtraArg)
 {
-    tsd::CLocale oC; /* tsd_locale.h */
+    tsd::EntryState oEntry; /* tsd_entry_state.h */
     std::unique_lock<std::recursive_mutex> oTurn;
     if (!TakeReadTurn(oTurn))
         return CE_Failure;

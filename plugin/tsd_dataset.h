@@ -125,6 +125,7 @@ class TSDataset final : public GDALPamDataset
         ComputingHere &operator=(const ComputingHere &) = delete;
     };
     bool m_bTried = false;
+    bool m_bDEMReleased = false; // CloseDependentDatasets closed the DEM
     bool m_bSavingOver = false; // in TrySaveXML's call of GDAL's (tsd_dataset_metadata.cpp)
     std::string m_osError{};      // why computing failed
     ts_status m_eStatus = TS_OK;  // and its status
@@ -174,6 +175,8 @@ class TSDataset final : public GDALPamDataset
     std::atomic<bool> m_bBelowSeaWarned{false}; // WarnBelowSea: once per dataset
     std::atomic<bool> m_bVoidsWarned{false};   // WarnVoids: once per dataset
     static GDALDataset *OpenDEM(const char *pszDEM);
+    /* why a read after CloseDependentDatasets fails */
+    std::string DEMReleasedError() const;
     ts_status LoadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg);
     void StartReadAhead();
     ts_status ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg);
@@ -221,6 +224,8 @@ class TSDataset final : public GDALPamDataset
                      GSpacing nBandSpace, GDALRasterIOExtraArg *psExtraArg) override;
     CPLErr GetGeoTransform(double *padfGT) override;
     const OGRSpatialReference *GetSpatialRef() const override;
+    /* GDALDestroyDriverManager: the DEM closed here (tsd_dataset.cpp) */
+    int CloseDependentDatasets() override;
     char **GetMetadata(const char *pszDomain = "") override;
     const char *GetMetadataItem(const char *pszName, const char *pszDomain = "") override;
 

@@ -21,7 +21,7 @@
 
 #include "tsd_dataset.h"
 #include "tsd_gdal.h"
-#include "tsd_locale.h"
+#include "tsd_entry_state.h"
 #include "tsd_source_stamp.h"
 
 namespace tsd
@@ -50,7 +50,7 @@ void TSDataset::EnsureBackendMetadata()
 
 char **TSDataset::GetMetadata(const char *pszDomain)
 {
-    tsd::CLocale oC; /* tsd_locale.h */
+    tsd::EntryState oEntry; /* tsd_entry_state.h */
     if (!pszDomain || !*pszDomain)
         EnsureBackendMetadata();
     return GDALPamDataset::GetMetadata(pszDomain);
@@ -58,7 +58,7 @@ char **TSDataset::GetMetadata(const char *pszDomain)
 
 const char *TSDataset::GetMetadataItem(const char *pszName, const char *pszDomain)
 {
-    tsd::CLocale oC; /* tsd_locale.h */
+    tsd::EntryState oEntry; /* tsd_entry_state.h */
     if ((!pszDomain || !*pszDomain) && pszName && STARTS_WITH_CI(pszName, "BACKEND"))
         EnsureBackendMetadata();
     return GDALPamDataset::GetMetadataItem(pszName, pszDomain);

@@ -16,7 +16,7 @@
 
 #include "tsd_dataset.h"
 #include "tsd_gdal.h"
-#include "tsd_locale.h"
+#include "tsd_entry_state.h"
 
 namespace tsd
 {
@@ -157,13 +157,13 @@ CPLErr TSDataset::IBuildOverviews(const char *, int, const int *, int, const int
 
 int TSRasterBand::GetOverviewCount()
 {
-    tsd::CLocale oC; /* tsd_locale.h */
+    tsd::EntryState oEntry; /* tsd_entry_state.h */
     return static_cast<TSDataset *>(poDS)->OverviewsOffered();
 }
 
 GDALRasterBand *TSRasterBand::GetOverview(int i)
 {
-    tsd::CLocale oC; /* tsd_locale.h */
+    tsd::EntryState oEntry; /* tsd_entry_state.h */
     TSDataset *poOvr = static_cast<TSDataset *>(poDS)->Overview(i);
     return poOvr ? poOvr->GetRasterBand(nBand) : nullptr;
 }

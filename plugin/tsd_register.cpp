@@ -14,7 +14,7 @@
 
 #include "tsd_connstr.h"
 #include "tsd_gdal.h"
-#include "tsd_locale.h"
+#include "tsd_entry_state.h"
 #include "tsd_options.h"
 #include "tsd_products.h"
 
@@ -23,13 +23,13 @@ namespace
 
 int IdentifyAny(GDALOpenInfo *poOpenInfo)
 {
-    tsd::CLocale oC;
+    tsd::EntryState oEntry;
     return tsd::IdentifyProduct(poOpenInfo) || tsd::IdentifyAtlas(poOpenInfo);
 }
 
 GDALDataset *OpenAny(GDALOpenInfo *poOpenInfo)
 {
-    tsd::CLocale oC;
+    tsd::EntryState oEntry;
     if (tsd::IdentifyProduct(poOpenInfo))
         return tsd::OpenProduct(poOpenInfo);
     if (!tsd::IdentifyAtlas(poOpenInfo))
@@ -96,7 +96,7 @@ char **AtlasFiles(const char *pszName)
 
 CPLErr DeleteAny(const char *pszName)
 {
-    tsd::CLocale oC;
+    tsd::EntryState oEntry;
     if (IsConnection(pszName))
         return RefuseConnection("delete", pszName);
     char **papszFiles = AtlasFiles(pszName);
@@ -116,7 +116,7 @@ CPLErr DeleteAny(const char *pszName)
 
 CPLErr RenameAny(const char *pszNewName, const char *pszOldName)
 {
-    tsd::CLocale oC;
+    tsd::EntryState oEntry;
     if (IsConnection(pszOldName) || IsConnection(pszNewName))
         return RefuseConnection("rename", IsConnection(pszOldName) ? pszOldName : pszNewName);
     // as GDAL's DefaultRename, from AtlasFiles (a damaged atlas too)
@@ -140,7 +140,7 @@ CPLErr RenameAny(const char *pszNewName, const char *pszOldName)
 
 CPLErr CopyFilesAny(const char *pszNewName, const char *pszOldName)
 {
-    tsd::CLocale oC;
+    tsd::EntryState oEntry;
     if (IsConnection(pszOldName) || IsConnection(pszNewName))
         return RefuseConnection("copy", IsConnection(pszOldName) ? pszOldName : pszNewName);
     return GDALDriver::DefaultCopyFiles(pszNewName, pszOldName);
@@ -150,7 +150,7 @@ GDALDataset *CreateCopyAny(const char *pszFilename, GDALDataset *poSrcDS, int bS
                            char **papszOptions, GDALProgressFunc pfnProgress,
                            void *pProgressData)
 {
-    tsd::CLocale oC;
+    tsd::EntryState oEntry;
     return tsd::CreateAtlasCopy(pszFilename, poSrcDS, bStrict, papszOptions, pfnProgress,
                                 pProgressData);
 }
@@ -173,7 +173,7 @@ void GDALRegister_TERRASHADE()
         return;
     if (GDALGetDriverByName(tsd::DRIVER) != nullptr)
         return;
-    tsd::CLocale oC; /* the option list's numbers */
+    tsd::EntryState oEntry; /* the option list's numbers */
     GDALDriver *poDriver = new GDALDriver();
     poDriver->SetDescription(tsd::DRIVER);
     poDriver->SetMetadataItem(GDAL_DCAP_RASTER, "YES");

@@ -33,7 +33,7 @@ ts_status tsd_fail_core(char *msg, size_t msg_size, const char *what, const ts_e
 
 /**
  * The "C" locale, made once for the process (NULL: out of memory). The
- * driver holds it on its thread while it runs (tsd_locale.h); the parser
+ * driver holds it on its thread while it runs (tsd_entry_state.h); the parser
  * below takes it whatever the thread holds.
  */
 locale_t tsd_c_locale(void);

@@ -232,6 +232,12 @@ bool TSDataset::EnsureFarField()
         adfGT[i] *= static_cast<double>(H) / fh;
     OGRSpatialReferenceH hSRS =
         m_oSRS.IsEmpty() ? nullptr : OGRSpatialReference::ToHandle(&m_oSRS);
+    if (!m_poDEM)
+    {
+        s.status = TS_ERR_INTERNAL;
+        s.error = DEMReleasedError();
+        return false;
+    }
     char szMsg[1024] = "";
     tsd_cells sCells{};
     ts_grid sCoarse{};
@@ -273,6 +279,12 @@ bool TSDataset::ComputeChunk(int cx, int cy, WindowChunk &c)
     char szMsg[1024] = "";
     bool bCancelled = false; // by the caller's progress callback
     ts_grid sGrid{};
+    if (!m_poDEM)
+    {
+        s.status = TS_ERR_INTERNAL;
+        s.error = DEMReleasedError();
+        return false;
+    }
     ts_status eSt =
         tsd_dem_load_window(GDALRasterBand::ToHandle(m_poDEM->GetRasterBand(m_sOpts.band)),
                             &m_sCells, m_sOpts.z_factor, ax0, ay0, aw, ah, &sGrid,

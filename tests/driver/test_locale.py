@@ -2,7 +2,7 @@
 
 QGIS (Qt) and scripts that call locale.setlocale switch the process to the
 user's locale. The driver reads and writes numbers and compares names in
-the "C" locale whatever the process's (plugin/tsd_locale.h): under de_DE,
+the "C" locale whatever the process's (plugin/tsd_entry_state.h): under de_DE,
 whose decimal separator is a comma, the defaults LIGHT_RADIUS=0.2666,
 REFRACTION=0.13 and PRESSURE=1013.25 once read as 0 (a shadow product came
 out all nodata, others silently without refraction), metadata and atlas

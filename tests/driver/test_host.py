@@ -1,0 +1,110 @@
+"""The driver as a guest in its host's process (QGIS, a Python script, a C
+program): what the host does around it must not break it, and what it
+does must not change the host (session 55's audit of host processes).
+
+Each case runs in a child process, so that a crash or a hang fails the
+test (T.run, with a timeout) rather than the suite.
+"""
+import os
+import unittest
+
+import tsdriver as T
+
+UTM_GT = (600000.0, 30.0, 0.0, 4000000.0, 0.0, -30.0)
+
+DESTROY_WITH_OPEN = """
+import ctypes, os, sys
+from osgeo import gdal
+gdal.UseExceptions()
+name, options, reads = sys.argv[1], sys.argv[3:], sys.argv[2]
+ds = gdal.OpenEx(name, gdal.OF_RASTER, open_options=options)
+band = ds.GetRasterBand(1)
+if 'block' in reads:
+    band.ReadRaster(0, 0, 1, 1)
+if 'overview' in reads and band.GetOverviewCount():
+    band.GetOverview(0).ReadRaster(0, 0, 1, 1)
+    print('overview read')
+sys.stdout.flush()
+ctypes.CDLL('libgdal.so.32').GDALDestroyDriverManager()
+print('destroyed', flush=True)
+os._exit(0)
+"""
+
+FLOATING_POINT = """
+import ctypes, ctypes.util, hashlib, sys
+from osgeo import gdal
+gdal.UseExceptions()
+libm = ctypes.CDLL(ctypes.util.find_library('m'))
+FE_INVALID, FE_DIVBYZERO, FE_UPWARD, FE_ALL = 0x01, 0x04, 0x800, 0x3d
+mode, name, options = sys.argv[1], sys.argv[2], sys.argv[3:]
+if mode == 'traps':
+    libm.feenableexcept(FE_INVALID | FE_DIVBYZERO)
+elif mode == 'upward':
+    libm.fesetround(FE_UPWARD)
+libm.feclearexcept(FE_ALL)
+ds = gdal.OpenEx(name, gdal.OF_RASTER, open_options=options)
+data = ds.GetRasterBand(1).ReadAsArray().tobytes()
+ds = None
+print(hashlib.md5(data).hexdigest(), libm.fegetexcept(), libm.fegetround(),
+      libm.fetestexcept(FE_INVALID | FE_DIVBYZERO))
+"""
+
+
+class Host(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = T.TempDir()
+        cls.dir = cls.tmp.__enter__()
+        cls.dem = T.write_tif(os.path.join(cls.dir, "dem.tif"), T.fractal_dem(320, seed=4),
+                              UTM_GT, 32617)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.__exit__(None, None, None)
+
+    def test_destroy_driver_manager_with_datasets_open(self):
+        """GDALDestroyDriverManager (QGIS's exitQgis, a C host's end) closes
+        every open dataset in any order: a product's destructor closed its
+        DEM again after GDAL had (SIGSEGV), unread, windowed or with an
+        overview level read; so did an atlas opened with SHADOWS=all."""
+        atlas = os.path.join(self.dir, "day.tsa")
+        T.run(["gdal_translate", "-q", "-of", "TERRASHADE", "-oo", "PRODUCT=farshadow",
+               "-oo", "DATE=2026-06-21", "-oo", "TIMEZONE=-04:00", "-oo", "ATLAS_STEPS=4",
+               "-oo", "FAR_THRESHOLD=8", "-oo", "PROGRESS=no", T.conn(self.dem), atlas])
+        cases = [(T.conn(self.dem), "none", []),
+                 (T.conn(self.dem), "block", []),
+                 (T.conn(self.dem), "block overview", []),
+                 (T.conn(self.dem), "none", ["PRODUCT=svf", "TILE_SIZE=128"]),
+                 (T.conn(self.dem), "block overview", ["PRODUCT=svf", "TILE_SIZE=128"]),
+                 (atlas, "none", ["SHADOWS=all"])]
+        for name, reads, options in cases:
+            with self.subTest(name=name, reads=reads, options=options):
+                p = T.run(["/usr/bin/python3", "-c", DESTROY_WITH_OPEN, name, reads] + options)
+                self.assertIn("destroyed", p.stdout)
+                if "overview" in reads:
+                    self.assertIn("overview read", p.stdout)
+
+    def test_floating_point_environment(self):
+        """A host's floating-point traps (feenableexcept) made the core's
+        first division by zero a SIGFPE, and another rounding mode changed
+        the bits (until session 55). The driver runs with traps off and
+        rounding to nearest, and gives the host back its own environment,
+        with no exception flag of its own raised."""
+        env_map = os.path.join(T.DATA, "envmaps", "forest.exr")
+        for options in (["PRODUCT=shade", "BACKEND=c", "THREADS=1"],
+                        ["PRODUCT=svf", "DIRECTIONS=8"],
+                        ["PRODUCT=svf", "DIRECTIONS=8", "TILE_SIZE=128"],
+                        ["PRODUCT=shade", "METHOD=sh"],
+                        ["PRODUCT=sunhours", "DATE=2026-06-21", "TIMEZONE=-04:00"],
+                        ["PRODUCT=envlight", "DIRECTIONS=8", "ENV_MAP=" + env_map]):
+            with self.subTest(options=options):
+                plain = T.run(["/usr/bin/python3", "-c", FLOATING_POINT, "plain",
+                               T.conn(self.dem)] + options).stdout.split()
+                for mode, traps, rounding in (("traps", "5", "0"), ("upward", "0", "2048")):
+                    got = T.run(["/usr/bin/python3", "-c", FLOATING_POINT, mode,
+                                 T.conn(self.dem)] + options).stdout.split()
+                    self.assertEqual(got, [plain[0], traps, rounding, "0"], mode)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
