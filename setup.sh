@@ -11,7 +11,7 @@ PACKAGES="build-essential autoconf automake libtool pkg-config check valgrind
   libopenexr-dev openexr ocl-icd-opencl-dev opencl-headers pocl-opencl-icd
   qgis python3-qgis qgis-providers xauth clang
   python3-dask python3-distributed python3-rasterio python3-rioxarray
-  qemu-user locales grass-core"
+  qemu-user locales grass-core saga"
 
 missing=$(dpkg-query -W -f='${db:Status-Abbrev} ${Package}\n' $PACKAGES 2>/dev/null |
           awk '$1 != "ii" {print $2}'; for p in $PACKAGES; do

@@ -388,7 +388,7 @@ typedef enum {
     /** Timonen eq. 5 with the cell's normal: the cosine-weighted visible
      * fraction of the hemisphere around the normal (the default). */
     TS_SVF_RADIATIVE = 0,
-    /** Zaksek et al. (2011), as RVT_py, SAGA and GRASS r.skyview: 1 - the
+    /** Zaksek et al. (2011), as RVT_py and GRASS r.skyview: 1 - the
      * mean over directions of sin(max(horizon, 0)), relative to the
      * horizontal; no normal. */
     TS_SVF_SOLID_ANGLE = 1

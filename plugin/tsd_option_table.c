@@ -261,7 +261,7 @@ const opt_def TSD_OPTION_ROWS[] = {
      "radiative|solid_angle", 1, P, LISTED, NULL,
      "svf: radiative (Timonen eq. 5 with the cell's normal: the "
      "cosine-weighted visible sky, the light a tilted surface gets from a "
-     "uniform sky) or solid_angle (Zaksek et al. 2011, as RVT_py, SAGA and "
+     "uniform sky) or solid_angle (Zaksek et al. 2011, as RVT_py and "
      "GRASS r.skyview: 1 - mean sin(max(horizon, 0)), relative to the "
      "horizontal)"},
     {"OPENNESS", K_SELECT, FIELD(openness_negative), "positive", 0, 0, 0, 0,
