@@ -21,6 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cl_host_guard.h"
 #include "cl_internal.h"
 #include "status_internal.h"
 
@@ -253,36 +254,21 @@ bad:
 static void *discover_once(void *unused)
 {
     (void)unused;
+    ts_cl_host_mark_loaded();
     pthread_once(&g_list_once, discover);
     atomic_store_explicit(&g_discovered, 1, memory_order_release);
     return NULL;
 }
 
-/* fn(arg) on a thread of its own with a stack of 8 MiB, or on the caller's
- * where no such thread can be made. The OpenCL drivers' own calls need deep
- * stacks that a host's thread may not have: PoCL's probe of the CPU and its
- * clang building the kernels overflowed a stack of 64 KB (ulimit -s 64,
- * SIGSEGV in pocl_cpuinfo_detect_device_info, in clang::Sema). */
-static void on_a_big_stack(void *(*fn)(void *), void *arg)
-{
-    pthread_attr_t attr;
-    pthread_t tid;
-    int made = 0;
-    if (pthread_attr_init(&attr) == 0) {
-        made = pthread_attr_setstacksize(&attr, (size_t)8 << 20) == 0 &&
-               pthread_create(&tid, &attr, fn, arg) == 0;
-        pthread_attr_destroy(&attr);
-    }
-    if (made)
-        pthread_join(tid, NULL);
-    else
-        fn(arg);
-}
-
 static ts_status list_ready(ts_error *err)
 {
+    if (ts_cl_host_forked())
+        return ts_fail(err, TS_ERR_INTERNAL,
+                       "OpenCL was set up in the parent of this process before the fork that "
+                       "made it, and its drivers' threads stayed there: OpenCL cannot run "
+                       "here (use BACKEND=c in forked children, or start them with spawn)");
     if (!atomic_load_explicit(&g_discovered, memory_order_acquire))
-        on_a_big_stack(discover_once, NULL);
+        ts_cl_host_call(discover_once, NULL); /* (cl_host_guard.h) */
     if (g_list.err != CL_SUCCESS) {
         if (g_list.err == -1001 || (g_list.err == CL_DEVICE_NOT_FOUND && g_list.ndev == 0))
             return ts_fail(err, TS_ERR_INTERNAL,
@@ -425,7 +411,7 @@ ts_status ts_cl_device(ts_cl_dev **dev, ts_error *err)
     pthread_mutex_lock(&g_lock);
     if (!g_dev[i] && g_dev_fail[i].code == TS_OK) {
         make_call c = {i, NULL, {0}};
-        on_a_big_stack(make_device_call, &c);
+        ts_cl_host_call(make_device_call, &c);
         g_dev[i] = c.made;
         if (!g_dev[i])
             g_dev_fail[i] =

@@ -49,6 +49,50 @@ print(hashlib.md5(data).hexdigest(), libm.fegetexcept(), libm.fegetround(),
       libm.fetestexcept(FE_INVALID | FE_DIVBYZERO))
 """
 
+SIGNALS = """
+import sys
+from osgeo import gdal
+gdal.UseExceptions()
+GLIBC = (1 << 31) | (1 << 32)  # signals 32 and 33: glibc's own, once threads exist
+def signals():
+    s = dict(l.split(':', 1) for l in open('/proc/self/status').read().splitlines())
+    return [int(s[k], 16) & ~GLIBC for k in ('SigCgt', 'SigIgn')]
+before = signals()
+for options in ([], ['PRODUCT=svf', 'BACKEND=opencl']):
+    ds = gdal.OpenEx(sys.argv[1], gdal.OF_RASTER, open_options=options)
+    ds.GetMetadata()
+    ds.GetRasterBand(1).ReadRaster(0, 0, 8, 8)
+    ds = None
+    print(options, before == signals(), before, signals())
+"""
+
+FORK = """
+import os, sys, time
+from osgeo import gdal
+gdal.UseExceptions()
+def read(options):
+    ds = gdal.OpenEx(sys.argv[1], gdal.OF_RASTER, open_options=options)
+    out = ds.GetRasterBand(1).ReadRaster()
+    ds = None
+    return out
+want = read(['PRODUCT=svf', 'BACKEND=opencl'])
+pid = os.fork()
+if pid == 0:
+    ok = all(read(options) == want for options in (['PRODUCT=svf', 'BACKEND=opencl'],
+                                                   ['PRODUCT=svf']))
+    os._exit(0 if ok else 3)
+start = time.time()
+while time.time() - start < 60:
+    done, status = os.waitpid(pid, os.WNOHANG)
+    if done:
+        print('child', os.waitstatus_to_exitcode(status))
+        break
+    time.sleep(0.1)
+else:
+    os.kill(pid, 9)
+    print('child hung')
+"""
+
 
 class Host(unittest.TestCase):
     @classmethod
@@ -104,6 +148,25 @@ class Host(unittest.TestCase):
                     got = T.run(["/usr/bin/python3", "-c", FLOATING_POINT, mode,
                                  T.conn(self.dem)] + options).stdout.split()
                     self.assertEqual(got, [plain[0], traps, rounding, "0"], mode)
+
+    def test_opencl_leaves_the_signals_alone(self):
+        """PoCL's LLVM took 15 signals over for the whole process as OpenCL
+        started (BACKEND=auto does, for the metadata, even for gdalinfo):
+        a host's SIGUSR1 handler (Python's faulthandler) was never called,
+        and SIGXFSZ no longer ignored. Until session 55."""
+        p = T.run(["/usr/bin/python3", "-c", SIGNALS, T.conn(self.dem)])
+        self.assertEqual([line.split("]")[1].split()[0] for line in p.stdout.splitlines()],
+                         ["True", "True"], p.stdout)
+
+    def test_fork_after_opencl(self):
+        """A child forked after its parent had set OpenCL up (multiprocessing's
+        fork, a prefork server) waited for ever on the drivers' threads,
+        which stayed in the parent; it now runs the C backend, with a
+        warning where BACKEND=opencl asked for OpenCL."""
+        p = T.run(["/usr/bin/python3", "-c", FORK, T.conn(self.dem)])
+        self.assertIn("child 0", p.stdout)
+        self.assertIn("OpenCL was set up in the parent of this process before the fork",
+                      p.stderr)
 
 
 if __name__ == "__main__":
