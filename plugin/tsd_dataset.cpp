@@ -123,21 +123,39 @@ void TSDataset::StartReadAhead()
 {
     if (m_poWindow || !m_poDEM || m_bTried || m_oReadAhead.joinable())
         return;
+    // the caller's thread-local configuration (a /vsicurl/ DEM's headers or
+    // credentials, set with CPLSetThreadLocalConfigOption, as GDAL 3.7's
+    // gdal.config_options does): without it the thread read as another
+    // client and failed ("Missing data for block"), where the caller's own
+    // read succeeds
+    char **papszThreadConfig = CPLGetThreadLocalConfigOptions();
     try
     {
         m_oReadAhead = std::thread(
-            [this]
+            [this, papszThreadConfig]
             {
+                CPLSetThreadLocalConfigOptions(papszThreadConfig);
+                CSLDestroy(papszThreadConfig);
                 tsd::EntryState oEntry; /* its messages' numbers (tsd_entry_state.h) */
+                CPLPushErrorHandlerEx(HoldMessage, &m_aoReadMessages);
                 char szMsg[1024] = "";
                 m_eReadStatus = LoadDEM(&m_sReadGrid, szMsg, sizeof szMsg);
                 m_osReadMsg = szMsg;
+                CPLPopErrorHandler();
+                CPLSetThreadLocalConfigOptions(nullptr);
             });
     }
     catch (const std::exception &)
     {
         // no thread: EnsureComputed reads the DEM itself
+        CSLDestroy(papszThreadConfig);
     }
+}
+
+void CPL_STDCALL TSDataset::HoldMessage(CPLErr eClass, CPLErrorNum nNum, const char *pszMsg)
+{
+    auto *paoHeld = static_cast<std::vector<HeldMessage> *>(CPLGetErrorHandlerUserData());
+    paoHeld->push_back(HeldMessage{eClass, nNum, pszMsg ? pszMsg : ""});
 }
 
 /* The open DEM's band, resampled to the dataset's size, into *psGrid. */
@@ -155,6 +173,9 @@ ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
     if (m_oReadAhead.joinable())
     {
         m_oReadAhead.join();
+        for (const HeldMessage &oHeld : m_aoReadMessages)
+            CPLError(oHeld.eClass, oHeld.nNum, "%s", oHeld.osMsg.c_str());
+        m_aoReadMessages.clear();
         *psGrid = m_sReadGrid;
         m_sReadGrid = ts_grid{};
         snprintf(pszMsg, nMsg, "%s", m_osReadMsg.c_str());

@@ -152,6 +152,16 @@ class TSDataset final : public GDALPamDataset
     ts_grid m_sReadGrid{};       // what it read, for ReadDEM
     ts_status m_eReadStatus = TS_OK;
     std::string m_osReadMsg{};
+    /* GDAL's messages on that thread, said again on the reader's (ReadDEM):
+     * a host's error handler is its thread's */
+    struct HeldMessage
+    {
+        CPLErr eClass;
+        CPLErrorNum nNum;
+        std::string osMsg;
+    };
+    std::vector<HeldMessage> m_aoReadMessages{};
+    static void CPL_STDCALL HoldMessage(CPLErr eClass, CPLErrorNum nNum, const char *pszMsg);
 
     CPLErr EnsureComputed();
     void StartProgress(tsd_progress *psProgress, const char *pszLabel, tsd_run *psRun,

@@ -93,6 +93,58 @@ else:
     print('child hung')
 """
 
+THREAD_LOCAL = """
+import http.server, re, sys, threading
+from osgeo import gdal
+gdal.UseExceptions()
+data = open(sys.argv[1], 'rb').read()
+class Handler(http.server.BaseHTTPRequestHandler):
+    def log_message(self, *args):
+        pass
+    def allowed(self):
+        if self.headers.get('X-Token') == 'sesame':
+            return True
+        self.send_response(403)
+        self.send_header('Content-Length', '0')
+        self.end_headers()
+        return False
+    def do_HEAD(self):
+        if self.allowed():
+            self.send_response(200)
+            self.send_header('Content-Length', str(len(data)))
+            self.send_header('Accept-Ranges', 'bytes')
+            self.end_headers()
+    def do_GET(self):
+        if not self.allowed():
+            return
+        m = re.match(r'bytes=(\\d+)-(\\d*)', self.headers.get('Range', 'bytes=0-'))
+        a, b = int(m.group(1)), min(int(m.group(2) or len(data) - 1), len(data) - 1)
+        self.send_response(206)
+        self.send_header('Content-Range', 'bytes %d-%d/%d' % (a, b, len(data)))
+        self.send_header('Content-Length', str(b - a + 1))
+        self.end_headers()
+        self.wfile.write(data[a:b + 1])
+server = http.server.ThreadingHTTPServer(('127.0.0.1', 0), Handler)
+threading.Thread(target=server.serve_forever, daemon=True).start()
+gdal.SetConfigOption('GDAL_DISABLE_READDIR_ON_OPEN', 'EMPTY_DIR')
+gdal.SetThreadLocalConfigOption('GDAL_HTTP_HEADERS', 'X-Token: sesame')
+url = '/vsicurl/http://127.0.0.1:%d/dem.tif' % server.server_address[1]
+ds = gdal.OpenEx('TERRASHADE:' + url, gdal.OF_RASTER)
+ds.GetMetadata()  # (as gdal_translate and QGIS do first)
+print('read', ds.GetRasterBand(1).Checksum())
+"""
+
+HANDLER = """
+import sys
+from osgeo import gdal
+said = []
+gdal.PushErrorHandler(lambda level, number, message: said.append(message))
+ds = gdal.OpenEx(sys.argv[1], gdal.OF_RASTER)
+ds.GetMetadata()  # (as gdal_translate and QGIS do first)
+print('read', ds.GetRasterBand(1).ReadRaster() is not None)
+print('said', '|'.join(said))
+"""
+
 
 class Host(unittest.TestCase):
     @classmethod
@@ -167,6 +219,31 @@ class Host(unittest.TestCase):
         self.assertIn("child 0", p.stdout)
         self.assertIn("OpenCL was set up in the parent of this process before the fork",
                       p.stderr)
+
+    def test_the_dem_read_ahead_is_the_callers(self):
+        """The DEM is read on a thread of the driver's while OpenCL is
+        probed (GetMetadata, which gdal_translate and QGIS call first): it
+        took none of the caller's thread-local configuration (a /vsicurl/
+        DEM's headers, as GDAL 3.7's gdal.config_options sets them), so that
+        the read failed where the caller's own succeeds, and GDAL's messages
+        on it bypassed the caller's error handler (printed on stderr)."""
+        # large enough that the open's sample leaves blocks unread by /vsicurl/
+        big = T.write_tif(os.path.join(self.dir, "big.tif"), T.fractal_dem(1024, seed=5),
+                          UTM_GT, 32617)
+        tiled = os.path.join(self.dir, "tiled.tif")
+        T.run(["gdal_translate", "-q", "-co", "TILED=YES", "-co", "COMPRESS=DEFLATE", big,
+               tiled])
+        p = T.run(["/usr/bin/python3", "-c", THREAD_LOCAL, tiled])
+        self.assertIn("read ", p.stdout)
+        truncated = os.path.join(self.dir, "truncated.tif")
+        T.run(["gdal_translate", "-q", "-co", "TILED=YES", "-co", "BLOCKXSIZE=64", "-co",
+               "BLOCKYSIZE=64", self.dem, truncated])
+        os.truncate(truncated, os.path.getsize(truncated) * 7 // 10)
+        p = T.run(["/usr/bin/python3", "-c", HANDLER, T.conn(truncated)])
+        self.assertIn("read False", p.stdout)
+        self.assertIn("Missing data for block", p.stdout)
+        self.assertIn("cannot read the DEM", p.stdout)
+        self.assertNotIn("Missing data", p.stderr)
 
 
 if __name__ == "__main__":
