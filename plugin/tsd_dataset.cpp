@@ -123,6 +123,13 @@ void TSDataset::StartReadAhead()
 {
     if (m_poWindow || !m_poDEM || m_bTried || m_oReadAhead.joinable())
         return;
+    // a DEM over the network is not read ahead: the metadata alone
+    // (gdalinfo, QGIS's layer properties) downloaded all of it
+    bool bLocal = VSIIsLocal(m_osDEMPath.c_str());
+    for (const std::string &osFile : m_aosDEMFiles)
+        bLocal = bLocal && VSIIsLocal(osFile.c_str());
+    if (!bLocal)
+        return;
     // the caller's thread-local configuration (a /vsicurl/ DEM's headers or
     // credentials, set with CPLSetThreadLocalConfigOption, as GDAL 3.7's
     // gdal.config_options does): without it the thread read as another

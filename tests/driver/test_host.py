@@ -93,18 +93,24 @@ else:
     print('child hung')
 """
 
-THREAD_LOCAL = """
+SERVER = """
 import http.server, re, sys, threading
 from osgeo import gdal
 gdal.UseExceptions()
 data = open(sys.argv[1], 'rb').read()
+sent = [0]
 class Handler(http.server.BaseHTTPRequestHandler):
+    # dem.tif to a client that sends X-Token: sesame; 404 for other names
     def log_message(self, *args):
         pass
     def allowed(self):
-        if self.headers.get('X-Token') == 'sesame':
+        if self.path != '/dem.tif':
+            code = 404
+        elif self.headers.get('X-Token') != 'sesame':
+            code = 403
+        else:
             return True
-        self.send_response(403)
+        self.send_response(code)
         self.send_header('Content-Length', '0')
         self.end_headers()
         return False
@@ -124,13 +130,25 @@ class Handler(http.server.BaseHTTPRequestHandler):
         self.send_header('Content-Length', str(b - a + 1))
         self.end_headers()
         self.wfile.write(data[a:b + 1])
+        sent[0] += b - a + 1
 server = http.server.ThreadingHTTPServer(('127.0.0.1', 0), Handler)
 threading.Thread(target=server.serve_forever, daemon=True).start()
 gdal.SetConfigOption('GDAL_DISABLE_READDIR_ON_OPEN', 'EMPTY_DIR')
-gdal.SetThreadLocalConfigOption('GDAL_HTTP_HEADERS', 'X-Token: sesame')
 url = '/vsicurl/http://127.0.0.1:%d/dem.tif' % server.server_address[1]
+"""
+
+THREAD_LOCAL = SERVER + """
+gdal.SetThreadLocalConfigOption('GDAL_HTTP_HEADERS', 'X-Token: sesame')
 ds = gdal.OpenEx('TERRASHADE:' + url, gdal.OF_RASTER)
 ds.GetMetadata()  # (as gdal_translate and QGIS do first)
+print('read', ds.GetRasterBand(1).Checksum())
+"""
+
+NETWORK_INFO = SERVER + """
+gdal.SetConfigOption('GDAL_HTTP_HEADERS', 'X-Token: sesame')
+gdal.Info('TERRASHADE:' + url)
+print('info', sent[0], len(data))
+ds = gdal.OpenEx('TERRASHADE:' + url, gdal.OF_RASTER)
 print('read', ds.GetRasterBand(1).Checksum())
 """
 
@@ -234,6 +252,12 @@ class Host(unittest.TestCase):
         T.run(["gdal_translate", "-q", "-co", "TILED=YES", "-co", "COMPRESS=DEFLATE", big,
                tiled])
         p = T.run(["/usr/bin/python3", "-c", THREAD_LOCAL, tiled])
+        self.assertIn("read ", p.stdout)
+        # and a DEM over the network is not read ahead: gdalinfo downloaded
+        # it all (until session 55), for its metadata alone
+        p = T.run(["/usr/bin/python3", "-c", NETWORK_INFO, tiled])
+        sent, size = map(int, p.stdout.split("info ")[1].split()[:2])
+        self.assertLess(sent, size / 2, p.stdout)  # (the open reads 256 x 256 cells)
         self.assertIn("read ", p.stdout)
         truncated = os.path.join(self.dir, "truncated.tif")
         T.run(["gdal_translate", "-q", "-co", "TILED=YES", "-co", "BLOCKXSIZE=64", "-co",
