@@ -17,16 +17,20 @@
 #define TS_CL_HOST_GUARD_H
 
 /* fn(arg) on a thread of its own with an 8 MiB stack (on the caller's
- * where no such thread can be made), the process's signal dispositions
- * before the call put back after it. */
+ * where no such thread can be made), in the caller's locale; a signal
+ * disposition the call set to a handler of the drivers' libraries (those
+ * loaded during such calls) is put back as it was before the call (one
+ * call at a time: a second caller would take the drivers' handlers for
+ * the host's). A host that sets a disposition on another thread while
+ * the drivers start (~50 ms) may have it replaced by theirs. */
 void ts_cl_host_call(void *(*fn)(void *), void *arg);
 
 /* Record that this process has set OpenCL up (its drivers are loaded). */
 void ts_cl_host_mark_loaded(void);
 
 /* 1 if OpenCL was set up in a parent process before a fork() that made
- * this one: the drivers' threads stayed there, and OpenCL must not be used
- * here. */
+ * this one (pthread_atfork): the drivers' threads stayed there, and OpenCL
+ * must not be used here. */
 int ts_cl_host_forked(void);
 
 #endif
