@@ -69,19 +69,22 @@ int TSDataset::CloseDependentDatasets()
     int bDropped = GDALPamDataset::CloseDependentDatasets();
     if (m_oReadAhead.joinable())
         m_oReadAhead.join();
-    for (std::unique_ptr<TSDataset> &poLevel : m_apoOverviews)
-        if (poLevel)
-        {
-            poLevel.reset();
-            bDropped = TRUE;
-        }
+    {
+        std::lock_guard<std::mutex> oLock(m_oOvrMutex);
+        for (std::unique_ptr<TSDataset> &poLevel : m_apoOverviews)
+            if (poLevel)
+            {
+                poLevel.reset();
+                bDropped = TRUE;
+            }
+        m_bDEMReleased = true; // (before a level could be made again)
+    }
     if (m_poDEM)
     {
         GDALClose(m_poDEM);
         m_poDEM = nullptr;
         bDropped = TRUE;
     }
-    m_bDEMReleased = true;
     return bDropped;
 }
 
@@ -115,6 +118,21 @@ GDALDataset *TSDataset::OpenDEM(const char *pszDEM)
     return GDALDataset::Open(pszDEM, GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR);
 }
 
+/* Whether a path reads no network: GDAL 3.6's VSIIsLocal looks at the
+ * outer file system only (/vsizip//vsicurl/..., /vsisubfile/...,/vsis3/...
+ * and /vsicurl_streaming/ read as local), so every file system named in
+ * it is asked, and URLs given as such. */
+static bool IsLocalPath(const std::string &osPath)
+{
+    for (const char *pszURL : {"http://", "https://", "ftp://", "_streaming/"})
+        if (osPath.find(pszURL) != std::string::npos)
+            return false;
+    for (size_t i = osPath.find("/vsi"); i != std::string::npos; i = osPath.find("/vsi", i + 1))
+        if (!VSIIsLocal(osPath.c_str() + i))
+            return false;
+    return VSIIsLocal(osPath.c_str());
+}
+
 /* Start reading the DEM on a thread of its own, for ReadDEM, while this
  * one probes the OpenCL device for the metadata (tens of ms with PoCL):
  * the whole-DEM path only, which reads it once, and only before computing.
@@ -125,9 +143,9 @@ void TSDataset::StartReadAhead()
         return;
     // a DEM over the network is not read ahead: the metadata alone
     // (gdalinfo, QGIS's layer properties) downloaded all of it
-    bool bLocal = VSIIsLocal(m_osDEMPath.c_str());
+    bool bLocal = IsLocalPath(m_osDEMPath);
     for (const std::string &osFile : m_aosDEMFiles)
-        bLocal = bLocal && VSIIsLocal(osFile.c_str());
+        bLocal = bLocal && IsLocalPath(osFile);
     if (!bLocal)
         return;
     // the caller's thread-local configuration (a /vsicurl/ DEM's headers or
@@ -146,8 +164,13 @@ void TSDataset::StartReadAhead()
                 tsd::EntryState oEntry; /* its messages' numbers (tsd_entry_state.h) */
                 CPLPushErrorHandlerEx(HoldMessage, &m_aoReadMessages);
                 char szMsg[1024] = "";
+                const auto tStart = std::chrono::steady_clock::now();
                 m_eReadStatus = LoadDEM(&m_sReadGrid, szMsg, sizeof szMsg);
                 m_osReadMsg = szMsg;
+                const std::chrono::duration<double> dfRead =
+                    std::chrono::steady_clock::now() - tStart;
+                CPLDebug(DRIVER, "read the DEM ahead, on a thread of its own, in %.3f s",
+                         dfRead.count());
                 CPLPopErrorHandler();
                 CPLSetThreadLocalConfigOptions(nullptr);
             });

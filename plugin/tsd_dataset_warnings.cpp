@@ -38,6 +38,10 @@ static std::string ProductInMosaic(GDALDataset *poDEM, const std::string &osDEM)
     const CPLStringList aosFiles(poDEM->GetFileList());
     std::string osFound;
     int nOpened = 0;
+    // quiet, and the caller's last error kept: a source that does not open
+    // here is the VRT's reads' to report
+    CPLErrorStateBackuper oState;
+    CPLErrorHandlerPusher oQuiet(CPLQuietErrorHandler);
     for (int i = 0; i < aosFiles.size() && nOpened < 4 && osFound.empty(); i++)
     {
         const char *pszFile = aosFiles[i];
@@ -56,7 +60,6 @@ static std::string ProductInMosaic(GDALDataset *poDEM, const std::string &osDEM)
         if (poSrc)
             poSrc->ReleaseRef();
     }
-    CPLErrorReset();
     return osFound;
 }
 

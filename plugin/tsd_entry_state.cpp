@@ -13,7 +13,8 @@ EntryState::EntryState() : m_old((locale_t)0), m_fenv(), m_bFenv(false)
         m_old = uselocale(c);
     /* feholdexcept: saved, flags cleared, every trap off */
     m_bFenv = feholdexcept(&m_fenv) == 0;
-    fesetround(FE_TONEAREST);
+    if (m_bFenv)
+        fesetround(FE_TONEAREST);
 }
 
 EntryState::~EntryState()

@@ -134,6 +134,8 @@ TSDataset *TSDataset::Overview(int i)
     MakeOverviews();
     if (i < 0 || i >= static_cast<int>(m_anOffered.size()))
         return nullptr;
+    if (!m_apoOverviews[i] && m_bDEMReleased) // (CloseDependentDatasets: no new level)
+        return nullptr;
     if (!m_apoOverviews[i])
         m_apoOverviews[i].reset(MakeOverview(m_anOffered[i]));
     return m_apoOverviews[i].get();

