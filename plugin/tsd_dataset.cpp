@@ -114,8 +114,44 @@ const OGRSpatialReference *TSDataset::GetSpatialRef() const
  * same values. The user's own setting wins. */
 GDALDataset *TSDataset::OpenDEM(const char *pszDEM)
 {
-    CPLConfigOptionSetter oDirect("GTIFF_DIRECT_IO", "YES", true);
+    // a file of the operating system's only: a virtual file system may not
+    // implement the reads it makes (rasterio's /vsipythonfilelike/: "Read
+    // not implemented", where GDAL's own reads succeed)
+    const bool bDirect = strstr(pszDEM, "/vsi") == nullptr;
+    CPLConfigOptionSetter oDirect("GTIFF_DIRECT_IO", bDirect ? "YES" : nullptr, true);
     return GDALDataset::Open(pszDEM, GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR);
+}
+
+/* Whether reading the DEM may call into the host's code (a Python pixel
+ * function of a VRT, a Python file object through rasterio's
+ * /vsipythonfilelike/): on a thread of the driver's that waited for the
+ * host's lock (Python's GIL, which rasterio holds in close, checksum and
+ * statistics) while the host waited for the thread (a deadlock). */
+static bool CallsTheHost(GDALDataset *poDEM, const std::vector<std::string> &aosFiles)
+{
+    const auto Python = [](const char *pszXML)
+    {
+        return pszXML && CPLString(pszXML).ifind("<PixelFunctionLanguage>Python") !=
+                             std::string::npos;
+    };
+    char **papszVRT = poDEM->GetMetadata("xml:VRT");
+    if (papszVRT && Python(papszVRT[0]))
+        return true;
+    for (const std::string &osFile : aosFiles)
+    {
+        if (osFile.find("/vsipython") != std::string::npos)
+            return true;
+        GByte *pabyText = nullptr;
+        if (EQUAL(CPLGetExtension(osFile.c_str()), "vrt") &&
+            VSIIngestFile(nullptr, osFile.c_str(), &pabyText, nullptr, 1 << 20))
+        {
+            const bool bPython = Python(reinterpret_cast<const char *>(pabyText));
+            VSIFree(pabyText);
+            if (bPython)
+                return true;
+        }
+    }
+    return false;
 }
 
 /* Whether a path reads no network: GDAL 3.6's VSIIsLocal looks at the
@@ -146,7 +182,8 @@ void TSDataset::StartReadAhead()
     bool bLocal = IsLocalPath(m_osDEMPath);
     for (const std::string &osFile : m_aosDEMFiles)
         bLocal = bLocal && IsLocalPath(osFile);
-    if (!bLocal)
+    if (!bLocal || m_osDEMPath.find("/vsipython") != std::string::npos ||
+        CallsTheHost(m_poDEM, m_aosDEMFiles))
         return;
     // the caller's thread-local configuration (a /vsicurl/ DEM's headers or
     // credentials, set with CPLSetThreadLocalConfigOption, as GDAL 3.7's

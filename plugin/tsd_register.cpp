@@ -53,7 +53,10 @@ CPLErr RefuseConnection(const char *pszWhat, const char *pszName)
     CPLError(CE_Failure, CPLE_NotSupported,
              "TERRASHADE: cannot %s '%s': a connection string names a product computed "
              "from a DEM, not a file of its own; the DEM is left as it is (%s it by its "
-             "own name if that is what you mean)",
+             "own name if that is what you mean). A product is read-only: its nodata, "
+             "unit and colour are set on a dataset opened read-only (gdal_edit.py -ro, "
+             "osgeo.gdal's SetNoDataValue), not through an update (rasterio's mode 'r+' "
+             "writes a copy over it on closing, which is this)",
              pszWhat, pszName, pszWhat);
     return CE_Failure;
 }

@@ -194,6 +194,56 @@ print('info', sent[0], len(data))
 ds = gdal.OpenEx('TERRASHADE:' + url, gdal.OF_RASTER)
 print('read', ds.GetRasterBand(1).Checksum())
 """
+PYTHON_VRT = """<VRTDataset rasterXSize="{w}" rasterYSize="{h}">
+  <SRS>EPSG:32617</SRS>
+  <GeoTransform>{gt}</GeoTransform>
+  <VRTRasterBand dataType="Float32" band="1" subClass="VRTDerivedRasterBand">
+    <PixelFunctionType>plus10</PixelFunctionType>
+    <PixelFunctionLanguage>Python</PixelFunctionLanguage>
+    <PixelFunctionCode><![CDATA[
+def plus10(in_ar, out_ar, xoff, yoff, xsize, ysize, raster_xsize, raster_ysize, buf_radius,
+           gt, **kwargs):
+    out_ar[:] = in_ar[0] + 10
+]]></PixelFunctionCode>
+    <SimpleSource><SourceFilename relativeToVRT="0">{dem}</SourceFilename>
+      <SourceBand>1</SourceBand></SimpleSource>
+  </VRTRasterBand>
+</VRTDataset>
+"""
+
+RASTERIO = """
+import faulthandler, sys
+import numpy as np
+import rasterio
+from rasterio.io import FilePath
+faulthandler.dump_traceback_later(120, exit=True)  # a hang fails, with its stacks
+vrt, dem = sys.argv[1], sys.argv[2]
+# a DEM read by a Python pixel function: rasterio holds the GIL in checksum,
+# statistics and close, which a read of the DEM on another thread waited for
+for trial in range(3):
+    with rasterio.Env(GDAL_VRT_ENABLE_PYTHON='YES'):
+        with rasterio.open('TERRASHADE:' + vrt, PRODUCT='svf', DIRECTIONS=8) as ds:
+            ds.tags()
+            ds.checksum(1)
+        with rasterio.open('TERRASHADE:' + vrt, PRODUCT='svf', DIRECTIONS=8) as ds:
+            ds.tags()
+            ds.statistics(1)
+print('python pixel function done')
+# a DEM as a Python file object (/vsipythonfilelike/), which GDAL reads
+with open(dem, 'rb') as f:
+    with rasterio.open('TERRASHADE:' + FilePath(f).name, PRODUCT='svf', DIRECTIONS=8) as ds:
+        got = ds.read(1)
+with rasterio.open('TERRASHADE:' + dem, PRODUCT='svf', DIRECTIONS=8) as ds:
+    want = ds.read(1)
+print('file object', np.array_equal(got, want, equal_nan=True))
+# mode 'r+' writes a copy over the product on closing: refused, saying how
+try:
+    with rasterio.open('TERRASHADE:' + dem, 'r+', PRODUCT='svf', DIRECTIONS=8) as ds:
+        ds.nodata = -1
+except Exception as e:
+    print('r+', 'A product is read-only' in str(e) and 'gdal_edit.py -ro' in str(e))
+"""
+
 
 class Host(unittest.TestCase):
     @classmethod
@@ -314,6 +364,26 @@ class Host(unittest.TestCase):
         sent, size = map(int, p.stdout.split("info ")[1].split()[:2])
         self.assertLess(sent, size / 2, p.stdout)  # (the open reads 256 x 256 cells)
         self.assertIn("read ", p.stdout)
+    def test_rasterio_hosts(self):
+        """Through rasterio (session 55's audit): a DEM whose reading runs
+        Python (a VRT's Python pixel function) deadlocked in checksum,
+        statistics or close after tags() in 6 of 9 runs (the DEM's
+        read-ahead thread waited for the GIL that rasterio held while it
+        waited for the thread); a DEM as a Python file object failed ("Read
+        not implemented for /vsipythonfilelike/") where GDAL reads it, as
+        the driver asked GeoTIFF for direct reads; mode 'r+' failed on
+        closing with a sentence about deleting, none about read-only."""
+        ds = gdal.Open(self.dem)
+        vrt = os.path.join(self.dir, "python.vrt")
+        with open(vrt, "w") as f:
+            f.write(PYTHON_VRT.format(w=ds.RasterXSize, h=ds.RasterYSize, dem=self.dem,
+                                      gt=", ".join(map(repr, ds.GetGeoTransform()))))
+        ds = None
+        p = T.run(["/usr/bin/python3", "-c", RASTERIO, vrt, self.dem])
+        self.assertIn("python pixel function done", p.stdout)
+        self.assertIn("file object True", p.stdout)
+        self.assertIn("r+ True", p.stdout)
+
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)
