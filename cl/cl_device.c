@@ -254,7 +254,6 @@ bad:
 static void *discover_once(void *unused)
 {
     (void)unused;
-    ts_cl_host_mark_loaded();
     pthread_once(&g_list_once, discover);
     atomic_store_explicit(&g_discovered, 1, memory_order_release);
     return NULL;

@@ -17,12 +17,12 @@
 #define TS_CL_HOST_GUARD_H
 
 /* fn(arg) on a thread of its own with an 8 MiB stack (on the caller's
- * where no such thread can be made), in the caller's locale; a signal
- * disposition the call set to a handler of the drivers' libraries (those
- * loaded during such calls) is put back as it was before the call (one
- * call at a time: a second caller would take the drivers' handlers for
- * the host's). A host that sets a disposition on another thread while
- * the drivers start (~50 ms) may have it replaced by theirs. */
+ * where no such thread can be made), in the caller's locale, the process
+ * marked as having set OpenCL up (ts_cl_host_forked); every signal
+ * disposition the call changed is put back as it was before it (one call
+ * at a time: a second caller would take the drivers' handlers for the
+ * host's). A host that sets a disposition on another thread while the
+ * drivers start (~50 ms) may have it undone. fn must not call this. */
 void ts_cl_host_call(void *(*fn)(void *), void *arg);
 
 /* Record that this process has set OpenCL up (its drivers are loaded). */
