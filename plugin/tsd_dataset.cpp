@@ -122,51 +122,27 @@ GDALDataset *TSDataset::OpenDEM(const char *pszDEM)
     return GDALDataset::Open(pszDEM, GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR);
 }
 
-/* Whether reading the DEM may call into the host's code (a Python pixel
- * function of a VRT, a Python file object through rasterio's
- * /vsipythonfilelike/): on a thread of the driver's that waited for the
- * host's lock (Python's GIL, which rasterio holds in close, checksum and
- * statistics) while the host waited for the thread (a deadlock). */
-static bool CallsTheHost(GDALDataset *poDEM, const std::vector<std::string> &aosFiles)
+/* Whether a file is read without the network and without the host's
+ * code: a path of the operating system's, or one through GDAL's own
+ * in-process file systems only. Over the network the metadata alone
+ * (gdalinfo, QGIS's layer properties) downloaded the whole DEM; and a file
+ * system a host adds (rasterio's /vsipythonfilelike/ and /vsiriopener_*,
+ * which run Python) read on the driver's thread waited for the host's lock
+ * (Python's GIL, which rasterio holds in close, checksum and statistics)
+ * while the host waited for the thread: a deadlock. */
+static bool ReadAheadSafe(const std::string &osPath)
 {
-    const auto Python = [](const char *pszXML)
-    {
-        return pszXML && CPLString(pszXML).ifind("<PixelFunctionLanguage>Python") !=
-                             std::string::npos;
-    };
-    char **papszVRT = poDEM->GetMetadata("xml:VRT");
-    if (papszVRT && Python(papszVRT[0]))
-        return true;
-    for (const std::string &osFile : aosFiles)
-    {
-        if (osFile.find("/vsipython") != std::string::npos)
-            return true;
-        GByte *pabyText = nullptr;
-        if (EQUAL(CPLGetExtension(osFile.c_str()), "vrt") &&
-            VSIIngestFile(nullptr, osFile.c_str(), &pabyText, nullptr, 1 << 20))
-        {
-            const bool bPython = Python(reinterpret_cast<const char *>(pabyText));
-            VSIFree(pabyText);
-            if (bPython)
-                return true;
-        }
-    }
-    return false;
-}
-
-/* Whether a path reads no network: GDAL 3.6's VSIIsLocal looks at the
- * outer file system only (/vsizip//vsicurl/..., /vsisubfile/...,/vsis3/...
- * and /vsicurl_streaming/ read as local), so every file system named in
- * it is asked, and URLs given as such. */
-static bool IsLocalPath(const std::string &osPath)
-{
-    for (const char *pszURL : {"http://", "https://", "ftp://", "_streaming/"})
-        if (osPath.find(pszURL) != std::string::npos)
-            return false;
+    static const char *const apszInProcess[] = {"/vsimem/", "/vsizip/", "/vsigzip/",
+                                                "/vsitar/", "/vsisubfile/", "/vsisparse/"};
     for (size_t i = osPath.find("/vsi"); i != std::string::npos; i = osPath.find("/vsi", i + 1))
-        if (!VSIIsLocal(osPath.c_str() + i))
+    {
+        bool bKnown = false;
+        for (const char *pszFS : apszInProcess)
+            bKnown = bKnown || osPath.compare(i, strlen(pszFS), pszFS) == 0;
+        if (!bKnown)
             return false;
-    return VSIIsLocal(osPath.c_str());
+    }
+    return osPath.find("://") == std::string::npos; // (a URL as a VRT source)
 }
 
 /* Start reading the DEM on a thread of its own, for ReadDEM, while this
@@ -177,13 +153,16 @@ void TSDataset::StartReadAhead()
 {
     if (m_poWindow || !m_poDEM || m_bTried || m_oReadAhead.joinable())
         return;
-    // a DEM over the network is not read ahead: the metadata alone
-    // (gdalinfo, QGIS's layer properties) downloaded all of it
-    bool bLocal = IsLocalPath(m_osDEMPath);
+    // a GeoTIFF only, of local files (ReadAheadSafe): the common case, and
+    // one whose reads run no code of the host's (a VRT may hold a Python
+    // pixel function, at any depth of VRTs of VRTs; GDAL drivers may be
+    // written in Python)
+    bool bSafe = m_poDEM->GetDriver() &&
+                 EQUAL(m_poDEM->GetDriver()->GetDescription(), "GTiff") &&
+                 ReadAheadSafe(m_osDEMPath);
     for (const std::string &osFile : m_aosDEMFiles)
-        bLocal = bLocal && IsLocalPath(osFile);
-    if (!bLocal || m_osDEMPath.find("/vsipython") != std::string::npos ||
-        CallsTheHost(m_poDEM, m_aosDEMFiles))
+        bSafe = bSafe && ReadAheadSafe(osFile);
+    if (!bSafe)
         return;
     // the caller's thread-local configuration (a /vsicurl/ DEM's headers or
     // credentials, set with CPLSetThreadLocalConfigOption, as GDAL 3.7's
@@ -241,7 +220,12 @@ ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
     {
         m_oReadAhead.join();
         for (const HeldMessage &oHeld : m_aoReadMessages)
+        {
+            // (a debug line said again sets no last error, as CPLDebug's)
+            std::unique_ptr<CPLErrorStateBackuper> poKeep(
+                oHeld.eClass == CE_Debug ? new CPLErrorStateBackuper() : nullptr);
             CPLError(oHeld.eClass, oHeld.nNum, "%s", oHeld.osMsg.c_str());
+        }
         m_aoReadMessages.clear();
         *psGrid = m_sReadGrid;
         m_sReadGrid = ts_grid{};

@@ -55,8 +55,8 @@ CPLErr RefuseConnection(const char *pszWhat, const char *pszName)
              "from a DEM, not a file of its own; the DEM is left as it is (%s it by its "
              "own name if that is what you mean). A product is read-only: its nodata, "
              "unit and colour are set on a dataset opened read-only (gdal_edit.py -ro, "
-             "osgeo.gdal's SetNoDataValue), not through an update (rasterio's mode 'r+' "
-             "writes a copy over it on closing, which is this)",
+             "osgeo.gdal's SetNoDataValue); rasterio's mode 'r+' writes a copy over it "
+             "on closing, which is refused so",
              pszWhat, pszName, pszWhat);
     return CE_Failure;
 }
