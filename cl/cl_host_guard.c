@@ -55,7 +55,17 @@ static void *guarded(void *p)
     signal_state *s = calloc(1, sizeof *s);
     if (s)
         signals_save(s);
+    /* the thread's alternate signal stack too: LLVM gives the thread that
+     * installs its handlers one of its own (malloc'd), and AddressSanitizer,
+     * which gave the thread its own, aborted as the thread ended ("unable
+     * to unmap") */
+    stack_t alt;
+    const int alt_saved = sigaltstack(NULL, &alt) == 0;
     c->fn(c->arg);
+    if (alt_saved) {
+        alt.ss_flags &= ~SS_ONSTACK;
+        sigaltstack(&alt, NULL);
+    }
     if (s)
         signals_restore(s);
     free(s);
