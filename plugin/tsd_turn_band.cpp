@@ -14,8 +14,22 @@ CPLErr TSTurnBand::ComputeStatistics(int bApproxOK, double *pdfMin, double *pdfM
     std::unique_lock<std::recursive_mutex> oTurn;
     if (!TakeReadTurn(oTurn))
         return CE_Failure;
-    return GDALPamRasterBand::ComputeStatistics(bApproxOK, pdfMin, pdfMax, pdfMean, pdfStdDev,
-                                                pfnProgress, pProgressData);
+    // GDAL takes approximate statistics from an overview level, which here
+    // is the product of a coarser DEM, not an average of this one (an svf
+    // level 16 times coarser: mean 0.965 where the product's is 0.765):
+    // the caller gets them, but they are not saved, where a later
+    // GetStatistics, and gdal_translate's copy into the file it writes,
+    // took them for this product's (QGIS's default stretch on a large DEM)
+    const bool bFromLevel = bApproxOK && GetOverviewCount() > 0 &&
+                            GetRasterSampleOverview(GDALSTAT_APPROX_NUMSAMPLES) != this;
+    const CPLErr eErr = GDALPamRasterBand::ComputeStatistics(
+        bApproxOK, pdfMin, pdfMax, pdfMean, pdfStdDev, pfnProgress, pProgressData);
+    if (eErr == CE_None && bFromLevel)
+        for (const char *pszItem : {"STATISTICS_MINIMUM", "STATISTICS_MAXIMUM", "STATISTICS_MEAN",
+                                    "STATISTICS_STDDEV", "STATISTICS_VALID_PERCENT",
+                                    "STATISTICS_APPROXIMATE"})
+            GDALPamRasterBand::SetMetadataItem(pszItem, nullptr);
+    return eErr;
 }
 
 CPLErr TSTurnBand::ComputeRasterMinMax(int bApproxOK, double *adfMinMax)

@@ -330,6 +330,38 @@ class Overviews(unittest.TestCase):
                     self.assertIn(words, p.stderr)
         self.assertEqual(set(os.listdir(self.tmp)), before)
 
+    def test_approximate_statistics_are_not_saved(self):
+        """GDAL takes approximate statistics (QGIS's default stretch,
+        gdalinfo -approx_stats) from an overview level, here the product of
+        a coarser DEM: they were saved beside the DEM as the product's, so
+        that a later GetStatistics, and gdal_translate's copy into the file
+        it writes, took them for the full resolution's (session 55's QGIS
+        audit: an svf's stretch 0.78-1.0 where half the product lies below
+        0.78). The caller gets them; exact ones are saved as before."""
+        with T.TempDir() as tmp:
+            dem = os.path.join(tmp, "dem.tif")
+            T.shutil.copy(self.dem, dem)
+            name = T.conn(dem, PRODUCT="svf", DIRECTIONS=8)
+            ds = gdal.OpenEx(name, gdal.OF_RASTER)
+            self.assertGreater(ds.GetRasterBand(1).GetOverviewCount(), 0)
+            approx = ds.GetRasterBand(1).ComputeStatistics(True)
+            ds = None
+            ds = gdal.OpenEx(name, gdal.OF_RASTER)
+            self.assertEqual(ds.GetRasterBand(1).GetStatistics(True, False), [0, 0, 0, -1])
+            ds = None
+            out = os.path.join(tmp, "svf.tif")
+            T.run(["gdal_translate", "-q", name, out])
+            self.assertNotIn("STATISTICS_", T.run(["gdalinfo", out]).stdout)
+            ds = gdal.OpenEx(name, gdal.OF_RASTER)
+            exact = ds.GetRasterBand(1).ComputeStatistics(False)
+            ds = None
+            self.assertNotEqual(approx, exact)
+            ds = gdal.OpenEx(name, gdal.OF_RASTER)
+            np.testing.assert_allclose(ds.GetRasterBand(1).GetStatistics(True, False), exact,
+                                       rtol=1e-9)  # (saved as text)
+            ds = None
+
+
 class Cost(unittest.TestCase):
     """A coarse level costs a fraction of the full level: time and memory."""
 
