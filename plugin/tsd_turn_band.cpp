@@ -20,15 +20,23 @@ CPLErr TSTurnBand::ComputeStatistics(int bApproxOK, double *pdfMin, double *pdfM
     // the caller gets them, but they are not saved, where a later
     // GetStatistics, and gdal_translate's copy into the file it writes,
     // took them for this product's (QGIS's default stretch on a large DEM)
-    const bool bFromLevel = bApproxOK && GetOverviewCount() > 0 &&
+    // (GDAL's own test, gcore/gdalrasterband.cpp; the band's saved items,
+    // exact ones among them, are what they were before)
+    const bool bFromLevel = bApproxOK && GetOverviewCount() > 0 && !HasArbitraryOverviews() &&
                             GetRasterSampleOverview(GDALSTAT_APPROX_NUMSAMPLES) != this;
+    static const char *const apszItems[] = {"STATISTICS_MINIMUM",       "STATISTICS_MAXIMUM",
+                                            "STATISTICS_MEAN",          "STATISTICS_STDDEV",
+                                            "STATISTICS_VALID_PERCENT", "STATISTICS_APPROXIMATE"};
+    CPLStringList aosBefore;
+    if (bFromLevel)
+        for (const char *pszItem : apszItems)
+            if (const char *pszValue = GDALPamRasterBand::GetMetadataItem(pszItem))
+                aosBefore.SetNameValue(pszItem, pszValue);
     const CPLErr eErr = GDALPamRasterBand::ComputeStatistics(
         bApproxOK, pdfMin, pdfMax, pdfMean, pdfStdDev, pfnProgress, pProgressData);
-    if (eErr == CE_None && bFromLevel)
-        for (const char *pszItem : {"STATISTICS_MINIMUM", "STATISTICS_MAXIMUM", "STATISTICS_MEAN",
-                                    "STATISTICS_STDDEV", "STATISTICS_VALID_PERCENT",
-                                    "STATISTICS_APPROXIMATE"})
-            GDALPamRasterBand::SetMetadataItem(pszItem, nullptr);
+    if (bFromLevel)
+        for (const char *pszItem : apszItems)
+            GDALPamRasterBand::SetMetadataItem(pszItem, aosBefore.FetchNameValue(pszItem));
     return eErr;
 }
 
