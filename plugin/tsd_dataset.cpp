@@ -164,11 +164,9 @@ void TSDataset::StartReadAhead()
         bSafe = bSafe && ReadAheadSafe(osFile);
     if (!bSafe)
         return;
-    // the caller's thread-local configuration (a /vsicurl/ DEM's headers or
-    // credentials, set with CPLSetThreadLocalConfigOption, as GDAL 3.7's
-    // gdal.config_options does): without it the thread read as another
-    // client and failed ("Missing data for block"), where the caller's own
-    // read succeeds
+    // the caller's thread-local configuration (CPLSetThreadLocalConfigOption,
+    // as GDAL 3.7's gdal.config_options sets it): the thread reads as the
+    // caller would (GTiff's options, CPL_DEBUG)
     char **papszThreadConfig = CPLGetThreadLocalConfigOptions();
     try
     {
@@ -220,12 +218,13 @@ ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
     {
         m_oReadAhead.join();
         for (const HeldMessage &oHeld : m_aoReadMessages)
-        {
-            // (a debug line said again sets no last error, as CPLDebug's)
-            std::unique_ptr<CPLErrorStateBackuper> poKeep(
-                oHeld.eClass == CE_Debug ? new CPLErrorStateBackuper() : nullptr);
-            CPLError(oHeld.eClass, oHeld.nNum, "%s", oHeld.osMsg.c_str());
-        }
+            if (oHeld.eClass == CE_Debug)
+            {
+                CPLErrorStateBackuper oKeep; // (sets no last error, as CPLDebug's)
+                CPLError(oHeld.eClass, oHeld.nNum, "%s", oHeld.osMsg.c_str());
+            }
+            else
+                CPLError(oHeld.eClass, oHeld.nNum, "%s", oHeld.osMsg.c_str());
         m_aoReadMessages.clear();
         *psGrid = m_sReadGrid;
         m_sReadGrid = ts_grid{};
