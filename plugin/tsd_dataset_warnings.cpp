@@ -4,10 +4,13 @@
  * MAX_DISTANCE shorter than a cell, a DEM too wide for one sun). */
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
+#include <vector>
 
 #include "cpl_error.h"
 #include "cpl_string.h"
+#include "cpl_vsi.h"
 
 #include "tsd_dataset.h"
 #include "tsd_dem_check.h"
@@ -28,28 +31,63 @@ static bool HoldsAProduct(GDALDataset *poDS, std::string *posWhat)
     return true;
 }
 
-/* A mosaic (gdalbuildvrt) keeps no metadata of its sources: the first few
- * of its files say whether it mosaics products. A few only, each opened,
- * so that a VRT of ten thousand tiles opens as fast as it did. */
+/* A live TERRASHADE: string among a VRT's sources (gdalbuildvrt of one):
+ * its XML says so, without opening anything. A scan of the text, not a
+ * parse: a mosaic of ten thousand tiles has megabytes of it. */
+static std::string ProductStringSource(const char *pszXML)
+{
+    static const char szTag[] = "<SourceFilename";
+    for (const char *p = strstr(pszXML, szTag); p; p = strstr(p + 1, szTag))
+    {
+        const char *pszName = strchr(p, '>');
+        if (!pszName)
+            break;
+        pszName++;
+        if (EQUALN(pszName, DRIVER, strlen(DRIVER)) && pszName[strlen(DRIVER)] == ':')
+            return std::string(pszName, strcspn(pszName, "<"));
+    }
+    return std::string();
+}
+
+/* A mosaic (gdalbuildvrt) keeps no metadata of its sources: its sources
+ * say whether it mosaics products. Four files only, spread from its first
+ * to its last, each opened, so that a VRT of ten thousand tiles opens as
+ * fast as it did. */
 static std::string ProductInMosaic(GDALDataset *poDEM, const std::string &osDEM)
 {
     if (!poDEM->GetDriver() || !EQUAL(poDEM->GetDriver()->GetDescription(), "VRT"))
         return std::string();
-    const CPLStringList aosFiles(poDEM->GetFileList());
-    std::string osFound;
-    int nOpened = 0;
     // quiet, and the caller's last error kept: a source that does not open
     // here is the VRT's reads' to report
     CPLErrorStateBackuper oState;
     CPLErrorHandlerPusher oQuiet(CPLQuietErrorHandler);
-    for (int i = 0; i < aosFiles.size() && nOpened < 4 && osFound.empty(); i++)
+    // the .vrt's own text where it is a file (serialising a mosaic of ten
+    // thousand tiles would double the time of its open), else its XML
+    GByte *pabyText = nullptr;
+    std::string osString;
+    if (VSIIngestFile(nullptr, poDEM->GetDescription(), &pabyText, nullptr, 256 << 20))
+        osString = ProductStringSource(reinterpret_cast<const char *>(pabyText));
+    else if (char **papszXML = poDEM->GetMetadata("xml:VRT"))
+        osString = papszXML[0] ? ProductStringSource(papszXML[0]) : std::string();
+    VSIFree(pabyText);
+    if (!osString.empty())
+        return CPLSPrintf("the DEM '%s' mosaics TERRASHADE products (its source '%s' is a "
+                          "product), not heights: mosaic the DEMs themselves",
+                          osDEM.c_str(), osString.c_str());
+    const CPLStringList aosAll(poDEM->GetFileList());
+    std::vector<const char *> apszTiles;
+    for (int i = 0; i < aosAll.size(); i++)
     {
-        const char *pszFile = aosFiles[i];
-        const char *pszExt = CPLGetExtension(pszFile);
-        if (EQUAL(pszExt, "vrt") || EQUAL(pszExt, "xml") || EQUAL(pszExt, "ovr") ||
-            EQUAL(pszFile, poDEM->GetDescription()))
-            continue;
-        nOpened++;
+        const char *pszExt = CPLGetExtension(aosAll[i]);
+        if (!(EQUAL(pszExt, "vrt") || EQUAL(pszExt, "xml") || EQUAL(pszExt, "ovr") ||
+              EQUAL(aosAll[i], poDEM->GetDescription())))
+            apszTiles.push_back(aosAll[i]);
+    }
+    const size_t nTiles = apszTiles.size(), nSample = std::min<size_t>(nTiles, 4);
+    std::string osFound;
+    for (size_t k = 0; k < nSample && osFound.empty(); k++)
+    {
+        const char *pszFile = apszTiles[nSample > 1 ? k * (nTiles - 1) / (nSample - 1) : 0];
         GDALDataset *poSrc = GDALDataset::Open(pszFile, GDAL_OF_RASTER);
         std::string osWhat;
         if (poSrc && HoldsAProduct(poSrc, &osWhat))

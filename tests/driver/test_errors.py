@@ -201,6 +201,35 @@ class Errors(unittest.TestCase):
             dems = os.path.join(tmp, "dems.vrt")
             T.run(["gdalbuildvrt", "-q", dems] + halves)
             T.run(["gdalinfo", "-checksum", T.conn(dems)])
+            # a mosaic of live TERRASHADE: strings, seen in the VRT's text
+            # (a file) or its XML (vrt://): shaded as heights until session 56
+            live = os.path.join(tmp, "live.vrt")
+            T.run(["gdalbuildvrt", "-q", live] + [T.conn(h) for h in halves])
+            for name in (live, "vrt://" + live + "?bands=1"):
+                p = T.run(["gdalinfo", "-checksum", T.conn(name)], ok=False)
+                self.assertIn("the DEM '%s' mosaics TERRASHADE products (its source '%s' is "
+                              "a product), not heights: mosaic the DEMs themselves"
+                              % (name, T.conn(halves[0])), p.stderr)
+            # four DEM strips, then a product: the sample of four files
+            # reaches the last (only the first four were opened until
+            # session 56)
+            strips = []
+            for i in range(5):
+                strip = os.path.join(tmp, "strip%d.tif" % i)
+                # Float32 as the products: gdalbuildvrt mosaics one type
+                T.run(["gdal_translate", "-q", "-ot", "Float32",
+                       "-srcwin", str(19 * i), "0", "19", "90", DEM, strip])
+                strips.append(strip)
+            last = os.path.join(tmp, "last_shade.tif")
+            T.run(["gdal_translate", "-q", "-oo", "PRODUCT=svf", T.conn(strips[4]), last])
+            mixed = os.path.join(tmp, "mixed.vrt")
+            T.run(["gdalbuildvrt", "-q", mixed] + strips[:4] + [last])
+            p = T.run(["gdalinfo", "-checksum", T.conn(mixed)], ok=False)
+            self.assertIn("(its source '%s' is PRODUCT=svf of %s, in its metadata)"
+                          % (last, strips[4]), p.stderr)
+            strips_vrt = os.path.join(tmp, "strips.vrt")
+            T.run(["gdalbuildvrt", "-q", strips_vrt] + strips)
+            T.run(["gdalinfo", "-checksum", T.conn(strips_vrt)])
 
     def test_out_of_memory_says_to_reopen(self):
         """A dataset keeps a failure for its life, its later reads repeating
