@@ -109,10 +109,7 @@ class Grass(unittest.TestCase):
                         self.assertTrue(0.65 <= ratio["diff"] <= 0.9, ratio["diff"])
 
     def test_horizons_on_the_axes(self):
-        dem = os.path.join(self.dir, "jacksboro_utm16.tif")
-        T.run(["gdalwarp", "-q", "-t_srs", "EPSG:%d" % EPSG, "-te", "732000", "4037700",
-               "760800", "4068000", "-tr", "75", "75", "-r", "bilinear", "-ot", "Float32",
-               T.JACKSBORO, dem])
+        dem = T.jacksboro_utm16(self.dir)
         self.grass(self.import_dem(dem, "dem") +
                    "r.horizon -d elevation=dem step=90 maxdistance=100000 output=hz "
                    "--overwrite --quiet\n"

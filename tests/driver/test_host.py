@@ -124,7 +124,9 @@ gdal.UseExceptions()
 data = open(sys.argv[1], 'rb').read()
 sent = [0]
 class Handler(http.server.BaseHTTPRequestHandler):
-    # dem.tif to a client that sends X-Token: sesame; 404 for other names
+    # dem.tif to a client that sends X-Token: sesame (the caller's
+    # GDAL_HTTP_HEADERS, which the product's reads must carry), 403 to
+    # others; 404 for other names
     def log_message(self, *args):
         pass
     def allowed(self):

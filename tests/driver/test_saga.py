@@ -29,10 +29,7 @@ class Saga(unittest.TestCase):
     def setUpClass(cls):
         cls.tmp = T.TempDir()
         cls.dir = cls.tmp.__enter__()
-        cls.dem = os.path.join(cls.dir, "jacksboro_utm16.tif")
-        T.run(["gdalwarp", "-q", "-t_srs", "EPSG:%d" % EPSG, "-te", "732000", "4037700",
-               "760800", "4068000", "-tr", "75", "75", "-r", "bilinear", "-ot", "Float32",
-               T.JACKSBORO, cls.dem])
+        cls.dem = T.jacksboro_utm16(cls.dir)
 
     @classmethod
     def tearDownClass(cls):

@@ -198,6 +198,18 @@ def jacksboro_utm(tmp):
     return out
 
 
+def jacksboro_utm16(tmp):
+    """jacksboro warped to UTM 16N (EPSG:32616), 75 m, bilinear, Float32,
+    cut to a rectangle inside the source footprint (no nodata): the DEM
+    that GRASS and SAGA shade beside the driver."""
+    out = os.path.join(tmp, "jacksboro_utm16.tif")
+    if not os.path.exists(out):
+        run(["gdalwarp", "-q", "-t_srs", "EPSG:32616", "-te", "732000", "4037700",
+             "760800", "4068000", "-tr", "75", "75", "-r", "bilinear", "-ot", "Float32",
+             JACKSBORO, out])
+    return out
+
+
 def utm17_grid_north(lon, lat, dlat):
     """The azimuth (degrees clockwise from UTM 17N's grid north) of true
     north at (lon, lat): the grid bearing from there to dlat degrees
