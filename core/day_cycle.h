@@ -8,7 +8,8 @@
  * Where the sun is seen from: a `ts_sun_sites` is one site (the DEM's
  * centre) or a lattice of sites over the grid; with a lattice the sun's
  * azimuth and elevation are computed with the SPA at every node and
- * interpolated bilinearly to each cell. Azimuths from the SPA are true
+ * interpolated bilinearly to each cell as a unit vector (smooth beside the
+ * zenith, where the angles are not). Azimuths from the SPA are true
  * azimuths; each site also gives the grid azimuth of true north (the
  * meridian convergence of a projected CRS, with the opposite sign), and the
  * horizon sweeps use grid azimuth = true azimuth + north_azimuth.

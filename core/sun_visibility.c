@@ -407,22 +407,31 @@ ts_status ts_vis_step(ts_vis_ctx *c, double t, float *vis, float *az, float *el,
                                 *n01 = &c->ns[j1 * s->nx + i], *n11 = &c->ns[j1 * s->nx + i1];
             double w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy,
                    w11 = fx * fy;
+            /* the nodes' sun vectors, not their angles, interpolated: the
+             * vector is smooth everywhere, while around the subsolar point
+             * the elevation is a cone and the azimuth turns a whole circle
+             * (angles interpolated there put the sun up to 3 deg off, and
+             * on the far side of the zenith). The azimuths as offsets from
+             * a_ref, each as its quad's first continues (the lattice's
+             * unwrapping leaves a seam around the subsolar point). */
+            const ts_sun_sample *nq[4] = {n00, n10, n01, n11};
+            const double wq[4] = {w00, w10, w01, w11};
+            const double o00 = c->noff[j * s->nx + i];
+            const double oq[4] = {o00, c->noff[j * s->nx + i1], c->noff[j1 * s->nx + i],
+                                  c->noff[j1 * s->nx + i1]};
+            double ve = 0, vn = 0, vu = 0;
+            for (int q = 0; q < 4; q++) {
+                const double e0q = nq[q]->true_elevation * DEG2RAD, aq = oq[q] * DEG2RAD;
+                ve += wq[q] * cos(e0q) * sin(aq);
+                vn += wq[q] * cos(e0q) * cos(aq);
+                vu += wq[q] * sin(e0q);
+            }
             /* refracted after: the refraction jumps at its cut-off, which
              * a lattice of sunrise and sunset straddles */
-            double e0 = w00 * n00->true_elevation + w10 * n10->true_elevation +
-                        w01 * n01->true_elevation + w11 * n11->true_elevation;
+            double e0 = atan2(vu, hypot(ve, vn)) / DEG2RAD;
             double e = e0 + ts_sun_refraction(e0, &c->o->sun);
-            /* around the subsolar (or antisolar) point the azimuths turn a
-             * whole circle, and the lattice's unwrapping leaves a seam: a
-             * node across it lies ~360 from its quad's first, which it
-             * continues here */
-            const double *off = c->noff, o00 = off[j * s->nx + i];
-            double o10 = off[j * s->nx + i1], o01 = off[j1 * s->nx + i],
-                   o11 = off[j1 * s->nx + i1];
-            o10 = fabs(o10 - o00) > 180.0 ? o00 + ts_wrap180(o10 - o00) : o10;
-            o01 = fabs(o01 - o00) > 180.0 ? o00 + ts_wrap180(o01 - o00) : o01;
-            o11 = fabs(o11 - o00) > 180.0 ? o00 + ts_wrap180(o11 - o00) : o11;
-            double d = w00 * o00 + w10 * o10 + w01 * o01 + w11 * o11;
+            double d = o00 + ts_wrap180(atan2(ve, vn) / DEG2RAD - o00);
+            emax = fmax(emax, e);
             clo = fmin(clo, d);
             chi = fmax(chi, d);
             size_t k = (size_t)y * W + x;

@@ -185,6 +185,45 @@ class SunFrames(unittest.TestCase):
                 print("%.1f E %.1f N: per cell %.4f, its own sun %.4f" % (lon, la, a[y, x], ref))
         self.assertLess(worst, 0.01)
 
+    def test_per_cell_sun_beside_the_zenith(self):
+        """Within a degree or two of the subsolar point (here 0, 1.9 E at
+        noon UTC on 20 March 2026) the sun's elevation is a cone and its
+        azimuth turns a whole circle: bilinear in the nodes' angles, the
+        cells took a sun up to 0.44 deg lower and 3 deg off in direction
+        (pvlib's SPA beside it; session 56), here on slopes of 17 degrees
+        shade up to 0.005 off. The nodes' sun vectors are interpolated now. Each
+        cell against a 3 x 3 DEM of its own, on slopes rising east and
+        north."""
+        n, cell = 40, 0.25
+        lat = -5 + cell * (n - 0.5 - np.arange(n))
+        lon = -5 + cell * (0.5 + np.arange(n))
+        ys = (n - 0.5 - np.arange(n))[:, None] * np.ones((1, n))
+        xs = np.ones((n, 1)) * (0.5 + np.arange(n))[None, :]
+        opts = ["PRODUCT=shade", "OUTPUT_TYPE=Float32", "DATETIME=2026-03-20T12:00:00Z",
+                "SKY_WEIGHT=0", "CURVATURE=NO", "EDGE=open", "Z_FACTOR=1000"]
+        worst = 0.0
+        for name, axis in (("east", xs), ("north", ys)):
+            # rising 0.3 a cell's own length (heights in km, Z_FACTOR)
+            z = axis * cell * 111.2 * 0.3 * (np.cos(np.radians(lat))[:, None]
+                                            if name == "east" else 1.0)
+            dem = T.write_tif("%s/zenith_%s.tif" % (self.dir, name), z.astype(np.float32),
+                              (-5.0, cell, 0, 5.0, 0, -cell), 4326)
+            ds = gdal.OpenEx(T.conn(dem), gdal.OF_RASTER,
+                             open_options=opts + ["SUN_POSITION=per_cell"])
+            a = ds.GetRasterBand(1).ReadAsArray()
+            ds = None
+            for y, x in ((20, 27), (21, 28), (19, 29), (20, 30), (22, 26), (18, 27)):
+                own = T.write_tif(self.dir + "/own.tif", z[y - 1:y + 2, x - 1:x + 2].astype(
+                    np.float32), (lon[x] - 1.5 * cell, cell, 0, lat[y] + 1.5 * cell, 0, -cell),
+                    4326)
+                d2 = gdal.OpenEx(T.conn(own), gdal.OF_RASTER, open_options=opts)
+                ref = float(d2.GetRasterBand(1).ReadAsArray()[1, 1])
+                d2 = None
+                worst = max(worst, abs(float(a[y, x]) - ref))
+                print("%s: %.3f E %.3f N: per cell %.5f, its own sun %.5f"
+                      % (name, lon[x], lat[y], a[y, x], ref))
+        self.assertLess(worst, 0.001)
+
     def test_a_pole_by_rounding(self):
         """A polar cap whose top is the pole give or take rounding (90 + 1e-13)
         opens; one 0.6 of a cell past it is off by more than rounding and
