@@ -30,6 +30,7 @@
 #include "tsd_gdal.h"
 #include "tsd_geodesy.h"
 #include "tsd_options.h"
+#include "tsd_path_check.h"
 #include "tsd_pam_band.h"
 #include "tsd_entry_state.h"
 
@@ -276,6 +277,15 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
         return FailOpen(TS_ERR_ARG,
                           "SHADOWS=all recomputes the near shadows from the DEM, but the "
                           "atlas names none: give it with the open option DEM=...");
+    // a pipe's open (also an atlas's SOURCE_DEM, which anyone who sends
+    // the file writes) would wait for ever, and a MEM::: name reads memory
+    const std::string osRefused =
+        bAll ? RefusedDEMName(poDS->m_osDEM.c_str(),
+                              poDS->m_bDEMGiven ? "the DEM" : "the atlas's SOURCE_DEM",
+                              !poDS->m_bDEMGiven)
+             : std::string();
+    if (!osRefused.empty())
+        return FailOpen(TS_ERR_ARG, osRefused.c_str());
     if (bAll && IsAtlasFile(poDS->m_osDEM.c_str()))
         return FailOpen(TS_ERR_ARG, AtlasAsDEM(poDS->m_osDEM, poDS->m_bDEMGiven).c_str());
     int nOffset = atoi(poDS->m_aosMeta.FetchNameValueDef("UTC_OFFSET_MINUTES", "0"));

@@ -35,6 +35,7 @@
 #include "tsd_dataset.h"
 #include "tsd_dem.h"
 #include "tsd_gdal.h"
+#include "tsd_path_check.h"
 #include "tsd_source_stamp.h"
 #include "tsd_window.h"
 #include "tsd_entry_state.h"
@@ -508,6 +509,9 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     }
     poDS->m_psProduct = tsd_product_of(&sOpts);
 
+    const std::string osRefused = RefusedDEMName(osDEM.c_str(), "the DEM", false);
+    if (!osRefused.empty())
+        return FailOpen(TS_ERR_ARG, osRefused.c_str());
     GDALDataset *poDEM = OpenDEM(osDEM.c_str());
     if (!poDEM)
     {

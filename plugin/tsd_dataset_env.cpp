@@ -16,6 +16,7 @@
 #include "cpl_vsi.h"
 
 #include "tsd_dataset.h"
+#include "tsd_path_check.h"
 #include "tsd_gdal.h"
 
 namespace tsd
@@ -36,6 +37,22 @@ constexpr GByte EXR_MAGIC[4] = {0x76, 0x2f, 0x31, 0x01};
 static bool ReadWholeFile(const char *pszPath, std::vector<GByte> &oBytes,
                           std::string &osError)
 {
+    // a pipe's open waits for a writer, forever (an audit), and a device
+    // may too (a terminal), also inside /vsigzip/ or /vsisubfile/ (a second
+    // audit); the host's standard input is no map's either: a map is a
+    // file. Asked before the stat, which opens an archive to look inside
+    const std::string osSource = NonRegularSource(pszPath);
+    if (!osSource.empty())
+    {
+        osError = osSource == "/vsistdin/"
+                      ? CPLSPrintf("ENV_MAP '%s' reads the standard input: give the file of "
+                                   "an OpenEXR map",
+                                   pszPath)
+                      : CPLSPrintf("ENV_MAP '%s' reads '%s', which is not a regular file (a "
+                                   "pipe, a device...), not an OpenEXR file",
+                                   pszPath, osSource.c_str());
+        return false;
+    }
     VSIStatBufL sStat;
     if (VSIStatExL(pszPath, &sStat, VSI_STAT_EXISTS_FLAG | VSI_STAT_NATURE_FLAG |
                                         VSI_STAT_SIZE_FLAG) != 0)
@@ -46,15 +63,6 @@ static bool ReadWholeFile(const char *pszPath, std::vector<GByte> &oBytes,
     if (VSI_ISDIR(sStat.st_mode))
     {
         osError = CPLSPrintf("ENV_MAP '%s' is a directory, not an OpenEXR file", pszPath);
-        return false;
-    }
-    // a pipe's open waits for a writer, forever (an audit), and a device
-    // may too (a terminal): a map is a file
-    if (!STARTS_WITH(pszPath, "/vsi") && !VSI_ISREG(sStat.st_mode))
-    {
-        osError = CPLSPrintf("ENV_MAP '%s' is not a regular file (a pipe, a device...), not "
-                             "an OpenEXR file",
-                             pszPath);
         return false;
     }
     const std::string osTooLarge =

@@ -263,14 +263,32 @@ class EnvLight(unittest.TestCase):
 
     def test_a_map_that_is_no_file_is_refused_at_once(self):
         """An ENV_MAP that is a pipe waited forever in its open for a
-        writer; a device could too: refused, as a folder is."""
+        writer; a device could too: refused, as a folder is. Also inside
+        GDAL's wrappers (/vsisubfile/ and /vsigzip/ of the pipe hung until
+        session 56), and the standard input (/vsistdin/ waited for the
+        host's)."""
         pipe = self.path("pipe.exr")
         os.mkfifo(pipe)
-        for m in (pipe, "/dev/zero"):
+        for m, source in ((pipe, pipe), ("/dev/zero", "/dev/zero"),
+                          ("/vsisubfile/0_0," + pipe, pipe), ("/vsigzip/" + pipe, pipe),
+                          ("/vsizip/" + pipe + "/map.exr", pipe)):
             p = T.run(["timeout", "60", "gdalinfo", T.conn(T.JACKSBORO, PRODUCT="envlight"),
                        "-oo", "ENV_MAP=" + m], ok=False)
             self.assertEqual(p.returncode, 1, p.stderr)
-            self.assertIn("ENV_MAP '%s' is not a regular file" % m, p.stderr)
+            self.assertIn("ENV_MAP '%s' reads '%s', which is not a regular file" % (m, source),
+                          p.stderr)
+        # (a pipe that stays open as stdin: a read of it would wait)
+        r, w = os.pipe()
+        try:
+            p = subprocess.run(["timeout", "60", "gdalinfo",
+                                T.conn(T.JACKSBORO, PRODUCT="envlight"),
+                                "-oo", "ENV_MAP=/vsistdin/"], stdin=r, capture_output=True,
+                               text=True, env=T.env())
+        finally:
+            os.close(r)
+            os.close(w)
+        self.assertEqual(p.returncode, 1, p.stderr)
+        self.assertIn("ENV_MAP '/vsistdin/' reads the standard input", p.stderr)
 
     def test_bands_and_metadata(self):
         ds = gdal.OpenEx(T.conn(T.JACKSBORO), open_options=[

@@ -3,6 +3,7 @@ through gdal_translate, gdalinfo and Python."""
 import os
 import re
 import shutil
+import subprocess
 import tempfile
 import unittest
 
@@ -315,6 +316,46 @@ class Errors(unittest.TestCase):
                     self.check_tools("not a raster", T.conn(path), [],
                                      "cannot open the DEM '%s' as a raster" % path,
                                      tmp)
+
+    def test_names_that_would_hang_or_read_memory(self):
+        """Refused before GDAL opens them (session 56's security audit): a
+        MEM::: name, which GDAL 3.6 opens at any address it gives (a
+        crash, or the process's memory shaded); a pipe, plainly or inside
+        /vsigzip/ or /vsisubfile/, whose open waited for a writer for ever;
+        an atlas's SOURCE_DEM that has become a pipe (the file names it,
+        whoever wrote the file). The standard input given by the user is
+        read as GDAL reads it."""
+        mem = "MEM:::DATAPOINTER=0x1000,PIXELS=64,LINES=64,DATATYPE=Float32"
+        p = T.run(["timeout", "60", "gdalinfo", "-checksum", T.conn(mem)], ok=False)
+        self.assertEqual(p.returncode, 1, p.stderr)
+        self.assertIn("the DEM '%s' is a MEM::: name, which reads the process's memory" % mem,
+                      p.stderr)
+        with T.TempDir() as tmp:
+            pipe = os.path.join(tmp, "dem.tif")
+            os.mkfifo(pipe)
+            for name in (pipe, "/vsigzip/" + pipe, "/vsisubfile/0_100," + pipe):
+                p = T.run(["timeout", "60", "gdalinfo", T.conn(name)], ok=False)
+                self.assertEqual(p.returncode, 1, p.stderr)
+                self.assertIn("the DEM '%s' reads '%s', which is not a regular file (a pipe, "
+                              "a device...)" % (name, pipe), p.stderr)
+            os.unlink(pipe)
+            shutil.copy(DEM, pipe)
+            atlas = os.path.join(tmp, "day.tsa")
+            T.run(["gdal_translate", "-q", "-of", "TERRASHADE", "-oo", "PRODUCT=farshadow",
+                   "-oo", "DATE=2026-06-21", "-oo", "TIMEZONE=+01:00", "-oo", "ATLAS_STEPS=2",
+                   T.conn(pipe), atlas])
+            os.unlink(pipe)
+            os.mkfifo(pipe)
+            p = T.run(["timeout", "60", "gdalinfo", "-oo", "SHADOWS=all", atlas], ok=False)
+            self.assertEqual(p.returncode, 1, p.stderr)
+            self.assertIn("the atlas's SOURCE_DEM '%s' reads '%s', which is not a regular "
+                          "file" % (pipe, pipe), p.stderr)
+        with open(DEM, "rb") as f:
+            p = subprocess.run(["timeout", "60", "gdalinfo", "-checksum",
+                                T.conn("/vsistdin/")], stdin=f, capture_output=True,
+                               text=True, env=T.env())
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("Checksum=", p.stdout)
 
     def test_update_access_refused(self):
         with self.assertRaises(RuntimeError) as e:
