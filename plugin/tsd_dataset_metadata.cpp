@@ -11,6 +11,8 @@
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <chrono>
+#include <map>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -298,8 +300,15 @@ std::recursive_mutex &PamFileMutex()
 
 /* How long a save or load waits for another process's turn on the same
  * DEM's file before it goes ahead without one (a save takes milliseconds;
- * a holder stuck on a network file system must not hang this one). */
+ * a holder stuck on a network file system must not hang this one). A load
+ * waits less: any process that may read the DEM's folder can hold its lock
+ * (an audit held it: each open of a product waited 30 s a turn, 61-93 s),
+ * and a load without a turn at worst misses a save's entries. */
 constexpr int PAM_LOCK_WAIT_MS = 30000;
+constexpr int PAM_LOAD_WAIT_MS = 2000;
+/* After a wait ran out on a folder, this process's turns on it go ahead
+ * without waiting for this long (an open takes several turns). */
+constexpr double PAM_STUCK_S = 60.0;
 
 /* Where an entry keeps the stamp of the contents its statistics are of:
  * band 1's metadata item, in a domain of its own. */
@@ -328,6 +337,12 @@ class PamFileTurn
         static int nDepth = 0; // guarded by PamFileMutex
         return nDepth;
     }
+    /* The folders whose wait ran out, and when (guarded by PamFileMutex). */
+    static std::map<std::string, std::chrono::steady_clock::time_point> &Stuck()
+    {
+        static std::map<std::string, std::chrono::steady_clock::time_point> oStuck;
+        return oStuck;
+    }
 
   public:
     PamFileTurn(const char *pszDEM, bool bWrite)
@@ -338,16 +353,28 @@ class PamFileTurn
         m_fd = open(osDir.empty() ? "." : osDir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
         if (m_fd < 0)
             return;
+        const auto tNow = std::chrono::steady_clock::now();
+        const auto oStuck = Stuck().find(osDir);
+        const bool bStuck = oStuck != Stuck().end() &&
+                            std::chrono::duration<double>(tNow - oStuck->second).count() <
+                                PAM_STUCK_S;
+        const int nWait = bStuck ? 0 : bWrite ? PAM_LOCK_WAIT_MS : PAM_LOAD_WAIT_MS;
         for (int nWaited = 0;; nWaited += 5)
         {
             if (flock(m_fd, (bWrite ? LOCK_EX : LOCK_SH) | LOCK_NB) == 0)
+            {
+                if (oStuck != Stuck().end())
+                    Stuck().erase(oStuck);
                 return;
+            }
             if (errno != EWOULDBLOCK && errno != EINTR)
                 break; // no locks here (some network file systems)
-            if (nWaited >= PAM_LOCK_WAIT_MS)
+            if (nWaited >= nWait)
             {
                 CPLDebug("TERRASHADE", "no turn on the auxiliary file of %s after %d ms: "
                          "going ahead without one", pszDEM, nWaited);
+                if (!bStuck)
+                    Stuck()[osDir] = std::chrono::steady_clock::now();
                 break;
             }
             usleep(5000);
