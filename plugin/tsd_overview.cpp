@@ -12,6 +12,7 @@
  * the full level.
  */
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 
 #include "tsd_dataset.h"
@@ -32,20 +33,25 @@ int TSDataset::OverviewCount(const tsd_product_def *psProduct, int W, int H)
     int n = 0;
     for (int w = W, h = H; std::max(w, h) > OVERVIEW_MIN_SIDE && std::min(w, h) > 1;)
     {
-        w = (w + 1) / 2;
-        h = (h + 1) / 2;
+        w = w / 2 + (w & 1); // (not (w + 1) / 2: a side of 2^31 - 1 overflowed)
+        h = h / 2 + (h & 1);
         n++;
     }
     return n;
+}
+
+/* Cells a side of level nLevel: n / 2^nLevel rounded up, in 64 bits (a
+ * side near 2^31 overflowed an int, an audit's UBSan). */
+static int LevelSide(int n, int nLevel)
+{
+    return static_cast<int>((static_cast<int64_t>(n) + (int64_t{1} << nLevel) - 1) >> nLevel);
 }
 
 /* The dataset of level nLevel (>= 1), set up as the product of the DEM
  * resampled to that level; nullptr with the error reported. */
 TSDataset *TSDataset::MakeOverview(int nLevel)
 {
-    const int nFactor = 1 << nLevel;
-    const int W = (nRasterXSize + nFactor - 1) / nFactor;
-    const int H = (nRasterYSize + nFactor - 1) / nFactor;
+    const int W = LevelSide(nRasterXSize, nLevel), H = LevelSide(nRasterYSize, nLevel);
     auto poOvr = std::unique_ptr<TSDataset>(new TSDataset());
     poOvr->m_nLevel = nLevel;
     poOvr->m_poBase = this;
@@ -100,10 +106,8 @@ void TSDataset::MakeOverviews()
             m_anOffered.push_back(k);
             continue;
         }
-        const int nFactor = 1 << k;
         osLeftOut += CPLSPrintf("%s%d (%d x %d)", osLeftOut.empty() ? "" : ", ", k,
-                                (nRasterXSize + nFactor - 1) / nFactor,
-                                (nRasterYSize + nFactor - 1) / nFactor);
+                                LevelSide(nRasterXSize, k), LevelSide(nRasterYSize, k));
         if (osWhy.empty()) // (without its "TERRASHADE: ")
             osWhy = osMsg.compare(0, 12, "TERRASHADE: ") == 0 ? osMsg.substr(12) : osMsg;
     }

@@ -57,7 +57,7 @@ static int far_factor(const tsd_options *o, int W, int H, int f_mem, double near
                       int planes)
 {
     double budget = far_budget(o);
-    if ((double)W * H <= TSD_FAR_OWN_MAX_CELLS &&
+    if (f_mem == 1 && (double)W * H <= TSD_FAR_OWN_MAX_CELLS &&
         (double)W * H * far_bytes_per_cell(planes, 1) <= budget)
         return 1;
     int f_budget = (int)ceil(sqrt((double)W * H * far_bytes_per_cell(planes, 0) / budget));
@@ -187,8 +187,12 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
     if (p->why_whole && !(fits && o->near_distance > 0 && !whole_by_method(o, d)))
         return 0;
     double cell = cells_min_x < cell_y ? cells_min_x : cell_y;
-    /* the far grid's coarsening that keeps it within TSD_FAR_MAX_CELLS */
+    /* the far grid's coarsening that keeps it within TSD_FAR_MAX_CELLS,
+     * and each of its sides within a grid's (a DEM of 3 x 2^31 - 1 cells
+     * opened, then failed at its first read: an audit) */
     int f_mem = (int)ceil(sqrt((double)W * H / TSD_FAR_MAX_CELLS));
+    int f_side = (int)(((long long)(W > H ? W : H) + TS_MAX_SIDE - 1) / TS_MAX_SIDE);
+    f_mem = f_mem > f_side ? f_mem : f_side;
     double near = o->near_distance;
     if (near == 0) {
         int cells = TSD_NEAR_AUTO_CELLS > TSD_FAR_CELLS_PER_NEAR * f_mem

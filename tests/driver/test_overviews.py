@@ -273,6 +273,37 @@ class Overviews(unittest.TestCase):
                           for i in range(ds.GetRasterBand(1).GetOverviewCount())], [512, 256])
         ds = None
 
+    def test_sides_near_2_to_the_31(self):
+        """A DEM of 2^31 - 1 x 3 cells (a VRT over a 64 x 64 one): its
+        levels' sides, rounded up in an int, overflowed (UBSan; the warning
+        named a level of -1073741824 x 2 and the DEM had "no cells"), and
+        its far grid of 53687092 x 1 cells, beyond a grid's 2^20 a side,
+        failed at the first read (session 56's security audit). The levels
+        are named with their sizes now, and a block reads."""
+        small = T.write_tif(os.path.join(self.tmp, "flat_64.tif"),
+                            np.zeros((64, 64), np.float32), GT, 32632)
+        wide = os.path.join(self.tmp, "wide.vrt")
+        with open(wide, "w") as f:
+            f.write('<VRTDataset rasterXSize="2147483647" rasterYSize="3">'
+                    '<SRS>EPSG:32632</SRS><GeoTransform>%s</GeoTransform>'
+                    '<VRTRasterBand dataType="Float32" band="1"><SimpleSource>'
+                    '<SourceFilename relativeToVRT="0">%s</SourceFilename>'
+                    '<SourceBand>1</SourceBand><SrcRect xOff="0" yOff="0" xSize="64" '
+                    'ySize="3"/><DstRect xOff="0" yOff="0" xSize="64" ySize="3"/>'
+                    '</SimpleSource></VRTRasterBand></VRTDataset>'
+                    % (",".join(map(str, GT)), small))
+        p = T.run(["gdal_translate", "-q", "-srcwin", "0", "0", "64", "3",
+                   "-oo", "PRODUCT=horizon", "-oo", "DIRECTIONS=4", "-oo", "TILE_SIZE=64",
+                   "-oo", "MAX_MEMORY=1048576", T.conn(wide),
+                   os.path.join(self.tmp, "wide_start.tif")])
+        self.assertIn("overview level(s) 1 (1073741824 x 2), 2 (536870912 x 1) of the "
+                      "product of %s not offered" % wide, p.stderr)
+        ds = gdal.Open(os.path.join(self.tmp, "wide_start.tif"))
+        a = ds.ReadAsArray()
+        ds = None
+        self.assertEqual(a.shape, (4, 3, 64))
+        self.assertTrue(np.isfinite(a).all())
+
     def test_env_map_read_once(self):
         """ENV_MAP is read once, when the dataset opens, and its levels use
         those bytes: a map deleted after the levels were listed gave GDAL a
