@@ -154,6 +154,19 @@ typedef struct ts_atlas ts_atlas;
 ts_status ts_atlas_open(const uint8_t *bytes, size_t size, ts_atlas **out,
                         ts_error *err);
 
+/**
+ * The checks of ts_atlas_open that need only the header, for a reader that
+ * has not read the file yet: `head` holds its first head_n bytes (at least
+ * TS_ATLAS_HEADER_SIZE, or the whole file when it is shorter), file_size is
+ * its size. The magic, version, header size, header CRC and the sections'
+ * offsets and sizes are checked, with ts_atlas_open's messages; TS_OK means
+ * the header says the file holds exactly file_size bytes, so a file with
+ * bytes beyond its last section, or a truncated one, is refused before it
+ * is read (rather than read whole first).
+ */
+ts_status ts_atlas_check_header(const uint8_t *head, size_t head_n, uint64_t file_size,
+                                ts_error *err);
+
 /** The atlas's header (size, steps, georeferencing, metadata text); owned
  * by the atlas, valid until ts_atlas_free. */
 const ts_atlas_info *ts_atlas_get_info(const ts_atlas *a);

@@ -127,6 +127,87 @@ static inline uint32_t index_at(const ts_atlas *a, size_t plane, size_t tile)
     return a->info.index_bytes == 2 ? (uint32_t)p[0] | (uint32_t)p[1] << 8 : get32(p);
 }
 
+/* The header's fields (docs/atlas-format.md). */
+typedef struct {
+    uint32_t version, W, H, steps, flags, ib, ntiles;
+    uint64_t so, sn, to, tn, dof, dn, io, in;
+} atlas_header;
+
+/* The checks that need only the header (the first min(n, 168) bytes at b)
+ * and the file's size n, so that a reader can refuse a file longer or
+ * shorter than its header says before reading it (ts_atlas_check_header). */
+static ts_status read_header(const uint8_t *b, size_t head_n, uint64_t n, atlas_header *h,
+                             ts_error *err)
+{
+    if (!b || !ts_atlas_identify(b, head_n))
+        return ts_fail(err, TS_ERR_ARG, "not a terrashade atlas (the file does not start "
+                       "with the atlas magic \\x89TSATLAS)");
+    if (head_n < (n < TS_ATLAS_HEADER_SIZE ? n : TS_ATLAS_HEADER_SIZE))
+        return ts_fail(err, TS_ERR_ARG, "ts_atlas_check_header: %zu bytes given, the header "
+                       "has %d", head_n, TS_ATLAS_HEADER_SIZE);
+    if (n < 16)
+        return ts_fail(err, TS_ERR_ARG, "the atlas is truncated: %llu bytes, the header "
+                       "alone has %d", (unsigned long long)n, TS_ATLAS_HEADER_SIZE);
+    uint32_t version = get32(b + 8), hsize = get32(b + 12);
+    if (version == 1)
+        return ts_fail(err, TS_ERR_ARG, "the atlas has format version 1, whose metadata and "
+                       "step table carry no checksum and cannot be validated; this terrashade "
+                       "reads version %d: recreate the atlas (gdal_translate -of TERRASHADE "
+                       "from PRODUCT=farshadow)", TS_ATLAS_VERSION);
+    if (version != TS_ATLAS_VERSION)
+        return ts_fail(err, TS_ERR_ARG, "the atlas has format version %u; this terrashade "
+                       "reads version %d", version, TS_ATLAS_VERSION);
+    if (hsize < TS_ATLAS_HEADER_SIZE || n < hsize)
+        return ts_fail(err, TS_ERR_ARG, "the atlas is truncated or its header is damaged "
+                       "(header of %u bytes in a %llu-byte file)", hsize,
+                       (unsigned long long)n);
+    if (lzma_crc32(b, 160, 0) != get32(b + 160))
+        return ts_fail(err, TS_ERR_ARG, "the atlas's header is damaged (CRC32 mismatch)");
+    uint32_t W = get32(b + 16), H = get32(b + 20), steps = get32(b + 24);
+    uint32_t tile = get32(b + 28), ib = get32(b + 36), ntiles = get32(b + 40);
+    if (W < 1 || H < 1 || W > INT32_MAX / 2 || H > INT32_MAX / 2 || steps < 1 ||
+        steps > INT32_MAX / 2 || tile != TS_ATLAS_TILE || (ib != 2 && ib != 4) ||
+        ntiles < 1 || (ib == 2 && ntiles > 65536))
+        return ts_fail(err, TS_ERR_ARG, "the atlas's header is inconsistent (%u x %u cells, "
+                       "%u maps, tile %u, %u-byte indices, %u tiles)", W, H, steps, tile, ib,
+                       ntiles);
+    *h = (atlas_header){version, W, H, steps, get32(b + 32), ib, ntiles, get64(b + 104),
+                        (uint64_t)steps * TS_ATLAS_STEP_SIZE, get64(b + 112), get64(b + 120),
+                        get64(b + 128), get64(b + 136), get64(b + 144), get64(b + 152)};
+    uint64_t secs[4][2] = {{h->so, h->sn}, {h->to, h->tn}, {h->dof, h->dn}, {h->io, h->in}};
+    uint64_t end = hsize;
+    for (int i = 0; i < 4; i++) {
+        if (secs[i][0] < hsize || secs[i][0] > n || secs[i][1] > n - secs[i][0])
+            return ts_fail(err, TS_ERR_ARG, "the atlas is truncated: a section at byte %llu "
+                           "of %llu bytes lies beyond the end of the %llu-byte file",
+                           (unsigned long long)secs[i][0], (unsigned long long)secs[i][1],
+                           (unsigned long long)n);
+        end = secs[i][0] + secs[i][1] > end ? secs[i][0] + secs[i][1] : end;
+    }
+    /* every byte under a checksum: bytes after the last section are none
+     * of the atlas's (appended data, a copy cut into another file), and the
+     * sections follow each other without gaps or overlaps */
+    if (end < n)
+        return ts_fail(err, TS_ERR_ARG, "the atlas is damaged: %llu bytes follow its last "
+                       "section, which ends at byte %llu of the %llu-byte file",
+                       (unsigned long long)(n - end), (unsigned long long)end,
+                       (unsigned long long)n);
+    if ((uint64_t)hsize + h->sn + h->tn + h->dn + h->in != n)
+        return ts_fail(err, TS_ERR_ARG, "the atlas is damaged: its header and sections hold "
+                       "%llu bytes of the %llu-byte file (gaps or overlaps between them)",
+                       (unsigned long long)((uint64_t)hsize + h->sn + h->tn + h->dn + h->in),
+                       (unsigned long long)n);
+    return TS_OK;
+}
+
+ts_status ts_atlas_check_header(const uint8_t *head, size_t head_n, uint64_t file_size,
+                                ts_error *err)
+{
+    atlas_header h;
+    ts_status st = read_header(head, head_n, file_size, &h, err);
+    return st == TS_OK ? ts_ok(err) : st;
+}
+
 #define BAD(...) do { st = ts_fail(err, TS_ERR_ARG, __VA_ARGS__); goto fail; } while (0)
 
 ts_status ts_atlas_open(const uint8_t *b, size_t n, ts_atlas **out, ts_error *err)
@@ -134,62 +215,17 @@ ts_status ts_atlas_open(const uint8_t *b, size_t n, ts_atlas **out, ts_error *er
     if (!out)
         return ts_fail(err, TS_ERR_ARG, "ts_atlas_open: the output is NULL");
     *out = NULL;
-    if (!b || !ts_atlas_identify(b, n))
-        return ts_fail(err, TS_ERR_ARG, "not a terrashade atlas (the file does not start "
-                       "with the atlas magic \\x89TSATLAS)");
-    ts_status st;
+    atlas_header h;
+    ts_status st = read_header(b, n, n, &h, err);
+    if (st != TS_OK)
+        return st;
+    uint32_t version = h.version, W = h.W, H = h.H, steps = h.steps, flags = h.flags,
+             ib = h.ib, ntiles = h.ntiles;
+    uint64_t so = h.so, sn = h.sn, to = h.to, tn = h.tn, dof = h.dof, dn = h.dn, io = h.io,
+             in = h.in;
     ts_atlas *a = calloc(1, sizeof *a);
     if (!a)
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate the atlas");
-    if (n < 16)
-        BAD("the atlas is truncated: %zu bytes, the header alone has %d", n,
-            TS_ATLAS_HEADER_SIZE);
-    uint32_t version = get32(b + 8), hsize = get32(b + 12);
-    if (version == 1)
-        BAD("the atlas has format version 1, whose metadata and step table carry no "
-            "checksum and cannot be validated; this terrashade reads version %d: "
-            "recreate the atlas (gdal_translate -of TERRASHADE from PRODUCT=farshadow)",
-            TS_ATLAS_VERSION);
-    if (version != TS_ATLAS_VERSION)
-        BAD("the atlas has format version %u; this terrashade reads version %d",
-            version, TS_ATLAS_VERSION);
-    if (hsize < TS_ATLAS_HEADER_SIZE || n < hsize)
-        BAD("the atlas is truncated or its header is damaged (header of %u bytes in a "
-            "%zu-byte file)", hsize, n);
-    if (lzma_crc32(b, 160, 0) != get32(b + 160))
-        BAD("the atlas's header is damaged (CRC32 mismatch)");
-    uint32_t W = get32(b + 16), H = get32(b + 20), steps = get32(b + 24);
-    uint32_t tile = get32(b + 28), flags = get32(b + 32), ib = get32(b + 36);
-    uint32_t ntiles = get32(b + 40);
-    if (W < 1 || H < 1 || W > INT32_MAX / 2 || H > INT32_MAX / 2 || steps < 1 ||
-        steps > INT32_MAX / 2 || tile != TS_ATLAS_TILE || (ib != 2 && ib != 4) ||
-        ntiles < 1 || (ib == 2 && ntiles > 65536))
-        BAD("the atlas's header is inconsistent (%u x %u cells, %u maps, tile %u, "
-            "%u-byte indices, %u tiles)", W, H, steps, tile, ib, ntiles);
-    uint64_t so = get64(b + 104), to = get64(b + 112), tn = get64(b + 120),
-             dof = get64(b + 128), dn = get64(b + 136), io = get64(b + 144),
-             in = get64(b + 152);
-    uint64_t sn = (uint64_t)steps * TS_ATLAS_STEP_SIZE;
-    uint64_t secs[4][2] = {{so, sn}, {to, tn}, {dof, dn}, {io, in}};
-    uint64_t end = hsize;
-    for (int i = 0; i < 4; i++) {
-        if (secs[i][0] < hsize || secs[i][0] > n || secs[i][1] > n - secs[i][0])
-            BAD("the atlas is truncated: a section at byte %llu of %llu bytes lies "
-                "beyond the end of the %zu-byte file",
-                (unsigned long long)secs[i][0], (unsigned long long)secs[i][1], n);
-        end = secs[i][0] + secs[i][1] > end ? secs[i][0] + secs[i][1] : end;
-    }
-    /* every byte under a checksum: bytes after the last section are none
-     * of the atlas's (appended data, a copy cut into another file), and the
-     * sections follow each other without gaps or overlaps */
-    if (end < n)
-        BAD("the atlas is damaged: %llu bytes follow its last section, which ends at byte "
-            "%llu of the %zu-byte file", (unsigned long long)(n - end),
-            (unsigned long long)end, n);
-    if ((uint64_t)hsize + sn + tn + dn + in != n)
-        BAD("the atlas is damaged: its header and sections hold %llu bytes of the %zu-byte "
-            "file (gaps or overlaps between them)",
-            (unsigned long long)((uint64_t)hsize + sn + tn + dn + in), n);
     if (lzma_crc32(b + to, (size_t)tn, lzma_crc32(b + so, (size_t)sn, 0)) != get32(b + 164))
         BAD("the atlas's step table or metadata text is damaged (CRC32 mismatch)");
     a->info.width = (int)W;

@@ -221,21 +221,40 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
     VSIFSeekL(fp, 0, SEEK_END);
     const vsi_l_offset nSize = VSIFTellL(fp);
     VSIFSeekL(fp, 0, SEEK_SET);
-    GByte *pabyFile = nSize < (static_cast<vsi_l_offset>(1) << 40)
-                          ? static_cast<GByte *>(VSI_MALLOC_VERBOSE(static_cast<size_t>(nSize)))
-                          : nullptr;
-    const bool bRead = pabyFile && VSIFReadL(pabyFile, 1, static_cast<size_t>(nSize), fp) ==
-                                       static_cast<size_t>(nSize);
+    // the header first, checked against the file's size: the file was read
+    // whole (up to 1 TiB; a /vsicurl/ one downloaded) before its header
+    // said that it ends much earlier (an audit); now a file longer or
+    // shorter than its header says is refused before the rest is read
+    GByte abyHead[TS_ATLAS_HEADER_SIZE];
+    const size_t nHead = static_cast<size_t>(
+        std::min(nSize, static_cast<vsi_l_offset>(sizeof abyHead)));
+    ts_error sErr;
+    bool bRead = VSIFReadL(abyHead, 1, nHead, fp) == nHead;
+    ts_status eSt = bRead ? ts_atlas_check_header(abyHead, nHead, nSize, &sErr) : TS_OK;
+    GByte *pabyFile = nullptr;
+    if (bRead && eSt == TS_OK)
+    {
+        pabyFile = nSize < (static_cast<vsi_l_offset>(1) << 40)
+                       ? static_cast<GByte *>(VSI_MALLOC_VERBOSE(static_cast<size_t>(nSize)))
+                       : nullptr;
+        bRead = pabyFile != nullptr;
+        if (bRead)
+        {
+            memcpy(pabyFile, abyHead, nHead);
+            const size_t nRest = static_cast<size_t>(nSize) - nHead;
+            bRead = VSIFReadL(pabyFile + nHead, 1, nRest, fp) == nRest;
+        }
+    }
     VSIFCloseL(fp);
     ts_atlas *psAtlas = nullptr;
-    ts_error sErr;
     if (!bRead)
     {
         VSIFree(pabyFile);
         return FailOpen(CPLE_FileIO, CPLSPrintf("cannot read the atlas '%s'",
                                                   poOpenInfo->pszFilename));
     }
-    const ts_status eSt = ts_atlas_open(pabyFile, static_cast<size_t>(nSize), &psAtlas, &sErr);
+    if (eSt == TS_OK)
+        eSt = ts_atlas_open(pabyFile, static_cast<size_t>(nSize), &psAtlas, &sErr);
     VSIFree(pabyFile);
     // a file that does not read as an atlas: FileIO, as docs/driver.md's
     // errors say (the core's argument error read as a bad option, 5)

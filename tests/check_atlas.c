@@ -171,6 +171,16 @@ START_TEST(test_bad_maps_and_files)
     printf("damaged atlas (%zu bytes): %d of %d single-bit flips refused\n", size, caught,
            total);
     ck_assert_int_eq(caught, total);
+    /* the header alone against the file's size (what the driver reads
+     * first): this file's size passes, a longer or shorter file does not */
+    ck_assert_msg(ts_atlas_check_header(file, TS_ATLAS_HEADER_SIZE, size, &err) == TS_OK,
+                  "%s", err.message);
+    EXPECT_ARG(ts_atlas_check_header(file, TS_ATLAS_HEADER_SIZE, (uint64_t)3 << 30, &err),
+               &err);
+    ck_assert(strstr(err.message, "bytes follow its last section"));
+    EXPECT_ARG(ts_atlas_check_header(file, TS_ATLAS_HEADER_SIZE, size - 1, &err), &err);
+    ck_assert(strstr(err.message, "truncated"));
+    EXPECT_ARG(ts_atlas_check_header(file, 100, size, &err), &err); /* too few bytes */
     /* not an atlas */
     EXPECT_ARG(ts_atlas_open((const uint8_t *)"GIF89a..........", 16, &a, &err), &err);
     ck_assert(!ts_atlas_identify((const uint8_t *)"\x89PNG", 4));

@@ -15,6 +15,7 @@ import datetime
 import os
 import shutil
 import struct
+import sys
 import unittest
 import zlib
 
@@ -267,6 +268,43 @@ class Atlas(unittest.TestCase):
         with self.assertRaises(RuntimeError) as e:
             gdal.Open(self.tsa, gdal.GA_Update)
         self.assertIn("read-only", str(e.exception))
+
+    def test_sparse_file_refused_before_it_is_read(self):
+        """An atlas was read whole into memory (any size below 1 TiB) before
+        its header was checked: a 3 GB file of a header and a hole cost 3 GB
+        of memory, a /vsicurl/ one its whole download. Now the header is
+        checked against the file's size first, and nothing more is read."""
+        with open(self.tsa, "rb") as f:
+            data = f.read()
+        # the child's peak RSS as VmHWM: its ru_maxrss starts from this
+        # process's, which Linux carries across fork and exec
+        child = ("import sys\n"
+                 "from osgeo import gdal\n"
+                 "gdal.UseExceptions()\n"
+                 "try:\n"
+                 "    gdal.Open(sys.argv[1])\n"
+                 "    print('opened')\n"
+                 "except RuntimeError as e:\n"
+                 "    print(e)\n"
+                 "print('peak_kb', [l.split()[1] for l in open('/proc/self/status')\n"
+                 "                    if l.startswith('VmHWM:')][0])\n")
+        size = 3 << 30
+        for name, blob in (("header and a hole", data[:168]),
+                           ("atlas and a hole", data)):
+            with self.subTest(name):
+                path = os.path.join(self.dir, "sparse.tsa")
+                with open(path, "wb") as f:
+                    f.write(blob)
+                    f.truncate(size)
+                p = T.run([sys.executable, "-c", child, path])
+                os.remove(path)
+                rss_mb = int(p.stdout.split("peak_kb")[1]) // 1024
+                print("%-17s -> %s (peak RSS %d MB)" % (name, p.stdout.splitlines()[0],
+                                                      rss_mb))
+                # (the header says the file ends where the atlas does)
+                self.assertIn("%d bytes follow its last section" % (size - len(data)),
+                              p.stdout)
+                self.assertLess(rss_mb, 200)
 
     def write(self, name, blob):
         path = os.path.join(self.dir, name)
