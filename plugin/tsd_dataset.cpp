@@ -635,6 +635,8 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
             CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szMsg);
         if (m_nLevel == 0 && tsd_sun_range_warning(&m_sSun, &sOpts, szMsg, sizeof szMsg))
             CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szMsg);
+        if (m_nLevel == 0 && tsd_sun_delta_t_warning(&m_sSun, &sOpts, szMsg, sizeof szMsg))
+            CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", szMsg);
     }
     const tsd_sun *psSun = m_bHasSun ? &m_sSun : nullptr;
     tsd_run_init(&m_sRun, &sOpts, psSun);

@@ -2,6 +2,7 @@
 #include "tsd_sun.h"
 
 #include "tsd_datetime.h"
+#include "tsd_delta_t.h"
 #include "tsd_dem_check.h"
 #include "tsd_products.h"
 #include "tsd_text.h"
@@ -350,5 +351,31 @@ int tsd_sun_night_warning(const tsd_sun *s, const tsd_options *o, char *warning,
                  "If that is not the time meant, check DATETIME's offset from UTC (%s; mean "
                  "solar time at longitude %.1f is UTC%s)",
                  given, lon, at);
+    return 1;
+}
+
+/* DELTA_T moves the sun along the ecliptic (the planetary theory runs on
+ * TT; the Earth's turn on UT), at its mean 360 deg a tropical year: an
+ * error worth a word from 0.01 deg (~880 s: before ~1130, after ~2370). */
+#define SUN_DEG_PER_S (360.0 / (365.2422 * 86400.0))
+#define DELTA_T_WARN_DEG 0.01
+
+int tsd_sun_delta_t_warning(const tsd_sun *s, const tsd_options *o, char *warning, size_t n)
+{
+    const double t = isfinite(s->instant) ? s->instant : s->day_start;
+    if (tsd_options_given(o, "DELTA_T") || !isfinite(t))
+        return 0;
+    const double year = 1970.0 + t / (365.2425 * 86400.0);
+    const double est = tsd_delta_t_estimate(year);
+    if (!(fabs(est - o->delta_t) * SUN_DEG_PER_S > DELTA_T_WARN_DEG))
+        return 0;
+    const double give = est > 8000 ? 8000 : est < -8000 ? -8000 : est;
+    snprintf(warning, n,
+             "DELTA_T (TT - UT) was not given: its default, %g s, is the 2020s' value, where "
+             "Espenak & Meeus estimate %.0f s for the year %d%s, which moves the sun by "
+             "%.2f deg along the ecliptic. Give DELTA_T=%.0f%s",
+             o->delta_t, est, (int)floor(year), year > 2025 ? " (an extrapolation)" : "",
+             fabs(est - o->delta_t) * SUN_DEG_PER_S, give,
+             give != est ? " (the SPA takes at most 8000 s)" : "");
     return 1;
 }

@@ -95,6 +95,15 @@ int tsd_sun_range_warning(const tsd_sun *s, const tsd_options *o, char *warning,
 int tsd_sun_zone_warning(const tsd_sun *s, const tsd_options *o, char *warning,
                          size_t warning_size);
 
+/** 1 with a sentence in `warning` when DELTA_T was not given and its
+ * default (69 s, the 2020s') is so far from Espenak & Meeus's estimate for
+ * the year of the sun's instant or day (the first of a range) that the sun
+ * moves by more than 0.01 deg along the ecliptic (dates before ~1130 or
+ * after ~2370). The sentence gives the estimate to set (within the SPA's
+ * limit of 8000 s). 0 otherwise. */
+int tsd_sun_delta_t_warning(const tsd_sun *s, const tsd_options *o, char *warning,
+                            size_t warning_size);
+
 /** ISO 8601 local time with its offset, whole seconds:
  * 2026-06-21T07:30:00+02:00 (or ...Z for offset 0). */
 void tsd_format_time(double unix_time, int offset_minutes, char *buf, size_t n);

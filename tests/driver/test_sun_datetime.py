@@ -94,6 +94,41 @@ class SunDatetime(T.TempDirCase):
                           "night): no time of that day lights the DEM", err)
             self.assertNotIn("check DATETIME's offset", err)
 
+    def test_delta_t_of_a_far_year_warns(self):
+        """DELTA_T's default (69 s) is the 2020s' value: for a date whose
+        delta T (Espenak & Meeus, pvlib's calculate_deltat) moves the sun by
+        more than 0.01 deg along the ecliptic, a warning gives the estimate
+        (session 56's pvlib audit: 0.13 deg of azimuth at the year 500, with
+        no word). The estimates against NASA's table of observed values
+        (5710 s in 500, 1570 s in 1000) and pvlib's 10583.6 s at the year
+        0; capped at the SPA's 8000 s in what to give."""
+        import re
+        said = {}
+        for dt in ("0500-01-01T12:00:00Z", "1000-01-01T12:00:00Z", "0001-01-01T12:00:00Z",
+                   "2400-06-01T12:00:00Z"):
+            err = T.open_stderr(T.JACKSBORO, PRODUCT="shade", DATETIME=dt)
+            m = re.search(r"DELTA_T \(TT - UT\) was not given: its default, 69 s, is the "
+                          r"2020s' value, where Espenak & Meeus estimate (-?\d+) s for the "
+                          r"year (\d+)(?: \(an extrapolation\))?, which moves the sun by "
+                          r"([\d.]+) deg along the ecliptic. Give DELTA_T=(-?\d+)", err)
+            self.assertIsNotNone(m, err)
+            said[dt[:4]] = [float(g) for g in m.groups()]
+        self.assertAlmostEqual(said["0500"][0], 5710, delta=5)
+        self.assertAlmostEqual(said["1000"][0], 1574, delta=5)
+        self.assertAlmostEqual(said["0001"][0], 10583.6 - 10.1, delta=5)
+        self.assertEqual(said["0001"][3], 8000)
+        self.assertAlmostEqual(said["0500"][2], (5710 - 69) * 360 / 365.2422 / 86400, delta=0.01)
+        # a day product's day, and a range's first
+        err = T.open_stderr(T.JACKSBORO, PRODUCT="sunhours", START_DATE="0800-03-01",
+                            END_DATE="0800-03-02", TIMEZONE="-05:00")
+        self.assertIn("for the year 800", err)
+        # none in the 20th and 21st centuries, nor where DELTA_T is given
+        for dt, extra in (("1950-06-01T12:00:00Z", {}), ("2026-06-21T12:00:00Z", {}),
+                          ("0500-01-01T12:00:00Z", {"DELTA_T": "5710"})):
+            with self.subTest(dt=dt):
+                self.assertNotIn("DELTA_T (TT", T.open_stderr(T.JACKSBORO, DATETIME=dt,
+                                                               **extra))
+
     def test_a_day_of_a_far_offset_warns(self):
         """A day product's TIMEZONE more than 4 hours from the mean solar time
         at the DEM's centre (modulo a day) puts its midnight in daylight:
