@@ -267,6 +267,27 @@ static ts_status check_image(const env_image *img, const char *name, ts_error *e
     return TS_OK;
 }
 
+/* The count env_from_image allocates (kept beside it so that they agree). */
+static size_t texel_count(const env_image *img, size_t max_texels)
+{
+    panel_split p = split_of(img);
+    int k = block_size(&p, max_texels);
+    size_t count = texels_for_block(&p, k);
+    if (max_texels != 0 && k == 1) { /* a map fit for lighting: coarse pixels cut */
+        pixel_part q = parts_of(img, count, max_texels);
+        count *= (size_t)q.nx * (size_t)q.ny;
+    }
+    return count;
+}
+
+size_t ts_env_map_texels(const ts_env_map_info *info, size_t max_texels)
+{
+    if (!info || info->width < 1 || info->height < 1)
+        return 0;
+    env_image img = {NULL, info->width, info->height, info->cube ? ENV_CUBE : ENV_LATLONG};
+    return texel_count(&img, max_texels);
+}
+
 ts_status env_from_image(const env_image *img, double rotation_deg, size_t max_texels,
                          const char *name, ts_env *out, ts_error *err)
 {

@@ -155,6 +155,11 @@ typedef struct {
 ts_status ts_env_exr_info(const void *buf, size_t size, const char *name,
                           ts_env_map_info *info, ts_error *err);
 
+/** The texels ts_env_load_exr_memory makes of that map with max_texels
+ *  (blocks merged, coarse pixels cut), without decoding it: what a caller
+ *  checks its memory against (28 bytes a texel, 12 a pixel while read). */
+size_t ts_env_map_texels(const ts_env_map_info *info, size_t max_texels);
+
 /* ------------------------------------------------- lat-long texel grids */
 
 /**

@@ -59,6 +59,53 @@ void tsd_environment_free(tsd_environment *e)
     memset(e, 0, sizeof *e);
 }
 
+/* OpenEXRCore's buffers for one chunk, packed and unpacked, per pixel of
+ * the map's width: up to 32 lines (PIZ, B44) of 4 float channels, twice
+ * (DWA's 256-line chunks are of half channels: the same order). */
+#define DECODE_BYTES_PER_COLUMN (2.0 * 32 * 4 * sizeof(float))
+
+void tsd_environment_cost(const tsd_options *o, const ts_env_map_info *map, double map_bytes,
+                          tsd_env_cost *c)
+{
+    memset(c, 0, sizeof *c);
+    if (!tsd_options_env(o))
+        return;
+    c->texels = map ? (double)ts_env_map_texels(map, TSD_ENV_MAX_TEXELS)
+                    : (double)TS_SKY_DEFAULT_WIDTH * TS_SKY_DEFAULT_HEIGHT;
+    const double texels = c->texels * sizeof(ts_env_texel);
+    const double nodes = (double)o->directions * (o->env_normal_steps ? o->env_normal_steps : 1) *
+                         o->env_horizon_steps;
+    /* ts_env_table_build sums in doubles, then copies to the kept floats:
+     * 8 doubles and 8 floats a node at once, three times the table */
+    const double table = nodes * 8 * sizeof(float);
+    c->table_peak = map_bytes + texels + nodes * 8 * (sizeof(double) + sizeof(float));
+    if (map) /* the pixels as three floats beside the texels made from them */
+        c->map_peak = map_bytes + (double)map->width * map->height * 3 * sizeof(float) +
+                      map->width * DECODE_BYTES_PER_COLUMN + texels;
+    else
+        c->map_peak = texels;
+    c->peak = c->map_peak > c->table_peak ? c->map_peak : c->table_peak;
+    c->kept = texels + table;
+}
+
+int tsd_environment_same(const tsd_options *a, const tsd_run *ra, const tsd_options *b,
+                         const tsd_run *rb)
+{
+    if (strcmp(a->env_map, b->env_map) != 0 || strcmp(a->sky, b->sky) != 0 ||
+        strcmp(a->exposure, b->exposure) != 0 || a->env_rotation != b->env_rotation ||
+        a->directions != b->directions || a->start_azimuth != b->start_azimuth ||
+        a->env_normal_steps != b->env_normal_steps ||
+        a->env_horizon_steps != b->env_horizon_steps)
+        return 0;
+    if (tsd_environment_sunless(a))
+        return 1;
+    /* a sky placed by the sun: the same sun, up to rounding (a level's sun
+     * is the same instant at the same centre, through a scaled
+     * geotransform); a sun in another place makes another sky */
+    return fabs(remainder(ra->sun_azimuth - rb->sun_azimuth, 360.0)) <= 1e-9 &&
+           fabs(ra->sun_elevation - rb->sun_elevation) <= 1e-9;
+}
+
 /* The light of unshadowed surfaces of every sampled slope and aspect (no
  * horizon above the tangent plane) through the table: e->flat from the flat
  * one, e->peak the largest channel of any. */
@@ -125,12 +172,8 @@ static ts_status load_environment(const tsd_options *o, const tsd_run *run, cons
     return TS_OK;
 }
 
-ts_status tsd_environment_setup(const tsd_options *o, const tsd_run *run, const void *map,
-                                size_t map_size, tsd_environment *e, char *msg, size_t n)
+ts_status tsd_environment_check_table(const tsd_options *o, char *msg, size_t n)
 {
-    ts_error err;
-    ts_status st;
-    memset(e, 0, sizeof *e);
     double table_bytes = (double)o->directions * (o->env_normal_steps ? o->env_normal_steps : 1) *
                          o->env_horizon_steps * 8 * sizeof(float);
     if (table_bytes > TSD_ENV_MAX_TABLE_BYTES)
@@ -140,6 +183,17 @@ ts_status tsd_environment_setup(const tsd_options *o, const tsd_run *run, const 
                         "ENV_NORMAL_STEPS=0 (exact) or fewer steps",
                         o->directions, o->env_normal_steps, o->env_horizon_steps,
                         table_bytes / 1048576, TSD_ENV_MAX_TABLE_BYTES / 1048576);
+    return TS_OK;
+}
+
+ts_status tsd_environment_setup(const tsd_options *o, const tsd_run *run, const void *map,
+                                size_t map_size, tsd_environment *e, char *msg, size_t n)
+{
+    ts_error err;
+    ts_status st;
+    memset(e, 0, sizeof *e);
+    if ((st = tsd_environment_check_table(o, msg, n)) != TS_OK)
+        return st;
     if ((st = load_environment(o, run, map, map_size, e, msg, n)) != TS_OK) {
         tsd_environment_free(e);
         return st;

@@ -53,6 +53,30 @@ int tsd_environment_sunless(const tsd_options *o);
  * it is neither (or out of +-TSD_EXPOSURE_MAX). */
 int tsd_exposure_parse(const char *text, double *stops);
 
+/* TS_OK, or the sentence refusing a light table over
+ * TSD_ENV_MAX_TABLE_BYTES kept (whatever MAX_MEMORY allows). */
+ts_status tsd_environment_check_table(const tsd_options *o, char *msg, size_t n);
+
+/* What an environment takes (bytes), for MAX_MEMORY (docs/driver.md). */
+typedef struct {
+    double map_peak;   /* decoding ENV_MAP: its file, its pixels as floats, the texels */
+    double table_peak; /* building the light table: its double sums beside its floats */
+    double peak;       /* the larger, while the environment is set up */
+    double kept;       /* held while the product computes: texels and table */
+    double texels;     /* how many */
+} tsd_env_cost;
+
+/* The cost of the options' environment: `map` is ENV_MAP's header
+ * (ts_env_exr_info) and map_bytes its file's size, or NULL / 0 for SKY. */
+void tsd_environment_cost(const tsd_options *o, const ts_env_map_info *map, double map_bytes,
+                          tsd_env_cost *c);
+
+/* 1 if options a with run ra set up the same environment as b with rb:
+ * the same map or sky, rotation, table and exposure, and a sky that follows
+ * the sun placed by the same sun (within 1e-9 degrees). */
+int tsd_environment_same(const tsd_options *a, const tsd_run *ra, const tsd_options *b,
+                         const tsd_run *rb);
+
 /**
  * The environment of the options: the map in `map` (map_size bytes of an
  * OpenEXR file, read from ENV_MAP by the caller) or the SKY with the sun of

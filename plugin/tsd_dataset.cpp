@@ -640,7 +640,8 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     }
     const tsd_sun *psSun = m_bHasSun ? &m_sSun : nullptr;
     tsd_run_init(&m_sRun, &sOpts, psSun);
-    if (!SetupEnvironment())
+    std::vector<GByte> oEnvMap; // ENV_MAP's bytes, until the environment is built
+    if (!PlanEnvironment(oEnvMap))
         return false;
     if (m_sCells.warning[0] && m_nLevel == 0) // said once, for the DEM itself
         CPLError(CE_Warning, CPLE_AppDefined, "TERRASHADE: %s", m_sCells.warning);
@@ -658,7 +659,9 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     double dfHeadroom = 0;
     if (!SetupWindow(W, H) ||
         !CheckMemory(sOpts, W, H, WindowPlan(m_poWindow), m_bHasSun ? &m_sSun : nullptr,
-                     m_sCells, m_nLevel, &dfHeadroom))
+                     m_sCells, m_nLevel, m_sEnvCost,
+                     m_sEnvMapInfo.width ? &m_sEnvMapInfo : nullptr, &dfHeadroom) ||
+        !BuildEnvironment(oEnvMap))
         return false;
     // a lattice's day keeps horizon planes across its steps: in at most
     // half of what the limit leaves (docs/day-cycle.md)

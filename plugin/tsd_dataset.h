@@ -56,10 +56,15 @@ void WarnHeightUnit(const tsd_cells &sCells, const OGRSpatialReference &oSRS,
 /* tsd_dataset_memory.cpp: whether a W x H product of sOpts (whole, or by
  * psPlan's windows) fits MAX_MEMORY; if not, fails with a sentence saying
  * what to do (psSun, sCells and nLevel serve the advice on windows, at
- * level 0). *pdfHeadroom: the bytes left under the limit. */
+ * level 0). sEnv: the environment's cost, built at open (its peak) and kept
+ * while computing; psMap its ENV_MAP's header, or null. *pdfHeadroom: the
+ * bytes left under the limit. */
 bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *psPlan,
                  const tsd_sun *psSun, const tsd_cells &sCells, int nLevel,
+                 const tsd_env_cost &sEnv, const ts_env_map_info *psMap,
                  double *pdfHeadroom);
+/* The limit CheckMemory holds to (bytes), and *ppszWhy where it comes from. */
+double MemoryLimit(const tsd_options &sOpts, const char **ppszWhy);
 
 /* What a failure that may pass adds to its sentence: a dataset keeps its
  * failures, its later reads repeating them. */
@@ -146,7 +151,9 @@ class TSDataset final : public GDALPamDataset
     bool m_bUsesBackend = false;
     bool m_bBackendKnown = false;     // m_sBackend filled (predicted or ran)
     tsd_backend_summary m_sBackend{}; // predicted, then what ran
-    tsd_environment m_sEnv{};         // ENV_MAP or SKY (tsd_dataset_env.cpp); a level's ENV_MAP: its dataset's
+    tsd_environment m_sEnv{};         // ENV_MAP or SKY (tsd_dataset_env.cpp); a level's: its dataset's
+    tsd_env_cost m_sEnvCost{};        // what it takes (a level sharing it: kept only)
+    ts_env_map_info m_sEnvMapInfo{};  // ENV_MAP's header, when it is built here
     WindowState *m_poWindow = nullptr; // computed chunk by chunk (tsd_window_cache.cpp), or null
     std::thread m_oReadAhead{};  // the DEM read while OpenCL is probed (StartReadAhead)
     ts_grid m_sReadGrid{};       // what it read, for ReadDEM
@@ -209,7 +216,8 @@ class TSDataset final : public GDALPamDataset
     std::string m_osDEMStamp{}, m_osPamStamp{};
     bool DEMUnchanged() const;
     void DropStalePamStatistics();
-    bool SetupEnvironment();
+    bool PlanEnvironment(std::vector<GByte> &oMap);
+    bool BuildEnvironment(const std::vector<GByte> &oMap);
     void SetupEnvironmentMetadata();
 
   public:

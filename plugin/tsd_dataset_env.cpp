@@ -7,6 +7,7 @@
  * OpenEXR reader. And its metadata.
  */
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "tsd_dataset.h"
 #include "tsd_path_check.h"
 #include "tsd_gdal.h"
+#include "tsd_text.h"
 
 namespace tsd
 {
@@ -30,6 +32,26 @@ constexpr vsi_l_offset MAX_MAP_BYTES = static_cast<vsi_l_offset>(2) << 30;
  * little-endian). */
 constexpr GByte EXR_MAGIC[4] = {0x76, 0x2f, 0x31, 0x01};
 
+/* Whether ENV_MAP names no pipe, device or standard input, with the
+ * sentence in osError where it does: a pipe's open waits for a writer,
+ * forever (an audit), and a device may too (a terminal), also inside
+ * /vsigzip/ or /vsisubfile/ (a second audit). Asked before any stat, which
+ * opens an archive to look inside it. */
+static bool EnvMapIsAFile(const char *pszPath, std::string &osError)
+{
+    const std::string osSource = NonRegularSource(pszPath);
+    if (osSource.empty())
+        return true;
+    osError = osSource == "/vsistdin/"
+                  ? CPLSPrintf("ENV_MAP '%s' reads the standard input: give the file of an "
+                               "OpenEXR map",
+                               pszPath)
+                  : CPLSPrintf("ENV_MAP '%s' reads '%s', which is not a regular file (a pipe, "
+                               "a device...), not an OpenEXR file",
+                               pszPath, osSource.c_str());
+    return false;
+}
+
 /* The bytes of the file at pszPath (any GDAL path) into oBytes; false with
  * a sentence in osError. What does not start as an OpenEXR file does is
  * refused after four bytes, and a file larger than MAX_MAP_BYTES before
@@ -37,22 +59,8 @@ constexpr GByte EXR_MAGIC[4] = {0x76, 0x2f, 0x31, 0x01};
 static bool ReadWholeFile(const char *pszPath, std::vector<GByte> &oBytes,
                           std::string &osError)
 {
-    // a pipe's open waits for a writer, forever (an audit), and a device
-    // may too (a terminal), also inside /vsigzip/ or /vsisubfile/ (a second
-    // audit); the host's standard input is no map's either: a map is a
-    // file. Asked before the stat, which opens an archive to look inside
-    const std::string osSource = NonRegularSource(pszPath);
-    if (!osSource.empty())
-    {
-        osError = osSource == "/vsistdin/"
-                      ? CPLSPrintf("ENV_MAP '%s' reads the standard input: give the file of "
-                                   "an OpenEXR map",
-                                   pszPath)
-                      : CPLSPrintf("ENV_MAP '%s' reads '%s', which is not a regular file (a "
-                                   "pipe, a device...), not an OpenEXR file",
-                                   pszPath, osSource.c_str());
+    if (!EnvMapIsAFile(pszPath, osError))
         return false;
-    }
     VSIStatBufL sStat;
     if (VSIStatExL(pszPath, &sStat, VSI_STAT_EXISTS_FLAG | VSI_STAT_NATURE_FLAG |
                                         VSI_STAT_SIZE_FLAG) != 0)
@@ -133,26 +141,78 @@ static bool ReadWholeFile(const char *pszPath, std::vector<GByte> &oBytes,
     return bOk;
 }
 
-bool TSDataset::SetupEnvironment()
+/* What the environment will take, before it is set up (MAX_MEMORY is
+ * checked on it with the product, CheckMemory): ENV_MAP's bytes read into
+ * oMap and its header parsed. An overview level lights with its dataset's
+ * environment, set up at open, where it is the same (always, today: a level
+ * has its dataset's options, and its sun is the same instant at the same
+ * centre): a level made later read ENV_MAP again (a map deleted meanwhile
+ * gave GDAL a NULL level, gdalwarp crashed; a replaced one another light),
+ * and under SKY every level built a light table of its own, at the cost of
+ * the dataset's. */
+bool TSDataset::PlanEnvironment(std::vector<GByte> &oMap)
 {
+    m_sEnvCost = tsd_env_cost{};
     if (!tsd_options_env(&m_sOpts))
         return true;
-    // an overview level lights with the dataset's own ENV_MAP, read and
-    // decoded at open (the map's light depends on the options only): a level
-    // made later read the file again, and a map deleted meanwhile gave GDAL a
-    // NULL level (gdalwarp crashed), a replaced one another light
-    if (m_sOpts.env_map[0] && m_poBase)
+    if (m_poBase && m_poBase->m_sRun.env &&
+        tsd_environment_same(&m_poBase->m_sOpts, &m_poBase->m_sRun, &m_sOpts, &m_sRun))
     {
-        m_sRun.env = &m_poBase->m_sEnv;
+        m_sRun.env = m_poBase->m_sRun.env;
+        m_sEnvCost.kept = m_poBase->m_sEnvCost.kept; // held while the level computes
+        m_sEnvCost.texels = m_poBase->m_sEnvCost.texels;
+        CPLDebug(DRIVER, "environment: level %d shares its dataset's", m_nLevel);
         return true;
     }
-    std::vector<GByte> oMap;
+    char szMsg[1024] = "";
+    const ts_status eSt = tsd_environment_check_table(&m_sOpts, szMsg, sizeof szMsg);
+    if (eSt != TS_OK)
+        return Fail(eSt, szMsg), false;
+    if (!m_sOpts.env_map[0])
+    {
+        tsd_environment_cost(&m_sOpts, nullptr, 0, &m_sEnvCost);
+        return true;
+    }
+    // a file larger than the limit is refused before it is read whole
     std::string osError;
-    if (m_sOpts.env_map[0] && !ReadWholeFile(m_sOpts.env_map, oMap, osError))
+    if (!EnvMapIsAFile(m_sOpts.env_map, osError))
+        return Fail(CPLE_OpenFailed, osError.c_str()), false;
+    const char *pszWhy = nullptr;
+    const double dfLimit = MemoryLimit(m_sOpts, &pszWhy);
+    VSIStatBufL sStat;
+    if (VSIStatExL(m_sOpts.env_map, &sStat, VSI_STAT_SIZE_FLAG) == 0 &&
+        VSI_ISREG(sStat.st_mode) && static_cast<double>(sStat.st_size) > dfLimit)
+        return Fail(TS_ERR_NOMEM,
+                    CPLSPrintf("ENV_MAP '%s' is a file of %.0f MiB, read whole into memory, "
+                               "more than the limit of %.0f MiB (%s); use a smaller map, or "
+                               "MAX_MEMORY=%.0f or more",
+                               m_sOpts.env_map, sStat.st_size / 1048576.0,
+                               dfLimit / 1048576.0, pszWhy,
+                               std::ceil(sStat.st_size / 1048576.0))),
+               false;
+    if (!ReadWholeFile(m_sOpts.env_map, oMap, osError))
     {
         Fail(CPLE_OpenFailed, osError.c_str());
         return false;
     }
+    ts_env_map_info sInfo;
+    ts_error sErr;
+    if (ts_env_exr_info(oMap.data(), oMap.size(), m_sOpts.env_map, &sInfo, &sErr) != TS_OK)
+    {
+        Fail(tsd_fail_core(szMsg, sizeof szMsg, "ENV_MAP", &sErr), szMsg);
+        return false;
+    }
+    m_sEnvMapInfo = sInfo;
+    tsd_environment_cost(&m_sOpts, &sInfo, static_cast<double>(oMap.size()), &m_sEnvCost);
+    return true;
+}
+
+/* The environment planned (PlanEnvironment), once MAX_MEMORY allows it:
+ * ENV_MAP decoded from oMap, or the SKY placed; then its light table. */
+bool TSDataset::BuildEnvironment(const std::vector<GByte> &oMap)
+{
+    if (!tsd_options_env(&m_sOpts) || m_sRun.env)
+        return true;
     char szMsg[1024] = "";
     const ts_status eSt = tsd_environment_setup(&m_sOpts, &m_sRun, oMap.data(), oMap.size(),
                                                 &m_sEnv, szMsg, sizeof szMsg);

@@ -2,6 +2,7 @@
  * the product's peak bytes (whole, or by window) against the limit, and
  * the sentence that says what to do where it does not fit. */
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <string>
 
@@ -14,10 +15,52 @@
 namespace tsd
 {
 
+double MemoryLimit(const tsd_options &sOpts, const char **ppszWhy)
+{
+    *ppszWhy = "MAX_MEMORY";
+    if (sOpts.max_memory_mb > 0)
+        return sOpts.max_memory_mb * 1048576.0;
+    *ppszWhy = "three quarters of the physical memory; set MAX_MEMORY to change";
+    const double dfLimit = 0.75 * static_cast<double>(CPLGetUsablePhysicalRAM());
+    return dfLimit > 0 ? dfLimit : static_cast<double>(std::numeric_limits<size_t>::max()) / 2;
+}
+
+/* What the environment needs, where it alone does not fit the limit: the
+ * light table (its axes, and what takes fewer) or ENV_MAP decoded (its
+ * pixels), empty where it fits; dfTotal, with the product, is the
+ * MAX_MEMORY that would do. */
+static std::string EnvironmentOver(const tsd_options &sOpts, const tsd_env_cost &sEnv,
+                                   const ts_env_map_info *psMap, double dfLimit,
+                                   const char *pszWhy, double dfTotal)
+{
+    if (std::max(sEnv.peak, sEnv.kept) <= dfLimit)
+        return std::string();
+    const double dfNeed = std::ceil(dfTotal / 1048576.0); // the product's share too
+    const std::string osSource =
+        sOpts.env_map[0] ? CPLSPrintf("ENV_MAP '%s'", sOpts.env_map)
+                         : CPLSPrintf("SKY=%s", sOpts.sky);
+    if (psMap && sEnv.map_peak >= sEnv.table_peak)
+        return CPLSPrintf("decoding %s (%d x %d pixels, read as 12 bytes each, into %.0f "
+                          "texels) needs about %.0f MiB, more than the limit of %.0f MiB "
+                          "(%s); use a smaller map (larger than 2048 x 1024 it is merged "
+                          "to that many texels anyway), or MAX_MEMORY=%.0f or more",
+                          osSource.c_str(), psMap->width, psMap->height, sEnv.texels,
+                          sEnv.peak / 1048576.0, dfLimit / 1048576.0, pszWhy, dfNeed);
+    return CPLSPrintf("the light table of %s (DIRECTIONS=%d x ENV_NORMAL_STEPS=%d x "
+                      "ENV_HORIZON_STEPS=%d) needs about %.0f MiB while it is built (%.0f MiB "
+                      "kept), more than the limit of %.0f MiB (%s); use fewer DIRECTIONS or "
+                      "ENV_HORIZON_STEPS%s, or MAX_MEMORY=%.0f or more",
+                      osSource.c_str(), sOpts.directions, sOpts.env_normal_steps,
+                      sOpts.env_horizon_steps, sEnv.peak / 1048576.0, sEnv.kept / 1048576.0,
+                      dfLimit / 1048576.0, pszWhy,
+                      sOpts.env_normal_steps ? " (or ENV_NORMAL_STEPS=0, exact)" : "", dfNeed);
+}
+
 /* Refuse products that cannot fit, with a sentence saying what to do.
  * psSun, the cells and nLevel serve the advice on windows (level 0). */
 bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *psPlan,
                  const tsd_sun *psSun, const tsd_cells &sCells, int nLevel,
+                 const tsd_env_cost &sEnv, const ts_env_map_info *psMap,
                  double *pdfHeadroom)
 {
     if (!psPlan && (W > TS_MAX_SIDE || H > TS_MAX_SIDE))
@@ -37,30 +80,36 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
     }
     double dfSteady = 0;
     // windowed: the chunk with its margin, the cache and the far field
-    const double dfPeak = psPlan ? tsd_window_peak_bytes(&sOpts, psPlan, &dfSteady)
-                                 : tsd_product_peak_bytes(&sOpts, W, H, &dfSteady);
-    double dfLimit = 0;
-    const char *pszWhy = "MAX_MEMORY";
-    if (sOpts.max_memory_mb > 0)
-        dfLimit = sOpts.max_memory_mb * 1048576.0;
-    else
-    {
-        dfLimit = 0.75 * static_cast<double>(CPLGetUsablePhysicalRAM());
-        pszWhy = "three quarters of the physical memory; set MAX_MEMORY to change";
-        if (dfLimit <= 0)
-            dfLimit = static_cast<double>(std::numeric_limits<size_t>::max()) / 2;
-    }
-    CPLDebug(DRIVER, "memory: about %.0f MiB while computing (%.0f MiB kept)%s, limit %.0f MiB",
+    double dfPeak = psPlan ? tsd_window_peak_bytes(&sOpts, psPlan, &dfSteady)
+                           : tsd_product_peak_bytes(&sOpts, W, H, &dfSteady);
+    // the environment: set up at open (its peak), then kept while computing
+    dfPeak = std::max(dfPeak + sEnv.kept, sEnv.peak);
+    dfSteady += sEnv.kept;
+    const char *pszWhy = nullptr;
+    const double dfLimit = MemoryLimit(sOpts, &pszWhy);
+    CPLDebug(DRIVER,
+             "memory: about %.0f MiB while computing (%.0f MiB kept)%s, limit %.0f MiB; the "
+             "environment %.0f MiB set up, %.0f MiB kept",
              dfPeak / 1048576.0, dfSteady / 1048576.0, psPlan ? " by window" : "",
-             dfLimit / 1048576.0);
+             dfLimit / 1048576.0, sEnv.peak / 1048576.0, sEnv.kept / 1048576.0);
     *pdfHeadroom = std::max(0.0, dfLimit - dfPeak);
     if (dfPeak <= dfLimit && dfPeak < static_cast<double>(std::numeric_limits<size_t>::max()) / 2)
         return true;
+    const std::string osEnv = EnvironmentOver(sOpts, sEnv, psMap, dfLimit, pszWhy, dfPeak);
+    if (!osEnv.empty()) // no crop of the DEM helps
+    {
+        Fail(TS_ERR_NOMEM,
+             CPLSPrintf("PRODUCT=%s needs about %.0f MiB while computing (%.0f MiB kept): %s",
+                        tsd_options_product_name(&sOpts), dfPeak / 1048576.0,
+                        dfSteady / 1048576.0, osEnv.c_str()));
+        return false;
+    }
     char szAdvice[512] = "";
     // a small DEM's chunks with their margins can need more than the whole
     // DEM at once: say so, where the advice named no TILE_SIZE at all
     double dfWholeSteady = 0;
-    const double dfWhole = tsd_product_peak_bytes(&sOpts, W, H, &dfWholeSteady);
+    const double dfWhole = std::max(tsd_product_peak_bytes(&sOpts, W, H, &dfWholeSteady) +
+                                    sEnv.kept, sEnv.peak);
     if (psPlan && W <= TS_MAX_SIDE && H <= TS_MAX_SIDE && dfWhole <= dfLimit)
         snprintf(szAdvice, sizeof szAdvice,
                  "; TILE_SIZE=0 computes it whole in about %.0f MiB (its chunks with their "

@@ -10,7 +10,9 @@
 - a /vsimem/ map, Byte output (exposure and the sRGB curve), colour
   interpretation and metadata;
 - shade's sky term from SKY, and the sun with a CIE clear sky from DATETIME;
-- bad input: a clear sentence and a non-zero exit of gdal_translate.
+- bad input: a clear sentence and a non-zero exit of gdal_translate;
+- MAX_MEMORY counts the light table and ENV_MAP decoded: refused at open,
+  before either is built, with what needs the memory.
 """
 import os
 import shutil
@@ -19,7 +21,7 @@ import unittest
 
 import tsdriver as T
 from tsdriver import gdal, np
-from exr_write import write_exr
+from exr_write import write_black_zip_exr, write_exr
 
 SUNSET = os.path.join(T.DATA, "envmaps", "sunset.exr")
 SUNSET_CUBE = os.path.join(T.DATA, "envmaps", "sunset_cube128.exr")
@@ -289,6 +291,61 @@ class EnvLight(unittest.TestCase):
             os.close(w)
         self.assertEqual(p.returncode, 1, p.stderr)
         self.assertIn("ENV_MAP '/vsistdin/' reads the standard input", p.stderr)
+
+    def open_peak(self, *args):
+        """gdalinfo of an envlight of a 64^2 crop of jacksboro with these
+        -oo arguments, in a child whose peak resident MiB is printed last:
+        (the CompletedProcess, that MiB)."""
+        dem = self.path("crop64.tif")
+        if not os.path.exists(dem):
+            T.run(["gdal_translate", "-q", "-outsize", 64, 64, T.JACKSBORO, dem])
+        child = ("import resource, subprocess, sys\n"
+                 "p = subprocess.run(sys.argv[1:])\n"
+                 "print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss // 1024)\n"
+                 "sys.exit(p.returncode)")
+        p = T.run(["/usr/bin/python3", "-c", child, "gdalinfo", "-nomd",
+                   T.conn(dem, PRODUCT="envlight")] + list(args), ok=None)
+        return p, int(p.stdout.split()[-1])
+
+    def test_max_memory_counts_the_light_table(self):
+        """A SKY's light table of DIRECTIONS=3600 x ENV_HORIZON_STEPS=3601
+        (405 MiB kept, 1197 MiB while its double sums are built) opened
+        under MAX_MEMORY=100 with a peak of 1254 MB (the table was counted
+        nowhere, and its own 512 MiB limit reckoned 32 bytes a node)."""
+        big = ["-oo", "SKY=clear", "-oo", "DIRECTIONS=3600", "-oo", "ENV_HORIZON_STEPS=3601"]
+        for method in ("table", "sh"):
+            p, peak = self.open_peak(*big + ["-oo", "MAX_MEMORY=100", "-oo",
+                                             "ENV_METHOD=" + method])
+            self.assertNotEqual(p.returncode, 0, method)
+            self.assertIn("the light table of SKY=clear (DIRECTIONS=3600 x ENV_NORMAL_STEPS=0 "
+                          "x ENV_HORIZON_STEPS=3601) needs about 1197 MiB while it is built "
+                          "(405 MiB kept), more than the limit of 100 MiB (MAX_MEMORY); use "
+                          "fewer DIRECTIONS or ENV_HORIZON_STEPS, or MAX_MEMORY=", p.stderr)
+            self.assertLess(peak, 200, "the table was built before the refusal")
+        # a table that fits the limit given opens
+        p, peak = self.open_peak("-oo", "SKY=clear", "-oo", "DIRECTIONS=360",
+                                 "-oo", "MAX_MEMORY=100")
+        self.assertEqual(p.returncode, 0, p.stderr)
+
+    def test_max_memory_counts_the_map_decoded(self):
+        """A 404 KB ZIP-compressed map of 11584 x 5792 black pixels decodes
+        to 12 bytes a pixel: it took 877 MB at open under MAX_MEMORY=64, its
+        only limits TS_ENV_MAX_PIXELS and a 2 GiB file. Refused under a small
+        MAX_MEMORY, before it is decoded; under the default (three quarters
+        of the memory) it opens, as before."""
+        bomb = write_black_zip_exr(self.path("bomb.exr"), 11584, 5792)
+        self.assertLess(os.path.getsize(bomb), 500000)
+        p, peak = self.open_peak("-oo", "ENV_MAP=" + bomb, "-oo", "MAX_MEMORY=64")
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn("decoding ENV_MAP '%s' (11584 x 5792 pixels, read as 12 bytes each, "
+                      "into 1865346 texels) needs about 8" % bomb, p.stderr)
+        self.assertIn("more than the limit of 64 MiB (MAX_MEMORY); use a smaller map",
+                      p.stderr)
+        self.assertLess(peak, 200, "the map was decoded before the refusal")
+        p, peak = self.open_peak("-oo", "ENV_MAP=" + bomb)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        print("the map under the default limit: peak %d MiB" % peak)
+        self.assertGreater(peak, 768)  # its pixels alone: 768 MiB
 
     def test_bands_and_metadata(self):
         ds = gdal.OpenEx(T.conn(T.JACKSBORO), open_options=[

@@ -168,6 +168,39 @@ class MemoryEstimate(unittest.TestCase):
     def test_estimate_brackets_the_peak(self):
         self.brackets(CASES, COMMON, estimate)
 
+    def test_environment_estimate_brackets_its_peak(self):
+        """The environment counts: a SKY's light table built (its double
+        sums beside its floats, three times the table kept) and ENV_MAP
+        decoded (12 bytes a pixel beside the texels). On the 16^2 crop, the
+        growth from a SKY of a small table to a large one (720 x 1801 nodes)
+        and to a 4096 x 2048 map, against the growth of the estimates,
+        within the bounds above. Neither was counted until a security audit
+        (a 1254 MB table and an 877 MB map opened under MAX_MEMORY=100)."""
+        from exr_write import write_black_zip_exr
+        emap = write_black_zip_exr(os.path.join(os.path.dirname(self.out), "map.exr"),
+                                   4096, 2048)
+        small = dict(COMMON, PRODUCT="envlight", SKY="overcast", DIRECTIONS=8)
+        large = [("SKY, 720 x 1801 nodes", dict(small, DIRECTIONS=720, ENV_HORIZON_STEPS=1801)),
+                 ("ENV_MAP of 4096 x 2048",
+                  dict({k: v for k, v in small.items() if k != "SKY"}, ENV_MAP=emap))]
+
+        def growth(options):
+            args = ["gdal_translate", "-q"] + T.oo_args(options) + [T.conn(self.tiny), self.out]
+            return peak_rss(args), estimate(self.tiny, options, self.out)
+
+        rss0, est0 = growth(small)
+        for name, case in large:
+            rss, est = growth(case)
+            grown, est = rss - rss0, est - est0
+            print("%-24s estimate grew %5.0f MiB, peak grew %6.1f MiB" %
+                  (name, est / MIB, grown / MIB))
+            with self.subTest(case=name):
+                self.assertGreater(grown, 100 * MIB)
+                self.assertGreaterEqual(est, 0.95 * grown - 4 * MIB,
+                                        "the estimate falls short of the real peak")
+                self.assertLessEqual(est, 1.3 * grown + 8 * MIB,
+                                     "the estimate is far above the real peak")
+
     def test_windowed_estimate_brackets_the_peak(self):
         self.brackets(WINDOWED, dict(COMMON, TILE_SIZE=512), estimate_logged)
 

@@ -116,7 +116,15 @@ class Overviews(unittest.TestCase):
                            ("svf", dict(PRODUCT="svf", DIRECTIONS=8)),
                            ("openness", dict(PRODUCT="openness", DIRECTIONS=4)),
                            ("sky", dict(PRODUCT="sky", DIRECTIONS=4,
-                                        MAX_DISTANCE=3000))]:
+                                        MAX_DISTANCE=3000)),
+                           # the levels light with the dataset's sky (its sun
+                           # the same at the same centre): still equal
+                           ("shade_clearsky", dict(SKY="clear", SKY_WEIGHT=0.5, DIRECTIONS=4,
+                                                   DATETIME="2026-06-21T08:00:00+02:00",
+                                                   OUTPUT_TYPE="Float32")),
+                           ("envlight_sky", dict(PRODUCT="envlight", SKY="cie:7",
+                                                 SUN_AZIMUTH=120, SUN_ELEVATION=25,
+                                                 DIRECTIONS=4))]:
             self.check_levels_equal_downsampled(self.dem, name, BACKEND="c", **opts)
 
     def test_day_products_equal_downsampled(self):
@@ -342,6 +350,36 @@ class Overviews(unittest.TestCase):
                     m))
         p = T.run(["/usr/bin/python3", "-c", child])  # (it crashed: exit 139)
         self.assertTrue(p.stdout.strip().isdigit(), p.stdout + p.stderr)
+
+    def test_sky_light_table_built_once(self):
+        """Under SKY, every level built a light table of its own when the
+        levels were listed and again when one was first used (only ENV_MAP
+        was shared): a 2048^2 SKY=clear envlight of DIRECTIONS=3600 x
+        ENV_HORIZON_STEPS=3601 went from 1254 MB and 3.9 s at open to 2471 MB
+        and 26.4 s once its three levels were asked for (a security audit).
+        The levels now light with the dataset's table: listing and making
+        them (no pixel read) grows the peak by far less than one table."""
+        code = ("import sys; sys.path.insert(0, %r); import tsdriver as T\n"
+                "from tsdriver import gdal\n"
+                "gdal.SetConfigOption('CPL_DEBUG', 'TERRASHADE')  # (tsdriver drops it)\n"
+                "def kib(key):\n"
+                "    return int([l for l in open('/proc/self/status')\n"
+                "                if l.startswith(key)][0].split()[1])\n"
+                "ds = gdal.OpenEx(T.conn(%r), open_options=['PRODUCT=envlight',"
+                " 'SKY=clear', 'DIRECTIONS=720', 'ENV_HORIZON_STEPS=1801'])\n"
+                "open('/proc/self/clear_refs', 'w').write('5')  # reset VmHWM\n"
+                "r0 = kib('VmRSS')\n"
+                "b = ds.GetRasterBand(1)\n"
+                "levels = [b.GetOverview(i) for i in range(b.GetOverviewCount())]\n"
+                "print(len(levels), kib('VmHWM') - r0)\n"
+                % (os.path.dirname(os.path.abspath(__file__)), self.dem))
+        p = T.run([sys.executable, "-c", code], GDAL_CACHEMAX=8)
+        levels, grown = map(int, p.stdout.split()[-2:])
+        # the table: 720 x 1801 nodes, 40 MiB kept, 119 MiB while built
+        print("%d levels listed and made: peak grew by %.1f MiB" % (levels, grown / 1024.0))
+        self.assertEqual(levels, 2)
+        self.assertLess(grown / 1024.0, 20)
+        self.assertEqual(p.stderr.count("environment: level 1 shares its dataset's"), 2)
 
     def test_gdaladdo_refused_with_what_to_do(self):
         """gdaladdo on a TERRASHADE source: the product's levels are its own
