@@ -50,14 +50,14 @@ static double far_budget(const tsd_options *o)
 }
 
 /* The far grid's cell in DEM cells: 1 (the DEM itself) where it fits
- * TSD_FAR_MAX_CELLS (f_mem) and the budget, else as fine as they allow;
+ * TSD_FAR_OWN_MAX_CELLS, a grid's sides and the budget, else as fine as they allow;
  * never coarser than near_cells / TSD_FAR_CELLS_PER_NEAR for the budget's
  * sake (the rule before the budget), nor finer than f_mem. */
 static int far_factor(const tsd_options *o, int W, int H, int f_mem, double near_cells,
                       int planes)
 {
     double budget = far_budget(o);
-    if (f_mem == 1 && (double)W * H <= TSD_FAR_OWN_MAX_CELLS &&
+    if (W <= TS_MAX_SIDE && H <= TS_MAX_SIDE && (double)W * H <= TSD_FAR_OWN_MAX_CELLS &&
         (double)W * H * far_bytes_per_cell(planes, 1) <= budget)
         return 1;
     int f_budget = (int)ceil(sqrt((double)W * H * far_bytes_per_cell(planes, 0) / budget));

@@ -53,6 +53,14 @@ def scaled_errors(label, dem, tile, other_tile, o):
     return med, p99, worst, agree
 
 
+
+def osr_utm17():
+    """The WKT of UTM 17N (EPSG:32617)."""
+    from osgeo import osr
+    srs = osr.SpatialReference()
+    srs.ImportFromEPSG(32617)
+    return srs.ExportToWkt()
+
 class Windows(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -380,6 +388,21 @@ np.save(sys.argv[2], a)
         print("  FAR_GRID: 600 x 520, with MAX_MEMORY=64 %s" % coarse)
         self.assertNotEqual(coarse, "600 x 520")
         self.assertIsNone(far_grid(PRODUCT="svf", DIRECTIONS=32, TILE_SIZE=0))
+        # a DEM of 5000 x 1000 and one of 3000 x 3000 cells are their own far
+        # grids (up to 4096 x 4096 cells, docs/windows.md): session 56's
+        # bound on a far grid's sides halved both, their pixels changed, by
+        # the default options (its review)
+        for w, h, tile in ((5000, 1000, 4096), (3000, 3000, 1024)):
+            big = os.path.join(self.tmp, "flat_%dx%d.tif" % (w, h))
+            src = gdal.GetDriverByName("GTiff").Create(big, w, h, 1, gdal.GDT_Float32,
+                                                        ["SPARSE_OK=YES"])
+            src.SetGeoTransform((500000.0, 10.0, 0, 4000000.0, 0, -10.0))
+            src.SetProjection(osr_utm17())
+            src = None
+            ds = gdal.OpenEx(T.conn(big), gdal.OF_RASTER, open_options=[
+                "PRODUCT=svf", "DIRECTIONS=8", "TILE_SIZE=%d" % tile])
+            self.assertEqual(ds.GetMetadataItem("FAR_GRID"), "%d x %d" % (w, h))
+            ds = None
 
     def test_small_dem_whole(self):
         """A DEM within one tile is computed whole: TILE_SIZE changes nothing."""
