@@ -5,49 +5,26 @@
 #include "tsd_path_check.h"
 
 #include <cstring>
+#include <vector>
 
 #include "cpl_conv.h"
+#include "cpl_minixml.h"
 #include "cpl_string.h"
 #include "cpl_vsi.h"
 
 namespace tsd
 {
 
-std::string NonRegularSource(const char *pszPath)
+/* The first part of an OS path that is not a folder, where it is no
+ * regular file (the file itself, or the archive whose member the rest
+ * names); "" otherwise. */
+static std::string NonRegularPrefix(const std::string &osPath)
 {
-    std::string osRest = pszPath ? pszPath : "";
-    // GDAL's in-process wrappers, outermost first: each reads the file
-    // named after it (an audit hung an open on /vsisubfile/0_0,fifo)
-    for (;;)
+    if (osPath.empty())
+        return std::string();
+    for (size_t nEnd = osPath.find('/', 1);; nEnd = osPath.find('/', nEnd + 1))
     {
-        if (STARTS_WITH_CI(osRest.c_str(), "/vsistdin"))
-            return "/vsistdin/";
-        bool bWrapped = false;
-        for (const char *pszWrapper : {"/vsigzip/", "/vsizip/", "/vsitar/", "/vsisubfile/"})
-        {
-            if (!STARTS_WITH_CI(osRest.c_str(), pszWrapper))
-                continue;
-            osRest.erase(0, strlen(pszWrapper));
-            if (EQUAL(pszWrapper, "/vsisubfile/"))
-            {
-                const size_t nComma = osRest.find(',');
-                osRest.erase(0, nComma == std::string::npos ? osRest.size() : nComma + 1);
-            }
-            else if (!osRest.empty() && osRest[0] == '{' && osRest.find('}') != std::string::npos)
-                osRest = osRest.substr(1, osRest.find('}') - 1);
-            bWrapped = true;
-            break;
-        }
-        if (!bWrapped)
-            break;
-    }
-    if (osRest.empty() || STARTS_WITH(osRest.c_str(), "/vsi"))
-        return std::string(); // a URL, an in-memory file: no open that waits
-    // the first part of the path that is not a folder: the file itself, or
-    // the archive whose member the rest names
-    for (size_t nEnd = osRest.find('/', 1);; nEnd = osRest.find('/', nEnd + 1))
-    {
-        const std::string osPart = osRest.substr(0, nEnd);
+        const std::string osPart = osPath.substr(0, nEnd);
         VSIStatBufL sStat;
         if (VSIStatL(osPart.c_str(), &sStat) == 0 && !VSI_ISDIR(sStat.st_mode))
             return VSI_ISREG(sStat.st_mode) ? std::string() : osPart;
@@ -56,9 +33,103 @@ std::string NonRegularSource(const char *pszPath)
     }
 }
 
+static std::string NonRegularSourceAt(const char *pszPath, int nDepth);
+
+/* /vsisparse/'s XML names the files it reads (its regions' Filename,
+ * relative to the XML where it says relative="1"): each is checked. */
+static std::string SparseSources(const std::string &osXML, int nDepth)
+{
+    VSIStatBufL sStat;
+    if (nDepth > 4 || VSIStatL(osXML.c_str(), &sStat) != 0 || !VSI_ISREG(sStat.st_mode) ||
+        sStat.st_size > (1 << 20))
+        return std::string();
+    CPLXMLTreeCloser oTree(CPLParseXMLFile(osXML.c_str()));
+    std::vector<const CPLXMLNode *> apsStack{oTree.get()};
+    while (!apsStack.empty())
+    {
+        const CPLXMLNode *psNode = apsStack.back();
+        apsStack.pop_back();
+        for (; psNode; psNode = psNode->psNext)
+        {
+            if (psNode->eType != CXT_Element)
+                continue;
+            if (EQUAL(psNode->pszValue, "Filename"))
+            {
+                const char *pszName = CPLGetXMLValue(psNode, nullptr, "");
+                const std::string osName =
+                    CPLTestBool(CPLGetXMLValue(psNode, "relative", "0"))
+                        ? std::string(CPLFormFilename(CPLGetPath(osXML.c_str()), pszName,
+                                                      nullptr))
+                        : std::string(pszName);
+                const std::string osFound = NonRegularSourceAt(osName.c_str(), nDepth + 1);
+                if (!osFound.empty())
+                    return osFound;
+            }
+            else
+                apsStack.push_back(psNode->psChild);
+        }
+    }
+    return std::string();
+}
+
+static std::string NonRegularSourceAt(const char *pszPath, int nDepth)
+{
+    const std::string osName = pszPath ? pszPath : "";
+    if (CPLString(osName).ifind("/vsistdin") != std::string::npos)
+        return "/vsistdin/";
+    // the name whole, and each of its pieces between the separators of
+    // GDAL's prefixes and wrappers (a driver's NAME:...:path, vrt://path?,
+    // /vsisubfile/o_n,path, /vsizip/{...} at any depth): any of them that is
+    // a path of the OS (an audit hung opens on /vsisubfile/0_0,fifo; its
+    // review on GTIFF_DIR:1:fifo, vrt://fifo and nested braces)
+    std::vector<std::string> aosPieces{osName};
+    for (size_t nStart = 0, nEnd;; nStart = nEnd + 1)
+    {
+        nEnd = osName.find_first_of(":,{}?\"", nStart);
+        aosPieces.push_back(osName.substr(nStart, nEnd - nStart));
+        if (nEnd == std::string::npos)
+            break;
+    }
+    for (std::string osRest : aosPieces)
+    {
+        // GDAL's in-process wrappers, outermost first: each reads the file
+        // named after it
+        for (bool bWrapped = true; bWrapped;)
+        {
+            bWrapped = false;
+            for (const char *pszWrapper :
+                 {"/vsigzip/", "/vsizip/", "/vsitar/", "/vsisubfile/", "/vsisparse/"})
+                if (STARTS_WITH_CI(osRest.c_str(), pszWrapper))
+                {
+                    if (EQUAL(pszWrapper, "/vsisparse/"))
+                    {
+                        const std::string osFound =
+                            SparseSources(osRest.substr(strlen(pszWrapper)), nDepth);
+                        if (!osFound.empty())
+                            return osFound;
+                    }
+                    osRest.erase(0, strlen(pszWrapper));
+                    bWrapped = true;
+                }
+        }
+        if (STARTS_WITH(osRest.c_str(), "/vsi"))
+            continue; // a URL, an in-memory file: no open that waits
+        const std::string osFound = NonRegularPrefix(osRest);
+        if (!osFound.empty())
+            return osFound;
+    }
+    return std::string();
+}
+
+std::string NonRegularSource(const char *pszPath)
+{
+    return NonRegularSourceAt(pszPath, 0);
+}
+
 std::string RefusedDEMName(const char *pszDEM, const char *pszWhat, bool bFromFile)
 {
-    if (STARTS_WITH_CI(pszDEM, "MEM:::") &&
+    // anywhere in the name: vrt://MEM:::... opened it too (the review)
+    if (CPLString(pszDEM).ifind("MEM:::") != std::string::npos &&
         !CPLTestBool(CPLGetConfigOption("GDAL_MEM_ENABLE_OPEN", "NO")))
         return CPLSPrintf("%s '%s' is a MEM::: name, which reads the process's memory at any "
                           "address it gives: refused (GDAL 3.10 refuses it too), unless the "
