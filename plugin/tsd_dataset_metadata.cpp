@@ -15,6 +15,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cpl_conv.h"
@@ -304,10 +305,12 @@ std::recursive_mutex &PamFileMutex()
  * waits less: any process that may read the DEM's folder can hold its lock
  * (an audit held it: each open of a product waited 30 s a turn, 61-93 s),
  * and a load without a turn at worst misses a save's entries. */
-constexpr int PAM_LOCK_WAIT_MS = 30000;
+constexpr int PAM_LOCK_WAIT_MS = 10000;
 constexpr int PAM_LOAD_WAIT_MS = 2000;
 /* After a wait ran out on a folder, this process's turns on it go ahead
- * without waiting for this long (an open takes several turns). */
+ * without waiting for this long (an open takes several turns): a load's
+ * loads only (a save waited behind a busy moment must still take turns,
+ * or entries are lost), a save's both. */
 constexpr double PAM_STUCK_S = 60.0;
 
 /* Where an entry keeps the stamp of the contents its statistics are of:
@@ -337,11 +340,21 @@ class PamFileTurn
         static int nDepth = 0; // guarded by PamFileMutex
         return nDepth;
     }
-    /* The folders whose wait ran out, and when (guarded by PamFileMutex). */
-    static std::map<std::string, std::chrono::steady_clock::time_point> &Stuck()
+    /* The folders (device, inode: one folder by any name) whose loads'
+     * [0] or saves' [1] wait ran out, and when (guarded by PamFileMutex). */
+    using Folder = std::pair<dev_t, ino_t>;
+    using StuckMap = std::map<Folder, std::chrono::steady_clock::time_point>;
+    static StuckMap &Stuck(bool bWrite)
     {
-        static std::map<std::string, std::chrono::steady_clock::time_point> oStuck;
-        return oStuck;
+        static StuckMap aoStuck[2];
+        return aoStuck[bWrite ? 1 : 0];
+    }
+    static bool IsStuck(bool bWrite, const Folder &oFolder)
+    {
+        const auto oIt = Stuck(bWrite).find(oFolder);
+        return oIt != Stuck(bWrite).end() &&
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - oIt->second)
+                       .count() < PAM_STUCK_S;
     }
 
   public:
@@ -353,18 +366,16 @@ class PamFileTurn
         m_fd = open(osDir.empty() ? "." : osDir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
         if (m_fd < 0)
             return;
-        const auto tNow = std::chrono::steady_clock::now();
-        const auto oStuck = Stuck().find(osDir);
-        const bool bStuck = oStuck != Stuck().end() &&
-                            std::chrono::duration<double>(tNow - oStuck->second).count() <
-                                PAM_STUCK_S;
+        struct stat sDir;
+        const Folder oFolder =
+            fstat(m_fd, &sDir) == 0 ? Folder(sDir.st_dev, sDir.st_ino) : Folder(0, 0);
+        const bool bStuck = IsStuck(bWrite, oFolder);
         const int nWait = bStuck ? 0 : bWrite ? PAM_LOCK_WAIT_MS : PAM_LOAD_WAIT_MS;
         for (int nWaited = 0;; nWaited += 5)
         {
             if (flock(m_fd, (bWrite ? LOCK_EX : LOCK_SH) | LOCK_NB) == 0)
             {
-                if (oStuck != Stuck().end())
-                    Stuck().erase(oStuck);
+                Stuck(bWrite).erase(oFolder);
                 return;
             }
             if (errno != EWOULDBLOCK && errno != EINTR)
@@ -374,7 +385,11 @@ class PamFileTurn
                 CPLDebug("TERRASHADE", "no turn on the auxiliary file of %s after %d ms: "
                          "going ahead without one", pszDEM, nWaited);
                 if (!bStuck)
-                    Stuck()[osDir] = std::chrono::steady_clock::now();
+                {
+                    Stuck(false)[oFolder] = std::chrono::steady_clock::now();
+                    if (bWrite)
+                        Stuck(true)[oFolder] = Stuck(false)[oFolder];
+                }
                 break;
             }
             usleep(5000);

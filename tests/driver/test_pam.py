@@ -281,9 +281,10 @@ class Pam(unittest.TestCase):
         """Any process that may read the DEM's folder can hold its lock (the
         turns' flock): each turn of an open waited 30 s for it, gdalinfo of
         a product 61 s and with -stats 93 s (session 56's security audit).
-        A load now waits 2 s, and after a wait runs out the process's other
-        turns on that folder go ahead at once; the statistics are still
-        saved."""
+        A load now waits 2 s and a save 10 s, and after a wait runs out the
+        process's other turns of that kind (a save's: both kinds) on that
+        folder go ahead at once; the statistics are still saved. (~15 s
+        here: two loads' 2 s and a save's 10 s.)"""
         import fcntl
         import time
         fd = os.open(self.demdir, os.O_RDONLY)
@@ -296,7 +297,7 @@ class Pam(unittest.TestCase):
         finally:
             os.close(fd)
         print("two gdalinfo runs under a held lock: %.1f s" % took)
-        self.assertLess(took, 20)
+        self.assertLess(took, 40)
         subs = [s.get("name") for s in
                 ET.parse(self.dem + ".terrashade.aux.xml").getroot().iter("Subdataset")]
         self.assertEqual(len(subs), 1, subs)
