@@ -33,7 +33,9 @@ static bool HoldsAProduct(GDALDataset *poDS, std::string *posWhat)
 
 /* A live TERRASHADE: string among a VRT's sources (gdalbuildvrt of one):
  * its XML says so, without opening anything. A scan of the text, not a
- * parse: a mosaic of ten thousand tiles has megabytes of it. */
+ * parse: a mosaic of ten thousand tiles has megabytes of it. (Hand-written
+ * XML can fool it: a source in a comment is taken, one in CDATA or with an
+ * escaped prefix is not.) */
 static std::string ProductStringSource(const char *pszXML)
 {
     static const char szTag[] = "<SourceFilename";

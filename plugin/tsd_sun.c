@@ -367,6 +367,11 @@ int tsd_sun_delta_t_warning(const tsd_sun *s, const tsd_options *o, char *warnin
         return 0;
     const double year = 1970.0 + t / (365.2425 * 86400.0);
     const double est = tsd_delta_t_estimate(year);
+    /* the calendar year of the instant (UTC), as the date says it: the
+     * fractional year above may fall a day short of 1 January */
+    char iso[64];
+    tsd_format_time(t, 0, iso, sizeof iso);
+    const int calendar_year = atoi(iso);
     if (!(fabs(est - o->delta_t) * SUN_DEG_PER_S > DELTA_T_WARN_DEG))
         return 0;
     const double give = est > 8000 ? 8000 : est < -8000 ? -8000 : est;
@@ -374,7 +379,7 @@ int tsd_sun_delta_t_warning(const tsd_sun *s, const tsd_options *o, char *warnin
              "DELTA_T (TT - UT) was not given: its default, %g s, is the 2020s' value, where "
              "Espenak & Meeus estimate %.0f s for the year %d%s, which moves the sun by "
              "%.2f deg along the ecliptic. Give DELTA_T=%.0f%s",
-             o->delta_t, est, (int)floor(year), year > 2025 ? " (an extrapolation)" : "",
+             o->delta_t, est, calendar_year, year > 2025 ? " (an extrapolation)" : "",
              fabs(est - o->delta_t) * SUN_DEG_PER_S, give,
              give != est ? " (the SPA takes at most 8000 s)" : "");
     return 1;

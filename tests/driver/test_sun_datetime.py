@@ -117,6 +117,9 @@ class SunDatetime(T.TempDirCase):
         self.assertAlmostEqual(said["1000"][0], 1574, delta=5)
         self.assertAlmostEqual(said["0001"][0], 10583.6 - 10.1, delta=5)
         self.assertEqual(said["0001"][3], 8000)
+        # the date's own year, on its 1 January too
+        self.assertEqual([said[y][1] for y in ("0500", "1000", "0001", "2400")],
+                         [500, 1000, 1, 2400])
         self.assertAlmostEqual(said["0500"][2], (5710 - 69) * 360 / 365.2422 / 86400, delta=0.01)
         # a day product's day, and a range's first
         err = T.open_stderr(T.JACKSBORO, PRODUCT="sunhours", START_DATE="0800-03-01",
