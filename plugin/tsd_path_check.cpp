@@ -82,11 +82,18 @@ static std::string NonRegularSourceAt(const char *pszPath, int nDepth)
     // /vsisubfile/o_n,path, /vsizip/{...} at any depth): any of them that is
     // a path of the OS (an audit hung opens on /vsisubfile/0_0,fifo; its
     // review on GTIFF_DIR:1:fifo, vrt://fifo and nested braces)
-    std::vector<std::string> aosPieces{osName};
+    // vrt://path?options wraps a path too: its prefix goes (vrt://fifo,
+    // vrt:///vsigzip/fifo hung until the second review)
+    std::string osBare = osName;
+    for (size_t nAt; (nAt = CPLString(osBare).ifind("vrt://")) != std::string::npos;)
+        osBare.erase(nAt, 6);
+    std::vector<std::string> aosPieces{osName, osBare};
     for (size_t nStart = 0, nEnd;; nStart = nEnd + 1)
     {
-        nEnd = osName.find_first_of(":,{}?\"", nStart);
-        aosPieces.push_back(osName.substr(nStart, nEnd - nStart));
+        nEnd = osBare.find_first_of(":,{}?\"", nStart);
+        // (not a URL's //host/path, after its scheme's ':')
+        if (osBare.compare(nStart, 2, "//") != 0)
+            aosPieces.push_back(osBare.substr(nStart, nEnd - nStart));
         if (nEnd == std::string::npos)
             break;
     }

@@ -349,9 +349,18 @@ class Errors(unittest.TestCase):
                 self.assertEqual(p.returncode, 1, p.stderr)
                 self.assertIn("the DEM '%s' reads '%s', which is not a regular file (a pipe, "
                               "a device...)" % (name, pipe), p.stderr)
-            p = T.run(["timeout", "60", "gdalinfo", T.conn("vrt://" + pipe)], ok=False)
-            self.assertEqual(p.returncode, 1, p.stderr)
-            self.assertIn("which is not a regular file", p.stderr)
+            # vrt:// of the pipe, also relative, with options, or of a wrapper
+            # (the second review: these hung)
+            for name, cwd in (("vrt://" + pipe, None), ("vrt://dem.tif", tmp),
+                              ("vrt://./dem.tif?bands=1", tmp),
+                              ("vrt:///vsigzip/" + pipe, None)):
+                p = T.run(["timeout", "60", "gdalinfo", T.conn(name)], ok=False, cwd=cwd)
+                self.assertEqual(p.returncode, 1, p.stderr)
+                self.assertIn("which is not a regular file", p.stderr)
+            # a URL's host is no path: refused as no file, not as a device
+            p = T.run(["timeout", "60", "gdalinfo", T.conn("/vsicurl/http://dev/null")],
+                      ok=False, GDAL_HTTP_TIMEOUT="2", CPL_VSIL_CURL_USE_HEAD="NO")
+            self.assertNotIn("not a regular file", p.stderr)
             os.unlink(pipe)
             shutil.copy(DEM, pipe)
             atlas = os.path.join(tmp, "day.tsa")
