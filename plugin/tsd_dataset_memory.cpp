@@ -69,8 +69,8 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
         char szAdvice[512] = "";
         if (nLevel == 0)
             tsd_window_advice(&sOpts, psSun, W, H, tsd_cells_min_x(&sCells, H),
-                              sCells.cell_y, std::numeric_limits<double>::max(), szAdvice,
-                              sizeof szAdvice);
+                              sCells.cell_y, std::numeric_limits<double>::max(), sEnv.kept,
+                              szAdvice, sizeof szAdvice);
         Fail(TS_ERR_ARG, CPLSPrintf("PRODUCT=%s computes this %d x %d DEM whole, and a DEM "
                                     "computed whole has at most %d cells a side%s; crop or "
                                     "downsample the DEM",
@@ -117,7 +117,7 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
                  dfWhole / 1048576.0);
     else if (nLevel == 0)
         tsd_window_advice(&sOpts, psSun, W, H, tsd_cells_min_x(&sCells, H), sCells.cell_y,
-                          dfLimit, szAdvice, sizeof szAdvice);
+                          dfLimit, sEnv.kept, szAdvice, sizeof szAdvice);
     // fewer bands need less where an option sets their count (svf streams its DIRECTIONS)
     const char *pszBands = tsd_product_of(&sOpts)->bands_option;
     const std::string osFewer = !pszBands ? ""

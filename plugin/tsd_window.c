@@ -263,10 +263,11 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
 }
 
 /* The largest of a few chunk sizes with which options o window a W x H
- * DEM within `limit` bytes: 1 with *tile and *bytes, else 0. */
+ * DEM within `limit` bytes, `extra` held beside the windows: 1 with *tile
+ * and *bytes (the windows' peak and extra), else 0. */
 static int tile_that_fits(const tsd_options *o, const tsd_sun *sun, int W, int H,
-                          double cells_min_x, double cell_y, double limit, int *tile,
-                          double *bytes)
+                          double cells_min_x, double cell_y, double limit, double extra,
+                          int *tile, double *bytes)
 {
     static const int tiles[] = {4096, 2048, 1024, 512, 256}; /* all >= TSD_TILE_MIN */
     for (size_t i = 0; i < sizeof tiles / sizeof tiles[0]; i++) {
@@ -279,7 +280,7 @@ static int tile_that_fits(const tsd_options *o, const tsd_sun *sun, int W, int H
             !p.windowed)
             continue;
         double steady;
-        const double peak = tsd_window_peak_bytes(&t, &p, &steady);
+        const double peak = tsd_window_peak_bytes(&t, &p, &steady) + extra;
         if (peak <= limit) {
             *tile = tiles[i];
             *bytes = peak;
@@ -290,7 +291,8 @@ static int tile_that_fits(const tsd_options *o, const tsd_sun *sun, int W, int H
 }
 
 void tsd_window_advice(const tsd_options *o, const tsd_sun *sun, int W, int H,
-                       double cells_min_x, double cell_y, double limit, char *out, size_t n)
+                       double cells_min_x, double cell_y, double limit, double extra,
+                       char *out, size_t n)
 {
     int tile;
     double bytes;
@@ -298,7 +300,7 @@ void tsd_window_advice(const tsd_options *o, const tsd_sun *sun, int W, int H,
     const char *why = whole_by_method(o, d);
     out[0] = '\0';
     if (!why) {
-        if (tile_that_fits(o, sun, W, H, cells_min_x, cell_y, limit, &tile, &bytes))
+        if (tile_that_fits(o, sun, W, H, cells_min_x, cell_y, limit, extra, &tile, &bytes))
             snprintf(out, n, "; TILE_SIZE=%d computes it window by window in about %.0f MiB",
                      tile, bytes / 1048576.0);
         return;
@@ -314,7 +316,7 @@ void tsd_window_advice(const tsd_options *o, const tsd_sun *sun, int W, int H,
                           : e.method != o->method ? "METHOD=exact"
                                                   : "HORIZON_METHOD=exact";
     if (!whole_by_method(&e, d) &&
-        tile_that_fits(&e, sun, W, H, cells_min_x, cell_y, limit, &tile, &bytes))
+        tile_that_fits(&e, sun, W, H, cells_min_x, cell_y, limit, extra, &tile, &bytes))
         snprintf(out, n,
                  "; it is computed on the whole DEM (%s): %s with TILE_SIZE=%d computes it "
                  "window by window in about %.0f MiB",

@@ -92,10 +92,13 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
  * for the error that says how windows would fit it ("; TILE_SIZE=1024
  * computes it window by window in about 310 MiB"), or why it needs the
  * whole DEM and which method would window it; empty where windows do not
- * help. The arguments as tsd_window_plan_make's.
+ * help. `extra`: bytes held beside the windows (an environment's light
+ * table and texels), counted in the fit and the figure. The other
+ * arguments as tsd_window_plan_make's.
  */
 void tsd_window_advice(const tsd_options *o, const tsd_sun *sun, int W, int H,
-                       double cells_min_x, double cell_y, double limit, char *out, size_t n);
+                       double cells_min_x, double cell_y, double limit, double extra,
+                       char *out, size_t n);
 
 /** Bytes a windowed computation keeps at most: one chunk with its margin
  * while computing, the cache, and the far grid with its planes. */
