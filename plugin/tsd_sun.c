@@ -367,10 +367,11 @@ int tsd_sun_delta_t_warning(const tsd_sun *s, const tsd_options *o, char *warnin
         return 0;
     const double year = 1970.0 + t / (365.2425 * 86400.0);
     const double est = tsd_delta_t_estimate(year);
-    /* the calendar year of the instant (UTC), as the date says it: the
-     * fractional year above may fall a day short of 1 January */
+    /* the calendar year of the date as given (its local time: a day
+     * product's local midnight east of UTC is the year before's in UTC),
+     * where the fractional year above may fall a day short of 1 January */
     char iso[64];
-    tsd_format_time(t, 0, iso, sizeof iso);
+    tsd_format_time(t, s->offset_minutes, iso, sizeof iso);
     const int calendar_year = atoi(iso);
     if (!(fabs(est - o->delta_t) * SUN_DEG_PER_S > DELTA_T_WARN_DEG))
         return 0;

@@ -125,6 +125,11 @@ class SunDatetime(T.TempDirCase):
         err = T.open_stderr(T.JACKSBORO, PRODUCT="sunhours", START_DATE="0800-03-01",
                             END_DATE="0800-03-02", TIMEZONE="-05:00")
         self.assertIn("for the year 800", err)
+        # the local date's year east of UTC, whose midnight is the year
+        # before's in UTC (the second review: 999 for 1000-01-01 at +02:00)
+        for oo in (dict(PRODUCT="sunhours", DATE="1000-01-01", TIMEZONE="+02:00"),
+                   dict(PRODUCT="shade", DATETIME="1000-01-01T00:30:00+02:00")):
+            self.assertIn("for the year 1000,", T.open_stderr(T.JACKSBORO, **oo))
         # none in the 20th and 21st centuries, nor where DELTA_T is given
         for dt, extra in (("1950-06-01T12:00:00Z", {}), ("2026-06-21T12:00:00Z", {}),
                           ("0500-01-01T12:00:00Z", {"DELTA_T": "5710"})):
