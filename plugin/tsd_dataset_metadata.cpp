@@ -383,7 +383,8 @@ class PamFileTurn
             if (nWaited >= nWait)
             {
                 CPLDebug("TERRASHADE", "no turn on the auxiliary file of %s after %d ms: "
-                         "going ahead without one", pszDEM, nWaited);
+                         "going ahead without one (a %s)", pszDEM, nWaited,
+                         bWrite ? "save" : "load");
                 if (!bStuck)
                 {
                     Stuck(false)[oFolder] = std::chrono::steady_clock::now();

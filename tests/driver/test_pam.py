@@ -302,6 +302,34 @@ class Pam(unittest.TestCase):
                 ET.parse(self.dem + ".terrashade.aux.xml").getroot().iter("Subdataset")]
         self.assertEqual(len(subs), 1, subs)
 
+    def test_a_load_that_waited_long_leaves_saves_their_turns(self):
+        """A load whose 2 s wait ran out lets this process's later loads go
+        ahead at once, but not its saves, which still wait their turn (up
+        to 10 s): until the second review of session 56, a save after such
+        a load went ahead unlocked at once, where entries are lost. The
+        lock is held for 6 s: the save waits for it."""
+        import fcntl
+        import threading
+        import time
+        fd = os.open(self.demdir, os.O_RDONLY)
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        release = threading.Timer(6.0, lambda: os.close(fd))
+        release.start()
+        try:
+            t = time.monotonic()
+            p = T.run(["gdalinfo", "-stats", T.conn(self.dem, PRODUCT="svf", DIRECTIONS=8)],
+                      CPL_DEBUG="TERRASHADE")
+            took = time.monotonic() - t
+        finally:
+            release.join()
+        said = [line for line in p.stderr.splitlines() if "no turn on the auxiliary" in line]
+        print("%.1f s;" % took, "\n".join(said))
+        self.assertTrue(said and all(line.endswith("(a load)") for line in said), said)
+        self.assertGreater(took, 5.0)  # (the save waited for the lock's release)
+        subs = [s.get("name") for s in
+                ET.parse(self.dem + ".terrashade.aux.xml").getroot().iter("Subdataset")]
+        self.assertEqual(len(subs), 1, subs)
+
     def test_many_products_at_once(self):
         """Statistics of 8 products saved at once: by 4 threads of one
         process every entry is kept (GDAL rewrites an .aux.xml whole, and
