@@ -267,7 +267,9 @@ static ts_status check_image(const env_image *img, const char *name, ts_error *e
     return TS_OK;
 }
 
-/* The count env_from_image allocates (kept beside it so that they agree). */
+/* The texels env_from_image makes of img: its blocks of k x k pixels, each
+ * cut into parts where a coarse map is fit for lighting (one count, for
+ * env_from_image and for ts_env_map_texels's estimate of its memory). */
 static size_t texel_count(const env_image *img, size_t max_texels)
 {
     panel_split p = split_of(img);
@@ -305,11 +307,10 @@ ts_status env_from_image(const env_image *img, double rotation_deg, size_t max_t
 
     panel_split p = split_of(img);
     int k = block_size(&p, max_texels);
-    size_t count = texels_for_block(&p, k);
     pixel_part q = {1, 1, 0, 0};
     if (max_texels != 0 && k == 1) /* a map fit for lighting: coarse pixels cut */
-        q = parts_of(img, count, max_texels);
-    count *= (size_t)q.nx * (size_t)q.ny;
+        q = parts_of(img, texels_for_block(&p, k), max_texels);
+    const size_t count = texel_count(img, max_texels); /* (the same count) */
     ts_env_texel *texels = malloc(count * sizeof *texels);
     if (!texels)
         return ts_fail(err, TS_ERR_NOMEM, "no memory for the %zu texels of environment map '%s'",

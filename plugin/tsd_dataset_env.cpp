@@ -185,7 +185,8 @@ bool TSDataset::PlanEnvironment(std::vector<GByte> &oMap)
         return Fail(TS_ERR_NOMEM,
                     CPLSPrintf("ENV_MAP '%s' is a file of %.0f MiB, read whole into memory, "
                                "more than the limit of %.0f MiB (%s); use a smaller map, or "
-                               "MAX_MEMORY=%.0f or more",
+                               "a MAX_MEMORY well above %.0f (its decoding needs its pixels "
+                               "at 12 bytes each besides)",
                                m_sOpts.env_map, sStat.st_size / 1048576.0,
                                dfLimit / 1048576.0, pszWhy,
                                std::ceil(sStat.st_size / 1048576.0))),
