@@ -40,15 +40,23 @@ static void site_grid(tsd_sites *s, int width, int height)
     s->dy = s->ny > 1 ? (height - 1.0) / (s->ny - 1) : 1.0;
 }
 
-/* Degrees of arc, about, between sites a and b: the sun's elevation and
+/* Degrees of arc, about, between sites a and b, or the turn of the sun's
+ * grid azimuth between them where that is larger: the sun's elevation and
  * azimuth curve with the hour angle and the latitude, so the bilinear
- * interpolation's error grows as the square of this. */
+ * interpolation's error grows as the square of this. The turn is the
+ * meridians' convergence, dlon sin(lat), less that of grid north (0 on a
+ * geographic grid; nearly all of it on a conformal one): near a pole, sites
+ * 2 degrees of arc apart may be tens of degrees of longitude apart, and
+ * their suns' directions, interpolated between, came up to 7.6 deg too
+ * high (session 56's audit of per_cell near the poles). */
 static double site_step(const tsd_sites *s, size_t a, size_t b)
 {
-    double lat = fabs(s->lat[b] - s->lat[a]);
-    double lon = fabs(remainder(s->lon[b] - s->lon[a], 360.0)) *
-                 cos(0.5 * (s->lat[a] + s->lat[b]) * M_PI / 180.0);
-    return lat > lon ? lat : lon;
+    const double mid = 0.5 * (s->lat[a] + s->lat[b]) * M_PI / 180.0;
+    const double dlon = remainder(s->lon[b] - s->lon[a], 360.0);
+    const double lat = fabs(s->lat[b] - s->lat[a]);
+    const double lon = fabs(dlon) * cos(mid);
+    const double turn = fabs(dlon * sin(mid) + remainder(s->north[b] - s->north[a], 360.0));
+    return fmax(fmax(lat, lon), turn);
 }
 
 /* Nodes a side so that neighbours lie at most SITE_MAX_STEP_DEG apart

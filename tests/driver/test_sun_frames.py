@@ -224,6 +224,38 @@ class SunFrames(unittest.TestCase):
                       % (name, lon[x], lat[y], a[y, x], ref))
         self.assertLess(worst, 0.001)
 
+    def test_per_cell_sun_near_a_pole(self):
+        """A ring of the world at 89-90 N in cells of 1.8 x 0.05 degrees: its
+        lattice's nodes, 2 degrees of arc apart, were ~20 degrees of
+        longitude apart, and the suns' directions interpolated between them
+        came 1.7 deg too high (session 56's audit of per_cell against pvlib;
+        the angles interpolated before 0f2b7c0 were 0.07 off). The lattice is
+        closer where its suns' grid azimuths turn by more than 2 degrees
+        between nodes. Each cell's elevation (a flat DEM's Float32 shade is
+        its sine) against a 3 x 3 DEM of its own."""
+        nx, ny, dx, dy = 200, 20, 1.8, 0.05
+        z = np.zeros((ny, nx), np.float32)
+        ring = T.write_tif(self.dir + "/ring.tif", z, (-180.0, dx, 0, 90.0, 0, -dy), 4326)
+        opts = ["PRODUCT=shade", "OUTPUT_TYPE=Float32", "DATETIME=2026-06-21T10:00:00Z",
+                "SKY_WEIGHT=0", "CURVATURE=NO", "EDGE=open"]
+        ds = gdal.OpenEx(T.conn(ring), gdal.OF_RASTER, open_options=opts +
+                         ["SUN_POSITION=per_cell"])
+        a = ds.GetRasterBand(1).ReadAsArray()
+        ds = None
+        worst = 0.0
+        for y, x in ((18, 5), (18, 103), (10, 57), (2, 151), (19, 190)):
+            own = T.write_tif(self.dir + "/own.tif", np.zeros((3, 3), np.float32),
+                              (-180.0 + (x - 1) * dx, dx, 0, 90.0 - (y - 1) * dy, 0, -dy),
+                              4326)
+            d2 = gdal.OpenEx(T.conn(own), gdal.OF_RASTER, open_options=opts)
+            ref = float(d2.GetRasterBand(1).ReadAsArray()[1, 1])
+            d2 = None
+            e, e_ref = (math.degrees(math.asin(v)) for v in (float(a[y, x]), ref))
+            worst = max(worst, abs(e - e_ref))
+            print("%.1f E %.3f N: per cell %.4f deg, its own sun %.4f"
+                  % (-180 + (x + 0.5) * dx, 90 - (y + 0.5) * dy, e, e_ref))
+        self.assertLess(worst, 0.01)
+
     def test_a_pole_by_rounding(self):
         """A polar cap whose top is the pole give or take rounding (90 + 1e-13)
         opens; one 0.6 of a cell past it is off by more than rounding and
