@@ -303,8 +303,10 @@ ts_shm_compute_fn ts_shm_compute;
 /**
  * Unit surface normals by Horn's method (as gdaldem hillshade), components
  * x = east, y = north, z = up; each array width*height (may not be NULL).
- * On edges and next to nodata the missing neighbours are replaced by the
- * centre cell; a nodata cell gets NaN. The type of every backend's normals.
+ * At the grid's edge the row or column beyond is extrapolated as gdaldem's
+ * -compute_edges does (cm_horn_normal); a neighbour that is nodata, or
+ * extrapolated from nodata, is replaced by the centre cell; a nodata cell
+ * gets NaN. The type of every backend's normals.
  */
 typedef ts_status ts_normals_fn(const ts_grid *grid, float *nx, float *ny, float *nz,
                                 ts_error *err);

@@ -48,20 +48,54 @@ START_TEST(test_sun_disk_fraction)
 }
 END_TEST
 
-/* Horn (as gdaldem): a..i the 3x3 neighbourhood from the north-west, row
- * by row; missing or nodata neighbours replaced by the centre. Normal
- * (east, north, up) = normalize(-dz/dx, dz/drow, 1): rows run south, so
- * the northward slope is -dz/drow. */
+/* gdaldem's -compute_edges extrapolation of the cell beyond a and b:
+ * 2 a - b in float (NaN from NaN). */
+static double beyond(double a, double b)
+{
+    return 2.0f * (float)a - (float)b;
+}
+
+/* Horn (as gdaldem hillshade -compute_edges): a..i the 3x3 neighbourhood
+ * from the north-west, row by row, built as gdaldem builds its window: on
+ * the first and last rows the row beyond extrapolated from the edge's and
+ * the next row's, with the columns beyond the edge's own (jmin, jmax); on
+ * the other rows the first and last columns' outer column extrapolated;
+ * on a grid under 2 x 2, missing neighbours are the centre's; nodata
+ * neighbours (or extrapolated from nodata) the centre's. Normal (east,
+ * north, up) = normalize(-dz/dx, dz/drow, 1): rows run south, so the
+ * northward slope is -dz/drow. */
 static void horn(const ts_grid *g, int x, int y, double n[3])
 {
+    const int W = g->width, H = g->height;
     double e = ts_grid_at(g, x, y), v[3][3];
-    for (int j = -1; j <= 1; j++)
-        for (int i = -1; i <= 1; i++) {
-            int xx = x + i, yy = y + j;
-            double z = xx >= 0 && xx < g->width && yy >= 0 && yy < g->height
-                           ? ts_grid_at(g, xx, yy) : NAN;
-            v[j + 1][i + 1] = isnan(z) ? e : z;
+    if (W >= 2 && H >= 2 && (y == 0 || y == H - 1)) {
+        int cols[3] = {x == 0 ? x : x - 1, x, x == W - 1 ? x : x + 1};
+        for (int c = 0; c < 3; c++) {
+            double edge = ts_grid_at(g, cols[c], y);
+            double next = ts_grid_at(g, cols[c], y == 0 ? 1 : H - 2);
+            v[1][c] = edge;
+            v[0][c] = y == 0 ? beyond(edge, next) : next;
+            v[2][c] = y == 0 ? next : beyond(edge, next);
         }
+    } else if (W >= 2 && (x == 0 || x == W - 1)) {
+        for (int r = 0; r < 3; r++) {
+            double edge = ts_grid_at(g, x, y - 1 + r);
+            double next = ts_grid_at(g, x == 0 ? 1 : W - 2, y - 1 + r);
+            v[r][1] = edge;
+            v[r][0] = x == 0 ? beyond(edge, next) : next;
+            v[r][2] = x == 0 ? next : beyond(edge, next);
+        }
+    } else {
+        for (int j = -1; j <= 1; j++)
+            for (int i = -1; i <= 1; i++) {
+                int xx = x + i, yy = y + j;
+                v[j + 1][i + 1] = xx >= 0 && xx < W && yy >= 0 && yy < H
+                                      ? ts_grid_at(g, xx, yy) : NAN;
+            }
+    }
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 3; i++)
+            v[j][i] = isnan(v[j][i]) ? e : v[j][i];
     double a = v[0][0], b = v[0][1], c = v[0][2], d = v[1][0], f = v[1][2];
     double gg = v[2][0], h = v[2][1], i = v[2][2];
     double dzdx = ((c + 2 * f + i) - (a + 2 * d + gg)) / (8 * ts_grid_cell_x(g, y));
@@ -106,6 +140,38 @@ START_TEST(test_normals_horn)
     g.z[0 * g.stride + 7] = NAN;
     g.z[39 * g.stride + 49] = NAN;
     check_normals(&g, "fractal with nodata");
+    ts_grid_free(&g);
+}
+END_TEST
+
+START_TEST(test_normals_plane_edges)
+{
+    /* A plane's edge cells have its slope, as gdaldem -compute_edges gives
+     * them (a missing neighbour as the centre's height halved a slope across
+     * the edge, session 56), but for the four corners along the first and
+     * last rows, whose columns beyond are the edge's own in gdaldem. */
+    ts_grid g;
+    const int W = 7, H = 6;
+    tdem_create(&g, W, H, 10.0, 20.0);
+    const double sx = 0.4, sn = -0.25; /* rise to the east, to the north */
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            g.z[y * g.stride + x] = (float)(100 + sx * x * 10.0 + sn * (H - 1 - y) * 20.0);
+    float nx[42], ny[42], nz[42];
+    ts_error err;
+    ck_assert(ts_normals(&g, nx, ny, nz, &err) == TS_OK);
+    const double len = sqrt(1 + sx * sx + sn * sn);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            const int k = y * W + x;
+            const int corner = (y == 0 || y == H - 1) && (x == 0 || x == W - 1);
+            /* a corner: the east-west slope is halved, the north-south kept */
+            const double ex = corner ? sx / 2 : sx;
+            const double l = corner ? sqrt(1 + ex * ex + sn * sn) : len;
+            ck_assert_msg(fabs(nx[k] + ex / l) < 1e-6 && fabs(ny[k] + sn / l) < 1e-6 &&
+                              fabs(nz[k] - 1 / l) < 1e-6,
+                          "(%d,%d): (%g, %g, %g)", x, y, nx[k], ny[k], nz[k]);
+        }
     ts_grid_free(&g);
 }
 END_TEST
@@ -477,6 +543,7 @@ int main(void)
     tcase_set_timeout(tc, 120);
     tcase_add_test(tc, test_sun_disk_fraction);
     tcase_add_test(tc, test_normals_horn);
+    tcase_add_test(tc, test_normals_plane_edges);
     tcase_add_test(tc, test_normals_signs);
     tcase_add_test(tc, test_normals_geographic_rows);
     tcase_add_test(tc, test_direct_flat);
