@@ -455,6 +455,9 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
             return Fail(eSt, CPLSPrintf("%s: %s", pszWhat, szMsg)), false;
         if (sOpts.sun_position != TSD_SUN_PER_CELL && m_nLevel == 0)
             WarnSunReach(W, H, hSRS, sSites.lon[0], sSites.lat[0]);
+        else if (m_nLevel == 0)
+            CPLDebug(DRIVER, "the sun: a lattice of %d x %d sites (SUN_POSITION=per_cell)",
+                     sSites.nx, sSites.ny);
         eSt = tsd_sun_setup(&sOpts, &sSites, dfMinCell, &m_sSun, szMsg, sizeof szMsg);
         if (eSt != TS_OK)
             return Fail(eSt, szMsg), false;

@@ -55,7 +55,9 @@ static double site_step(const tsd_sites *s, size_t a, size_t b)
     const double dlon = remainder(s->lon[b] - s->lon[a], 360.0);
     const double lat = fabs(s->lat[b] - s->lat[a]);
     const double lon = fabs(dlon) * cos(mid);
-    const double turn = fabs(dlon * sin(mid) + remainder(s->north[b] - s->north[a], 360.0));
+    /* (the sum wrapped: across a pole dlon and the norths' difference are
+     * each 180, and wrapped apart they added to 360) */
+    const double turn = fabs(remainder(dlon * sin(mid) + s->north[b] - s->north[a], 360.0));
     return fmax(fmax(lat, lon), turn);
 }
 

@@ -77,7 +77,7 @@ static void horn(const ts_grid *g, int x, int y, double n[3])
             v[0][c] = y == 0 ? beyond(edge, next) : next;
             v[2][c] = y == 0 ? next : beyond(edge, next);
         }
-    } else if (W >= 2 && (x == 0 || x == W - 1)) {
+    } else if (W >= 2 && H >= 2 && (x == 0 || x == W - 1)) {
         for (int r = 0; r < 3; r++) {
             double edge = ts_grid_at(g, x, y - 1 + r);
             double next = ts_grid_at(g, x == 0 ? 1 : W - 2, y - 1 + r);
@@ -141,6 +141,19 @@ START_TEST(test_normals_horn)
     g.z[39 * g.stride + 49] = NAN;
     check_normals(&g, "fractal with nodata");
     ts_grid_free(&g);
+    /* small grids, where the edges are most of it: 2 x N, N x 2, 2 x 2,
+     * 1 x N, N x 1, with nodata beside an edge */
+    const int sizes[][2] = {{2, 7}, {7, 2}, {2, 2}, {3, 3}, {1, 6}, {6, 1}, {5, 4}};
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+        tdem_create(&g, sizes[k][0], sizes[k][1], 10.0, 15.0);
+        tdem_fractal(&g, 7 + k, 80.0);
+        check_normals(&g, "small");
+        if (g.width * g.height > 3) {
+            g.z[g.width > 1 ? 1 : g.stride] = NAN;
+            check_normals(&g, "small with nodata");
+        }
+        ts_grid_free(&g);
+    }
 }
 END_TEST
 

@@ -255,6 +255,20 @@ class SunFrames(unittest.TestCase):
             print("%.1f E %.3f N: per cell %.4f deg, its own sun %.4f"
                   % (-180 + (x + 0.5) * dx, 90 - (y + 0.5) * dy, e, e_ref))
         self.assertLess(worst, 0.01)
+        # a polar stereographic grid around the pole keeps its lattice: its
+        # grid azimuths do not turn (a first version took the turn across the
+        # pole, two 180s wrapped apart, as 360 degrees: 21 x 181 nodes; the
+        # third review of session 56)
+        for epsg in (3413, 3031):
+            polar = T.write_tif("%s/polar_%d.tif" % (self.dir, epsg),
+                                np.zeros((600, 600), np.float32),
+                                (-300000.0, 1000.0, 0, 300000.0, 0, -1000.0), epsg)
+            p = T.run(["gdalinfo", "-oo", "DATETIME=2026-06-21T10:00:00Z", "-oo",
+                       "SUN_POSITION=per_cell", T.conn(polar)], CPL_DEBUG="TERRASHADE")
+            self.assertIn("the sun: a lattice of 21 x 21 sites", p.stderr)
+        p = T.run(["gdalinfo", "-oo", "DATETIME=2026-06-21T10:00:00Z", "-oo",
+                   "SUN_POSITION=per_cell", T.conn(ring)], CPL_DEBUG="TERRASHADE")
+        self.assertIn("the sun: a lattice of 181 x", p.stderr)
 
     def test_a_pole_by_rounding(self):
         """A polar cap whose top is the pole give or take rounding (90 + 1e-13)
