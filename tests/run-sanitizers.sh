@@ -63,7 +63,10 @@ ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 # (Python's own). Tests that cap the address space (ulimit -v) cannot run
 # under ASan's shadow memory, so test_errors is not among them.
 make -j"$JOBS" plugin/gdal_TERRASHADE.la
-ASAN_LIB=$(${CC:-gcc} -print-file-name=libasan.so)
+# (UBSan's runtime with ASan's: it brings libstdc++ in at the start, and
+# without it ASan found no __cxa_throw to intercept when GDAL's C++ threw:
+# "CHECK failed: asan_interceptors.cpp", CI of session 56)
+ASAN_LIB="$(${CC:-gcc} -print-file-name=libasan.so) $(${CC:-gcc} -print-file-name=libubsan.so)"
 for t in test_hostile test_atlas test_envlight; do
     if ! TS_BUILDDIR="$BUILD" TERRASHADE_BACKEND=c LD_PRELOAD="$ASAN_LIB" \
         ASAN_OPTIONS=detect_leaks=0:halt_on_error=1 \
