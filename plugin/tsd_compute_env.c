@@ -59,6 +59,14 @@ void tsd_environment_free(tsd_environment *e)
     memset(e, 0, sizeof *e);
 }
 
+/* The light table's nodes: DIRECTIONS x ENV_NORMAL_STEPS (1 when exact) x
+ * ENV_HORIZON_STEPS (one count for its limit and its memory estimate). */
+static double table_nodes(const tsd_options *o)
+{
+    return (double)o->directions * (o->env_normal_steps ? o->env_normal_steps : 1) *
+           o->env_horizon_steps;
+}
+
 /* OpenEXRCore's buffers for one chunk, packed and unpacked, per pixel of
  * the map's width: up to 32 lines (PIZ, B44) of 4 float channels, twice
  * (DWA's 256-line chunks are of half channels: the same order). */
@@ -73,8 +81,7 @@ void tsd_environment_cost(const tsd_options *o, const ts_env_map_info *map, doub
     c->texels = map ? (double)ts_env_map_texels(map, TSD_ENV_MAX_TEXELS)
                     : (double)TS_SKY_DEFAULT_WIDTH * TS_SKY_DEFAULT_HEIGHT;
     const double texels = c->texels * sizeof(ts_env_texel);
-    const double nodes = (double)o->directions * (o->env_normal_steps ? o->env_normal_steps : 1) *
-                         o->env_horizon_steps;
+    const double nodes = table_nodes(o);
     /* ts_env_table_build sums in doubles, then copies to the kept floats:
      * 8 doubles and 8 floats a node at once, three times the table */
     const double table = nodes * 8 * sizeof(float);
@@ -174,8 +181,7 @@ static ts_status load_environment(const tsd_options *o, const tsd_run *run, cons
 
 ts_status tsd_environment_check_table(const tsd_options *o, char *msg, size_t n)
 {
-    double table_bytes = (double)o->directions * (o->env_normal_steps ? o->env_normal_steps : 1) *
-                         o->env_horizon_steps * 8 * sizeof(float);
+    double table_bytes = table_nodes(o) * 8 * sizeof(float);
     if (table_bytes > TSD_ENV_MAX_TABLE_BYTES)
         return tsd_fail(msg, n, TS_ERR_ARG,
                         "the light table of DIRECTIONS=%d, ENV_NORMAL_STEPS=%d and "
