@@ -54,6 +54,8 @@ TSDataset::~TSDataset()
     FreeWindow(m_poWindow);
     if (m_poDEM)
         GDALClose(m_poDEM);
+    if (!m_osStdinCopy.empty())
+        VSIUnlink(m_osStdinCopy.c_str());
     tsd_cells_free(&m_sCells);
     tsd_sun_free(&m_sSun);
     tsd_environment_free(&m_sEnv);
@@ -341,7 +343,11 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     const std::string osRefused = RefusedDEMName(osDEM.c_str(), "the DEM", false);
     if (!osRefused.empty())
         return FailOpen(TS_ERR_ARG, osRefused.c_str());
-    GDALDataset *poDEM = OpenDEM(osDEM.c_str());
+    // (exactly GDAL's name for it; a prefix before it is GDAL's business)
+    const bool bStdin = osDEM == "/vsistdin/" || osDEM == "/vsistdin";
+    if (bStdin && (poDS->m_osStdinCopy = CopyStdin(sOpts)).empty())
+        return nullptr;
+    GDALDataset *poDEM = OpenDEM(bStdin ? poDS->m_osStdinCopy.c_str() : osDEM.c_str());
     if (!poDEM)
     {
         snprintf(szMsg, sizeof szMsg, "cannot open the DEM '%s' as a raster", osDEM.c_str());
@@ -350,7 +356,8 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     }
     poDS->m_poDEM = poDEM;
     poDS->m_osDEM = osDEM;
-    poDS->m_osDEMPath = AbsolutePath(osDEM.c_str()); // (a chdir before a level's read)
+    poDS->m_osDEMPath = bStdin ? poDS->m_osStdinCopy
+                               : AbsolutePath(osDEM.c_str()); // (a chdir before a level's read)
     // an atlas, which this driver opens (its 0/1 maps were taken as heights);
     // its file read only then, not for every DEM
     const bool bOurs = poDEM->GetDriver() && EQUAL(poDEM->GetDriver()->GetDescription(), DRIVER);
@@ -530,6 +537,8 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
         SetDescription(pszConnection);
         nPamFlags |= GPF_DISABLED; // a level's statistics are its parent's business
     }
+    if (!m_osStdinCopy.empty())
+        nPamFlags |= GPF_DISABLED; // (the next run's standard input is another DEM)
     return true;
 }
 

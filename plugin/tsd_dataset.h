@@ -85,6 +85,7 @@ class TSDataset final : public GDALPamDataset
     GDALDataset *m_poDEM = nullptr; // open until the product is computed
     std::string m_osDEM;
     std::string m_osDEMPath; // m_osDEM made absolute at open: what an overview level reopens
+    std::string m_osStdinCopy; // /vsimem/ copy of the standard input (the DEM), unlinked at close
     tsd_options m_sOpts{};                  // what the user said
     const tsd_product_def *m_psProduct = nullptr; // its row of the product table
     tsd_run m_sRun{};                       // the sun used (progress: while computing)
@@ -192,6 +193,11 @@ class TSDataset final : public GDALPamDataset
     std::atomic<bool> m_bBelowSeaWarned{false}; // WarnBelowSea: once per dataset
     std::atomic<bool> m_bVoidsWarned{false};   // WarnVoids: once per dataset
     static GDALDataset *OpenDEM(const char *pszDEM);
+    /* The standard input read whole into a /vsimem/ file, which is what
+     * the DEM /vsistdin/ is read from: its stream reads forward only, but
+     * a DEM is read more than once (the steepness sample at open, the grid,
+     * each overview level's open). Its name, or "" with the error said. */
+    static std::string CopyStdin(const tsd_options &sOpts);
     /* why a read after CloseDependentDatasets fails */
     std::string DEMReleasedError() const;
     ts_status LoadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg);

@@ -7,11 +7,14 @@
  */
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <exception>
 #include <string>
 #include <thread>
 #include <vector>
+
+#include <unistd.h>
 
 #include "cpl_conv.h"
 #include "cpl_error.h"
@@ -39,6 +42,45 @@ GDALDataset *TSDataset::OpenDEM(const char *pszDEM)
     const bool bDirect = strstr(pszDEM, "/vsi") == nullptr;
     CPLConfigOptionSetter oDirect("GTIFF_DIRECT_IO", bDirect ? "YES" : nullptr, true);
     return GDALDataset::Open(pszDEM, GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR);
+}
+
+std::string TSDataset::CopyStdin(const tsd_options &sOpts)
+{
+    const char *pszWhy = nullptr;
+    const double dfLimit = MemoryLimit(sOpts, &pszWhy);
+    static std::atomic<unsigned> nCopies{0};
+    const std::string osCopy =
+        CPLSPrintf("/vsimem/terrashade_stdin_%ld_%u", static_cast<long>(getpid()), nCopies++);
+    VSILFILE *fpIn = VSIFOpenL("/vsistdin/", "rb");
+    VSILFILE *fpOut = fpIn ? VSIFOpenL(osCopy.c_str(), "wb") : nullptr;
+    std::vector<GByte> abyChunk(1 << 20);
+    double dfBytes = 0;
+    bool bOver = false, bFailed = fpOut == nullptr;
+    while (!bFailed && !bOver)
+    {
+        const size_t nRead = VSIFReadL(abyChunk.data(), 1, abyChunk.size(), fpIn);
+        dfBytes += static_cast<double>(nRead);
+        bOver = dfBytes > dfLimit;
+        bFailed = VSIFWriteL(abyChunk.data(), 1, nRead, fpOut) != nRead;
+        if (nRead < abyChunk.size())
+            break;
+    }
+    if (fpOut)
+        VSIFCloseL(fpOut);
+    if (fpIn)
+        VSIFCloseL(fpIn);
+    if (!bFailed && !bOver && dfBytes > 0)
+        return osCopy;
+    VSIUnlink(osCopy.c_str());
+    Fail(bOver ? CPLE_OutOfMemory : CPLE_OpenFailed,
+         bOver ? CPLSPrintf("the DEM '/vsistdin/' is read whole into memory (a stream reads "
+                            "forward only, and the DEM is read more than once), and the "
+                            "standard input holds more than the limit of %.0f MiB (%s): "
+                            "write the DEM to a file first",
+                            std::floor(dfLimit / 1048576.0), pszWhy)
+               : dfBytes > 0 ? "cannot copy the DEM '/vsistdin/' into memory"
+                             : "the DEM '/vsistdin/': the standard input is empty");
+    return std::string();
 }
 
 /* Whether a file is read without the network and without the host's

@@ -373,12 +373,49 @@ class Errors(unittest.TestCase):
             self.assertEqual(p.returncode, 1, p.stderr)
             self.assertIn("the atlas's SOURCE_DEM '%s' reads '%s', which is not a regular "
                           "file" % (pipe, pipe), p.stderr)
-        with open(DEM, "rb") as f:
-            p = subprocess.run(["timeout", "60", "gdalinfo", "-checksum",
-                                T.conn("/vsistdin/")], stdin=f, capture_output=True,
-                               text=True, env=T.env())
-        self.assertEqual(p.returncode, 0, p.stderr)
-        self.assertIn("Checksum=", p.stdout)
+        self.check_stdin()
+
+    def check_stdin(self):
+        """The DEM /vsistdin/, given by the user, is read from the standard
+        input, whole, into memory: a stream reads forward only, and a DEM
+        larger than the 256² steepness sample read at open, or one with
+        overview levels, failed ("backward read not supported": session
+        57's audit) where the small LUX passed."""
+        def run(args, dem, **env):
+            stdin = open(dem, "rb") if dem else subprocess.DEVNULL
+            try:
+                return subprocess.run(["timeout", "60"] + args, stdin=stdin,
+                                      capture_output=True, text=True, env=T.env(**env))
+            finally:
+                if dem:
+                    stdin.close()
+
+        def checksums(path):
+            return re.findall(r"Checksum=(\d+)", T.run(["gdalinfo", "-checksum", path]).stdout)
+
+        with T.TempDir() as tmp:
+            for dem in (DEM, T.JACKSBORO):
+                p = run(["gdalinfo", "-checksum", T.conn("/vsistdin/")], dem)
+                self.assertEqual(p.returncode, 0, p.stderr)
+                self.assertIn("Checksum=", p.stdout)
+                cog = os.path.join(tmp, "stdin.tif")
+                p = run(["gdal_translate", "-q", "-of", "COG", T.conn("/vsistdin/"), cog], dem)
+                self.assertEqual(p.returncode, 0, p.stderr)
+                ref = os.path.join(tmp, "file.tif")
+                T.run(["gdal_translate", "-q", "-of", "COG", T.conn(dem), ref])
+                self.assertEqual(checksums(cog), checksums(ref))
+            self.assertFalse([f for f in os.listdir(tmp) if f.endswith(".aux.xml")])
+            # its copy counts against MAX_MEMORY (2.4 MiB of heights here)
+            big = os.path.join(tmp, "big.tif")
+            T.run(["gdal_translate", "-q", "-ot", "Float32", "-outsize", "800", "800",
+                   T.JACKSBORO, big])
+            p = run(["gdalinfo", "-oo", "MAX_MEMORY=2", T.conn("/vsistdin/")], big)
+            self.assertEqual(p.returncode, 1, p.stderr)
+            self.assertIn("the standard input holds more than the limit of 2 MiB "
+                          "(MAX_MEMORY): write the DEM to a file first", p.stderr)
+        p = run(["gdalinfo", T.conn("/vsistdin/")], None)
+        self.assertEqual(p.returncode, 1, p.stderr)
+        self.assertIn("the standard input is empty", p.stderr)
 
     def test_update_access_refused(self):
         with self.assertRaises(RuntimeError) as e:
