@@ -371,7 +371,26 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
             poBand->GDALMajorObject::SetDescription(CPLSPrintf("map %d", k + 1));
     }
     poDS->SetDescription(poOpenInfo->pszFilename);
-    poDS->TryLoadXML();
+    // SHADOWS=all is other pixels than the atlas's own (and another DEM's
+    // near shadows are others again): each view has an entry of its own in
+    // the atlas's .aux.xml, where the two reported each other's statistics
+    // and histograms and the far view took SHADOWS=all from the saved
+    // metadata (and GDAL rewrites the file whole for a view without one)
+    const std::string osView =
+        bAll ? "SHADOWS=all" + (poDS->m_bDEMGiven ? ":DEM=" + poDS->m_osDEM : "")
+             : std::string("SHADOWS=far");
+    const char *pszPam = poDS->BuildPamFilename();
+    if (!bAll && pszPam && !HasPamEntry(pszPam, osView.c_str(), nullptr))
+        poDS->TryLoadXML(); // the file's top level, where the atlas's entries
+                            // were before session 57: saved as the view's
+    poDS->SetSubdatasetName(osView.c_str());
+    if (!pszPam || HasPamEntry(pszPam, osView.c_str(), nullptr))
+        poDS->TryLoadXML();
+    // the driver's own items over what the entry holds (one saved by an
+    // earlier version for the other view)
+    poDS->GDALDataset::SetMetadataItem("SHADOWS", bAll ? "all" : nullptr);
+    if (!poDS->m_bDEMGiven && !poDS->m_osDEM.empty())
+        poDS->GDALDataset::SetMetadataItem("SOURCE_DEM", poDS->m_osDEM.c_str());
     poDS->nPamFlags &= ~GPF_DIRTY;
     return poDS.release();
 }

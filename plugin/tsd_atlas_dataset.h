@@ -84,6 +84,14 @@ class TSAtlasDataset final : public GDALPamDataset
     {
         return m_oSRS.IsEmpty() ? nullptr : &m_oSRS;
     }
+    CPLErr SetGeoTransform(double *) override
+    {
+        return RefuseGeoreferencing(this, "geotransform");
+    }
+    CPLErr SetSpatialRef(const OGRSpatialReference *) override
+    {
+        return RefuseGeoreferencing(this, "spatial reference");
+    }
     /* gdaladdo: GDAL's own refusal ("BuildOverviews() not supported") was
      * no TERRASHADE sentence and said nothing of what to do */
     CPLErr IBuildOverviews(const char *, int, const int *, int, const int *, GDALProgressFunc,

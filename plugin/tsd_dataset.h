@@ -20,6 +20,7 @@
 #include "tsd_backend.h"
 #include "tsd_compute.h"
 #include "tsd_compute_env.h"
+#include "tsd_gdal.h"
 #include "tsd_geodesy.h"
 #include "tsd_options.h"
 #include "tsd_turn_band.h"
@@ -248,6 +249,22 @@ class TSDataset final : public GDALPamDataset
                      GSpacing nBandSpace, GDALRasterIOExtraArg *psExtraArg) override;
     CPLErr GetGeoTransform(double *padfGT) override;
     const OGRSpatialReference *GetSpatialRef() const override;
+    /* refused: the DEM's georeferencing is the product's */
+    CPLErr SetGeoTransform(double *) override
+    {
+        return RefuseGeoreferencing(this, "geotransform");
+    }
+    CPLErr SetSpatialRef(const OGRSpatialReference *) override
+    {
+        return RefuseGeoreferencing(this, "spatial reference");
+    }
+    /* none: a product has no file of its own, and GDAL's generic Delete
+     * (gdalmanage delete -f GTiff TERRASHADE:dem.tif) unlinked what PAM
+     * listed, the DEM among them */
+    char **GetFileList() override
+    {
+        return nullptr;
+    }
     /* GDALDestroyDriverManager: the DEM closed here (tsd_dataset.cpp) */
     int CloseDependentDatasets() override;
     char **GetMetadata(const char *pszDomain = "") override;

@@ -14,6 +14,7 @@
 #include <chrono>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -491,12 +492,14 @@ CPLErr TSDataset::TryLoadXML(char **papszSiblingFiles)
 /* Whether the .aux.xml at pszPath holds a <Subdataset> named pszName (in
  * a turn on DEM pszDEM's auxiliary file: a save may be under way in another
  * thread or process). */
-static bool HasPamEntry(const char *pszPath, const char *pszName, const char *pszDEM)
+bool HasPamEntry(const char *pszPath, const char *pszName, const char *pszDEM)
 {
     VSIStatBufL sStat;
     if (!*pszPath || VSIStatL(pszPath, &sStat) != 0)
         return false;
-    const PamFileTurn oTurn(pszDEM, false);
+    std::optional<PamFileTurn> oTurn;
+    if (pszDEM)
+        oTurn.emplace(pszDEM, false);
     CPLPushErrorHandler(CPLQuietErrorHandler);
     CPLXMLNode *psTree = CPLParseXMLFile(pszPath);
     CPLPopErrorHandler();

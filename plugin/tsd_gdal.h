@@ -67,6 +67,24 @@ inline GDALDataset *FailOpen(ts_status eStatus, const char *pszMsg)
     return nullptr;
 }
 
+/** Whether the .aux.xml file pszPath holds an entry <Subdataset
+ * name="pszName"> (read in the products' turn of the DEM pszDEM where it is
+ * not null; tsd_dataset_metadata.cpp). GDAL's TryLoadXML does not say. */
+bool HasPamEntry(const char *pszPath, const char *pszName, const char *pszDEM);
+
+/** Refuse SetGeoTransform/SetSpatialRef on a dataset whose georeferencing
+ * is fixed (a product's is its DEM's, an atlas's what it stores): GDAL's
+ * PAM took them, saved them and reported nothing of them. */
+inline CPLErr RefuseGeoreferencing(const GDALDataset *poDS, const char *pszWhat)
+{
+    Fail(CPLE_NotSupported,
+         CPLSPrintf("%s: the %s cannot be changed: a product's georeferencing is its "
+                    "DEM's, an atlas's the one it stores; set it on the DEM (gdal_edit.py "
+                    "-a_srs / -a_ullr dem.tif) or on a copy (gdal_translate -a_srs / -a_ullr)",
+                    poDS->GetDescription(), pszWhat));
+    return CE_Failure;
+}
+
 /* TERRASHADE:<dem> datasets (tsd_dataset.cpp). */
 int IdentifyProduct(GDALOpenInfo *poOpenInfo);
 GDALDataset *OpenProduct(GDALOpenInfo *poOpenInfo);

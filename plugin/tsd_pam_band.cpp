@@ -44,6 +44,24 @@ GDALColorInterp TSPamBand::GetColorInterpretation()
     return OwnColor();
 }
 
+double TSPamBand::GetOffset(int *pbSuccess)
+{
+    const GDALRasterBandPamInfo *psPamInfo = UserPam();
+    const bool bSet = psPamInfo && psPamInfo->bOffsetSet;
+    if (pbSuccess)
+        *pbSuccess = bSet;
+    return bSet ? psPamInfo->dfOffset : 0.0;
+}
+
+double TSPamBand::GetScale(int *pbSuccess)
+{
+    const GDALRasterBandPamInfo *psPamInfo = UserPam();
+    const bool bSet = psPamInfo && psPamInfo->bScaleSet;
+    if (pbSuccess)
+        *pbSuccess = bSet;
+    return bSet ? psPamInfo->dfScale : 1.0;
+}
+
 /* Whether what the user sets on this band is reported; if not, say why
  * and where to set it (GDAL's PAM would take it and report nothing). */
 bool TSPamBand::Accepts(const char *pszWhat)
@@ -71,6 +89,16 @@ CPLErr TSPamBand::SetColorInterpretation(GDALColorInterp eColor)
 {
     return Accepts("colour interpretation") ? GDALPamRasterBand::SetColorInterpretation(eColor)
                                             : CE_Failure;
+}
+
+CPLErr TSPamBand::SetOffset(double dfOffset)
+{
+    return Accepts("offset") ? GDALPamRasterBand::SetOffset(dfOffset) : CE_Failure;
+}
+
+CPLErr TSPamBand::SetScale(double dfScale)
+{
+    return Accepts("scale") ? GDALPamRasterBand::SetScale(dfScale) : CE_Failure;
 }
 
 CPLErr TSPamBand::DeleteNoDataValue()

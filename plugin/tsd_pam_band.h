@@ -45,10 +45,16 @@ class TSPamBand : public GDALPamRasterBand
     double GetNoDataValue(int *pbSuccess = nullptr) override;
     const char *GetUnitType() override;
     GDALColorInterp GetColorInterpretation() override;
+    /* none (0 and 1) unless the user set one; a level reports its
+     * full-resolution band's */
+    double GetOffset(int *pbSuccess = nullptr) override;
+    double GetScale(int *pbSuccess = nullptr) override;
     /* refused where NotHere says so */
     CPLErr SetNoDataValue(double dfValue) override;
     CPLErr SetUnitType(const char *pszUnit) override;
     CPLErr SetColorInterpretation(GDALColorInterp eColor) override;
+    CPLErr SetOffset(double dfOffset) override;
+    CPLErr SetScale(double dfScale) override;
     /* drops a value the user set; the product's own cannot be dropped */
     CPLErr DeleteNoDataValue() override;
     /* drops the statistics and histograms PAM holds (saved for contents

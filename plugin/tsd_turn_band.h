@@ -24,6 +24,10 @@ class TSTurnBand : public TSPamBand
      * true with oTurn holding the dataset's read lock. */
     virtual bool TakeReadTurn(std::unique_lock<std::recursive_mutex> &oTurn) = 0;
 
+    /* whether GDAL answers an approximate request from an overview level
+     * (GetRasterSampleOverview(nSamples)), which is a coarser DEM's product */
+    bool ApproxFromLevel(int bApproxOK, GUIntBig nSamples);
+
   public:
     CPLErr ComputeStatistics(int bApproxOK, double *pdfMin, double *pdfMax, double *pdfMean,
                              double *pdfStdDev, GDALProgressFunc pfnProgress,

@@ -434,6 +434,37 @@ class Overviews(unittest.TestCase):
                     self.assertEqual(ds.GetRasterBand(1).ComputeStatistics(True), approx)
                 ds = None
 
+    def test_approximate_histograms_are_not_saved(self):
+        """The same for histograms: GDAL takes an approximate one from the
+        coarsest level, and GDAL's PAM saved it, so that GetDefaultHistogram
+        and gdalinfo -hist (QGIS's estimated histograms) reported the
+        level's counts as the product's after a reopen (session 57's GDAL
+        API audit: 34 744 cells counted of 138 632). An exact one is saved
+        and still answers an approximate request."""
+        with T.TempDir() as tmp:
+            dem = os.path.join(tmp, "dem.tif")
+            T.shutil.copy(self.dem, dem)
+            name = T.conn(dem, PRODUCT="svf", DIRECTIONS=8)
+            ds = gdal.OpenEx(name, gdal.OF_RASTER)
+            band = ds.GetRasterBand(1)
+            cells = ds.RasterXSize * ds.RasterYSize
+            approx = band.GetHistogram(0, 1, 4, approx_ok=1)
+            print("approximate histogram:", approx, "of", cells, "cells")
+            self.assertLess(sum(approx), cells / 2)
+            ds = band = None
+            ds = gdal.OpenEx(name, gdal.OF_RASTER)
+            self.assertIsNone(ds.GetRasterBand(1).GetDefaultHistogram(force=0))
+            exact = ds.GetRasterBand(1).GetHistogram(0, 1, 4, approx_ok=0)
+            ds = None
+            ds = gdal.OpenEx(name, gdal.OF_RASTER)
+            self.assertEqual(ds.GetRasterBand(1).GetDefaultHistogram(force=0)[3], exact)
+            self.assertEqual(ds.GetRasterBand(1).GetHistogram(0, 1, 4, approx_ok=1), exact)
+            other = ds.GetRasterBand(1).GetHistogram(0, 1, 5, approx_ok=1)  # the level's
+            self.assertLess(sum(other), cells / 2)
+            ds = None
+            with open(dem + ".terrashade.aux.xml") as f:
+                self.assertEqual(f.read().count("<HistItem>"), 1)
+
 
 class Cost(unittest.TestCase):
     """A coarse level costs a fraction of the full level: time and memory."""

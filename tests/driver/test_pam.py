@@ -153,6 +153,79 @@ class Pam(unittest.TestCase):
         self.assertIn("full-resolution band", str(e.exception))
         self.assertEqual(ds.GetRasterBand(1).GetNoDataValue(), 0.0)
 
+    def test_scale_and_offset(self):
+        """SetScale and SetOffset: kept, reported by the overview levels
+        (they reported none, so gdal_translate -ovr 0 lost them: session
+        57's GDAL API audit), refused on a level."""
+        conn = T.conn(self.dem, PRODUCT="svf", DIRECTIONS=4)
+        ds = gdal.Open(conn)
+        b = ds.GetRasterBand(1)
+        self.assertEqual((b.GetScale(), b.GetOffset()), (None, None))  # none set
+        b.SetScale(0.5)
+        b.SetOffset(10)
+        self.assertEqual((b.GetOverview(0).GetScale(), b.GetOverview(0).GetOffset()),
+                         (0.5, 10.0))
+        with self.assertRaises(RuntimeError) as e:
+            b.GetOverview(0).SetScale(2)
+        self.assertIn("full-resolution band", str(e.exception))
+        ds = b = None
+        ds = gdal.Open(conn)
+        b = ds.GetRasterBand(1)
+        self.assertEqual((b.GetScale(), b.GetOffset()), (0.5, 10.0))
+        self.assertEqual((b.GetOverview(0).GetScale(), b.GetOverview(0).GetOffset()),
+                         (0.5, 10.0))
+        ds = b = None
+        out = os.path.join(self.tmp.path, "level.tif")
+        T.run(["gdal_translate", "-q", "-ovr", "0", conn, out])
+        ds = gdal.Open(out)
+        self.assertEqual((ds.GetRasterBand(1).GetScale(), ds.GetRasterBand(1).GetOffset()),
+                         (0.5, 10.0))
+
+    def test_georeferencing_is_the_dems(self):
+        """SetGeoTransform and SetSpatialRef on a product are refused: GDAL's
+        PAM took them, saved them in the products' file and reported the
+        DEM's all the same (session 57's GDAL API audit)."""
+        conn = T.conn(self.dem, PRODUCT="svf", DIRECTIONS=4)
+        ds = gdal.Open(conn)
+        gt = ds.GetGeoTransform()
+        srs = osr.SpatialReference()
+        srs.ImportFromEPSG(4326)
+        for call in (lambda: ds.SetGeoTransform([0, 1, 0, 0, 0, -1]),
+                     lambda: ds.SetSpatialRef(srs)):
+            with self.assertRaises(RuntimeError) as e:
+                call()
+            print(e.exception)
+            self.assertIn("georeferencing is its DEM's", str(e.exception))
+            self.assertIn("gdal_edit.py", str(e.exception))
+        self.assertEqual(ds.GetGeoTransform(), gt)
+        ds = None
+        aux = self.dem + ".terrashade.aux.xml"
+        if os.path.exists(aux):
+            with open(aux) as f:
+                text = f.read()
+            self.assertNotIn("<GeoTransform>", text)
+            self.assertNotIn("<SRS", text)
+
+    def test_generic_delete_leaves_the_dem(self):
+        """A product has no files of its own: GDAL's generic Delete through
+        another driver (gdalmanage delete -f GTiff TERRASHADE:dem.tif)
+        unlinked what the product's file list named, the DEM and the
+        products' .aux.xml (session 57's GDAL API audit)."""
+        conn = T.conn(self.dem)
+        T.run(["gdalinfo", "-stats", conn], cwd=self.cwd)
+        before = sorted(os.listdir(self.demdir))
+        self.assertIn("jacksboro.tif.terrashade.aux.xml", before)
+        ds = gdal.Open(conn)
+        self.assertFalse(ds.GetFileList())
+        ds = None
+        p = T.run(["gdalmanage", "delete", "-f", "GTiff", conn], ok=None, cwd=self.cwd)
+        print(p.stdout, p.stderr)
+        self.assertIn("Unable to determine files associated", p.stderr)
+        with self.assertRaises(RuntimeError):
+            gdal.GetDriverByName("GTiff").Delete(conn)
+        self.assertEqual(sorted(os.listdir(self.demdir)), before)
+        self.assertIn("STATISTICS_MEAN", T.run(["gdalinfo", conn], cwd=self.cwd).stdout)
+
     def test_gdal_edit(self):
         """gdal_edit.py -ro on a connection string: kept in the DEM's
         .aux.xml, shown by gdalinfo, copied by gdal_translate. Without -ro
@@ -258,6 +331,48 @@ class Pam(unittest.TestCase):
         ds = gdal.Open(tsa)
         self.assertEqual(ds.GetRasterBand(2).GetNoDataValue(), 255.0)
         self.assertTrue(os.path.exists(tsa + ".aux.xml"))
+
+    def test_atlas_views_keep_their_own_entries(self):
+        """An atlas read with SHADOWS=all is other pixels than the atlas
+        alone: its statistics and histograms have an entry of their own in
+        the atlas's .aux.xml. The two views shared one: each reported the
+        other's statistics, and once the SHADOWS=all view had saved, the
+        plain atlas said SHADOWS=all, so that gdal_translate -of TERRASHADE
+        refused to copy it (session 57's GDAL API audit)."""
+        tsa = os.path.join(self.demdir, "v.tsa")
+        T.run(["gdal_translate", "-q", "-of", "TERRASHADE"] + T.oo_args(dict(
+            PRODUCT="farshadow", DATE="2026-12-21", TIMEZONE="-05:00", ATLAS_STEPS=4,
+            FAR_THRESHOLD=24)) + [T.conn(self.dem), tsa])
+
+        def mean(*oo):
+            ds = gdal.OpenEx(tsa, gdal.OF_RASTER, open_options=list(oo))
+            return ds.GetRasterBand(1).ComputeStatistics(False)[2]
+
+        far, both = mean(), mean("SHADOWS=all")
+        print("means: far %.4f, all %.4f" % (far, both))
+        self.assertNotAlmostEqual(far, both, places=3)
+        for oo, want in (((), far), (("SHADOWS=all",), both)):
+            ds = gdal.OpenEx(tsa, gdal.OF_RASTER, open_options=list(oo))
+            self.assertAlmostEqual(ds.GetRasterBand(1).GetStatistics(False, False)[2], want)
+            ds.GetRasterBand(1).GetHistogram(0, 1, 2, approx_ok=0)
+            ds = None
+        ds = gdal.Open(tsa)
+        self.assertIsNone(ds.GetMetadataItem("SHADOWS"))
+        ds = None
+        T.run(["gdal_translate", "-q", "-of", "TERRASHADE", tsa,
+               os.path.join(self.demdir, "copy.tsa")])
+        # an entry of the file's top level (written before session 57) is
+        # still read by the atlas's own view, and kept as its entry
+        with open(tsa + ".aux.xml", "w") as f:
+            f.write('<PAMDataset><PAMRasterBand band="1"><NoDataValue>7</NoDataValue>'
+                    '</PAMRasterBand></PAMDataset>\n')
+        for trial in range(2):
+            ds = gdal.Open(tsa)
+            self.assertEqual(ds.GetRasterBand(1).GetNoDataValue(), 7.0)
+            ds.GetRasterBand(1).ComputeStatistics(False)
+            ds = None
+        ds = gdal.OpenEx(tsa, gdal.OF_RASTER, open_options=["SHADOWS=all"])
+        self.assertEqual(ds.GetRasterBand(1).GetNoDataValue(), 255.0)
 
     def test_an_entry_in_the_dems_own_file_is_still_read(self):
         """Before session 48 the entries went into the DEM's .aux.xml: a
