@@ -15,6 +15,15 @@
 namespace tsd
 {
 
+/* Bytes as the MiB a message says: rounded up, so that a MAX_MEMORY of the
+ * figure said opens (rounded to the nearest, "needs about 79 MiB ... more
+ * than the limit of 79 MiB", and the TILE_SIZE advised at "about 38 MiB"
+ * was refused again under MAX_MEMORY=38: session 57's memory audit). */
+static double MiBUp(double dfBytes)
+{
+    return std::ceil(dfBytes / 1048576.0);
+}
+
 double MemoryLimit(const tsd_options &sOpts, const char **ppszWhy)
 {
     *ppszWhy = "MAX_MEMORY";
@@ -45,13 +54,13 @@ static std::string EnvironmentOver(const tsd_options &sOpts, const tsd_env_cost 
                           "(%s); use a smaller map (larger than 2048 x 1024 it is merged "
                           "to that many texels anyway), or MAX_MEMORY=%.0f or more",
                           osSource.c_str(), psMap->width, psMap->height, sEnv.texels,
-                          sEnv.peak / 1048576.0, dfLimit / 1048576.0, pszWhy, dfNeed);
+                          MiBUp(sEnv.peak), dfLimit / 1048576.0, pszWhy, dfNeed);
     return CPLSPrintf("the light table of %s (DIRECTIONS=%d x ENV_NORMAL_STEPS=%d x "
                       "ENV_HORIZON_STEPS=%d) needs about %.0f MiB while it is built (%.0f MiB "
                       "kept), more than the limit of %.0f MiB (%s); use fewer DIRECTIONS or "
                       "ENV_HORIZON_STEPS%s, or MAX_MEMORY=%.0f or more",
                       osSource.c_str(), sOpts.directions, sOpts.env_normal_steps,
-                      sOpts.env_horizon_steps, sEnv.peak / 1048576.0, sEnv.kept / 1048576.0,
+                      sOpts.env_horizon_steps, MiBUp(sEnv.peak), MiBUp(sEnv.kept),
                       dfLimit / 1048576.0, pszWhy,
                       sOpts.env_normal_steps ? " (or ENV_NORMAL_STEPS=0, exact)" : "", dfNeed);
 }
@@ -100,8 +109,8 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
     {
         Fail(TS_ERR_NOMEM,
              CPLSPrintf("PRODUCT=%s needs about %.0f MiB while computing (%.0f MiB kept): %s",
-                        tsd_options_product_name(&sOpts), dfPeak / 1048576.0,
-                        dfSteady / 1048576.0, osEnv.c_str()));
+                        tsd_options_product_name(&sOpts), MiBUp(dfPeak), MiBUp(dfSteady),
+                        osEnv.c_str()));
         return false;
     }
     char szAdvice[512] = "";
@@ -114,7 +123,7 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
         snprintf(szAdvice, sizeof szAdvice,
                  "; TILE_SIZE=0 computes it whole in about %.0f MiB (its chunks with their "
                  "margins need more)",
-                 dfWhole / 1048576.0);
+                 MiBUp(dfWhole));
     else if (nLevel == 0)
         tsd_window_advice(&sOpts, psSun, W, H, tsd_cells_min_x(&sCells, H), sCells.cell_y,
                           dfLimit, sEnv.kept, szAdvice, sizeof szAdvice);
@@ -128,8 +137,8 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
                     "about %.0f MiB while computing (%.0f MiB kept), more than the "
                     "limit of %.0f MiB (%s)%s; crop or downsample the DEM, %sor raise "
                     "MAX_MEMORY", tsd_options_product_name(&sOpts),
-                    tsd_options_band_count(&sOpts), W, H, dfPeak / 1048576.0,
-                    dfSteady / 1048576.0, dfLimit / 1048576.0, pszWhy, szAdvice,
+                    tsd_options_band_count(&sOpts), W, H, MiBUp(dfPeak), MiBUp(dfSteady),
+                    dfLimit / 1048576.0, pszWhy, szAdvice,
                     osFewer.c_str()));
     return false;
 }

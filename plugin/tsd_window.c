@@ -302,7 +302,7 @@ void tsd_window_advice(const tsd_options *o, const tsd_sun *sun, int W, int H,
     if (!why) {
         if (tile_that_fits(o, sun, W, H, cells_min_x, cell_y, limit, extra, &tile, &bytes))
             snprintf(out, n, "; TILE_SIZE=%d computes it window by window in about %.0f MiB",
-                     tile, bytes / 1048576.0);
+                     tile, ceil(bytes / 1048576.0)); /* (up: a MAX_MEMORY that does) */
         return;
     }
     /* the exact methods, windowed (farshadow has none) */
@@ -320,7 +320,7 @@ void tsd_window_advice(const tsd_options *o, const tsd_sun *sun, int W, int H,
         snprintf(out, n,
                  "; it is computed on the whole DEM (%s): %s with TILE_SIZE=%d computes it "
                  "window by window in about %.0f MiB",
-                 why, instead, tile, bytes / 1048576.0);
+                 why, instead, tile, ceil(bytes / 1048576.0));
     else
         snprintf(out, n, "; it is computed on the whole DEM (%s)", why);
 }

@@ -319,7 +319,7 @@ class EnvLight(unittest.TestCase):
             self.assertNotEqual(p.returncode, 0, method)
             self.assertIn("the light table of SKY=clear (DIRECTIONS=3600 x ENV_NORMAL_STEPS=0 "
                           "x ENV_HORIZON_STEPS=3601) needs about 1197 MiB while it is built "
-                          "(405 MiB kept), more than the limit of 100 MiB (MAX_MEMORY); use "
+                          "(406 MiB kept), more than the limit of 100 MiB (MAX_MEMORY); use "
                           "fewer DIRECTIONS or ENV_HORIZON_STEPS, or MAX_MEMORY=", p.stderr)
             self.assertLess(peak, 200, "the table was built before the refusal")
         # a table that fits the limit given opens

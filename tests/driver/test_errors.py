@@ -476,6 +476,15 @@ class Errors(unittest.TestCase):
         self.assertIn("needs about", p.stderr)
         self.assertIn("crop or downsample the DEM, use fewer DIRECTIONS, or raise MAX_MEMORY",
                       p.stderr)
+        # the figure it says, given as MAX_MEMORY, opens: rounded up (to the
+        # nearest, "needs about 79 MiB ..., more than the limit of 79 MiB")
+        for product in ("shade", "svf", "horizon"):
+            p = T.run(["gdalinfo", "-oo", "PRODUCT=" + product, "-oo", "MAX_MEMORY=1",
+                       T.conn(T.JACKSBORO)], ok=False)
+            need = re.search(r"needs about (\d+) MiB while computing", p.stderr).group(1)
+            self.assertNotIn("more than the limit of %s MiB" % need, p.stderr)
+            T.run(["gdalinfo", "-oo", "PRODUCT=" + product, "-oo", "MAX_MEMORY=" + need,
+                   T.conn(T.JACKSBORO)])
 
     def test_memory_limit_says_how_windows_fit(self):
         """Over MAX_MEMORY, the message says which TILE_SIZE (and, for the
@@ -511,6 +520,10 @@ class Errors(unittest.TestCase):
                     taken = [o for o in opts if not o.startswith(("TILE_SIZE", "METHOD"))]
                     taken += ["TILE_SIZE=" + m.group(2)] + (["METHOD=exact"] if why else [])
                     T.run(["gdalinfo"] + oo(taken + limit) + [T.conn(dem)])
+                    # and within the limit it says (rounded up: to the nearest,
+                    # MAX_MEMORY=38 refused "about 38 MiB": session 57's audit)
+                    T.run(["gdalinfo"] + oo(taken + ["MAX_MEMORY=" + m.group(3)])
+                          + [T.conn(dem)])
             p = T.run(["gdalinfo"] + oo(["PRODUCT=farshadow", "DATE=2024-06-21",
                                          "TIMEZONE=+01:00", "MAX_MEMORY=10"])
                       + [T.conn(dem)], ok=False)
