@@ -473,6 +473,17 @@ class EnvLight(unittest.TestCase):
         p = T.run(["gdal_translate", "-q", "-oo", "SKY=clear",
                    T.conn(T.JACKSBORO), self.path("bad.tif")], ok=False)
         self.assertIn("SKY_WEIGHT > 0", p.stderr)
+        # the light table's steps for shade's sky term without a SKY: it is
+        # the sky-view factor's, which has no table (taken without a word
+        # until session 57's audit); with a SKY they change its pixels
+        for steps in ("ENV_HORIZON_STEPS=3", "ENV_NORMAL_STEPS=3"):
+            p = T.run(["gdal_translate", "-q", "-oo", "SKY_WEIGHT=0.3", "-oo", steps,
+                       T.conn(T.JACKSBORO), self.path("bad.tif")], ok=False)
+            self.assertIn("%s sets the light table of SKY or ENV_MAP; without them "
+                          "PRODUCT=shade's sky term is the sky-view factor's uniform sky"
+                          % steps.split("=")[0], p.stderr)
+            T.run(["gdal_translate", "-q", "-oo", "SKY_WEIGHT=0.3", "-oo", steps, "-oo",
+                   "SKY=uniform", T.conn(T.JACKSBORO), self.path("ok.tif")])
 
 
 if __name__ == "__main__":
