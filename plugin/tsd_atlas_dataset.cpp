@@ -32,6 +32,7 @@
 #include "tsd_options.h"
 #include "tsd_path_check.h"
 #include "tsd_pam_band.h"
+#include "tsd_source_stamp.h"
 #include "tsd_entry_state.h"
 
 namespace tsd
@@ -376,13 +377,25 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
     // the atlas's .aux.xml, where the two reported each other's statistics
     // and histograms and the far view took SHADOWS=all from the saved
     // metadata (and GDAL rewrites the file whole for a view without one)
+    // (DEM= by its absolute path: a relative one is read from the working
+    // directory, and two DEMs of one name shared an entry: the review)
     const std::string osView =
-        bAll ? "SHADOWS=all" + (poDS->m_bDEMGiven ? ":DEM=" + poDS->m_osDEM : "")
+        bAll ? "SHADOWS=all" +
+                   (poDS->m_bDEMGiven ? ":DEM=" + AbsolutePath(poDS->m_osDEM.c_str()) : "")
              : std::string("SHADOWS=far");
+    if (bAll && CPLString(poDS->m_osDEM).ifind("/vsistdin") != std::string::npos)
+        poDS->nPamFlags |= GPF_DISABLED; // the next run's standard input is another DEM
     const char *pszPam = poDS->BuildPamFilename();
     if (!bAll && pszPam && !HasPamEntry(pszPam, osView.c_str(), nullptr))
-        poDS->TryLoadXML(); // the file's top level, where the atlas's entries
-                            // were before session 57: saved as the view's
+    {
+        // the file's top level, where the atlas's entries were before
+        // session 57: what the user set is saved as the view's; its
+        // statistics and histograms may be the other view's (one entry
+        // served both), and are computed again
+        poDS->TryLoadXML();
+        for (int i = 1; i <= poDS->nBands; i++)
+            static_cast<TSAtlasBand *>(poDS->GetRasterBand(i))->DropSavedStatistics();
+    }
     poDS->SetSubdatasetName(osView.c_str());
     if (!pszPam || HasPamEntry(pszPam, osView.c_str(), nullptr))
         poDS->TryLoadXML();

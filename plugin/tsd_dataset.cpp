@@ -499,7 +499,8 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     if (!SetupWindow(W, H) ||
         !CheckMemory(sOpts, W, H, WindowPlan(m_poWindow), m_bHasSun ? &m_sSun : nullptr,
                      m_sCells, m_nLevel, m_sEnvCost,
-                     m_sEnvMapInfo.width ? &m_sEnvMapInfo : nullptr, &dfHeadroom) ||
+                     m_sEnvMapInfo.width ? &m_sEnvMapInfo : nullptr, StdinCopyBytes(),
+                     &dfHeadroom) ||
         !BuildEnvironment(oEnvMap))
         return false;
     // a lattice's day keeps horizon planes across its steps: in at most

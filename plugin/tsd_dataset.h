@@ -58,11 +58,12 @@ void WarnHeightUnit(const tsd_cells &sCells, const OGRSpatialReference &oSRS,
  * psPlan's windows) fits MAX_MEMORY; if not, fails with a sentence saying
  * what to do (psSun, sCells and nLevel serve the advice on windows, at
  * level 0). sEnv: the environment's cost, built at open (its peak) and kept
- * while computing; psMap its ENV_MAP's header, or null. *pdfHeadroom: the
- * bytes left under the limit. */
+ * while computing; psMap its ENV_MAP's header, or null; dfDEMCopy the bytes
+ * of the DEM held in memory beside the product (the standard input's copy).
+ * *pdfHeadroom: the bytes left under the limit. */
 bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *psPlan,
                  const tsd_sun *psSun, const tsd_cells &sCells, int nLevel,
-                 const tsd_env_cost &sEnv, const ts_env_map_info *psMap,
+                 const tsd_env_cost &sEnv, const ts_env_map_info *psMap, double dfDEMCopy,
                  double *pdfHeadroom);
 /* The limit CheckMemory holds to (bytes), and *ppszWhy where it comes from. */
 double MemoryLimit(const tsd_options &sOpts, const char **ppszWhy);
@@ -199,6 +200,8 @@ class TSDataset final : public GDALPamDataset
      * a DEM is read more than once (the steepness sample at open, the grid,
      * each overview level's open). Its name, or "" with the error said. */
     static std::string CopyStdin(const tsd_options &sOpts);
+    /* the bytes of that copy (level 0's, which a level reads too), or 0 */
+    double StdinCopyBytes() const;
     /* why a read after CloseDependentDatasets fails */
     std::string DEMReleasedError() const;
     ts_status LoadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg);

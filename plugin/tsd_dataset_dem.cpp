@@ -77,10 +77,19 @@ std::string TSDataset::CopyStdin(const tsd_options &sOpts)
                             "forward only, and the DEM is read more than once), and the "
                             "standard input holds more than the limit of %.0f MiB (%s): "
                             "write the DEM to a file first",
-                            std::floor(dfLimit / 1048576.0), pszWhy)
+                            dfLimit / 1048576.0, pszWhy)
                : dfBytes > 0 ? "cannot copy the DEM '/vsistdin/' into memory"
                              : "the DEM '/vsistdin/': the standard input is empty");
     return std::string();
+}
+
+double TSDataset::StdinCopyBytes() const
+{
+    const std::string &osCopy = (m_poBase ? m_poBase : this)->m_osStdinCopy;
+    VSIStatBufL sStat;
+    return !osCopy.empty() && VSIStatL(osCopy.c_str(), &sStat) == 0
+               ? static_cast<double>(sStat.st_size)
+               : 0.0;
 }
 
 /* Whether a file is read without the network and without the host's

@@ -69,7 +69,7 @@ static std::string EnvironmentOver(const tsd_options &sOpts, const tsd_env_cost 
  * psSun, the cells and nLevel serve the advice on windows (level 0). */
 bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *psPlan,
                  const tsd_sun *psSun, const tsd_cells &sCells, int nLevel,
-                 const tsd_env_cost &sEnv, const ts_env_map_info *psMap,
+                 const tsd_env_cost &sEnv, const ts_env_map_info *psMap, double dfDEMCopy,
                  double *pdfHeadroom)
 {
     if (!psPlan && (W > TS_MAX_SIDE || H > TS_MAX_SIDE))
@@ -92,8 +92,9 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
     double dfPeak = psPlan ? tsd_window_peak_bytes(&sOpts, psPlan, &dfSteady)
                            : tsd_product_peak_bytes(&sOpts, W, H, &dfSteady);
     // the environment: set up at open (its peak), then kept while computing
-    dfPeak = std::max(dfPeak + sEnv.kept, sEnv.peak);
-    dfSteady += sEnv.kept;
+    // (and the DEM's copy in memory, held from open to close)
+    dfPeak = std::max(dfPeak + sEnv.kept, sEnv.peak) + dfDEMCopy;
+    dfSteady += sEnv.kept + dfDEMCopy;
     const char *pszWhy = nullptr;
     const double dfLimit = MemoryLimit(sOpts, &pszWhy);
     CPLDebug(DRIVER,

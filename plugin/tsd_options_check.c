@@ -153,15 +153,17 @@ static int check_environment(const tsd_options *o, char *msg, size_t n)
     /* as ENV_ROTATION: shade's sky term without SKY or ENV_MAP is the
      * sky-view factor's uniform sky, which has no table (session 57's audit:
      * taken without a word) */
-    if (!o->env_map[0] && !o->sky[0] &&
-        (o->env_horizon_steps != TS_ENV_DEFAULT_HORIZON_STEPS ||
-         o->env_normal_steps != TS_ENV_DEFAULT_NORMAL_STEPS))
+    const char *steps = o->env_horizon_steps != TS_ENV_DEFAULT_HORIZON_STEPS ? "ENV_HORIZON_STEPS"
+                        : o->env_normal_steps != TS_ENV_DEFAULT_NORMAL_STEPS ? "ENV_NORMAL_STEPS"
+                                                                              : NULL;
+    if (steps && !envlight && !(o->sky_weight > 0))
+        REFUSE("%s sets the light table of PRODUCT=%s's sky term, which SKY_WEIGHT=0 leaves "
+               "out: give SKY_WEIGHT > 0 and a SKY or ENV_MAP", steps, p->name);
+    if (steps && !o->env_map[0] && !o->sky[0])
         REFUSE("%s sets the light table of SKY or ENV_MAP; without them PRODUCT=%s's sky "
                "term is the sky-view factor's uniform sky, which has none: give a SKY "
                "(uniform, overcast, clear, cie:N) or ENV_MAP with it",
-               o->env_horizon_steps != TS_ENV_DEFAULT_HORIZON_STEPS ? "ENV_HORIZON_STEPS"
-                                                                    : "ENV_NORMAL_STEPS",
-               p->name);
+               steps, p->name);
     if (!envlight && (o->env_map[0] || o->sky[0]) && !(o->sky_weight > 0))
         REFUSE("%s sets the sky term of PRODUCT=%s, which SKY_WEIGHT=0 leaves out: give "
                "SKY_WEIGHT > 0", o->env_map[0] ? "ENV_MAP" : "SKY", p->name);

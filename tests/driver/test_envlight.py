@@ -484,6 +484,12 @@ class EnvLight(unittest.TestCase):
                           % steps.split("=")[0], p.stderr)
             T.run(["gdal_translate", "-q", "-oo", "SKY_WEIGHT=0.3", "-oo", steps, "-oo",
                    "SKY=uniform", T.conn(T.JACKSBORO), self.path("ok.tif")])
+            # without a sky term at all, SKY_WEIGHT is what to give (a SKY
+            # alone was refused in turn: the review)
+            p = T.run(["gdal_translate", "-q", "-oo", steps, T.conn(T.JACKSBORO),
+                       self.path("bad.tif")], ok=False)
+            self.assertIn("which SKY_WEIGHT=0 leaves out: give SKY_WEIGHT > 0 and a SKY or "
+                          "ENV_MAP", p.stderr)
 
 
 if __name__ == "__main__":

@@ -413,6 +413,12 @@ class Errors(unittest.TestCase):
             self.assertEqual(p.returncode, 1, p.stderr)
             self.assertIn("the standard input holds more than the limit of 2 MiB "
                           "(MAX_MEMORY): write the DEM to a file first", p.stderr)
+            # and beside the product: the estimate counts it (the review)
+            def need(dem, name):
+                p = run(["gdalinfo", "-oo", "MAX_MEMORY=3", T.conn(name)], dem)
+                self.assertEqual(p.returncode, 1, p.stderr)
+                return int(re.search(r"needs about (\d+) MiB", p.stderr).group(1))
+            self.assertGreaterEqual(need(big, "/vsistdin/"), need(None, big) + 2)
         p = run(["gdalinfo", T.conn("/vsistdin/")], None)
         self.assertEqual(p.returncode, 1, p.stderr)
         self.assertIn("the standard input is empty", p.stderr)

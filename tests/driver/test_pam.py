@@ -363,16 +363,50 @@ class Pam(unittest.TestCase):
                os.path.join(self.demdir, "copy.tsa")])
         # an entry of the file's top level (written before session 57) is
         # still read by the atlas's own view, and kept as its entry
+        # (its statistics may be the other view's, which one entry served:
+        # computed again, the review)
         with open(tsa + ".aux.xml", "w") as f:
             f.write('<PAMDataset><PAMRasterBand band="1"><NoDataValue>7</NoDataValue>'
-                    '</PAMRasterBand></PAMDataset>\n')
+                    '<Metadata><MDI key="STATISTICS_MEAN">%r</MDI><MDI key="STATISTICS_'
+                    'MINIMUM">0</MDI><MDI key="STATISTICS_MAXIMUM">1</MDI><MDI key="'
+                    'STATISTICS_STDDEV">0.5</MDI></Metadata>'
+                    '</PAMRasterBand></PAMDataset>\n' % both)
         for trial in range(2):
             ds = gdal.Open(tsa)
             self.assertEqual(ds.GetRasterBand(1).GetNoDataValue(), 7.0)
+            if trial == 0:
+                self.assertEqual(ds.GetRasterBand(1).GetStatistics(False, False),
+                                 [0, 0, 0, -1])
             ds.GetRasterBand(1).ComputeStatistics(False)
             ds = None
         ds = gdal.OpenEx(tsa, gdal.OF_RASTER, open_options=["SHADOWS=all"])
         self.assertEqual(ds.GetRasterBand(1).GetNoDataValue(), 255.0)
+        ds = None
+        # DEM= is read from the working directory: its entry is keyed by the
+        # absolute path, so that two DEMs of one relative name keep their
+        # own statistics (the review)
+        other = os.path.join(self.cwd, "jacksboro.tif")
+        T.run(["gdal_translate", "-q", "-scale", "0", "1", "0", "3", "-ot", "Float32",
+               self.dem, other])
+        means = []
+        for folder in (self.demdir, self.cwd):
+            old = os.getcwd()
+            os.chdir(folder)
+            try:
+                ds = gdal.OpenEx(tsa, gdal.OF_RASTER,
+                                 open_options=["SHADOWS=all", "DEM=jacksboro.tif"])
+                self.assertEqual(ds.GetRasterBand(1).GetStatistics(False, False),
+                                 [0, 0, 0, -1])
+                means.append(ds.GetRasterBand(1).ComputeStatistics(False)[2])
+                ds = None
+            finally:
+                os.chdir(old)
+        print("SHADOWS=all means with DEM=jacksboro.tif in two folders:", means)
+        self.assertNotAlmostEqual(means[0], means[1], places=3)
+        with open(tsa + ".aux.xml") as f:
+            text = f.read()
+        self.assertIn('name="SHADOWS=all:DEM=%s"' % self.dem, text)
+        self.assertIn('name="SHADOWS=all:DEM=%s"' % other, text)
 
     def test_an_entry_in_the_dems_own_file_is_still_read(self):
         """Before session 48 the entries went into the DEM's .aux.xml: a
