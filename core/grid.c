@@ -6,6 +6,13 @@
 
 #include "status_internal.h"
 
+/* A cell size the sweeps can take (TS_CELL_MIN_M .. TS_CELL_MAX_M metres;
+ * NaN fails it). */
+static int cell_ok(double m)
+{
+    return m >= TS_CELL_MIN_M && m <= TS_CELL_MAX_M;
+}
+
 ts_status ts_grid_create(ts_grid *grid, int width, int height, double cell_x,
                          double cell_y, ts_error *err)
 {
@@ -16,10 +23,9 @@ ts_status ts_grid_create(ts_grid *grid, int width, int height, double cell_x,
         return ts_fail(err, TS_ERR_ARG,
                        "grid size must be between 1 and %d cells per side, got %d x %d",
                        TS_MAX_SIDE, width, height);
-    if (!isfinite(cell_x) || !isfinite(cell_y) || cell_x <= 0 || cell_y <= 0)
-        return ts_fail(err, TS_ERR_ARG,
-                       "cell size must be finite and positive, got %g x %g",
-                       cell_x, cell_y);
+    if (!cell_ok(cell_x) || !cell_ok(cell_y))
+        return ts_fail(err, TS_ERR_ARG, "cell size must be %g to %g m, got %g x %g",
+                       TS_CELL_MIN_M, TS_CELL_MAX_M, cell_x, cell_y);
     size_t n = (size_t)width * (size_t)height;
     if (n > SIZE_MAX / sizeof(float))
         return ts_fail(err, TS_ERR_NOMEM, "grid of %d x %d cells is too large",
@@ -47,10 +53,10 @@ ts_status ts_grid_set_row_spacing(ts_grid *grid, const double *cell_x_row,
         return ts_fail(err, TS_ERR_ARG,
                        "row spacing can only be set on a grid made by ts_grid_create");
     for (int y = 0; y < grid->height; y++)
-        if (!isfinite(cell_x_row[y]) || cell_x_row[y] <= 0)
+        if (!cell_ok(cell_x_row[y]))
             return ts_fail(err, TS_ERR_ARG,
-                           "east-west cell size of row %d must be finite and positive, got %g",
-                           y, cell_x_row[y]);
+                           "east-west cell size of row %d must be %g to %g m, got %g", y,
+                           TS_CELL_MIN_M, TS_CELL_MAX_M, cell_x_row[y]);
     double *copy = malloc((size_t)grid->height * sizeof *copy);
     if (!copy)
         return ts_fail(err, TS_ERR_NOMEM, "cannot allocate row spacing");
@@ -85,16 +91,14 @@ ts_status ts_grid_validate(const ts_grid *grid, ts_error *err)
     if (grid->stride < grid->width)
         return ts_fail(err, TS_ERR_ARG, "grid stride %td is smaller than its width %d",
                        grid->stride, grid->width);
-    if (!isfinite(grid->cell_x) || !isfinite(grid->cell_y) || grid->cell_x <= 0 ||
-        grid->cell_y <= 0)
-        return ts_fail(err, TS_ERR_ARG,
-                       "cell size must be finite and positive, got %g x %g",
-                       grid->cell_x, grid->cell_y);
+    if (!cell_ok(grid->cell_x) || !cell_ok(grid->cell_y))
+        return ts_fail(err, TS_ERR_ARG, "cell size must be %g to %g m, got %g x %g",
+                       TS_CELL_MIN_M, TS_CELL_MAX_M, grid->cell_x, grid->cell_y);
     if (grid->cell_x_row)
         for (int y = 0; y < grid->height; y++)
-            if (!isfinite(grid->cell_x_row[y]) || grid->cell_x_row[y] <= 0)
+            if (!cell_ok(grid->cell_x_row[y]))
                 return ts_fail(err, TS_ERR_ARG,
-                               "east-west cell size of row %d must be finite and positive, got %g",
-                               y, grid->cell_x_row[y]);
+                               "east-west cell size of row %d must be %g to %g m, got %g", y,
+                               TS_CELL_MIN_M, TS_CELL_MAX_M, grid->cell_x_row[y]);
     return ts_ok(err);
 }

@@ -88,9 +88,16 @@ typedef struct {
  * and every index in ptrdiff_t, and turns absurd sizes into a clear error. */
 #define TS_MAX_SIDE (1 << 20)
 
+/** The cell sizes a grid may have, metres: below a nanometre the sweeps'
+ * steps overflowed (cells of 1e-320 m read NaN everywhere), and no terrain
+ * has cells of more than 100 000 km. */
+#define TS_CELL_MIN_M 1e-9
+#define TS_CELL_MAX_M 1e8
+
 /**
  * Allocate a width x height grid (each side 1 .. TS_MAX_SIDE) with stride =
- * width, heights set to 0 and constant cell sizes. Free it with
+ * width, heights set to 0 and constant cell sizes (TS_CELL_MIN_M ..
+ * TS_CELL_MAX_M). Free it with
  * ts_grid_free.
  */
 ts_status ts_grid_create(ts_grid *grid, int width, int height, double cell_x,
@@ -98,7 +105,7 @@ ts_status ts_grid_create(ts_grid *grid, int width, int height, double cell_x,
 
 /**
  * Give the grid per-row east-west cell sizes (copied; `height` values, all
- * finite and > 0). Only for a grid made by ts_grid_create.
+ * TS_CELL_MIN_M .. TS_CELL_MAX_M). Only for a grid made by ts_grid_create.
  */
 ts_status ts_grid_set_row_spacing(ts_grid *grid, const double *cell_x_row,
                                   ts_error *err);

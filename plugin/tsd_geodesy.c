@@ -368,9 +368,14 @@ done:
     return st;
 }
 
-ts_status tsd_cells_compute(const double gt[6], int width, int height,
-                      OGRSpatialReferenceH srs, tsd_cell_sizes mode, tsd_cells *c,
-                      char *msg, size_t n)
+/* A projected DEM's corners farther than this from its CRS's origin (m),
+ * more than twice around the Earth, took GDAL 3.6's Web Mercator inverse
+ * seconds a point (1e17 m: an open that never ended; session 57's fuzzing). */
+#define TSD_CORNER_MAX_M 1e8
+
+static ts_status cells_compute(const double gt[6], int width, int height,
+                               OGRSpatialReferenceH srs, tsd_cell_sizes mode, tsd_cells *c,
+                               char *msg, size_t n)
 {
     memset(c, 0, sizeof *c);
     if (width < 1 || height < 1)
@@ -424,6 +429,14 @@ ts_status tsd_cells_compute(const double gt[6], int width, int height,
             return tsd_fail(msg, n, TS_ERR_ARG, "CELL_SIZES=ground: the DEM's CRS is a "
                             "local one, without longitudes and latitudes; use "
                             "CELL_SIZES=grid");
+        const double far = c->unit_to_m *
+                           fmax(fmax(fabs(gt[0]), fabs(gt[0] + width * gt[1])),
+                                fmax(fabs(gt[3]), fabs(gt[3] + height * gt[5])));
+        if (!(far <= TSD_CORNER_MAX_M))
+            return tsd_fail(msg, n, TS_ERR_ARG,
+                            "the DEM's corners lie up to %g m from its CRS's origin, more "
+                            "than twice around the Earth: its geotransform is not one of "
+                            "this CRS (coordinates in another unit, or another CRS?)", far);
         return projected(gt, width, height, srs, mode, c, msg, n);
     }
     if (srs && OSRIsGeocentric(srs))
@@ -440,6 +453,29 @@ ts_status tsd_cells_compute(const double gt[6], int width, int height,
     c->cell_x = fabs(gt[1]) * c->unit_to_m;
     c->cell_y = fabs(gt[5]) * c->unit_to_m;
     return TS_OK;
+}
+
+ts_status tsd_cells_compute(const double gt[6], int width, int height,
+                            OGRSpatialReferenceH srs, tsd_cell_sizes mode, tsd_cells *c,
+                            char *msg, size_t n)
+{
+    ts_status st = cells_compute(gt, width, height, srs, mode, c, msg, n);
+    if (st != TS_OK)
+        return st;
+    double lo = fmin(c->cell_x, c->cell_y), hi = fmax(c->cell_x, c->cell_y);
+    for (int y = 0; c->cell_x_row && y < height; y++) {
+        lo = fmin(lo, c->cell_x_row[y]);
+        hi = fmax(hi, c->cell_x_row[y]);
+    }
+    /* (the core's bounds, said here with the DEM's own words: cells of
+     * 1e-320 m read NaN or nodata everywhere, and a NaN reached an int) */
+    if (lo >= TS_CELL_MIN_M && hi <= TS_CELL_MAX_M)
+        return TS_OK;
+    tsd_cells_free(c);
+    return tsd_fail(msg, n, TS_ERR_ARG,
+                    "the DEM's cells measure %g to %g m, beyond any terrain's (%g m to %g "
+                    "m): a geotransform in another unit?",
+                    lo, hi, TS_CELL_MIN_M, TS_CELL_MAX_M);
 }
 
 tsd_cell_sizes tsd_cells_mode(const tsd_cells *c)

@@ -81,6 +81,14 @@ START_TEST(test_grid_args)
     EXPECT_ARG(ts_grid_create(&g, 10, 10, 1, INFINITY, err), err);
     EXPECT_ARG(ts_grid_create(&g, 10, 10, 0, 1, err), err);
     EXPECT_ARG(ts_grid_create(&g, 10, 10, 1, -1, err), err);
+    /* beyond any terrain's: 1e-320 m cells read NaN everywhere (session 57) */
+    EXPECT_ARG(ts_grid_create(&g, 10, 10, 1e-320, 1e-320, err), err);
+    EXPECT_ARG(ts_grid_create(&g, 10, 10, 1, TS_CELL_MIN_M / 2, err), err);
+    EXPECT_ARG(ts_grid_create(&g, 10, 10, TS_CELL_MAX_M * 2, 1, err), err);
+    ts_grid edge;
+    if (ts_grid_create(&edge, 3, 3, TS_CELL_MIN_M, TS_CELL_MAX_M, err) != TS_OK)
+        ck_abort_msg("cells at the bounds refused: %s", err->message);
+    ts_grid_free(&edge);
     EXPECT_ARG_NOERR(ts_grid_create(&g, 0, 0, 1, 1, err));
     double rows[10] = {1, 1, 1, 1, NAN, 1, 1, 1, 1, 1};
     EXPECT_ARG(ts_grid_set_row_spacing(&G, NULL, err), err);
@@ -90,6 +98,8 @@ START_TEST(test_grid_args)
                err);
     EXPECT_ARG(ts_grid_set_row_spacing(&G, rows, err), err);
     rows[4] = -2;
+    EXPECT_ARG(ts_grid_set_row_spacing(&G, rows, err), err);
+    rows[4] = 1e-12;
     EXPECT_ARG(ts_grid_set_row_spacing(&G, rows, err), err);
     EXPECT_ARG(ts_grid_validate(NULL, err), err);
     ts_grid bad = G;
@@ -102,6 +112,8 @@ START_TEST(test_grid_args)
     bad = G, bad.cell_x = NAN;
     EXPECT_ARG(ts_grid_validate(&bad, err), err);
     bad = G, bad.cell_y = -INFINITY;
+    EXPECT_ARG(ts_grid_validate(&bad, err), err);
+    bad = G, bad.cell_y = 1e-20;
     EXPECT_ARG(ts_grid_validate(&bad, err), err);
     double nan_rows[10] = {1, 1, 1, 1, 1, 1, 1, 1, 1, NAN};
     bad = G, bad.cell_x_row = nan_rows;

@@ -398,6 +398,22 @@ class Hostile(unittest.TestCase):
             dem = T.write_tif(self.path("geo%d.tif" % i), z, gt, 4326)
             cases.append((n, ["gdal_translate", "-q", T.conn(dem),
                               self.path("geo%d_out.tif" % i)], t))
+        # session 57's fuzzing: cells no float holds read NaN or nodata
+        # everywhere (and a NaN reached an int); Web Mercator corners at
+        # 1e17 m took GDAL's inverse minutes, an open that never ended
+        beyond = [("cells of 1e-320", (0, 1e-320, 0, 0, 0, -1e-320), None,
+                   "the DEM's cells measure 9.99989e-321 to 9.99989e-321 m, beyond any "
+                   "terrain's (1e-09 m to 1e+08 m)"),
+                  ("cells of 1e-12 m in UTM", (600000, 1e-12, 0, 4000000, 0, -1e-12), UTM,
+                   "beyond any terrain's"),
+                  ("cells of 1e9 m", (0, 1e9, 0, 0, 0, -1e9), None, "beyond any terrain's"),
+                  ("Web Mercator at 1e17 m", (1e17, 30, 0, 2e7, 0, -30), 3857,
+                   "the DEM's corners lie up to 1e+17 m from its CRS's origin, more than "
+                   "twice around the Earth")]
+        for i, (n, gt, crs, t) in enumerate(beyond):
+            dem = T.write_tif(self.path("far%d.tif" % i), z, gt, crs)
+            cases.append((n, ["timeout", "60", "gdal_translate", "-q", T.conn(dem),
+                              self.path("far%d_out.tif" % i)], t))
         self.check_failures(cases)
         for i in range(len(gts)):
             self.assertFalse(os.path.exists(self.path("g%d.tif" % i)), "an output was written")
@@ -452,7 +468,9 @@ class Hostile(unittest.TestCase):
         z = T.fractal_dem(64, seed=9)
         src = T.write_tif(self.path("huge_src.tif"), z, GT, UTM)
         huge = write_vrt(self.path("huge.vrt"), 1000000, 1000000, src)
-        wide = write_vrt(self.path("wide.vrt"), 2000000000, 1, src)
+        # (cells of 1 cm: at 30 m its 60 million km are no terrain, refused first)
+        wide = write_vrt(self.path("wide.vrt"), 2000000000, 1, src,
+                         (600000, 0.01, 0, 4000000, 0, -0.01))
         cases = [
             ("10^6 x 10^6 VRT, gdalinfo", ["gdalinfo", "-nomd", T.conn(huge)],
              ("on this 1000000 x 1000000 DEM needs about", "set MAX_MEMORY to change")),
