@@ -72,7 +72,7 @@ const char *tsd_options_value(const tsd_options *o, int i, char *buf, size_t n)
         if (d->kind == K_FLOAT_AUTO && isnan(x))
             snprintf(buf, n, "%s", d->values); /* not decided yet */
         else
-            snprintf(buf, n, "%.10g", x);
+            snprintf(buf, n, "%.10g", x + 0.0); /* (-0 as 0: one value, one PAM entry) */
         break;
     case K_TEXT:
         snprintf(buf, n, "%s", field);

@@ -65,6 +65,11 @@ class Options(unittest.TestCase):
         np.testing.assert_array_equal(
             product(self.dem, PRODUCT="shadow", SUN_ELEVATION=10, SUN_AZIMUTH=0),
             product(self.dem, PRODUCT="shadow", SUN_ELEVATION=10, SUN_AZIMUTH=360))
+        # -0 is 0, in the metadata too (it said SUN_AZIMUTH=-0: session 57's
+        # audit), and so in the statistics' entry beside the DEM
+        ds = gdal.OpenEx(T.conn(self.dem), gdal.OF_RASTER, open_options=["SUN_AZIMUTH=-0.0"])
+        self.assertEqual(ds.GetMetadataItem("SUN_AZIMUTH"), "0")
+        ds = None
         lower = product(self.dem, PRODUCT="shadow", SUN_ELEVATION=3)
         self.assertLess(np.nanmean(lower), np.nanmean(base))
         # sun below the horizontal, with an open sky beyond the edge
