@@ -383,7 +383,7 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
         bAll ? "SHADOWS=all" +
                    (poDS->m_bDEMGiven ? ":DEM=" + AbsolutePath(poDS->m_osDEM.c_str()) : "")
              : std::string("SHADOWS=far");
-    if (bAll && CPLString(poDS->m_osDEM).ifind("/vsistdin") != std::string::npos)
+    if (bAll && IsStdinName(poDS->m_osDEM))
         poDS->nPamFlags |= GPF_DISABLED; // the next run's standard input is another DEM
     const char *pszPam = poDS->BuildPamFilename();
     if (!bAll && pszPam && !HasPamEntry(pszPam, osView.c_str(), nullptr))

@@ -344,7 +344,7 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     if (!osRefused.empty())
         return FailOpen(TS_ERR_ARG, osRefused.c_str());
     // (exactly GDAL's name for it; a prefix before it is GDAL's business)
-    const bool bStdin = osDEM == "/vsistdin/" || osDEM == "/vsistdin";
+    const bool bStdin = IsStdinName(osDEM);
     if (bStdin && (poDS->m_osStdinCopy = CopyStdin(sOpts)).empty())
         return nullptr;
     GDALDataset *poDEM = OpenDEM(bStdin ? poDS->m_osStdinCopy.c_str() : osDEM.c_str());

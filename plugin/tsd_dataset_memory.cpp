@@ -119,7 +119,7 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
     // DEM at once: say so, where the advice named no TILE_SIZE at all
     double dfWholeSteady = 0;
     const double dfWhole = std::max(tsd_product_peak_bytes(&sOpts, W, H, &dfWholeSteady) +
-                                    sEnv.kept, sEnv.peak);
+                                    sEnv.kept, sEnv.peak) + dfDEMCopy;
     if (psPlan && W <= TS_MAX_SIDE && H <= TS_MAX_SIDE && dfWhole <= dfLimit)
         snprintf(szAdvice, sizeof szAdvice,
                  "; TILE_SIZE=0 computes it whole in about %.0f MiB (its chunks with their "
@@ -127,7 +127,14 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
                  MiBUp(dfWhole));
     else if (nLevel == 0)
         tsd_window_advice(&sOpts, psSun, W, H, tsd_cells_min_x(&sCells, H), sCells.cell_y,
-                          dfLimit, sEnv.kept, szAdvice, sizeof szAdvice);
+                          dfLimit, sEnv.kept + dfDEMCopy, szAdvice, sizeof szAdvice);
+    // (the advice counts the copy too: without it each mode's sent the
+    // user to the other, the review)
+    const std::string osCopy =
+        dfDEMCopy > 0 ? CPLSPrintf(" (%.0f MiB of it the DEM's copy from the standard input, "
+                                   "which a DEM written to a file does not need)",
+                                   MiBUp(dfDEMCopy))
+                      : "";
     // fewer bands need less where an option sets their count (svf streams its DIRECTIONS)
     const char *pszBands = tsd_product_of(&sOpts)->bands_option;
     const std::string osFewer = !pszBands ? ""
@@ -135,11 +142,11 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
                                 : std::string("use fewer ") + pszBands + ", ";
     Fail(TS_ERR_NOMEM,
          CPLSPrintf("PRODUCT=%s with %d band(s) on this %d x %d DEM needs "
-                    "about %.0f MiB while computing (%.0f MiB kept), more than the "
+                    "about %.0f MiB while computing (%.0f MiB kept)%s, more than the "
                     "limit of %.0f MiB (%s)%s; crop or downsample the DEM, %sor raise "
                     "MAX_MEMORY", tsd_options_product_name(&sOpts),
                     tsd_options_band_count(&sOpts), W, H, MiBUp(dfPeak), MiBUp(dfSteady),
-                    dfLimit / 1048576.0, pszWhy, szAdvice,
+                    osCopy.c_str(), dfLimit / 1048576.0, pszWhy, szAdvice,
                     osFewer.c_str()));
     return false;
 }

@@ -157,4 +157,9 @@ std::string RefusedDEMName(const char *pszDEM, const char *pszWhat, bool bFromFi
     return std::string();
 }
 
+bool IsStdinName(const std::string &osName)
+{
+    return osName == "/vsistdin/" || osName == "/vsistdin";
+}
+
 } // namespace tsd

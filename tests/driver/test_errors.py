@@ -414,9 +414,13 @@ class Errors(unittest.TestCase):
             self.assertIn("the standard input holds more than the limit of 2 MiB "
                           "(MAX_MEMORY): write the DEM to a file first", p.stderr)
             # and beside the product: the estimate counts it (the review)
+            # and names it (its advice counts it too: each mode's sent the
+            # user to the other, the second review)
             def need(dem, name):
                 p = run(["gdalinfo", "-oo", "MAX_MEMORY=3", T.conn(name)], dem)
                 self.assertEqual(p.returncode, 1, p.stderr)
+                self.assertEqual("the DEM's copy from the standard input" in p.stderr,
+                                 dem is not None, p.stderr)
                 return int(re.search(r"needs about (\d+) MiB", p.stderr).group(1))
             self.assertGreaterEqual(need(big, "/vsistdin/"), need(None, big) + 2)
         p = run(["gdalinfo", T.conn("/vsistdin/")], None)
