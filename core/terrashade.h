@@ -88,10 +88,12 @@ typedef struct {
  * and every index in ptrdiff_t, and turns absurd sizes into a clear error. */
 #define TS_MAX_SIDE (1 << 20)
 
-/** The cell sizes a grid may have, metres: below a nanometre the sweeps'
- * steps overflowed (cells of 1e-320 m read NaN everywhere), and no terrain
- * has cells of more than 100 000 km. */
-#define TS_CELL_MIN_M 1e-9
+/** The cell sizes a grid may have, metres: below about 1e-45 (where a
+ * float's range ends) the sweeps' steps overflowed and cells read NaN
+ * (1e-320 m: every cell), so 1e-30 keeps a wide margin and takes the
+ * rows near a pole of a geographic grid (R cos(lat) dlon, 1e-12 m on a
+ * row centred on it); no terrain has cells of more than 100 000 km. */
+#define TS_CELL_MIN_M 1e-30
 #define TS_CELL_MAX_M 1e8
 
 /**

@@ -473,8 +473,8 @@ ts_status tsd_cells_compute(const double gt[6], int width, int height,
         return TS_OK;
     tsd_cells_free(c);
     return tsd_fail(msg, n, TS_ERR_ARG,
-                    "the DEM's cells measure %g to %g m, beyond any terrain's (%g m to %g "
-                    "m): a geotransform in another unit?",
+                    "the DEM's cells measure %g to %g m, outside the %g to %g m that "
+                    "terrashade computes with: a geotransform in another unit?",
                     lo, hi, TS_CELL_MIN_M, TS_CELL_MAX_M);
 }
 

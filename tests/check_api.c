@@ -81,7 +81,7 @@ START_TEST(test_grid_args)
     EXPECT_ARG(ts_grid_create(&g, 10, 10, 1, INFINITY, err), err);
     EXPECT_ARG(ts_grid_create(&g, 10, 10, 0, 1, err), err);
     EXPECT_ARG(ts_grid_create(&g, 10, 10, 1, -1, err), err);
-    /* beyond any terrain's: 1e-320 m cells read NaN everywhere (session 57) */
+    /* beyond what the sweeps hold: 1e-320 m cells read NaN everywhere (session 57) */
     EXPECT_ARG(ts_grid_create(&g, 10, 10, 1e-320, 1e-320, err), err);
     EXPECT_ARG(ts_grid_create(&g, 10, 10, 1, TS_CELL_MIN_M / 2, err), err);
     EXPECT_ARG(ts_grid_create(&g, 10, 10, TS_CELL_MAX_M * 2, 1, err), err);
@@ -99,8 +99,13 @@ START_TEST(test_grid_args)
     EXPECT_ARG(ts_grid_set_row_spacing(&G, rows, err), err);
     rows[4] = -2;
     EXPECT_ARG(ts_grid_set_row_spacing(&G, rows, err), err);
-    rows[4] = 1e-12;
+    rows[4] = 1e-40;
     EXPECT_ARG(ts_grid_set_row_spacing(&G, rows, err), err);
+    rows[4] = 1.7e-12; /* a geographic row centred on a pole: taken */
+    if (ts_grid_set_row_spacing(&G, rows, err) != TS_OK)
+        ck_abort_msg("a pole row's cells refused: %s", err->message);
+    free(G.cell_x_row); /* (the checks below take G without row spacing) */
+    G.cell_x_row = NULL;
     EXPECT_ARG(ts_grid_validate(NULL, err), err);
     ts_grid bad = G;
     bad.z = NULL;
@@ -113,7 +118,7 @@ START_TEST(test_grid_args)
     EXPECT_ARG(ts_grid_validate(&bad, err), err);
     bad = G, bad.cell_y = -INFINITY;
     EXPECT_ARG(ts_grid_validate(&bad, err), err);
-    bad = G, bad.cell_y = 1e-20;
+    bad = G, bad.cell_y = 1e-40;
     EXPECT_ARG(ts_grid_validate(&bad, err), err);
     double nan_rows[10] = {1, 1, 1, 1, 1, 1, 1, 1, 1, NAN};
     bad = G, bad.cell_x_row = nan_rows;

@@ -402,11 +402,12 @@ class Hostile(unittest.TestCase):
         # everywhere (and a NaN reached an int); Web Mercator corners at
         # 1e17 m took GDAL's inverse minutes, an open that never ended
         beyond = [("cells of 1e-320", (0, 1e-320, 0, 0, 0, -1e-320), None,
-                   "the DEM's cells measure 9.99989e-321 to 9.99989e-321 m, beyond any "
-                   "terrain's (1e-09 m to 1e+08 m)"),
-                  ("cells of 1e-12 m in UTM", (600000, 1e-12, 0, 4000000, 0, -1e-12), UTM,
-                   "beyond any terrain's"),
-                  ("cells of 1e9 m", (0, 1e9, 0, 0, 0, -1e9), None, "beyond any terrain's"),
+                   "the DEM's cells measure 9.99989e-321 to 9.99989e-321 m, outside the "
+                   "1e-30 to 1e+08 m that terrashade computes with"),
+                  ("cells of 1e-40 m in UTM", (600000, 1e-40, 0, 4000000, 0, -1e-40), UTM,
+                   "outside the 1e-30 to 1e+08 m"),
+                  ("cells of 1e9 m", (0, 1e9, 0, 0, 0, -1e9), None,
+                   "outside the 1e-30 to 1e+08 m"),
                   ("Web Mercator at 1e17 m", (1e17, 30, 0, 2e7, 0, -30), 3857,
                    "the DEM's corners lie up to 1e+17 m from its CRS's origin, more than "
                    "twice around the Earth")]
