@@ -105,8 +105,13 @@ result = {"algorithms": sorted(a.id() for a in provider.algorithms()),
           "problem": provider.warningMessage(),
           "parameters": {a.name(): {p.name(): describe(p) for p in a.parameterDefinitions()}
                          for a in provider.algorithms()}}
+from qgis.core import QgsCoordinateReferenceSystem, QgsRasterLayer
 for name, alg, params in json.loads(sys.argv[2]):
     fb = Log(cancel=name.startswith("cancel"))
+    if name.startswith("crs_"):  # a layer given another CRS in QGIS
+        layer = QgsRasterLayer(params["INPUT"], name, "gdal")
+        layer.setCrs(QgsCoordinateReferenceSystem("EPSG:4326"))
+        params["INPUT"] = layer
     try:
         out = processing.run(alg, params, feedback=fb)
         result[name] = {"output": out["OUTPUT"], "log": fb.lines, "warnings": fb.warnings}
@@ -116,6 +121,10 @@ for name, alg, params in json.loads(sys.argv[2]):
 # draws a layer of several bands (not a colour image) as its first band in grey
 from qgis.core import QgsProcessingContext, QgsProject, QgsRasterLayer
 result["renderers"] = {}
+# every run first, then every post-processor, as where two runs' outputs wait
+# at once (two dialogs, a model): one slot for them all had lost the earlier
+# runs' (session 57's review of the plugin)
+waiting = []
 for name in ("horizon", "range_default", "envlight", "svf"):
     if "output" not in result.get(name, {}):
         continue
@@ -126,6 +135,8 @@ for name in ("horizon", "range_default", "envlight", "svf"):
     context.addLayerToLoadOnCompletion(params["OUTPUT"], QgsProcessingContext.LayerDetails(
         name, QgsProject.instance(), name))
     processing.run(alg, params, context=context, feedback=Log())
+    waiting.append((name, params, context))
+for name, params, context in waiting:
     post = context.layerToLoadOnCompletionDetails(params["OUTPUT"]).postProcessor()
     layer = QgsRasterLayer(params["OUTPUT"], name)
     before = layer.renderer().type()
@@ -194,6 +205,30 @@ BAD = [
     ("no_date", "terrashade:sunhours", {"INPUT": J, "TIMEZONE": "-05:00"}),
     ("bad_time", "terrashade:shade", {"INPUT": J, "DATETIME": "2026-12-21T09:00"}),
 ]
+# refused before anything is written (session 57's review of the plugin):
+# name, algorithm, parameters with their own OUTPUT, words of the error
+_ONTO = shutil.copy(T.JACKSBORO, os.path.join(_J_DIR, "onto.tif"))
+_NOCRS = os.path.join(_J_DIR, "nocrs.tif")
+_src = T.gdal.Open(T.JACKSBORO)
+T.write_tif(_NOCRS, T.read(T.JACKSBORO), _src.GetGeoTransform(), None)
+_src = None
+REFUSED = [
+    # GDAL deleted the output, the DEM itself, before the product was read
+    ("onto_dem", "terrashade:shade", {"INPUT": _ONTO, "OUTPUT": _ONTO},
+     "the DEM itself, which the elevation model reads"),
+    # PNG holds bytes: svf's values were written as 0 and 1, and the run succeeded
+    ("png_svf", "terrashade:svf", {"INPUT": J, "DIRECTIONS": 4,
+                                   "OUTPUT": os.path.join(_J_DIR, "svf.png")},
+     "The output format PNG cannot hold this product's Float32 values"),
+    ("vrt_svf", "terrashade:svf", {"INPUT": J, "DIRECTIONS": 4,
+                                   "OUTPUT": os.path.join(_J_DIR, "svf.vrt")},
+     "A VRT output holds no pixels"),
+    # the layer's CRS, set in QGIS, was not the file's: computed in the file's
+    # (none: cells taken as metres) and reported a success
+    ("crs_nocrs", "terrashade:svf", {"INPUT": _NOCRS, "DIRECTIONS": 4,
+                                     "OUTPUT": os.path.join(_J_DIR, "crs.tif")},
+     "The layer's CRS, EPSG:4326, is not its file's (none)"),
+]
 # the user cancels once the progress bar moves (Log in CHILD, by the name)
 CANCEL = [("cancel_svf", "terrashade:svf", {"INPUT": J, "DIRECTIONS": 8}),
           # several bands: GDAL's failed copy left OUTPUT.aux.xml behind
@@ -248,6 +283,11 @@ class Processing(unittest.TestCase):
         os.mkdir(cls.home, 0o700)
         runs = [(n, a, dict(p, OUTPUT=cls.out(n))) for n, a, p, _ in CASES]
         runs += [(n, a, dict(p, OUTPUT=cls.out(n))) for n, a, p in BAD + CANCEL]
+        runs += [(n, a, p) for n, a, p, _ in REFUSED]
+        # a layer source with QGIS's URI parts (a GDAL open option)
+        runs += [("uri_option", "terrashade:svf",
+                  {"INPUT": J + "|option:NUM_THREADS=1", "DIRECTIONS": 4,
+                   "OUTPUT": cls.out("uri_option")})]
         cls.result, cls.child = cls.run_qgis(runs)
         # again with gdal.UseExceptions(): the errors, a warning and a cancel
         runs = [(n, a, dict(p, OUTPUT=cls.out(n + "_exc"))) for n, a, p, _ in CASES
@@ -358,6 +398,34 @@ class Processing(unittest.TestCase):
         # a time without an offset: the driver's sentence
         self.assertIn("TERRASHADE", result["bad_time"].get("error", ""))
         self.assertIn("offset", result["bad_time"]["error"])
+
+    def test_refused_before_anything_is_written(self):
+        """An output onto the DEM (GDAL deleted it before the product was
+        read), a format that cannot hold the product or holds no pixels, a
+        layer given another CRS in QGIS than its file's: refused with a
+        sentence, the DEM untouched, nothing written (session 57's review of
+        the plugin)."""
+        for name, _alg, params, words in REFUSED:
+            with self.subTest(name):
+                r = self.result[name]
+                print("%-10s -> %s" % (name, r.get("error")))
+                self.assertIn(words, r.get("error", ""), r)
+                if params["OUTPUT"] != params["INPUT"]:
+                    self.assertFalse(os.path.exists(params["OUTPUT"]))
+        np.testing.assert_array_equal(T.read(_ONTO), T.read(T.JACKSBORO))
+
+    def test_layer_uri_parts(self):
+        """A layer whose source carries QGIS's URI parts (|option:...): the
+        file is the DEM, and the log says what is not passed (the driver
+        was asked to open 'jacksboro.tif|option:NUM_THREADS=1')."""
+        r = self.result["uri_option"]
+        self.assertIn("output", r, r.get("error"))
+        self.assertTrue(any("option:NUM_THREADS=1" in w and "not passed" in w
+                            for w in r["warnings"]), r["warnings"])
+        ref = os.path.join(self.dir, "uri_ref.tif")
+        T.run(["gdal_translate", "-q", "-oo", "PRODUCT=svf", "-oo", "DIRECTIONS=4",
+               T.conn(J), ref])
+        np.testing.assert_array_equal(T.read(r["output"]), T.read(ref))
 
     def test_loaded_outputs_of_several_bands_show_their_first_band(self):
         """QGIS draws a raster of three bands or more as red, green and blue

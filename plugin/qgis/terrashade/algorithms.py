@@ -15,7 +15,8 @@ import shlex
 import sys
 
 from osgeo import gdal
-from qgis.core import (QgsContrastEnhancement, QgsProcessingAlgorithm, QgsProcessingException,
+from qgis.core import (QgsContrastEnhancement, QgsCoordinateReferenceSystem,
+                       QgsProcessingAlgorithm, QgsProcessingException,
                        QgsProcessingLayerPostProcessorInterface,
                        QgsProcessingParameterBoolean, QgsProcessingParameterDefinition,
                        QgsProcessingParameterEnum, QgsProcessingParameterFile,
@@ -158,6 +159,84 @@ def command_line(dem, options, out):
     return " ".join(shlex.quote(a) for a in args + [connection(dem), out])
 
 
+def layer_dem(layer, feedback=None):
+    """The GDAL name of a layer's file: its source without the parts QGIS
+    adds to a GDAL layer's URI (|option:KEY=VALUE, |credential:...), which
+    GDAL read as part of the file's name ("cannot open the DEM
+    'dem.tif|option:NUM_THREADS=1'"); what they set is not passed, and the
+    log says so."""
+    src = layer.source()
+    cuts = [i for i in (src.find("|option:"), src.find("|credential:")) if i >= 0]
+    if not cuts:
+        return src
+    dem = src[:min(cuts)]
+    if feedback is not None:
+        feedback.pushWarning("The layer's GDAL settings (%s) are not passed to terrashade, "
+                             "which opens %s as it is." % (src[min(cuts) + 1:], dem))
+    return dem
+
+
+def check_layer_crs(layer, dem):
+    """Refuses a layer whose CRS (set in QGIS) is not its file's: the driver
+    reads the file, whose CRS measures the cells (a file without one, given
+    EPSG:4326 in QGIS, was computed with its degrees taken as metres, and
+    the run succeeded)."""
+    ds, _ = gdal_call(gdal.OpenEx, dem, gdal.OF_RASTER)
+    if ds is None:
+        return  # the driver's open says why
+    wkt = ds.GetProjectionRef()
+    ds = None
+    own = QgsCoordinateReferenceSystem.fromWkt(wkt) if wkt else QgsCoordinateReferenceSystem()
+    crs = layer.crs()
+    if not crs.isValid() or crs == own:
+        return
+    name = crs.authid() or crs.description()
+    raise QgsProcessingException(
+        "The layer's CRS, %s, is not its file's (%s): terrashade reads the file, whose CRS "
+        "measures its cells. Assign the CRS to the file (gdal_edit.py -a_srs %s %s), or save "
+        "the layer as a new file with it, and run on that."
+        % (name, own.authid() or own.description() or "none", shlex.quote(name or "..."),
+           shlex.quote(dem)))
+
+
+def check_output(dem, out):
+    """Refuses an output that is the DEM or one of the files it reads (a
+    VRT's sources): GDAL deletes the output before the product is read, and
+    the DEM was gone."""
+    ds, _ = gdal_call(gdal.OpenEx, dem, gdal.OF_RASTER)
+    files = (ds.GetFileList() or []) if ds is not None else []
+    ds = None
+    target = os.path.realpath(out)
+    for f in files:
+        if os.path.realpath(f) == target or (
+                os.path.exists(f) and os.path.exists(out) and os.path.samefile(f, out)):
+            raise QgsProcessingException(
+                "The output %s is %s, which the elevation model reads: writing it would "
+                "delete the DEM before its product is computed. Choose another file."
+                % (out, "the DEM itself" if os.path.realpath(dem) == target else
+                   "one of its files (%s)" % f))
+
+
+def check_format(fmt, ds):
+    """Refuses an output format that cannot hold the product (PNG or JPEG:
+    Float32 values written as bytes, svf read 1 everywhere, and the run
+    succeeded) or that holds no pixels (a VRT of the TERRASHADE: string,
+    computed again at every read)."""
+    if fmt == "VRT":
+        raise QgsProcessingException(
+            "A VRT output holds no pixels: it would name TERRASHADE:<dem> and compute it "
+            "again at every read. Write a GeoTIFF (.tif).")
+    types = (gdal.GetDriverByName(fmt).GetMetadataItem(gdal.DMD_CREATIONDATATYPES)
+             or "").split() if gdal.GetDriverByName(fmt) is not None else []
+    kind = gdal.GetDataTypeName(ds.GetRasterBand(1).DataType)
+    if types and kind not in types:
+        raise QgsProcessingException(
+            "The output format %s cannot hold this product's %s values (it takes %s). Write a "
+            "GeoTIFF (.tif)%s." % (fmt, kind, ", ".join(types),
+                                   ", or set OUTPUT_TYPE=Byte where the product has it"
+                                   if kind == "Float32" else ""))
+
+
 class Warnings:
     """GDAL's warnings while it is pushed (gdal.PushErrorHandler), kept for the
     Processing log, where GDAL's own handler (stderr) would not show them."""
@@ -205,6 +284,7 @@ def write(dem, options, out, feedback):
     if ds is None:
         raise QgsProcessingException(message or "cannot open %s" % dem)
     fmt, creation = output_format(out)
+    check_format(fmt, ds)
 
     def progress(done, _message, _data):
         if feedback is not None:
@@ -319,7 +399,10 @@ class TerrashadeAlgorithm(QgsProcessingAlgorithm):
             raise QgsProcessingException(
                 "The elevation model must be a raster file read through GDAL (got %s, "
                 "provider %s)." % (dem, layer.providerType()))
+        dem = layer_dem(layer, feedback)
+        check_layer_crs(layer, dem)
         out = self.parameterAsOutputLayer(parameters, "OUTPUT", context)
+        check_output(dem, out)
         opts = self.open_options(parameters, context)
         feedback.pushInfo("Same as: " + command_line(dem, opts, out))
         feedback.pushInfo("Computing %s on the whole DEM first; the progress bar moves "
@@ -340,6 +423,7 @@ class FirstBandGray(QgsProcessingLayerPostProcessorInterface):
     green and blue bands keep QGIS's colour rendering."""
 
     def postProcessLayer(self, layer, context, feedback):  # noqa: N802
+        FirstBandGray.pending.pop(self.key, None)  # (QGIS deletes it after this call)
         provider = layer.dataProvider() if layer is not None else None
         if provider is None or provider.bandCount() < 2:
             return
@@ -358,13 +442,21 @@ class FirstBandGray(QgsProcessingLayerPostProcessorInterface):
         layer.triggerRepaint()
 
     # QGIS deletes a post-processor once it has run, and keeps no Python
-    # reference to it: one for each run, kept here until the next
-    instance = None
+    # reference to it: each is kept here until it has run. One slot for all
+    # (as QGIS's docs show it) lost an earlier run's Python part, whose layer
+    # was left unstyled, where two runs' outputs waited at once (two dialogs,
+    # a model): session 57's review of the plugin.
+    pending = {}
+
+    def __init__(self):
+        super().__init__()
+        self.key = id(self)
 
     @staticmethod
     def create():
-        FirstBandGray.instance = FirstBandGray()
-        return FirstBandGray.instance
+        processor = FirstBandGray()
+        FirstBandGray.pending[processor.key] = processor
+        return processor
 
 
 def make_algorithms():
