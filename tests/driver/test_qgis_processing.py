@@ -209,13 +209,28 @@ BAD = [
 # name, algorithm, parameters with their own OUTPUT, words of the error
 _ONTO = shutil.copy(T.JACKSBORO, os.path.join(_J_DIR, "onto.tif"))
 _NOCRS = os.path.join(_J_DIR, "nocrs.tif")
+_ENV = shutil.copy(SUNSET, os.path.join(_J_DIR, "env.exr"))
+# a projected CRS without an EPSG code: the layer's is its file's (the
+# review: compared through GDAL's WKT1, every such DEM was refused)
+_CUSTOM = os.path.join(_J_DIR, "custom_lcc.tif")
 _src = T.gdal.Open(T.JACKSBORO)
 T.write_tif(_NOCRS, T.read(T.JACKSBORO), _src.GetGeoTransform(), None)
+T.write_tif(_CUSTOM, T.read(T.JACKSBORO), _src.GetGeoTransform(),
+            "+proj=lcc +lat_1=33 +lat_2=45 +lat_0=39 +lon_0=-96 +x_0=0 +y_0=0 +ellps=intl "
+            "+units=m +no_defs")
 _src = None
 REFUSED = [
     # GDAL deleted the output, the DEM itself, before the product was read
     ("onto_dem", "terrashade:shade", {"INPUT": _ONTO, "OUTPUT": _ONTO},
-     "the DEM itself, which the elevation model reads"),
+     "the DEM itself, which the algorithm reads"),
+    # an environment map was replaced by a GeoTIFF, and the run succeeded (the review)
+    ("onto_env_map", "terrashade:envlight",
+     {"INPUT": J, "ENV_MAP": _ENV, "DIRECTIONS": 4, "OUTPUT": _ENV},
+     "its environment map (ENV_MAP), which the algorithm reads"),
+    # a format that drops bands with a warning (the review)
+    ("xyz_horizon", "terrashade:horizon", {"INPUT": J, "DIRECTIONS": 4,
+                                           "OUTPUT": os.path.join(_J_DIR, "hz.xyz")},
+     "The output format XYZ did not keep the product"),
     # PNG holds bytes: svf's values were written as 0 and 1, and the run succeeded
     ("png_svf", "terrashade:svf", {"INPUT": J, "DIRECTIONS": 4,
                                    "OUTPUT": os.path.join(_J_DIR, "svf.png")},
@@ -285,6 +300,8 @@ class Processing(unittest.TestCase):
         runs += [(n, a, dict(p, OUTPUT=cls.out(n))) for n, a, p in BAD + CANCEL]
         runs += [(n, a, p) for n, a, p, _ in REFUSED]
         # a layer source with QGIS's URI parts (a GDAL open option)
+        runs += [("custom_crs", "terrashade:svf",
+                  {"INPUT": _CUSTOM, "DIRECTIONS": 4, "OUTPUT": cls.out("custom_crs")})]
         runs += [("uri_option", "terrashade:svf",
                   {"INPUT": J + "|option:NUM_THREADS=1", "DIRECTIONS": 4,
                    "OUTPUT": cls.out("uri_option")})]
@@ -410,9 +427,17 @@ class Processing(unittest.TestCase):
                 r = self.result[name]
                 print("%-10s -> %s" % (name, r.get("error")))
                 self.assertIn(words, r.get("error", ""), r)
-                if params["OUTPUT"] != params["INPUT"]:
+                if params["OUTPUT"] not in (params["INPUT"], params.get("ENV_MAP")):
                     self.assertFalse(os.path.exists(params["OUTPUT"]))
         np.testing.assert_array_equal(T.read(_ONTO), T.read(T.JACKSBORO))
+        with open(_ENV, "rb") as f, open(SUNSET, "rb") as g:
+            self.assertEqual(f.read(), g.read())
+
+    def test_a_custom_crs_is_the_files(self):
+        """A DEM in a projected CRS without an EPSG code runs: its layer's
+        CRS is the file's (the review found every such DEM refused)."""
+        r = self.result["custom_crs"]
+        self.assertIn("output", r, r.get("error"))
 
     def test_layer_uri_parts(self):
         """A layer whose source carries QGIS's URI parts (|option:...): the
@@ -502,6 +527,24 @@ class Processing(unittest.TestCase):
                 ds = None
             finally:
                 os.chdir(here)
+
+    def test_the_files_a_name_reads(self):
+        """The output check compares files of the OS: a /vsizip/ DEM's is its
+        archive (writing over it deleted the DEM: the review)."""
+        sys.path.insert(0, PLUGINS)
+        try:
+            from terrashade.algorithms import local_files
+        finally:
+            sys.path.remove(PLUGINS)
+        with T.TempDir() as d:
+            archive = os.path.join(d, "z.zip")
+            import zipfile
+            with zipfile.ZipFile(archive, "w") as z:
+                z.write(J, "in/dem.tif")
+            self.assertEqual(local_files("/vsizip/%s/in/dem.tif" % archive), [archive])
+            self.assertEqual(local_files("/vsizip/{%s}/in/dem.tif" % archive), [archive])
+            self.assertEqual(local_files("/vsicurl/http://example.com/dem.tif"), [])
+            self.assertEqual(local_files(J), [J])
 
     def test_qgis_process_command_line(self):
         """qgis_process.bin (Debian's qgis_process wrapper fails on a flag in

@@ -23,8 +23,9 @@ from qgis.core import (QgsContrastEnhancement, QgsCoordinateReferenceSystem,
                        QgsProcessingParameterNumber,
                        QgsProcessingParameterRasterDestination,
                        QgsProcessingParameterRasterLayer, QgsProcessingParameterString,
-                       QgsRaster, QgsRasterBandStats, QgsRasterFileWriter,
+                       QgsRaster, QgsRasterBandStats, QgsRasterFileWriter, QgsRasterLayer,
                        QgsSingleBandGrayRenderer)
+from qgis.PyQt import sip
 
 from .driver_tables import DRIVER, is_yes, read_driver, single_raster
 
@@ -180,41 +181,57 @@ def check_layer_crs(layer, dem):
     """Refuses a layer whose CRS (set in QGIS) is not its file's: the driver
     reads the file, whose CRS measures the cells (a file without one, given
     EPSG:4326 in QGIS, was computed with its degrees taken as metres, and
-    the run succeeded)."""
-    ds, _ = gdal_call(gdal.OpenEx, dem, gdal.OF_RASTER)
-    if ds is None:
-        return  # the driver's open says why
-    wkt = ds.GetProjectionRef()
-    ds = None
-    own = QgsCoordinateReferenceSystem.fromWkt(wkt) if wkt else QgsCoordinateReferenceSystem()
+    the run succeeded). The file's CRS is what QGIS's own GDAL provider reads
+    for it (a custom CRS read through GDAL's WKT1 lost its conversion's name
+    and never matched: the review)."""
+    own = QgsRasterLayer(layer.source(), "", "gdal")
     crs = layer.crs()
-    if not crs.isValid() or crs == own:
+    if not own.isValid() or not crs.isValid() or crs == own.crs():
         return
-    name = crs.authid() or crs.description()
+    name = crs.authid() or crs.toProj() or crs.description()
+    mine = own.crs()
     raise QgsProcessingException(
         "The layer's CRS, %s, is not its file's (%s): terrashade reads the file, whose CRS "
         "measures its cells. Assign the CRS to the file (gdal_edit.py -a_srs %s %s), or save "
         "the layer as a new file with it, and run on that."
-        % (name, own.authid() or own.description() or "none", shlex.quote(name or "..."),
-           shlex.quote(dem)))
+        % (name, (mine.authid() or mine.toProj() or mine.description()) if mine.isValid()
+           else "none", shlex.quote(name or "..."), shlex.quote(dem)))
 
 
-def check_output(dem, out):
-    """Refuses an output that is the DEM or one of the files it reads (a
-    VRT's sources): GDAL deletes the output before the product is read, and
-    the DEM was gone."""
+def local_files(name):
+    """The files of the OS a GDAL name reads: itself, or for a name in a
+    virtual file system (/vsizip/archive.zip/dem.tif) the archive that holds
+    it."""
+    if not name.startswith("/vsi"):
+        return [name]
+    rest = name[name.index("/", 1) + 1:]  # after /vsizip/: /data/a.zip/dem.tif
+    if rest.startswith("{") and "}" in rest:  # /vsizip/{/data/a.zip}/dem.tif
+        return [f for f in (rest[1:rest.index("}")],) if os.path.isfile(f)]
+    parts = rest.split("/")
+    return [p for p in ("/".join(parts[:k]) for k in range(1, len(parts) + 1))
+            if p and os.path.isfile(p)][:1]
+
+
+def check_output(dem, out, options):
+    """Refuses an output that is the DEM, one of the files it reads (a
+    VRT's sources, the archive of a /vsizip/ DEM) or ENV_MAP: GDAL deletes
+    the output before the product is read, and the DEM was gone (an
+    environment map was replaced, and the run succeeded: the review)."""
     ds, _ = gdal_call(gdal.OpenEx, dem, gdal.OF_RASTER)
     files = (ds.GetFileList() or []) if ds is not None else []
     ds = None
+    files = [(f, "the DEM itself" if f == dem else "one of its files (%s)" % f)
+             for g in files for f in local_files(g)]
+    if options.get("ENV_MAP"):
+        files += [(f, "its environment map (ENV_MAP)")
+                  for f in local_files(options["ENV_MAP"])]
     target = os.path.realpath(out)
-    for f in files:
+    for f, what in files:
         if os.path.realpath(f) == target or (
                 os.path.exists(f) and os.path.exists(out) and os.path.samefile(f, out)):
             raise QgsProcessingException(
-                "The output %s is %s, which the elevation model reads: writing it would "
-                "delete the DEM before its product is computed. Choose another file."
-                % (out, "the DEM itself" if os.path.realpath(dem) == target else
-                   "one of its files (%s)" % f))
+                "The output %s is %s, which the algorithm reads: writing it would delete "
+                "it before the product is computed. Choose another file." % (out, what))
 
 
 def check_format(fmt, ds):
@@ -294,6 +311,8 @@ def write(dem, options, out, feedback):
 
     res, message = gdal_call(gdal.Translate, out, ds, options=gdal.TranslateOptions(
         format=fmt, creationOptions=creation, callback=progress))
+    bands = ds.RasterCount
+    kind = ds.GetRasterBand(1).DataType
     ds = None
     if res is None:
         # GDAL's failed copy of a multi-band product deletes the raster but
@@ -307,6 +326,28 @@ def write(dem, options, out, feedback):
         raise QgsProcessingException(message or "gdal.Translate failed")
     res.FlushCache()
     res = None
+    check_written(out, fmt, bands, kind)
+
+
+def check_written(out, fmt, bands, kind):
+    """Reads the output back: a format that dropped bands (horizon's 4 as
+    one in Golden Software's grid or XYZ, with a warning) or wrote what GDAL
+    cannot read again (GSAG's NaN, XYZ's rows) was a success that was not
+    (the review); the file is removed and the run fails."""
+    back, _ = gdal_call(gdal.OpenEx, out, gdal.OF_RASTER)
+    got = (back.RasterCount, back.GetRasterBand(1).DataType) if back is not None else None
+    back = None
+    if got is not None and got[0] == bands and gdal.GetDataTypeSize(got[1]) >= \
+            gdal.GetDataTypeSize(kind):
+        return
+    for f in (out, out + ".aux.xml"):
+        with contextlib.suppress(OSError):
+            os.remove(f)
+    raise QgsProcessingException(
+        "The output format %s did not keep the product (%s read back where %d band(s) of %s "
+        "were written). Write a GeoTIFF (.tif)."
+        % (fmt, "nothing" if got is None else "%d band(s) of %s" % (
+            got[0], gdal.GetDataTypeName(got[1])), bands, gdal.GetDataTypeName(kind)))
 
 
 class TerrashadeAlgorithm(QgsProcessingAlgorithm):
@@ -402,8 +443,8 @@ class TerrashadeAlgorithm(QgsProcessingAlgorithm):
         dem = layer_dem(layer, feedback)
         check_layer_crs(layer, dem)
         out = self.parameterAsOutputLayer(parameters, "OUTPUT", context)
-        check_output(dem, out)
         opts = self.open_options(parameters, context)
+        check_output(dem, out, opts)
         feedback.pushInfo("Same as: " + command_line(dem, opts, out))
         feedback.pushInfo("Computing %s on the whole DEM first; the progress bar moves "
                           "while the result is written." % self.product.name)
@@ -423,7 +464,7 @@ class FirstBandGray(QgsProcessingLayerPostProcessorInterface):
     green and blue bands keep QGIS's colour rendering."""
 
     def postProcessLayer(self, layer, context, feedback):  # noqa: N802
-        FirstBandGray.pending.pop(self.key, None)  # (QGIS deletes it after this call)
+        FirstBandGray.pending.pop(self.key, None)  # (QGIS deletes it with its context)
         provider = layer.dataProvider() if layer is not None else None
         if provider is None or provider.bandCount() < 2:
             return
@@ -441,7 +482,7 @@ class FirstBandGray(QgsProcessingLayerPostProcessorInterface):
         layer.setRenderer(renderer)
         layer.triggerRepaint()
 
-    # QGIS deletes a post-processor once it has run, and keeps no Python
+    # QGIS deletes a post-processor with its context, and keeps no Python
     # reference to it: each is kept here until it has run. One slot for all
     # (as QGIS's docs show it) lost an earlier run's Python part, whose layer
     # was left unstyled, where two runs' outputs waited at once (two dialogs,
@@ -454,6 +495,10 @@ class FirstBandGray(QgsProcessingLayerPostProcessorInterface):
 
     @staticmethod
     def create():
+        # (those whose context QGIS has deleted unrun: a cancelled load, a
+        # layer that failed to load; the review)
+        for key in [k for k, p in FirstBandGray.pending.items() if sip.isdeleted(p)]:
+            del FirstBandGray.pending[key]
         processor = FirstBandGray()
         FirstBandGray.pending[processor.key] = processor
         return processor
