@@ -131,8 +131,8 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
     // (the advice counts the copy too: without it each mode's sent the
     // user to the other, the review)
     const std::string osCopy =
-        dfDEMCopy > 0 ? CPLSPrintf(" (%.0f MiB of it the DEM's copy from the standard input, "
-                                   "which a DEM written to a file does not need)",
+        dfDEMCopy > 0 ? CPLSPrintf("; %.0f MiB of both the DEM's copy from the standard "
+                                   "input, which a DEM written to a file does not need",
                                    MiBUp(dfDEMCopy))
                       : "";
     // fewer bands need less where an option sets their count (svf streams its DIRECTIONS)
@@ -142,7 +142,7 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
                                 : std::string("use fewer ") + pszBands + ", ";
     Fail(TS_ERR_NOMEM,
          CPLSPrintf("PRODUCT=%s with %d band(s) on this %d x %d DEM needs "
-                    "about %.0f MiB while computing (%.0f MiB kept)%s, more than the "
+                    "about %.0f MiB while computing (%.0f MiB kept%s), more than the "
                     "limit of %.0f MiB (%s)%s; crop or downsample the DEM, %sor raise "
                     "MAX_MEMORY", tsd_options_product_name(&sOpts),
                     tsd_options_band_count(&sOpts), W, H, MiBUp(dfPeak), MiBUp(dfSteady),

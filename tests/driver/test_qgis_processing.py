@@ -300,6 +300,12 @@ class Processing(unittest.TestCase):
         runs += [(n, a, dict(p, OUTPUT=cls.out(n))) for n, a, p in BAD + CANCEL]
         runs += [(n, a, p) for n, a, p, _ in REFUSED]
         # a layer source with QGIS's URI parts (a GDAL open option)
+        # formats whose read-back differs from the bands written, and holds
+        # them all: netCDF's variables, MBTiles' RGBA (the third review)
+        runs += [("nc_horizon", "terrashade:horizon",
+                  {"INPUT": J, "DIRECTIONS": 4, "OUTPUT": os.path.join(cls.dir, "hz.nc")}),
+                 ("mbtiles_shade", "terrashade:shade",
+                  {"INPUT": J, "OUTPUT": os.path.join(cls.dir, "shade.mbtiles")})]
         runs += [("custom_crs", "terrashade:svf",
                   {"INPUT": _CUSTOM, "DIRECTIONS": 4, "OUTPUT": cls.out("custom_crs")})]
         runs += [("uri_option", "terrashade:svf",
@@ -433,6 +439,17 @@ class Processing(unittest.TestCase):
         with open(_ENV, "rb") as f, open(SUNSET, "rb") as g:
             self.assertEqual(f.read(), g.read())
 
+    def test_formats_that_read_back_otherwise(self):
+        """netCDF reads back a multi-band product as subdatasets, MBTiles a
+        grey image as RGBA: both hold the product, and the run succeeds (the
+        read-back check failed them with a traceback or a refusal: the third
+        review)."""
+        for name in ("nc_horizon", "mbtiles_shade"):
+            with self.subTest(name):
+                r = self.result[name]
+                self.assertIn("output", r, r.get("error"))
+                self.assertTrue(os.path.exists(r["output"]))
+
     def test_a_custom_crs_is_the_files(self):
         """A DEM in a projected CRS without an EPSG code runs: its layer's
         CRS is the file's (the review found every such DEM refused)."""
@@ -544,6 +561,12 @@ class Processing(unittest.TestCase):
             self.assertEqual(local_files("/vsizip/%s/in/dem.tif" % archive), [archive])
             self.assertEqual(local_files("/vsizip/{%s}/in/dem.tif" % archive), [archive])
             self.assertEqual(local_files("/vsicurl/http://example.com/dem.tif"), [])
+            # (the third review: these missed the DEM's file, then deleted it)
+            self.assertEqual(local_files("/vsisubfile/0_7994,%s" % J), [J])
+            odd = os.path.join(d, "we{ird}.zip")
+            shutil.copy(archive, odd)
+            self.assertEqual(local_files("/vsizip/{%s}/in/dem.tif" % odd), [odd])
+            self.assertEqual(local_files("/vsimem"), [])
             self.assertEqual(local_files(J), [J])
 
     def test_qgis_process_command_line(self):

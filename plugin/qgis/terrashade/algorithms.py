@@ -15,7 +15,7 @@ import shlex
 import sys
 
 from osgeo import gdal
-from qgis.core import (QgsContrastEnhancement, QgsCoordinateReferenceSystem,
+from qgis.core import (QgsContrastEnhancement, QgsDataProvider,
                        QgsProcessingAlgorithm, QgsProcessingException,
                        QgsProcessingLayerPostProcessorInterface,
                        QgsProcessingParameterBoolean, QgsProcessingParameterDefinition,
@@ -23,8 +23,8 @@ from qgis.core import (QgsContrastEnhancement, QgsCoordinateReferenceSystem,
                        QgsProcessingParameterNumber,
                        QgsProcessingParameterRasterDestination,
                        QgsProcessingParameterRasterLayer, QgsProcessingParameterString,
-                       QgsRaster, QgsRasterBandStats, QgsRasterFileWriter, QgsRasterLayer,
-                       QgsSingleBandGrayRenderer)
+                       QgsProviderRegistry, QgsRaster, QgsRasterBandStats,
+                       QgsRasterFileWriter, QgsSingleBandGrayRenderer)
 from qgis.PyQt import sip
 
 from .driver_tables import DRIVER, is_yes, read_driver, single_raster
@@ -184,9 +184,13 @@ def check_layer_crs(layer, dem):
     the run succeeded). The file's CRS is what QGIS's own GDAL provider reads
     for it (a custom CRS read through GDAL's WKT1 lost its conversion's name
     and never matched: the review)."""
-    own = QgsRasterLayer(layer.source(), "", "gdal")
+    # (the provider alone: a layer validates a file without a CRS, which can
+    # ask the user or take a default, and computes statistics for its
+    # stretch, 1.5 s and a write into a VRT mosaic: the third review)
+    own = QgsProviderRegistry.instance().createProvider(
+        "gdal", layer.source(), QgsDataProvider.ProviderOptions())
     crs = layer.crs()
-    if not own.isValid() or not crs.isValid() or crs == own.crs():
+    if own is None or not own.isValid() or not crs.isValid() or crs == own.crs():
         return
     name = crs.authid() or crs.toProj() or crs.description()
     mine = own.crs()
@@ -204,9 +208,18 @@ def local_files(name):
     it."""
     if not name.startswith("/vsi"):
         return [name]
-    rest = name[name.index("/", 1) + 1:]  # after /vsizip/: /data/a.zip/dem.tif
-    if rest.startswith("{") and "}" in rest:  # /vsizip/{/data/a.zip}/dem.tif
-        return [f for f in (rest[1:rest.index("}")],) if os.path.isfile(f)]
+    if "/" not in name[1:]:
+        return []  # (/vsimem, /vsistdin)
+    prefix, rest = name[:name.index("/", 1) + 1], name[name.index("/", 1) + 1:]
+    if prefix == "/vsisubfile/" and "," in rest:  # /vsisubfile/offset_size,/data/dem.tif
+        return local_files(rest.split(",", 1)[1])
+    if rest.startswith("{"):  # /vsizip/{/data/a.zip}/dem.tif, braces nested as GDAL reads them
+        depth = 0
+        for i, c in enumerate(rest):
+            depth += {"{": 1, "}": -1}.get(c, 0)
+            if depth == 0:
+                return local_files(rest[1:i])
+        return []
     parts = rest.split("/")
     return [p for p in ("/".join(parts[:k]) for k in range(1, len(parts) + 1))
             if p and os.path.isfile(p)][:1]
@@ -335,9 +348,19 @@ def check_written(out, fmt, bands, kind):
     cannot read again (GSAG's NaN, XYZ's rows) was a success that was not
     (the review); the file is removed and the run fails."""
     back, _ = gdal_call(gdal.OpenEx, out, gdal.OF_RASTER)
-    got = (back.RasterCount, back.GetRasterBand(1).DataType) if back is not None else None
+    got = None
+    if back is not None and back.RasterCount > 0:
+        got = (back.RasterCount, back.GetRasterBand(1).DataType)
+    elif back is not None:  # netCDF's bands are variables: its subdatasets
+        subs = back.GetSubDatasets()
+        first = gdal_call(gdal.OpenEx, subs[0][0], gdal.OF_RASTER)[0] if subs else None
+        if first is not None and first.RasterCount > 0:
+            got = (len(subs), first.GetRasterBand(1).DataType)
+        first = None
     back = None
-    if got is not None and got[0] == bands and gdal.GetDataTypeSize(got[1]) >= \
+    # (at least the bands written: a grey image reads back as RGBA from
+    # MBTiles, PDF or KMZ, the third review)
+    if got is not None and got[0] >= bands and gdal.GetDataTypeSize(got[1]) >= \
             gdal.GetDataTypeSize(kind):
         return
     for f in (out, out + ".aux.xml"):
