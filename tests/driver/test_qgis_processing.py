@@ -210,6 +210,7 @@ BAD = [
 _ONTO = shutil.copy(T.JACKSBORO, os.path.join(_J_DIR, "onto.tif"))
 _NOCRS = os.path.join(_J_DIR, "nocrs.tif")
 _ENV = shutil.copy(SUNSET, os.path.join(_J_DIR, "env.exr"))
+_LUX = shutil.copy(T.LUX, os.path.join(_J_DIR, "lux.tif"))
 # a projected CRS without an EPSG code: the layer's is its file's (the
 # review: compared through GDAL's WKT1, every such DEM was refused)
 _CUSTOM = os.path.join(_J_DIR, "custom_lcc.tif")
@@ -227,14 +228,26 @@ REFUSED = [
     ("onto_env_map", "terrashade:envlight",
      {"INPUT": J, "ENV_MAP": _ENV, "DIRECTIONS": 4, "OUTPUT": _ENV},
      "its environment map (ENV_MAP), which the algorithm reads"),
-    # a format that drops bands with a warning (the review)
+    # formats that drop bands or lose values, refused before the run
     ("xyz_horizon", "terrashade:horizon", {"INPUT": J, "DIRECTIONS": 4,
                                            "OUTPUT": os.path.join(_J_DIR, "hz.xyz")},
-     "The output format XYZ did not keep the product"),
+     "The output format XYZ does not keep the product's values"),
+    # read back: SAGA's grid lost lux_elev's georeferencing (its cells not
+    # quite square in x and y), with an error that did not fail the copy
+    ("sdat_svf", "terrashade:svf", {"INPUT": _LUX, "DIRECTIONS": 4,
+                                    "OUTPUT": os.path.join(_J_DIR, "svf.sdat")},
+     "The output format SAGA did not keep the product"),
     # PNG holds bytes: svf's values were written as 0 and 1, and the run succeeded
     ("png_svf", "terrashade:svf", {"INPUT": J, "DIRECTIONS": 4,
                                    "OUTPUT": os.path.join(_J_DIR, "svf.png")},
      "The output format PNG cannot hold this product's Float32 values"),
+    # lossy or redrawn: JPEG, MBTiles (reprojected), PDF wrote other values
+    # and the run succeeded (the fourth review)
+    ("jpg_shade", "terrashade:shade", {"INPUT": J, "OUTPUT": os.path.join(_J_DIR, "s.jpg")},
+     "The output format JPEG does not keep the product's values as they are"),
+    ("mbtiles_shade", "terrashade:shade",
+     {"INPUT": J, "OUTPUT": os.path.join(_J_DIR, "s.mbtiles")},
+     "The output format MBTiles does not keep the product's values as they are"),
     ("vrt_svf", "terrashade:svf", {"INPUT": J, "DIRECTIONS": 4,
                                    "OUTPUT": os.path.join(_J_DIR, "svf.vrt")},
      "A VRT output holds no pixels"),
@@ -300,12 +313,12 @@ class Processing(unittest.TestCase):
         runs += [(n, a, dict(p, OUTPUT=cls.out(n))) for n, a, p in BAD + CANCEL]
         runs += [(n, a, p) for n, a, p, _ in REFUSED]
         # a layer source with QGIS's URI parts (a GDAL open option)
-        # formats whose read-back differs from the bands written, and holds
-        # them all: netCDF's variables, MBTiles' RGBA (the third review)
+        # formats that keep the product: netCDF, whose bands read back as its
+        # variables (a traceback: the third review), PNG for a Byte product
         runs += [("nc_horizon", "terrashade:horizon",
                   {"INPUT": J, "DIRECTIONS": 4, "OUTPUT": os.path.join(cls.dir, "hz.nc")}),
-                 ("mbtiles_shade", "terrashade:shade",
-                  {"INPUT": J, "OUTPUT": os.path.join(cls.dir, "shade.mbtiles")})]
+                 ("png_shade", "terrashade:shade",
+                  {"INPUT": J, "OUTPUT": os.path.join(cls.dir, "shade.png")})]
         runs += [("custom_crs", "terrashade:svf",
                   {"INPUT": _CUSTOM, "DIRECTIONS": 4, "OUTPUT": cls.out("custom_crs")})]
         runs += [("uri_option", "terrashade:svf",
@@ -435,20 +448,25 @@ class Processing(unittest.TestCase):
                 self.assertIn(words, r.get("error", ""), r)
                 if params["OUTPUT"] not in (params["INPUT"], params.get("ENV_MAP")):
                     self.assertFalse(os.path.exists(params["OUTPUT"]))
+        # (and the files the format wrote beside it)
+        self.assertFalse([f for f in os.listdir(_J_DIR) if f.startswith("svf.")])
         np.testing.assert_array_equal(T.read(_ONTO), T.read(T.JACKSBORO))
         with open(_ENV, "rb") as f, open(SUNSET, "rb") as g:
             self.assertEqual(f.read(), g.read())
 
     def test_formats_that_read_back_otherwise(self):
-        """netCDF reads back a multi-band product as subdatasets, MBTiles a
-        grey image as RGBA: both hold the product, and the run succeeds (the
-        read-back check failed them with a traceback or a refusal: the third
+        """netCDF reads back a multi-band product as subdatasets, and PNG
+        holds a Byte product: both keep the product, and the run succeeds
+        (the read-back check failed netCDF with a traceback: the third
         review)."""
-        for name in ("nc_horizon", "mbtiles_shade"):
+        for name in ("nc_horizon", "png_shade"):
             with self.subTest(name):
                 r = self.result[name]
                 self.assertIn("output", r, r.get("error"))
                 self.assertTrue(os.path.exists(r["output"]))
+        ref = os.path.join(self.dir, "png_ref.tif")
+        T.run(["gdal_translate", "-q", T.conn(J), ref])
+        np.testing.assert_array_equal(T.read(self.result["png_shade"]["output"]), T.read(ref))
 
     def test_a_custom_crs_is_the_files(self):
         """A DEM in a projected CRS without an EPSG code runs: its layer's

@@ -247,24 +247,40 @@ def check_output(dem, out, options):
                 "it before the product is computed. Choose another file." % (out, what))
 
 
+# Output formats that keep a product's values as they are (each read back
+# equal to the GeoTIFF by the fourth review), and those that keep a Byte
+# product's only. The others change them: JPEG, WebP, KMZ are lossy, PDF
+# redraws, MBTiles reprojects, XPM writes palette indices, XYZ and Golden
+# Software's grid lose bands or cannot be read again; each was a success.
+FAITHFUL = ("GTiff", "COG", "HFA", "netCDF", "AAIGrid", "ENVI", "EHdr", "ERS", "RST",
+            "PCIDSK", "GRIB", "NITF", "BT", "SAGA", "GPKG", "KEA")
+FAITHFUL_BYTE = ("PNG", "BMP", "GIF")
+
+
 def check_format(fmt, ds):
-    """Refuses an output format that cannot hold the product (PNG or JPEG:
-    Float32 values written as bytes, svf read 1 everywhere, and the run
-    succeeded) or that holds no pixels (a VRT of the TERRASHADE: string,
-    computed again at every read)."""
+    """Refuses an output format that does not keep the product's values (PNG
+    or JPEG of Float32 values wrote svf as 0 and 1, and the run succeeded) or
+    that holds no pixels (a VRT of the TERRASHADE: string, computed again at
+    every read)."""
     if fmt == "VRT":
         raise QgsProcessingException(
             "A VRT output holds no pixels: it would name TERRASHADE:<dem> and compute it "
             "again at every read. Write a GeoTIFF (.tif).")
+    kind = gdal.GetDataTypeName(ds.GetRasterBand(1).DataType)
     types = (gdal.GetDriverByName(fmt).GetMetadataItem(gdal.DMD_CREATIONDATATYPES)
              or "").split() if gdal.GetDriverByName(fmt) is not None else []
-    kind = gdal.GetDataTypeName(ds.GetRasterBand(1).DataType)
-    if types and kind not in types:
+    if fmt in FAITHFUL_BYTE and kind != "Byte" or types and kind not in types:
         raise QgsProcessingException(
             "The output format %s cannot hold this product's %s values (it takes %s). Write a "
-            "GeoTIFF (.tif)%s." % (fmt, kind, ", ".join(types),
+            "GeoTIFF (.tif)%s." % (fmt, kind, ", ".join(types) or "Byte",
                                    ", or set OUTPUT_TYPE=Byte where the product has it"
                                    if kind == "Float32" else ""))
+    if fmt not in FAITHFUL + FAITHFUL_BYTE:
+        raise QgsProcessingException(
+            "The output format %s does not keep the product's values as they are (a lossy, "
+            "display or tiled format). Write a GeoTIFF (.tif), or another format that keeps "
+            "them (%s; %s for Byte products), and convert that if you need %s."
+            % (fmt, ", ".join(FAITHFUL), ", ".join(FAITHFUL_BYTE), fmt))
 
 
 class Warnings:
@@ -275,7 +291,9 @@ class Warnings:
         self.messages = []
 
     def __call__(self, level, _number, message):
-        if level == gdal.CE_Warning and message not in self.messages:
+        # (and errors that do not fail the copy: SAGA's "Unable to set
+        # GeoTransform" left a grid without its georeferencing, the fourth review)
+        if level in (gdal.CE_Warning, gdal.CE_Failure) and message not in self.messages:
             self.messages.append(message)
 
 
@@ -324,8 +342,8 @@ def write(dem, options, out, feedback):
 
     res, message = gdal_call(gdal.Translate, out, ds, options=gdal.TranslateOptions(
         format=fmt, creationOptions=creation, callback=progress))
-    bands = ds.RasterCount
-    kind = ds.GetRasterBand(1).DataType
+    shape = (ds.RasterCount, ds.GetRasterBand(1).DataType, ds.RasterXSize, ds.RasterYSize,
+             ds.GetGeoTransform(can_return_null=True))
     ds = None
     if res is None:
         # GDAL's failed copy of a multi-band product deletes the raster but
@@ -339,38 +357,46 @@ def write(dem, options, out, feedback):
         raise QgsProcessingException(message or "gdal.Translate failed")
     res.FlushCache()
     res = None
-    check_written(out, fmt, bands, kind)
+    check_written(out, fmt, shape)
 
 
-def check_written(out, fmt, bands, kind):
-    """Reads the output back: a format that dropped bands (horizon's 4 as
-    one in Golden Software's grid or XYZ, with a warning) or wrote what GDAL
-    cannot read again (GSAG's NaN, XYZ's rows) was a success that was not
-    (the review); the file is removed and the run fails."""
+def check_written(out, fmt, shape):
+    """Reads the output back: a format that dropped bands, narrowed the
+    type, changed the grid or its georeferencing (SAGA for cells that are
+    not square), or wrote what GDAL cannot read again, was a success that
+    was not (the reviews); the file is removed and the run fails. shape:
+    the product's (bands, type, width, height, geotransform)."""
+    bands, kind, width, height, gt = shape
     back, _ = gdal_call(gdal.OpenEx, out, gdal.OF_RASTER)
+    written = (back.GetFileList() or []) if back is not None else []  # (SAGA's .sgrd, .prj)
+    if back is not None and back.RasterCount == 0:  # netCDF's bands are its variables
+        subs = back.GetSubDatasets()
+        count = len(subs)
+        back = gdal_call(gdal.OpenEx, subs[0][0], gdal.OF_RASTER)[0] if subs else None
+    elif back is not None:
+        count = back.RasterCount
     got = None
     if back is not None and back.RasterCount > 0:
-        got = (back.RasterCount, back.GetRasterBand(1).DataType)
-    elif back is not None:  # netCDF's bands are variables: its subdatasets
-        subs = back.GetSubDatasets()
-        first = gdal_call(gdal.OpenEx, subs[0][0], gdal.OF_RASTER)[0] if subs else None
-        if first is not None and first.RasterCount > 0:
-            got = (len(subs), first.GetRasterBand(1).DataType)
-        first = None
+        got = (count, back.GetRasterBand(1).DataType, back.RasterXSize, back.RasterYSize,
+               back.GetGeoTransform(can_return_null=True))
     back = None
-    # (at least the bands written: a grey image reads back as RGBA from
-    # MBTiles, PDF or KMZ, the third review)
-    if got is not None and got[0] >= bands and gdal.GetDataTypeSize(got[1]) >= \
-            gdal.GetDataTypeSize(kind):
+    def same_place(read):
+        return gt is None or read is not None and all(
+            abs(a - b) <= 1e-9 * max(1.0, abs(b)) for a, b in zip(read, gt))
+
+    if got is not None and got[0] == bands and got[2:4] == (width, height) and \
+            gdal.GetDataTypeSize(got[1]) >= gdal.GetDataTypeSize(kind) and same_place(got[4]):
         return
-    for f in (out, out + ".aux.xml"):
+    for f in set(written) | {out, out + ".aux.xml"}:
         with contextlib.suppress(OSError):
             os.remove(f)
     raise QgsProcessingException(
-        "The output format %s did not keep the product (%s read back where %d band(s) of %s "
-        "were written). Write a GeoTIFF (.tif)."
-        % (fmt, "nothing" if got is None else "%d band(s) of %s" % (
-            got[0], gdal.GetDataTypeName(got[1])), bands, gdal.GetDataTypeName(kind)))
+        "The output format %s did not keep the product (%s read back where %d band(s) of %s, "
+        "%d x %d cells, were written, georeferenced). Write a GeoTIFF (.tif)."
+        % (fmt, "nothing" if got is None else "%d band(s) of %s, %d x %d cells, %s" % (
+            got[0], gdal.GetDataTypeName(got[1]), got[2], got[3],
+            "georeferenced as written" if same_place(got[4]) else "another georeferencing"),
+            bands, gdal.GetDataTypeName(kind), width, height))
 
 
 class TerrashadeAlgorithm(QgsProcessingAlgorithm):
