@@ -211,6 +211,15 @@ _ONTO = shutil.copy(T.JACKSBORO, os.path.join(_J_DIR, "onto.tif"))
 _NOCRS = os.path.join(_J_DIR, "nocrs.tif")
 _ENV = shutil.copy(SUNSET, os.path.join(_J_DIR, "env.exr"))
 _LUX = shutil.copy(T.LUX, os.path.join(_J_DIR, "lux.tif"))
+# a DEM whose .prj the output's would replace (SAGA writes dem.prj beside
+# dem.sdat), and a GeoPackage of the user's with a vector layer
+_BIL_DIR = os.path.join(_J_DIR, "bil")
+os.mkdir(_BIL_DIR)
+T.gdal.Translate(os.path.join(_BIL_DIR, "dem.bil"), T.LUX, format="EHdr")
+_USER_GPKG = os.path.join(_J_DIR, "user.gpkg")
+_gpkg = T.gdal.GetDriverByName("GPKG").Create(_USER_GPKG, 0, 0, 0, T.gdal.GDT_Unknown)
+_gpkg.CreateLayer("parcels")
+_gpkg = None
 # a projected CRS without an EPSG code: the layer's is its file's (the
 # review: compared through GDAL's WKT1, every such DEM was refused)
 _CUSTOM = os.path.join(_J_DIR, "custom_lcc.tif")
@@ -237,6 +246,15 @@ REFUSED = [
     ("sdat_svf", "terrashade:svf", {"INPUT": _LUX, "DIRECTIONS": 4,
                                     "OUTPUT": os.path.join(_J_DIR, "svf.sdat")},
      "The output format SAGA did not keep the product"),
+    # ... and what it wrote is removed, but for the DEM's .prj it replaced
+    # (removed too by a first version: the fifth review)
+    ("sdat_beside_bil", "terrashade:svf",
+     {"INPUT": os.path.join(_BIL_DIR, "dem.bil"), "DIRECTIONS": 4,
+      "OUTPUT": os.path.join(_BIL_DIR, "dem.sdat")},
+     "The output format SAGA did not keep the product"),
+    # GDAL's copy replaces a GeoPackage whole: a vector layer was lost
+    ("gpkg_of_the_user", "terrashade:shade", {"INPUT": J, "OUTPUT": _USER_GPKG},
+     "is a GeoPackage that holds other layers"),
     # PNG holds bytes: svf's values were written as 0 and 1, and the run succeeded
     ("png_svf", "terrashade:svf", {"INPUT": J, "DIRECTIONS": 4,
                                    "OUTPUT": os.path.join(_J_DIR, "svf.png")},
@@ -318,7 +336,11 @@ class Processing(unittest.TestCase):
         runs += [("nc_horizon", "terrashade:horizon",
                   {"INPUT": J, "DIRECTIONS": 4, "OUTPUT": os.path.join(cls.dir, "hz.nc")}),
                  ("png_shade", "terrashade:shade",
-                  {"INPUT": J, "OUTPUT": os.path.join(cls.dir, "shade.png")})]
+                  {"INPUT": J, "OUTPUT": os.path.join(cls.dir, "shade.png")}),
+                 # Idrisi keeps 7 decimals of degrees: its georeferencing is
+                 # the same grid (refused at 1e-9: the fifth review)
+                 ("rst_lux", "terrashade:svf",
+                  {"INPUT": _LUX, "DIRECTIONS": 4, "OUTPUT": os.path.join(cls.dir, "lux.rst")})]
         runs += [("custom_crs", "terrashade:svf",
                   {"INPUT": _CUSTOM, "DIRECTIONS": 4, "OUTPUT": cls.out("custom_crs")})]
         runs += [("uri_option", "terrashade:svf",
@@ -446,10 +468,17 @@ class Processing(unittest.TestCase):
                 r = self.result[name]
                 print("%-10s -> %s" % (name, r.get("error")))
                 self.assertIn(words, r.get("error", ""), r)
-                if params["OUTPUT"] not in (params["INPUT"], params.get("ENV_MAP")):
+                if params["OUTPUT"] not in (params["INPUT"], params.get("ENV_MAP"),
+                                            _USER_GPKG):
                     self.assertFalse(os.path.exists(params["OUTPUT"]))
-        # (and the files the format wrote beside it)
+        # (and the files the format wrote beside it, not the DEM's own)
         self.assertFalse([f for f in os.listdir(_J_DIR) if f.startswith("svf.")])
+        left = os.listdir(_BIL_DIR)
+        self.assertIn("dem.prj", left)
+        self.assertFalse([f for f in left if f.startswith("dem.s") and f != "dem.stx"], left)
+        held = T.gdal.OpenEx(_USER_GPKG, T.gdal.OF_VECTOR)
+        self.assertEqual(held.GetLayerCount(), 1)
+        held = None
         np.testing.assert_array_equal(T.read(_ONTO), T.read(T.JACKSBORO))
         with open(_ENV, "rb") as f, open(SUNSET, "rb") as g:
             self.assertEqual(f.read(), g.read())
@@ -459,7 +488,7 @@ class Processing(unittest.TestCase):
         holds a Byte product: both keep the product, and the run succeeds
         (the read-back check failed netCDF with a traceback: the third
         review)."""
-        for name in ("nc_horizon", "png_shade"):
+        for name in ("nc_horizon", "png_shade", "rst_lux"):
             with self.subTest(name):
                 r = self.result[name]
                 self.assertIn("output", r, r.get("error"))

@@ -225,35 +225,55 @@ def local_files(name):
             if p and os.path.isfile(p)][:1]
 
 
-def check_output(dem, out, options):
-    """Refuses an output that is the DEM, one of the files it reads (a
-    VRT's sources, the archive of a /vsizip/ DEM) or ENV_MAP: GDAL deletes
-    the output before the product is read, and the DEM was gone (an
-    environment map was replaced, and the run succeeded: the review)."""
+def inputs(dem, options):
+    """(file, what it is) for each file of the OS the algorithm reads: the
+    DEM's (a VRT's sources, the archive of a /vsizip/ DEM) and ENV_MAP."""
     ds, _ = gdal_call(gdal.OpenEx, dem, gdal.OF_RASTER)
     files = (ds.GetFileList() or []) if ds is not None else []
     ds = None
-    files = [(f, "the DEM itself" if f == dem else "one of its files (%s)" % f)
+    found = [(f, "the DEM itself" if f == dem else "one of its files (%s)" % f)
              for g in files for f in local_files(g)]
     if options.get("ENV_MAP"):
-        files += [(f, "its environment map (ENV_MAP)")
-                  for f in local_files(options["ENV_MAP"])]
+        found += [(f, "its environment map (ENV_MAP)") for f in local_files(options["ENV_MAP"])]
+    return found
+
+
+def check_output(dem, out, options):
+    """Refuses an output that is the DEM, one of the files it reads or
+    ENV_MAP: GDAL deletes the output before the product is read, and the DEM
+    was gone (an environment map was replaced, and the run succeeded: the
+    reviews); and an existing GeoPackage that holds other layers, which
+    GDAL's copy replaces whole (the fourth review: a vector layer was lost)."""
     target = os.path.realpath(out)
-    for f, what in files:
+    for f, what in inputs(dem, options):
         if os.path.realpath(f) == target or (
                 os.path.exists(f) and os.path.exists(out) and os.path.samefile(f, out)):
             raise QgsProcessingException(
                 "The output %s is %s, which the algorithm reads: writing it would delete "
                 "it before the product is computed. Choose another file." % (out, what))
+    if output_format(out)[0] == "GPKG" and os.path.exists(out):
+        gdal.PushErrorHandler("CPLQuietErrorHandler")
+        try:
+            held, _ = gdal_call(gdal.OpenEx, out, gdal.OF_RASTER | gdal.OF_VECTOR)
+            others = held is not None and (held.GetLayerCount() > 0 or
+                                           len(held.GetSubDatasets()) > 1)
+            held = None
+        finally:
+            gdal.PopErrorHandler()
+        if others:
+            raise QgsProcessingException(
+                "The output %s is a GeoPackage that holds other layers: GDAL's copy would "
+                "replace it whole, and them with it. Choose a new file." % out)
 
 
 # Output formats that keep a product's values as they are (each read back
-# equal to the GeoTIFF by the fourth review), and those that keep a Byte
-# product's only. The others change them: JPEG, WebP, KMZ are lossy, PDF
-# redraws, MBTiles reprojects, XPM writes palette indices, XYZ and Golden
-# Software's grid lose bands or cannot be read again; each was a success.
+# equal to the GeoTIFF by the fourth and fifth reviews), and those that keep
+# a Byte product's only. The others change them: JPEG, WebP, KMZ are lossy,
+# PDF redraws, MBTiles reprojects, XPM writes palette indices, XYZ and Golden
+# Software's grid lose bands or cannot be read again, GRIB drops the NaN
+# nodata and keeps micro-degrees; each was a success.
 FAITHFUL = ("GTiff", "COG", "HFA", "netCDF", "AAIGrid", "ENVI", "EHdr", "ERS", "RST",
-            "PCIDSK", "GRIB", "NITF", "BT", "SAGA", "GPKG", "KEA")
+            "PCIDSK", "NITF", "BT", "SAGA", "GPKG", "KEA")
 FAITHFUL_BYTE = ("PNG", "BMP", "GIF")
 
 
@@ -288,13 +308,19 @@ class Warnings:
     Processing log, where GDAL's own handler (stderr) would not show them."""
 
     def __init__(self):
-        self.messages = []
+        self.messages = []  # (level, message)
 
     def __call__(self, level, _number, message):
-        # (and errors that do not fail the copy: SAGA's "Unable to set
-        # GeoTransform" left a grid without its georeferencing, the fourth review)
-        if level in (gdal.CE_Warning, gdal.CE_Failure) and message not in self.messages:
-            self.messages.append(message)
+        if level in (gdal.CE_Warning, gdal.CE_Failure) and \
+                (level, message) not in self.messages:
+            self.messages.append((level, message))
+
+    def said(self, failed):
+        """What goes to the log: the warnings, and where the run did not fail,
+        the errors that did not fail the copy either (SAGA's "Unable to set
+        GeoTransform" left a grid without its georeferencing, the fourth
+        review); a failed run's errors are its own sentence."""
+        return [m for level, m in self.messages if level == gdal.CE_Warning or not failed]
 
 
 def translate(dem, options, out, feedback=None):
@@ -305,12 +331,14 @@ def translate(dem, options, out, feedback=None):
         raise QgsProcessingException("The TERRASHADE GDAL driver is not loaded any more.")
     warnings = Warnings()
     gdal.PushErrorHandler(warnings)
+    failed = True
     try:
         write(dem, options, out, feedback)
+        failed = False
     finally:
         gdal.PopErrorHandler()
         if feedback is not None:
-            for message in warnings.messages:
+            for message in warnings.said(failed):
                 feedback.pushWarning(message)
 
 
@@ -340,6 +368,8 @@ def write(dem, options, out, feedback):
             return 0 if feedback.isCanceled() else 1
         return 1
 
+    folder = os.path.dirname(os.path.abspath(out))
+    before = set(os.listdir(folder)) if os.path.isdir(folder) else set()
     res, message = gdal_call(gdal.Translate, out, ds, options=gdal.TranslateOptions(
         format=fmt, creationOptions=creation, callback=progress))
     shape = (ds.RasterCount, ds.GetRasterBand(1).DataType, ds.RasterXSize, ds.RasterYSize,
@@ -357,16 +387,56 @@ def write(dem, options, out, feedback):
         raise QgsProcessingException(message or "gdal.Translate failed")
     res.FlushCache()
     res = None
-    check_written(out, fmt, shape)
+    # (only files the write made: SAGA's .prj replaced a .bil DEM's, the
+    # fourth review, and is the DEM's still)
+    kept = {os.path.join(folder, f) for f in before} | {f for f, _ in inputs(dem, options)}
+    check_written(out, fmt, shape, kept)
 
 
-def check_written(out, fmt, shape):
+def check_written(out, fmt, shape, kept):
     """Reads the output back: a format that dropped bands, narrowed the
     type, changed the grid or its georeferencing (SAGA for cells that are
     not square), or wrote what GDAL cannot read again, was a success that
     was not (the reviews); the file is removed and the run fails. shape:
     the product's (bands, type, width, height, geotransform)."""
     bands, kind, width, height, gt = shape
+    gdal.PushErrorHandler("CPLQuietErrorHandler")  # (HFA's "NaN converted to INT_MAX")
+    try:
+        got, written = read_back(out)
+    finally:
+        gdal.PopErrorHandler()
+
+    def same_place(read):
+        """The same grid within what formats that write text keep (7 to 12
+        decimals, micro-degrees): half a cell at the origin, 1 % of a cell's
+        size; a lost georeferencing is another grid (the fourth review)."""
+        if gt is None:
+            return True
+        if read is None:
+            return False
+        cell = max(abs(gt[1]), abs(gt[5]))
+        return (all(abs(read[i] - gt[i]) <= 0.01 * cell for i in (1, 2, 4, 5)) and
+                all(abs(read[i] - gt[i]) <= 0.5 * cell for i in (0, 3)))
+
+    if got is not None and got[0] == bands and got[2:4] == (width, height) and \
+            gdal.GetDataTypeSize(got[1]) >= gdal.GetDataTypeSize(kind) and same_place(got[4]):
+        return
+    for f in ({os.path.abspath(f) for f in written} - {os.path.abspath(k) for k in kept}) \
+            | {out, out + ".aux.xml"}:
+        with contextlib.suppress(OSError):
+            os.remove(f)
+    raise QgsProcessingException(
+        "The output format %s did not keep the product (%s read back where %d band(s) of %s, "
+        "%d x %d cells, were written, georeferenced). Write a GeoTIFF (.tif)."
+        % (fmt, "nothing" if got is None else "%d band(s) of %s, %d x %d cells, %s" % (
+            got[0], gdal.GetDataTypeName(got[1]), got[2], got[3],
+            "georeferenced as written" if same_place(got[4]) else "another georeferencing"),
+            bands, gdal.GetDataTypeName(kind), width, height))
+
+
+def read_back(out):
+    """(bands, type, width, height, geotransform) of the file written, or
+    None; and the files it consists of."""
     back, _ = gdal_call(gdal.OpenEx, out, gdal.OF_RASTER)
     written = (back.GetFileList() or []) if back is not None else []  # (SAGA's .sgrd, .prj)
     if back is not None and back.RasterCount == 0:  # netCDF's bands are its variables
@@ -380,23 +450,7 @@ def check_written(out, fmt, shape):
         got = (count, back.GetRasterBand(1).DataType, back.RasterXSize, back.RasterYSize,
                back.GetGeoTransform(can_return_null=True))
     back = None
-    def same_place(read):
-        return gt is None or read is not None and all(
-            abs(a - b) <= 1e-9 * max(1.0, abs(b)) for a, b in zip(read, gt))
-
-    if got is not None and got[0] == bands and got[2:4] == (width, height) and \
-            gdal.GetDataTypeSize(got[1]) >= gdal.GetDataTypeSize(kind) and same_place(got[4]):
-        return
-    for f in set(written) | {out, out + ".aux.xml"}:
-        with contextlib.suppress(OSError):
-            os.remove(f)
-    raise QgsProcessingException(
-        "The output format %s did not keep the product (%s read back where %d band(s) of %s, "
-        "%d x %d cells, were written, georeferenced). Write a GeoTIFF (.tif)."
-        % (fmt, "nothing" if got is None else "%d band(s) of %s, %d x %d cells, %s" % (
-            got[0], gdal.GetDataTypeName(got[1]), got[2], got[3],
-            "georeferenced as written" if same_place(got[4]) else "another georeferencing"),
-            bands, gdal.GetDataTypeName(kind), width, height))
+    return got, written
 
 
 class TerrashadeAlgorithm(QgsProcessingAlgorithm):
