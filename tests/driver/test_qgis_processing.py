@@ -216,6 +216,10 @@ _LUX = shutil.copy(T.LUX, os.path.join(_J_DIR, "lux.tif"))
 _BIL_DIR = os.path.join(_J_DIR, "bil")
 os.mkdir(_BIL_DIR)
 T.gdal.Translate(os.path.join(_BIL_DIR, "dem.bil"), T.LUX, format="EHdr")
+with open(os.path.join(_BIL_DIR, "keep.prj"), "w") as _f:
+    _f.write("a file of the user's\n")
+_FLT = os.path.join(_BIL_DIR, "flt.flt")  # EHdr with its header flt.hdr
+T.gdal.Translate(_FLT, T.LUX, format="EHdr")
 _USER_GPKG = os.path.join(_J_DIR, "user.gpkg")
 _gpkg = T.gdal.GetDriverByName("GPKG").Create(_USER_GPKG, 0, 0, 0, T.gdal.GDT_Unknown)
 _gpkg.CreateLayer("parcels")
@@ -246,12 +250,21 @@ REFUSED = [
     ("sdat_svf", "terrashade:svf", {"INPUT": _LUX, "DIRECTIONS": 4,
                                     "OUTPUT": os.path.join(_J_DIR, "svf.sdat")},
      "The output format SAGA did not keep the product"),
-    # ... and what it wrote is removed, but for the DEM's .prj it replaced
-    # (removed too by a first version: the fifth review)
+    # ... and what it wrote is removed, but for a file that was there before
+    # (a DEM's .prj replaced by SAGA's was removed too: the fifth review)
+    ("sdat_over_a_prj", "terrashade:svf",
+     {"INPUT": _LUX, "DIRECTIONS": 4, "OUTPUT": os.path.join(_BIL_DIR, "keep.sdat")},
+     "The output format SAGA did not keep the product"),
+    # an output of the DEM's name is refused before (the sixth review)
     ("sdat_beside_bil", "terrashade:svf",
      {"INPUT": os.path.join(_BIL_DIR, "dem.bil"), "DIRECTIONS": 4,
       "OUTPUT": os.path.join(_BIL_DIR, "dem.sdat")},
-     "The output format SAGA did not keep the product"),
+     "has the name of the DEM itself"),
+    # an output of the DEM's name: EHdr's flt.hdr replaced the DEM's, and the
+    # DEM could not be read any more (the sixth review)
+    ("name_of_the_dem", "terrashade:shade",
+     {"INPUT": _FLT, "OUTPUT": os.path.join(_BIL_DIR, "flt.bil")},
+     "has the name of the DEM itself"),
     # GDAL's copy replaces a GeoPackage whole: a vector layer was lost
     ("gpkg_of_the_user", "terrashade:shade", {"INPUT": J, "OUTPUT": _USER_GPKG},
      "is a GeoPackage that holds other layers"),
@@ -337,6 +350,11 @@ class Processing(unittest.TestCase):
                   {"INPUT": J, "DIRECTIONS": 4, "OUTPUT": os.path.join(cls.dir, "hz.nc")}),
                  ("png_shade", "terrashade:shade",
                   {"INPUT": J, "OUTPUT": os.path.join(cls.dir, "shade.png")}),
+                 # a folder that does not exist yet (GDAL creates none: the
+                 # sixth review)
+                 ("new_folder", "terrashade:svf",
+                  {"INPUT": J, "DIRECTIONS": 4,
+                   "OUTPUT": os.path.join(cls.dir, "new", "sub", "svf.tif")}),
                  # Idrisi keeps 7 decimals of degrees: its georeferencing is
                  # the same grid (refused at 1e-9: the fifth review)
                  ("rst_lux", "terrashade:svf",
@@ -471,11 +489,19 @@ class Processing(unittest.TestCase):
                 if params["OUTPUT"] not in (params["INPUT"], params.get("ENV_MAP"),
                                             _USER_GPKG):
                     self.assertFalse(os.path.exists(params["OUTPUT"]))
+        # SAGA's error, which did not fail the copy, is in the log (a failed
+        # run logged none of GDAL's errors: the sixth review)
+        self.assertTrue(any("Unable to set GeoTransform" in w
+                            for w in self.result["sdat_svf"]["warnings"]),
+                        self.result["sdat_svf"])
+        self.assertIsNotNone(T.gdal.Open(_FLT))
         # (and the files the format wrote beside it, not the DEM's own)
         self.assertFalse([f for f in os.listdir(_J_DIR) if f.startswith("svf.")])
         left = os.listdir(_BIL_DIR)
         self.assertIn("dem.prj", left)
-        self.assertFalse([f for f in left if f.startswith("dem.s") and f != "dem.stx"], left)
+        self.assertIn("keep.prj", left)
+        self.assertFalse([f for f in left if f.startswith(("dem.s", "keep.s"))
+                          and f != "dem.stx"], left)
         held = T.gdal.OpenEx(_USER_GPKG, T.gdal.OF_VECTOR)
         self.assertEqual(held.GetLayerCount(), 1)
         held = None
@@ -488,7 +514,7 @@ class Processing(unittest.TestCase):
         holds a Byte product: both keep the product, and the run succeeds
         (the read-back check failed netCDF with a traceback: the third
         review)."""
-        for name in ("nc_horizon", "png_shade", "rst_lux"):
+        for name in ("nc_horizon", "png_shade", "rst_lux", "new_folder"):
             with self.subTest(name):
                 r = self.result[name]
                 self.assertIn("output", r, r.get("error"))

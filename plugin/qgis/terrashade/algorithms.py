@@ -251,6 +251,16 @@ def check_output(dem, out, options):
             raise QgsProcessingException(
                 "The output %s is %s, which the algorithm reads: writing it would delete "
                 "it before the product is computed. Choose another file." % (out, what))
+    # the files a format writes beside its output (EHdr's .hdr and .prj,
+    # SAGA's .sgrd): over a DEM of the same name in the same folder, its
+    # header was replaced and the DEM unreadable (the sixth review)
+    stem = os.path.splitext(os.path.realpath(out))[0]
+    for f, what in inputs(dem, options):
+        if os.path.splitext(os.path.realpath(f))[0] == stem:
+            raise QgsProcessingException(
+                "The output %s has the name of %s (%s), which the algorithm reads: the files "
+                "its format writes beside it (a header, a .prj) would replace those. Choose "
+                "another name." % (out, what.split(" (")[0], f))
     if output_format(out)[0] == "GPKG" and os.path.exists(out):
         gdal.PushErrorHandler("CPLQuietErrorHandler")
         try:
@@ -315,12 +325,13 @@ class Warnings:
                 (level, message) not in self.messages:
             self.messages.append((level, message))
 
-    def said(self, failed):
-        """What goes to the log: the warnings, and where the run did not fail,
-        the errors that did not fail the copy either (SAGA's "Unable to set
-        GeoTransform" left a grid without its georeferencing, the fourth
-        review); a failed run's errors are its own sentence."""
-        return [m for level, m in self.messages if level == gdal.CE_Warning or not failed]
+    def said(self, error=None):
+        """What goes to the log: the warnings, and the errors (where the run
+        did not fail, errors that did not fail the copy: SAGA's "Unable to
+        set GeoTransform" left a grid without its georeferencing, the fourth
+        review), but for the failed run's own sentence, error."""
+        return [m for level, m in self.messages
+                if level == gdal.CE_Warning or not error or m not in error]
 
 
 def translate(dem, options, out, feedback=None):
@@ -331,14 +342,16 @@ def translate(dem, options, out, feedback=None):
         raise QgsProcessingException("The TERRASHADE GDAL driver is not loaded any more.")
     warnings = Warnings()
     gdal.PushErrorHandler(warnings)
-    failed = True
+    error = None
     try:
         write(dem, options, out, feedback)
-        failed = False
+    except QgsProcessingException as e:
+        error = str(e) or "failed"
+        raise
     finally:
         gdal.PopErrorHandler()
         if feedback is not None:
-            for message in warnings.said(failed):
+            for message in warnings.said(error):
                 feedback.pushWarning(message)
 
 
@@ -369,7 +382,12 @@ def write(dem, options, out, feedback):
         return 1
 
     folder = os.path.dirname(os.path.abspath(out))
-    before = set(os.listdir(folder)) if os.path.isdir(folder) else set()
+    with contextlib.suppress(OSError):  # (GDAL creates no folder: the sixth review)
+        os.makedirs(folder, exist_ok=True)
+    try:
+        before = set(os.listdir(folder))
+    except OSError:
+        before = set()
     res, message = gdal_call(gdal.Translate, out, ds, options=gdal.TranslateOptions(
         format=fmt, creationOptions=creation, callback=progress))
     shape = (ds.RasterCount, ds.GetRasterBand(1).DataType, ds.RasterXSize, ds.RasterYSize,
