@@ -386,7 +386,8 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
     if (bAll && IsStdinName(poDS->m_osDEM))
         poDS->nPamFlags |= GPF_DISABLED; // the next run's standard input is another DEM
     const char *pszPam = poDS->BuildPamFilename();
-    if (!bAll && pszPam && !HasPamEntry(pszPam, osView.c_str(), nullptr))
+    const bool bHasView = pszPam && HasPamEntry(pszPam, osView.c_str(), nullptr);
+    if (!bAll && pszPam && !bHasView)
     {
         // the file's top level, where the atlas's entries were before
         // session 57: what the user set is saved as the view's; its
@@ -397,7 +398,7 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
             static_cast<TSAtlasBand *>(poDS->GetRasterBand(i))->DropSavedStatistics();
     }
     poDS->SetSubdatasetName(osView.c_str());
-    if (!pszPam || HasPamEntry(pszPam, osView.c_str(), nullptr))
+    if (!pszPam || bHasView)
         poDS->TryLoadXML();
     // the driver's own items over what the entry holds (one saved by an
     // earlier version for the other view)

@@ -238,14 +238,14 @@ def inputs(dem, options):
     return found
 
 
-def check_output(dem, out, options):
-    """Refuses an output that is the DEM, one of the files it reads or
-    ENV_MAP: GDAL deletes the output before the product is read, and the DEM
+def check_output(out, found):
+    """Refuses an output that is one of the files the algorithm reads
+    (found: inputs()), the DEM, one of its files or ENV_MAP: GDAL deletes the output before the product is read, and the DEM
     was gone (an environment map was replaced, and the run succeeded: the
     reviews); and an existing GeoPackage that holds other layers, which
     GDAL's copy replaces whole (the fourth review: a vector layer was lost)."""
     target = os.path.realpath(out)
-    for f, what in inputs(dem, options):
+    for f, what in found:
         if os.path.realpath(f) == target or (
                 os.path.exists(f) and os.path.exists(out) and os.path.samefile(f, out)):
             raise QgsProcessingException(
@@ -255,7 +255,7 @@ def check_output(dem, out, options):
     # SAGA's .sgrd): over a DEM of the same name in the same folder, its
     # header was replaced and the DEM unreadable (the sixth review)
     stem = os.path.splitext(os.path.realpath(out))[0]
-    for f, what in inputs(dem, options):
+    for f, what in found:
         if os.path.splitext(os.path.realpath(f))[0] == stem:
             raise QgsProcessingException(
                 "The output %s has the name of %s (%s), which the algorithm reads: the files "
@@ -334,17 +334,18 @@ class Warnings:
                 if level == gdal.CE_Warning or not error or m not in error]
 
 
-def translate(dem, options, out, feedback=None):
+def translate(dem, options, out, feedback=None, found=()):
     """gdal_translate -oo ... TERRASHADE:dem out, with the feedback's
     progress and cancellation; the driver's warnings go to the feedback's
-    log; raises QgsProcessingException on failure."""
+    log; raises QgsProcessingException on failure. found: the files the
+    algorithm reads (inputs()), which a failed output's removal keeps."""
     if gdal.GetDriverByName(DRIVER) is None:
         raise QgsProcessingException("The TERRASHADE GDAL driver is not loaded any more.")
     warnings = Warnings()
     gdal.PushErrorHandler(warnings)
     error = None
     try:
-        write(dem, options, out, feedback)
+        write(dem, options, out, feedback, found)
     except QgsProcessingException as e:
         error = str(e) or "failed"
         raise
@@ -367,7 +368,7 @@ def gdal_call(function, *args, **kwargs):
         return None, str(e)
 
 
-def write(dem, options, out, feedback):
+def write(dem, options, out, feedback, found):
     ds, message = gdal_call(gdal.OpenEx, connection(dem), gdal.OF_RASTER,
                             open_options=["%s=%s" % kv for kv in options.items()])
     if ds is None:
@@ -407,7 +408,7 @@ def write(dem, options, out, feedback):
     res = None
     # (only files the write made: SAGA's .prj replaced a .bil DEM's, the
     # fourth review, and is the DEM's still)
-    kept = {os.path.join(folder, f) for f in before} | {f for f, _ in inputs(dem, options)}
+    kept = {os.path.join(folder, f) for f in before} | {f for f, _ in found}
     check_written(out, fmt, shape, kept)
 
 
@@ -565,11 +566,12 @@ class TerrashadeAlgorithm(QgsProcessingAlgorithm):
         check_layer_crs(layer, dem)
         out = self.parameterAsOutputLayer(parameters, "OUTPUT", context)
         opts = self.open_options(parameters, context)
-        check_output(dem, out, opts)
+        found = inputs(dem, opts)  # (the DEM opened once for both)
+        check_output(out, found)
         feedback.pushInfo("Same as: " + command_line(dem, opts, out))
         feedback.pushInfo("Computing %s on the whole DEM first; the progress bar moves "
                           "while the result is written." % self.product.name)
-        translate(dem, opts, out, feedback)
+        translate(dem, opts, out, feedback, found)
         if context.willLoadLayerOnCompletion(out):
             context.layerToLoadOnCompletionDetails(out).setPostProcessor(
                 FirstBandGray.create())
