@@ -406,6 +406,21 @@ GDALDataset *TSAtlasDataset::Open(GDALOpenInfo *poOpenInfo)
     if (!poDS->m_bDEMGiven && !poDS->m_osDEM.empty())
         poDS->GDALDataset::SetMetadataItem("SOURCE_DEM", poDS->m_osDEM.c_str());
     poDS->nPamFlags &= ~GPF_DIRTY;
+    // statistics saved for other contents of the atlas's file or, with
+    // SHADOWS=all, of the DEM's (regenerated under the same name: the
+    // view's entry reported the former DEM's near shadows' statistics): dropped,
+    // and the entry saved without them at close
+    // (the atlas's file passed as SourceFiles' one other file)
+    std::vector<std::string> aosFiles = SourceFiles(nullptr, poOpenInfo->pszFilename);
+    if (bAll && !(poDS->nPamFlags & GPF_DISABLED)) // (none for a standard input's DEM)
+    {
+        char **papszDEMFiles = poDS->m_poDEM->GetFileList();
+        const std::vector<std::string> aosDEM = SourceFiles(papszDEMFiles, nullptr);
+        CSLDestroy(papszDEMFiles);
+        aosFiles.insert(aosFiles.end(), aosDEM.begin(), aosDEM.end());
+    }
+    poDS->m_osPamStamp = SourceStamp(aosFiles);
+    DropStaleStatistics(poDS.get(), poDS->m_osPamStamp);
     return poDS.release();
 }
 

@@ -52,6 +52,10 @@ class TSAtlasDataset final : public GDALPamDataset
                                     // until EnsureNear has read it
 
     bool m_bDEMReleased = false; // closed by CloseDependentDatasets before EnsureNear
+    /* the stamp (tsd_source_stamp.h) of the atlas's file, and SHADOWS=all's
+     * DEM's files, when it opened: the statistics its entry holds are of
+     * those contents (StampPamEntry) */
+    std::string m_osPamStamp{};
 
     CPLErr EnsureNear();
 
@@ -62,6 +66,12 @@ class TSAtlasDataset final : public GDALPamDataset
     /* GDALDestroyDriverManager: SHADOWS=all's DEM closed here, as a
      * product's (TSDataset::CloseDependentDatasets) */
     int CloseDependentDatasets() override;
+    /* GDAL's, with the stamp of the contents the statistics are of */
+    CPLErr TrySaveXML() override
+    {
+        StampPamEntry(this, m_osPamStamp);
+        return GDALPamDataset::TrySaveXML();
+    }
 
     CPLErr IRasterIO(GDALRWFlag eRWFlag, int nXOff, int nYOff, int nXSize, int nYSize,
                      void *pData, int nBufXSize, int nBufYSize, GDALDataType eBufType,

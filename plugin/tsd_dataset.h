@@ -225,7 +225,6 @@ class TSDataset final : public GDALPamDataset
     std::vector<std::string> m_aosDEMFiles{};
     std::string m_osDEMStamp{}, m_osPamStamp{};
     bool DEMUnchanged() const;
-    void DropStalePamStatistics();
     bool PlanEnvironment(std::vector<GByte> &oMap);
     bool BuildEnvironment(const std::vector<GByte> &oMap);
     void SetupEnvironmentMetadata();

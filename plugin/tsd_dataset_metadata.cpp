@@ -314,11 +314,6 @@ constexpr int PAM_LOAD_WAIT_MS = 2000;
  * or entries are lost), a save's both. */
 constexpr double PAM_STUCK_S = 60.0;
 
-/* Where an entry keeps the stamp of the contents its statistics are of:
- * band 1's metadata item, in a domain of its own. */
-constexpr const char *PAM_STAMP_ITEM = "SOURCE_FILES";
-constexpr const char *PAM_STAMP_DOMAIN = "TERRASHADE_PAM";
-
 /* One turn on the products' auxiliary file of a DEM: this process's
  * threads one at a time (PamFileMutex), and processes too, by an advisory
  * lock (flock) on the DEM's directory, which every product of that DEM
@@ -442,9 +437,8 @@ static bool RestoreAfterFailedSave(const std::string &osPath, const std::vector<
 CPLErr TSDataset::TrySaveXML()
 {
     const PamFileTurn oTurn(GetPhysicalFilename(), true);
-    // the contents the entry's statistics are of (DropStalePamStatistics)
-    if (!m_osPamStamp.empty() && nBands > 0)
-        GetRasterBand(1)->SetMetadataItem(PAM_STAMP_ITEM, m_osPamStamp.c_str(), PAM_STAMP_DOMAIN);
+    // the contents the entry's statistics are of (DropStaleStatistics)
+    StampPamEntry(this, m_osPamStamp);
     const char *pszPam = psPam && !(nPamFlags & GPF_DISABLED) ? BuildPamFilename() : nullptr;
     if (m_bSavingOver || !pszPam)
         return GDALPamDataset::TrySaveXML(); // (GDAL's retry in its proxy folder, nested)
@@ -509,29 +503,6 @@ bool HasPamEntry(const char *pszPath, const char *pszName, const char *pszDEM)
                  EQUAL(CPLGetXMLValue(ps, "name", ""), pszName);
     CPLDestroyXMLNode(psTree);
     return bFound;
-}
-
-/* Statistics and histograms saved for other contents of the DEM or of
- * ENV_MAP (regenerated under the same name: GDAL drops the DEM's own
- * .aux.xml then, not the products'), or by a version that kept no stamp,
- * are dropped: they were reported, and copied into gdal_translate's
- * output and QGIS's stretch, as this product's. What the user set stays.
- * The entry is saved without them when the dataset closes. */
-void TSDataset::DropStalePamStatistics()
-{
-    if (nBands < 1)
-        return;
-    const char *pszSaved = GetRasterBand(1)->GetMetadataItem(PAM_STAMP_ITEM, PAM_STAMP_DOMAIN);
-    if (pszSaved && m_osPamStamp == pszSaved)
-        return;
-    bool bDropped = false;
-    for (int i = 1; i <= nBands; i++)
-        bDropped = static_cast<TSRasterBand *>(GetRasterBand(i))->DropSavedStatistics() ||
-                   bDropped;
-    if (bDropped)
-        CPLDebug(DRIVER, "%s: statistics saved for other contents of its files dropped "
-                 "(saved for '%s', now '%s')",
-                 GetDescription(), pszSaved ? pszSaved : "(no stamp)", m_osPamStamp.c_str());
 }
 
 bool TSDataset::DEMUnchanged() const
@@ -615,7 +586,13 @@ void TSDataset::SetupPam(const char *pszConnection)
         m_osPamStamp = m_sOpts.env_map[0] ? m_osDEMStamp + "; ENV_MAP: " +
                                                 SourceStamp(SourceFiles(nullptr, m_sOpts.env_map))
                                           : m_osDEMStamp;
-        DropStalePamStatistics();
+        // statistics and histograms saved for other contents of the DEM or
+        // ENV_MAP (regenerated under the same name: GDAL drops the DEM's
+        // own .aux.xml then, not the products'), or by a version that kept
+        // no stamp, were reported, and copied into gdal_translate's output
+        // and QGIS's stretch, as this product's: dropped (what the user set
+        // stays), and the entry saved without them at close
+        DropStaleStatistics(this, m_osPamStamp);
     }
     else
     {

@@ -143,4 +143,33 @@ bool TSPamBand::DropSavedStatistics()
     return bDropped;
 }
 
+constexpr const char *PAM_STAMP_ITEM = "SOURCE_FILES";
+constexpr const char *PAM_STAMP_DOMAIN = "TERRASHADE_PAM";
+
+void StampPamEntry(GDALPamDataset *poDS, const std::string &osStamp)
+{
+    if (!osStamp.empty() && poDS->GetRasterCount() > 0)
+        poDS->GetRasterBand(1)->SetMetadataItem(PAM_STAMP_ITEM, osStamp.c_str(),
+                                                PAM_STAMP_DOMAIN);
+}
+
+bool DropStaleStatistics(GDALPamDataset *poDS, const std::string &osStamp)
+{
+    if (poDS->GetRasterCount() < 1)
+        return false;
+    const char *pszSaved =
+        poDS->GetRasterBand(1)->GetMetadataItem(PAM_STAMP_ITEM, PAM_STAMP_DOMAIN);
+    if (pszSaved && osStamp == pszSaved)
+        return false;
+    bool bDropped = false;
+    for (int i = 1; i <= poDS->GetRasterCount(); i++)
+        bDropped = static_cast<TSPamBand *>(poDS->GetRasterBand(i))->DropSavedStatistics() ||
+                   bDropped;
+    if (bDropped)
+        CPLDebug("TERRASHADE", "%s: statistics saved for other contents of its files dropped "
+                 "(saved for '%s', now '%s')",
+                 poDS->GetDescription(), pszSaved ? pszSaved : "(no stamp)", osStamp.c_str());
+    return bDropped;
+}
+
 } // namespace tsd

@@ -8,6 +8,8 @@
 #ifndef TSD_PAM_BAND_H
 #define TSD_PAM_BAND_H
 
+#include <string>
+
 #include "gdal_pam.h"
 
 namespace tsd
@@ -62,6 +64,16 @@ class TSPamBand : public GDALPamRasterBand
      * whether there were any */
     bool DropSavedStatistics();
 };
+
+/* The stamp (tsd_source_stamp.h) of the files a dataset's statistics are
+ * of, kept beside them in its entry: band 1's PAM metadata item
+ * SOURCE_FILES, domain TERRASHADE_PAM. StampPamEntry sets it (before a
+ * save: setting it marks nothing dirty that was not); DropStaleStatistics
+ * drops every band's saved statistics and histograms where the entry's
+ * stamp is missing or not osStamp, and says whether it dropped any. The
+ * bands must be TSPamBands. */
+void StampPamEntry(GDALPamDataset *poDS, const std::string &osStamp);
+bool DropStaleStatistics(GDALPamDataset *poDS, const std::string &osStamp);
 
 } // namespace tsd
 

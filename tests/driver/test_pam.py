@@ -408,6 +408,58 @@ class Pam(unittest.TestCase):
         self.assertIn('name="SHADOWS=all:DEM=%s"' % self.dem, text)
         self.assertIn('name="SHADOWS=all:DEM=%s"' % other, text)
 
+    def test_atlas_statistics_follow_the_dems_contents(self):
+        """SHADOWS=all's statistics are of the atlas's far shadows and the
+        DEM's near ones: saved, then the DEM regenerated under its name
+        with other heights, they were reported again as the view's (its
+        entry kept no stamp of the DEM, as a product's does: session 57's
+        closing note). Dropped now; the far view's, of the atlas alone,
+        stay; and a copy of another atlas over the file drops those too."""
+        d = os.path.join(self.demdir, "stamp")
+        os.makedirs(d)
+        dem = os.path.join(d, "dem.tif")
+        T.run(["gdal_translate", "-q", self.dem, dem])
+        tsa = os.path.join(d, "s.tsa")
+
+        def atlas(src, out, steps):
+            T.run(["gdal_translate", "-q", "-of", "TERRASHADE"] + T.oo_args(dict(
+                PRODUCT="farshadow", DATE="2026-12-21", TIMEZONE="-05:00",
+                ATLAS_STEPS=steps, FAR_THRESHOLD=24)) + [T.conn(src), out])
+
+        atlas(dem, tsa, 4)
+
+        def saved_and_computed(*oo):
+            ds = gdal.OpenEx(tsa, gdal.OF_RASTER, open_options=list(oo))
+            band = ds.GetRasterBand(1)
+            saved = band.GetStatistics(False, False)
+            computed = band.ComputeStatistics(False)
+            ds = None
+            return saved, computed
+
+        _, far = saved_and_computed()
+        _, both = saved_and_computed("SHADOWS=all")
+        def same(a, b, msg=None):
+            self.assertEqual(len(a), len(b), msg)
+            for x, y in zip(a, b):
+                self.assertAlmostEqual(x, y, places=9, msg=msg)
+
+        same(saved_and_computed("SHADOWS=all")[0], both)
+        # the same size and ground, other heights: other near shadows
+        T.run(["gdal_translate", "-q", "-scale", "0", "1", "0", "3", "-ot", "Float32",
+               self.dem, dem + ".new.tif"])
+        os.replace(dem + ".new.tif", dem)
+        saved, now = saved_and_computed("SHADOWS=all")
+        print("SHADOWS=all mean before %.4f, after the DEM changed %.4f" % (both[2], now[2]))
+        self.assertNotAlmostEqual(both[2], now[2], places=3)
+        self.assertEqual(saved, [0, 0, 0, -1], "the former DEM's statistics reported")
+        same(saved_and_computed("SHADOWS=all")[0], now)
+        same(saved_and_computed()[0], far, "the far view's own were dropped")
+        # another atlas written over the file (outside GDAL: its .aux.xml stays)
+        atlas(dem, os.path.join(d, "other.tsa"), 2)
+        shutil.copyfile(os.path.join(d, "other.tsa"), tsa)
+        saved, _ = saved_and_computed()
+        self.assertEqual(saved, [0, 0, 0, -1], "another atlas's file took these statistics")
+
     def test_an_entry_in_the_dems_own_file_is_still_read(self):
         """Before session 48 the entries went into the DEM's .aux.xml: a
         nodata value set there is still what the band reports, and the
