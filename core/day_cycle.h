@@ -351,8 +351,10 @@ ts_status ts_date_range_check(const ts_date_range *r, int *days, int *sampled,
  * weighted as described at ts_date_range, of what ts_sun_hours gives for
  * that local day (same steps, same o->sun_hours_rule, same Earth horizon),
  * except that the horizon toward the sun is not swept at each sun position:
- * the horizons are swept once for r->horizon_directions azimuths
- * (ts_horizon_azimuth with o->horizon.start_azimuth) and the horizon at
+ * the horizons are swept once for r->horizon_directions azimuths, k * 360
+ * / r->horizon_directions degrees from grid north (not from
+ * o->horizon.start_azimuth, which turns only ts_insolation_range's sky
+ * term's azimuths), and the horizon at
  * the sun's azimuth interpolated linearly between the two nearest. Planes
  * are streamed (three at most in memory). Progress through
  * o->horizon.progress. One sun site only: a lattice is refused

@@ -168,8 +168,8 @@ const opt_def TSD_OPTION_ROWS[] = {
      "days; the middle day of each is computed and stands for the block"},
     {"HORIZON_DIRECTIONS", K_INT, FIELD(horizon_directions),
      TSD_XSTR(TS_RANGE_HORIZON_DIRECTIONS), 4, 3600, 0, 1, NULL, 1, P, LISTED, NULL,
-     "Date range (START_DATE): azimuths at which the horizons are swept once; "
-     "each sun position uses the two nearest"},
+     "Date range (START_DATE): azimuths at which the horizons are swept once, every "
+     "360/HORIZON_DIRECTIONS degrees from grid north; each sun position uses the two nearest"},
     /* the ranges where the SPA's refraction (Bennett / Saemundsson form)
      * holds: the air at the Earth's surface (docs/driver.md) */
     {"PRESSURE", K_FLOAT, FIELD(pressure), "1013.25", 300, 1100, 0, 1, NULL, 1, P, LISTED,

@@ -180,6 +180,33 @@ class Year(unittest.TestCase):
         self.assertLessEqual(mean_rel, 0.004)
         self.assertLessEqual(max_abs, 1.0)
 
+    def test_start_azimuth_turns_the_sky_only(self):
+        """START_AZIMUTH turns insolation's sky term (DIRECTIONS), not the
+        HORIZON_DIRECTIONS planes the sun's beam is read from: until
+        session 58 it turned those too, and a range's beam changed with it
+        (by up to 336 Wh/m^2 in three days, session 58's audit) and differed
+        from sunhours', which takes no START_AZIMUTH. The beam is now the
+        same bits whatever START_AZIMUTH; the diffuse term from planes the
+        stream sweeps anyway (5.625 = plane 1 of 64: every fourth plane
+        from there) is the one of sky sweeps of its own (HORIZON_DIRECTIONS
+        60: none shared), and a range of one day's is that day's (DATE)."""
+        rng = {"PRODUCT": "insolation", "START_DATE": "2026-06-01", "END_DATE": "2026-06-03",
+               "TIMEZONE": "-05:00", "DAY_INTERVAL": 1}
+        base = self.product(rng)
+        for start in (10, 5.625, 191.25):
+            turned = self.product(dict(rng, START_AZIMUTH=start))
+            with self.subTest(start=start):
+                np.testing.assert_array_equal(turned[1], base[1])  # the beam
+                self.assertGreater(np.nanmax(np.abs(turned[2] - base[2])), 0.1)
+        shared = self.product(dict(rng, START_AZIMUTH=5.625))
+        own = self.product(dict(rng, START_AZIMUTH=5.625, HORIZON_DIRECTIONS=60))
+        np.testing.assert_allclose(shared[2], own[2], rtol=1e-5)
+        one = {"PRODUCT": "insolation", "TIMEZONE": "-05:00", "STEP_MINUTES": 30,
+               "START_AZIMUTH": 5.625}
+        day = self.product(dict(one, DATE="2026-06-02"))
+        as_range = self.product(dict(one, START_DATE="2026-06-02"))
+        np.testing.assert_allclose(as_range[2], day[2], rtol=1e-5)
+
     def test_long_interval_warns(self):
         """A DAY_INTERVAL over 61 days over a range that long: one computed
         day stands for a stretch of the seasons, so a warning (a year at 365
