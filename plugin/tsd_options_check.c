@@ -129,9 +129,17 @@ static int check_environment(const tsd_options *o, char *msg, size_t n)
     const tsd_product_def *p = tsd_product_of(o);
     const int envlight = tsd_product_takes(p, tsd_option_find("EXPOSURE"));
     char list[256];
+    /* what each holds other than its declared default: given with its
+     * default, an option of another product is no mistake (the warning of
+     * unused options names it), as METHOD=exact with svf */
+    double stops;
+    const int set[] = {o->env_map[0] != '\0', o->sky[0] != '\0', o->env_rotation != 0,
+                       o->env_horizon_steps != TS_ENV_DEFAULT_HORIZON_STEPS,
+                       o->env_normal_steps != TS_ENV_DEFAULT_NORMAL_STEPS,
+                       tsd_exposure_parse(o->exposure, &stops) == 0};
     for (size_t i = 0; i < sizeof own / sizeof own[0]; i++) {
         int id = tsd_option_find(own[i]);
-        if (tsd_options_given(o, own[i]) && !tsd_product_takes(p, id)) {
+        if (set[i] && !tsd_product_takes(p, id)) {
             tsd_products_taking(id, "PRODUCT=", " and ", list, sizeof list);
             REFUSE("%s applies to %s, not to PRODUCT=%s", own[i], list, p->name);
         }
@@ -142,9 +150,10 @@ static int check_environment(const tsd_options *o, char *msg, size_t n)
     if (envlight && !o->env_map[0] && !o->sky[0])
         REFUSE("PRODUCT=%s needs a light: ENV_MAP=<an OpenEXR map> or "
                "SKY=uniform|overcast|clear|cie:N", p->name);
-    if (o->env_map[0] && envlight && (tsd_options_given(o, "SUN_AZIMUTH") ||
-                                      tsd_options_given(o, "SUN_ELEVATION") ||
-                                      o->datetime[0]))
+    tsd_options d; /* (a sun given at its defaults is warned of, as unused) */
+    tsd_options_defaults(&d);
+    if (o->env_map[0] && envlight && (o->sun_azimuth != d.sun_azimuth ||
+                                      o->sun_elevation != d.sun_elevation || o->datetime[0]))
         REFUSE("PRODUCT=%s with ENV_MAP is lit by the map alone: SUN_AZIMUTH, "
                "SUN_ELEVATION and DATETIME place the sun of a SKY", p->name);
     if (o->env_rotation != 0 && !o->env_map[0])
@@ -176,8 +185,7 @@ static int check_environment(const tsd_options *o, char *msg, size_t n)
                "horizon of open flat ground, which else reads too little light), got %d",
                o->env_horizon_steps);
     /* (EXPOSURE=AUTO, the default, is no mistake) */
-    double stops;
-    if (tsd_exposure_parse(o->exposure, &stops) == 0 && !tsd_options_output_byte(o))
+    if (set[5] && !tsd_options_output_byte(o))
         REFUSE("EXPOSURE applies to OUTPUT_TYPE=Byte (the display image); Float32 "
                "keeps the light's own values");
     return 0;
@@ -307,7 +315,7 @@ int tsd_options_check(const tsd_options *o, char *msg, size_t n)
                     "start at FAR_THRESHOLD cells and have no end)", pn);
     if (o->sun_position == TSD_SUN_PER_CELL &&
         !tsd_product_takes(p, tsd_option_find("SUN_POSITION"))) {
-        tsd_products_taking(tsd_option_find("SUN_POSITION"), "PRODUCT=", ", ", list,
+        tsd_products_taking(tsd_option_find("SUN_POSITION"), "PRODUCT=", " and ", list,
                             sizeof list);
         REFUSE("SUN_POSITION=per_cell applies to %s, not to PRODUCT=%s", list, pn);
     }

@@ -15,11 +15,18 @@ int tsd_options_check_pyramid(const tsd_options *o, char *msg, size_t n)
     static const char *const own[] = {"HORIZON_METHOD", "PYRAMID_LEVEL_STEP", "PYRAMID_OFFSET"};
     const tsd_product_def *p = tsd_product_of(o);
     char list[256];
+    double k0 = 0, o0 = 0; /* (the table's defaults are numbers) */
+    tsd_parse_decimal(tsd_option_default(tsd_option_find("PYRAMID_LEVEL_STEP")), &k0);
+    tsd_parse_decimal(tsd_option_default(tsd_option_find("PYRAMID_OFFSET")), &o0);
+    /* given with its default, an option of another product is no mistake
+     * (the warning of unused options names it: HORIZON_METHOD=exact with
+     * sunhours, whose sweeps are exact, was refused until session 58) */
+    const int set[] = {o->horizon_method != TSD_HORIZON_EXACT, o->pyramid_level_step != k0,
+                       o->pyramid_offset != o0};
     for (size_t i = 0; i < sizeof own / sizeof own[0]; i++) {
         int id = tsd_option_find(own[i]);
         /* METHOD=sh's key light (shade, shadow) is built from horizons */
-        if (!tsd_options_given(o, own[i]) || tsd_product_takes(p, id) ||
-            o->method == TSD_METHOD_SH)
+        if (!set[i] || tsd_product_takes(p, id) || o->method == TSD_METHOD_SH)
             continue;
         tsd_products_taking(id, "PRODUCT=", " and ", list, sizeof list);
         REFUSE("%s applies to the products whose horizons the pyramid can give (%s; shade: "
@@ -32,9 +39,6 @@ int tsd_options_check_pyramid(const tsd_options *o, char *msg, size_t n)
     /* as SVF_MODEL: a value that would do nothing is a mistake; the
      * default given explicitly is not */
     if (o->horizon_method != TSD_HORIZON_PYRAMID) {
-        double k0 = 0, o0 = 0; /* (the table's defaults are numbers) */
-        tsd_parse_decimal(tsd_option_default(tsd_option_find("PYRAMID_LEVEL_STEP")), &k0);
-        tsd_parse_decimal(tsd_option_default(tsd_option_find("PYRAMID_OFFSET")), &o0);
         const char *which = o->pyramid_offset != o0         ? "PYRAMID_OFFSET"
                             : o->pyramid_level_step != k0 ? "PYRAMID_LEVEL_STEP"
                                                           : NULL;

@@ -13,6 +13,7 @@ the driver does:
   is refused where tsd_options_check refuses it (DATE with shade, METHOD=shm
   with svf, DATETIME with horizon, MAX_DISTANCE with farshadow).
 """
+import os
 import unittest
 import xml.etree.ElementTree as ET
 
@@ -138,6 +139,41 @@ class ProductsItem(unittest.TestCase):
                     open_product(refuses, values)
                 print("%s with %s: %s" % (option, refuses, e.exception))
                 self.assertIn(text, str(e.exception))
+
+    def test_options_at_their_defaults_are_warned_of(self):
+        """An option of other products given with its declared default is no
+        mistake of meaning (docs/driver.md, "Which options apply"): the
+        dataset opens with the warning that names it, as METHOD=exact with
+        svf always did. HORIZON_METHOD=exact with sunhours (whose sweeps are
+        exact), PYRAMID_*, ENV_ROTATION=0, the ENV_*_STEPS, EXPOSURE=AUTO
+        and, with ENV_MAP, SUN_AZIMUTH=315 were refused until session 58's
+        audit; other values still are."""
+        envmap = os.path.join(T.DATA, "envmaps", "sunset.exr")
+        cases = [("sunhours", ["HORIZON_METHOD=exact", "PYRAMID_LEVEL_STEP=4",
+                               "PYRAMID_OFFSET=0"], ["HORIZON_METHOD=pyramid"]),
+                 ("farshadow", ["PYRAMID_OFFSET=0"], ["PYRAMID_OFFSET=8"]),
+                 ("svf", ["ENV_ROTATION=0", "ENV_HORIZON_STEPS=181", "ENV_NORMAL_STEPS=0",
+                          "EXPOSURE=AUTO"], ["ENV_ROTATION=10"]),
+                 ("horizon", ["EXPOSURE=auto"], ["EXPOSURE=1"]),
+                 ("envlight", ["ENV_MAP=" + envmap, "SUN_AZIMUTH=315"],
+                  ["ENV_MAP=" + envmap, "SUN_AZIMUTH=200"])]
+        for name, defaults, refused in cases:
+            with self.subTest(name):
+                said = []
+                gdal.PushErrorHandler(lambda cls, no, msg: said.append(msg))
+                try:
+                    ds = open_product(name, defaults)
+                finally:
+                    gdal.PopErrorHandler()
+                said = " ".join(said)
+                self.assertIsNotNone(ds)
+                self.assertIn("nothing here", said)
+                for d in defaults[1:] if name == "envlight" else defaults:
+                    self.assertIn(d.split("=")[0], said)
+                ds = None
+                with self.assertRaises(RuntimeError) as e:
+                    open_product(name, refused)
+                print("%s: %s" % (name, e.exception))
 
 
 if __name__ == "__main__":
