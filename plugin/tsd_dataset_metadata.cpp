@@ -213,7 +213,9 @@ void TSDataset::SetupSunMetadata()
                                  CPLSPrintf("%.8f", s.sites.longitude[nRef]));
     GDALDataset::SetMetadataItem("SUN_SITE_LATITUDE",
                                  CPLSPrintf("%.8f", s.sites.latitude[nRef]));
-    GDALDataset::SetMetadataItem("MERIDIAN_CONVERGENCE", CPLSPrintf("%.6f", -dfNorth));
+    // (a geographic grid's 0 was written -0.000000, as any below 5e-7 was)
+    GDALDataset::SetMetadataItem("MERIDIAN_CONVERGENCE",
+                                 CPLSPrintf("%.6f", std::fabs(dfNorth) < 5e-7 ? 0.0 : -dfNorth));
     GDALDataset::SetMetadataItem("SUN_MODEL", "SPA (Reda & Andreas 2004), apparent "
                                               "elevation with refraction");
     char szTime[64];

@@ -188,7 +188,7 @@ const opt_def TSD_OPTION_ROWS[] = {
      "center|per_cell", 1, P, LISTED, NULL,
      "Where the sun is computed from: the DEM's centre (center), or every "
      "cell (per_cell: the SPA on a lattice over the DEM, interpolated), for "
-     "extents of a few degrees or more"},
+     "extents of a degree or more"},
     {"LINKE_TURBIDITY", K_FLOAT, FIELD(linke_turbidity), "3", 1, 10, 0, 1, NULL, 1, P,
      LISTED, NULL,
      "Linke turbidity factor of the clear-sky model of insolation (2 very "

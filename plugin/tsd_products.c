@@ -157,7 +157,7 @@ static const tsd_product_def PRODUCTS[] = {
      * Earth horizon, horizon plane (a date range: three horizon planes,
      * one double accumulator) */
     {"insolation", "clear-sky irradiation on DATE, or in total from START_DATE to "
-     "END_DATE, Wh/m2: total, beam, diffuse", "Wh/m2",
+     "END_DATE, Wh/m2: global, beam, diffuse", "Wh/m2",
      "Wh/m2", insolation_bands, NULL, band_insolation, TSD_BYTE_NEVER, 0, 1,
      TSD_STEPS_NONE, 12, 0, 5, NULL,
      SWEEP WINDOW DAY "STEP_MINUTES SUN_POSITION LINKE_TURBIDITY " RANGE, "CLEAR_SKY_MODEL",
@@ -291,6 +291,10 @@ int tsd_options_unused(const tsd_options *o, const tsd_product_def *p, char *buf
                                ? moot_beside(o, p, tsd_option_name(i), why, sizeof why)
                                : NULL;
         if (tsd_product_takes(p, i) && !moot)
+            continue;
+        /* a Byte-only product's OUTPUT_TYPE=Byte or AUTO names what it
+         * writes (Float32 is refused): "does nothing here" misled */
+        if (p->byte == TSD_BYTE_ALWAYS && !strcmp(tsd_option_name(i), "OUTPUT_TYPE"))
             continue;
         /* "SUN_AZIMUTH (an option of shade, shadow and envlight)" */
         if (!moot)

@@ -175,6 +175,30 @@ class ProductsItem(unittest.TestCase):
                     open_product(name, refused)
                 print("%s: %s" % (name, e.exception))
 
+    def test_what_the_table_says_is_what_the_bands_are(self):
+        """Session 58's options audit: insolation's first band was 'total'
+        in the product's description and 'global' in its band description
+        and the docs (now 'global' everywhere); farshadow's OUTPUT_TYPE=Byte,
+        what it writes, was warned of as doing nothing; a geographic DEM's
+        MERIDIAN_CONVERGENCE read -0.000000."""
+        p = {q["name"]: q for q in products()}
+        self.assertIn("global, beam, diffuse", p["insolation"]["description"])
+        ds = open_product("insolation")
+        self.assertEqual(ds.GetRasterBand(1).GetDescription(), "insolation global")
+        ds = None
+        for value in ("Byte", "AUTO"):
+            said = []
+            gdal.PushErrorHandler(lambda cls, no, msg: said.append(msg))
+            try:
+                ds = open_product("farshadow", ["OUTPUT_TYPE=" + value, "ATLAS_STEPS=2"])
+            finally:
+                gdal.PopErrorHandler()
+            self.assertIsNotNone(ds)
+            self.assertFalse([m for m in said if "OUTPUT_TYPE" in m], said)
+            ds = None
+        ds = open_product("shade", ["DATETIME=2026-06-21T12:00:00-05:00"])
+        self.assertEqual(ds.GetMetadataItem("MERIDIAN_CONVERGENCE"), "0.000000")
+
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)
