@@ -260,6 +260,31 @@ static ts_status shadowmap_visibility(const tsd_compute_ctx *c, const ts_grid *g
     so.threads = c->opts->threads;
     so.progress = c->run->progress;
     so.progress_user = c->run->progress_user;
+    /* the map's rows grow with the relief seen from a low sun, which the
+     * estimate at open could not know: refused where the real map does
+     * not fit what the limit leaves (session 57's audit: 1.10-1.14 times
+     * MAX_MEMORY taken) */
+    ts_shadowmap_frame f;
+    if (c->run->limit_bytes > 0 &&
+        ts_shadowmap_frame_make(g, c->run->sun_azimuth, c->run->sun_elevation, &so, &f,
+                                &err) == TS_OK) {
+        const double plane = (double)g->width * g->height * sizeof(float);
+        const double real = 3 * plane + (double)ts_shadowmap_keys(&f) * sizeof(int);
+        const double over = real - tsd_shadowmap_bytes(c->opts, g->width, g->height) -
+                            c->run->headroom_bytes;
+        if (over > 0) {
+            return tsd_fail(c->msg, c->msg_size, TS_ERR_NOMEM,
+                     "METHOD=shadowmap's depth map for a sun %.1f degrees high over this "
+                     "terrain's relief is %d x %d texels: with its buffers about %.0f MiB, "
+                     "%.0f MiB more than the memory limit of %.0f MiB leaves (MAX_MEMORY; by default "
+                     "three quarters of the physical memory); give "
+                     "MAX_MEMORY=%.0f or more, a smaller SHADOWMAP_SCALE (now %g), or "
+                     "METHOD=exact",
+                     c->run->sun_elevation, f.width, f.height, ceil(real / 1048576.0),
+                     ceil(over / 1048576.0), c->run->limit_bytes / 1048576.0,
+                     ceil((c->run->limit_bytes + over) / 1048576.0), so.scale);
+        }
+    }
     if (NOTE(c, ts_backend_shadowmap_compute(BK(c), g, c->run->sun_azimuth,
                                              c->run->sun_elevation, &so, vis, &rep, &err),
              rep) != TS_OK)

@@ -63,6 +63,11 @@ typedef struct {
     /* host memory a horizon stream may add for batches of planes, each
      * batch one OpenCL call (tsd_compute_stream); 0: one plane a call */
     double batch_bytes;
+    /* MAX_MEMORY's limit and what the estimate at open left under it
+     * (tsd_dataset_memory.cpp), for the buffers whose size is known only
+     * when computing (METHOD=shadowmap's map, taller with the relief at a
+     * low sun); 0: unchecked */
+    double limit_bytes, headroom_bytes;
 } tsd_run;
 
 /** The run state of options `o`, with `sun` (may be NULL) placing the sun

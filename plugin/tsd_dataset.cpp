@@ -511,6 +511,10 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     // OpenCL sweeps of a horizon stream in batches: in the other half
     // (docs/opencl.md, "Through the driver")
     m_sRun.batch_bytes = dfHeadroom / 2;
+    // and what is known only when computing, against the whole headroom
+    const char *pszLimitWhy = nullptr;
+    m_sRun.limit_bytes = MemoryLimit(sOpts, &pszLimitWhy);
+    m_sRun.headroom_bytes = dfHeadroom;
     /* a bad TERRASHADE_BACKEND or _SIMD is an error here (without probing OpenCL) */
     m_bUsesBackend = m_psProduct->uses_backend && m_psProduct->uses_backend(&sOpts, psSun);
     if (tsd_backend_check_env(&sOpts, m_bUsesBackend, szMsg, sizeof szMsg) != 0)

@@ -324,6 +324,17 @@ static int pyramid_planes(const tsd_options *o, const tsd_product_def *p, int en
     return batch;
 }
 
+double tsd_shadowmap_bytes(const tsd_options *o, int width, int height)
+{
+    const double w = width, h = height, plane = w * h * sizeof(float);
+    /* the sun's azimuth is known here unless DATETIME sets it: then the
+     * widest, a diagonal */
+    const double az = (o->datetime[0] ? 45.0 : o->sun_azimuth) * M_PI / 180;
+    const double ca = fabs(cos(az)), sa = fabs(sin(az)), k = o->shadowmap_scale;
+    const double texels = (k * (w * ca + h * sa) + 3) * (k * (w * sa + h * ca) + 3);
+    return 3 * plane + texels * (1 + 1.0 / 256) * sizeof(int);
+}
+
 /* Bytes of the shading method's own buffers beside its planes:
  * METHOD=shadowmap's map (SHADOWMAP_SCALE^2 int texels a cell of the DEM
  * turned to face the sun, the relief's extra rows at a low sun left out)
@@ -334,15 +345,8 @@ static double method_bytes(const tsd_options *o, const tsd_product_def *p, int w
 {
     if (!tsd_product_takes(p, tsd_option_find("METHOD")))
         return 0;
-    const double w = width, h = height, plane = w * h * sizeof(float);
-    if (o->method == TSD_METHOD_SHADOWMAP) {
-        /* the sun's azimuth is known here unless DATETIME sets it: then
-         * the widest, a diagonal */
-        const double az = (o->datetime[0] ? 45.0 : o->sun_azimuth) * M_PI / 180;
-        const double ca = fabs(cos(az)), sa = fabs(sin(az)), k = o->shadowmap_scale;
-        const double texels = (k * (w * ca + h * sa) + 3) * (k * (w * sa + h * ca) + 3);
-        return 3 * plane + texels * (1 + 1.0 / 256) * sizeof(int);
-    }
+    if (o->method == TSD_METHOD_SHADOWMAP)
+        return tsd_shadowmap_bytes(o, width, height);
     if (o->method == TSD_METHOD_SH && o->swath_directions <= 8)
         return (o->swath_directions - 1) * (double)TS_SH_WEDGE_STEPS * TS_SH_WEDGE_STEPS *
                TS_SH_COEFFS * sizeof(float);

@@ -110,6 +110,15 @@ double tsd_product_peak_bytes(const tsd_options *o, int width, int height,
                               double *steady);
 
 /**
+ * METHOD=shadowmap's own buffers on a width x height grid as counted at
+ * open: its depth map, SHADOWMAP_SCALE^2 int texels a cell of the DEM
+ * turned to face the sun, without the rows that the relief adds at a low
+ * sun (the relief is not known at open; tsd_compute checks the real map
+ * against what the limit leaves), and three projected-coordinate planes.
+ */
+double tsd_shadowmap_bytes(const tsd_options *o, int width, int height);
+
+/**
  * The driver metadata item TERRASHADE_PRODUCTS: an XML list
  * <Products><Product name='shade' description='...' unit='...' bands='1'
  * daily='no' byte='auto' options='SUN_AZIMUTH,...'/>...</Products>, where

@@ -201,6 +201,34 @@ class MemoryEstimate(unittest.TestCase):
                 self.assertLessEqual(est, 1.3 * grown + 8 * MIB,
                                      "the estimate is far above the real peak")
 
+    def test_shadowmap_at_a_low_sun_keeps_to_the_limit(self):
+        """METHOD=shadowmap's depth map grows with the relief seen from a low
+        sun (relief x cot(elevation) more rows), which the estimate at open
+        cannot know: under a MAX_MEMORY that fits the estimate but not the
+        map, the read is refused with the map's size and the MAX_MEMORY that
+        does; under that one it runs, and the process grows by no more than
+        it. Until session 58 such a run took what it needed: 1.10-1.14 times
+        the limit in session 57's audit, 1.6 times it here at a 2 degree
+        sun."""
+        for elevation in (5, 2):
+            with self.subTest(elevation=elevation):
+                o = dict(COMMON, PRODUCT="shade", METHOD="shadowmap",
+                         SUN_ELEVATION=elevation)
+                est = estimate(self.dem, o, self.out) // MIB
+                p = T.run(["gdal_translate", "-q"] + T.oo_args(dict(o, MAX_MEMORY=est)) +
+                          [T.conn(self.dem), self.out], ok=False)
+                print(p.stderr.strip().splitlines()[0][:300])
+                self.assertIn("METHOD=shadowmap's depth map", p.stderr)
+                limit = int(re.search(r"MAX_MEMORY=(\d+) or more", p.stderr).group(1))
+                self.assertGreater(limit, est)
+                args = ["gdal_translate", "-q"] + T.oo_args(dict(o, MAX_MEMORY=limit))
+                grown = (peak_rss(args + [T.conn(self.dem), self.out]) -
+                         peak_rss(args + [T.conn(self.tiny), self.out]))
+                print("sun %d deg: estimate %d MiB, map's limit %d MiB, grew %.1f MiB" %
+                      (elevation, est, limit, grown / MIB))
+                self.assertLessEqual(grown, limit * MIB)
+                self.assertGreaterEqual(limit, 0.95 * grown / MIB - 4)
+
     def test_windowed_estimate_brackets_the_peak(self):
         self.brackets(WINDOWED, dict(COMMON, TILE_SIZE=512), estimate_logged)
 
