@@ -49,15 +49,27 @@ static void site_grid(tsd_sites *s, int width, int height)
  * 2 degrees of arc apart may be tens of degrees of longitude apart, and
  * their suns' directions, interpolated between, came up to 7.6 deg too
  * high (session 56's audit of per_cell near the poles). */
+/* The turn of a distant sun's grid azimuth from a place (lon, lat, grid
+ * azimuth of true north) to another, degrees: its true azimuth turns with
+ * the meridians, dlon sin(mid-latitude), its grid azimuth by that plus the
+ * turn of grid north (they cancel on a conformal grid, not on a geographic
+ * one near a pole). (The sum wrapped: across a pole dlon and the norths'
+ * difference are each 180, and wrapped apart they added to 360.) */
+static double sun_turn(double lon_a, double lat_a, double north_a, double lon_b, double lat_b,
+                       double north_b)
+{
+    const double dlon = remainder(lon_b - lon_a, 360.0);
+    return fabs(remainder(dlon * sin(0.5 * (lat_a + lat_b) * M_PI / 180.0) + north_b - north_a,
+                          360.0));
+}
+
 static double site_step(const tsd_sites *s, size_t a, size_t b)
 {
     const double mid = 0.5 * (s->lat[a] + s->lat[b]) * M_PI / 180.0;
-    const double dlon = remainder(s->lon[b] - s->lon[a], 360.0);
     const double lat = fabs(s->lat[b] - s->lat[a]);
-    const double lon = fabs(dlon) * cos(mid);
-    /* (the sum wrapped: across a pole dlon and the norths' difference are
-     * each 180, and wrapped apart they added to 360) */
-    const double turn = fabs(remainder(dlon * sin(mid) + s->north[b] - s->north[a], 360.0));
+    const double lon = fabs(remainder(s->lon[b] - s->lon[a], 360.0)) * cos(mid);
+    const double turn =
+        sun_turn(s->lon[a], s->lat[a], s->north[a], s->lon[b], s->lat[b], s->north[b]);
     return fmax(fmax(lat, lon), turn);
 }
 
@@ -221,12 +233,7 @@ double tsd_sites_reach(const double gt[6], int width, int height, OGRSpatialRefe
         double a = sp * sp + cos(s.lat[k] * rad) * cos(lat0 * rad) * sl * sl;
         double angle = 2 * asin(sqrt(a < 1 ? a : 1)) / rad;
         reach = angle > reach ? angle : reach;
-        /* a distant sun's true azimuth turns with the meridians, its grid
-         * azimuth by that plus the turn of grid north (they cancel on a
-         * conformal grid, not on a geographic one near a pole) */
-        double dlon = remainder(s.lon[k] - lon0, 360.0);
-        double t = fabs(remainder(dlon * sin(0.5 * (s.lat[k] + lat0) * rad) + s.north[k] -
-                                  north0, 360.0));
+        double t = sun_turn(lon0, lat0, north0, s.lon[k], s.lat[k], s.north[k]);
         most = t > most ? t : most;
     }
     tsd_sites_free(&s);
