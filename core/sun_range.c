@@ -477,10 +477,19 @@ ts_status ts_insolation_range(const ts_grid *grid, const ts_sun_sites *sites,
      * planes' span from north) */
     ts_horizon_opts h = o->horizon;
     h.directions = h.directions < 1 ? 1 : h.directions;
-    const double turns = fmod(h.start_azimuth, 360.0) / (360.0 / c.D);
-    const int first = (int)floor(turns + 0.5) % c.D;
-    int shared = c.D % h.directions == 0 && fabs(turns - floor(turns + 0.5)) < 1e-9;
+    double start = fmod(h.start_azimuth, 360.0); /* in [0, 360): a plane's index */
+    start = start < 0 ? start + 360.0 : start;
+    const int first = (int)floor(start / (360.0 / c.D) + 0.5) % c.D;
+    int shared = c.D % h.directions == 0;
     const int every = shared ? c.D / h.directions : 1;
+    /* shared where every sky azimuth is a plane's to the bit (a start a
+     * hair off a plane, 359.9999999999 by plane 0, is swept on its own) */
+    ts_horizon_opts planes = h;
+    planes.directions = c.D;
+    planes.start_azimuth = 0;
+    for (int k = 0; shared && k < h.directions; k++)
+        shared = ts_horizon_azimuth(&planes, (first + k * every) % c.D) ==
+                 ts_horizon_azimuth(&h, k);
     sky_share share = {grid, nx, ny, nz, sky, every, first % every, h.directions};
     double p0 = s0;
     if (!shared) {

@@ -326,6 +326,54 @@ START_TEST(test_interval_weights)
 }
 END_TEST
 
+/* The sky term's start_azimuth turns its azimuths only: a start below 0
+ * or at 360 names the azimuths of its turn into [0, 360) (the planes the
+ * stream shares had a negative phase at -5.625 and the sky summed none:
+ * diffuse 0, session 58's review), and a start a hair off a plane is
+ * swept on its own (359.9999999999 was read from plane 0). */
+START_TEST(test_sky_start_azimuth_turns)
+{
+    ts_grid g;
+    test_site p;
+    ts_day_opts o;
+    fixture(&g, 48, 40, 3, 300.0, &p, &o);
+    o.horizon.directions = 16;
+    size_t n = (size_t)g.width * g.height;
+    float *want = tdem_floats(n), *got = tdem_floats(n), *dummy = tdem_floats(n);
+    ts_error err;
+    ts_date_range r;
+    range_set(&r, 2026, 6, 1, 2026, 6, 2, 60, 1);
+    static const double pairs[][2] = {{354.375, -5.625}, {354.375, -365.625}, {0, 360},
+                                      {11.25, 371.25}};
+    for (size_t k = 0; k < sizeof pairs / sizeof pairs[0]; k++) {
+        o.horizon.start_azimuth = pairs[k][0];
+        ck_assert(ts_insolation_range(&g, &p.s, &o, &r, dummy, NULL, want, &err) == TS_OK);
+        o.horizon.start_azimuth = pairs[k][1];
+        ck_assert(ts_insolation_range(&g, &p.s, &o, &r, dummy, NULL, got, &err) == TS_OK);
+        double mean = 0;
+        for (size_t i = 0; i < n; i++) {
+            mean += want[i] / n;
+            ck_assert_msg(fabs(got[i] - want[i]) <= 1e-4 * want[i], "start %g vs %g, cell %zu: "
+                          "diffuse %g vs %g", pairs[k][1], pairs[k][0], i, got[i], want[i]);
+        }
+        ck_assert_msg(mean > 100, "diffuse %g Wh/m2", mean);
+    }
+    /* a hair off plane 0: the sweeps at 359.9999999999 + k * 22.5, as one
+     * sky sweep per azimuth gives them (HORIZON_DIRECTIONS 60: none shared) */
+    o.horizon.start_azimuth = 359.9999999999;
+    ck_assert(ts_insolation_range(&g, &p.s, &o, &r, dummy, NULL, got, &err) == TS_OK);
+    r.horizon_directions = 60;
+    ck_assert(ts_insolation_range(&g, &p.s, &o, &r, dummy, NULL, want, &err) == TS_OK);
+    for (size_t i = 0; i < n; i++)
+        ck_assert_msg(fabs(got[i] - want[i]) <= 1e-5 * want[i], "cell %zu: diffuse %g vs %g", i,
+                      got[i], want[i]);
+    free(want);
+    free(got);
+    free(dummy);
+    ts_grid_free(&g);
+}
+END_TEST
+
 typedef struct {
     int calls, stop_at;
     double last;
@@ -431,6 +479,7 @@ int main(void)
     tcase_add_test(tc, test_jacksboro_against_exact);
     tcase_add_test(tc, test_flat_year);
     tcase_add_test(tc, test_interval_weights);
+    tcase_add_test(tc, test_sky_start_azimuth_turns);
     tcase_add_test(tc, test_progress_and_cancel);
     tcase_add_test(tc, test_bad_arguments);
     suite_add_tcase(s, tc);
