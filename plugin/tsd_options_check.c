@@ -300,11 +300,16 @@ int tsd_options_check(const tsd_options *o, char *msg, size_t n)
                     "unknown", o->date);
     if (o->timezone[0] && !o->date[0] && !o->start_date[0] && !(o->datetime[0] && p->daily))
         REFUSE("TIMEZONE applies with DATE (or DATETIME) to the day products only");
-    if (from_time && (tsd_options_given(o, "SUN_AZIMUTH") ||
-                      tsd_options_given(o, "SUN_ELEVATION")))
+    /* (at their defaults, 315 and 45, they are warned of as doing nothing:
+     * a script's one set of options, tsd_options_unused) */
+    tsd_options d;
+    tsd_options_defaults(&d);
+    const int az_set = o->sun_azimuth != d.sun_azimuth,
+              el_set = o->sun_elevation != d.sun_elevation;
+    if (from_time && (az_set || el_set))
         REFUSE("%s places the sun: do not give %s with it",
                     o->datetime[0] ? "DATETIME" : o->start_date[0] ? "START_DATE" : "DATE",
-                    tsd_options_given(o, "SUN_AZIMUTH") ? "SUN_AZIMUTH" : "SUN_ELEVATION");
+                    az_set ? "SUN_AZIMUTH" : "SUN_ELEVATION");
     if (p->daily && o->sun_position == TSD_SUN_PER_CELL &&
         !tsd_product_takes(p, tsd_option_find("SUN_POSITION")))
         REFUSE("PRODUCT=%s computes the sun at the DEM's centre only "

@@ -270,6 +270,19 @@ static const char *moot_beside(const tsd_options *o, const tsd_product_def *p, c
          !strcmp(name, "DELTA_T")) &&
         !tsd_options_sun_from_time(o))
         return "it refracts and places a sun computed from DATETIME";
+    /* given at their defaults (other values are refused, tsd_options_check) */
+    if ((!strcmp(name, "SUN_AZIMUTH") || !strcmp(name, "SUN_ELEVATION")) &&
+        tsd_options_sun_from_time(o))
+        return o->datetime[0] ? "DATETIME places the sun" : "the day places the sun";
+    if (!strcmp(name, "EXPOSURE") && !tsd_options_output_byte(o))
+        return "it sets the exposure of OUTPUT_TYPE=Byte; Float32 keeps the light's values";
+    if (!strcmp(name, "ENV_ROTATION") && !o->env_map[0])
+        return "it turns ENV_MAP; a SKY turns with its sun";
+    if ((!strcmp(name, "ENV_HORIZON_STEPS") || !strcmp(name, "ENV_NORMAL_STEPS")) &&
+        !tsd_product_takes(p, tsd_option_find("EXPOSURE")) &&
+        (!(o->sky_weight > 0) || (!o->sky[0] && !o->env_map[0])))
+        return "of the sky term's SKY or ENV_MAP, which SKY_WEIGHT > 0 with one of them "
+               "would use";
     if ((!strcmp(name, "DIRECTIONS") || !strcmp(name, "START_AZIMUTH")) &&
         tsd_product_takes(p, tsd_option_find("SKY_WEIGHT")) && !(o->sky_weight > 0))
         return "of the sky term, which SKY_WEIGHT=0 leaves out";

@@ -46,7 +46,7 @@ CASES = [
     # without a word)
     ("per-cell sun for svf", T.conn(DEM), ["PRODUCT=svf", "SUN_POSITION=per_cell"],
      "SUN_POSITION=per_cell applies to PRODUCT=shade, PRODUCT=shadow, PRODUCT=sunhours, "
-     "PRODUCT=insolation, PRODUCT=daycycle, not to PRODUCT=svf"),
+     "PRODUCT=insolation and PRODUCT=daycycle, not to PRODUCT=svf"),
     ("per-cell sun for envlight", T.conn(DEM),
      ["PRODUCT=envlight", "SKY=clear", "DATETIME=2026-06-21T12:00-05:00",
       "SUN_POSITION=per_cell"], "not to PRODUCT=envlight"),
