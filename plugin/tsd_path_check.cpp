@@ -159,7 +159,12 @@ std::string RefusedDEMName(const char *pszDEM, const char *pszWhat, bool bFromFi
 
 bool IsStdinName(const std::string &osName)
 {
-    return osName == "/vsistdin/" || osName == "/vsistdin";
+    // with GDAL's options too (/vsistdin?buffer_limit=-1: session 58's review
+    // found an atlas's SHADOWS=all entry shared by whatever DEM came in)
+    if (osName.compare(0, 9, "/vsistdin") != 0)
+        return false;
+    const std::string osRest = osName.substr(9);
+    return osRest.empty() || osRest == "/" || osRest[0] == '?' || osRest.compare(0, 2, "/?") == 0;
 }
 
 } // namespace tsd

@@ -25,9 +25,10 @@ std::string NonRegularSource(const char *pszPath);
  * pszWhat says what the name is ("the DEM", "the atlas's SOURCE_DEM"). */
 std::string RefusedDEMName(const char *pszDEM, const char *pszWhat, bool bFromFile);
 
-/* Whether a DEM's name is GDAL's for the standard input itself, which the
- * driver copies into memory at open (a path that merely contains the
- * word is a file's). */
+/* Whether a DEM's name is GDAL's for the standard input itself, with or
+ * without its options (/vsistdin?buffer_limit=...), which the driver
+ * copies into memory at open (a path that merely contains the word is a
+ * file's). */
 bool IsStdinName(const std::string &osName);
 
 } // namespace tsd

@@ -8,6 +8,7 @@ never touch the DEM's own file (its georeferencing, for a PNG DEM)."""
 import math
 import os
 import shutil
+import subprocess
 import unittest
 import xml.etree.ElementTree as ET
 
@@ -459,6 +460,17 @@ class Pam(unittest.TestCase):
         shutil.copyfile(os.path.join(d, "other.tsa"), tsa)
         saved, _ = saved_and_computed()
         self.assertEqual(saved, [0, 0, 0, -1], "another atlas's file took these statistics")
+        # a DEM from the standard input, GDAL's options with it or not, is
+        # another DEM each run: no entry (with ?buffer_limit one was kept,
+        # keyed by the name, which any DEM piped in then took: the review)
+        for name in ("/vsistdin/", "/vsistdin?buffer_limit=-1"):
+            with open(dem, "rb") as stdin:
+                p = subprocess.run(["gdalinfo", "-stats", "-oo", "SHADOWS=all", "-oo",
+                                    "DEM=" + name, tsa], stdin=stdin, capture_output=True,
+                                   text=True, env=T.env(), timeout=120)
+            self.assertEqual(p.returncode, 0, p.stderr)
+            with open(tsa + ".aux.xml") as f:
+                self.assertNotIn("vsistdin", f.read(), name)
 
     def test_an_entry_in_the_dems_own_file_is_still_read(self):
         """Before session 48 the entries went into the DEM's .aux.xml: a
