@@ -213,9 +213,11 @@ void TSDataset::SetupSunMetadata()
                                  CPLSPrintf("%.8f", s.sites.longitude[nRef]));
     GDALDataset::SetMetadataItem("SUN_SITE_LATITUDE",
                                  CPLSPrintf("%.8f", s.sites.latitude[nRef]));
-    // (a geographic grid's 0 was written -0.000000, as any below 5e-7 was)
-    GDALDataset::SetMetadataItem("MERIDIAN_CONVERGENCE",
-                                 CPLSPrintf("%.6f", std::fabs(dfNorth) < 5e-7 ? 0.0 : -dfNorth));
+    // (a geographic grid's 0 was written -0.000000)
+    std::string osConvergence = CPLSPrintf("%.6f", -dfNorth);
+    if (osConvergence == "-0.000000")
+        osConvergence.erase(0, 1);
+    GDALDataset::SetMetadataItem("MERIDIAN_CONVERGENCE", osConvergence.c_str());
     GDALDataset::SetMetadataItem("SUN_MODEL", "SPA (Reda & Andreas 2004), apparent "
                                               "elevation with refraction");
     char szTime[64];
