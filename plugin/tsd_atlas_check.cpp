@@ -178,11 +178,23 @@ std::string CheckAtlasDEM(GDALDataset *poDEM, const std::string &osDEM, bool bGi
                               padfGT[4], padfGT[5]);
     }
     const OGRSpatialReference *poDEMSRS = poDEM->GetSpatialRef();
-    if (poSRS && !poSRS->IsEmpty() && poDEMSRS && !poDEMSRS->IsEmpty() &&
-        !poSRS->IsSame(poDEMSRS))
-        return CPLSPrintf("SHADOWS=all: the DEM '%s'%s is in another CRS (%s) than the "
-                          "atlas (%s): name the DEM the atlas was made from with DEM=...",
-                          osDEM.c_str(), pszWhich, poDEMSRS->GetName(), poSRS->GetName());
+    // their ground: an atlas keeps no vertical CRS (a product's is the
+    // DEM's without it since session 58, one written before keeps it)
+    auto Ground = [](const OGRSpatialReference *po)
+    {
+        OGRSpatialReference o(*po);
+        if (o.IsCompound())
+            o.StripVertical();
+        return o;
+    };
+    if (poSRS && !poSRS->IsEmpty() && poDEMSRS && !poDEMSRS->IsEmpty())
+    {
+        const OGRSpatialReference oAtlas = Ground(poSRS), oDEM = Ground(poDEMSRS);
+        if (!oAtlas.IsSame(&oDEM))
+            return CPLSPrintf("SHADOWS=all: the DEM '%s'%s is in another CRS (%s) than the "
+                              "atlas (%s): name the DEM the atlas was made from with DEM=...",
+                              osDEM.c_str(), pszWhich, poDEMSRS->GetName(), poSRS->GetName());
+    }
     return std::string();
 }
 

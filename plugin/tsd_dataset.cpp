@@ -109,7 +109,7 @@ CPLErr TSDataset::GetGeoTransform(double *padfGT)
 
 const OGRSpatialReference *TSDataset::GetSpatialRef() const
 {
-    return m_oSRS.IsEmpty() ? nullptr : &m_oSRS;
+    return m_oProductSRS.IsEmpty() ? nullptr : &m_oProductSRS;
 }
 
 /* Start the progress line of a computation run by psRun (PROGRESS, after
@@ -421,6 +421,9 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     const tsd_options &sOpts = m_sOpts;
     OGRSpatialReferenceH hSRS =
         m_oSRS.IsEmpty() ? nullptr : OGRSpatialReference::ToHandle(&m_oSRS);
+    m_oProductSRS = m_oSRS;
+    if (m_oProductSRS.IsCompound())
+        m_oProductSRS.StripVertical();
     ts_status eSt = tsd_cells_compute(m_adfGT, W, H, hSRS, sOpts.cell_sizes, &m_sCells, szMsg,
                                       sizeof szMsg);
     if (eSt != TS_OK)

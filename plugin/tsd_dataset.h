@@ -95,6 +95,10 @@ class TSDataset final : public GDALPamDataset
     double m_adfGT[6] = {0, 1, 0, 0, 0, 1};
     bool m_bHasGT = true;
     OGRSpatialReference m_oSRS{};
+    /* what the product reports: m_oSRS without a compound CRS's vertical
+     * part (shading is no height: gdalwarp scaled an svf of a DEM in
+     * NAVD88 feet by 0.3048, session 58's CRS audit); set by Setup */
+    OGRSpatialReference m_oProductSRS{};
     std::mutex m_oMutex{};
     /* one reader at a time through GDAL's block cache (IRasterIO, the
      * statistics): GDAL 3.6 files a block in the band's cache before

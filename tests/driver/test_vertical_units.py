@@ -65,6 +65,37 @@ class VerticalUnits(unittest.TestCase):
         self.assertFalse(np.array_equal(got, T.read(T.conn(self.plain), band=1,
                                                     options=OPTIONS)))
 
+    def test_products_carry_no_vertical_crs(self):
+        """Shading is no height: a product of a DEM in a compound CRS
+        reports its horizontal part only (its overview levels are set up
+        alike), so that
+        gdalwarp does not convert its values by the vertical unit (an svf
+        of a DEM in NAVD88 feet, warped to UTM, read 0.295 for 0.969 until
+        session 58's CRS audit). Its heights are still taken in feet, and an
+        atlas of it reads its near shadows from the compound DEM."""
+        ds = opened(self.ftus, PRODUCT="svf", OUTPUT_TYPE="Float32")
+        srs = ds.GetSpatialRef()
+        self.assertFalse(srs.IsCompound())
+        self.assertTrue(srs.IsProjected())
+        self.assertEqual(ds.GetMetadataItem("Z_FACTOR"), "%.10g" % FT_US)
+        want = ds.GetRasterBand(1).ComputeStatistics(False)[2]
+        ds = None
+        out = os.path.join(self.dir, "svf_utm.tif")
+        T.run(["gdalwarp", "-q", "-overwrite", "-t_srs", "EPSG:32617"] +
+              T.oo_args(dict(OPTIONS, PRODUCT="svf")) + [T.conn(self.ftus), out])
+        ds = gdal.Open(out)
+        got = ds.GetRasterBand(1).ComputeStatistics(False)[2]
+        ds = None
+        print("svf mean %.4f, warped to UTM %.4f" % (want, got))
+        self.assertAlmostEqual(got, want, delta=0.02)
+        tsa = os.path.join(self.dir, "ftus.tsa")
+        T.run(["gdal_translate", "-q", "-of", "TERRASHADE"] + T.oo_args(dict(
+            PRODUCT="farshadow", DATE="2026-06-21", TIMEZONE="-05:00", ATLAS_STEPS=2,
+            FAR_THRESHOLD=8)) + [T.conn(self.ftus), tsa])
+        ds = gdal.OpenEx(tsa, gdal.OF_RASTER, open_options=["SHADOWS=all"])
+        self.assertIsNotNone(ds.GetRasterBand(1).Checksum())
+        ds = None
+
     def test_band_unit_feet(self):
         self.check(self.ft, 0.3048, "band unit ft", self.m_ft)
 
