@@ -218,6 +218,25 @@ static int ground_open(ground_ctx *t, OGRSpatialReferenceH srs)
     return ok;
 }
 
+/* The ends of the n segments (x0, y0)-(x1, y1) of the DEM's pixel space,
+ * as longitude X and latitude Y (2n each: segment i's at 2i and 2i + 1),
+ * and which of them PROJ could place (ok); 0 where it failed outright. */
+static int segments_lonlat(const ground_ctx *t, const double gt[6], int n, const double *x0,
+                           const double *y0, const double *x1, const double *y1, double *X,
+                           double *Y, int *ok)
+{
+    for (int i = 0; i < n; i++) {
+        X[2 * i] = gt[0] + x0[i] * gt[1];
+        Y[2 * i] = gt[3] + y0[i] * gt[5];
+        X[2 * i + 1] = gt[0] + x1[i] * gt[1];
+        Y[2 * i + 1] = gt[3] + y1[i] * gt[5];
+    }
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    const int good = tsd_lonlat_to(&t->ll, 2 * n, X, Y, ok);
+    CPLPopErrorHandler();
+    return good;
+}
+
 /* The ground lengths of the n segments (x0, y0)-(x1, y1) of the DEM's pixel
  * space (x, y: columns and rows from its top-left corner, as gt maps them)
  * into len; 0 where PROJ cannot place an end. */
@@ -226,17 +245,7 @@ static int ground_lengths(const ground_ctx *t, const double gt[6], int n, const 
 {
     double *X = malloc((size_t)2 * n * sizeof *X), *Y = malloc((size_t)2 * n * sizeof *Y);
     int *ok = malloc((size_t)2 * n * sizeof *ok), good = X && Y && ok;
-    for (int i = 0; good && i < n; i++) {
-        X[2 * i] = gt[0] + x0[i] * gt[1];
-        Y[2 * i] = gt[3] + y0[i] * gt[5];
-        X[2 * i + 1] = gt[0] + x1[i] * gt[1];
-        Y[2 * i + 1] = gt[3] + y1[i] * gt[5];
-    }
-    if (good) {
-        CPLPushErrorHandler(CPLQuietErrorHandler);
-        good = tsd_lonlat_to(&t->ll, 2 * n, X, Y, ok);
-        CPLPopErrorHandler();
-    }
+    good = good && segments_lonlat(t, gt, n, x0, y0, x1, y1, X, Y, ok);
     for (int i = 0; good && i < n; i++) {
         const int a = 2 * i, b = 2 * i + 1;
         if (!ok[a] || !ok[b] || !isfinite(X[a] + Y[a] + X[b] + Y[b]) || fabs(Y[a]) > 90 ||
@@ -251,6 +260,50 @@ static int ground_lengths(const ground_ctx *t, const double gt[6], int n, const 
     free(X);
     free(Y);
     free(ok);
+    return good;
+}
+
+/* A point on the ellipsoid's surface in Earth-centred Cartesian metres. */
+static void ecef(const struct geod_geodesic *g, double lon, double lat, double out[3])
+{
+    const double f = lon * M_PI / 180, p = lat * M_PI / 180, e2 = g->f * (2 - g->f);
+    const double N = g->a / sqrt(1 - e2 * sin(p) * sin(p));
+    out[0] = N * cos(p) * cos(f);
+    out[1] = N * cos(p) * sin(f);
+    out[2] = N * (1 - e2) * sin(p);
+}
+
+/* How far the grid's axes are from a right angle on the ground, at most,
+ * over the m cells whose east-west and north-south segments are pairs
+ * 2i, 2i + 1 of (x0, y0)-(x1, y1) (ground_lengths'): the angle between the
+ * two chords in space, which, unlike azimuths, holds at a pole. */
+static int ground_skew(const ground_ctx *t, const double gt[6], int m, const double *x0,
+                       const double *y0, const double *x1, const double *y1, double *skew)
+{
+    double X[36], Y[36];
+    int ok[36];
+    const int good = m <= 9 && segments_lonlat(t, gt, 2 * m, x0, y0, x1, y1, X, Y, ok);
+    *skew = 0;
+    for (int i = 0; good && i < m; i++) {
+        double v[2][3];
+        for (int k = 0; k < 2; k++) {
+            const int a = 4 * i + 2 * k, b = a + 1;
+            double pa[3], pb[3];
+            if (!ok[a] || !ok[b] || !isfinite(X[a] + Y[a] + X[b] + Y[b]))
+                return 0;
+            ecef(&t->g, X[a], Y[a], pa);
+            ecef(&t->g, X[b], Y[b], pb);
+            for (int j = 0; j < 3; j++)
+                v[k][j] = pb[j] - pa[j];
+        }
+        const double dot = v[0][0] * v[1][0] + v[0][1] * v[1][1] + v[0][2] * v[1][2];
+        const double n0 = sqrt(v[0][0] * v[0][0] + v[0][1] * v[0][1] + v[0][2] * v[0][2]);
+        const double n1 = sqrt(v[1][0] * v[1][0] + v[1][1] * v[1][1] + v[1][2] * v[1][2]);
+        if (!(n0 > 0 && n1 > 0))
+            return 0;
+        const double c = fmax(-1.0, fmin(1.0, dot / (n0 * n1)));
+        *skew = fmax(*skew, fabs(acos(c) * 180 / M_PI - 90.0));
+    }
     return good;
 }
 
@@ -272,7 +325,8 @@ static int ground_scale(const ground_ctx *t, const double gt[6], int width, int 
             x0[i + 1] = x1[i + 1] = fx[k], y0[i + 1] = fy[j] - 0.5, y1[i + 1] = fy[j] + 0.5;
             grid[i + 1] = fabs(gt[5]) * c->unit_to_m;
         }
-    if (!ground_lengths(t, gt, 18, x0, y0, x1, y1, len))
+    if (!ground_lengths(t, gt, 18, x0, y0, x1, y1, len) ||
+        !ground_skew(t, gt, 9, x0, y0, x1, y1, &c->skew_deg))
         return 0;
     c->scale_lo = INFINITY;
     c->scale_hi = 0;
@@ -297,17 +351,43 @@ static ts_status projected(const double gt[6], int width, int height,
 {
     c->cell_x = fabs(gt[1]) * c->unit_to_m;
     c->cell_y = fabs(gt[5]) * c->unit_to_m;
-    if (mode == TSD_CELLS_GRID || OSRIsLocal(srs))
+    if (OSRIsLocal(srs))
         return TS_OK;
     ground_ctx t;
     double across = 0, along = 0;
     if (!ground_open(&t, srs) || !ground_scale(&t, gt, width, height, c, &across, &along)) {
         ground_close(&t);
-        c->scale_lo = c->scale_hi = 0;
-        if (mode == TSD_CELLS_AUTO)
+        c->scale_lo = c->scale_hi = c->skew_deg = 0;
+        if (mode != TSD_CELLS_GROUND)
             return TS_OK; /* nothing known against the grid's sizes */
         return tsd_fail(msg, n, TS_ERR_ARG, "CELL_SIZES=ground: PROJ cannot take the DEM's "
                         "cells to longitude and latitude; use CELL_SIZES=grid");
+    }
+    /* one cell size a row and a north-south one cannot hold axes that are
+     * not at right angles on the ground: slopes, aspects and shadows turn
+     * by as much (Sinusoidal at 84 W 37 N: 41 degrees, a peak's shadow 31
+     * degrees off the sun; session 58's CRS audit) */
+    if (c->skew_deg > TSD_SKEW_MAX_DEG) {
+        ground_close(&t);
+        return tsd_fail(msg, n, TS_ERR_ARG,
+                        "the DEM's grid axes are up to %.1f degrees from a right angle on "
+                        "the ground (its projection shears it there, as Sinusoidal or "
+                        "Mollweide do away from their central meridian), which would turn "
+                        "slopes, aspects and shadows by as much: warp it to a conformal "
+                        "projection first, e.g. gdalwarp -t_srs EPSG:326NN (UTM) dem.tif "
+                        "utm.tif", c->skew_deg);
+    }
+    if (c->skew_deg > TSD_SKEW_WARN_DEG)
+        snprintf(c->warning, sizeof c->warning,
+                 "the DEM's grid axes are up to %.1f degrees from a right angle on the "
+                 "ground (its projection shears it there): slopes, aspects and shadows "
+                 "turn by up to as much; warp it to a conformal projection (e.g. UTM) "
+                 "for exact directions", c->skew_deg);
+    if (mode == TSD_CELLS_GRID) {
+        /* (measured for the shear only: grid sizes and no scale, as asked) */
+        ground_close(&t);
+        c->scale_lo = c->scale_hi = 0;
+        return TS_OK;
     }
     if (mode == TSD_CELLS_AUTO && fabs(c->scale_lo - 1) <= 0.01 && fabs(c->scale_hi - 1) <= 0.01) {
         ground_close(&t);
@@ -352,7 +432,7 @@ static ts_status projected(const double gt[6], int width, int height,
     c->cell_x = c->cell_x_row[height / 2];
     /* what one length per row (east-west) and one for the whole DEM
      * (north-south) cannot hold */
-    if (across > 0.01 || along > 0.05)
+    if ((across > 0.01 || along > 0.05) && !c->warning[0])
         snprintf(c->warning, sizeof c->warning,
                  "the projection's scale varies by %.1f %% across the DEM's columns and its "
                  "cells' north-south length by %.1f %% along its rows; they are measured "
@@ -372,6 +452,27 @@ done:
  * more than twice around the Earth, took GDAL 3.6's Web Mercator inverse
  * seconds a point (1e17 m: an open that never ended; session 57's fuzzing). */
 #define TSD_CORNER_MAX_M 1e8
+
+/* Whether the DEM's columns (x) run along the axis that GIS order puts
+ * second (latitude, northing): a CRS whose data axes keep its authority's
+ * order (EPSG:4326's latitude first: a VRT's dataAxisToSRSAxisMapping="1,2")
+ * with the geotransform in that order. Read as longitude, such a DEM's site
+ * landed in Antarctica (session 58's CRS audit). (Not the axes' names: a
+ * polar stereographic CRS's first axis points "south along 45 E".) */
+static int columns_run_north(OGRSpatialReferenceH srs)
+{
+    OGRSpatialReferenceH gis = OSRClone(srs);
+    if (!gis)
+        return 0;
+    OSRSetAxisMappingStrategy(gis, OAMS_TRADITIONAL_GIS_ORDER);
+    int n_data = 0, n_gis = 0;
+    const int *data = OSRGetDataAxisToSRSAxisMapping(srs, &n_data);
+    const int *order = OSRGetDataAxisToSRSAxisMapping(gis, &n_gis);
+    const int swapped = data && order && n_data >= 2 && n_gis >= 2 &&
+                        abs(data[0]) != abs(order[0]);
+    OSRDestroySpatialReference(gis);
+    return swapped;
+}
 
 static ts_status cells_compute(const double gt[6], int width, int height,
                                OGRSpatialReferenceH srs, tsd_cell_sizes mode, tsd_cells *c,
@@ -396,6 +497,12 @@ static ts_status cells_compute(const double gt[6], int width, int height,
     c->flip_x = gt[1] < 0;
     c->flip_y = gt[5] > 0;
     c->unit_to_m = 1;
+    if (srs && (OSRIsGeographic(srs) || OSRIsProjected(srs)) && columns_run_north(srs))
+        return tsd_fail(msg, n, TS_ERR_ARG,
+                        "the DEM's columns run north-south: its CRS's first axis is "
+                        "latitude or northing, and its geotransform is in that order (a "
+                        "VRT's dataAxisToSRSAxisMapping=\"1,2\", say); terrashade needs "
+                        "x east-west: warp it first, e.g. gdalwarp dem.vrt north_up.tif");
     if (srs && OSRIsGeographic(srs)) {
         if (mode == TSD_CELLS_GRID)
             return tsd_fail(msg, n, TS_ERR_ARG, "CELL_SIZES=grid: the DEM's CRS is "

@@ -31,6 +31,12 @@ extern "C" {
 
 typedef enum { TSD_CRS_NONE = 0, TSD_CRS_PROJECTED, TSD_CRS_GEOGRAPHIC } tsd_crs_kind;
 
+/* The most a projected DEM's grid axes may be from a right angle on the
+ * ground: beyond the first, a warning; beyond the second, a refusal (its
+ * slopes, aspects and shadows would turn by as much). */
+#define TSD_SKEW_WARN_DEG 1.0
+#define TSD_SKEW_MAX_DEG 5.0
+
 typedef struct {
     tsd_crs_kind kind;
     double cell_x;      /* metres; geographic: at the central row */
@@ -44,6 +50,9 @@ typedef struct {
     double scale_lo, scale_hi; /* projected: the projection's scale (grid length
                                   over ground length) seen over the DEM; 0: not
                                   measured (CELL_SIZES=grid, a local CRS) */
+    double skew_deg;    /* projected: how far the grid's axes are from a right
+                           angle on the ground, at most, over nine cells; 0:
+                           not measured (a local CRS) */
     char warning[512];  /* non-empty: something the user should know */
 } tsd_cells;
 

@@ -192,6 +192,64 @@ class CellSizes(unittest.TestCase):
         self.assertAlmostEqual(float(g["CELL_SIZE_Y"]), 30 / 0.9996, 3)
         np.testing.assert_array_equal(self.horizons(dem), self.horizons(dem, CELL_SIZES="grid"))
 
+    def test_grids_the_projection_shears_are_refused(self):
+        """A grid whose axes are not at right angles on the ground (a
+        pseudocylindrical projection away from its central meridian) turns
+        slopes, aspects and shadows by as much: a peak's shadow in
+        Sinusoidal at 84 W 37 N pointed 31 degrees off the sun (session 58's
+        CRS audit). Beyond 5 degrees it is refused, beyond 1 degree warned
+        of; the same place in UTM, or Sinusoidal on its central meridian,
+        opens without a word, whatever CELL_SIZES."""
+        z = np.zeros((32, 32), np.float32)
+        cases = [("+proj=sinu +lon_0=0 +R=6371007.181 +units=m", -84.25, "refused"),
+                 ("+proj=moll +lon_0=0 +datum=WGS84 +units=m", -84.25, "refused"),
+                 ("+proj=sinu +lon_0=-84 +R=6371007.181 +units=m", -84.25, None),
+                 ("+proj=laea +lat_0=52 +lon_0=10 +x_0=4321000 +y_0=3210000 "
+                  "+ellps=GRS80 +units=m", 40.0, "warned"),
+                 ("EPSG:32617", -84.25, None)]
+        for i, (crs, lon, said) in enumerate(cases):
+            s = gdal.osr.SpatialReference()
+            s.SetFromUserInput(crs)
+            s.SetAxisMappingStrategy(gdal.osr.OAMS_TRADITIONAL_GIS_ORDER)
+            wgs = gdal.osr.SpatialReference()
+            wgs.ImportFromEPSG(4326)
+            wgs.SetAxisMappingStrategy(gdal.osr.OAMS_TRADITIONAL_GIS_ORDER)
+            lat = 60.0 if lon == 40.0 else 36.59
+            x, y, _ = gdal.osr.CoordinateTransformation(wgs, s).TransformPoint(lon, lat)
+            dem = T.write_tif(os.path.join(self.dir, "shear%d.tif" % i), z,
+                              (x, 50.0, 0, y, 0, -50.0), crs)
+            for mode in ("auto", "grid"):
+                p = T.run(["gdalinfo", "-oo", "CELL_SIZES=" + mode, T.conn(dem)],
+                          ok=said != "refused")
+                with self.subTest(crs=crs, mode=mode):
+                    print(crs, mode, "->", p.stderr.strip()[:160] or "(nothing said)")
+                    if said is None:
+                        self.assertNotIn("right angle", p.stderr)
+                    else:
+                        self.assertIn("degrees from a right angle on the ground", p.stderr)
+                        self.assertIn("ERROR" if said == "refused" else "Warning", p.stderr)
+
+    def test_columns_along_latitude_are_refused(self):
+        """A geographic DEM whose geotransform is in EPSG:4326's own axis
+        order (a VRT with dataAxisToSRSAxisMapping="1,2": x is latitude) was
+        read as longitude first: its sun's site in Antarctica, its cells 4.5
+        x 55.8 m (session 58's CRS audit). Refused, as a rotated grid is."""
+        base = T.write_tif(os.path.join(self.dir, "latlon.tif"),
+                           np.zeros((40, 30), np.float32), (0, 1, 0, 0, 0, -1), None)
+        vrt = os.path.join(self.dir, "latlon.vrt")
+        with open(vrt, "w") as f:
+            f.write('<VRTDataset rasterXSize="30" rasterYSize="40">'
+                    '<SRS dataAxisToSRSAxisMapping="1,2">EPSG:4326</SRS>'
+                    '<GeoTransform>36.63, -0.0004, 0, -84.3, 0, 0.0005</GeoTransform>'
+                    '<VRTRasterBand dataType="Float32" band="1"><SimpleSource>'
+                    '<SourceFilename relativeToVRT="0">%s</SourceFilename>'
+                    '<SourceBand>1</SourceBand></SimpleSource></VRTRasterBand>'
+                    '</VRTDataset>' % base)
+        p = T.run(["gdalinfo", T.conn(vrt)], ok=False)
+        self.assertIn("the DEM's columns run north-south", p.stderr)
+        # GDAL's own order (GeoTIFF's) opens as before
+        T.run(["gdalinfo", T.conn(T.JACKSBORO)])
+
     def test_bad_requests_are_errors(self):
         z = T.fractal_dem(32, seed=10)
         bare = T.write_tif(os.path.join(self.dir, "bare.tif"), z, (0, 30, 0, 0, 0, -30), None)
