@@ -127,7 +127,8 @@ const opt_def TSD_OPTION_ROWS[] = {
      check_tile_size,
      "Compute the product in chunks of this many cells square, each from the DEM "
      "around it (NEAR_DISTANCE) and one coarse grid of the whole DEM, so that "
-     "memory does not grow with the DEM (docs/windows.md); 0 = the whole DEM "
+     "memory grows with the chunk and the DEM's width (a row of chunks is cached), "
+     "not with its size (docs/windows.md); 0 = the whole DEM "
      "at once, as does a DEM within one chunk. At least 64"},
     {"NEAR_DISTANCE", K_FLOAT, FIELD(near_distance), "0", 0, 1e6, 0, 1, NULL, 1, P, LISTED,
      NULL,
