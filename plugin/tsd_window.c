@@ -267,27 +267,51 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
  * and *bytes (the windows' peak and extra), else 0. */
 static int tile_that_fits(const tsd_options *o, const tsd_sun *sun, int W, int H,
                           double cells_min_x, double cell_y, double limit, double extra,
-                          int *tile, double *bytes)
+                          int *tile, double *near, double *bytes)
 {
     static const int tiles[] = {4096, 2048, 1024, 512, 256}; /* all >= TSD_TILE_MIN */
-    for (size_t i = 0; i < sizeof tiles / sizeof tiles[0]; i++) {
-        tsd_options t = *o;
-        t.tile_size = tiles[i];
-        tsd_window_plan p;
-        char msg[256];
-        if ((W <= tiles[i] && H <= tiles[i]) ||
-            tsd_window_plan_make(&t, sun, W, H, cells_min_x, cell_y, &p, msg, sizeof msg) != 0 ||
-            !p.windowed)
-            continue;
-        double steady;
-        const double peak = tsd_window_peak_bytes(&t, &p, &steady) + extra;
-        if (peak <= limit) {
-            *tile = tiles[i];
-            *bytes = peak;
-            return 1;
+    /* then, with the automatic near field, wider ones: a coarser far grid
+     * keeps less (a day's far planes on a 16384^2 DEM: 6768 MiB at 256 m,
+     * 421 MiB at 2048 m; session 58's large-DEM audit) */
+    static const double wider[] = {1, 2, 4, 8, 16};
+    double auto_near = 0;
+    for (size_t k = 0; k < sizeof wider / sizeof wider[0]; k++) {
+        if (k > 0 && !(o->near_distance == 0 && auto_near > 0))
+            break;
+        for (size_t i = 0; i < sizeof tiles / sizeof tiles[0]; i++) {
+            tsd_options t = *o;
+            t.tile_size = tiles[i];
+            t.near_distance = k > 0 ? auto_near * wider[k] : o->near_distance;
+            tsd_window_plan p;
+            char msg[256];
+            if ((W <= tiles[i] && H <= tiles[i]) ||
+                tsd_window_plan_make(&t, sun, W, H, cells_min_x, cell_y, &p, msg, sizeof msg) !=
+                    0 ||
+                !p.windowed)
+                continue;
+            if (k == 0 && auto_near == 0)
+                auto_near = p.far ? p.near_m : 0; /* (the first plan's) */
+            double steady;
+            const double peak = tsd_window_peak_bytes(&t, &p, &steady) + extra;
+            if (peak <= limit) {
+                *tile = tiles[i];
+                *near = k > 0 ? t.near_distance : 0;
+                *bytes = peak;
+                return 1;
+            }
         }
     }
     return 0;
+}
+
+/* "TILE_SIZE=512" or "TILE_SIZE=512 and NEAR_DISTANCE=2048" */
+static const char *tile_words(int tile, double near, char *buf, size_t n)
+{
+    if (near > 0)
+        snprintf(buf, n, "TILE_SIZE=%d and NEAR_DISTANCE=%.0f", tile, ceil(near));
+    else
+        snprintf(buf, n, "TILE_SIZE=%d", tile);
+    return buf;
 }
 
 void tsd_window_advice(const tsd_options *o, const tsd_sun *sun, int W, int H,
@@ -295,14 +319,17 @@ void tsd_window_advice(const tsd_options *o, const tsd_sun *sun, int W, int H,
                        char *out, size_t n)
 {
     int tile;
-    double bytes;
+    double bytes, near;
+    char words[96];
     const tsd_product_def *d = tsd_product_of(o);
     const char *why = whole_by_method(o, d);
     out[0] = '\0';
     if (!why) {
-        if (tile_that_fits(o, sun, W, H, cells_min_x, cell_y, limit, extra, &tile, &bytes))
-            snprintf(out, n, "; TILE_SIZE=%d computes it window by window in about %.0f MiB",
-                     tile, ceil(bytes / 1048576.0)); /* (up: a MAX_MEMORY that does) */
+        if (tile_that_fits(o, sun, W, H, cells_min_x, cell_y, limit, extra, &tile, &near,
+                           &bytes))
+            snprintf(out, n, "; %s computes it window by window in about %.0f MiB",
+                     tile_words(tile, near, words, sizeof words),
+                     ceil(bytes / 1048576.0)); /* (up: a MAX_MEMORY that does) */
         return;
     }
     /* the exact methods, windowed (farshadow has none) */
@@ -316,11 +343,12 @@ void tsd_window_advice(const tsd_options *o, const tsd_sun *sun, int W, int H,
                           : e.method != o->method ? "METHOD=exact"
                                                   : "HORIZON_METHOD=exact";
     if (!whole_by_method(&e, d) &&
-        tile_that_fits(&e, sun, W, H, cells_min_x, cell_y, limit, extra, &tile, &bytes))
+        tile_that_fits(&e, sun, W, H, cells_min_x, cell_y, limit, extra, &tile, &near, &bytes))
         snprintf(out, n,
-                 "; it is computed on the whole DEM (%s): %s with TILE_SIZE=%d computes it "
+                 "; it is computed on the whole DEM (%s): %s with %s computes it "
                  "window by window in about %.0f MiB",
-                 why, instead, tile, ceil(bytes / 1048576.0));
+                 why, instead, tile_words(tile, near, words, sizeof words),
+                 ceil(bytes / 1048576.0));
     else
         snprintf(out, n, "; it is computed on the whole DEM (%s)", why);
 }

@@ -534,6 +534,19 @@ class Errors(unittest.TestCase):
                     # MAX_MEMORY=38 refused "about 38 MiB": session 57's audit)
                     T.run(["gdalinfo"] + oo(taken + ["MAX_MEMORY=" + m.group(3)])
                           + [T.conn(dem)])
+            # a day's far planes, which no TILE_SIZE alone cuts: a wider
+            # NEAR_DISTANCE coarsens the far grid (the advice named none:
+            # session 58's large-DEM audit), and taken it opens
+            day = ["PRODUCT=sunhours", "DATE=2024-06-21", "TIMEZONE=+01:00"]
+            p = T.run(["gdalinfo"] + oo(day + ["MAX_MEMORY=100"]) + [T.conn(dem)], ok=False)
+            print(p.stderr.strip())
+            m = re.search(r"TILE_SIZE=(\d+) and NEAR_DISTANCE=(\d+) computes it window by "
+                          r"window in about (\d+) MiB", p.stderr)
+            self.assertIsNotNone(m, p.stderr)
+            self.assertLessEqual(int(m.group(3)), 100)
+            T.run(["gdalinfo"] + oo(day + ["TILE_SIZE=" + m.group(1), "NEAR_DISTANCE=" +
+                                           m.group(2), "MAX_MEMORY=" + m.group(3)])
+                  + [T.conn(dem)])
             p = T.run(["gdalinfo"] + oo(["PRODUCT=farshadow", "DATE=2024-06-21",
                                          "TIMEZONE=+01:00", "MAX_MEMORY=10"])
                       + [T.conn(dem)], ok=False)
