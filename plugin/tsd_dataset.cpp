@@ -419,15 +419,25 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
 {
     char szMsg[1024] = "";
     const tsd_options &sOpts = m_sOpts;
-    OGRSpatialReferenceH hSRS =
-        m_oSRS.IsEmpty() ? nullptr : OGRSpatialReference::ToHandle(&m_oSRS);
-    m_oProductSRS = m_oSRS;
+    // a vertical CRS alone places nothing: as no CRS for the cells and the
+    // sun (its unit still scales the heights; PROJ's errors on asking it
+    // for an ellipsoid, and "the DEM has no CRS", misled: the CRS audit)
+    const bool bVerticalOnly = m_oSRS.IsVertical() && !m_oSRS.IsCompound();
+    OGRSpatialReferenceH hSRS = m_oSRS.IsEmpty() || bVerticalOnly
+                                    ? nullptr
+                                    : OGRSpatialReference::ToHandle(&m_oSRS);
+    m_oProductSRS = bVerticalOnly ? OGRSpatialReference() : m_oSRS;
     if (m_oProductSRS.IsCompound())
         m_oProductSRS.StripVertical();
     ts_status eSt = tsd_cells_compute(m_adfGT, W, H, hSRS, sOpts.cell_sizes, &m_sCells, szMsg,
                                       sizeof szMsg);
     if (eSt != TS_OK)
         return Fail(eSt, szMsg), false;
+    if (bVerticalOnly)
+        snprintf(m_sCells.warning, sizeof m_sCells.warning,
+                 "the DEM's CRS is a vertical one only (%s), which places nothing on the "
+                 "ground: its cell size (%g x %g) is taken as metres",
+                 m_oSRS.GetName(), std::fabs(m_adfGT[1]), std::fabs(m_adfGT[5]));
     const double dfMinCell = std::min(m_sCells.cell_y, tsd_cells_min_x(&m_sCells, H));
     if (m_nLevel == 0 && sOpts.max_distance > 0 &&
         sOpts.max_distance < std::min(TSD_MAX_DISTANCE_MIN, dfMinCell) &&

@@ -135,9 +135,11 @@ void TSDataset::SetupMetadata()
         GDALDataset::SetMetadataItem(pszName, szValue);
     }
     GDALDataset::SetMetadataItem("SOURCE_DEM", m_osDEM.c_str());
-    const char *pszKind = m_sCells.kind == TSD_CRS_GEOGRAPHIC  ? "geographic"
-                          : m_sCells.kind == TSD_CRS_PROJECTED ? "projected"
-                                                               : "none";
+    // (a local or engineering CRS is measured as a projected one's grid)
+    const char *pszKind = m_sCells.kind == TSD_CRS_GEOGRAPHIC ? "geographic"
+                          : m_sCells.kind == TSD_CRS_PROJECTED
+                              ? (m_oSRS.IsLocal() ? "local" : "projected")
+                              : "none";
     GDALDataset::SetMetadataItem("SOURCE_CRS_KIND", pszKind);
     GDALDataset::SetMetadataItem("CELL_SIZE_X", CPLSPrintf("%.6f", m_sCells.cell_x));
     GDALDataset::SetMetadataItem("CELL_SIZE_Y", CPLSPrintf("%.6f", m_sCells.cell_y));

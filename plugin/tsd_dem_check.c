@@ -36,8 +36,11 @@ static int height_limits(GDALRasterBandH band, const tsd_dem_conversion *c, doub
     GDALDatasetH ds = GDALGetBandDataset(band);
     OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
     OGRErr err = OGRERR_FAILURE;
-    /* a local CRS has no ellipsoid: PROJ said so as an ERROR, four times */
-    double a = srs && !OSRIsLocal(srs) ? OSRGetSemiMajor(srs, &err) : 0;
+    /* a local CRS, or a vertical one alone, has no ellipsoid: PROJ said so
+     * as an ERROR (four times; twice) */
+    double a = srs && !OSRIsLocal(srs) && !(OSRIsVertical(srs) && !OSRIsCompound(srs))
+                   ? OSRGetSemiMajor(srs, &err)
+                   : 0;
     const int earth = !(err == OGRERR_NONE && a > 0 && fabs(a - TS_EARTH_RADIUS) > 100000.0);
     if (!earth) {
         *low = -a;

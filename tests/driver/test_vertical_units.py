@@ -96,6 +96,35 @@ class VerticalUnits(unittest.TestCase):
         self.assertIsNotNone(ds.GetRasterBand(1).Checksum())
         ds = None
 
+    def test_a_vertical_crs_alone_scales_only(self):
+        """A DEM whose CRS is a vertical one alone (a VRT's SRS EPSG:6360):
+        its unit scales the heights, and it places nothing: the DEM opens
+        as one without a CRS, with a warning that says which it has (it
+        said "the DEM has no CRS", beside three PROJ errors on asking it for
+        an ellipsoid: session 58's CRS audit), and its products carry none.
+        A local CRS is SOURCE_CRS_KIND=local (it said projected)."""
+        vrt = os.path.join(self.dir, "vertical.vrt")
+        with open(vrt, "w") as f:
+            f.write('<VRTDataset rasterXSize="64" rasterYSize="64"><SRS>EPSG:6360</SRS>'
+                    '<GeoTransform>%s</GeoTransform><VRTRasterBand dataType="Float32" '
+                    'band="1"><SimpleSource><SourceFilename relativeToVRT="0">%s'
+                    '</SourceFilename><SourceBand>1</SourceBand></SimpleSource>'
+                    '</VRTRasterBand></VRTDataset>' % (", ".join(map(repr, NC_GT)), self.plain))
+        p = T.run(["gdalinfo", T.conn(vrt, **OPTIONS)])
+        print(p.stderr.strip())
+        self.assertNotIn("ERROR", p.stderr)
+        self.assertIn("the DEM's CRS is a vertical one only (NAVD88 height (ftUS))", p.stderr)
+        self.assertIn("SOURCE_CRS_KIND=none", p.stdout)
+        self.assertIn("Z_FACTOR=%.10g" % FT_US, p.stdout)
+        ds = opened(vrt)
+        self.assertIsNone(ds.GetSpatialRef())
+        ds = None
+        local = T.write_tif(os.path.join(self.dir, "local.tif"), self.z, NC_GT,
+                            'LOCAL_CS["site",UNIT["metre",1]]')
+        ds = opened(local)
+        self.assertEqual(ds.GetMetadataItem("SOURCE_CRS_KIND"), "local")
+        ds = None
+
     def test_band_unit_feet(self):
         self.check(self.ft, 0.3048, "band unit ft", self.m_ft)
 
