@@ -270,8 +270,11 @@ static ts_status shadowmap_visibility(const tsd_compute_ctx *c, const ts_grid *g
                                 &err) == TS_OK) {
         const double plane = (double)g->width * g->height * sizeof(float);
         const double real = 3 * plane + (double)ts_shadowmap_keys(&f) * sizeof(int);
-        const double over = real - tsd_shadowmap_bytes(c->opts, g->width, g->height) -
-                            c->run->headroom_bytes;
+        double map_x, map_y; /* (as counted at open) */
+        tsd_shadowmap_aspect(g->cell_x, g->cell_x_row, g->height, g->cell_y, &map_x, &map_y);
+        const double over =
+            real - tsd_shadowmap_bytes(c->opts, g->width, g->height, map_x, map_y) -
+            c->run->headroom_bytes;
         if (over > 0) {
             return tsd_fail(c->msg, c->msg_size, TS_ERR_NOMEM,
                      "METHOD=shadowmap's depth map for a sun %.1f degrees high over this "

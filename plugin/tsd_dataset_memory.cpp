@@ -89,8 +89,10 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
     }
     double dfSteady = 0;
     // windowed: the chunk with its margin, the cache and the far field
+    double dfMapX = 1, dfMapY = 1;
+    tsd_shadowmap_aspect(sCells.cell_x, sCells.cell_x_row, H, sCells.cell_y, &dfMapX, &dfMapY);
     double dfPeak = psPlan ? tsd_window_peak_bytes(&sOpts, psPlan, &dfSteady)
-                           : tsd_product_peak_bytes(&sOpts, W, H, &dfSteady);
+                           : tsd_product_peak_bytes(&sOpts, W, H, dfMapX, dfMapY, &dfSteady);
     // the environment: set up at open (its peak), then kept while computing
     // (and the DEM's copy in memory, held from open to close)
     dfPeak = std::max(dfPeak + sEnv.kept, sEnv.peak) + dfDEMCopy;
@@ -118,7 +120,8 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
     // a small DEM's chunks with their margins can need more than the whole
     // DEM at once: say so, where the advice named no TILE_SIZE at all
     double dfWholeSteady = 0;
-    const double dfWhole = std::max(tsd_product_peak_bytes(&sOpts, W, H, &dfWholeSteady) +
+    const double dfWhole = std::max(tsd_product_peak_bytes(&sOpts, W, H, dfMapX, dfMapY,
+                                                           &dfWholeSteady) +
                                     sEnv.kept, sEnv.peak) + dfDEMCopy;
     if (psPlan && W <= TS_MAX_SIDE && H <= TS_MAX_SIDE && dfWhole <= dfLimit)
         snprintf(szAdvice, sizeof szAdvice,

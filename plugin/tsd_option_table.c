@@ -130,7 +130,8 @@ const opt_def TSD_OPTION_ROWS[] = {
      "memory grows with the chunk and the DEM's width (a row of chunks is cached), "
      "not with its size (docs/windows.md); 0 = the whole DEM "
      "at once, as does a DEM within one chunk. At least 64"},
-    {"NEAR_DISTANCE", K_FLOAT, FIELD(near_distance), "0", 0, 1e6, 0, 1, NULL, 1, P, LISTED,
+    {"NEAR_DISTANCE", K_FLOAT, FIELD(near_distance), "0", 0, TSD_NEAR_MAX_M, 0, 1, NULL, 1, P,
+     LISTED,
      NULL,
      "Chunks (TILE_SIZE): metres within which occluders come from the "
      "full-resolution DEM, exactly; farther ones from a coarser grid "

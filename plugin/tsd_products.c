@@ -337,9 +337,26 @@ static int pyramid_planes(const tsd_options *o, const tsd_product_def *p, int en
     return batch;
 }
 
-double tsd_shadowmap_bytes(const tsd_options *o, int width, int height)
+void tsd_shadowmap_aspect(double cell_x, const double *cell_x_row, int height, double cell_y,
+                          double *map_x, double *map_y)
 {
-    const double w = width, h = height, plane = w * h * sizeof(float);
+    double lo = cell_x, hi = cell_x;
+    for (int y = 0; cell_x_row && y < height; y++) {
+        lo = fmin(lo, cell_x_row[y]);
+        hi = fmax(hi, cell_x_row[y]);
+    }
+    const double shorter = fmin(cell_y, lo);
+    *map_x = shorter > 0 ? hi / shorter : 1;
+    *map_y = shorter > 0 ? cell_y / shorter : 1;
+}
+
+double tsd_shadowmap_bytes(const tsd_options *o, int width, int height, double map_x,
+                           double map_y)
+{
+    /* (non-square cells: a map of 30 x 89 m cells at 70 N was 3 times the
+     * square cells' one counted, session 58's review) */
+    const double w = width * map_x, h = height * map_y;
+    const double plane = (double)width * height * sizeof(float);
     /* the sun's azimuth is known here unless DATETIME sets it: then the
      * widest, a diagonal */
     const double az = (o->datetime[0] ? 45.0 : o->sun_azimuth) * M_PI / 180;
@@ -354,19 +371,20 @@ double tsd_shadowmap_bytes(const tsd_options *o, int width, int height)
  * and its three projected-coordinate planes; METHOD=sh's folded wedge
  * tables (core/sh_swath_light.c: 256 x 256 x 16 floats an interior slot). */
 static double method_bytes(const tsd_options *o, const tsd_product_def *p, int width,
-                           int height)
+                           int height, double map_x, double map_y)
 {
     if (!tsd_product_takes(p, tsd_option_find("METHOD")))
         return 0;
     if (o->method == TSD_METHOD_SHADOWMAP)
-        return tsd_shadowmap_bytes(o, width, height);
+        return tsd_shadowmap_bytes(o, width, height, map_x, map_y);
     if (o->method == TSD_METHOD_SH && o->swath_directions <= 8)
         return (o->swath_directions - 1) * (double)TS_SH_WEDGE_STEPS * TS_SH_WEDGE_STEPS *
                TS_SH_COEFFS * sizeof(float);
     return 0;
 }
 
-double tsd_product_peak_bytes(const tsd_options *o, int width, int height, double *steady)
+double tsd_product_peak_bytes(const tsd_options *o, int width, int height, double map_x,
+                              double map_y, double *steady)
 {
     const tsd_product_def *p = tsd_product_of(o);
     double plane = (double)width * (double)height * sizeof(float);
@@ -388,7 +406,7 @@ double tsd_product_peak_bytes(const tsd_options *o, int width, int height, doubl
         extra -= p->planes;
     if (steady)
         *steady = kept * plane;
-    return (1 + kept + extra) * plane + method_bytes(o, p, width, height) +
+    return (1 + kept + extra) * plane + method_bytes(o, p, width, height, map_x, map_y) +
            tsd_pyramid_bytes(o, width, height, pyramid_planes(o, p, env_sky));
 }
 

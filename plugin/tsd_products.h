@@ -104,19 +104,31 @@ int tsd_options_unused(const tsd_options *o, const tsd_product_def *p, char *buf
  * Peak memory in bytes while computing a width x height product, the DEM
  * grid included; `steady` (may be NULL) receives what stays afterwards
  * (the product, as float planes, or byte planes). Doubles, so that nothing
- * overflows.
+ * overflows. map_x, map_y: METHOD=shadowmap's texels a cell against square
+ * cells (tsd_shadowmap_aspect; 1, 1 for square cells).
  */
-double tsd_product_peak_bytes(const tsd_options *o, int width, int height,
-                              double *steady);
+double tsd_product_peak_bytes(const tsd_options *o, int width, int height, double map_x,
+                              double map_y, double *steady);
 
 /**
- * METHOD=shadowmap's own buffers on a width x height grid as counted at
- * open: its depth map, SHADOWMAP_SCALE^2 int texels a cell of the DEM
- * turned to face the sun, without the rows that the relief adds at a low
- * sun (the relief is not known at open; tsd_compute checks the real map
- * against what the limit leaves), and three projected-coordinate planes.
+ * How many times a square cell's texels METHOD=shadowmap's map gives a
+ * cell of cell_x (or, where cell_x_row is not NULL, of its `height` rows'
+ * sizes) x cell_y metres along x and y: the map is as fine as the shorter
+ * side (ts_shadowmap_frame_make), over the widest row.
  */
-double tsd_shadowmap_bytes(const tsd_options *o, int width, int height);
+void tsd_shadowmap_aspect(double cell_x, const double *cell_x_row, int height, double cell_y,
+                          double *map_x, double *map_y);
+
+/**
+ * METHOD=shadowmap's own buffers on a width x height grid (its cells'
+ * aspect map_x, map_y) as counted at open: its depth map, SHADOWMAP_SCALE^2
+ * int texels a cell turned to face the sun, without the rows that the
+ * relief adds at a low sun (the relief is not known at open; tsd_compute
+ * checks the real map against what the limit leaves), and three
+ * projected-coordinate planes.
+ */
+double tsd_shadowmap_bytes(const tsd_options *o, int width, int height, double map_x,
+                           double map_y);
 
 /**
  * The driver metadata item TERRASHADE_PRODUCTS: an XML list

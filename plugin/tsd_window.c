@@ -281,7 +281,11 @@ static int tile_that_fits(const tsd_options *o, const tsd_sun *sun, int W, int H
         for (size_t i = 0; i < sizeof tiles / sizeof tiles[0]; i++) {
             tsd_options t = *o;
             t.tile_size = tiles[i];
-            t.near_distance = k > 0 ? auto_near * wider[k] : o->near_distance;
+            /* (whole metres, as the advice says it: the plan of the value
+             * unrounded was up to 1 MiB smaller, the review) */
+            t.near_distance = k > 0 ? ceil(auto_near * wider[k]) : o->near_distance;
+            if (t.near_distance > TSD_NEAR_MAX_M)
+                break;
             tsd_window_plan p;
             char msg[256];
             if ((W <= tiles[i] && H <= tiles[i]) ||
@@ -308,7 +312,7 @@ static int tile_that_fits(const tsd_options *o, const tsd_sun *sun, int W, int H
 static const char *tile_words(int tile, double near, char *buf, size_t n)
 {
     if (near > 0)
-        snprintf(buf, n, "TILE_SIZE=%d and NEAR_DISTANCE=%.0f", tile, ceil(near));
+        snprintf(buf, n, "TILE_SIZE=%d and NEAR_DISTANCE=%.0f", tile, near);
     else
         snprintf(buf, n, "TILE_SIZE=%d", tile);
     return buf;
@@ -371,7 +375,9 @@ double tsd_window_peak_bytes(const tsd_options *o, const tsd_window_plan *p, dou
     const int W = window_side(p->tile, p->margin_x, p->dem_w);
     const int H = window_side(p->tile, p->margin_y, p->dem_h);
     double kept_one = 0;
-    double computing = tsd_product_peak_bytes(o, W, H, &kept_one);
+    /* (square cells: METHOD=shadowmap, the one method that counts them, is
+     * computed whole) */
+    double computing = tsd_product_peak_bytes(o, W, H, 1, 1, &kept_one);
     /* the chunk cropped out of it, and the cache */
     double chunk = (double)chunk_side(p->tile, p->dem_w) * chunk_side(p->tile, p->dem_h) *
                    sizeof(float) * tsd_options_band_count(o);

@@ -31,6 +31,8 @@ extern "C" {
 #define TSD_NEAR_AUTO_CELLS 128
 /** The near field must reach at least this many cells. */
 #define TSD_NEAR_MIN_CELLS 16
+/* The longest NEAR_DISTANCE, metres (its row of the option table). */
+#define TSD_NEAR_MAX_M 1e6
 /** The far grid is the DEM at full resolution where it fits (docs/windows.md:
  * the far field's error is the averaging of its cells): a DEM of at most
  * TSD_FAR_OWN_MAX_CELLS cells, with one plane of 16-bit angles per azimuth

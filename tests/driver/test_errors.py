@@ -547,6 +547,27 @@ class Errors(unittest.TestCase):
             T.run(["gdalinfo"] + oo(day + ["TILE_SIZE=" + m.group(1), "NEAR_DISTANCE=" +
                                            m.group(2), "MAX_MEMORY=" + m.group(3)])
                   + [T.conn(dem)])
+            # on coarse cells the wider near fields reach NEAR_DISTANCE's
+            # limit, 1e6 m: the advice stays within it (1134036 was advised,
+            # and refused when taken: the review), and opens at its figure
+            # (it planned with the metres unrounded: 1 MiB short)
+            geo = os.path.join(tmp, "sparse_geo.tif")
+            T.run(["gdal_create", "-of", "GTiff", "-outsize", 4096, 4096, "-bands", 1,
+                   "-ot", "Float32", "-a_srs", "EPSG:4326", "-a_ullr", -40, 40, 41.92, -41.92,
+                   "-co", "SPARSE_OK=TRUE", "-co", "TILED=YES", geo])
+            advised = 0
+            for limit in (120, 200, 280):
+                p = T.run(["gdalinfo"] + oo(day + ["MAX_MEMORY=%d" % limit]) + [T.conn(geo)],
+                          ok=False)
+                m = re.search(r"TILE_SIZE=(\d+) and NEAR_DISTANCE=(\d+) computes it window "
+                              r"by window in about (\d+) MiB", p.stderr)
+                if m:
+                    advised += 1
+                    self.assertLessEqual(int(m.group(2)), 1000000)
+                    T.run(["gdalinfo"] + oo(day + ["TILE_SIZE=" + m.group(1),
+                                                   "NEAR_DISTANCE=" + m.group(2),
+                                                   "MAX_MEMORY=" + m.group(3)]) + [T.conn(geo)])
+            self.assertGreater(advised, 0)
             p = T.run(["gdalinfo"] + oo(["PRODUCT=farshadow", "DATE=2024-06-21",
                                          "TIMEZONE=+01:00", "MAX_MEMORY=10"])
                       + [T.conn(dem)], ok=False)

@@ -32,6 +32,7 @@ import re
 import unittest
 
 import tsdriver as T
+from tsdriver import np
 
 N = 1024
 DAY = {"DATE": "2024-06-21", "TIMEZONE": "-05:00"}
@@ -228,6 +229,31 @@ class MemoryEstimate(unittest.TestCase):
                       (elevation, est, limit, grown / MIB))
                 self.assertLessEqual(grown, limit * MIB)
                 self.assertGreaterEqual(limit, 0.95 * grown / MIB - 4)
+
+    def test_shadowmap_counts_oblong_cells(self):
+        """METHOD=shadowmap's map is as fine as a cell's shorter side: on
+        cells of 30 x 89 m (a geographic DEM at 70 N) it is about three times
+        the square cells' one, which the estimate counted, so that a flat
+        DEM was refused at its first read, blamed on its relief (session
+        58's review). Counted at open now, within the test's bounds."""
+        d = os.path.dirname(self.out)
+        n = 512
+        gt = (20.0, 0.0008, 0.0, 70.2, 0.0, -0.0008)  # ~30 x 89 m cells
+        flat = T.write_tif(os.path.join(d, "flat70.tif"), np.full((n, n), 100, np.float32),
+                           gt, 4326)
+        tiny = os.path.join(d, "flat70_tiny.tif")
+        T.run(["gdal_translate", "-q", "-srcwin", 0, 0, 16, 16, flat, tiny])
+        o = dict(COMMON, PRODUCT="shade", METHOD="shadowmap")
+        args = ["gdal_translate", "-q"] + T.oo_args(o)
+        grown = peak_rss(args + [T.conn(flat), self.out]) - peak_rss(args + [T.conn(tiny),
+                                                                              self.out])
+        est = estimate(flat, o, self.out)
+        print("shadowmap on 30 x 89 m cells: estimate %.0f MiB, grew %.1f MiB" %
+              (est / MIB, grown / MIB))
+        self.assertGreaterEqual(est, 0.95 * grown - 4 * MIB)
+        self.assertLessEqual(est, 1.3 * grown + 8 * MIB)
+        # and under its own figure it runs
+        T.run(args[:2] + T.oo_args(dict(o, MAX_MEMORY=est // MIB)) + [T.conn(flat), self.out])
 
     def test_windowed_estimate_brackets_the_peak(self):
         self.brackets(WINDOWED, dict(COMMON, TILE_SIZE=512), estimate_logged)
