@@ -16,6 +16,7 @@
 
 #include "shadow_atlas.h"
 #include "tsd_atlas_check.h"
+#include "tsd_gdal.h"
 
 namespace tsd
 {
@@ -179,18 +180,14 @@ std::string CheckAtlasDEM(GDALDataset *poDEM, const std::string &osDEM, bool bGi
     }
     const OGRSpatialReference *poDEMSRS = poDEM->GetSpatialRef();
     // their ground: an atlas keeps no vertical CRS (a product's is the
-    // DEM's without it since session 58, one written before keeps it)
-    auto Ground = [](const OGRSpatialReference *po)
-    {
-        OGRSpatialReference o(*po);
-        if (o.IsCompound())
-            o.StripVertical();
-        return o;
-    };
+    // DEM's without it since session 58, one written before keeps it), nor
+    // its DEM's data axes (a VRT's "1,2,3")
     if (poSRS && !poSRS->IsEmpty() && poDEMSRS && !poDEMSRS->IsEmpty())
     {
-        const OGRSpatialReference oAtlas = Ground(poSRS), oDEM = Ground(poDEMSRS);
-        if (!oAtlas.IsSame(&oDEM))
+        const OGRSpatialReference oAtlas = GroundSRS(*poSRS), oDEM = GroundSRS(*poDEMSRS);
+        const char *const apszIgnoreAxes[] = {"IGNORE_DATA_AXIS_TO_SRS_AXIS_MAPPING=YES",
+                                              nullptr};
+        if (!oAtlas.IsSame(&oDEM, apszIgnoreAxes))
             return CPLSPrintf("SHADOWS=all: the DEM '%s'%s is in another CRS (%s) than the "
                               "atlas (%s): name the DEM the atlas was made from with DEM=...",
                               osDEM.c_str(), pszWhich, poDEMSRS->GetName(), poSRS->GetName());

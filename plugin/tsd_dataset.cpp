@@ -426,9 +426,7 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     OGRSpatialReferenceH hSRS = m_oSRS.IsEmpty() || bVerticalOnly
                                     ? nullptr
                                     : OGRSpatialReference::ToHandle(&m_oSRS);
-    m_oProductSRS = bVerticalOnly ? OGRSpatialReference() : m_oSRS;
-    if (m_oProductSRS.IsCompound())
-        m_oProductSRS.StripVertical();
+    m_oProductSRS = bVerticalOnly ? OGRSpatialReference() : GroundSRS(m_oSRS);
     ts_status eSt = tsd_cells_compute(m_adfGT, W, H, hSRS, sOpts.cell_sizes, &m_sCells, szMsg,
                                       sizeof szMsg);
     if (eSt != TS_OK)

@@ -250,4 +250,19 @@ ts_status TSDataset::ReadDEM(ts_grid *psGrid, char *pszMsg, size_t nMsg)
     return LoadDEM(psGrid, pszMsg, nMsg);
 }
 
+OGRSpatialReference GroundSRS(const OGRSpatialReference &oSRS)
+{
+    OGRSpatialReference oGround(oSRS);
+    if (!oGround.IsCompound())
+        return oGround;
+    std::vector<int> anAxes = oSRS.GetDataAxisToSRSAxisMapping();
+    oGround.StripVertical();
+    if (anAxes.size() >= 2)
+    {
+        anAxes.resize(2);
+        oGround.SetDataAxisToSRSAxisMapping(anAxes);
+    }
+    return oGround;
+}
+
 } // namespace tsd

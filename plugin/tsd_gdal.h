@@ -85,6 +85,12 @@ inline CPLErr RefuseGeoreferencing(const GDALDataset *poDS, const char *pszWhat)
     return CE_Failure;
 }
 
+/** The horizontal part of a CRS: a compound one's without its vertical
+ * CRS, its data axes as they were (a VRT's "1,2,3" made "1,2"; GDAL's
+ * StripVertical left three on two axes, and the CRS then differed from the
+ * same CRS read elsewhere); any other as it is (tsd_dataset_dem.cpp). */
+OGRSpatialReference GroundSRS(const OGRSpatialReference &oSRS);
+
 /* TERRASHADE:<dem> datasets (tsd_dataset.cpp). */
 int IdentifyProduct(GDALOpenInfo *poOpenInfo);
 GDALDataset *OpenProduct(GDALOpenInfo *poOpenInfo);

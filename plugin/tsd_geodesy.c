@@ -220,7 +220,7 @@ static int ground_open(ground_ctx *t, OGRSpatialReferenceH srs)
 
 /* The ends of the n segments (x0, y0)-(x1, y1) of the DEM's pixel space,
  * as longitude X and latitude Y (2n each: segment i's at 2i and 2i + 1),
- * and which of them PROJ could place (ok); 0 where it failed outright. */
+ * and which of them PROJ could place (ok); 0 unless it placed them all. */
 static int segments_lonlat(const ground_ctx *t, const double gt[6], int n, const double *x0,
                            const double *y0, const double *x1, const double *y1, double *X,
                            double *Y, int *ok)
@@ -273,38 +273,68 @@ static void ecef(const struct geod_geodesic *g, double lon, double lat, double o
     out[2] = N * (1 - e2) * sin(p);
 }
 
-/* How far the grid's axes are from a right angle on the ground, at most,
- * over the m cells whose east-west and north-south segments are pairs
- * 2i, 2i + 1 of (x0, y0)-(x1, y1) (ground_lengths'): the angle between the
- * two chords in space, which, unlike azimuths, holds at a pole. */
-static int ground_skew(const ground_ctx *t, const double gt[6], int m, const double *x0,
-                       const double *y0, const double *x1, const double *y1, double *skew)
+/* side x side cells of the DEM, from corner to corner (3: its corners,
+ * its edges' middles, its centre): the segments of each one's east-west
+ * side (2i) and north-south side (2i + 1) in pixel space. */
+static void lattice_cells(int width, int height, int side, double *x0, double *y0, double *x1,
+                          double *y1)
 {
-    double X[36], Y[36];
-    int ok[36];
-    const int good = m <= 9 && segments_lonlat(t, gt, 2 * m, x0, y0, x1, y1, X, Y, ok);
+    for (int j = 0, i = 0; j < side; j++)
+        for (int k = 0; k < side; k++, i += 2) {
+            const double fx = 0.5 + (width - 1.0) * k / (side - 1);
+            const double fy = 0.5 + (height - 1.0) * j / (side - 1);
+            x0[i] = fx - 0.5, x1[i] = fx + 0.5, y0[i] = y1[i] = fy;
+            x0[i + 1] = x1[i + 1] = fx, y0[i + 1] = fy - 0.5, y1[i + 1] = fy + 0.5;
+        }
+}
+
+/* Cells a side of the lattice the shear is measured on: a world
+ * Mollweide's shear lies off its axes, its corners outside its domain. */
+#define SKEW_SIDE 5
+
+/* How far the grid's axes are from a right angle on the ground, at most,
+ * over the cells of a SKEW_SIDE^2 lattice that PROJ can place, as the
+ * angle between the chords of a cell's two sides in space, which, unlike
+ * azimuths, holds at a pole; the number of cells measured. */
+static int ground_skew(const ground_ctx *t, const double gt[6], int width, int height,
+                       double *skew)
+{
+    enum { CELLS = SKEW_SIDE * SKEW_SIDE };
+    double x0[2 * CELLS], y0[2 * CELLS], x1[2 * CELLS], y1[2 * CELLS], X[4 * CELLS],
+        Y[4 * CELLS];
+    int ok[4 * CELLS], measured = 0;
+    lattice_cells(width, height, SKEW_SIDE, x0, y0, x1, y1);
     *skew = 0;
-    for (int i = 0; good && i < m; i++) {
+    for (int i = 0; i < 4 * CELLS; i++)
+        ok[i] = 0;
+    segments_lonlat(t, gt, 2 * CELLS, x0, y0, x1, y1, X, Y, ok); /* (the points placed: ok) */
+    for (int i = 0; i < CELLS; i++) {
         double v[2][3];
+        int placed = 1;
         for (int k = 0; k < 2; k++) {
             const int a = 4 * i + 2 * k, b = a + 1;
             double pa[3], pb[3];
-            if (!ok[a] || !ok[b] || !isfinite(X[a] + Y[a] + X[b] + Y[b]))
-                return 0;
+            placed = placed && ok[a] && ok[b] && isfinite(X[a] + Y[a] + X[b] + Y[b]) &&
+                     fabs(Y[a]) <= 90 && fabs(Y[b]) <= 90;
+            if (!placed)
+                break;
             ecef(&t->g, X[a], Y[a], pa);
             ecef(&t->g, X[b], Y[b], pb);
             for (int j = 0; j < 3; j++)
                 v[k][j] = pb[j] - pa[j];
         }
+        if (!placed)
+            continue;
         const double dot = v[0][0] * v[1][0] + v[0][1] * v[1][1] + v[0][2] * v[1][2];
         const double n0 = sqrt(v[0][0] * v[0][0] + v[0][1] * v[0][1] + v[0][2] * v[0][2]);
         const double n1 = sqrt(v[1][0] * v[1][0] + v[1][1] * v[1][1] + v[1][2] * v[1][2]);
         if (!(n0 > 0 && n1 > 0))
-            return 0;
+            continue;
         const double c = fmax(-1.0, fmin(1.0, dot / (n0 * n1)));
         *skew = fmax(*skew, fabs(acos(c) * 180 / M_PI - 90.0));
+        measured++;
     }
-    return good;
+    return measured;
 }
 
 /* The projection's scale (grid length over ground length) at nine cells
@@ -315,18 +345,13 @@ static int ground_skew(const ground_ctx *t, const double gt[6], int m, const dou
 static int ground_scale(const ground_ctx *t, const double gt[6], int width, int height,
                         tsd_cells *c, double *across, double *along)
 {
-    const double fx[3] = {0.5, 0.5 * width, width - 0.5};
-    const double fy[3] = {0.5, 0.5 * height, height - 0.5};
     double x0[18], y0[18], x1[18], y1[18], len[18], grid[18];
-    for (int j = 0, i = 0; j < 3; j++)
-        for (int k = 0; k < 3; k++, i += 2) {
-            x0[i] = fx[k] - 0.5, x1[i] = fx[k] + 0.5, y0[i] = y1[i] = fy[j];
-            grid[i] = fabs(gt[1]) * c->unit_to_m;
-            x0[i + 1] = x1[i + 1] = fx[k], y0[i + 1] = fy[j] - 0.5, y1[i + 1] = fy[j] + 0.5;
-            grid[i + 1] = fabs(gt[5]) * c->unit_to_m;
-        }
-    if (!ground_lengths(t, gt, 18, x0, y0, x1, y1, len) ||
-        !ground_skew(t, gt, 9, x0, y0, x1, y1, &c->skew_deg))
+    lattice_cells(width, height, 3, x0, y0, x1, y1);
+    for (int i = 0; i < 18; i += 2) {
+        grid[i] = fabs(gt[1]) * c->unit_to_m;
+        grid[i + 1] = fabs(gt[5]) * c->unit_to_m;
+    }
+    if (!ground_lengths(t, gt, 18, x0, y0, x1, y1, len))
         return 0;
     c->scale_lo = INFINITY;
     c->scale_hi = 0;
@@ -355,14 +380,9 @@ static ts_status projected(const double gt[6], int width, int height,
         return TS_OK;
     ground_ctx t;
     double across = 0, along = 0;
-    if (!ground_open(&t, srs) || !ground_scale(&t, gt, width, height, c, &across, &along)) {
-        ground_close(&t);
-        c->scale_lo = c->scale_hi = c->skew_deg = 0;
-        if (mode != TSD_CELLS_GROUND)
-            return TS_OK; /* nothing known against the grid's sizes */
-        return tsd_fail(msg, n, TS_ERR_ARG, "CELL_SIZES=ground: PROJ cannot take the DEM's "
-                        "cells to longitude and latitude; use CELL_SIZES=grid");
-    }
+    const int opened = ground_open(&t, srs);
+    if (opened)
+        ground_skew(&t, gt, width, height, &c->skew_deg);
     /* one cell size a row and a north-south one cannot hold axes that are
      * not at right angles on the ground: slopes, aspects and shadows turn
      * by as much (Sinusoidal at 84 W 37 N: 41 degrees, a peak's shadow 31
@@ -374,8 +394,9 @@ static ts_status projected(const double gt[6], int width, int height,
                         "the ground (its projection shears it there, as Sinusoidal or "
                         "Mollweide do away from their central meridian), which would turn "
                         "slopes, aspects and shadows by as much: warp it to a conformal "
-                        "projection first, e.g. gdalwarp -t_srs EPSG:326NN (UTM) dem.tif "
-                        "utm.tif", c->skew_deg);
+                        "projection first (UTM, e.g. gdalwarp -t_srs EPSG:326NN dem.tif "
+                        "utm.tif; for a continent a Lambert conformal conic, for a pole a "
+                        "polar stereographic one)", c->skew_deg);
     }
     if (c->skew_deg > TSD_SKEW_WARN_DEG)
         snprintf(c->warning, sizeof c->warning,
@@ -383,11 +404,16 @@ static ts_status projected(const double gt[6], int width, int height,
                  "ground (its projection shears it there): slopes, aspects and shadows "
                  "turn by up to as much; warp it to a conformal projection (e.g. UTM) "
                  "for exact directions", c->skew_deg);
-    if (mode == TSD_CELLS_GRID) {
-        /* (measured for the shear only: grid sizes and no scale, as asked) */
+    if (!opened || mode == TSD_CELLS_GRID ||
+        !ground_scale(&t, gt, width, height, c, &across, &along)) {
+        /* (CELL_SIZES=grid: measured for the shear only, grid sizes and no
+         * scale, as asked) */
         ground_close(&t);
         c->scale_lo = c->scale_hi = 0;
-        return TS_OK;
+        if (mode != TSD_CELLS_GROUND)
+            return TS_OK; /* nothing known against the grid's sizes */
+        return tsd_fail(msg, n, TS_ERR_ARG, "CELL_SIZES=ground: PROJ cannot take the DEM's "
+                        "cells to longitude and latitude; use CELL_SIZES=grid");
     }
     if (mode == TSD_CELLS_AUTO && fabs(c->scale_lo - 1) <= 0.01 && fabs(c->scale_hi - 1) <= 0.01) {
         ground_close(&t);

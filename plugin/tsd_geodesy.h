@@ -35,7 +35,7 @@ typedef enum { TSD_CRS_NONE = 0, TSD_CRS_PROJECTED, TSD_CRS_GEOGRAPHIC } tsd_crs
  * ground: beyond the first, a warning; beyond the second, a refusal (its
  * slopes, aspects and shadows would turn by as much). */
 #define TSD_SKEW_WARN_DEG 1.0
-#define TSD_SKEW_MAX_DEG 5.0
+#define TSD_SKEW_MAX_DEG 10.0
 
 typedef struct {
     tsd_crs_kind kind;

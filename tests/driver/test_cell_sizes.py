@@ -197,7 +197,7 @@ class CellSizes(unittest.TestCase):
         pseudocylindrical projection away from its central meridian) turns
         slopes, aspects and shadows by as much: a peak's shadow in
         Sinusoidal at 84 W 37 N pointed 31 degrees off the sun (session 58's
-        CRS audit). Beyond 5 degrees it is refused, beyond 1 degree warned
+        CRS audit). Beyond 10 degrees it is refused, beyond 1 degree warned
         of; the same place in UTM, or Sinusoidal on its central meridian,
         opens without a word, whatever CELL_SIZES."""
         z = np.zeros((32, 32), np.float32)
@@ -207,6 +207,14 @@ class CellSizes(unittest.TestCase):
                  ("+proj=laea +lat_0=52 +lon_0=10 +x_0=4321000 +y_0=3210000 "
                   "+ellps=GRS80 +units=m", 40.0, "warned"),
                  ("EPSG:32617", -84.25, None)]
+        # a world Mollweide: its shear lies off its axes, its corners outside
+        # its domain (skipped whole until the review: it opened silently)
+        world = T.write_tif(os.path.join(self.dir, "moll_world.tif"),
+                            np.zeros((45, 90), np.float32),
+                            (-18040095.7, 400891.0, 0, 9020047.8, 0, -400891.0),
+                            "+proj=moll +lon_0=0 +datum=WGS84 +units=m")
+        p = T.run(["gdalinfo", T.conn(world)], ok=False)
+        self.assertIn("degrees from a right angle on the ground", p.stderr)
         for i, (crs, lon, said) in enumerate(cases):
             s = gdal.osr.SpatialReference()
             s.SetFromUserInput(crs)

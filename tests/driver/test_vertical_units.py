@@ -88,13 +88,27 @@ class VerticalUnits(unittest.TestCase):
         ds = None
         print("svf mean %.4f, warped to UTM %.4f" % (want, got))
         self.assertAlmostEqual(got, want, delta=0.02)
-        tsa = os.path.join(self.dir, "ftus.tsa")
-        T.run(["gdal_translate", "-q", "-of", "TERRASHADE"] + T.oo_args(dict(
-            PRODUCT="farshadow", DATE="2026-06-21", TIMEZONE="-05:00", ATLAS_STEPS=2,
-            FAR_THRESHOLD=8)) + [T.conn(self.ftus), tsa])
-        ds = gdal.OpenEx(tsa, gdal.OF_RASTER, open_options=["SHADOWS=all"])
-        self.assertIsNotNone(ds.GetRasterBand(1).Checksum())
-        ds = None
+        # the DEM as a VRT too, whose data axes gdalbuildvrt writes out
+        # ("1,2,3": left on two axes, the product's CRS differed from the
+        # same CRS read elsewhere, and its atlas's SHADOWS=all was refused:
+        # the review)
+        vrt = os.path.join(self.dir, "ftus.vrt")
+        T.run(["gdalbuildvrt", "-q", vrt, self.ftus])
+        plain = gdal.osr.SpatialReference()
+        plain.ImportFromEPSG(2264)
+        plain.SetAxisMappingStrategy(gdal.osr.OAMS_TRADITIONAL_GIS_ORDER)
+        for dem in (self.ftus, vrt):
+            ds = opened(dem)
+            self.assertTrue(ds.GetSpatialRef().IsSame(plain), dem)
+            self.assertEqual(ds.GetSpatialRef().GetDataAxisToSRSAxisMapping(), [1, 2])
+            ds = None
+            tsa = os.path.join(self.dir, "ftus.tsa")
+            T.run(["gdal_translate", "-q", "-of", "TERRASHADE"] + T.oo_args(dict(
+                PRODUCT="farshadow", DATE="2026-06-21", TIMEZONE="-05:00", ATLAS_STEPS=2,
+                FAR_THRESHOLD=8)) + [T.conn(dem), tsa])
+            ds = gdal.OpenEx(tsa, gdal.OF_RASTER, open_options=["SHADOWS=all"])
+            self.assertIsNotNone(ds.GetRasterBand(1).Checksum())
+            ds = None
 
     def test_a_vertical_crs_alone_scales_only(self):
         """A DEM whose CRS is a vertical one alone (a VRT's SRS EPSG:6360):
