@@ -345,7 +345,7 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
         return FailOpen(TS_ERR_ARG, osRefused.c_str());
     // (exactly GDAL's name for it; a prefix before it is GDAL's business)
     const bool bStdin = IsStdinName(osDEM);
-    if (bStdin && (poDS->m_osStdinCopy = CopyStdin(sOpts)).empty())
+    if (bStdin && (poDS->m_osStdinCopy = CopyStdin(sOpts, osDEM)).empty())
         return nullptr;
     GDALDataset *poDEM = OpenDEM(bStdin ? poDS->m_osStdinCopy.c_str() : osDEM.c_str());
     if (!poDEM)

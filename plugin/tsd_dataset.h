@@ -199,11 +199,13 @@ class TSDataset final : public GDALPamDataset
     std::atomic<bool> m_bBelowSeaWarned{false}; // WarnBelowSea: once per dataset
     std::atomic<bool> m_bVoidsWarned{false};   // WarnVoids: once per dataset
     static GDALDataset *OpenDEM(const char *pszDEM);
-    /* The standard input read whole into a /vsimem/ file, which is what
-     * the DEM /vsistdin/ is read from: its stream reads forward only, but
+    /* The standard input read whole into a /vsimem/ file, through what
+     * the DEM's name chains before it (osDEM, IsStdinName's:
+     * /vsigzip//vsistdin/ decompressed), which is what the DEM is read
+     * from: its stream reads forward only, but
      * a DEM is read more than once (the steepness sample at open, the grid,
      * each overview level's open). Its name, or "" with the error said. */
-    static std::string CopyStdin(const tsd_options &sOpts);
+    static std::string CopyStdin(const tsd_options &sOpts, const std::string &osDEM);
     /* the bytes of that copy (level 0's, which a level reads too), or 0 */
     double StdinCopyBytes() const;
     /* why a read after CloseDependentDatasets fails */

@@ -44,14 +44,15 @@ GDALDataset *TSDataset::OpenDEM(const char *pszDEM)
     return GDALDataset::Open(pszDEM, GDAL_OF_RASTER | GDAL_OF_VERBOSE_ERROR);
 }
 
-std::string TSDataset::CopyStdin(const tsd_options &sOpts)
+std::string TSDataset::CopyStdin(const tsd_options &sOpts, const std::string &osDEM)
 {
     const char *pszWhy = nullptr;
     const double dfLimit = MemoryLimit(sOpts, &pszWhy);
     static std::atomic<unsigned> nCopies{0};
     const std::string osCopy =
         CPLSPrintf("/vsimem/terrashade_stdin_%ld_%u", static_cast<long>(getpid()), nCopies++);
-    VSILFILE *fpIn = VSIFOpenL("/vsistdin/", "rb");
+    // (through the handlers named before it: /vsigzip//vsistdin/ decompressed)
+    VSILFILE *fpIn = VSIFOpenL(osDEM.c_str(), "rb");
     VSILFILE *fpOut = fpIn ? VSIFOpenL(osCopy.c_str(), "wb") : nullptr;
     std::vector<GByte> abyChunk(1 << 20);
     double dfBytes = 0;
@@ -73,13 +74,14 @@ std::string TSDataset::CopyStdin(const tsd_options &sOpts)
         return osCopy;
     VSIUnlink(osCopy.c_str());
     Fail(bOver ? CPLE_OutOfMemory : CPLE_OpenFailed,
-         bOver ? CPLSPrintf("the DEM '/vsistdin/' is read whole into memory (a stream reads "
+         bOver ? CPLSPrintf("the DEM '%s' is read whole into memory (a stream reads "
                             "forward only, and the DEM is read more than once), and the "
                             "standard input holds more than the limit of %.0f MiB (%s): "
                             "write the DEM to a file first",
-                            dfLimit / 1048576.0, pszWhy)
-               : dfBytes > 0 ? "cannot copy the DEM '/vsistdin/' into memory"
-                             : "the DEM '/vsistdin/': the standard input is empty");
+                            osDEM.c_str(), dfLimit / 1048576.0, pszWhy)
+         : dfBytes > 0 ? CPLSPrintf("cannot copy the DEM '%s' into memory", osDEM.c_str())
+                       : CPLSPrintf("the DEM '%s': the standard input is empty",
+                                    osDEM.c_str()));
     return std::string();
 }
 

@@ -4,6 +4,7 @@
  */
 #include "tsd_path_check.h"
 
+#include <cctype>
 #include <cstring>
 #include <vector>
 
@@ -160,11 +161,25 @@ std::string RefusedDEMName(const char *pszDEM, const char *pszWhat, bool bFromFi
 bool IsStdinName(const std::string &osName)
 {
     // with GDAL's options too (/vsistdin?buffer_limit=-1: session 58's review
-    // found an atlas's SHADOWS=all entry shared by whatever DEM came in)
-    if (osName.compare(0, 9, "/vsistdin") != 0)
-        return false;
-    const std::string osRest = osName.substr(9);
-    return osRest.empty() || osRest == "/" || osRest[0] == '?' || osRest.compare(0, 2, "/?") == 0;
+    // found an atlas's SHADOWS=all entry shared by whatever DEM came in), and
+    // behind other handlers (/vsigzip//vsistdin/, /vsitar//vsistdin/x.tif)
+    size_t nAt = 0;
+    while (osName.compare(nAt, 9, "/vsistdin") != 0)
+    {
+        // a chain of handlers' prefixes only: /vsiNAME/ (a path's folder
+        // named vsistdin is a file's)
+        if (osName.compare(nAt, 4, "/vsi") != 0)
+            return false;
+        const size_t nEnd = osName.find('/', nAt + 4);
+        if (nEnd == std::string::npos)
+            return false;
+        for (size_t i = nAt + 4; i < nEnd; i++)
+            if (!isalnum(static_cast<unsigned char>(osName[i])) && osName[i] != '_')
+                return false;
+        nAt = nEnd + 1;
+    }
+    const std::string osRest = osName.substr(nAt + 9);
+    return osRest.empty() || osRest[0] == '/' || osRest[0] == '?';
 }
 
 } // namespace tsd

@@ -1,5 +1,6 @@
 """Bad inputs: each gives a clear message and a non-zero exit, never a crash,
 through gdal_translate, gdalinfo and Python."""
+import gzip
 import os
 import re
 import shutil
@@ -404,6 +405,17 @@ class Errors(unittest.TestCase):
                 ref = os.path.join(tmp, "file.tif")
                 T.run(["gdal_translate", "-q", "-of", "COG", T.conn(dem), ref])
                 self.assertEqual(checksums(cog), checksums(ref))
+            # GDAL's names for it with options, or behind another handler
+            # (a gzip'd DEM piped in), are read the same way (session 58)
+            gz = os.path.join(tmp, "dem.gz")
+            with open(T.JACKSBORO, "rb") as f, gzip.open(gz, "wb") as g:
+                g.write(f.read())
+            for name, src in (("/vsistdin?buffer_limit=-1", T.JACKSBORO),
+                              ("/vsigzip//vsistdin/", gz)):
+                p = run(["gdalinfo", "-checksum", T.conn(name)], src)
+                self.assertEqual(p.returncode, 0, p.stderr)
+                self.assertEqual(re.findall(r"Checksum=(\d+)", p.stdout),
+                                 checksums(T.conn(T.JACKSBORO)), name)
             self.assertFalse([f for f in os.listdir(tmp) if f.endswith(".aux.xml")])
             # its copy counts against MAX_MEMORY (2.4 MiB of heights here)
             big = os.path.join(tmp, "big.tif")

@@ -5,6 +5,7 @@ what the band reports, on that product and options only. Entries written
 into the DEM's own .aux.xml before are still read. Threads saving several
 products' statistics at once keep every entry, and so do processes, which
 never touch the DEM's own file (its georeferencing, for a PNG DEM)."""
+import gzip
 import math
 import os
 import shutil
@@ -463,8 +464,11 @@ class Pam(unittest.TestCase):
         # a DEM from the standard input, GDAL's options with it or not, is
         # another DEM each run: no entry (with ?buffer_limit one was kept,
         # keyed by the name, which any DEM piped in then took: the review)
-        for name in ("/vsistdin/", "/vsistdin?buffer_limit=-1"):
-            with open(dem, "rb") as stdin:
+        with open(dem, "rb") as f, gzip.open(dem + ".gz", "wb") as g:
+            g.write(f.read())
+        for name, src in (("/vsistdin/", dem), ("/vsistdin?buffer_limit=-1", dem),
+                          ("/vsigzip//vsistdin/", dem + ".gz")):
+            with open(src, "rb") as stdin:
                 p = subprocess.run(["gdalinfo", "-stats", "-oo", "SHADOWS=all", "-oo",
                                     "DEM=" + name, tsa], stdin=stdin, capture_output=True,
                                    text=True, env=T.env(), timeout=120)
