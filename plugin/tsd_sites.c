@@ -40,15 +40,6 @@ static void site_grid(tsd_sites *s, int width, int height)
     s->dy = s->ny > 1 ? (height - 1.0) / (s->ny - 1) : 1.0;
 }
 
-/* Degrees of arc, about, between sites a and b, or the turn of the sun's
- * grid azimuth between them where that is larger: the sun's elevation and
- * azimuth curve with the hour angle and the latitude, so the bilinear
- * interpolation's error grows as the square of this. The turn is the
- * meridians' convergence, dlon sin(lat), less that of grid north (0 on a
- * geographic grid; nearly all of it on a conformal one): near a pole, sites
- * 2 degrees of arc apart may be tens of degrees of longitude apart, and
- * their suns' directions, interpolated between, came up to 7.6 deg too
- * high (session 56's audit of per_cell near the poles). */
 /* The turn of a distant sun's grid azimuth from a place (lon, lat, grid
  * azimuth of true north) to another, degrees: its true azimuth turns with
  * the meridians, dlon sin(mid-latitude), its grid azimuth by that plus the
@@ -63,6 +54,15 @@ static double sun_turn(double lon_a, double lat_a, double north_a, double lon_b,
                           360.0));
 }
 
+/* Degrees of arc, about, between sites a and b, or the turn of the sun's
+ * grid azimuth between them where that is larger: the sun's elevation and
+ * azimuth curve with the hour angle and the latitude, so the bilinear
+ * interpolation's error grows as the square of this. The turn is the
+ * meridians' convergence, dlon sin(lat), less that of grid north (0 on a
+ * geographic grid; nearly all of it on a conformal one): near a pole, sites
+ * 2 degrees of arc apart may be tens of degrees of longitude apart, and
+ * their suns' directions, interpolated between, came up to 7.6 deg too
+ * high (session 56's audit of per_cell near the poles). */
 static double site_step(const tsd_sites *s, size_t a, size_t b)
 {
     const double mid = 0.5 * (s->lat[a] + s->lat[b]) * M_PI / 180.0;
