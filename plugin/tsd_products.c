@@ -340,12 +340,13 @@ static int pyramid_planes(const tsd_options *o, const tsd_product_def *p, int en
 void tsd_shadowmap_aspect(double cell_x, const double *cell_x_row, int height, double cell_y,
                           double *map_x, double *map_y)
 {
-    double lo = cell_x, hi = cell_x;
-    for (int y = 0; cell_x_row && y < height; y++) {
-        lo = fmin(lo, cell_x_row[y]);
+    /* the frame's cell: the shorter of cell_y and the central row's
+     * (the narrowest row's counted a 0-80 N DEM's map 23 times over, the
+     * review); its width: the widest row's */
+    double hi = cell_x;
+    for (int y = 0; cell_x_row && y < height; y++)
         hi = fmax(hi, cell_x_row[y]);
-    }
-    const double shorter = fmin(cell_y, lo);
+    const double shorter = fmin(cell_y, cell_x_row && height > 0 ? cell_x_row[height / 2] : cell_x);
     *map_x = shorter > 0 ? hi / shorter : 1;
     *map_y = shorter > 0 ? cell_y / shorter : 1;
 }

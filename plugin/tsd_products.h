@@ -113,8 +113,9 @@ double tsd_product_peak_bytes(const tsd_options *o, int width, int height, doubl
 /**
  * How many times a square cell's texels METHOD=shadowmap's map gives a
  * cell of cell_x (or, where cell_x_row is not NULL, of its `height` rows'
- * sizes) x cell_y metres along x and y: the map is as fine as the shorter
- * side (ts_shadowmap_frame_make), over the widest row.
+ * sizes, row 0 north) x cell_y metres along x and y: the map's texels are
+ * as fine as the shorter of cell_y and the central row's size
+ * (ts_shadowmap_frame_make), and span the widest row.
  */
 void tsd_shadowmap_aspect(double cell_x, const double *cell_x_row, int height, double cell_y,
                           double *map_x, double *map_y);
