@@ -343,7 +343,8 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     const std::string osRefused = RefusedDEMName(osDEM.c_str(), "the DEM", false);
     if (!osRefused.empty())
         return FailOpen(TS_ERR_ARG, osRefused.c_str());
-    // (exactly GDAL's name for it; a prefix before it is GDAL's business)
+    // (GDAL's names for the stream, with its options or behind a handler
+    // that streams, /vsigzip/: IsStdinName)
     const bool bStdin = IsStdinName(osDEM);
     if (bStdin && (poDS->m_osStdinCopy = CopyStdin(sOpts, osDEM)).empty())
         return nullptr;

@@ -51,8 +51,12 @@ std::string TSDataset::CopyStdin(const tsd_options &sOpts, const std::string &os
     static std::atomic<unsigned> nCopies{0};
     const std::string osCopy =
         CPLSPrintf("/vsimem/terrashade_stdin_%ld_%u", static_cast<long>(getpid()), nCopies++);
-    // (through the handlers named before it: /vsigzip//vsistdin/ decompressed)
-    VSILFILE *fpIn = VSIFOpenL(osDEM.c_str(), "rb");
+    // (through the handlers named before it: /vsigzip//vsistdin/ decompressed;
+    // GDAL opens /vsistdin with its slash only)
+    const std::string osStream =
+        osDEM.size() >= 9 && osDEM.compare(osDEM.size() - 9, 9, "/vsistdin") == 0 ? osDEM + "/"
+                                                                                  : osDEM;
+    VSILFILE *fpIn = VSIFOpenL(osStream.c_str(), "rb");
     VSILFILE *fpOut = fpIn ? VSIFOpenL(osCopy.c_str(), "wb") : nullptr;
     std::vector<GByte> abyChunk(1 << 20);
     double dfBytes = 0;
@@ -75,10 +79,12 @@ std::string TSDataset::CopyStdin(const tsd_options &sOpts, const std::string &os
     VSIUnlink(osCopy.c_str());
     Fail(bOver ? CPLE_OutOfMemory : CPLE_OpenFailed,
          bOver ? CPLSPrintf("the DEM '%s' is read whole into memory (a stream reads "
-                            "forward only, and the DEM is read more than once), and the "
-                            "standard input holds more than the limit of %.0f MiB (%s): "
-                            "write the DEM to a file first",
+                            "forward only, and the DEM is read more than once), and it holds "
+                            "more than the limit of %.0f MiB (%s): write the DEM to a file "
+                            "first",
                             osDEM.c_str(), dfLimit / 1048576.0, pszWhy)
+         : !fpIn       ? CPLSPrintf("cannot read the DEM '%s' from the standard input",
+                                    osDEM.c_str())
          : dfBytes > 0 ? CPLSPrintf("cannot copy the DEM '%s' into memory", osDEM.c_str())
                        : CPLSPrintf("the DEM '%s': the standard input is empty",
                                     osDEM.c_str()));

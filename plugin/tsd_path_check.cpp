@@ -162,7 +162,7 @@ bool IsStdinName(const std::string &osName)
 {
     // with GDAL's options too (/vsistdin?buffer_limit=-1: session 58's review
     // found an atlas's SHADOWS=all entry shared by whatever DEM came in), and
-    // behind other handlers (/vsigzip//vsistdin/, /vsitar//vsistdin/x.tif)
+    // behind other handlers (/vsigzip//vsistdin/)
     size_t nAt = 0;
     while (osName.compare(nAt, 9, "/vsistdin") != 0)
     {
@@ -178,8 +178,10 @@ bool IsStdinName(const std::string &osName)
                 return false;
         nAt = nEnd + 1;
     }
+    // the stream itself (a file in it, /vsitar//vsistdin/x.tif, is not
+    // read through a copy: GDAL's handlers seek in the archive)
     const std::string osRest = osName.substr(nAt + 9);
-    return osRest.empty() || osRest[0] == '/' || osRest[0] == '?';
+    return osRest.empty() || osRest == "/" || osRest[0] == '?' || osRest.compare(0, 2, "/?") == 0;
 }
 
 } // namespace tsd

@@ -411,11 +411,16 @@ class Errors(unittest.TestCase):
             with open(T.JACKSBORO, "rb") as f, gzip.open(gz, "wb") as g:
                 g.write(f.read())
             for name, src in (("/vsistdin?buffer_limit=-1", T.JACKSBORO),
-                              ("/vsigzip//vsistdin/", gz)):
+                              ("/vsistdin", T.JACKSBORO), ("/vsigzip//vsistdin/", gz)):
                 p = run(["gdalinfo", "-checksum", T.conn(name)], src)
                 self.assertEqual(p.returncode, 0, p.stderr)
                 self.assertEqual(re.findall(r"Checksum=(\d+)", p.stdout),
                                  checksums(T.conn(T.JACKSBORO)), name)
+            # a file in an archive read from it is GDAL's to open (its
+            # handlers seek), and its failure is not "the input is empty"
+            p = run(["gdalinfo", T.conn("/vsitar//vsistdin/dem.tif")], T.JACKSBORO)
+            self.assertNotEqual(p.returncode, 0)
+            self.assertNotIn("is empty", p.stderr)
             self.assertFalse([f for f in os.listdir(tmp) if f.endswith(".aux.xml")])
             # its copy counts against MAX_MEMORY (2.4 MiB of heights here)
             big = os.path.join(tmp, "big.tif")
@@ -423,8 +428,9 @@ class Errors(unittest.TestCase):
                    T.JACKSBORO, big])
             p = run(["gdalinfo", "-oo", "MAX_MEMORY=2", T.conn("/vsistdin/")], big)
             self.assertEqual(p.returncode, 1, p.stderr)
-            self.assertIn("the standard input holds more than the limit of 2 MiB "
-                          "(MAX_MEMORY): write the DEM to a file first", p.stderr)
+            self.assertIn("is read whole into memory (a stream reads forward only, and the "
+                          "DEM is read more than once), and it holds more than the limit of "
+                          "2 MiB (MAX_MEMORY): write the DEM to a file first", p.stderr)
             # and beside the product: the estimate counts it (the review)
             # and names it (its advice counts it too: each mode's sent the
             # user to the other, the second review)
