@@ -420,23 +420,35 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
 {
     char szMsg[1024] = "";
     const tsd_options &sOpts = m_sOpts;
-    // a vertical CRS alone places nothing: as no CRS for the cells and the
-    // sun (its unit still scales the heights; PROJ's errors on asking it
-    // for an ellipsoid, and "the DEM has no CRS", misled: the CRS audit)
+    // The cells and the sun are the ground's: a compound CRS's horizontal
+    // part (an engineering one with heights was measured as no CRS at all,
+    // its unit ignored: the review), none for a vertical CRS alone, which
+    // places nothing (PROJ's errors on asking it for an ellipsoid, and "the
+    // DEM has no CRS", misled: the CRS audit). The heights' unit is the
+    // DEM's whole CRS's (Z_FACTOR=AUTO, tsd_dem.c).
     const bool bVerticalOnly = m_oSRS.IsVertical() && !m_oSRS.IsCompound();
-    OGRSpatialReferenceH hSRS = m_oSRS.IsEmpty() || bVerticalOnly
-                                    ? nullptr
-                                    : OGRSpatialReference::ToHandle(&m_oSRS);
     m_oProductSRS = bVerticalOnly ? OGRSpatialReference() : GroundSRS(m_oSRS);
+    OGRSpatialReferenceH hSRS = m_oProductSRS.IsEmpty()
+                                    ? nullptr
+                                    : OGRSpatialReference::ToHandle(&m_oProductSRS);
+    const std::string osVertical =
+        bVerticalOnly ? CPLSPrintf("a vertical CRS only (%s), which places nothing on the ground",
+                                   m_oSRS.GetName())
+                      : std::string();
+    if (bVerticalOnly && sOpts.cell_sizes == TSD_CELLS_GROUND)
+        return Fail(TS_ERR_ARG, CPLSPrintf("CELL_SIZES=ground: the DEM has %s, so its cells "
+                                           "cannot be measured on the ground; give it a "
+                                           "horizontal CRS too (gdal_edit.py -a_srs)",
+                                           osVertical.c_str())),
+               false;
     ts_status eSt = tsd_cells_compute(m_adfGT, W, H, hSRS, sOpts.cell_sizes, &m_sCells, szMsg,
                                       sizeof szMsg);
     if (eSt != TS_OK)
         return Fail(eSt, szMsg), false;
     if (bVerticalOnly)
         snprintf(m_sCells.warning, sizeof m_sCells.warning,
-                 "the DEM's CRS is a vertical one only (%s), which places nothing on the "
-                 "ground: its cell size (%g x %g) is taken as metres",
-                 m_oSRS.GetName(), std::fabs(m_adfGT[1]), std::fabs(m_adfGT[5]));
+                 "the DEM has %s: its cell size (%g x %g) is taken as metres",
+                 osVertical.c_str(), std::fabs(m_adfGT[1]), std::fabs(m_adfGT[5]));
     const double dfMinCell = std::min(m_sCells.cell_y, tsd_cells_min_x(&m_sCells, H));
     if (m_nLevel == 0 && sOpts.max_distance > 0 &&
         sOpts.max_distance < std::min(TSD_MAX_DISTANCE_MIN, dfMinCell) &&
@@ -459,10 +471,13 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
         if (!m_bHasGT || !hSRS)
             return Fail(
                        CPLE_AppDefined,
-                       CPLSPrintf("%s needs a georeferenced DEM, but '%s' has no %s: the "
+                       CPLSPrintf("%s needs a georeferenced DEM, but '%s' has %s: the "
                                   "sun's position over it is unknown. Give it one "
                                   "(gdal_edit.py -a_srs / -a_ullr)%s",
-                                  pszWhat, m_osDEM.c_str(), !m_bHasGT ? "geotransform" : "CRS",
+                                  pszWhat, m_osDEM.c_str(),
+                                  !m_bHasGT       ? "no geotransform"
+                                  : bVerticalOnly ? osVertical.c_str()
+                                                  : "no CRS",
                                   m_psProduct->daily ? ""
                                                      : " or use SUN_AZIMUTH and SUN_ELEVATION")),
                    false;

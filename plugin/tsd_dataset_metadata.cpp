@@ -138,7 +138,7 @@ void TSDataset::SetupMetadata()
     // (a local or engineering CRS is measured as a projected one's grid)
     const char *pszKind = m_sCells.kind == TSD_CRS_GEOGRAPHIC ? "geographic"
                           : m_sCells.kind == TSD_CRS_PROJECTED
-                              ? (m_oSRS.IsLocal() ? "local" : "projected")
+                              ? (m_oProductSRS.IsLocal() ? "local" : "projected")
                               : "none";
     GDALDataset::SetMetadataItem("SOURCE_CRS_KIND", pszKind);
     GDALDataset::SetMetadataItem("CELL_SIZE_X", CPLSPrintf("%.6f", m_sCells.cell_x));

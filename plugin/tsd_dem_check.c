@@ -36,11 +36,17 @@ static int height_limits(GDALRasterBandH band, const tsd_dem_conversion *c, doub
     GDALDatasetH ds = GDALGetBandDataset(band);
     OGRSpatialReferenceH srs = ds ? GDALGetSpatialRef(ds) : NULL;
     OGRErr err = OGRERR_FAILURE;
-    /* a local CRS, or a vertical one alone, has no ellipsoid: PROJ said so
-     * as an ERROR (four times; twice) */
-    double a = srs && !OSRIsLocal(srs) && !(OSRIsVertical(srs) && !OSRIsCompound(srs))
-                   ? OSRGetSemiMajor(srs, &err)
+    /* a local CRS, or a vertical one alone, or a compound of either with
+     * heights, has no ellipsoid: PROJ said so as an ERROR (four times;
+     * twice) */
+    OGRSpatialReferenceH ground = srs ? OSRClone(srs) : NULL;
+    if (ground && OSRIsCompound(ground))
+        OSRStripVertical(ground);
+    double a = ground && !OSRIsLocal(ground) && !OSRIsVertical(ground)
+                   ? OSRGetSemiMajor(ground, &err)
                    : 0;
+    if (ground)
+        OSRDestroySpatialReference(ground);
     const int earth = !(err == OGRERR_NONE && a > 0 && fabs(a - TS_EARTH_RADIUS) > 100000.0);
     if (!earth) {
         *low = -a;

@@ -275,35 +275,42 @@ static void ecef(const struct geod_geodesic *g, double lon, double lat, double o
 
 /* side x side cells of the DEM, from corner to corner (3: its corners,
  * its edges' middles, its centre): the segments of each one's east-west
- * side (2i) and north-south side (2i + 1) in pixel space. */
-static void lattice_cells(int width, int height, int side, double *x0, double *y0, double *x1,
-                          double *y1)
+ * side (2i) and north-south side (2i + 1) in pixel space, hx and hy cells
+ * either side of its centre (0.5: the cell's own sides). */
+static void lattice_cells(int width, int height, int side, double hx, double hy, double *x0,
+                          double *y0, double *x1, double *y1)
 {
     for (int j = 0, i = 0; j < side; j++)
         for (int k = 0; k < side; k++, i += 2) {
             const double fx = 0.5 + (width - 1.0) * k / (side - 1);
             const double fy = 0.5 + (height - 1.0) * j / (side - 1);
-            x0[i] = fx - 0.5, x1[i] = fx + 0.5, y0[i] = y1[i] = fy;
-            x0[i + 1] = x1[i + 1] = fx, y0[i + 1] = fy - 0.5, y1[i + 1] = fy + 0.5;
+            x0[i] = fx - hx, x1[i] = fx + hx, y0[i] = y1[i] = fy;
+            x0[i + 1] = x1[i + 1] = fx, y0[i + 1] = fy - hy, y1[i + 1] = fy + hy;
         }
 }
 
 /* Cells a side of the lattice the shear is measured on: a world
  * Mollweide's shear lies off its axes, its corners outside its domain. */
 #define SKEW_SIDE 5
+/* The shortest chord on the ground the shear is measured along, metres. */
+#define SKEW_CHORD_M 100.0
 
 /* How far the grid's axes are from a right angle on the ground, at most,
  * over the cells of a SKEW_SIDE^2 lattice that PROJ can place, as the
  * angle between the chords of a cell's two sides in space, which, unlike
  * azimuths, holds at a pole; the number of cells measured. */
 static int ground_skew(const ground_ctx *t, const double gt[6], int width, int height,
-                       double *skew)
+                       double unit_to_m, double *skew)
 {
     enum { CELLS = SKEW_SIDE * SKEW_SIDE };
     double x0[2 * CELLS], y0[2 * CELLS], x1[2 * CELLS], y1[2 * CELLS], X[4 * CELLS],
         Y[4 * CELLS];
     int ok[4 * CELLS], measured = 0;
-    lattice_cells(width, height, SKEW_SIDE, x0, y0, x1, y1);
+    /* chords of at least SKEW_CHORD_M: on cells of a nanometre the
+     * points' own rounding read 28 degrees of shear */
+    const double hx = fmax(0.5, 0.5 * SKEW_CHORD_M / (fabs(gt[1]) * unit_to_m));
+    const double hy = fmax(0.5, 0.5 * SKEW_CHORD_M / (fabs(gt[5]) * unit_to_m));
+    lattice_cells(width, height, SKEW_SIDE, hx, hy, x0, y0, x1, y1);
     *skew = 0;
     for (int i = 0; i < 4 * CELLS; i++)
         ok[i] = 0;
@@ -346,7 +353,7 @@ static int ground_scale(const ground_ctx *t, const double gt[6], int width, int 
                         tsd_cells *c, double *across, double *along)
 {
     double x0[18], y0[18], x1[18], y1[18], len[18], grid[18];
-    lattice_cells(width, height, 3, x0, y0, x1, y1);
+    lattice_cells(width, height, 3, 0.5, 0.5, x0, y0, x1, y1);
     for (int i = 0; i < 18; i += 2) {
         grid[i] = fabs(gt[1]) * c->unit_to_m;
         grid[i + 1] = fabs(gt[5]) * c->unit_to_m;
@@ -382,7 +389,7 @@ static ts_status projected(const double gt[6], int width, int height,
     double across = 0, along = 0;
     const int opened = ground_open(&t, srs);
     if (opened)
-        ground_skew(&t, gt, width, height, &c->skew_deg);
+        ground_skew(&t, gt, width, height, c->unit_to_m, &c->skew_deg);
     /* one cell size a row and a north-south one cannot hold axes that are
      * not at right angles on the ground: slopes, aspects and shadows turn
      * by as much (Sinusoidal at 84 W 37 N: 41 degrees, a peak's shadow 31
@@ -458,13 +465,19 @@ static ts_status projected(const double gt[6], int width, int height,
     c->cell_x = c->cell_x_row[height / 2];
     /* what one length per row (east-west) and one for the whole DEM
      * (north-south) cannot hold */
-    if ((across > 0.01 || along > 0.05) && !c->warning[0])
-        snprintf(c->warning, sizeof c->warning,
+    if (across > 0.01 || along > 0.05) {
+        /* (after the shear's, where it warned: one sentence hid the other) */
+        const size_t used = strlen(c->warning);
+        snprintf(c->warning + used, sizeof c->warning - used, "%s",
+                 used ? "; and " : "");
+        const size_t at = strlen(c->warning);
+        snprintf(c->warning + at, sizeof c->warning - at,
                  "the projection's scale varies by %.1f %% across the DEM's columns and its "
                  "cells' north-south length by %.1f %% along its rows; they are measured "
                  "along the central column, north-south as their mean: crop the DEM or "
                  "warp it to a local projection (e.g. UTM) for exact slopes at its edges",
                  100 * across, 100 * along);
+    }
 done:
     free(x0);
     free(y0);

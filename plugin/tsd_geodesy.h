@@ -53,7 +53,7 @@ typedef struct {
     double skew_deg;    /* projected: how far the grid's axes are from a right
                            angle on the ground, at most, over nine cells; 0:
                            not measured (a local CRS) */
-    char warning[512];  /* non-empty: something the user should know */
+    char warning[1024]; /* non-empty: something the user should know */
 } tsd_cells;
 
 /**

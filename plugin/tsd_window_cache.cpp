@@ -230,8 +230,9 @@ bool TSDataset::EnsureFarField()
         adfGT[i] *= static_cast<double>(W) / fw;
     for (int i : {2, 5})
         adfGT[i] *= static_cast<double>(H) / fh;
+    // (the ground's CRS, as Setup measured the DEM's own cells with)
     OGRSpatialReferenceH hSRS =
-        m_oSRS.IsEmpty() ? nullptr : OGRSpatialReference::ToHandle(&m_oSRS);
+        m_oProductSRS.IsEmpty() ? nullptr : OGRSpatialReference::ToHandle(&m_oProductSRS);
     if (!m_poDEM)
     {
         s.status = TS_ERR_INTERNAL;

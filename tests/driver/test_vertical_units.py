@@ -3,6 +3,7 @@ metres, from the vertical CRS or the band's unit type; a number overrides;
 the metadata says which factor was used and why (docs/driver.md)."""
 import os
 import unittest
+from xml.sax.saxutils import escape as xml_escape
 
 import tsdriver as T
 from tsdriver import gdal, np
@@ -127,17 +128,47 @@ class VerticalUnits(unittest.TestCase):
         p = T.run(["gdalinfo", T.conn(vrt, **OPTIONS)])
         print(p.stderr.strip())
         self.assertNotIn("ERROR", p.stderr)
-        self.assertIn("the DEM's CRS is a vertical one only (NAVD88 height (ftUS))", p.stderr)
+        self.assertIn("the DEM has a vertical CRS only (NAVD88 height (ftUS))", p.stderr)
         self.assertIn("SOURCE_CRS_KIND=none", p.stdout)
         self.assertIn("Z_FACTOR=%.10g" % FT_US, p.stdout)
         ds = opened(vrt)
         self.assertIsNone(ds.GetSpatialRef())
         ds = None
+        # and where a CRS on the ground is needed, it says which it has
+        for options, said in ((dict(OPTIONS, CELL_SIZES="ground"),
+                               "CELL_SIZES=ground: the DEM has a vertical CRS only"),
+                              ({"PRODUCT": "shadow", "DATETIME": "2026-06-21T1200Z"},
+                               "has a vertical CRS only")):
+            p = T.run(["gdalinfo", T.conn(vrt, **options)], ok=False)
+            self.assertIn(said, p.stderr)
         local = T.write_tif(os.path.join(self.dir, "local.tif"), self.z, NC_GT,
                             'LOCAL_CS["site",UNIT["metre",1]]')
         ds = opened(local)
         self.assertEqual(ds.GetMetadataItem("SOURCE_CRS_KIND"), "local")
         ds = None
+        # an engineering CRS in feet with heights in NAVD88 feet: local, its
+        # cells in its feet (taken as no CRS, 30.5 times too long, beside
+        # four PROJ errors: the review), its heights in the vertical unit
+        eng = ('ENGCRS["site ft",EDATUM["d"],CS[Cartesian,2],AXIS["x",east,LENGTHUNIT['
+               '"foot",0.3048]],AXIS["y",north,LENGTHUNIT["foot",0.3048]]]')
+        vert = ('VERTCRS["NAVD88 height (ftUS)",VDATUM["North American Vertical Datum 1988"],'
+                'CS[vertical,1],AXIS["gravity-related height (H)",up,LENGTHUNIT['
+                '"US survey foot",0.304800609601219]],ID["EPSG",6360]]')
+        both = os.path.join(self.dir, "engvert.vrt")
+        with open(both, "w") as f:
+            f.write('<VRTDataset rasterXSize="64" rasterYSize="64"><SRS>%s</SRS>'
+                    '<GeoTransform>%s</GeoTransform><VRTRasterBand dataType="Float32" '
+                    'band="1"><SimpleSource><SourceFilename relativeToVRT="0">%s'
+                    '</SourceFilename><SourceBand>1</SourceBand></SimpleSource>'
+                    '</VRTRasterBand></VRTDataset>' % (
+                        xml_escape('COMPOUNDCRS["site ft+NAVD88",%s,%s]' % (eng, vert)),
+                        ", ".join(map(repr, NC_GT)), self.plain))
+        p = T.run(["gdalinfo", T.conn(both, **OPTIONS)])
+        self.assertNotIn("ERROR", p.stderr)
+        self.assertNotIn("no CRS", p.stderr)
+        self.assertIn("SOURCE_CRS_KIND=local", p.stdout)
+        self.assertIn("CELL_SIZE_X=%.6f" % (NC_GT[1] * 0.3048), p.stdout)
+        self.assertIn("Z_FACTOR=%.10g" % FT_US, p.stdout)
 
     def test_band_unit_feet(self):
         self.check(self.ft, 0.3048, "band unit ft", self.m_ft)
