@@ -455,10 +455,11 @@ static ts_status projected(const double gt[6], int width, int height,
         free(c->cell_x_row);
         c->cell_x_row = NULL;
         c->ground = 0;
-        snprintf(c->warning, sizeof c->warning,
-                 "the projection's scale is %.4f to %.4f over the DEM, but PROJ cannot take "
+        const size_t used = strlen(c->warning); /* (after the shear's) */
+        snprintf(c->warning + used, sizeof c->warning - used,
+                 "%sthe projection's scale is %.4f to %.4f over the DEM, but PROJ cannot take "
                  "every row of its central column to longitude and latitude, so its cells "
-                 "are the grid's, not the ground's", c->scale_lo, c->scale_hi);
+                 "are the grid's, not the ground's", used ? "; and " : "", c->scale_lo, c->scale_hi);
         goto done;
     }
     c->cell_y = c->cell_x_row[height] / height;

@@ -51,7 +51,8 @@ typedef struct {
                                   over ground length) seen over the DEM; 0: not
                                   measured (CELL_SIZES=grid, a local CRS) */
     double skew_deg;    /* projected: how far the grid's axes are from a right
-                           angle on the ground, at most, over nine cells; 0:
+                           angle on the ground, at most, over a 5 x 5 lattice
+                           of cells (chords of at least 100 m); 0:
                            not measured (a local CRS) */
     char warning[1024]; /* non-empty: something the user should know */
 } tsd_cells;

@@ -362,7 +362,8 @@ double tsd_shadowmap_bytes(const tsd_options *o, int width, int height, double m
      * widest, a diagonal */
     const double az = (o->datetime[0] ? 45.0 : o->sun_azimuth) * M_PI / 180;
     const double ca = fabs(cos(az)), sa = fabs(sin(az)), k = o->shadowmap_scale;
-    const double texels = (k * (w * ca + h * sa) + 3) * (k * (w * sa + h * ca) + 3);
+    /* (+ 4: the frame's ceil and its 3 texels of border, at every scale) */
+    const double texels = (k * (w * ca + h * sa) + 4) * (k * (w * sa + h * ca) + 4);
     return 3 * plane + texels * (1 + 1.0 / 256) * sizeof(int);
 }
 

@@ -215,6 +215,13 @@ class CellSizes(unittest.TestCase):
                             "+proj=moll +lon_0=0 +datum=WGS84 +units=m")
         p = T.run(["gdalinfo", T.conn(world)], ok=False)
         self.assertIn("degrees from a right angle on the ground", p.stderr)
+        # LAEA over the EU-DEM's extent: its shear warned of, and its scale
+        # too, after it (the shear's sentence hid the scale's: the review)
+        eu = T.write_tif(os.path.join(self.dir, "laea_eu.tif"), np.zeros((64, 64), np.float32),
+                         (943609.0, 95233.0, 0, 6021050.0, 0, -79357.0), 3035)
+        p = T.run(["gdalinfo", T.conn(eu)])
+        self.assertRegex(p.stderr, r"up to [5-8]\.\d degrees from a right angle on the ground"
+                                   r"[^\n]*; and the projection's scale varies by")
         for i, (crs, lon, said) in enumerate(cases):
             s = gdal.osr.SpatialReference()
             s.SetFromUserInput(crs)

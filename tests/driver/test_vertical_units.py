@@ -147,7 +147,7 @@ class VerticalUnits(unittest.TestCase):
         self.assertEqual(ds.GetMetadataItem("SOURCE_CRS_KIND"), "local")
         ds = None
         # an engineering CRS in feet with heights in NAVD88 feet: local, its
-        # cells in its feet (taken as no CRS, 30.5 times too long, beside
+        # cells in its feet (taken as no CRS, 3.3 times too long, beside
         # four PROJ errors: the review), its heights in the vertical unit
         eng = ('ENGCRS["site ft",EDATUM["d"],CS[Cartesian,2],AXIS["x",east,LENGTHUNIT['
                '"foot",0.3048]],AXIS["y",north,LENGTHUNIT["foot",0.3048]]]')
