@@ -263,8 +263,9 @@ int tsd_window_plan_make(const tsd_options *o, const tsd_sun *sun, int W, int H,
 }
 
 /* The largest of a few chunk sizes with which options o window a W x H
- * DEM within `limit` bytes, `extra` held beside the windows: 1 with *tile
- * and *bytes (the windows' peak and extra), else 0. */
+ * DEM within `limit` bytes, `extra` held beside the windows, with o's
+ * near field or else the least of a few wider ones: 1 with *tile, *near
+ * (metres; 0: o's own) and *bytes (the windows' peak and extra), else 0. */
 static int tile_that_fits(const tsd_options *o, const tsd_sun *sun, int W, int H,
                           double cells_min_x, double cell_y, double limit, double extra,
                           int *tile, double *near, double *bytes)
