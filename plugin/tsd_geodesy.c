@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <stdarg.h>
 #include <string.h>
 
 /* A grid-registered (node) grid, as ETOPO1's "_g_" ones, has rows centred
@@ -374,6 +375,21 @@ static int ground_scale(const ground_ctx *t, const double gt[6], int width, int 
     return 1;
 }
 
+/* Add a sentence to the cells' warning: after the one there, where there
+ * is one (the shear's hid the scale's: session 58's review). */
+static void add_warning(tsd_cells *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void add_warning(tsd_cells *c, const char *fmt, ...)
+{
+    const size_t used = strlen(c->warning);
+    if (used)
+        snprintf(c->warning + used, sizeof c->warning - used, "; and ");
+    const size_t at = strlen(c->warning);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(c->warning + at, sizeof c->warning - at, fmt, ap);
+    va_end(ap);
+}
+
 /* A projected DEM's cells on the ground (CELL_SIZES=ground, or auto where
  * the scale departs from 1 by more than 1 %): east-west per row and the
  * north-south mean, both along the central column, as geographic() does. */
@@ -406,11 +422,11 @@ static ts_status projected(const double gt[6], int width, int height,
                         "polar stereographic one)", c->skew_deg);
     }
     if (c->skew_deg > TSD_SKEW_WARN_DEG)
-        snprintf(c->warning, sizeof c->warning,
-                 "the DEM's grid axes are up to %.1f degrees from a right angle on the "
-                 "ground (its projection shears it there): slopes, aspects and shadows "
-                 "turn by up to as much; warp it to a conformal projection (e.g. UTM) "
-                 "for exact directions", c->skew_deg);
+        add_warning(c,
+                    "the DEM's grid axes are up to %.1f degrees from a right angle on the "
+                    "ground (its projection shears it there): slopes, aspects and shadows "
+                    "turn by up to as much; warp it to a conformal projection (e.g. UTM) "
+                    "for exact directions", c->skew_deg);
     if (!opened || mode == TSD_CELLS_GRID ||
         !ground_scale(&t, gt, width, height, c, &across, &along)) {
         /* (CELL_SIZES=grid: measured for the shear only, grid sizes and no
@@ -455,30 +471,23 @@ static ts_status projected(const double gt[6], int width, int height,
         free(c->cell_x_row);
         c->cell_x_row = NULL;
         c->ground = 0;
-        const size_t used = strlen(c->warning); /* (after the shear's) */
-        snprintf(c->warning + used, sizeof c->warning - used,
-                 "%sthe projection's scale is %.4f to %.4f over the DEM, but PROJ cannot take "
-                 "every row of its central column to longitude and latitude, so its cells "
-                 "are the grid's, not the ground's", used ? "; and " : "", c->scale_lo, c->scale_hi);
+        add_warning(c,
+                    "the projection's scale is %.4f to %.4f over the DEM, but PROJ cannot take "
+                    "every row of its central column to longitude and latitude, so its cells "
+                    "are the grid's, not the ground's", c->scale_lo, c->scale_hi);
         goto done;
     }
     c->cell_y = c->cell_x_row[height] / height;
     c->cell_x = c->cell_x_row[height / 2];
     /* what one length per row (east-west) and one for the whole DEM
      * (north-south) cannot hold */
-    if (across > 0.01 || along > 0.05) {
-        /* (after the shear's, where it warned: one sentence hid the other) */
-        const size_t used = strlen(c->warning);
-        snprintf(c->warning + used, sizeof c->warning - used, "%s",
-                 used ? "; and " : "");
-        const size_t at = strlen(c->warning);
-        snprintf(c->warning + at, sizeof c->warning - at,
-                 "the projection's scale varies by %.1f %% across the DEM's columns and its "
-                 "cells' north-south length by %.1f %% along its rows; they are measured "
-                 "along the central column, north-south as their mean: crop the DEM or "
-                 "warp it to a local projection (e.g. UTM) for exact slopes at its edges",
-                 100 * across, 100 * along);
-    }
+    if (across > 0.01 || along > 0.05)
+        add_warning(c,
+                    "the projection's scale varies by %.1f %% across the DEM's columns and its "
+                    "cells' north-south length by %.1f %% along its rows; they are measured "
+                    "along the central column, north-south as their mean: crop the DEM or "
+                    "warp it to a local projection (e.g. UTM) for exact slopes at its edges",
+                    100 * across, 100 * along);
 done:
     free(x0);
     free(y0);
