@@ -133,10 +133,12 @@ static int check_environment(const tsd_options *o, char *msg, size_t n)
      * default, an option of another product is no mistake (the warning of
      * unused options names it), as METHOD=exact with svf */
     double stops;
-    const int set[] = {o->env_map[0] != '\0', o->sky[0] != '\0', o->env_rotation != 0,
-                       o->env_horizon_steps != TS_ENV_DEFAULT_HORIZON_STEPS,
-                       o->env_normal_steps != TS_ENV_DEFAULT_NORMAL_STEPS,
-                       tsd_exposure_parse(o->exposure, &stops) == 0};
+    enum { MAP, SKY, ROTATION, HORIZON_STEPS, NORMAL_STEPS, EXPOSURE }; /* (own's order) */
+    const int set[] = {[MAP] = o->env_map[0] != '\0', [SKY] = o->sky[0] != '\0',
+                       [ROTATION] = o->env_rotation != 0,
+                       [HORIZON_STEPS] = o->env_horizon_steps != TS_ENV_DEFAULT_HORIZON_STEPS,
+                       [NORMAL_STEPS] = o->env_normal_steps != TS_ENV_DEFAULT_NORMAL_STEPS,
+                       [EXPOSURE] = tsd_exposure_parse(o->exposure, &stops) == 0};
     for (size_t i = 0; i < sizeof own / sizeof own[0]; i++) {
         int id = tsd_option_find(own[i]);
         if (set[i] && !tsd_product_takes(p, id)) {
@@ -156,15 +158,15 @@ static int check_environment(const tsd_options *o, char *msg, size_t n)
                                       o->sun_elevation != d.sun_elevation || o->datetime[0]))
         REFUSE("PRODUCT=%s with ENV_MAP is lit by the map alone: SUN_AZIMUTH, "
                "SUN_ELEVATION and DATETIME place the sun of a SKY", p->name);
-    if (o->env_rotation != 0 && !o->env_map[0])
+    if (set[ROTATION] && !o->env_map[0])
         REFUSE("ENV_ROTATION turns ENV_MAP; a SKY turns with its sun (SUN_AZIMUTH or "
                "DATETIME)");
     /* as ENV_ROTATION: shade's sky term without SKY or ENV_MAP is the
      * sky-view factor's uniform sky, which has no table (session 57's audit:
      * taken without a word) */
-    const char *steps = o->env_horizon_steps != TS_ENV_DEFAULT_HORIZON_STEPS ? "ENV_HORIZON_STEPS"
-                        : o->env_normal_steps != TS_ENV_DEFAULT_NORMAL_STEPS ? "ENV_NORMAL_STEPS"
-                                                                              : NULL;
+    const char *steps = set[HORIZON_STEPS]  ? "ENV_HORIZON_STEPS"
+                        : set[NORMAL_STEPS] ? "ENV_NORMAL_STEPS"
+                                            : NULL;
     if (steps && !envlight && !(o->sky_weight > 0))
         REFUSE("%s sets the light table of PRODUCT=%s's sky term, which SKY_WEIGHT=0 leaves "
                "out: give SKY_WEIGHT > 0 and a SKY or ENV_MAP", steps, p->name);
@@ -185,7 +187,7 @@ static int check_environment(const tsd_options *o, char *msg, size_t n)
                "horizon of open flat ground, which else reads too little light), got %d",
                o->env_horizon_steps);
     /* (EXPOSURE=AUTO, the default, is no mistake) */
-    if (set[5] && !tsd_options_output_byte(o))
+    if (set[EXPOSURE] && !tsd_options_output_byte(o))
         REFUSE("EXPOSURE applies to OUTPUT_TYPE=Byte (the display image); Float32 "
                "keeps the light's own values");
     return 0;

@@ -21,8 +21,10 @@ int tsd_options_check_pyramid(const tsd_options *o, char *msg, size_t n)
     /* given with its default, an option of another product is no mistake
      * (the warning of unused options names it: HORIZON_METHOD=exact with
      * sunhours, whose sweeps are exact, was refused until session 58) */
-    const int set[] = {o->horizon_method != TSD_HORIZON_EXACT, o->pyramid_level_step != k0,
-                       o->pyramid_offset != o0};
+    enum { METHOD, LEVEL_STEP, OFFSET };
+    const int set[] = {[METHOD] = o->horizon_method != TSD_HORIZON_EXACT,
+                       [LEVEL_STEP] = o->pyramid_level_step != k0,
+                       [OFFSET] = o->pyramid_offset != o0};
     for (size_t i = 0; i < sizeof own / sizeof own[0]; i++) {
         int id = tsd_option_find(own[i]);
         /* METHOD=sh's key light (shade, shadow) is built from horizons */
@@ -39,9 +41,9 @@ int tsd_options_check_pyramid(const tsd_options *o, char *msg, size_t n)
     /* as SVF_MODEL: a value that would do nothing is a mistake; the
      * default given explicitly is not */
     if (o->horizon_method != TSD_HORIZON_PYRAMID) {
-        const char *which = o->pyramid_offset != o0         ? "PYRAMID_OFFSET"
-                            : o->pyramid_level_step != k0 ? "PYRAMID_LEVEL_STEP"
-                                                          : NULL;
+        const char *which = set[OFFSET]       ? "PYRAMID_OFFSET"
+                            : set[LEVEL_STEP] ? "PYRAMID_LEVEL_STEP"
+                                              : NULL;
         if (which)
             REFUSE("%s applies with HORIZON_METHOD=pyramid; HORIZON_METHOD=exact (the "
                    "sweep) has no pyramid",
