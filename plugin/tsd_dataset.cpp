@@ -522,12 +522,12 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
         WarnDistances(dfMinCell, W, H);
         WarnSweepTurn(H);
     }
-    double dfHeadroom = 0;
+    double dfLimit = 0, dfHeadroom = 0;
     if (!SetupWindow(W, H) ||
         !CheckMemory(sOpts, W, H, WindowPlan(m_poWindow), m_bHasSun ? &m_sSun : nullptr,
                      m_sCells, m_nLevel, m_sEnvCost,
                      m_sEnvMapInfo.width ? &m_sEnvMapInfo : nullptr, StdinCopyBytes(),
-                     &dfHeadroom) ||
+                     &dfLimit, &dfHeadroom) ||
         !BuildEnvironment(oEnvMap))
         return false;
     // a lattice's day keeps horizon planes across its steps: in at most
@@ -539,8 +539,7 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     // (docs/opencl.md, "Through the driver")
     m_sRun.batch_bytes = dfHeadroom / 2;
     // and what is known only when computing, against the whole headroom
-    const char *pszLimitWhy = nullptr;
-    m_sRun.limit_bytes = MemoryLimit(sOpts, &pszLimitWhy);
+    m_sRun.limit_bytes = dfLimit;
     m_sRun.headroom_bytes = dfHeadroom;
     /* a bad TERRASHADE_BACKEND or _SIMD is an error here (without probing OpenCL) */
     m_bUsesBackend = m_psProduct->uses_backend && m_psProduct->uses_backend(&sOpts, psSun);

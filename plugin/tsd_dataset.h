@@ -60,11 +60,11 @@ void WarnHeightUnit(const tsd_cells &sCells, const OGRSpatialReference &oSRS,
  * level 0). sEnv: the environment's cost, built at open (its peak) and kept
  * while computing; psMap its ENV_MAP's header, or null; dfDEMCopy the bytes
  * of the DEM held in memory beside the product (the standard input's copy).
- * *pdfHeadroom: the bytes left under the limit. */
+ * *pdfLimit: the limit (MemoryLimit's), *pdfHeadroom: the bytes left under it. */
 bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *psPlan,
                  const tsd_sun *psSun, const tsd_cells &sCells, int nLevel,
                  const tsd_env_cost &sEnv, const ts_env_map_info *psMap, double dfDEMCopy,
-                 double *pdfHeadroom);
+                 double *pdfLimit, double *pdfHeadroom);
 /* The limit CheckMemory holds to (bytes), and *ppszWhy where it comes from. */
 double MemoryLimit(const tsd_options &sOpts, const char **ppszWhy);
 

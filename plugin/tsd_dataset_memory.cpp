@@ -70,7 +70,7 @@ static std::string EnvironmentOver(const tsd_options &sOpts, const tsd_env_cost 
 bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *psPlan,
                  const tsd_sun *psSun, const tsd_cells &sCells, int nLevel,
                  const tsd_env_cost &sEnv, const ts_env_map_info *psMap, double dfDEMCopy,
-                 double *pdfHeadroom)
+                 double *pdfLimit, double *pdfHeadroom)
 {
     if (!psPlan && (W > TS_MAX_SIDE || H > TS_MAX_SIDE))
     {
@@ -104,6 +104,7 @@ bool CheckMemory(const tsd_options &sOpts, int W, int H, const tsd_window_plan *
              "environment %.0f MiB set up, %.0f MiB kept",
              dfPeak / 1048576.0, dfSteady / 1048576.0, psPlan ? " by window" : "",
              dfLimit / 1048576.0, sEnv.peak / 1048576.0, sEnv.kept / 1048576.0);
+    *pdfLimit = dfLimit;
     *pdfHeadroom = std::max(0.0, dfLimit - dfPeak);
     if (dfPeak <= dfLimit && dfPeak < static_cast<double>(std::numeric_limits<size_t>::max()) / 2)
         return true;
