@@ -251,15 +251,8 @@ class CellSizes(unittest.TestCase):
         x 55.8 m (session 58's CRS audit). Refused, as a rotated grid is."""
         base = T.write_tif(os.path.join(self.dir, "latlon.tif"),
                            np.zeros((40, 30), np.float32), (0, 1, 0, 0, 0, -1), None)
-        vrt = os.path.join(self.dir, "latlon.vrt")
-        with open(vrt, "w") as f:
-            f.write('<VRTDataset rasterXSize="30" rasterYSize="40">'
-                    '<SRS dataAxisToSRSAxisMapping="1,2">EPSG:4326</SRS>'
-                    '<GeoTransform>36.63, -0.0004, 0, -84.3, 0, 0.0005</GeoTransform>'
-                    '<VRTRasterBand dataType="Float32" band="1"><SimpleSource>'
-                    '<SourceFilename relativeToVRT="0">%s</SourceFilename>'
-                    '<SourceBand>1</SourceBand></SimpleSource></VRTRasterBand>'
-                    '</VRTDataset>' % base)
+        vrt = T.write_vrt(os.path.join(self.dir, "latlon.vrt"), base, 30, 40,
+                          (36.63, -0.0004, 0, -84.3, 0, 0.0005), "EPSG:4326", axes="1,2")
         p = T.run(["gdalinfo", T.conn(vrt)], ok=False)
         self.assertIn("the DEM's columns run north-south", p.stderr)
         # GDAL's own order (GeoTIFF's) opens as before

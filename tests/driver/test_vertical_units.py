@@ -3,7 +3,6 @@ metres, from the vertical CRS or the band's unit type; a number overrides;
 the metadata says which factor was used and why (docs/driver.md)."""
 import os
 import unittest
-from xml.sax.saxutils import escape as xml_escape
 
 import tsdriver as T
 from tsdriver import gdal, np
@@ -118,13 +117,8 @@ class VerticalUnits(unittest.TestCase):
         said "the DEM has no CRS", beside three PROJ errors on asking it for
         an ellipsoid: session 58's CRS audit), and its products carry none.
         A local CRS is SOURCE_CRS_KIND=local (it said projected)."""
-        vrt = os.path.join(self.dir, "vertical.vrt")
-        with open(vrt, "w") as f:
-            f.write('<VRTDataset rasterXSize="64" rasterYSize="64"><SRS>EPSG:6360</SRS>'
-                    '<GeoTransform>%s</GeoTransform><VRTRasterBand dataType="Float32" '
-                    'band="1"><SimpleSource><SourceFilename relativeToVRT="0">%s'
-                    '</SourceFilename><SourceBand>1</SourceBand></SimpleSource>'
-                    '</VRTRasterBand></VRTDataset>' % (", ".join(map(repr, NC_GT)), self.plain))
+        vrt = T.write_vrt(os.path.join(self.dir, "vertical.vrt"), self.plain, 64, 64, NC_GT,
+                          "EPSG:6360")
         p = T.run(["gdalinfo", T.conn(vrt, **OPTIONS)])
         print(p.stderr.strip())
         self.assertNotIn("ERROR", p.stderr)
@@ -154,15 +148,8 @@ class VerticalUnits(unittest.TestCase):
         vert = ('VERTCRS["NAVD88 height (ftUS)",VDATUM["North American Vertical Datum 1988"],'
                 'CS[vertical,1],AXIS["gravity-related height (H)",up,LENGTHUNIT['
                 '"US survey foot",0.304800609601219]],ID["EPSG",6360]]')
-        both = os.path.join(self.dir, "engvert.vrt")
-        with open(both, "w") as f:
-            f.write('<VRTDataset rasterXSize="64" rasterYSize="64"><SRS>%s</SRS>'
-                    '<GeoTransform>%s</GeoTransform><VRTRasterBand dataType="Float32" '
-                    'band="1"><SimpleSource><SourceFilename relativeToVRT="0">%s'
-                    '</SourceFilename><SourceBand>1</SourceBand></SimpleSource>'
-                    '</VRTRasterBand></VRTDataset>' % (
-                        xml_escape('COMPOUNDCRS["site ft+NAVD88",%s,%s]' % (eng, vert)),
-                        ", ".join(map(repr, NC_GT)), self.plain))
+        both = T.write_vrt(os.path.join(self.dir, "engvert.vrt"), self.plain, 64, 64, NC_GT,
+                           'COMPOUNDCRS["site ft+NAVD88",%s,%s]' % (eng, vert))
         p = T.run(["gdalinfo", T.conn(both, **OPTIONS)])
         self.assertNotIn("ERROR", p.stderr)
         self.assertNotIn("no CRS", p.stderr)

@@ -164,6 +164,23 @@ def write_tif(path, array, gt, srs, nodata=None, dtype=gdal.GDT_Float32):
     return path
 
 
+def write_vrt(path, source, width, height, gt, srs, axes=None):
+    """A one-band Float32 VRT of band 1 of `source` (width x height cells),
+    with geotransform gt and CRS srs (any text GDAL takes), its data axes
+    `axes` ("1,2") where given: the CRSs and axis orders a GeoTIFF cannot
+    hold (vertical, engineering with heights, a CRS's own axis order)."""
+    from xml.sax.saxutils import escape, quoteattr
+    mapping = " dataAxisToSRSAxisMapping=%s" % quoteattr(axes) if axes else ""
+    with open(path, "w") as f:
+        f.write('<VRTDataset rasterXSize="%d" rasterYSize="%d"><SRS%s>%s</SRS>'
+                '<GeoTransform>%s</GeoTransform><VRTRasterBand dataType="Float32" '
+                'band="1"><SimpleSource><SourceFilename relativeToVRT="0">%s'
+                '</SourceFilename><SourceBand>1</SourceBand></SimpleSource>'
+                '</VRTRasterBand></VRTDataset>' % (width, height, mapping, escape(srs),
+                                                    ", ".join(map(repr, gt)), escape(source)))
+    return path
+
+
 def fractal_dem(n, seed=1, relief=300.0):
     """A reproducible fractal DEM (spectral synthesis, beta = 2.2)."""
     rng = np.random.default_rng(seed)
