@@ -223,16 +223,30 @@ ts_status ts_parse_iso8601(const char *s, double *unix_seconds,
     if (*p != '\0')
         BAD("unexpected text '%.16s' after the offset", p);
 
-    /* Leap second: only as hh:mm:60, read as the first second of the next
-     * minute (POSIX time does not count it). */
-    if (check_fields(year, month, day, hour, minute, isec == 60 ? 0.0 : second,
-                     what, sizeof what))
+    /* Leap second: only 23:59:60 UTC, read as the last instant of its
+     * minute (POSIX time does not count it; read as the next minute's first
+     * second it moved a day product to the next day) */
+    if (check_fields(year, month, day, hour, minute, second, what, sizeof what))
         return ts_fail(err, TS_ERR_ARG,
                        "Cannot read '%.64s' as an ISO 8601 date and time: %s.", s, what);
+    if (isec == 60) {
+        const int utc = ((hour * 60 + minute - offset) % 1440 + 1440) % 1440;
+        if (utc != 23 * 60 + 59)
+            BAD("second 60 is a leap second, which only ends a UTC day (23:59:60Z), and "
+                "%02d:%02d here is %02d:%02d UTC", hour, minute, utc / 60, utc % 60);
+    }
 #undef BAD
 
-    *unix_seconds = unix_from_fields(year, month, day, hour, minute, second) -
-                    offset * 60.0;
+    /* The whole seconds, then the fraction, kept within its second: a leap
+     * second is its minute's last instant (read as the next minute's first
+     * second, it moved a day product to the next day), and .9999999999 past
+     * what a double holds at this time stays short of the next second */
+    const int whole = isec == 60 ? 59 : isec;
+    const double base = unix_from_fields(year, month, day, hour, minute, whole) - offset * 60.0;
+    double t = base + (isec == 60 ? 1.0 : second - isec);
+    if (t >= base + 1.0)
+        t = nextafter(base + 1.0, -INFINITY);
+    *unix_seconds = t;
     if (offset_minutes)
         *offset_minutes = offset;
     return ts_ok(err);

@@ -36,8 +36,14 @@ ts_status ts_parse_date(const char *s, int *year, int *month, int *day,
     if (!s || !year || !month || !day)
         return ts_fail(err, TS_ERR_ARG, "ts_parse_date: NULL argument");
     int y, m, d;
-    if (strlen(s) != 10 || !digits(s, 4, &y) || s[4] != '-' || !digits(s + 5, 2, &m) ||
-        s[7] != '-' || !digits(s + 8, 2, &d))
+    const int dated = strlen(s) >= 10 && digits(s, 4, &y) && s[4] == '-' &&
+                      digits(s + 5, 2, &m) && s[7] == '-' && digits(s + 8, 2, &d);
+    if (dated && s[10] != '\0')
+        return ts_fail(err, TS_ERR_ARG,
+                       "Cannot read '%.64s' as a date: a date is YYYY-MM-DD alone, here "
+                       "followed by '%.24s' (the day's offset from UTC is TIMEZONE's, e.g. "
+                       "TIMEZONE=+02:00; an instant is DATETIME's).", s, s + 10);
+    if (!dated)
         return ts_fail(err, TS_ERR_ARG,
                        "Cannot read '%.64s' as a date: expected YYYY-MM-DD, e.g. "
                        "2026-06-21.", s);

@@ -84,6 +84,9 @@ START_TEST(test_parse_date_and_offset)
     ck_assert(strstr(err.message, "YYYY-MM-DD"));
     EXPECT_ARG(ts_parse_date("21.06.2026", &y, &m, &d, &err), &err);
     EXPECT_ARG(ts_parse_date("2026-06-21T00:00Z", &y, &m, &d, &err), &err);
+    ck_assert(strstr(err.message, "DATETIME"));
+    EXPECT_ARG(ts_parse_date("2026-06-21+02:00", &y, &m, &d, &err), &err);
+    ck_assert(strstr(err.message, "followed by '+02:00'") && strstr(err.message, "TIMEZONE"));
     EXPECT_ARG(ts_parse_date("", &y, &m, &d, &err), &err);
 
     ck_assert(ts_parse_utc_offset("+02:00", &off, &err) == TS_OK && off == 120);

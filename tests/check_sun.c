@@ -121,6 +121,7 @@ START_TEST(test_iso8601_good)
         {"1970-01-01T00:00:00Z", 0.0, 0},
         {"1969-12-31T23:59:59.5Z", -0.5, 0},
         {"2016-12-31T23:59:60Z", 1483228800.0, 0}, /* leap second */
+        {"2017-01-01T00:59:60+01:00", 1483228800.0, 60}, /* the same, local */
         {"2003-10-17T12:30:30-07:00", 1066419030.0, -420},
         {"2000-01-01T12:00:00Z", 946728000.0, 0},
         {"2024-02-29T12:00:00Z", 1709208000.0, 0},
@@ -140,6 +141,13 @@ START_TEST(test_iso8601_good)
     /* offset_minutes may be NULL. */
     double t;
     ck_assert(ts_parse_iso8601("2026-06-21T05:30:00Z", &t, NULL, NULL) == TS_OK);
+    /* a leap second and a fraction of nines stay within their day: read
+     * as the next day's first second, they moved a day product to it */
+    ck_assert(ts_parse_iso8601("2016-12-31T23:59:60.5Z", &t, NULL, NULL) == TS_OK);
+    ck_assert_msg(t < 1483228800.0, "%.9f", t);
+    ck_assert(ts_parse_iso8601("2026-06-21T23:59:59.99999999999999999Z", &t, NULL, NULL) ==
+              TS_OK);
+    ck_assert_msg(t < 1782086400.0, "%.9f", t);
 }
 END_TEST
 
@@ -158,6 +166,8 @@ START_TEST(test_iso8601_bad)
         "2026-06-21T24:00:00Z",      /* hour 24 */
         "2026-06-21T12:60:00Z",      /* minute 60 */
         "2026-06-21T12:00:61Z",      /* second 61 */
+        "2026-06-21T12:00:60Z",      /* a leap second only ends a UTC day */
+        "2016-12-31T23:59:60+01:00", /* 22:59:60 UTC */
         "garbage",
         "",
         "2026-06-21",                /* no time */

@@ -95,6 +95,17 @@ class Sun(T.TempDirCase):
                                     "DATETIME": "2026-06-21T21:59:00Z", "TIMEZONE": "+02:00",
                                     "STEP_MINUTES": 1})
         np.testing.assert_array_equal(a, c)
+        # a leap second ends its day (as the next day's first second it
+        # named the next day); a fraction's nines stay within their second
+        for leap in ("2016-12-31T23:59:60Z", "2017-01-01T00:59:60.5+01:00",
+                     "2016-12-31T23:59:59.99999999999999999Z"):
+            ds = gdal.OpenEx(T.conn(dem), open_options=[
+                "PRODUCT=sunhours", "DATETIME=" + leap, "TIMEZONE=Z"])
+            self.assertIsNotNone(ds, leap)
+            self.assertEqual(ds.GetMetadataItem("DAY_START"), "2016-12-31T00:00:00Z", leap)
+        with self.assertRaisesRegex(RuntimeError, "only ends a UTC day"):
+            gdal.OpenEx(T.conn(dem), open_options=[
+                "PRODUCT=sunhours", "DATETIME=2026-06-21T12:00:60+02:00"])
         e = T.read(T.conn(dem), 1, {"PRODUCT": "sunhours", "DATE": "2026-06-21",
                                     "TIMEZONE": "+02:00", "STEP_MINUTES": 30})
         print("Bern, 2026-06-21: %.4f h (1-minute steps), %.4f h (30-minute steps)"
