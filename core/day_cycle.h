@@ -347,6 +347,15 @@ ts_status ts_date_range_check(const ts_date_range *r, int *days, int *sampled,
                               ts_error *err);
 
 /**
+ * Block i (0 .. sampled - 1) of a range of `days` days (as
+ * ts_date_range_check gives them): *first its first day and *length its
+ * days, counted from the range's first day, and *sampled the day that
+ * stands for it.
+ */
+void ts_date_range_block(const ts_date_range *r, int days, int i, int *first, int *length,
+                         int *sampled);
+
+/**
  * Hours of direct sun over a date range: the sum over the sampled days,
  * weighted as described at ts_date_range, of what ts_sun_hours gives for
  * that local day (same steps, same o->sun_hours_rule, same Earth horizon),

@@ -77,6 +77,17 @@ ts_status ts_date_range_check(const ts_date_range *r, int *days, int *sampled, t
     return ts_ok(err);
 }
 
+void ts_date_range_block(const ts_date_range *r, int days, int i, int *first, int *length,
+                         int *sampled)
+{
+    /* sampled at its middle day: its first day stood for the days after
+     * it, the shortest of them while the days lengthen (-5 % of a spring's
+     * insolation at interval 14) */
+    *first = i * r->day_interval;
+    *length = days - *first < r->day_interval ? days - *first : r->day_interval;
+    *sampled = *first + (*length - 1) / 2;
+}
+
 /* Everything a range computation holds. */
 typedef struct {
     const ts_grid *g;
@@ -169,13 +180,8 @@ static ts_status range_positions(range_ctx *c, const ts_sun_sites *sites, int be
     for (int i = 0; i < sampled; i++) {
         if ((st = ts_progress(&c->o->horizon, *share * i / sampled, err)) != TS_OK)
             goto done;
-        /* the block of days i * interval .. (next block or the last day)
-         * is sampled at its middle day: its first day stood for the days
-         * after it, the shortest of them while the days lengthen (-5 % of
-         * a spring's insolation at interval 14) */
-        int block = i * r->day_interval;
-        int weight = days - block < r->day_interval ? days - block : r->day_interval;
-        int d = block + (weight - 1) / 2;
+        int block, weight, d;
+        ts_date_range_block(r, days, i, &block, &weight, &d);
         double start = (double)(day0 + d) * 86400.0 - r->utc_offset_minutes * 60.0;
         if ((st = ts_day_uniform_times(start, 86400.0, step, mid, dur, err)) != TS_OK)
             goto done;

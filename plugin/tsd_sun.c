@@ -266,12 +266,121 @@ int tsd_sun_zone_warning(const tsd_sun *s, const tsd_options *o, char *warning, 
  * curvature, ~1 % of a block's sun at 46.5 N at 61 days, 3 % at 91. */
 #define RANGE_INTERVAL_WARN_DAYS 61
 
+/* No polar night nor midnight sun on flat ground nearer the equator (the
+ * polar circles less the refraction and the disk: ~65.7 degrees) */
+#define POLAR_EDGE_LATITUDE 63.0
+/* Warned of where the blocks across such an edge put a range's flat ground
+ * this share of its sun hours off, and an hour or more (a year at 78 N at
+ * the defaults: -0.6 %; 14 October to 10 November: +13 %) */
+#define POLAR_EDGE_ERROR 0.02
+
+/* Hours of a day (from `start`, Unix) with part of the sun's disk above
+ * flat ground at the reference site, in the range's steps (`mid`, `dur`:
+ * room for a day's), as the product counts them. */
+static double flat_sun_hours(const tsd_sun *s, double start, double *mid, double *dur)
+{
+    ts_error err;
+    const double step = s->range.step_minutes * 60.0;
+    const int steps = ts_day_step_count(86400.0, step);
+    double hours = 0;
+    if (ts_day_uniform_times(start, 86400.0, step, mid, dur, &err) != TS_OK)
+        return 0;
+    for (int k = 0; k < steps; k++) {
+        ts_sun_sample at;
+        if (ts_sun_at_site(&s->sites, &s->day, mid[k], &at, &err) == TS_OK &&
+            at.elevation + TS_SUN_RADIUS_DEG > 0)
+            hours += dur[k] / 3600.0;
+    }
+    return hours;
+}
+
+/* Whether the sun rises and sets over flat ground at the reference site on
+ * the local day from `start`: 0 polar night, 2 midnight sun, 1 both; from
+ * its elevation at the site's mean solar noon and midnight. */
+static int day_kind(const tsd_sun *s, double start, double lon)
+{
+    const double noon = start + s->offset_minutes * 60.0 + 43200.0 - lon * 240.0;
+    ts_sun_sample hi, lo;
+    ts_error err;
+    if (ts_sun_at_site(&s->sites, &s->day, noon, &hi, &err) != TS_OK ||
+        ts_sun_at_site(&s->sites, &s->day, noon + 43200.0, &lo, &err) != TS_OK)
+        return 1;
+    return hi.elevation + TS_SUN_RADIUS_DEG <= 0 ? 0 : lo.elevation + TS_SUN_RADIUS_DEG > 0 ? 2 : 1;
+}
+
+/* Blocks of a range across the edge of a polar night or midnight sun,
+ * where the sun's hours change too fast for one day to stand for others
+ * (6.2 h for 10.5 h over 12 days at 70 N: session 59's audit): a sentence
+ * where they put the flat ground's sun hours at the DEM's centre
+ * POLAR_EDGE_ERROR off, over the range or its first year (a century's
+ * blocks would take seconds; the error repeats year by year). */
+static int polar_edge_warning(const tsd_sun *s, const tsd_options *o, char *warning, size_t n)
+{
+    const tsd_sites *st = &s->sites_owned;
+    const size_t centre = (size_t)(st->ny / 2) * st->nx + st->nx / 2;
+    const double lat = st->lat[centre], lon = st->lon[centre];
+    if (o->day_interval <= 1 || fabs(lat) < POLAR_EDGE_LATITUDE)
+        return 0;
+    const size_t steps = (size_t)ts_day_step_count(86400.0, s->range.step_minutes * 60.0);
+    double *mid = malloc(steps * sizeof *mid), *dur = malloc(steps * sizeof *dur);
+    double off = 0, total = 0, worst = 0, worst_all = 0, worst_one = 0;
+    int worst_block = -1, kind = 1, days = 0;
+    if (!mid || !dur)
+        days = 366; /* (no memory: no warning) */
+    for (int i = 0; i < s->range_sampled && days < 366; i++) {
+        int first, length, sampled;
+        ts_date_range_block(&s->range, s->range_days, i, &first, &length, &sampled);
+        days += length;
+        const double one = length * flat_sun_hours(s, s->day_start + sampled * 86400.0, mid, dur);
+        total += one;
+        const int a = day_kind(s, s->day_start + first * 86400.0, lon);
+        const int b = day_kind(s, s->day_start + (first + length - 1) * 86400.0, lon);
+        if (a == b)
+            continue;
+        double all = 0;
+        for (int d = first; d < first + length; d++)
+            all += flat_sun_hours(s, s->day_start + d * 86400.0, mid, dur);
+        off += one - all;
+        total += all - one;
+        if (fabs(one - all) >= worst) {
+            worst = fabs(one - all);
+            worst_all = all;
+            worst_one = one;
+            worst_block = i;
+            kind = a == 1 ? b : a;
+        }
+    }
+    free(mid);
+    free(dur);
+    if (worst_block < 0 || !(fabs(off) >= 1.0 && fabs(off) > POLAR_EDGE_ERROR * total))
+        return 0;
+    int first, length, sampled;
+    ts_date_range_block(&s->range, s->range_days, worst_block, &first, &length, &sampled);
+    char from[40], to[40], day[40];
+    tsd_format_time(s->day_start + first * 86400.0, s->offset_minutes, from, sizeof from);
+    tsd_format_time(s->day_start + (first + length - 1) * 86400.0, s->offset_minutes, to,
+                    sizeof to);
+    tsd_format_time(s->day_start + sampled * 86400.0, s->offset_minutes, day, sizeof day);
+    snprintf(warning, n,
+             "DAY_INTERVAL=%d counts one computed day for each block of days, and blocks cross "
+             "the edge of the %s at the DEM's centre (latitude %.1f), where the sun's hours "
+             "change too fast for one day to stand for others: on flat ground there the "
+             "block %.10s to %.10s counts %.1f hours of sun from %.10s, where its %d days have "
+             "%.1f, and the %s's total is %+.0f %% off (%+.1f of %.1f hours). DAY_INTERVAL=1 "
+             "computes every day",
+             o->day_interval, kind == 0 ? "polar night" : "midnight sun", lat, from, to,
+             worst_one, day, length, worst_all, s->range_days > days ? "first year" : "range",
+             100.0 * off / total, off, total);
+    return 1;
+}
+
 int tsd_sun_range_warning(const tsd_sun *s, const tsd_options *o, char *warning, size_t n)
 {
-    /* a block's days: the interval, or the whole range where it is shorter */
-    if (!s->is_range || o->day_interval <= RANGE_INTERVAL_WARN_DAYS ||
-        s->range_days <= RANGE_INTERVAL_WARN_DAYS)
+    if (!s->is_range)
         return 0;
+    /* a block's days: the interval, or the whole range where it is shorter */
+    if (o->day_interval <= RANGE_INTERVAL_WARN_DAYS || s->range_days <= RANGE_INTERVAL_WARN_DAYS)
+        return polar_edge_warning(s, o, warning, n);
     snprintf(warning, n,
              "DAY_INTERVAL=%d computes one day of every %d of the range (%d days, %d "
              "computed) and counts it for the others: the sun's days change with the "

@@ -223,6 +223,39 @@ class Year(unittest.TestCase):
                    "DAY_INTERVAL=100", T.conn(self.dem)])
         self.assertNotIn("computes one day of every", p.stderr)
 
+    def test_polar_edge_warns(self):
+        """A block of days across the edge of a polar night or midnight
+        sun is counted from one day whose sun hours differ from its other
+        days' by more than the seasons' curve (12 days ending in the polar
+        night at 70 N read 6.2 h against 10.5 h): a warning whose flat
+        ground figures are the product's own on a flat plane at interval 14
+        and 1; none for a whole year there (-0.2 %), nor at 46.5 N."""
+        cases = [(70.0, "2026-11-20", "2026-12-01", True),
+                 (70.0, "2026-05-10", "2026-06-01", True),
+                 (-78.0, "2026-04-20", "2026-05-10", True),
+                 (78.0, "2026-01-01", "2026-12-31", False),
+                 (46.5, "2026-01-01", "2026-12-31", False)]
+        for lat, start, end, warns in cases:
+            with self.subTest(lat=lat, start=start):
+                dem = flat_dem(os.path.join(self.dir, "flat%g.tif" % lat), lat, 20.0)
+                oo = {"PRODUCT": "sunhours", "START_DATE": start, "END_DATE": end,
+                      "TIMEZONE": "+01:00"}
+                p = T.run(["gdalinfo"] + [a for kv in oo.items()
+                                          for a in ("-oo", "%s=%s" % kv)] + [T.conn(dem)])
+                self.assertEqual("crosses" in p.stderr or "cross the edge" in p.stderr,
+                                 warns, p.stderr)
+                if not warns:
+                    continue
+                sampled = T.read(T.conn(dem), 1, oo).mean()
+                every = T.read(T.conn(dem), 1, dict(oo, DAY_INTERVAL=1)).mean()
+                m = re.search(r"total is [-+]\d+ % off \(([-+][\d.]+) of ([\d.]+) hours\)",
+                              p.stderr)
+                self.assertIsNotNone(m, p.stderr)
+                print("latitude %g, %s to %s: interval 14 %.1f h, every day %.1f h; warned: %s of "
+                      "%s" % (lat, start, end, sampled, every, m.group(1), m.group(2)))
+                self.assertAlmostEqual(float(m.group(2)), every, delta=0.05)
+                self.assertAlmostEqual(float(m.group(1)), sampled - every, delta=0.05)
+
     def test_bad_input(self):
         zone = ["TIMEZONE=-05:00"]
         cases = [
