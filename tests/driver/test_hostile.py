@@ -209,7 +209,7 @@ class Hostile(unittest.TestCase):
                        ("2026-6-1", "expected YYYY-MM-DD"),
                        ("20260621", "expected YYYY-MM-DD"),
                        ("2026/06/21", "expected YYYY-MM-DD"),
-                       ("2026-06-21T00:00Z", "expected YYYY-MM-DD"),
+                       ("2026-06-21T00:00Z", "a date is YYYY-MM-DD alone, here followed by 'T00:00Z'"),
                        ("yesterday", "expected YYYY-MM-DD")):
             cases.append(("DATE=" + v, ["gdalinfo", "-nomd"] + day +
                           ["-oo", "DATE=" + v, "-oo", "TIMEZONE=Z", T.conn(DEM)],
