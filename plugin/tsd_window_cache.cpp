@@ -74,6 +74,8 @@ const tsd_window_plan *WindowPlan(const WindowState *p)
 struct OverviewSample
 {
     double dfAverage, dfNearest, dfTol;
+    int nHoles;      // overview cells with a height over full-resolution nodata only
+    double dfHole;   // the first such height
 };
 
 static bool SampleOverview(GDALRasterBand *poBand, GDALRasterBand *poOvr, int ox, int oy, int n,
@@ -94,8 +96,8 @@ static bool SampleOverview(GDALRasterBand *poBand, GDALRasterBand *poOvr, int ox
     int bHasNoData = FALSE;
     const double dfNoData = tsd_dem_nodata(GDALRasterBand::ToHandle(poBand), &bHasNoData);
     auto valid = [&](double v) { return std::isfinite(v) && !(bHasNoData && v == dfNoData); };
-    double dfAvg = 0, dfNear = 0, dfMin = INFINITY, dfMax = -INFINITY;
-    int nCompared = 0;
+    double dfAvg = 0, dfNear = 0, dfMin = INFINITY, dfMax = -INFINITY, dfHole = 0, dfSpread = 0;
+    int nCompared = 0, nHoles = 0;
     for (int j = 0; j < n; j++)
         for (int i = 0; i < n; i++)
         {
@@ -113,29 +115,51 @@ static bool SampleOverview(GDALRasterBand *poBand, GDALRasterBand *poOvr, int ox
                     if (valid(v))
                         s += v, c++;
                 }
+            double dev = 0; // the cells' mean |deviation| from their average
+            for (int y = y0; y < y1 && c > 0; y++)
+                for (int x = x0; x < x1; x++)
+                {
+                    const float v = afFull[static_cast<size_t>(y) * fw + x];
+                    if (valid(v))
+                        dev += std::fabs(v - s / c);
+                }
             // (the cell -r nearest takes: GDAL 3.6's round((i) r), the first)
             const int cx = std::min(fw - 1, static_cast<int>((ox + i) * rx + 0.5) - fx);
             const int cy = std::min(fh - 1, static_cast<int>((oy + j) * ry + 0.5) - fy);
             const float fCentre = afFull[static_cast<size_t>(cy) * fw + cx];
+            // a height where every cell under it is nodata: no resampling
+            // makes one (an overview of a former nodata value: session 59's
+            // audit, whose heights were then called cliffs)
+            if (c == 0 && valid(o) && x1 > x0 && y1 > y0 && nHoles++ == 0)
+                dfHole = o;
             if (c == 0 || !valid(o))
                 continue;
             dfAvg += std::fabs(o - s / c);
             dfNear += valid(fCentre) ? std::fabs(o - fCentre) : std::fabs(o - s / c);
+            dfSpread += dev / c;
             dfMin = std::min(dfMin, s / c);
             dfMax = std::max(dfMax, s / c);
             nCompared++;
         }
-    if (nCompared == 0)
+    if (nCompared == 0 && nHoles == 0)
         return false;
-    *psOut = {dfAvg / nCompared, dfNear / nCompared, std::max(0.5, 0.02 * (dfMax - dfMin))};
+    // within 6 times the cells' own spread about their average: what GDAL's
+    // resamplings differ by on rough terrain (gauss 3.2 times it, the others
+    // 1.6 where the overview's cells do not fall on whole cells, 2048 to
+    // 683; a stale edit of session 59's audit 38 times)
+    const double dfSpreadMean = nCompared ? dfSpread / nCompared : 0;
+    *psOut = {nCompared ? dfAvg / nCompared : 0, nCompared ? dfNear / nCompared : 0,
+              std::max({0.5, 0.02 * (dfMax - dfMin), 6 * dfSpreadMean}), nHoles, dfHole};
     return true;
 }
 
 /* The overview of `hBand` that GDAL would read for a W' = w grid (the
  * smallest not smaller), compared with the full-resolution cells under it
- * over nine samples across the DEM (corners, edges' middles, centre), so
- * that one stale tile of a mosaic is seen (a centred sample alone missed
- * it). false with the error set. */
+ * over a 16 x 16 lattice of samples across the DEM, so that a stale part
+ * (a tile of a mosaic, an edit since gdaladdo) a sixteenth of the DEM wide
+ * and high is seen: nine samples of 32 x 32 overview cells, 3.5 % of a
+ * 2048^2 DEM, missed an edited tile of an 8 x 8 mosaic (session 59's
+ * audit). A sampled check, not a proof. false with the error set. */
 static bool OverviewsAgree(GDALRasterBand *poBand, int w, const std::string &osDEM)
 {
     GDALRasterBand *poOvr = nullptr;
@@ -150,15 +174,32 @@ static bool OverviewsAgree(GDALRasterBand *poBand, int w, const std::string &osD
     const int ow = poOvr->GetXSize(), oh = poOvr->GetYSize();
     const double r = std::max(static_cast<double>(poBand->GetXSize()) / ow,
                               static_cast<double>(poBand->GetYSize()) / oh);
-    // samples of at most 32 x 32 overview cells and 1024 x 1024 DEM cells
-    const int n = std::max(1, std::min({32, ow, oh, static_cast<int>(1024 / r)}));
-    for (int sy = 0; sy < 3; sy++)
-        for (int sx = 0; sx < 3; sx++)
+    // samples of at most 8 x 8 overview cells and 256 x 256 DEM cells
+    const int n = std::max(1, std::min({8, ow, oh, static_cast<int>(256 / r)}));
+    const int nx = std::min(16, ow / n), ny = std::min(16, oh / n);
+    for (int sy = 0; sy < ny; sy++)
+        for (int sx = 0; sx < nx; sx++)
         {
-            const int ox = (ow - n) * sx / 2, oy = (oh - n) * sy / 2;
+            const int ox = nx > 1 ? (ow - n) * sx / (nx - 1) : 0;
+            const int oy = ny > 1 ? (oh - n) * sy / (ny - 1) : 0;
             OverviewSample sS;
-            if (!SampleOverview(poBand, poOvr, ox, oy, n, &sS) ||
-                std::min(sS.dfAverage, sS.dfNearest) <= sS.dfTol)
+            if (!SampleOverview(poBand, poOvr, ox, oy, n, &sS))
+                continue;
+            if (sS.nHoles > 0)
+            {
+                Fail(TS_ERR_ARG,
+                     CPLSPrintf("the DEM '%s' has overviews that disagree with it: its %d x %d "
+                                "overview holds heights (%.6g, and %d cells in all) over the "
+                                "%d x %d overview cells from column %d, row %d where every "
+                                "full-resolution cell under them is nodata (an overview made "
+                                "before the nodata value or the cells changed?); the far "
+                                "field of TILE_SIZE would come from it. Rebuild the overviews "
+                                "(gdaladdo -r average) or remove them (gdaladdo -clean), or "
+                                "set TILE_SIZE=0",
+                                osDEM.c_str(), ow, oh, sS.dfHole, sS.nHoles, n, n, ox, oy));
+                return false;
+            }
+            if (std::min(sS.dfAverage, sS.dfNearest) <= sS.dfTol)
                 continue;
             Fail(TS_ERR_ARG,
                  CPLSPrintf("the DEM '%s' has overviews that disagree with it: its %d x %d "

@@ -546,25 +546,51 @@ np.save(sys.argv[2], a)
         T.run(["gdal_translate", "-q", "-oo", "TILE_SIZE=0", T.conn(dem),
                os.path.join(self.tmp, "y.tif")])
         # one corner stale (a tile of a mosaic replaced): a centred sample
-        # alone missed it (session 46); overviews of gdaladdo's default
-        # -r nearest are no stale ones (they were refused by a hair on rough
-        # terrain: 4.99 against a tolerance of 4.97)
-        for name, how, stale in (("corner.tif", "average", True),
-                                 ("nearest.tif", "nearest", False)):
+        # alone missed it (session 46); a block between the nine samples of
+        # sessions 46-58 (an edited tile of an 8 x 8 mosaic passed: session
+        # 59's audit); overviews of gdaladdo's default -r nearest are no
+        # stale ones (they were refused by a hair on rough terrain: 4.99
+        # against a tolerance of 4.97), nor those of a third, whose cells do
+        # not fall on whole cells, whatever the resampling (refused with
+        # samples of 8 x 8 cells and the old tolerance)
+        for name, how, levels, stale in (
+                ("corner.tif", "average", ["2", "4"], (0, 0)),
+                ("between.tif", "average", ["2", "4"], (380, 120)),
+                ("nearest.tif", "nearest", ["2", "4"], None),
+                ("average3.tif", "average", ["3"], None),
+                ("gauss3.tif", "gauss", ["3"], None),
+                ("cubic3.tif", "cubic", ["3"], None)):
             with self.subTest(overviews=name):
                 dem = os.path.join(self.tmp, name)
                 shutil.copy(self.dem, dem)
-                T.run(["gdaladdo", "-q", "-r", how, dem, "2", "4"])
+                T.run(["gdaladdo", "-q", "-r", how, dem] + levels)
                 if stale:
                     ds = gdal.Open(dem, gdal.GA_Update)
                     b = ds.GetRasterBand(1)
-                    z = b.ReadAsArray(0, 0, 100, 100)
-                    b.WriteArray(z * 2, 0, 0)
+                    size = 100 if stale == (0, 0) else 50
+                    z = b.ReadAsArray(stale[0], stale[1], size, size)
+                    b.WriteArray(z * 2, stale[0], stale[1])
                     ds = None
-                    self.refused(coarse, ["has overviews that disagree with it",
-                                          "from column 0, row 0"], dem=dem)
+                    self.refused(coarse, ["has overviews that disagree with it"] +
+                                 (["from column 0, row 0"] if stale == (0, 0) else []),
+                                 dem=dem)
                 else:
                     self.assertTrue(np.isfinite(product(dem, **coarse)).all())
+        # a hole made nodata under another value after gdaladdo: its
+        # overviews hold the old value as a height, which the far field took
+        # as a cliff (the error said to declare a nodata value it had)
+        dem = os.path.join(self.tmp, "holes.tif")
+        z = gdal.Open(self.dem).ReadAsArray()
+        z[200:240, 300:340] = -9999
+        T.write_tif(dem, z, GT, UTM, nodata=-9999)
+        T.run(["gdaladdo", "-q", "-r", "average", dem, "2", "4"])
+        ds = gdal.Open(dem, gdal.GA_Update)
+        z[200:240, 300:340] = -32767
+        ds.GetRasterBand(1).WriteArray(z)
+        ds.GetRasterBand(1).SetNoDataValue(-32767)
+        ds = None
+        self.refused(coarse, ["holds heights (-9999", "full-resolution cell under them is "
+                              "nodata"], dem=dem)
 
 
 if __name__ == "__main__":
