@@ -351,7 +351,8 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     GDALDataset *poDEM = OpenDEM(bStdin ? poDS->m_osStdinCopy.c_str() : osDEM.c_str());
     if (!poDEM)
     {
-        snprintf(szMsg, sizeof szMsg, "cannot open the DEM '%s' as a raster", osDEM.c_str());
+        snprintf(szMsg, sizeof szMsg, "cannot open the DEM '%s' as a raster%s", osDEM.c_str(),
+                 DEMNameHint(osDEM).c_str());
         tsd_connstr_add_hint(szMsg, sizeof szMsg, szCut);
         return FailOpen(CPLE_OpenFailed, tsd_connstr_add_hint(szMsg, sizeof szMsg, szSegment));
     }
@@ -561,7 +562,8 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     for (int i = 1; i <= tsd_options_band_count(&sOpts); i++)
         SetBand(i, new TSRasterBand(this, i, eType));
     if (m_nLevel == 0)
-        SetupPam(pszConnection); // the metadata too, over what a saved entry holds
+        SetupPam(AbsoluteConnection(pszConnection).c_str()); // the metadata too, over what a
+                                                             // saved entry holds
     else
     {
         SetupMetadata();
@@ -571,6 +573,25 @@ bool TSDataset::Setup(const char *pszConnection, int W, int H)
     if (!m_osStdinCopy.empty())
         nPamFlags |= GPF_DISABLED; // (the next run's standard input is another DEM)
     return true;
+}
+
+std::string TSDataset::AbsoluteConnection(const char *pszConnection) const
+{
+    // a VRT of a product whose DEM was relative read another directory's
+    // DEM of that name, silently, where it was read from (session 59's audit)
+    const std::string osConn = pszConnection;
+    const size_t n = m_osDEM.size();
+    if (!m_osStdinCopy.empty() || m_osDEMPath == m_osDEM || osConn.size() < n ||
+        osConn.compare(osConn.size() - n, n, m_osDEM) != 0)
+        return osConn;
+    const std::string osAbs = osConn.substr(0, osConn.size() - n) + m_osDEMPath;
+    // (where it reads back as another DEM, as given)
+    tsd_connstr sConn;
+    char szMsg[256];
+    const bool bSame = tsd_connstr_parse(osAbs.c_str(), &sConn, szMsg, sizeof szMsg) == TS_OK &&
+                       m_osDEMPath == sConn.dem;
+    tsd_connstr_free(&sConn);
+    return bSame ? osAbs : osConn;
 }
 
 int IdentifyProduct(GDALOpenInfo *poOpenInfo)

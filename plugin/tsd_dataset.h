@@ -49,6 +49,11 @@ std::string NotHeights(GDALDataset *poDEM, int nBand, const std::string &osDEM);
  * empty (the DEM of a product and of an atlas's SHADOWS=all alike). */
 std::string ProductAsDEM(GDALDataset *poDEM, const std::string &osDEM);
 void WarnNoGeoTransform(GDALDataset *poDEM, const std::string &osDEM);
+/* tsd_dataset_warnings.cpp: what to add to "cannot open the DEM": that a
+ * relative name is looked for from the working directory (named), or that
+ * a file named TERRASHADE:... exists and is reached as ./TERRASHADE:...;
+ * else empty. */
+std::string DEMNameHint(const std::string &osDEM);
 /* The warning of heights taken as metres for want of a unit on a grid in
  * another unit (US state planes in feet), with the Z_FACTOR that would
  * take them in the grid's unit. */
@@ -189,6 +194,10 @@ class TSDataset final : public GDALPamDataset
     CPLErr WindowBlock(int nPlanes, const int *piPlane, void *const *ppImage, int x0, int y0,
                        int nBW, int nBH, bool bByte);
     bool Setup(const char *pszConnection, int W, int H);
+    // the connection string with the DEM's absolute path where it named a
+    // relative one (what gdal_translate -of VRT and gdalbuildvrt write as
+    // the source), else as given
+    std::string AbsoluteConnection(const char *pszConnection) const;
     void WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfLon, double dfLat);
     void WarnDistances(double dfMinCell, int W, int H);
     void WarnSweepTurn(int H);

@@ -12,6 +12,7 @@
 #include "cpl_string.h"
 #include "cpl_vsi.h"
 
+#include "tsd_connstr.h"
 #include "tsd_dataset.h"
 #include "tsd_dem_check.h"
 #include "tsd_gdal.h"
@@ -101,6 +102,25 @@ static std::string ProductInMosaic(GDALDataset *poDEM, const std::string &osDEM)
             poSrc->ReleaseRef();
     }
     return osFound;
+}
+
+std::string DEMNameHint(const std::string &osDEM)
+{
+    VSIStatBufL sStat;
+    // a file whose name is itself a connection string: opened as one
+    if (tsd_connstr_matches(osDEM.c_str()) && VSIStatL(osDEM.c_str(), &sStat) == 0)
+        return CPLSPrintf(" (a file of that name exists, but a name starting TERRASHADE: is "
+                          "read as another product: name the file ./%s)",
+                          osDEM.c_str());
+    if (osDEM.empty() || STARTS_WITH(osDEM.c_str(), "/vsi") ||
+        !CPLIsFilenameRelative(osDEM.c_str()) || strchr(osDEM.c_str(), ':'))
+        return std::string();
+    char *pszCwd = CPLGetCurrentDir();
+    const std::string osHint =
+        pszCwd ? CPLSPrintf(" (a relative name, looked for from the working directory %s)", pszCwd)
+               : std::string();
+    CPLFree(pszCwd);
+    return osHint;
 }
 
 std::string ProductAsDEM(GDALDataset *poDEM, const std::string &osDEM)

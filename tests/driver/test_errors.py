@@ -279,6 +279,36 @@ class Errors(unittest.TestCase):
             self.assertNotIn("is a file", p.stderr)
             T.run(["gdalinfo", 'TERRASHADE:"a=b:c.tif"'], cwd=tmp)
 
+    def test_relative_dem_names(self):
+        """A product of a relative DEM describes itself with the DEM's
+        absolute path, which gdal_translate -of VRT writes as the source: the
+        VRT read from another directory holding its own dem.tif reads the
+        first DEM (it read the other, silently). A relative DEM that does not
+        open names the working directory; a file named TERRASHADE:... is
+        reached as ./TERRASHADE:..., which the error says."""
+        with T.TempDir() as tmp:
+            a, b = os.path.join(tmp, "a"), os.path.join(tmp, "b")
+            os.makedirs(a)
+            os.makedirs(b)
+            shutil.copy(DEM, os.path.join(a, "dem.tif"))
+            T.run(["gdal_translate", "-q", "-scale", "0", "1000", "0", "3000", "-ot",
+                   "Float32", DEM, os.path.join(b, "dem.tif")])
+            T.run(["gdal_translate", "-q", "-of", "VRT", "-oo", "PRODUCT=svf",
+                   "TERRASHADE:dem.tif", "p.vrt"], cwd=a)
+            T.run(["gdal_translate", "-q", "-oo", "PRODUCT=svf", "TERRASHADE:dem.tif",
+                   os.path.join(tmp, "ref.tif")], cwd=a)
+            T.run(["gdal_translate", "-q", os.path.join(a, "p.vrt"),
+                   os.path.join(tmp, "from_b.tif")], cwd=b)
+            np.testing.assert_array_equal(T.read(os.path.join(tmp, "from_b.tif")),
+                                          T.read(os.path.join(tmp, "ref.tif")))
+            p = T.run(["gdalinfo", "TERRASHADE:nothere.tif"], ok=False, cwd=tmp)
+            self.assertIn("a relative name, looked for from the working directory %s"
+                          % os.path.realpath(tmp), p.stderr)
+            shutil.copy(DEM, os.path.join(tmp, "TERRASHADE:x.tif"))
+            p = T.run(["gdalinfo", "TERRASHADE:TERRASHADE:x.tif"], ok=False, cwd=tmp)
+            self.assertIn("name the file ./TERRASHADE:x.tif", p.stderr)
+            T.run(["gdalinfo", "TERRASHADE:./TERRASHADE:x.tif"], cwd=tmp)
+
     def test_inline_colon_hint_only_for_a_cut_value(self):
         """The hint of a value cut at its ':' is for TIMEZONE, DATETIME and
         SKY only, and the spellings it suggests open: SKY=cie9 inline is
