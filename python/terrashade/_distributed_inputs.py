@@ -94,6 +94,33 @@ def given_keys(source, open_options):
 ARCHIVES = ("/vsizip/", "/vsigzip/", "/vsitar/")
 
 
+def archive_of(path):
+    """(prefix, archive, rest) where path reads inside an archive file here
+    (/vsizip/, /vsigzip/, /vsitar/; its name in braces, or the longest
+    leading part that is a file), path == prefix + archive + rest; None
+    where it names none."""
+    prefix = next((a for a in ARCHIVES if path.startswith(a)), "")
+    if not prefix:
+        return None
+    rest = path[len(prefix):]
+    if prefix in ("/vsizip/", "/vsitar/") and rest.startswith("{") and "}" in rest:
+        name, after = rest[1:].split("}", 1)  # /vsizip/{a.zip}/dem.tif
+        return (prefix + "{", name, "}" + after) if name and os.path.isfile(name) else None
+    cut = [i for i in range(len(rest), 0, -1)
+           if (i == len(rest) or rest[i] == "/") and os.path.isfile(rest[:i])]
+    return (prefix, rest[:cut[0]], rest[cut[0]:]) if cut else None
+
+
+def local_file(name):
+    """The file here that name reads: itself, or its archive (a DEST onto
+    dem.zip replaced the archive of /vsizip/dem.zip/dem.tif); None for
+    another virtual file system's or a name that is no file."""
+    parts = archive_of(name)
+    if parts is not None:
+        return parts[1]
+    return name if name and not name.startswith("/vsi") and os.path.exists(name) else None
+
+
 def absolute_path(text):
     """text (a name, quoted or not) made absolute if it is a relative path
     that exists here, plainly or inside /vsizip/, /vsigzip/ or /vsitar/
@@ -101,21 +128,11 @@ def absolute_path(text):
     if it is not one."""
     quoted = len(text) > 1 and text[0] == text[-1] == '"'
     path = text[1:-1] if quoted else text
-    prefix = next((a for a in ARCHIVES if path.startswith(a)), "")
-    rest = path[len(prefix):]
-    braced = prefix in ("/vsizip/", "/vsitar/") and rest.startswith("{") and "}" in rest
-    if braced:  # /vsizip/{a.zip}/dem.tif: the archive's name in braces
-        name, after = rest[1:].split("}", 1)
-        if not name or os.path.isabs(name) or not os.path.isfile(name):
+    if path.startswith(ARCHIVES):
+        parts = archive_of(path)
+        if parts is None or os.path.isabs(parts[1]):
             return None
-        path = prefix + "{" + os.path.abspath(name) + "}" + after
-        return '"%s"' % path if quoted else path
-    if prefix:  # the archive: the longest leading part that is a file here
-        cut = [i for i in range(len(rest), 0, -1)
-               if (i == len(rest) or rest[i] == "/") and os.path.isfile(rest[:i])]
-        if not cut or os.path.isabs(rest):
-            return None
-        path = prefix + os.path.abspath(rest[:cut[0]]) + rest[cut[0]:]
+        path = parts[0] + os.path.abspath(parts[1]) + parts[2]
         return '"%s"' % path if quoted else path
     if not path or os.path.isabs(path) or path.startswith("/vsi") or not os.path.exists(path):
         return None

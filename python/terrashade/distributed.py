@@ -35,7 +35,7 @@ from terrashade._distributed_report import (  # noqa: E402,F401
     LOST, SAID, Failure, ProgressBar, Said)
 from terrashade._distributed_inputs import (  # noqa: E402,F401
     INLINE, PROG, TILE_MAX, TILE_MIN, _ITEM, absolute_env_map, absolute_path, absolute_source,
-    given_keys, open_source, parse_args, positive, split_source, tile_size)
+    given_keys, local_file, open_source, parse_args, positive, split_source, tile_size)
 from terrashade._distributed_output import (  # noqa: E402,F401
     RENAMED, SIDE_FILES, block_size, create_like, finish, output_format, partial_names, remove,
     written)
@@ -104,7 +104,7 @@ def dem_files(dem):
     except RuntimeError:
         return []
     files = (ds.GetFileList() or []) if ds is not None else []
-    return [f for f in files if not f.startswith("/vsi") and os.path.exists(f)]
+    return [f for f in map(local_file, files) if f is not None]
 
 
 def run(args):
@@ -126,9 +126,11 @@ def run(args):
     tiles_partial, dest_partial = partial_names(args.dest)
     partial = tiles_partial if fmt == "COG" else dest_partial
     dem = src.GetMetadataItem("SOURCE_DEM") or ""
-    if os.path.exists(dem) and os.path.exists(args.dest) and os.path.samefile(dem, args.dest):
-        raise Failure("DEST %s is the DEM itself: the product would replace it; write "
-                      "it to another file" % args.dest)
+    dem_file = local_file(dem)  # (an archive's: /vsizip/dem.zip/dem.tif onto dem.zip)
+    if dem_file and os.path.exists(args.dest) and os.path.samefile(dem_file, args.dest):
+        raise Failure("DEST %s is the DEM itself%s: the product would replace it; write "
+                      "it to another file"
+                      % (args.dest, "" if dem_file == dem else " (its archive, for %s)" % dem))
     for part in dem_files(dem):  # a VRT's sources: replaced the same way (exit 0)
         if os.path.exists(args.dest) and os.path.samefile(part, args.dest):
             raise Failure("DEST %s is a file of the DEM %s: the product would replace it; "

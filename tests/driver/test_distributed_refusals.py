@@ -136,6 +136,37 @@ class DistributedRefusals(TD.DistributedCase):
         with open(src, "rb") as f:
             self.assertEqual(f.read(), before)
 
+    def test_destination_is_the_dems_archive(self):
+        """DEST naming the archive SOURCE reads the DEM from (/vsizip/,
+        /vsigzip/, braces, and a VRT's source inside a zip): the archive
+        was replaced by the product with exit 0, the DEM lost (session 59's
+        Python audit)."""
+        import gzip
+        import zipfile
+        zipped, gz = self.path("dem.zip"), self.path("dem.tif.gz")
+        with zipfile.ZipFile(zipped, "w") as z:
+            z.write(self.dem, "dem.tif")
+        with open(self.dem, "rb") as f, gzip.open(gz, "wb") as g:
+            g.write(f.read())
+        vrt = self.path("zipped.vrt")
+        gdal.BuildVRT(vrt, ["/vsizip/%s/dem.tif" % zipped])
+        itself = "DEST %s is the DEM itself (its archive, for %s)"
+        for archive, source, said in (
+                (zipped, "/vsizip/%s/dem.tif" % zipped, itself),
+                (zipped, "/vsizip/{%s}/dem.tif" % zipped, itself),
+                (gz, "/vsigzip/%s" % gz, itself),
+                (zipped, vrt, "DEST %s is a file of the DEM %s")):
+            with self.subTest(source=source):
+                with open(archive, "rb") as f:
+                    before = f.read()
+                p = distributed(["--workers", 1, "--format", "GTiff", T.conn(source), archive],
+                                ok=False)
+                self.assertEqual(p.returncode, 1, p.stderr)
+                self.assertIn(said % (archive, source), p.stderr)
+                with open(archive, "rb") as f:
+                    self.assertEqual(f.read(), before)
+                self.assertEqual(TD.partials(archive), [])
+
     def test_python_without_gdal(self):
         """A Python that cannot import osgeo (python3 first on PATH is often
         not the system one): a sentence and exit 1, even for --help."""
