@@ -50,7 +50,7 @@ def start_cluster(args):
         except (OSError, TimeoutError) as e:
             raise Failure("cannot reach the Dask scheduler at %s within %d s: %s"
                           % (args.scheduler, args.timeout, e), code=2)
-        dask_logs(logging.ERROR)  # as the local cluster's: the program says what failed
+        dask_logs(logging.CRITICAL)  # as the local cluster's: the program says what failed
         # A worker has one task slot per thread, by default one per core.
         return client, None, 1
     workers = args.workers or cores()
@@ -61,11 +61,13 @@ def start_cluster(args):
     try:
         # on this machine's loopback only, with its HTTP servers on free ports:
         # dashboard_address=None still served the scheduler's on 0.0.0.0:8787,
-        # reachable from other machines, and warned where that port was taken
+        # reachable from other machines, and warned where that port was taken;
+        # Dask's logs below CRITICAL unsaid: the program says what failed, where
+        # a killed worker's "Couldn't gather keys" ERROR lines came before it
         cluster = OwnCluster(LocalCluster(
             n_workers=workers, threads_per_worker=args.threads_per_worker, processes=True,
             host="127.0.0.1", dashboard_address="127.0.0.1:0",
-            worker_dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR,
+            worker_dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL,
             loop=runner.loop), runner, before)
     except BaseException:
         # a start cut short (a second Ctrl-C): its workers, still blocking

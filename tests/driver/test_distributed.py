@@ -278,6 +278,9 @@ class Distributed(TD.DistributedCase):
         self.assertRegex(p.stderr, r"terrashade.distributed: error: the window "
                          r"\(xoff, yoff, xsize, ysize\) = \(\d+, \d+, \d+, \d+\) of "
                          + re.escape(T.conn(self.dem)) + " failed: KilledWorker")
+        # the program's sentence alone: Dask's ERROR lines ("Couldn't gather
+        # keys", "Shut down workers that don't have promised key") came first
+        self.assertNotIn(" - ERROR - ", p.stderr)
         with open(dest) as f:
             self.assertEqual(f.read(), "an older result")  # DEST untouched
         os.remove(dest)
