@@ -43,11 +43,15 @@ from terrashade._distributed_cluster import (  # noqa: E402,F401
     Terminated, Watch, _terminate, check_workers, dask_logs, interrupts_held, start_cluster)
 
 
-def compute(client, watch, out, source, task_options, tile, quiet, run):
+def compute(client, watch, out, source, task_options, tile, chunk, quiet, run):
     from dask.distributed import as_completed
     wins = W.windows(out.RasterXSize, out.RasterYSize, tile)
-    futures = [client.submit(W.read_window, source, task_options, w, run, pure=False)
-               for w in wins]
+    # each chunk's windows on one worker (loosely: another takes them where
+    # it is gone or idle), whose dataset computes the chunk once
+    workers = sorted(client.scheduler_info().get("workers", {}))
+    futures = [client.submit(W.read_window, source, task_options, w, run, pure=False,
+                             workers=None if at is None else [at], allow_other_workers=True)
+               for w, at in zip(wins, W.placement(wins, chunk, workers))]
     window_of = dict(zip((f.key for f in futures), wins))
     bar = None if quiet else ProgressBar(futures)
     # Written windows are released so that the workers drop them, but not
@@ -141,6 +145,9 @@ def run(args):
         raise Failure("DEST %s is the ENV_MAP of SOURCE: the product would replace it; "
                       "write it to another file" % args.dest)
     size = (src.RasterXSize, src.RasterYSize, src.RasterCount)
+    # the driver's chunks (TILE_SIZE, where it windows: FAR_GRID), else the
+    # whole product at once (0)
+    chunk = int(src.GetMetadataItem("TILE_SIZE") or 0) if src.GetMetadataItem("FAR_GRID") else 0
     out = client = cluster = watch = None
     run_id = uuid.uuid4().hex  # no worker reuses a dataset opened for an earlier run
     t0 = time.time()
@@ -161,7 +168,7 @@ def run(args):
             task_options.append("PROGRESS=no")  # the Dask bar says it
         tasks_source = absolute_source(args.source)
         SAID.same_dem = (split_source(tasks_source)[1], split_source(args.source)[1])
-        n = compute(client, watch, out, tasks_source, task_options, args.tile_size,
+        n = compute(client, watch, out, tasks_source, task_options, args.tile_size, chunk,
                     args.quiet, run_id)
         out.FlushCache()
         out = None
@@ -199,7 +206,10 @@ def run(args):
 def main(argv=None):
     """The command; returns its exit status. From a script too: GDAL's
     exceptions and the SIGTERM handler are the caller's again after it."""
-    args = parse_args(argv)
+    try:
+        args = parse_args(argv)
+    except SystemExit as e:  # a usage error (2, said), --help (0): returned, not raised
+        return e.code if isinstance(e.code, int) else 2
     SAID.reset()
     RENAMED.clear()
     previous = None

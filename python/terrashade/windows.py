@@ -35,6 +35,24 @@ def windows(width, height, tile):
             for y in range(0, height, tile) for x in range(0, width, tile)]
 
 
+def placement(wins, chunk, workers):
+    """For each window, the worker whose dataset computes its driver chunk
+    (chunk cells square from the raster's corner, or the whole raster where
+    chunk is 0): the windows of one chunk on one worker, the chunks dealt
+    round the workers in order, so that no chunk is computed by two workers
+    (1024-cell windows of the driver's 4096-cell chunks were dealt to any,
+    and each worker touched computed the chunk: the audit's two workers
+    took 6.1 s where one product takes 2.1). None for every window where no
+    worker is known."""
+    if not workers:
+        return [None] * len(wins)
+    order = {}
+    for x, y, _, _ in wins:
+        order.setdefault((x // chunk, y // chunk) if chunk else (0, 0), len(order))
+    return [workers[order[(x // chunk, y // chunk) if chunk else (0, 0)] % len(workers)]
+            for x, y, _, _ in wins]
+
+
 def _dataset(source, open_options, run):
     key, me = (source, tuple(open_options), run), threading.get_ident()
     with _open_lock:

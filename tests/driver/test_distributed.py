@@ -42,6 +42,22 @@ class Distributed(TD.DistributedCase):
         self.assertEqual([D.block_size(t) for t in (16, 64, 496, 512, 1024, 1040, 3072)],
                          [16, 64, 496, 512, 512, 16, 512])
 
+    def test_chunks_placed_on_one_worker_each(self):
+        """The windows of one driver chunk go to one worker, the chunks
+        dealt round the workers in order, so that no chunk is computed by
+        two (1024-cell windows of 4096-cell chunks went to any worker); the
+        whole raster is one chunk where the driver does not window."""
+        from terrashade import windows as W
+        wins = W.windows(300, 200, 64)  # chunks of 128: 3 x 2
+        at = W.placement(wins, 128, ["a", "b"])
+        chunk_of = {}
+        for (x, y, _, _), w in zip(wins, at):
+            self.assertEqual(chunk_of.setdefault((x // 128, y // 128), w), w)
+        self.assertEqual([chunk_of[(cx, cy)] for cy in range(2) for cx in range(3)],
+                         ["a", "b", "a", "b", "a", "b"])
+        self.assertEqual(set(W.placement(wins, 0, ["a", "b"])), {"a"})
+        self.assertEqual(W.placement(wins, 128, []), [None] * len(wins))
+
     def test_local_cluster_products(self):
         for name, options in (("shade", SHADE), ("horizon", HORIZON), ("sunhours", SUNHOURS)):
             with self.subTest(product=name):
@@ -93,6 +109,8 @@ class Distributed(TD.DistributedCase):
                                      "MAX_DISTANCE=1", "TERRASHADE:PRODUCT=svf,DIRECTIONS=4:"
                                      + sys.argv[1], sys.argv[2] + str(k) + ".tif"])
                         print("run", k, "rc", rc, file=sys.stderr)
+                    # a usage error is returned as the command's status, not raised
+                    print("bad tile size rc", D.main(["--tile-size", "17", "x", "y.tif"]))
                     print("exceptions after main:", gdal.GetUseExceptions())
                     print("SIGTERM is mine:", signal.getsignal(signal.SIGTERM) is mine)
                     w, a, said = W.read_window("TERRASHADE:PRODUCT=svf,DIRECTIONS=4:"
@@ -118,6 +136,7 @@ class Distributed(TD.DistributedCase):
         # DEM's 900 m void wider than it
         self.assertIn("window (1, 8, 8) 2", p.stdout)
         self.assertIn("missing DEM raised: True", p.stdout)
+        self.assertIn("bad tile size rc 2", p.stdout)
         said = "Warning 1: TERRASHADE: MAX_DISTANCE=1 m is shorter than the DEM's cells"
         self.assertEqual(p.stderr.count(said), 2, p.stderr)
         self.assertIn("run 1 rc 0", p.stderr)
