@@ -249,9 +249,8 @@ def check_workers(client, watch):
         raise Failure("the Dask cluster at %s has no workers" % watch.address, code=2)
     missing = [w for w, r in found.items() if not r["driver"]]
     if missing:
-        raise Failure("GDAL on worker(s) %s cannot find the TERRASHADE driver: set "
-                      "GDAL_DRIVER_PATH there (now %r) or install the plugin"
-                      % (", ".join(missing), found[missing[0]]["GDAL_DRIVER_PATH"]))
+        raise Failure(W.no_driver("on worker(s) %s" % ", ".join(missing),
+                                  found[missing[0]]["GDAL_DRIVER_PATH"]))
     return len(found)
 
 

@@ -195,8 +195,7 @@ def open_source(source, open_options):
         raise Failure("SOURCE must be a TERRASHADE connection string "
                       "(TERRASHADE:[KEY=VALUE,...:]dem.tif), got %r" % source)
     if gdal.GetDriverByName("TERRASHADE") is None:
-        raise Failure("GDAL cannot find the TERRASHADE driver: set GDAL_DRIVER_PATH "
-                      "to the directory of gdal_TERRASHADE.so, or make install")
+        raise Failure(W.no_driver("on this machine", os.environ.get("GDAL_DRIVER_PATH", "")))
     said = W.Warnings()
     gdal.PushErrorHandler(said)
     try:

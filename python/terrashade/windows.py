@@ -31,8 +31,18 @@ CRASH_ONCE_ENV = "TERRASHADE_DISTRIBUTED_CRASH_ONCE"
 def windows(width, height, tile):
     """(xoff, yoff, xsize, ysize) of every tile x tile window, row by row;
     the last column and row are cut to the raster's size."""
+    if tile < 1:  # (none for a negative one: an empty product written)
+        raise ValueError("the window size must be at least 1 cell, got %r" % tile)
     return [(x, y, min(tile, width - x), min(tile, height - y))
             for y in range(0, height, tile) for x in range(0, width, tile)]
+
+
+def no_driver(where, driver_path):
+    """The sentence for GDAL `where` (on which machine) without the
+    TERRASHADE driver, its GDAL_DRIVER_PATH being driver_path."""
+    return ("GDAL %s cannot find the TERRASHADE driver: set GDAL_DRIVER_PATH there (now %r) "
+            "to the directory of gdal_TERRASHADE.so, or install the plugin (make install)"
+            % (where, driver_path))
 
 
 def placement(wins, chunk, workers):
@@ -64,9 +74,8 @@ def _dataset(source, open_options, run):
     if gdal.GetDriverByName("TERRASHADE") is None:
         # a worker that joined after the start's check (probe): GDAL's open
         # then failed with no message at all
-        raise RuntimeError("GDAL on the worker at %s cannot find the TERRASHADE driver: set "
-                           "GDAL_DRIVER_PATH there (now %r) or install the plugin"
-                           % (socket.gethostname(), os.environ.get("GDAL_DRIVER_PATH", "")))
+        raise RuntimeError(no_driver("on the worker at %s" % socket.gethostname(),
+                                     os.environ.get("GDAL_DRIVER_PATH", "")))
     ds = gdal.OpenEx(source, gdal.OF_RASTER | gdal.OF_READONLY, open_options=list(open_options))
     if ds is None:  # (with GDAL's exceptions off; on, OpenEx raised)
         raise RuntimeError("cannot open %s: %s" % (source, gdal.GetLastErrorMsg()))
