@@ -25,6 +25,7 @@
 
 #include "tsd_dataset.h"
 #include "tsd_gdal.h"
+#include "tsd_pam_turn.h"
 #include "tsd_entry_state.h"
 #include "tsd_source_stamp.h"
 
@@ -296,120 +297,6 @@ const char *TSDataset::BuildPamFilename()
     return psPam->pszPamFilename;
 }
 
-namespace
-{
-/* recursive: GDAL's save calls TrySaveXML again, virtually, to write into
- * GDAL_PAM_PROXY_DIR where the file next to the DEM cannot be written */
-std::recursive_mutex &PamFileMutex()
-{
-    static std::recursive_mutex oMutex;
-    return oMutex;
-}
-
-/* How long a save or load waits for another process's turn on the same
- * DEM's file before it goes ahead without one (a save takes milliseconds;
- * a holder stuck on a network file system must not hang this one). A load
- * waits less: any process that may read the DEM's folder can hold its lock
- * (an audit held it: each open of a product waited 30 s a turn, 61-93 s),
- * and a load without a turn at worst misses a save's entries. */
-constexpr int PAM_LOCK_WAIT_MS = 10000;
-constexpr int PAM_LOAD_WAIT_MS = 2000;
-/* After a wait ran out on a folder, this process's turns on it go ahead
- * without waiting for this long (an open takes several turns): a load's
- * loads only (a save waited behind a busy moment must still take turns,
- * or entries are lost), a save's both. */
-constexpr double PAM_STUCK_S = 60.0;
-
-/* One turn on the products' auxiliary file of a DEM: this process's
- * threads one at a time (PamFileMutex), and processes too, by an advisory
- * lock (flock) on the DEM's directory, which every product of that DEM
- * shares and which is never written: GDAL rewrites an .aux.xml whole
- * (reads, truncates, writes), so processes saving statistics of several
- * products at once lost each other's entries. (Not on the DEM's file: its
- * open and close here would drop the POSIX locks this process holds on it,
- * SQLite's in a GeoPackage DEM.) Saves lock exclusively, loads shared (a
- * load never reads a half-written file). Nested turns of the same thread
- * (the proxy directory's save) take no second lock. No lock where the DEM
- * is not a local file (/vsimem/), where the file system refuses it (NFS's
- * emulation of flock on a directory) or after PAM_LOCK_WAIT_MS: then as
- * before. */
-class PamFileTurn
-{
-    std::lock_guard<std::recursive_mutex> m_oThreads{PamFileMutex()};
-    int m_fd = -1;
-    static int &Depth()
-    {
-        static int nDepth = 0; // guarded by PamFileMutex
-        return nDepth;
-    }
-    /* The folders (device, inode: one folder by any name) whose loads'
-     * [0] or saves' [1] wait ran out, and when (guarded by PamFileMutex). */
-    using Folder = std::pair<dev_t, ino_t>;
-    using StuckMap = std::map<Folder, std::chrono::steady_clock::time_point>;
-    static StuckMap &Stuck(bool bWrite)
-    {
-        static StuckMap aoStuck[2];
-        return aoStuck[bWrite ? 1 : 0];
-    }
-    static bool IsStuck(bool bWrite, const Folder &oFolder)
-    {
-        const auto oIt = Stuck(bWrite).find(oFolder);
-        return oIt != Stuck(bWrite).end() &&
-               std::chrono::duration<double>(std::chrono::steady_clock::now() - oIt->second)
-                       .count() < PAM_STUCK_S;
-    }
-
-  public:
-    PamFileTurn(const char *pszDEM, bool bWrite)
-    {
-        if (Depth()++ > 0 || !pszDEM || !*pszDEM || STARTS_WITH(pszDEM, "/vsi"))
-            return;
-        const std::string osDir = CPLGetPath(pszDEM);
-        m_fd = open(osDir.empty() ? "." : osDir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-        if (m_fd < 0)
-            return;
-        struct stat sDir;
-        const Folder oFolder =
-            fstat(m_fd, &sDir) == 0 ? Folder(sDir.st_dev, sDir.st_ino) : Folder(0, 0);
-        const bool bStuck = IsStuck(bWrite, oFolder);
-        const int nWait = bStuck ? 0 : bWrite ? PAM_LOCK_WAIT_MS : PAM_LOAD_WAIT_MS;
-        for (int nWaited = 0;; nWaited += 5)
-        {
-            if (flock(m_fd, (bWrite ? LOCK_EX : LOCK_SH) | LOCK_NB) == 0)
-            {
-                Stuck(bWrite).erase(oFolder);
-                return;
-            }
-            if (errno != EWOULDBLOCK && errno != EINTR)
-                break; // no locks here (some network file systems)
-            if (nWaited >= nWait)
-            {
-                CPLDebug("TERRASHADE", "no turn on the auxiliary file of %s after %d ms: "
-                         "going ahead without one (a %s)", pszDEM, nWaited,
-                         bWrite ? "save" : "load");
-                if (!bStuck)
-                {
-                    Stuck(false)[oFolder] = std::chrono::steady_clock::now();
-                    if (bWrite)
-                        Stuck(true)[oFolder] = Stuck(false)[oFolder];
-                }
-                break;
-            }
-            usleep(5000);
-        }
-        close(m_fd);
-        m_fd = -1;
-    }
-    ~PamFileTurn()
-    {
-        Depth()--;
-        if (m_fd >= 0)
-            close(m_fd); // (releases the lock)
-    }
-    PamFileTurn(const PamFileTurn &) = delete;
-    PamFileTurn &operator=(const PamFileTurn &) = delete;
-};
-} // namespace
 
 /* The bytes of the file at osPath, for RestoreAfterFailedSave: false where
  * there is none (or it cannot be read, quietly: GDAL's save says why). */

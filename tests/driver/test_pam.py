@@ -547,6 +547,50 @@ class Pam(unittest.TestCase):
                 ET.parse(self.dem + ".terrashade.aux.xml").getroot().iter("Subdataset")]
         self.assertEqual(len(subs), 1, subs)
 
+    def test_a_wait_holds_no_other_folders_turns(self):
+        """A thread whose save waits for another program's lock on its DEM's
+        folder holds no thread of this process working on another folder:
+        one mutex for the whole process held an unrelated DEM's open behind
+        it for 9.9 s (session 59's concurrency audit)."""
+        import fcntl
+        import threading
+        import time
+        other = os.path.join(os.path.dirname(self.demdir), "other")
+        os.makedirs(other)
+        dem2 = os.path.join(other, "dem.tif")
+        shutil.copy(self.dem, dem2)
+        ds = gdal.OpenEx(T.conn(self.dem), gdal.OF_RASTER, open_options=["PRODUCT=shade"])
+        ds.GetRasterBand(1).ComputeStatistics(False)
+        fd = os.open(self.demdir, os.O_RDONLY)
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        took = {}
+
+        def save():
+            nonlocal ds
+            t = time.monotonic()
+            ds = None  # its statistics saved: waits for the lock (10 s)
+            took["save"] = time.monotonic() - t
+
+        def open_other():
+            time.sleep(0.5)
+            t = time.monotonic()
+            d2 = gdal.OpenEx(T.conn(dem2), gdal.OF_RASTER, open_options=["PRODUCT=svf"])
+            d2.GetRasterBand(1).Checksum()
+            took["other"] = time.monotonic() - t
+
+        threads = [threading.Thread(target=save), threading.Thread(target=open_other)]
+        try:
+            for t in threads:
+                t.start()
+            for t in threads:
+                t.join()
+        finally:
+            os.close(fd)
+        print("save under a held lock %.1f s; another folder's product meanwhile %.1f s"
+              % (took["save"], took["other"]))
+        self.assertGreater(took["save"], 5.0)
+        self.assertLess(took["other"], 3.0)
+
     def test_many_products_at_once(self):
         """Statistics of 8 products saved at once: by 4 threads of one
         process every entry is kept (GDAL rewrites an .aux.xml whole, and
