@@ -30,10 +30,12 @@ static int g_count;
 
 int ts_cl_profiling(void)
 {
-    static int on = -1;
+    static int known = -1; /* (atomic: every OpenCL job asks, from any thread) */
+    int on = __atomic_load_n(&known, __ATOMIC_RELAXED);
     if (on < 0) {
         const char *s = getenv("TERRASHADE_OPENCL_PROFILE");
         on = s && *s && strcmp(s, "0") != 0;
+        __atomic_store_n(&known, on, __ATOMIC_RELAXED);
     }
     return on;
 }
