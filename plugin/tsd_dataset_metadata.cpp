@@ -226,7 +226,7 @@ void TSDataset::SetupSunMetadata()
     char szTime[64];
     if (!m_psProduct->daily)
     {
-        tsd_format_time(s.instant, s.offset_minutes, szTime, sizeof szTime);
+        tsd_format_instant(s.instant, s.offset_minutes, szTime, sizeof szTime);
         GDALDataset::SetMetadataItem("SUN_TIME", szTime);
         GDALDataset::SetMetadataItem("SUN_AZIMUTH", CPLSPrintf("%.6f", s.sun.grid_azimuth));
         GDALDataset::SetMetadataItem("SUN_AZIMUTH_TRUE", CPLSPrintf("%.6f", s.sun.azimuth));

@@ -21,13 +21,21 @@ static void offset_text(int minutes, char buf[OFFSET_TEXT])
              abs(minutes) % 60);
 }
 
-void tsd_format_time(double t, int offset, char *buf, size_t n)
+/* tsd_format_time, or with_ms tsd_format_instant. */
+static void format_time(double t, int offset, int with_ms, char *buf, size_t n)
 {
     if (!isfinite(t)) {
         snprintf(buf, n, "unknown");
         return;
     }
-    long long local = (long long)llround(t) + offset * 60LL;
+    /* the milliseconds begun, never the next second; or whole seconds,
+     * rounded (computed instants: an atlas's read back differ in the µs) */
+    const double whole = with_ms ? floor(t) : (double)llround(t);
+    long long us = with_ms ? llround((t - whole) * 1e6) : 0;
+    if (us > 999999)
+        us = 999999;
+    const long long ms = us / 1000;
+    long long local = (long long)whole + offset * 60LL;
     long long days = local >= 0 ? local / 86400 : -((-local + 86399) / 86400);
     long long sec = local - days * 86400;
     /* civil from days (Howard Hinnant's algorithm) */
@@ -47,8 +55,25 @@ void tsd_format_time(double t, int offset, char *buf, size_t n)
         snprintf(off, sizeof off, "Z");
     else
         offset_text(offset, off);
-    snprintf(buf, n, "%04lld-%02lld-%02lldT%02lld:%02lld:%02lld%s", y, m, d, sec / 3600,
-             sec / 60 % 60, sec % 60, off);
+    char frac[8] = "";
+    if (ms > 0) {
+        snprintf(frac, sizeof frac, ".%03lld", ms);
+        size_t k = strlen(frac);
+        while (k > 2 && frac[k - 1] == '0')
+            frac[--k] = '\0'; /* .500 as .5 */
+    }
+    snprintf(buf, n, "%04lld-%02lld-%02lldT%02lld:%02lld:%02lld%s%s", y, m, d, sec / 3600,
+             sec / 60 % 60, sec % 60, frac, off);
+}
+
+void tsd_format_time(double t, int offset, char *buf, size_t n)
+{
+    format_time(t, offset, 0, buf, n);
+}
+
+void tsd_format_instant(double t, int offset, char *buf, size_t n)
+{
+    format_time(t, offset, 1, buf, n);
 }
 
 int tsd_sun_per_cell(const tsd_sun *sun)

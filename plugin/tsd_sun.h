@@ -108,6 +108,11 @@ int tsd_sun_delta_t_warning(const tsd_sun *s, const tsd_options *o, char *warnin
  * 2026-06-21T07:30:00+02:00 (or ...Z for offset 0). */
 void tsd_format_time(double unix_time, int offset_minutes, char *buf, size_t n);
 
+/** tsd_format_time with the milliseconds an instant has begun, where it has
+ * them (07:30:00.5; a leap second, its day's last instant, 23:59:59.999):
+ * DATETIME as given (08:00:00.5 was said as 08:00:01). */
+void tsd_format_instant(double unix_time, int offset_minutes, char *buf, size_t n);
+
 #ifdef __cplusplus
 }
 #endif

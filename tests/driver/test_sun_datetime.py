@@ -37,6 +37,14 @@ class SunDatetime(T.TempDirCase):
         self.assertEqual(float(m["MERIDIAN_CONVERGENCE"]), 0)
         self.assertEqual(m["SUN_TIME"], "2026-06-21T13:36:00-04:00")
         self.assertEqual(m["DATETIME"], "2026-06-21T13:36:00-04:00")
+        # the milliseconds begun, never the next second (08:00:00.5 was said
+        # as 08:00:01; a leap second is its day's last instant)
+        for given, said in (("2026-06-21T13:36:00.5-04:00", "2026-06-21T13:36:00.5-04:00"),
+                            ("2026-06-21T13:36:00.9996-04:00",
+                             "2026-06-21T13:36:00.999-04:00"),
+                            ("2016-12-31T23:59:60Z", "2016-12-31T23:59:59.999Z")):
+            self.assertEqual(md(conn, {"PRODUCT": "shadow", "DATETIME": given})["SUN_TIME"],
+                             said)
 
     def test_datetime_equals_the_explicit_sun(self):
         """DATETIME gives the pixels of SUN_AZIMUTH / SUN_ELEVATION set to the
