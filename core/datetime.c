@@ -225,8 +225,11 @@ ts_status ts_parse_iso8601(const char *s, double *unix_seconds,
 
     /* Leap second: only 23:59:60 UTC, read as the last instant of its
      * minute (POSIX time does not count it; read as the next minute's first
-     * second it moved a day product to the next day) */
-    if (check_fields(year, month, day, hour, minute, second, what, sizeof what))
+     * second it moved a day product to the next day). The fraction's nines
+     * may sum to the next second (61.0 after a leap second's 60): checked
+     * within its second, and kept there below. */
+    if (check_fields(year, month, day, hour, minute, fmin(second, isec + 0.5), what,
+                     sizeof what))
         return ts_fail(err, TS_ERR_ARG,
                        "Cannot read '%.64s' as an ISO 8601 date and time: %s.", s, what);
     if (isec == 60) {

@@ -400,6 +400,7 @@ GDALDataset *TSDataset::Open(GDALOpenInfo *poOpenInfo)
     }
     if (const OGRSpatialReference *poSRS = poDEM->GetSpatialRef())
         poDS->m_oSRS = *poSRS;
+    poDS->m_bShared = (poOpenInfo->nOpenFlags & GDAL_OF_SHARED) != 0;
     if (!poDS->Setup(poOpenInfo->pszFilename, W, H))
         return nullptr;
     if (bUnitNote)
@@ -579,9 +580,11 @@ std::string TSDataset::AbsoluteConnection(const char *pszConnection) const
 {
     // a VRT of a product whose DEM was relative read another directory's
     // DEM of that name, silently, where it was read from (session 59's audit)
+    // (GDALOpenShared finds a dataset again by its description, and warns
+    // where it is not the name opened: the first review)
     const std::string osConn = pszConnection;
     const size_t n = m_osDEM.size();
-    if (!m_osStdinCopy.empty() || m_osDEMPath == m_osDEM || osConn.size() < n ||
+    if (m_bShared || !m_osStdinCopy.empty() || m_osDEMPath == m_osDEM || osConn.size() < n ||
         osConn.compare(osConn.size() - n, n, m_osDEM) != 0)
         return osConn;
     const std::string osAbs = osConn.substr(0, osConn.size() - n) + m_osDEMPath;

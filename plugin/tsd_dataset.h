@@ -93,6 +93,7 @@ class TSDataset final : public GDALPamDataset
     std::string m_osDEM;
     std::string m_osDEMPath; // m_osDEM made absolute at open: what an overview level reopens
     std::string m_osStdinCopy; // /vsimem/ copy of the standard input (the DEM), unlinked at close
+    bool m_bShared = false;    // opened by GDALOpenShared: described by the name it was given
     tsd_options m_sOpts{};                  // what the user said
     const tsd_product_def *m_psProduct = nullptr; // its row of the product table
     tsd_run m_sRun{};                       // the sun used (progress: while computing)
@@ -195,8 +196,8 @@ class TSDataset final : public GDALPamDataset
                        int nBW, int nBH, bool bByte);
     bool Setup(const char *pszConnection, int W, int H);
     // the connection string with the DEM's absolute path where it named a
-    // relative one (what gdal_translate -of VRT and gdalbuildvrt write as
-    // the source), else as given
+    // relative one (what gdal_translate -of VRT writes as the source), else
+    // (and where opened shared) as given
     std::string AbsoluteConnection(const char *pszConnection) const;
     void WarnSunReach(int W, int H, OGRSpatialReferenceH hSRS, double dfLon, double dfLat);
     void WarnDistances(double dfMinCell, int W, int H);

@@ -95,8 +95,11 @@ thread_local int t_nDepth = 0;
 
 PamFileTurn::PamFileTurn(const char *pszDEM, bool bWrite)
 {
-    if (t_nDepth++ > 0)
+    if (t_nDepth > 0)
+    {
+        t_nDepth++;
         return;
+    }
     const bool bLocal = pszDEM && *pszDEM && !STARTS_WITH(pszDEM, "/vsi");
     if (bLocal)
     {
@@ -107,6 +110,7 @@ PamFileTurn::PamFileTurn(const char *pszDEM, bool bWrite)
     const Folder oFolder =
         m_fd >= 0 && fstat(m_fd, &sDir) == 0 ? Folder(sDir.st_dev, sDir.st_ino) : Folder(0, 0);
     m_oThreads = std::unique_lock<std::recursive_mutex>(FolderMutex(oFolder));
+    t_nDepth++; // (once the turn is taken: a throw before left it raised, unlocked)
     if (m_fd < 0)
         return;
     const bool bStuck = IsStuck(bWrite, oFolder);

@@ -333,7 +333,8 @@ static int day_kind(const tsd_sun *s, double start, double lon)
     return hi.elevation + TS_SUN_RADIUS_DEG <= 0 ? 0 : lo.elevation + TS_SUN_RADIUS_DEG > 0 ? 2 : 1;
 }
 
-/* Blocks of a range across the edge of a polar night or midnight sun,
+/* Blocks of a range across the edge of a polar night or midnight sun (or
+ * holding a whole short one),
  * where the sun's hours change too fast for one day to stand for others
  * (6.2 h for 10.5 h over 12 days at 70 N: session 59's audit): a sentence
  * where they put the flat ground's sun hours at the DEM's centre
@@ -358,9 +359,12 @@ static int polar_edge_warning(const tsd_sun *s, const tsd_options *o, char *warn
         days += length;
         const double one = length * flat_sun_hours(s, s->day_start + sampled * 86400.0, mid, dur);
         total += one;
-        const int a = day_kind(s, s->day_start + first * 86400.0, lon);
-        const int b = day_kind(s, s->day_start + (first + length - 1) * 86400.0, lon);
-        if (a == b)
+        /* every day's kind: between ~63 and ~68 degrees a whole polar night
+         * fits within a block, its first and last days rising and setting */
+        int kinds = 0; /* the kinds seen, a bit each */
+        for (int d = first; d < first + length; d++)
+            kinds |= 1 << day_kind(s, s->day_start + d * 86400.0, lon);
+        if (kinds == 1 << 0 || kinds == 1 << 1 || kinds == 1 << 2)
             continue;
         double all = 0;
         for (int d = first; d < first + length; d++)
@@ -372,7 +376,7 @@ static int polar_edge_warning(const tsd_sun *s, const tsd_options *o, char *warn
             worst_all = all;
             worst_one = one;
             worst_block = i;
-            kind = a == 1 ? b : a;
+            kind = kinds & 1 << 0 ? 0 : 2;
         }
     }
     free(mid);
@@ -457,7 +461,7 @@ int tsd_sun_night_warning(const tsd_sun *s, const tsd_options *o, char *warning,
     const double lon = s->sites_owned.lon[node];
     const long solar = lround(fmod(fmod(s->instant / 60.0 + lon * 4.0, 1440.0) + 1440.0, 1440.0));
     char when[64], given[48], at[OFFSET_TEXT];
-    tsd_format_time(s->instant, s->offset_minutes, when, sizeof when);
+    tsd_format_instant(s->instant, s->offset_minutes, when, sizeof when);
     offset_text((int)lround(lon * 4.0), at);
     if (s->offset_minutes == 0) {
         snprintf(given, sizeof given, "Z is UTC itself");
@@ -505,7 +509,7 @@ int tsd_sun_delta_t_warning(const tsd_sun *s, const tsd_options *o, char *warnin
      * product's local midnight east of UTC is the year before's in UTC),
      * where the fractional year above may fall a day short of 1 January */
     char iso[64];
-    tsd_format_time(t, s->offset_minutes, iso, sizeof iso);
+    tsd_format_instant(t, s->offset_minutes, iso, sizeof iso);
     const int calendar_year = atoi(iso);
     if (!(fabs(est - o->delta_t) * SUN_DEG_PER_S > DELTA_T_WARN_DEG))
         return 0;

@@ -78,6 +78,27 @@ struct OverviewSample
     double dfHole;   // the first such height
 };
 
+/* Whether every cell of the full-resolution block afFull (fw x fh, from
+ * column fx, row fy) under overview cell (i, j) and the overview cells
+ * around it is nodata; false where those reach beyond the block (the
+ * sample's border cells, which its neighbours' interiors cover). */
+template <class Valid>
+static bool IsHole(const std::vector<float> &afFull, int fw, int fh, int i, int j, int fx, int fy,
+                   double rx, double ry, const Valid &valid)
+{
+    const int x0 = static_cast<int>(std::floor((i - 1) * rx)) - fx;
+    const int y0 = static_cast<int>(std::floor((j - 1) * ry)) - fy;
+    const int x1 = static_cast<int>(std::ceil((i + 2) * rx)) - fx;
+    const int y1 = static_cast<int>(std::ceil((j + 2) * ry)) - fy;
+    if (x0 < 0 || y0 < 0 || x1 > fw || y1 > fh)
+        return false;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++)
+            if (valid(afFull[static_cast<size_t>(y) * fw + x]))
+                return false;
+    return true;
+}
+
 static bool SampleOverview(GDALRasterBand *poBand, GDALRasterBand *poOvr, int ox, int oy, int n,
                            OverviewSample *psOut)
 {
@@ -127,10 +148,15 @@ static bool SampleOverview(GDALRasterBand *poBand, GDALRasterBand *poOvr, int ox
             const int cx = std::min(fw - 1, static_cast<int>((ox + i) * rx + 0.5) - fx);
             const int cy = std::min(fh - 1, static_cast<int>((oy + j) * ry + 0.5) - fy);
             const float fCentre = afFull[static_cast<size_t>(cy) * fw + cx];
-            // a height where every cell under it is nodata: no resampling
-            // makes one (an overview of a former nodata value: session 59's
-            // audit, whose heights were then called cliffs)
-            if (c == 0 && valid(o) && x1 > x0 && y1 > y0 && nHoles++ == 0)
+            // a height where every cell under it and around it is nodata: no
+            // resampling makes one (an overview of a former nodata value:
+            // session 59's audit, whose heights were then called cliffs). The
+            // cells around: GDAL's average weighs the cells an overview cell
+            // only partly covers, and bilinear, cubic and gauss reach further
+            // (their overviews of a DEM with nodata edges were refused)
+            if (c == 0 && valid(o) && IsHole(afFull, fw, fh, ox + i, oy + j, fx, fy, rx, ry,
+                                             valid) &&
+                nHoles++ == 0)
                 dfHole = o;
             if (c == 0 || !valid(o))
                 continue;
@@ -191,7 +217,7 @@ static bool OverviewsAgree(GDALRasterBand *poBand, int w, const std::string &osD
                      CPLSPrintf("the DEM '%s' has overviews that disagree with it: its %d x %d "
                                 "overview holds heights (%.6g, and %d cells in all) over the "
                                 "%d x %d overview cells from column %d, row %d where every "
-                                "full-resolution cell under them is nodata (an overview made "
+                                "full-resolution cell under and around them is nodata (an overview made "
                                 "before the nodata value or the cells changed?); the far "
                                 "field of TILE_SIZE would come from it. Rebuild the overviews "
                                 "(gdaladdo -r average) or remove them (gdaladdo -clean), or "

@@ -145,6 +145,9 @@ START_TEST(test_iso8601_good)
      * as the next day's first second, they moved a day product to it */
     ck_assert(ts_parse_iso8601("2016-12-31T23:59:60.5Z", &t, NULL, NULL) == TS_OK);
     ck_assert_msg(t < 1483228800.0, "%.9f", t);
+    ck_assert(ts_parse_iso8601("2016-12-31T23:59:60.99999999999999999Z", &t, NULL, NULL) ==
+              TS_OK); /* (its nines sum to 61.0: "second 61") */
+    ck_assert_msg(t < 1483228800.0, "%.9f", t);
     ck_assert(ts_parse_iso8601("2026-06-21T23:59:59.99999999999999999Z", &t, NULL, NULL) ==
               TS_OK);
     ck_assert_msg(t < 1782086400.0, "%.9f", t);

@@ -115,6 +115,11 @@ def local_file(name):
     """The file here that name reads: itself, or its archive (a DEST onto
     dem.zip replaced the archive of /vsizip/dem.zip/dem.tif); None for
     another virtual file system's or a name that is no file."""
+    prefix = next((a for a in ARCHIVES if name.startswith(a)), "")
+    rest = name[len(prefix):]
+    inner = rest[1:].split("}", 1)[0] if rest.startswith("{") and "}" in rest else rest
+    if prefix and inner.startswith(ARCHIVES):  # /vsitar//vsigzip/dem.tar.gz/...: the outer file
+        return local_file(inner)
     parts = archive_of(name)
     if parts is not None:
         return parts[1]

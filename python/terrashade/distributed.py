@@ -13,6 +13,7 @@ failure removes what was written and exits non-zero (3 where the cluster was
 lost during the run). See docs/distributed.md.
 """
 import contextlib
+import logging
 import os
 import signal
 import sys
@@ -213,6 +214,11 @@ def main(argv=None):
     SAID.reset()
     RENAMED.clear()
     previous = None
+    # Dask's log levels, which the run's silence (dask_logs, the local
+    # cluster's silence_logs) sets for the whole process: the script's again
+    # (its handlers are set up by its import)
+    import distributed  # noqa: F401
+    logs = [(h, h.level) for h in logging.getLogger("distributed").handlers]
     # (an ignored SIGTERM stays ignored, as SIGINT: interrupts_held)
     if threading.current_thread() is threading.main_thread() and \
             signal.getsignal(signal.SIGTERM) is not signal.SIG_IGN:
@@ -239,6 +245,8 @@ def main(argv=None):
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
+        for handler, level in logs:
+            handler.setLevel(level)
     return 0
 
 

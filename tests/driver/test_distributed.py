@@ -101,7 +101,11 @@ class Distributed(TD.DistributedCase):
 
 
                 def main():  # (the workers import this file: spawn)
+                    import logging
+                    import distributed  # (a script that uses Dask itself)
                     print("exceptions after import:", gdal.GetUseExceptions())
+                    logs = lambda: [h.level for h in logging.getLogger("distributed").handlers]
+                    before = logs()
                     mine = lambda *_: None
                     signal.signal(signal.SIGTERM, mine)
                     for k in range(2):
@@ -112,6 +116,7 @@ class Distributed(TD.DistributedCase):
                     # a usage error is returned as the command's status, not raised
                     print("bad tile size rc", D.main(["--tile-size", "17", "x", "y.tif"]))
                     print("exceptions after main:", gdal.GetUseExceptions())
+                    print("Dask's log levels as they were:", logs() == before, before)
                     print("SIGTERM is mine:", signal.getsignal(signal.SIGTERM) is mine)
                     w, a, said = W.read_window("TERRASHADE:PRODUCT=svf,DIRECTIONS=4:"
                                                + sys.argv[1], ["MAX_DISTANCE=1"],
@@ -131,6 +136,7 @@ class Distributed(TD.DistributedCase):
         print(p.stdout)
         self.assertIn("exceptions after import: 0", p.stdout)
         self.assertIn("exceptions after main: 0", p.stdout)
+        self.assertIn("Dask's log levels as they were: True", p.stdout)
         self.assertIn("SIGTERM is mine: True", p.stdout)
         # its two warnings: MAX_DISTANCE=1 m against 30 m cells, and the
         # DEM's 900 m void wider than it

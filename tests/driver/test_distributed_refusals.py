@@ -150,11 +150,21 @@ class DistributedRefusals(TD.DistributedCase):
             g.write(f.read())
         vrt = self.path("zipped.vrt")
         gdal.BuildVRT(vrt, ["/vsizip/%s/dem.tif" % zipped])
+        # archives within archives: the outer file is the one replaced (the
+        # first review: refused only where the outer name was a file itself)
+        import tarfile
+        tgz, zgz = self.path("dem.tar.gz"), self.path("nest.zip.gz")
+        with tarfile.open(tgz, "w:gz") as t:
+            t.add(self.dem, "dem.tif")
+        with open(zipped, "rb") as f, gzip.open(zgz, "wb") as g:
+            g.write(f.read())
         itself = "DEST %s is the DEM itself (its archive, for %s)"
         for archive, source, said in (
                 (zipped, "/vsizip/%s/dem.tif" % zipped, itself),
                 (zipped, "/vsizip/{%s}/dem.tif" % zipped, itself),
                 (gz, "/vsigzip/%s" % gz, itself),
+                (tgz, "/vsitar//vsigzip/%s/dem.tif" % tgz, itself),
+                (zgz, "/vsizip/{/vsigzip/%s}/dem.tif" % zgz, itself),
                 (zipped, vrt, "DEST %s is a file of the DEM %s")):
             with self.subTest(source=source):
                 with open(archive, "rb") as f:

@@ -301,6 +301,17 @@ class Errors(unittest.TestCase):
                    os.path.join(tmp, "from_b.tif")], cwd=b)
             np.testing.assert_array_equal(T.read(os.path.join(tmp, "from_b.tif")),
                                           T.read(os.path.join(tmp, "ref.tif")))
+            # opened shared, a dataset keeps the name it was opened by, which
+            # GDALOpenShared finds it again by (the first review: two datasets
+            # and a warning each time)
+            p = T.run(["/usr/bin/python3", "-c",
+                       "from osgeo import gdal; gdal.UseExceptions(); "
+                       "n = 'TERRASHADE:PRODUCT=shade:dem.tif'; "
+                       "a = gdal.OpenEx(n, gdal.OF_RASTER | gdal.OF_SHARED); "
+                       "b = gdal.OpenEx(n, gdal.OF_RASTER | gdal.OF_SHARED); "
+                       "print(a.GetDescription() == n, a.this == b.this)"], cwd=a)
+            self.assertEqual(p.stdout.strip(), "True True")
+            self.assertNotIn("GDALOpenShared", p.stderr)
             p = T.run(["gdalinfo", "TERRASHADE:nothere.tif"], ok=False, cwd=tmp)
             self.assertIn("a relative name, looked for from the working directory %s"
                           % os.path.realpath(tmp), p.stderr)

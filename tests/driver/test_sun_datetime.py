@@ -89,6 +89,10 @@ class SunDatetime(T.TempDirCase):
                       "longitude -84.2 is UTC-05:37)", err)
         night = T.read(conn, 1, {"PRODUCT": "shadow", "DATETIME": "2026-06-21T02:00:00Z"})
         self.assertEqual(np.nanmax(night), 0)
+        # the instant as given, never rounded to the next second (a leap
+        # second was quoted as the next day's midnight: the first review)
+        err = T.open_stderr(T.JACKSBORO, PRODUCT="shadow", DATETIME="2016-12-31T23:59:60Z")
+        self.assertIn("DATETIME=2016-12-31T23:59:59.999Z puts the sun's centre", err)
         for dt in ("2026-06-22T01:00:00Z", "2026-06-21T12:00:00-05:00"):
             with self.subTest(dt=dt):
                 self.assertNotIn("below the horizon", T.open_stderr(T.JACKSBORO, DATETIME=dt))

@@ -233,6 +233,9 @@ class Year(unittest.TestCase):
         cases = [(70.0, "2026-11-20", "2026-12-01", True),
                  (70.0, "2026-05-10", "2026-06-01", True),
                  (-78.0, "2026-04-20", "2026-05-10", True),
+                 # a whole polar night within the block, its first and last
+                 # days with sun: unwarned when only those two were looked at
+                 (67.5, "2026-12-15", "2026-12-28", True),
                  (78.0, "2026-01-01", "2026-12-31", False),
                  (46.5, "2026-01-01", "2026-12-31", False)]
         for lat, start, end, warns in cases:
