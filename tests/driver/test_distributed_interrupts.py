@@ -16,12 +16,23 @@ from tsdriver import gdal
 
 
 class DistributedInterrupts(TD.DistributedCase):
-    def start_signalled_run(self, dest):
-        """A run of the horizon product into dest, to be signalled: in its own
-        session (the shell's job control may ignore SIGINT)."""
+    def big_dem(self):
+        """600 x 600 cells of 10 m: its svf in 512 directions takes seconds."""
+        dem = self.path("big.tif")
+        if not os.path.exists(dem):
+            T.write_tif(dem, T.fractal_dem(600, seed=5, relief=300.0),
+                        (500000, 10, 0, 4000000, 0, -10), 32617)
+        return dem
+
+    def start_signalled_run(self, dest, long=False):
+        """A run of the horizon product into dest (long: the big DEM's svf in
+        512 directions, seconds), to be signalled: in its own session (the
+        shell's job control may ignore SIGINT)."""
+        what = (["-oo", "PRODUCT=svf", "-oo", "DIRECTIONS=512", T.conn(self.big_dem())] if long
+                else T.oo_args(HORIZON) + [T.conn(self.dem)])
         return subprocess.Popen(
             ["/usr/bin/python3", "-m", "terrashade.distributed", "--workers", "1",
-             "--tile-size", "64", "-q"] + T.oo_args(HORIZON) + [T.conn(self.dem), dest],
+             "--tile-size", "64", "-q"] + what + [dest],
             stderr=subprocess.PIPE, text=True, start_new_session=True,
             env=T.env(PYTHONPATH=PYTHONPATH),
             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
@@ -41,7 +52,9 @@ class DistributedInterrupts(TD.DistributedCase):
             with self.subTest(said, delay=delay):
                 with open(dest, "w") as f:
                     f.write("an older result")
-                p = self.start_signalled_run(dest)
+                # (a long run: the horizon's ended before a signal 0.8 s into
+                # the cluster's start on an idle machine, session 59's CI)
+                p = self.start_signalled_run(dest, long=True)
                 for _ in range(600):  # created before the cluster starts
                     if TD.partials(dest) or p.poll() is not None:
                         break
@@ -71,10 +84,7 @@ class DistributedInterrupts(TD.DistributedCase):
         before a signal 3 s after the workers' start on an idle CI machine,
         and Python discarded the Ctrl-C that came while it exited (exit 0;
         session 55's CI)."""
-        dem = self.path("big.tif")
-        if not os.path.exists(dem):
-            T.write_tif(dem, T.fractal_dem(600, seed=5, relief=300.0),
-                        (500000, 10, 0, 4000000, 0, -10), 32617)
+        dem = self.big_dem()
         p = subprocess.Popen(
             ["/usr/bin/python3", "-m", "terrashade.distributed", "--workers", "2",
              "--tile-size", "64", "-q", "-oo", "PRODUCT=svf", "-oo", "DIRECTIONS=512",
