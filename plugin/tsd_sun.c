@@ -251,6 +251,12 @@ ts_status tsd_sun_setup(const tsd_options *o, tsd_sites *sites, double min_cell_
 #define CIVIL_OFFSET_WEST_MIN (-12 * 60)
 #define CIVIL_OFFSET_EAST_MIN (14 * 60)
 
+/* The DEM's centre among the sun's sites: the middle node of a lattice. */
+static size_t centre_node(const tsd_sites *st)
+{
+    return (size_t)(st->ny / 2) * st->nx + st->nx / 2;
+}
+
 int tsd_sun_zone_warning(const tsd_sun *s, const tsd_options *o, char *warning, size_t n)
 {
     /* the day products' day: from DATE and TIMEZONE, a range's, or DATETIME's
@@ -270,8 +276,7 @@ int tsd_sun_zone_warning(const tsd_sun *s, const tsd_options *o, char *warning, 
                  s->offset_minutes > 0 ? "before" : "after");
         return 1;
     }
-    const tsd_sites *st = &s->sites_owned; /* the centre: the middle node of a lattice */
-    const double lon = st->lon[(size_t)(st->ny / 2) * st->nx + st->nx / 2];
+    const double lon = s->sites_owned.lon[centre_node(&s->sites_owned)];
     const double solar = lon * 4.0; /* minutes east of UTC */
     const double apart = remainder(s->offset_minutes - solar, 1440.0);
     if (!(fabs(apart) > 240.0))
@@ -342,9 +347,8 @@ static int day_kind(const tsd_sun *s, double start, double lon)
  * blocks would take seconds; the error repeats year by year). */
 static int polar_edge_warning(const tsd_sun *s, const tsd_options *o, char *warning, size_t n)
 {
-    const tsd_sites *st = &s->sites_owned;
-    const size_t centre = (size_t)(st->ny / 2) * st->nx + st->nx / 2;
-    const double lat = st->lat[centre], lon = st->lon[centre];
+    const size_t centre = centre_node(&s->sites_owned);
+    const double lat = s->sites_owned.lat[centre], lon = s->sites_owned.lon[centre];
     if (o->day_interval <= 1 || fabs(lat) < POLAR_EDGE_LATITUDE)
         return 0;
     const size_t steps = (size_t)ts_day_step_count(86400.0, s->range.step_minutes * 60.0);

@@ -94,17 +94,28 @@ def given_keys(source, open_options):
 ARCHIVES = ("/vsizip/", "/vsigzip/", "/vsitar/")
 
 
+def _archive_split(path):
+    """(prefix, rest, braced) of a /vsizip/, /vsigzip/ or /vsitar/ path:
+    braced where the archive's name is in braces (/vsizip/{a.zip}/dem.tif;
+    not /vsigzip/'s, which has no such form); None for any other path."""
+    prefix = next((a for a in ARCHIVES if path.startswith(a)), "")
+    if not prefix:
+        return None
+    rest = path[len(prefix):]
+    return prefix, rest, prefix != "/vsigzip/" and rest.startswith("{") and "}" in rest
+
+
 def archive_of(path):
     """(prefix, archive, rest) where path reads inside an archive file here
     (/vsizip/, /vsigzip/, /vsitar/; its name in braces, or the longest
     leading part that is a file), path == prefix + archive + rest; None
     where it names none."""
-    prefix = next((a for a in ARCHIVES if path.startswith(a)), "")
-    if not prefix:
+    split = _archive_split(path)
+    if split is None:
         return None
-    rest = path[len(prefix):]
-    if prefix in ("/vsizip/", "/vsitar/") and rest.startswith("{") and "}" in rest:
-        name, after = rest[1:].split("}", 1)  # /vsizip/{a.zip}/dem.tif
+    prefix, rest, braced = split
+    if braced:
+        name, after = rest[1:].split("}", 1)
         return (prefix + "{", name, "}" + after) if name and os.path.isfile(name) else None
     cut = [i for i in range(len(rest), 0, -1)
            if (i == len(rest) or rest[i] == "/") and os.path.isfile(rest[:i])]
@@ -115,11 +126,12 @@ def local_file(name):
     """The file here that name reads: itself, or its archive (a DEST onto
     dem.zip replaced the archive of /vsizip/dem.zip/dem.tif); None for
     another virtual file system's or a name that is no file."""
-    prefix = next((a for a in ARCHIVES if name.startswith(a)), "")
-    rest = name[len(prefix):]
-    inner = rest[1:].split("}", 1)[0] if rest.startswith("{") and "}" in rest else rest
-    if prefix and inner.startswith(ARCHIVES):  # /vsitar//vsigzip/dem.tar.gz/...: the outer file
-        return local_file(inner)
+    split = _archive_split(name)
+    if split is not None:  # /vsitar//vsigzip/dem.tar.gz/...: the outer file
+        _, rest, braced = split
+        inner = rest[1:].split("}", 1)[0] if braced else rest
+        if inner.startswith(ARCHIVES):
+            return local_file(inner)
     parts = archive_of(name)
     if parts is not None:
         return parts[1]

@@ -50,10 +50,10 @@ def placement(wins, chunk, workers):
     (chunk cells square from the raster's corner, or the whole raster where
     chunk is 0): the windows of one chunk on one worker, the chunks dealt
     round the workers in order, so that no chunk is computed by two workers
-    (1024-cell windows of the driver's 4096-cell chunks were dealt to any,
-    and each worker touched computed the chunk: the audit's two workers
-    took 6.1 s where one product takes 2.1). None for every window where no
-    worker is known."""
+    (windows were dealt to any worker, and each one given a window of a
+    chunk computed the chunk: svf over a 2048^2 DEM in chunks of 512,
+    windows of 128, two workers, 29 s of CPU, now 20). None for every window
+    where no worker is known."""
     if not workers:
         return [None] * len(wins)
     order = {}
